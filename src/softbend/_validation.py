@@ -1,0 +1,96 @@
+"""Input checks that produce one message format everywhere.
+
+The format follows scikit-learn's parameter validation::
+
+    The 'wall_thickness_mm' of SFRBADesign must be in (0, inf). Got -2.0 instead.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Iterable
+from typing import Any
+
+import numpy as np
+
+from softbend.errors import DatasetError
+
+
+def _fmt_bound(value: float) -> str:
+    if math.isinf(value):
+        return "inf" if value > 0 else "-inf"
+    return f"{value:g}"
+
+
+def check_range(
+    value: Any,
+    name: str,
+    owner: str,
+    *,
+    low: float = -math.inf,
+    high: float = math.inf,
+    low_inclusive: bool = False,
+    high_inclusive: bool = False,
+) -> float:
+    """Return ``value`` as a float if it lies in the interval, else raise ``ValueError``.
+
+    Parameters
+    ----------
+    value : Any
+        The value to check; must convert to a finite float (``inf`` only if a
+        bound allows it).
+    name : str
+        Field name used in the message, with its unit suffix (``"t_mm"``).
+    owner : str
+        Name of the object or function the field belongs to.
+    low, high : float
+        Interval bounds.
+    low_inclusive, high_inclusive : bool
+        Whether the bounds belong to the interval.
+
+    Returns
+    -------
+    float
+        The validated value.
+    """
+    interval = (
+        ("[" if low_inclusive else "(")
+        + f"{_fmt_bound(low)}, {_fmt_bound(high)}"
+        + ("]" if high_inclusive else ")")
+    )
+    message = f"The '{name}' of {owner} must be a number in {interval}. Got {value!r} instead."
+    if isinstance(value, bool):
+        raise ValueError(message)
+    try:
+        number = float(value)
+    except (TypeError, ValueError):
+        raise ValueError(message) from None
+    if math.isnan(number):
+        raise ValueError(message)
+    below = number < low or (number == low and not low_inclusive)
+    above = number > high or (number == high and not high_inclusive)
+    if below or above:
+        raise ValueError(message)
+    return number
+
+
+def check_choice(value: Any, name: str, owner: str, choices: Iterable[Any]) -> Any:
+    """Return ``value`` if it is one of ``choices``, else raise ``ValueError``."""
+    options = list(choices)
+    if value not in options:
+        allowed = ", ".join(repr(c) for c in options)
+        raise ValueError(f"The '{name}' of {owner} must be one of {allowed}. Got {value!r} instead.")
+    return value
+
+
+def check_finite_array(values: Any, name: str, owner: str) -> np.ndarray:
+    """Convert to a float array and raise :class:`DatasetError` if anything is NaN or infinite."""
+    array = np.asarray(values, dtype=float)
+    bad = ~np.isfinite(array)
+    if bad.any():
+        first = int(np.flatnonzero(bad.ravel())[0])
+        raise DatasetError(
+            f"The '{name}' of {owner} must be finite. Got {array.ravel()[first]!r} "
+            f"at position {first} ({int(bad.sum())} non-finite values in all)."
+        )
+    return array

@@ -1,0 +1,109 @@
+"""Shared CLI plumbing: consoles, one-line errors, JSON output, progress bars."""
+
+from __future__ import annotations
+
+import json
+import logging
+import math
+from collections.abc import Callable, Iterator
+from contextlib import contextmanager
+from typing import Any
+
+import numpy as np
+from rich.console import Console
+from rich.logging import RichHandler
+from rich.progress import (
+    BarColumn,
+    MofNCompleteColumn,
+    Progress,
+    TextColumn,
+    TimeElapsedColumn,
+    TimeRemainingColumn,
+)
+from rich.table import Table
+
+from softbend.errors import SoftbendError
+
+__all__ = [
+    "SoftbendError",
+    "configure_logging",
+    "console",
+    "error_line",
+    "err_console",
+    "print_json",
+    "print_table",
+    "progress_bar",
+]
+
+console = Console()
+err_console = Console(stderr=True)
+
+
+def configure_logging(verbose: bool) -> None:
+    """Send softbend's log records to stderr; INFO when verbose, WARNING otherwise."""
+    logger = logging.getLogger("softbend")
+    logger.handlers[:] = [RichHandler(console=err_console, show_path=False)]
+    logger.setLevel(logging.INFO if verbose else logging.WARNING)
+    logging.captureWarnings(True)
+
+
+def error_line(message: str) -> None:
+    """Print one error line to stderr (no traceback)."""
+    text = " ".join(str(message).split())
+    err_console.print(f"softbend: error: {text}", markup=False, highlight=False, soft_wrap=True)
+
+
+def _jsonable(value: Any) -> Any:
+    if isinstance(value, dict):
+        return {str(k): _jsonable(v) for k, v in value.items()}
+    if isinstance(value, list | tuple):
+        return [_jsonable(v) for v in value]
+    if isinstance(value, np.ndarray):
+        return _jsonable(value.tolist())
+    if isinstance(value, np.generic):
+        return _jsonable(value.item())
+    if isinstance(value, float) and not math.isfinite(value):
+        return None
+    return value
+
+
+def print_json(payload: Any) -> None:
+    """Print ``payload`` as JSON on stdout (NaN and inf become null)."""
+    print(json.dumps(_jsonable(payload), indent=2))
+
+
+def print_table(title: str, columns: list[str], rows: list[list[Any]]) -> None:
+    """Print a rich table; floats are shown with four significant digits."""
+    table = Table(title=title)
+    for column in columns:
+        table.add_column(column, justify="right" if column != columns[0] else "left")
+    for row in rows:
+        table.add_row(*(f"{v:.4g}" if isinstance(v, float) else str(v) for v in row))
+    console.print(table)
+
+
+@contextmanager
+def progress_bar(
+    description: str, total: int, *, enabled: bool = True
+) -> Iterator[Callable[..., None]]:
+    """Yield ``advance(n=1, **fields)``, drawing a rich progress bar on stderr.
+
+    Extra keyword fields (e.g. ``failed=3``) are shown after the bar.
+    """
+    columns = [
+        TextColumn("[progress.description]{task.description}"),
+        BarColumn(),
+        MofNCompleteColumn(),
+        TextColumn("{task.fields[info]}"),
+        TimeElapsedColumn(),
+        TextColumn("ETA"),
+        TimeRemainingColumn(),
+    ]
+    with Progress(*columns, console=err_console, disable=not enabled, transient=False) as bar:
+        task = bar.add_task(description, total=total, info="")
+
+        def advance(n: int = 1, **fields: Any) -> None:
+            info = "  ".join(f"{k} {v}" for k, v in fields.items())
+            bar.update(task, advance=n, info=info)
+
+        yield advance

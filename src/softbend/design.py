@@ -1,0 +1,240 @@
+"""Design vector of the soft fiber-reinforced bending actuator (SFRBA) and design spaces.
+
+The actuator of paper B: a chamber of length ``l`` with a semicircular top of
+inner radius ``r`` and wall thickness ``t``, a flat rectangular bottom wall of
+thickness ``b`` carrying the strain-limiting layer, double-helix fibers wound at
+``phi`` degrees from the circumferential direction, and a distal cap of length
+``lc``. All lengths in mm, the angle in degrees.
+
+``DesignSpace.table1()`` is paper B Table 1 (972 designs); ``DesignSpace.sample``
+draws space-filling designs (Latin hypercube or Sobol) over the same ranges.
+"""
+
+from __future__ import annotations
+
+import hashlib
+import itertools
+from collections.abc import Iterator, Sequence
+from dataclasses import asdict, dataclass, fields
+from typing import Literal
+
+import numpy as np
+
+from softbend._validation import check_choice, check_range
+
+#: Order of the design parameters in tables, arrays and CLI strings.
+PARAMETERS: tuple[str, ...] = ("l_mm", "r_mm", "t_mm", "b_mm", "phi_deg", "lc_mm")
+
+#: Fixed quantities of paper B (mm).
+FIBER_DIAMETER_MM = 0.28
+STRAIN_LIMITING_LAYER_MM = 0.1
+
+
+# (low, high, low_inclusive); every upper bound is inclusive.
+_BOUNDS: dict[str, tuple[float, float, bool]] = {
+    "l_mm": (0.0, 1000.0, False),
+    "r_mm": (0.0, 100.0, False),
+    "t_mm": (0.0, 50.0, False),
+    "b_mm": (0.0, 50.0, False),
+    "phi_deg": (0.0, 60.0, True),
+    "lc_mm": (0.0, 200.0, False),
+}
+
+
+@dataclass(frozen=True)
+class SFRBADesign:
+    """One fiber-reinforced bending actuator design.
+
+    Parameters
+    ----------
+    l_mm : float
+        Chamber length, mm; in (0, 1000].
+    r_mm : float
+        Inner radius of the semicircular chamber, mm; in (0, 100].
+    t_mm : float
+        Thickness of the semicircular top wall, mm; in (0, 50].
+    b_mm : float
+        Thickness of the flat bottom wall, mm; in (0, 50].
+    phi_deg : float
+        Fiber winding angle measured from the circumferential direction, degrees;
+        in [0, 60]. Small angles confine radial expansion best.
+    lc_mm : float
+        Length of the distal (tip) cap, mm; in (0, 200].
+
+    Raises
+    ------
+    ValueError
+        Naming the field, the allowed interval and the value received.
+    """
+
+    l_mm: float
+    r_mm: float
+    t_mm: float
+    b_mm: float
+    phi_deg: float
+    lc_mm: float
+
+    def __post_init__(self) -> None:
+        for name in PARAMETERS:
+            low, high, low_inclusive = _BOUNDS[name]
+            value = check_range(
+                getattr(self, name),
+                name,
+                "SFRBADesign",
+                low=low,
+                high=high,
+                low_inclusive=low_inclusive,
+                high_inclusive=True,
+            )
+            object.__setattr__(self, name, value)
+
+    @classmethod
+    def from_sequence(cls, values: Sequence[float]) -> SFRBADesign:
+        """Build a design from ``(l, r, t, b, phi, lc)`` in that order."""
+        values = list(values)
+        if len(values) != len(PARAMETERS):
+            raise ValueError(
+                f"A design needs {len(PARAMETERS)} values ({', '.join(PARAMETERS)}). "
+                f"Got {len(values)} instead."
+            )
+        return cls(*values)
+
+    @classmethod
+    def parse(cls, text: str) -> SFRBADesign:
+        """Parse ``"100,6,2,2,5,10"`` (l, r, t, b, phi, lc) as used on the CLI."""
+        try:
+            values = [float(v) for v in text.split(",")]
+        except ValueError:
+            raise ValueError(
+                f"The 'design' must be six comma-separated numbers "
+                f"({', '.join(PARAMETERS)}). Got {text!r} instead."
+            ) from None
+        return cls.from_sequence(values)
+
+    @property
+    def design_id(self) -> str:
+        """Stable 16-hex-digit identifier: a SHA-1 of the parameters rounded to 1e-6."""
+        canonical = ",".join(f"{getattr(self, n):.6f}" for n in PARAMETERS)
+        return hashlib.sha1(canonical.encode()).hexdigest()[:16]
+
+    def as_dict(self) -> dict[str, float]:
+        """Parameters as an ordered ``{name: value}`` mapping."""
+        return {k: v for k, v in asdict(self).items() if k in PARAMETERS}
+
+    def as_array(self) -> np.ndarray:
+        """Parameters as a float array in :data:`PARAMETERS` order."""
+        return np.array([getattr(self, n) for n in PARAMETERS], dtype=float)
+
+    def __str__(self) -> str:
+        return ",".join(f"{getattr(self, n):g}" for n in PARAMETERS)
+
+
+
+
+@dataclass(frozen=True)
+class DesignSpace:
+    """A finite set of designs.
+
+    Parameters
+    ----------
+    designs : tuple of SFRBADesign
+        The designs, unique, in a stable order.
+    name : str
+        A label for reports.
+    """
+
+    designs: tuple[SFRBADesign, ...]
+    name: str = "custom"
+
+    def __post_init__(self) -> None:
+        ids = [d.design_id for d in self.designs]
+        if len(set(ids)) != len(ids):
+            raise ValueError(f"The 'designs' of DesignSpace must be unique. Got {len(ids) - len(set(ids))} duplicates.")
+
+    def __len__(self) -> int:
+        return len(self.designs)
+
+    def __iter__(self) -> Iterator[SFRBADesign]:
+        return iter(self.designs)
+
+    def __getitem__(self, index: int) -> SFRBADesign:
+        return self.designs[index]
+
+    @classmethod
+    def grid(cls, levels: dict[str, Sequence[float]], name: str = "grid") -> DesignSpace:
+        """Full factorial grid over ``levels`` (one sequence per parameter in :data:`PARAMETERS`)."""
+        missing = [p for p in PARAMETERS if p not in levels]
+        extra = [p for p in levels if p not in PARAMETERS]
+        if missing or extra:
+            raise ValueError(
+                f"The 'levels' of DesignSpace.grid must name exactly {', '.join(PARAMETERS)}. "
+                f"Missing {missing}, unknown {extra}."
+            )
+        combos = itertools.product(*(levels[p] for p in PARAMETERS))
+        return cls(tuple(SFRBADesign(*c) for c in combos), name=name)
+
+    @classmethod
+    def table1(cls) -> DesignSpace:
+        """Paper B Table 1: 4 x 3 x 3 x 3 x 3 x 3 = 972 designs."""
+        return cls.grid(TABLE1_LEVELS, name="table1")
+
+    @classmethod
+    def corners(cls) -> DesignSpace:
+        """The 64 corners of Table 1 (each parameter at its minimum or maximum)."""
+        levels = {p: (min(v), max(v)) for p, v in TABLE1_LEVELS.items()}
+        return cls.grid(levels, name="table1-corners")
+
+    @classmethod
+    def sample(
+        cls,
+        n: int,
+        *,
+        method: Literal["lhs", "sobol"] = "lhs",
+        seed: int = 0,
+        bounds: dict[str, tuple[float, float]] | None = None,
+    ) -> DesignSpace:
+        """Space-filling sample of ``n`` designs over ``bounds`` (default: Table 1 ranges).
+
+        Parameters
+        ----------
+        n : int
+            Number of designs, at least 1.
+        method : {"lhs", "sobol"}
+            Latin hypercube (optimised by random CD) or scrambled Sobol sequence.
+        seed : int
+            Seed of the sampler; the same seed gives the same designs.
+        bounds : dict, optional
+            ``{parameter: (low, high)}`` for every parameter.
+        """
+        from scipy.stats import qmc
+
+        n = int(check_range(n, "n", "DesignSpace.sample", low=1, low_inclusive=True))
+        check_choice(method, "method", "DesignSpace.sample", ("lhs", "sobol"))
+        bounds = bounds or {p: (min(v), max(v)) for p, v in TABLE1_LEVELS.items()}
+        low = np.array([bounds[p][0] for p in PARAMETERS], dtype=float)
+        high = np.array([bounds[p][1] for p in PARAMETERS], dtype=float)
+        if method == "lhs":
+            sampler = qmc.LatinHypercube(d=len(PARAMETERS), seed=seed)
+        else:
+            sampler = qmc.Sobol(d=len(PARAMETERS), scramble=True, seed=seed)
+        unit = sampler.random(n)
+        values = np.round(qmc.scale(unit, low, high), 6)
+        return cls(tuple(SFRBADesign(*row) for row in values), name=f"{method}-{n}-seed{seed}")
+
+    def to_frame(self):  # -> pandas.DataFrame
+        """Designs as a DataFrame with ``design_id`` and one column per parameter."""
+        import pandas as pd
+
+        rows = [{"design_id": d.design_id, **d.as_dict()} for d in self.designs]
+        return pd.DataFrame(rows, columns=["design_id", *PARAMETERS])
+
+
+#: Levels of paper B Table 1.
+TABLE1_LEVELS: dict[str, tuple[float, ...]] = {
+    "l_mm": (100.0, 120.0, 140.0, 160.0),
+    "r_mm": (6.0, 8.0, 10.0),
+    "t_mm": (2.0, 3.0, 4.0),
+    "b_mm": (2.0, 3.0, 4.0),
+    "phi_deg": (5.0, 10.0, 15.0),
+    "lc_mm": (8.0, 10.0, 12.0),
+}
