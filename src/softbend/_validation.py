@@ -79,7 +79,9 @@ def check_choice(value: Any, name: str, owner: str, choices: Iterable[Any]) -> A
     options = list(choices)
     if value not in options:
         allowed = ", ".join(repr(c) for c in options)
-        raise ValueError(f"The '{name}' of {owner} must be one of {allowed}. Got {value!r} instead.")
+        raise ValueError(
+            f"The '{name}' of {owner} must be one of {allowed}. Got {value!r} instead."
+        )
     return value
 
 

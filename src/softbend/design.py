@@ -15,7 +15,7 @@ from __future__ import annotations
 import hashlib
 import itertools
 from collections.abc import Iterator, Sequence
-from dataclasses import asdict, dataclass, fields
+from dataclasses import asdict, dataclass
 from typing import Literal
 
 import numpy as np
@@ -129,8 +129,6 @@ class SFRBADesign:
         return ",".join(f"{getattr(self, n):g}" for n in PARAMETERS)
 
 
-
-
 @dataclass(frozen=True)
 class DesignSpace:
     """A finite set of designs.
@@ -149,7 +147,10 @@ class DesignSpace:
     def __post_init__(self) -> None:
         ids = [d.design_id for d in self.designs]
         if len(set(ids)) != len(ids):
-            raise ValueError(f"The 'designs' of DesignSpace must be unique. Got {len(ids) - len(set(ids))} duplicates.")
+            duplicates = len(ids) - len(set(ids))
+            raise ValueError(
+                f"The 'designs' of DesignSpace must be unique. Got {duplicates} duplicates."
+            )
 
     def __len__(self) -> int:
         return len(self.designs)
@@ -162,7 +163,7 @@ class DesignSpace:
 
     @classmethod
     def grid(cls, levels: dict[str, Sequence[float]], name: str = "grid") -> DesignSpace:
-        """Full factorial grid over ``levels`` (one sequence per parameter in :data:`PARAMETERS`)."""
+        """Full factorial grid over ``levels``, one sequence per name in :data:`PARAMETERS`."""
         missing = [p for p in PARAMETERS if p not in levels]
         extra = [p for p in levels if p not in PARAMETERS]
         if missing or extra:

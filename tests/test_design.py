@@ -1,0 +1,90 @@
+import hashlib
+
+import numpy as np
+import pytest
+
+from softbend.design import PARAMETERS, TABLE1_LEVELS, DesignSpace, SFRBADesign
+
+
+def test_table1_has_972_unique_designs_over_the_paper_levels():
+    space = DesignSpace.table1()
+    assert len(space) == 972
+    assert len({d.design_id for d in space}) == 972
+    frame = space.to_frame()
+    for name, levels in TABLE1_LEVELS.items():
+        assert sorted(frame[name].unique()) == sorted(levels)
+
+
+def test_corners_are_the_64_extremes():
+    corners = DesignSpace.corners()
+    assert len(corners) == 64
+    frame = corners.to_frame()
+    for name, levels in TABLE1_LEVELS.items():
+        assert set(frame[name]) == {min(levels), max(levels)}
+
+
+def test_design_id_is_stable_and_distinguishes_designs():
+    a = SFRBADesign(100, 6, 2, 2, 5, 10)
+    assert a.design_id == SFRBADesign(100.0, 6.0, 2.0, 2.0, 5.0, 10.0).design_id
+    assert a.design_id == SFRBADesign.parse("100,6,2,2,5,10").design_id
+    assert a.design_id != SFRBADesign(100, 6, 2, 2, 5, 12).design_id
+    # The id is a content hash of the rounded parameters, so stored campaigns stay addressable
+    # across versions and machines.
+    canonical = "100.000000,6.000000,2.000000,2.000000,5.000000,10.000000"
+    assert a.design_id == hashlib.sha1(canonical.encode()).hexdigest()[:16]
+
+
+def test_parse_round_trip_and_array_order():
+    design = SFRBADesign.parse("120,8,3,2,10,12")
+    assert SFRBADesign.parse(str(design)) == design
+    np.testing.assert_array_equal(design.as_array(), [120, 8, 3, 2, 10, 12])
+    assert list(design.as_dict()) == list(PARAMETERS)
+
+
+@pytest.mark.parametrize("method", ["lhs", "sobol"])
+def test_space_filling_samples_are_seeded_and_inside_the_ranges(method):
+    a = DesignSpace.sample(16, method=method, seed=3)
+    b = DesignSpace.sample(16, method=method, seed=3)
+    c = DesignSpace.sample(16, method=method, seed=4)
+    assert [d.design_id for d in a] == [d.design_id for d in b]
+    assert [d.design_id for d in a] != [d.design_id for d in c]
+    frame = a.to_frame()
+    for name, levels in TABLE1_LEVELS.items():
+        assert frame[name].between(min(levels), max(levels)).all()
+
+
+def test_latin_hypercube_stratifies_every_parameter():
+    n = 20
+    frame = DesignSpace.sample(n, method="lhs", seed=0).to_frame()
+    for name, levels in TABLE1_LEVELS.items():
+        unit = (frame[name] - min(levels)) / (max(levels) - min(levels))
+        strata = np.minimum((unit * n).astype(int), n - 1)
+        assert sorted(strata) == list(range(n))
+
+
+@pytest.mark.parametrize(
+    ("field", "value"),
+    [("t_mm", -2.0), ("r_mm", 0.0), ("l_mm", float("nan")), ("phi_deg", 75.0), ("lc_mm", "x")],
+)
+def test_bad_design_values_name_the_field_and_the_range(field, value):
+    values = dict(zip(PARAMETERS, (100, 6, 2, 2, 5, 10), strict=True))
+    values[field] = value
+    with pytest.raises(ValueError, match=rf"'{field}' of SFRBADesign must be a number in"):
+        SFRBADesign(**values)
+
+
+def test_parse_rejects_wrong_count_and_text():
+    with pytest.raises(ValueError, match="six comma-separated"):
+        SFRBADesign.parse("100,6,a,2,5,10")
+    with pytest.raises(ValueError, match="needs 6 values"):
+        SFRBADesign.parse("100,6,2")
+
+
+def test_design_space_rejects_duplicates_and_bad_levels():
+    d = SFRBADesign(100, 6, 2, 2, 5, 10)
+    with pytest.raises(ValueError, match="unique"):
+        DesignSpace((d, d))
+    with pytest.raises(ValueError, match="Missing"):
+        DesignSpace.grid({"l_mm": [100]})
+    with pytest.raises(ValueError, match="'method'"):
+        DesignSpace.sample(4, method="grid")

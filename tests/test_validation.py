@@ -1,0 +1,46 @@
+import math
+
+import numpy as np
+import pytest
+
+from softbend._validation import check_choice, check_finite_array, check_range
+from softbend.errors import ConvergenceError, DatasetError, SoftbendError
+
+
+def test_check_range_message_format_matches_the_project_convention():
+    with pytest.raises(ValueError) as info:
+        check_range(-2.0, "wall_thickness_mm", "SFRBADesign", low=0.0)
+    assert str(info.value) == (
+        "The 'wall_thickness_mm' of SFRBADesign must be a number in (0, inf). Got -2.0 instead."
+    )
+
+
+@pytest.mark.parametrize("value", [math.nan, "abc", None, True, 0.0, 1.0])
+def test_check_range_rejects_nan_non_numbers_bools_and_open_bounds(value):
+    with pytest.raises(ValueError):
+        check_range(value, "x", "f", low=0.0, high=1.0)
+
+
+def test_check_range_accepts_inclusive_bounds_and_converts():
+    assert check_range("0.5", "x", "f", low=0.0, high=1.0) == 0.5
+    assert check_range(1, "x", "f", low=0.0, high=1.0, high_inclusive=True) == 1.0
+
+
+def test_check_choice_lists_the_allowed_values():
+    with pytest.raises(ValueError, match=r"one of 'a', 'b'\. Got 'c'"):
+        check_choice("c", "mode", "f", ("a", "b"))
+
+
+def test_check_finite_array_points_at_the_first_bad_value():
+    with pytest.raises(
+        DatasetError, match=r"'pressure_kpa' of f must be finite.*position 2 \(2 non"
+    ):
+        check_finite_array([1.0, 2.0, np.nan, np.inf], "pressure_kpa", "f")
+
+
+def test_error_hierarchy_lets_standard_handlers_catch_input_errors():
+    assert issubclass(DatasetError, ValueError)
+    assert issubclass(DatasetError, SoftbendError)
+    error = ConvergenceError("Newton stalled", pressure_mpa=0.105, step=21, residual=3e-4)
+    assert "pressure_mpa=0.105" in str(error) and "step=21" in str(error)
+    assert error.residual == 3e-4
