@@ -1,0 +1,209 @@
+"""Material presets of the fiber-reinforced bending actuator of paper B (§3.1).
+
+Densities are in tonne/mm³, the density unit consistent with mm, N, MPa and s
+(1 g/cm³ = 1e-9 tonne/mm³).
+
+* :data:`DRAGON_SKIN_30` — the elastomer body (Smooth-On Dragon Skin 30), Yeoh
+  C10 = 0.11, C20 = 0.003, C30 = 0 MPa, 1.08 g/cm³. Paper B fits the three models
+  of :mod:`softbend.materials.models` to uniaxial data of Dragon Skin 30 and keeps
+  Yeoh (R² = 0.9982, RMSE = 0.0204 MPa).
+* :data:`FIBERGLASS_LAYER` — the 0.1 mm strain-limiting layer (fiberglass S2-120),
+  Yeoh C10 = 7.9 MPa, C20 = C30 = 0, 2.40 g/cm³ (paper B after Polygerinos et al. 2015).
+* :data:`KEVLAR_FIBER` — the 0.28 mm Kevlar reinforcement, linear elastic
+  E = 31076 MPa, ν = 0.36, 1.67 g/cm³; modelled as beams of radius
+  :data:`KEVLAR_MODELLED_RADIUS_MM` = 0.07 mm, half the real radius, which paper B
+  (after Polygerinos et al. 2015) uses to reduce the modelled fiber stiffness.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Mapping
+from dataclasses import dataclass
+from typing import Any, ClassVar
+
+from softbend._validation import check_choice, check_range
+from softbend.materials.models import HyperelasticModel, Yeoh
+
+__all__ = [
+    "DRAGON_SKIN_30",
+    "FIBERGLASS_LAYER",
+    "G_PER_CM3_TO_T_PER_MM3",
+    "KEVLAR_FIBER",
+    "KEVLAR_MODELLED_RADIUS_MM",
+    "PRESETS",
+    "LinearElastic",
+    "Material",
+    "get_preset",
+]
+
+#: Conversion factor from g/cm³ to tonne/mm³.
+G_PER_CM3_TO_T_PER_MM3 = 1e-9
+
+#: Radius of the beams that model the Kevlar fibers in paper B, mm (real diameter 0.28 mm).
+KEVLAR_MODELLED_RADIUS_MM = 0.07
+
+
+@dataclass(frozen=True)
+class LinearElastic:
+    """Isotropic linear elastic material (small strain), used for the fibers.
+
+    Parameters
+    ----------
+    e_mpa : float
+        Young's modulus in MPa, > 0.
+    nu : float
+        Poisson's ratio, dimensionless, in (-1, 0.5).
+    """
+
+    name: ClassVar[str] = "linear-elastic"
+
+    e_mpa: float
+    nu: float
+
+    def __post_init__(self) -> None:
+        object.__setattr__(
+            self, "e_mpa", check_range(self.e_mpa, "e_mpa", "LinearElastic", low=0.0)
+        )
+        object.__setattr__(
+            self, "nu", check_range(self.nu, "nu", "LinearElastic", low=-1.0, high=0.5)
+        )
+
+    @property
+    def shear_modulus_mpa(self) -> float:
+        """Shear modulus ``G = E / (2(1 + ν))`` in MPa."""
+        return self.e_mpa / (2.0 * (1.0 + self.nu))
+
+    @property
+    def bulk_modulus_mpa(self) -> float:
+        """Bulk modulus ``K = E / (3(1 − 2ν))`` in MPa."""
+        return self.e_mpa / (3.0 * (1.0 - 2.0 * self.nu))
+
+    def to_dict(self) -> dict[str, Any]:
+        """Parameters as a JSON-friendly mapping with ``"model": "linear-elastic"``."""
+        return {"model": self.name, "e_mpa": self.e_mpa, "nu": self.nu}
+
+    @classmethod
+    def from_dict(cls, data: Mapping[str, Any]) -> LinearElastic:
+        """Rebuild from :meth:`to_dict` output."""
+        params = dict(data)
+        name = params.pop("model", cls.name)
+        check_choice(name, "model", "LinearElastic.from_dict", (cls.name,))
+        return cls(**params)
+
+
+def _model_from_dict(data: Mapping[str, Any]) -> HyperelasticModel | LinearElastic:
+    if data.get("model") == LinearElastic.name:
+        return LinearElastic.from_dict(data)
+    return HyperelasticModel.from_dict(data)
+
+
+@dataclass(frozen=True)
+class Material:
+    """A named material: a constitutive model, a density and where the values come from.
+
+    Parameters
+    ----------
+    name : str
+        Human-readable name, non-empty.
+    model : HyperelasticModel or LinearElastic
+        Constitutive law (stresses in MPa).
+    density_t_per_mm3 : float
+        Mass density in tonne/mm³, > 0 (1 g/cm³ = 1e-9 tonne/mm³).
+    source : str
+        Provenance of the values (paper, section, data set).
+    """
+
+    name: str
+    model: HyperelasticModel | LinearElastic
+    density_t_per_mm3: float
+    source: str = ""
+
+    def __post_init__(self) -> None:
+        if not isinstance(self.name, str) or not self.name.strip():
+            raise ValueError(
+                f"The 'name' of Material must be a non-empty string. Got {self.name!r} instead."
+            )
+        if not isinstance(self.model, HyperelasticModel | LinearElastic):
+            raise ValueError(
+                "The 'model' of Material must be a HyperelasticModel (NeoHookean, Yeoh, "
+                f"ArrudaBoyce) or LinearElastic. Got {self.model!r} instead."
+            )
+        density = check_range(self.density_t_per_mm3, "density_t_per_mm3", "Material", low=0.0)
+        object.__setattr__(self, "density_t_per_mm3", density)
+        if not isinstance(self.source, str):
+            raise ValueError(
+                f"The 'source' of Material must be a string. Got {self.source!r} instead."
+            )
+
+    @property
+    def density_g_per_cm3(self) -> float:
+        """Mass density in g/cm³."""
+        return self.density_t_per_mm3 / G_PER_CM3_TO_T_PER_MM3
+
+    def to_dict(self) -> dict[str, Any]:
+        """JSON-friendly mapping; the model is nested as its own ``to_dict``."""
+        return {
+            "name": self.name,
+            "model": self.model.to_dict(),
+            "density_t_per_mm3": self.density_t_per_mm3,
+            "source": self.source,
+        }
+
+    @classmethod
+    def from_dict(cls, data: Mapping[str, Any]) -> Material:
+        """Rebuild from :meth:`to_dict` output."""
+        return cls(
+            name=data["name"],
+            model=_model_from_dict(data["model"]),
+            density_t_per_mm3=data["density_t_per_mm3"],
+            source=data.get("source", ""),
+        )
+
+
+_PAPER_B = "Ye et al., Sens. Actuators A 368 (2024) 115095, §3.1"
+
+#: Dragon Skin 30 silicone, Yeoh C10 = 0.11, C20 = 0.003, C30 = 0 MPa; 1.08 g/cm³.
+DRAGON_SKIN_30 = Material(
+    name="Dragon Skin 30",
+    model=Yeoh(c10_mpa=0.11, c20_mpa=0.003, c30_mpa=0.0),
+    density_t_per_mm3=1.08 * G_PER_CM3_TO_T_PER_MM3,
+    source=f"{_PAPER_B}: Yeoh fit to uniaxial tension of Dragon Skin 30 (R² 0.9982).",
+)
+
+#: Fiberglass strain-limiting layer (0.1 mm), Yeoh C10 = 7.9 MPa; 2.40 g/cm³.
+FIBERGLASS_LAYER = Material(
+    name="Fiberglass strain-limiting layer",
+    model=Yeoh(c10_mpa=7.9, c20_mpa=0.0, c30_mpa=0.0),
+    density_t_per_mm3=2.40 * G_PER_CM3_TO_T_PER_MM3,
+    source=f"{_PAPER_B}, after Polygerinos et al., IEEE Trans. Robot. 31 (2015) 778.",
+)
+
+#: Kevlar fiber, linear elastic E = 31076 MPa, ν = 0.36; 1.67 g/cm³.
+KEVLAR_FIBER = Material(
+    name="Kevlar fiber",
+    model=LinearElastic(e_mpa=31076.0, nu=0.36),
+    density_t_per_mm3=1.67 * G_PER_CM3_TO_T_PER_MM3,
+    source=(
+        f"{_PAPER_B}: 0.28 mm fiber modelled as beams of radius 0.07 mm "
+        "(half the real radius, after Polygerinos et al. 2015)."
+    ),
+)
+
+#: Presets by registry name.
+PRESETS: dict[str, Material] = {
+    "dragon-skin-30": DRAGON_SKIN_30,
+    "fiberglass": FIBERGLASS_LAYER,
+    "kevlar": KEVLAR_FIBER,
+}
+
+
+def get_preset(name: str) -> Material:
+    """Return the preset registered under ``name`` (``"dragon-skin-30"``, ...).
+
+    Raises
+    ------
+    ValueError
+        Listing the allowed names.
+    """
+    check_choice(name, "preset", "get_preset", PRESETS)
+    return PRESETS[name]
