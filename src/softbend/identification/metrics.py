@@ -1,0 +1,196 @@
+"""Error measures for identified dynamic models (paper A §4, SPEC §3).
+
+Each function compares a measured signal ``y`` with a prediction ``y_hat`` of
+the same length (one-step-ahead or free-run simulation of one output, e.g. the
+bending grade ρ, dimensionless, or the arc length L in mm):
+
+========================  =====================================================
+``rmse``                  √(mean((y − ŷ)²)), in the unit of ``y``
+``nrmse``                 RMSE / (max(y) − min(y)): normalized by the *range*
+                          of the measurement, dimensionless (0.05 = 5 %)
+``r2``                    1 − Σ(y − ŷ)² / Σ(y − ȳ)², the coefficient of
+                          determination
+``fit_percent``           100 · (1 − ‖y − ŷ‖ / ‖y − ȳ‖), the "fit" reported by
+                          system-identification toolboxes (MATLAB ``compare``)
+========================  =====================================================
+
+Rules that hold for all of them:
+
+* ``y`` must be finite (it is a measurement; NaN there is a data error and
+  raises :class:`~softbend.errors.DatasetError`).
+* ``y_hat`` may contain NaN or ±inf, e.g. a free-run simulation that diverged.
+  Nothing is dropped: the result is then NaN (or inf / −inf) so that a
+  diverged model can never look good.
+* If ``y`` is constant (max(y) = min(y)), the normalizers of ``nrmse``, ``r2``
+  and ``fit_percent`` are zero and these three metrics are undefined: they
+  return NaN, even for a perfect prediction. ``rmse`` stays defined.
+
+Perfect prediction gives rmse = nrmse = 0, r2 = 1, fit = 100; predicting the
+mean of ``y`` gives r2 = 0 and fit = 0.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+from numpy.typing import ArrayLike
+
+from softbend._validation import check_finite_array
+
+__all__ = ["fit_percent", "nrmse", "r2", "regression_metrics", "rmse"]
+
+
+def _pair(y: ArrayLike, y_hat: ArrayLike, owner: str) -> tuple[np.ndarray, np.ndarray]:
+    """Validate a (measurement, prediction) pair and return two 1-D float arrays."""
+    arrays = []
+    for name, values in (("y", y), ("y_hat", y_hat)):
+        try:
+            array = np.asarray(values, dtype=float)
+        except (TypeError, ValueError):
+            raise ValueError(
+                f"The '{name}' of {owner} must be a 1-D array of numbers. "
+                f"Got {type(values).__name__} instead."
+            ) from None
+        if array.ndim == 2 and array.shape[1] == 1:
+            array = array[:, 0]
+        if array.ndim != 1 or array.size == 0:
+            raise ValueError(
+                f"The '{name}' of {owner} must be a non-empty 1-D array (n_samples,). "
+                f"Got shape {array.shape} instead."
+            )
+        arrays.append(array)
+    measured, predicted = arrays
+    if measured.shape != predicted.shape:
+        raise ValueError(
+            f"The 'y_hat' of {owner} must have the length of 'y' ({measured.size}). "
+            f"Got {predicted.size} instead."
+        )
+    check_finite_array(measured, "y", owner)
+    return measured, predicted
+
+
+def _sum_squared_error(measured: np.ndarray, predicted: np.ndarray) -> float:
+    with np.errstate(over="ignore", invalid="ignore"):
+        return float(np.sum((measured - predicted) ** 2))
+
+
+def _is_constant(measured: np.ndarray) -> bool:
+    return bool(np.ptp(measured) == 0.0)
+
+
+def rmse(y: ArrayLike, y_hat: ArrayLike) -> float:
+    """Root-mean-square error.
+
+    Parameters
+    ----------
+    y : array-like, shape (n_samples,)
+        Measured output (finite).
+    y_hat : array-like, shape (n_samples,)
+        Predicted output; NaN/inf allowed and propagated.
+
+    Returns
+    -------
+    float
+        √(mean((y − ŷ)²)) in the unit of ``y``; NaN if ``y_hat`` has NaN, inf if
+        it has infinite values.
+    """
+    measured, predicted = _pair(y, y_hat, "rmse")
+    return math.sqrt(_sum_squared_error(measured, predicted) / measured.size)
+
+
+def nrmse(y: ArrayLike, y_hat: ArrayLike) -> float:
+    """RMSE normalized by the range of the measurement.
+
+    Parameters
+    ----------
+    y, y_hat : array-like, shape (n_samples,)
+        Measured (finite) and predicted output.
+
+    Returns
+    -------
+    float
+        RMSE / (max(y) − min(y)), dimensionless (multiply by 100 for percent).
+        NaN if ``y`` is constant (zero range); NaN/inf propagate from ``y_hat``.
+
+    Notes
+    -----
+    The range normalization (not the standard deviation or the mean) makes the
+    number comparable between ρ (≈ 0.5 range) and L (mm) and between
+    experiments with small and large excursions.
+    """
+    measured, predicted = _pair(y, y_hat, "nrmse")
+    if _is_constant(measured):
+        return math.nan
+    error = math.sqrt(_sum_squared_error(measured, predicted) / measured.size)
+    return error / float(np.ptp(measured))
+
+
+def r2(y: ArrayLike, y_hat: ArrayLike) -> float:
+    """Coefficient of determination.
+
+    Parameters
+    ----------
+    y, y_hat : array-like, shape (n_samples,)
+        Measured (finite) and predicted output.
+
+    Returns
+    -------
+    float
+        1 − Σ(y − ŷ)² / Σ(y − ȳ)²; 1 for a perfect prediction, 0 for predicting
+        the mean, unbounded below. NaN if ``y`` is constant (unlike
+        scikit-learn's ``r2_score``, which returns 1 or 0 there); NaN or −inf
+        propagate from ``y_hat``.
+    """
+    measured, predicted = _pair(y, y_hat, "r2")
+    if _is_constant(measured):
+        return math.nan
+    total = float(np.sum((measured - measured.mean()) ** 2))
+    return 1.0 - _sum_squared_error(measured, predicted) / total
+
+
+def fit_percent(y: ArrayLike, y_hat: ArrayLike) -> float:
+    """Normalized fit of system-identification toolboxes, in percent.
+
+    Parameters
+    ----------
+    y, y_hat : array-like, shape (n_samples,)
+        Measured (finite) and predicted output.
+
+    Returns
+    -------
+    float
+        100 · (1 − ‖y − ŷ‖₂ / ‖y − ȳ‖₂); 100 for a perfect prediction, 0 for
+        predicting the mean, unbounded below. Related to R² by
+        fit = 100 · (1 − √(1 − R²)). NaN if ``y`` is constant; NaN or −inf
+        propagate from ``y_hat``.
+    """
+    measured, predicted = _pair(y, y_hat, "fit_percent")
+    if _is_constant(measured):
+        return math.nan
+    total = float(np.sum((measured - measured.mean()) ** 2))
+    return 100.0 * (1.0 - math.sqrt(_sum_squared_error(measured, predicted) / total))
+
+
+def regression_metrics(y: ArrayLike, y_hat: ArrayLike) -> dict[str, float]:
+    """All four measures at once.
+
+    Parameters
+    ----------
+    y, y_hat : array-like, shape (n_samples,)
+        Measured (finite) and predicted output. To score a NARX prediction,
+        leave out the initial-condition samples first (see
+        ``NARXRegressor.warmup_mask``).
+
+    Returns
+    -------
+    dict
+        ``{"rmse", "nrmse", "r2", "fit_percent"}`` as defined in this module.
+    """
+    measured, predicted = _pair(y, y_hat, "regression_metrics")
+    return {
+        "rmse": rmse(measured, predicted),
+        "nrmse": nrmse(measured, predicted),
+        "r2": r2(measured, predicted),
+        "fit_percent": fit_percent(measured, predicted),
+    }
