@@ -2,7 +2,108 @@
 
 from __future__ import annotations
 
+from pathlib import Path
+from typing import Annotated
 
-def analyze() -> None:
-    """Correlations and standardized regression of a campaign database."""
-    raise NotImplementedError
+import typer
+
+from softbend.cli import _common
+
+#: Files written into ``--out``.
+CORRELATION_PNG = "correlation.png"
+LOADINGS_PNG = "loadings.png"
+PARITY_PNG = "parity.png"
+COEFFICIENTS_CSV = "coefficients.csv"
+CORRELATION_CSV = "correlation.csv"
+
+
+def analyze(
+    db: Annotated[Path, typer.Argument(help="Campaign database (DuckDB file) to analyze.")],
+    out: Annotated[
+        Path,
+        typer.Option("--out", "-o", help="Folder for the figures and tables (created if missing)."),
+    ],
+    mape_threshold_deg: Annotated[
+        float,
+        typer.Option(
+            "--mape-threshold-deg",
+            help="Leave samples with |angle| below this (degrees) out of the MAPE.",
+        ),
+    ] = 1.0,
+    json_output: Annotated[bool, typer.Option("--json", help="Print the results as JSON.")] = False,
+) -> None:
+    """Correlations and standardized regression of a campaign database.
+
+    Uses the converged samples of the campaign: Pearson correlations of the
+    design parameters, pressure and bending angle, and a multiple linear
+    regression of the z-scored angle on the z-scored inputs (loadings,
+    t-tests, R², F, MAPE). Writes correlation.png, loadings.png, parity.png,
+    coefficients.csv and correlation.csv into OUT.
+    """
+    from softbend.analysis import correlation_matrix, standardized_regression
+    from softbend.errors import DatasetError
+    from softbend.reports.analysis_figures import correlation_heatmap, loadings_bar, parity_plot
+
+    if not db.exists():
+        raise FileNotFoundError(f"Campaign database {str(db)!r} does not exist.")
+    if db.is_dir():
+        raise DatasetError(f"Campaign database {str(db)!r} is a folder, not a DuckDB file.")
+
+    from softbend.campaign.store import load_samples
+
+    samples = load_samples(db)
+    if len(samples) == 0:
+        raise DatasetError(f"Campaign database {str(db)!r} holds no samples to analyze.")
+
+    report = standardized_regression(samples, mape_threshold=mape_threshold_deg)
+    corr = correlation_matrix(samples)
+
+    out.mkdir(parents=True, exist_ok=True)
+    figures = {
+        "correlation": correlation_heatmap(corr, out / CORRELATION_PNG),
+        "loadings": loadings_bar(report, out / LOADINGS_PNG),
+        "parity": parity_plot(report, out / PARITY_PNG),
+    }
+    tables = {"coefficients": out / COEFFICIENTS_CSV, "correlation": out / CORRELATION_CSV}
+    report.coefficients.to_csv(tables["coefficients"], float_format="%.10g")
+    corr.to_csv(tables["correlation"], float_format="%.10g")
+
+    if json_output:
+        payload = report.to_dict()
+        payload["database"] = str(db)
+        payload["correlation"] = {
+            str(row): {str(col): float(v) for col, v in corr.loc[row].items()} for row in corr.index
+        }
+        payload["files"] = {k: str(v) for k, v in {**figures, **tables}.items()}
+        _common.print_json(payload)
+        return
+
+    rows = [
+        [
+            str(feature),
+            float(row["loading"]),
+            float(row["t_value"]),
+            float(row["p_value"]),
+            str(row["stars"]) or "n.s.",
+        ]
+        for feature, row in report.coefficients.iterrows()
+    ]
+    _common.print_table(
+        f"Standardized regression of {report.target} ({report.n_samples} samples)",
+        ["feature", "loading", "t", "p", "sig"],
+        rows,
+    )
+    summary = [
+        ["R²", report.r2],
+        ["adjusted R²", report.adj_r2],
+        ["F", report.f_value],
+        ["p(F)", report.f_pvalue],
+        [f"MAPE % (|θ| ≥ {report.mape_threshold:g}°)", report.mape_pct],
+        ["samples left out of MAPE", report.n_mape_excluded],
+        ["RMSE (°)", report.rmse],
+        ["rows excluded (non-converged / NaN)", report.n_rows_excluded],
+    ]
+    if report.dropped_features:
+        summary.append(["constant features dropped", ", ".join(report.dropped_features)])
+    _common.print_table("Fit", ["quantity", "value"], summary)
+    _common.console.print(f"Figures and tables written to {out}", highlight=False)
