@@ -1,0 +1,290 @@
+import os
+
+import numpy as np
+import pytest
+
+from softbend.errors import DatasetError
+from softbend.identification.data import (
+    REQUIRED_COLUMNS,
+    Experiment,
+    load_experiments,
+    save_experiments,
+)
+from softbend.kinematics import tip_position
+
+
+def _experiment(name="exp-a", n=8, rho_peak=0.3, length_mm=16.0, **kwargs):
+    time = 0.02 * np.arange(n)
+    rho = np.linspace(0.0, rho_peak, n)
+    x, y = tip_position(rho, np.full(n, length_mm))
+    pressure = np.linspace(0.0, 80.0 if rho_peak >= 0 else -60.0, n)
+    return Experiment(name, time, pressure, x, y, **kwargs)
+
+
+def _write(path, text):
+    path.write_text(text, encoding="utf-8")
+    return path
+
+
+GOOD = "time_s,pressure_kpa,x_mm,y_mm\n0,0,0,0\n0.02,10,0.5,0.1\n0.04,20,1.0,0.3\n"
+
+
+# ---------------------------------------------------------------- Experiment
+def test_bending_and_length_come_from_the_tip_by_constant_curvature():
+    rho = np.array([0.0, 0.1, 0.25, 0.45, -0.3])
+    length = np.array([15.25, 16.0, 17.0, 18.25, 9.25])
+    x, y = tip_position(rho, length)
+    exp = Experiment("k", np.arange(5.0), np.array([0, 10, 40, 100, -80.0]), x, y)
+    np.testing.assert_allclose(exp.rho, rho, atol=1e-12)
+    np.testing.assert_allclose(exp.length_mm, length, rtol=1e-12)
+    assert exp.n_samples == 5
+    assert exp.dt_s == 1.0
+
+
+def test_sign_follows_the_pressure_of_largest_magnitude():
+    assert _experiment(rho_peak=0.3).sign == "positive"
+    assert _experiment(rho_peak=-0.2).sign == "negative"
+    mixed = Experiment("m", [0, 1, 2.0], [5.0, -40.0, 30.0], [0, 0, 0.0], [0, 0, 0.0])
+    assert mixed.sign == "negative"
+
+
+def test_dt_is_the_median_step():
+    exp = Experiment("d", [0, 0.02, 0.04, 0.07, 0.09], [0.0] * 5, [0.0] * 5, [0.0] * 5)
+    assert exp.dt_s == pytest.approx(0.02)
+
+
+def test_arrays_are_read_only_copies_and_frame_has_every_column():
+    x = np.zeros(4)
+    exp = Experiment("f", np.arange(4.0), np.zeros(4), x, np.zeros(4))
+    x[0] = 99.0
+    assert exp.x_mm[0] == 0.0
+    with pytest.raises(ValueError):
+        exp.x_mm[0] = 1.0
+    frame = exp.to_frame()
+    assert list(frame.columns) == [
+        "experiment",
+        "time_s",
+        "pressure_kpa",
+        "x_mm",
+        "y_mm",
+        "rho",
+        "length_mm",
+    ]
+    assert (frame["experiment"] == "f").all()
+    np.testing.assert_array_equal(frame["length_mm"], 15.25)
+
+
+@pytest.mark.parametrize(
+    ("kwargs", "pattern"),
+    [
+        ({"x_mm": np.zeros(3)}, "equal lengths.*x_mm: 3"),
+        ({"n": 2}, "at least 3 samples"),
+        ({"y_mm": np.array([0, 0, np.nan, 0, 0])}, "'y_mm'.*finite.*nan at sample 2"),
+        ({"pressure_kpa": np.array([0, 1, 2, np.inf, 4])}, "'pressure_kpa'.*inf at sample 3"),
+        ({"time_s": np.array([0, 1, 1, 2, 3.0])}, "'time_s'.*increase strictly.*sample 2"),
+        ({"time_s": np.zeros((5, 1))}, "'time_s'.*1-D"),
+    ],
+)
+def test_experiment_rejects_bad_columns(kwargs, pattern):
+    n = kwargs.pop("n", 5)
+    columns = {c: np.arange(float(n)) * (c == "time_s") for c in REQUIRED_COLUMNS}
+    columns.update(kwargs)
+    with pytest.raises(DatasetError, match=pattern):
+        Experiment("bad", **columns)
+
+
+def test_experiment_rejects_empty_name_and_bad_rest_length():
+    with pytest.raises(ValueError, match="'name' of Experiment"):
+        Experiment(" ", [0, 1, 2.0], [0.0] * 3, [0.0] * 3, [0.0] * 3)
+    with pytest.raises(ValueError, match=r"'rest_length_mm' of Experiment.*\(0, inf\)"):
+        Experiment("r", [0, 1, 2.0], [0.0] * 3, [0.0] * 3, [0.0] * 3, rest_length_mm=-1)
+
+
+# ------------------------------------------------------------------ round trip
+def test_csv_round_trip_is_exact(tmp_path):
+    rng = np.random.default_rng(5)
+    originals = [
+        _experiment("pos", n=40, metadata={"operator": "lab 2", "run": 3}),
+        _experiment(
+            "neg",
+            n=30,
+            rho_peak=-0.25,
+            length_mm=11.0,
+            synthetic=True,
+            metadata={"label": "SYNTHETIC DATA test", "seed": 7, "gains": [1.5, 2.0]},
+        ),
+        Experiment(
+            "noisy",
+            np.cumsum(rng.uniform(0.01, 0.03, 50)),
+            rng.normal(0, 50, 50),
+            rng.normal(0, 3, 50),
+            rng.normal(0, 3, 50) - 1e-17,
+            rest_length_mm=20.5,
+        ),
+    ]
+    paths = save_experiments(originals, tmp_path / "out")
+    assert [p.name for p in paths] == ["pos.csv", "neg.csv", "noisy.csv"]
+    loaded = load_experiments(tmp_path / "out")
+    by_name = {e.name: e for e in loaded}
+    assert [e.name for e in loaded] == ["neg", "noisy", "pos"]  # sorted file order
+    for original in originals:
+        again = by_name[original.name]
+        assert again == original
+        for column in REQUIRED_COLUMNS:
+            assert np.array_equal(getattr(again, column), getattr(original, column))
+        assert again.rest_length_mm == original.rest_length_mm
+        assert again.synthetic == original.synthetic
+        assert again.metadata == original.metadata
+    # Nothing but the CSV files is left behind (the temporary files were moved into place).
+    assert sorted(os.listdir(tmp_path / "out")) == ["neg.csv", "noisy.csv", "pos.csv"]
+
+
+def test_synthetic_files_say_so_in_the_header(tmp_path):
+    (path,) = save_experiments(
+        _experiment("s", synthetic=True, metadata={"label": "SYNTHETIC DATA x"}), tmp_path
+    )
+    header = [line for line in path.read_text().splitlines() if line.startswith("#")]
+    assert "# synthetic: true" in header
+    assert any("SYNTHETIC DATA" in line for line in header)
+    (real,) = save_experiments(_experiment("r"), tmp_path)
+    assert "# synthetic: false" in real.read_text()
+    assert "SYNTHETIC" not in real.read_text()
+
+
+def test_unsafe_names_are_kept_in_an_experiment_column(tmp_path):
+    original = _experiment("run 1/a")
+    (path,) = save_experiments([original], tmp_path)
+    assert path.name == "run_1_a.csv"
+    (loaded,) = load_experiments(path)
+    assert loaded == original
+
+
+def test_saving_two_names_to_one_file_is_refused(tmp_path):
+    with pytest.raises(ValueError, match="distinct file names"):
+        save_experiments([_experiment("a b"), _experiment("a_b")], tmp_path)
+
+
+def test_saving_over_a_file_is_refused(tmp_path):
+    target = _write(tmp_path / "x.csv", GOOD)
+    with pytest.raises(ValueError, match="must be a folder"):
+        save_experiments([_experiment()], target)
+
+
+# ---------------------------------------------------------------------- loading
+def test_file_stem_names_a_single_experiment_and_extra_columns_are_ignored(tmp_path):
+    text = "# a comment\ntime_s,temperature_c,pressure_kpa,x_mm,y_mm\n"
+    text += "0,21,0,0,0\n0.02,21,10,0.5,0.1\n# mid comment\n\n0.04,22,20,1.0,0.3\n"
+    (exp,) = load_experiments(_write(tmp_path / "trial7.csv", text))
+    assert exp.name == "trial7"
+    assert not exp.synthetic
+    assert exp.rest_length_mm == 15.25
+    np.testing.assert_array_equal(exp.pressure_kpa, [0, 10, 20])
+    np.testing.assert_array_equal(exp.y_mm, [0, 0.1, 0.3])
+
+
+def test_experiment_column_splits_one_file(tmp_path):
+    text = "experiment,time_s,pressure_kpa,x_mm,y_mm\n"
+    for name in ("b", "a"):
+        for k in range(4):
+            text += f"{name},{0.02 * k},{5 * k},{0.1 * k},0\n"
+    experiments = load_experiments(_write(tmp_path / "many.csv", text), rest_length_mm=14.0)
+    assert [e.name for e in experiments] == ["b", "a"]
+    assert all(e.n_samples == 4 and e.rest_length_mm == 14.0 for e in experiments)
+
+
+def _error(path) -> str:
+    with pytest.raises(DatasetError) as info:
+        load_experiments(path)
+    message = str(info.value)
+    assert "\n" not in message
+    return message
+
+
+def test_missing_path(tmp_path):
+    message = _error(tmp_path / "nope.csv")
+    assert "not found" in message and "nope.csv" in message
+
+
+def test_folder_without_csv(tmp_path):
+    _write(tmp_path / "notes.txt", "nothing")
+    assert "no CSV files" in _error(tmp_path)
+
+
+def test_empty_file(tmp_path):
+    assert "is empty" in _error(_write(tmp_path / "e.csv", ""))
+    message = _error(_write(tmp_path / "c.csv", "# only comments\n\n"))
+    assert "is empty" in message and "time_s, pressure_kpa, x_mm, y_mm" in message
+
+
+def test_header_without_rows(tmp_path):
+    assert "no data rows" in _error(_write(tmp_path / "h.csv", "time_s,pressure_kpa,x_mm,y_mm\n"))
+
+
+def test_missing_columns_are_named_with_the_required_list(tmp_path):
+    message = _error(_write(tmp_path / "m.csv", "time_s,pressure,x_mm\n0,0,0\n"))
+    assert "missing column(s) pressure_kpa, y_mm" in message
+    assert "required columns are time_s, pressure_kpa, x_mm, y_mm" in message
+
+
+def test_non_numeric_value_names_column_and_row(tmp_path):
+    text = "# header comment\n" + GOOD.replace("0.02,10,0.5", "0.02,ten,0.5")
+    message = _error(_write(tmp_path / "n.csv", text))
+    assert "row 4" in message and "'pressure_kpa'" in message and "'ten'" in message
+
+
+@pytest.mark.parametrize("cell", ["", "nan", "NaN"])
+def test_missing_value_names_column_and_row(tmp_path, cell):
+    text = GOOD.replace("0.04,20,1.0,0.3", f"0.04,20,{cell},0.3")
+    message = _error(_write(tmp_path / "v.csv", text))
+    assert "row 4" in message and "'x_mm'" in message and "missing value" in message
+
+
+def test_infinite_value_is_refused(tmp_path):
+    message = _error(_write(tmp_path / "i.csv", GOOD.replace("0.1\n", "inf\n")))
+    assert "row 3" in message and "'y_mm'" in message and "not finite" in message
+
+
+def test_ragged_row(tmp_path):
+    message = _error(_write(tmp_path / "r.csv", GOOD + "0.06,1,2\n"))
+    assert "row 5" in message and "3 fields" in message
+
+
+def test_non_increasing_time_names_experiment_and_row(tmp_path):
+    text = "experiment,time_s,pressure_kpa,x_mm,y_mm\n"
+    text += "a,0,0,0,0\nb,0,0,0,0\na,0.02,1,0,0\nb,0.02,1,0,0\na,0.02,2,0,0\n"
+    message = _error(_write(tmp_path / "t.csv", text))
+    assert "experiment 'a'" in message and "row 6" in message and "row 4" in message
+    assert "increase strictly" in message
+
+
+def test_too_few_samples_in_an_experiment(tmp_path):
+    message = _error(
+        _write(tmp_path / "s.csv", "time_s,pressure_kpa,x_mm,y_mm\n0,0,0,0\n1,0,0,0\n")
+    )
+    assert "2 sample(s)" in message and "at least 3" in message
+
+
+def test_duplicate_names_across_files(tmp_path):
+    text = "experiment,time_s,pressure_kpa,x_mm,y_mm\n" + "".join(
+        f"same,{k},0,0,0\n" for k in range(3)
+    )
+    _write(tmp_path / "a.csv", text)
+    _write(tmp_path / "b.csv", text)
+    message = _error(tmp_path)
+    assert "'same'" in message and "unique" in message
+
+
+def test_bad_header_comment(tmp_path):
+    message = _error(_write(tmp_path / "h.csv", "# rest_length_mm: long\n" + GOOD))
+    assert "row 1" in message and "rest_length_mm" in message
+
+
+def test_unreachable_tip_is_a_dataset_error(tmp_path):
+    # On the rest axis above the base: no arc of positive length ends there.
+    message = _error(_write(tmp_path / "u.csv", GOOD.replace("0,0,0,0\n", "0,0,0,20\n")))
+    assert "row 2" in message and "y_mm=20.0" in message and "u.csv" in message
+
+
+def test_bad_rest_length_argument(tmp_path):
+    with pytest.raises(ValueError, match=r"'rest_length_mm' of load_experiments.*\(0, inf\)"):
+        load_experiments(_write(tmp_path / "g.csv", GOOD), rest_length_mm=0.0)
