@@ -241,13 +241,19 @@ class GeneralizedGaussianSVR(RegressorMixin, BaseEstimator):
         self.intercept_ = intercept
         self.n_support_ = int(dual_coef.size)
         self.n_iter_ = int(np.asarray(svr.n_iter_).ravel()[0])
-        # Everything predict_one needs, precomputed: K = c·exp(−(rate·d²)^(γ/2)),
-        # with c folded into the coefficients.
+        self._precompute()
+        return self
+
+    def _precompute(self) -> None:
+        """Derive what prediction needs from the public fitted attributes.
+
+        K = c·exp(−(rate·d²)^(γ/2)), with c folded into the coefficients. Called by
+        ``fit`` and by :func:`softbend.identification.persistence.load_narx`.
+        """
         self._rate = gg_scale(self.shape_) ** 2 / self.sigma_**2
         self._half_shape = 0.5 * self.shape_
-        self._coef = dual_coef * scale
+        self._coef = self.dual_coef_ * self.kernel_scale_
         self._x_shape = (self.n_features_in_,)
-        return self
 
     def _expansion(self, sqdist: np.ndarray) -> np.ndarray:
         kernel = _kernel_from_sqdist(sqdist, sigma=self.sigma_, shape=self.shape_, scale=1.0)

@@ -1,0 +1,90 @@
+import numpy as np
+import pytest
+
+from softbend.errors import DatasetError
+from softbend.identification.study import (
+    IdentificationConfig,
+    identify,
+    n_fits,
+    split_by_sign,
+)
+from softbend.identification.synthetic import synthetic_dataset
+
+
+@pytest.fixture(scope="module")
+def small_dataset():
+    data = synthetic_dataset(n_experiments=3, n_samples=256, seed=3)
+    return [e for group in data.values() for e in group]
+
+
+@pytest.fixture(scope="module")
+def small_result(small_dataset):
+    calls = []
+    result = identify(small_dataset, progress=calls.append)
+    return result, calls
+
+
+def test_every_experiment_is_held_out_once_per_output_and_mode(small_result, small_dataset):
+    result, calls = small_result
+    assert len(calls) == n_fits(small_dataset) == 2 * 2 * (3 + 1)
+    counts = result.metrics.groupby(["sign", "output", "mode"]).size()
+    assert (counts == 3).all() and len(counts) == 8
+    names = {e.name for e in small_dataset}
+    assert set(result.metrics["experiment"]) == names
+
+
+def test_held_out_predictions_keep_measured_initial_conditions(small_result):
+    result, _ = small_result
+    for (sign, output, name), pred in result.predictions.items():
+        experiment = next(e for e in result.experiments[sign] if e.name == name)
+        measured = getattr(experiment, output)
+        lag = result.models[(sign, output)].max_lag_
+        for y_hat in pred.values():
+            assert y_hat.shape == measured.shape
+            np.testing.assert_array_equal(y_hat[:lag], measured[:lag])
+
+
+def test_one_step_beats_free_run_and_free_run_is_accurate(small_result):
+    result, _ = small_result
+    summary = result.summary().set_index(["sign", "output", "mode"])
+    for sign in ("positive", "negative"):
+        for output in ("rho", "length_mm"):
+            one = summary.loc[(sign, output, "one-step"), "nrmse_mean"]
+            free = summary.loc[(sign, output, "free-run"), "nrmse_mean"]
+            assert one <= free
+            assert free < 0.15
+
+
+def test_final_models_are_trained_on_every_experiment_of_their_sign(small_result):
+    result, _ = small_result
+    for (sign, _output), model in result.models.items():
+        assert model.n_experiments_ == len(result.experiments[sign])
+        params = result.kernel_params[(sign, _output)]
+        assert 0 < params["shape"] <= 2 and params["sigma"] > 0
+
+
+def test_identification_is_deterministic(small_dataset):
+    subset = [e for e in small_dataset if e.sign == "negative"][:2]
+    a = identify(subset).metrics
+    b = identify(subset).metrics
+    assert a.equals(b)
+
+
+def test_a_sign_with_one_experiment_is_refused(small_dataset):
+    one = [e for e in small_dataset if e.sign == "positive"][:1]
+    with pytest.raises(DatasetError, match="at least 2 positive-pressure experiments"):
+        identify(one)
+
+
+def test_split_by_sign_keeps_order(small_dataset):
+    groups = split_by_sign(list(reversed(small_dataset)))
+    assert list(groups) == ["positive", "negative"]
+    assert all(e.sign == "negative" for e in groups["negative"])
+
+
+@pytest.mark.parametrize(
+    ("field", "value"), [("C", 0.0), ("epsilon", -0.1), ("output_lags", 0), ("kernel", "grid")]
+)
+def test_bad_configuration_names_the_field(field, value):
+    with pytest.raises(ValueError, match=f"'{field}' of IdentificationConfig"):
+        IdentificationConfig(**{field: value})
