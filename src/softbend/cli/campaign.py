@@ -1,7 +1,228 @@
-"""``softbend campaign``: run, inspect and export design campaigns."""
+"""``softbend campaign``: run, inspect and export design campaigns.
+
+``run`` sweeps a design space into a DuckDB file (resuming if it exists),
+``status`` summarises a database, ``export`` writes its samples (or designs) to
+Parquet or CSV.
+"""
 
 from __future__ import annotations
 
+import re
+from contextlib import ExitStack
+from pathlib import Path
+from typing import TYPE_CHECKING
+
 import typer
 
+from softbend.cli import _common
+
+if TYPE_CHECKING:
+    from softbend.design import DesignSpace
+
 app = typer.Typer(help="Run FEM or analytical sweeps over a design space.", no_args_is_help=True)
+
+_SPACE_FORMS = "table1, corners, lhs:N or sobol:N"
+
+
+def parse_space(spec: str, seed: int = 0) -> DesignSpace:
+    """Design space from a CLI string: ``table1``, ``corners``, ``lhs:N`` or ``sobol:N``.
+
+    ``lhs`` and ``sobol`` sample ``N`` designs over the Table 1 ranges with ``seed``.
+    """
+    from softbend.design import DesignSpace
+
+    text = spec.strip().lower()
+    if text == "table1":
+        return DesignSpace.table1()
+    if text == "corners":
+        return DesignSpace.corners()
+    match = re.fullmatch(r"(lhs|sobol):(\d+)", text)
+    if match is None or int(match[2]) < 1:
+        raise ValueError(
+            f"The '--space' of softbend campaign run must be one of {_SPACE_FORMS} "
+            f"(N >= 1). Got {spec!r} instead."
+        )
+    return DesignSpace.sample(int(match[2]), method=match[1], seed=seed)
+
+
+def _designs_to_run(db: Path, designs: DesignSpace, retry_failed: bool) -> int:
+    """Designs of ``designs`` that a run on ``db`` will sweep (the progress bar total)."""
+    from softbend.campaign import CampaignStore
+
+    if not db.exists():
+        return len(designs)
+    with CampaignStore(db, read_only=True) as store:
+        skip = store.finished_ids(include_failed=not retry_failed)
+    return sum(d.design_id not in skip for d in designs)
+
+
+def _one_line(text: str) -> str:
+    return " ".join(str(text).split())
+
+
+@app.command("run")
+def run(
+    db: Path = typer.Argument(..., help="Campaign database (DuckDB); created or resumed."),
+    backend: str = typer.Option("analytical", help="Sweep model: analytical or fem."),
+    space: str = typer.Option("table1", help=f"Designs: {_SPACE_FORMS}."),
+    seed: int = typer.Option(0, help="Seed of the lhs/sobol sampler."),
+    pmax: float = typer.Option(0.5, help="Largest pressure of the sweep, MPa."),
+    pstep: float = typer.Option(0.005, help="Pressure step of the sweep, MPa."),
+    workers: int | None = typer.Option(
+        None, help="Local worker processes (default: all cores; 0 or 1: serial)."
+    ),
+    scheduler: str | None = typer.Option(
+        None, help="Dask scheduler tcp://HOST:PORT (or scheduler file) to run on a cluster."
+    ),
+    retry_failed: bool = typer.Option(
+        True, "--retry-failed/--no-retry-failed", help="Re-run designs recorded as failed."
+    ),
+    chunk_size: int | None = typer.Option(None, help="Designs per worker task (default: auto)."),
+    connect_timeout: float = typer.Option(
+        5.0, help="Seconds allowed to reach the Dask scheduler and find a worker."
+    ),
+    json_output: bool = typer.Option(False, "--json", help="Print the summary as JSON."),
+) -> None:
+    """Sweep every design of a space not yet in DB; re-run the same command to resume."""
+    from softbend.campaign import default_pressures_mpa, get_backend, run_campaign
+    from softbend.campaign.runner import parse_scheduler_address
+
+    designs = parse_space(space, seed)
+    pressures = default_pressures_mpa(pmax, pstep)
+    backend_obj = get_backend(backend)
+    if scheduler is not None:
+        parse_scheduler_address(scheduler)
+    n_todo = _designs_to_run(db, designs, retry_failed)
+    if n_todo < len(designs) and not json_output:
+        _common.err_console.print(
+            f"resuming {db}: {len(designs) - n_todo} of {len(designs)} designs already recorded",
+            highlight=False,
+        )
+    with ExitStack() as stack:
+        # The bar opens with the first report, so errors before any work print no bar.
+        advance = None
+        shown = 0
+
+        def progress(done: int, failed: int, running: int, total: int) -> None:
+            nonlocal advance, shown
+            if advance is None:
+                advance = stack.enter_context(
+                    _common.progress_bar(
+                        f"campaign {db.name}", total=total, enabled=not json_output
+                    )
+                )
+            advance(done + failed - shown, done=done, failed=failed, running=running)
+            shown = done + failed
+
+        summary = run_campaign(
+            db,
+            designs,
+            backend=backend_obj,
+            pressures_mpa=pressures,
+            workers=workers,
+            scheduler=scheduler,
+            retry_failed=retry_failed,
+            progress=progress,
+            chunk_size=chunk_size,
+            connect_timeout_s=connect_timeout,
+        )
+    if json_output:
+        _common.print_json({"space": designs.name, **summary.as_dict()})
+        return
+    _common.print_table(
+        f"campaign {summary.db_path}",
+        ["quantity", "value"],
+        [
+            ["backend", summary.backend],
+            ["space", f"{designs.name} ({summary.n_designs} designs)"],
+            ["executor", summary.executor],
+            ["already done (skipped)", summary.n_skipped_done],
+            ["failed before, not retried", summary.n_skipped_failed],
+            ["done in this run", summary.n_done],
+            ["failed in this run", summary.n_failed],
+            ["wall time (s)", summary.wall_time_s],
+            ["designs per second", summary.designs_per_s],
+            ["sweep time, sum (s)", summary.sweep_time_s],
+        ],
+    )
+    if summary.failures:
+        _common.print_table(
+            "failed designs",
+            ["design_id", "error"],
+            [[i, _one_line(e)] for i, e in summary.failures[:20]],
+        )
+
+
+@app.command("status")
+def status(
+    db: Path = typer.Argument(..., help="Campaign database (DuckDB)."),
+    json_output: bool = typer.Option(False, "--json", help="Print the status as JSON."),
+) -> None:
+    """Summarise a campaign database: designs done and failed, samples, metadata."""
+    from softbend.campaign import CampaignStore
+
+    with CampaignStore(db, read_only=True) as store:
+        summary = store.status_summary()
+    if json_output:
+        _common.print_json(summary)
+        return
+    planned = summary["n_designs_planned"]
+    grid = (
+        "-"
+        if summary["n_pressures"] is None
+        else (
+            f"{summary['n_pressures']} pressures, "
+            f"{summary['pmin_mpa']:g}–{summary['pmax_mpa']:g} MPa"
+        )
+    )
+    _common.print_table(
+        f"campaign {summary['path']}",
+        ["quantity", "value"],
+        [
+            ["backend", summary["backend"] or "-"],
+            ["space of the latest run", f"{summary['space'] or '-'} ({planned or 0} designs)"],
+            ["designs done", summary["done"]],
+            ["designs failed", summary["failed"]],
+            ["samples (converged)", f"{summary['samples']} ({summary['converged_samples']})"],
+            ["pressure grid", grid],
+            ["sweep time, sum (s)", summary["sweep_time_s_total"]],
+            [
+                "largest angle (deg)",
+                summary["max_angle_deg"] if summary["max_angle_deg"] is not None else "-",
+            ],
+            ["schema / softbend", f"{summary['schema_version']} / {summary['softbend_version']}"],
+            [
+                "created / last design",
+                f"{summary['created_at']} / {summary['last_finished_at'] or '-'}",
+            ],
+        ],
+    )
+    if summary["failures"]:
+        _common.print_table(
+            "failed designs",
+            ["design_id", "design", "error"],
+            [[f["design_id"], f["design"], _one_line(f["error"])] for f in summary["failures"]],
+        )
+
+
+@app.command("export")
+def export(
+    db: Path = typer.Argument(..., help="Campaign database (DuckDB)."),
+    out: Path = typer.Argument(..., help="Output file (.parquet or .csv)."),
+    format: str | None = typer.Option(
+        None, "--format", help="parquet or csv (default: from the suffix of OUT, else parquet)."
+    ),
+    table: str = typer.Option("samples", help="samples (joined with the designs) or designs."),
+) -> None:
+    """Write the samples (or the designs table) of a campaign to Parquet or CSV."""
+    from softbend._validation import check_choice
+    from softbend.campaign import CampaignStore
+
+    if format is None:
+        format = "csv" if out.suffix.lower() == ".csv" else "parquet"
+    check_choice(format, "--format", "softbend campaign export", ("parquet", "csv"))
+    check_choice(table, "--table", "softbend campaign export", ("samples", "designs"))
+    with CampaignStore(db, read_only=True) as store:
+        path = store.export(out, format=format, table=table)
+        n_rows = len(store.load_samples() if table == "samples" else store.load_designs())
+    _common.console.print(f"wrote {n_rows} {table} rows to {path} ({format})", highlight=False)

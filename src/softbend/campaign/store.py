@@ -1,0 +1,697 @@
+"""The campaign database: one DuckDB file per campaign.
+
+Tables (schema version :data:`SCHEMA_VERSION`):
+
+``meta(key, value)``
+    ``schema_version``, ``softbend_version`` and ``created_at`` (set on creation),
+    ``backend`` and ``pressures_mpa`` (JSON list; set by the first run and checked
+    by every later one, so a resumed campaign cannot mix models or grids),
+    ``space`` and ``n_designs_planned`` (of the latest run).
+``designs``
+    One row per attempted design: its parameters (``l_mm`` ... ``lc_mm``),
+    ``status`` ``'done'`` or ``'failed'``, ``error`` (``"ExceptionType: message"``
+    for failed designs), ``wall_time_s``, ``n_samples`` (rows in ``samples``,
+    including the final non-converged pressure), ``max_pressure_mpa`` and
+    ``max_angle_deg`` (over converged pressures), ``newton_iterations_total``,
+    ``mesh_size``, ``backend``, ``softbend_version``, ``schema_version``,
+    ``finished_at`` (UTC) and ``stats`` (backend details as JSON).
+``samples``
+    One row per applied pressure of a done design: ``pressure_mpa``,
+    ``angle_deg``, ``tip_x_mm``, ``tip_z_mm`` (NULL where not converged),
+    ``converged``, ``newton_iterations``; primary key ``(design_id, pressure_mpa)``.
+
+Every design is written in one transaction (its ``designs`` row and all its
+``samples`` rows, or nothing), so a campaign killed at any instant leaves only
+complete designs, and a design recorded again (a failed design retried) replaces
+its earlier row in the same transaction: no design and no sample is ever stored
+twice. DuckDB allows one writing process per file: only the process that
+coordinates a campaign writes; workers only compute.
+"""
+
+from __future__ import annotations
+
+import json
+import logging
+import math
+import os
+import uuid
+from collections.abc import Iterator
+from contextlib import contextmanager
+from datetime import UTC, datetime
+from pathlib import Path
+from typing import TYPE_CHECKING, Any, Literal
+
+import numpy as np
+
+from softbend._validation import check_choice
+from softbend.campaign.backends import SweepResult, check_pressures_mpa
+from softbend.design import PARAMETERS, SFRBADesign
+from softbend.errors import SchemaError, SoftbendError
+
+if TYPE_CHECKING:
+    import pandas as pd
+
+__all__ = ["SCHEMA_VERSION", "CampaignStore", "load_designs", "load_samples"]
+
+logger = logging.getLogger(__name__)
+
+#: Version of the table layout written by this softbend. A database with a newer
+#: version is refused with :class:`~softbend.errors.SchemaError`.
+SCHEMA_VERSION = 1
+
+#: Columns of :meth:`CampaignStore.load_samples`.
+SAMPLE_COLUMNS: tuple[str, ...] = (
+    "design_id",
+    *PARAMETERS,
+    "pressure_mpa",
+    "angle_deg",
+    "tip_x_mm",
+    "tip_z_mm",
+    "converged",
+)
+
+_DDL = (
+    """
+    CREATE TABLE IF NOT EXISTS meta (
+        key VARCHAR PRIMARY KEY,
+        value VARCHAR NOT NULL
+    )
+    """,
+    """
+    CREATE TABLE IF NOT EXISTS designs (
+        design_id VARCHAR PRIMARY KEY,
+        l_mm DOUBLE NOT NULL,
+        r_mm DOUBLE NOT NULL,
+        t_mm DOUBLE NOT NULL,
+        b_mm DOUBLE NOT NULL,
+        phi_deg DOUBLE NOT NULL,
+        lc_mm DOUBLE NOT NULL,
+        status VARCHAR NOT NULL CHECK (status IN ('done', 'failed')),
+        error VARCHAR,
+        wall_time_s DOUBLE,
+        n_samples INTEGER NOT NULL,
+        max_pressure_mpa DOUBLE,
+        max_angle_deg DOUBLE,
+        newton_iterations_total BIGINT,
+        mesh_size BIGINT,
+        backend VARCHAR NOT NULL,
+        softbend_version VARCHAR NOT NULL,
+        schema_version INTEGER NOT NULL,
+        finished_at TIMESTAMP NOT NULL,
+        stats VARCHAR
+    )
+    """,
+    """
+    CREATE TABLE IF NOT EXISTS samples (
+        design_id VARCHAR NOT NULL,
+        pressure_mpa DOUBLE NOT NULL,
+        angle_deg DOUBLE,
+        tip_x_mm DOUBLE,
+        tip_z_mm DOUBLE,
+        converged BOOLEAN NOT NULL,
+        newton_iterations INTEGER,
+        PRIMARY KEY (design_id, pressure_mpa)
+    )
+    """,
+)
+
+_DESIGN_COLUMNS = (
+    "design_id",
+    *PARAMETERS,
+    "status",
+    "error",
+    "wall_time_s",
+    "n_samples",
+    "max_pressure_mpa",
+    "max_angle_deg",
+    "newton_iterations_total",
+    "mesh_size",
+    "backend",
+    "softbend_version",
+    "schema_version",
+    "finished_at",
+    "stats",
+)
+_INSERT_DESIGN = (
+    f"INSERT INTO designs ({', '.join(_DESIGN_COLUMNS)}) "
+    f"VALUES ({', '.join('?' for _ in _DESIGN_COLUMNS)})"
+)
+# One statement for all samples of a design: parallel lists unnested row-wise.
+_INSERT_SAMPLES = (
+    "INSERT INTO samples SELECT ?, unnest(?::DOUBLE[]), unnest(?::DOUBLE[]), "
+    "unnest(?::DOUBLE[]), unnest(?::DOUBLE[]), unnest(?::BOOLEAN[]), unnest(?::INTEGER[])"
+)
+_SAMPLES_QUERY = (
+    f"SELECT s.design_id, {', '.join('d.' + p for p in PARAMETERS)}, s.pressure_mpa, "
+    "s.angle_deg, s.tip_x_mm, s.tip_z_mm, s.converged "
+    "FROM samples s JOIN designs d USING (design_id) "
+    "ORDER BY s.design_id, s.pressure_mpa"
+)
+
+
+def _softbend_version() -> str:
+    from softbend import __version__
+
+    return __version__
+
+
+def _utc_now() -> datetime:
+    return datetime.now(UTC).replace(tzinfo=None)
+
+
+def _nullable(values: np.ndarray) -> list[float | None]:
+    """Floats for DuckDB with NaN as NULL (no value rather than a NaN value)."""
+    return [v if math.isfinite(v) else None for v in values.tolist()]
+
+
+def _finite_or_none(value: float) -> float | None:
+    return value if math.isfinite(value) else None
+
+
+class CampaignStore:
+    """Open (or create) the DuckDB database of a campaign.
+
+    Parameters
+    ----------
+    path : str or os.PathLike
+        Database file. Created with the current schema when missing (unless
+        ``read_only``).
+    read_only : bool
+        Open an existing database for reading only (status, export, analysis).
+
+    Raises
+    ------
+    FileNotFoundError
+        ``read_only`` and no file at ``path``.
+    SchemaError
+        The file is not a DuckDB database, not a softbend campaign, or has a
+        schema version newer than :data:`SCHEMA_VERSION`.
+    SoftbendError
+        The file is locked by another process (a running campaign).
+
+    Notes
+    -----
+    Use as a context manager or call :meth:`close`. DuckDB lets one process
+    write a database file at a time, and a reader cannot open it while a
+    campaign writes to it.
+    """
+
+    def __init__(self, path: str | os.PathLike[str], *, read_only: bool = False) -> None:
+        import duckdb
+
+        self.path = Path(path)
+        self.read_only = bool(read_only)
+        if self.read_only and not self.path.is_file():
+            raise FileNotFoundError(f"No campaign database at {str(self.path)!r}.")
+        if not self.read_only and not self.path.parent.is_dir():
+            raise FileNotFoundError(
+                f"The folder of the campaign database {str(self.path)!r} does not exist."
+            )
+        try:
+            self._con = duckdb.connect(str(self.path), read_only=self.read_only)
+        except duckdb.Error as exc:
+            raise _open_error(self.path, exc) from None
+        try:
+            self._init_schema()
+            self._load_binding()
+            self._recorded: set[str] = {
+                row[0] for row in self._con.execute("SELECT design_id FROM designs").fetchall()
+            }
+        except BaseException:
+            self._con.close()
+            raise
+
+    # -- opening -----------------------------------------------------------------
+    def _init_schema(self) -> None:
+        tables = {
+            row[0]
+            for row in self._con.execute(
+                "SELECT table_name FROM information_schema.tables WHERE table_schema = 'main'"
+            ).fetchall()
+        }
+        if "meta" not in tables:
+            if tables or self.read_only:
+                found = ", ".join(sorted(tables)) or "no tables"
+                raise SchemaError(
+                    f"{str(self.path)!r} is not a softbend campaign database "
+                    f"(no 'meta' table; found {found})."
+                )
+            self._create()
+            return
+        version_text = self.meta().get("schema_version")
+        try:
+            version = int(version_text) if version_text is not None else None
+        except ValueError:
+            version = None
+        if version is None or version < 1:
+            raise SchemaError(
+                f"The campaign database {str(self.path)!r} has an unknown schema version "
+                f"{version_text!r}; this softbend reads version {SCHEMA_VERSION}."
+            )
+        if version > SCHEMA_VERSION:
+            raise SchemaError(
+                f"The campaign database {str(self.path)!r} has schema version {version}, newer "
+                f"than this softbend supports ({SCHEMA_VERSION}); upgrade softbend to read it."
+            )
+        missing = {"designs", "samples"} - tables
+        if missing:
+            raise SchemaError(
+                f"The campaign database {str(self.path)!r} lacks the table(s) "
+                f"{', '.join(sorted(missing))}."
+            )
+
+    def _create(self) -> None:
+        with self._transaction():
+            for statement in _DDL:
+                self._con.execute(statement)
+            for key, value in (
+                ("schema_version", str(SCHEMA_VERSION)),
+                ("softbend_version", _softbend_version()),
+                ("created_at", _utc_now().isoformat(timespec="seconds") + "Z"),
+            ):
+                self._con.execute("INSERT INTO meta VALUES (?, ?)", [key, value])
+        logger.info("created campaign database %s (schema %d)", self.path, SCHEMA_VERSION)
+
+    @contextmanager
+    def _transaction(self) -> Iterator[None]:
+        self._con.execute("BEGIN TRANSACTION")
+        try:
+            yield
+        except BaseException:
+            self._con.execute("ROLLBACK")
+            raise
+        self._con.execute("COMMIT")
+
+    def close(self) -> None:
+        """Close the connection (checkpointing the write-ahead log)."""
+        self._con.close()
+
+    def __enter__(self) -> CampaignStore:
+        return self
+
+    def __exit__(self, *exc: object) -> None:
+        self.close()
+
+    def __repr__(self) -> str:
+        return f"CampaignStore({str(self.path)!r}, read_only={self.read_only})"
+
+    # -- campaign metadata -------------------------------------------------------
+    def meta(self) -> dict[str, str]:
+        """The ``meta`` table as a ``{key: value}`` dict of strings."""
+        return dict(self._con.execute("SELECT key, value FROM meta").fetchall())
+
+    def _set_meta(self, key: str, value: str) -> None:
+        self._con.execute(
+            "INSERT INTO meta VALUES (?, ?) ON CONFLICT (key) DO UPDATE SET value = excluded.value",
+            [key, value],
+        )
+
+    def _load_binding(self) -> None:
+        # Backend and grid change only through bind(); cached for the hot write path.
+        meta = self.meta()
+        text = meta.get("pressures_mpa")
+        self._backend = meta.get("backend")
+        self._grid = None if text is None else np.asarray(json.loads(text), dtype=float)
+        if self._grid is not None:
+            self._grid.setflags(write=False)
+
+    @property
+    def backend(self) -> str | None:
+        """Backend the campaign was started with (None before the first run)."""
+        return self._backend
+
+    @property
+    def pressures_mpa(self) -> np.ndarray | None:
+        """Pressure grid of the campaign in MPa (None before the first run)."""
+        return self._grid
+
+    def bind(
+        self,
+        backend: str,
+        pressures_mpa: np.ndarray,
+        *,
+        space: str | None = None,
+        n_designs_planned: int | None = None,
+    ) -> None:
+        """Fix the backend and pressure grid of the campaign, or check them on resume.
+
+        Parameters
+        ----------
+        backend : str
+            Backend name.
+        pressures_mpa : numpy.ndarray
+            Sweep grid, MPa, strictly increasing.
+        space : str, optional
+            Label of the design space (stored for reports).
+        n_designs_planned : int, optional
+            Number of designs this run asked for.
+
+        Raises
+        ------
+        ValueError
+            If the database already holds a campaign with another backend or grid:
+            mixing them would make the data inconsistent; use a new database.
+        """
+        grid = check_pressures_mpa(pressures_mpa, "CampaignStore.bind")
+        stored_backend, stored_grid = self.backend, self.pressures_mpa
+        if stored_backend is not None and stored_backend != backend:
+            raise ValueError(
+                f"The 'backend' of the campaign in {str(self.path)!r} is {stored_backend!r}. "
+                f"Got {backend!r} instead; use a new database for another backend."
+            )
+        if stored_grid is not None and not np.array_equal(stored_grid, grid):
+            raise ValueError(
+                f"The 'pressures_mpa' of the campaign in {str(self.path)!r} are "
+                f"{_describe_grid(stored_grid)}. Got {_describe_grid(grid)} instead; "
+                "use a new database for another pressure grid."
+            )
+        with self._transaction():
+            if stored_backend is None:
+                self._set_meta("backend", backend)
+            if stored_grid is None:
+                self._set_meta("pressures_mpa", json.dumps(grid.tolist()))
+            if space is not None:
+                self._set_meta("space", str(space))
+            if n_designs_planned is not None:
+                self._set_meta("n_designs_planned", str(int(n_designs_planned)))
+        self._load_binding()
+
+    # -- writing -----------------------------------------------------------------
+    def record_success(self, result: SweepResult, *, backend: str | None = None) -> None:
+        """Store a finished sweep (its ``designs`` row and samples) in one transaction.
+
+        A row already recorded for the design (e.g. a failed attempt) is replaced.
+
+        Parameters
+        ----------
+        result : SweepResult
+            The sweep; its converged pressures must be the leading values of the
+            campaign grid when one is bound.
+        backend : str, optional
+            Backend name; default the campaign's (see :meth:`bind`).
+        """
+        if not isinstance(result, SweepResult):
+            raise ValueError(
+                f"The 'result' of CampaignStore.record_success must be a SweepResult. "
+                f"Got {type(result).__name__} instead."
+            )
+        backend = self._backend_name(backend)
+        self._check_on_grid(result)
+        design = result.design
+        stats = json.dumps(result.stats, default=str) if result.stats else None
+        row = [
+            design.design_id,
+            *design.as_array().tolist(),
+            "done",
+            None,
+            result.wall_time_s,
+            len(result.pressure_mpa),
+            _finite_or_none(result.max_pressure_mpa),
+            _finite_or_none(result.max_angle_deg),
+            int(result.newton_iterations.sum()),
+            result.mesh_size,
+            backend,
+            _softbend_version(),
+            SCHEMA_VERSION,
+            _utc_now(),
+            stats,
+        ]
+        with self._transaction():
+            self._delete(design.design_id)
+            self._con.execute(_INSERT_DESIGN, row)
+            if len(result.pressure_mpa):
+                self._con.execute(
+                    _INSERT_SAMPLES,
+                    [
+                        design.design_id,
+                        result.pressure_mpa.tolist(),
+                        _nullable(result.angle_deg),
+                        _nullable(result.tip_x_mm),
+                        _nullable(result.tip_z_mm),
+                        result.converged.tolist(),
+                        result.newton_iterations.tolist(),
+                    ],
+                )
+        self._recorded.add(design.design_id)
+
+    def record_failure(
+        self,
+        design: SFRBADesign,
+        error_text: str,
+        wall_time_s: float,
+        *,
+        backend: str | None = None,
+    ) -> None:
+        """Store a design whose sweep raised, with ``error_text``, in one transaction.
+
+        Parameters
+        ----------
+        design : SFRBADesign
+            The design.
+        error_text : str
+            Why it failed, conventionally ``"ExceptionType: message"``.
+        wall_time_s : float
+            Time spent before the failure, s.
+        backend : str, optional
+            Backend name; default the campaign's.
+        """
+        if not isinstance(design, SFRBADesign):
+            raise ValueError(
+                f"The 'design' of CampaignStore.record_failure must be an SFRBADesign. "
+                f"Got {design!r} instead."
+            )
+        backend = self._backend_name(backend)
+        wall = float(wall_time_s)
+        row = [
+            design.design_id,
+            *design.as_array().tolist(),
+            "failed",
+            str(error_text),
+            wall if math.isfinite(wall) else None,
+            0,
+            None,
+            None,
+            None,
+            None,
+            backend,
+            _softbend_version(),
+            SCHEMA_VERSION,
+            _utc_now(),
+            None,
+        ]
+        with self._transaction():
+            self._delete(design.design_id)
+            self._con.execute(_INSERT_DESIGN, row)
+        self._recorded.add(design.design_id)
+
+    def _delete(self, design_id: str) -> None:
+        # Only when something is there: a DELETE costs as much as the insert.
+        if design_id in self._recorded:
+            self._con.execute("DELETE FROM samples WHERE design_id = ?", [design_id])
+            self._con.execute("DELETE FROM designs WHERE design_id = ?", [design_id])
+
+    def _backend_name(self, backend: str | None) -> str:
+        name = backend if backend is not None else self.backend
+        if not name:
+            raise ValueError(
+                "The 'backend' of the recorded design must be given: bind the campaign to a "
+                "backend first (CampaignStore.bind) or pass backend=..."
+            )
+        return str(name)
+
+    def _check_on_grid(self, result: SweepResult) -> None:
+        grid = self.pressures_mpa
+        if grid is None:
+            return
+        done = result.pressure_mpa[result.converged]
+        if len(done) > len(grid) or not np.array_equal(done, grid[: len(done)]):
+            raise ValueError(
+                f"The pressures of design {result.design} must be the leading values of the "
+                f"campaign grid ({_describe_grid(grid)}). Got {_describe_grid(done)} instead."
+            )
+
+    # -- reading -----------------------------------------------------------------
+    def finished_ids(self, *, include_failed: bool = False) -> set[str]:
+        """IDs of the designs recorded as done (and failed, if ``include_failed``)."""
+        statuses = ("done", "failed") if include_failed else ("done",)
+        rows = self._con.execute(
+            f"SELECT design_id FROM designs WHERE status IN ({', '.join('?' for _ in statuses)})",
+            list(statuses),
+        ).fetchall()
+        return {row[0] for row in rows}
+
+    def failed_ids(self) -> set[str]:
+        """IDs of the designs recorded as failed."""
+        rows = self._con.execute("SELECT design_id FROM designs WHERE status = 'failed'").fetchall()
+        return {row[0] for row in rows}
+
+    def status_summary(self, *, max_failures: int = 20) -> dict[str, Any]:
+        """Counts and metadata of the campaign, JSON-serialisable.
+
+        Keys: ``path``, ``schema_version``, ``softbend_version``, ``created_at``,
+        ``backend``, ``space``, ``n_designs_planned`` (None if never run),
+        ``n_pressures``, ``pmin_mpa``, ``pmax_mpa``, ``designs_recorded``,
+        ``done``, ``failed``, ``samples``, ``converged_samples``,
+        ``sweep_time_s_total``, ``sweep_time_s_mean`` (over done designs),
+        ``max_angle_deg``, ``last_finished_at`` and ``failures`` (up to
+        ``max_failures`` ``{"design_id", "design", "error"}`` entries).
+        """
+        meta = self.meta()
+        grid = self.pressures_mpa
+        done, failed, wall_total, wall_mean, max_angle, last = self._con.execute(
+            "SELECT count(*) FILTER (WHERE status = 'done'), "
+            "count(*) FILTER (WHERE status = 'failed'), "
+            "sum(wall_time_s) FILTER (WHERE status = 'done'), "
+            "avg(wall_time_s) FILTER (WHERE status = 'done'), "
+            "max(max_angle_deg), max(finished_at) FROM designs"
+        ).fetchone()
+        n_samples, n_converged = self._con.execute(
+            "SELECT count(*), count(*) FILTER (WHERE converged) FROM samples"
+        ).fetchone()
+        failures = self._con.execute(
+            f"SELECT design_id, {', '.join(PARAMETERS)}, error FROM designs "
+            "WHERE status = 'failed' ORDER BY finished_at, design_id LIMIT ?",
+            [int(max_failures)],
+        ).fetchall()
+        planned = meta.get("n_designs_planned")
+        return {
+            "path": str(self.path),
+            "schema_version": int(meta["schema_version"]),
+            "softbend_version": meta.get("softbend_version"),
+            "created_at": meta.get("created_at"),
+            "backend": meta.get("backend"),
+            "space": meta.get("space"),
+            "n_designs_planned": int(planned) if planned is not None else None,
+            "n_pressures": None if grid is None else len(grid),
+            "pmin_mpa": None if grid is None else float(grid[0]),
+            "pmax_mpa": None if grid is None else float(grid[-1]),
+            "designs_recorded": int(done + failed),
+            "done": int(done),
+            "failed": int(failed),
+            "samples": int(n_samples),
+            "converged_samples": int(n_converged),
+            "sweep_time_s_total": float(wall_total or 0.0),
+            "sweep_time_s_mean": None if wall_mean is None else float(wall_mean),
+            "max_angle_deg": None if max_angle is None else float(max_angle),
+            "last_finished_at": None if last is None else last.isoformat(timespec="seconds") + "Z",
+            "failures": [
+                {
+                    "design_id": row[0],
+                    "design": str(SFRBADesign(*row[1:7])),
+                    "error": row[7],
+                }
+                for row in failures
+            ],
+        }
+
+    def load_samples(self) -> pd.DataFrame:
+        """Every stored sample joined with its design parameters.
+
+        Returns
+        -------
+        pandas.DataFrame
+            Columns ``design_id, l_mm, r_mm, t_mm, b_mm, phi_deg, lc_mm,
+            pressure_mpa, angle_deg, tip_x_mm, tip_z_mm, converged``, sorted by
+            design and pressure. The last pressure of a truncated sweep has
+            ``converged`` False and NaN angle and tip: filter on ``converged`` to
+            get training data.
+        """
+        frame = self._con.execute(_SAMPLES_QUERY).df()
+        frame["converged"] = frame["converged"].astype(bool)
+        return frame
+
+    def load_designs(self) -> pd.DataFrame:
+        """The ``designs`` table (done and failed), sorted by ``design_id``."""
+        return self._con.execute(
+            f"SELECT {', '.join(_DESIGN_COLUMNS)} FROM designs ORDER BY design_id"
+        ).df()
+
+    def export(
+        self,
+        path: str | os.PathLike[str],
+        format: Literal["parquet", "csv"] = "parquet",
+        *,
+        table: Literal["samples", "designs"] = "samples",
+    ) -> Path:
+        """Write the samples (as :meth:`load_samples`) or the designs table to a file.
+
+        The file appears atomically: it is written to a temporary file in the same
+        folder and moved into place with :func:`os.replace`, so a reader never
+        sees a half-written export and an interrupted export leaves any previous
+        file intact.
+
+        Parameters
+        ----------
+        path : str or os.PathLike
+            Output file; its folder must exist.
+        format : {"parquet", "csv"}
+            Apache Parquet (typed, compressed) or CSV with a header (NULL as an
+            empty field).
+        table : {"samples", "designs"}
+            What to export.
+
+        Returns
+        -------
+        pathlib.Path
+            The written file.
+        """
+        check_choice(format, "format", "CampaignStore.export", ("parquet", "csv"))
+        check_choice(table, "table", "CampaignStore.export", ("samples", "designs"))
+        target = Path(path)
+        if not target.parent.is_dir():
+            raise FileNotFoundError(
+                f"The folder of the export file {str(target)!r} does not exist."
+            )
+        query = (
+            _SAMPLES_QUERY
+            if table == "samples"
+            else f"SELECT {', '.join(_DESIGN_COLUMNS)} FROM designs ORDER BY design_id"
+        )
+        tmp = target.with_name(f".{target.name}.{uuid.uuid4().hex}.tmp")
+        try:
+            relation = self._con.sql(query)
+            if format == "parquet":
+                relation.write_parquet(str(tmp))
+            else:
+                relation.write_csv(str(tmp), header=True)
+            os.replace(tmp, target)
+        finally:
+            tmp.unlink(missing_ok=True)
+        logger.info("exported %s of %s to %s (%s)", table, self.path, target, format)
+        return target
+
+
+def _describe_grid(grid: np.ndarray) -> str:
+    if len(grid) == 0:
+        return "an empty grid"
+    return f"{len(grid)} pressures from {grid[0]:g} to {grid[-1]:g} MPa"
+
+
+def _open_error(path: Path, exc: Exception) -> SoftbendError:
+    text = str(exc)
+    if "lock" in text.lower():
+        return SoftbendError(
+            f"The campaign database {str(path)!r} is in use by another process (a running "
+            "campaign?); DuckDB allows one writer and no reader meanwhile."
+        )
+    if "not a valid DuckDB database" in text:
+        return SchemaError(f"{str(path)!r} is not a DuckDB database file.")
+    if "different configuration" in text:
+        return SoftbendError(
+            f"The campaign database {str(path)!r} is already open in this process in another "
+            "mode; close that CampaignStore first."
+        )
+    first_line = text.splitlines()[0] if text else type(exc).__name__
+    return SoftbendError(f"Cannot open the campaign database {str(path)!r}: {first_line}")
+
+
+def load_samples(db_path: str | os.PathLike[str]) -> pd.DataFrame:
+    """Samples of the campaign database at ``db_path`` (see :meth:`CampaignStore.load_samples`)."""
+    with CampaignStore(db_path, read_only=True) as store:
+        return store.load_samples()
+
+
+def load_designs(db_path: str | os.PathLike[str]) -> pd.DataFrame:
+    """Designs table of the campaign database at ``db_path`` (done and failed)."""
+    with CampaignStore(db_path, read_only=True) as store:
+        return store.load_designs()

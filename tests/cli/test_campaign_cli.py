@@ -1,0 +1,186 @@
+"""``softbend campaign run|status|export``: in-process CLI runs and one-line errors."""
+
+from __future__ import annotations
+
+import json
+import socket
+
+import duckdb
+import pandas as pd
+import pytest
+
+from softbend.campaign import CampaignStore, load_samples
+from softbend.cli import main
+
+RUN = ["--space", "lhs:6", "--seed", "3", "--pmax", "0.1", "--pstep", "0.05"]
+
+
+def _one_error_line(capsys) -> str:
+    err = capsys.readouterr().err.strip().splitlines()
+    assert len(err) == 1, err
+    assert err[0].startswith("softbend: error: ")
+    return err[0]
+
+
+def test_run_status_export_and_resume(tmp_path, capsys):
+    db = tmp_path / "c.duckdb"
+    assert main(["campaign", "run", str(db), *RUN, "--workers", "0", "--json"]) == 0
+    summary = json.loads(capsys.readouterr().out)
+    assert summary["space"] == "lhs-6-seed3" and summary["backend"] == "analytical"
+    assert (summary["n_designs"], summary["n_done"], summary["n_failed"]) == (6, 6, 0)
+    assert summary["executor"] == "serial"
+
+    assert main(["campaign", "run", str(db), *RUN, "--workers", "2"]) == 0
+    captured = capsys.readouterr()
+    assert "already done (skipped)" in captured.out and "done in this run" in captured.out
+    assert "resuming" in captured.err and "6 of 6 designs already recorded" in captured.err
+
+    assert main(["campaign", "status", str(db), "--json"]) == 0
+    status = json.loads(capsys.readouterr().out)
+    assert (status["done"], status["failed"], status["samples"]) == (6, 0, 18)
+    assert status["n_pressures"] == 3 and status["pmax_mpa"] == 0.1
+    assert main(["campaign", "status", str(db)]) == 0
+    assert "designs done" in capsys.readouterr().out
+
+    samples = load_samples(db)
+    for suffix, reader in ((".parquet", pd.read_parquet), (".csv", pd.read_csv)):
+        out = tmp_path / f"samples{suffix}"
+        assert main(["campaign", "export", str(db), str(out)]) == 0
+        assert f"wrote 18 samples rows to {out}" in " ".join(capsys.readouterr().out.split())
+        back = reader(out)
+        pd.testing.assert_frame_equal(
+            back.astype({"design_id": object}),
+            samples.astype({"design_id": object}),
+            check_dtype=False,
+        )
+    forced = tmp_path / "designs.out"
+    assert (
+        main(["campaign", "export", str(db), str(forced), "--format", "csv", "--table", "designs"])
+        == 0
+    )
+    assert len(pd.read_csv(forced)) == 6
+
+
+def test_a_space_of_the_table_and_the_summary_table(tmp_path, capsys):
+    db = tmp_path / "c.duckdb"
+    assert (
+        main(
+            [
+                "campaign",
+                "run",
+                str(db),
+                "--space",
+                "sobol:4",
+                "--pmax",
+                "0.02",
+                "--pstep",
+                "0.01",
+                "--workers",
+                "1",
+                "--no-retry-failed",
+            ]
+        )
+        == 0
+    )
+    out = capsys.readouterr().out
+    assert "sobol-4-seed0 (4 designs)" in out and "done in this run" in out
+    with CampaignStore(db, read_only=True) as store:
+        assert len(store.finished_ids()) == 4
+
+
+def _closed_port() -> int:
+    with socket.socket() as sock:
+        sock.bind(("127.0.0.1", 0))
+        return sock.getsockname()[1]
+
+
+@pytest.mark.parametrize(
+    ("args", "needle"),
+    [
+        (["--backend", "abaqus"], "'backend' of get_backend must be one of 'analytical', 'fem'"),
+        (["--space", "grid:5"], "'--space' of softbend campaign run must be one of table1"),
+        (["--space", "lhs:0"], "'--space'"),
+        (["--pmax", "0.1", "--pstep", "0.03"], "whole number of steps"),
+        (["--pmax", "-1"], "'pmax_mpa'"),
+        (["--workers", "-2"], "'workers' of run_campaign"),
+        (
+            ["--scheduler", "127.0.0.1:8786"],
+            "(--scheduler) of run_campaign must be an address of the form tcp://HOST:PORT",
+        ),
+    ],
+)
+def test_bad_run_input_is_one_line_and_exit_2(tmp_path, capsys, args, needle):
+    db = tmp_path / "c.duckdb"
+    assert main(["campaign", "run", str(db), *RUN, *args]) == 2
+    assert needle in _one_error_line(capsys)
+    assert not db.exists()
+
+
+def test_fem_backend_without_fem_is_exit_2(tmp_path, capsys):
+    try:
+        import softbend.fem  # noqa: F401
+    except ImportError:
+        pass
+    else:
+        pytest.skip("softbend.fem is installed")
+    assert main(["campaign", "run", str(tmp_path / "c.duckdb"), "--backend", "fem"]) == 2
+    assert "the FEM backend needs softbend.fem" in _one_error_line(capsys)
+
+
+def test_unreachable_scheduler_is_exit_2(tmp_path, capsys):
+    address = f"tcp://127.0.0.1:{_closed_port()}"
+    code = main(
+        [
+            "campaign",
+            "run",
+            str(tmp_path / "c.duckdb"),
+            *RUN,
+            "--scheduler",
+            address,
+            "--connect-timeout",
+            "3",
+        ]
+    )
+    assert code == 2
+    assert f"Cannot reach the Dask scheduler at {address}" in _one_error_line(capsys)
+
+
+def test_newer_schema_is_exit_2_for_every_subcommand(tmp_path, capsys):
+    db = tmp_path / "future.duckdb"
+    CampaignStore(db).close()
+    con = duckdb.connect(str(db))
+    con.execute("UPDATE meta SET value = '2' WHERE key = 'schema_version'")
+    con.close()
+    for argv in (
+        ["campaign", "run", str(db), *RUN],
+        ["campaign", "status", str(db)],
+        ["campaign", "export", str(db), str(tmp_path / "x.parquet")],
+    ):
+        assert main(argv) == 2
+        assert "schema version 2, newer than this softbend supports (1)" in _one_error_line(capsys)
+    assert not (tmp_path / "x.parquet").exists()
+
+
+def test_status_and_export_bad_input(tmp_path, capsys):
+    assert main(["campaign", "status", str(tmp_path / "missing.duckdb")]) == 2
+    assert "No campaign database" in _one_error_line(capsys)
+    db = tmp_path / "c.duckdb"
+    assert main(["campaign", "run", str(db), *RUN, "--workers", "0", "--json"]) == 0
+    capsys.readouterr()
+    assert main(["campaign", "export", str(db), str(tmp_path / "x.xlsx"), "--format", "xlsx"]) == 2
+    assert "'--format' of softbend campaign export must be one of 'parquet', 'csv'" in (
+        _one_error_line(capsys)
+    )
+    assert main(["campaign", "export", str(db), str(tmp_path / "no" / "x.csv")]) == 2
+    assert "does not exist" in _one_error_line(capsys)
+
+
+def test_help_lists_the_subcommands_and_options(capsys):
+    assert main(["campaign", "--help"]) == 0
+    out = capsys.readouterr().out
+    for word in ("run", "status", "export"):
+        assert word in out
+    assert main(["campaign", "run", "--help"]) == 0
+    out = capsys.readouterr().out
+    for option in ("--backend", "--space", "--scheduler", "--retry-failed", "--json", "--pmax"):
+        assert option in out
