@@ -2,6 +2,124 @@
 
 from __future__ import annotations
 
+from pathlib import Path
+
 import typer
 
-app = typer.Typer(help="Curling actuator (paper A): synthetic data and NARX identification.", no_args_is_help=True)
+from softbend.cli import _common
+
+app = typer.Typer(
+    help="Curling actuator (paper A): synthetic experiments and NARX/SVR identification.",
+    no_args_is_help=True,
+)
+
+
+@app.command("simulate")
+def simulate(
+    out: Path = typer.Option(..., "--out", help="Folder for the experiment CSV files."),
+    experiments: int = typer.Option(6, help="Experiments per pressure sign."),
+    samples: int = typer.Option(512, help="Samples per experiment."),
+    dt: float = typer.Option(0.02, "--dt", help="Sample period in s."),
+    seed: int = typer.Option(0, help="Seed of the experiment design and the camera noise."),
+    as_json: bool = typer.Option(False, "--json", help="Print a JSON summary instead of a table."),
+) -> None:
+    """Write synthetic curling-actuator experiments (positive and negative pressure) as CSV."""
+    from softbend.identification.data import save_experiments
+    from softbend.identification.synthetic import synthetic_dataset
+
+    dataset = synthetic_dataset(n_experiments=experiments, n_samples=samples, dt_s=dt, seed=seed)
+    all_experiments = [e for group in dataset.values() for e in group]
+    paths = save_experiments(all_experiments, out)
+    rows = [
+        [
+            e.name,
+            e.n_samples,
+            float(e.pressure_kpa.min()) + 0.0,
+            float(e.pressure_kpa.max()) + 0.0,
+            str(p),
+        ]
+        for e, p in zip(all_experiments, paths, strict=True)
+    ]
+    if as_json:
+        _common.print_json(
+            {
+                "out": str(out),
+                "synthetic": True,
+                "experiments": [
+                    dict(
+                        zip(["name", "n_samples", "p_min_kpa", "p_max_kpa", "path"], r, strict=True)
+                    )
+                    for r in rows
+                ],
+            }
+        )
+        return
+    _common.print_table(
+        "Synthetic curling-actuator experiments",
+        ["experiment", "samples", "p min (kPa)", "p max (kPa)", "file"],
+        rows,
+    )
+
+
+@app.command("identify")
+def identify(
+    data: Path = typer.Argument(..., help="A CSV file or a folder of CSV files."),
+    out: Path = typer.Option(..., "--out", help="Folder for metrics, models and figures."),
+    c: float = typer.Option(100.0, "--C", help="SVR penalty C (paper A calls it gamma)."),
+    epsilon: float = typer.Option(0.1, help="SVR epsilon, in units of the standardized output."),
+    output_lags: int = typer.Option(2, help="Past outputs in the regressor."),
+    input_lags: int = typer.Option(2, help="Inputs in the regressor, u(t) included."),
+    kernel: str = typer.Option(
+        "moments", help="Kernel width/shape: 'moments' (paper A) or 'cv' (cross-validated)."
+    ),
+    as_json: bool = typer.Option(False, "--json", help="Print metrics as JSON."),
+) -> None:
+    """Identify rho and L NARX models per pressure sign; leave-one-experiment-out metrics."""
+    from softbend.identification.data import load_experiments
+    from softbend.identification.study import IdentificationConfig, n_fits
+    from softbend.identification.study import identify as run_identify
+    from softbend.reports.paper_a import write_identification_outputs
+
+    config = IdentificationConfig(
+        C=c, epsilon=epsilon, output_lags=output_lags, input_lags=input_lags, kernel=kernel
+    )
+    experiments = load_experiments(data)
+    with _common.progress_bar(
+        "fitting NARX models", n_fits(experiments), enabled=not as_json
+    ) as bar:
+        result = run_identify(experiments, config, progress=lambda label: bar())
+    outputs = write_identification_outputs(result, out)
+    if as_json:
+        _common.print_json(
+            {
+                "metrics": result.metrics.to_dict(orient="records"),
+                "summary": result.summary().to_dict(orient="records"),
+                "kernel": {f"{s}/{o}": v for (s, o), v in result.kernel_params.items()},
+                "files": {k: str(v) for k, v in outputs.items()},
+            }
+        )
+        return
+    print_metrics(result)
+    _common.console.print(f"models, metrics and figures written to {out}")
+
+
+def print_metrics(result) -> None:
+    """Print the per-experiment metrics table and the summary (used by reproduce too)."""
+    rows = [
+        [r.sign, r.output, r.experiment, r.mode, r.rmse, 100 * r.nrmse, r.r2, r.fit_percent]
+        for r in result.metrics.itertuples()
+    ]
+    _common.print_table(
+        "Held-out experiments (leave-one-experiment-out)",
+        ["sign", "output", "experiment", "mode", "RMSE", "NRMSE %", "R²", "fit %"],
+        rows,
+    )
+    summary = [
+        [r.sign, r.output, r.mode, 100 * r.nrmse_mean, 100 * r.nrmse_max, r.r2_mean]
+        for r in result.summary().itertuples()
+    ]
+    _common.print_table(
+        "Summary over held-out experiments",
+        ["sign", "output", "mode", "NRMSE mean %", "NRMSE worst %", "R² mean"],
+        summary,
+    )

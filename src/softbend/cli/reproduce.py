@@ -2,7 +2,66 @@
 
 from __future__ import annotations
 
+from pathlib import Path
 
-def reproduce() -> None:
-    """Run the whole pipeline on built-in defaults and write an HTML report."""
-    raise NotImplementedError
+import typer
+from rich.progress import BarColumn, MofNCompleteColumn, Progress, TextColumn, TimeElapsedColumn
+
+from softbend.cli import _common
+
+
+def reproduce(
+    out: Path = typer.Option(Path("results/reproduce"), "--out", help="Output folder."),
+    seed: int = typer.Option(0, help="Seed of every random process."),
+    workers: int | None = typer.Option(
+        None, help="Local worker processes for the campaign (default: all cores)."
+    ),
+    as_json: bool = typer.Option(False, "--json", help="Print the headline figures as JSON."),
+) -> None:
+    """Run the papers' pipelines end to end on built-in defaults; write OUT/index.html."""
+    from softbend.reports.reproduce import run_reproduce
+
+    columns = [
+        TextColumn("{task.description}"),
+        BarColumn(),
+        MofNCompleteColumn(),
+        TimeElapsedColumn(),
+    ]
+    with Progress(*columns, console=_common.err_console, disable=as_json) as bar:
+        tasks: dict[str, int] = {}
+
+        def progress(phase: str, done: int, total: int) -> None:
+            if phase not in tasks:
+                tasks[phase] = bar.add_task(phase, total=total)
+            bar.update(tasks[phase], completed=done, total=total)
+
+        summary = run_reproduce(out, seed=seed, workers=workers, progress=progress)
+    if as_json:
+        _common.print_json(summary)
+        return
+    rows = [
+        [
+            key,
+            f"{100 * value:.2f}",
+            f"{100 * summary['paper_a']['free_run_nrmse_worst'][key]:.2f}",
+        ]
+        for key, value in summary["paper_a"]["free_run_nrmse_mean"].items()
+    ]
+    _common.print_table("Paper A: held-out free-run NRMSE", ["model", "mean %", "worst %"], rows)
+    b = summary["paper_b"]
+    _common.print_table(
+        "Paper B: Table 1 campaign and standardized regression (Fig. 4)",
+        ["designs done", "failed", "R²", "MAPE %", "loading P", "loading t", "loading b"],
+        [
+            [
+                b["done"],
+                b["failed"],
+                b["r2"],
+                b["mape_pct"],
+                b["loadings"]["pressure_mpa"],
+                b["loadings"]["t_mm"],
+                b["loadings"]["b_mm"],
+            ]
+        ],
+    )
+    _common.console.print(f"report: {summary['report']}  ({summary['seconds']:.0f} s)")

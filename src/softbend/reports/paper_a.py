@@ -1,0 +1,121 @@
+"""Paper A outputs: files of an identification run and its section of the HTML report."""
+
+from __future__ import annotations
+
+from pathlib import Path
+from typing import TYPE_CHECKING
+
+from softbend._io import write_text_atomic
+from softbend.reports import curling_figures
+from softbend.reports.html import Report
+
+if TYPE_CHECKING:  # pragma: no cover
+    from softbend.identification.study import IdentificationResult
+
+
+def write_identification_outputs(result: IdentificationResult, out_dir: Path) -> dict[str, Path]:
+    """Write metrics (CSV), the fitted models (JSON) and paper A Figs. 5–7, 9, 10.
+
+    Returns
+    -------
+    dict
+        ``{artefact name: path}``.
+    """
+    from softbend.identification.persistence import save_narx
+
+    out_dir = Path(out_dir)
+    out_dir.mkdir(parents=True, exist_ok=True)
+    paths: dict[str, Path] = {}
+    paths["metrics"] = write_text_atomic(
+        out_dir / "metrics.csv", result.metrics.to_csv(index=False)
+    )
+    paths["summary"] = write_text_atomic(
+        out_dir / "summary.csv", result.summary().to_csv(index=False)
+    )
+    synthetic = any(e.synthetic for group in result.experiments.values() for e in group)
+    for (sign, output), model in result.models.items():
+        names = [e.name for e in result.experiments[sign]]
+        metadata = {
+            "sign": sign,
+            "output": output,
+            "input": "pressure_kpa",
+            "output_unit": "mm" if output == "length_mm" else "1",
+            "trained_on": names,
+            "synthetic_data": synthetic,
+        }
+        paths[f"model_{sign}_{output}"] = save_narx(
+            model, out_dir / "models" / f"{sign}_{output}.json", metadata=metadata
+        )
+    paths.update(curling_figures.all_figures(result, out_dir))
+    return paths
+
+
+def add_section(
+    report: Report, result: IdentificationResult, paths: dict[str, Path], root: Path
+) -> None:
+    """Append the paper A section (tables and figures) to ``report``."""
+    config = result.config
+    section = report.section("Paper A — curling actuator: NARX identification with a GG-SVR")
+    synthetic = any(e.synthetic for group in result.experiments.values() for e in group)
+    if synthetic:
+        section.text(
+            "All data in this section are SYNTHETIC: paper A's measurements are not public, so "
+            "softbend's synthetic curling actuator (pneumatic lag, viscoelastic creep, "
+            "rate-independent hysteresis, camera noise; calibrated to L0 = 15.25 mm, "
+            "L = 18.25 mm at full pressure and 9.25 mm at full vacuum) generated them.",
+            note=True,
+        )
+    counts = {sign: len(group) for sign, group in result.experiments.items()}
+    section.text(
+        f"Regressor φ(t) = [y(t−1) … y(t−{config.output_lags}), u(t) … "
+        f"u(t−{config.input_lags - 1})], C = {config.C:g}, ε = {config.epsilon:g} "
+        f"(standardized output), kernel parameters by '{config.kernel}'. Experiments: "
+        + ", ".join(f"{n} {sign}" for sign, n in counts.items())
+        + ". Every metric is on an experiment the model did not see "
+        "(leave-one-experiment-out); NRMSE = RMSE / range of the measured output."
+    )
+    summary = result.summary()
+    section.table(
+        ["sign", "output", "mode", "NRMSE mean (%)", "NRMSE worst (%)", "R² mean", "fit mean (%)"],
+        [
+            [
+                r.sign,
+                r.output,
+                r.mode,
+                100 * r.nrmse_mean,
+                100 * r.nrmse_max,
+                r.r2_mean,
+                r.fit_percent_mean,
+            ]
+            for r in summary.itertuples()
+        ],
+        caption="Held-out accuracy, mean and worst over experiments",
+    )
+    section.table(
+        ["model", "σ (std units)", "shape γ", "clipped to 2", "support vectors"],
+        [
+            [
+                f"{sign} {output}",
+                p["sigma"],
+                p["shape"],
+                "yes" if p["shape_clipped"] else "no",
+                p["n_support"],
+            ]
+            for (sign, output), p in result.kernel_params.items()
+        ],
+        caption="Generalized-Gaussian kernel of the final models",
+    )
+    captions = {
+        "fig5_tip_positions": "Fig. 5 — measured tip positions",
+        "fig6_bending_grade": "Fig. 6 — bending grade ρ against pressure",
+        "fig7_arc_length": "Fig. 7 — arc length L against pressure",
+        "fig9_identified_rho": "Fig. 9 — identified ρ (held out) against measured",
+        "fig10_identified_length": "Fig. 10 — identified L (held out) against measured",
+    }
+    for key, caption in captions.items():
+        if key in paths:
+            section.figure(paths[key], caption, root=root)
+    section.frame(
+        result.metrics.assign(nrmse_percent=100 * result.metrics["nrmse"]).drop(columns="nrmse"),
+        caption="Per held-out experiment",
+    )

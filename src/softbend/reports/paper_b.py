@@ -1,0 +1,171 @@
+"""Paper B data section: the design-space campaign and its preliminary analysis (Fig. 4)."""
+
+from __future__ import annotations
+
+from pathlib import Path
+from typing import TYPE_CHECKING, Any
+
+if TYPE_CHECKING:  # pragma: no cover
+    import pandas as pd
+
+    from softbend.analysis import RegressionReport
+    from softbend.reports.html import Report
+
+#: Paper B §3.3 (FEM data, 972 designs): standardized loadings, R², F and MAPE.
+PAPER_B_FIG4 = {
+    "pressure_mpa": 0.832,
+    "t_mm": -0.369,
+    "b_mm": -0.005,
+    "r2": 0.8893,
+    "f_value": 33935.8,
+    "mape_pct": 42.3,
+}
+
+#: The seven actuators measured in paper B Fig. 7 (l, r, t, b, phi, lc).
+FIG7_DESIGNS: tuple[tuple[float, ...], ...] = (
+    (100, 6, 2, 2, 5, 8),
+    (120, 6, 2, 2, 5, 8),
+    (100, 8, 2, 2, 5, 8),
+    (100, 6, 3, 2, 5, 8),
+    (100, 6, 2, 3, 5, 8),
+    (100, 6, 2, 2, 10, 8),
+    (100, 6, 2, 2, 5, 10),
+)
+
+
+def angle_curves(
+    samples: pd.DataFrame, designs: list[str], path: Path, *, backend: str = "analytical"
+) -> Path:
+    """Bending angle against pressure for the given design ids (one line each).
+
+    Line styles alternate so that designs with identical curves (the analytical
+    model ignores φ and lc) stay visible; a dotted line marks 360°, where the tip
+    of a real actuator would reach its own base.
+    """
+    from matplotlib.figure import Figure
+
+    fig = Figure(figsize=(7, 4.5))
+    ax = fig.subplots()
+    styles = ("-", "--", ":", "-.")
+    for index, design_id in enumerate(designs):
+        rows = samples[(samples["design_id"] == design_id) & samples["converged"]]
+        if rows.empty:
+            continue
+        first = rows.iloc[0]
+        label = ",".join(
+            f"{first[c]:g}" for c in ("l_mm", "r_mm", "t_mm", "b_mm", "phi_deg", "lc_mm")
+        )
+        ax.plot(
+            rows["pressure_mpa"],
+            rows["angle_deg"],
+            linestyle=styles[index % len(styles)],
+            lw=1.6,
+            label=label,
+        )
+    ax.axhline(360.0, color="0.4", lw=0.8, ls=":")
+    ax.annotate(
+        "360°: tip reaches the base",
+        (0.0, 360.0),
+        xytext=(2, 3),
+        textcoords="offset points",
+        fontsize=8,
+        color="0.3",
+    )
+    ax.set_xlabel("pressure (MPa)")
+    ax.set_ylabel("bending angle (°)")
+    ax.set_title(f"{backend} backend: Fig. 7 designs (l, r, t, b, φ, lc in mm, °)")
+    ax.grid(alpha=0.3)
+    ax.legend(fontsize=8)
+    path.parent.mkdir(parents=True, exist_ok=True)
+    fig.savefig(path, dpi=130, bbox_inches="tight")
+    return path
+
+
+def add_section(
+    report: Report,
+    *,
+    campaign: dict[str, Any],
+    regression: RegressionReport,
+    figures: dict[str, Path],
+    root: Path,
+) -> None:
+    """Append the campaign summary and the Fig. 4 analysis to ``report``."""
+    section = report.section("Paper B — design space, campaign and preliminary analysis (Fig. 4)")
+    section.text(
+        f"Campaign over paper B Table 1 ({campaign['n_designs']} designs, pressure 0–0.5 MPa "
+        f"in 0.005 MPa steps) with the '{campaign['backend']}' backend: the quasi-static "
+        "moment-balance model of Polygerinos et al. (no gravity; the fiber angle φ and cap "
+        "length lc do not enter it). Sweeps end at the first pressure the backend cannot solve "
+        "or at its physical stop. Angles above 360° mean the tip would pass its own base: "
+        "the analytical model has no contact, so read them as its extrapolation. "
+        "The FEM backend replaces it when available; paper B's "
+        "numbers below come from its FEM data, so they are a reference, not a target.",
+        note=True,
+    )
+    section.table(
+        ["designs", "done", "failed", "samples", "run now", "wall time (s)", "designs/s"],
+        [
+            [
+                campaign["n_designs"],
+                campaign["done"],
+                campaign["failed"],
+                campaign["n_samples"],
+                campaign.get("run_now", campaign["done"]),
+                campaign["seconds"],
+                "— (resumed: nothing left to run)"
+                if campaign["designs_per_s"] is None
+                else campaign["designs_per_s"],
+            ]
+        ],
+        caption="Campaign",
+    )
+    coefficients = regression.coefficients
+    rows = []
+    for feature, row in coefficients.iterrows():
+        paper = PAPER_B_FIG4.get(str(feature))
+        rows.append(
+            [
+                str(feature),
+                float(row["loading"]),
+                float(row["t_value"]),
+                float(row["p_value"]),
+                str(row["stars"]),
+                "" if paper is None else paper,
+            ]
+        )
+    section.table(
+        ["feature", "loading", "t", "p", "sig.", "paper B loading"],
+        rows,
+        caption="Standardized multiple linear regression of the bending angle",
+    )
+    section.table(
+        ["metric", "softbend", "paper B"],
+        [
+            ["R²", regression.r2, PAPER_B_FIG4["r2"]],
+            ["F-value", regression.f_value, PAPER_B_FIG4["f_value"]],
+            [
+                f"MAPE (%; |θ| ≥ {regression.mape_threshold:g}°)",
+                regression.mape_pct,
+                PAPER_B_FIG4["mape_pct"],
+            ],
+            ["samples", float(regression.n_samples), 29577.0],
+        ],
+        caption="Fit of the linear model",
+    )
+    captions = {
+        "curves": "Bending angle of the seven Fig. 7 actuators (curves that coincide differ "
+        "only in φ or lc)",
+        "correlation": "Fig. 4a — Pearson correlation of inputs and bending angle",
+        "loadings": "Fig. 4b — standardized regression coefficients (loadings)",
+        "parity": "Fig. 4c — multiple linear regression against the data",
+    }
+    for key, caption in captions.items():
+        if key in figures:
+            section.figure(figures[key], caption, root=root)
+
+
+def fig7_design_ids() -> list[str]:
+    """Design ids of :data:`FIG7_DESIGNS`."""
+    from softbend.design import SFRBADesign
+
+    return [SFRBADesign(*values).design_id for values in FIG7_DESIGNS]

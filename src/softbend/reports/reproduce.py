@@ -1,0 +1,206 @@
+"""The main job: the papers' pipelines end to end on built-in defaults, one HTML report.
+
+``run_reproduce(out_dir)`` writes ``out_dir/index.html`` with every section
+softbend can reproduce, and the data, models and figures beside it:
+
+- ``paper_a/``: synthetic curling-actuator experiments (CSV), the leave-one-
+  experiment-out NARX/GG-SVR identification (metrics, models, Figs. 5–7, 9, 10).
+- ``paper_b/``: the Table 1 campaign database (DuckDB; resumed if present), its
+  Parquet export, and the preliminary analysis (Fig. 4).
+"""
+
+from __future__ import annotations
+
+import logging
+import platform
+import time
+from collections.abc import Callable
+from datetime import UTC, datetime
+from pathlib import Path
+from typing import Any
+
+from softbend import __version__
+from softbend._validation import check_range
+from softbend.design import DesignSpace
+from softbend.reports.html import Report
+
+logger = logging.getLogger(__name__)
+
+#: progress(phase, done, total)
+Progress = Callable[[str, int, int], None]
+
+
+def _paper_a(report: Report, out_dir: Path, seed: int, progress: Progress | None) -> dict[str, Any]:
+    from softbend.identification.data import save_experiments
+    from softbend.identification.study import IdentificationConfig, identify, n_fits
+    from softbend.identification.synthetic import synthetic_dataset
+    from softbend.reports import paper_a
+
+    phase = "paper A: identification"
+    start = time.perf_counter()
+    dataset = synthetic_dataset(seed=seed)
+    experiments = [e for group in dataset.values() for e in group]
+    save_experiments(experiments, out_dir / "paper_a" / "data")
+    total = n_fits(experiments)
+    done = 0
+
+    def step(_label: str) -> None:
+        nonlocal done
+        done += 1
+        if progress is not None:
+            progress(phase, done, total)
+
+    if progress is not None:
+        progress(phase, 0, total)
+    result = identify(experiments, IdentificationConfig(), progress=step)
+    paths = paper_a.write_identification_outputs(result, out_dir / "paper_a")
+    paper_a.add_section(report, result, paths, root=out_dir)
+    summary = result.summary()
+    free_run = summary[summary["mode"] == "free-run"]
+    return {
+        "seconds": time.perf_counter() - start,
+        "free_run_nrmse_mean": {
+            f"{r.sign}/{r.output}": float(r.nrmse_mean) for r in free_run.itertuples()
+        },
+        "free_run_nrmse_worst": {
+            f"{r.sign}/{r.output}": float(r.nrmse_max) for r in free_run.itertuples()
+        },
+    }
+
+
+def _paper_b(
+    report: Report,
+    out_dir: Path,
+    workers: int | None,
+    progress: Progress | None,
+    space: DesignSpace | None = None,
+) -> dict[str, Any]:
+    from softbend.analysis import (
+        DEFAULT_FEATURES,
+        DEFAULT_TARGET,
+        correlation_matrix,
+        standardized_regression,
+    )
+    from softbend.campaign import run_campaign
+    from softbend.campaign.store import CampaignStore
+    from softbend.reports import analysis_figures, paper_b
+
+    phase = "paper B: campaign (analytical)"
+    folder = out_dir / "paper_b"
+    folder.mkdir(parents=True, exist_ok=True)
+    space = DesignSpace.table1() if space is None else space
+
+    def on_progress(done: int, failed: int, running: int, total: int) -> None:
+        if progress is not None:
+            progress(phase, done + failed, total)
+
+    summary = run_campaign(
+        folder / "campaign.duckdb",
+        space,
+        backend="analytical",
+        workers=workers,
+        progress=on_progress,
+    )
+    with CampaignStore(folder / "campaign.duckdb", read_only=True) as store:
+        samples = store.load_samples()
+        status = store.status_summary()
+        store.export(folder / "samples.parquet", format="parquet")
+    regression = standardized_regression(samples)
+    features = [*DEFAULT_FEATURES, DEFAULT_TARGET]
+    figures = {
+        "curves": paper_b.angle_curves(
+            samples,
+            paper_b.fig7_design_ids(),
+            folder / f"fig7_designs_{summary.backend}.png",
+            backend=summary.backend,
+        ),
+        "correlation": analysis_figures.correlation_heatmap(
+            correlation_matrix(samples, features), folder / "fig4a_correlation.png"
+        ),
+        "loadings": analysis_figures.loadings_bar(regression, folder / "fig4b_loadings.png"),
+        "parity": analysis_figures.parity_plot(regression, folder / "fig4c_parity.png"),
+    }
+    campaign = {
+        "backend": summary.backend,
+        "n_designs": len(space),
+        "done": int(status["done"]),
+        "failed": int(status["failed"]),
+        "n_samples": len(samples),
+        "run_now": summary.n_run,
+        "resumed_done": summary.n_skipped_done,
+        "seconds": summary.wall_time_s,
+        # None (not NaN) when a resumed run had nothing left to do: JSON has no NaN.
+        "designs_per_s": summary.designs_per_s if summary.n_run else None,
+    }
+    paper_b.add_section(
+        report, campaign=campaign, regression=regression, figures=figures, root=out_dir
+    )
+    loadings = regression.coefficients["loading"]
+    return {
+        **campaign,
+        "r2": regression.r2,
+        "f_value": regression.f_value,
+        "mape_pct": regression.mape_pct,
+        "loadings": {str(k): float(v) for k, v in loadings.items()},
+    }
+
+
+def run_reproduce(
+    out_dir: str | Path,
+    *,
+    seed: int = 0,
+    workers: int | None = None,
+    progress: Progress | None = None,
+    design_space: DesignSpace | None = None,
+) -> dict[str, Any]:
+    """Run every reproducible section and write ``out_dir/index.html``.
+
+    Parameters
+    ----------
+    out_dir : path
+        Output folder (created).
+    seed : int
+        Seed of every random process (synthetic data, noise, samplers).
+    workers : int, optional
+        Local worker processes of the campaign (default: all cores).
+    progress : callable, optional
+        ``progress(phase, done, total)``.
+    design_space : DesignSpace, optional
+        Designs of the paper B campaign (default: Table 1, 972 designs). A
+        different space needs a new ``out_dir``: the campaign database resumes.
+
+    Returns
+    -------
+    dict
+        Headline figures per section, the report path and the wall time.
+    """
+    if workers is not None:
+        # Checked before any work starts, not after paper A.
+        workers = int(
+            check_range(
+                workers,
+                "workers",
+                "run_reproduce",
+                low=0,
+                low_inclusive=True,
+                high=4096,
+                high_inclusive=True,
+            )
+        )
+    out_dir = Path(out_dir)
+    out_dir.mkdir(parents=True, exist_ok=True)
+    started = datetime.now(UTC)
+    report = Report(
+        "softbend — reproduction report",
+        subtitle=(
+            f"softbend {__version__}, Python {platform.python_version()}, seed {seed}, "
+            f"started {started:%Y-%m-%d %H:%M} UTC"
+        ),
+    )
+    summary: dict[str, Any] = {"seed": seed}
+    summary["paper_a"] = _paper_a(report, out_dir, seed, progress)
+    summary["paper_b"] = _paper_b(report, out_dir, workers, progress, design_space)
+    path = report.write(out_dir / "index.html")
+    summary["report"] = str(path)
+    summary["seconds"] = (datetime.now(UTC) - started).total_seconds()
+    return summary

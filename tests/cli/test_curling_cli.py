@@ -1,0 +1,93 @@
+import json
+
+import pytest
+
+from softbend.cli import main
+from softbend.identification.persistence import load_narx
+
+
+@pytest.fixture(scope="module")
+def simulated(tmp_path_factory):
+    out = tmp_path_factory.mktemp("sim")
+    code = main(
+        [
+            "curling",
+            "simulate",
+            "--out",
+            str(out),
+            "--experiments",
+            "2",
+            "--samples",
+            "160",
+            "--seed",
+            "5",
+            "--json",
+        ]
+    )
+    assert code == 0
+    return out
+
+
+def test_simulate_writes_labelled_csv_files(simulated):
+    files = sorted(simulated.glob("*.csv"))
+    assert len(files) == 4
+    header = files[0].read_text().splitlines()[:3]
+    assert any("SYNTHETIC DATA" in line for line in header)
+
+
+def test_identify_prints_metrics_and_writes_models_and_figures(simulated, tmp_path, capsys):
+    capsys.readouterr()
+    code = main(["curling", "identify", str(simulated), "--out", str(tmp_path), "--json"])
+    assert code == 0
+    payload = json.loads(capsys.readouterr().out)
+    assert len(payload["metrics"]) == 2 * 2 * 2 * 2  # signs x outputs x held-out x modes
+    assert {row["mode"] for row in payload["metrics"]} == {"one-step", "free-run"}
+    for name in (
+        "fig5_tip_positions",
+        "fig6_bending_grade",
+        "fig7_arc_length",
+        "fig9_identified_rho",
+        "fig10_identified_length",
+    ):
+        assert (tmp_path / f"{name}.png").stat().st_size > 10_000
+    model, metadata = load_narx(tmp_path / "models" / "negative_length_mm.json")
+    assert metadata["output_unit"] == "mm" and metadata["synthetic_data"] is True
+    assert model.max_lag_ == 2
+
+
+def _one_error_line(capsys):
+    err = capsys.readouterr().err.strip().splitlines()
+    assert len(err) == 1, err
+    assert err[0].startswith("softbend: error:")
+    return err[0]
+
+
+def _write(path, text):
+    path.write_text(text)
+    return path
+
+
+@pytest.mark.parametrize(
+    ("content", "expected"),
+    [
+        ("time_s,pressure_kpa,x_mm\n0,1,0\n0.1,2,0\n0.2,3,0\n", "y_mm"),
+        ("time_s,pressure_kpa,x_mm,y_mm\n0,1,0,0\n0.1,nan,0,0\n0.2,3,0,0\n", "pressure_kpa"),
+        ("time_s,pressure_kpa,x_mm,y_mm\n0,1,0,0\n0.1,2,0,0\n0.1,3,0,0\n", "time"),
+    ],
+    ids=["missing-column", "nan", "non-increasing-time"],
+)
+def test_bad_csv_gives_one_line_and_exit_2(tmp_path, capsys, content, expected):
+    path = _write(tmp_path / "bad.csv", content)
+    assert main(["curling", "identify", str(path), "--out", str(tmp_path / "o")]) == 2
+    assert expected in _one_error_line(capsys)
+
+
+def test_missing_data_path_and_bad_options_exit_2(tmp_path, capsys):
+    assert main(["curling", "identify", str(tmp_path / "nope.csv"), "--out", str(tmp_path)]) == 2
+    _one_error_line(capsys)
+    assert (
+        main(["curling", "identify", str(tmp_path), "--out", str(tmp_path), "--kernel", "x"]) == 2
+    )
+    assert "'kernel'" in _one_error_line(capsys)
+    assert main(["curling", "simulate", "--out", str(tmp_path), "--samples", "abc"]) == 2
+    _one_error_line(capsys)

@@ -1,0 +1,103 @@
+"""The main job end to end: report sections, headline figures, resume."""
+
+from __future__ import annotations
+
+import json
+import math
+
+import pytest
+
+from softbend.design import DesignSpace
+from softbend.reports.reproduce import run_reproduce
+
+
+def _small_space() -> DesignSpace:
+    # Two levels of l and t only: enough for the regression, fast enough for CI.
+    return DesignSpace.grid(
+        {
+            "l_mm": [100.0, 130.0],
+            "r_mm": [6.0],
+            "t_mm": [2.0, 3.0],
+            "b_mm": [2.0, 3.0],
+            "phi_deg": [5.0],
+            "lc_mm": [8.0],
+        },
+        name="small",
+    )
+
+
+@pytest.fixture(scope="module")
+def first_run(tmp_path_factory):
+    out = tmp_path_factory.mktemp("reproduce")
+    phases: dict[str, tuple[int, int]] = {}
+
+    def progress(phase: str, done: int, total: int) -> None:
+        phases[phase] = (done, total)
+
+    summary = run_reproduce(out, seed=0, workers=1, progress=progress, design_space=_small_space())
+    return out, summary, phases
+
+
+def test_report_has_both_papers_and_their_files(first_run):
+    out, summary, _ = first_run
+    html = (out / "index.html").read_text(encoding="utf-8")
+    assert "Paper A" in html and "Paper B" in html
+    for name in (
+        "paper_a/fig5_tip_positions.png",
+        "paper_a/fig9_identified_rho.png",
+        "paper_a/fig10_identified_length.png",
+        "paper_a/metrics.csv",
+        "paper_a/models/positive_rho.json",
+        "paper_b/campaign.duckdb",
+        "paper_b/samples.parquet",
+        "paper_b/fig4a_correlation.png",
+        "paper_b/fig4b_loadings.png",
+        "paper_b/fig4c_parity.png",
+        "paper_b/fig7_designs_analytical.png",
+    ):
+        assert (out / name).is_file(), name
+        assert name in html or not name.endswith(".png"), name
+    assert len(list((out / "paper_a" / "data").glob("*.csv"))) == 12
+    json.dumps(summary)  # the headline figures are JSON-serializable
+
+
+def test_progress_reaches_every_total(first_run):
+    _, _, phases = first_run
+    assert phases, "no progress reported"
+    for phase, (done, total) in phases.items():
+        assert done == total > 0, phase
+
+
+def test_paper_a_free_run_below_ten_percent(first_run):
+    # Issue acceptance: held-out free-run NRMSE of rho and L below 10 %.
+    _, summary, _ = first_run
+    worst = summary["paper_a"]["free_run_nrmse_worst"]
+    assert set(worst) == {
+        "positive/rho",
+        "positive/length_mm",
+        "negative/rho",
+        "negative/length_mm",
+    }
+    assert all(0.0 < value < 0.10 for value in worst.values()), worst
+
+
+def test_paper_b_section_physics(first_run):
+    _, summary, _ = first_run
+    b = summary["paper_b"]
+    assert b["n_designs"] == 8 and b["done"] == 8 and b["failed"] == 0
+    # Pressure drives the angle, a thicker top wall opposes it (paper B Fig. 4b signs).
+    assert b["loadings"]["pressure_mpa"] > 0.5
+    assert b["loadings"]["t_mm"] < 0.0
+    assert 0.0 < b["r2"] < 1.0
+
+
+def test_second_run_resumes_the_campaign(first_run):
+    out, first, _ = first_run
+    again = run_reproduce(out, seed=0, workers=1, design_space=_small_space())
+    b = again["paper_b"]
+    assert b["run_now"] == 0 and b["resumed_done"] == 8
+    assert b["designs_per_s"] is None
+    assert b["n_samples"] == first["paper_b"]["n_samples"]
+    assert math.isclose(b["r2"], first["paper_b"]["r2"], rel_tol=1e-12)
+    # Same seed, same numbers.
+    assert again["paper_a"] == first["paper_a"] | {"seconds": again["paper_a"]["seconds"]}
