@@ -1,0 +1,171 @@
+"""Inputs and target of the surrogate models (paper B §4.1): (l, r, t, b, φ, lc, P) → θ.
+
+Every surrogate in :mod:`softbend.surrogates` takes a float array of shape
+``(n_samples, 7)`` whose columns are :data:`FEATURES` in this order and units,
+and predicts the bending angle in degrees. :func:`training_data` builds that
+array from a campaign's samples table (:func:`softbend.campaign.load_samples`),
+with the design ids as CV groups so that a sweep never spans two folds.
+"""
+
+from __future__ import annotations
+
+import hashlib
+from dataclasses import dataclass
+
+import numpy as np
+import pandas as pd
+from numpy.typing import ArrayLike
+
+from softbend.errors import DatasetError
+
+#: Input columns, in the order every surrogate expects them.
+FEATURES: tuple[str, ...] = (
+    "l_mm",
+    "r_mm",
+    "t_mm",
+    "b_mm",
+    "phi_deg",
+    "lc_mm",
+    "pressure_mpa",
+)
+
+#: Unit of each input and of the target.
+UNITS: dict[str, str] = {
+    "l_mm": "mm",
+    "r_mm": "mm",
+    "t_mm": "mm",
+    "b_mm": "mm",
+    "phi_deg": "deg",
+    "lc_mm": "mm",
+    "pressure_mpa": "MPa",
+    "angle_deg": "deg",
+}
+
+#: Target column.
+TARGET = "angle_deg"
+
+#: Group column: one group per design (one pressure sweep).
+GROUP = "design_id"
+
+
+@dataclass(frozen=True)
+class TrainingData:
+    """Arrays for fitting and cross-validating a surrogate.
+
+    Attributes
+    ----------
+    X : ndarray, shape (n_samples, 7)
+        Inputs, columns :data:`FEATURES`.
+    y : ndarray, shape (n_samples,)
+        Bending angle, degrees.
+    groups : ndarray of str, shape (n_samples,)
+        Design id of each row (CV groups).
+    data_hash : str
+        SHA-256 of ``X``, ``y`` and ``groups`` (hex, first 16 characters):
+        identifies the training data in a saved model's metadata.
+    n_dropped : int
+        Rows left out: not converged, or a non-finite input or angle.
+    """
+
+    X: np.ndarray
+    y: np.ndarray
+    groups: np.ndarray
+    data_hash: str
+    n_dropped: int = 0
+
+    @property
+    def n_samples(self) -> int:
+        """Number of rows."""
+        return int(self.y.size)
+
+    @property
+    def n_groups(self) -> int:
+        """Number of distinct designs."""
+        return int(np.unique(self.groups).size)
+
+
+def data_hash(X: ArrayLike, y: ArrayLike, groups: ArrayLike | None = None) -> str:
+    """Short SHA-256 of the training arrays (first 16 hex characters).
+
+    The hash covers the float64 bytes of ``X`` (C order) and ``y`` and the
+    group labels, so the same data in the same row order give the same hash.
+    """
+    digest = hashlib.sha256()
+    digest.update(np.ascontiguousarray(X, dtype=np.float64).tobytes())
+    digest.update(np.ascontiguousarray(y, dtype=np.float64).tobytes())
+    if groups is not None:
+        digest.update("\x1f".join(map(str, np.asarray(groups).tolist())).encode())
+    return digest.hexdigest()[:16]
+
+
+def training_data(samples: pd.DataFrame, *, converged_only: bool = True) -> TrainingData:
+    """Inputs, target and CV groups from a campaign samples table.
+
+    Parameters
+    ----------
+    samples : pandas.DataFrame
+        One row per (design, pressure) with the columns :data:`FEATURES`,
+        ``angle_deg`` and ``design_id`` (and optionally ``converged``), as
+        returned by :func:`softbend.campaign.load_samples`.
+    converged_only : bool
+        Leave out rows whose ``converged`` flag is false (default True).
+
+    Returns
+    -------
+    TrainingData
+
+    Raises
+    ------
+    DatasetError
+        If a column is missing or no usable row remains.
+    """
+    needed = [*FEATURES, TARGET, GROUP]
+    missing = [c for c in needed if c not in samples.columns]
+    if missing:
+        raise DatasetError(
+            f"The samples table lacks the column(s) {', '.join(missing)}; "
+            f"a surrogate needs {', '.join(needed)}."
+        )
+    keep = np.ones(len(samples), dtype=bool)
+    if converged_only and "converged" in samples.columns:
+        keep &= samples["converged"].to_numpy(dtype=bool, na_value=False)
+    X = samples[list(FEATURES)].to_numpy(dtype=np.float64, na_value=np.nan)
+    y = samples[TARGET].to_numpy(dtype=np.float64, na_value=np.nan)
+    keep &= np.isfinite(X).all(axis=1) & np.isfinite(y)
+    if not keep.any():
+        raise DatasetError(
+            f"The samples table has no converged row with finite {', '.join(needed[:-1])} "
+            f"({len(samples)} rows in all)."
+        )
+    X, y = np.ascontiguousarray(X[keep]), np.ascontiguousarray(y[keep])
+    groups = samples[GROUP].astype(str).to_numpy()[keep]
+    return TrainingData(
+        X=X,
+        y=y,
+        groups=groups,
+        data_hash=data_hash(X, y, groups),
+        n_dropped=int((~keep).sum()),
+    )
+
+
+def check_features(X: ArrayLike, owner: str) -> np.ndarray:
+    """``X`` as a finite float64 array of shape (n, 7), or one clear ``ValueError``.
+
+    A single sample may be given as a 1-D array of length 7.
+    """
+    array = np.asarray(X, dtype=np.float64)
+    if array.ndim == 1:
+        array = array[None, :]
+    if array.ndim != 2 or array.shape[1] != len(FEATURES):
+        raise ValueError(
+            f"The 'X' of {owner} must have {len(FEATURES)} columns "
+            f"({', '.join(FEATURES)}). Got shape {np.shape(X)} instead."
+        )
+    bad = ~np.isfinite(array)
+    if bad.any():
+        row, col = np.argwhere(bad)[0]
+        raise ValueError(
+            f"The 'X' of {owner} must be finite. Got {array[row, col]} in column "
+            f"'{FEATURES[col]}' of row {row}."
+        )
+    return array

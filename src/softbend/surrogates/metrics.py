@@ -1,0 +1,117 @@
+"""Accuracy and speed of a surrogate: R², RMSE, MAPE, maximum error, inference time.
+
+MAPE treats angles near 0° as paper B cannot: a percentage of a 0.01° angle is
+meaningless, so samples with ``|θ| < mape_threshold_deg`` (default 1°) are left
+out of the MAPE and counted (:func:`softbend.analysis.thresholded_mape`). The
+other metrics use every sample.
+"""
+
+from __future__ import annotations
+
+import time
+from collections.abc import Callable
+from typing import Any
+
+import numpy as np
+from numpy.typing import ArrayLike
+
+from softbend.analysis import thresholded_mape
+from softbend.identification.metrics import r2, rmse
+
+#: Default smallest |θ| (degrees) included in the MAPE.
+MAPE_THRESHOLD_DEG = 1.0
+
+
+def accuracy(
+    y_true: ArrayLike, y_pred: ArrayLike, *, mape_threshold_deg: float = MAPE_THRESHOLD_DEG
+) -> dict[str, float]:
+    """Accuracy of predicted bending angles.
+
+    Parameters
+    ----------
+    y_true, y_pred : array_like, shape (n,)
+        Observed and predicted angles, degrees.
+    mape_threshold_deg : float
+        Smallest ``|y_true|`` in the MAPE, degrees (default 1).
+
+    Returns
+    -------
+    dict
+        ``r2``, ``rmse_deg``, ``mape_pct``, ``max_abs_error_deg``, ``n`` and
+        ``n_mape_excluded``.
+    """
+    y_true = np.asarray(y_true, dtype=float).ravel()
+    y_pred = np.asarray(y_pred, dtype=float).ravel()
+    mape, excluded = thresholded_mape(y_true, y_pred, threshold=mape_threshold_deg)
+    return {
+        "r2": r2(y_true, y_pred),
+        "rmse_deg": rmse(y_true, y_pred),
+        "mape_pct": mape,
+        "max_abs_error_deg": float(np.max(np.abs(y_pred - y_true))),
+        "n": int(y_true.size),
+        "n_mape_excluded": excluded,
+    }
+
+
+def _median_time(call: Callable[[], Any], *, repeats: int, number: int) -> float:
+    """Median over ``repeats`` of the mean time of ``number`` calls, s."""
+    times = []
+    for _ in range(repeats):
+        start = time.perf_counter()
+        for _ in range(number):
+            call()
+        times.append((time.perf_counter() - start) / number)
+    return float(np.median(times))
+
+
+def inference_time(
+    model: Any, X: ArrayLike, *, batch: int = 10_000, repeats: int = 5, seed: int = 0
+) -> dict[str, float]:
+    """Inference time of a fitted surrogate for one sample and for a batch.
+
+    The single-sample figure uses the model's fast path ``predictor()`` when it
+    has one (what a control loop calls), else ``predict`` on one row; both are
+    reported when they differ.
+
+    Parameters
+    ----------
+    model : fitted estimator
+        Anything with ``predict(X)``; optionally ``predictor()``.
+    X : array_like, shape (n, 7)
+        Inputs to draw samples from (rows are resampled to fill the batch).
+    batch : int
+        Batch size for the batch figure (default 10 000).
+    repeats : int
+        Timing repeats; the median is reported.
+    seed : int
+        Seed of the row resampling.
+
+    Returns
+    -------
+    dict
+        ``single_us`` (fast path or predict), ``single_predict_us`` (``predict``
+        on one row) and ``batch_ms`` (``predict`` on ``batch`` rows), plus
+        ``batch`` and ``fast_path`` (bool).
+    """
+    X = np.asarray(X, dtype=float)
+    rng = np.random.default_rng(seed)
+    rows = X[rng.integers(0, X.shape[0], size=batch)]
+    one = np.ascontiguousarray(rows[:1])
+    sample = one[0].copy()
+    predict_one = _median_time(lambda: model.predict(one), repeats=repeats, number=20)
+    fast = getattr(model, "predictor", None)
+    if callable(fast):
+        f = fast()
+        f(sample)  # warm up
+        single = _median_time(lambda: f(sample), repeats=repeats, number=2000)
+    else:
+        single = predict_one
+    model.predict(rows[:100])  # warm up
+    batch_s = _median_time(lambda: model.predict(rows), repeats=repeats, number=1)
+    return {
+        "single_us": 1e6 * single,
+        "single_predict_us": 1e6 * predict_one,
+        "batch_ms": 1e3 * batch_s,
+        "batch": int(batch),
+        "fast_path": callable(fast),
+    }
