@@ -1,0 +1,200 @@
+"""Benchmark: paper B's MLP grid search, batched training vs one model at a time.
+
+Paper B §4.1 searches two tanh hidden layers of 55–65 units each (121
+configurations) with five-fold cross-validation grouped by design, 1000 epochs of
+Adam on mini-batches of 1024 rows: 605 trainings on about 24 000 rows each.
+:func:`softbend.surrogates.batched.train_mlp_grid` trains all (configuration, fold)
+models in one batched tensor program; the baseline is the same code with one
+model per call (M = 1), run sequentially.
+
+Data: synthetic and smooth, of the size of paper B's set (the 972 designs of
+Table 1, each swept from 0 MPa in steps of 0.005 MPa up to a design-dependent
+limit: about 30 000 rows x 7), or a campaign database (``--db PATH``, read with
+:func:`softbend.campaign.load_samples` and
+:func:`softbend.surrogates.features.training_data`). Five grouped folds
+(:class:`sklearn.model_selection.GroupKFold`, one group per design).
+
+Printed: seconds per (configuration, fold) for E epochs, batched and sequential,
+the speed-up, and the projected time of the full paper grid (121 configurations x
+5 folds x 1000 epochs) from the measured cost per model-epoch. Run::
+
+    taskset -c 0,1 .venv/bin/python benchmarks/bench_mlp_search.py           # K=8, E=20
+    .venv/bin/python benchmarks/bench_mlp_search.py --configs 4 --epochs 5 --json
+"""
+
+from __future__ import annotations
+
+import argparse
+import itertools
+import json
+import os
+import time
+
+import numpy as np
+import torch
+from sklearn.model_selection import GroupKFold
+
+from softbend.surrogates.batched import estimate_pass_bytes, train_mlp_grid
+
+PAPER_GRID = [(h1, h2) for h1 in range(55, 66) for h2 in range(55, 66)]
+PAPER_FOLDS = 5
+PAPER_EPOCHS = 1000
+
+
+def synthetic_data(seed: int = 0) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Smooth stand-in for paper B's FEM set: (X, angle_deg, design groups)."""
+    rng = np.random.default_rng(seed)
+    designs = itertools.product(
+        (100, 120, 140, 160), (6, 8, 10), (2, 3, 4), (2, 3, 4), (5, 10, 15), (8, 10, 12)
+    )
+    rows, groups = [], []
+    for k, (length, r, t, b, phi, lc) in enumerate(designs):
+        p_max = 0.08 + 0.035 * (t - 2) + 0.035 * (b - 2) + rng.uniform(-0.02, 0.02)
+        pressures = np.arange(0.0, p_max + 1e-9, 0.005)
+        rows.append(
+            np.column_stack([np.tile([length, r, t, b, phi, lc], (pressures.size, 1)), pressures])
+        )
+        groups.append(np.full(pressures.size, k))
+    X = np.vstack(rows)
+    length, r, t, b, phi, lc, p = X.T
+    stiffness = t**0.7 * b**0.4 * (1 + 0.03 * phi)
+    y = (
+        200
+        * np.tanh(1.5 * p * length / 130 * (r / 8) ** 1.5 / stiffness * 10)
+        * (1 - 0.02 * (lc - 10))
+    )
+    return X, y, np.concatenate(groups)
+
+
+def load_data(args: argparse.Namespace) -> tuple[np.ndarray, np.ndarray, np.ndarray, str]:
+    if args.db is None:
+        X, y, groups = synthetic_data(args.seed)
+        return X, y, groups, "synthetic"
+    from softbend.campaign import load_samples
+    from softbend.surrogates.features import training_data
+
+    data = training_data(load_samples(args.db))
+    return data.X, data.y, data.groups, str(args.db)
+
+
+def pick_configs(k: int) -> list[tuple[int, int]]:
+    """K configurations spread evenly over the paper grid (55–65 x 55–65)."""
+    idx = np.unique(np.linspace(0, len(PAPER_GRID) - 1, k).round().astype(int))
+    return [PAPER_GRID[i] for i in idx]
+
+
+def main(argv: list[str] | None = None) -> int:
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--configs", type=int, default=8, help="K configurations (default 8)")
+    parser.add_argument("--epochs", type=int, default=20, help="E epochs (default 20)")
+    parser.add_argument("--batch-size", type=int, default=1024)
+    parser.add_argument("--device", default="auto", choices=("auto", "cpu", "cuda"))
+    parser.add_argument(
+        "--threads",
+        type=int,
+        default=None,
+        help="torch CPU threads (default: the CPUs this process may run on)",
+    )
+    parser.add_argument(
+        "--sequential",
+        type=int,
+        default=None,
+        help="time only this many one-at-a-time trainings (default: all K x 5)",
+    )
+    parser.add_argument("--db", default=None, help="campaign database instead of synthetic data")
+    parser.add_argument("--seed", type=int, default=0)
+    parser.add_argument("--json", action="store_true", help="print one JSON object")
+    args = parser.parse_args(argv)
+
+    threads = args.threads or len(os.sched_getaffinity(0))
+    X, y, groups, source = load_data(args)
+    splits = list(GroupKFold(n_splits=PAPER_FOLDS).split(X, y, groups))
+    configs = pick_configs(args.configs)
+    common = dict(
+        epochs=args.epochs,
+        batch_size=args.batch_size,
+        seed=args.seed,
+        device=args.device,
+        num_threads=threads,
+    )
+
+    n_models = len(configs) * len(splits)
+    batched = train_mlp_grid(X, y, splits, configs, **common)
+    batched_per_model_epoch = batched.elapsed_s / (n_models * args.epochs)
+
+    jobs = [(c, s) for c in configs for s in splits]
+    jobs = jobs[: args.sequential] if args.sequential else jobs
+    start = time.perf_counter()
+    for config, split in jobs:
+        train_mlp_grid(X, y, [split], [config], **common)
+    sequential_s = time.perf_counter() - start
+    sequential_per_model_epoch = sequential_s / (len(jobs) * args.epochs)
+
+    full_models = len(PAPER_GRID) * PAPER_FOLDS
+    n_train_max = max(train.size for train, _ in splits)
+    full_pass_gb = (
+        estimate_pass_bytes(full_models, X.shape[1], 65, 65, args.batch_size, n_train_max) / 1e9
+    )
+    val_mape = [
+        float(
+            np.mean(
+                np.abs(m.val_pred_deg - y[m.val_index]) / np.maximum(np.abs(y[m.val_index]), 1.0)
+            )
+        )
+        for m in batched.models
+    ]
+    report = {
+        "data": source,
+        "n_rows": int(X.shape[0]),
+        "n_designs": int(np.unique(groups).size),
+        "device": batched.device,
+        "threads": threads,
+        "configs": configs,
+        "folds": len(splits),
+        "epochs": args.epochs,
+        "batch_size": args.batch_size,
+        "models_batched": n_models,
+        "models_sequential": len(jobs),
+        "batched_s": batched.elapsed_s,
+        "sequential_s": sequential_s,
+        "batched_s_per_config_fold": batched.elapsed_s / n_models,
+        "sequential_s_per_config_fold": sequential_s / len(jobs),
+        "speedup": sequential_per_model_epoch / batched_per_model_epoch,
+        "projected_full_grid_batched_h": batched_per_model_epoch
+        * full_models
+        * PAPER_EPOCHS
+        / 3600,
+        "projected_full_grid_sequential_h": sequential_per_model_epoch
+        * full_models
+        * PAPER_EPOCHS
+        / 3600,
+        "full_grid_one_pass_memory_gb": full_pass_gb,
+        "median_val_mape_pct_after_E_epochs": 100 * float(np.median(val_mape)),
+    }
+    if args.json:
+        print(json.dumps(report))
+        return 0
+    print(
+        f"{source}: {report['n_rows']} rows x {X.shape[1]}, {report['n_designs']} designs, "
+        f"{len(splits)} grouped folds; device {batched.device}, {threads} torch thread(s), "
+        f"torch {torch.__version__}"
+    )
+    print(f"{len(configs)} configurations {configs}, {args.epochs} epochs, batch {args.batch_size}")
+    print(f"{'':24}{'models':>8}{'total s':>10}{'s/config-fold':>15}{'ms/model-epoch':>16}")
+    for name, count, total, per in (
+        ("batched (one program)", n_models, batched.elapsed_s, batched_per_model_epoch),
+        ("one at a time (M = 1)", len(jobs), sequential_s, sequential_per_model_epoch),
+    ):
+        print(f"{name:24}{count:>8}{total:>10.2f}{total / count:>15.3f}{per * 1e3:>16.2f}")
+    print(f"speed-up batched vs one at a time: {report['speedup']:.2f}x")
+    print(
+        f"projected full paper grid ({len(PAPER_GRID)} configs x {PAPER_FOLDS} folds x "
+        f"{PAPER_EPOCHS} epochs): batched {report['projected_full_grid_batched_h']:.2f} h, "
+        f"one at a time {report['projected_full_grid_sequential_h']:.2f} h "
+        f"(one pass of all {full_models} models needs about {full_pass_gb:.1f} GB)"
+    )
+    return 0
+
+
+if __name__ == "__main__":
+    raise SystemExit(main())
