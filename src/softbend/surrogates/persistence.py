@@ -1,0 +1,489 @@
+"""Save and load fitted surrogates as one JSON file, without pickle.
+
+A saved surrogate records what it is (``kind``), how it was configured
+(``params``, from ``get_params``), what it learned (``state``: the fitted
+arrays as nested lists, or the XGBoost booster as JSON text), what it maps
+(``features`` and ``units`` of :mod:`softbend.surrogates.features`, ``target``)
+and where it came from (``softbend_version``, ``created_utc`` and the caller's
+``metadata``, e.g. the training data hash and cross-validated metrics)::
+
+    {"format": "softbend-surrogate", "schema_version": 1, "kind": "polynomial",
+     "features": [...], "units": {...}, "target": "angle_deg",
+     "softbend_version": "0.1.0", "created_utc": "2025-01-01T00:00:00+00:00",
+     "metadata": {...}, "params": {...}, "state": {...}}
+
+Python writes a float with the shortest decimal that reads back to the same
+float64 (``repr``), so a reloaded polynomial or MLP predicts bit for bit what
+the saved one did; XGBoost restores its own JSON model exactly. Non-finite
+floats are written as ``NaN``/``Infinity`` (Python's JSON dialect), which
+XGBoost's default ``missing=nan`` needs.
+
+Arrays are stored as ``{"__ndarray__": nested list, "dtype": ..., "shape": ...}``,
+NumPy scalars as ``{"__scalar__": value, "dtype": ...}`` and tuples as
+``{"__tuple__": [...]}``, so dtypes and parameter types come back unchanged.
+Fitted attributes that are none of these (a framework object such as a torch
+module) are not written; everything ``predict`` needs under the surrogate
+contract is.
+"""
+
+from __future__ import annotations
+
+import importlib
+import json
+import logging
+import sys
+from dataclasses import dataclass, field
+from datetime import UTC, datetime
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+from sklearn.exceptions import NotFittedError
+
+from softbend import __version__
+from softbend._io import write_text_atomic
+from softbend.errors import SchemaError
+from softbend.surrogates.features import FEATURES, TARGET, UNITS
+
+logger = logging.getLogger(__name__)
+
+__all__ = [
+    "FORMAT",
+    "KINDS",
+    "SCHEMA_VERSION",
+    "SavedSurrogate",
+    "check_fitted_surrogate",
+    "kind_of",
+    "load_surrogate",
+    "save_surrogate",
+]
+
+#: Format tag of a saved surrogate file.
+FORMAT = "softbend-surrogate"
+
+#: Newest schema version this softbend writes and reads.
+SCHEMA_VERSION = 1
+
+#: Surrogate kinds and the (module, class) each is restored into.
+_CLASSES: dict[str, tuple[str, str]] = {
+    "polynomial": ("softbend.surrogates.polynomial", "PolynomialRegressor"),
+    "mlp": ("softbend.surrogates.mlp", "NormalizedMLPRegressor"),
+    "xgboost": ("xgboost", "XGBRegressor"),
+}
+
+#: Kinds of surrogate that can be saved.
+KINDS: tuple[str, ...] = tuple(_CLASSES)
+
+#: Fitted attributes that prediction needs (the surrogate contract), per kind.
+_REQUIRED_STATE: dict[str, tuple[str, ...]] = {
+    "polynomial": (
+        "n_features_in_",
+        "x_mean_",
+        "x_scale_",
+        "y_mean_",
+        "y_scale_",
+        "powers_",
+        "coef_",
+    ),
+    "mlp": (
+        "n_features_in_",
+        "x_mean_",
+        "x_scale_",
+        "y_mean_",
+        "y_scale_",
+        "coefs_",
+        "intercepts_",
+    ),
+    "xgboost": ("booster",),
+}
+
+_HEADER_KEYS = (
+    "kind",
+    "features",
+    "units",
+    "target",
+    "softbend_version",
+    "created_utc",
+    "metadata",
+    "params",
+    "state",
+)
+
+
+@dataclass(frozen=True)
+class SavedSurrogate:
+    """A surrogate read back by :func:`load_surrogate`.
+
+    Attributes
+    ----------
+    model : estimator
+        The fitted surrogate (``PolynomialRegressor``, ``NormalizedMLPRegressor``
+        or ``xgboost.XGBRegressor``); it maps inputs :data:`FEATURES` (mm, deg, MPa)
+        to the bending angle in degrees.
+    kind : str
+        One of :data:`KINDS`.
+    metadata : dict
+        The caller's metadata as given to :func:`save_surrogate` (after a JSON
+        round trip: tuples become lists, NumPy numbers Python numbers).
+    softbend_version : str
+        Version of softbend that wrote the file.
+    created_utc : str
+        When the file was written, ISO 8601 in UTC.
+    """
+
+    model: Any
+    kind: str
+    metadata: dict[str, Any] = field(default_factory=dict)
+    softbend_version: str = ""
+    created_utc: str = ""
+
+
+def _class_of(kind: str) -> type:
+    module, name = _CLASSES[kind]
+    return getattr(importlib.import_module(module), name)
+
+
+def _allowed() -> str:
+    return ", ".join(f"{name} ({kind!r})" for kind, (_, name) in _CLASSES.items())
+
+
+def kind_of(model: Any) -> str:
+    """The kind of a surrogate: ``"polynomial"``, ``"mlp"`` or ``"xgboost"``.
+
+    Only the exact classes count (a subclass could change what ``params`` and
+    ``state`` mean). No heavy module is imported: a model's class is loaded
+    whenever the model exists.
+
+    Parameters
+    ----------
+    model : estimator
+        A ``PolynomialRegressor``, ``NormalizedMLPRegressor`` or ``xgboost.XGBRegressor``.
+
+    Returns
+    -------
+    str
+        One of :data:`KINDS`.
+
+    Raises
+    ------
+    ValueError
+        For any other type, naming the allowed ones.
+    """
+    for kind, (module, name) in _CLASSES.items():
+        cls = getattr(sys.modules.get(module), name, None)
+        if cls is not None and type(model) is cls:
+            return kind
+    raise ValueError(
+        f"The 'model' of kind_of must be one of {_allowed()}. Got {type(model).__name__} instead."
+    )
+
+
+def check_fitted_surrogate(model: Any, owner: str) -> str:
+    """Return the kind of a fitted surrogate on the 7 inputs, or raise a clear error.
+
+    Parameters
+    ----------
+    model : estimator
+        The surrogate to check.
+    owner : str
+        Name of the calling function, used in the messages.
+
+    Returns
+    -------
+    str
+        The model's kind.
+
+    Raises
+    ------
+    ValueError
+        Unknown model type, or a model fitted on other than the 7 :data:`FEATURES`.
+    sklearn.exceptions.NotFittedError
+        If the model is not fitted (a ``ValueError`` too).
+    """
+    try:
+        kind = kind_of(model)
+    except ValueError:
+        raise ValueError(
+            f"The 'model' of {owner} must be one of {_allowed()}. "
+            f"Got {type(model).__name__} instead."
+        ) from None
+    name = type(model).__name__
+    if kind == "xgboost":
+        fitted = model.__sklearn_is_fitted__()
+    else:
+        fitted = all(hasattr(model, key) for key in _REQUIRED_STATE[kind])
+    if not fitted:
+        raise NotFittedError(f"This {name} instance is not fitted yet. Call 'fit' before {owner}.")
+    n_features = int(model.n_features_in_)
+    if n_features != len(FEATURES):
+        raise ValueError(
+            f"The 'model' of {owner} must be fitted on the {len(FEATURES)} surrogate inputs "
+            f"({', '.join(FEATURES)}). Got a {name} with n_features_in_ = {n_features} instead."
+        )
+    names = getattr(model, "feature_names_in_", None)
+    if names is not None and [str(n) for n in names] != list(FEATURES):
+        raise ValueError(
+            f"The 'model' of {owner} must be fitted on the columns {', '.join(FEATURES)} in "
+            f"this order. Got a {name} fitted on {', '.join(map(str, names))} instead."
+        )
+    return kind
+
+
+# --- JSON codec --------------------------------------------------------------------------------
+
+
+def _encode(value: Any, where: str) -> Any:
+    """JSON-ready form of ``value`` that :func:`_decode` turns back into an equal object."""
+    if value is None or isinstance(value, bool | int | float | str):
+        return value
+    if isinstance(value, np.generic | np.ndarray):
+        array = np.asarray(value)
+        if array.dtype.kind in "biuf":
+            dtype = array.dtype.name
+        elif array.dtype.kind in "OU" and all(isinstance(v, str) for v in array.ravel()):
+            dtype = "str"
+        else:
+            raise TypeError(f"{where}: arrays of dtype {array.dtype} cannot be saved")
+        if isinstance(value, np.generic):
+            return {"__scalar__": value.item(), "dtype": dtype}
+        return {"__ndarray__": array.tolist(), "dtype": dtype, "shape": list(array.shape)}
+    if isinstance(value, tuple):
+        return {"__tuple__": [_encode(v, where) for v in value]}
+    if isinstance(value, list):
+        return [_encode(v, where) for v in value]
+    if isinstance(value, dict) and all(isinstance(k, str) for k in value):
+        return {k: _encode(v, where) for k, v in value.items()}
+    raise TypeError(f"{where}: values of type {type(value).__name__} cannot be saved")
+
+
+def _decode(value: Any) -> Any:
+    if isinstance(value, list):
+        return [_decode(v) for v in value]
+    if not isinstance(value, dict):
+        return value
+    if "__ndarray__" in value:
+        if value["dtype"] == "str":
+            array = np.asarray(value["__ndarray__"], dtype=object)
+        else:
+            array = np.asarray(value["__ndarray__"], dtype=np.dtype(value["dtype"]))
+        return np.ascontiguousarray(array.reshape(value["shape"]))
+    if "__scalar__" in value:
+        if value["dtype"] == "str":
+            return np.str_(value["__scalar__"])
+        return np.dtype(value["dtype"]).type(value["__scalar__"])
+    if "__tuple__" in value:
+        return tuple(_decode(v) for v in value["__tuple__"])
+    return {k: _decode(v) for k, v in value.items()}
+
+
+def _plain_json(value: Any) -> Any:
+    """``json.dumps`` fallback for caller metadata: NumPy numbers and arrays as Python ones."""
+    if isinstance(value, np.generic | np.ndarray):
+        return value.tolist()
+    if isinstance(value, Path):
+        return str(value)
+    raise TypeError(f"values of type {type(value).__name__} are not JSON-serializable")
+
+
+# --- save --------------------------------------------------------------------------------------
+
+
+def _params(model: Any) -> dict[str, Any]:
+    params = {}
+    for key, value in model.get_params(deep=False).items():
+        try:
+            params[key] = _encode(value, key)
+        except TypeError:
+            raise ValueError(
+                f"The parameter '{key}' of {type(model).__name__} must be JSON-serializable to "
+                f"save the model (None, numbers, strings, arrays, lists, tuples, dicts). "
+                f"Got {type(value).__name__} instead."
+            ) from None
+    return params
+
+
+def _state(model: Any, kind: str) -> dict[str, Any]:
+    if kind == "xgboost":
+        return {"booster": bytes(model.get_booster().save_raw("json")).decode("utf-8")}
+    state = {}
+    fitted = [k for k in vars(model) if k.endswith("_") and not k.startswith("_")]
+    for key in fitted:
+        try:
+            state[key] = _encode(getattr(model, key), key)
+        except TypeError as err:
+            if key in _REQUIRED_STATE[kind]:
+                raise ValueError(
+                    f"The fitted attribute '{key}' of {type(model).__name__} cannot be saved: "
+                    f"{err}."
+                ) from None
+            logger.debug("save_surrogate leaves out %s: %s", key, err)
+    return state
+
+
+def save_surrogate(model: Any, path: str | Path, *, metadata: dict[str, Any] | None = None) -> Path:
+    """Write a fitted surrogate to one JSON file (atomically) and return its path.
+
+    Parameters
+    ----------
+    model : estimator
+        A fitted ``PolynomialRegressor``, ``NormalizedMLPRegressor`` or
+        ``xgboost.XGBRegressor`` on the 7 inputs :data:`FEATURES` (mm, deg, MPa),
+        predicting the bending angle in degrees.
+    path : str or Path
+        File to write; parent folders are created. An existing file is replaced
+        only once the new one is complete.
+    metadata : dict, optional
+        JSON-serializable provenance with string keys, e.g. ``data_hash``,
+        ``metrics``, ``cv``; NumPy numbers and arrays are written as Python ones.
+
+    Returns
+    -------
+    Path
+        The written file.
+
+    Raises
+    ------
+    ValueError
+        Unknown model type (naming the allowed kinds), a model fitted on other than
+        7 features, a parameter or ``metadata`` that JSON cannot hold.
+    sklearn.exceptions.NotFittedError
+        If the model is not fitted.
+    """
+    kind = check_fitted_surrogate(model, "save_surrogate")
+    if metadata is None:
+        metadata = {}
+    if not isinstance(metadata, dict) or not all(isinstance(k, str) for k in metadata):
+        raise ValueError(
+            "The 'metadata' of save_surrogate must be a dict with string keys. "
+            f"Got {type(metadata).__name__} instead."
+        )
+    try:
+        metadata_json = json.dumps(metadata, default=_plain_json)
+    except (TypeError, ValueError) as err:
+        raise ValueError(
+            f"The 'metadata' of save_surrogate must be JSON-serializable. Got an error: {err}."
+        ) from None
+    document = {
+        "format": FORMAT,
+        "schema_version": SCHEMA_VERSION,
+        "kind": kind,
+        "features": list(FEATURES),
+        "units": {name: UNITS[name] for name in (*FEATURES, TARGET)},
+        "target": TARGET,
+        "softbend_version": __version__,
+        "created_utc": datetime.now(UTC).isoformat(timespec="seconds"),
+        "params": _params(model),
+        "state": _state(model, kind),
+    }
+    # One top-level key per line: the header stays readable, big arrays stay on one line.
+    lines = [f"{json.dumps(key)}: {json.dumps(value)}" for key, value in document.items()]
+    lines.insert(-2, f'"metadata": {metadata_json}')
+    return write_text_atomic(Path(path), "{\n " + ",\n ".join(lines) + "\n}\n")
+
+
+# --- load --------------------------------------------------------------------------------------
+
+
+def _read_document(path: Path) -> dict[str, Any]:
+    if not path.is_file():
+        raise FileNotFoundError(f"No saved surrogate at {path}.")
+    try:
+        document = json.loads(path.read_text(encoding="utf-8"))
+    except (json.JSONDecodeError, UnicodeDecodeError) as err:
+        raise SchemaError(f"{path} is not a softbend surrogate: not valid JSON ({err}).") from None
+    if not isinstance(document, dict) or document.get("format") != FORMAT:
+        found = document.get("format") if isinstance(document, dict) else type(document).__name__
+        raise SchemaError(
+            f"{path} is not a softbend surrogate: format {found!r}, expected {FORMAT!r}."
+        )
+    version = document.get("schema_version")
+    if isinstance(version, bool) or not isinstance(version, int) or version < 1:
+        raise SchemaError(
+            f"{path} has an invalid schema_version {version!r}; expected an integer "
+            f"from 1 to {SCHEMA_VERSION}."
+        )
+    if version > SCHEMA_VERSION:
+        raise SchemaError(
+            f"{path} has schema version {version}, newer than this softbend ({__version__}) "
+            f"reads (up to {SCHEMA_VERSION}). Upgrade softbend to load it."
+        )
+    missing = [key for key in _HEADER_KEYS if key not in document]
+    if missing:
+        raise SchemaError(
+            f"{path} is an incomplete softbend surrogate: key(s) {', '.join(missing)} missing."
+        )
+    if document["kind"] not in _CLASSES:
+        raise SchemaError(
+            f"{path} holds an unknown surrogate kind {document['kind']!r}; "
+            f"expected one of {', '.join(map(repr, KINDS))}."
+        )
+    if list(document["features"]) != list(FEATURES) or document["target"] != TARGET:
+        raise SchemaError(
+            f"{path} maps {document['features']} -> {document['target']!r}; this softbend's "
+            f"surrogates map {list(FEATURES)} -> {TARGET!r}."
+        )
+    for key in ("params", "state", "metadata"):
+        if not isinstance(document[key], dict):
+            raise SchemaError(f"{path}: '{key}' must be a JSON object.")
+    return document
+
+
+def _restore(document: dict[str, Any], path: Path) -> Any:
+    kind = document["kind"]
+    state = document["state"]
+    missing = [key for key in _REQUIRED_STATE[kind] if key not in state]
+    if missing:
+        raise SchemaError(
+            f"{path} is an incomplete softbend surrogate: state key(s) "
+            f"{', '.join(missing)} missing for kind {kind!r}."
+        )
+    try:
+        params = _decode(document["params"])
+        model = _class_of(kind)(**params)
+        if kind == "xgboost":
+            model.load_model(bytearray(state["booster"].encode("utf-8")))
+            # load_model fills base_score, booster, ... from the booster; put back the
+            # parameters as they were set, so that get_params (and a refit) is unchanged.
+            for key, value in params.items():
+                setattr(model, key, value)
+        else:
+            for key, value in state.items():
+                setattr(model, key, _decode(value))
+    except Exception as err:  # bad params or arrays, xgboost.core.XGBoostError, ...
+        raise SchemaError(f"{path}: cannot rebuild the {kind} surrogate ({err}).") from None
+    return model
+
+
+def load_surrogate(path: str | Path) -> SavedSurrogate:
+    """Read a surrogate written by :func:`save_surrogate`.
+
+    Parameters
+    ----------
+    path : str or Path
+        The JSON file.
+
+    Returns
+    -------
+    SavedSurrogate
+        The fitted model (predicting bit for bit as the saved one did), its kind,
+        the caller's metadata and the provenance fields.
+
+    Raises
+    ------
+    FileNotFoundError
+        If ``path`` is not a file.
+    softbend.errors.SchemaError
+        If the file is not JSON, not a softbend surrogate, has a newer schema
+        version, lacks a key, or its content cannot rebuild the model; the message
+        names the file.
+    """
+    path = Path(path)
+    document = _read_document(path)
+    model = _restore(document, path)
+    return SavedSurrogate(
+        model=model,
+        kind=document["kind"],
+        metadata=document["metadata"],
+        softbend_version=str(document["softbend_version"]),
+        created_utc=str(document["created_utc"]),
+    )
