@@ -54,6 +54,10 @@ def test_report_has_both_papers_and_their_files(first_run):
         "paper_b/fig4b_loadings.png",
         "paper_b/fig4c_parity.png",
         "paper_b/fig7_designs_analytical.png",
+        "paper_b/surrogates/fig5_parity_errors.png",
+        "paper_b/surrogates/models/plr.json",
+        "paper_b/surrogates/models/xgb.onnx",
+        "paper_b/surrogates/models/mlp.json",
     ):
         assert (out / name).is_file(), name
         assert name in html or not name.endswith(".png"), name
@@ -89,6 +93,14 @@ def test_paper_b_section_physics(first_run):
     assert b["loadings"]["pressure_mpa"] > 0.5
     assert b["loadings"]["t_mm"] < 0.0
     assert 0.0 < b["r2"] < 1.0
+
+
+def test_surrogate_section(first_run):
+    out, summary, _ = first_run
+    models = summary["paper_b_surrogates"]["models"]
+    assert set(models) == {"plr", "xgb", "mlp"}
+    assert all(0.5 < m["r2"] <= 1.0 for m in models.values())
+    assert "Fig. 5" in (out / "index.html").read_text(encoding="utf-8")
 
 
 def test_second_run_resumes_the_campaign(first_run):

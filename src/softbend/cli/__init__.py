@@ -30,11 +30,13 @@ app = typer.Typer(
 def _register() -> None:
     # Imported here so that ``import softbend.cli`` stays cheap and each
     # subcommand module owns its own imports.
-    from softbend.cli import analyze, campaign, curling, reproduce
+    from softbend.cli import analyze, campaign, curling, reproduce, train
 
     app.add_typer(curling.app, name="curling")
     app.add_typer(campaign.app, name="campaign")
     app.command("analyze")(analyze.analyze)
+    app.command("train")(train.train)
+    app.command("predict")(train.predict)
     app.command("reproduce")(reproduce.reproduce)
 
 

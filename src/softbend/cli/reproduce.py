@@ -64,4 +64,20 @@ def reproduce(
             ]
         ],
     )
+    surrogates = summary["paper_b_surrogates"]["models"]
+    _common.print_table(
+        "Paper B: surrogates, grouped 5-fold CV on held-out designs (Fig. 5)",
+        ["model", "best configuration", "R²", "RMSE °", "MAPE %", "1 sample µs"],
+        [
+            [
+                name,
+                m["params"],
+                f"{m['r2']:.5f}",
+                f"{m['rmse_deg']:.3f}",
+                f"{m['mape_pct']:.3f}",
+                f"{m['inference_single_us']:.1f}",
+            ]
+            for name, m in surrogates.items()
+        ],
+    )
     _common.console.print(f"report: {summary['report']}  ({summary['seconds']:.0f} s)")

@@ -169,3 +169,70 @@ def fig7_design_ids() -> list[str]:
     from softbend.design import SFRBADesign
 
     return [SFRBADesign(*values).design_id for values in FIG7_DESIGNS]
+
+
+def add_surrogate_section(report: Report, summary: dict[str, Any], *, root: Path) -> None:
+    """Append the surrogate search (paper B Fig. 5) to ``report``."""
+    from softbend.surrogates.search import MODEL_TITLES
+
+    settings = summary["settings"]
+    section = report.section("Paper B — surrogate models (Fig. 5)")
+    section.text(
+        f"Grid search ('{settings['grid']}' grid) with {settings['folds']}-fold cross-validation "
+        f"grouped by design on the campaign above ({settings['n_samples']} samples, "
+        f"{settings['n_designs']} designs): every score is that of designs the model never saw. "
+        f"The best configuration of each family (lowest mean fold RMSE) is refitted on all "
+        f"designs; its inference time is measured on this machine (single sample: the NumPy "
+        f"fast path where the model has one). MAPE leaves out |θ| < "
+        f"{settings['mape_threshold_deg']:g}°. MLP: {settings['mlp_epochs']} epochs; XGBoost: "
+        f"{settings['xgb_trees']} trees. Paper B's figures come from its FEM data.",
+        note=True,
+    )
+    rows = []
+    for name, m in summary["models"].items():
+        paper = m["paper_b"]
+        rows.append(
+            [
+                MODEL_TITLES[name],
+                m["params"],
+                m["r2"],
+                m["rmse_deg"],
+                m["mape_pct"],
+                m["max_abs_error_deg"],
+                m["inference_single_us"],
+                m["inference_batch_ms"],
+                m.get("onnx_max_abs_diff_deg", ""),
+                paper["params"],
+                paper["r2"],
+                paper["mape_pct"],
+                paper["inference_ms"],
+            ]
+        )
+    section.table(
+        [
+            "model",
+            "best configuration",
+            "R²",
+            "RMSE (°)",
+            "MAPE (%)",
+            "max |error| (°)",
+            "1 sample (µs)",
+            "10 000 samples (ms)",
+            "ONNX − predict (°)",
+            "paper B configuration",
+            "paper B R²",
+            "paper B MAPE (%)",
+            "paper B inference (ms)",
+        ],
+        rows,
+        caption="Best model of each family, cross-validated on held-out designs",
+    )
+    files = summary["files"]
+    if "fig5" in files:
+        section.figure(
+            Path(files["fig5"]),
+            "Fig. 5 — out-of-fold predictions against the data, and the error distribution",
+            root=root,
+        )
+    if "mlp_loss" in files:
+        section.figure(Path(files["mlp_loss"]), "Training loss of the refitted MLP", root=root)

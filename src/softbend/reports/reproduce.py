@@ -6,7 +6,8 @@ softbend can reproduce, and the data, models and figures beside it:
 - ``paper_a/``: synthetic curling-actuator experiments (CSV), the leave-one-
   experiment-out NARX/GG-SVR identification (metrics, models, Figs. 5–7, 9, 10).
 - ``paper_b/``: the Table 1 campaign database (DuckDB; resumed if present), its
-  Parquet export, and the preliminary analysis (Fig. 4).
+  Parquet export, the preliminary analysis (Fig. 4), and the surrogate models
+  trained on it with the quick grid (``paper_b/surrogates/``, Fig. 5).
 """
 
 from __future__ import annotations
@@ -145,6 +146,40 @@ def _paper_b(
     }
 
 
+def _paper_b_surrogates(
+    report: Report, out_dir: Path, seed: int, progress: Progress | None
+) -> dict[str, Any]:
+    from softbend.reports import paper_b
+    from softbend.surrogates.workflow import train_surrogates
+
+    folder = out_dir / "paper_b"
+
+    def on_progress(phase: str, done: int, total: int) -> None:
+        if progress is not None:
+            progress(f"paper B: surrogates, {phase}", done, total)
+
+    start = time.perf_counter()
+    _, summary = train_surrogates(
+        folder / "campaign.duckdb",
+        folder / "surrogates",
+        grid_name="quick",
+        seed=seed,
+        progress=on_progress,
+    )
+    paper_b.add_surrogate_section(report, summary, root=out_dir)
+    return {
+        "seconds": time.perf_counter() - start,
+        "best_by_mape": summary["best_by_mape"],
+        "models": {
+            name: {
+                key: m[key]
+                for key in ("params", "r2", "rmse_deg", "mape_pct", "inference_single_us")
+            }
+            for name, m in summary["models"].items()
+        },
+    }
+
+
 def run_reproduce(
     out_dir: str | Path,
     *,
@@ -200,6 +235,7 @@ def run_reproduce(
     summary: dict[str, Any] = {"seed": seed}
     summary["paper_a"] = _paper_a(report, out_dir, seed, progress)
     summary["paper_b"] = _paper_b(report, out_dir, workers, progress, design_space)
+    summary["paper_b_surrogates"] = _paper_b_surrogates(report, out_dir, seed, progress)
     path = report.write(out_dir / "index.html")
     summary["report"] = str(path)
     summary["seconds"] = (datetime.now(UTC) - started).total_seconds()

@@ -570,8 +570,9 @@ def _cpu_settings(num_threads: int | None) -> Iterator[None]:
     """Torch intra-op threads (if given) and flush-to-zero of subnormal floats while training.
 
     Squared gradients in Adam's second moment can fall into the subnormal range,
-    where x86 arithmetic is many times slower; flushing them to zero changes
-    nothing measurable in the result. Both settings are restored afterwards.
+    where x86 arithmetic is slower (measured: 200 epochs of one 63x65 model on
+    22 000 rows, 4.5 s without, 3.6 s with flush-to-zero). Both settings are
+    restored afterwards (flush-to-zero is switched off again).
     """
     threads_before = torch.get_num_threads()
     if num_threads is not None:

@@ -1,0 +1,165 @@
+"""``softbend train`` and ``softbend predict``: surrogate models of a campaign (paper B §4.1)."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import typer
+from rich.progress import (
+    BarColumn,
+    MofNCompleteColumn,
+    Progress,
+    TextColumn,
+    TimeElapsedColumn,
+    TimeRemainingColumn,
+)
+
+from softbend.cli import _common
+
+
+def _floats(text: str, name: str) -> list[float]:
+    try:
+        values = [float(v) for v in text.split(",") if v.strip()]
+    except ValueError:
+        raise ValueError(
+            f"The '{name}' must be comma-separated numbers, e.g. 0.05,0.1. Got {text!r} instead."
+        ) from None
+    if not values:
+        raise ValueError(f"The '{name}' must hold at least one number. Got {text!r} instead.")
+    return values
+
+
+def train(
+    db: Path = typer.Argument(..., help="Campaign database (DuckDB) to learn from."),
+    out: Path = typer.Option(..., "--out", help="Folder for models, tables and figures."),
+    models: str = typer.Option("plr,xgb,mlp", help="Comma-separated families: plr, xgb, mlp."),
+    grid: str = typer.Option("quick", help="Hyperparameter grid: quick or paper."),
+    folds: int = typer.Option(5, help="Design-grouped cross-validation folds."),
+    seed: int = typer.Option(0, help="Seed of the folds, XGBoost and the MLP."),
+    device: str = typer.Option("auto", help="MLP device: auto, cpu or cuda."),
+    epochs: int | None = typer.Option(
+        None, help="MLP epochs (default: 200 quick grid, 1000 paper grid as paper B)."
+    ),
+    jobs: int | None = typer.Option(None, "--jobs", help="XGBoost threads (default: all)."),
+    no_onnx: bool = typer.Option(False, "--no-onnx", help="Skip the ONNX export."),
+    as_json: bool = typer.Option(False, "--json", help="Print the results as JSON."),
+) -> None:
+    """Grid-search the surrogates with grouped K-fold CV, refit the best, save and plot."""
+    from softbend.surrogates.workflow import train_surrogates
+
+    names = [m.strip() for m in models.split(",") if m.strip()]
+    columns = [
+        TextColumn("{task.description}"),
+        BarColumn(),
+        MofNCompleteColumn(),
+        TimeElapsedColumn(),
+        TextColumn("ETA"),
+        TimeRemainingColumn(),
+    ]
+    with Progress(*columns, console=_common.err_console, disable=as_json) as bar:
+        tasks: dict[str, int] = {}
+
+        def progress(phase: str, done: int, total: int) -> None:
+            if phase not in tasks:
+                tasks[phase] = bar.add_task(phase, total=total)
+            bar.update(tasks[phase], completed=done, total=total)
+
+        _, summary = train_surrogates(
+            db,
+            out,
+            models=names,
+            grid_name=grid,
+            folds=folds,
+            seed=seed,
+            device=device,
+            n_jobs=jobs,
+            epochs=epochs,
+            export_onnx=not no_onnx,
+            progress=progress,
+        )
+    if as_json:
+        _common.print_json(summary)
+        return
+    print_summary(summary)
+    _common.console.print(f"models, tables and figures written to {out}")
+
+
+def print_summary(summary: dict) -> None:
+    """The per-family table beside paper B's figures (used by reproduce too)."""
+    rows = []
+    for name, m in summary["models"].items():
+        paper = m["paper_b"]
+        rows.append(
+            [
+                name,
+                m["params"],
+                f"{m['r2']:.5f}",
+                f"{m['rmse_deg']:.3f}",
+                f"{m['mape_pct']:.3f}",
+                f"{m['max_abs_error_deg']:.2f}",
+                f"{m['inference_single_us']:.1f}",
+                f"{m['inference_batch_ms']:.2f}",
+                f"{paper['r2']} / {paper['mape_pct']} % / {paper['inference_ms']} ms",
+            ]
+        )
+    _common.print_table(
+        "Surrogates: grouped cross-validation (held-out designs) and inference",
+        [
+            "model",
+            "best configuration",
+            "R²",
+            "RMSE °",
+            "MAPE %",
+            "max |e| °",
+            "1 sample µs",
+            "10k batch ms",
+            "paper B R² / MAPE / IT",
+        ],
+        rows,
+    )
+
+
+def predict(
+    model: Path = typer.Argument(..., help="A model saved by 'softbend train' (models/*.json)."),
+    design: str = typer.Option(..., help="l,r,t,b,phi,lc in mm and degrees, e.g. 100,6,2,2,5,8."),
+    pressure: str = typer.Option(..., help="Pressures in MPa, comma-separated, e.g. 0.05,0.1."),
+    as_json: bool = typer.Option(False, "--json", help="Print the predictions as JSON."),
+) -> None:
+    """Predict the bending angle of a design at the given pressures."""
+    import numpy as np
+
+    from softbend.design import SFRBADesign
+    from softbend.surrogates.persistence import load_surrogate
+
+    values = _floats(design, "design")
+    if len(values) != 6:
+        raise ValueError(
+            "The 'design' must be 6 numbers l,r,t,b,phi,lc (mm, mm, mm, mm, deg, mm). "
+            f"Got {len(values)}: {design!r}."
+        )
+    checked = SFRBADesign(*values)  # validates the ranges, names the parameter
+    pressures = np.asarray(_floats(pressure, "pressure"))
+    if not np.all(np.isfinite(pressures)) or np.any(pressures < 0):
+        raise ValueError(f"The 'pressure' must be finite and >= 0 MPa. Got {pressure!r} instead.")
+    saved = load_surrogate(model)
+    row = [checked.l_mm, checked.r_mm, checked.t_mm, checked.b_mm, checked.phi_deg, checked.lc_mm]
+    X = np.column_stack([np.tile(row, (pressures.size, 1)), pressures])
+    angles = saved.model.predict(X)
+    if as_json:
+        _common.print_json(
+            {
+                "model": str(model),
+                "kind": saved.kind,
+                "design": dict(
+                    zip(["l_mm", "r_mm", "t_mm", "b_mm", "phi_deg", "lc_mm"], row, strict=True)
+                ),
+                "pressure_mpa": pressures.tolist(),
+                "angle_deg": angles.tolist(),
+            }
+        )
+        return
+    _common.print_table(
+        f"{saved.kind} surrogate, design {checked.design_id}",
+        ["pressure (MPa)", "angle (°)"],
+        [[f"{p:g}", f"{a:.2f}"] for p, a in zip(pressures, angles, strict=True)],
+    )

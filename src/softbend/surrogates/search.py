@@ -1,0 +1,457 @@
+"""Grid search with design-grouped K-fold cross-validation (paper B §4.1).
+
+Every configuration of every model family is fitted on K−1 folds and scored
+on the held-out fold, where the folds are groups of whole designs: a pressure
+sweep is never split between training and validation, so the score is that of
+an unseen actuator, not of an unseen pressure of a seen one. The best
+configuration of each family (lowest mean validation RMSE) is refitted on all
+the data. The MLP configurations are trained together in one batched tensor
+program (:func:`softbend.surrogates.batched.train_mlp_grid`).
+
+Grids (``grid="paper"`` is paper B's):
+
+========  ==================================  ====================================
+family    ``quick``                           ``paper``
+========  ==================================  ====================================
+``plr``   degree 2, 4, 6                      degree 2 … 10
+``xgb``   max depth 6, 9 x learning rate      max depth 1 … 20 x learning rate
+          0.2, 0.4                            0.1, 0.2 … 1.0
+``mlp``   hidden (55, 55), (63, 65)           hidden 55 … 65 x 55 … 65
+========  ==================================  ====================================
+
+XGBoost uses 300 trees (paper B does not give the number), histogram tree
+method. The MLP trains with batch 1024 and Adam lr 6e-4 (paper B) for 1000
+epochs in the ``paper`` grid (paper B) and 200 in the ``quick`` grid (about a
+tenth of the time on a laptop CPU, at some cost in accuracy), unless ``epochs``
+is given.
+"""
+
+from __future__ import annotations
+
+import logging
+import time
+from collections.abc import Callable
+from dataclasses import dataclass, field
+from typing import Any
+
+import numpy as np
+import pandas as pd
+
+from softbend._validation import check_choice, check_range
+from softbend.surrogates.features import TrainingData
+from softbend.surrogates.metrics import MAPE_THRESHOLD_DEG, accuracy, inference_time
+
+logger = logging.getLogger(__name__)
+
+#: Model families, by their command-line names.
+MODEL_NAMES: tuple[str, ...] = ("plr", "xgb", "mlp")
+
+#: Long names of the families.
+MODEL_TITLES: dict[str, str] = {
+    "plr": "polynomial regression",
+    "xgb": "XGBoost",
+    "mlp": "normalized MLP",
+}
+
+#: Grid names.
+GRID_NAMES: tuple[str, ...] = ("quick", "paper")
+
+#: Trees per XGBoost model.
+XGB_TREES = 300
+
+#: MLP epochs per grid (paper B: 1000).
+MLP_EPOCHS: dict[str, int] = {"quick": 200, "paper": 1000}
+
+
+def grid(name: str, model: str) -> list[dict[str, Any]]:
+    """The configurations of ``model`` in the grid ``name`` (see the module docstring)."""
+    check_choice(name, "grid", "surrogate search", GRID_NAMES)
+    check_choice(model, "model", "surrogate search", MODEL_NAMES)
+    if model == "plr":
+        degrees = (2, 4, 6) if name == "quick" else range(2, 11)
+        return [{"degree": int(d)} for d in degrees]
+    if model == "xgb":
+        if name == "quick":
+            depths, rates = (6, 9), (0.2, 0.4)
+        else:
+            depths, rates = range(1, 21), [round(0.1 * k, 1) for k in range(1, 11)]
+        return [{"max_depth": int(d), "learning_rate": float(r)} for d in depths for r in rates]
+    sizes = (
+        ((55, 55), (63, 65))
+        if name == "quick"
+        else [(a, b) for a in range(55, 66) for b in range(55, 66)]
+    )
+    return [{"hidden_sizes": (int(a), int(b))} for a, b in sizes]
+
+
+def describe(params: dict[str, Any]) -> str:
+    """Short text of a configuration, e.g. ``"max_depth=9, learning_rate=0.2"``."""
+    return ", ".join(f"{k}={v}" for k, v in params.items())
+
+
+def grouped_splits(
+    groups: np.ndarray, n_splits: int = 5, seed: int = 0
+) -> list[tuple[np.ndarray, np.ndarray]]:
+    """K folds of whole groups (designs), shuffled with ``seed``.
+
+    Returns
+    -------
+    list of (train_idx, val_idx)
+        Row indices; every group's rows are in exactly one ``val_idx``.
+    """
+    from sklearn.model_selection import GroupKFold
+
+    n_groups = np.unique(groups).size
+    n_splits = int(
+        check_range(
+            n_splits,
+            "folds",
+            "grouped_splits",
+            low=2,
+            low_inclusive=True,
+            high=max(2, n_groups),
+            high_inclusive=True,
+        )
+    )
+    if n_groups < n_splits:
+        raise ValueError(
+            f"Grouped {n_splits}-fold cross-validation needs at least {n_splits} designs. "
+            f"Got {n_groups}."
+        )
+    splitter = GroupKFold(n_splits=n_splits, shuffle=True, random_state=seed)
+    dummy = np.zeros((groups.size, 1))
+    return [(train, val) for train, val in splitter.split(dummy, groups=groups)]
+
+
+@dataclass
+class FamilyResult:
+    """The search over one model family.
+
+    Attributes
+    ----------
+    name : str
+        ``"plr"``, ``"xgb"`` or ``"mlp"``.
+    params : dict
+        Best configuration.
+    cv : dict
+        Accuracy of the best configuration on the pooled out-of-fold
+        predictions (:func:`softbend.surrogates.metrics.accuracy`), plus
+        ``r2_fold_mean``, ``r2_fold_std``, ``rmse_fold_mean``, ``rmse_fold_std``.
+    oof_pred : ndarray
+        Out-of-fold predictions of the best configuration, degrees (each row
+        predicted by the model that did not see its design).
+    model : estimator
+        The best configuration refitted on all rows.
+    timing : dict
+        :func:`softbend.surrogates.metrics.inference_time` of ``model``.
+    fit_s : float
+        Wall time of the refit, s.
+    search_s : float
+        Wall time of the cross-validated search of this family, s.
+    """
+
+    name: str
+    params: dict[str, Any]
+    cv: dict[str, float]
+    oof_pred: np.ndarray
+    model: Any
+    timing: dict[str, float]
+    fit_s: float
+    search_s: float
+
+
+@dataclass
+class SearchResult:
+    """Outcome of :func:`search`.
+
+    Attributes
+    ----------
+    cv_results : pandas.DataFrame
+        One row per (family, configuration): mean and std over folds of R²,
+        RMSE, MAPE, the pooled figures, fit seconds, and a ``status`` (``ok``
+        or why it was skipped).
+    families : dict
+        ``{name: FamilyResult}`` for each family searched.
+    data : TrainingData
+        The data used.
+    settings : dict
+        Grid, folds, seed, device, epochs.
+    """
+
+    cv_results: pd.DataFrame
+    families: dict[str, FamilyResult]
+    data: TrainingData
+    settings: dict[str, Any] = field(default_factory=dict)
+
+    def summary(self) -> pd.DataFrame:
+        """One row per family: best configuration, CV accuracy, inference time."""
+        rows = []
+        for name, fam in self.families.items():
+            rows.append(
+                {
+                    "model": name,
+                    "params": describe(fam.params),
+                    "r2": fam.cv["r2"],
+                    "rmse_deg": fam.cv["rmse_deg"],
+                    "mape_pct": fam.cv["mape_pct"],
+                    "max_abs_error_deg": fam.cv["max_abs_error_deg"],
+                    "single_us": fam.timing["single_us"],
+                    "batch_10k_ms": fam.timing["batch_ms"],
+                    "fit_s": fam.fit_s,
+                    "search_s": fam.search_s,
+                }
+            )
+        return pd.DataFrame(rows)
+
+
+Progress = Callable[[str, int, int], None]
+
+
+def _make(
+    model: str, params: dict[str, Any], *, seed: int, n_jobs: int | None, device: str, epochs: int
+) -> Any:
+    if model == "plr":
+        from softbend.surrogates.polynomial import PolynomialRegressor
+
+        return PolynomialRegressor(**params)
+    if model == "xgb":
+        from xgboost import XGBRegressor
+
+        return XGBRegressor(
+            n_estimators=XGB_TREES,
+            objective="reg:squarederror",
+            tree_method="hist",
+            random_state=seed,
+            n_jobs=n_jobs,
+            **params,
+        )
+    from softbend.surrogates.mlp import NormalizedMLPRegressor
+
+    return NormalizedMLPRegressor(**params, epochs=epochs, seed=seed, device=device)
+
+
+def _fold_scores(
+    y: np.ndarray, pred: np.ndarray, splits: list[tuple[np.ndarray, np.ndarray]], threshold: float
+) -> dict[str, float]:
+    per_fold = [accuracy(y[val], pred[val], mape_threshold_deg=threshold) for _, val in splits]
+    pooled = accuracy(y, pred, mape_threshold_deg=threshold)
+    r2s = np.array([f["r2"] for f in per_fold])
+    rmses = np.array([f["rmse_deg"] for f in per_fold])
+    mapes = np.array([f["mape_pct"] for f in per_fold])
+    return {
+        **pooled,
+        "r2_fold_mean": float(r2s.mean()),
+        "r2_fold_std": float(r2s.std(ddof=1)),
+        "rmse_fold_mean": float(rmses.mean()),
+        "rmse_fold_std": float(rmses.std(ddof=1)),
+        "mape_fold_mean": float(np.nanmean(mapes)),
+    }
+
+
+def _cv_sequential(
+    model: str,
+    configs: list[dict[str, Any]],
+    data: TrainingData,
+    splits: list[tuple[np.ndarray, np.ndarray]],
+    make: Callable[[dict[str, Any]], Any],
+    tick: Callable[[], None],
+) -> list[tuple[dict[str, Any], np.ndarray | None, float, str]]:
+    """(params, oof predictions or None, fit seconds, status) per configuration."""
+    out = []
+    for params in configs:
+        pred = np.empty_like(data.y)
+        start = time.perf_counter()
+        fitted = 0
+        try:
+            for train, val in splits:
+                estimator = make(params).fit(data.X[train], data.y[train])
+                pred[val] = estimator.predict(data.X[val])
+                fitted += 1
+                tick()
+        except ValueError as exc:
+            # Only the polynomial's memory guard is a reason to skip a configuration.
+            if model != "plr" or "max_memory_mb" not in str(exc):
+                raise
+            logger.warning("%s %s skipped: %s", model, describe(params), exc)
+            for _ in range(len(splits) - fitted):
+                tick()
+            out.append((params, None, time.perf_counter() - start, f"skipped: {exc}"))
+            continue
+        out.append((params, pred, time.perf_counter() - start, "ok"))
+    return out
+
+
+def _cv_mlp_batched(
+    configs: list[dict[str, Any]],
+    data: TrainingData,
+    splits: list[tuple[np.ndarray, np.ndarray]],
+    *,
+    epochs: int,
+    seed: int,
+    device: str,
+    progress: Callable[[int, int], None] | None,
+) -> list[tuple[dict[str, Any], np.ndarray | None, float, str]]:
+    from softbend.surrogates.batched import train_mlp_grid
+
+    sizes = [tuple(p["hidden_sizes"]) for p in configs]
+    start = time.perf_counter()
+    result = train_mlp_grid(
+        data.X, data.y, splits, sizes, epochs=epochs, seed=seed, device=device, progress=progress
+    )
+    seconds = (time.perf_counter() - start) / max(1, len(configs))
+    out = []
+    for i, params in enumerate(configs):
+        pred = np.empty_like(data.y)
+        for j in range(len(splits)):
+            trained = result.model(i, j)
+            pred[trained.val_index] = trained.val_pred_deg
+        out.append((params, pred, seconds, "ok"))
+    return out
+
+
+def search(
+    data: TrainingData,
+    *,
+    models: tuple[str, ...] | list[str] = MODEL_NAMES,
+    grid_name: str = "quick",
+    folds: int = 5,
+    seed: int = 0,
+    device: str = "auto",
+    n_jobs: int | None = None,
+    epochs: int | None = None,
+    mape_threshold_deg: float = MAPE_THRESHOLD_DEG,
+    param_grid: dict[str, list[dict[str, Any]]] | None = None,
+    progress: Progress | None = None,
+) -> SearchResult:
+    """Grouped K-fold grid search of each model family, then a refit of the best.
+
+    Parameters
+    ----------
+    data : TrainingData
+        From :func:`softbend.surrogates.features.training_data`.
+    models : sequence of str
+        Families among ``"plr"``, ``"xgb"``, ``"mlp"``.
+    grid_name : {"quick", "paper"}
+        Hyperparameter grid (module docstring).
+    folds : int
+        Number of design-grouped folds (default 5, as paper B).
+    seed : int
+        Seed of the fold assignment, XGBoost and the MLP.
+    device : {"auto", "cpu", "cuda"}
+        Where the MLP trains.
+    n_jobs : int, optional
+        XGBoost threads (default: all cores).
+    epochs : int, optional
+        MLP epochs (default :data:`MLP_EPOCHS` of the grid: 200 quick, 1000 paper).
+    mape_threshold_deg : float
+        Smallest |θ| in the MAPE, degrees.
+    param_grid : dict, optional
+        Own configurations for some families, replacing the named grid for
+        them, e.g. ``{"plr": [{"degree": 3}, {"degree": 5}]}``.
+    progress : callable, optional
+        ``progress(phase, done, total)``.
+
+    Returns
+    -------
+    SearchResult
+    """
+    owner = "surrogate search"
+    models = list(dict.fromkeys(models))
+    if not models:
+        raise ValueError(
+            f"The 'models' of {owner} must name at least one of {', '.join(MODEL_NAMES)}."
+        )
+    for model in models:
+        check_choice(model, "models", owner, MODEL_NAMES)
+    check_choice(grid_name, "grid", owner, GRID_NAMES)
+    check_choice(device, "device", owner, ("auto", "cpu", "cuda"))
+    epochs = (
+        MLP_EPOCHS[grid_name]
+        if epochs is None
+        else int(check_range(epochs, "epochs", owner, low=1, low_inclusive=True))
+    )
+    splits = grouped_splits(data.groups, folds, seed)
+    rows: list[dict[str, Any]] = []
+    families: dict[str, FamilyResult] = {}
+    param_grid = dict(param_grid or {})
+    for name in param_grid:
+        check_choice(name, "param_grid", owner, MODEL_NAMES)
+    for model in models:
+        configs = list(param_grid.get(model) or grid(grid_name, model))
+        phase = f"{model}: {len(configs)} configurations x {len(splits)} folds"
+        started = time.perf_counter()
+
+        def make(params: dict[str, Any], model: str = model) -> Any:
+            return _make(model, params, seed=seed, n_jobs=n_jobs, device=device, epochs=epochs)
+
+        if model == "mlp":
+
+            def on_epoch(done: int, total_epochs: int, phase: str = phase) -> None:
+                if progress is not None:
+                    progress(phase, done, total_epochs)
+
+            outcomes = _cv_mlp_batched(
+                configs, data, splits, epochs=epochs, seed=seed, device=device, progress=on_epoch
+            )
+        else:
+            total = len(configs) * len(splits)
+            done = 0
+
+            def tick(phase: str = phase, total: int = total) -> None:
+                nonlocal done
+                done += 1
+                if progress is not None:
+                    progress(phase, done, total)
+
+            if progress is not None:
+                progress(phase, 0, total)
+            outcomes = _cv_sequential(model, configs, data, splits, make, tick)
+        best: tuple[float, dict[str, Any], np.ndarray, dict[str, float]] | None = None
+        for params, pred, seconds, status in outcomes:
+            row: dict[str, Any] = {
+                "model": model,
+                "params": describe(params),
+                "status": status,
+                "fit_s_per_config": seconds,
+            }
+            if pred is not None:
+                scores = _fold_scores(data.y, pred, splits, mape_threshold_deg)
+                row.update(scores)
+                if best is None or scores["rmse_fold_mean"] < best[0]:
+                    best = (scores["rmse_fold_mean"], params, pred, scores)
+            rows.append(row)
+        search_s = time.perf_counter() - started
+        if best is None:
+            logger.warning("no configuration of %s could be fitted", model)
+            continue
+        _, params, pred, scores = best
+        start = time.perf_counter()
+        final = make(params).fit(data.X, data.y)
+        fit_s = time.perf_counter() - start
+        families[model] = FamilyResult(
+            name=model,
+            params=params,
+            cv=scores,
+            oof_pred=pred,
+            model=final,
+            timing=inference_time(final, data.X, seed=seed),
+            fit_s=fit_s,
+            search_s=search_s,
+        )
+    settings = {
+        "grid": grid_name
+        if not param_grid
+        else f"{grid_name} (own grid for {', '.join(param_grid)})",
+        "folds": len(splits),
+        "seed": seed,
+        "device": device,
+        "mlp_epochs": epochs,
+        "xgb_trees": XGB_TREES,
+        "mape_threshold_deg": mape_threshold_deg,
+        "n_samples": data.n_samples,
+        "n_designs": data.n_groups,
+        "data_hash": data.data_hash,
+    }
+    return SearchResult(
+        cv_results=pd.DataFrame(rows), families=families, data=data, settings=settings
+    )

@@ -1,0 +1,96 @@
+import json
+
+import numpy as np
+import pytest
+
+from softbend.cli import main
+
+
+def _run(args, capsys):
+    code = main(args)
+    captured = capsys.readouterr()
+    return code, captured.out, captured.err
+
+
+def test_train_writes_models_tables_figures_and_predicts(small_campaign, tmp_path, capsys):
+    args = ["train", str(small_campaign), "--out", str(tmp_path), "--models", "plr,mlp"]
+    code, out, _ = _run([*args, "--epochs", "20", "--folds", "4", "--json"], capsys)
+    assert code == 0
+    summary = json.loads(out)
+    assert set(summary["models"]) == {"plr", "mlp"}
+    for name in ("plr", "mlp"):
+        m = summary["models"][name]
+        assert 0.0 < m["r2"] <= 1.0 and m["onnx_max_abs_diff_deg"] < 1e-3
+        assert (tmp_path / "models" / f"{name}.json").is_file()
+        assert (tmp_path / "models" / f"{name}.onnx").is_file()
+    for name in ("cv_results.csv", "summary.csv", "fig5_parity_errors.png", "mlp_loss.png"):
+        assert (tmp_path / name).is_file(), name
+    assert summary["settings"]["folds"] == 4
+
+    from softbend.surrogates.persistence import load_surrogate
+
+    model = load_surrogate(tmp_path / "models" / "plr.json").model
+    code, out, _ = _run(
+        [
+            "predict",
+            str(tmp_path / "models" / "plr.json"),
+            "--design",
+            "100,6,2,2,5,8",
+            "--pressure",
+            "0,0.05,0.1",
+            "--json",
+        ],
+        capsys,
+    )
+    assert code == 0
+    angles = json.loads(out)["angle_deg"]
+    X = np.array([[100, 6, 2, 2, 5, 8, p] for p in (0, 0.05, 0.1)], dtype=float)
+    np.testing.assert_array_equal(angles, model.predict(X))
+    assert angles[0] < angles[1] < angles[2]
+
+
+@pytest.mark.parametrize(
+    ("extra", "needle"),
+    [
+        (["--models", "plr,svm"], "'models'"),
+        (["--grid", "huge"], "'grid'"),
+        (["--device", "tpu"], "'device'"),
+        (["--folds", "1"], "folds"),
+    ],
+)
+def test_train_bad_input_is_one_line_exit_2(small_campaign, tmp_path, capsys, extra, needle):
+    code, _, err = _run(["train", str(small_campaign), "--out", str(tmp_path), *extra], capsys)
+    assert code == 2
+    lines = err.strip().splitlines()
+    assert len(lines) == 1 and needle in lines[0]
+
+
+def test_train_missing_database(tmp_path, capsys):
+    code, _, err = _run(["train", str(tmp_path / "nope.duckdb"), "--out", str(tmp_path)], capsys)
+    assert code == 2 and "does not exist" in err
+
+
+@pytest.mark.parametrize(
+    ("design", "pressure", "needle"),
+    [
+        ("100,6,2,2,5", "0.1", "6 numbers"),
+        ("100,6,-2,2,5,8", "0.1", "t_mm"),
+        ("100,6,2,2,5,8", "0.1,abc", "'pressure'"),
+        ("100,6,2,2,5,8", "-0.1", "'pressure'"),
+    ],
+)
+def test_predict_bad_input(tmp_path, capsys, design, pressure, needle):
+    fake = tmp_path / "m.json"
+    fake.write_text("{}")
+    code, _, err = _run(["predict", str(fake), "--design", design, "--pressure", pressure], capsys)
+    assert code == 2
+    assert needle in err and len(err.strip().splitlines()) == 1
+
+
+def test_predict_not_a_model(tmp_path, capsys):
+    fake = tmp_path / "m.json"
+    fake.write_text('{"hello": 1}')
+    code, _, err = _run(
+        ["predict", str(fake), "--design", "100,6,2,2,5,8", "--pressure", "0.1"], capsys
+    )
+    assert code == 2 and len(err.strip().splitlines()) == 1
