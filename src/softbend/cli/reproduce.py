@@ -72,7 +72,7 @@ def reproduce(
             [
                 name,
                 m["params"],
-                f"{m['r2']:.5f}",
+                f"{m['r2']:.6f}",
                 f"{m['rmse_deg']:.3f}",
                 f"{m['mape_pct']:.3f}",
                 f"{m['inference_single_us']:.1f}",

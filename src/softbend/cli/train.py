@@ -93,7 +93,7 @@ def print_summary(summary: dict) -> None:
             [
                 name,
                 m["params"],
-                f"{m['r2']:.5f}",
+                f"{m['r2']:.6f}",
                 f"{m['rmse_deg']:.3f}",
                 f"{m['mape_pct']:.3f}",
                 f"{m['max_abs_error_deg']:.2f}",

@@ -44,7 +44,7 @@ def parity_and_errors(result: SearchResult, path: Path) -> Path:
         ax_parity.set_ylabel("predicted (°), held-out designs")
         ax_parity.set_title(
             f"{MODEL_TITLES[name]} ({describe(fam.params)})\n"
-            f"R² {fam.cv['r2']:.4f}, RMSE {fam.cv['rmse_deg']:.2f}°, "
+            f"R² {fam.cv['r2']:.6f}, RMSE {fam.cv['rmse_deg']:.2f}°, "
             f"MAPE {fam.cv['mape_pct']:.2f} %",
             fontsize=9,
         )
