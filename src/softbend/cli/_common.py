@@ -107,3 +107,51 @@ def progress_bar(
             bar.update(task, advance=n, info=info)
 
         yield advance
+
+
+@contextmanager
+def phase_progress(*, enabled: bool = True) -> Iterator[Callable[[str, int, int], None]]:
+    """Yield ``progress(phase, done, total)`` for jobs with several phases.
+
+    On a terminal each phase gets a rich progress bar on stderr. Elsewhere (a
+    batch queue, a CI log) a bar would draw nothing until the end, so a plain
+    line is written to stderr when a phase starts, at every further tenth of
+    it, and when it ends.
+    """
+    if not enabled:
+        yield lambda phase, done, total: None
+        return
+    if err_console.is_terminal:
+        columns = [
+            TextColumn("{task.description}"),
+            BarColumn(),
+            MofNCompleteColumn(),
+            TimeElapsedColumn(),
+            TextColumn("ETA"),
+            TimeRemainingColumn(),
+        ]
+        with Progress(*columns, console=err_console) as bar:
+            tasks: dict[str, Any] = {}
+
+            def draw(phase: str, done: int, total: int) -> None:
+                if phase not in tasks:
+                    tasks[phase] = bar.add_task(phase, total=total)
+                bar.update(tasks[phase], completed=done, total=total)
+
+            yield draw
+        return
+    import time
+
+    last_tenth: dict[str, int] = {}
+    started: dict[str, float] = {}
+
+    def write(phase: str, done: int, total: int) -> None:
+        tenth = 10 if total <= 0 else min(10, (10 * done) // total)
+        if phase in last_tenth and tenth <= last_tenth[phase]:
+            return
+        started.setdefault(phase, time.monotonic())
+        last_tenth[phase] = tenth
+        elapsed = time.monotonic() - started[phase]
+        err_console.print(f"{phase}: {done}/{total} ({elapsed:.0f} s)", highlight=False)
+
+    yield write

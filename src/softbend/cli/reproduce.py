@@ -5,7 +5,6 @@ from __future__ import annotations
 from pathlib import Path
 
 import typer
-from rich.progress import BarColumn, MofNCompleteColumn, Progress, TextColumn, TimeElapsedColumn
 
 from softbend.cli import _common
 
@@ -21,20 +20,7 @@ def reproduce(
     """Run the papers' pipelines end to end on built-in defaults; write OUT/index.html."""
     from softbend.reports.reproduce import run_reproduce
 
-    columns = [
-        TextColumn("{task.description}"),
-        BarColumn(),
-        MofNCompleteColumn(),
-        TimeElapsedColumn(),
-    ]
-    with Progress(*columns, console=_common.err_console, disable=as_json) as bar:
-        tasks: dict[str, int] = {}
-
-        def progress(phase: str, done: int, total: int) -> None:
-            if phase not in tasks:
-                tasks[phase] = bar.add_task(phase, total=total)
-            bar.update(tasks[phase], completed=done, total=total)
-
+    with _common.phase_progress(enabled=not as_json) as progress:
         summary = run_reproduce(out, seed=seed, workers=workers, progress=progress)
     if as_json:
         _common.print_json(summary)

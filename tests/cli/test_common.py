@@ -1,0 +1,23 @@
+from softbend.cli import _common
+
+
+def test_phase_progress_writes_plain_lines_off_a_terminal(capsys):
+    with _common.phase_progress() as progress:
+        for done in range(101):
+            progress("fitting", done, 100)
+        progress("refit", 0, 1)
+        progress("refit", 1, 1)
+    lines = capsys.readouterr().err.strip().splitlines()
+    fitting = [line for line in lines if line.startswith("fitting:")]
+    assert len(fitting) == 11  # start, every tenth, end
+    assert fitting[0].startswith("fitting: 0/100") and fitting[-1].startswith("fitting: 100/100")
+    assert [line.split(" (")[0] for line in lines if line.startswith("refit")] == [
+        "refit: 0/1",
+        "refit: 1/1",
+    ]
+
+
+def test_phase_progress_disabled_is_silent(capsys):
+    with _common.phase_progress(enabled=False) as progress:
+        progress("fitting", 5, 10)
+    assert capsys.readouterr().err == ""
