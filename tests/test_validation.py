@@ -3,7 +3,7 @@ import math
 import numpy as np
 import pytest
 
-from softbend._validation import check_choice, check_finite_array, check_range
+from softbend._validation import check_choice, check_finite_array, check_int, check_range
 from softbend.errors import ConvergenceError, DatasetError, SoftbendError
 
 
@@ -44,3 +44,14 @@ def test_error_hierarchy_lets_standard_handlers_catch_input_errors():
     error = ConvergenceError("Newton stalled", pressure_mpa=0.105, step=21, residual=3e-4)
     assert "pressure_mpa=0.105" in str(error) and "step=21" in str(error)
     assert error.residual == 3e-4
+
+
+@pytest.mark.parametrize("value", [0, -1, 1.0, 2.5, True, "3", None])
+def test_check_int_rejects_non_integers_and_values_below_low(value):
+    with pytest.raises(ValueError, match=r"The 'epochs' of f must be an integer in \[1, inf\)"):
+        check_int(value, "epochs", "f", low=1)
+
+
+def test_check_int_accepts_numpy_integers():
+    assert check_int(np.int64(3), "epochs", "f", low=1) == 3
+    assert type(check_int(np.int64(3), "epochs", "f")) is int

@@ -8,6 +8,7 @@ The format follows scikit-learn's parameter validation::
 from __future__ import annotations
 
 import math
+import numbers
 from collections.abc import Iterable
 from typing import Any
 
@@ -83,6 +84,21 @@ def check_choice(value: Any, name: str, owner: str, choices: Iterable[Any]) -> A
             f"The '{name}' of {owner} must be one of {allowed}. Got {value!r} instead."
         )
     return value
+
+
+def check_int(value: Any, name: str, owner: str, *, low: int = 0) -> int:
+    """Return ``value`` as an int if it is an integer (not a bool) ``>= low``, else raise.
+
+    Raises
+    ------
+    ValueError
+        ``The 'name' of owner must be an integer in [low, inf). Got ... instead.``
+    """
+    if isinstance(value, bool) or not isinstance(value, numbers.Integral) or value < low:
+        raise ValueError(
+            f"The '{name}' of {owner} must be an integer in [{low}, inf). Got {value!r} instead."
+        )
+    return int(value)
 
 
 def check_finite_array(values: Any, name: str, owner: str) -> np.ndarray:

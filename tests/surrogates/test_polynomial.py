@@ -74,7 +74,7 @@ def test_monomial_powers_are_graded_lex_like_polynomial_features(n_features, deg
     ("n_features", "degree"), [(0, 2), (-1, 2), (2.0, 2), (True, 2), (3, -1), (3, 1.5)]
 )
 def test_n_terms_rejects_bad_input(n_features, degree):
-    with pytest.raises(ValueError, match="must be an integer >="):
+    with pytest.raises(ValueError, match=r"must be an integer in \[-?\d+, inf\)"):
         n_terms(n_features, degree)
 
 

@@ -38,7 +38,7 @@ from sklearn.base import BaseEstimator, RegressorMixin, clone
 from sklearn.preprocessing import StandardScaler
 from sklearn.utils.validation import check_is_fitted
 
-from softbend._validation import check_choice, check_finite_array
+from softbend._validation import check_choice, check_finite_array, check_int
 from softbend.errors import DatasetError
 from softbend.identification.metrics import r2
 
@@ -71,19 +71,11 @@ class _Segments:
     labels: list[Any]
 
 
-def _check_lag(value: Any, name: str, owner: str) -> int:
-    if isinstance(value, bool) or not isinstance(value, numbers.Integral) or value < 1:
-        raise ValueError(
-            f"The '{name}' of {owner} must be an integer in [1, inf). Got {value!r} instead."
-        )
-    return int(value)
-
-
 def _lag_structure(
     output_lags: Any, input_lags: Any, include_current_input: Any, owner: str
 ) -> _LagStructure:
-    na = _check_lag(output_lags, "output_lags", owner)
-    nb = _check_lag(input_lags, "input_lags", owner)
+    na = check_int(output_lags, "output_lags", owner, low=1)
+    nb = check_int(input_lags, "input_lags", owner, low=1)
     check_choice(include_current_input, "include_current_input", owner, (True, False))
     first = 0 if include_current_input else 1
     input_offsets = np.arange(first, first + nb)

@@ -23,7 +23,7 @@ from typing import Any, Literal
 import numpy as np
 import pandas as pd
 
-from softbend._validation import check_choice, check_range
+from softbend._validation import check_choice, check_int, check_range
 from softbend.errors import DatasetError
 from softbend.identification.data import Experiment
 from softbend.identification.kernels import ShapeClippedWarning
@@ -69,12 +69,7 @@ class IdentificationConfig:
         check_range(self.C, "C", "IdentificationConfig", low=0.0)
         check_range(self.epsilon, "epsilon", "IdentificationConfig", low=0.0, low_inclusive=True)
         for name in ("output_lags", "input_lags"):
-            value = getattr(self, name)
-            if isinstance(value, bool) or not isinstance(value, int | np.integer) or value < 1:
-                raise ValueError(
-                    f"The '{name}' of IdentificationConfig must be an integer >= 1. "
-                    f"Got {value!r} instead."
-                )
+            check_int(getattr(self, name), name, "IdentificationConfig", low=1)
         check_choice(self.kernel, "kernel", "IdentificationConfig", ("moments", "cv"))
 
 

@@ -45,7 +45,7 @@ import numpy as np
 import torch
 from numpy.typing import ArrayLike
 
-from softbend._validation import check_choice, check_range
+from softbend._validation import check_choice, check_int, check_range
 from softbend.errors import ConvergenceError
 from softbend.surrogates.mlp import NormalizedMLPRegressor, mlp_forward
 
@@ -67,14 +67,6 @@ _DTYPES = {"float32": torch.float32, "float64": torch.float64}
 
 
 # --- validation ------------------------------------------------------------------------
-
-
-def _check_int(value: object, name: str, owner: str, *, low: int) -> int:
-    if isinstance(value, bool) or not isinstance(value, Integral) or value < low:
-        raise ValueError(
-            f"The '{name}' of {owner} must be an integer in [{low}, inf). Got {value!r} instead."
-        )
-    return int(value)
 
 
 def _check_hidden_pair(value: object, name: str, owner: str) -> tuple[int, int]:
@@ -667,10 +659,10 @@ def train_mlp_grid(
             f"The 'hidden_sizes' of {_OWNER} must be a non-empty list of (h1, h2) pairs of "
             f"positive integers. Got {hidden_sizes!r} instead."
         )
-    epochs = _check_int(epochs, "epochs", _OWNER, low=1)
-    batch_size = _check_int(batch_size, "batch_size", _OWNER, low=1)
+    epochs = check_int(epochs, "epochs", _OWNER, low=1)
+    batch_size = check_int(batch_size, "batch_size", _OWNER, low=1)
     learning_rate = check_range(learning_rate, "learning_rate", _OWNER, low=0.0, high=math.inf)
-    seed = _check_int(seed, "seed", _OWNER, low=0)
+    seed = check_int(seed, "seed", _OWNER, low=0)
     device = resolve_device(device)
     dtype = _check_dtype(dtype)
     if progress is not None and not callable(progress):
@@ -678,11 +670,11 @@ def train_mlp_grid(
             f"The 'progress' of {_OWNER} must be a callable or None. Got {progress!r} instead."
         )
     if max_models_per_pass is not None:
-        max_models_per_pass = _check_int(max_models_per_pass, "max_models_per_pass", _OWNER, low=1)
+        max_models_per_pass = check_int(max_models_per_pass, "max_models_per_pass", _OWNER, low=1)
     if max_memory_mb is not None:
         max_memory_mb = check_range(max_memory_mb, "max_memory_mb", _OWNER, low=0.0)
     if num_threads is not None:
-        num_threads = _check_int(num_threads, "num_threads", _OWNER, low=1)
+        num_threads = check_int(num_threads, "num_threads", _OWNER, low=1)
 
     jobs = [
         _Job(c, s, h1, h2, train, val)

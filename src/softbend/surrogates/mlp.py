@@ -23,7 +23,7 @@ from numpy.typing import ArrayLike
 from sklearn.base import BaseEstimator, RegressorMixin
 from sklearn.utils.validation import check_is_fitted, validate_data
 
-from softbend._validation import check_range
+from softbend._validation import check_int, check_range
 from softbend.surrogates.features import FEATURES
 
 __all__ = ["NormalizedMLPRegressor", "mlp_forward"]
@@ -183,12 +183,12 @@ class NormalizedMLPRegressor(RegressorMixin, BaseEstimator):
         from softbend.surrogates import batched
 
         hidden = batched._check_hidden_pair(self.hidden_sizes, "hidden_sizes", _OWNER)
-        epochs = batched._check_int(self.epochs, "epochs", _OWNER, low=1)
-        batch_size = batched._check_int(self.batch_size, "batch_size", _OWNER, low=1)
+        epochs = check_int(self.epochs, "epochs", _OWNER, low=1)
+        batch_size = check_int(self.batch_size, "batch_size", _OWNER, low=1)
         learning_rate = check_range(
             self.learning_rate, "learning_rate", _OWNER, low=0.0, high=math.inf
         )
-        seed = batched._check_int(self.seed, "seed", _OWNER, low=0)
+        seed = check_int(self.seed, "seed", _OWNER, low=0)
         device = batched.resolve_device(self.device, _OWNER)
 
         _check_finite_y(y)

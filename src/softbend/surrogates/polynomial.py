@@ -21,7 +21,6 @@ import logging
 import math
 from collections.abc import Callable
 from dataclasses import dataclass
-from numbers import Integral
 
 import numpy as np
 from numpy.typing import ArrayLike
@@ -31,7 +30,7 @@ from scipy.linalg.lapack import dpocon, dpotrf, dpotrs
 from sklearn.base import BaseEstimator, RegressorMixin
 from sklearn.utils.validation import check_is_fitted, validate_data
 
-from softbend._validation import check_range
+from softbend._validation import check_int, check_range
 from softbend.errors import ConvergenceError
 
 logger = logging.getLogger(__name__)
@@ -59,8 +58,8 @@ def n_terms(n_features: int, degree: int) -> int:
         T = C(d + degree, degree), the constant term included (7 inputs:
         degree 4 → 330, degree 9 → 11440, degree 10 → 19448).
     """
-    n_features = _check_int(n_features, "n_features", "n_terms", low=1)
-    degree = _check_int(degree, "degree", "n_terms", low=0)
+    n_features = check_int(n_features, "n_features", "n_terms", low=1)
+    degree = check_int(degree, "degree", "n_terms", low=0)
     return math.comb(n_features + degree, degree)
 
 
@@ -117,14 +116,6 @@ def monomial_powers(n_features: int, degree: int) -> np.ndarray:
             np.add.at(powers[row], list(combo), 1)
             row += 1
     return powers
-
-
-def _check_int(value: object, name: str, owner: str, *, low: int) -> int:
-    if isinstance(value, bool) or not isinstance(value, Integral) or value < low:
-        raise ValueError(
-            f"The '{name}' of {owner} must be an integer >= {low}. Got {value!r} instead."
-        )
-    return int(value)
 
 
 def _check_finite(values: np.ndarray, name: str) -> None:
@@ -335,9 +326,9 @@ class PolynomialRegressor(RegressorMixin, BaseEstimator):
         ConvergenceError
             If the solve produces non-finite coefficients.
         """
-        degree = _check_int(self.degree, "degree", _OWNER, low=1)
+        degree = check_int(self.degree, "degree", _OWNER, low=1)
         alpha = check_range(self.alpha, "alpha", _OWNER, low=0.0, low_inclusive=True)
-        chunk_rows = _check_int(self.chunk_rows, "chunk_rows", _OWNER, low=1)
+        chunk_rows = check_int(self.chunk_rows, "chunk_rows", _OWNER, low=1)
         limit = check_range(self.max_memory_mb, "max_memory_mb", _OWNER, low=0.0)
 
         y_values = np.asarray(y)
