@@ -1,0 +1,159 @@
+"""FEM robustness and speed: the 64 corner designs of paper B Table 1.
+
+Every corner design (each parameter at its minimum or maximum) is swept from
+0 MPa in 0.005 MPa outputs up to 0.5 MPa, a bending angle of 300° or a
+documented stop, on one thread. Prints, per design and in summary: where the sweep
+stopped and why, wall time, Newton iterations per step, and the shares of time
+in assembly (Hessian and residual) and factorisation. With ``--check-interpolation
+N`` it also re-runs N designs solving every 0.005 MPa output and reports the
+largest difference of the interpolated angles.
+
+Results are appended to a JSON-lines file as each design finishes, so an
+interrupted run resumes where it stopped::
+
+    python benchmarks/bench_fem.py --out results/bench_fem.jsonl
+    python benchmarks/bench_fem.py --out results/bench_fem.jsonl --summary   # table only
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import os
+import statistics
+import sys
+import time
+from pathlib import Path
+
+import numpy as np
+
+from softbend.campaign.backends import default_pressures_mpa
+from softbend.design import DesignSpace
+from softbend.fem import FEMOptions, simulate
+
+
+def _row(result, seconds: float) -> dict:
+    s = result.stats
+    t = s["timings"]
+    busy = t["assembly_s"] + t["residual_s"] + t["factorization_s"] + t["solve_s"]
+    steps = s["step_iterations"][1:]  # pressure steps (the first is gravity)
+    return {
+        "design": str(result.design),
+        "stop_reason": s["stop_reason"],
+        "max_pressure_mpa": result.max_pressure_mpa,
+        "max_angle_deg": result.max_angle_deg,
+        "outputs": int(result.n_converged),
+        "wall_s": seconds,
+        "steps": len(steps),
+        "rejected_steps": s["rejected_steps"],
+        "iterations_total": int(t["iterations"]),
+        "iterations_per_step": float(np.mean(steps)) if steps else 0.0,
+        "gravity_iterations": s["step_iterations"][0],
+        "assembly_share": (t["assembly_s"] + t["residual_s"]) / seconds,
+        "factorization_share": t["factorization_s"] / seconds,
+        "solver_share": busy / seconds,
+        "elements": result.mesh_size,
+        "ndof": s["ndof"],
+        "angle_at_0": float(result.angle_deg[0]),
+    }
+
+
+def _is_physical_stop(row: dict) -> bool:
+    return row["stop_reason"].startswith(("reached", "bending angle"))
+
+
+def summarize(rows: list[dict]) -> None:
+    walls = [r["wall_s"] for r in rows]
+    print(f"\n{len(rows)} designs")
+    print(
+        f"{'design':<24} {'stop':<28} {'p max':>6} {'angle':>7} {'wall s':>7} "
+        f"{'steps':>5} {'rej':>4} {'it/step':>7} {'asm %':>6} {'fact %':>6}"
+    )
+    for r in rows:
+        print(
+            f"{r['design']:<24} {r['stop_reason'][:28]:<28} {r['max_pressure_mpa']:6.3f} "
+            f"{r['max_angle_deg']:7.1f} {r['wall_s']:7.1f} {r['steps']:5d} "
+            f"{r['rejected_steps']:4d} {r['iterations_per_step']:7.2f} "
+            f"{100 * r['assembly_share']:6.1f} {100 * r['factorization_share']:6.1f}"
+        )
+    stalled = [r for r in rows if not _is_physical_stop(r)]
+    print(
+        f"\nwall time per sweep: median {statistics.median(walls):.1f} s, "
+        f"worst {max(walls):.1f} s, mean {statistics.fmean(walls):.1f} s"
+    )
+    print(
+        "Newton iterations per pressure step: median "
+        f"{statistics.median(r['iterations_per_step'] for r in rows):.2f}, "
+        f"worst design {max(r['iterations_per_step'] for r in rows):.2f}"
+    )
+    print(
+        f"time in assembly (Hessian + residual): median "
+        f"{100 * statistics.median(r['assembly_share'] for r in rows):.1f} %; "
+        f"in factorisation: median "
+        f"{100 * statistics.median(r['factorization_share'] for r in rows):.1f} %"
+    )
+    print(f"stopped by the physical criteria: {len(rows) - len(stalled)} of {len(rows)}")
+    for r in stalled:
+        print(f"  NOT reached: {r['design']}: {r['stop_reason']}")
+
+
+def check_interpolation(designs, options: FEMOptions, pressures: np.ndarray) -> None:
+    print("\ninterpolated outputs against a Newton solve at every output pressure:")
+    for design in designs:
+        fast = simulate(design, pressures, options)
+        full = simulate(design, pressures, options.replace(output="solve"))
+        n = min(fast.n_converged, full.n_converged)
+        diff = np.abs(fast.angle_deg[:n] - full.angle_deg[:n])
+        print(
+            f"  {design}: max |Δθ| {diff.max():.4f}° over {n} outputs "
+            f"(max θ {full.angle_deg[:n].max():.1f}°); wall {fast.wall_time_s:.1f} s "
+            f"interpolated vs {full.wall_time_s:.1f} s every point"
+        )
+
+
+def main(argv: list[str] | None = None) -> int:
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--out", type=Path, default=Path("results/bench_fem.jsonl"))
+    parser.add_argument("--limit", type=int, default=None, help="Only the first N corners.")
+    parser.add_argument("--maxh", type=float, default=FEMOptions().maxh_mm)
+    parser.add_argument("--summary", action="store_true", help="Only print the stored table.")
+    parser.add_argument("--check-interpolation", type=int, default=0, metavar="N")
+    args = parser.parse_args(argv)
+
+    os.environ.setdefault("OMP_NUM_THREADS", "1")
+    options = FEMOptions(maxh_mm=args.maxh, threads=1)
+    pressures = default_pressures_mpa()
+    designs = list(DesignSpace.corners())[: args.limit]
+    args.out.parent.mkdir(parents=True, exist_ok=True)
+    done = {}
+    if args.out.exists():
+        for line in args.out.read_text().splitlines():
+            if line.strip():
+                row = json.loads(line)
+                done[row["design"]] = row
+    if not args.summary:
+        for i, design in enumerate(designs):
+            if str(design) in done:
+                continue
+            start = time.perf_counter()
+            result = simulate(design, pressures, options)
+            row = _row(result, time.perf_counter() - start)
+            with args.out.open("a") as handle:
+                handle.write(json.dumps(row) + "\n")
+            done[row["design"]] = row
+            print(
+                f"[{i + 1}/{len(designs)}] {design}: {row['stop_reason']} at "
+                f"{row['max_pressure_mpa']:.3f} MPa, {row['max_angle_deg']:.1f}°, "
+                f"{row['wall_s']:.1f} s",
+                flush=True,
+            )
+    rows = [done[str(d)] for d in designs if str(d) in done]
+    if rows:
+        summarize(rows)
+    if args.check_interpolation:
+        check_interpolation(designs[: args.check_interpolation], options, pressures)
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())

@@ -1,0 +1,210 @@
+"""``softbend fem``: one FEM sweep with its files, and the mesh-convergence study."""
+
+from __future__ import annotations
+
+import json
+from pathlib import Path
+from typing import Annotated
+
+import typer
+
+from softbend.cli import _common
+
+app = typer.Typer(
+    help="Nonlinear 3D finite-element model of the fiber-reinforced actuator.",
+    no_args_is_help=True,
+)
+
+#: Files written by ``fem run`` into ``--out``.
+SWEEP_CSV = "sweep.csv"
+SWEEP_JSON = "sweep.json"
+CURVE_PNG = "angle_pressure.png"
+SHAPES_PNG = "shapes.png"
+VTK_DIR = "vtk"
+
+DesignOption = Annotated[
+    str,
+    typer.Option("--design", help="Design l,r,t,b,phi,lc (mm, mm, mm, mm, deg, mm)."),
+]
+MaxhOption = Annotated[float, typer.Option("--maxh", help="Largest element size, mm.")]
+GravityOption = Annotated[
+    str, typer.Option("--gravity", help="bending, against, axial or none (see FEMOptions).")
+]
+
+
+def _options(maxh: float, gravity: str, **extra):
+    from softbend.fem import FEMOptions
+
+    return FEMOptions(maxh_mm=maxh, gravity=gravity, **extra)
+
+
+def _shape_steps(history, count: int) -> list:
+    """The converged steps nearest to ``count`` evenly spaced pressures."""
+    import numpy as np
+
+    pressures = history.pressures
+    targets = np.linspace(0.0, pressures[-1], count)
+    picked = sorted({int(np.abs(pressures - t).argmin()) for t in targets})
+    return [history.steps[i] for i in picked]
+
+
+@app.command("run")
+def run(
+    design: DesignOption = "100,6,2,2,5,10",
+    pmax: Annotated[float, typer.Option("--pmax", help="Largest pressure, MPa.")] = 0.2,
+    step: Annotated[float, typer.Option("--step", help="Output pressure step, MPa.")] = 0.005,
+    out: Annotated[Path, typer.Option("--out", "-o", help="Output folder.")] = Path("results/fem"),
+    maxh: MaxhOption = 4.0,
+    gravity: GravityOption = "bending",
+    shapes: Annotated[int, typer.Option("--shapes", help="Deformed shapes drawn and saved.")] = 5,
+    solve_every: Annotated[
+        bool,
+        typer.Option("--solve-every", help="Solve every output pressure (no interpolation)."),
+    ] = False,
+    json_output: Annotated[bool, typer.Option("--json", help="Print the sweep as JSON.")] = False,
+) -> None:
+    """Sweep one design from 0 MPa to PMAX; write CSV, figures and VTK into OUT.
+
+    Writes sweep.csv (pressure, angle, tip, converged, Newton iterations),
+    sweep.json (solver statistics and options), angle_pressure.png (with the
+    analytical model), shapes.png (deformed shapes, paper B Fig. 2b) and
+    vtk/shape_<kPa>kPa.vtu (e.g. shape_050p00kPa.vtu) for ParaView (apply Warp By Vector).
+    """
+    from softbend.campaign.backends import default_pressures_mpa, get_backend
+    from softbend.design import SFRBADesign
+    from softbend.fem.export import silhouette_mm, write_sweep_csv, write_vtk
+    from softbend.fem.sweep import run_sweep
+    from softbend.reports.fem_figures import angle_pressure_curve, deformed_shapes
+
+    actuator = SFRBADesign.parse(design)
+    pressures = default_pressures_mpa(pmax, step)
+    options = _options(maxh, gravity, output="solve" if solve_every else "interpolate")
+    if shapes < 1:
+        raise ValueError(f"The '--shapes' must be an integer in [1, inf). Got {shapes} instead.")
+    scale = 1000
+    with _common.progress_bar(
+        "FEM sweep (pressure x 1000 / pmax)", scale, enabled=not json_output
+    ) as advance:
+        state = {"done": 0}
+
+        def on_step(pressure: float, angle: float, target: float) -> None:
+            done = round(scale * pressure / target) if target > 0 else scale
+            advance(max(done - state["done"], 0), p=f"{pressure:.4f} MPa", angle=f"{angle:.1f}°")
+            state["done"] = max(done, state["done"])
+
+        result, model, history = run_sweep(
+            actuator, pressures, options, progress=on_step, keep_states=True
+        )
+    out.mkdir(parents=True, exist_ok=True)
+    write_sweep_csv(result, out / SWEEP_CSV)
+    summary = {
+        "design": str(actuator),
+        "stop_reason": result.stats["stop_reason"],
+        "max_pressure_mpa": result.max_pressure_mpa,
+        "max_angle_deg": result.max_angle_deg,
+        "wall_time_s": result.wall_time_s,
+        "elements": result.mesh_size,
+        "stats": result.stats,
+    }
+    from softbend._io import write_text_atomic
+
+    write_text_atomic(out / SWEEP_JSON, json.dumps(_common._jsonable(summary), indent=2))
+    analytical = get_backend("analytical").sweep(actuator, pressures)
+    angle_pressure_curve(result, out / CURVE_PNG, analytical=analytical)
+    outlines = []
+    for chosen in _shape_steps(history, shapes):
+        model.set_state(chosen.state)
+        outlines.append((chosen.pressure_mpa, silhouette_mm(model)))
+        kpa = f"{1000 * chosen.pressure_mpa:06.2f}".replace(".", "p")
+        write_vtk(model, out / VTK_DIR / f"shape_{kpa}kPa.vtu")
+    deformed_shapes(outlines, out / SHAPES_PNG, title=f"Design ({actuator}), FEM")
+    if json_output:
+        _common.print_json(
+            {**summary, "pressure_mpa": result.pressure_mpa, "angle_deg": result.angle_deg}
+        )
+        return
+    rows = [
+        [f"{p:.3f}", f"{a:.2f}", f"{x:.1f}", f"{z:.1f}", int(i)]
+        for p, a, x, z, i in zip(
+            result.pressure_mpa,
+            result.angle_deg,
+            result.tip_x_mm,
+            result.tip_z_mm,
+            result.newton_iterations,
+            strict=True,
+        )
+        if round(p / step) % max(1, round(0.02 / step)) == 0
+    ]
+    _common.print_table(
+        f"FEM sweep of ({actuator})",
+        ["pressure MPa", "angle °", "tip x mm", "tip z mm", "Newton its"],
+        rows,
+    )
+    t = result.stats["timings"]
+    _common.console.print(
+        f"stop: {result.stats['stop_reason']}; {result.mesh_size} elements, "
+        f"{result.stats['ndof']} dofs; {result.wall_time_s:.1f} s "
+        f"(assembly {t['assembly_s'] + t['residual_s']:.1f} s, "
+        f"factorisation {t['factorization_s']:.1f} s); files in {out}"
+    )
+
+
+@app.command("mesh-study")
+def mesh_study(
+    design: DesignOption = "100,6,2,2,5,10",
+    maxh: Annotated[
+        str, typer.Option("--maxh", help="Comma-separated element sizes, mm, coarse to fine.")
+    ] = "6,4,3",
+    pressures: Annotated[
+        str, typer.Option("--pressures", help="Comma-separated pressures, MPa.")
+    ] = "0,0.05,0.1",
+    gravity: GravityOption = "bending",
+    json_output: Annotated[bool, typer.Option("--json", help="Print the table as JSON.")] = False,
+) -> None:
+    """Bending angle at PRESSURES for each element size; change relative to the previous size."""
+    from softbend.design import SFRBADesign
+    from softbend.fem.verification import mesh_study as study
+
+    actuator = SFRBADesign.parse(design)
+    sizes = _floats(maxh, "--maxh")
+    grid = _floats(pressures, "--pressures")
+    with _common.progress_bar("mesh sizes", len(sizes), enabled=not json_output) as advance:
+        rows = study(actuator, sizes, grid, _options(4.0, gravity), progress=lambda d, n: advance())
+    table = []
+    for i, row in enumerate(rows):
+        change = (
+            [
+                abs(a - b) / abs(b) * 100 if b else float("nan")
+                for a, b in zip(row.angles_deg, rows[i - 1].angles_deg, strict=True)
+            ]
+            if i
+            else [float("nan")] * len(grid)
+        )
+        table.append({**row.__dict__, "change_pct": change})
+    if json_output:
+        _common.print_json({"design": str(actuator), "pressures_mpa": grid, "rows": table})
+        return
+    columns = ["maxh mm", "elements", "dofs", "s"]
+    columns += [f"θ at {p:g} MPa" for p in grid] + [f"Δ% at {p:g}" for p in grid]
+    _common.print_table(
+        f"Mesh convergence of ({actuator})",
+        columns,
+        [
+            [r["maxh_mm"], r["elements"], r["ndof"], f"{r['wall_time_s']:.0f}"]
+            + [f"{a:.3f}" for a in r["angles_deg"]]
+            + [f"{c:.2f}" for c in r["change_pct"]]
+            for r in table
+        ],
+    )
+
+
+def _floats(text: str, name: str) -> list[float]:
+    try:
+        values = [float(v) for v in text.split(",") if v.strip()]
+    except ValueError:
+        raise ValueError(
+            f"The '{name}' must be comma-separated numbers. Got {text!r} instead."
+        ) from None
+    if not values:
+        raise ValueError(f"The '{name}' must hold at least one number. Got {text!r} instead.")
+    return values

@@ -1,0 +1,13 @@
+"""Nonlinear 3D finite-element model of the fiber-reinforced bending actuator (SPEC §4.2).
+
+NGSolve and netgen are imported only inside this subpackage. The pipeline:
+``geometry`` (netgen.occ solid and mesh) → ``mechanics`` (energy densities) →
+``actuator`` (the model's energy, state and measurements) → ``newton`` (energy
+minimisation) → ``sweep`` (load stepping, :func:`simulate`); ``verification``
+holds the closed-form cases solved with the same core.
+"""
+
+from softbend.fem.options import GRAVITY_DIRECTIONS, OUTPUT_MODES, FEMOptions
+from softbend.fem.sweep import simulate
+
+__all__ = ["GRAVITY_DIRECTIONS", "OUTPUT_MODES", "FEMOptions", "simulate"]

@@ -1,0 +1,274 @@
+"""The finite-element model of one actuator: its energy, state and measurements.
+
+:class:`ActuatorModel` meshes the half actuator of a design, assembles the total
+potential energy
+
+    Π(u) = ∫ W_solid dV + ∫_bottom W_layer dA + ∫_outer+bottom Σ± W_fiber dA
+           − p·V_cavity(u) − ∫ ρ g·u dV (elastomer, layer and fiber masses)
+
+over quadratic displacements with the base face fixed and ``u_y = 0`` on the
+symmetry plane, and exposes what the load stepping needs: set the load, solve,
+the derivative of the state with respect to pressure, and the measurements
+(bending angle by the arc fit of the backbone, tip position, cavity volume).
+
+Measurement frame (that of :func:`softbend.analytical.tip_position_mm`): origin
+at the fixed base on the strain-limiting layer, ``x`` along the undeformed axis,
+``z`` normal to the layer towards the side the actuator bends to. The backbone
+is the strain-limiting layer on the symmetry plane over the chamber length
+``l``; the angle is ``arc length / radius`` of the least-squares arc through it
+(paper B §3.1).
+"""
+
+from __future__ import annotations
+
+import logging
+import math
+from dataclasses import dataclass
+from typing import Any
+
+import numpy as np
+
+from softbend.design import FIBER_DIAMETER_MM, SFRBADesign
+from softbend.fem.geometry import ActuatorGeometry, mesh_actuator
+from softbend.fem.mechanics import (
+    fiber_energy,
+    helix_stiffness_n_per_mm,
+    membrane_energy,
+    solid_energy,
+    volume_flux,
+)
+from softbend.fem.newton import EnergySolver
+from softbend.fem.options import FEMOptions
+from softbend.kinematics import fit_arc
+
+__all__ = ["ActuatorModel", "Measurement"]
+
+logger = logging.getLogger(__name__)
+
+
+@dataclass(frozen=True)
+class Measurement:
+    """What is read off a deformed state."""
+
+    angle_deg: float
+    tip_x_mm: float
+    tip_z_mm: float
+
+    def as_array(self) -> np.ndarray:
+        return np.array([self.angle_deg, self.tip_x_mm, self.tip_z_mm])
+
+
+class ActuatorModel:
+    """Mesh, energy and state of the FEM model of ``design``.
+
+    Parameters
+    ----------
+    design : SFRBADesign
+    options : FEMOptions, optional
+    """
+
+    def __init__(self, design: SFRBADesign, options: FEMOptions | None = None) -> None:
+        import ngsolve as ngs
+
+        self.design = design
+        self.options = options = options or FEMOptions()
+        ngs.ngsglobals.msg_level = 0
+        self.mesh, self.geometry = mesh_actuator(
+            design, maxh_mm=options.maxh_mm, order=options.order, base_cap_mm=options.base_cap_mm
+        )
+        self.fes = ngs.VectorH1(
+            self.mesh,
+            order=options.order,
+            dirichletx="base",
+            dirichlety="base|symmetry",
+            dirichletz="base",
+        )
+        self.gfu = ngs.GridFunction(self.fes)
+        self.pressure = ngs.Parameter(0.0)
+        self.gravity_factor = ngs.Parameter(0.0)
+        self.form, self.volume_form = self._assemble_energy()
+        self.solver = EnergySolver(
+            self.form,
+            self.gfu,
+            self.fes.FreeDofs(),
+            rtol=options.rtol,
+            max_iterations=options.max_iterations,
+        )
+        self._backbone_x = np.linspace(*self.geometry.chamber_mm, options.backbone_points)
+        self._backbone_points = [self.mesh(float(x), 0.0, 0.0) for x in self._backbone_x]
+        self._tip_point = self.mesh(self.geometry.length_mm, 0.0, 0.0)
+        self._cavity_area = ngs.Integrate(
+            ngs.CoefficientFunction(1.0), self.mesh, definedon=self.mesh.Boundaries("cavity")
+        )
+        self._weight_n = self._total_weight_n()
+
+    # -- energy --------------------------------------------------------------------------
+    def fiber_spacing_mm(self) -> float:
+        """Distance between neighbouring fibers of one family, normal to them, mm."""
+        phi = math.radians(self.design.phi_deg)
+        if self.options.fiber_pitch_mm is not None:
+            spacing = self.options.fiber_pitch_mm * math.cos(phi)
+        else:
+            spacing = self.geometry.perimeter_mm * math.sin(phi)
+        return max(spacing, FIBER_DIAMETER_MM)
+
+    def fiber_stiffness_n_per_mm(self) -> float:
+        """Smeared stiffness ``E A / s`` of one fiber family, N/mm."""
+        return helix_stiffness_n_per_mm(
+            self.options.fiber.model.e_mpa, self.options.fiber_radius_mm, self.fiber_spacing_mm()
+        )
+
+    def _gravity_vector(self) -> tuple[float, float, float]:
+        g = self.options.gravity_mm_s2
+        return {
+            "bending": (0.0, 0.0, -g),
+            "against": (0.0, 0.0, g),
+            "axial": (g, 0.0, 0.0),
+            "none": (0.0, 0.0, 0.0),
+        }[self.options.gravity]
+
+    def _layer_and_fiber_mass_per_area(self) -> tuple[float, float]:
+        o = self.options
+        layer = o.layer.density_t_per_mm3 * o.layer_thickness_mm
+        fibers = 2.0 * o.fiber.density_t_per_mm3 * math.pi * (FIBER_DIAMETER_MM / 2) ** 2
+        return layer, fibers / self.fiber_spacing_mm()
+
+    def _total_weight_n(self) -> float:
+        import ngsolve as ngs
+
+        o, geo = self.options, self.geometry
+        layer, fibers = self._layer_and_fiber_mass_per_area()
+        one = ngs.CoefficientFunction(1.0)
+        outer_area = ngs.Integrate(one, self.mesh, definedon=self.mesh.Boundaries("outer|bottom"))
+        bottom_area = ngs.Integrate(one, self.mesh, definedon=self.mesh.Boundaries("bottom"))
+        mass = o.elastomer.density_t_per_mm3 * geo.half_volume_mm3
+        mass += layer * bottom_area + fibers * outer_area
+        return mass * o.gravity_mm_s2
+
+    def _assemble_energy(self) -> tuple[Any, Any]:
+        import ngsolve as ngs
+        from ngsolve import CoefficientFunction as CF  # noqa: N817
+        from ngsolve import Cross, Grad, Id, Norm, ds, dx, specialcf
+
+        o = self.options
+        u = self.fes.TrialFunction()
+        F = Id(3) + Grad(u)
+        Fs = Id(3) + Grad(u).Trace()
+        normal = specialcf.normal(3)
+        g = CF(self._gravity_vector())
+        factor = self.gravity_factor
+        mu0 = o.elastomer.model.initial_shear_modulus_mpa
+        w_solid = solid_energy(F, o.elastomer.model, o.bulk_ratio * mu0)
+        # The potential of gravity is linear in u; kept out of the compiled
+        # hyperelastic terms, whose automatic differentiation it slows 4x.
+        g_solid = -factor * o.elastomer.density_t_per_mm3 * ngs.InnerProduct(g, u)
+
+        layer_mass, fiber_mass = self._layer_and_fiber_mass_per_area()
+        ex, ey = CF((1.0, 0.0, 0.0)), CF((0.0, 1.0, 0.0))
+        w_layer = membrane_energy(Fs, (ex, ey), o.layer.model, o.layer_thickness_mm)
+        g_layer = -factor * layer_mass * ngs.InnerProduct(g, u.Trace())
+
+        circumferential = Cross(normal, ex)
+        circumferential = circumferential / Norm(circumferential)
+        phi = math.radians(self.design.phi_deg)
+        stiffness = self.fiber_stiffness_n_per_mm()
+        g_fiber = -factor * fiber_mass * ngs.InnerProduct(g, u.Trace())
+        w_fiber = 0.0
+        for sign in (1.0, -1.0):
+            direction = math.cos(phi) * circumferential + sign * math.sin(phi) * ex
+            w_fiber = w_fiber + fiber_energy(Fs, direction, stiffness, o.fiber_law)
+
+        position = CF((ngs.x, ngs.y, ngs.z)) + u.Trace()
+        flux = volume_flux(position, Fs, normal, axes=(0, 2))  # = −(cavity volume) density
+
+        form = ngs.BilinearForm(self.fes, symmetric=True)
+        form += ngs.Variation(w_solid.Compile() * dx)
+        form += ngs.Variation(w_layer.Compile() * ds("bottom"))
+        form += ngs.Variation(w_fiber.Compile() * ds("outer|bottom"))
+        form += ngs.Variation((self.pressure * flux).Compile() * ds("cavity"))
+        form += ngs.Variation(g_solid * dx)
+        form += ngs.Variation(g_layer * ds("bottom"))
+        form += ngs.Variation(g_fiber * ds("outer|bottom"))
+        volume = ngs.BilinearForm(self.fes, symmetric=True)
+        volume += ngs.Variation(flux.Compile() * ds("cavity"))
+        return form, volume
+
+    # -- loads and state -----------------------------------------------------------------
+    @property
+    def ndof(self) -> int:
+        """Free degrees of freedom."""
+        return int(sum(self.fes.FreeDofs()))
+
+    @property
+    def n_elements(self) -> int:
+        """Tetrahedra of the half model."""
+        return int(self.mesh.ne)
+
+    def set_load(self, pressure_mpa: float, gravity_factor: float = 1.0) -> None:
+        """Set the cavity pressure (MPa) and the fraction of gravity applied."""
+        self.pressure.Set(float(pressure_mpa))
+        self.gravity_factor.Set(float(gravity_factor))
+
+    def force_scale_n(self, pressure_mpa: float) -> float:
+        """Load size for the Newton tolerance: pressure resultant on the half cavity + weight, N."""
+        return abs(pressure_mpa) * self._cavity_area + self._weight_n
+
+    def state(self) -> np.ndarray:
+        """A copy of the displacement vector."""
+        return np.array(self.gfu.vec.FV().NumPy(), copy=True)
+
+    def set_state(self, values: np.ndarray) -> None:
+        """Overwrite the displacement vector."""
+        self.gfu.vec.FV().NumPy()[:] = values
+
+    def pressure_tangent(self, *, refactorize: bool = True) -> np.ndarray:
+        """``du/dp`` at the current (converged) state, mm/MPa.
+
+        From ``K du/dp = −∂r/∂p`` with ``∂r/∂p = −∂V/∂u`` (the load is ``−p·V``).
+        With ``refactorize=False`` the Hessian factorised by the last Newton
+        iteration is used (one Newton update away from the converged state,
+        where the residual was already small), which saves a factorisation.
+        """
+        rhs = self.gfu.vec.CreateVector()
+        self.volume_form.Apply(self.gfu.vec, rhs)  # ∂(−V)/∂u = ∂r/∂p
+        out = self.gfu.vec.CreateVector()
+        if refactorize or not self.solver.has_factorization:
+            self.solver.factorize()
+        self.solver.solve_tangent(rhs, out)
+        return -np.array(out.FV().NumPy(), copy=True)
+
+    def cavity_volume_mm3(self) -> float:
+        """Deformed volume of the whole cavity (both halves), mm³."""
+        return -2.0 * float(self.volume_form.Energy(self.gfu.vec))
+
+    # -- measurements --------------------------------------------------------------------
+    def backbone_mm(self) -> np.ndarray:
+        """Deformed backbone in the measurement frame, shape (n, 2): columns x, z."""
+        values = np.array([self.gfu(p) for p in self._backbone_points])
+        x = self._backbone_x + values[:, 0]
+        z = -values[:, 2]
+        return np.column_stack([x, z])
+
+    def measure(self) -> Measurement:
+        """Bending angle (arc fit of the backbone, degrees) and tip position (mm)."""
+        fit = fit_arc(self.backbone_mm())
+        tip = self.gfu(self._tip_point)
+        return Measurement(
+            angle_deg=float(fit.angle_deg),
+            tip_x_mm=float(self.geometry.length_mm + tip[0]),
+            tip_z_mm=float(-tip[2]),
+        )
+
+    def measure_derivative(self, tangent: np.ndarray, step_mpa: float = 1e-5) -> np.ndarray:
+        """``d(angle, tip x, tip z)/dp`` along ``tangent = du/dp`` by central differences."""
+        base = self.state()
+        self.set_state(base + step_mpa * tangent)
+        plus = self.measure().as_array()
+        self.set_state(base - step_mpa * tangent)
+        minus = self.measure().as_array()
+        self.set_state(base)
+        return (plus - minus) / (2.0 * step_mpa)
+
+    @property
+    def geometry_info(self) -> ActuatorGeometry:
+        return self.geometry

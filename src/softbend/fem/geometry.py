@@ -1,0 +1,167 @@
+"""Solid geometry and mesh of the fiber-reinforced actuator (netgen.occ).
+
+The half actuator ``y ≥ 0`` (SPEC §4.2, paper B Fig. 1a): a body whose section is
+a rectangle ``2(r+t) × b`` under a half-disc of radius ``r + t``, from ``x = 0``
+to ``x = cap + l + lc``, minus the cavity: a half-disc of radius ``r`` standing
+on the bottom wall (centre at height ``b``) from ``x = cap`` to ``x = cap + l``.
+Faces are named for the physics: ``base`` (fixed), ``symmetry`` (``y = 0``),
+``bottom`` (strain-limiting layer), ``outer`` (curved top and side, fibers),
+``tip`` and ``cavity`` (pressure).
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+from typing import Any
+
+from softbend.design import SFRBADesign
+from softbend.errors import SoftbendError
+
+__all__ = ["ActuatorGeometry", "actuator_geometry", "mesh_actuator"]
+
+#: Largest number of tetrahedra a mesh may have (guards against a tiny maxh).
+MAX_ELEMENTS = 400_000
+
+
+@dataclass(frozen=True)
+class ActuatorGeometry:
+    """Dimensions of the meshed half actuator, mm.
+
+    Attributes
+    ----------
+    design : SFRBADesign
+    base_cap_mm : float
+        Proximal end wall.
+    length_mm : float
+        Whole body, ``cap + l + lc``.
+    outer_radius_mm : float
+        ``r + t``.
+    perimeter_mm : float
+        Outer perimeter of the full section, ``π(r+t) + 2(r+t) + 2b``.
+    """
+
+    design: SFRBADesign
+    base_cap_mm: float
+
+    @property
+    def length_mm(self) -> float:
+        d = self.design
+        return self.base_cap_mm + d.l_mm + d.lc_mm
+
+    @property
+    def outer_radius_mm(self) -> float:
+        return self.design.r_mm + self.design.t_mm
+
+    @property
+    def perimeter_mm(self) -> float:
+        ro = self.outer_radius_mm
+        return math.pi * ro + 2.0 * ro + 2.0 * self.design.b_mm
+
+    @property
+    def chamber_mm(self) -> tuple[float, float]:
+        """Axial extent ``(x0, x1)`` of the cavity."""
+        return self.base_cap_mm, self.base_cap_mm + self.design.l_mm
+
+    @property
+    def half_volume_mm3(self) -> float:
+        """Volume of the half body (elastomer), mm³."""
+        d = self.design
+        ro = self.outer_radius_mm
+        section = ro * d.b_mm + math.pi * ro**2 / 4.0
+        return section * self.length_mm - math.pi * d.r_mm**2 / 4.0 * d.l_mm
+
+    @property
+    def half_cavity_volume_mm3(self) -> float:
+        """Undeformed volume of the half cavity, mm³."""
+        return math.pi * self.design.r_mm**2 / 4.0 * self.design.l_mm
+
+
+def actuator_geometry(design: SFRBADesign, base_cap_mm: float) -> tuple[Any, ActuatorGeometry]:
+    """Build the half actuator as an OCC solid with named faces.
+
+    Returns
+    -------
+    (netgen.occ.TopoDS_Shape, ActuatorGeometry)
+    """
+    from netgen.occ import Box, Cylinder, Pnt, X
+
+    info = ActuatorGeometry(design, base_cap_mm)
+    r, b = design.r_mm, design.b_mm
+    ro, length = info.outer_radius_mm, info.length_mm
+    x0, x1 = info.chamber_mm
+    upper = Cylinder(Pnt(0, 0, b), X, ro, length) * Box(Pnt(0, 0, b), Pnt(length, ro, b + ro))
+    body = upper + Box(Pnt(0, 0, 0), Pnt(length, ro, b))
+    cavity = Cylinder(Pnt(x0, 0, b), X, r, x1 - x0) * Box(Pnt(x0, 0, b), Pnt(x1, r, b + r))
+    cavity.faces.name = "cavity"
+    solid = body - cavity
+    tol = 1e-7 * length
+    for face in solid.faces:
+        if face.name == "cavity":
+            continue
+        c = face.center
+        if abs(c.x) < tol:
+            face.name = "base"
+        elif abs(c.x - length) < tol:
+            face.name = "tip"
+        elif abs(c.y) < tol:
+            face.name = "symmetry"
+        elif abs(c.z) < tol:
+            face.name = "bottom"
+        else:
+            face.name = "outer"
+    names = {f.name for f in solid.faces}
+    expected = {"base", "tip", "symmetry", "bottom", "outer", "cavity"}
+    if names != expected:  # pragma: no cover - a netgen behaviour change
+        raise SoftbendError(
+            f"the actuator geometry of design {design} has faces {sorted(map(str, names))}, "
+            f"expected {sorted(expected)}"
+        )
+    return solid, info
+
+
+def mesh_actuator(
+    design: SFRBADesign, *, maxh_mm: float, order: int = 2, base_cap_mm: float = 3.0
+) -> tuple[Any, ActuatorGeometry]:
+    """Quadratic (curved) tetrahedral mesh of the half actuator.
+
+    Parameters
+    ----------
+    design : SFRBADesign
+    maxh_mm : float
+        Largest element size, mm.
+    order : int
+        Geometric order of the curved elements (the displacement order).
+    base_cap_mm : float
+        Proximal end wall, mm.
+
+    Returns
+    -------
+    (ngsolve.Mesh, ActuatorGeometry)
+
+    Raises
+    ------
+    ValueError
+        If the mesh would exceed :data:`MAX_ELEMENTS` tetrahedra for this
+        ``maxh_mm`` (estimated before meshing).
+    SoftbendError
+        If netgen fails to mesh the geometry.
+    """
+    import ngsolve
+    from netgen.occ import OCCGeometry
+
+    shape, info = actuator_geometry(design, base_cap_mm)
+    estimate = 6.0 * info.half_volume_mm3 / (maxh_mm**3 / (6.0 * math.sqrt(2.0)))
+    if estimate > MAX_ELEMENTS:
+        raise ValueError(
+            f"The 'maxh_mm' of the FEM mesh must give at most {MAX_ELEMENTS} elements for "
+            f"design {design}. Got {maxh_mm:g} mm (about {estimate:.0f} elements) instead."
+        )
+    try:
+        mesh = ngsolve.Mesh(OCCGeometry(shape).GenerateMesh(maxh=maxh_mm))
+    except Exception as exc:  # netgen raises its own exception types
+        raise SoftbendError(
+            f"netgen could not mesh design {design} with maxh_mm={maxh_mm:g}: {exc}"
+        ) from exc
+    mesh.Curve(order)
+    return mesh, info

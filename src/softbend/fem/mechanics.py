@@ -1,0 +1,212 @@
+"""Strain energy densities of the actuator's parts, as NGSolve coefficient functions.
+
+The whole finite-element model is one potential energy minimised by Newton's
+method on its exact (automatically differentiated) Hessian, so every part of the
+physics is a scalar energy density here:
+
+* :func:`solid_energy` — nearly incompressible hyperelastic solid, isochoric
+  ``W(Ī1)`` plus a volumetric penalty ``K/2 (J − 1)²`` (MPa = mJ/mm³);
+* :func:`membrane_energy` — an incompressible hyperelastic membrane bonded to a
+  face (the 0.1 mm strain-limiting layer), energy per reference area (N/mm);
+* :func:`fiber_energy` — one family of fibers smeared over a face, energy per
+  reference area (N/mm);
+* :func:`volume_flux` — the integrand whose surface integral is the enclosed
+  cavity volume in the deformed state, so a follower pressure is the
+  conservative load ``−p·V``.
+
+All functions take NGSolve coefficient functions (a deformation gradient ``F``
+on volumes, or the surface deformation gradient ``F_s = I + ∇_Γu`` on faces) and
+return one. They are pure: no mesh, no state.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Sequence
+from typing import Any
+
+from softbend.materials.models import ArrudaBoyce, HyperelasticModel, NeoHookean, Yeoh
+
+__all__ = [
+    "FIBER_LAWS",
+    "fiber_energy",
+    "isochoric_energy",
+    "membrane_energy",
+    "solid_energy",
+    "volume_flux",
+]
+
+#: Fiber laws: "tension-compression" (a tied beam, paper B) or "tension-only" (a thread).
+FIBER_LAWS: tuple[str, ...] = ("tension-compression", "tension-only")
+
+# Arruda–Boyce series coefficients C1..C5 (as in softbend.materials.models).
+_AB_COEFFS = (1 / 2, 1 / 20, 11 / 1050, 19 / 7000, 519 / 673750)
+
+
+def isochoric_energy(model: HyperelasticModel, I1: Any) -> Any:
+    """Strain energy density ``W(I1)`` of an incompressible model, MPa.
+
+    Works on NGSolve coefficient functions as well as on floats, which the
+    NumPy methods of :mod:`softbend.materials.models` do not.
+
+    Parameters
+    ----------
+    model : NeoHookean, Yeoh or ArrudaBoyce
+        The law and its constants (MPa).
+    I1 : CoefficientFunction or float
+        First invariant (or its isochoric version ``Ī1``), dimensionless.
+    """
+    if isinstance(model, NeoHookean):
+        return model.c10_mpa * (I1 - 3.0)
+    if isinstance(model, Yeoh):
+        d = I1 - 3.0
+        return d * (model.c10_mpa + d * (model.c20_mpa + d * model.c30_mpa))
+    if isinstance(model, ArrudaBoyce):
+        total = 0.0
+        for i, c in enumerate(_AB_COEFFS, start=1):
+            total = total + c / model.lambda_m ** (2 * i - 2) * (I1**i - 3.0**i)
+        return model.mu_mpa * total
+    raise ValueError(
+        "The 'model' of isochoric_energy must be a NeoHookean, Yeoh or ArrudaBoyce model. "
+        f"Got {model!r} instead."
+    )
+
+
+def solid_energy(F: Any, model: HyperelasticModel, bulk_modulus_mpa: float) -> Any:
+    """Nearly incompressible solid: ``W(Ī1) + K/2 (J − 1)²``, MPa.
+
+    The isochoric split ``Ī1 = J^(−2/3) tr(FᵀF)`` makes the deviatoric response
+    independent of the volume change, and the penalty with bulk modulus ``K``
+    keeps ``J`` close to 1. With quadratic tetrahedra and ``K = 100 μ``
+    (Poisson's ratio ≈ 0.495) the element does not lock; see
+    :class:`softbend.fem.FEMOptions`.
+
+    Parameters
+    ----------
+    F : CoefficientFunction
+        Deformation gradient, 3×3.
+    model : HyperelasticModel
+        Isochoric law.
+    bulk_modulus_mpa : float
+        Penalty bulk modulus ``K``, MPa.
+    """
+    from ngsolve import Det, Trace
+
+    J = Det(F)
+    I1_bar = J ** (-2.0 / 3.0) * Trace(F.trans * F)
+    return isochoric_energy(model, I1_bar) + 0.5 * bulk_modulus_mpa * (J - 1.0) ** 2
+
+
+def membrane_energy(
+    Fs: Any,
+    tangents: Sequence[Any],
+    model: HyperelasticModel,
+    thickness_mm: float,
+) -> Any:
+    """Incompressible hyperelastic membrane bonded to a face, N/mm (energy per area).
+
+    With ``C_s`` the 2×2 metric of the deformed face in the orthonormal reference
+    tangents ``t1, t2``, incompressibility sets the thickness stretch to
+    ``det(C_s)^(−1/2)``, so ``I1 = tr C_s + 1/det C_s``; the energy per reference
+    area is ``h·W(I1)``. The membrane has no bending stiffness: it follows the
+    face it is bonded to.
+
+    Parameters
+    ----------
+    Fs : CoefficientFunction
+        Surface deformation gradient ``I + ∇_Γ u``, 3×3.
+    tangents : pair of CoefficientFunction
+        Orthonormal tangent vectors of the reference face.
+    model : HyperelasticModel
+        The membrane's law (MPa).
+    thickness_mm : float
+        Reference thickness ``h``, mm.
+    """
+    from ngsolve import InnerProduct
+
+    a1, a2 = (Fs * t for t in tangents)
+    c11, c22, c12 = InnerProduct(a1, a1), InnerProduct(a2, a2), InnerProduct(a1, a2)
+    I1 = c11 + c22 + 1.0 / (c11 * c22 - c12 * c12)
+    return thickness_mm * isochoric_energy(model, I1)
+
+
+def fiber_energy(
+    Fs: Any,
+    direction: Any,
+    stiffness_n_per_mm: float,
+    law: str = "tension-compression",
+    *,
+    smoothing: float = 0.01,
+) -> Any:
+    """One family of fibers smeared over a face, N/mm (energy per reference area).
+
+    A fiber along the unit reference direction ``a`` stretches by
+    ``λ = |F_s a|``; with ``k = E_f A_f / s`` (axial stiffness per unit width of
+    the family, fiber spacing ``s``) the energy is ``k/2 (λ − 1)²``.
+
+    * ``"tension-compression"``: the fiber carries compression as well, as the
+      beams tied to the elastomer of paper B do (the matrix around it holds it
+      against buckling).
+    * ``"tension-only"``: a thread: ``k/2 ⟨λ − 1⟩²`` with the ramp smoothed over
+      ``|λ − 1| ≲ smoothing`` so the Hessian stays continuous.
+
+    Parameters
+    ----------
+    Fs : CoefficientFunction
+        Surface deformation gradient, 3×3.
+    direction : CoefficientFunction
+        Unit fiber direction in the reference face.
+    stiffness_n_per_mm : float
+        ``E_f A_f / s``, N/mm.
+    law : {"tension-compression", "tension-only"}
+    smoothing : float
+        Width of the smoothed ramp of the tension-only law (stretch units).
+    """
+    from ngsolve import Norm, sqrt
+
+    strain = Norm(Fs * direction) - 1.0
+    if law == "tension-compression":
+        return 0.5 * stiffness_n_per_mm * strain * strain
+    if law == "tension-only":
+        positive = 0.5 * (strain + sqrt(strain * strain + smoothing * smoothing))
+        return 0.5 * stiffness_n_per_mm * positive * positive
+    raise ValueError(
+        f"The 'fiber_law' must be one of {', '.join(repr(v) for v in FIBER_LAWS)}. "
+        f"Got {law!r} instead."
+    )
+
+
+def volume_flux(position: Any, Fs: Any, normal: Any, axes: Sequence[int]) -> Any:
+    """Integrand of the enclosed volume: ``w(x)·n da`` per reference area, mm.
+
+    By the divergence theorem the volume enclosed by a closed surface is
+    ``∫ w·n da`` for any field with ``div w = 1``. With
+    ``w = x_axes / len(axes)`` (only the listed components of the deformed
+    position ``x``), faces on which ``w·n = 0`` may be left out: symmetry planes
+    normal to an axis not in ``axes``, and the end planes of a plane-strain
+    slice. Nanson's relation gives ``n da = cof(F_s) N dA``. With ``normal`` the
+    outward normal of the solid (pointing into the cavity) the result is the
+    *negative* cavity volume.
+
+    Parameters
+    ----------
+    position : CoefficientFunction
+        Deformed position ``X + u``, 3-vector, mm.
+    Fs : CoefficientFunction
+        Surface deformation gradient, 3×3.
+    normal : CoefficientFunction
+        Reference unit normal ``N`` of the face.
+    axes : sequence of int
+        Components of ``w`` (0, 1, 2 for x, y, z), non-empty.
+    """
+    from ngsolve import Cof
+
+    if not axes:
+        raise ValueError("The 'axes' of volume_flux must name at least one of 0, 1, 2.")
+    nda = Cof(Fs) * normal
+    return sum(position[i] * nda[i] for i in axes) / float(len(axes))
+
+
+def helix_stiffness_n_per_mm(e_mpa: float, radius_mm: float, spacing_mm: float) -> float:
+    """Smeared axial stiffness ``E A / s`` of a fiber family, N/mm."""
+    return e_mpa * math.pi * radius_mm**2 / spacing_mm

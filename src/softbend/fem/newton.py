@@ -1,0 +1,219 @@
+"""Newton's method on a potential energy, with a line search and honest failure.
+
+:class:`EnergySolver` owns one NGSolve ``BilinearForm`` built from ``Variation``
+terms (the total potential energy), the displacement ``GridFunction`` and the
+free degrees of freedom. :meth:`EnergySolver.solve` minimises the energy from the
+current state: exact Newton steps on the automatically differentiated Hessian,
+factorised by sparse Cholesky (the symbolic factorisation is reused), with a
+backtracking line search on the energy. Round-off makes energy differences
+meaningless near convergence (the energy is ~1e4 times the last decreases), so
+there a step is accepted when it lowers the residual instead.
+
+Convergence is measured on the residual force: ``‖r‖₂ ≤ rtol·force_scale`` where
+the caller states the force scale of the load (pressure resultant, weight). A
+solve that does not converge raises :class:`~softbend.errors.ConvergenceError`
+with the residual and the iteration; the state is then restored, so the caller
+can cut the load step and retry. Time spent in assembly and factorisation is
+accumulated in :attr:`EnergySolver.timings`.
+"""
+
+from __future__ import annotations
+
+import logging
+import math
+import time
+from dataclasses import dataclass, field
+from typing import Any
+
+from softbend.errors import ConvergenceError
+
+__all__ = ["EnergySolver", "NewtonReport"]
+
+logger = logging.getLogger(__name__)
+
+
+@dataclass
+class NewtonReport:
+    """What one converged Newton solve did."""
+
+    iterations: int
+    residual: float
+    line_search_cuts: int
+
+
+@dataclass
+class _Timings:
+    assembly_s: float = 0.0
+    factorization_s: float = 0.0
+    residual_s: float = 0.0
+    solve_s: float = 0.0
+    iterations: int = 0
+    factorizations: int = 0
+
+    def as_dict(self) -> dict[str, float]:
+        return {k: float(v) for k, v in self.__dict__.items()}
+
+
+@dataclass
+class EnergySolver:
+    """Newton minimiser of the energy ``form`` over ``gfu``'s free dofs.
+
+    Parameters
+    ----------
+    form : ngsolve.BilinearForm
+        Symmetric form made of ``Variation`` terms (the potential energy).
+    gfu : ngsolve.GridFunction
+        Displacement, mm; the solve starts from and updates it.
+    freedofs : ngsolve.BitArray
+        Degrees of freedom not fixed by Dirichlet conditions.
+    rtol : float
+        Relative residual tolerance.
+    max_iterations : int
+        Newton iterations per solve.
+    stall_iteration, stall_factor
+        Early give-up rule (see the attributes).
+    """
+
+    form: Any
+    gfu: Any
+    freedofs: Any
+    rtol: float = 1e-8
+    max_iterations: int = 25
+    #: Give up early when, after this many iterations, the residual is still
+    #: ``stall_factor`` times the tolerance (not yet in Newton's quadratic phase):
+    #: a shorter load step is cheaper than a long crawl.
+    stall_iteration: int = 6
+    stall_factor: float = 1e4
+    timings: _Timings = field(default_factory=_Timings)
+
+    def __post_init__(self) -> None:
+        vec = self.gfu.vec
+        self._res = vec.CreateVector()
+        self._du = vec.CreateVector()
+        self._backup = vec.CreateVector()
+        self._inverse = None
+
+    @property
+    def has_factorization(self) -> bool:
+        """Whether a Hessian has been factorised yet."""
+        return self._inverse is not None
+
+    # -- linear algebra --------------------------------------------------------------
+    def residual(self, out: Any = None) -> Any:
+        """Gradient of the energy at the current state (N), zero on fixed dofs."""
+        out = self._res if out is None else out
+        start = time.perf_counter()
+        self.form.Apply(self.gfu.vec, out)
+        self.timings.residual_s += time.perf_counter() - start
+        return out
+
+    def _norm(self, vec: Any) -> float:
+        values = vec.FV().NumPy()
+        free = self._free_mask()
+        return float(math.sqrt(float((values[free] ** 2).sum())))
+
+    def _free_mask(self) -> Any:
+        if getattr(self, "_mask", None) is None:
+            import numpy as np
+
+            self._mask = np.array(list(self.freedofs), dtype=bool)
+        return self._mask
+
+    def factorize(self) -> Any:
+        """Assemble the Hessian at the current state and factorise it."""
+        start = time.perf_counter()
+        self.form.AssembleLinearization(self.gfu.vec)
+        middle = time.perf_counter()
+        if self._inverse is None:
+            self._inverse = self.form.mat.Inverse(self.freedofs, inverse="sparsecholesky")
+        else:
+            self._inverse.Update()
+        end = time.perf_counter()
+        self.timings.assembly_s += middle - start
+        self.timings.factorization_s += end - middle
+        self.timings.factorizations += 1
+        return self._inverse
+
+    def solve_tangent(self, rhs: Any, out: Any) -> Any:
+        """``out = K⁻¹ rhs`` with the last factorised Hessian."""
+        start = time.perf_counter()
+        out.data = self._inverse * rhs
+        self.timings.solve_s += time.perf_counter() - start
+        return out
+
+    # -- Newton ----------------------------------------------------------------------
+    def solve(self, force_scale: float, *, load: float | None = None, step: int | None = None):
+        """Minimise the energy from the current state.
+
+        Parameters
+        ----------
+        force_scale : float
+            Size of the applied load, N; the solve converges when the residual
+            norm drops below ``rtol·force_scale``.
+        load, step : optional
+            Pressure (MPa) and step index, only for error messages.
+
+        Returns
+        -------
+        NewtonReport
+
+        Raises
+        ------
+        ConvergenceError
+            If the residual is not below tolerance after ``max_iterations``, or
+            becomes non-finite, or no step along the Newton direction lowers the
+            energy or the residual. The state is restored to where it started.
+        """
+        tolerance = self.rtol * max(force_scale, 1e-12)
+        vec, du, res = self.gfu.vec, self._du, self._res
+        self._backup.data = vec
+        cuts = 0
+        residual = self._norm(self.residual())
+        for iteration in range(self.max_iterations + 1):
+            if not math.isfinite(residual):
+                break
+            if residual <= tolerance:
+                self.timings.iterations += iteration
+                return NewtonReport(iteration, residual, cuts)
+            if iteration == self.max_iterations:
+                break
+            if iteration >= self.stall_iteration and residual > self.stall_factor * tolerance:
+                break
+            self.factorize()
+            self.solve_tangent(res, du)
+            alpha, residual, n_cuts = self._line_search(residual)
+            cuts += n_cuts
+            if alpha == 0.0:
+                break
+        self.timings.iterations += iteration
+        vec.data = self._backup
+        raise ConvergenceError(
+            f"Newton did not converge in {iteration} iterations (tolerance {tolerance:.3g} N)",
+            pressure_mpa=load,
+            step=step,
+            residual=residual,
+        )
+
+    def _line_search(self, residual0: float) -> tuple[float, float, int]:
+        """Step ``u -= α du``; returns ``(α, new residual norm, cuts)`` (α = 0: failed)."""
+        vec, du = self.gfu.vec, self._du
+        energy0 = self.form.Energy(vec)
+        slope = -float(du.InnerProduct(self._res))  # d/dα E(u − α du) at α = 0
+        alpha = 1.0
+        for cuts in range(12):
+            vec.data -= alpha * du
+            energy = self.form.Energy(vec)
+            residual = self._norm(self.residual())
+            roundoff = 1e-11 * max(abs(energy0), 1.0)
+            if math.isfinite(energy) and math.isfinite(residual):
+                if abs(energy - energy0) <= roundoff or slope >= 0.0:
+                    # Energy differences drown in round-off (or the Hessian is not
+                    # positive definite here): judge the step by the residual.
+                    if residual < residual0:
+                        return alpha, residual, cuts
+                elif energy <= energy0 + 1e-4 * alpha * slope:
+                    return alpha, residual, cuts
+            vec.data += alpha * du
+            alpha *= 0.5
+        self.residual()
+        return 0.0, residual0, 12

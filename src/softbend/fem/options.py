@@ -1,0 +1,198 @@
+"""Every modelling and solver assumption of the FEM model, as one validated object."""
+
+from __future__ import annotations
+
+from dataclasses import asdict, dataclass, field, fields
+from typing import Any
+
+from softbend._validation import check_choice, check_int, check_range
+from softbend.fem.mechanics import FIBER_LAWS
+from softbend.materials.models import HyperelasticModel
+from softbend.materials.presets import (
+    DRAGON_SKIN_30,
+    FIBERGLASS_LAYER,
+    KEVLAR_FIBER,
+    KEVLAR_MODELLED_RADIUS_MM,
+    LinearElastic,
+    Material,
+)
+
+__all__ = ["GRAVITY_DIRECTIONS", "OUTPUT_MODES", "FEMOptions"]
+
+#: Where gravity points, relative to the actuator (see :class:`FEMOptions`).
+GRAVITY_DIRECTIONS: tuple[str, ...] = ("bending", "against", "axial", "none")
+
+#: How outputs on the requested pressure grid are obtained.
+OUTPUT_MODES: tuple[str, ...] = ("interpolate", "solve")
+
+
+@dataclass(frozen=True)
+class FEMOptions:
+    """Modelling assumptions and solver settings of :func:`softbend.fem.simulate`.
+
+    Geometry (mm). The actuator lies along ``+x`` from its fixed base face at
+    ``x = 0``; the strain-limiting layer is the flat bottom face ``z = 0`` and
+    the semicircular chamber is above it. Only the half ``y ≥ 0`` is modelled
+    (the bending plane ``y = 0`` is a plane of symmetry of geometry and loads).
+
+    Parameters
+    ----------
+    maxh_mm : float
+        Largest element size, mm, in (0, 20]. The default 4 mm gives quadratic
+        tetrahedra with about one element across a 2 mm wall (see
+        ``softbend fem mesh-study`` for the convergence of the angle).
+    order : int
+        Polynomial order of the displacement, 2 or 3 (1 locks: the gravity sag of
+        linear tetrahedra is half the converged one).
+    base_cap_mm : float
+        Thickness of the proximal (fixed) end wall, mm, in (0, 50]. Paper B does
+        not give it; 3 mm is assumed. The distal cap is the design's ``lc``.
+    bulk_ratio : float
+        Penalty bulk modulus over the initial shear modulus, ``K/μ0``, in
+        [10, 1e5]; 100 (Poisson's ratio 0.495) is nearly incompressible
+        without ill-conditioning.
+    elastomer, layer : Material
+        Hyperelastic materials of the body (Dragon Skin 30, paper B) and of the
+        strain-limiting layer (fiberglass, Yeoh C10 = 7.9 MPa).
+    layer_thickness_mm : float
+        Thickness of the strain-limiting layer, mm (paper B: 0.1). It is a
+        membrane bonded to the bottom face, not a meshed solid.
+    fiber : Material
+        Fiber material, linear elastic (Kevlar, E = 31076 MPa).
+    fiber_radius_mm : float
+        Radius that sets the fiber stiffness, mm; paper B halves the real radius
+        (0.07 mm for 0.28 mm fibers) after Polygerinos et al.
+    fiber_pitch_mm : float or None
+        Axial distance between neighbouring turns of one helix family, mm. None:
+        one fiber per family wound once around the section per
+        ``perimeter·tan φ`` of length (paper B gives no pitch). The fibers are
+        smeared over the outer faces (curved top, sides, bottom) as two families
+        at ``±φ`` from the circumferential direction.
+    fiber_law : {"tension-compression", "tension-only"}
+        Whether the fibers also carry compression. Paper B ties beam elements to
+        the elastomer, which do; default "tension-compression".
+    gravity : {"bending", "against", "axial", "none"}
+        Direction of gravity: "bending" — across the actuator towards the
+        strain-limiting layer, the side it bends to (lying horizontally, layer
+        down, as in paper B's experiments); "against" — the opposite; "axial" —
+        along the actuator from base to tip (hanging); "none".
+    gravity_mm_s2 : float
+        Gravitational acceleration, mm/s² (9810).
+    max_angle_deg : float
+        The sweep stops once the bending angle exceeds this, degrees, in
+        (0, 340]; default 300°, where the tip approaches the base.
+    initial_step_mpa, min_step_mpa, max_step_mpa : float
+        Adaptive pressure stepping: first step, smallest step before the sweep
+        is declared stopped (no convergence), largest step, MPa.
+    rtol : float
+        Newton tolerance on the residual force relative to the load (pressure
+        resultant on the cavity walls plus weight), in (0, 1e-3].
+    max_iterations : int
+        Newton iterations per step before the step is cut, >= 3.
+    output : {"interpolate", "solve"}
+        "interpolate": outputs on the requested pressure grid come from cubic
+        Hermite interpolation between converged steps, with the slopes
+        ``dθ/dp`` from the tangent stiffness (exact at the steps); "solve": every
+        requested pressure is a converged Newton solve.
+    backbone_points : int
+        Points along the strain-limiting layer used for the arc fit, >= 5.
+    threads : int
+        Threads of NGSolve's task manager, >= 1 (1: one core per sweep, the
+        campaign runs sweeps in parallel instead).
+    """
+
+    maxh_mm: float = 4.0
+    order: int = 2
+    base_cap_mm: float = 3.0
+    bulk_ratio: float = 100.0
+    elastomer: Material = DRAGON_SKIN_30
+    layer: Material = FIBERGLASS_LAYER
+    layer_thickness_mm: float = 0.1
+    fiber: Material = KEVLAR_FIBER
+    fiber_radius_mm: float = KEVLAR_MODELLED_RADIUS_MM
+    fiber_pitch_mm: float | None = None
+    fiber_law: str = "tension-compression"
+    gravity: str = "bending"
+    gravity_mm_s2: float = 9810.0
+    max_angle_deg: float = 300.0
+    initial_step_mpa: float = 0.01
+    min_step_mpa: float = 2e-4
+    max_step_mpa: float = 0.025
+    rtol: float = 1e-7
+    max_iterations: int = 12
+    output: str = "interpolate"
+    backbone_points: int = 41
+    threads: int = 1
+    extra: dict[str, Any] = field(default_factory=dict, repr=False, compare=False)
+
+    def __post_init__(self) -> None:
+        owner = "FEMOptions"
+
+        def number(name: str, low: float, high: float, low_inclusive: bool = False) -> None:
+            value = check_range(
+                getattr(self, name),
+                name,
+                owner,
+                low=low,
+                high=high,
+                low_inclusive=low_inclusive,
+                high_inclusive=True,
+            )
+            object.__setattr__(self, name, value)
+
+        number("maxh_mm", 0.0, 20.0)
+        order = check_int(self.order, "order", owner, low=1)
+        if order not in (2, 3):
+            raise ValueError(f"The 'order' of {owner} must be one of 2, 3. Got {order!r} instead.")
+        number("base_cap_mm", 0.0, 50.0)
+        number("bulk_ratio", 10.0, 1e5, low_inclusive=True)
+        for name in ("elastomer", "layer"):
+            material = getattr(self, name)
+            if not isinstance(material, Material) or not isinstance(
+                material.model, HyperelasticModel
+            ):
+                raise ValueError(
+                    f"The '{name}' of {owner} must be a Material with a hyperelastic model. "
+                    f"Got {material!r} instead."
+                )
+        if not isinstance(self.fiber, Material) or not isinstance(self.fiber.model, LinearElastic):
+            raise ValueError(
+                f"The 'fiber' of {owner} must be a Material with a LinearElastic model. "
+                f"Got {self.fiber!r} instead."
+            )
+        number("layer_thickness_mm", 0.0, 10.0)
+        number("fiber_radius_mm", 0.0, 5.0)
+        if self.fiber_pitch_mm is not None:
+            number("fiber_pitch_mm", 0.0, 1000.0)
+        check_choice(self.fiber_law, "fiber_law", owner, FIBER_LAWS)
+        check_choice(self.gravity, "gravity", owner, GRAVITY_DIRECTIONS)
+        number("gravity_mm_s2", 0.0, 1e6, low_inclusive=True)
+        number("max_angle_deg", 0.0, 340.0)
+        number("max_step_mpa", 0.0, 10.0)
+        number("initial_step_mpa", 0.0, self.max_step_mpa)
+        number("min_step_mpa", 0.0, self.initial_step_mpa)
+        number("rtol", 0.0, 1e-3)
+        check_int(self.max_iterations, "max_iterations", owner, low=3)
+        check_choice(self.output, "output", owner, OUTPUT_MODES)
+        check_int(self.backbone_points, "backbone_points", owner, low=5)
+        check_int(self.threads, "threads", owner, low=1)
+
+    def replace(self, **changes: Any) -> FEMOptions:
+        """A copy with ``changes`` applied (validated again)."""
+        values = {f.name: getattr(self, f.name) for f in fields(self)}
+        unknown = sorted(set(changes) - set(values))
+        if unknown:
+            raise ValueError(
+                f"The options of FEMOptions must be among {', '.join(sorted(values))}. "
+                f"Got unknown {unknown!r}."
+            )
+        values.update(changes)
+        return FEMOptions(**values)
+
+    def to_dict(self) -> dict[str, Any]:
+        """JSON-friendly description (materials as their own dicts)."""
+        out = asdict(self)
+        for name in ("elastomer", "layer", "fiber"):
+            out[name] = getattr(self, name).to_dict()
+        out.pop("extra")
+        return out

@@ -1,0 +1,355 @@
+"""Load stepping: the pressure sweep of one design, ``simulate(design, pressures)``.
+
+1. Gravity is applied first (cut into smaller fractions if Newton does not
+   converge); that state is the 0 MPa output.
+2. Pressure is raised in adaptive steps. Each step starts from the tangent
+   predictor ``u + Δp·du/dp`` (``K du/dp = ∂V/∂u``), so Newton starts close to
+   the solution. A step that does not converge is restored and halved; a step
+   that converged in few iterations lets the next one grow (up to
+   ``max_step_mpa``).
+3. At every converged step the angle, the tip and their derivatives with respect
+   to pressure are stored; outputs on the requested grid are the cubic Hermite
+   interpolants between steps (or, with ``output="solve"``, the steps land on
+   every requested pressure).
+
+The sweep ends at the last requested pressure, when the angle passes
+``max_angle_deg`` (the actuator has curled round; outputs above it are not
+reported), or when a step shorter than ``min_step_mpa`` still does not converge
+— then the first requested pressure beyond the last converged state is reported
+with ``converged=False`` and the reason is in ``stats["stop_reason"]``. A model
+that does not even hold its own weight raises
+:class:`~softbend.errors.ConvergenceError`.
+"""
+
+from __future__ import annotations
+
+import logging
+import time
+from collections.abc import Callable
+from dataclasses import dataclass, field
+from typing import Any
+
+import numpy as np
+from numpy.typing import ArrayLike
+
+from softbend.campaign.backends import SweepResult, check_pressures_mpa
+from softbend.design import SFRBADesign
+from softbend.errors import ConvergenceError
+from softbend.fem.actuator import ActuatorModel
+from softbend.fem.options import FEMOptions
+
+__all__ = ["Step", "StepHistory", "run_sweep", "simulate"]
+
+logger = logging.getLogger(__name__)
+
+#: Called after every converged step with (pressure MPa, angle deg, target pressure MPa).
+ProgressCallback = Callable[[float, float, float], None]
+
+
+@dataclass(frozen=True)
+class Step:
+    """One converged load step."""
+
+    pressure_mpa: float
+    values: np.ndarray  # angle deg, tip x mm, tip z mm
+    slopes: np.ndarray  # their derivatives per MPa
+    iterations: int
+    state: np.ndarray | None = field(default=None, repr=False)
+
+
+@dataclass
+class StepHistory:
+    """The converged steps of a sweep, in order, and why it stopped."""
+
+    steps: list[Step] = field(default_factory=list)
+    stop_reason: str = "reached the last pressure"
+    failed_pressure_mpa: float | None = None
+    failure: str | None = None
+    rejected_steps: int = 0
+
+    @property
+    def pressures(self) -> np.ndarray:
+        return np.array([s.pressure_mpa for s in self.steps])
+
+    def interpolate(self, pressures_mpa: np.ndarray) -> np.ndarray:
+        """Cubic Hermite values (n, 3) at pressures inside the converged range."""
+        p = self.pressures
+        values = np.array([s.values for s in self.steps])
+        slopes = np.array([s.slopes for s in self.steps])
+        out = np.empty((len(pressures_mpa), 3))
+        for row, q in enumerate(pressures_mpa):
+            k = int(np.searchsorted(p, q, side="left"))
+            if k < len(p) and abs(p[k] - q) <= 1e-12:
+                out[row] = values[k]
+                continue
+            k = min(max(k, 1), len(p) - 1)
+            h = p[k] - p[k - 1]
+            s = (q - p[k - 1]) / h
+            h00 = (1 + 2 * s) * (1 - s) ** 2
+            h10 = s * (1 - s) ** 2
+            h01 = s * s * (3 - 2 * s)
+            h11 = s * s * (s - 1)
+            out[row] = (
+                h00 * values[k - 1]
+                + h10 * h * slopes[k - 1]
+                + h01 * values[k]
+                + h11 * h * slopes[k]
+            )
+        return out
+
+
+def _record(model: ActuatorModel, pressure: float, iterations: int, keep_state: bool) -> Step:
+    values = model.measure().as_array()
+    tangent = model.pressure_tangent(refactorize=iterations == 0)
+    slopes = model.measure_derivative(tangent)
+    return Step(
+        pressure, values, slopes, iterations, model.state() if keep_state else None
+    ), tangent
+
+
+def _apply_gravity(model: ActuatorModel) -> int:
+    """Ramp gravity in as few fractions as converge; returns the Newton iterations.
+
+    From the straight state the first solve is a long way off (the sag of a soft
+    cantilever), so it gets plain Newton without the early give-up rule.
+    """
+    solver = model.solver
+    saved = solver.stall_iteration, solver.max_iterations
+    solver.stall_iteration, solver.max_iterations = 10**6, max(30, solver.max_iterations)
+    try:
+        return _gravity_fractions(model)
+    finally:
+        solver.stall_iteration, solver.max_iterations = saved
+
+
+def _gravity_fractions(model: ActuatorModel) -> int:
+    options = model.options
+    if options.gravity == "none" or options.gravity_mm_s2 == 0.0:
+        model.set_load(0.0, 0.0)
+        return model.solver.solve(model.force_scale_n(0.0), load=0.0, step=0).iterations
+    done, fraction, iterations, step = 0.0, 1.0, 0, 0
+    while done < 1.0:
+        target = min(1.0, done + fraction)
+        model.set_load(0.0, target)
+        try:
+            iterations += model.solver.solve(
+                model.force_scale_n(0.0), load=0.0, step=step
+            ).iterations
+        except ConvergenceError as exc:
+            fraction /= 2.0
+            if fraction < 1.0 / 64.0:
+                raise ConvergenceError(
+                    f"the actuator {model.design} does not hold its own weight: gravity "
+                    f"fraction {target:.3g} did not converge",
+                    pressure_mpa=0.0,
+                    step=step,
+                    residual=exc.residual,
+                ) from exc
+            continue
+        done = target
+        step += 1
+        fraction = min(1.0, 2.0 * fraction)
+    return iterations
+
+
+def run_steps(
+    model: ActuatorModel,
+    pmax_mpa: float,
+    *,
+    landing_mpa: np.ndarray | None = None,
+    keep_states: bool = False,
+    progress: ProgressCallback | None = None,
+) -> StepHistory:
+    """Gravity, then adaptive pressure steps up to ``pmax_mpa`` (see module docstring).
+
+    ``landing_mpa``: pressures every step must land on (``output="solve"``).
+    ``keep_states``: store the displacement of every step (for VTK output).
+    """
+    options = model.options
+    history = StepHistory()
+    gravity_iterations = _apply_gravity(model)
+    step, tangent = _record(model, 0.0, gravity_iterations, keep_states)
+    history.steps.append(step)
+    if progress is not None:
+        progress(0.0, float(step.values[0]), pmax_mpa)
+    pressure, dp = 0.0, options.initial_step_mpa
+    while pressure < pmax_mpa - 1e-12:
+        target = min(pressure + dp, pmax_mpa)
+        if landing_mpa is not None:
+            ahead = landing_mpa[landing_mpa > pressure + 1e-12]
+            if ahead.size:
+                target = min(target, float(ahead[0]))
+        start = model.state()
+        model.set_state(start + (target - pressure) * tangent)
+        model.set_load(target, 1.0)
+        try:
+            report = model.solver.solve(
+                model.force_scale_n(target), load=target, step=len(history.steps)
+            )
+        except ConvergenceError as exc:
+            model.set_state(start)
+            model.set_load(pressure, 1.0)
+            history.rejected_steps += 1
+            dp = 0.5 * (target - pressure)
+            if dp < options.min_step_mpa:
+                history.stop_reason = (
+                    f"no convergence above {pressure:.6g} MPa (step cut below "
+                    f"{options.min_step_mpa:g} MPa)"
+                )
+                history.failed_pressure_mpa = target
+                history.failure = str(exc)
+                break
+            continue
+        pressure = target
+        step, tangent = _record(model, pressure, report.iterations, keep_states)
+        history.steps.append(step)
+        if progress is not None:
+            progress(pressure, float(step.values[0]), pmax_mpa)
+        if step.values[0] > options.max_angle_deg:
+            history.stop_reason = f"bending angle above {options.max_angle_deg:g} deg"
+            break
+        if report.iterations <= 5:
+            dp = min(options.max_step_mpa, 1.5 * dp)
+        elif report.iterations >= 9:
+            dp = max(options.min_step_mpa, 0.7 * dp)
+    return history
+
+
+def simulate(
+    design: SFRBADesign,
+    pressures_mpa: ArrayLike,
+    options: FEMOptions | None = None,
+    *,
+    progress: ProgressCallback | None = None,
+) -> SweepResult:
+    """Sweep the FEM model of ``design`` over increasing pressures.
+
+    Parameters
+    ----------
+    design : SFRBADesign
+        The actuator (l, r, t, b, φ, lc).
+    pressures_mpa : array_like
+        Requested gauge pressures, MPa, strictly increasing from 0 or above.
+    options : FEMOptions, optional
+        Modelling assumptions and solver settings (defaults documented there).
+    progress : callable, optional
+        ``progress(pressure_mpa, angle_deg, pmax_mpa)`` after each converged step.
+
+    Returns
+    -------
+    SweepResult
+        One entry per requested pressure up to where the sweep stopped. Angle by
+        the arc fit of the backbone (degrees), tip in the frame of
+        :func:`softbend.analytical.tip_position_mm` (mm), Newton iterations of
+        the step that reached each pressure, ``mesh_size`` = tetrahedra of the
+        half model. ``stats`` holds the steps, the stop reason, the degrees of
+        freedom and the time spent in assembly and factorisation.
+
+    Raises
+    ------
+    ConvergenceError
+        If the gravity-only state does not converge.
+    ValueError
+        For a bad pressure grid or options.
+    """
+    result, _, _ = run_sweep(design, pressures_mpa, options, progress=progress)
+    return result
+
+
+def run_sweep(
+    design: SFRBADesign,
+    pressures_mpa: ArrayLike,
+    options: FEMOptions | None = None,
+    *,
+    progress: ProgressCallback | None = None,
+    keep_states: bool = False,
+) -> tuple[SweepResult, ActuatorModel, StepHistory]:
+    """:func:`simulate`, also returning the model and the converged steps.
+
+    With ``keep_states=True`` every step keeps its displacement vector, so the
+    deformed shapes can be drawn or exported (``model.set_state(step.state)``).
+    """
+    from ngsolve import SetNumThreads, TaskManager
+
+    grid = check_pressures_mpa(pressures_mpa, "simulate")
+    options = options or FEMOptions()
+    if not isinstance(options, FEMOptions):
+        raise ValueError(f"The 'options' of simulate must be FEMOptions. Got {options!r} instead.")
+    if not isinstance(design, SFRBADesign):
+        raise ValueError(
+            f"The 'design' of simulate must be an SFRBADesign. Got {design!r} instead."
+        )
+    started = time.perf_counter()
+    SetNumThreads(options.threads)
+    with TaskManager():
+        model = ActuatorModel(design, options)
+        built = time.perf_counter()
+        landing = grid if options.output == "solve" else None
+        history = run_steps(
+            model, float(grid[-1]), landing_mpa=landing, progress=progress, keep_states=keep_states
+        )
+    return _to_result(model, grid, history, started, built), model, history
+
+
+def _to_result(
+    model: ActuatorModel, grid: np.ndarray, history: StepHistory, started: float, built: float
+) -> SweepResult:
+    options = model.options
+    p_steps = history.pressures
+    reached = grid[grid <= p_steps[-1] + 1e-12]
+    values = history.interpolate(reached)
+    # Drop outputs beyond the angle limit.
+    keep = values[:, 0] <= options.max_angle_deg
+    if not keep.all():
+        cut = int(np.flatnonzero(~keep)[0])
+        reached, values = reached[:cut], values[:cut]
+    iterations = np.array(
+        [
+            history.steps[
+                min(int(np.searchsorted(p_steps, q - 1e-12)), len(p_steps) - 1)
+            ].iterations
+            for q in reached
+        ],
+        dtype=np.int64,
+    )
+    pressure, angle = list(reached), list(values[:, 0])
+    tip_x, tip_z, its = list(values[:, 1]), list(values[:, 2]), list(iterations)
+    converged = [True] * len(reached)
+    if history.failed_pressure_mpa is not None:
+        beyond = grid[grid > p_steps[-1] + 1e-12]
+        if beyond.size:
+            pressure.append(float(beyond[0]))
+            angle.append(np.nan)
+            tip_x.append(np.nan)
+            tip_z.append(np.nan)
+            its.append(options.max_iterations)
+            converged.append(False)
+    timings = model.solver.timings.as_dict()
+    wall = time.perf_counter() - started
+    stats: dict[str, Any] = {
+        "model": "3D FEM, NGSolve, half model, quadratic tetrahedra",
+        "stop_reason": history.stop_reason,
+        "steps_mpa": [float(s.pressure_mpa) for s in history.steps],
+        "step_angles_deg": [float(s.values[0]) for s in history.steps],
+        "step_iterations": [int(s.iterations) for s in history.steps],
+        "rejected_steps": history.rejected_steps,
+        "ndof": model.ndof,
+        "setup_s": built - started,
+        "timings": timings,
+        "options": options.to_dict(),
+        "fiber_spacing_mm": model.fiber_spacing_mm(),
+    }
+    if history.failure:
+        stats["failure"] = history.failure
+    return SweepResult(
+        design=model.design,
+        pressure_mpa=np.array(pressure, dtype=float),
+        angle_deg=np.array(angle, dtype=float),
+        tip_x_mm=np.array(tip_x, dtype=float),
+        tip_z_mm=np.array(tip_z, dtype=float),
+        converged=np.array(converged, dtype=bool),
+        newton_iterations=np.array(its, dtype=np.int64),
+        wall_time_s=wall,
+        mesh_size=model.n_elements,
+        stats=stats,
+    )
