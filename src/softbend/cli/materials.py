@@ -1,0 +1,184 @@
+"""``softbend materials``: shipped tensile tests and hyperelastic fits (paper B §3.1, Fig. 2a)."""
+
+from __future__ import annotations
+
+import json
+from pathlib import Path
+from typing import TYPE_CHECKING, Annotated, Any
+
+import typer
+
+from softbend.cli import _common
+
+if TYPE_CHECKING:
+    from softbend.materials.fit import FitResult
+    from softbend.materials.tensile import TensileTest
+
+app = typer.Typer(
+    help="Materials (paper B §3.1): shipped tensile tests and hyperelastic model fits.",
+    no_args_is_help=True,
+)
+
+#: Files written into ``--out`` by ``fit``.
+FIT_PNG = "fit.png"
+FIT_JSON = "fit.json"
+#: Shipped test fitted when no CSV is given.
+DEFAULT_TEST = "dragon-skin-30"
+
+_SYMBOLS = {
+    "c10_mpa": "C10",
+    "c20_mpa": "C20",
+    "c30_mpa": "C30",
+    "mu_mpa": "μ",
+    "lambda_m": "λm",
+}
+
+
+def _load(csv: str | None) -> TensileTest:
+    """A CSV file, else a shipped test by name; the shipped Dragon Skin 30 by default."""
+    from softbend.materials.tensile import load_shipped, load_tensile_csv, shipped_tensile_tests
+
+    if csv is None:
+        return load_shipped(DEFAULT_TEST)
+    if Path(csv).exists():
+        return load_tensile_csv(csv)
+    shipped = shipped_tensile_tests()
+    if csv in shipped:
+        return load_shipped(csv)
+    raise FileNotFoundError(
+        f"Tensile data file {csv!r} does not exist and is not a shipped test "
+        f"({', '.join(shipped)})."
+    )
+
+
+def _describe(result: FitResult) -> str:
+    return ", ".join(f"{_SYMBOLS.get(k, k)} {v:.4g}" for k, v in result.parameters.items())
+
+
+def _payload(
+    test: TensileTest, results: dict[str, FitResult], max_stretch: float | None
+) -> dict[str, Any]:
+    ranked = [r for r in results.values() if r.r2 == r.r2]  # NaN R² never ranks
+    best = max(ranked, key=lambda r: r.r2).name if ranked else None
+    return {
+        "test": {
+            "name": test.name,
+            "material": test.material,
+            "source": str(test.source) if test.source is not None else None,
+            "attribution": test.attribution,
+            "n_points": test.n_points,
+            "max_engineering_strain": test.max_strain,
+            "max_engineering_stress_mpa": float(test.engineering_stress_mpa.max()),
+        },
+        "max_stretch": max_stretch,
+        "fits": [r.to_dict() for r in results.values()],
+        "best_model": best,
+    }
+
+
+@app.command("fit")
+def fit(
+    csv: Annotated[
+        str | None,
+        typer.Argument(
+            help=(
+                "Tensile data file (semicolon-separated, with the columns 'Engineering Strain' "
+                "and 'Engineering Stress (MPa)') or the name of a shipped test "
+                "(see 'softbend materials list'). Default: the shipped Dragon Skin 30 test."
+            ),
+            show_default=False,
+        ),
+    ] = None,
+    models: Annotated[
+        str,
+        typer.Option(
+            "--models", help="Comma-separated models among neo-hookean, yeoh, arruda-boyce."
+        ),
+    ] = "neo-hookean,yeoh,arruda-boyce",
+    out: Annotated[
+        Path,
+        typer.Option("--out", "-o", help="Folder for fit.png and fit.json (created if missing)."),
+    ] = Path("results/materials"),
+    max_stretch: Annotated[
+        float | None,
+        typer.Option(
+            "--max-stretch",
+            help="Fit only the points with stretch ≤ this (> 1). Default: all, to failure.",
+            show_default=False,
+        ),
+    ] = None,
+    json_output: Annotated[bool, typer.Option("--json", help="Print the results as JSON.")] = False,
+) -> None:
+    """Fit hyperelastic models to a uniaxial tensile test (paper B Fig. 2a).
+
+    Least squares of each model's nominal stress in incompressible uniaxial
+    tension against the measured engineering stress (MPa), with R² and RMSE.
+    Writes OUT/fit.png (data and fitted curves) and OUT/fit.json.
+    """
+    from softbend._io import write_text_atomic
+    from softbend.materials.fit import fit_models
+    from softbend.reports.material_figures import fit_figure
+
+    names = [m.strip() for m in models.split(",") if m.strip()]
+    test = _load(csv)
+    results = fit_models(test, names, max_stretch=max_stretch)
+
+    figure = fit_figure(test, results, out / FIT_PNG)
+    payload = _payload(test, results, max_stretch)
+    payload["files"] = {"figure": str(figure), "json": str(out / FIT_JSON)}
+    text = json.dumps(_common._jsonable(payload), indent=2, allow_nan=False)
+    write_text_atomic(out / FIT_JSON, text + "\n")
+
+    if json_output:
+        _common.print_json(payload)
+        return
+    first, last = next(iter(results.values())).stretch_range
+    _common.print_table(
+        f"{test.material}: {test.n_points} points, stretch {first:.4g} to {last:.4g} fitted",
+        ["model", "parameters (C, μ in MPa)", "R²", "RMSE (MPa)", "points"],
+        [
+            [r.name, _describe(r), f"{r.r2:.4f}", f"{r.rmse_mpa:.4f}", r.n_points]
+            for r in results.values()
+        ],
+    )
+    if test.attribution:
+        _common.console.print(f"Data: {test.attribution}", highlight=False)
+    if payload["best_model"] is not None:
+        _common.console.print(f"Best fit (highest R²): {payload['best_model']}", highlight=False)
+    _common.console.print(f"Figure and JSON written to {out}", highlight=False)
+
+
+@app.command("list")
+def list_tests(
+    json_output: Annotated[bool, typer.Option("--json", help="Print the list as JSON.")] = False,
+) -> None:
+    """List the tensile tests shipped with softbend (Marechal et al. 2021, ODbL 1.0)."""
+    from softbend.materials.tensile import SHIPPED_ATTRIBUTION, load_shipped, shipped_tensile_tests
+
+    tests = [load_shipped(name) for name in shipped_tensile_tests()]
+    rows = [
+        [t.name, t.n_points, t.max_strain, float(t.engineering_stress_mpa.max())] for t in tests
+    ]
+    if json_output:
+        _common.print_json(
+            {
+                "attribution": SHIPPED_ATTRIBUTION,
+                "tests": [
+                    {
+                        "name": t.name,
+                        "material": t.material,
+                        "n_points": t.n_points,
+                        "max_engineering_strain": t.max_strain,
+                        "max_engineering_stress_mpa": float(t.engineering_stress_mpa.max()),
+                    }
+                    for t in tests
+                ],
+            }
+        )
+        return
+    _common.print_table(
+        "Shipped uniaxial tensile tests (pull to failure)",
+        ["name", "points", "max strain", "max stress (MPa)"],
+        rows,
+    )
+    _common.console.print(f"Data: {SHIPPED_ATTRIBUTION}", highlight=False)

@@ -1,0 +1,460 @@
+"""Least-squares fits of the hyperelastic models to uniaxial tension data (paper B §3.1).
+
+Each model's nominal stress in incompressible uniaxial tension,
+:meth:`~softbend.materials.models.HyperelasticModel.uniaxial_nominal_stress_mpa`,
+is fitted to measured nominal (engineering) stress by ordinary least squares in
+MPa, with :func:`scipy.optimize.least_squares` (trust-region reflective, bounds
+below). With ``g = 2(λ − λ⁻²)`` and ``d = I1 − 3 = λ² + 2/λ − 3``:
+
+* neo-Hookean ``P = C10·g`` and Yeoh ``P = C10·g + C20·2gd + C30·3gd²`` are linear
+  in their constants. The unconstrained optimum comes from a linear least-squares
+  solve (columns scaled to unit norm: at λ ≈ 8 the ``d²`` column is ~10⁴ times
+  the ``g`` column) and starts ``least_squares``, which only has work to do if the
+  bound ``C10 > 0`` is active.
+* Arruda–Boyce ``P = μ·g·Σ i·Ci·λm^(2−2i)·I1^(i−1)`` is linear in ``μ`` for a
+  fixed locking stretch ``λm``. The start is the best ``(μ, λm)`` of a log-spaced
+  ``λm`` grid with ``μ`` solved in closed form at each node; then both are
+  refined with the bounds ``μ > 0`` and ``1 < λm ≤ 1000``. At ``λm = 1000`` the
+  model is neo-Hookean to within ~10⁻⁶ relative; a fit that ends there means the
+  data show no chain locking (logged as a warning).
+
+Metrics over the points used: ``R² = 1 − Σ(P − P̂)² / Σ(P − P̄)²`` and
+``RMSE = sqrt(mean((P − P̂)²))`` in MPa. Being unweighted in MPa, the fit is
+dominated by the high-stress points near failure; ``max_stretch`` restricts it to
+the working range of an actuator instead.
+"""
+
+from __future__ import annotations
+
+import logging
+import math
+from collections.abc import Callable, Sequence
+from dataclasses import dataclass
+from typing import Any
+
+import numpy as np
+from numpy.typing import ArrayLike
+from scipy.optimize import least_squares
+
+from softbend._validation import check_choice, check_finite_array, check_range
+from softbend.errors import ConvergenceError, DatasetError
+from softbend.materials.models import (
+    _AB_COEFFS,
+    MODELS,
+    ArrudaBoyce,
+    HyperelasticModel,
+    NeoHookean,
+    Yeoh,
+)
+from softbend.materials.tensile import TensileTest
+
+__all__ = [
+    "DEFAULT_MODELS",
+    "LAMBDA_M_MAX",
+    "MIN_FIT_POINTS",
+    "FitResult",
+    "fit_model",
+    "fit_models",
+]
+
+logger = logging.getLogger(__name__)
+
+#: The three models of paper B §3.1, in the order they are fitted by default.
+DEFAULT_MODELS: tuple[str, ...] = ("neo-hookean", "yeoh", "arruda-boyce")
+#: Fewest points a fit may use.
+MIN_FIT_POINTS = 5
+#: Upper bound of the Arruda–Boyce locking stretch in the fit (neo-Hookean limit).
+LAMBDA_M_MAX = 1e3
+#: Lower bounds of the strictly positive moduli (C10, μ) in MPa.
+_MODULUS_FLOOR_MPA = 1e-12
+#: Lower bound of λm (the model requires λm > 1).
+_LAMBDA_M_FLOOR = 1.0 + 1e-6
+_TOL = 1e-12
+
+
+@dataclass(frozen=True)
+class FitResult:
+    """A hyperelastic model fitted to uniaxial tension data, with its goodness of fit.
+
+    Parameters
+    ----------
+    model : HyperelasticModel
+        The fitted model (constants in MPa).
+    r2 : float
+        Coefficient of determination over the points used, ``1 − SS_res/SS_tot``;
+        NaN if the stresses are all equal.
+    rmse_mpa : float
+        Root-mean-square error of the nominal stress over the points used, MPa.
+    n_points : int
+        Number of points used.
+    stretch_range : tuple of float
+        Smallest and largest stretch used, dimensionless.
+    at_bound : tuple of str, optional
+        Parameters that ended on a bound of the fit (e.g. ``("lambda_m",)``).
+    """
+
+    model: HyperelasticModel
+    r2: float
+    rmse_mpa: float
+    n_points: int
+    stretch_range: tuple[float, float]
+    at_bound: tuple[str, ...] = ()
+
+    def __post_init__(self) -> None:
+        if not isinstance(self.model, HyperelasticModel):
+            raise ValueError(
+                f"The 'model' of FitResult must be a HyperelasticModel. Got {self.model!r} instead."
+            )
+        object.__setattr__(self, "r2", float(self.r2))
+        object.__setattr__(
+            self,
+            "rmse_mpa",
+            check_range(self.rmse_mpa, "rmse_mpa", "FitResult", low=0.0, low_inclusive=True),
+        )
+        object.__setattr__(self, "stretch_range", tuple(float(s) for s in self.stretch_range))
+        object.__setattr__(self, "at_bound", tuple(self.at_bound))
+
+    @property
+    def name(self) -> str:
+        """Registry name of the fitted model (``"yeoh"`` ...)."""
+        return self.model.name
+
+    @property
+    def parameters(self) -> dict[str, float]:
+        """Fitted constants by field name (``c10_mpa`` ... in MPa, ``lambda_m`` dimensionless)."""
+        params = self.model.to_dict()
+        params.pop("model")
+        return {k: float(v) for k, v in params.items()}
+
+    def predict(self, stretch: ArrayLike) -> np.ndarray:
+        """Nominal stress of the fitted model at ``stretch``, MPa."""
+        return self.model.uniaxial_nominal_stress_mpa(stretch)
+
+    def to_dict(self) -> dict[str, Any]:
+        """JSON-friendly summary: model name, parameters, metrics and the range used."""
+        return {
+            "model": self.name,
+            "parameters": self.parameters,
+            "initial_shear_modulus_mpa": self.model.initial_shear_modulus_mpa,
+            "r2": self.r2,
+            "rmse_mpa": self.rmse_mpa,
+            "n_points": self.n_points,
+            "stretch_min": self.stretch_range[0],
+            "stretch_max": self.stretch_range[1],
+            "at_bound": list(self.at_bound),
+        }
+
+
+def _g(lam: np.ndarray) -> np.ndarray:
+    """``2(λ − λ⁻²)``: nominal stress per unit ``∂W/∂I1`` in uniaxial tension."""
+    return 2.0 * (lam - lam**-2)
+
+
+def _i1(lam: np.ndarray) -> np.ndarray:
+    return lam**2 + 2.0 / lam
+
+
+def _linear_design(model_name: str, lam: np.ndarray) -> np.ndarray:
+    """Columns of the linear models: ``P = A @ constants``."""
+    g = _g(lam)
+    if model_name == NeoHookean.name:
+        return g[:, None]
+    d = _i1(lam) - 3.0
+    return np.column_stack([g, 2.0 * g * d, 3.0 * g * d**2])
+
+
+def _scaled_lstsq(A: np.ndarray, y: np.ndarray) -> np.ndarray:
+    norms = np.linalg.norm(A, axis=0)
+    norms[norms == 0.0] = 1.0
+    solution, *_ = np.linalg.lstsq(A / norms, y, rcond=None)
+    return solution / norms
+
+
+def _ab_series(lam: np.ndarray, lambda_m: float) -> tuple[np.ndarray, np.ndarray]:
+    """``Σ i·Ci·λm^(2−2i)·I1^(i−1)`` and its derivative with respect to ``λm``."""
+    I1 = _i1(lam)
+    value = np.zeros_like(lam)
+    d_value = np.zeros_like(lam)
+    for i, c in enumerate(_AB_COEFFS, start=1):
+        term = i * c * I1 ** (i - 1)
+        value = value + term * lambda_m ** (2 - 2 * i)
+        d_value = d_value + term * (2 - 2 * i) * lambda_m ** (1 - 2 * i)
+    return value, d_value
+
+
+def _ab_start(lam: np.ndarray, y: np.ndarray) -> np.ndarray:
+    """Best ``(μ, λm)`` on a log-spaced ``λm`` grid, ``μ`` by linear least squares."""
+    g = _g(lam)
+    best_cost, best = math.inf, np.array([max(float(y @ g / (g @ g)), 1.0) * 2.0, 10.0])
+    for lambda_m in np.geomspace(1.01, LAMBDA_M_MAX, 241):
+        basis = g * _ab_series(lam, float(lambda_m))[0]
+        mu = float(basis @ y / (basis @ basis))
+        if mu <= 0.0:
+            continue
+        residual = mu * basis - y
+        cost = float(residual @ residual)
+        if cost < best_cost:
+            best_cost, best = cost, np.array([mu, float(lambda_m)])
+    return best
+
+
+@dataclass(frozen=True)
+class _Problem:
+    """What ``least_squares`` needs for one model."""
+
+    names: tuple[str, ...]
+    build: Callable[[np.ndarray], HyperelasticModel]
+    jac: Callable[[np.ndarray], np.ndarray]
+    x0: np.ndarray
+    lower: np.ndarray
+    upper: np.ndarray
+
+
+def _problem(model_name: str, lam: np.ndarray, y: np.ndarray) -> _Problem:
+    if model_name in (NeoHookean.name, Yeoh.name):
+        A = _linear_design(model_name, lam)
+        n = A.shape[1]
+        names = ("c10_mpa", "c20_mpa", "c30_mpa")[:n]
+        return _Problem(
+            names=names,
+            build=(lambda p: NeoHookean(p[0])) if n == 1 else (lambda p: Yeoh(*p)),
+            jac=lambda p: A,
+            x0=_scaled_lstsq(A, y),
+            lower=np.array([_MODULUS_FLOOR_MPA] + [-np.inf] * (n - 1)),
+            upper=np.full(n, np.inf),
+        )
+    g = _g(lam)
+
+    def jac(p: np.ndarray) -> np.ndarray:
+        series, d_series = _ab_series(lam, float(p[1]))
+        return np.column_stack([g * series, p[0] * g * d_series])
+
+    return _Problem(
+        names=("mu_mpa", "lambda_m"),
+        build=lambda p: ArrudaBoyce(mu_mpa=p[0], lambda_m=p[1]),
+        jac=jac,
+        x0=_ab_start(lam, y),
+        lower=np.array([_MODULUS_FLOOR_MPA, _LAMBDA_M_FLOOR]),
+        upper=np.array([np.inf, LAMBDA_M_MAX]),
+    )
+
+
+def _metrics(y: np.ndarray, predicted: np.ndarray) -> tuple[float, float]:
+    """``(R², RMSE)`` of ``predicted`` against ``y``; R² is NaN if ``y`` is constant."""
+    residual = y - predicted
+    ss_res = float(residual @ residual)
+    centred = y - y.mean()
+    ss_tot = float(centred @ centred)
+    r2 = 1.0 - ss_res / ss_tot if ss_tot > 0.0 else math.nan
+    return r2, math.sqrt(ss_res / y.size)
+
+
+def _check_data(stretch: ArrayLike, stress: ArrayLike, owner: str) -> tuple[np.ndarray, np.ndarray]:
+    lam = check_finite_array(stretch, "stretch", owner)
+    y = check_finite_array(stress, "nominal_stress_mpa", owner)
+    if lam.ndim != 1 or y.shape != lam.shape:
+        raise DatasetError(
+            f"The 'stretch' and 'nominal_stress_mpa' of {owner} must be 1-D arrays of one "
+            f"length. Got shapes {lam.shape} and {y.shape} instead."
+        )
+    bad = np.flatnonzero(lam <= 0.0)
+    if bad.size:
+        raise DatasetError(
+            f"The 'stretch' of {owner} must be in (0, inf). "
+            f"Got {lam[bad[0]]!r} at position {int(bad[0])} instead."
+        )
+    return lam, y
+
+
+def _select(
+    lam: np.ndarray, y: np.ndarray, max_stretch: float | None, owner: str
+) -> tuple[np.ndarray, np.ndarray]:
+    if max_stretch is None:
+        if lam.size < MIN_FIT_POINTS:
+            raise DatasetError(
+                f"The 'stretch' of {owner} must have at least {MIN_FIT_POINTS} points. "
+                f"Got {lam.size} instead."
+            )
+        return lam, y
+    limit = check_range(max_stretch, "max_stretch", owner, low=1.0)
+    keep = lam <= limit
+    if int(keep.sum()) < MIN_FIT_POINTS:
+        raise ValueError(
+            f"The 'max_stretch' of {owner} must keep at least {MIN_FIT_POINTS} points of "
+            f"the data (stretch {lam.min():.4g} to {lam.max():.4g}). Got {max_stretch!r} "
+            f"({int(keep.sum())} points) instead."
+        )
+    return lam[keep], y[keep]
+
+
+def fit_model(
+    model_name: str,
+    stretch: ArrayLike,
+    nominal_stress_mpa: ArrayLike,
+    *,
+    max_stretch: float | None = None,
+) -> FitResult:
+    """Fit one hyperelastic model to uniaxial tension data by least squares.
+
+    Parameters
+    ----------
+    model_name : str
+        ``"neo-hookean"``, ``"yeoh"`` (three terms) or ``"arruda-boyce"``.
+    stretch : array_like
+        Axial stretch ``λ = 1 + engineering strain``, dimensionless, > 0.
+    nominal_stress_mpa : array_like
+        Measured nominal (engineering) stress, force per undeformed area, MPa;
+        same length as ``stretch``.
+    max_stretch : float, optional
+        Fit only the points with ``λ ≤ max_stretch`` (> 1), e.g. the working range
+        of an actuator; default: all points (to failure for a pull-to-failure test).
+
+    Returns
+    -------
+    FitResult
+        The fitted model with R² and RMSE (MPa) over the points used.
+
+    Raises
+    ------
+    ValueError
+        If ``model_name`` is unknown (the message lists the allowed names) or
+        ``max_stretch`` keeps fewer than :data:`MIN_FIT_POINTS` points.
+    DatasetError
+        If the data are not finite, not 1-D of one length, have a stretch ≤ 0 or
+        fewer than :data:`MIN_FIT_POINTS` points.
+    ConvergenceError
+        If ``least_squares`` stops without converging or returns non-finite values.
+
+    Notes
+    -----
+    Bounds: ``C10 > 0`` (neo-Hookean, Yeoh), ``μ > 0`` and ``1 < λm ≤ 1000``
+    (Arruda–Boyce); ``C20`` and ``C30`` are free. See the module docstring for the
+    starting points.
+    """
+    check_choice(model_name, "model", "fit_model", MODELS)
+    lam, y = _check_data(stretch, nominal_stress_mpa, "fit_model")
+    lam, y = _select(lam, y, max_stretch, "fit_model")
+    problem = _problem(model_name, lam, y)
+    span = problem.upper - problem.lower
+    margin = np.where(np.isfinite(span), 1e-9 * span, 0.0)
+    x0 = np.clip(problem.x0, problem.lower + margin, problem.upper - margin)
+
+    def residual(p: np.ndarray) -> np.ndarray:
+        return problem.build(p).uniaxial_nominal_stress_mpa(lam) - y
+
+    solution = least_squares(
+        residual,
+        x0,
+        jac=problem.jac,
+        bounds=(problem.lower, problem.upper),
+        method="trf",
+        x_scale="jac",
+        ftol=_TOL,
+        xtol=_TOL,
+        gtol=_TOL,
+        max_nfev=2000,
+    )
+    if solution.status <= 0 or not np.all(np.isfinite(solution.x)):
+        raise ConvergenceError(
+            f"least_squares did not converge fitting the {model_name} model "
+            f"(status {solution.status}: {solution.message}; x = {solution.x.tolist()})."
+        )
+    model = problem.build(solution.x)
+    r2, rmse = _metrics(y, model.uniaxial_nominal_stress_mpa(lam))
+    # trf keeps its iterates strictly feasible, so its active_mask can miss a bound
+    # approached to within its step tolerance: check the distance as well.
+    near = np.minimum(
+        np.abs(solution.x - problem.lower), np.abs(problem.upper - solution.x)
+    ) <= 1e-8 * np.maximum(1.0, np.abs(solution.x))
+    at_bound = tuple(
+        n
+        for n, active, close in zip(problem.names, solution.active_mask, near, strict=True)
+        if active or close
+    )
+    if at_bound:
+        logger.warning(
+            "%s fit: %s ended on a bound of the fit (%s)",
+            model_name,
+            ", ".join(at_bound),
+            ", ".join(f"{n} = {v:.6g}" for n, v in zip(problem.names, solution.x, strict=True)),
+        )
+    logger.info(
+        "%s fit over %d points: %s, R2 %.6f, RMSE %.4g MPa", model_name, lam.size, model, r2, rmse
+    )
+    return FitResult(
+        model=model,
+        r2=r2,
+        rmse_mpa=rmse,
+        n_points=int(lam.size),
+        stretch_range=(float(lam.min()), float(lam.max())),
+        at_bound=at_bound,
+    )
+
+
+def _stretch_and_stress(
+    data: TensileTest | tuple[ArrayLike, ArrayLike],
+) -> tuple[ArrayLike, ArrayLike]:
+    if isinstance(data, TensileTest):
+        return data.stretch, data.engineering_stress_mpa
+    if isinstance(data, tuple | list) and len(data) == 2:
+        return data[0], data[1]
+    raise ValueError(
+        "The 'data' of fit_models must be a TensileTest or a (stretch, nominal_stress_mpa) "
+        f"pair. Got {type(data).__name__} instead."
+    )
+
+
+def fit_models(
+    data: TensileTest | tuple[ArrayLike, ArrayLike],
+    models: Sequence[str] | str = DEFAULT_MODELS,
+    *,
+    max_stretch: float | None = None,
+) -> dict[str, FitResult]:
+    """Fit several hyperelastic models to one uniaxial tension test.
+
+    Parameters
+    ----------
+    data : TensileTest or (array_like, array_like)
+        A test (its stretch ``1 + engineering strain`` and its engineering stress
+        are used) or a pair ``(stretch, nominal_stress_mpa)`` (dimensionless, MPa).
+    models : sequence of str or str, default ``DEFAULT_MODELS``
+        Names among ``"neo-hookean"``, ``"yeoh"``, ``"arruda-boyce"``, distinct;
+        a single string is one name. All are checked before any fit runs.
+    max_stretch : float, optional
+        Fit only the points with stretch ≤ ``max_stretch``; see :func:`fit_model`.
+
+    Returns
+    -------
+    dict of str to FitResult
+        One result per model, in the order of ``models``.
+
+    Raises
+    ------
+    ValueError
+        If ``models`` is empty, repeats a name or names an unknown model (the
+        message lists the allowed names); see also :func:`fit_model`.
+
+    Notes
+    -----
+    On the shipped Dragon Skin 30 test (Marechal et al. 2021, 311 points, strain
+    to 7.09) Yeoh fits best, as in paper B, but not with paper B's numbers (R²
+    0.9982, RMSE 0.0204 MPa, C10 0.11, C20 0.003 MPa): over the full range to
+    failure it gives R² ≈ 0.9986, RMSE ≈ 0.045 MPa, C10 ≈ 0.141, C20 ≈ 0.0020,
+    C30 ≈ −1.2e-5 MPa; with ``max_stretch=5`` C10 ≈ 0.111, C20 ≈ 0.0045 MPa,
+    RMSE ≈ 0.018 MPa. Neo-Hookean (R² ≈ 0.95) and Arruda–Boyce (R² ≈ 0.988)
+    follow.
+    """
+    names = (models,) if isinstance(models, str) else tuple(models)
+    if not names:
+        raise ValueError(
+            "The 'models' of fit_models must name at least one of "
+            f"{', '.join(repr(m) for m in MODELS)}. Got {models!r} instead."
+        )
+    for name in names:
+        check_choice(name, "model", "fit_models", MODELS)
+    if len(set(names)) != len(names):
+        raise ValueError(
+            f"The 'models' of fit_models must be distinct. Got {list(names)!r} instead."
+        )
+    stretch, stress = _stretch_and_stress(data)
+    return {name: fit_model(name, stretch, stress, max_stretch=max_stretch) for name in names}

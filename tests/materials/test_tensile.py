@@ -1,0 +1,243 @@
+"""Uniaxial tensile data: the shipped Marechal et al. tests and the file parser."""
+
+from importlib import resources
+
+import numpy as np
+import pytest
+
+from softbend.errors import DatasetError
+from softbend.materials import (
+    SHIPPED_ATTRIBUTION,
+    TensileTest,
+    load_shipped,
+    load_tensile_csv,
+    shipped_tensile_tests,
+)
+
+#: Data rows of each shipped file (counted from the files themselves).
+SHIPPED_ROWS = {
+    "dragon-skin-10-medium": 457,
+    "dragon-skin-20": 404,
+    "dragon-skin-30": 311,
+    "ecoflex-0030": 705,
+    "ecoflex-0050": 721,
+}
+HEADER = "Time (s);True Strain;True Stress (MPa);Engineering Strain;Engineering Stress (MPa)"
+METADATA = [
+    "PARAMETER;INFO;URL;;",
+    "Standard;ASTM D412;;;",
+    "Material supplier;Smooth-On;https://example.org/ds30;;",
+    "Material;TestSilicone;;;",
+    ";;;;",
+]
+
+
+def _rows(n, start=0.05, step=0.05):
+    """``n`` well-formed data rows (time; true strain; true stress; eng. strain; eng. stress)."""
+    rows = []
+    for i in range(n):
+        eps = start + step * i
+        sig = 0.4 * eps
+        rows.append(f"{0.1 * i:.1f};{np.log1p(eps):.6f};{sig * (1 + eps):.6f};{eps:.6f};{sig:.6f}")
+    return rows
+
+
+def _write(tmp_path, rows, *, header=HEADER, metadata=METADATA, name="Test_Silicone.csv"):
+    path = tmp_path / name
+    path.write_text("\n".join([*metadata, header, *rows]) + "\n", encoding="utf-8")
+    return path
+
+
+def test_shipped_names():
+    assert shipped_tensile_tests() == tuple(sorted(SHIPPED_ROWS))
+
+
+def _reference_columns(path):
+    """Engineering strain and stress read independently: fixed layout, 18 lines to skip."""
+    table = np.loadtxt(path, delimiter=";", skiprows=18, usecols=(3, 4))
+    return table[:, 0], table[:, 1]
+
+
+@pytest.mark.parametrize("name", sorted(SHIPPED_ROWS))
+def test_shipped_round_trip(name):
+    test = load_shipped(name)
+    assert test.name == name
+    assert test.n_points == SHIPPED_ROWS[name]
+    assert test.source is not None and test.source.is_file()
+    strain, stress = _reference_columns(test.source)
+    np.testing.assert_array_equal(test.engineering_strain, strain)
+    np.testing.assert_array_equal(test.engineering_stress_mpa, stress)
+    np.testing.assert_allclose(test.stretch, 1.0 + strain, rtol=0, atol=0)
+    # Pull to failure from (almost) rest: the strain starts small and rises.
+    assert 0.0 <= test.engineering_strain[0] < 0.1
+    assert np.all(np.diff(test.engineering_strain[:50]) > 0.0)
+    # Silicones fail at several hundred percent strain and a few MPa.
+    assert 5.0 < test.max_strain < 20.0
+    assert 1.0 < test.engineering_stress_mpa.max() < 6.0
+    assert test.metadata["Standard"] == "ASTM D412"
+    assert test.metadata["Type of test"] == "Pull-to-failure"
+    assert test.attribution == SHIPPED_ATTRIBUTION
+    # A file path loads the same arrays as the package resource.
+    again = load_tensile_csv(test.source)
+    assert again.name == name
+    np.testing.assert_array_equal(again.engineering_stress_mpa, test.engineering_stress_mpa)
+
+
+def test_dragon_skin_30_units_and_metadata():
+    test = load_shipped("dragon-skin-30")
+    assert test.material == "Dragon Skin 30"
+    assert test.metadata["Material"] == "DragonSkin30"
+    assert test.metadata["Specimen Cross-section (cm^2)"] == "0.18"
+    assert test.metadata["Material supplier URL"].startswith("https://www.smooth-on.com/")
+    # MPa, not kPa or Pa: about 0.44 MPa at 100 % strain (Smooth-On quotes 0.59 MPa).
+    at_100 = np.interp(1.0, test.engineering_strain, test.engineering_stress_mpa)
+    assert 0.2 < at_100 < 1.0
+    assert test.max_strain == pytest.approx(7.09091)
+    assert test.engineering_stress_mpa.max() == pytest.approx(4.15491)
+
+
+def test_attribution_and_licence_ship_beside_the_data():
+    folder = resources.files("softbend").joinpath("data", "materials")
+    readme = folder.joinpath("README.md").read_text(encoding="utf-8")
+    licence = folder.joinpath("LICENSE-ODbL.md").read_text(encoding="utf-8")
+    assert "Marechal" in readme and "10.1089/soro.2019.0115" in readme
+    assert "Open Database License" in licence
+    assert "Marechal" in SHIPPED_ATTRIBUTION and "ODbL" in SHIPPED_ATTRIBUTION
+
+
+def test_unknown_shipped_name_lists_the_allowed_names():
+    with pytest.raises(ValueError, match="'name' of load_shipped") as info:
+        load_shipped("dragon-skin-40")
+    message = str(info.value)
+    assert "'dragon-skin-40'" in message
+    for name in SHIPPED_ROWS:
+        assert repr(name) in message
+
+
+def test_header_is_found_by_name_with_other_layouts(tmp_path):
+    # Two metadata lines, no blank line, columns reordered, an extra column.
+    rows = [f"{0.1 * i:.1f};x;{0.4 * 0.1 * i:.4f};{0.1 * i:.4f}" for i in range(1, 8)]
+    path = _write(
+        tmp_path,
+        rows,
+        header="Time (s);Comment;Engineering Stress (MPa);Engineering Strain",
+        metadata=["Material;Mine;;", "Lab;Here;;"],
+        name="My_Rubber.csv",
+    )
+    test = load_tensile_csv(path)
+    assert test.name == "my-rubber"
+    assert test.material == "Mine"
+    assert test.metadata == {"Material": "Mine", "Lab": "Here"}
+    np.testing.assert_allclose(test.engineering_strain, 0.1 * np.arange(1, 8))
+    np.testing.assert_allclose(test.engineering_stress_mpa, 0.04 * np.arange(1, 8))
+    assert test.attribution == ""
+
+
+def test_metadata_and_trailing_blank_lines(tmp_path):
+    path = _write(tmp_path, [*_rows(6), ";;;;", ""])
+    test = load_tensile_csv(path, name="sample", material="Sample silicone")
+    assert (test.name, test.material, test.n_points) == ("sample", "Sample silicone", 6)
+    assert test.metadata["Material supplier URL"] == "https://example.org/ds30"
+    assert "PARAMETER" not in test.metadata
+
+
+@pytest.mark.parametrize(
+    "missing", ["Engineering Strain", "Engineering Stress (MPa)"], ids=["strain", "stress"]
+)
+def test_missing_column_names_column_file_and_found_columns(tmp_path, missing):
+    renamed = {"Engineering Strain": "Eng Strain", "Engineering Stress (MPa)": "Eng Stress (kPa)"}
+    header = HEADER.replace(missing, renamed[missing])
+    path = _write(tmp_path, _rows(6), header=header)
+    with pytest.raises(DatasetError) as info:
+        load_tensile_csv(path)
+    message = str(info.value)
+    assert repr(missing) in message
+    assert "Test_Silicone.csv" in message
+    assert repr(renamed[missing]) in message and "'Time (s)'" in message
+
+
+def test_header_without_any_known_column_still_lists_what_it_has(tmp_path):
+    path = _write(tmp_path, ["0.1;0.04", "0.2;0.08"] * 3, header="strain;stress")
+    with pytest.raises(DatasetError, match="Engineering Strain") as info:
+        load_tensile_csv(path)
+    assert "'strain', 'stress'" in str(info.value)
+
+
+@pytest.mark.parametrize("bad", ["nan", "abc", "", "inf"])
+def test_non_numeric_value_names_column_and_row(tmp_path, bad):
+    rows = _rows(8)
+    cells = rows[2].split(";")
+    cells[4] = bad  # engineering stress of the third data row
+    rows[2] = ";".join(cells)
+    path = _write(tmp_path, rows)
+    with pytest.raises(DatasetError) as info:
+        load_tensile_csv(path)
+    message = str(info.value)
+    assert "'Engineering Stress (MPa)'" in message
+    assert "data row 3" in message and f"line {len(METADATA) + 1 + 3}" in message
+    assert repr(bad) in message
+
+
+def test_nan_outside_the_used_columns_is_ignored(tmp_path):
+    rows = _rows(6)
+    rows[1] = "nan;" + rows[1].split(";", 1)[1]
+    assert load_tensile_csv(_write(tmp_path, rows)).n_points == 6
+
+
+def test_negative_strain_names_the_row(tmp_path):
+    rows = _rows(6)
+    cells = rows[4].split(";")
+    cells[3] = "-0.01"
+    rows[4] = ";".join(cells)
+    with pytest.raises(DatasetError, match=r"\[0, inf\).*'-0.01' at data row 5"):
+        load_tensile_csv(_write(tmp_path, rows))
+
+
+def test_short_row_names_the_row(tmp_path):
+    rows = _rows(6)
+    rows[3] = "0.3;0.1"
+    with pytest.raises(DatasetError, match="Got 2 at data row 4"):
+        load_tensile_csv(_write(tmp_path, rows))
+
+
+@pytest.mark.parametrize("n", [0, 1, 4])
+def test_too_few_rows(tmp_path, n):
+    with pytest.raises(DatasetError, match=f"at least 5. Got {n} instead"):
+        load_tensile_csv(_write(tmp_path, _rows(n)))
+
+
+def test_five_rows_are_enough(tmp_path):
+    assert load_tensile_csv(_write(tmp_path, _rows(5))).n_points == 5
+
+
+def test_empty_missing_and_folder_paths(tmp_path):
+    empty = tmp_path / "empty.csv"
+    empty.write_text("\n\n", encoding="utf-8")
+    with pytest.raises(DatasetError, match="empty file"):
+        load_tensile_csv(empty)
+    with pytest.raises(FileNotFoundError, match=r"nope\.csv"):
+        load_tensile_csv(tmp_path / "nope.csv")
+    with pytest.raises(DatasetError, match="folder"):
+        load_tensile_csv(tmp_path)
+
+
+def test_tensile_test_validates_and_freezes():
+    strain = np.linspace(0.0, 1.0, 6)
+    test = TensileTest("t", "m", strain, 0.3 * strain, metadata={"a": "b"})
+    np.testing.assert_allclose(test.stretch, 1.0 + strain)
+    strain[0] = 5.0  # the test kept its own copy
+    assert test.engineering_strain[0] == 0.0
+    with pytest.raises(ValueError, match="read-only"):
+        test.engineering_strain[0] = 1.0
+    with pytest.raises(TypeError):
+        test.metadata["a"] = "c"
+    with pytest.raises(DatasetError, match="at least 5"):
+        TensileTest("t", "m", strain[:4], strain[:4])
+    with pytest.raises(DatasetError, match="one length"):
+        TensileTest("t", "m", strain, strain[:5])
+    with pytest.raises(DatasetError, match="must be finite"):
+        TensileTest("t", "m", strain, np.where(strain > 0.5, np.nan, strain))
+    with pytest.raises(DatasetError, match=r"\[0, inf\)"):
+        TensileTest("t", "m", np.linspace(-0.1, 0.9, 6), strain)
+    with pytest.raises(ValueError, match="'name' of TensileTest"):
+        TensileTest(" ", "m", strain, strain)
