@@ -20,7 +20,7 @@ from softbend.campaign.backends import (
     register_backend,
 )
 from softbend.design import SFRBADesign
-from softbend.errors import ConvergenceError, SoftbendError
+from softbend.errors import ConvergenceError
 
 DESIGN = SFRBADesign(100, 6, 2, 2, 5, 8)
 
@@ -144,20 +144,6 @@ def test_registry_names_the_allowed_backends():
         get_backend("abaqus")
     with pytest.raises(ValueError, match="options of backend 'analytical' are invalid"):
         get_backend("analytical", mesh_size=3)
-
-
-def test_fem_backend_without_softbend_fem_is_a_clear_error():
-    try:
-        import softbend.fem  # noqa: F401
-    except ImportError:
-        pass
-    else:
-        pytest.skip("softbend.fem is installed")
-    with pytest.raises(SoftbendError) as info:
-        get_backend("fem")
-    assert str(info.value) == (
-        "the FEM backend needs softbend.fem (not available in this installation)"
-    )
 
 
 def test_register_backend_plugs_in_a_model_and_refuses_silent_replacement(monkeypatch):

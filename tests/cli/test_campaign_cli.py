@@ -116,17 +116,6 @@ def test_bad_run_input_is_one_line_and_exit_2(tmp_path, capsys, args, needle):
     assert not db.exists()
 
 
-def test_fem_backend_without_fem_is_exit_2(tmp_path, capsys):
-    try:
-        import softbend.fem  # noqa: F401
-    except ImportError:
-        pass
-    else:
-        pytest.skip("softbend.fem is installed")
-    assert main(["campaign", "run", str(tmp_path / "c.duckdb"), "--backend", "fem"]) == 2
-    assert "the FEM backend needs softbend.fem" in _one_error_line(capsys)
-
-
 def test_unreachable_scheduler_is_exit_2(tmp_path, capsys):
     address = f"tcp://127.0.0.1:{_closed_port()}"
     code = main(

@@ -30,10 +30,12 @@ app = typer.Typer(
 def _register() -> None:
     # Imported here so that ``import softbend.cli`` stays cheap and each
     # subcommand module owns its own imports.
-    from softbend.cli import analyze, campaign, curling, reproduce, train
+    from softbend.cli import analyze, campaign, curling, fem, materials, reproduce, train
 
     app.add_typer(curling.app, name="curling")
     app.add_typer(campaign.app, name="campaign")
+    app.add_typer(materials.app, name="materials")
+    app.add_typer(fem.app, name="fem")
     app.command("analyze")(analyze.analyze)
     app.command("train")(train.train)
     app.command("predict")(train.predict)

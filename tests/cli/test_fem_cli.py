@@ -1,0 +1,62 @@
+import json
+
+import pytest
+
+from softbend.cli import main
+
+
+def _one_error_line(capsys) -> str:
+    err = capsys.readouterr().err.strip().splitlines()
+    assert len(err) == 1, err
+    return err[0]
+
+
+@pytest.mark.parametrize(
+    ("args", "needle"),
+    [
+        (["--design", "100,6,-2,2,5,10"], "'t_mm' of SFRBADesign must be a number in (0, 50]"),
+        (["--design", "100,6,2"], "A design needs 6 values"),
+        (["--maxh", "0"], "'maxh_mm' of FEMOptions"),
+        (["--gravity", "up"], "'gravity' of FEMOptions must be one of"),
+        (["--pmax", "nan"], "'pmax_mpa' of default_pressures_mpa"),
+    ],
+)
+def test_fem_run_bad_input_is_one_line_and_exit_2(tmp_path, capsys, args, needle):
+    assert main(["fem", "run", "--out", str(tmp_path), *args]) == 2
+    assert needle in _one_error_line(capsys)
+
+
+def test_mesh_study_bad_sizes_exit_2(capsys):
+    assert main(["fem", "mesh-study", "--maxh", "4,x"]) == 2
+    assert "'--maxh' must be comma-separated numbers" in _one_error_line(capsys)
+
+
+def test_fem_run_writes_the_sweep_figures_and_vtk(tmp_path, capsys):
+    out = tmp_path / "run"
+    code = main(
+        [
+            "fem",
+            "run",
+            "--pmax",
+            "0.01",
+            "--maxh",
+            "6",
+            "--shapes",
+            "2",
+            "--out",
+            str(out),
+            "--json",
+        ]
+    )
+    assert code == 0
+    payload = json.loads(capsys.readouterr().out)
+    assert payload["pressure_mpa"] == [0.0, 0.005, 0.01]
+    assert payload["angle_deg"][2] > payload["angle_deg"][0] > 0
+    lines = (out / "sweep.csv").read_text().splitlines()
+    assert lines[0] == "pressure_mpa,angle_deg,tip_x_mm,tip_z_mm,converged,newton_iterations"
+    assert len(lines) == 4
+    for name in ("angle_pressure.png", "shapes.png", "sweep.json"):
+        assert (out / name).stat().st_size > 1000
+    vtks = sorted(p.name for p in (out / "vtk").glob("*.vtu"))
+    assert vtks[0] == "shape_000p00kPa.vtu" and len(vtks) == 2
+    assert b"displacement" in (out / "vtk" / vtks[0]).read_bytes()

@@ -1,0 +1,64 @@
+import math
+
+import pytest
+
+from softbend.design import SFRBADesign
+from softbend.fem import FEMOptions
+from softbend.fem.geometry import actuator_geometry, mesh_actuator
+
+
+@pytest.mark.parametrize(
+    ("field", "value", "needle"),
+    [
+        ("maxh_mm", -1.0, "'maxh_mm' of FEMOptions must be a number in (0, 20]"),
+        ("maxh_mm", float("nan"), "'maxh_mm' of FEMOptions"),
+        ("order", 1, "'order' of FEMOptions must be one of 2, 3"),
+        ("fiber_law", "rope", "'fiber_law' of FEMOptions must be one of 'tension-compression'"),
+        ("gravity", "down", "'gravity' of FEMOptions must be one of 'bending', 'against'"),
+        ("output", "all", "'output' of FEMOptions must be one of 'interpolate', 'solve'"),
+        ("max_angle_deg", 400.0, "'max_angle_deg' of FEMOptions must be a number in (0, 340]"),
+        ("base_cap_mm", 0.0, "'base_cap_mm' of FEMOptions"),
+        ("elastomer", "silicone", "'elastomer' of FEMOptions must be a Material"),
+    ],
+)
+def test_bad_options_name_the_field(field, value, needle):
+    with pytest.raises(ValueError) as info:
+        FEMOptions(**{field: value})
+    assert needle in str(info.value)
+
+
+def test_step_bounds_are_ordered():
+    with pytest.raises(ValueError, match="'initial_step_mpa' of FEMOptions"):
+        FEMOptions(initial_step_mpa=0.1, max_step_mpa=0.05)
+    with pytest.raises(ValueError, match="unknown"):
+        FEMOptions().replace(mesh=3)
+
+
+def test_impossible_geometry_is_refused_by_the_design():
+    with pytest.raises(ValueError, match="'t_mm' of SFRBADesign must be a number in \\(0, 50\\]"):
+        SFRBADesign(100, 6, -2, 2, 5, 10)
+
+
+def test_a_mesh_too_fine_to_afford_is_refused_before_meshing():
+    with pytest.raises(ValueError, match="'maxh_mm' of the FEM mesh must give at most"):
+        mesh_actuator(SFRBADesign(160, 10, 4, 4, 5, 12), maxh_mm=0.05)
+
+
+def test_faces_are_named_and_the_mesh_has_the_solid_volume():
+    import ngsolve as ngs
+
+    design = SFRBADesign(100, 6, 2, 2, 5, 10)
+    shape, info = actuator_geometry(design, 3.0)
+    assert {f.name for f in shape.faces} == {
+        "base",
+        "tip",
+        "symmetry",
+        "bottom",
+        "outer",
+        "cavity",
+    }
+    mesh, info = mesh_actuator(design, maxh_mm=6.0)
+    volume = ngs.Integrate(ngs.CoefficientFunction(1.0), mesh)
+    assert volume == pytest.approx(info.half_volume_mm3, rel=2e-3)
+    assert info.length_mm == 113.0
+    assert info.perimeter_mm == pytest.approx(math.pi * 8 + 16 + 4)
