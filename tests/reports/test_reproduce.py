@@ -8,6 +8,7 @@ import math
 import pytest
 
 from softbend.design import DesignSpace
+from softbend.fem import FEMOptions
 from softbend.reports.reproduce import run_reproduce
 
 
@@ -34,7 +35,15 @@ def first_run(tmp_path_factory):
     def progress(phase: str, done: int, total: int) -> None:
         phases[phase] = (done, total)
 
-    summary = run_reproduce(out, seed=0, workers=1, progress=progress, design_space=_small_space())
+    summary = run_reproduce(
+        out,
+        seed=0,
+        workers=1,
+        progress=progress,
+        design_space=_small_space(),
+        fem_options=FEMOptions(maxh_mm=6.0),
+        fem_pmax_mpa=0.02,
+    )
     return out, summary, phases
 
 
@@ -58,6 +67,10 @@ def test_report_has_both_papers_and_their_files(first_run):
         "paper_b/surrogates/models/plr.json",
         "paper_b/surrogates/models/xgb.onnx",
         "paper_b/surrogates/models/mlp.json",
+        "paper_b_fem/dragon_skin_30_fit.png",
+        "paper_b_fem/fem_angle_pressure.png",
+        "paper_b_fem/fem_shapes.png",
+        "paper_b_fem/fem_sweep.csv",
     ):
         assert (out / name).is_file(), name
         assert name in html or not name.endswith(".png"), name
@@ -113,3 +126,12 @@ def test_second_run_resumes_the_campaign(first_run):
     assert math.isclose(b["r2"], first["paper_b"]["r2"], rel_tol=1e-12)
     # Same seed, same numbers.
     assert again["paper_a"] == first["paper_a"] | {"seconds": again["paper_a"]["seconds"]}
+
+
+def test_fem_section_fits_dragon_skin_and_bends_with_pressure(first_run):
+    _, summary, _ = first_run
+    fem = summary["paper_b_fem"]
+    fits = fem["dragon_skin_30_fit"]
+    assert fits["yeoh"]["r2"] > fits["neo-hookean"]["r2"]
+    assert fem["fem_angles_deg"]["0.02"] > fem["fem_angles_deg"]["0"] > 0.0
+    assert fem["analytical_angles_deg"]["0"] == 0.0

@@ -66,4 +66,16 @@ def reproduce(
             for name, m in surrogates.items()
         ],
     )
+    fem = summary["paper_b_fem"]
+    fits = fem["dragon_skin_30_fit"]
+    _common.print_table(
+        f"Paper B: Dragon Skin 30 fit and FEM sweep of ({fem['fem_design']}) (Fig. 2)",
+        ["quantity", "value"],
+        [
+            [f"{name} fit R² / RMSE MPa", f"{f['r2']:.4f} / {f['rmse_mpa']:.4f}"]
+            for name, f in fits.items()
+        ]
+        + [[f"FEM angle at {p} MPa (°)", f"{a:.1f}"] for p, a in fem["fem_angles_deg"].items()]
+        + [["FEM sweep wall time (s)", f"{fem['fem_wall_time_s']:.0f}"]],
+    )
     _common.console.print(f"report: {summary['report']}  ({summary['seconds']:.0f} s)")

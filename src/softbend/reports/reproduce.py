@@ -187,6 +187,8 @@ def run_reproduce(
     workers: int | None = None,
     progress: Progress | None = None,
     design_space: DesignSpace | None = None,
+    fem_options: Any = None,
+    fem_pmax_mpa: float | None = None,
 ) -> dict[str, Any]:
     """Run every reproducible section and write ``out_dir/index.html``.
 
@@ -203,6 +205,9 @@ def run_reproduce(
     design_space : DesignSpace, optional
         Designs of the paper B campaign (default: Table 1, 972 designs). A
         different space needs a new ``out_dir``: the campaign database resumes.
+    fem_options, fem_pmax_mpa : optional
+        Settings of the FEM sweep of the Fig. 2 design (default: the model's
+        defaults, 0.17 MPa as in paper B Fig. 2b).
 
     Returns
     -------
@@ -236,6 +241,15 @@ def run_reproduce(
     summary["paper_a"] = _paper_a(report, out_dir, seed, progress)
     summary["paper_b"] = _paper_b(report, out_dir, workers, progress, design_space)
     summary["paper_b_surrogates"] = _paper_b_surrogates(report, out_dir, seed, progress)
+    from softbend.reports import paper_b_fem
+
+    summary["paper_b_fem"] = paper_b_fem.add_section(
+        report,
+        out_dir,
+        progress,
+        options=fem_options,
+        pmax_mpa=fem_pmax_mpa or paper_b_fem.FIG2_PMAX_MPA,
+    )
     path = report.write(out_dir / "index.html")
     summary["report"] = str(path)
     summary["seconds"] = (datetime.now(UTC) - started).total_seconds()
