@@ -18,6 +18,7 @@ from typing import TYPE_CHECKING
 import numpy as np
 
 from softbend._validation import check_choice
+from softbend.reports.analysis_figures import _figure, _save
 
 if TYPE_CHECKING:
     from softbend.materials.fit import FitResult
@@ -25,7 +26,6 @@ if TYPE_CHECKING:
 
 __all__ = ["MODEL_LABELS", "fit_figure"]
 
-_DPI = 150
 
 #: Legend names of the hyperelastic models.
 MODEL_LABELS: dict[str, str] = {
@@ -39,23 +39,6 @@ _COLORS: dict[str, str] = {
     "arruda-boyce": "#7570b3",
 }
 _STYLES: dict[str, str] = {"neo-hookean": "--", "yeoh": "-", "arruda-boyce": "-."}
-
-
-def _figure(figsize: tuple[float, float]):
-    """A figure drawn by the Agg canvas, outside pyplot's global state."""
-    from matplotlib.backends.backend_agg import FigureCanvasAgg
-    from matplotlib.figure import Figure
-
-    fig = Figure(figsize=figsize)
-    FigureCanvasAgg(fig)
-    return fig, fig.subplots()
-
-
-def _save(fig, path: str | Path) -> Path:
-    out = Path(path)
-    out.parent.mkdir(parents=True, exist_ok=True)
-    fig.savefig(out, dpi=_DPI, bbox_inches="tight", format="png")
-    return out
 
 
 def _source_line(test: TensileTest) -> str:
