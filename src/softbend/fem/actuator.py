@@ -29,7 +29,7 @@ from typing import Any
 import numpy as np
 
 from softbend.design import FIBER_DIAMETER_MM, SFRBADesign
-from softbend.fem.geometry import ActuatorGeometry, mesh_actuator
+from softbend.fem.geometry import mesh_actuator
 from softbend.fem.mechanics import (
     fiber_energy,
     helix_stiffness_n_per_mm,
@@ -268,7 +268,3 @@ class ActuatorModel:
         minus = self.measure().as_array()
         self.set_state(base)
         return (plus - minus) / (2.0 * step_mpa)
-
-    @property
-    def geometry_info(self) -> ActuatorGeometry:
-        return self.geometry

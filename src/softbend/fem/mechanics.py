@@ -30,6 +30,7 @@ from softbend.materials.models import ArrudaBoyce, HyperelasticModel, NeoHookean
 __all__ = [
     "FIBER_LAWS",
     "fiber_energy",
+    "helix_stiffness_n_per_mm",
     "isochoric_energy",
     "membrane_energy",
     "solid_energy",

@@ -25,6 +25,8 @@ import time
 from dataclasses import dataclass, field
 from typing import Any
 
+import numpy as np
+
 from softbend.errors import ConvergenceError
 
 __all__ = ["EnergySolver", "NewtonReport"]
@@ -92,6 +94,7 @@ class EnergySolver:
         self._du = vec.CreateVector()
         self._backup = vec.CreateVector()
         self._inverse = None
+        self._mask = np.array(list(self.freedofs), dtype=bool)
 
     @property
     def has_factorization(self) -> bool:
@@ -109,15 +112,7 @@ class EnergySolver:
 
     def _norm(self, vec: Any) -> float:
         values = vec.FV().NumPy()
-        free = self._free_mask()
-        return float(math.sqrt(float((values[free] ** 2).sum())))
-
-    def _free_mask(self) -> Any:
-        if getattr(self, "_mask", None) is None:
-            import numpy as np
-
-            self._mask = np.array(list(self.freedofs), dtype=bool)
-        return self._mask
+        return float(math.sqrt(float((values[self._mask] ** 2).sum())))
 
     def factorize(self) -> Any:
         """Assemble the Hessian at the current state and factorise it."""
