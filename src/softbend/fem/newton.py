@@ -86,6 +86,11 @@ class EnergySolver:
     #: a shorter load step is cheaper than a long crawl.
     stall_iteration: int = 6
     stall_factor: float = 1e4
+    #: Give up earlier still when, after this many iterations, the residual has
+    #: not even fallen below ``progress_factor`` times the starting residual: a
+    #: start outside Newton's basin (the failed steps of a sweep look like this).
+    progress_iteration: int = 3
+    progress_factor: float = 0.25
     timings: _Timings = field(default_factory=_Timings)
 
     def __post_init__(self) -> None:
@@ -164,6 +169,7 @@ class EnergySolver:
         self._backup.data = vec
         cuts = 0
         residual = self._norm(self.residual())
+        initial = residual
         for iteration in range(self.max_iterations + 1):
             if not math.isfinite(residual):
                 break
@@ -173,6 +179,12 @@ class EnergySolver:
             if iteration == self.max_iterations:
                 break
             if iteration >= self.stall_iteration and residual > self.stall_factor * tolerance:
+                break
+            if (
+                iteration == self.progress_iteration
+                and residual > self.progress_factor * initial
+                and residual > self.stall_factor * tolerance
+            ):
                 break
             self.factorize()
             self.solve_tangent(res, du)

@@ -2,9 +2,9 @@
 
 1. Gravity is applied first (cut into smaller fractions if Newton does not
    converge); that state is the 0 MPa output.
-2. Pressure is raised in adaptive steps. Each step starts from the tangent
-   predictor ``u + Δp·du/dp`` (``K du/dp = ∂V/∂u``), so Newton starts close to
-   the solution. A step that does not converge is restored and halved; a step
+2. Pressure is raised in adaptive steps. Each step starts from the cubic
+   extrapolation of the last two converged states and their tangents ``du/dp``
+   (``K du/dp = ∂V/∂u``), so Newton starts close to the solution. A step that does not converge is restored and halved; a step
    that converged in few iterations lets the next one grow (up to
    ``max_step_mpa``).
 3. At every converged step the angle, the tip and their derivatives with respect
@@ -108,34 +108,64 @@ def _record(model: ActuatorModel, pressure: float, iterations: int, keep_state: 
 
 
 def _apply_gravity(model: ActuatorModel) -> int:
-    """Ramp gravity in as few fractions as converge; returns the Newton iterations.
+    """Ramp gravity in fractions with extrapolated starts; returns the Newton iterations.
 
-    From the straight state the first solve is a long way off (the sag of a soft
-    cantilever), so it gets plain Newton without the early give-up rule.
+    The weight is followed like the pressure: from 1/4 of it, doubling the
+    fraction after a quick solve and halving it after a failed one, each solve
+    starting from the cubic extrapolation of the last two states along
+    ``du/dg``. A long soft actuator sags tens of degrees; Newton straight from
+    the undeformed state to the full weight zigzags through that rotation (51
+    iterations for (160, 6, 2, 2, 5, 8) against 17 followed). The early
+    give-up rules stay off: the first solve starts a long way off by nature.
     """
     solver = model.solver
-    saved = solver.stall_iteration, solver.max_iterations
-    solver.stall_iteration, solver.max_iterations = 10**6, max(30, solver.max_iterations)
+    saved = solver.stall_iteration, solver.progress_iteration, solver.max_iterations
+    solver.stall_iteration = solver.progress_iteration = 10**6
+    solver.max_iterations = max(30, solver.max_iterations)
     try:
         return _gravity_fractions(model)
     finally:
-        solver.stall_iteration, solver.max_iterations = saved
+        solver.stall_iteration, solver.progress_iteration, solver.max_iterations = saved
+
+
+def _gravity_tangent(model: ActuatorModel) -> np.ndarray:
+    """``du/dg`` at the current state, g the fraction of gravity applied (mm)."""
+    solver = model.solver
+    applied = model.gravity_factor.Get()
+    model.set_load(0.0, 1.0)
+    full = solver.residual().FV().NumPy().copy()
+    model.set_load(0.0, 0.0)
+    none = solver.residual().FV().NumPy().copy()
+    model.set_load(0.0, applied)
+    rhs = solver.gfu.vec.CreateVector()
+    rhs.FV().NumPy()[:] = full - none  # ∂r/∂g: the gravity load is linear in g
+    out = solver.gfu.vec.CreateVector()
+    if not solver.has_factorization:
+        solver.factorize()
+    solver.solve_tangent(rhs, out)
+    return -np.array(out.FV().NumPy(), copy=True)
 
 
 def _gravity_fractions(model: ActuatorModel) -> int:
     options = model.options
+    solver = model.solver
     if options.gravity == "none" or options.gravity_mm_s2 == 0.0:
         model.set_load(0.0, 0.0)
-        return model.solver.solve(model.force_scale_n(0.0), load=0.0, step=0).iterations
-    done, fraction, iterations, step = 0.0, 1.0, 0, 0
+        return solver.solve(model.force_scale_n(0.0), load=0.0, step=0).iterations
+    done, fraction, iterations, step = 0.0, 0.25, 0, 0
+    model.set_load(0.0, 0.0)
+    tangent = _gravity_tangent(model)
+    previous: tuple[float, np.ndarray, np.ndarray] | None = None
     while done < 1.0:
         target = min(1.0, done + fraction)
+        start = model.state()
+        model.set_state(_predict(start, tangent, done, target, previous))
         model.set_load(0.0, target)
         try:
-            iterations += model.solver.solve(
-                model.force_scale_n(0.0), load=0.0, step=step
-            ).iterations
+            report = solver.solve(model.force_scale_n(0.0), load=0.0, step=step)
         except ConvergenceError as exc:
+            model.set_state(start)
+            model.set_load(0.0, done)
             fraction /= 2.0
             if fraction < 1.0 / 64.0:
                 raise ConvergenceError(
@@ -146,10 +176,44 @@ def _gravity_fractions(model: ActuatorModel) -> int:
                     residual=exc.residual,
                 ) from exc
             continue
+        iterations += report.iterations
+        previous = (done, start, tangent)
         done = target
         step += 1
-        fraction = min(1.0, 2.0 * fraction)
+        if done < 1.0:
+            tangent = _gravity_tangent(model)
+        if report.iterations <= 6:
+            fraction *= 2.0
     return iterations
+
+
+def _predict(
+    state: np.ndarray,
+    tangent: np.ndarray,
+    pressure: float,
+    target: float,
+    previous: tuple[float, np.ndarray, np.ndarray] | None,
+) -> np.ndarray:
+    """Starting guess for the step ``pressure → target``.
+
+    The cubic through the last two converged states and their tangents
+    ``(p₀, u₀, u₀'), (p₁, u₁, u₁')``, extrapolated to ``target`` (the first
+    step has no earlier state: linear, ``u₁ + Δp·u₁'``). The linear predictor
+    misses the curvature of the path, which on a curling actuator is a large
+    rotation: its error stretches the stiff fibers and costs Newton iterations
+    and rejected steps (reference design: 64 s with it, 21 s with the cubic).
+    """
+    h = target - pressure
+    if previous is None:
+        return state + h * tangent
+    p0, u0, t0 = previous
+    h1 = pressure - p0
+    s = 1.0 + h / h1  # 0 at p0, 1 at pressure
+    h00 = (1 + 2 * s) * (1 - s) ** 2
+    h10 = s * (1 - s) ** 2
+    h01 = s * s * (3 - 2 * s)
+    h11 = s * s * (s - 1)
+    return h00 * u0 + h10 * h1 * t0 + h01 * state + h11 * h1 * tangent
 
 
 def run_steps(
@@ -173,6 +237,7 @@ def run_steps(
     if progress is not None:
         progress(0.0, float(step.values[0]), pmax_mpa)
     pressure, dp = 0.0, options.initial_step_mpa
+    previous: tuple[float, np.ndarray, np.ndarray] | None = None
     while pressure < pmax_mpa - 1e-12:
         target = min(pressure + dp, pmax_mpa)
         if landing_mpa is not None:
@@ -180,7 +245,7 @@ def run_steps(
             if ahead.size:
                 target = min(target, float(ahead[0]))
         start = model.state()
-        model.set_state(start + (target - pressure) * tangent)
+        model.set_state(_predict(start, tangent, pressure, target, previous))
         model.set_load(target, 1.0)
         try:
             report = model.solver.solve(
@@ -200,6 +265,7 @@ def run_steps(
                 history.failure = str(exc)
                 break
             continue
+        previous = (pressure, start, tangent)
         pressure = target
         step, tangent = _record(model, pressure, report.iterations, keep_states)
         history.steps.append(step)
