@@ -73,3 +73,73 @@ def test_campaign_backend_builds_options_from_keywords():
     assert backend.preferred_chunk_size == 1
     with pytest.raises(ValueError, match="'gravity' of FEMOptions"):
         get_backend("fem", gravity="sideways")
+
+
+def test_predictor_extrapolates_a_cubic_path_exactly():
+    from softbend.fem.sweep import _predict
+
+    def path(p):  # a cubic load path of two "dofs" and its derivative
+        u = np.array([1.0 + 2.0 * p - 3.0 * p**2 + 5.0 * p**3, -p + 4.0 * p**3])
+        du = np.array([2.0 - 6.0 * p + 15.0 * p**2, -1.0 + 12.0 * p**2])
+        return u, du
+
+    u0, t0 = path(0.1)
+    u1, t1 = path(0.13)
+    for target in (0.14, 0.16, 0.175):
+        guess = _predict(u1, t1, 0.13, target, (0.1, u0, t0))
+        np.testing.assert_allclose(guess, path(target)[0], rtol=1e-12)
+    # Without an earlier state the predictor is the tangent line.
+    np.testing.assert_allclose(_predict(u1, t1, 0.13, 0.15, None), u1 + 0.02 * t1)
+
+
+def test_gravity_followed_in_fractions_matches_one_plain_newton_solve():
+    from softbend.fem.actuator import ActuatorModel
+    from softbend.fem.sweep import _apply_gravity
+
+    followed = ActuatorModel(REFERENCE, COARSE)
+    _apply_gravity(followed)
+    direct = ActuatorModel(REFERENCE, COARSE)
+    direct.set_load(0.0, 1.0)
+    direct.solver.max_iterations = 40
+    direct.solver.stall_iteration = direct.solver.progress_iteration = 10**6
+    direct.solver.solve(direct.force_scale_n(0.0))
+    assert followed.gravity_factor.Get() == 1.0
+    np.testing.assert_allclose(
+        followed.measure().as_array(), direct.measure().as_array(), rtol=1e-6, atol=1e-6
+    )
+
+
+def test_interpolated_outputs_match_solving_every_output_pressure(reference):
+    solved = simulate(REFERENCE, GRID, COARSE.replace(output="solve"))
+    assert len(solved.stats["steps_mpa"]) >= len(GRID)  # every output is a step
+    assert len(reference.stats["steps_mpa"]) < len(GRID)  # interpolation skips some
+    np.testing.assert_allclose(reference.angle_deg, solved.angle_deg, atol=0.02)
+    np.testing.assert_allclose(reference.tip_z_mm, solved.tip_z_mm, atol=0.01)
+
+
+def test_stretch_beyond_the_material_model_stops_the_sweep(reference):
+    stretches = reference.stats["step_max_stretch"]
+    assert np.all(np.diff(stretches) >= -1e-9)
+    limit = 0.5 * (1.0 + stretches[-1])  # reached part-way through the sweep
+    stopped = simulate(REFERENCE, GRID, COARSE.replace(max_stretch=limit))
+    reason = stopped.stats["stop_reason"]
+    assert reason.startswith("stretch") and "beyond the material model" in reason
+    assert stopped.stats["step_max_stretch"][-1] > limit
+    assert stopped.stats["step_max_stretch"][-2] <= limit
+    # Outputs end at the last step inside the limit, and all of them converged.
+    assert stopped.pressure_mpa[-1] <= stopped.stats["steps_mpa"][-2] + 1e-12
+    assert stopped.converged.all()
+    n = len(stopped.pressure_mpa)
+    np.testing.assert_allclose(stopped.angle_deg, reference.angle_deg[:n], atol=0.05)
+
+
+def test_undeformed_state_has_unit_stretch():
+    from softbend.fem.actuator import ActuatorModel
+
+    model = ActuatorModel(REFERENCE, COARSE)
+    stretch, where = model.max_stretch()
+    assert stretch == pytest.approx(1.0, abs=1e-12)
+    assert model.region_of(1.0) == "proximal cap"
+    assert model.region_of(50.0) == "chamber wall"
+    assert model.region_of(REFERENCE.l_mm + COARSE.base_cap_mm + 1.0) == "distal cap"
+    assert where.shape == (3,)

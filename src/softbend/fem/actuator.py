@@ -101,6 +101,12 @@ class ActuatorModel:
             ngs.CoefficientFunction(1.0), self.mesh, definedon=self.mesh.Boundaries("cavity")
         )
         self._weight_n = self._total_weight_n()
+        # The centroid of every tetrahedron: where the stretch is checked.
+        rule = ngs.IntegrationRule(points=[(0.25, 0.25, 0.25)], weights=[1.0 / 6.0])
+        self._check_points = self.mesh.MapToAllElements(rule, ngs.VOL)
+        centroids = ngs.CoefficientFunction((ngs.x, ngs.y, ngs.z))(self._check_points)
+        self._check_xyz = np.asarray(centroids)
+        self._deformation = ngs.Id(3) + ngs.Grad(self.gfu)
 
     # -- energy --------------------------------------------------------------------------
     def fiber_spacing_mm(self) -> float:
@@ -258,6 +264,28 @@ class ActuatorModel:
             tip_x_mm=float(self.geometry.length_mm + tip[0]),
             tip_z_mm=float(-tip[2]),
         )
+
+    def max_stretch(self) -> tuple[float, np.ndarray]:
+        """Largest principal stretch in the elastomer and where it is (undeformed x, y, z mm).
+
+        Checked at the centroid of every tetrahedron, so the singular peak at a
+        sharp inner corner (where the chamber meets a cap) is not what counts:
+        the value follows the deformation of whole elements.
+        """
+        F = np.asarray(self._deformation(self._check_points)).reshape(-1, 3, 3)
+        C = np.einsum("nki,nkj->nij", F, F)
+        largest = np.linalg.eigvalsh(C)[:, -1]
+        k = int(np.argmax(largest))
+        return float(math.sqrt(largest[k])), self._check_xyz[k].copy()
+
+    def region_of(self, x_mm: float) -> str:
+        """Name of the part of the actuator at axial position ``x_mm``."""
+        start, end = self.geometry.chamber_mm
+        if x_mm < start:
+            return "proximal cap"
+        if x_mm > end:
+            return "distal cap"
+        return "chamber wall"
 
     def measure_derivative(self, tangent: np.ndarray, step_mpa: float = 1e-5) -> np.ndarray:
         """``d(angle, tip x, tip z)/dp`` along ``tangent = du/dp`` by central differences."""

@@ -1,12 +1,12 @@
 """Load stepping: the pressure sweep of one design, ``simulate(design, pressures)``.
 
-1. Gravity is applied first (cut into smaller fractions if Newton does not
-   converge); that state is the 0 MPa output.
+1. Gravity is applied first, followed in growing fractions of the weight the
+   same way as the pressure below; that state is the 0 MPa output.
 2. Pressure is raised in adaptive steps. Each step starts from the cubic
    extrapolation of the last two converged states and their tangents ``du/dp``
-   (``K du/dp = ∂V/∂u``), so Newton starts close to the solution. A step that does not converge is restored and halved; a step
-   that converged in few iterations lets the next one grow (up to
-   ``max_step_mpa``).
+   (``K du/dp = ∂V/∂u``), so Newton starts close to the solution. A step that
+   does not converge is restored and halved; a step that converged in few
+   iterations lets the next one grow (up to ``max_step_mpa``).
 3. At every converged step the angle, the tip and their derivatives with respect
    to pressure are stored; outputs on the requested grid are the cubic Hermite
    interpolants between steps (or, with ``output="solve"``, the steps land on
@@ -14,7 +14,9 @@
 
 The sweep ends at the last requested pressure, when the angle passes
 ``max_angle_deg`` (the actuator has curled round; outputs above it are not
-reported), or when a step shorter than ``min_step_mpa`` still does not converge
+reported), when the largest stretch in the elastomer passes ``max_stretch``
+(outside the material model; outputs stop at the step before), or when a step
+shorter than ``min_step_mpa`` still does not converge
 — then the first requested pressure beyond the last converged state is reported
 with ``converged=False`` and the reason is in ``stats["stop_reason"]``. A model
 that does not even hold its own weight raises
@@ -54,6 +56,7 @@ class Step:
     values: np.ndarray  # angle deg, tip x mm, tip z mm
     slopes: np.ndarray  # their derivatives per MPa
     iterations: int
+    max_stretch: float = float("nan")
     state: np.ndarray | None = field(default=None, repr=False)
 
 
@@ -66,6 +69,8 @@ class StepHistory:
     failed_pressure_mpa: float | None = None
     failure: str | None = None
     rejected_steps: int = 0
+    #: Outputs are reported up to here (the last step inside the stretch limit).
+    valid_up_to_mpa: float | None = None
 
     @property
     def pressures(self) -> np.ndarray:
@@ -102,9 +107,9 @@ def _record(model: ActuatorModel, pressure: float, iterations: int, keep_state: 
     values = model.measure().as_array()
     tangent = model.pressure_tangent(refactorize=iterations == 0)
     slopes = model.measure_derivative(tangent)
-    return Step(
-        pressure, values, slopes, iterations, model.state() if keep_state else None
-    ), tangent
+    stretch, _ = model.max_stretch()
+    state = model.state() if keep_state else None
+    return Step(pressure, values, slopes, iterations, stretch, state), tangent
 
 
 def _apply_gravity(model: ActuatorModel) -> int:
@@ -271,6 +276,15 @@ def run_steps(
         history.steps.append(step)
         if progress is not None:
             progress(pressure, float(step.values[0]), pmax_mpa)
+        if step.max_stretch > options.max_stretch:
+            _, where = model.max_stretch()
+            history.stop_reason = (
+                f"stretch {step.max_stretch:.2f} above {options.max_stretch:g} in the "
+                f"{model.region_of(float(where[0]))} at x = {where[0]:.0f} mm (beyond the "
+                "material model)"
+            )
+            history.valid_up_to_mpa = history.steps[-2].pressure_mpa
+            break
         if step.values[0] > options.max_angle_deg:
             history.stop_reason = f"bending angle above {options.max_angle_deg:g} deg"
             break
@@ -362,7 +376,8 @@ def _to_result(
 ) -> SweepResult:
     options = model.options
     p_steps = history.pressures
-    reached = grid[grid <= p_steps[-1] + 1e-12]
+    last = p_steps[-1] if history.valid_up_to_mpa is None else history.valid_up_to_mpa
+    reached = grid[grid <= last + 1e-12]
     values = history.interpolate(reached)
     # Drop outputs beyond the angle limit.
     keep = values[:, 0] <= options.max_angle_deg
@@ -398,6 +413,7 @@ def _to_result(
         "steps_mpa": [float(s.pressure_mpa) for s in history.steps],
         "step_angles_deg": [float(s.values[0]) for s in history.steps],
         "step_iterations": [int(s.iterations) for s in history.steps],
+        "step_max_stretch": [float(s.max_stretch) for s in history.steps],
         "rejected_steps": history.rejected_steps,
         "ndof": model.ndof,
         "setup_s": built - started,
