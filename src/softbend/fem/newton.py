@@ -87,10 +87,12 @@ class EnergySolver:
     stall_iteration: int = 6
     stall_factor: float = 1e4
     #: Give up earlier still when, after this many iterations, the residual has
-    #: not even fallen below ``progress_factor`` times the starting residual: a
-    #: start outside Newton's basin (the failed steps of a sweep look like this).
+    #: not even fallen below ``progress_factor`` times the residual after the
+    #: first iteration: a start outside Newton's basin (the failed steps of a
+    #: sweep look like this). The first iteration is the reference because it
+    #: removes the large residual of the stiff fibers from any starting guess.
     progress_iteration: int = 3
-    progress_factor: float = 0.25
+    progress_factor: float = 0.3
     timings: _Timings = field(default_factory=_Timings)
 
     def __post_init__(self) -> None:
@@ -169,8 +171,10 @@ class EnergySolver:
         self._backup.data = vec
         cuts = 0
         residual = self._norm(self.residual())
-        initial = residual
+        after_first = math.inf
         for iteration in range(self.max_iterations + 1):
+            if iteration == 1:
+                after_first = residual
             if not math.isfinite(residual):
                 break
             if residual <= tolerance:
@@ -182,7 +186,7 @@ class EnergySolver:
                 break
             if (
                 iteration == self.progress_iteration
-                and residual > self.progress_factor * initial
+                and residual > self.progress_factor * after_first
                 and residual > self.stall_factor * tolerance
             ):
                 break

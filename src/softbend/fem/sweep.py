@@ -48,6 +48,11 @@ logger = logging.getLogger(__name__)
 ProgressCallback = Callable[[float, float, float], None]
 
 
+def _hermite_basis(s: float) -> tuple[float, float, float, float]:
+    """Cubic Hermite basis ``h00, h10, h01, h11`` at ``s`` (0 and 1: the two ends)."""
+    return (1 + 2 * s) * (1 - s) ** 2, s * (1 - s) ** 2, s * s * (3 - 2 * s), s * s * (s - 1)
+
+
 @dataclass(frozen=True)
 class Step:
     """One converged load step."""
@@ -89,11 +94,7 @@ class StepHistory:
                 continue
             k = min(max(k, 1), len(p) - 1)
             h = p[k] - p[k - 1]
-            s = (q - p[k - 1]) / h
-            h00 = (1 + 2 * s) * (1 - s) ** 2
-            h10 = s * (1 - s) ** 2
-            h01 = s * s * (3 - 2 * s)
-            h11 = s * s * (s - 1)
+            h00, h10, h01, h11 = _hermite_basis((q - p[k - 1]) / h)
             out[row] = (
                 h00 * values[k - 1]
                 + h10 * h * slopes[k - 1]
@@ -213,11 +214,7 @@ def _predict(
         return state + h * tangent
     p0, u0, t0 = previous
     h1 = pressure - p0
-    s = 1.0 + h / h1  # 0 at p0, 1 at pressure
-    h00 = (1 + 2 * s) * (1 - s) ** 2
-    h10 = s * (1 - s) ** 2
-    h01 = s * s * (3 - 2 * s)
-    h11 = s * s * (s - 1)
+    h00, h10, h01, h11 = _hermite_basis(1.0 + h / h1)  # s = 0 at p0, 1 at pressure
     return h00 * u0 + h10 * h1 * t0 + h01 * state + h11 * h1 * tangent
 
 
