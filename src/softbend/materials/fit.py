@@ -38,6 +38,7 @@ from scipy.optimize import least_squares
 
 from softbend._validation import check_choice, check_finite_array, check_range
 from softbend.errors import ConvergenceError, DatasetError
+from softbend.identification import metrics
 from softbend.materials.models import (
     _AB_COEFFS,
     MODELS,
@@ -239,16 +240,6 @@ def _problem(model_name: str, lam: np.ndarray, y: np.ndarray) -> _Problem:
     )
 
 
-def _metrics(y: np.ndarray, predicted: np.ndarray) -> tuple[float, float]:
-    """``(R², RMSE)`` of ``predicted`` against ``y``; R² is NaN if ``y`` is constant."""
-    residual = y - predicted
-    ss_res = float(residual @ residual)
-    centred = y - y.mean()
-    ss_tot = float(centred @ centred)
-    r2 = 1.0 - ss_res / ss_tot if ss_tot > 0.0 else math.nan
-    return r2, math.sqrt(ss_res / y.size)
-
-
 def _check_data(stretch: ArrayLike, stress: ArrayLike, owner: str) -> tuple[np.ndarray, np.ndarray]:
     lam = check_finite_array(stretch, "stretch", owner)
     y = check_finite_array(stress, "nominal_stress_mpa", owner)
@@ -360,7 +351,8 @@ def fit_model(
             f"(status {solution.status}: {solution.message}; x = {solution.x.tolist()})."
         )
     model = problem.build(solution.x)
-    r2, rmse = _metrics(y, model.uniaxial_nominal_stress_mpa(lam))
+    predicted = model.uniaxial_nominal_stress_mpa(lam)
+    r2, rmse = metrics.r2(y, predicted), metrics.rmse(y, predicted)
     # trf keeps its iterates strictly feasible, so its active_mask can miss a bound
     # approached to within its step tolerance: check the distance as well.
     near = np.minimum(
