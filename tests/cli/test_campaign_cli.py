@@ -12,14 +12,9 @@ import pytest
 from softbend.campaign import CampaignStore, load_samples
 from softbend.cli import main
 
+from .conftest import one_error_line
+
 RUN = ["--space", "lhs:6", "--seed", "3", "--pmax", "0.1", "--pstep", "0.05"]
-
-
-def _one_error_line(capsys) -> str:
-    err = capsys.readouterr().err.strip().splitlines()
-    assert len(err) == 1, err
-    assert err[0].startswith("softbend: error: ")
-    return err[0]
 
 
 def test_run_status_export_and_resume(tmp_path, capsys):
@@ -112,7 +107,7 @@ def _closed_port() -> int:
 def test_bad_run_input_is_one_line_and_exit_2(tmp_path, capsys, args, needle):
     db = tmp_path / "c.duckdb"
     assert main(["campaign", "run", str(db), *RUN, *args]) == 2
-    assert needle in _one_error_line(capsys)
+    assert needle in one_error_line(capsys)
     assert not db.exists()
 
 
@@ -131,7 +126,7 @@ def test_unreachable_scheduler_is_exit_2(tmp_path, capsys):
         ]
     )
     assert code == 2
-    assert f"Cannot reach the Dask scheduler at {address}" in _one_error_line(capsys)
+    assert f"Cannot reach the Dask scheduler at {address}" in one_error_line(capsys)
 
 
 def test_newer_schema_is_exit_2_for_every_subcommand(tmp_path, capsys):
@@ -146,22 +141,22 @@ def test_newer_schema_is_exit_2_for_every_subcommand(tmp_path, capsys):
         ["campaign", "export", str(db), str(tmp_path / "x.parquet")],
     ):
         assert main(argv) == 2
-        assert "schema version 2, newer than this softbend supports (1)" in _one_error_line(capsys)
+        assert "schema version 2, newer than this softbend supports (1)" in one_error_line(capsys)
     assert not (tmp_path / "x.parquet").exists()
 
 
 def test_status_and_export_bad_input(tmp_path, capsys):
     assert main(["campaign", "status", str(tmp_path / "missing.duckdb")]) == 2
-    assert "No campaign database" in _one_error_line(capsys)
+    assert "No campaign database" in one_error_line(capsys)
     db = tmp_path / "c.duckdb"
     assert main(["campaign", "run", str(db), *RUN, "--workers", "0", "--json"]) == 0
     capsys.readouterr()
     assert main(["campaign", "export", str(db), str(tmp_path / "x.xlsx"), "--format", "xlsx"]) == 2
     assert "'--format' of softbend campaign export must be one of 'parquet', 'csv'" in (
-        _one_error_line(capsys)
+        one_error_line(capsys)
     )
     assert main(["campaign", "export", str(db), str(tmp_path / "no" / "x.csv")]) == 2
-    assert "does not exist" in _one_error_line(capsys)
+    assert "does not exist" in one_error_line(capsys)
 
 
 def test_help_lists_the_subcommands_and_options(capsys):

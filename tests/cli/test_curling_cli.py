@@ -5,6 +5,8 @@ import pytest
 from softbend.cli import main
 from softbend.identification.persistence import load_narx
 
+from .conftest import one_error_line
+
 
 @pytest.fixture(scope="module")
 def simulated(tmp_path_factory):
@@ -55,13 +57,6 @@ def test_identify_prints_metrics_and_writes_models_and_figures(simulated, tmp_pa
     assert model.max_lag_ == 2
 
 
-def _one_error_line(capsys):
-    err = capsys.readouterr().err.strip().splitlines()
-    assert len(err) == 1, err
-    assert err[0].startswith("softbend: error:")
-    return err[0]
-
-
 def _write(path, text):
     path.write_text(text)
     return path
@@ -79,15 +74,15 @@ def _write(path, text):
 def test_bad_csv_gives_one_line_and_exit_2(tmp_path, capsys, content, expected):
     path = _write(tmp_path / "bad.csv", content)
     assert main(["curling", "identify", str(path), "--out", str(tmp_path / "o")]) == 2
-    assert expected in _one_error_line(capsys)
+    assert expected in one_error_line(capsys)
 
 
 def test_missing_data_path_and_bad_options_exit_2(tmp_path, capsys):
     assert main(["curling", "identify", str(tmp_path / "nope.csv"), "--out", str(tmp_path)]) == 2
-    _one_error_line(capsys)
+    one_error_line(capsys)
     assert (
         main(["curling", "identify", str(tmp_path), "--out", str(tmp_path), "--kernel", "x"]) == 2
     )
-    assert "'kernel'" in _one_error_line(capsys)
+    assert "'kernel'" in one_error_line(capsys)
     assert main(["curling", "simulate", "--out", str(tmp_path), "--samples", "abc"]) == 2
-    _one_error_line(capsys)
+    one_error_line(capsys)

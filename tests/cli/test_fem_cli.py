@@ -4,11 +4,7 @@ import pytest
 
 from softbend.cli import main
 
-
-def _one_error_line(capsys) -> str:
-    err = capsys.readouterr().err.strip().splitlines()
-    assert len(err) == 1, err
-    return err[0]
+from .conftest import one_error_line
 
 
 @pytest.mark.parametrize(
@@ -19,16 +15,17 @@ def _one_error_line(capsys) -> str:
         (["--maxh", "0"], "'maxh_mm' of FEMOptions"),
         (["--gravity", "up"], "'gravity' of FEMOptions must be one of"),
         (["--pmax", "nan"], "'pmax_mpa' of default_pressures_mpa"),
+        (["--shapes", "0"], "'--shapes' must be an integer in [1, inf)"),
     ],
 )
 def test_fem_run_bad_input_is_one_line_and_exit_2(tmp_path, capsys, args, needle):
     assert main(["fem", "run", "--out", str(tmp_path), *args]) == 2
-    assert needle in _one_error_line(capsys)
+    assert needle in one_error_line(capsys)
 
 
 def test_mesh_study_bad_sizes_exit_2(capsys):
     assert main(["fem", "mesh-study", "--maxh", "4,x"]) == 2
-    assert "'--maxh' must be comma-separated numbers" in _one_error_line(capsys)
+    assert "'--maxh' must be comma-separated numbers" in one_error_line(capsys)
 
 
 def test_fem_run_writes_the_sweep_figures_and_vtk(tmp_path, capsys):

@@ -7,15 +7,10 @@ import pytest
 from softbend.cli import main
 from softbend.materials import fit_models, load_shipped
 
+from .conftest import one_error_line
+
 PNG_MAGIC = b"\x89PNG\r\n\x1a\n"
 MODELS = ("neo-hookean", "yeoh", "arruda-boyce")
-
-
-def _one_error_line(capsys):
-    err = capsys.readouterr().err.strip().splitlines()
-    assert len(err) == 1, err
-    assert err[0].startswith("softbend: error: ")
-    return err[0]
 
 
 def test_default_fit_prints_a_table_and_writes_figure_and_json(tmp_path, capsys):
@@ -77,7 +72,7 @@ def test_user_csv_file(tmp_path, capsys):
 def test_unknown_model_is_one_line_exit_2_naming_allowed_models(tmp_path, capsys):
     out = tmp_path / "o"
     assert main(["materials", "fit", "--models", "yeoh,mooney", "--out", str(out)]) == 2
-    line = _one_error_line(capsys)
+    line = one_error_line(capsys)
     assert "'mooney'" in line
     for name in MODELS:
         assert repr(name) in line
@@ -90,7 +85,7 @@ def test_missing_column_is_one_line_exit_2(tmp_path, capsys):
     csv.write_text("Engineering Strain;Stress (MPa)\n" + rows + "\n")
     out = tmp_path / "o"
     assert main(["materials", "fit", str(csv), "--out", str(out)]) == 2
-    line = _one_error_line(capsys)
+    line = one_error_line(capsys)
     assert "'Engineering Stress (MPa)'" in line and "bad.csv" in line
     assert "'Stress (MPa)'" in line
     assert not out.exists()
@@ -98,10 +93,10 @@ def test_missing_column_is_one_line_exit_2(tmp_path, capsys):
 
 def test_missing_file_and_bad_max_stretch_exit_2(tmp_path, capsys):
     assert main(["materials", "fit", str(tmp_path / "nope.csv"), "--out", str(tmp_path)]) == 2
-    line = _one_error_line(capsys)
+    line = one_error_line(capsys)
     assert "nope.csv" in line and "dragon-skin-30" in line
     assert main(["materials", "fit", "--max-stretch", "0.5", "--out", str(tmp_path / "o")]) == 2
-    assert "'max_stretch'" in _one_error_line(capsys)
+    assert "'max_stretch'" in one_error_line(capsys)
 
 
 def test_list_shipped_tests(capsys):

@@ -70,6 +70,7 @@ def run(
     analytical model), shapes.png (deformed shapes, paper B Fig. 2b) and
     vtk/shape_<kPa>kPa.vtu (e.g. shape_050p00kPa.vtu) for ParaView (apply Warp By Vector).
     """
+    from softbend._io import write_text_atomic
     from softbend.campaign.backends import default_pressures_mpa, get_backend
     from softbend.design import SFRBADesign
     from softbend.fem.export import silhouette_mm, write_sweep_csv, write_vtk
@@ -106,8 +107,6 @@ def run(
         "elements": result.mesh_size,
         "stats": result.stats,
     }
-    from softbend._io import write_text_atomic
-
     write_text_atomic(out / SWEEP_JSON, json.dumps(_common._jsonable(summary), indent=2))
     analytical = get_backend("analytical").sweep(actuator, pressures)
     angle_pressure_curve(result, out / CURVE_PNG, analytical=analytical)
