@@ -67,9 +67,14 @@ def _jsonable(value: Any) -> Any:
     return value
 
 
+def json_text(payload: Any) -> str:
+    """``payload`` as indented JSON text (NumPy values converted, NaN and inf as null)."""
+    return json.dumps(_jsonable(payload), indent=2, allow_nan=False)
+
+
 def print_json(payload: Any) -> None:
     """Print ``payload`` as JSON on stdout (NaN and inf become null)."""
-    print(json.dumps(_jsonable(payload), indent=2))
+    print(json_text(payload))
 
 
 def print_table(title: str, columns: list[str], rows: list[list[Any]]) -> None:

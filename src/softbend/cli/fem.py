@@ -2,7 +2,6 @@
 
 from __future__ import annotations
 
-import json
 from pathlib import Path
 from typing import Annotated
 
@@ -107,7 +106,7 @@ def run(
         "elements": result.mesh_size,
         "stats": result.stats,
     }
-    write_text_atomic(out / SWEEP_JSON, json.dumps(_common._jsonable(summary), indent=2))
+    write_text_atomic(out / SWEEP_JSON, _common.json_text(summary))
     analytical = get_backend("analytical").sweep(actuator, pressures)
     angle_pressure_curve(result, out / CURVE_PNG, analytical=analytical)
     outlines = []

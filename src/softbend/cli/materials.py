@@ -2,7 +2,6 @@
 
 from __future__ import annotations
 
-import json
 from pathlib import Path
 from typing import TYPE_CHECKING, Annotated, Any
 
@@ -126,8 +125,7 @@ def fit(
     figure = fit_figure(test, results, out / FIT_PNG)
     payload = _payload(test, results, max_stretch)
     payload["files"] = {"figure": str(figure), "json": str(out / FIT_JSON)}
-    text = json.dumps(_common._jsonable(payload), indent=2, allow_nan=False)
-    write_text_atomic(out / FIT_JSON, text + "\n")
+    write_text_atomic(out / FIT_JSON, _common.json_text(payload) + "\n")
 
     if json_output:
         _common.print_json(payload)
