@@ -25,13 +25,12 @@ import math
 from collections.abc import Sequence
 from typing import Any
 
-from softbend.materials.models import ArrudaBoyce, HyperelasticModel, NeoHookean, Yeoh
+from softbend.materials.models import HyperelasticModel
 
 __all__ = [
     "FIBER_LAWS",
     "fiber_energy",
     "helix_stiffness_n_per_mm",
-    "isochoric_energy",
     "membrane_energy",
     "solid_energy",
     "volume_flux",
@@ -39,38 +38,6 @@ __all__ = [
 
 #: Fiber laws: "tension-compression" (a tied beam, paper B) or "tension-only" (a thread).
 FIBER_LAWS: tuple[str, ...] = ("tension-compression", "tension-only")
-
-# Arruda–Boyce series coefficients C1..C5 (as in softbend.materials.models).
-_AB_COEFFS = (1 / 2, 1 / 20, 11 / 1050, 19 / 7000, 519 / 673750)
-
-
-def isochoric_energy(model: HyperelasticModel, I1: Any) -> Any:
-    """Strain energy density ``W(I1)`` of an incompressible model, MPa.
-
-    Works on NGSolve coefficient functions as well as on floats, which the
-    NumPy methods of :mod:`softbend.materials.models` do not.
-
-    Parameters
-    ----------
-    model : NeoHookean, Yeoh or ArrudaBoyce
-        The law and its constants (MPa).
-    I1 : CoefficientFunction or float
-        First invariant (or its isochoric version ``Ī1``), dimensionless.
-    """
-    if isinstance(model, NeoHookean):
-        return model.c10_mpa * (I1 - 3.0)
-    if isinstance(model, Yeoh):
-        d = I1 - 3.0
-        return d * (model.c10_mpa + d * (model.c20_mpa + d * model.c30_mpa))
-    if isinstance(model, ArrudaBoyce):
-        total = 0.0
-        for i, c in enumerate(_AB_COEFFS, start=1):
-            total = total + c / model.lambda_m ** (2 * i - 2) * (I1**i - 3.0**i)
-        return model.mu_mpa * total
-    raise ValueError(
-        "The 'model' of isochoric_energy must be a NeoHookean, Yeoh or ArrudaBoyce model. "
-        f"Got {model!r} instead."
-    )
 
 
 def solid_energy(F: Any, model: HyperelasticModel, bulk_modulus_mpa: float) -> Any:
@@ -95,7 +62,7 @@ def solid_energy(F: Any, model: HyperelasticModel, bulk_modulus_mpa: float) -> A
 
     J = Det(F)
     I1_bar = J ** (-2.0 / 3.0) * Trace(F.trans * F)
-    return isochoric_energy(model, I1_bar) + 0.5 * bulk_modulus_mpa * (J - 1.0) ** 2
+    return model.energy(I1_bar) + 0.5 * bulk_modulus_mpa * (J - 1.0) ** 2
 
 
 def membrane_energy(
@@ -128,7 +95,7 @@ def membrane_energy(
     a1, a2 = (Fs * t for t in tangents)
     c11, c22, c12 = InnerProduct(a1, a1), InnerProduct(a2, a2), InnerProduct(a1, a2)
     I1 = c11 + c22 + 1.0 / (c11 * c22 - c12 * c12)
-    return thickness_mm * isochoric_energy(model, I1)
+    return thickness_mm * model.energy(I1)
 
 
 def fiber_energy(

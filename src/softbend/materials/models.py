@@ -64,9 +64,14 @@ class HyperelasticModel:
     #: Registry name of the model ("neo-hookean", "yeoh", "arruda-boyce").
     name: ClassVar[str] = ""
 
-    def strain_energy(self, I1: ArrayLike) -> np.ndarray:  # pragma: no cover - abstract
-        """Strain energy density ``W(I1)`` in MPa."""
+    def energy(self, I1: Any) -> Any:  # pragma: no cover - abstract
+        """``W(I1)`` in MPa for any number-like ``I1``: a float, an array or a
+        symbolic expression (the FEM passes NGSolve coefficient functions)."""
         raise NotImplementedError
+
+    def strain_energy(self, I1: ArrayLike) -> np.ndarray:
+        """Strain energy density ``W(I1)`` in MPa; ``I1`` dimensionless."""
+        return self.energy(np.asarray(I1, dtype=float))
 
     def dW_dI1(self, I1: ArrayLike) -> np.ndarray:  # noqa: N802  # pragma: no cover
         """Derivative ``∂W/∂I1`` in MPa."""
@@ -148,9 +153,9 @@ class NeoHookean(HyperelasticModel):
         value = check_range(self.c10_mpa, "c10_mpa", "NeoHookean", low=0.0)
         object.__setattr__(self, "c10_mpa", value)
 
-    def strain_energy(self, I1: ArrayLike) -> np.ndarray:
-        """Strain energy density ``C10 (I1 − 3)`` in MPa; ``I1`` dimensionless."""
-        return self.c10_mpa * (np.asarray(I1, dtype=float) - 3.0)
+    def energy(self, I1: Any) -> Any:
+        """``C10 (I1 − 3)`` in MPa (see :meth:`HyperelasticModel.energy`)."""
+        return self.c10_mpa * (I1 - 3.0)
 
     def dW_dI1(self, I1: ArrayLike) -> np.ndarray:  # noqa: N802
         """``∂W/∂I1 = C10`` in MPa, broadcast to the shape of ``I1``."""
@@ -183,9 +188,9 @@ class Yeoh(HyperelasticModel):
             value = check_range(getattr(self, field_name), field_name, "Yeoh")
             object.__setattr__(self, field_name, value)
 
-    def strain_energy(self, I1: ArrayLike) -> np.ndarray:
-        """Strain energy density in MPa; ``I1`` dimensionless."""
-        d = np.asarray(I1, dtype=float) - 3.0
+    def energy(self, I1: Any) -> Any:
+        """``Σ Ci0 (I1 − 3)^i`` in MPa (see :meth:`HyperelasticModel.energy`)."""
+        d = I1 - 3.0
         return d * (self.c10_mpa + d * (self.c20_mpa + d * self.c30_mpa))
 
     def dW_dI1(self, I1: ArrayLike) -> np.ndarray:  # noqa: N802
@@ -233,12 +238,11 @@ class ArrudaBoyce(HyperelasticModel):
     def _scaled_coeffs(self) -> list[float]:
         return [c / self.lambda_m ** (2 * i) for i, c in enumerate(_AB_COEFFS)]
 
-    def strain_energy(self, I1: ArrayLike) -> np.ndarray:
-        """Strain energy density in MPa; ``I1`` dimensionless."""
-        x = np.asarray(I1, dtype=float)
-        total = np.zeros_like(x)
+    def energy(self, I1: Any) -> Any:
+        """``μ Σ Ci/λm^(2i−2) (I1^i − 3^i)`` in MPa (see :meth:`HyperelasticModel.energy`)."""
+        total = 0.0
         for i, c in enumerate(self._scaled_coeffs(), start=1):
-            total = total + c * (x**i - 3.0**i)
+            total = total + c * (I1**i - 3.0**i)
         return self.mu_mpa * total
 
     def dW_dI1(self, I1: ArrayLike) -> np.ndarray:  # noqa: N802
