@@ -143,3 +143,14 @@ def test_undeformed_state_has_unit_stretch():
     assert model.region_of(50.0) == "chamber wall"
     assert model.region_of(REFERENCE.l_mm + COARSE.base_cap_mm + 1.0) == "distal cap"
     assert where.shape == (3,)
+
+
+def test_nearest_steps_are_unique_and_in_pressure_order():
+    from softbend.fem.sweep import Step, StepHistory
+
+    def step(p):
+        return Step(p, np.zeros(3), np.zeros(3), 1)
+
+    history = StepHistory([step(p) for p in (0.0, 0.01, 0.025, 0.04)])
+    picked = history.nearest_steps([0.04, 0.012, 0.0, 0.009, 0.1])
+    assert [s.pressure_mpa for s in picked] == [0.0, 0.01, 0.04]

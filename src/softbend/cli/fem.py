@@ -37,16 +37,6 @@ def _options(maxh: float, gravity: str, **extra):
     return FEMOptions(maxh_mm=maxh, gravity=gravity, **extra)
 
 
-def _shape_steps(history, count: int) -> list:
-    """The converged steps nearest to ``count`` evenly spaced pressures."""
-    import numpy as np
-
-    pressures = history.pressures
-    targets = np.linspace(0.0, pressures[-1], count)
-    picked = sorted({int(np.abs(pressures - t).argmin()) for t in targets})
-    return [history.steps[i] for i in picked]
-
-
 @app.command("run")
 def run(
     design: DesignOption = "100,6,2,2,5,10",
@@ -69,6 +59,8 @@ def run(
     analytical model), shapes.png (deformed shapes, paper B Fig. 2b) and
     vtk/shape_<kPa>kPa.vtu (e.g. shape_050p00kPa.vtu) for ParaView (apply Warp By Vector).
     """
+    import numpy as np
+
     from softbend._io import write_text_atomic
     from softbend.campaign.backends import default_pressures_mpa, get_backend
     from softbend.design import SFRBADesign
@@ -110,7 +102,7 @@ def run(
     analytical = get_backend("analytical").sweep(actuator, pressures)
     angle_pressure_curve(result, out / CURVE_PNG, analytical=analytical)
     outlines = []
-    for chosen in _shape_steps(history, shapes):
+    for chosen in history.nearest_steps(np.linspace(0.0, history.pressures[-1], shapes)):
         model.set_state(chosen.state)
         outlines.append((chosen.pressure_mpa, silhouette_mm(model)))
         kpa = f"{1000 * chosen.pressure_mpa:06.2f}".replace(".", "p")

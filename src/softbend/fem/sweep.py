@@ -81,6 +81,12 @@ class StepHistory:
     def pressures(self) -> np.ndarray:
         return np.array([s.pressure_mpa for s in self.steps])
 
+    def nearest_steps(self, pressures_mpa: ArrayLike) -> list[Step]:
+        """The converged steps nearest to ``pressures_mpa``, each once, in order."""
+        p = self.pressures
+        picked = {int(np.abs(p - q).argmin()) for q in np.atleast_1d(pressures_mpa)}
+        return [self.steps[i] for i in sorted(picked)]
+
     def interpolate(self, pressures_mpa: np.ndarray) -> np.ndarray:
         """Cubic Hermite values (n, 3) at pressures inside the converged range."""
         p = self.pressures

@@ -73,8 +73,7 @@ def add_section(
         result, folder / "fem_angle_pressure.png", analytical=analytical
     )
     outlines = []
-    for target in sorted({0.0, min(0.05, pmax_mpa), min(0.10, pmax_mpa), pmax_mpa}):
-        step = min(history.steps, key=lambda s: abs(s.pressure_mpa - target))
+    for step in history.nearest_steps([0.0, 0.05, 0.10, pmax_mpa]):
         model.set_state(step.state)
         outlines.append((step.pressure_mpa, silhouette_mm(model)))
     shapes_png = deformed_shapes(outlines, folder / "fem_shapes.png", title=f"Design ({design})")
