@@ -1,5 +1,6 @@
 """Uniaxial tensile data: the shipped Marechal et al. tests and the file parser."""
 
+import json
 from importlib import resources
 
 import numpy as np
@@ -241,3 +242,13 @@ def test_tensile_test_validates_and_freezes():
         TensileTest("t", "m", np.linspace(-0.1, 0.9, 6), strain)
     with pytest.raises(ValueError, match="'name' of TensileTest"):
         TensileTest(" ", "m", strain, strain)
+
+
+def test_summary_describes_the_shipped_dragon_skin_30():
+    summary = load_shipped("dragon-skin-30").summary()
+    assert summary["name"] == "dragon-skin-30"
+    assert summary["n_points"] == 311
+    assert summary["max_engineering_strain"] == pytest.approx(7.09, abs=0.01)  # stretch 8.09
+    assert summary["source"].endswith("Dragon_Skin_30.csv")
+    assert "Marechal" in summary["attribution"]
+    json.dumps(summary)  # JSON-friendly as it is

@@ -60,15 +60,7 @@ def _payload(
     ranked = [r for r in results.values() if r.r2 == r.r2]  # NaN R² never ranks
     best = max(ranked, key=lambda r: r.r2).name if ranked else None
     return {
-        "test": {
-            "name": test.name,
-            "material": test.material,
-            "source": str(test.source) if test.source is not None else None,
-            "attribution": test.attribution,
-            "n_points": test.n_points,
-            "max_engineering_strain": test.max_strain,
-            "max_engineering_stress_mpa": float(test.engineering_stress_mpa.max()),
-        },
+        "test": test.summary(),
         "max_stretch": max_stretch,
         "fits": [r.to_dict() for r in results.values()],
         "best_model": best,
@@ -161,16 +153,7 @@ def list_tests(
         _common.print_json(
             {
                 "attribution": SHIPPED_ATTRIBUTION,
-                "tests": [
-                    {
-                        "name": t.name,
-                        "material": t.material,
-                        "n_points": t.n_points,
-                        "max_engineering_strain": t.max_strain,
-                        "max_engineering_stress_mpa": float(t.engineering_stress_mpa.max()),
-                    }
-                    for t in tests
-                ],
+                "tests": [t.summary() for t in tests],
             }
         )
         return

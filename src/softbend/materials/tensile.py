@@ -26,6 +26,7 @@ from dataclasses import dataclass, field
 from importlib import resources
 from pathlib import Path
 from types import MappingProxyType
+from typing import Any
 
 import numpy as np
 
@@ -162,6 +163,18 @@ class TensileTest:
     def max_strain(self) -> float:
         """Largest engineering strain reached (the strain at failure for a pull-to-failure test)."""
         return float(self.engineering_strain.max())
+
+    def summary(self) -> dict[str, Any]:
+        """What the test is, JSON-friendly: name, material, source, size and range."""
+        return {
+            "name": self.name,
+            "material": self.material,
+            "source": str(self.source) if self.source is not None else None,
+            "attribution": self.attribution,
+            "n_points": self.n_points,
+            "max_engineering_strain": self.max_strain,
+            "max_engineering_stress_mpa": float(self.engineering_stress_mpa.max()),
+        }
 
 
 def _cells(line: str) -> list[str]:
