@@ -56,6 +56,22 @@ def test_rigid_translation_costs_no_strain_energy(model):
     assert model.form.Energy(shifted.vec) == pytest.approx(0.0, abs=1e-9)
 
 
+def test_weight_vector_is_the_whole_weight_as_a_dead_load(model):
+    """A rigid lift by 1 mm does work −W against gravity; the energy counts it once."""
+    import ngsolve as ngs
+
+    lift = ngs.GridFunction(model.fes)
+    lift.Set(ngs.CoefficientFunction((0.0, 0.0, 1.0)))
+    work = float(model.weight_vector.InnerProduct(lift.vec))
+    assert work == pytest.approx(-model._weight_n, rel=2e-3)
+    model.set_state(lift.vec.FV().NumPy())
+    model.set_load(0.0, 0.5)
+    assert model.solver.energy() == pytest.approx(0.5 * model._weight_n, rel=2e-3)
+    residual = model.solver.residual().FV().NumPy()
+    np.testing.assert_allclose(residual, -0.5 * model.weight_vector.FV().NumPy(), atol=1e-9)
+    model.set_state(np.zeros_like(model.state()))
+
+
 def test_newton_failure_raises_with_residual_and_restores_the_state(model):
     model.set_state(np.zeros_like(model.state()))
     model.set_load(0.05, 1.0)

@@ -2,8 +2,11 @@
 
 :class:`EnergySolver` owns one NGSolve ``BilinearForm`` built from ``Variation``
 terms (the total potential energy), the displacement ``GridFunction`` and the
-free degrees of freedom. :meth:`EnergySolver.solve` minimises the energy from the
-current state: exact Newton steps on the automatically differentiated Hessian,
+free degrees of freedom, and optionally a load that does not depend on the
+state (``−λ f·u``, a dead load such as gravity, assembled once and scaled by the
+factor ``λ``: its Hessian is zero, so it is kept out of the differentiated
+form). :meth:`EnergySolver.solve` minimises the energy from the current state:
+exact Newton steps on the automatically differentiated Hessian,
 factorised by sparse Cholesky (the symbolic factorisation is reused), with a
 backtracking line search on the energy. Round-off makes energy differences
 meaningless near convergence (the energy is ~1e4 times the last decreases), so
@@ -72,6 +75,10 @@ class EnergySolver:
         Relative residual tolerance.
     max_iterations : int
         Newton iterations per solve.
+    load : ngsolve.BaseVector, optional
+        Dead load ``f`` (N per dof), the gradient of a potential ``−f·u``.
+    load_factor : ngsolve.Parameter, optional
+        Its scale ``λ`` (read at every evaluation); 1 if not given.
     stall_iteration, stall_factor
         Early give-up rule (see the attributes).
     """
@@ -81,6 +88,8 @@ class EnergySolver:
     freedofs: Any
     rtol: float = 1e-8
     max_iterations: int = 25
+    load: Any = None
+    load_factor: Any = None
     #: Give up early when, after this many iterations, the residual is still
     #: ``stall_factor`` times the tolerance (not yet in Newton's quadratic phase):
     #: a shorter load step is cheaper than a long crawl.
@@ -108,12 +117,25 @@ class EnergySolver:
         """Whether a Hessian has been factorised yet."""
         return self._inverse is not None
 
-    # -- linear algebra --------------------------------------------------------------
+    # -- energy and its derivatives ---------------------------------------------------
+    def _load_scale(self) -> float:
+        return 1.0 if self.load_factor is None else float(self.load_factor.Get())
+
+    def energy(self, vec: Any = None) -> float:
+        """Total potential energy at ``vec`` (default: the current state), mJ."""
+        vec = self.gfu.vec if vec is None else vec
+        value = float(self.form.Energy(vec))
+        if self.load is not None:
+            value -= self._load_scale() * float(self.load.InnerProduct(vec))
+        return value
+
     def residual(self, out: Any = None) -> Any:
-        """Gradient of the energy at the current state (N), zero on fixed dofs."""
+        """Gradient of the energy at the current state (N); fixed dofs are not masked."""
         out = self._res if out is None else out
         start = time.perf_counter()
         self.form.Apply(self.gfu.vec, out)
+        if self.load is not None:
+            out.data -= self._load_scale() * self.load
         self.timings.residual_s += time.perf_counter() - start
         return out
 
@@ -208,12 +230,12 @@ class EnergySolver:
     def _line_search(self, residual0: float) -> tuple[float, float, int]:
         """Step ``u -= α du``; returns ``(α, new residual norm, cuts)`` (α = 0: failed)."""
         vec, du = self.gfu.vec, self._du
-        energy0 = self.form.Energy(vec)
+        energy0 = self.energy(vec)
         slope = -float(du.InnerProduct(self._res))  # d/dα E(u − α du) at α = 0
         alpha = 1.0
         for cuts in range(12):
             vec.data -= alpha * du
-            energy = self.form.Energy(vec)
+            energy = self.energy(vec)
             residual = self._norm(self.residual())
             roundoff = 1e-11 * max(abs(energy0), 1.0)
             if math.isfinite(energy) and math.isfinite(residual):

@@ -141,21 +141,16 @@ def _apply_gravity(model: ActuatorModel) -> int:
 
 
 def _gravity_tangent(model: ActuatorModel) -> np.ndarray:
-    """``du/dg`` at the current state, g the fraction of gravity applied (mm)."""
+    """``du/dg`` at the current state, g the fraction of gravity applied (mm).
+
+    The weight is a dead load ``g·f``, so ``∂r/∂g = −f`` and ``K du/dg = f``.
+    """
     solver = model.solver
-    applied = model.gravity_factor.Get()
-    model.set_load(0.0, 1.0)
-    full = solver.residual().FV().NumPy().copy()
-    model.set_load(0.0, 0.0)
-    none = solver.residual().FV().NumPy().copy()
-    model.set_load(0.0, applied)
-    rhs = solver.gfu.vec.CreateVector()
-    rhs.FV().NumPy()[:] = full - none  # ∂r/∂g: the gravity load is linear in g
     out = solver.gfu.vec.CreateVector()
     if not solver.has_factorization:
         solver.factorize()
-    solver.solve_tangent(rhs, out)
-    return -np.array(out.FV().NumPy(), copy=True)
+    solver.solve_tangent(model.weight_vector, out)
+    return np.array(out.FV().NumPy(), copy=True)
 
 
 def _gravity_fractions(model: ActuatorModel) -> int:
