@@ -92,6 +92,21 @@ def test_predictor_extrapolates_a_cubic_path_exactly():
     np.testing.assert_allclose(_predict(u1, t1, 0.13, 0.15, None), u1 + 0.02 * t1)
 
 
+def test_step_is_sized_for_the_target_predictor_error():
+    from softbend.fem.sweep import _next_step
+
+    options = FEMOptions(predictor_error_mm=0.3, min_step_mpa=1e-4, max_step_mpa=0.02)
+    # On target: keep the step; 16x the target: half the step (error ~ step⁴).
+    assert _next_step(0.01, 0.3, options) == pytest.approx(0.01)
+    assert _next_step(0.01, 4.8, options) == pytest.approx(0.005)
+    assert _next_step(0.01, 0.3 / 1.2**4, options) == pytest.approx(0.012)
+    # Never more than 1.5x up or 2x down, and within the step bounds.
+    assert _next_step(0.01, 0.0, options) == pytest.approx(0.015)
+    assert _next_step(0.01, 1e3, options) == pytest.approx(0.005)
+    assert _next_step(0.018, 1e-6, options) == pytest.approx(0.02)
+    assert _next_step(1.5e-4, 1e3, options) == pytest.approx(1e-4)
+
+
 def test_gravity_followed_in_fractions_matches_one_plain_newton_solve():
     from softbend.fem.actuator import ActuatorModel
     from softbend.fem.sweep import _apply_gravity

@@ -5,8 +5,11 @@
 2. Pressure is raised in adaptive steps. Each step starts from the cubic
    extrapolation of the last two converged states and their tangents ``du/dp``
    (``K du/dp = ∂V/∂u``), so Newton starts close to the solution. A step that
-   does not converge is restored and halved; a step that converged in few
-   iterations lets the next one grow (up to ``max_step_mpa``).
+   does not converge is restored and halved. After a converged step, the
+   distance between the predicted and the converged state sets the next step:
+   the predictor's error grows like ``Δp⁴``, so the step is sized for an error
+   of ``predictor_error_mm`` (growing or shrinking by at most 1.5× or 2×),
+   between ``min_step_mpa`` and ``max_step_mpa``.
 3. At every converged step the angle, the tip and their derivatives with respect
    to pressure are stored; outputs on the requested grid are the cubic Hermite
    interpolants between steps (or, with ``output="solve"``, the steps land on
@@ -248,7 +251,8 @@ def run_steps(
             if ahead.size:
                 target = min(target, float(ahead[0]))
         start = model.state()
-        model.set_state(_predict(start, tangent, pressure, target, previous))
+        predicted = _predict(start, tangent, pressure, target, previous)
+        model.set_state(predicted)
         model.set_load(target, 1.0)
         try:
             report = model.solver.solve(
@@ -286,11 +290,22 @@ def run_steps(
         if step.values[0] > options.max_angle_deg:
             history.stop_reason = f"bending angle above {options.max_angle_deg:g} deg"
             break
-        if report.iterations <= 5:
-            dp = min(options.max_step_mpa, 1.5 * dp)
-        elif report.iterations >= 9:
-            dp = max(options.min_step_mpa, 0.7 * dp)
+        miss = float(np.abs(model.state() - predicted).max())
+        dp = _next_step(dp, miss, options)
     return history
+
+
+def _next_step(dp: float, miss_mm: float, options: FEMOptions) -> float:
+    """The next pressure step from how far the predictor missed the converged state.
+
+    The error of the cubic predictor grows like ``Δp⁴``, so the step that would
+    have missed by ``predictor_error_mm`` is ``Δp (target / miss)^¼``; the
+    change is held within a factor 0.5–1.5 per step and the step within
+    ``[min_step_mpa, max_step_mpa]``.
+    """
+    factor = (options.predictor_error_mm / max(miss_mm, 1e-12)) ** 0.25
+    factor = min(1.5, max(0.5, factor))
+    return min(options.max_step_mpa, max(options.min_step_mpa, factor * dp))
 
 
 def simulate(
