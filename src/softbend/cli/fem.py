@@ -43,7 +43,7 @@ def run(
     pmax: Annotated[float, typer.Option("--pmax", help="Largest pressure, MPa.")] = 0.2,
     step: Annotated[float, typer.Option("--step", help="Output pressure step, MPa.")] = 0.005,
     out: Annotated[Path, typer.Option("--out", "-o", help="Output folder.")] = Path("results/fem"),
-    maxh: MaxhOption = 4.0,
+    maxh: MaxhOption = 5.0,
     gravity: GravityOption = "bending",
     shapes: Annotated[int, typer.Option("--shapes", help="Deformed shapes drawn and saved.")] = 5,
     solve_every: Annotated[
@@ -144,7 +144,7 @@ def mesh_study(
     design: DesignOption = "100,6,2,2,5,10",
     maxh: Annotated[
         str, typer.Option("--maxh", help="Comma-separated element sizes, mm, coarse to fine.")
-    ] = "6,4,3",
+    ] = "6,5,4,3",
     pressures: Annotated[
         str, typer.Option("--pressures", help="Comma-separated pressures, MPa.")
     ] = "0,0.05,0.1",
