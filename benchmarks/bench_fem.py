@@ -65,7 +65,7 @@ def _row(result, seconds: float) -> dict:
 
 
 def _is_physical_stop(row: dict) -> bool:
-    return row["stop_reason"].startswith(("reached", "bending angle", "stretch"))
+    return row["stop_reason"].startswith(("reached", "bending angle", "stretch", "inflation"))
 
 
 def summarize(rows: list[dict]) -> None:

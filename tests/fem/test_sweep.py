@@ -169,3 +169,40 @@ def test_nearest_steps_are_unique_and_in_pressure_order():
     history = StepHistory([step(p) for p in (0.0, 0.01, 0.025, 0.04)])
     picked = history.nearest_steps([0.04, 0.012, 0.0, 0.009, 0.1])
     assert [s.pressure_mpa for s in picked] == [0.0, 0.01, 0.04]
+
+
+def _balloon_steps(volumes):
+    """Steps on the pressure–volume curve p = V − V²/2 (a maximum of 0.5 at V = 1)."""
+    from softbend.fem.sweep import Step
+
+    return [
+        Step(v - v * v / 2.0, np.zeros(3), np.zeros(3), 4, volume_rate=1.0 / (1.0 - v))
+        for v in volumes
+    ]
+
+
+def test_a_flattening_pressure_volume_curve_is_told_apart_from_a_stall():
+    from softbend.fem.sweep import Step, _pressure_maximum
+
+    close = _pressure_maximum(_balloon_steps([0.2, 0.5, 0.8, 0.9, 0.95]))
+    assert close is not None
+    assert close[0] == pytest.approx(0.5, abs=0.005)
+    assert close[1] > 1.0  # dp/dV fell
+    # Still far from the maximum, or stiffening, or too few steps: no signature.
+    assert _pressure_maximum(_balloon_steps([0.1, 0.3, 0.5])) is None
+    stiffening = [
+        Step(v + v * v, np.zeros(3), np.zeros(3), 4, volume_rate=1.0 / (1.0 + 2.0 * v))
+        for v in (0.2, 0.5, 0.8)
+    ]
+    assert _pressure_maximum(stiffening) is None
+    assert _pressure_maximum(_balloon_steps([0.9, 0.95])) is None
+
+
+@pytest.mark.slow
+def test_a_ballooning_end_cap_stops_as_an_inflation_instability():
+    """(100, 10, 4, 4, 15, 8): its unreinforced 8 mm distal cap balloons near 0.49 MPa."""
+    result = simulate(SFRBADesign.parse("100,10,4,4,15,8"), default_pressures_mpa(), FEMOptions())
+    reason = result.stats["stop_reason"]
+    assert reason.startswith(("inflation instability", "stretch")), reason
+    assert "distal cap" in reason
+    assert result.converged[:-1].all()

@@ -247,6 +247,13 @@ class ActuatorModel:
         self.solver.solve_tangent(rhs, out)
         return -np.array(out.FV().NumPy(), copy=True)
 
+    def cavity_volume_rate(self, tangent: np.ndarray) -> float:
+        """``dV/dp`` of the whole cavity along ``tangent = du/dp``, mm³/MPa."""
+        gradient = self.gfu.vec.CreateVector()
+        self.volume_form.Apply(self.gfu.vec, gradient)  # ∂(−V_half)/∂u
+        free = self.solver._mask
+        return -2.0 * float(np.dot(gradient.FV().NumPy()[free], tangent[free]))
+
     def cavity_volume_mm3(self) -> float:
         """Deformed volume of the whole cavity (both halves), mm³."""
         return -2.0 * float(self.volume_form.Energy(self.gfu.vec))

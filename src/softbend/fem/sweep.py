@@ -19,9 +19,13 @@ The sweep ends at the last requested pressure, when the angle passes
 ``max_angle_deg`` (the actuator has curled round; outputs above it are not
 reported), when the largest stretch in the elastomer passes ``max_stretch``
 (outside the material model; outputs stop at the step before), or when a step
-shorter than ``min_step_mpa`` still does not converge
-— then the first requested pressure beyond the last converged state is reported
-with ``converged=False`` and the reason is in ``stats["stop_reason"]``. A model
+shorter than ``min_step_mpa`` still does not converge — then the first requested
+pressure beyond the last converged state is reported with ``converged=False``.
+That last stop is told apart: where the cavity's stiffness ``dp/dV`` is falling
+to zero just ahead (a ballooning part, the inflation instability of rubber: no
+equilibrium nearby above a pressure maximum) the reason says so and names the
+region; otherwise it is a plain "no convergence". The reason is always in
+``stats["stop_reason"]``. A model
 that does not even hold its own weight raises
 :class:`~softbend.errors.ConvergenceError`.
 """
@@ -66,6 +70,7 @@ class Step:
     iterations: int
     max_stretch: float = float("nan")
     state: np.ndarray | None = field(default=None, repr=False)
+    volume_rate: float = float("nan")  # dV/dp of the cavity, mm³/MPa
 
 
 @dataclass
@@ -119,7 +124,8 @@ def _record(model: ActuatorModel, pressure: float, iterations: int, keep_state: 
     slopes = model.measure_derivative(tangent)
     stretch, _ = model.max_stretch()
     state = model.state() if keep_state else None
-    return Step(pressure, values, slopes, iterations, stretch, state), tangent
+    rate = model.cavity_volume_rate(tangent)
+    return Step(pressure, values, slopes, iterations, stretch, state, rate), tangent
 
 
 def _apply_gravity(model: ActuatorModel) -> int:
@@ -264,10 +270,21 @@ def run_steps(
             history.rejected_steps += 1
             dp = 0.5 * (target - pressure)
             if dp < options.min_step_mpa:
-                history.stop_reason = (
-                    f"no convergence above {pressure:.6g} MPa (step cut below "
-                    f"{options.min_step_mpa:g} MPa)"
-                )
+                limit = _pressure_maximum(history.steps)
+                if limit is None:
+                    history.stop_reason = (
+                        f"no convergence above {pressure:.6g} MPa (step cut below "
+                        f"{options.min_step_mpa:g} MPa)"
+                    )
+                else:
+                    _, where = model.max_stretch()
+                    history.stop_reason = (
+                        f"inflation instability above {pressure:.6g} MPa: the "
+                        f"{model.region_of(float(where[0]))} balloons (stretch "
+                        f"{history.steps[-1].max_stretch:.2f} at x = {where[0]:.0f} mm), "
+                        f"dp/dV fell {limit[1]:.1f}-fold over the last 0.05 MPa towards a "
+                        f"pressure maximum near {limit[0]:.4g} MPa"
+                    )
                 history.failed_pressure_mpa = target
                 history.failure = str(exc)
                 break
@@ -293,6 +310,41 @@ def run_steps(
         miss = float(np.abs(model.state() - predicted).max())
         dp = _next_step(dp, miss, options)
     return history
+
+
+def _pressure_maximum(steps: list[Step], *, within_mpa: float = 0.01) -> tuple[float, float] | None:
+    """A pressure maximum just ahead of the last step, from the cavity's stiffness.
+
+    When an unreinforced part of the actuator balloons, the pressure–volume
+    curve flattens towards a maximum (the inflation instability of rubber
+    membranes): past it no nearby state is in equilibrium under a prescribed
+    pressure, so Newton cannot converge however short the step. The signature
+    is the stiffness ``dp/dV`` falling towards zero: over the last three steps it
+    decreases, and its straight-line extrapolation through the last two reaches
+    zero within ``within_mpa`` of the last converged pressure.
+
+    Returns
+    -------
+    (float, float) or None
+        The extrapolated pressure of the maximum (MPa) and the factor by which
+        ``dp/dV`` fell over the last 0.05 MPa; None without that signature.
+    """
+    if len(steps) < 3:
+        return None
+    p = np.array([s.pressure_mpa for s in steps])
+    rate = np.array([s.volume_rate for s in steps])
+    if not np.all(np.isfinite(rate[-3:])) or np.any(rate[-3:] <= 0.0):
+        return None
+    stiffness = 1.0 / rate
+    k0, k1, k2 = stiffness[-3:]
+    if not k0 > k1 > k2:
+        return None
+    slope = (k2 - k1) / (p[-1] - p[-2])
+    maximum = p[-1] - k2 / slope
+    if maximum - p[-1] > within_mpa:
+        return None
+    earlier = int(np.searchsorted(p, p[-1] - 0.05))
+    return float(maximum), float(stiffness[earlier] / k2)
 
 
 def _next_step(dp: float, miss_mm: float, options: FEMOptions) -> float:
@@ -427,6 +479,7 @@ def _to_result(
         "step_angles_deg": [float(s.values[0]) for s in history.steps],
         "step_iterations": [int(s.iterations) for s in history.steps],
         "step_max_stretch": [float(s.max_stretch) for s in history.steps],
+        "step_volume_rate_mm3_per_mpa": [float(s.volume_rate) for s in history.steps],
         "rejected_steps": history.rejected_steps,
         "ndof": model.ndof,
         "setup_s": built - started,
