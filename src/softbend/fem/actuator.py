@@ -251,7 +251,7 @@ class ActuatorModel:
         """``dV/dp`` of the whole cavity along ``tangent = du/dp``, mm³/MPa."""
         gradient = self.gfu.vec.CreateVector()
         self.volume_form.Apply(self.gfu.vec, gradient)  # ∂(−V_half)/∂u
-        free = self.solver._mask
+        free = self.solver.free_mask
         return -2.0 * float(np.dot(gradient.FV().NumPy()[free], tangent[free]))
 
     def cavity_volume_mm3(self) -> float:

@@ -113,6 +113,11 @@ class EnergySolver:
         self._mask = np.array(list(self.freedofs), dtype=bool)
 
     @property
+    def free_mask(self) -> np.ndarray:
+        """Boolean mask of the free degrees of freedom."""
+        return self._mask
+
+    @property
     def has_factorization(self) -> bool:
         """Whether a Hessian has been factorised yet."""
         return self._inverse is not None
