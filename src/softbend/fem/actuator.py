@@ -289,6 +289,11 @@ class ActuatorModel:
         k = int(np.argmax(largest))
         return float(math.sqrt(largest[k])), self._check_xyz[k].copy()
 
+    def stretch_site(self) -> tuple[float, str]:
+        """Largest principal stretch and where it is, e.g. ``"distal cap at x = 104 mm"``."""
+        stretch, where = self.max_stretch()
+        return stretch, f"{self.region_of(float(where[0]))} at x = {where[0]:.0f} mm"
+
     def region_of(self, x_mm: float) -> str:
         """Name of the part of the actuator at axial position ``x_mm``."""
         start, end = self.geometry.chamber_mm

@@ -277,13 +277,12 @@ def run_steps(
                         f"{options.min_step_mpa:g} MPa)"
                     )
                 else:
-                    _, where = model.max_stretch()
+                    stretch, site = model.stretch_site()
                     history.stop_reason = (
-                        f"inflation instability above {pressure:.6g} MPa: the "
-                        f"{model.region_of(float(where[0]))} balloons (stretch "
-                        f"{history.steps[-1].max_stretch:.2f} at x = {where[0]:.0f} mm), "
-                        f"dp/dV fell {limit[1]:.1f}-fold over the last 0.05 MPa towards a "
-                        f"pressure maximum near {limit[0]:.4g} MPa"
+                        f"inflation instability above {pressure:.6g} MPa: the {site} "
+                        f"balloons (stretch {stretch:.2f}), dp/dV fell {limit[1]:.1f}-fold "
+                        f"over the last 0.05 MPa towards a pressure maximum near "
+                        f"{limit[0]:.4g} MPa"
                     )
                 history.failed_pressure_mpa = target
                 history.failure = str(exc)
@@ -296,11 +295,10 @@ def run_steps(
         if progress is not None:
             progress(pressure, float(step.values[0]), pmax_mpa)
         if step.max_stretch > options.max_stretch:
-            _, where = model.max_stretch()
+            _, site = model.stretch_site()
             history.stop_reason = (
                 f"stretch {step.max_stretch:.2f} above {options.max_stretch:g} in the "
-                f"{model.region_of(float(where[0]))} at x = {where[0]:.0f} mm (beyond the "
-                "material model)"
+                f"{site} (beyond the material model)"
             )
             history.valid_up_to_mpa = history.steps[-2].pressure_mpa
             break
