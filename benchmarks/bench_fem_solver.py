@@ -1,0 +1,158 @@
+"""Where a Newton iteration of the FEM spends its time, and what the step control saves.
+
+Two measurements behind the solver's design choices (one thread):
+
+``assembly``
+    Hessian assembly time of each energy term of one design (default: the
+    largest corner), mean of repeats at a perturbed state. Also timed, for
+    comparison: gravity as a twice-differentiated ``Variation`` term (softbend
+    assembles it once as a dead-load vector instead), and two other ways to
+    give NGSolve the elastomer's tangent — the first variation ``P:∇v`` with
+    NGSolve's linearisation, and the tangent ``∂P/∂F`` written out with
+    ``Diff`` as a linear form.
+
+``steps``
+    Six slow corner designs swept to 0.5 MPa / 300° with the pressure step sized
+    by the predictor's miss (softbend's rule) and with the earlier rule (grow
+    1.5× after a step of at most five Newton iterations, shrink 0.7× after nine
+    or more); prints Newton iterations and rejected steps. Iteration counts do
+    not depend on the machine's speed, so the two rules may run side by side.
+
+::
+
+    python benchmarks/bench_fem_solver.py assembly
+    python benchmarks/bench_fem_solver.py steps
+"""
+
+from __future__ import annotations
+
+import argparse
+import time
+
+import numpy as np
+
+import softbend.fem  # noqa: F401  (loads PyTorch before NGSolve)
+from softbend.campaign.backends import default_pressures_mpa
+from softbend.design import SFRBADesign
+from softbend.fem import FEMOptions, simulate, sweep
+from softbend.fem.actuator import ActuatorModel
+from softbend.fem.mechanics import solid_energy
+
+SLOW_CORNERS = (
+    "160,10,4,2,15,8",
+    "160,10,4,2,5,12",
+    "160,10,4,2,5,8",
+    "160,10,2,2,15,12",
+    "100,6,4,4,15,12",
+    "160,6,2,2,5,8",
+)
+
+
+def _mean_time(action, repeats: int) -> float:
+    action()  # first call allocates the matrix
+    start = time.perf_counter()
+    for _ in range(repeats):
+        action()
+    return (time.perf_counter() - start) / repeats
+
+
+def assembly(design: str, repeats: int) -> None:
+    import ngsolve as ngs
+
+    model = ActuatorModel(SFRBADesign.parse(design), FEMOptions())
+    rng = np.random.default_rng(0)
+    model.set_state(0.01 * rng.standard_normal(model.state().shape) * model.solver.free_mask)
+    model.set_load(0.05, 1.0)
+    vec = model.gfu.vec
+    print(f"design {design}: {model.ndof} unknowns, {model.n_elements} tetrahedra")
+
+    def linearization_time(*terms) -> float:
+        form = ngs.BilinearForm(model.fes, symmetric=True)
+        for term in terms:
+            form += term
+        return _mean_time(lambda: form.AssembleLinearization(vec), repeats)
+
+    names = ("elastomer (volume)", "layer membrane", "fibers", "pressure")
+    terms = list(model.form.integrators)
+    print(f"  all terms together: {linearization_time(*terms):.3f} s")
+    for name, term in zip(names, terms, strict=True):
+        print(f"  {name}: {linearization_time(term):.3f} s")
+
+    u, v = model.fes.TnT()
+    g = ngs.CoefficientFunction(model._gravity_vector())
+    rho = model.options.elastomer.density_t_per_mm3
+    gravity = ngs.Variation(-rho * ngs.InnerProduct(g, u) * ngs.dx)
+    print(f"  gravity as a Variation term (not used): {linearization_time(gravity):.3f} s")
+
+    o = model.options
+    bulk = o.bulk_ratio * o.elastomer.model.initial_shear_modulus_mpa
+    F = ngs.Id(3) + ngs.Grad(u)
+    stress = solid_energy(F, o.elastomer.model, bulk).Diff(ngs.Grad(u))
+    first = ngs.BilinearForm(model.fes, symmetric=True)
+    first += ngs.InnerProduct(stress, ngs.Grad(v)).Compile() * ngs.dx
+    seconds = _mean_time(lambda: first.AssembleLinearization(vec), repeats)
+    print(f"  elastomer as first variation P:grad v (not used): {seconds:.3f} s")
+
+    Fg = ngs.Id(3) + ngs.Grad(model.gfu)
+    Pg = solid_energy(Fg, o.elastomer.model, bulk).Diff(Fg)
+    tangent = ngs.BilinearForm(model.fes, symmetric=True)
+    tangent += ngs.InnerProduct(Pg.Diff(Fg, ngs.Grad(u)), ngs.Grad(v)).Compile() * ngs.dx
+    seconds = _mean_time(tangent.Assemble, max(1, repeats // 3))
+    print(f"  elastomer tangent dP/dF written with Diff (not used): {seconds:.3f} s")
+
+
+def _iteration_rule() -> None:
+    """Replace the step control by the earlier rule on Newton's iteration count."""
+    record, last = sweep._record, {"iterations": 0}
+
+    def recording(model, pressure, iterations, keep_state):
+        last["iterations"] = iterations
+        return record(model, pressure, iterations, keep_state)
+
+    def by_iterations(dp, miss_mm, options):
+        if last["iterations"] <= 5:
+            return min(options.max_step_mpa, 1.5 * dp)
+        if last["iterations"] >= 9:
+            return max(options.min_step_mpa, 0.7 * dp)
+        return dp
+
+    sweep._record, sweep._next_step = recording, by_iterations
+
+
+def steps(rule: str) -> None:
+    if rule == "iterations":
+        _iteration_rule()
+    total_iterations = total_rejected = 0
+    for design in SLOW_CORNERS:
+        result = simulate(SFRBADesign.parse(design), default_pressures_mpa(), FEMOptions())
+        iterations = int(result.stats["timings"]["iterations"])
+        rejected = int(result.stats["rejected_steps"])
+        total_iterations += iterations
+        total_rejected += rejected
+        print(f"  {design:<18} {iterations:4d} Newton iterations, {rejected} rejected steps")
+    print(f"step rule '{rule}': {total_iterations} Newton iterations, {total_rejected} rejected")
+
+
+def main(argv: list[str] | None = None) -> int:
+    parser = argparse.ArgumentParser(description=__doc__.split("\n")[0])
+    parser.add_argument("what", choices=("assembly", "steps"))
+    parser.add_argument("--design", default="160,10,4,2,5,12", help="For 'assembly'.")
+    parser.add_argument("--repeats", type=int, default=6, help="For 'assembly'.")
+    parser.add_argument(
+        "--rule", choices=("miss", "iterations", "both"), default="both", help="For 'steps'."
+    )
+    args = parser.parse_args(argv)
+    from ngsolve import SetNumThreads, TaskManager
+
+    SetNumThreads(1)
+    with TaskManager():
+        if args.what == "assembly":
+            assembly(args.design, args.repeats)
+        else:
+            for rule in ("miss", "iterations") if args.rule == "both" else (args.rule,):
+                steps(rule)
+    return 0
+
+
+if __name__ == "__main__":
+    raise SystemExit(main())
