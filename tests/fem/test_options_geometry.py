@@ -18,6 +18,11 @@ from softbend.fem.geometry import actuator_geometry, mesh_actuator
         ("output", "all", "'output' of FEMOptions must be one of 'interpolate', 'solve'"),
         ("max_angle_deg", 400.0, "'max_angle_deg' of FEMOptions must be a number in (0, 340]"),
         ("max_stretch", 0.9, "'max_stretch' of FEMOptions must be a number in (1, 50]"),
+        (
+            "predictor_error_mm",
+            0.0,
+            "'predictor_error_mm' of FEMOptions must be a number in (0, 10]",
+        ),
         ("base_cap_mm", 0.0, "'base_cap_mm' of FEMOptions"),
         ("elastomer", "silicone", "'elastomer' of FEMOptions must be a Material"),
     ],
