@@ -61,6 +61,7 @@ def _row(result, seconds: float) -> dict:
         "elements": result.mesh_size,
         "ndof": s["ndof"],
         "angle_at_0": float(result.angle_deg[0]),
+        "angles_deg": [round(float(a), 6) for a in result.angle_deg[: result.n_converged]],
     }
 
 
@@ -103,6 +104,38 @@ def summarize(rows: list[dict]) -> None:
         print(f"  NOT reached: {r['design']}: {r['stop_reason']}")
 
 
+def compare(rows: list[dict], reference: Path) -> None:
+    """Largest change of the angle at any common output against an earlier run's file."""
+    before = {}
+    for line in reference.read_text().splitlines():
+        if line.strip():
+            row = json.loads(line)
+            before[row["design"]] = row
+    worst_abs, worst_rel, lost, where = 0.0, 0.0, 0, ""
+    pairs = [(r, before[r["design"]]) for r in rows if r["design"] in before]
+    for now, old in pairs:
+        a, b = np.array(now["angles_deg"]), np.array(old["angles_deg"])
+        n = min(len(a), len(b))
+        lost += abs(len(a) - len(b))
+        diff = np.abs(a[:n] - b[:n])
+        rel = diff / np.maximum(np.abs(b[:n]), 1e-9)
+        # An output passes if it is within 0.2° or within 0.2 %: the larger of the two.
+        k = int(np.argmax(np.minimum(diff / 0.2, rel / 0.002)))
+        if diff[k] > worst_abs:
+            worst_abs, worst_rel, where = float(diff[k]), float(rel[k]), now["design"]
+    t_now = [r["wall_s"] for r, _ in pairs]
+    t_old = [o["wall_s"] for _, o in pairs]
+    print(f"\nagainst {reference} ({len(pairs)} designs in both):")
+    print(
+        f"  wall per sweep: median {statistics.median(t_old):.1f} -> "
+        f"{statistics.median(t_now):.1f} s, worst {max(t_old):.1f} -> {max(t_now):.1f} s"
+    )
+    print(
+        f"  largest angle change at a common output: {worst_abs:.4f} deg "
+        f"({100 * worst_rel:.4f} %) in {where}; outputs gained or lost: {lost}"
+    )
+
+
 def check_interpolation(designs, options: FEMOptions, pressures: np.ndarray) -> None:
     print("\ninterpolated outputs against a Newton solve at every output pressure:")
     for design in designs:
@@ -124,6 +157,13 @@ def main(argv: list[str] | None = None) -> int:
     parser.add_argument("--maxh", type=float, default=FEMOptions().maxh_mm)
     parser.add_argument("--summary", action="store_true", help="Only print the stored table.")
     parser.add_argument("--check-interpolation", type=int, default=0, metavar="N")
+    parser.add_argument(
+        "--compare",
+        type=Path,
+        default=None,
+        metavar="FILE",
+        help="An earlier run's JSON lines: print the time ratio and the largest angle change.",
+    )
     parser.add_argument(
         "--shard", default="0/1", metavar="K/N", help="Only designs i with i %% N == K."
     )
@@ -160,6 +200,8 @@ def main(argv: list[str] | None = None) -> int:
     rows = [done[str(d)] for d in designs if str(d) in done]
     if rows:
         summarize(rows)
+    if rows and args.compare is not None:
+        compare(rows, args.compare)
     if args.check_interpolation:
         picks = np.linspace(0, len(designs) - 1, args.check_interpolation).round().astype(int)
         check_interpolation([designs[i] for i in picks], options, pressures)

@@ -161,6 +161,30 @@ class DesignSpace:
     def __getitem__(self, index: int) -> SFRBADesign:
         return self.designs[index]
 
+    def shard(self, index: int, count: int) -> DesignSpace:
+        """Every ``count``-th design from ``index`` on: shard ``index`` of ``count`` (0-based).
+
+        The shards of one space are disjoint and together hold every design once,
+        so a long campaign can run as several shorter ones (on one machine after
+        another, or on several) whose databases are merged afterwards; taking
+        every ``count``-th design spreads cheap and expensive designs evenly.
+
+        Raises
+        ------
+        ValueError
+            ``count < 1`` or ``index`` not in ``0 … count − 1``.
+        """
+        if isinstance(count, bool) or not isinstance(count, int) or count < 1:
+            raise ValueError(
+                f"The shard 'count' of DesignSpace.shard must be an integer >= 1. Got {count!r}."
+            )
+        if isinstance(index, bool) or not isinstance(index, int) or not 0 <= index < count:
+            raise ValueError(
+                f"The shard 'index' of DesignSpace.shard must be an integer in 0..{count - 1}. "
+                f"Got {index!r} instead."
+            )
+        return DesignSpace(self.designs[index::count], name=f"{self.name}[{index}/{count}]")
+
     @classmethod
     def grid(cls, levels: dict[str, Sequence[float]], name: str = "grid") -> DesignSpace:
         """Full factorial grid over ``levels``, one sequence per name in :data:`PARAMETERS`."""

@@ -376,6 +376,88 @@ class CampaignStore:
                 self._set_meta("n_designs_planned", str(int(n_designs_planned)))
         self._load_binding()
 
+    def merge(self, source: str | os.PathLike[str]) -> dict[str, int]:
+        """Copy the designs of another campaign database (a shard) into this one.
+
+        The source must hold the same backend and pressure grid (this database
+        takes them if it has none yet). Each design is copied with its samples in
+        one transaction per source: a design done here is kept; a design done in
+        the source replaces a failed row here; a design failed in the source is
+        copied only where this database has no row for it. Merging the same shard
+        twice changes nothing.
+
+        Parameters
+        ----------
+        source : str or os.PathLike
+            Campaign database to read (not modified).
+
+        Returns
+        -------
+        dict
+            ``{"added": designs copied, "replaced_failed": failed rows replaced,
+            "kept": designs of the source left out because this database has them}``.
+
+        Raises
+        ------
+        ValueError
+            The source holds another backend or pressure grid, or is this database.
+        """
+        if self.read_only:
+            raise SoftbendError(f"{str(self.path)!r} is open read-only; it cannot be merged into.")
+        source_path = Path(source)
+        if source_path.resolve() == self.path.resolve():
+            raise ValueError(f"A campaign cannot be merged into itself: {str(source_path)!r}.")
+        with CampaignStore(source_path, read_only=True) as other:
+            backend, grid = other.backend, other.pressures_mpa
+            theirs = {
+                row[0]: row[1]
+                for row in other._con.execute("SELECT design_id, status FROM designs").fetchall()
+            }
+        if backend is None or grid is None:
+            return {"added": 0, "replaced_failed": 0, "kept": 0}
+        self.bind(backend, grid)
+        mine = {
+            row[0]: row[1]
+            for row in self._con.execute("SELECT design_id, status FROM designs").fetchall()
+        }
+        take = [
+            i
+            for i, status in theirs.items()
+            if i not in mine or (status == "done" and mine[i] == "failed")
+        ]
+        replaced = sum(i in mine for i in take)
+        self._con.execute(f"ATTACH '{_sql_text(source_path)}' AS merge_src (READ_ONLY)")
+        try:
+            with self._transaction():
+                self._con.execute("CREATE TEMP TABLE merge_ids (design_id VARCHAR)")
+                if take:
+                    self._con.executemany("INSERT INTO merge_ids VALUES (?)", [[i] for i in take])
+                self._con.execute(
+                    "DELETE FROM samples WHERE design_id IN (SELECT * FROM merge_ids)"
+                )
+                self._con.execute(
+                    "DELETE FROM designs WHERE design_id IN (SELECT * FROM merge_ids)"
+                )
+                columns = ", ".join(_DESIGN_COLUMNS)
+                self._con.execute(
+                    f"INSERT INTO designs ({columns}) SELECT {columns} FROM merge_src.designs "
+                    "WHERE design_id IN (SELECT * FROM merge_ids)"
+                )
+                self._con.execute(
+                    "INSERT INTO samples SELECT * FROM merge_src.samples "
+                    "WHERE design_id IN (SELECT * FROM merge_ids)"
+                )
+                self._con.execute("DROP TABLE merge_ids")
+        finally:
+            self._con.execute("DETACH merge_src")
+        self._recorded.update(take)
+        logger.info("merged %d designs of %s into %s", len(take), source_path, self.path)
+        return {
+            "added": len(take) - replaced,
+            "replaced_failed": replaced,
+            "kept": len(theirs) - len(take),
+        }
+
     # -- writing -----------------------------------------------------------------
     def record_success(self, result: SweepResult, *, backend: str | None = None) -> None:
         """Store a finished sweep (its ``designs`` row and samples) in one transaction.
@@ -659,6 +741,11 @@ class CampaignStore:
             tmp.unlink(missing_ok=True)
         logger.info("exported %s of %s to %s (%s)", table, self.path, target, format)
         return target
+
+
+def _sql_text(path: Path) -> str:
+    """A path as the body of a single-quoted SQL string literal."""
+    return str(path).replace("'", "''")
 
 
 def _describe_grid(grid: np.ndarray) -> str:

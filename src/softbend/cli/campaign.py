@@ -1,8 +1,8 @@
 """``softbend campaign``: run, inspect and export design campaigns.
 
-``run`` sweeps a design space into a DuckDB file (resuming if it exists),
-``status`` summarises a database, ``export`` writes its samples (or designs) to
-Parquet or CSV.
+``run`` sweeps a design space (or one shard of it) into a DuckDB file (resuming
+if it exists), ``merge`` joins the databases of shards, ``status`` summarises a
+database, ``export`` writes its samples (or designs) to Parquet or CSV.
 """
 
 from __future__ import annotations
@@ -45,6 +45,17 @@ def parse_space(spec: str, seed: int = 0) -> DesignSpace:
     return DesignSpace.sample(int(match[2]), method=match[1], seed=seed)
 
 
+def parse_shard(spec: str) -> tuple[int, int]:
+    """``K/N`` (0-based shard K of N) from the CLI."""
+    match = re.fullmatch(r"\s*(\d+)\s*/\s*(\d+)\s*", spec)
+    if match is None or int(match[2]) < 1 or int(match[1]) >= int(match[2]):
+        raise ValueError(
+            "The '--shard' of softbend campaign run must be K/N with N >= 1 and K in 0..N-1 "
+            f"(e.g. 0/8). Got {spec!r} instead."
+        )
+    return int(match[1]), int(match[2])
+
+
 def _designs_to_run(db: Path, designs: DesignSpace, retry_failed: bool) -> int:
     """Designs of ``designs`` that a run on ``db`` will sweep (the progress bar total)."""
     from softbend.campaign import CampaignStore
@@ -66,6 +77,11 @@ def run(
     backend: str = typer.Option("analytical", help="Sweep model: analytical or fem."),
     space: str = typer.Option("table1", help=f"Designs: {_SPACE_FORMS}."),
     seed: int = typer.Option(0, help="Seed of the lhs/sobol sampler."),
+    shard: str | None = typer.Option(
+        None,
+        help="Only shard K/N of the space (every N-th design from the K-th, K in 0..N-1); "
+        "merge the shards' databases with 'softbend campaign merge'.",
+    ),
     pmax: float = typer.Option(0.5, help="Largest pressure of the sweep, MPa."),
     pstep: float = typer.Option(0.005, help="Pressure step of the sweep, MPa."),
     workers: int | None = typer.Option(
@@ -88,6 +104,8 @@ def run(
     from softbend.campaign.runner import parse_scheduler_address
 
     designs = parse_space(space, seed)
+    if shard is not None:
+        designs = designs.shard(*parse_shard(shard))
     pressures = default_pressures_mpa(pmax, pstep)
     backend_obj = get_backend(backend)
     if scheduler is not None:
@@ -151,6 +169,39 @@ def run(
             ["design_id", "error"],
             [[i, _one_line(e)] for i, e in summary.failures[:20]],
         )
+
+
+@app.command("merge")
+def merge(
+    db: Path = typer.Argument(..., help="Campaign database to merge into; created if missing."),
+    shards: list[Path] = typer.Argument(..., help="Campaign databases to copy designs from."),
+    json_output: bool = typer.Option(False, "--json", help="Print the counts as JSON."),
+) -> None:
+    """Merge the databases of campaign shards (same backend and grid) into DB."""
+    from softbend.campaign import CampaignStore
+
+    for shard in shards:
+        if not shard.is_file():
+            raise FileNotFoundError(f"No campaign database at {str(shard)!r}.")
+    rows = []
+    with CampaignStore(db) as store:
+        for shard in shards:
+            counts = store.merge(shard)
+            rows.append({"shard": str(shard), **counts})
+        total = store.status_summary()
+    if json_output:
+        _common.print_json(
+            {"db": str(db), "shards": rows, "done": total["done"], "failed": total["failed"]}
+        )
+        return
+    _common.print_table(
+        f"merged into {db}",
+        ["shard", "added", "replaced failed", "already there"],
+        [[r["shard"], r["added"], r["replaced_failed"], r["kept"]] for r in rows],
+    )
+    _common.err_console.print(
+        f"{db}: {total['done']} designs done, {total['failed']} failed", highlight=False
+    )
 
 
 @app.command("status")

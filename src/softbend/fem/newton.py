@@ -54,6 +54,7 @@ class _Timings:
     solve_s: float = 0.0
     iterations: int = 0
     factorizations: int = 0
+    chord_steps: int = 0
 
     def as_dict(self) -> dict[str, float]:
         return {k: float(v) for k, v in self.__dict__.items()}
@@ -102,6 +103,17 @@ class EnergySolver:
     #: removes the large residual of the stiff fibers from any starting guess.
     progress_iteration: int = 3
     progress_factor: float = 0.3
+    #: Give up after the first iteration when it has not cut the residual of the
+    #: starting guess at least this much: a converging step of a sweep cuts it
+    #: 100-fold or more (the predictor is close), a step that fails cuts it by
+    #: less than half or raises it, and goes on failing for 5–10 costly
+    #: iterations (``math.inf`` turns the rule off).
+    first_contraction: float = 0.1
+    #: Below this many times the tolerance, try the last factorised Hessian
+    #: (a chord step: one back-substitution and one residual instead of an
+    #: assembly and a factorisation); it is kept when it cuts the residual
+    #: ten-fold, else a full Newton iteration follows (0 turns it off).
+    chord_below: float = 0.0
     timings: _Timings = field(default_factory=_Timings)
 
     def __post_init__(self) -> None:
@@ -198,7 +210,9 @@ class EnergySolver:
         self._backup.data = vec
         cuts = 0
         residual = self._norm(self.residual())
-        after_first = math.inf
+        start_residual, after_first = residual, math.inf
+        energy: float | None = None
+        chord_failed = False
         for iteration in range(self.max_iterations + 1):
             if iteration == 1:
                 after_first = residual
@@ -209,17 +223,21 @@ class EnergySolver:
                 return NewtonReport(iteration, residual, cuts)
             if iteration == self.max_iterations:
                 break
-            if iteration >= self.stall_iteration and residual > self.stall_factor * tolerance:
+            if self._hopeless(iteration, residual, start_residual, after_first, tolerance):
                 break
             if (
-                iteration == self.progress_iteration
-                and residual > self.progress_factor * after_first
-                and residual > self.stall_factor * tolerance
+                not chord_failed
+                and self.has_factorization
+                and residual <= self.chord_below * tolerance
             ):
-                break
+                chord = self._chord_step(residual)
+                if chord is not None:
+                    residual, energy = chord, None
+                    continue
+                chord_failed = True
             self.factorize()
             self.solve_tangent(res, du)
-            alpha, residual, n_cuts = self._line_search(residual)
+            alpha, residual, n_cuts, energy = self._line_search(residual, energy)
             cuts += n_cuts
             if alpha == 0.0:
                 break
@@ -232,10 +250,54 @@ class EnergySolver:
             residual=residual,
         )
 
-    def _line_search(self, residual0: float) -> tuple[float, float, int]:
-        """Step ``u -= α du``; returns ``(α, new residual norm, cuts)`` (α = 0: failed)."""
+    def _hopeless(
+        self,
+        iteration: int,
+        residual: float,
+        start_residual: float,
+        after_first: float,
+        tolerance: float,
+    ) -> bool:
+        """The early give-up rules (see the attributes); never within ``stall_factor``·tol."""
+        if residual <= self.stall_factor * tolerance:
+            return False
+        if iteration >= self.stall_iteration:
+            return True
+        if iteration == 1 and residual > self.first_contraction * start_residual:
+            return True
+        return (
+            iteration == self.progress_iteration and residual > self.progress_factor * after_first
+        )
+
+    def _chord_step(self, residual0: float) -> float | None:
+        """``u -= K_old⁻¹ r`` with the last factorisation; its residual, or None (undone).
+
+        Near convergence the state moves by far less than the last Newton update,
+        so the Hessian factorised for that update is still close to the current
+        one and a step with it converges almost as fast as a Newton step.
+        """
         vec, du = self.gfu.vec, self._du
-        energy0 = self.energy(vec)
+        self.solve_tangent(self._res, du)
+        vec.data -= du
+        residual = self._norm(self.residual())
+        if math.isfinite(residual) and residual <= 0.1 * residual0:
+            self.timings.chord_steps += 1
+            return residual
+        vec.data += du
+        self.residual()
+        return None
+
+    def _line_search(
+        self, residual0: float, energy0: float | None = None
+    ) -> tuple[float, float, int, float | None]:
+        """Step ``u -= α du``; returns ``(α, residual norm, cuts, energy)`` (α = 0: failed).
+
+        ``energy0``: the energy at the current state when already known (the
+        previous line search ended there), saving one evaluation.
+        """
+        vec, du = self.gfu.vec, self._du
+        if energy0 is None:
+            energy0 = self.energy(vec)
         slope = -float(du.InnerProduct(self._res))  # d/dα E(u − α du) at α = 0
         alpha = 1.0
         for cuts in range(12):
@@ -248,10 +310,10 @@ class EnergySolver:
                     # Energy differences drown in round-off (or the Hessian is not
                     # positive definite here): judge the step by the residual.
                     if residual < residual0:
-                        return alpha, residual, cuts
+                        return alpha, residual, cuts, energy
                 elif energy <= energy0 + 1e-4 * alpha * slope:
-                    return alpha, residual, cuts
+                    return alpha, residual, cuts, energy
             vec.data += alpha * du
             alpha *= 0.5
         self.residual()
-        return 0.0, residual0, 12
+        return 0.0, residual0, 12, energy0

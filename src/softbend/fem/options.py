@@ -219,6 +219,18 @@ class FEMOptions:
         values.update(changes)
         return FEMOptions(**values)
 
+    def digest(self) -> str:
+        """SHA-256 of :meth:`to_dict` as canonical JSON: equal options, equal digest.
+
+        Stored with every sweep, so data produced with other modelling or solver
+        settings can be told apart.
+        """
+        import hashlib
+        import json
+
+        text = json.dumps(self.to_dict(), sort_keys=True, separators=(",", ":"), default=str)
+        return hashlib.sha256(text.encode()).hexdigest()
+
     def to_dict(self) -> dict[str, Any]:
         """JSON-friendly description (materials as their own dicts)."""
         out = asdict(self)

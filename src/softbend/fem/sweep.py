@@ -33,6 +33,7 @@ that does not even hold its own weight raises
 from __future__ import annotations
 
 import logging
+import math
 import time
 from collections.abc import Callable
 from dataclasses import dataclass, field
@@ -140,13 +141,16 @@ def _apply_gravity(model: ActuatorModel) -> int:
     give-up rules stay off: the first solve starts a long way off by nature.
     """
     solver = model.solver
-    saved = solver.stall_iteration, solver.progress_iteration, solver.max_iterations
+    names = ("stall_iteration", "progress_iteration", "first_contraction", "max_iterations")
+    saved = [getattr(solver, name) for name in names]
     solver.stall_iteration = solver.progress_iteration = 10**6
+    solver.first_contraction = math.inf
     solver.max_iterations = max(30, solver.max_iterations)
     try:
         return _gravity_fractions(model)
     finally:
-        solver.stall_iteration, solver.progress_iteration, solver.max_iterations = saved
+        for name, value in zip(names, saved, strict=True):
+            setattr(solver, name, value)
 
 
 def _gravity_tangent(model: ActuatorModel) -> np.ndarray:
@@ -483,6 +487,7 @@ def _to_result(
         "setup_s": built - started,
         "timings": timings,
         "options": options.to_dict(),
+        "options_sha256": options.digest(),
         "fiber_spacing_mm": model.fiber_spacing_mm(),
     }
     if history.failure:
