@@ -88,3 +88,16 @@ def test_design_space_rejects_duplicates_and_bad_levels():
         DesignSpace.grid({"l_mm": [100]})
     with pytest.raises(ValueError, match="'method'"):
         DesignSpace.sample(4, method="grid")
+
+
+def test_shards_are_disjoint_and_cover_the_space():
+    space = DesignSpace.table1()
+    shards = [space.shard(k, 7) for k in range(7)]
+    ids = [d.design_id for shard in shards for d in shard]
+    assert len(ids) == len(set(ids)) == len(space)
+    assert max(len(s) for s in shards) - min(len(s) for s in shards) <= 1
+    assert shards[2].name == "table1[2/7]"
+    assert list(space.shard(0, 1)) == list(space)
+    for index, count in ((7, 7), (-1, 3), (0, 0), (1.0, 3)):
+        with pytest.raises(ValueError, match="shard"):
+            space.shard(index, count)

@@ -289,3 +289,27 @@ def test_module_level_load_samples(tmp_path):
         expected = store.load_samples()
     pd.testing.assert_frame_equal(load_samples(path), expected)
     pd.testing.assert_frame_equal(load_samples(str(path)), expected)
+
+
+def test_merge_takes_done_designs_over_failed_and_refuses_another_campaign(tmp_path):
+    with CampaignStore(tmp_path / "a.duckdb") as a:
+        a.bind("analytical", GRID)
+        a.record_success(_sweep(A))
+        a.record_failure(B, "RuntimeError: lost worker", 1.0)
+    with CampaignStore(tmp_path / "b.duckdb") as b:
+        b.bind("analytical", GRID)
+        b.record_success(_sweep(B))
+        b.record_failure(A, "RuntimeError: other failure", 1.0)
+    with CampaignStore(tmp_path / "a.duckdb") as a:
+        counts = a.merge(tmp_path / "b.duckdb")
+        assert counts == {"added": 0, "replaced_failed": 1, "kept": 1}
+        designs = a.load_designs().set_index("design_id")
+        assert set(designs["status"]) == {"done"}  # B's failure replaced, A's success kept
+        assert len(a.load_samples()) == 2 * len(GRID)
+        with pytest.raises(ValueError, match="merged into itself"):
+            a.merge(tmp_path / "a.duckdb")
+    with CampaignStore(tmp_path / "other.duckdb") as other:
+        other.bind("analytical", default_pressures_mpa(0.5, 0.1))
+        other.record_success(_sweep(A, default_pressures_mpa(0.5, 0.1)))
+    with CampaignStore(tmp_path / "a.duckdb") as a, pytest.raises(ValueError, match="pressures"):
+        a.merge(tmp_path / "other.duckdb")

@@ -83,6 +83,31 @@ def test_a_space_of_the_table_and_the_summary_table(tmp_path, capsys):
         assert len(store.finished_ids()) == 4
 
 
+def test_shards_run_apart_and_merge_into_the_whole_campaign(tmp_path, capsys):
+    whole = tmp_path / "whole.duckdb"
+    assert main(["campaign", "run", str(whole), *RUN, "--workers", "0", "--json"]) == 0
+    capsys.readouterr()
+    shards = [tmp_path / f"s{k}.duckdb" for k in range(4)]
+    for k, shard in enumerate(shards):
+        assert main(["campaign", "run", str(shard), *RUN, "--shard", f"{k}/4", "--json"]) == 0
+        summary = json.loads(capsys.readouterr().out)
+        assert summary["space"] == f"lhs-6-seed3[{k}/4]"
+    capsys.readouterr()
+    merged = tmp_path / "merged.duckdb"
+    assert main(["campaign", "merge", str(merged), *map(str, shards), "--json"]) == 0
+    counts = json.loads(capsys.readouterr().out)
+    assert [r["added"] for r in counts["shards"]] == [2, 2, 1, 1]
+    assert (counts["done"], counts["failed"]) == (6, 0)
+    pd.testing.assert_frame_equal(load_samples(merged), load_samples(whole))
+    # Merging a shard again changes nothing.
+    assert main(["campaign", "merge", str(merged), str(shards[0]), "--json"]) == 0
+    assert json.loads(capsys.readouterr().out)["shards"][0]["kept"] == 2
+    assert len(load_samples(merged)) == len(load_samples(whole))
+    # A missing shard is one line.
+    assert main(["campaign", "merge", str(merged), str(tmp_path / "nope.duckdb")]) == 2
+    assert "No campaign database" in one_error_line(capsys)
+
+
 def _closed_port() -> int:
     with socket.socket() as sock:
         sock.bind(("127.0.0.1", 0))
@@ -98,6 +123,8 @@ def _closed_port() -> int:
         (["--pmax", "0.1", "--pstep", "0.03"], "whole number of steps"),
         (["--pmax", "-1"], "'pmax_mpa'"),
         (["--workers", "-2"], "'workers' of run_campaign"),
+        (["--shard", "3/3"], "'--shard' of softbend campaign run must be K/N"),
+        (["--shard", "1of2"], "'--shard'"),
         (
             ["--scheduler", "127.0.0.1:8786"],
             "(--scheduler) of run_campaign must be an address of the form tcp://HOST:PORT",

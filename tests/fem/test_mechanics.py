@@ -98,3 +98,22 @@ def test_hermite_output_is_exact_for_a_cubic():
     history = StepHistory(steps=steps)
     grid = np.linspace(0.0, 0.08, 17)
     np.testing.assert_allclose(history.interpolate(grid)[:, 0], f(grid), rtol=1e-12)
+
+
+def test_a_first_iteration_that_does_not_contract_gives_up_at_once(model):
+    """A start far off the path (a failing load step) costs one iteration, not ten."""
+    model.set_state(np.zeros_like(model.state()))
+    model.set_load(0.3, 1.0)  # the whole way to 0.3 MPa from rest: far outside the basin
+    strict = EnergySolver(model.form, model.gfu, model.fes.FreeDofs(), max_iterations=12)
+    with pytest.raises(ConvergenceError):
+        strict.solve(model.force_scale_n(0.3), load=0.3)
+    assert strict.timings.iterations == 1
+    assert not model.state().any()
+    lenient = EnergySolver(
+        model.form, model.gfu, model.fes.FreeDofs(), max_iterations=12, first_contraction=math.inf
+    )
+    with pytest.raises(ConvergenceError):
+        lenient.solve(model.force_scale_n(0.3), load=0.3)
+    assert lenient.timings.iterations > 1
+    model.set_state(np.zeros_like(model.state()))
+    model.set_load(0.0, 0.0)

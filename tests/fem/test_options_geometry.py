@@ -68,3 +68,11 @@ def test_faces_are_named_and_the_mesh_has_the_solid_volume():
     assert volume == pytest.approx(info.half_volume_mm3, rel=2e-3)
     assert info.length_mm == 113.0
     assert info.perimeter_mm == pytest.approx(math.pi * 8 + 16 + 4)
+
+
+def test_options_digest_follows_every_setting():
+    base = FEMOptions()
+    assert base.digest() == FEMOptions().digest()
+    assert len(base.digest()) == 64
+    assert base.replace(maxh_mm=4.0).digest() != base.digest()
+    assert base.replace(rtol=1e-8).digest() != base.digest()

@@ -54,7 +54,6 @@ class _Timings:
     solve_s: float = 0.0
     iterations: int = 0
     factorizations: int = 0
-    chord_steps: int = 0
 
     def as_dict(self) -> dict[str, float]:
         return {k: float(v) for k, v in self.__dict__.items()}
@@ -109,11 +108,6 @@ class EnergySolver:
     #: less than half or raises it, and goes on failing for 5–10 costly
     #: iterations (``math.inf`` turns the rule off).
     first_contraction: float = 0.1
-    #: Below this many times the tolerance, try the last factorised Hessian
-    #: (a chord step: one back-substitution and one residual instead of an
-    #: assembly and a factorisation); it is kept when it cuts the residual
-    #: ten-fold, else a full Newton iteration follows (0 turns it off).
-    chord_below: float = 0.0
     timings: _Timings = field(default_factory=_Timings)
 
     def __post_init__(self) -> None:
@@ -212,7 +206,6 @@ class EnergySolver:
         residual = self._norm(self.residual())
         start_residual, after_first = residual, math.inf
         energy: float | None = None
-        chord_failed = False
         for iteration in range(self.max_iterations + 1):
             if iteration == 1:
                 after_first = residual
@@ -225,16 +218,6 @@ class EnergySolver:
                 break
             if self._hopeless(iteration, residual, start_residual, after_first, tolerance):
                 break
-            if (
-                not chord_failed
-                and self.has_factorization
-                and residual <= self.chord_below * tolerance
-            ):
-                chord = self._chord_step(residual)
-                if chord is not None:
-                    residual, energy = chord, None
-                    continue
-                chord_failed = True
             self.factorize()
             self.solve_tangent(res, du)
             alpha, residual, n_cuts, energy = self._line_search(residual, energy)
@@ -268,24 +251,6 @@ class EnergySolver:
         return (
             iteration == self.progress_iteration and residual > self.progress_factor * after_first
         )
-
-    def _chord_step(self, residual0: float) -> float | None:
-        """``u -= K_old⁻¹ r`` with the last factorisation; its residual, or None (undone).
-
-        Near convergence the state moves by far less than the last Newton update,
-        so the Hessian factorised for that update is still close to the current
-        one and a step with it converges almost as fast as a Newton step.
-        """
-        vec, du = self.gfu.vec, self._du
-        self.solve_tangent(self._res, du)
-        vec.data -= du
-        residual = self._norm(self.residual())
-        if math.isfinite(residual) and residual <= 0.1 * residual0:
-            self.timings.chord_steps += 1
-            return residual
-        vec.data += du
-        self.residual()
-        return None
 
     def _line_search(
         self, residual0: float, energy0: float | None = None
