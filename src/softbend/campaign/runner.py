@@ -57,6 +57,7 @@ from typing import Any
 import numpy as np
 from numpy.typing import ArrayLike
 
+from softbend import __version__
 from softbend._validation import check_range
 from softbend.campaign.backends import (
     Backend,
@@ -626,6 +627,21 @@ def run_campaign(
                 n_threads = max(1, sum(client.nthreads().values()))
                 chunk_size = chunk_size or _auto_chunk_size(backend_obj, len(todo), n_threads)
                 _run_dask(backend_obj, _chunks(todo, chunk_size), grid, client, recorder)
+            if recorder.done or recorder.failed:
+                store.log_run(
+                    {
+                        "space": getattr(designs, "name", None),
+                        "executor": executor,
+                        "host": socket.gethostname(),
+                        "cpu_count": os.cpu_count(),
+                        "softbend_version": __version__,
+                        "done": recorder.done,
+                        "failed": recorder.failed,
+                        "sweep_time_s": recorder.sweep_time_s,
+                        "wall_time_s": time.perf_counter() - start,
+                        "finished_at": time.strftime("%Y-%m-%dT%H:%M:%SZ", time.gmtime()),
+                    }
+                )
     finally:
         if client is not None:
             client.close()

@@ -376,6 +376,16 @@ class CampaignStore:
                 self._set_meta("n_designs_planned", str(int(n_designs_planned)))
         self._load_binding()
 
+    def runs(self) -> list[dict[str, Any]]:
+        """The runs recorded by :meth:`log_run` (oldest first), shards merged in included."""
+        return json.loads(self.meta().get("runs", "[]"))
+
+    def log_run(self, run: dict[str, Any]) -> None:
+        """Append one run's record (executor, cores, counts, times) to the ``runs`` metadata."""
+        runs = [*self.runs(), run]
+        with self._transaction():
+            self._set_meta("runs", json.dumps(runs, default=str))
+
     def merge(self, source: str | os.PathLike[str]) -> dict[str, int]:
         """Copy the designs of another campaign database (a shard) into this one.
 
@@ -409,6 +419,7 @@ class CampaignStore:
             raise ValueError(f"A campaign cannot be merged into itself: {str(source_path)!r}.")
         with CampaignStore(source_path, read_only=True) as other:
             backend, grid = other.backend, other.pressures_mpa
+            their_runs = other.runs()
             theirs = {
                 row[0]: row[1]
                 for row in other._con.execute("SELECT design_id, status FROM designs").fetchall()
@@ -451,6 +462,11 @@ class CampaignStore:
         finally:
             self._con.execute("DETACH merge_src")
         self._recorded.update(take)
+        if take:
+            known = self.runs()
+            for run in their_runs:
+                if run not in known:
+                    self.log_run({**run, "merged_from": str(source_path.name)})
         logger.info("merged %d designs of %s into %s", len(take), source_path, self.path)
         return {
             "added": len(take) - replaced,

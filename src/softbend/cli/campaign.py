@@ -277,3 +277,39 @@ def export(
         path = store.export(out, format=format, table=table)
         n_rows = len(store.load_samples() if table == "samples" else store.load_designs())
     _common.console.print(f"wrote {n_rows} {table} rows to {path} ({format})", highlight=False)
+
+
+@app.command("dataset")
+def dataset(
+    db: Path = typer.Argument(..., help="Campaign database (DuckDB)."),
+    out: Path = typer.Argument(..., help="Dataset folder (created; its files are replaced)."),
+    command: str = typer.Option(
+        ..., help="The command that produced the campaign (recorded in the provenance)."
+    ),
+    description: str = typer.Option("", help="What the data are, one paragraph."),
+    json_output: bool = typer.Option(False, "--json", help="Print the provenance as JSON."),
+) -> None:
+    """Write a campaign as a verified dataset: Parquet samples and designs, provenance."""
+    from softbend.datasets import write_dataset
+
+    if not db.is_file():
+        raise FileNotFoundError(f"No campaign database at {str(db)!r}.")
+    provenance = write_dataset(db, out, command=command, description=description)
+    if json_output:
+        _common.print_json(provenance)
+        return
+    designs = provenance["designs"]
+    _common.print_table(
+        f"dataset {out}",
+        ["quantity", "value"],
+        [
+            ["designs done / failed", f"{designs['done']} / {designs['failed']}"],
+            [
+                "samples (converged)",
+                f"{provenance['samples']['rows']} ({provenance['samples']['converged']})",
+            ],
+            ["stops", ", ".join(f"{k}: {v}" for k, v in designs["by_stop_kind"].items())],
+            ["CPU time (h)", provenance["cpu_time_s"] / 3600.0],
+            ["files", ", ".join(f"{k} ({v['bytes']} B)" for k, v in provenance["files"].items())],
+        ],
+    )
