@@ -1,3 +1,5 @@
+import itertools
+
 import numpy as np
 import pytest
 
@@ -123,3 +125,47 @@ def test_refit_model_predicts_the_training_data(searched, small_data):
         pred = fam.model.predict(small_data.X)
         assert np.all(np.isfinite(pred))
         assert np.corrcoef(pred, small_data.y)[0, 1] > 0.95
+
+
+def test_halving_rungs_shrink_by_eta_and_end_at_the_full_epochs():
+    from softbend.surrogates.search import halving_rungs
+
+    assert halving_rungs(121, 1000, 3) == [(121, 37), (41, 111), (14, 333), (5, 1000)]
+    assert halving_rungs(9, 90, 3) == [(9, 30), (3, 90)]
+    assert halving_rungs(2, 50, 3) == [(2, 50)]  # too few to race
+    for n, eta in ((121, 2), (40, 4), (7, 3)):
+        rungs = halving_rungs(n, 1000, eta)
+        assert rungs[0][0] == n and rungs[-1][1] == 1000
+        assert all(a[0] > b[0] and a[1] < b[1] for a, b in itertools.pairwise(rungs))
+
+
+def test_successive_halving_keeps_the_exhaustive_models_of_its_survivors(small_data):
+    sizes = [{"hidden_sizes": (h, h)} for h in (2, 3, 4, 6, 8, 10, 12, 14, 16)]
+    common = {"models": ["mlp"], "param_grid": {"mlp": sizes}, "epochs": 60, "seed": 1}
+    exhaustive = search(small_data, **common)
+    raced = search(small_data, **common, halving=3)
+    cv_all, cv_raced = (r.cv_results.set_index("params") for r in (exhaustive, raced))
+    survivors = cv_raced.index[cv_raced["status"] == "ok"]
+    assert len(survivors) == 3
+    stopped = cv_raced.loc[cv_raced["status"] != "ok", "status"]
+    assert stopped.str.contains("stopped after 20 epochs").all()
+    # A survivor trained the full epochs from the same start: the same model.
+    for params in survivors:
+        assert cv_raced.loc[params, "rmse_fold_mean"] == cv_all.loc[params, "rmse_fold_mean"]
+    best = raced.families["mlp"]
+    assert best.cv["rmse_fold_mean"] == cv_all.loc[survivors, "rmse_fold_mean"].min()
+    assert raced.settings["mlp_halving"] == 3
+    with pytest.raises(ValueError, match="'halving'"):
+        search(small_data, **common, halving=1)
+
+
+def test_random_folds_mix_the_designs(small_data):
+    from softbend.surrogates.search import random_splits
+
+    splits = random_splits(small_data.n_samples, 5, seed=0)
+    train, val = splits[0]
+    assert set(small_data.groups[train]) & set(small_data.groups[val])
+    result = search(small_data, models=["plr"], param_grid=SMALL_GRID, cv="random")
+    assert result.settings["cv"] == "random"
+    with pytest.raises(ValueError, match="'cv'"):
+        search(small_data, models=["plr"], cv="loo")

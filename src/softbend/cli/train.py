@@ -33,6 +33,14 @@ def train(
         None, help="MLP epochs (default: 200 quick grid, 1000 paper grid as paper B)."
     ),
     jobs: int | None = typer.Option(None, "--jobs", help="XGBoost threads (default: all)."),
+    halving: int | None = typer.Option(
+        None,
+        help="Race the MLP configurations by successive halving with this factor (e.g. 3): "
+        "a fraction of the exhaustive search's time on the paper grid.",
+    ),
+    cv: str = typer.Option(
+        "grouped", help="Folds: grouped (whole designs) or random (shuffled samples, paper B's)."
+    ),
     no_onnx: bool = typer.Option(False, "--no-onnx", help="Skip the ONNX export."),
     as_json: bool = typer.Option(False, "--json", help="Print the results as JSON."),
 ) -> None:
@@ -53,6 +61,8 @@ def train(
             epochs=epochs,
             export_onnx=not no_onnx,
             progress=progress,
+            cv=cv,
+            halving=halving,
         )
     if as_json:
         _common.print_json(summary)

@@ -21,6 +21,9 @@ PAPER_B_FIG4 = {
     "mape_pct": 42.3,
 }
 
+#: Samples of paper B's FEM dataset (§3.3).
+PAPER_B_SAMPLES = 29577
+
 #: The seven actuators measured in paper B Fig. 7 (l, r, t, b, phi, lc).
 FIG7_DESIGNS: tuple[tuple[float, ...], ...] = (
     (100, 6, 2, 2, 5, 8),
@@ -119,37 +122,14 @@ def add_section(
         ],
         caption="Campaign",
     )
-    coefficients = regression.coefficients
-    rows = []
-    for feature, row in coefficients.iterrows():
-        paper = PAPER_B_FIG4.get(str(feature))
-        rows.append(
-            [
-                str(feature),
-                float(row["loading"]),
-                float(row["t_value"]),
-                float(row["p_value"]),
-                str(row["stars"]),
-                "" if paper is None else paper,
-            ]
-        )
     section.table(
         ["feature", "loading", "t", "p", "sig.", "paper B loading"],
-        rows,
+        loadings_rows(regression),
         caption="Standardized multiple linear regression of the bending angle",
     )
     section.table(
         ["metric", "softbend", "paper B"],
-        [
-            ["R²", regression.r2, PAPER_B_FIG4["r2"]],
-            ["F-value", regression.f_value, PAPER_B_FIG4["f_value"]],
-            [
-                f"MAPE (%; |θ| ≥ {regression.mape_threshold:g}°)",
-                regression.mape_pct,
-                PAPER_B_FIG4["mape_pct"],
-            ],
-            ["samples", float(regression.n_samples), 29577.0],
-        ],
+        fit_rows(regression),
         caption="Fit of the linear model",
     )
     captions = {
@@ -162,6 +142,38 @@ def add_section(
     for key, caption in captions.items():
         if key in figures:
             section.figure(figures[key], caption, root=root)
+
+
+def loadings_rows(regression: RegressionReport) -> list[list[Any]]:
+    """Rows (feature, loading, t, p, stars, paper B's loading) of the Fig. 4 table."""
+    rows = []
+    for feature, row in regression.coefficients.iterrows():
+        paper = PAPER_B_FIG4.get(str(feature))
+        rows.append(
+            [
+                str(feature),
+                float(row["loading"]),
+                float(row["t_value"]),
+                float(row["p_value"]),
+                str(row["stars"]),
+                "" if paper is None else paper,
+            ]
+        )
+    return rows
+
+
+def fit_rows(regression: RegressionReport) -> list[list[Any]]:
+    """Rows (metric, softbend, paper B) of the linear model's fit: R², F, MAPE, samples."""
+    return [
+        ["R²", regression.r2, PAPER_B_FIG4["r2"]],
+        ["F-value", regression.f_value, PAPER_B_FIG4["f_value"]],
+        [
+            f"MAPE (%; |θ| ≥ {regression.mape_threshold:g}°)",
+            regression.mape_pct,
+            PAPER_B_FIG4["mape_pct"],
+        ],
+        ["samples", float(regression.n_samples), float(PAPER_B_SAMPLES)],
+    ]
 
 
 def fig7_design_ids() -> list[str]:

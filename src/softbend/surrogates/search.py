@@ -29,6 +29,7 @@ is given.
 from __future__ import annotations
 
 import logging
+import math
 import time
 from collections.abc import Callable
 from dataclasses import dataclass, field
@@ -37,7 +38,7 @@ from typing import Any
 import numpy as np
 import pandas as pd
 
-from softbend._validation import check_choice, check_range
+from softbend._validation import check_choice, check_int, check_range
 from softbend.surrogates.features import TrainingData
 from softbend.surrogates.metrics import MAPE_THRESHOLD_DEG, accuracy, inference_time
 
@@ -121,6 +122,37 @@ def grouped_splits(
     splitter = GroupKFold(n_splits=n_splits, shuffle=True, random_state=seed)
     dummy = np.zeros((groups.size, 1))
     return [(train, val) for train, val in splitter.split(dummy, groups=groups)]
+
+
+#: Cross-validation protocols: folds of whole designs (the honest one), or of
+#: samples shuffled across designs (paper B's, for comparison).
+CV_PROTOCOLS: tuple[str, ...] = ("grouped", "random")
+
+
+def random_splits(
+    n_samples: int, n_splits: int = 5, seed: int = 0
+) -> list[tuple[np.ndarray, np.ndarray]]:
+    """K folds of samples shuffled with ``seed``, ignoring designs (paper B's protocol).
+
+    A design's pressures then fall into several folds, so a model is scored on
+    pressures between ones it was trained on: an interpolation score, optimistic
+    for a new actuator. Offered to compare with paper B, not to choose models.
+    """
+    from sklearn.model_selection import KFold
+
+    n_splits = int(
+        check_range(
+            n_splits,
+            "folds",
+            "random_splits",
+            low=2,
+            low_inclusive=True,
+            high=max(2, n_samples),
+            high_inclusive=True,
+        )
+    )
+    splitter = KFold(n_splits=n_splits, shuffle=True, random_state=seed)
+    return list(splitter.split(np.zeros((n_samples, 1))))
 
 
 @dataclass
@@ -281,6 +313,28 @@ def _cv_sequential(
     return out
 
 
+def halving_rungs(n_configs: int, epochs: int, eta: int) -> list[tuple[int, int]]:
+    """(configurations kept, epochs) of each rung of successive halving.
+
+    Every configuration trains ``epochs / eta^k`` epochs first; after each rung
+    the best ``1/eta`` (rounded up) go on to ``eta`` times as many epochs, until
+    the survivors train the full ``epochs``. The number of rungs is chosen so
+    that the last rung keeps at least ``eta`` configurations and the first rung
+    trains at least 1/27 of the epochs (at most four rungs): a short first rung
+    ranks configurations by their early loss, which only loosely predicts the
+    final one.
+    """
+    rungs = 1
+    while rungs < 4 and math.ceil(n_configs / eta**rungs) >= eta:
+        rungs += 1
+    out = []
+    kept = n_configs
+    for k in range(rungs):
+        out.append((kept, max(1, round(epochs / eta ** (rungs - 1 - k)))))
+        kept = max(1, math.ceil(kept / eta))
+    return out
+
+
 def _cv_mlp_batched(
     configs: list[dict[str, Any]],
     data: TrainingData,
@@ -290,23 +344,66 @@ def _cv_mlp_batched(
     seed: int,
     device: str,
     progress: Callable[[int, int], None] | None,
+    halving: int | None = None,
 ) -> list[tuple[dict[str, Any], np.ndarray | None, float, str]]:
+    """Cross-validated predictions of every MLP configuration, all trained at once.
+
+    With ``halving=eta`` the configurations race by successive halving
+    (:func:`halving_rungs`): every rung retrains its survivors from their
+    initial weights for the rung's epochs, which gives exactly the first epochs
+    of the full training (each model has its own random stream), so a
+    configuration that reaches the last rung is the model the exhaustive search
+    would have trained. A configuration that stops earlier keeps the scores of
+    its last rung and says so in its status.
+    """
     from softbend.surrogates.batched import train_mlp_grid
 
-    sizes = [tuple(p["hidden_sizes"]) for p in configs]
-    start = time.perf_counter()
-    result = train_mlp_grid(
-        data.X, data.y, splits, sizes, epochs=epochs, seed=seed, device=device, progress=progress
+    rungs = (
+        [(len(configs), epochs)] if not halving else halving_rungs(len(configs), epochs, halving)
     )
-    seconds = (time.perf_counter() - start) / max(1, len(configs))
-    out = []
-    for i, params in enumerate(configs):
-        pred = np.empty_like(data.y)
-        for j in range(len(splits)):
-            trained = result.model(i, j)
-            pred[trained.val_index] = trained.val_pred_deg
-        out.append((params, pred, seconds, "ok"))
-    return out
+    total = sum(epochs_k for _, epochs_k in rungs)
+    done_before = 0
+    alive = list(range(len(configs)))
+    out: dict[int, tuple[dict[str, Any], np.ndarray, float, str]] = {}
+    for rung, (_, rung_epochs) in enumerate(rungs):
+        sizes = [tuple(configs[i]["hidden_sizes"]) for i in alive]
+
+        def forward(done: int, _total: int, offset: int = done_before) -> None:
+            if progress is not None:
+                progress(offset + done, total)
+
+        start = time.perf_counter()
+        result = train_mlp_grid(
+            data.X,
+            data.y,
+            splits,
+            sizes,
+            epochs=rung_epochs,
+            seed=seed,
+            device=device,
+            progress=forward,
+        )
+        seconds = (time.perf_counter() - start) / max(1, len(alive))
+        done_before += rung_epochs
+        scores = []
+        last = rung == len(rungs) - 1
+        for k, i in enumerate(alive):
+            pred = np.empty_like(data.y)
+            for j in range(len(splits)):
+                trained = result.model(k, j)
+                pred[trained.val_index] = trained.val_pred_deg
+            status = "ok" if last else f"stopped after {rung_epochs} epochs (successive halving)"
+            previous = out.get(i, (None, None, 0.0, ""))[2]
+            out[i] = (configs[i], pred, previous + seconds, status)
+            fold_rmse = [
+                float(np.sqrt(np.mean((pred[val] - data.y[val]) ** 2))) for _, val in splits
+            ]
+            scores.append((float(np.mean(fold_rmse)), i))
+        if not last:
+            keep = rungs[rung + 1][0]
+            alive = sorted(i for _, i in sorted(scores)[:keep])
+            logger.info("successive halving: %d of %d configurations go on", keep, len(scores))
+    return [out[i] for i in range(len(configs))]
 
 
 def search(
@@ -322,6 +419,8 @@ def search(
     mape_threshold_deg: float = MAPE_THRESHOLD_DEG,
     param_grid: dict[str, list[dict[str, Any]]] | None = None,
     progress: Progress | None = None,
+    cv: str = "grouped",
+    halving: int | None = None,
 ) -> SearchResult:
     """Grouped K-fold grid search of each model family, then a refit of the best.
 
@@ -350,6 +449,14 @@ def search(
         them, e.g. ``{"plr": [{"degree": 3}, {"degree": 5}]}``.
     progress : callable, optional
         ``progress(phase, done, total)``.
+    cv : {"grouped", "random"}
+        Folds of whole designs (default), or of samples shuffled across designs
+        as paper B did (:func:`random_splits`; optimistic, for comparison only).
+    halving : int, optional
+        Race the MLP configurations by successive halving with this factor
+        (e.g. 3; :func:`halving_rungs`) instead of training each for all the
+        epochs: the paper grid then costs a fraction of the exhaustive search.
+        The best configuration is chosen among those that reach the full epochs.
 
     Returns
     -------
@@ -370,7 +477,14 @@ def search(
         if epochs is None
         else int(check_range(epochs, "epochs", owner, low=1, low_inclusive=True))
     )
-    splits = grouped_splits(data.groups, folds, seed)
+    check_choice(cv, "cv", owner, CV_PROTOCOLS)
+    if halving is not None:
+        halving = check_int(halving, "halving", owner, low=2)
+    splits = (
+        grouped_splits(data.groups, folds, seed)
+        if cv == "grouped"
+        else random_splits(data.n_samples, folds, seed)
+    )
     rows: list[dict[str, Any]] = []
     families: dict[str, FamilyResult] = {}
     param_grid = dict(param_grid or {})
@@ -391,7 +505,14 @@ def search(
                     progress(phase, done, total_epochs)
 
             outcomes = _cv_mlp_batched(
-                configs, data, splits, epochs=epochs, seed=seed, device=device, progress=on_epoch
+                configs,
+                data,
+                splits,
+                epochs=epochs,
+                seed=seed,
+                device=device,
+                progress=on_epoch,
+                halving=halving,
             )
         else:
             total = len(configs) * len(splits)
@@ -417,7 +538,8 @@ def search(
             if pred is not None:
                 scores = _fold_scores(data.y, pred, splits, mape_threshold_deg)
                 row.update(scores)
-                if best is None or scores["rmse_fold_mean"] < best[0]:
+                # A configuration stopped early by successive halving is no candidate.
+                if status == "ok" and (best is None or scores["rmse_fold_mean"] < best[0]):
                     best = (scores["rmse_fold_mean"], params, pred, scores)
             rows.append(row)
         search_s = time.perf_counter() - started
@@ -443,6 +565,8 @@ def search(
         if not param_grid
         else f"{grid_name} (own grid for {', '.join(param_grid)})",
         "folds": len(splits),
+        "cv": cv,
+        "mlp_halving": halving,
         "seed": seed,
         "device": device,
         "mlp_epochs": epochs,

@@ -64,6 +64,8 @@ def train_surrogates(
     epochs: int | None = None,
     export_onnx: bool = True,
     progress: Progress | None = None,
+    cv: str = "grouped",
+    halving: int | None = None,
 ) -> tuple[SearchResult, dict[str, Any]]:
     """Search, refit, save, export and plot the surrogates of a campaign.
 
@@ -77,6 +79,9 @@ def train_surrogates(
         As :func:`softbend.surrogates.search.search`.
     export_onnx : bool
         Also write and check ``models/<model>.onnx`` (default True).
+    cv : {"grouped", "random"}, halving : int, optional
+        Cross-validation protocol and successive halving of the MLP grid (see
+        :func:`softbend.surrogates.search.search`).
 
     Returns
     -------
@@ -99,6 +104,8 @@ def train_surrogates(
         n_jobs=n_jobs,
         epochs=epochs,
         progress=progress,
+        cv=cv,
+        halving=halving,
     )
     out = Path(out_dir)
     (out / "models").mkdir(parents=True, exist_ok=True)
