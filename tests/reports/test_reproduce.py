@@ -27,8 +27,24 @@ def _small_space() -> DesignSpace:
     )
 
 
+def _stand_in_fem_dataset(folder):
+    """A small dataset in the shipped format (analytical sweeps: fast, same table)."""
+    from softbend.campaign import run_campaign
+    from softbend.datasets import write_dataset
+
+    db = folder / "stand_in.duckdb"
+    run_campaign(db, DesignSpace.sample(15, seed=4), backend="analytical", workers=0)
+    write_dataset(db, folder / "dataset", command="stand-in for the test")
+    return folder / "dataset"
+
+
 @pytest.fixture(scope="module")
-def first_run(tmp_path_factory):
+def fem_dataset(tmp_path_factory):
+    return _stand_in_fem_dataset(tmp_path_factory.mktemp("fem_dataset"))
+
+
+@pytest.fixture(scope="module")
+def first_run(tmp_path_factory, fem_dataset):
     out = tmp_path_factory.mktemp("reproduce")
     phases: dict[str, tuple[int, int]] = {}
 
@@ -43,6 +59,8 @@ def first_run(tmp_path_factory):
         design_space=_small_space(),
         fem_options=FEMOptions(maxh_mm=6.0),
         fem_pmax_mpa=0.02,
+        fem_dataset=fem_dataset,
+        fem_dataset_epochs=5,
     )
     return out, summary, phases
 
@@ -71,6 +89,10 @@ def test_report_has_both_papers_and_their_files(first_run):
         "paper_b_fem/fem_angle_pressure.png",
         "paper_b_fem/fem_shapes.png",
         "paper_b_fem/fem_sweep.csv",
+        "paper_b_fem/fig4a_correlation_fem.png",
+        "paper_b_fem/fig4b_loadings_fem.png",
+        "paper_b_fem/surrogates/fig5_parity_errors.png",
+        "paper_b_fem/surrogates/models/mlp.json",
     ):
         assert (out / name).is_file(), name
         assert name in html or not name.endswith(".png"), name
@@ -116,9 +138,16 @@ def test_surrogate_section(first_run):
     assert "Fig. 5" in (out / "index.html").read_text(encoding="utf-8")
 
 
-def test_second_run_resumes_the_campaign(first_run):
+def test_second_run_resumes_the_campaign(first_run, fem_dataset):
     out, first, _ = first_run
-    again = run_reproduce(out, seed=0, workers=1, design_space=_small_space())
+    again = run_reproduce(
+        out,
+        seed=0,
+        workers=1,
+        design_space=_small_space(),
+        fem_dataset=fem_dataset,
+        fem_dataset_epochs=5,
+    )
     b = again["paper_b"]
     assert b["run_now"] == 0 and b["resumed_done"] == 8
     assert b["designs_per_s"] is None
@@ -135,3 +164,15 @@ def test_fem_section_fits_dragon_skin_and_bends_with_pressure(first_run):
     assert fits["yeoh"]["r2"] > fits["neo-hookean"]["r2"]
     assert fem["fem_angles_deg"]["0.02"] > fem["fem_angles_deg"]["0"] > 0.0
     assert fem["analytical_angles_deg"]["0"] == 0.0
+
+
+def test_fem_data_section_reads_the_dataset_and_compares_both_protocols(first_run):
+    out, summary, _ = first_run
+    section = summary["paper_b_fem_data"]
+    assert section["designs_done"] == 15 and section["samples"] > 0
+    assert section["loadings"]["pressure_mpa"] > 0.5
+    grouped, shuffled = section["surrogates_grouped"], section["surrogates_random"]
+    assert set(grouped) == set(shuffled) == {"plr", "xgb", "mlp"}
+    html = (out / "index.html").read_text(encoding="utf-8")
+    assert "Figs. 4 and 5 on softbend" in html and "random CV" in html
+    assert "stand-in for the test" in html

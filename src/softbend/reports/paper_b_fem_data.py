@@ -26,7 +26,7 @@ TABLE1_DESIGNS = 972
 
 
 def _surrogates(
-    samples: Any, folder: Path, seed: int, progress: Progress | None
+    samples: Any, folder: Path, seed: int, progress: Progress | None, epochs: int | None
 ) -> tuple[dict[str, Any], dict[str, Any]]:
     """Grouped search with saved models, then the same grid with random folds."""
     from softbend.surrogates.features import training_data
@@ -42,7 +42,7 @@ def _surrogates(
 
     data = training_data(samples)
     _, grouped = train_surrogates(
-        data, folder, grid_name="quick", seed=seed, progress=on_progress("grouped")
+        data, folder, grid_name="quick", seed=seed, epochs=epochs, progress=on_progress("grouped")
     )
     started = time.perf_counter()
     shuffled = search(
@@ -69,6 +69,7 @@ def add_section(
     progress: Progress | None = None,
     *,
     dataset: str | Path | None = None,
+    epochs: int | None = None,
 ) -> dict[str, Any]:
     """Append Figs. 4 and 5 on the shipped FEM data to ``report``; return the headline figures.
 
@@ -82,6 +83,8 @@ def add_section(
     progress : callable, optional
     dataset : path, optional
         A dataset folder (default: the one shipped in the package).
+    epochs : int, optional
+        MLP epochs (default: the quick grid's).
     """
     from softbend.analysis import (
         DEFAULT_FEATURES,
@@ -112,7 +115,7 @@ def add_section(
         "loadings": analysis_figures.loadings_bar(regression, folder / "fig4b_loadings_fem.png"),
         "parity": analysis_figures.parity_plot(regression, folder / "fig4c_parity_fem.png"),
     }
-    grouped, shuffled = _surrogates(samples, folder / "surrogates", seed, progress)
+    grouped, shuffled = _surrogates(samples, folder / "surrogates", seed, progress, epochs)
 
     section = report.section("Paper B — Figs. 4 and 5 on softbend's FEM data")
     complete = len(done) == TABLE1_DESIGNS

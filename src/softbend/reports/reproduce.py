@@ -189,6 +189,8 @@ def run_reproduce(
     design_space: DesignSpace | None = None,
     fem_options: Any = None,
     fem_pmax_mpa: float | None = None,
+    fem_dataset: str | Path | None = None,
+    fem_dataset_epochs: int | None = None,
 ) -> dict[str, Any]:
     """Run every reproducible section and write ``out_dir/index.html``.
 
@@ -208,6 +210,10 @@ def run_reproduce(
     fem_options, fem_pmax_mpa : optional
         Settings of the FEM sweep of the Fig. 2 design (default: the model's
         defaults, 0.17 MPa as in paper B Fig. 2b).
+    fem_dataset, fem_dataset_epochs : optional
+        The FEM dataset of the Figs. 4 and 5 section on FEM data (default: the
+        one shipped in the package, read, never recomputed) and its MLP epochs
+        (default: the quick grid's).
 
     Returns
     -------
@@ -249,6 +255,11 @@ def run_reproduce(
         progress,
         options=fem_options,
         pmax_mpa=fem_pmax_mpa or paper_b_fem.FIG2_PMAX_MPA,
+    )
+    from softbend.reports import paper_b_fem_data
+
+    summary["paper_b_fem_data"] = paper_b_fem_data.add_section(
+        report, out_dir, seed, progress, dataset=fem_dataset, epochs=fem_dataset_epochs
     )
     path = report.write(out_dir / "index.html")
     summary["report"] = str(path)
