@@ -93,8 +93,32 @@ def progress_bar(
 ) -> Iterator[Callable[..., None]]:
     """Yield ``advance(n=1, **fields)``, drawing a rich progress bar on stderr.
 
-    Extra keyword fields (e.g. ``failed=3``) are shown after the bar.
+    Extra keyword fields (e.g. ``failed=3``) are shown after the bar. Off a
+    terminal (a batch queue, a log file) a bar would draw nothing until the end,
+    so a plain line with the count, the fields, the elapsed time and an estimate
+    of the time left is written at every tenth of the total instead.
     """
+    if enabled and not err_console.is_terminal:
+        import time
+
+        state = {"done": 0, "tenth": -1, "start": time.monotonic()}
+
+        def advance_plain(n: int = 1, **fields: Any) -> None:
+            state["done"] += n
+            done = state["done"]
+            tenth = 10 if total <= 0 else min(10, (10 * done) // total)
+            if tenth <= state["tenth"]:
+                return
+            state["tenth"] = tenth
+            elapsed = time.monotonic() - state["start"]
+            eta = f", about {elapsed / done * (total - done):.0f} s left" if done else ""
+            info = "  ".join(f"{k} {v}" for k, v in fields.items())
+            err_console.print(
+                f"{description}: {done}/{total}  {info}  {elapsed:.0f} s{eta}", highlight=False
+            )
+
+        yield advance_plain
+        return
     columns = [
         TextColumn("[progress.description]{task.description}"),
         BarColumn(),
