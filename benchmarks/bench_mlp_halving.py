@@ -1,0 +1,122 @@
+"""Benchmark: successive halving against the exhaustive MLP grid search.
+
+Both run the same design-grouped five-fold search of
+:func:`softbend.surrogates.search.search` over a subset of paper B's grid (two
+tanh layers of 55–65 units), on the shipped FEM dataset
+(:func:`softbend.datasets.table1_fem`) or a campaign database (``--db``):
+
+* exhaustive: every configuration trains all the epochs;
+* successive halving (``--eta``, default 3): every configuration trains a
+  fraction of the epochs, the best third goes on, … until the survivors train
+  all of them (:func:`softbend.surrogates.search.halving_rungs`).
+
+Printed: wall time of each, the configuration each picks and its cross-validated
+RMSE and MAPE, the rank of the halving's pick among all configurations of the
+exhaustive search, and the projected wall time of the whole paper grid (121
+configurations × 1000 epochs) both ways from the measured cost per model-epoch::
+
+    .venv/bin/python benchmarks/bench_mlp_halving.py --configs 12 --epochs 100
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import time
+
+from softbend.surrogates.features import training_data
+from softbend.surrogates.search import grid, halving_rungs, search
+
+PAPER_CONFIGS = 121
+PAPER_EPOCHS = 1000
+
+
+def _model_epochs(n_configs: int, epochs: int, eta: int | None) -> int:
+    if eta is None:
+        return n_configs * epochs
+    return sum(n * e for n, e in halving_rungs(n_configs, epochs, eta))
+
+
+def main(argv: list[str] | None = None) -> int:
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--db", default=None, help="Campaign database (default: shipped FEM data).")
+    parser.add_argument("--configs", type=int, default=12, help="Configurations of the subset.")
+    parser.add_argument("--epochs", type=int, default=100)
+    parser.add_argument("--eta", type=int, default=3)
+    parser.add_argument("--seed", type=int, default=0)
+    parser.add_argument("--json", action="store_true")
+    args = parser.parse_args(argv)
+
+    if args.db is None:
+        from softbend.datasets import table1_fem
+
+        samples = table1_fem()
+    else:
+        from softbend.campaign import load_samples
+
+        samples = load_samples(args.db)
+    data = training_data(samples)
+    paper = grid("paper", "mlp")
+    step = max(1, len(paper) // args.configs)
+    subset = paper[::step][: args.configs]
+    common = {
+        "models": ["mlp"],
+        "param_grid": {"mlp": subset},
+        "epochs": args.epochs,
+        "seed": args.seed,
+        "device": "cpu",
+    }
+    runs = {}
+    for label, eta in (("exhaustive", None), (f"halving eta={args.eta}", args.eta)):
+        start = time.perf_counter()
+        result = search(data, halving=eta, **common)
+        seconds = time.perf_counter() - start
+        fam = result.families["mlp"]
+        runs[label] = {
+            "seconds": seconds,
+            "model_epochs": _model_epochs(len(subset), args.epochs, eta),
+            "pick": str(fam.params["hidden_sizes"]),
+            "rmse_deg": fam.cv["rmse_deg"],
+            "mape_pct": fam.cv["mape_pct"],
+            "cv": result.cv_results,
+        }
+    exhaustive = runs["exhaustive"]["cv"].sort_values("rmse_fold_mean").reset_index(drop=True)
+    pick = runs[f"halving eta={args.eta}"]["pick"]
+    rank = 1 + int(exhaustive.index[exhaustive["params"] == f"hidden_sizes={pick}"][0])
+    per_model_epoch = runs["exhaustive"]["seconds"] / runs["exhaustive"]["model_epochs"]
+    projection = {
+        label: per_model_epoch * _model_epochs(PAPER_CONFIGS, PAPER_EPOCHS, eta) / 3600.0
+        for label, eta in (("exhaustive", None), ("halving", args.eta))
+    }
+    out = {
+        "samples": data.n_samples,
+        "designs": data.n_groups,
+        "configs": len(subset),
+        "epochs": args.epochs,
+        "folds": 5,
+        **{label: {k: v for k, v in run.items() if k != "cv"} for label, run in runs.items()},
+        "halving_pick_rank_in_exhaustive": rank,
+        "paper_grid_projected_hours": projection,
+    }
+    if args.json:
+        print(json.dumps(out, indent=2))
+        return 0
+    print(
+        f"{data.n_samples} samples of {data.n_groups} designs; {len(subset)} configurations, "
+        f"{args.epochs} epochs, 5 grouped folds"
+    )
+    for label, run in runs.items():
+        print(
+            f"  {label:<16} {run['seconds']:8.1f} s  {run['model_epochs']:6d} config-epochs  "
+            f"pick {run['pick']}: RMSE {run['rmse_deg']:.3f} deg, MAPE {run['mape_pct']:.3f} %"
+        )
+    print(f"  the halving's pick ranks {rank} of {len(subset)} in the exhaustive search")
+    print(
+        f"  paper grid (121 x 1000 epochs) projected: exhaustive {projection['exhaustive']:.1f} h, "
+        f"halving {projection['halving']:.2f} h"
+    )
+    return 0
+
+
+if __name__ == "__main__":
+    raise SystemExit(main())
