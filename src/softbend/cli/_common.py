@@ -114,7 +114,9 @@ def progress_bar(
             eta = f", about {elapsed / done * (total - done):.0f} s left" if done else ""
             info = "  ".join(f"{k} {v}" for k, v in fields.items())
             err_console.print(
-                f"{description}: {done}/{total}  {info}  {elapsed:.0f} s{eta}", highlight=False
+                f"{description}: {done}/{total}  {info}  {elapsed:.0f} s{eta}",
+                highlight=False,
+                soft_wrap=True,
             )
 
         yield advance_plain

@@ -189,9 +189,17 @@ class Yeoh(HyperelasticModel):
             object.__setattr__(self, field_name, value)
 
     def energy(self, I1: Any) -> Any:
-        """``Σ Ci0 (I1 − 3)^i`` in MPa (see :meth:`HyperelasticModel.energy`)."""
+        """``Σ Ci0 (I1 − 3)^i`` in MPa (see :meth:`HyperelasticModel.energy`).
+
+        Terms whose constant is zero are left out of the expression (the value is
+        the same): on a symbolic ``I1`` each term costs automatic differentiation.
+        """
         d = I1 - 3.0
-        return d * (self.c10_mpa + d * (self.c20_mpa + d * self.c30_mpa))
+        if self.c30_mpa != 0.0:
+            return d * (self.c10_mpa + d * (self.c20_mpa + d * self.c30_mpa))
+        if self.c20_mpa != 0.0:
+            return d * (self.c10_mpa + d * self.c20_mpa)
+        return self.c10_mpa * d
 
     def dW_dI1(self, I1: ArrayLike) -> np.ndarray:  # noqa: N802
         """``∂W/∂I1 = C10 + 2 C20 (I1 − 3) + 3 C30 (I1 − 3)²`` in MPa."""
