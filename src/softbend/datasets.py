@@ -235,6 +235,7 @@ def write_dataset(
     *,
     command: str,
     description: str = "",
+    planned: int | None = None,
 ) -> dict[str, Any]:
     """Write a campaign database as a verified dataset folder (Parquet + provenance).
 
@@ -249,6 +250,9 @@ def write_dataset(
         The command that produced the campaign, recorded for reproduction.
     description : str
         One paragraph saying what the data are.
+    planned : int, optional
+        Designs of the whole campaign; recorded so that a dataset written from
+        part of it (some shards) says so.
 
     Returns
     -------
@@ -288,6 +292,7 @@ def write_dataset(
             "count": len(grid),
         },
         "designs": {
+            "planned": int(planned) if planned is not None else len(table),
             "recorded": len(table),
             "done": int(status["done"]),
             "failed": int(status["failed"]),

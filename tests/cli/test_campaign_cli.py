@@ -108,6 +108,28 @@ def test_shards_run_apart_and_merge_into_the_whole_campaign(tmp_path, capsys):
     assert "No campaign database" in one_error_line(capsys)
 
 
+def test_a_dataset_from_some_shards_says_how_many_designs_it_lacks(tmp_path, capsys):
+    from softbend.datasets import table1_fem, table1_fem_provenance
+
+    shards = [tmp_path / f"s{k}.duckdb" for k in range(2)]
+    for k, shard in enumerate(shards):
+        assert main(["campaign", "run", str(shard), *RUN, "--shard", f"{k}/3", "--json"]) == 0
+    part = tmp_path / "part.duckdb"
+    assert main(["campaign", "merge", str(part), *map(str, shards), "--json"]) == 0
+    capsys.readouterr()
+    out = tmp_path / "ds"
+    args = ["campaign", "dataset", str(part), str(out), "--command", "run it", "--space", "lhs:6"]
+    assert main(args) == 0
+    assert "4 / 0 (of 6)" in capsys.readouterr().out
+    provenance = table1_fem_provenance(out)
+    assert (provenance["designs"]["planned"], provenance["designs"]["done"]) == (6, 4)
+    pd.testing.assert_frame_equal(table1_fem(out), load_samples(part))
+    assert (
+        main(["campaign", "dataset", str(part), str(out), "--command", "x", "--space", "grid"]) == 2
+    )
+    assert "'--space'" in one_error_line(capsys)
+
+
 def _closed_port() -> int:
     with socket.socket() as sock:
         sock.bind(("127.0.0.1", 0))

@@ -287,6 +287,9 @@ def dataset(
         ..., help="The command that produced the campaign (recorded in the provenance)."
     ),
     description: str = typer.Option("", help="What the data are, one paragraph."),
+    space: str | None = typer.Option(
+        None, help=f"The campaign's whole design space, {_SPACE_FORMS}: its size is recorded."
+    ),
     json_output: bool = typer.Option(False, "--json", help="Print the provenance as JSON."),
 ) -> None:
     """Write a campaign as a verified dataset: Parquet samples and designs, provenance."""
@@ -294,7 +297,8 @@ def dataset(
 
     if not db.is_file():
         raise FileNotFoundError(f"No campaign database at {str(db)!r}.")
-    provenance = write_dataset(db, out, command=command, description=description)
+    planned = len(parse_space(space)) if space is not None else None
+    provenance = write_dataset(db, out, command=command, description=description, planned=planned)
     if json_output:
         _common.print_json(provenance)
         return
@@ -303,7 +307,10 @@ def dataset(
         f"dataset {out}",
         ["quantity", "value"],
         [
-            ["designs done / failed", f"{designs['done']} / {designs['failed']}"],
+            [
+                "designs done / failed (of planned)",
+                f"{designs['done']} / {designs['failed']} (of {designs['planned']})",
+            ],
             [
                 "samples (converged)",
                 f"{provenance['samples']['rows']} ({provenance['samples']['converged']})",
