@@ -54,6 +54,7 @@ import numpy as np
 import pandas as pd
 
 from softbend._validation import check_finite_array, check_range
+from softbend.design import FEATURES
 from softbend.errors import DatasetError
 
 __all__ = [
@@ -70,15 +71,7 @@ __all__ = [
 logger = logging.getLogger(__name__)
 
 #: Inputs of paper B's analysis: the design vector and the actuation pressure.
-DEFAULT_FEATURES: tuple[str, ...] = (
-    "l_mm",
-    "r_mm",
-    "t_mm",
-    "b_mm",
-    "phi_deg",
-    "lc_mm",
-    "pressure_mpa",
-)
+DEFAULT_FEATURES: tuple[str, ...] = FEATURES
 #: Output of paper B's analysis: the bending angle in degrees.
 DEFAULT_TARGET = "angle_deg"
 

@@ -38,9 +38,11 @@ from __future__ import annotations
 
 import logging
 import math
+import time
 import warnings
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from functools import lru_cache
+from typing import Any
 
 import numpy as np
 from numpy.typing import ArrayLike
@@ -50,8 +52,10 @@ from softbend._validation import check_finite_array, check_range
 from softbend.design import SFRBADesign
 from softbend.materials.models import HyperelasticModel
 from softbend.materials.presets import DRAGON_SKIN_30, Material
+from softbend.models import SweepResult
 
 __all__ = [
+    "AnalyticalModel",
     "SectionQuadrature",
     "bending_angle_deg",
     "elastomer_moment_nmm",
@@ -399,3 +403,87 @@ def tip_position_mm(design: SFRBADesign, angle_deg: ArrayLike) -> tuple[np.ndarr
     x_mm = length * sin_over + cap * np.cos(theta)
     z_mm = length * one_minus_cos_over + cap * np.sin(theta)
     return x_mm, z_mm
+
+
+@dataclass(frozen=True)
+class AnalyticalModel:
+    """The quasi-static moment balance of Polygerinos et al. (SPEC §4.3).
+
+    Calls :func:`softbend.analytical.bending_angle_deg` on the whole grid and
+    :func:`softbend.analytical.tip_position_mm` for the tip; the sweep ends at the
+    first pressure where the walls cannot balance the pressure (the root finder
+    finds no angle), which is kept with ``converged=False``. No gravity and no
+    Newton iterations (``newton_iterations`` is 0); ``mesh_size`` is None. The
+    model's own warnings (non-convergence, limit points) are not re-emitted in the
+    workers but stored in ``stats["warnings"]``.
+
+    Parameters
+    ----------
+    material : Material, HyperelasticModel or str, optional
+        Elastomer of the walls: a material, a hyperelastic law, or the name of a
+        preset of :mod:`softbend.materials.presets` (``"dragon-skin-30"``); default
+        Dragon Skin 30 (Yeoh, paper B).
+    max_angle_deg : float, optional
+        Largest bending angle searched, degrees, in (0, 3600]; default that of
+        :mod:`softbend.analytical` (720).
+    """
+
+    material: Any = None
+    max_angle_deg: float | None = None
+    name: str = field(default="analytical", init=False)
+
+    def __post_init__(self) -> None:
+        from softbend.materials.presets import get_preset
+
+        material = self.material
+        if isinstance(material, str):
+            material = get_preset(material)
+        model = material.model if isinstance(material, Material) else material
+        if material is not None and not isinstance(model, HyperelasticModel):
+            raise ValueError(
+                "The 'material' of AnalyticalModel must be a hyperelastic model, a Material "
+                f"holding one, or a preset name. Got {self.material!r} instead."
+            )
+        object.__setattr__(self, "material", material)
+        if self.max_angle_deg is not None:
+            limit = check_range(
+                self.max_angle_deg,
+                "max_angle_deg",
+                "AnalyticalModel",
+                low=0.0,
+                high=3600.0,
+                high_inclusive=True,
+            )
+            object.__setattr__(self, "max_angle_deg", limit)
+
+    def sweep(self, design: SFRBADesign, pressures_mpa: ArrayLike) -> SweepResult:
+        """Solve the moment balance at every pressure of the grid, in MPa."""
+        start = time.perf_counter()
+        options = {} if self.max_angle_deg is None else {"max_angle_deg": self.max_angle_deg}
+        with warnings.catch_warnings(record=True) as caught:
+            warnings.simplefilter("always")
+            angle = bending_angle_deg(design, pressures_mpa, self.material, **options)
+        tip_x, tip_z = tip_position_mm(design, angle)
+        stats: dict[str, Any] = {
+            "model": "Polygerinos et al. 2015, quasi-static",
+            "material": _describe_material(self.material),
+        }
+        if caught:
+            stats["warnings"] = [str(w.message) for w in caught]
+        return SweepResult.from_angles(
+            design,
+            pressures_mpa,
+            angle,
+            tip_x,
+            tip_z,
+            wall_time_s=time.perf_counter() - start,
+            stats=stats,
+        )
+
+
+def _describe_material(material: Any) -> str:
+    if material is None:
+        material = DRAGON_SKIN_30
+    if isinstance(material, Material):
+        return f"{material.name}: {material.model!r}"
+    return repr(material)

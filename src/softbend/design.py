@@ -25,6 +25,10 @@ from softbend._validation import check_choice, check_range
 #: Order of the design parameters in tables, arrays and CLI strings.
 PARAMETERS: tuple[str, ...] = ("l_mm", "r_mm", "t_mm", "b_mm", "phi_deg", "lc_mm")
 
+#: Inputs of every model of the bending angle (paper B §3.2 and §4.1), in this
+#: order: the design vector and the gauge pressure (mm, deg, MPa).
+FEATURES: tuple[str, ...] = (*PARAMETERS, "pressure_mpa")
+
 #: Fixed quantities of paper B (mm).
 FIBER_DIAMETER_MM = 0.28
 STRAIN_LIMITING_LAYER_MM = 0.1
@@ -124,6 +128,25 @@ class SFRBADesign:
     def as_array(self) -> np.ndarray:
         """Parameters as a float array in :data:`PARAMETERS` order."""
         return np.array([getattr(self, n) for n in PARAMETERS], dtype=float)
+
+    def feature_rows(self, pressures_mpa: Sequence[float] | np.ndarray) -> np.ndarray:
+        """Model inputs for this design at each pressure: one row per pressure.
+
+        Parameters
+        ----------
+        pressures_mpa : array_like, shape (n,)
+            Gauge pressures, MPa (not checked here: models check their grids).
+
+        Returns
+        -------
+        numpy.ndarray, shape (n, 7)
+            Columns :data:`FEATURES`: l, r, t, b (mm), φ (deg), lc (mm), P (MPa).
+        """
+        pressures = np.asarray(pressures_mpa, dtype=float).reshape(-1)
+        rows = np.empty((pressures.size, len(FEATURES)))
+        rows[:, :-1] = self.as_array()
+        rows[:, -1] = pressures
+        return rows
 
     def __str__(self) -> str:
         return ",".join(f"{getattr(self, n):g}" for n in PARAMETERS)

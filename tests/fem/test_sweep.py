@@ -5,9 +5,9 @@ import math
 import numpy as np
 import pytest
 
-from softbend.campaign.backends import FEMBackend, default_pressures_mpa, get_backend
+from softbend.campaign.backends import default_pressures_mpa, get_backend
 from softbend.design import SFRBADesign
-from softbend.fem import FEMOptions, simulate
+from softbend.fem import FEMModel, FEMOptions, simulate
 
 from .conftest import COARSE, REFERENCE
 
@@ -70,7 +70,7 @@ def test_bad_pressures_and_options_are_clear_errors():
 
 def test_campaign_backend_builds_options_from_keywords():
     backend = get_backend("fem", maxh_mm=6.0, gravity="none")
-    assert isinstance(backend, FEMBackend)
+    assert isinstance(backend, FEMModel)
     assert backend.options == FEMOptions(maxh_mm=6.0, gravity="none")
     assert backend.preferred_chunk_size == 1
     with pytest.raises(ValueError, match="'gravity' of FEMOptions"):

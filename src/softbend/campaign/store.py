@@ -44,9 +44,9 @@ from typing import TYPE_CHECKING, Any, Literal
 import numpy as np
 
 from softbend._validation import check_choice
-from softbend.campaign.backends import SweepResult, check_pressures_mpa
 from softbend.design import PARAMETERS, SFRBADesign
 from softbend.errors import SchemaError, SoftbendError
+from softbend.models import SweepResult, check_pressures_mpa
 
 if TYPE_CHECKING:
     import pandas as pd

@@ -74,7 +74,12 @@ def _one_line(text: str) -> str:
 @app.command("run")
 def run(
     db: Path = typer.Argument(..., help="Campaign database (DuckDB); created or resumed."),
-    backend: str = typer.Option("analytical", help="Sweep model: analytical or fem."),
+    backend: str = typer.Option(
+        "analytical", help="Sweep model: analytical, fem or surrogate (with --model)."
+    ),
+    model: Path | None = typer.Option(
+        None, help="A surrogate saved by 'softbend train' (models/*.json), for --backend surrogate."
+    ),
     space: str = typer.Option("table1", help=f"Designs: {_SPACE_FORMS}."),
     seed: int = typer.Option(0, help="Seed of the lhs/sobol sampler."),
     shard: str | None = typer.Option(
@@ -107,7 +112,12 @@ def run(
     if shard is not None:
         designs = designs.shard(*parse_shard(shard))
     pressures = default_pressures_mpa(pmax, pstep)
-    backend_obj = get_backend(backend)
+    if (backend == "surrogate") != (model is not None):
+        raise ValueError(
+            "The '--model' of softbend campaign run must be given with --backend surrogate, "
+            f"and only then. Got --backend {backend} and --model {model} instead."
+        )
+    backend_obj = get_backend(backend, path=model) if model is not None else get_backend(backend)
     if scheduler is not None:
         parse_scheduler_address(scheduler)
     n_todo = _designs_to_run(db, designs, retry_failed)

@@ -129,17 +129,13 @@ def predict(
     if not np.all(np.isfinite(pressures)) or np.any(pressures < 0):
         raise ValueError(f"The 'pressure' must be finite and >= 0 MPa. Got {pressure!r} instead.")
     saved = load_surrogate(model)
-    row = [checked.l_mm, checked.r_mm, checked.t_mm, checked.b_mm, checked.phi_deg, checked.lc_mm]
-    X = np.column_stack([np.tile(row, (pressures.size, 1)), pressures])
-    angles = saved.model.predict(X)
+    angles = saved.model.predict(checked.feature_rows(pressures))
     if as_json:
         _common.print_json(
             {
                 "model": str(model),
                 "kind": saved.kind,
-                "design": dict(
-                    zip(["l_mm", "r_mm", "t_mm", "b_mm", "phi_deg", "lc_mm"], row, strict=True)
-                ),
+                "design": checked.as_dict(),
                 "pressure_mpa": pressures.tolist(),
                 "angle_deg": angles.tolist(),
             }

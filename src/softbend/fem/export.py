@@ -8,8 +8,8 @@ from pathlib import Path
 import numpy as np
 
 from softbend._io import write_text_atomic
-from softbend.campaign.backends import SweepResult
 from softbend.fem.actuator import ActuatorModel
+from softbend.models import SweepResult
 
 __all__ = ["silhouette_mm", "sweep_csv", "write_sweep_csv", "write_vtk"]
 

@@ -42,11 +42,11 @@ from typing import Any
 import numpy as np
 from numpy.typing import ArrayLike
 
-from softbend.campaign.backends import SweepResult, check_pressures_mpa
 from softbend.design import SFRBADesign
 from softbend.errors import ConvergenceError
 from softbend.fem.actuator import ActuatorModel
 from softbend.fem.options import FEMOptions
+from softbend.models import SweepResult, check_pressures_mpa
 
 __all__ = ["Step", "StepHistory", "run_sweep", "simulate"]
 

@@ -27,6 +27,7 @@ _EXPORTS = {
     "grouped_splits": "search",
     "SearchResult": "search",
     "train_surrogates": "workflow",
+    "SurrogateModel": "model",
     "save_surrogate": "persistence",
     "load_surrogate": "persistence",
     "to_onnx": "onnx_export",

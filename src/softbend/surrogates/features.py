@@ -16,18 +16,11 @@ import numpy as np
 import pandas as pd
 from numpy.typing import ArrayLike
 
+from softbend.design import FEATURES as DESIGN_FEATURES
 from softbend.errors import DatasetError
 
-#: Input columns, in the order every surrogate expects them.
-FEATURES: tuple[str, ...] = (
-    "l_mm",
-    "r_mm",
-    "t_mm",
-    "b_mm",
-    "phi_deg",
-    "lc_mm",
-    "pressure_mpa",
-)
+#: Input columns, in the order every surrogate expects them (those of every model).
+FEATURES: tuple[str, ...] = DESIGN_FEATURES
 
 #: Unit of each input and of the target.
 UNITS: dict[str, str] = {

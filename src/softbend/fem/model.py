@@ -1,0 +1,47 @@
+"""The finite-element model as a :class:`~softbend.models.BendingModel`."""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+from numpy.typing import ArrayLike
+
+from softbend.design import SFRBADesign
+from softbend.fem.options import FEMOptions
+from softbend.fem.sweep import simulate
+from softbend.models import SweepResult
+
+__all__ = ["FEMModel"]
+
+
+@dataclass(frozen=True)
+class FEMModel:
+    """The 3D nonlinear finite-element model (SPEC §4.2): :func:`simulate` with fixed options.
+
+    Parameters
+    ----------
+    options : FEMOptions, optional
+        Mesh, materials, solver and stop rules; None for the defaults.
+
+    Examples
+    --------
+    >>> from softbend.fem import FEMModel
+    >>> from softbend.models import default_pressures_mpa
+    >>> result = FEMModel().sweep(design, default_pressures_mpa(0.2))  # doctest: +SKIP
+    """
+
+    options: FEMOptions | None = None
+    name: str = field(default="fem", init=False)
+    #: One design per task: an FEM sweep takes seconds to minutes, so batching hurts balance.
+    preferred_chunk_size: int = field(default=1, init=False)
+
+    def __post_init__(self) -> None:
+        if self.options is not None and not isinstance(self.options, FEMOptions):
+            raise ValueError(
+                "The 'options' of FEMModel must be FEMOptions or None. "
+                f"Got {type(self.options).__name__} instead."
+            )
+
+    def sweep(self, design: SFRBADesign, pressures_mpa: ArrayLike) -> SweepResult:
+        """Run the load-stepping sweep of ``design`` over ``pressures_mpa`` (MPa)."""
+        return simulate(design, pressures_mpa, self.options)
