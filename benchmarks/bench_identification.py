@@ -38,10 +38,10 @@ from sklearn.model_selection import GridSearchCV, KFold
 from sklearn.svm import SVR
 
 from softbend.identification.kernels import ShapeClippedWarning
-from softbend.identification.metrics import nrmse
 from softbend.identification.narx import NARXRegressor
 from softbend.identification.svr import GeneralizedGaussianSVR
 from softbend.identification.synthetic import synthetic_dataset
+from softbend.metrics import nrmse
 
 MODELS = ("gg-svr", "rbf-svr", "linear-arx", "sysidentpy")
 GAMMAS = (0.03, 0.1, 0.3, 1.0, 3.0)

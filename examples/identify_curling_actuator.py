@@ -12,7 +12,7 @@ from __future__ import annotations
 import numpy as np
 
 from softbend.identification import NARXRegressor, synthetic_dataset
-from softbend.identification.metrics import regression_metrics
+from softbend.metrics import regression_metrics
 
 
 def main(seed: int = 0) -> dict[str, float]:

@@ -224,28 +224,6 @@ def test_report_is_frozen_read_only_and_json_ready():
 # ----------------------------------------------------------------------------- MAPE, stars
 
 
-def test_thresholded_mape_rule():
-    observed = np.array([0.0, 0.5, -0.99, 2.0, -4.0, 10.0])
-    predicted = np.array([3.0, 1.0, 0.0, 2.2, -3.0, 10.0])
-    mape, excluded = thresholded_mape(observed, predicted, threshold=1.0)
-    # Kept: 2.0 (10 %), -4.0 (25 %), 10.0 (0 %).
-    assert excluded == 3
-    assert mape == pytest.approx((10.0 + 25.0 + 0.0) / 3.0)
-    # Threshold 0 keeps everything except exact zeros.
-    mape0, excluded0 = thresholded_mape(observed, predicted, threshold=0.0)
-    assert excluded0 == 1
-    assert mape0 == pytest.approx((100.0 + 100.0 + 10.0 + 25.0 + 0.0) / 5.0)
-    # A threshold above every value gives NaN, not an error.
-    nan_mape, all_out = thresholded_mape(observed, predicted, threshold=100.0)
-    assert math.isnan(nan_mape) and all_out == 6
-    with pytest.raises(ValueError, match="'threshold'"):
-        thresholded_mape(observed, predicted, threshold=-0.1)
-    with pytest.raises(ValueError, match="shape"):
-        thresholded_mape(observed, predicted[:3])
-    with pytest.raises(DatasetError, match="'predicted'"):
-        thresholded_mape(observed, np.full(6, np.nan))
-
-
 def test_regression_mape_uses_the_threshold():
     df = _campaign_like_frame()
     report = standardized_regression(df, mape_threshold=5.0)

@@ -53,9 +53,10 @@ from typing import Any
 import numpy as np
 import pandas as pd
 
-from softbend._validation import check_finite_array, check_range
+from softbend._validation import check_range
 from softbend.design import FEATURES
 from softbend.errors import DatasetError
+from softbend.metrics import thresholded_mape
 
 __all__ = [
     "DEFAULT_FEATURES",
@@ -208,58 +209,6 @@ def significance_stars(p_value: float) -> str:
     if p_value <= 0.05:
         return "*"
     return ""
-
-
-def thresholded_mape(
-    observed: Any,
-    predicted: Any,
-    *,
-    threshold: float = 1.0,
-) -> tuple[float, int]:
-    """Mean absolute percentage error over the samples with ``|observed| >= threshold``.
-
-    ``MAPE = 100 / m · Σ |predicted_i − observed_i| / |observed_i|`` over the
-    ``m`` samples whose observed value is at least ``threshold`` in magnitude
-    and non-zero. Bending angles at and near zero pressure are 0° or a fraction
-    of a degree, where a percentage error is undefined or meaningless; they are
-    left out and counted.
-
-    Parameters
-    ----------
-    observed, predicted : array_like
-        Same-shaped arrays, in the same unit (degrees for bending angles).
-    threshold : float, default 1.0
-        Smallest ``|observed|`` included, in the unit of ``observed``; ≥ 0.
-        With 0 only exact zeros are left out.
-
-    Returns
-    -------
-    mape_pct : float
-        MAPE in percent; NaN if no sample passes the threshold.
-    n_excluded : int
-        Number of samples left out by the threshold.
-
-    Raises
-    ------
-    ValueError
-        If ``threshold`` is negative or the shapes differ.
-    DatasetError
-        If an input is NaN or infinite.
-    """
-    threshold = check_range(threshold, "threshold", "thresholded_mape", low=0.0, low_inclusive=True)
-    obs = check_finite_array(observed, "observed", "thresholded_mape").ravel()
-    pred = check_finite_array(predicted, "predicted", "thresholded_mape").ravel()
-    if obs.shape != pred.shape:
-        raise ValueError(
-            f"The 'predicted' of thresholded_mape must have the shape of 'observed' {obs.shape}. "
-            f"Got {pred.shape} instead."
-        )
-    keep = (np.abs(obs) >= threshold) & (obs != 0.0)
-    n_excluded = int((~keep).sum())
-    if not keep.any():
-        return math.nan, n_excluded
-    mape = 100.0 * float(np.mean(np.abs(pred[keep] - obs[keep]) / np.abs(obs[keep])))
-    return mape, n_excluded
 
 
 # ----------------------------------------------------------------------------- regression

@@ -9,8 +9,8 @@ from sklearn.svm import SVR
 from sklearn.utils import estimator_checks
 
 from softbend.errors import DatasetError
-from softbend.identification.metrics import nrmse, r2, rmse
 from softbend.identification.narx import NARXRegressor, lagged_matrix
+from softbend.metrics import nrmse, r2, rmse
 
 # ----------------------------------------------------------------------------- systems
 

@@ -40,7 +40,7 @@ from sklearn.utils.validation import check_is_fitted
 
 from softbend._validation import check_choice, check_finite_array, check_int
 from softbend.errors import DatasetError
-from softbend.identification.metrics import r2
+from softbend.metrics import r2
 
 __all__ = ["NARXRegressor", "lagged_matrix"]
 

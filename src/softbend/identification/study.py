@@ -27,8 +27,8 @@ from softbend._validation import check_choice, check_int, check_range
 from softbend.errors import DatasetError
 from softbend.identification.data import Experiment
 from softbend.identification.kernels import ShapeClippedWarning
-from softbend.identification.metrics import regression_metrics
 from softbend.identification.narx import NARXRegressor
+from softbend.metrics import regression_metrics
 
 logger = logging.getLogger(__name__)
 

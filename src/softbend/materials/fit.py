@@ -36,9 +36,9 @@ import numpy as np
 from numpy.typing import ArrayLike
 from scipy.optimize import least_squares
 
+from softbend import metrics
 from softbend._validation import check_choice, check_finite_array, check_range
 from softbend.errors import ConvergenceError, DatasetError
-from softbend.identification import metrics
 from softbend.materials.models import (
     _AB_COEFFS,
     MODELS,

@@ -15,8 +15,7 @@ from typing import Any
 import numpy as np
 from numpy.typing import ArrayLike
 
-from softbend.analysis import thresholded_mape
-from softbend.identification.metrics import r2, rmse
+from softbend.metrics import r2, rmse, thresholded_mape
 
 #: Default smallest |θ| (degrees) included in the MAPE.
 MAPE_THRESHOLD_DEG = 1.0

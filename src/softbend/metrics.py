@@ -1,8 +1,10 @@
-"""Error measures for identified dynamic models (paper A §4, SPEC §3).
+r"""Error measures shared by every stage: materials fits, identified dynamic
+models (paper A §4, SPEC §3), the linear model of paper B Fig. 4 and the
+surrogates (paper B §4.1).
 
 Each function compares a measured signal ``y`` with a prediction ``y_hat`` of
-the same length (one-step-ahead or free-run simulation of one output, e.g. the
-bending grade ρ, dimensionless, or the arc length L in mm):
+the same length (a stress–stretch curve, a one-step-ahead or free-run
+simulation of ρ or L, bending angles):
 
 ========================  =====================================================
 ``rmse``                  √(mean((y − ŷ)²)), in the unit of ``y``
@@ -12,6 +14,9 @@ bending grade ρ, dimensionless, or the arc length L in mm):
                           determination
 ``fit_percent``           100 · (1 − ‖y − ŷ‖ / ‖y − ȳ‖), the "fit" reported by
                           system-identification toolboxes (MATLAB ``compare``)
+``thresholded_mape``      mean absolute percentage error over the samples with
+                          \|y\| at least a threshold (bending angles near 0°
+                          are left out and counted)
 ========================  =====================================================
 
 Rules that hold for all of them:
@@ -32,13 +37,21 @@ mean of ``y`` gives r2 = 0 and fit = 0.
 from __future__ import annotations
 
 import math
+from typing import Any
 
 import numpy as np
 from numpy.typing import ArrayLike
 
-from softbend._validation import check_finite_array
+from softbend._validation import check_finite_array, check_range
 
-__all__ = ["fit_percent", "nrmse", "r2", "regression_metrics", "rmse"]
+__all__ = [
+    "fit_percent",
+    "nrmse",
+    "r2",
+    "regression_metrics",
+    "rmse",
+    "thresholded_mape",
+]
 
 
 def _pair(y: ArrayLike, y_hat: ArrayLike, owner: str) -> tuple[np.ndarray, np.ndarray]:
@@ -194,3 +207,55 @@ def regression_metrics(y: ArrayLike, y_hat: ArrayLike) -> dict[str, float]:
         "r2": r2(measured, predicted),
         "fit_percent": fit_percent(measured, predicted),
     }
+
+
+def thresholded_mape(
+    observed: Any,
+    predicted: Any,
+    *,
+    threshold: float = 1.0,
+) -> tuple[float, int]:
+    """Mean absolute percentage error over the samples with ``|observed| >= threshold``.
+
+    ``MAPE = 100 / m · Σ |predicted_i − observed_i| / |observed_i|`` over the
+    ``m`` samples whose observed value is at least ``threshold`` in magnitude
+    and non-zero. Bending angles at and near zero pressure are 0° or a fraction
+    of a degree, where a percentage error is undefined or meaningless; they are
+    left out and counted.
+
+    Parameters
+    ----------
+    observed, predicted : array_like
+        Same-shaped arrays, in the same unit (degrees for bending angles).
+    threshold : float, default 1.0
+        Smallest ``|observed|`` included, in the unit of ``observed``; ≥ 0.
+        With 0 only exact zeros are left out.
+
+    Returns
+    -------
+    mape_pct : float
+        MAPE in percent; NaN if no sample passes the threshold.
+    n_excluded : int
+        Number of samples left out by the threshold.
+
+    Raises
+    ------
+    ValueError
+        If ``threshold`` is negative or the shapes differ.
+    DatasetError
+        If an input is NaN or infinite.
+    """
+    threshold = check_range(threshold, "threshold", "thresholded_mape", low=0.0, low_inclusive=True)
+    obs = check_finite_array(observed, "observed", "thresholded_mape").ravel()
+    pred = check_finite_array(predicted, "predicted", "thresholded_mape").ravel()
+    if obs.shape != pred.shape:
+        raise ValueError(
+            f"The 'predicted' of thresholded_mape must have the shape of 'observed' {obs.shape}. "
+            f"Got {pred.shape} instead."
+        )
+    keep = (np.abs(obs) >= threshold) & (obs != 0.0)
+    n_excluded = int((~keep).sum())
+    if not keep.any():
+        return math.nan, n_excluded
+    mape = 100.0 * float(np.mean(np.abs(pred[keep] - obs[keep]) / np.abs(obs[keep])))
+    return mape, n_excluded

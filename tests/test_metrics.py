@@ -5,12 +5,13 @@ import pytest
 from sklearn.metrics import mean_squared_error, r2_score
 
 from softbend.errors import DatasetError
-from softbend.identification.metrics import (
+from softbend.metrics import (
     fit_percent,
     nrmse,
     r2,
     regression_metrics,
     rmse,
+    thresholded_mape,
 )
 
 ALL = (rmse, nrmse, r2, fit_percent, regression_metrics)
@@ -116,3 +117,25 @@ def test_bad_shapes_raise_value_error_naming_the_field(metric, y, y_hat, field):
 def test_non_finite_measurement_is_a_dataset_error(metric):
     with pytest.raises(DatasetError, match=r"'y' of .* must be finite"):
         metric([1.0, np.nan, 3.0], [1.0, 2.0, 3.0])
+
+
+def test_thresholded_mape_rule():
+    observed = np.array([0.0, 0.5, -0.99, 2.0, -4.0, 10.0])
+    predicted = np.array([3.0, 1.0, 0.0, 2.2, -3.0, 10.0])
+    mape, excluded = thresholded_mape(observed, predicted, threshold=1.0)
+    # Kept: 2.0 (10 %), -4.0 (25 %), 10.0 (0 %).
+    assert excluded == 3
+    assert mape == pytest.approx((10.0 + 25.0 + 0.0) / 3.0)
+    # Threshold 0 keeps everything except exact zeros.
+    mape0, excluded0 = thresholded_mape(observed, predicted, threshold=0.0)
+    assert excluded0 == 1
+    assert mape0 == pytest.approx((100.0 + 100.0 + 10.0 + 25.0 + 0.0) / 5.0)
+    # A threshold above every value gives NaN, not an error.
+    nan_mape, all_out = thresholded_mape(observed, predicted, threshold=100.0)
+    assert math.isnan(nan_mape) and all_out == 6
+    with pytest.raises(ValueError, match="'threshold'"):
+        thresholded_mape(observed, predicted, threshold=-0.1)
+    with pytest.raises(ValueError, match="shape"):
+        thresholded_mape(observed, predicted[:3])
+    with pytest.raises(DatasetError, match="'predicted'"):
+        thresholded_mape(observed, np.full(6, np.nan))
