@@ -26,7 +26,7 @@ DESIGN = SFRBADesign(100, 6, 2, 2, 5, 8)
 
 
 def test_registry_names_the_allowed_backends():
-    assert {"analytical", "fem", "surrogate", "fault-injection"} <= set(available_backends())
+    assert {"analytical", "fem", "fault-injection"} <= set(available_backends())
     with pytest.raises(
         ValueError, match="'backend' of get_backend must be one of 'analytical', 'fem'"
     ):

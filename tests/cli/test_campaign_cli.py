@@ -139,7 +139,10 @@ def _closed_port() -> int:
 @pytest.mark.parametrize(
     ("args", "needle"),
     [
-        (["--backend", "abaqus"], "'backend' of get_backend must be one of 'analytical', 'fem'"),
+        (
+            ["--backend", "abaqus"],
+            "'--backend' of softbend campaign run must be one of 'analytical', 'fem'",
+        ),
         (["--space", "grid:5"], "'--space' of softbend campaign run must be one of table1"),
         (["--space", "lhs:0"], "'--space'"),
         (["--pmax", "0.1", "--pstep", "0.03"], "whole number of steps"),

@@ -3,15 +3,9 @@ import pytest
 import torch
 
 from softbend.errors import ConvergenceError
-from softbend.surrogates.batched import (
-    _BatchedMLP,
-    _standardization,
-    estimate_pass_bytes,
-    init_parameters,
-    model_rng,
-    train_mlp_grid,
-)
-from softbend.surrogates.mlp import NormalizedMLPRegressor, mlp_forward
+from softbend.surrogates.batched import _BatchedMLP, estimate_pass_bytes, train_mlp_grid
+from softbend.surrogates.mlp import NormalizedMLPRegressor
+from softbend.surrogates.mlp_core import init_parameters, mlp_forward, model_rng, standardization
 
 
 @pytest.fixture(autouse=True, scope="module")
@@ -115,7 +109,7 @@ def test_standardization_uses_each_models_own_training_rows():
 
 def test_constant_column_gets_unit_scale():
     X = np.column_stack([np.linspace(0, 1, 20), np.full(20, 0.1)])
-    _, scale = _standardization(X)
+    _, scale = standardization(X)
     assert scale[1] == 1.0 and scale[0] == pytest.approx(X[:, 0].std())
 
 
@@ -258,7 +252,7 @@ def test_validation_predictions_and_estimator_from_result():
             m = grid.model(c, s)
             np.testing.assert_array_equal(m.val_index, val)
             assert m.val_pred_deg.dtype == np.float64 and m.val_pred_deg.shape == val.shape
-            estimator = grid.estimator(c, s)
+            estimator = NormalizedMLPRegressor.from_grid(grid, c, s)
             assert isinstance(estimator, NormalizedMLPRegressor)
             assert estimator.hidden_sizes == CONFIGS[c] and estimator.epochs == 3
             np.testing.assert_array_equal(estimator.predict(X[val]), m.val_pred_deg)

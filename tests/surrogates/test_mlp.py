@@ -86,7 +86,7 @@ def test_fit_is_train_mlp_grid_with_one_config_and_one_split(fitted):
     _, y = _actuator_like(300, seed=1)
     rows = np.arange(300)
     grid = train_mlp_grid(X, y, [(rows, rows[:0])], [(65, 65)], epochs=5, batch_size=64)
-    rebuilt = grid.estimator(0, 0)
+    rebuilt = NormalizedMLPRegressor.from_grid(grid, 0, 0)
     for a, b in zip(
         model.coefs_ + model.intercepts_, rebuilt.coefs_ + rebuilt.intercepts_, strict=True
     ):

@@ -8,7 +8,7 @@ import numpy as np
 import pytest
 
 from softbend.analytical import AnalyticalModel, tip_position_mm
-from softbend.campaign import get_backend, load_samples, run_campaign
+from softbend.campaign import load_samples, run_campaign
 from softbend.cli import main
 from softbend.design import DesignSpace, SFRBADesign
 from softbend.models import BendingModel, default_pressures_mpa
@@ -74,8 +74,8 @@ def test_bad_surrogates_and_grids_are_refused():
 
 def test_a_campaign_runs_on_a_saved_surrogate(saved, tmp_path, capsys):
     path, estimator = saved
-    backend = get_backend("surrogate", path=path)
     db = tmp_path / "s.duckdb"
+    backend = SurrogateModel.load(path)
     run_campaign(db, DesignSpace.sample(3, seed=9), backend=backend, pressures_mpa=GRID)
     samples = load_samples(db)
     assert len(samples) == 3 * len(GRID)

@@ -5,8 +5,12 @@ module maps the names a command line or a database uses to them::
 
     backend = get_backend("analytical")      # softbend.analytical.AnalyticalModel
     backend = get_backend("fem", maxh_mm=4)  # softbend.fem.FEMModel
-    backend = get_backend("surrogate", path="models/mlp.json")
     result = backend.sweep(design, default_pressures_mpa())
+
+A trained surrogate is not in the registry (surrogates sit above the campaign in
+the pipeline): pass a :class:`softbend.surrogates.SurrogateModel` to
+:func:`~softbend.campaign.run_campaign` as its backend, or use
+``softbend campaign run --backend surrogate --model FILE``.
 
 The sweep result, the pressure grid and the protocol live in
 :mod:`softbend.models` and are re-exported here.
@@ -189,16 +193,9 @@ def _id_set(ids: Any) -> frozenset[str]:
     return frozenset(str(i) for i in ids)
 
 
-def _make_surrogate(path: str | os.PathLike[str]) -> BendingModel:
-    from softbend.surrogates.model import SurrogateModel
-
-    return SurrogateModel.load(path)
-
-
 _REGISTRY: dict[str, Callable[..., Backend]] = {
     "analytical": AnalyticalModel,
     "fem": _make_fem,
-    "surrogate": _make_surrogate,
     "fault-injection": _make_fault_injection,
 }
 

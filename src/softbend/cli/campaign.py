@@ -117,7 +117,18 @@ def run(
             "The '--model' of softbend campaign run must be given with --backend surrogate, "
             f"and only then. Got --backend {backend} and --model {model} instead."
         )
-    backend_obj = get_backend(backend, path=model) if model is not None else get_backend(backend)
+    if backend == "surrogate":
+        from softbend.surrogates.model import SurrogateModel
+
+        backend_obj = SurrogateModel.load(model)
+    else:
+        from softbend._validation import check_choice
+        from softbend.campaign.backends import available_backends
+
+        check_choice(
+            backend, "--backend", "softbend campaign run", (*available_backends(), "surrogate")
+        )
+        backend_obj = get_backend(backend)
     if scheduler is not None:
         parse_scheduler_address(scheduler)
     n_todo = _designs_to_run(db, designs, retry_failed)

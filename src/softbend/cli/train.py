@@ -45,11 +45,12 @@ def train(
     as_json: bool = typer.Option(False, "--json", help="Print the results as JSON."),
 ) -> None:
     """Grid-search the surrogates with grouped K-fold CV, refit the best, save and plot."""
+    from softbend.reports.surrogate_figures import training_figures
     from softbend.surrogates.workflow import train_surrogates
 
     names = [m.strip() for m in models.split(",") if m.strip()]
     with _common.phase_progress(enabled=not as_json) as progress:
-        _, summary = train_surrogates(
+        result, summary = train_surrogates(
             db,
             out,
             models=names,
@@ -64,6 +65,7 @@ def train(
             cv=cv,
             halving=halving,
         )
+    summary["files"].update(training_figures(result, out))
     if as_json:
         _common.print_json(summary)
         return

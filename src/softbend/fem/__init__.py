@@ -8,13 +8,8 @@ the FEM as a :class:`~softbend.models.BendingModel`); ``verification``
 holds the closed-form cases solved with the same core.
 """
 
-# PyTorch is loaded before NGSolve on purpose. NGSolve's bundled OpenBLAS
-# exports the BLAS symbols that PyTorch's CPU kernels otherwise bind to: with
-# NGSolve imported first, a batched matrix product in PyTorch (the surrogates'
-# MLP training) crashes the interpreter with a segmentation fault. Loaded in
-# this order, both work in one process.
-import torch  # noqa: F401  (import order, see above)
-
+# PyTorch before NGSolve: see softbend._torch.
+import softbend._torch  # noqa: F401  (import order)
 from softbend.fem.model import FEMModel
 from softbend.fem.options import GRAVITY_DIRECTIONS, OUTPUT_MODES, FEMOptions
 from softbend.fem.sweep import simulate

@@ -29,6 +29,7 @@ def _surrogates(
     samples: Any, folder: Path, seed: int, progress: Progress | None, epochs: int | None
 ) -> tuple[dict[str, Any], dict[str, Any]]:
     """Grouped search with saved models, then the same grid with random folds."""
+    from softbend.reports.surrogate_figures import training_figures
     from softbend.surrogates.features import training_data
     from softbend.surrogates.search import search
     from softbend.surrogates.workflow import train_surrogates
@@ -41,9 +42,10 @@ def _surrogates(
         return forward
 
     data = training_data(samples)
-    _, grouped = train_surrogates(
+    result, grouped = train_surrogates(
         data, folder, grid_name="quick", seed=seed, epochs=epochs, progress=on_progress("grouped")
     )
+    grouped["files"].update(training_figures(result, folder))
     started = time.perf_counter()
     shuffled = search(
         data, grid_name="quick", seed=seed, cv="random", progress=on_progress("random")

@@ -150,6 +150,7 @@ def _paper_b_surrogates(
     report: Report, out_dir: Path, seed: int, progress: Progress | None
 ) -> dict[str, Any]:
     from softbend.reports import paper_b
+    from softbend.reports.surrogate_figures import training_figures
     from softbend.surrogates.workflow import train_surrogates
 
     folder = out_dir / "paper_b"
@@ -159,13 +160,14 @@ def _paper_b_surrogates(
             progress(f"paper B: surrogates, {phase}", done, total)
 
     start = time.perf_counter()
-    _, summary = train_surrogates(
+    result, summary = train_surrogates(
         folder / "campaign.duckdb",
         folder / "surrogates",
         grid_name="quick",
         seed=seed,
         progress=on_progress,
     )
+    summary["files"].update(training_figures(result, folder / "surrogates"))
     paper_b.add_surrogate_section(report, summary, root=out_dir)
     return {
         "seconds": time.perf_counter() - start,

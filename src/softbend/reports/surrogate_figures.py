@@ -87,3 +87,32 @@ def mlp_loss_curve(loss_curve: list[float] | np.ndarray, path: Path) -> Path:
     path.parent.mkdir(parents=True, exist_ok=True)
     fig.savefig(path, dpi=_DPI)
     return path
+
+
+def training_figures(result: SearchResult, out_dir: str | Path) -> dict[str, str]:
+    """Paper B Fig. 5 and the refitted MLP's loss curve of a surrogate search.
+
+    Parameters
+    ----------
+    result : SearchResult
+        What :func:`softbend.surrogates.workflow.train_surrogates` (or
+        :func:`~softbend.surrogates.search.search`) returned.
+    out_dir : path
+        Folder of ``fig5_parity_errors.png`` and ``mlp_loss.png`` (created).
+
+    Returns
+    -------
+    dict
+        ``{"fig5": path, "mlp_loss": path}``, the figures drawn (none without
+        families; no loss curve without an MLP).
+    """
+    out = Path(out_dir)
+    out.mkdir(parents=True, exist_ok=True)
+    files: dict[str, str] = {}
+    if result.families:
+        files["fig5"] = str(parity_and_errors(result, out / "fig5_parity_errors.png"))
+    if "mlp" in result.families:
+        curve = getattr(result.families["mlp"].model, "loss_curve_", None)
+        if curve:
+            files["mlp_loss"] = str(mlp_loss_curve(curve, out / "mlp_loss.png"))
+    return files

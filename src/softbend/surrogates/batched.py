@@ -39,15 +39,21 @@ import time
 from collections.abc import Callable, Iterator, Sequence
 from contextlib import contextmanager
 from dataclasses import dataclass, field
-from numbers import Integral
 
 import numpy as np
-import torch
 from numpy.typing import ArrayLike
 
-from softbend._validation import check_choice, check_int, check_range
+from softbend._torch import torch
+from softbend._validation import check_int, check_range
 from softbend.errors import ConvergenceError
-from softbend.surrogates.mlp import NormalizedMLPRegressor, mlp_forward
+from softbend.surrogates.mlp_core import (
+    check_hidden_pair,
+    init_parameters,
+    mlp_forward,
+    model_rng,
+    resolve_device,
+    standardization,
+)
 
 logger = logging.getLogger(__name__)
 
@@ -55,7 +61,6 @@ __all__ = [
     "GridTrainingResult",
     "TrainedMLP",
     "estimate_pass_bytes",
-    "resolve_device",
     "train_mlp_grid",
 ]
 
@@ -67,53 +72,6 @@ _DTYPES = {"float32": torch.float32, "float64": torch.float64}
 
 
 # --- validation ------------------------------------------------------------------------
-
-
-def _check_hidden_pair(value: object, name: str, owner: str) -> tuple[int, int]:
-    message = (
-        f"The '{name}' of {owner} must be a pair of positive integers (h1, h2). "
-        f"Got {value!r} instead."
-    )
-    try:
-        pair = tuple(value)  # type: ignore[arg-type]
-    except TypeError:
-        raise ValueError(message) from None
-    if len(pair) != 2 or not all(
-        isinstance(h, Integral) and not isinstance(h, bool) and h >= 1 for h in pair
-    ):
-        raise ValueError(message)
-    return int(pair[0]), int(pair[1])
-
-
-def resolve_device(device: object, owner: str = _OWNER) -> str:
-    """The torch device a ``device`` parameter means: ``"cpu"`` or ``"cuda"``.
-
-    Parameters
-    ----------
-    device : {"auto", "cpu", "cuda"}
-        ``"auto"`` is ``"cuda"`` when :func:`torch.cuda.is_available`, else ``"cpu"``.
-    owner : str
-        Name used in the error message.
-
-    Returns
-    -------
-    str
-        ``"cpu"`` or ``"cuda"``.
-
-    Raises
-    ------
-    ValueError
-        For another value, or ``"cuda"`` without a usable GPU.
-    """
-    check_choice(device, "device", owner, ("auto", "cpu", "cuda"))
-    if device == "auto":
-        return "cuda" if torch.cuda.is_available() else "cpu"
-    if device == "cuda" and not torch.cuda.is_available():
-        raise ValueError(
-            f"The 'device' of {owner} is 'cuda' but torch.cuda.is_available() is False "
-            f"(torch {torch.__version__}); use 'auto' or 'cpu'."
-        )
-    return str(device)
 
 
 def _check_dtype(dtype: object) -> torch.dtype:
@@ -190,64 +148,6 @@ def _check_splits(splits: object, n_samples: int) -> list[tuple[np.ndarray, np.n
 
 
 # --- per-model pieces -------------------------------------------------------------------
-
-
-def model_rng(seed: int, h1: int, h2: int, split_index: int) -> np.random.Generator:
-    """The random stream of one model of the grid.
-
-    Derived from ``(seed, h1, h2, split_index)`` only, so a model draws the same
-    initial weights and row permutations whatever else is trained beside it.
-
-    Parameters
-    ----------
-    seed : int
-        Seed of the grid, >= 0.
-    h1, h2 : int
-        Hidden layer sizes of the model.
-    split_index : int
-        Index of the model's (train, validation) split.
-
-    Returns
-    -------
-    numpy.random.Generator
-    """
-    return np.random.Generator(np.random.PCG64(np.random.SeedSequence([seed, h1, h2, split_index])))
-
-
-def init_parameters(
-    rng: np.random.Generator, n_features: int, h1: int, h2: int
-) -> tuple[list[np.ndarray], list[np.ndarray]]:
-    """Initial weights and biases, as ``torch.nn.Linear`` draws them.
-
-    Every weight and bias of a layer with ``fan_in`` inputs is uniform on
-    (-1/sqrt(fan_in), 1/sqrt(fan_in)). Drawn in the order W1, b1, W2, b2, W3, b3.
-
-    Parameters
-    ----------
-    rng : numpy.random.Generator
-        The model's stream (:func:`model_rng`).
-    n_features, h1, h2 : int
-        Layer sizes d, h1, h2.
-
-    Returns
-    -------
-    coefs, intercepts : list of ndarray
-        Float64 arrays of shapes (d, h1), (h1, h2), (h2, 1) and (h1,), (h2,), (1,).
-    """
-    coefs, intercepts = [], []
-    for fan_in, fan_out in ((n_features, h1), (h1, h2), (h2, 1)):
-        bound = 1.0 / math.sqrt(fan_in)
-        coefs.append(rng.uniform(-bound, bound, size=(fan_in, fan_out)))
-        intercepts.append(rng.uniform(-bound, bound, size=fan_out))
-    return coefs, intercepts
-
-
-def _standardization(values: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """Mean and standard deviation along axis 0; scale 1 for a constant column."""
-    mean = values.mean(axis=0)
-    scale = values.std(axis=0)
-    constant = np.ptp(values, axis=0) == 0.0
-    return mean, np.where(constant | (scale == 0.0), 1.0, scale)
 
 
 # --- the batched network ----------------------------------------------------------------
@@ -525,24 +425,6 @@ class GridTrainingResult:
         """The model of configuration ``config_index`` trained on split ``split_index``."""
         return self.models[config_index * self.n_splits + split_index]
 
-    def estimator(self, config_index: int, split_index: int) -> NormalizedMLPRegressor:
-        """A fitted :class:`NormalizedMLPRegressor` of one model, without retraining."""
-        fitted = self.model(config_index, split_index)
-        return NormalizedMLPRegressor.from_arrays(
-            x_mean=fitted.x_mean,
-            x_scale=fitted.x_scale,
-            y_mean=fitted.y_mean,
-            y_scale=fitted.y_scale,
-            coefs=fitted.coefs,
-            intercepts=fitted.intercepts,
-            loss_curve=fitted.loss_curve.tolist(),
-            fitted_device=self.device,
-            epochs=self.epochs,
-            batch_size=self.batch_size,
-            learning_rate=self.learning_rate,
-            seed=self.seed,
-        )
-
 
 # --- training ---------------------------------------------------------------------------
 
@@ -651,7 +533,7 @@ def train_mlp_grid(
     X, y = _check_data(X, y)
     split_list = _check_splits(splits, X.shape[0])
     try:
-        configs = [_check_hidden_pair(h, "hidden_sizes", _OWNER) for h in hidden_sizes]
+        configs = [check_hidden_pair(h, "hidden_sizes", _OWNER) for h in hidden_sizes]
     except TypeError:
         configs = []
     if not configs:
@@ -780,8 +662,8 @@ def _train_pass(
         c, b = init_parameters(rng, d, job.h1, job.h2)
         coefs.append(c)
         intercepts.append(b)
-        x_stats.append(_standardization(X[job.train_idx]))
-        y_mean, y_scale = _standardization(y[job.train_idx])
+        x_stats.append(standardization(X[job.train_idx]))
+        y_mean, y_scale = standardization(y[job.train_idx])
         y_stats.append((float(y_mean), float(y_scale)))
     net = _BatchedMLP(coefs, intercepts, h1_max, h2_max, device=device, dtype=dtype)
 

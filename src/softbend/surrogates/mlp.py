@@ -24,46 +24,13 @@ from sklearn.base import BaseEstimator, RegressorMixin
 from sklearn.utils.validation import check_is_fitted, validate_data
 
 from softbend._validation import check_int, check_range
+from softbend.surrogates.batched import GridTrainingResult, train_mlp_grid
 from softbend.surrogates.features import FEATURES
+from softbend.surrogates.mlp_core import check_hidden_pair, mlp_forward, resolve_device
 
 __all__ = ["NormalizedMLPRegressor", "mlp_forward"]
 
 _OWNER = "NormalizedMLPRegressor"
-
-
-def mlp_forward(
-    X: np.ndarray,
-    x_mean: np.ndarray,
-    x_scale: np.ndarray,
-    y_mean: float,
-    y_scale: float,
-    coefs: Sequence[np.ndarray],
-    intercepts: Sequence[np.ndarray],
-) -> np.ndarray:
-    """Forward pass of a normalized two-hidden-layer tanh MLP, NumPy float64.
-
-    Parameters
-    ----------
-    X : ndarray of shape (n, d)
-        Inputs, in their units (mm, deg, MPa for softbend's features).
-    x_mean, x_scale : ndarray of shape (d,)
-        Input standardization.
-    y_mean, y_scale : float
-        Target standardization (degrees for the bending angle).
-    coefs : sequence of 3 ndarray
-        Weights of shapes (d, h1), (h1, h2), (h2, 1).
-    intercepts : sequence of 3 ndarray
-        Biases of shapes (h1,), (h2,), (1,).
-
-    Returns
-    -------
-    ndarray of shape (n,)
-        Predictions in the target's units, float64.
-    """
-    z = (np.asarray(X, dtype=np.float64) - x_mean) / x_scale
-    a = np.tanh(z @ coefs[0] + intercepts[0])
-    a = np.tanh(a @ coefs[1] + intercepts[1])
-    return y_mean + y_scale * (a @ coefs[2] + intercepts[2])[:, 0]
 
 
 def _check_finite_x(X: np.ndarray, method: str) -> None:
@@ -99,7 +66,7 @@ class NormalizedMLPRegressor(RegressorMixin, BaseEstimator):
     loss, Adam (lr 6e-4), mini-batches of 1024 rows, 1000 epochs; the target is
     standardized too. Initial weights as ``torch.nn.Linear`` draws them, from a
     NumPy stream seeded by ``(seed, h1, h2, 0)`` (see
-    :func:`softbend.surrogates.batched.model_rng`); the same seed gives identical
+    :func:`softbend.surrogates.mlp_core.model_rng`); the same seed gives identical
     weights on the CPU.
 
     Parameters
@@ -180,22 +147,20 @@ class NormalizedMLPRegressor(RegressorMixin, BaseEstimator):
         ConvergenceError
             If training produced non-finite weights.
         """
-        from softbend.surrogates import batched
-
-        hidden = batched._check_hidden_pair(self.hidden_sizes, "hidden_sizes", _OWNER)
+        hidden = check_hidden_pair(self.hidden_sizes, "hidden_sizes", _OWNER)
         epochs = check_int(self.epochs, "epochs", _OWNER, low=1)
         batch_size = check_int(self.batch_size, "batch_size", _OWNER, low=1)
         learning_rate = check_range(
             self.learning_rate, "learning_rate", _OWNER, low=0.0, high=math.inf
         )
         seed = check_int(self.seed, "seed", _OWNER, low=0)
-        device = batched.resolve_device(self.device, _OWNER)
+        device = resolve_device(self.device, _OWNER)
 
         _check_finite_y(y)
         X, y = validate_data(self, X, y, dtype=np.float64, y_numeric=True, ensure_all_finite=False)
         _check_finite_x(X, "fit")
         rows = np.arange(X.shape[0])
-        result = batched.train_mlp_grid(
+        result = train_mlp_grid(
             X,
             y,
             [(rows, rows[:0])],
@@ -239,6 +204,35 @@ class NormalizedMLPRegressor(RegressorMixin, BaseEstimator):
         self.loss_curve_ = [float(v) for v in loss_curve]
         self.device_ = str(device)
         self.n_features_in_ = int(self.x_mean_.shape[0])
+
+    @classmethod
+    def from_grid(
+        cls, grid: GridTrainingResult, config_index: int, split_index: int
+    ) -> NormalizedMLPRegressor:
+        """A fitted model of :func:`~softbend.surrogates.batched.train_mlp_grid`, not retrained.
+
+        Parameters
+        ----------
+        grid : GridTrainingResult
+            What the batched trainer returned.
+        config_index, split_index : int
+            The configuration (position in its ``hidden_sizes``) and the split.
+        """
+        fitted = grid.model(config_index, split_index)
+        return cls.from_arrays(
+            x_mean=fitted.x_mean,
+            x_scale=fitted.x_scale,
+            y_mean=fitted.y_mean,
+            y_scale=fitted.y_scale,
+            coefs=fitted.coefs,
+            intercepts=fitted.intercepts,
+            loss_curve=fitted.loss_curve.tolist(),
+            fitted_device=grid.device,
+            epochs=grid.epochs,
+            batch_size=grid.batch_size,
+            learning_rate=grid.learning_rate,
+            seed=grid.seed,
+        )
 
     @classmethod
     def from_arrays(

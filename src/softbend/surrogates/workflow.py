@@ -8,8 +8,10 @@ into ``out_dir``:
   metadata (feature order and units, data hash, CV metrics, softbend version);
 - ``models/<model>.onnx`` — its ONNX export, checked against ``predict``;
 - ``cv_results.csv`` — every configuration's cross-validated scores;
-- ``summary.csv`` — the best of each family beside paper B's figures;
-- ``fig5_parity_errors.png`` and ``mlp_loss.png`` (paper B Fig. 5).
+- ``summary.csv`` — the best of each family beside paper B's figures.
+
+It draws nothing: :func:`softbend.reports.surrogate_figures.training_figures`
+draws paper B Fig. 5 and the MLP's loss from what it returns.
 """
 
 from __future__ import annotations
@@ -67,7 +69,7 @@ def train_surrogates(
     cv: str = "grouped",
     halving: int | None = None,
 ) -> tuple[SearchResult, dict[str, Any]]:
-    """Search, refit, save, export and plot the surrogates of a campaign.
+    """Search, refit, save and export the surrogates of a campaign.
 
     Parameters
     ----------
@@ -90,7 +92,6 @@ def train_surrogates(
         JSON-friendly headline figures, per family and paper B's beside them,
         and the files written.
     """
-    from softbend.reports import surrogate_figures
     from softbend.surrogates.persistence import save_surrogate
 
     data = _load_data(source)
@@ -155,14 +156,6 @@ def train_surrogates(
     write_text_atomic(out / "summary.csv", summary_table.to_csv(index=False))
     files["cv_results"] = str(cv_path)
     files["summary"] = str(out / "summary.csv")
-    if result.families:
-        files["fig5"] = str(
-            surrogate_figures.parity_and_errors(result, out / "fig5_parity_errors.png")
-        )
-    if "mlp" in result.families:
-        curve = getattr(result.families["mlp"].model, "loss_curve_", None)
-        if curve:
-            files["mlp_loss"] = str(surrogate_figures.mlp_loss_curve(curve, out / "mlp_loss.png"))
     best = min(result.families, key=lambda m: result.families[m].cv["mape_pct"], default=None)
     summary = {
         "settings": result.settings,
