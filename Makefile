@@ -11,7 +11,7 @@ OUT ?= results/reproduce
 $(BIN)/.softbend-installed: pyproject.toml
 	$(PYTHON) -m venv $(VENV)
 	$(BIN)/python -m pip install --quiet --upgrade pip
-	$(BIN)/python -m pip install --quiet -e ".[dev]"
+	$(BIN)/python -m pip install --quiet -e ".[all,dev]"
 	touch $@
 
 setup: $(BIN)/.softbend-installed

@@ -55,3 +55,10 @@ class ConvergenceError(SoftbendError, RuntimeError):
         if residual is not None:
             details.append(f"residual={residual:.3g}")
         super().__init__(message + (f" ({', '.join(details)})" if details else ""))
+
+
+class MissingExtraError(SoftbendError, ImportError):
+    """A part of softbend needs an optional dependency that is not installed.
+
+    The message names the extra that installs it, e.g. ``pip install 'softbend[fem]'``.
+    """

@@ -58,6 +58,7 @@ import numpy as np
 from numpy.typing import ArrayLike
 
 from softbend import __version__
+from softbend._extras import require
 from softbend._validation import check_range
 from softbend.campaign.backends import (
     Backend,
@@ -423,7 +424,7 @@ def _run_local(
 
 
 def _connect(address: str, timeout_s: float) -> Any:
-    from distributed import Client
+    Client = require("distributed", "A campaign on a Dask cluster (--scheduler)").Client
 
     _probe(address, timeout_s)
     try:

@@ -8,10 +8,14 @@ the FEM as a :class:`~softbend.models.BendingModel`); ``verification``
 holds the closed-form cases solved with the same core.
 """
 
-# PyTorch before NGSolve: see softbend._torch.
+# PyTorch (if installed) before NGSolve: see softbend._torch.
 import softbend._torch  # noqa: F401  (import order)
-from softbend.fem.model import FEMModel
-from softbend.fem.options import GRAVITY_DIRECTIONS, OUTPUT_MODES, FEMOptions
-from softbend.fem.sweep import simulate
+from softbend._extras import require
+
+require("ngsolve", "The FEM (softbend.fem)")  # one line naming softbend[fem] if missing
+
+from softbend.fem.model import FEMModel  # noqa: E402
+from softbend.fem.options import GRAVITY_DIRECTIONS, OUTPUT_MODES, FEMOptions  # noqa: E402
+from softbend.fem.sweep import simulate  # noqa: E402
 
 __all__ = ["GRAVITY_DIRECTIONS", "OUTPUT_MODES", "FEMModel", "FEMOptions", "simulate"]

@@ -43,7 +43,7 @@ from dataclasses import dataclass, field
 import numpy as np
 from numpy.typing import ArrayLike
 
-from softbend._torch import torch
+from softbend._torch import require_torch
 from softbend._validation import check_int, check_range
 from softbend.errors import ConvergenceError
 from softbend.surrogates.mlp_core import (
@@ -54,6 +54,8 @@ from softbend.surrogates.mlp_core import (
     resolve_device,
     standardization,
 )
+
+torch = require_torch("the MLP surrogate (softbend.surrogates)")
 
 logger = logging.getLogger(__name__)
 

@@ -16,8 +16,10 @@ from numbers import Integral
 
 import numpy as np
 
-from softbend._torch import torch
+from softbend._torch import require_torch
 from softbend._validation import check_choice
+
+torch = require_torch("the MLP surrogate (softbend.surrogates)")
 
 __all__ = [
     "check_hidden_pair",

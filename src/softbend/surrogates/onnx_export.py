@@ -30,13 +30,15 @@ from pathlib import Path
 from typing import Any
 
 import numpy as np
-import onnx
 from numpy.typing import ArrayLike
-from onnx import TensorProto, helper, numpy_helper
 
 from softbend import __version__
+from softbend._extras import require
 from softbend.surrogates.features import FEATURES, TARGET, UNITS, check_features
 from softbend.surrogates.persistence import check_fitted_surrogate
+
+onnx = require("onnx", "ONNX export (softbend.surrogates.onnx_export)")
+TensorProto, helper, numpy_helper = onnx.TensorProto, onnx.helper, onnx.numpy_helper
 
 __all__ = ["DEFAULT_OPSET", "onnx_predict", "save_onnx", "to_onnx"]
 
@@ -149,7 +151,7 @@ def _double_graph(model: Any, kind: str, opset: int) -> onnx.ModelProto:
 
 
 def _xgboost_graph(model: Any, opset: int | None) -> onnx.ModelProto:
-    from onnxmltools import convert_xgboost
+    convert_xgboost = require("onnxmltools", "ONNX export of XGBoost").convert_xgboost
     from onnxmltools.convert.common._topology import get_maximum_opset_supported
     from onnxmltools.convert.common.data_types import FloatTensorType
 
@@ -271,8 +273,7 @@ def onnx_predict(
     ValueError
         ``X`` of the wrong shape or not finite, or a ``model`` of another type.
     """
-    import onnxruntime
-
+    onnxruntime = require("onnxruntime", "ONNX prediction (onnx_predict)")
     X = check_features(X, "onnx_predict")
     session = onnxruntime.InferenceSession(_as_bytes(model), providers=["CPUExecutionProvider"])
     (source,) = session.get_inputs()

@@ -41,6 +41,7 @@ import numpy as np
 from sklearn.exceptions import NotFittedError
 
 from softbend import __version__
+from softbend._extras import require
 from softbend._io import write_text_atomic
 from softbend.errors import SchemaError
 from softbend.surrogates.features import FEATURES, TARGET, UNITS
@@ -140,6 +141,8 @@ class SavedSurrogate:
 
 def _class_of(kind: str) -> type:
     module, name = _CLASSES[kind]
+    if module == "xgboost":
+        return getattr(require("xgboost", "An XGBoost surrogate"), name)
     return getattr(importlib.import_module(module), name)
 
 

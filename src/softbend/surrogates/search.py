@@ -38,6 +38,7 @@ from typing import Any
 import numpy as np
 import pandas as pd
 
+from softbend._extras import require
 from softbend._validation import check_choice, check_int, check_range
 from softbend.surrogates.features import TrainingData
 from softbend.surrogates.metrics import MAPE_THRESHOLD_DEG, accuracy, inference_time
@@ -247,7 +248,7 @@ def _make(
 
         return PolynomialRegressor(**params)
     if model == "xgb":
-        from xgboost import XGBRegressor
+        XGBRegressor = require("xgboost", "The XGBoost surrogate").XGBRegressor
 
         return XGBRegressor(
             n_estimators=XGB_TREES,

@@ -1,0 +1,124 @@
+"""softbend without its optional extras: what still works, and the one-line errors.
+
+Each case runs in a fresh interpreter in which the extras' packages cannot be
+imported (a meta-path hook refuses them), as on an installation without
+``softbend[fem]``, ``softbend[ml]`` or ``softbend[dask]``.
+"""
+
+from __future__ import annotations
+
+import subprocess
+import sys
+import textwrap
+
+import pytest
+
+from softbend._extras import EXTRAS, require
+from softbend.errors import MissingExtraError
+
+BLOCK = textwrap.dedent(
+    f"""
+    import sys
+
+    class _NotInstalled:
+        blocked = {sorted(EXTRAS)!r}
+
+        def find_spec(self, name, path=None, target=None):
+            if name.split(".")[0] in self.blocked:
+                raise ModuleNotFoundError(f"No module named {{name!r}}", name=name)
+            return None
+
+    sys.meta_path.insert(0, _NotInstalled())
+    """
+)
+
+
+XGB = (
+    "from softbend.surrogates.search import _make; "
+    "_make('xgb', {}, seed=0, n_jobs=1, device='cpu', epochs=1)"
+)
+
+
+def _run(code: str) -> subprocess.CompletedProcess[str]:
+    return subprocess.run(
+        [sys.executable, "-c", BLOCK + textwrap.dedent(code)],
+        capture_output=True,
+        text=True,
+        timeout=300,
+        check=False,
+    )
+
+
+def test_the_core_works_without_extras(tmp_path):
+    model = tmp_path / "plr.json"
+    done = _run(
+        f"""
+        import numpy as np
+        from softbend.kinematics import bending_from_tip, tip_position
+        from softbend.identification import NARXRegressor, synthetic_dataset
+        from softbend.analytical import AnalyticalModel
+        from softbend.design import SFRBADesign
+        from softbend.models import default_pressures_mpa
+        from softbend.surrogates.polynomial import PolynomialRegressor
+        from softbend.surrogates.persistence import load_surrogate, save_surrogate
+
+        experiment = synthetic_dataset(seed=0)["positive"][0]
+        narx = NARXRegressor().fit(experiment.pressure_kpa, experiment.rho)
+        assert np.isfinite(narx.simulate(experiment.pressure_kpa, experiment.rho)).all()
+        sweep = AnalyticalModel().sweep(SFRBADesign(100, 6, 2, 2, 5, 8), default_pressures_mpa(0.1))
+        X = np.random.default_rng(0).random((50, 7)) + 1.0
+        plr = PolynomialRegressor(degree=2).fit(X, X.sum(axis=1))
+        save_surrogate(plr, {str(model)!r})
+        assert np.allclose(load_surrogate({str(model)!r}).model.predict(X), plr.predict(X))
+        loaded = [m for m in ("torch", "ngsolve", "xgboost", "distributed") if m in sys.modules]
+        assert not loaded, loaded
+        print("ok", sweep.angle_deg[-1])
+        """
+    )
+    assert done.returncode == 0, done.stderr
+    assert done.stdout.startswith("ok")
+
+
+@pytest.mark.parametrize(
+    ("code", "extra"),
+    [
+        ("import softbend.fem", "softbend[fem]"),
+        ("from softbend.surrogates import NormalizedMLPRegressor", "softbend[ml]"),
+        (XGB, "softbend[ml]"),
+    ],
+)
+def test_a_missing_extra_is_one_error_naming_it(code, extra):
+    done = _run(
+        f"""
+        from softbend.errors import MissingExtraError
+        try:
+            {code}
+        except MissingExtraError as exc:
+            print(exc)
+        """
+    )
+    assert done.returncode == 0, done.stderr
+    assert extra in done.stdout and "pip install" in done.stdout
+
+
+def test_the_cli_exits_2_naming_the_extra():
+    done = _run(
+        """
+        from softbend.cli import main
+        sys.exit(main(["fem", "run", "--design", "100,6,2,2,5,8", "--pmax", "0.01"]))
+        """
+    )
+    assert done.returncode == 2, done.stderr
+    lines = done.stderr.strip().splitlines()
+    assert len(lines) == 1 and "softbend[fem]" in lines[0], done.stderr
+
+
+def test_require_names_the_package_and_the_extra(monkeypatch):
+    import importlib
+
+    def refuse(name):
+        raise ImportError(name)
+
+    monkeypatch.setattr(importlib, "import_module", refuse)
+    with pytest.raises(MissingExtraError, match=r"Dask distributed.*softbend\[dask\]"):
+        require("distributed", "A campaign on a Dask cluster")
