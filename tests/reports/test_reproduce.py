@@ -98,6 +98,8 @@ def test_report_has_both_papers_and_their_files(first_run):
         assert name in html or not name.endswith(".png"), name
     assert len(list((out / "paper_a" / "data").glob("*.csv"))) == 12
     json.dumps(summary)  # the headline figures are JSON-serializable
+    written = json.loads((out / "summary.json").read_text(encoding="utf-8"))
+    assert written["report"] == summary["report"] and written["seed"] == 0
 
 
 def test_progress_reaches_every_total(first_run):
@@ -176,3 +178,20 @@ def test_fem_data_section_reads_the_dataset_and_compares_both_protocols(first_ru
     html = (out / "index.html").read_text(encoding="utf-8")
     assert "Figs. 4 and 5 on softbend" in html and "random CV" in html
     assert "stand-in for the test" in html
+
+
+def test_the_report_as_a_user_sees_it_in_chromium(first_run, tmp_path):
+    from .conftest import open_in_browser
+
+    out, _, _ = first_run
+    html = (out / "index.html").read_text(encoding="utf-8")
+    seen = open_in_browser(out / "index.html", screenshot=tmp_path / "report.png")
+    assert seen["console_errors"] == []
+    assert seen["broken_images"] == []
+    assert len(seen["images"]) == html.count("<img ") >= 15
+    # Every section is listed in the contents and every link lands on one.
+    assert seen["toc_targets"] == [s for s in seen["section_ids"] if s != "provenance"]
+    assert len(seen["toc_targets"]) == html.count("<section id=") - 1 >= 5
+    assert seen["section_ids"][-1] == "provenance"
+    assert seen["tables"] == html.count("<table>") >= 15
+    assert "0.23094937748277466" not in html  # no 17-digit reprs

@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import sys
 from pathlib import Path
 
 import typer
@@ -21,7 +22,13 @@ def reproduce(
     from softbend.reports.reproduce import run_reproduce
 
     with _common.phase_progress(enabled=not as_json) as progress:
-        summary = run_reproduce(out, seed=seed, workers=workers, progress=progress)
+        summary = run_reproduce(
+            out,
+            seed=seed,
+            workers=workers,
+            progress=progress,
+            command=" ".join(["softbend", *sys.argv[1:]]) if sys.argv[1:] else None,
+        )
     if as_json:
         _common.print_json(summary)
         return

@@ -122,16 +122,7 @@ def add_section(
         ],
         caption="Campaign",
     )
-    section.table(
-        ["feature", "loading", "t", "p", "sig.", "paper B loading"],
-        loadings_rows(regression),
-        caption="Standardized multiple linear regression of the bending angle",
-    )
-    section.table(
-        ["metric", "softbend", "paper B"],
-        fit_rows(regression),
-        caption="Fit of the linear model",
-    )
+    add_regression_tables(section, regression)
     captions = {
         "curves": "Bending angle of the seven Fig. 7 actuators (curves that coincide differ "
         "only in φ or lc)",
@@ -142,6 +133,24 @@ def add_section(
     for key, caption in captions.items():
         if key in figures:
             section.figure(figures[key], caption, root=root)
+
+
+def add_regression_tables(section: Any, regression: Any, data: str = "") -> None:
+    """The loadings and the fit of paper B's linear model beside paper B's, as two tables.
+
+    ``data`` names the data in the captions and the column (e.g. ``"FEM"``).
+    """
+    suffix = f" ({data} data)" if data else ""
+    section.table(
+        ["feature", "loading", "t", "p", "sig.", "paper B loading"],
+        loadings_rows(regression),
+        caption=f"Standardized multiple linear regression of the bending angle{suffix}",
+    )
+    section.table(
+        ["metric", f"softbend {data}".rstrip(), "paper B"],
+        fit_rows(regression),
+        caption=f"Fit of the linear model{suffix}",
+    )
 
 
 def loadings_rows(regression: RegressionReport) -> list[list[Any]]:

@@ -96,7 +96,7 @@ def add_section(
     )
     from softbend.datasets import table1_fem, table1_fem_designs, table1_fem_provenance
     from softbend.reports import analysis_figures
-    from softbend.reports.paper_b import PAPER_B_FIG4, PAPER_B_SAMPLES, fit_rows, loadings_rows
+    from softbend.reports.paper_b import PAPER_B_FIG4, PAPER_B_SAMPLES, add_regression_tables
     from softbend.surrogates.search import MODEL_TITLES
     from softbend.surrogates.workflow import PAPER_B_FIG5
 
@@ -151,16 +151,7 @@ def add_section(
         ],
         caption="The FEM dataset",
     )
-    section.table(
-        ["feature", "loading", "t", "p", "sig.", "paper B loading"],
-        loadings_rows(regression),
-        caption="Standardized multiple linear regression of the bending angle (FEM data)",
-    )
-    section.table(
-        ["metric", "softbend FEM", "paper B"],
-        fit_rows(regression),
-        caption="Fit of the linear model (FEM data)",
-    )
+    add_regression_tables(section, regression, "FEM")
     section.text(
         f"Why the numbers differ from paper B: its sweeps stopped where ABAQUS stopped "
         f"converging ({PAPER_B_SAMPLES} samples over 972 designs, about 30 per design), ours at "
@@ -238,6 +229,7 @@ def add_section(
     return {
         "seconds": time.perf_counter() - start,
         "designs_done": len(done),
+        "samples_sha256": provenance["files"]["samples.parquet"]["sha256"],
         "samples": len(samples),
         "converged_samples": len(converged),
         "stops": {str(k): int(v) for k, v in stops.items()},

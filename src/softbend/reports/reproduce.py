@@ -12,7 +12,9 @@ softbend can reproduce, and the data, models and figures beside it:
 
 from __future__ import annotations
 
+import json
 import logging
+import os
 import platform
 import time
 from collections.abc import Callable
@@ -21,6 +23,7 @@ from pathlib import Path
 from typing import Any
 
 from softbend import __version__
+from softbend._io import write_text_atomic
 from softbend._validation import check_range
 from softbend.design import DesignSpace
 from softbend.reports.html import Report
@@ -193,6 +196,7 @@ def run_reproduce(
     fem_pmax_mpa: float | None = None,
     fem_dataset: str | Path | None = None,
     fem_dataset_epochs: int | None = None,
+    command: str | None = None,
 ) -> dict[str, Any]:
     """Run every reproducible section and write ``out_dir/index.html``.
 
@@ -216,11 +220,14 @@ def run_reproduce(
         The FEM dataset of the Figs. 4 and 5 section on FEM data (default: the
         one shipped in the package, read, never recomputed) and its MLP epochs
         (default: the quick grid's).
+    command : str, optional
+        The command line that started the run, shown in the report's provenance.
 
     Returns
     -------
     dict
-        Headline figures per section, the report path and the wall time.
+        Headline figures per section, the report path and the wall time (also
+        written to ``out_dir/summary.json``).
     """
     if workers is not None:
         # Checked before any work starts, not after paper A.
@@ -263,7 +270,25 @@ def run_reproduce(
     summary["paper_b_fem_data"] = paper_b_fem_data.add_section(
         report, out_dir, seed, progress, dataset=fem_dataset, epochs=fem_dataset_epochs
     )
+    finished = datetime.now(UTC)
+    summary["seconds"] = (finished - started).total_seconds()
+    fem_data = summary["paper_b_fem_data"]
+    report.provenance = {
+        "command": command or f"run_reproduce({str(out_dir)!r}, seed={seed})",
+        "softbend": __version__,
+        "Python": f"{platform.python_version()} ({platform.python_implementation()})",
+        "machine": f"{platform.system()} {platform.machine()}, {os.cpu_count()} logical CPUs",
+        "seed": seed,
+        "campaign workers": "all cores" if workers is None else workers,
+        "FEM dataset": (
+            f"{fem_data['designs_done']} of 972 Table 1 designs, samples.parquet SHA-256 "
+            f"{fem_data['samples_sha256'][:16]}…"
+        ),
+        "started (UTC)": f"{started:%Y-%m-%d %H:%M:%S}",
+        "finished (UTC)": f"{finished:%Y-%m-%d %H:%M:%S}",
+        "wall time": f"{summary['seconds']:.0f} s",
+    }
     path = report.write(out_dir / "index.html")
     summary["report"] = str(path)
-    summary["seconds"] = (datetime.now(UTC) - started).total_seconds()
+    write_text_atomic(out_dir / "summary.json", json.dumps(summary, indent=2, default=str) + "\n")
     return summary
