@@ -14,12 +14,9 @@ app = typer.Typer(
     no_args_is_help=True,
 )
 
-#: Files written by ``fem run`` into ``--out``.
-SWEEP_CSV = "sweep.csv"
+#: Solver statistics written by ``fem run`` beside the files of
+#: :func:`softbend.reports.fem_figures.sweep_with_files`.
 SWEEP_JSON = "sweep.json"
-CURVE_PNG = "angle_pressure.png"
-SHAPES_PNG = "shapes.png"
-VTK_DIR = "vtk"
 
 DesignOption = Annotated[
     str,
@@ -59,14 +56,10 @@ def run(
     analytical model), shapes.png (deformed shapes, paper B Fig. 2b) and
     vtk/shape_<kPa>kPa.vtu (e.g. shape_050p00kPa.vtu) for ParaView (apply Warp By Vector).
     """
-    import numpy as np
-
     from softbend._io import write_text_atomic
-    from softbend.campaign.backends import default_pressures_mpa, get_backend
     from softbend.design import SFRBADesign
-    from softbend.fem.export import silhouette_mm, write_sweep_csv, write_vtk
-    from softbend.fem.sweep import run_sweep
-    from softbend.reports.fem_figures import angle_pressure_curve, deformed_shapes
+    from softbend.models import default_pressures_mpa
+    from softbend.reports.fem_figures import sweep_with_files
 
     actuator = SFRBADesign.parse(design)
     pressures = default_pressures_mpa(pmax, step)
@@ -84,11 +77,16 @@ def run(
             advance(max(done - state["done"], 0), p=f"{pressure:.4f} MPa", angle=f"{angle:.1f}°")
             state["done"] = max(done, state["done"])
 
-        result, model, history = run_sweep(
-            actuator, pressures, options, progress=on_step, keep_states=True
+        sweep = sweep_with_files(
+            actuator,
+            pressures,
+            options,
+            out,
+            shape_pressures_mpa=shapes,
+            vtk=True,
+            progress=on_step,
         )
-    out.mkdir(parents=True, exist_ok=True)
-    write_sweep_csv(result, out / SWEEP_CSV)
+    result = sweep.result
     summary = {
         "design": str(actuator),
         "stop_reason": result.stats["stop_reason"],
@@ -99,15 +97,6 @@ def run(
         "stats": result.stats,
     }
     write_text_atomic(out / SWEEP_JSON, _common.json_text(summary))
-    analytical = get_backend("analytical").sweep(actuator, pressures)
-    angle_pressure_curve(result, out / CURVE_PNG, analytical=analytical)
-    outlines = []
-    for chosen in history.nearest_steps(np.linspace(0.0, history.pressures[-1], shapes)):
-        model.set_state(chosen.state)
-        outlines.append((chosen.pressure_mpa, silhouette_mm(model)))
-        kpa = f"{1000 * chosen.pressure_mpa:06.2f}".replace(".", "p")
-        write_vtk(model, out / VTK_DIR / f"shape_{kpa}kPa.vtu")
-    deformed_shapes(outlines, out / SHAPES_PNG, title=f"Design ({actuator}), FEM")
     if json_output:
         _common.print_json(
             {**summary, "pressure_mpa": result.pressure_mpa, "angle_deg": result.angle_deg}

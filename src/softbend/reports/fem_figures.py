@@ -2,15 +2,17 @@
 
 from __future__ import annotations
 
-from collections.abc import Sequence
+from collections.abc import Callable, Sequence
+from dataclasses import dataclass, field
 from pathlib import Path
+from typing import Any
 
 import numpy as np
 
-from softbend.campaign.backends import SweepResult
+from softbend.models import SweepResult
 from softbend.reports.analysis_figures import _figure, _save
 
-__all__ = ["angle_pressure_curve", "deformed_shapes"]
+__all__ = ["FEMSweepFiles", "angle_pressure_curve", "deformed_shapes", "sweep_with_files"]
 
 
 def angle_pressure_curve(
@@ -78,3 +80,95 @@ def deformed_shapes(
     ax.grid(alpha=0.3)
     ax.legend(fontsize=8, loc="best")
     return _save(fig, path)
+
+
+@dataclass(frozen=True)
+class FEMSweepFiles:
+    """One FEM sweep of :func:`sweep_with_files`, what it was compared with and its files.
+
+    Attributes
+    ----------
+    result, analytical : SweepResult
+        The FEM sweep and the analytical model's on the same grid.
+    shape_pressures_mpa : list of float
+        Pressures of the converged steps whose shapes were drawn (and exported).
+    steps : int
+        Load steps of the sweep (the gravity step not counted).
+    files : dict
+        ``{"csv", "curve", "shapes"}`` paths, and ``"vtk"`` paths when exported.
+    """
+
+    result: SweepResult
+    analytical: SweepResult
+    shape_pressures_mpa: list[float]
+    steps: int
+    files: dict[str, Any] = field(default_factory=dict)
+
+
+def sweep_with_files(
+    design: Any,
+    pressures_mpa: Any,
+    options: Any,
+    out_dir: str | Path,
+    *,
+    shape_pressures_mpa: Sequence[float] | int,
+    prefix: str = "",
+    vtk: bool = False,
+    progress: Callable[[float, float, float], None] | None = None,
+) -> FEMSweepFiles:
+    """Sweep one design with the FEM and write what a person looks at.
+
+    Writes ``<prefix>sweep.csv`` (pressure, angle, tip, converged, Newton
+    iterations), ``<prefix>angle_pressure.png`` (with the analytical model) and
+    ``<prefix>shapes.png`` (the deformed actuator at the converged steps nearest
+    to ``shape_pressures_mpa``, paper B Fig. 2b), and with ``vtk`` the same
+    shapes as ``vtk/shape_<kPa>kPa.vtu`` for ParaView.
+
+    Parameters
+    ----------
+    design : SFRBADesign
+    pressures_mpa : array_like
+        Output pressures, MPa, increasing.
+    options : FEMOptions or None
+    out_dir : path
+        Folder of the files (created).
+    shape_pressures_mpa : sequence of float or int
+        Where to draw the shape, MPa; an integer ``n`` draws ``n`` shapes evenly
+        spaced from 0 to the last converged step.
+    prefix : str
+        Start of every file name.
+    vtk : bool
+        Also export the shapes as VTK.
+    progress : callable, optional
+        ``progress(pressure_mpa, angle_deg, target_mpa)`` after each load step.
+    """
+    from softbend.analytical import AnalyticalModel
+    from softbend.fem.export import silhouette_mm, write_sweep_csv, write_vtk
+    from softbend.fem.sweep import run_sweep
+
+    out = Path(out_dir)
+    out.mkdir(parents=True, exist_ok=True)
+    result, model, history = run_sweep(
+        design, pressures_mpa, options, progress=progress, keep_states=True
+    )
+    files: dict[str, Any] = {"csv": write_sweep_csv(result, out / f"{prefix}sweep.csv")}
+    analytical = AnalyticalModel().sweep(design, pressures_mpa)
+    files["curve"] = angle_pressure_curve(
+        result, out / f"{prefix}angle_pressure.png", analytical=analytical
+    )
+    if isinstance(shape_pressures_mpa, int):
+        shape_pressures_mpa = np.linspace(0.0, history.pressures[-1], shape_pressures_mpa)
+    outlines, drawn, vtk_files = [], [], []
+    for chosen in history.nearest_steps(shape_pressures_mpa):
+        model.set_state(chosen.state)
+        outlines.append((chosen.pressure_mpa, silhouette_mm(model)))
+        drawn.append(float(chosen.pressure_mpa))
+        if vtk:
+            kpa = f"{1000 * chosen.pressure_mpa:06.2f}".replace(".", "p")
+            vtk_files.append(write_vtk(model, out / "vtk" / f"shape_{kpa}kPa.vtu"))
+    files["shapes"] = deformed_shapes(
+        outlines, out / f"{prefix}shapes.png", title=f"Design ({design}), FEM"
+    )
+    if vtk:
+        files["vtk"] = vtk_files
+    return FEMSweepFiles(result, analytical, drawn, len(history.steps) - 1, files)

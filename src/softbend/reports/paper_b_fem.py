@@ -27,12 +27,10 @@ def add_section(
     ``options`` (:class:`softbend.fem.FEMOptions`) and ``pmax_mpa`` default to
     the model's defaults and paper B's 0.17 MPa.
     """
-    from softbend.campaign.backends import default_pressures_mpa, get_backend
     from softbend.design import SFRBADesign
-    from softbend.fem.export import silhouette_mm, write_sweep_csv
-    from softbend.fem.sweep import run_sweep
     from softbend.materials import fit_models, load_shipped
-    from softbend.reports.fem_figures import angle_pressure_curve, deformed_shapes
+    from softbend.models import default_pressures_mpa
+    from softbend.reports.fem_figures import sweep_with_files
     from softbend.reports.material_figures import fit_figure
 
     start = time.perf_counter()
@@ -62,21 +60,19 @@ def add_section(
         if progress is not None:
             progress(phase, round(1000 * pressure), total)
 
-    result, model, history = run_sweep(
-        design, pressures, options, progress=on_step, keep_states=True
+    sweep = sweep_with_files(
+        design,
+        pressures,
+        options,
+        folder,
+        shape_pressures_mpa=[0.0, 0.05, 0.10, pmax_mpa],
+        prefix="fem_",
+        progress=on_step,
     )
     if progress is not None:
         progress(phase, total, total)
-    write_sweep_csv(result, folder / "fem_sweep.csv")
-    analytical = get_backend("analytical").sweep(design, pressures)
-    curve_png = angle_pressure_curve(
-        result, folder / "fem_angle_pressure.png", analytical=analytical
-    )
-    outlines = []
-    for step in history.nearest_steps([0.0, 0.05, 0.10, pmax_mpa]):
-        model.set_state(step.state)
-        outlines.append((step.pressure_mpa, silhouette_mm(model)))
-    shapes_png = deformed_shapes(outlines, folder / "fem_shapes.png", title=f"Design ({design})")
+    result, analytical = sweep.result, sweep.analytical
+    curve_png, shapes_png = sweep.files["curve"], sweep.files["shapes"]
     picks = sorted({p for p in (0.0, 0.05, 0.10, 0.15, pmax_mpa) if p <= pmax_mpa})
     rows = []
     for p in picks:
@@ -90,7 +86,7 @@ def add_section(
         caption=(
             f"Design ({design}) swept from 0 to {pmax_mpa:g} MPa: {result.mesh_size} quadratic "
             f"tetrahedra (half model), {result.stats['ndof']} unknowns, "
-            f"{len(history.steps) - 1} pressure steps, {int(timings['iterations'])} Newton "
+            f"{sweep.steps} pressure steps, {int(timings['iterations'])} Newton "
             f"iterations, {result.wall_time_s:.0f} s; stop: {result.stats['stop_reason']}. "
             "The analytical model has no gravity (0° at 0 MPa) and no bulging."
         ),
