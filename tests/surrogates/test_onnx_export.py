@@ -14,18 +14,9 @@ from softbend.surrogates.onnx_export import DEFAULT_OPSET, onnx_predict, save_on
 from softbend.surrogates.persistence import KINDS, load_surrogate, save_surrogate
 from softbend.surrogates.polynomial import PolynomialRegressor, monomial_powers
 
-# Paper B Table 1: l, r, t, b, phi, lc, and the pressure range.
-LOW = np.array([100.0, 6.0, 2.0, 2.0, 5.0, 8.0, 0.0])
-HIGH = np.array([160.0, 10.0, 4.0, 4.0, 15.0, 12.0, 0.5])
-
-
-def _inputs(n, seed):
-    return LOW + (HIGH - LOW) * np.random.default_rng(seed).random((n, LOW.size))
-
-
-def _angle(X):
-    length, r, t, b, phi, lc, p = X.T
-    return 250.0 * p * (length / 130.0) * (r / 8.0) / (t * (1.0 + 0.02 * phi)) - 0.3 * b + 0.1 * lc
+from .conftest import HIGH, LOW
+from .conftest import smooth_angle as _angle
+from .conftest import table1_inputs as _inputs
 
 
 @pytest.fixture(scope="module")

@@ -10,7 +10,6 @@ from sklearn.pipeline import make_pipeline
 from sklearn.preprocessing import PolynomialFeatures, StandardScaler
 from sklearn.utils.estimator_checks import parametrize_with_checks
 
-from softbend.surrogates.features import FEATURES
 from softbend.surrogates.polynomial import (
     PolynomialRegressor,
     monomial_powers,
@@ -18,14 +17,7 @@ from softbend.surrogates.polynomial import (
     system_memory_mb,
 )
 
-# Ranges of paper B's design space (Table 1) and pressure, in FEATURES order.
-LOW = np.array([100.0, 6.0, 2.0, 2.0, 5.0, 8.0, 0.0])
-HIGH = np.array([160.0, 10.0, 4.0, 4.0, 15.0, 12.0, 0.5])
-
-
-def _design_samples(n_samples, seed):
-    rng = np.random.default_rng(seed)
-    return LOW + (HIGH - LOW) * rng.random((n_samples, len(FEATURES)))
+from .conftest import table1_inputs as _design_samples
 
 
 def _monomials(Z, powers):
