@@ -135,6 +135,15 @@ def add_section(
             section.figure(figures[key], caption, root=root)
 
 
+def surrogate_cells(name: str, model: dict[str, Any]) -> list[Any]:
+    """Model, configuration, R², RMSE, MAPE, max error and inference times of a family."""
+    from softbend.surrogates.search import MODEL_TITLES
+
+    keys = ("params", "r2", "rmse_deg", "mape_pct", "max_abs_error_deg")
+    timing = ("inference_single_us", "inference_batch_ms")
+    return [MODEL_TITLES[name], *(model[k] for k in keys), *(model[k] for k in timing)]
+
+
 def add_regression_tables(section: Any, regression: Any, data: str = "") -> None:
     """The loadings and the fit of paper B's linear model beside paper B's, as two tables.
 
@@ -194,7 +203,6 @@ def fig7_design_ids() -> list[str]:
 
 def add_surrogate_section(report: Report, summary: dict[str, Any], *, root: Path) -> None:
     """Append the surrogate search (paper B Fig. 5) to ``report``."""
-    from softbend.surrogates.search import MODEL_TITLES
 
     settings = summary["settings"]
     section = report.section("Paper B — surrogate models (Fig. 5)")
@@ -214,14 +222,7 @@ def add_surrogate_section(report: Report, summary: dict[str, Any], *, root: Path
         paper = m["paper_b"]
         rows.append(
             [
-                MODEL_TITLES[name],
-                m["params"],
-                m["r2"],
-                m["rmse_deg"],
-                m["mape_pct"],
-                m["max_abs_error_deg"],
-                m["inference_single_us"],
-                m["inference_batch_ms"],
+                *surrogate_cells(name, m),
                 m.get("onnx_max_abs_diff_deg", ""),
                 paper["params"],
                 paper["r2"],

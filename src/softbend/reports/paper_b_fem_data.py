@@ -96,8 +96,12 @@ def add_section(
     )
     from softbend.datasets import table1_fem, table1_fem_designs, table1_fem_provenance
     from softbend.reports import analysis_figures
-    from softbend.reports.paper_b import PAPER_B_FIG4, PAPER_B_SAMPLES, add_regression_tables
-    from softbend.surrogates.search import MODEL_TITLES
+    from softbend.reports.paper_b import (
+        PAPER_B_FIG4,
+        PAPER_B_SAMPLES,
+        add_regression_tables,
+        surrogate_cells,
+    )
     from softbend.surrogates.workflow import PAPER_B_FIG5
 
     start = time.perf_counter()
@@ -175,14 +179,7 @@ def add_section(
         paper = PAPER_B_FIG5[name]
         rows.append(
             [
-                MODEL_TITLES[name],
-                m["params"],
-                m["r2"],
-                m["rmse_deg"],
-                m["mape_pct"],
-                m["max_abs_error_deg"],
-                m["inference_single_us"],
-                m["inference_batch_ms"],
+                *surrogate_cells(name, m),
                 other.get("r2", ""),
                 other.get("mape_pct", ""),
                 f"{paper['params']}: R² {paper['r2']}, MAPE {paper['mape_pct']} %",
