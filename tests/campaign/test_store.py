@@ -313,3 +313,77 @@ def test_merge_takes_done_designs_over_failed_and_refuses_another_campaign(tmp_p
         other.record_success(_sweep(A, default_pressures_mpa(0.5, 0.1)))
     with CampaignStore(tmp_path / "a.duckdb") as a, pytest.raises(ValueError, match="pressures"):
         a.merge(tmp_path / "other.duckdb")
+
+
+def _campaign_file(tmp_path):
+    """A closed campaign database with two done designs, and its bytes."""
+    path = tmp_path / "good.duckdb"
+    with CampaignStore(path) as opened:
+        opened.bind("analytical", GRID)
+        opened.record_success(_sweep(A))
+        opened.record_success(_sweep(B))
+    return path, path.read_bytes()
+
+
+def _overwrite_every_block(data: bytes) -> bytes:
+    """Garbage over the first 4 KiB of every 256 KiB block (after its checksum)."""
+    corrupt = bytearray(data)
+    block, header = 262144, 3 * 4096
+    for start in range(header, len(corrupt) - block + 1, block):
+        corrupt[start + 8 : start + 4096] = b"\xa5" * (4096 - 8)
+    return bytes(corrupt)
+
+
+_BROKEN_FILES = {
+    "truncated to 600000 bytes": lambda data: data[:600000],
+    "truncated by 5000 bytes": lambda data: data[:-5000],
+    "headers only": lambda data: data[: 3 * 4096],
+    "truncated to 100 bytes": lambda data: data[:100],
+    "garbage in every block": _overwrite_every_block,
+    "a csv renamed": lambda data: b"design_id,angle_deg\nd1,12.5\n",
+    "empty": lambda data: b"",
+    "random bytes": lambda data: np.random.default_rng(0).bytes(len(data)),
+}
+
+
+@pytest.mark.parametrize("read_only", [True, False], ids=["read-only", "read-write"])
+@pytest.mark.parametrize("damage", list(_BROKEN_FILES))
+def test_unreadable_files_are_one_schema_error_naming_the_file(tmp_path, damage, read_only):
+    _, data = _campaign_file(tmp_path)
+    broken = tmp_path / "broken.duckdb"
+    broken.write_bytes(_BROKEN_FILES[damage](data))
+    before = broken.read_bytes()
+    with pytest.raises(SchemaError) as info:
+        CampaignStore(broken, read_only=read_only)
+    message = str(info.value)
+    assert message.startswith(f"{str(broken)!r} is not a readable softbend campaign database (")
+    assert message.endswith(").") and "\n" not in message and len(message) < 400
+    assert broken.read_bytes() == before  # refused without writing to it
+    with pytest.raises(SchemaError, match="not a readable softbend campaign database"):
+        load_samples(broken)
+
+
+def test_a_truncated_file_names_the_sizes(tmp_path):
+    path, data = _campaign_file(tmp_path)
+    broken = tmp_path / "t.duckdb"
+    broken.write_bytes(data[:600000])
+    with pytest.raises(
+        SchemaError, match=r"\(truncated: 600000 bytes, its blocks in use need \d+\)"
+    ):
+        CampaignStore(broken, read_only=True)
+    with CampaignStore(path, read_only=True) as intact:  # the original still reads
+        assert intact.status_summary()["done"] == 2
+
+
+def test_a_damaged_samples_block_is_found_when_opening_not_on_a_later_query(tmp_path):
+    path, data = _campaign_file(tmp_path)
+    block_id = _count(
+        path, "SELECT max(block_id) FROM pragma_storage_info('samples') WHERE persistent"
+    )
+    start = 3 * 4096 + block_id * 262144
+    corrupt = bytearray(data)
+    corrupt[start + 8 : start + 4096] = b"\xa5" * (4096 - 8)
+    broken = tmp_path / "broken.duckdb"
+    broken.write_bytes(bytes(corrupt))
+    with pytest.raises(SchemaError, match=r"not a readable .*\(Corrupt database file: "):
+        CampaignStore(broken, read_only=True)

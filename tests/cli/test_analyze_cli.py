@@ -159,3 +159,27 @@ def test_analyze_an_analytical_campaign(tmp_path, capsys):
     assert payload["n_mape_excluded"] >= len(designs)
     for name in OUTPUTS:
         assert (out / name).stat().st_size > 0
+
+
+def test_truncated_database_is_one_line_naming_the_file(tmp_path, capsys):
+    """``head -c 600000 good.duckdb > t.duckdb``: one line and exit 2, no traceback."""
+    store = pytest.importorskip("softbend.campaign.store")
+    from softbend.campaign import default_pressures_mpa
+    from softbend.campaign.backends import AnalyticalBackend
+    from softbend.design import SFRBADesign
+
+    good = tmp_path / "good.duckdb"
+    grid = default_pressures_mpa(0.1, 0.05)
+    with store.CampaignStore(good) as opened:
+        opened.bind("analytical", grid)
+        for l_mm in (100.0, 120.0, 140.0):
+            design = SFRBADesign(l_mm, 8.0, 3.0, 2.0, 5.0, 10.0)
+            opened.record_success(AnalyticalBackend().sweep(design, grid))
+    data = good.read_bytes()
+    db = tmp_path / "t.duckdb"
+    db.write_bytes(data[: min(600000, len(data) // 2)])
+    assert main(["analyze", str(db), "--out", str(tmp_path / "o")]) == 2
+    err = capsys.readouterr().err.strip().splitlines()
+    assert len(err) == 1, err
+    assert f"{str(db)!r} is not a readable softbend campaign database (truncated" in err[0]
+    assert not (tmp_path / "o").exists()

@@ -220,3 +220,48 @@ def test_help_lists_the_subcommands_and_options(capsys):
     out = capsys.readouterr().out
     for option in ("--backend", "--space", "--scheduler", "--retry-failed", "--json", "--pmax"):
         assert option in out
+
+
+def test_a_truncated_database_is_one_line_and_exit_2_for_every_subcommand(tmp_path, capsys):
+    """``head -c 600000 good.duckdb > t.duckdb`` used to end in a traceback."""
+    good = tmp_path / "good.duckdb"
+    assert main(["campaign", "run", str(good), *RUN, "--workers", "0", "--json"]) == 0
+    capsys.readouterr()
+    data = good.read_bytes()
+    db = tmp_path / "t.duckdb"
+    db.write_bytes(data[: min(600000, len(data) // 2)])
+    before = db.read_bytes()
+    for argv in (
+        ["campaign", "status", str(db)],
+        ["campaign", "status", str(db), "--json"],
+        ["campaign", "export", str(db), str(tmp_path / "x.parquet")],
+        ["campaign", "export", str(db), str(tmp_path / "x.csv"), "--table", "designs"],
+        ["campaign", "run", str(db), *RUN, "--workers", "0"],
+    ):
+        assert main(argv) == 2, argv
+        line = one_error_line(capsys)
+        assert f"{str(db)!r} is not a readable softbend campaign database (truncated" in line
+    assert db.read_bytes() == before
+    assert not (tmp_path / "x.parquet").exists() and not (tmp_path / "x.csv").exists()
+
+
+@pytest.mark.parametrize(
+    ("content", "reason"),
+    [
+        (b"design_id,angle_deg\nd1,12.5\n", "not a DuckDB database file"),
+        (b"", "not a DuckDB database file"),
+    ],
+    ids=["a csv renamed", "empty"],
+)
+def test_a_file_that_is_no_database_is_one_line_for_status_and_export(
+    tmp_path, capsys, content, reason
+):
+    db = tmp_path / "c.duckdb"
+    db.write_bytes(content)
+    for argv in (
+        ["campaign", "status", str(db)],
+        ["campaign", "export", str(db), str(tmp_path / "x.csv")],
+    ):
+        assert main(argv) == 2
+        line = one_error_line(capsys)
+        assert f"{str(db)!r} is not a readable softbend campaign database ({reason})" in line

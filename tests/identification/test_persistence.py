@@ -64,3 +64,137 @@ def test_only_gg_svr_models_can_be_saved(tmp_path):
     model = NARXRegressor(estimator=LinearRegression()).fit(u, y)
     with pytest.raises(ValueError, match="GeneralizedGaussianSVR"):
         save_narx(model, tmp_path / "m.json")
+
+
+def test_unscaled_multi_input_models_without_current_input_round_trip(tmp_path):
+    rng = np.random.default_rng(4)
+    u = rng.uniform(-1, 1, (300, 2))
+    y = np.convolve(u[:, 0] - 0.5 * u[:, 1], [0.5, 0.3, 0.1], mode="same")
+    model = NARXRegressor(
+        estimator=GeneralizedGaussianSVR(sigma=1.0, shape=2.0),
+        output_lags=1,
+        input_lags=3,
+        include_current_input=False,
+        scale=False,
+    ).fit(u, y)
+    loaded, _ = load_narx(save_narx(model, tmp_path / "m.json"))
+    np.testing.assert_array_equal(model.predict_one_step(u, y), loaded.predict_one_step(u, y))
+
+
+def _first_row(key):
+    def change(data):
+        data["estimator"][key][0] = [float("nan"), *data["estimator"][key][0][1:]]
+
+    return change
+
+
+_CORRUPTIONS = [
+    (
+        "nan dual coef",
+        lambda d: d["estimator"]["dual_coef"].__setitem__(0, float("nan")),
+        r"'estimator.dual_coef\[0\]' must be a finite number",
+    ),
+    (
+        "string dual coef",
+        lambda d: d["estimator"]["dual_coef"].__setitem__(0, "0.5"),
+        r"'estimator.dual_coef\[0\]' must be a finite number",
+    ),
+    ("nan support vector", _first_row("support_vectors"), r"support_vectors\[0\]\[0\]"),
+    (
+        "support vector removed",
+        lambda d: d["estimator"]["support_vectors"].pop(),
+        "'estimator.support_vectors' must be a list of",
+    ),
+    (
+        "support vector column removed",
+        lambda d: d["estimator"]["support_vectors"][0].pop(),
+        r"'estimator.support_vectors\[0\]' must be a list of 4 numbers",
+    ),
+    ("zero sigma", lambda d: d["estimator"].update(sigma=0.0), "'estimator.sigma' .* > 0"),
+    ("string sigma", lambda d: d["estimator"].update(sigma="1.0"), "'estimator.sigma'"),
+    ("shape above 2", lambda d: d["estimator"].update(shape=3.0), "'estimator.shape'.*<= 2"),
+    (
+        "negative kernel scale",
+        lambda d: d["estimator"].update(kernel_scale=-1.0),
+        "'estimator.kernel_scale'",
+    ),
+    (
+        "infinite intercept",
+        lambda d: d["estimator"].update(intercept=float("inf")),
+        "'estimator.intercept'",
+    ),
+    (
+        "wrong feature count",
+        lambda d: d["estimator"].update(n_features_in=5),
+        "'estimator.n_features_in' must be 4",
+    ),
+    ("other estimator", lambda d: d["estimator"].update({"class": "SVR"}), "'estimator.class'"),
+    ("bad C", lambda d: d["estimator"]["params"].update(C=-1), "'estimator.params.C'"),
+    (
+        "unknown estimator key",
+        lambda d: d["estimator"].update(predict=1),
+        "unknown key.*'predict' in 'estimator'; allowed keys: class",
+    ),
+    (
+        "unknown svr param",
+        lambda d: d["estimator"]["params"].update(kernel="rbf"),
+        "unknown key.*'kernel' in 'estimator.params'",
+    ),
+    ("unknown top-level key", lambda d: d.update(extra=1), r"'extra' in '\(top level\)'"),
+    ("missing key", lambda d: d["narx"].pop("max_lag"), "'narx' lacks the key.*max_lag"),
+    (
+        "lags and offsets disagree",
+        lambda d: d["narx"].update(output_offsets=[1, 3]),
+        "'narx.output_offsets' must be \\[1, 2\\]",
+    ),
+    (
+        "string lag",
+        lambda d: d["narx"]["params"].update(output_lags="2"),
+        "'narx.params.output_lags' must be an integer >= 1",
+    ),
+    (
+        "zero scale",
+        lambda d: d["narx"]["y_scaler"].update(scale=[0.0]),
+        r"'narx.y_scaler.scale\[0\]' must be a finite number > 0",
+    ),
+    (
+        "nan mean",
+        lambda d: d["narx"]["u_scaler"].update(mean=[float("nan")]),
+        r"'narx.u_scaler.mean\[0\]'",
+    ),
+    (
+        "scaler for two inputs",
+        lambda d: d["narx"]["u_scaler"].update(mean=[0.0, 1.0]),
+        "'narx.u_scaler.mean' must be a list of 1 numbers",
+    ),
+    (
+        "scaler without scaling",
+        lambda d: d["narx"]["params"].update(scale=False),
+        "'narx.y_scaler' must be null",
+    ),
+    ("metadata not an object", lambda d: d.update(metadata=[1]), "'metadata' must be a JSON"),
+    ("not an object", lambda d: d["narx"].update(params=[2, 2]), "'narx.params' must be a JSON"),
+]
+
+
+@pytest.mark.parametrize(
+    ("change", "match"), [pytest.param(c, m, id=name) for name, c, m in _CORRUPTIONS]
+)
+def test_hand_edited_models_are_refused_in_one_line_naming_file_and_key(tmp_path, change, match):
+    u, y = _system(0)
+    path = save_narx(NARXRegressor().fit(u, y), tmp_path / "m.json")
+    data = json.loads(path.read_text())
+    change(data)
+    path.write_text(json.dumps(data))
+    with pytest.raises(SchemaError, match=match) as info:
+        load_narx(path)
+    message = str(info.value)
+    assert message.startswith(f"{path}: ") and "\n" not in message
+
+
+@pytest.mark.parametrize("text", ["[1, 2]", '"softbend.narx-gg-svr"', "null"])
+def test_json_that_is_not_an_object_is_refused(tmp_path, text):
+    path = tmp_path / "m.json"
+    path.write_text(text)
+    with pytest.raises(SchemaError, match=f"Not a saved softbend NARX model: {path}"):
+        load_narx(path)

@@ -175,8 +175,11 @@ def _edit(document, change):
         (lambda d: d["state"].pop("coef_"), r"state key\(s\) coef_ missing"),
         (lambda d: d.update(kind="gaussian_process"), "unknown surrogate kind"),
         (lambda d: d.update(features=d["features"][::-1]), "surrogates map"),
-        (lambda d: d["state"]["powers_"].update(shape=[3, 3]), "cannot rebuild"),
-        (lambda d: d["params"].update(nonsense=1), "cannot rebuild"),
+        (lambda d: d["state"]["powers_"].update(shape=[3, 3]), "'powers_'.*its shape"),
+        (lambda d: d["params"].update(nonsense=1), "unknown params key.*'nonsense'"),
+        (lambda d: d.update(extra=1), r"unknown key\(s\) 'extra'"),
+        (lambda d: d.update(features=7), "surrogates map"),
+        (lambda d: d.update(created_utc=5), "'created_utc' must be a string"),
         (lambda d: d.update(state=[1, 2]), "'state' must be a JSON object"),
     ],
 )
@@ -205,7 +208,7 @@ def test_broken_xgboost_booster_raises_schema_error(fitted, tmp_path):
     document = json.loads(path.read_text())
     document["state"]["booster"] = "{not a booster"
     path.write_text(json.dumps(document))
-    with pytest.raises(SchemaError, match="cannot rebuild the xgboost surrogate"):
+    with pytest.raises(SchemaError, match=r"'booster' of the xgboost surrogate .* not valid JSON"):
         load_surrogate(path)
 
 
@@ -290,3 +293,202 @@ def test_xgboost_early_stopping_round_trips(tmp_path):
     loaded = load_surrogate(save_surrogate(model, tmp_path / "m.json")).model
     assert loaded.best_iteration == model.best_iteration
     np.testing.assert_array_equal(loaded.predict(Xv), model.predict(Xv))
+
+
+# --- hand-edited files: every value is checked against the kind's schema ---------------------
+
+
+def _mlp_layer_removed(state):
+    state["coefs_"].pop(1)
+    state["intercepts_"].pop(1)
+
+
+def _set_first(array_key, value, index=0):
+    """Set one element of a saved array (first row of a 2-D one)."""
+
+    def change(state):
+        target = state[array_key]
+        if isinstance(target, list):  # the MLP's list of layers
+            target = target[index]
+        nested = target["__ndarray__"]
+        while isinstance(nested[0], list):
+            nested = nested[0]
+        nested[0] = value
+
+    return change
+
+
+_CORRUPTIONS = {
+    "mlp": [
+        ("nan weight", _set_first("coefs_", float("nan")), "coefs_.*item 0 must hold only finite"),
+        ("inf bias", _set_first("intercepts_", float("inf"), 2), "intercepts_.*finite"),
+        ("zero x scale", _set_first("x_scale_", 0.0), "x_scale_.*values > 0"),
+        ("zero y scale", lambda s: s.update(y_scale_=0.0), "y_scale_.*> 0; got 0"),
+        ("negative y scale", lambda s: s.update(y_scale_=-2.5), "y_scale_.*> 0"),
+        ("nan y mean", lambda s: s.update(y_mean_=float("nan")), "y_mean_.*finite number"),
+        ("string scale", lambda s: s.update(y_scale_="12.5"), "y_scale_.*a finite number"),
+        ("layer removed", _mlp_layer_removed, "coefs_.*list of 3 2-D float64 arrays; got 2"),
+        (
+            "wrong layer shape",
+            lambda s: s["coefs_"][2].update(__ndarray__=[[1.0]], shape=[1, 1]),
+            "chained shapes",
+        ),
+        ("strings as weights", _set_first("coefs_", "0.5"), 'only finite numbers; got "0.5"'),
+        (
+            "list of strings",
+            lambda s: s["x_mean_"].update(__ndarray__=["a"] * 7),
+            "x_mean_.*only finite numbers",
+        ),
+        ("wrong dtype", lambda s: s["x_mean_"].update(dtype="str"), 'x_mean_.*got dtype "str"'),
+        ("array as plain list", lambda s: s.update(x_scale_=[1.0] * 7), "x_scale_.*1-D float64"),
+        ("unknown key", lambda s: s.update(predict="boom"), "unknown state key.*'predict'"),
+        ("private key", lambda s: s.update(_plan=1), "unknown state key.*'_plan'"),
+        ("7 features", lambda s: s.update(n_features_in_=3), "n_features_in_' must be 7"),
+        ("bool feature count", lambda s: s.update(n_features_in_=True), "n_features_in_"),
+        ("device", lambda s: s.update(device_="tpu"), "device_.*one of 'cpu', 'cuda'"),
+    ],
+    "polynomial": [
+        ("nan coefficient", _set_first("coef_", float("nan")), "coef_.*finite"),
+        ("zero x scale", _set_first("x_scale_", 0.0), "x_scale_.*values > 0"),
+        ("zero y scale", lambda s: s.update(y_scale_=0), "y_scale_.*> 0"),
+        ("string scale", lambda s: s.update(y_scale_="1"), "y_scale_.*a finite number"),
+        (
+            "term removed",
+            lambda s: s["coef_"].update(
+                __ndarray__=s["coef_"]["__ndarray__"][:-1], shape=[s["coef_"]["shape"][0] - 1]
+            ),
+            "coef_' must have shape",
+        ),
+        ("float powers", lambda s: s["powers_"].update(dtype="float64"), "powers_.*got dtype"),
+        ("negative power", _set_first("powers_", -1), "powers_.*values >= 0"),
+        ("no constant term", _set_first("powers_", 1), "complete exponent table"),
+        (
+            "list of strings",
+            lambda s: s["coef_"].update(__ndarray__=["x"] * len(s["coef_"]["__ndarray__"])),
+            "coef_.*only finite numbers",
+        ),
+        ("unknown key", lambda s: s.update(predict="boom"), "unknown state key.*'predict'"),
+        (
+            "feature names",
+            lambda s: s.update(
+                feature_names_in_={"__ndarray__": list("abcdefg"), "dtype": "str", "shape": [7]}
+            ),
+            "feature_names_in_' must be",
+        ),
+    ],
+}
+
+
+@pytest.mark.parametrize(
+    ("kind", "change", "match"),
+    [
+        pytest.param(kind, change, match, id=f"{kind}-{name}")
+        for kind, cases in _CORRUPTIONS.items()
+        for name, change, match in cases
+    ],
+)
+def test_hand_edited_state_is_refused_in_one_line_naming_file_and_key(
+    fitted, tmp_path, kind, change, match
+):
+    path = save_surrogate(fitted[kind], tmp_path / "m.json")
+    document = json.loads(path.read_text())
+    change(document["state"])
+    path.write_text(json.dumps(document))
+    with pytest.raises(SchemaError, match=match) as info:
+        load_surrogate(path)
+    message = str(info.value)
+    assert message.startswith(f"{path}: ") and "\n" not in message
+
+
+def test_unknown_state_key_names_the_allowed_keys_and_is_never_set(fitted, tmp_path):
+    path = save_surrogate(fitted["mlp"], tmp_path / "m.json")
+    document = json.loads(path.read_text())
+    document["state"]["predict"] = {"__ndarray__": [1.0], "dtype": "float64", "shape": [1]}
+    path.write_text(json.dumps(document))
+    with pytest.raises(SchemaError) as info:
+        load_surrogate(path)
+    message = str(info.value)
+    assert "'predict'" in message and "allowed keys: n_features_in_" in message
+    assert "coefs_, intercepts_" in message
+
+
+@pytest.mark.parametrize(
+    ("kind", "params", "match"),
+    [
+        ("polynomial", {"chunk_rows": "many"}, "params key 'chunk_rows'.*integer >= 1"),
+        ("polynomial", {"degree": 0}, "params key 'degree'.*integer >= 1"),
+        ("polynomial", {"alpha": float("nan")}, "params key 'alpha'"),
+        ("mlp", {"hidden_sizes": [8]}, "params key 'hidden_sizes'.*two integers"),
+        ("mlp", {"predict": 1}, "unknown params key.*'predict'"),
+        ("xgboost", {"predict": 1}, "unknown params key.*'predict'"),
+        ("xgboost", {"_Booster": 1}, "unknown params key.*'_Booster'"),
+    ],
+)
+def test_hand_edited_params_are_refused(fitted, tmp_path, kind, params, match):
+    path = save_surrogate(fitted[kind], tmp_path / "m.json")
+    document = json.loads(path.read_text())
+    document["params"].update(params)
+    path.write_text(json.dumps(document))
+    with pytest.raises(SchemaError, match=match) as info:
+        load_surrogate(path)
+    assert str(path) in str(info.value) and "\n" not in str(info.value)
+
+
+@pytest.mark.parametrize(
+    ("change", "match"),
+    [
+        (lambda s: s.update(extra="x"), "unknown state key.*'extra'.*allowed keys: booster"),
+        (lambda s: s.update(booster=3), "booster.*as a string"),
+        (
+            lambda s: s.update(
+                booster=s["booster"].replace('"base_weights":[', '"base_weights":[NaN,', 1)
+            ),
+            "finite numbers",
+        ),
+        (
+            lambda s: s.update(
+                booster=s["booster"].replace('"num_feature":"7"', '"num_feature":"5"')
+            ),
+            "7 surrogate inputs",
+        ),
+    ],
+)
+def test_hand_edited_xgboost_state_is_refused(fitted, tmp_path, change, match):
+    path = save_surrogate(fitted["xgboost"], tmp_path / "m.json")
+    document = json.loads(path.read_text())
+    change(document["state"])
+    path.write_text(json.dumps(document))
+    with pytest.raises(SchemaError, match=match):
+        load_surrogate(path)
+
+
+def test_numpy_scalars_and_xgboost_extra_parameters_still_load(fitted, tmp_path):
+    path = save_surrogate(fitted["polynomial"], tmp_path / "m.json")
+    document = json.loads(path.read_text())
+    document["state"]["y_scale_"] = {"__scalar__": 2.0, "dtype": "float64"}
+    document["state"]["rank_"] = {"__scalar__": 120, "dtype": "int64"}
+    document["params"]["degree"] = {"__scalar__": 3, "dtype": "int64"}
+    path.write_text(json.dumps(document))
+    model = load_surrogate(path).model
+    assert model.y_scale_ == 2.0 and type(model.y_scale_) is np.float64
+    X = _inputs(5, 3)
+    assert np.isfinite(model.predict(X)).all()
+
+    X = _inputs(100, 4)
+    extra = xgb.XGBRegressor(n_estimators=3, n_jobs=1, max_cat_to_onehot=1, seed_per_iteration=True)
+    extra.fit(X, _angle(X))
+    loaded = load_surrogate(save_surrogate(extra, tmp_path / "x.json")).model
+    assert loaded.get_params()["seed_per_iteration"] is True
+    np.testing.assert_array_equal(loaded.predict(X), extra.predict(X))
+
+
+def test_a_booster_xgboost_refuses_is_one_line(fitted, tmp_path):
+    path = save_surrogate(fitted["xgboost"], tmp_path / "m.json")
+    document = json.loads(path.read_text())
+    booster = json.loads(document["state"]["booster"])
+    booster["learner"]["gradient_booster"]["model"]["trees"][0]["base_weights"].append(1.0)
+    document["state"]["booster"] = json.dumps(booster)
+    path.write_text(json.dumps(document))
+    with pytest.raises(SchemaError, match="cannot rebuild the xgboost surrogate") as info:
+        load_surrogate(path)
+    assert "\n" not in str(info.value) and "Stack trace" not in str(info.value)

@@ -34,6 +34,7 @@ import json
 import logging
 import math
 import os
+import re
 import uuid
 from collections.abc import Iterator
 from contextlib import contextmanager
@@ -184,8 +185,10 @@ class CampaignStore:
     FileNotFoundError
         ``read_only`` and no file at ``path``.
     SchemaError
-        The file is not a DuckDB database, not a softbend campaign, or has a
-        schema version newer than :data:`SCHEMA_VERSION`.
+        The file is not a readable DuckDB database (not DuckDB, truncated, a
+        damaged block: every block is read once on opening), not a softbend
+        campaign, or has a schema version newer than :data:`SCHEMA_VERSION`;
+        one line naming the file.
     SoftbendError
         The file is locked by another process (a running campaign).
 
@@ -207,16 +210,26 @@ class CampaignStore:
             raise FileNotFoundError(
                 f"The folder of the campaign database {str(self.path)!r} does not exist."
             )
+        existed = self.path.is_file()
         try:
             self._con = duckdb.connect(str(self.path), read_only=self.read_only)
         except duckdb.Error as exc:
             raise _open_error(self.path, exc) from None
+        # Every DuckDB error while reading what opening needs (a truncated or corrupt file
+        # fails here, at connect or on the first reads) is one SchemaError naming the file.
         try:
+            # No progress bar of DuckDB's own on a long query: it would write to stdout.
+            self._con.execute("SET enable_progress_bar = false")
+            if existed:
+                _check_complete(self._con, self.path)
             self._init_schema()
             self._load_binding()
             self._recorded: set[str] = {
                 row[0] for row in self._con.execute("SELECT design_id FROM designs").fetchall()
             }
+        except duckdb.Error as exc:
+            self._con.close()
+            raise _unreadable(self.path, _first_line(exc)) from None
         except BaseException:
             self._con.close()
             raise
@@ -770,22 +783,64 @@ def _describe_grid(grid: np.ndarray) -> str:
     return f"{len(grid)} pressures from {grid[0]:g} to {grid[-1]:g} MPa"
 
 
+#: Bytes before the first block of a DuckDB file: its main header and two database headers.
+_DUCKDB_HEADER_BYTES = 3 * 4096
+
+
+def _first_line(exc: Exception, limit: int = 200) -> str:
+    """The first line of an error's message, at most ``limit`` characters."""
+    lines = str(exc).strip().splitlines()
+    text = lines[0] if lines else type(exc).__name__
+    return text if len(text) <= limit else text[: limit - 3] + "..."
+
+
+def _unreadable(path: Path, reason: str) -> SchemaError:
+    return SchemaError(
+        f"{str(path)!r} is not a readable softbend campaign database ({reason.rstrip('.!')})."
+    )
+
+
+def _check_complete(con: Any, path: Path) -> None:
+    """Raise unless the file holds every block of the database, each one readable.
+
+    DuckDB reads a block only when a query needs it, so a truncated or partly
+    overwritten file opens and then fails on some later query. Here the file must
+    be long enough for its headers and all blocks in use (DuckDB cuts trailing
+    free blocks off), and every table is read once in full, which loads and
+    checksums each of its blocks (a fraction of a second for millions of samples).
+    A DuckDB error raised here is turned into one line by the caller.
+    """
+    size = path.stat().st_size
+    block_size, total, free = con.execute(
+        "SELECT block_size, total_blocks, free_blocks FROM pragma_database_size()"
+    ).fetchone()
+    needed = _DUCKDB_HEADER_BYTES + block_size * (total - free)
+    if size < needed:
+        raise _unreadable(path, f"truncated: {size} bytes, its blocks in use need {needed}")
+    tables = con.execute(
+        "SELECT schema_name, table_name FROM duckdb_tables() "
+        "WHERE database_name = current_database() AND NOT temporary"
+    ).fetchall()
+    for schema, table in tables:
+        name = '"{}"."{}"'.format(schema.replace('"', '""'), table.replace('"', '""'))
+        con.execute(f"SELECT max(hash(COLUMNS(*))) FROM {name}").fetchall()
+
+
 def _open_error(path: Path, exc: Exception) -> SoftbendError:
     text = str(exc)
-    if "lock" in text.lower():
+    if re.search(r"\block\b", text, re.IGNORECASE):  # a lock, not a "block"
         return SoftbendError(
             f"The campaign database {str(path)!r} is in use by another process (a running "
             "campaign?); DuckDB allows one writer and no reader meanwhile."
         )
-    if "not a valid DuckDB database" in text:
-        return SchemaError(f"{str(path)!r} is not a DuckDB database file.")
     if "different configuration" in text:
         return SoftbendError(
             f"The campaign database {str(path)!r} is already open in this process in another "
             "mode; close that CampaignStore first."
         )
-    first_line = text.splitlines()[0] if text else type(exc).__name__
-    return SoftbendError(f"Cannot open the campaign database {str(path)!r}: {first_line}")
+    if "not a valid DuckDB database" in text:
+        return _unreadable(path, "not a DuckDB database file")
+    return _unreadable(path, _first_line(exc))
 
 
 def load_samples(db_path: str | os.PathLike[str]) -> pd.DataFrame:

@@ -10,6 +10,7 @@ precision, so a reloaded model predicts bit-identically.
 from __future__ import annotations
 
 import json
+import math
 from pathlib import Path
 from typing import Any
 
@@ -19,7 +20,7 @@ from sklearn.preprocessing import StandardScaler
 from softbend import __version__
 from softbend._io import write_text_atomic
 from softbend.errors import SchemaError
-from softbend.identification.narx import NARXRegressor, _regressor_names
+from softbend.identification.narx import NARXRegressor, _lag_structure, _regressor_names
 from softbend.identification.svr import GeneralizedGaussianSVR
 
 FORMAT = "softbend.narx-gg-svr"
@@ -93,18 +94,259 @@ def narx_to_dict(model: NARXRegressor, metadata: dict[str, Any] | None = None) -
     }
 
 
-def narx_from_dict(data: dict[str, Any]) -> NARXRegressor:
-    """Rebuild a fitted NARX model from :func:`narx_to_dict` data."""
-    if data.get("format") != FORMAT:
+# --- schema ------------------------------------------------------------------------------------
+#
+# Loading validates the whole document before building anything: the keys of every object
+# (an unknown key is refused), the type of every value, the shapes of the arrays (support
+# vectors (n_sv, n_features), scaler vectors per signal), finiteness and bounds (kernel width
+# and scales > 0), and the lag structure against the NARX parameters.
+
+
+class _RuleError(Exception):
+    """A value breaks its rule; the message names the key and the rule (not the file)."""
+
+
+def _shown(value: Any) -> str:
+    try:
+        text = json.dumps(value)
+    except (TypeError, ValueError):
+        text = repr(value)
+    return text if len(text) <= 60 else text[:57] + "..."
+
+
+def _is_real(value: Any) -> bool:
+    return type(value) in (int, float)  # JSON numbers, not bool
+
+
+def _object(value: Any, where: str, keys: tuple[str, ...]) -> dict[str, Any]:
+    if not isinstance(value, dict):
+        raise _RuleError(f"'{where}' must be a JSON object; got {_shown(value)}")
+    unknown = [key for key in value if key not in keys]
+    if unknown:
+        raise _RuleError(
+            f"unknown key(s) {', '.join(map(repr, unknown))} in '{where}'; "
+            f"allowed keys: {', '.join(keys)}"
+        )
+    missing = [key for key in keys if key not in value]
+    if missing:
+        raise _RuleError(f"'{where}' lacks the key(s) {', '.join(missing)}")
+    return value
+
+
+def _int(value: Any, where: str, low: int) -> int:
+    if type(value) is not int or value < low:
+        raise _RuleError(f"'{where}' must be an integer >= {low}; got {_shown(value)}")
+    return value
+
+
+def _bool(value: Any, where: str) -> bool:
+    if not isinstance(value, bool):
+        raise _RuleError(f"'{where}' must be true or false; got {_shown(value)}")
+    return value
+
+
+def _real(
+    value: Any,
+    where: str,
+    *,
+    low: float | None = None,
+    strict: bool = False,
+    high: float | None = None,
+) -> float:
+    rule = "a finite number"
+    if low is not None:
+        rule += f" {'>' if strict else '>='} {low:g}"
+    if high is not None:
+        rule += f" and <= {high:g}"
+    ok = _is_real(value) and math.isfinite(value)
+    if ok and low is not None:
+        ok = value > low if strict else value >= low
+    if ok and high is not None:
+        ok = value <= high
+    if not ok:
+        raise _RuleError(f"'{where}' must be {rule}; got {_shown(value)}")
+    return float(value)
+
+
+def _vector(
+    value: Any,
+    where: str,
+    length: int | None = None,
+    *,
+    low: float | None = None,
+    strict: bool = False,
+) -> np.ndarray:
+    if not isinstance(value, list) or (length is not None and len(value) != length):
+        size = f"{length} " if length is not None else ""
+        raise _RuleError(f"'{where}' must be a list of {size}numbers; got {_shown(value)}")
+    for i, item in enumerate(value):
+        _real(item, f"{where}[{i}]", low=low, strict=strict)
+    return np.asarray(value, dtype=float)
+
+
+def _int_vector(value: Any, where: str) -> np.ndarray:
+    if not isinstance(value, list):
+        raise _RuleError(f"'{where}' must be a list of integers; got {_shown(value)}")
+    for i, item in enumerate(value):
+        _int(item, f"{where}[{i}]", 0)
+    return np.asarray(value, dtype=int)
+
+
+def _matrix(value: Any, where: str, rows: int, columns: int) -> np.ndarray:
+    if not isinstance(value, list) or len(value) != rows:
+        raise _RuleError(
+            f"'{where}' must be a list of {rows} rows (one per dual coefficient); "
+            f"got {_shown(value)}"
+        )
+    for i, row in enumerate(value):
+        _vector(row, f"{where}[{i}]", columns)
+    return np.asarray(value, dtype=float).reshape(rows, columns)
+
+
+_SCALER_KEYS = ("mean", "scale", "var", "n_samples_seen")
+
+
+def _scaler(value: Any, where: str, scale: bool, size: int) -> dict[str, Any] | None:
+    if not scale:
+        if value is not None:
+            raise _RuleError(f"'{where}' must be null when 'narx.params.scale' is false")
+        return None
+    state = _object(value, where, _SCALER_KEYS)
+    _vector(state["mean"], f"{where}.mean", size)
+    _vector(state["scale"], f"{where}.scale", size, low=0.0, strict=True)
+    _vector(state["var"], f"{where}.var", size, low=0.0)
+    _int(state["n_samples_seen"], f"{where}.n_samples_seen", 1)
+    return state
+
+
+_TOP_KEYS = ("format", "schema_version", "softbend_version", "metadata", "narx", "estimator")
+_NARX_KEYS = (
+    "params",
+    "n_inputs",
+    "max_lag",
+    "output_offsets",
+    "input_offsets",
+    "n_train_rows",
+    "n_experiments",
+    "y_scaler",
+    "u_scaler",
+)
+_NARX_PARAMS = ("output_lags", "input_lags", "include_current_input", "scale")
+_ESTIMATOR_KEYS = (
+    "class",
+    "params",
+    "n_features_in",
+    "sigma",
+    "shape",
+    "kernel_scale",
+    "intercept",
+    "n_iter",
+    "dual_coef",
+    "support_vectors",
+)
+
+
+def _svr_params(value: Any) -> dict[str, Any]:
+    where = "estimator.params"
+    params = _object(value, where, tuple(GeneralizedGaussianSVR._get_param_names()))
+    for key in ("C", "tol", "cache_size"):
+        _real(params[key], f"{where}.{key}", low=0.0, strict=True)
+    _real(params["epsilon"], f"{where}.epsilon", low=0.0)
+    if params["sigma"] is not None:
+        _real(params["sigma"], f"{where}.sigma", low=0.0, strict=True)
+    if params["shape"] is not None:
+        _real(params["shape"], f"{where}.shape", low=0.0, strict=True, high=2.0)
+    _bool(params["normalize"], f"{where}.normalize")
+    _int(params["max_iter"], f"{where}.max_iter", -1)
+    return params
+
+
+def _check_document(data: dict[str, Any]) -> None:
+    """Raise :class:`_RuleError` unless ``data`` holds a complete, consistent model."""
+    _object(data, "(top level)", _TOP_KEYS)
+    if not isinstance(data["softbend_version"], str):
+        raise _RuleError(
+            f"'softbend_version' must be a string; got {_shown(data['softbend_version'])}"
+        )
+    if not isinstance(data["metadata"], dict):
+        raise _RuleError(f"'metadata' must be a JSON object; got {_shown(data['metadata'])}")
+
+    narx = _object(data["narx"], "narx", _NARX_KEYS)
+    params = _object(narx["params"], "narx.params", _NARX_PARAMS)
+    na = _int(params["output_lags"], "narx.params.output_lags", 1)
+    nb = _int(params["input_lags"], "narx.params.input_lags", 1)
+    current = _bool(params["include_current_input"], "narx.params.include_current_input")
+    scale = _bool(params["scale"], "narx.params.scale")
+    n_inputs = _int(narx["n_inputs"], "narx.n_inputs", 1)
+    structure = _lag_structure(na, nb, current, "load_narx")
+    for key, expected in (
+        ("max_lag", structure.max_lag),
+        ("output_offsets", structure.output_offsets.tolist()),
+        ("input_offsets", structure.input_offsets.tolist()),
+    ):
+        found = narx[key]
+        if isinstance(expected, int):
+            _int(found, f"narx.{key}", 0)
+        else:
+            _int_vector(found, f"narx.{key}")
+        if found != expected:
+            raise _RuleError(
+                f"'narx.{key}' must be {expected} for output_lags={na}, input_lags={nb}, "
+                f"include_current_input={str(current).lower()}; got {_shown(found)}"
+            )
+    _int(narx["n_train_rows"], "narx.n_train_rows", 0)
+    _int(narx["n_experiments"], "narx.n_experiments", 0)
+    _scaler(narx["y_scaler"], "narx.y_scaler", scale, 1)
+    _scaler(narx["u_scaler"], "narx.u_scaler", scale, n_inputs)
+
+    estimator = _object(data["estimator"], "estimator", _ESTIMATOR_KEYS)
+    if estimator["class"] != "GeneralizedGaussianSVR":
+        raise _RuleError(
+            f"'estimator.class' must be 'GeneralizedGaussianSVR'; got {_shown(estimator['class'])}"
+        )
+    _svr_params(estimator["params"])
+    n_features = na + n_inputs * nb
+    if estimator["n_features_in"] != n_features or type(estimator["n_features_in"]) is not int:
+        raise _RuleError(
+            f"'estimator.n_features_in' must be {n_features} (output_lags + n_inputs x "
+            f"input_lags); got {_shown(estimator['n_features_in'])}"
+        )
+    _real(estimator["sigma"], "estimator.sigma", low=0.0, strict=True)
+    _real(estimator["shape"], "estimator.shape", low=0.0, strict=True, high=2.0)
+    _real(estimator["kernel_scale"], "estimator.kernel_scale", low=0.0, strict=True)
+    _real(estimator["intercept"], "estimator.intercept")
+    _int(estimator["n_iter"], "estimator.n_iter", 0)
+    dual_coef = _vector(estimator["dual_coef"], "estimator.dual_coef")
+    _matrix(estimator["support_vectors"], "estimator.support_vectors", dual_coef.size, n_features)
+
+
+def narx_from_dict(data: dict[str, Any], *, source: str = "the saved model") -> NARXRegressor:
+    """Rebuild a fitted NARX model from :func:`narx_to_dict` data.
+
+    Every key and value is checked first (see the schema above); ``source`` (the
+    file, for :func:`load_narx`) starts the one-line :class:`SchemaError` message.
+    """
+    if not isinstance(data, dict) or data.get("format") != FORMAT:
+        found = data.get("format") if isinstance(data, dict) else type(data).__name__
         raise SchemaError(
-            f"Not a saved softbend NARX model: format {data.get('format')!r}, expected {FORMAT!r}."
+            f"Not a saved softbend NARX model: {source} has format {found!r}, expected {FORMAT!r}."
         )
     version = data.get("schema_version")
-    if not isinstance(version, int) or version > SCHEMA_VERSION:
+    if isinstance(version, bool) or not isinstance(version, int) or version < 1:
         raise SchemaError(
-            f"The saved model has schema version {version!r}; this softbend ({__version__}) "
+            f"{source} has an invalid schema version {version!r}; expected an integer from 1 "
+            f"to {SCHEMA_VERSION}."
+        )
+    if version > SCHEMA_VERSION:
+        raise SchemaError(
+            f"{source} has schema version {version}; this softbend ({__version__}) "
             f"reads versions up to {SCHEMA_VERSION}. Upgrade softbend to load it."
         )
+    try:
+        _check_document(data)
+    except _RuleError as err:
+        raise SchemaError(f"{source}: {err}.") from None
+
     state = data["estimator"]
     svr = GeneralizedGaussianSVR(**state["params"])
     svr.n_features_in_ = int(state["n_features_in"])
@@ -147,12 +389,22 @@ def save_narx(
 
 
 def load_narx(path: str | Path) -> tuple[NARXRegressor, dict[str, Any]]:
-    """Load a model written by :func:`save_narx`; returns ``(model, metadata)``."""
+    """Load a model written by :func:`save_narx`; returns ``(model, metadata)``.
+
+    Raises
+    ------
+    FileNotFoundError
+        If ``path`` is not a file.
+    softbend.errors.SchemaError
+        If the file is not JSON, not a saved NARX model, has a newer schema, an
+        unknown or missing key, or a value of the wrong type or shape, non-finite
+        or out of bounds; the one-line message names the file and the key.
+    """
     path = Path(path)
     if not path.is_file():
         raise FileNotFoundError(f"No saved model at {path}.")
     try:
         data = json.loads(path.read_text(encoding="utf-8"))
-    except json.JSONDecodeError as err:
+    except (json.JSONDecodeError, UnicodeDecodeError) as err:
         raise SchemaError(f"{path} is not valid JSON: {err}.") from None
-    return narx_from_dict(data), dict(data.get("metadata", {}))
+    return narx_from_dict(data, source=str(path)), dict(data["metadata"])
