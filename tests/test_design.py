@@ -101,3 +101,18 @@ def test_shards_are_disjoint_and_cover_the_space():
     for index, count in ((7, 7), (-1, 3), (0, 0), (1.0, 3)):
         with pytest.raises(ValueError, match="shard"):
             space.shard(index, count)
+
+
+@pytest.mark.parametrize("text", ["100,6,7,2,5,10", "100,1,50,2,5,10", "100,6,6,2,5,10"])
+def test_a_wall_not_thinner_than_the_radius_is_refused_naming_the_rule(text):
+    with pytest.raises(ValueError, match=r"'t_mm' of SFRBADesign must be less than its 'r_mm'"):
+        SFRBADesign.parse(text)
+
+
+def test_every_design_over_the_table1_ranges_stays_valid():
+    # The thickest wall in the narrowest chamber of Table 1: t/r = 4/6.
+    low = {p: min(v) for p, v in TABLE1_LEVELS.items()}
+    high = {p: max(v) for p, v in TABLE1_LEVELS.items()}
+    SFRBADesign(**{**low, "t_mm": high["t_mm"]})
+    assert len(DesignSpace.table1()) == 972 and len(DesignSpace.corners()) == 64
+    assert len(DesignSpace.sample(64, method="sobol", seed=1)) == 64

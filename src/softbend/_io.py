@@ -1,22 +1,79 @@
-"""Atomic file writes: a finished file is either the old one or the complete new one."""
+"""Atomic file writes: a finished file is either the old one or the complete new one.
+
+The new file gets the permissions a plain ``open(path, "w")`` would give it: those
+of the file it replaces, or ``0o666`` less the process umask for a new file (a
+temporary file from :func:`tempfile.mkstemp` alone would be ``0o600``).
+"""
 
 from __future__ import annotations
 
 import os
+import stat
 import tempfile
+from collections.abc import Iterator
+from contextlib import contextmanager
 from pathlib import Path
+from typing import IO
+
+__all__ = ["atomic_file", "new_file_mode", "write_bytes_atomic", "write_text_atomic"]
 
 
-def write_text_atomic(path: str | os.PathLike[str], text: str) -> Path:
-    """Write ``text`` to ``path`` through a temporary file in the same folder and a rename."""
+def _umask() -> int:
+    """The process umask, read without changing it where the system allows."""
+    try:
+        with open("/proc/self/status", encoding="ascii") as status:
+            for line in status:
+                if line.startswith("Umask:"):
+                    return int(line.split()[1], 8)
+    except (OSError, ValueError):
+        pass
+    mask = os.umask(0o022)  # elsewhere: set and restore at once
+    os.umask(mask)
+    return mask
+
+
+def new_file_mode(path: str | os.PathLike[str]) -> int:
+    """Permission bits a plain ``open(path, "w")`` leaves ``path`` with."""
+    try:
+        return stat.S_IMODE(os.stat(path).st_mode) & 0o777
+    except FileNotFoundError:
+        return 0o666 & ~_umask()
+
+
+@contextmanager
+def atomic_file(path: str | os.PathLike[str], mode: str = "w") -> Iterator[IO]:
+    """Yield a handle on a temporary file that replaces ``path`` when the block ends.
+
+    ``mode`` is ``"w"`` (UTF-8 text) or ``"wb"``. The temporary file lies in the
+    folder of ``path`` (created if missing), so the final :func:`os.replace` is
+    atomic; if the block raises, it is removed and ``path`` is left as it was.
+    """
+    if mode not in ("w", "wb"):
+        raise ValueError(f"The 'mode' of atomic_file must be one of 'w', 'wb'. Got {mode!r}.")
     path = Path(path)
     path.parent.mkdir(parents=True, exist_ok=True)
+    permissions = new_file_mode(path)
     fd, tmp = tempfile.mkstemp(dir=path.parent, prefix=f".{path.name}.", suffix=".tmp")
     try:
-        with os.fdopen(fd, "w", encoding="utf-8") as handle:
-            handle.write(text)
+        encoding = None if "b" in mode else "utf-8"
+        with os.fdopen(fd, mode, encoding=encoding) as handle:
+            os.chmod(tmp, permissions)
+            yield handle
         os.replace(tmp, path)
     except BaseException:
         Path(tmp).unlink(missing_ok=True)
         raise
-    return path
+
+
+def write_text_atomic(path: str | os.PathLike[str], text: str) -> Path:
+    """Write ``text`` to ``path`` through a temporary file in the same folder and a rename."""
+    with atomic_file(path, "w") as handle:
+        handle.write(text)
+    return Path(path)
+
+
+def write_bytes_atomic(path: str | os.PathLike[str], data: bytes) -> Path:
+    """Write ``data`` to ``path`` through a temporary file in the same folder and a rename."""
+    with atomic_file(path, "wb") as handle:
+        handle.write(data)
+    return Path(path)

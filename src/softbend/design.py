@@ -56,7 +56,8 @@ class SFRBADesign:
     r_mm : float
         Inner radius of the semicircular chamber, mm; in (0, 100].
     t_mm : float
-        Thickness of the semicircular top wall, mm; in (0, 50].
+        Thickness of the semicircular top wall, mm; in (0, 50] and less than
+        ``r_mm`` (see below).
     b_mm : float
         Thickness of the flat bottom wall, mm; in (0, 50].
     phi_deg : float
@@ -65,10 +66,22 @@ class SFRBADesign:
     lc_mm : float
         Length of the distal (tip) cap, mm; in (0, 200].
 
+    Notes
+    -----
+    The wall must be thinner than the chamber radius, ``t_mm < r_mm``: the
+    actuator is a thin-walled chamber whose pressure bends it, and every model
+    here rests on that. The analytical model lets the walls only stretch axially
+    and thin through their thickness, with the fibers on the outer surface
+    confining the chamber; with ``t >= r`` the "chamber" is a narrow hole in a
+    thick rod (``100,1,50,2,5,10`` has a 2 mm bore in a 102 mm wide body) that
+    no fiber-reinforced actuator of paper B resembles. Paper B Table 1 has
+    ``t/r <= 2/3`` (t 2–4 mm, r 6–10 mm).
+
     Raises
     ------
     ValueError
-        Naming the field, the allowed interval and the value received.
+        Naming the field, the allowed interval and the value received; for a wall
+        not thinner than the radius, the rule and both values.
     """
 
     l_mm: float
@@ -91,6 +104,11 @@ class SFRBADesign:
                 high_inclusive=True,
             )
             object.__setattr__(self, name, value)
+        if self.t_mm >= self.r_mm:
+            raise ValueError(
+                "The 't_mm' of SFRBADesign must be less than its 'r_mm' (a wall thinner than "
+                f"the chamber radius). Got t_mm={self.t_mm:g} and r_mm={self.r_mm:g} instead."
+            )
 
     @classmethod
     def from_sequence(cls, values: Sequence[float]) -> SFRBADesign:

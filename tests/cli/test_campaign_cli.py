@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import errno
 import json
 import socket
 
@@ -265,3 +266,126 @@ def test_a_file_that_is_no_database_is_one_line_for_status_and_export(
         assert main(argv) == 2
         line = one_error_line(capsys)
         assert f"{str(db)!r} is not a readable softbend campaign database ({reason})" in line
+
+
+@pytest.fixture
+def campaign_db(tmp_path, capsys):
+    db = tmp_path / "c.duckdb"
+    assert main(["campaign", "run", str(db), *RUN, "--workers", "0", "--json"]) == 0
+    capsys.readouterr()
+    return db
+
+
+@pytest.mark.parametrize("extra", [[], ["--format", "csv"], ["--format", "parquet"]])
+def test_export_onto_its_own_database_is_refused_and_keeps_it(campaign_db, capsys, extra):
+    before = campaign_db.read_bytes()
+    assert main(["campaign", "export", str(campaign_db), str(campaign_db), *extra]) == 2
+    assert f"The 'OUT' {campaign_db} is also an input" in one_error_line(capsys)
+    assert campaign_db.read_bytes() == before
+    assert main(["campaign", "status", str(campaign_db), "--json"]) == 0
+    assert json.loads(capsys.readouterr().out)["done"] == 6
+
+
+def test_export_never_replaces_a_file_of_another_kind(campaign_db, tmp_path, capsys):
+    other = tmp_path / "other.duckdb"
+    other.write_bytes(campaign_db.read_bytes())
+    parquet = tmp_path / "s.parquet"
+    assert main(["campaign", "export", str(campaign_db), str(parquet)]) == 0
+    capsys.readouterr()
+    for out, kind, found in ((other, "parquet", "DuckDB database"), (parquet, "csv", "Parquet")):
+        before = out.read_bytes()
+        assert main(["campaign", "export", str(campaign_db), str(out), "--format", kind]) == 2
+        assert (
+            f"The 'OUT' must be a new file or a {kind} file to replace. "
+            f"Got {out}, an existing {found} file, instead."
+        ) in one_error_line(capsys)
+        assert out.read_bytes() == before
+    # The same kind is replaced, as before.
+    assert main(["campaign", "export", str(campaign_db), str(parquet)]) == 0
+
+
+def test_export_onto_a_folder_or_into_a_read_only_one_is_one_line(
+    campaign_db, tmp_path, monkeypatch, capsys
+):
+    assert main(["campaign", "export", str(campaign_db), str(tmp_path)]) == 2
+    assert f"The 'OUT' must name a file; {tmp_path} is a folder." in one_error_line(capsys)
+    import os
+
+    # As root every folder is writable: make the check see a read-only one.
+    monkeypatch.setattr(os, "access", lambda path, mode: not mode & os.W_OK)
+    out = tmp_path / "x.csv"
+    assert main(["campaign", "export", str(campaign_db), str(out)]) == 2
+    assert f"The 'OUT' {out} cannot be written: {tmp_path} is read-only." in one_error_line(capsys)
+
+
+def test_a_full_disk_during_the_export_is_one_line_naming_out(campaign_db, tmp_path, capsys):
+    from unittest import mock
+
+    out = tmp_path / "x.parquet"
+    full = OSError(errno.ENOSPC, "No space left on device")
+    with mock.patch.object(CampaignStore, "export", side_effect=full):
+        assert main(["campaign", "export", str(campaign_db), str(out)]) == 2
+    assert one_error_line(capsys) == (
+        f"softbend: error: The 'OUT' {out} could not be written: No space left on device."
+    )
+
+
+def test_merge_and_run_refuse_an_output_that_is_an_input_or_a_folder(campaign_db, tmp_path, capsys):
+    other = tmp_path / "other.duckdb"
+    other.write_bytes(campaign_db.read_bytes())
+    argv = ["campaign", "merge", str(campaign_db), str(other), str(campaign_db)]
+    assert main(argv) == 2
+    assert f"The 'DB' {campaign_db} is also an input" in one_error_line(capsys)
+    assert main(["campaign", "run", str(tmp_path), *RUN]) == 2
+    assert f"The 'DB' must name a file; {tmp_path} is a folder." in one_error_line(capsys)
+
+
+@pytest.mark.parametrize("space", ["LHS:3", "Sobol:4", "TABLE1"])
+def test_space_names_are_lower_case_like_every_other_choice(tmp_path, capsys, space):
+    db = tmp_path / "c.duckdb"
+    assert main(["campaign", "run", str(db), "--space", space]) == 2
+    assert f"(lower case, N >= 1). Got {space!r} instead." in one_error_line(capsys)
+    assert not db.exists()
+    assert main(["campaign", "export", str(db), str(tmp_path / "x.csv"), "--format", "CSV"]) == 2
+    assert "'--format' of softbend campaign export must be one of" in one_error_line(capsys)
+
+
+@pytest.fixture
+def roomy_machine(monkeypatch):
+    from softbend.campaign import spaces
+
+    monkeypatch.setattr(spaces, "_available_memory_bytes", lambda: 1024**4)
+    monkeypatch.setattr(spaces, "_free_disk_bytes", lambda db: 1024**5)
+
+
+def test_a_large_space_needs_allow_large_and_is_refused_before_any_design(
+    tmp_path, capsys, roomy_machine
+):
+    import time
+
+    db = tmp_path / "c.duckdb"
+    start = time.monotonic()
+    assert main(["campaign", "run", str(db), "--space", "lhs:10000000"]) == 2
+    line = one_error_line(capsys)
+    assert time.monotonic() - start < 10  # no design was drawn
+    assert "The '--space' of softbend campaign run gives a large campaign, about 23.3 GiB" in line
+    assert "86.5 GiB of disk for 10000000 designs x 101 pressures" in line
+    assert line.endswith("pass --allow-large to run it.")
+    assert not db.exists()
+
+
+def test_a_space_that_does_not_fit_is_refused_even_with_allow_large(tmp_path, capsys):
+    db = tmp_path / "c.duckdb"
+    argv = ["campaign", "run", str(db), "--space", "sobol:1000000000000", "--allow-large"]
+    assert main(argv) == 2
+    line = one_error_line(capsys)
+    assert "must give a campaign that fits this machine. Got 1000000000000 designs" in line
+    assert "about 2.22 PiB of memory" in line
+    assert not db.exists()
+
+
+def test_dataset_records_a_huge_planned_space_without_building_it(campaign_db, tmp_path, capsys):
+    out = tmp_path / "ds"
+    argv = ["campaign", "dataset", str(campaign_db), str(out), "--command", "x"]
+    assert main([*argv, "--space", "sobol:1000000000000", "--json"]) == 0
+    assert json.loads(capsys.readouterr().out)["designs"]["planned"] == 10**12

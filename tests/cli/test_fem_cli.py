@@ -57,3 +57,34 @@ def test_fem_run_writes_the_sweep_figures_and_vtk(tmp_path, capsys):
     vtks = sorted(p.name for p in (out / "vtk").glob("*.vtu"))
     assert vtks[0] == "shape_000p00kPa.vtu" and len(vtks) == 2
     assert b"displacement" in (out / "vtk" / vtks[0]).read_bytes()
+
+
+def test_maxh_has_one_rule_in_run_and_mesh_study(tmp_path, monkeypatch, capsys):
+    from types import SimpleNamespace
+
+    import softbend.fem.sweep as sweep
+
+    message = "The 'maxh_mm' of FEMOptions must be a number in (0, 20]. Got 20.5 instead."
+    for argv in (
+        ["fem", "run", "--out", str(tmp_path / "o"), "--maxh", "20.5"],
+        ["fem", "mesh-study", "--maxh", "4,20.5"],
+    ):
+        assert main(argv) == 2
+        assert message in one_error_line(capsys)
+    sizes = []
+
+    def fake_simulate(design, pressures, options):
+        sizes.append(options.maxh_mm)
+        stats = {"ndof": 30, "stop_reason": "reached pmax"}
+        return SimpleNamespace(angle_deg=[1.0], mesh_size=10, stats=stats, wall_time_s=0.1)
+
+    monkeypatch.setattr(sweep, "simulate", fake_simulate)
+    assert main(["fem", "mesh-study", "--maxh", "20", "--pressures", "0", "--json"]) == 0
+    assert sizes == [20.0]
+
+
+@pytest.mark.parametrize("design", ["100,6,7,2,5,10", "100,1,50,2,5,10"])
+def test_a_wall_thicker_than_the_radius_is_refused_before_solving(tmp_path, capsys, design):
+    assert main(["fem", "run", "--design", design, "--out", str(tmp_path / "o")]) == 2
+    assert "'t_mm' of SFRBADesign must be less than its 'r_mm'" in one_error_line(capsys)
+    assert not (tmp_path / "o").exists()

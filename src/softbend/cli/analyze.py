@@ -40,6 +40,7 @@ def analyze(
     t-tests, R², F, MAPE). Writes correlation.png, loadings.png, parity.png,
     coefficients.csv and correlation.csv into OUT.
     """
+    from softbend._io import write_text_atomic
     from softbend.analysis import correlation_matrix, standardized_regression
     from softbend.errors import DatasetError
     from softbend.reports.analysis_figures import correlation_heatmap, loadings_bar, parity_plot
@@ -48,6 +49,8 @@ def analyze(
         raise FileNotFoundError(f"Campaign database {str(db)!r} does not exist.")
     if db.is_dir():
         raise DatasetError(f"Campaign database {str(db)!r} is a folder, not a DuckDB file.")
+    written = (CORRELATION_PNG, LOADINGS_PNG, PARITY_PNG, COEFFICIENTS_CSV, CORRELATION_CSV)
+    _common.check_output_dir(out, "--out", inputs=(db,), files=written)
 
     from softbend.campaign.store import load_samples
 
@@ -58,15 +61,16 @@ def analyze(
     report = standardized_regression(samples, mape_threshold=mape_threshold_deg)
     corr = correlation_matrix(samples)
 
-    out.mkdir(parents=True, exist_ok=True)
-    figures = {
-        "correlation": correlation_heatmap(corr, out / CORRELATION_PNG),
-        "loadings": loadings_bar(report, out / LOADINGS_PNG),
-        "parity": parity_plot(report, out / PARITY_PNG),
-    }
-    tables = {"coefficients": out / COEFFICIENTS_CSV, "correlation": out / CORRELATION_CSV}
-    report.coefficients.to_csv(tables["coefficients"], float_format="%.10g")
-    corr.to_csv(tables["correlation"], float_format="%.10g")
+    with _common.output_errors(out, "--out"):
+        out.mkdir(parents=True, exist_ok=True)
+        figures = {
+            "correlation": correlation_heatmap(corr, out / CORRELATION_PNG),
+            "loadings": loadings_bar(report, out / LOADINGS_PNG),
+            "parity": parity_plot(report, out / PARITY_PNG),
+        }
+        tables = {"coefficients": out / COEFFICIENTS_CSV, "correlation": out / CORRELATION_CSV}
+        write_text_atomic(tables["coefficients"], report.coefficients.to_csv(float_format="%.10g"))
+        write_text_atomic(tables["correlation"], corr.to_csv(float_format="%.10g"))
 
     if json_output:
         payload = report.to_dict()

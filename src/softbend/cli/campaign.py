@@ -17,6 +17,7 @@ import typer
 from softbend.cli import _common
 
 if TYPE_CHECKING:
+    from softbend.campaign.spaces import SpaceSpec
     from softbend.design import DesignSpace
 
 app = typer.Typer(help="Run FEM or analytical sweeps over a design space.", no_args_is_help=True)
@@ -29,20 +30,13 @@ def parse_space(spec: str, seed: int = 0) -> DesignSpace:
 
     ``lhs`` and ``sobol`` sample ``N`` designs over the Table 1 ranges with ``seed``.
     """
-    from softbend.design import DesignSpace
+    return _space_spec(spec).build(seed)
 
-    text = spec.strip().lower()
-    if text == "table1":
-        return DesignSpace.table1()
-    if text == "corners":
-        return DesignSpace.corners()
-    match = re.fullmatch(r"(lhs|sobol):(\d+)", text)
-    if match is None or int(match[2]) < 1:
-        raise ValueError(
-            f"The '--space' of softbend campaign run must be one of {_SPACE_FORMS} "
-            f"(N >= 1). Got {spec!r} instead."
-        )
-    return DesignSpace.sample(int(match[2]), method=match[1], seed=seed)
+
+def _space_spec(spec: str) -> SpaceSpec:
+    from softbend.campaign.spaces import parse_space as parse
+
+    return parse(spec, option="--space", owner="softbend campaign run")
 
 
 def parse_shard(spec: str) -> tuple[int, int]:
@@ -102,15 +96,22 @@ def run(
     connect_timeout: float = typer.Option(
         5.0, help="Seconds allowed to reach the Dask scheduler and find a worker."
     ),
+    allow_large: bool = typer.Option(
+        False,
+        "--allow-large",
+        help="Run a campaign estimated above 2 GiB of memory or 20 GiB of disk "
+        "(one that does not fit the machine is refused anyway).",
+    ),
     json_output: bool = typer.Option(False, "--json", help="Print the summary as JSON."),
 ) -> None:
     """Sweep every design of a space not yet in DB; re-run the same command to resume."""
     from softbend.campaign import default_pressures_mpa, get_backend, run_campaign
     from softbend.campaign.runner import parse_scheduler_address
+    from softbend.campaign.spaces import campaign_footprint, check_footprint
 
-    designs = parse_space(space, seed)
-    if shard is not None:
-        designs = designs.shard(*parse_shard(shard))
+    _common.check_output_file(db, "DB", inputs=(model,) if model is not None else ())
+    spec = _space_spec(space)
+    shard_of = parse_shard(shard) if shard is not None else None
     pressures = default_pressures_mpa(pmax, pstep)
     if (backend == "surrogate") != (model is not None):
         raise ValueError(
@@ -131,6 +132,19 @@ def run(
         backend_obj = get_backend(backend)
     if scheduler is not None:
         parse_scheduler_address(scheduler)
+    k, count = shard_of or (0, 1)
+    n_stored = len(range(k, spec.n_designs, count))  # designs of the shard
+    check_footprint(
+        campaign_footprint(spec.n_designs, len(pressures), n_stored=n_stored),
+        db,
+        allow_large=allow_large,
+        option="--space",
+        owner="softbend campaign run",
+        allow_flag="--allow-large",
+    )
+    designs = spec.build(seed)
+    if shard_of is not None:
+        designs = designs.shard(*shard_of)
     n_todo = _designs_to_run(db, designs, retry_failed)
     if n_todo < len(designs) and not json_output:
         _common.err_console.print(
@@ -204,6 +218,7 @@ def merge(
     for shard in shards:
         if not shard.is_file():
             raise FileNotFoundError(f"No campaign database at {str(shard)!r}.")
+    _common.check_output_file(db, "DB", inputs=tuple(shards))
     rows = []
     with CampaignStore(db) as store:
         for shard in shards:
@@ -294,7 +309,8 @@ def export(
         format = "csv" if out.suffix.lower() == ".csv" else "parquet"
     check_choice(format, "--format", "softbend campaign export", ("parquet", "csv"))
     check_choice(table, "--table", "softbend campaign export", ("samples", "designs"))
-    with CampaignStore(db, read_only=True) as store:
+    _common.check_output_file(out, "OUT", inputs=(db,), kind=format)
+    with CampaignStore(db, read_only=True) as store, _common.output_errors(out, "OUT"):
         path = store.export(out, format=format, table=table)
         n_rows = len(store.load_samples() if table == "samples" else store.load_designs())
     _common.console.print(f"wrote {n_rows} {table} rows to {path} ({format})", highlight=False)
@@ -314,12 +330,17 @@ def dataset(
     json_output: bool = typer.Option(False, "--json", help="Print the provenance as JSON."),
 ) -> None:
     """Write a campaign as a verified dataset: Parquet samples and designs, provenance."""
-    from softbend.datasets import write_dataset
+    from softbend.datasets import DESIGNS_FILE, PROVENANCE_FILE, SAMPLES_FILE, write_dataset
 
     if not db.is_file():
         raise FileNotFoundError(f"No campaign database at {str(db)!r}.")
-    planned = len(parse_space(space)) if space is not None else None
-    provenance = write_dataset(db, out, command=command, description=description, planned=planned)
+    planned = _space_spec(space).n_designs if space is not None else None
+    written = (SAMPLES_FILE, DESIGNS_FILE, PROVENANCE_FILE)
+    _common.check_output_dir(out, "OUT", inputs=(db,), files=written)
+    with _common.output_errors(out, "OUT"):
+        provenance = write_dataset(
+            db, out, command=command, description=description, planned=planned
+        )
     if json_output:
         _common.print_json(provenance)
         return

@@ -27,9 +27,11 @@ def simulate(
     from softbend.identification.data import save_experiments
     from softbend.identification.synthetic import synthetic_dataset
 
+    _common.check_output_dir(out, "--out")
     dataset = synthetic_dataset(n_experiments=experiments, n_samples=samples, dt_s=dt, seed=seed)
     all_experiments = [e for group in dataset.values() for e in group]
-    paths = save_experiments(all_experiments, out)
+    with _common.output_errors(out, "--out"):
+        paths = save_experiments(all_experiments, out)
     rows = [
         [
             e.name,
@@ -72,10 +74,17 @@ def identify(
     kernel: str = typer.Option(
         "moments", help="Kernel width/shape: 'moments' (paper A) or 'cv' (cross-validated)."
     ),
+    max_memory_mb: float | None = typer.Option(
+        None,
+        "--max-memory-mb",
+        help="Memory the run may use, MiB; data estimated to need more are refused before "
+        "reading. Default: the memory available.",
+    ),
     as_json: bool = typer.Option(False, "--json", help="Print metrics as JSON."),
 ) -> None:
     """Identify rho and L NARX models per pressure sign; leave-one-experiment-out metrics."""
     from softbend.identification.data import load_experiments
+    from softbend.identification.resources import check_identify_memory
     from softbend.identification.study import IdentificationConfig, n_fits
     from softbend.identification.study import identify as run_identify
     from softbend.reports.paper_a import write_identification_outputs
@@ -83,12 +92,22 @@ def identify(
     config = IdentificationConfig(
         C=c, epsilon=epsilon, output_lags=output_lags, input_lags=input_lags, kernel=kernel
     )
+    csvs = [p for p in data.iterdir() if p.suffix.lower() == ".csv"] if data.is_dir() else []
+    inputs = (data, *csvs)
+    _common.check_output_dir(out, "--out", inputs=inputs, files=("metrics.csv", "summary.csv"))
+    need = check_identify_memory(data, max_memory_mb=max_memory_mb)
+    if not as_json and need.csv_bytes >= 4 * 2**20:  # long enough to be worth a line
+        _common.err_console.print(
+            f"reading {need.csv_bytes / 2**20:.1f} MiB of CSV (about {need.rows:,} samples)",
+            highlight=False,
+        )
     experiments = load_experiments(data)
     with _common.progress_bar(
         "fitting NARX models", n_fits(experiments), enabled=not as_json
     ) as bar:
-        result = run_identify(experiments, config, progress=lambda label: bar())
-    outputs = write_identification_outputs(result, out)
+        result = run_identify(experiments, config, progress=lambda label: bar(last=label))
+    with _common.output_errors(out, "--out"):
+        outputs = write_identification_outputs(result, out)
     if as_json:
         _common.print_json(
             {

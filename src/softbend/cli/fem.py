@@ -66,10 +66,15 @@ def run(
     options = _options(maxh, gravity, output="solve" if solve_every else "interpolate")
     if shapes < 1:
         raise ValueError(f"The '--shapes' must be an integer in [1, inf). Got {shapes} instead.")
+    written = ("sweep.csv", SWEEP_JSON, "angle_pressure.png", "shapes.png")
+    _common.check_output_dir(out, "--out", files=written)
     scale = 1000
-    with _common.progress_bar(
-        "FEM sweep (pressure x 1000 / pmax)", scale, enabled=not json_output
-    ) as advance:
+    with (
+        _common.output_errors(out, "--out"),
+        _common.progress_bar(
+            "FEM sweep (pressure x 1000 / pmax)", scale, enabled=not json_output
+        ) as advance,
+    ):
         state = {"done": 0}
 
         def on_step(pressure: float, angle: float, target: float) -> None:
@@ -96,7 +101,8 @@ def run(
         "elements": result.mesh_size,
         "stats": result.stats,
     }
-    write_text_atomic(out / SWEEP_JSON, _common.json_text(summary))
+    with _common.output_errors(out, "--out"):
+        write_text_atomic(out / SWEEP_JSON, _common.json_text(summary))
     if json_output:
         _common.print_json(
             {**summary, "pressure_mpa": result.pressure_mpa, "angle_deg": result.angle_deg}

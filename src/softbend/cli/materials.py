@@ -111,13 +111,16 @@ def fit(
     from softbend.reports.material_figures import fit_figure
 
     names = [m.strip() for m in models.split(",") if m.strip()]
+    inputs = (Path(csv),) if csv is not None and Path(csv).exists() else ()
+    _common.check_output_dir(out, "--out", inputs=inputs, files=(FIT_PNG, FIT_JSON))
     test = _load(csv)
     results = fit_models(test, names, max_stretch=max_stretch)
 
-    figure = fit_figure(test, results, out / FIT_PNG)
-    payload = _payload(test, results, max_stretch)
-    payload["files"] = {"figure": str(figure), "json": str(out / FIT_JSON)}
-    write_text_atomic(out / FIT_JSON, _common.json_text(payload) + "\n")
+    with _common.output_errors(out, "--out"):
+        figure = fit_figure(test, results, out / FIT_PNG)
+        payload = _payload(test, results, max_stretch)
+        payload["files"] = {"figure": str(figure), "json": str(out / FIT_JSON)}
+        write_text_atomic(out / FIT_JSON, _common.json_text(payload) + "\n")
 
     if json_output:
         _common.print_json(payload)

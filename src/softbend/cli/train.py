@@ -32,7 +32,7 @@ def train(
     epochs: int | None = typer.Option(
         None, help="MLP epochs (default: 200 quick grid, 1000 paper grid as paper B)."
     ),
-    jobs: int | None = typer.Option(None, "--jobs", help="XGBoost threads (default: all)."),
+    jobs: int | None = typer.Option(None, "--jobs", help="XGBoost threads, >= 1 (default: all)."),
     halving: int | None = typer.Option(
         None,
         help="Race the MLP configurations by successive halving with this factor (e.g. 3): "
@@ -45,11 +45,18 @@ def train(
     as_json: bool = typer.Option(False, "--json", help="Print the results as JSON."),
 ) -> None:
     """Grid-search the surrogates with grouped K-fold CV, refit the best, save and plot."""
+    from softbend._validation import check_int
     from softbend.reports.surrogate_figures import training_figures
     from softbend.surrogates.workflow import train_surrogates
 
+    if jobs is not None:
+        check_int(jobs, "--jobs", "softbend train", low=1)
+    _common.check_output_dir(out, "--out", inputs=(db,))
     names = [m.strip() for m in models.split(",") if m.strip()]
-    with _common.phase_progress(enabled=not as_json) as progress:
+    with (
+        _common.output_errors(out, "--out"),
+        _common.phase_progress(enabled=not as_json) as progress,
+    ):
         result, summary = train_surrogates(
             db,
             out,
@@ -65,7 +72,8 @@ def train(
             cv=cv,
             halving=halving,
         )
-    summary["files"].update(training_figures(result, out))
+    with _common.output_errors(out, "--out"):
+        summary["files"].update(training_figures(result, out))
     if as_json:
         _common.print_json(summary)
         return

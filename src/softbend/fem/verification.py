@@ -23,7 +23,6 @@ from typing import Any
 
 import numpy as np
 
-from softbend._validation import check_range
 from softbend.design import SFRBADesign
 from softbend.errors import ConvergenceError
 from softbend.fem.mechanics import solid_energy, volume_flux
@@ -301,7 +300,7 @@ def mesh_study(
     from softbend.fem.sweep import simulate
 
     options = options or FEMOptions()
-    sizes = [check_range(h, "maxh_mm", "mesh_study", low=0.0, high=20.0) for h in maxh_mm]
+    sizes = [options.replace(maxh_mm=h).maxh_mm for h in maxh_mm]  # FEMOptions' rule
     if not sizes:
         raise ValueError("The 'maxh_mm' of mesh_study must hold at least one size.")
     rows = []

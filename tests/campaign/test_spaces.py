@@ -1,0 +1,78 @@
+"""Design spaces named by text, and the size guard of a campaign over one."""
+
+from __future__ import annotations
+
+import pytest
+
+from softbend.campaign import spaces
+from softbend.campaign.spaces import (
+    DISK_LIMIT_BYTES,
+    MEMORY_LIMIT_BYTES,
+    campaign_footprint,
+    check_footprint,
+    parse_space,
+)
+
+
+@pytest.mark.parametrize(
+    ("text", "kind", "n"),
+    [("table1", "table1", 972), ("corners", "corners", 64), ("lhs:3", "lhs", 3)],
+)
+def test_the_size_is_known_before_any_design_is_built(text, kind, n):
+    spec = parse_space(text)
+    assert (spec.kind, spec.n_designs) == (kind, n)
+    assert len(spec.build(seed=1)) == n
+
+
+def test_a_huge_space_is_read_without_being_built():
+    assert parse_space("sobol:1000000000000").n_designs == 10**12
+
+
+@pytest.mark.parametrize("text", ["LHS:3", "Table1", " lhs:3", "lhs:0", "lhs:", "grid:5", "lhs:-3"])
+def test_names_are_lower_case_like_every_other_choice(text):
+    with pytest.raises(ValueError, match=r"'--space' of cmd must be one of table1, corners") as err:
+        parse_space(text, option="--space", owner="cmd")
+    assert "(lower case, N >= 1)" in str(err.value) and repr(text) in str(err.value)
+
+
+def test_the_footprint_grows_with_designs_and_pressures():
+    one = campaign_footprint(1000, 101)
+    assert campaign_footprint(2000, 101).memory_bytes == 2 * one.memory_bytes
+    assert campaign_footprint(1000, 201).disk_bytes > 1.9 * one.disk_bytes
+    # Measured: about 8.8 kB per analytical design of 101 pressures in DuckDB.
+    assert 8_000 < one.disk_bytes / 1000 < 12_000
+    shard = campaign_footprint(1000, 101, n_stored=100)
+    assert shard.memory_bytes == one.memory_bytes and shard.disk_bytes == one.disk_bytes // 10
+    assert "1000 designs (100 in this shard) x 101 pressures" in shard.describe()
+
+
+@pytest.fixture
+def roomy(monkeypatch):
+    """A machine with 1 TiB of memory and 1 PiB of free disk."""
+    monkeypatch.setattr(spaces, "_available_memory_bytes", lambda: 1024**4)
+    monkeypatch.setattr(spaces, "_free_disk_bytes", lambda db: 1024**5)
+
+
+def test_a_large_campaign_needs_allow_large(tmp_path, roomy):
+    big = campaign_footprint(10_000_000, 101)
+    assert big.memory_bytes > MEMORY_LIMIT_BYTES and big.disk_bytes > DISK_LIMIT_BYTES
+    with pytest.raises(ValueError, match=r"gives a large campaign, about 23.3 GiB of memory") as e:
+        check_footprint(big, tmp_path / "c.duckdb", allow_flag="--allow-large")
+    assert "86.5 GiB of disk for 10000000 designs x 101 pressures" in str(e.value)
+    assert str(e.value).endswith("pass --allow-large to run it.")
+    check_footprint(big, tmp_path / "c.duckdb", allow_large=True)
+    check_footprint(campaign_footprint(100_000, 101), tmp_path / "c.duckdb")
+
+
+def test_a_campaign_that_does_not_fit_is_refused_even_when_allowed(tmp_path, monkeypatch):
+    monkeypatch.setattr(spaces, "_available_memory_bytes", lambda: 8 * 1024**3)
+    monkeypatch.setattr(spaces, "_free_disk_bytes", lambda db: 50 * 1024**3)
+    big = campaign_footprint(10_000_000, 101)
+    with pytest.raises(ValueError, match="must give a campaign that fits this machine") as e:
+        check_footprint(big, tmp_path / "c.duckdb", allow_large=True)
+    assert "(8 GiB available)" in str(e.value) and "(50 GiB free for" in str(e.value)
+    # Disk alone: a small space at the finest pressure grid.
+    with pytest.raises(ValueError, match="fits this machine"):
+        check_footprint(
+            campaign_footprint(10_000, 100_001), tmp_path / "c.duckdb", allow_large=True
+        )

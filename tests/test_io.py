@@ -1,0 +1,59 @@
+"""Atomic writes: all or nothing, and the permissions a plain ``open`` would give."""
+
+from __future__ import annotations
+
+import os
+import stat
+
+import pytest
+
+from softbend._io import atomic_file, write_bytes_atomic, write_text_atomic
+
+
+@pytest.fixture
+def umask():
+    """Set the process umask for one test and restore it afterwards."""
+    saved = os.umask(0o022)
+    os.umask(saved)
+    yield os.umask
+    os.umask(saved)
+
+
+def _mode(path) -> int:
+    return stat.S_IMODE(path.stat().st_mode)
+
+
+@pytest.mark.parametrize("mask", [0o022, 0o002, 0o077])
+def test_a_new_file_gets_0666_less_the_umask_as_with_open(tmp_path, umask, mask):
+    umask(mask)
+    (tmp_path / "plain.txt").write_text("x")
+    write_text_atomic(tmp_path / "atomic.txt", "x")
+    write_bytes_atomic(tmp_path / "atomic.bin", b"x")
+    assert _mode(tmp_path / "atomic.txt") == _mode(tmp_path / "plain.txt") == 0o666 & ~mask
+    assert _mode(tmp_path / "atomic.bin") == 0o666 & ~mask
+
+
+def test_a_replaced_file_keeps_its_permissions(tmp_path, umask):
+    umask(0o077)
+    path = tmp_path / "shared.json"
+    path.write_text("old")
+    path.chmod(0o644)
+    write_text_atomic(path, "new")
+    assert path.read_text() == "new" and _mode(path) == 0o644
+
+
+def test_a_failed_write_leaves_the_old_file_and_no_temporary(tmp_path):
+    path = tmp_path / "a.csv"
+    path.write_text("old\n")
+    with pytest.raises(OSError, match="No space left"), atomic_file(path) as handle:
+        handle.write("half")
+        raise OSError(28, "No space left on device")
+    assert path.read_text() == "old\n"
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["a.csv"]
+
+
+def test_text_is_utf8_and_the_folder_is_created(tmp_path):
+    path = write_text_atomic(tmp_path / "new" / "t.txt", "λ ≤ 4\n")
+    assert path.read_bytes() == "λ ≤ 4\n".encode()
+    with pytest.raises(ValueError, match="'mode' of atomic_file"), atomic_file(path, "a"):
+        pass
