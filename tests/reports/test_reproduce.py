@@ -38,6 +38,15 @@ def _stand_in_fem_dataset(folder):
     return folder / "dataset"
 
 
+#: Transfer learning in seconds: few epochs, one ensemble pair, no GP restarts.
+QUICK_TRANSFER = {
+    "experimental": {"epochs": 50},
+    "refined": {"epochs": 30},
+    "refined-ensemble": {"epochs": 30, "n_members": 2},
+    "residual-gp": {"n_restarts": 0},
+}
+
+
 @pytest.fixture(scope="module")
 def fem_dataset(tmp_path_factory):
     return _stand_in_fem_dataset(tmp_path_factory.mktemp("fem_dataset"))
@@ -61,6 +70,7 @@ def first_run(tmp_path_factory, fem_dataset):
         fem_pmax_mpa=0.02,
         fem_dataset=fem_dataset,
         fem_dataset_epochs=5,
+        transfer_options=QUICK_TRANSFER,
     )
     return out, summary, phases
 
@@ -149,6 +159,7 @@ def test_second_run_resumes_the_campaign(first_run, fem_dataset):
         design_space=_small_space(),
         fem_dataset=fem_dataset,
         fem_dataset_epochs=5,
+        transfer_options=QUICK_TRANSFER,
     )
     b = again["paper_b"]
     assert b["run_now"] == 0 and b["resumed_done"] == 8
@@ -178,6 +189,19 @@ def test_fem_data_section_reads_the_dataset_and_compares_both_protocols(first_ru
     html = (out / "index.html").read_text(encoding="utf-8")
     assert "Figs. 4 and 5 on softbend" in html and "random CV" in html
     assert "stand-in for the test" in html
+
+
+def test_transfer_section_is_labelled_synthetic_and_beside_paper_b(first_run):
+    out, summary, _ = first_run
+    section = summary["transfer"]
+    assert section["n_measurements"] >= 7 * 10
+    assert set(section["summary"]) >= {"fem-only", "refined", "residual-gp"}
+    assert section["summary"]["fem-only"]["coverage"] is None
+    assert 0.0 <= section["summary"]["residual-gp"]["coverage"] <= 1.0
+    html = (out / "index.html").read_text(encoding="utf-8")
+    assert "SYNTHETIC" in html and "paper B refined MLP" in html and "7.935" in html
+    for name in ("fig6_loss_curves.png", "fig7_actuators.png", "learning_curve.png"):
+        assert (out / "transfer" / name).is_file()
 
 
 def test_the_report_as_a_user_sees_it_in_chromium(first_run, tmp_path):

@@ -30,12 +30,23 @@ app = typer.Typer(
 def _register() -> None:
     # Imported here so that ``import softbend.cli`` stays cheap and each
     # subcommand module owns its own imports.
-    from softbend.cli import analyze, campaign, curling, fem, materials, reproduce, train
+    from softbend.cli import (
+        analyze,
+        campaign,
+        curling,
+        fem,
+        materials,
+        reproduce,
+        train,
+        transfer,
+    )
 
     app.add_typer(curling.app, name="curling")
     app.add_typer(campaign.app, name="campaign")
     app.add_typer(materials.app, name="materials")
     app.add_typer(fem.app, name="fem")
+    app.add_typer(transfer.lab_app, name="lab")
+    app.add_typer(transfer.app, name="transfer")
     app.command("analyze")(analyze.analyze)
     app.command("train")(train.train)
     app.command("predict")(train.predict)
@@ -71,11 +82,14 @@ def main(argv: Sequence[str] | None = None) -> int:
         return int(getattr(exc, "exit_code", 2))
     except (ValueError, FileNotFoundError, NotADirectoryError, PermissionError) as exc:
         # SoftbendError input errors derive from ValueError.
-        _common.error_line(str(exc))
+        _common.error_line(_common.os_error_message(exc) if isinstance(exc, OSError) else str(exc))
         return 2
     except _common.SoftbendError as exc:
         _common.error_line(str(exc))
         return 2
+    except OSError as exc:  # last resort: an OS error no command named an option for
+        _common.error_line(_common.os_error_message(exc))
+        return 1
     return int(result) if isinstance(result, int) else 0
 
 

@@ -8,6 +8,9 @@ softbend can reproduce, and the data, models and figures beside it:
 - ``paper_b/``: the Table 1 campaign database (DuckDB; resumed if present), its
   Parquet export, the preliminary analysis (Fig. 4), and the surrogate models
   trained on it with the quick grid (``paper_b/surrogates/``, Fig. 5).
+- ``paper_b_fem/``: the FEM sweep of the Fig. 2 design and Figs. 4 and 5 on the
+  shipped FEM dataset.
+- ``transfer/``: transfer learning on the shipped virtual lab (Figs. 6 and 7).
 """
 
 from __future__ import annotations
@@ -196,6 +199,7 @@ def run_reproduce(
     fem_pmax_mpa: float | None = None,
     fem_dataset: str | Path | None = None,
     fem_dataset_epochs: int | None = None,
+    transfer_options: dict[str, dict[str, Any]] | None = None,
     command: str | None = None,
 ) -> dict[str, Any]:
     """Run every reproducible section and write ``out_dir/index.html``.
@@ -220,6 +224,9 @@ def run_reproduce(
         The FEM dataset of the Figs. 4 and 5 section on FEM data (default: the
         one shipped in the package, read, never recomputed) and its MLP epochs
         (default: the quick grid's).
+    transfer_options : dict, optional
+        Options per transfer-learning strategy (e.g. ``{"refined": {"epochs": 30}}``
+        for a quick run); default paper B's settings.
     command : str, optional
         The command line that started the run, shown in the report's provenance.
 
@@ -269,6 +276,11 @@ def run_reproduce(
 
     summary["paper_b_fem_data"] = paper_b_fem_data.add_section(
         report, out_dir, seed, progress, dataset=fem_dataset, epochs=fem_dataset_epochs
+    )
+    from softbend.reports import transfer_section
+
+    summary["transfer"] = transfer_section.add_section(
+        report, out_dir, seed, progress, options=transfer_options
     )
     finished = datetime.now(UTC)
     summary["seconds"] = (finished - started).total_seconds()

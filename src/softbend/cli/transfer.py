@@ -1,0 +1,261 @@
+"""``softbend lab`` and ``softbend transfer``: measurements, refinement and its evaluation."""
+
+from __future__ import annotations
+
+from pathlib import Path
+from typing import TYPE_CHECKING
+
+import typer
+
+from softbend.cli import _common
+
+if TYPE_CHECKING:
+    from softbend.transfer.loco import LocoResult
+
+lab_app = typer.Typer(
+    help="The virtual lab: labelled-synthetic measurements of paper B's Fig. 7 actuators.",
+    no_args_is_help=True,
+)
+app = typer.Typer(
+    help="Transfer learning (paper B §4.2–4.3): refine a surrogate on measurements.",
+    no_args_is_help=True,
+)
+
+
+def _names(text: str) -> list[str]:
+    return [n.strip() for n in text.split(",") if n.strip()]
+
+
+@lab_app.command("measure")
+def measure(
+    out: Path = typer.Option(..., "--out", help="CSV file to write the measurements to."),
+    plant: str = typer.Option("fem", help="Model of the actuators as built: fem or analytical."),
+    seed: int = typer.Option(0, help="Seed of the fabrication errors and the camera noise."),
+    fabrication_error: float = typer.Option(
+        0.2, help="Half-width of the uniform error of the wall t and layer b, mm."
+    ),
+    hysteresis: float = typer.Option(
+        0.02, help="Half the largest loading/unloading gap, fraction of the angle."
+    ),
+    camera_noise: float = typer.Option(1.0, help="Standard deviation of the angle reading, deg."),
+    elastomer_max_stretch: float = typer.Option(
+        3.0, help="Largest stretch of the shipped Dragon Skin 30 test used by the lab's fit."
+    ),
+    pmax: float = typer.Option(0.25, help="Highest pressure set, MPa."),
+    step: float = typer.Option(0.01, help="Pressure increment, MPa."),
+    max_angle: float = typer.Option(270.0, help="Stop raising the pressure past this angle, deg."),
+    unloading: bool = typer.Option(False, "--unloading", help="Also read the unloading branch."),
+    cycles: int = typer.Option(1, help="Inflation cycles per actuator."),
+    as_json: bool = typer.Option(False, "--json", help="Print a JSON summary."),
+) -> None:
+    """Measure the 7 actuators of paper B Fig. 7 in the virtual lab (synthetic data)."""
+    from softbend.reports.transfer_figures import lab_measurements
+    from softbend.transfer.lab import VirtualLab
+    from softbend.transfer.measurements import save_measurements
+
+    _common.check_output_file(out, "--out", kind="csv")
+    lab = VirtualLab(
+        plant=plant,
+        seed=seed,
+        fabrication_error_mm=fabrication_error,
+        hysteresis=hysteresis,
+        camera_noise_deg=camera_noise,
+        elastomer_max_stretch=elastomer_max_stretch,
+        pmax_mpa=pmax,
+        pressure_step_mpa=step,
+        max_angle_deg=max_angle,
+        unloading=unloading,
+        cycles=cycles,
+    )
+    total = len(lab.actuators)
+    with _common.progress_bar("virtual lab", total, enabled=not as_json) as advance:
+        measurements = lab.measure(progress=lambda done, n, name: advance(actuator=name))
+    path = save_measurements(measurements, out)
+    figure = lab_measurements(measurements, path.with_suffix(".png"))
+    frame = measurements.frame
+    per = frame.groupby("actuator_id", sort=False).agg(
+        points=("angle_deg", "size"),
+        pmax=("pressure_mpa", "max"),
+        angle_max=("angle_deg", "max"),
+    )
+    if as_json:
+        _common.print_json(
+            {
+                "out": str(path),
+                "figure": str(figure),
+                "synthetic": True,
+                "n_measurements": len(frame),
+                "actuators": per.reset_index().to_dict(orient="records"),
+                "metadata": dict(measurements.metadata),
+            }
+        )
+        return
+    _common.print_table(
+        f"Virtual lab (SYNTHETIC, {plant}, seed {seed}): {len(frame)} readings",
+        ["actuator (l,r,t,b,φ,lc)", "readings", "top pressure (MPa)", "largest angle (°)"],
+        [[str(k), int(r.points), float(r.pmax), float(r.angle_max)] for k, r in per.iterrows()],
+    )
+    _common.console.print(f"measurements written to {path}, figure {figure}")
+
+
+@app.command("base")
+def base(
+    out: Path = typer.Option(..., "--out", help="File for the saved MLP (JSON)."),
+    epochs: int = typer.Option(1000, help="Training epochs (paper B: 1000)."),
+    seed: int = typer.Option(0, help="Seed of the weights and the batch order."),
+) -> None:
+    """Train paper B's MLP (63, 65) on the shipped Table 1 FEM dataset and save it."""
+    from softbend.datasets import table1_fem_provenance
+    from softbend.surrogates.persistence import save_surrogate
+    from softbend.transfer.base import BASE_HIDDEN_SIZES, train_base_mlp
+
+    _common.check_output_file(out, "--out", kind="json")
+    with _common.progress_bar("training the FEM MLP (epochs)", epochs) as advance:
+        state = {"done": 0}
+
+        def progress(done: int, total: int) -> None:
+            advance(done - state["done"])
+            state["done"] = done
+
+        model = train_base_mlp(epochs=epochs, seed=seed, progress=progress)
+    provenance = table1_fem_provenance()
+    path = save_surrogate(
+        model,
+        out,
+        metadata={
+            "purpose": "the FEM-trained MLP that transfer learning starts from",
+            "trained_on": "softbend.datasets.table1_fem(), converged samples",
+            "dataset_samples_sha256": provenance.get("files", {})
+            .get("samples.parquet", {})
+            .get("sha256"),
+            "hidden_sizes": list(BASE_HIDDEN_SIZES),
+            "epochs": epochs,
+            "seed": seed,
+            "command": f"softbend transfer base --out {out.name} --epochs {epochs} --seed {seed}",
+            "final_training_mse_deg2": float(model.loss_curve_[-1]) * model.y_scale_**2,
+        },
+    )
+    _common.console.print(
+        f"FEM MLP {BASE_HIDDEN_SIZES} written to {path} "
+        f"(final training MSE {model.loss_curve_[-1] * model.y_scale_**2:.4g} deg²)"
+    )
+
+
+@app.command("loco")
+def loco(
+    measurements: Path = typer.Argument(..., help="Measurements CSV (see 'softbend lab measure')."),
+    out: Path = typer.Option(..., "--out", help="Folder for tables and figures."),
+    base: Path | None = typer.Option(
+        None, help="Saved surrogate to start from (default: the shipped FEM-trained MLP)."
+    ),
+    strategies: str = typer.Option(
+        "all", help="Comma-separated strategies, or 'all' (see 'softbend transfer strategies')."
+    ),
+    level: float = typer.Option(0.9, help="Probability of the prediction intervals."),
+    learning_curve: bool = typer.Option(
+        True, "--learning-curve/--no-learning-curve", help="Also fit on 1..n-2 actuators."
+    ),
+    seed: int = typer.Option(0, help="Seed of the strategies and the learning curve."),
+    as_json: bool = typer.Option(False, "--json", help="Print the results as JSON."),
+) -> None:
+    """Leave one configuration out: every strategy, every held-out actuator (paper B Fig. 7)."""
+    from softbend.reports import transfer_figures
+    from softbend.transfer.base import load_base
+    from softbend.transfer.loco import DEFAULT_STRATEGIES, leave_one_configuration_out
+    from softbend.transfer.measurements import load_measurements
+
+    _common.check_output_dir(out, "--out", inputs=(measurements,))
+    data = load_measurements(measurements)
+    names = list(DEFAULT_STRATEGIES) if strategies.strip() == "all" else _names(strategies)
+    model = load_base(base)
+    with _common.phase_progress(enabled=not as_json) as progress:
+        result = leave_one_configuration_out(
+            data,
+            model,
+            names,
+            level=level,
+            learning_curve=learning_curve,
+            seed=seed,
+            progress=lambda done, total, name: progress("fitting strategies", done, total),
+        )
+    files = result.write(out)
+    out = Path(out)
+    synthetic = str(data.metadata.get("synthetic", "")).startswith("true")
+    files["fig6"] = str(transfer_figures.loss_curves(result, out / "fig6_loss_curves.png"))
+    files["fig7"] = str(
+        transfer_figures.actuator_panels(result, out / "fig7_actuators.png", synthetic=synthetic)
+    )
+    if learning_curve:
+        files["learning_curve_figure"] = str(
+            transfer_figures.learning_curve(result, out / "learning_curve.png")
+        )
+    if as_json:
+        _common.print_json({**result.to_dict(), "files": files, "synthetic": synthetic})
+        return
+    print_loco_summary(result)
+    _common.console.print(f"tables and figures written to {out}")
+
+
+def print_loco_summary(result: LocoResult) -> None:
+    """The per-strategy table beside paper B's refined MLP (used by reproduce too)."""
+    rows = []
+    for _, r in result.summary.iterrows():
+        rows.append(
+            [
+                r["strategy"],
+                float(r["rmse_deg"]),
+                float(r["mape_pct"]),
+                float(r["max_error_deg"]),
+                "—" if r["coverage"] != r["coverage"] else f"{100 * r['coverage']:.1f} %",
+                f"{r['worst_actuator']} ({r['worst_rmse_deg']:.1f}°)",
+            ]
+        )
+    rows.append(["paper B refined MLP", 7.935, 6.45, "—", "—", "120,6,2,2,5,8 (19.58°)"])
+    _common.print_table(
+        f"Leave one configuration out ({len(result.settings['actuators'])} actuators, "
+        f"{result.settings['n_measurements']} readings; intervals {result.level:.0%})",
+        ["strategy", "mean RMSE °", "mean MAPE %", "max |e| °", "coverage", "worst actuator"],
+        rows,
+    )
+
+
+@app.command("refine")
+def refine(
+    base: Path = typer.Argument(..., help="Saved surrogate to start from (an mlp for 'refined')."),
+    measurements: Path = typer.Argument(..., help="Measurements CSV."),
+    out: Path = typer.Option(..., "--out", help="File for the refined model (JSON)."),
+    strategy: str = typer.Option("refined", help="Strategy: refined or experimental."),
+    epochs: int | None = typer.Option(None, help="Epochs (default: the strategy's)."),
+    seed: int = typer.Option(0, help="Seed of the training."),
+) -> None:
+    """Fit a strategy on all measurements and save it like the other surrogates."""
+    from softbend._validation import check_choice
+    from softbend.surrogates.persistence import save_surrogate
+    from softbend.transfer.base import load_base
+    from softbend.transfer.measurements import load_measurements
+    from softbend.transfer.strategies import make_strategy
+
+    check_choice(strategy, "strategy", "softbend transfer refine", ("refined", "experimental"))
+    _common.check_output_file(out, "--out", inputs=(base, measurements), kind="json")
+    data = load_measurements(measurements)
+    options = {} if epochs is None else {"epochs": epochs}
+    model = make_strategy(strategy, load_base(base), seed=seed, **options)
+    model.fit(data.features, data.angle_deg)
+    path = save_surrogate(
+        model.model_,
+        out,
+        metadata={
+            "strategy": strategy,
+            "base": str(base),
+            "measurements": str(measurements),
+            "n_measurements": len(data),
+            "actuators": list(data.actuator_ids),
+            "synthetic_measurements": str(data.metadata.get("synthetic", "false")),
+            "final_training_mse_deg2": float(model.loss_curve_[-1]),
+        },
+    )
+    _common.console.print(
+        f"{strategy} model on {len(data)} readings of {len(data.actuator_ids)} actuators "
+        f"written to {path} (final training MSE {model.loss_curve_[-1]:.4g} deg²); "
+        f"use it with 'softbend predict {path}'"
+    )

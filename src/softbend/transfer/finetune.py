@@ -1,0 +1,194 @@
+"""Training a fitted MLP further on a few measurements, many variants at once.
+
+Transfer learning trains the same network again and again on small row sets:
+one refit per held-out actuator, per learning-curve point, per ensemble
+member. Each is a full-batch problem of ~100 rows, where PyTorch's per-call
+overhead, not arithmetic, sets the time (about 1 ms per Adam step). So the K
+variants are stacked along a leading axis and trained together: one batched
+matrix product per layer, one Adam step for all. Each variant's loss is the
+weighted mean over its own rows, and Adam acts element by element, so variant
+k ends exactly where training it alone would (up to rounding).
+"""
+
+from __future__ import annotations
+
+from typing import Any
+
+import numpy as np
+from numpy.typing import ArrayLike
+
+from softbend._validation import check_int, check_range
+from softbend.errors import ConvergenceError
+
+__all__ = ["fine_tune_many", "fine_tune_mlp", "row_weights"]
+
+
+def _check_mlp(base: Any, owner: str) -> Any:
+    from sklearn.utils.validation import check_is_fitted
+
+    from softbend.surrogates.mlp import NormalizedMLPRegressor
+
+    if not isinstance(base, NormalizedMLPRegressor):
+        raise ValueError(
+            f"The 'base' of {owner} must be a fitted NormalizedMLPRegressor (an 'mlp' "
+            f"surrogate): its weights are trained further. Got {type(base).__name__} instead."
+        )
+    check_is_fitted(base)
+    return base
+
+
+def row_weights(row_sets: list[np.ndarray], n_rows: int) -> np.ndarray:
+    """``(K, n_rows)`` counts of each row in each set (a bootstrap draw counts twice)."""
+    return np.array([np.bincount(np.asarray(r), minlength=n_rows) for r in row_sets], dtype=float)
+
+
+def fine_tune_many(
+    base: Any | list[Any],
+    X: ArrayLike,
+    y: ArrayLike,
+    weights: ArrayLike,
+    *,
+    epochs: int = 1000,
+    learning_rate: float = 6e-4,
+) -> list[Any]:
+    """Train K copies of a fitted MLP further, full batch, each on its own weighted rows.
+
+    Parameters
+    ----------
+    base : NormalizedMLPRegressor or list of them
+        The starting point of every variant, or one per variant (K of the
+        same architecture); each keeps its own standardization. Not modified.
+    X : array_like of shape (n, d)
+        Rows of :data:`softbend.design.FEATURES` (mm, deg, MPa), finite.
+    y : array_like of shape (n,)
+        Measured angle, degrees, finite.
+    weights : array_like of shape (K, n)
+        Non-negative weight of each row in each variant (0: not used; integer
+        counts reproduce a draw with repeats); every variant needs a positive sum.
+    epochs : int, default 1000
+        Adam steps (full batch: one per epoch), >= 1.
+    learning_rate : float, default 6e-4
+        Adam step size, > 0.
+
+    Returns
+    -------
+    list of NormalizedMLPRegressor
+        K fitted models; each ``loss_curve_`` is its training MSE per epoch in
+        the base's standardized units, as for any fitted MLP (times
+        ``y_scale_**2``: deg², paper B Fig. 6's unit).
+    """
+    from softbend._torch import require_torch
+    from softbend.surrogates.mlp import NormalizedMLPRegressor
+
+    owner = "fine_tune_many"
+    starts = [_check_mlp(b, owner) for b in (base if isinstance(base, list) else [base])]
+    base = starts[0]
+    epochs = check_int(epochs, "epochs", owner, low=1)
+    learning_rate = check_range(learning_rate, "learning_rate", owner, low=0.0)
+    X = np.asarray(X, dtype=np.float64)
+    y = np.asarray(y, dtype=np.float64).ravel()
+    w = np.asarray(weights, dtype=np.float64)
+    d = base.n_features_in_
+    if X.ndim != 2 or X.shape[1] != d or X.shape[0] != y.size or y.size == 0:
+        raise ValueError(
+            f"The 'X' and 'y' of {owner} must have shapes (n, {d}) and (n,) with n >= 1. "
+            f"Got {X.shape} and {y.shape} instead."
+        )
+    if not (np.isfinite(X).all() and np.isfinite(y).all()):
+        raise ValueError(f"The 'X' and 'y' of {owner} must be finite (no NaN or inf).")
+    if w.ndim != 2 or w.shape[1] != y.size:
+        raise ValueError(
+            f"The 'weights' of {owner} must have shape (K, {y.size}). Got {w.shape} instead."
+        )
+    if not np.isfinite(w).all() or (w < 0).any() or (w.sum(axis=1) <= 0).any():
+        raise ValueError(
+            f"The 'weights' of {owner} must be finite, >= 0, with a positive sum per variant."
+        )
+    k = w.shape[0]
+    if len(starts) == 1:
+        starts = starts * k
+    shapes = {tuple(c.shape for c in m.coefs_) for m in starts}
+    if len(starts) != k or len(shapes) != 1:
+        raise ValueError(
+            f"The 'base' of {owner} must be one MLP or {k} MLPs of one architecture. "
+            f"Got {len(starts)} with layer shapes {sorted(shapes)}."
+        )
+    x_mean = np.array([m.x_mean_ for m in starts])[:, None, :]
+    x_scale = np.array([m.x_scale_ for m in starts])[:, None, :]
+    y_mean = np.array([m.y_mean_ for m in starts])[:, None]
+    y_scale = np.array([m.y_scale_ for m in starts])[:, None]
+
+    torch = require_torch("refining the MLP surrogate")
+    threads = torch.get_num_threads()
+    torch.set_num_threads(1)
+    try:
+        f64 = torch.float64
+        z = torch.as_tensor((X[None, :, :] - x_mean) / x_scale, dtype=f64)  # (K, n, d)
+        t = torch.as_tensor((y[None, :] - y_mean) / y_scale, dtype=f64)  # (K, n)
+        share = torch.as_tensor(w / w.sum(axis=1, keepdims=True), dtype=f64)
+
+        def stacked(arrays: list[np.ndarray], bias: bool) -> Any:
+            tiled = np.stack(arrays)[:, None, :] if bias else np.stack(arrays)
+            return torch.tensor(tiled, dtype=f64, requires_grad=True)
+
+        weights_ = [stacked([m.coefs_[i] for m in starts], False) for i in range(3)]
+        biases = [stacked([m.intercepts_[i] for m in starts], True) for i in range(3)]
+        optimizer = torch.optim.Adam([*weights_, *biases], lr=learning_rate)
+        curve = np.empty((k, epochs))
+        for epoch in range(epochs):
+            a = torch.tanh(z @ weights_[0] + biases[0])
+            a = torch.tanh(a @ weights_[1] + biases[1])
+            out = (a @ weights_[2] + biases[2])[..., 0]
+            per_variant = (((out - t) ** 2) * share).sum(dim=1)
+            optimizer.zero_grad()
+            per_variant.sum().backward()
+            optimizer.step()
+            curve[:, epoch] = per_variant.detach().numpy()
+    finally:
+        torch.set_num_threads(threads)
+    coefs = [p.detach().numpy() for p in weights_]
+    intercepts = [p.detach().numpy()[:, 0, :] for p in biases]
+    if not all(np.isfinite(a).all() for a in (*coefs, *intercepts)):
+        raise ConvergenceError(f"{owner} produced non-finite weights; lower the learning_rate")
+    return [
+        NormalizedMLPRegressor.from_arrays(
+            x_mean=starts[i].x_mean_,
+            x_scale=starts[i].x_scale_,
+            y_mean=starts[i].y_mean_,
+            y_scale=starts[i].y_scale_,
+            coefs=[c[i].copy() for c in coefs],
+            intercepts=[b[i].copy() for b in intercepts],
+            loss_curve=curve[i].tolist(),
+            fitted_device="cpu",
+            epochs=epochs,
+            batch_size=max(int(np.count_nonzero(w[i])), 1),
+            learning_rate=learning_rate,
+            seed=0,
+        )
+        for i in range(k)
+    ]
+
+
+def fine_tune_mlp(
+    base: Any,
+    X: ArrayLike,
+    y: ArrayLike,
+    *,
+    epochs: int = 1000,
+    learning_rate: float = 6e-4,
+) -> Any:
+    """Train every layer of a fitted MLP further on new rows (full batch), scaling kept.
+
+    :func:`fine_tune_many` with one variant holding every row once. Paper B's
+    batches of 1024 rows are larger than any set of measurements, so a batch
+    is the whole set, as here.
+
+    Returns
+    -------
+    NormalizedMLPRegressor
+        A new fitted model (``loss_curve_`` in standardized units).
+    """
+    y = np.asarray(y, dtype=np.float64).ravel()
+    return fine_tune_many(
+        base, X, y, np.ones((1, y.size)), epochs=epochs, learning_rate=learning_rate
+    )[0]

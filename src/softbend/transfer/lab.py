@@ -1,0 +1,345 @@
+"""A virtual lab: labelled-synthetic measurements of real-looking actuators (SPEC §4.7).
+
+Paper B's measurements are not public. The virtual lab produces measurements
+of the seven actuators of paper B Fig. 7 the way their rig did (pressure set
+from 0 in 0.01 MPa increments, each reading at a stable state, the angle read
+from a camera), with a *reality gap* between the lab and the simulations the
+surrogates were trained on:
+
+* **Elastomer.** The lab's silicone is the shipped Dragon Skin 30 tensile test
+  (:func:`softbend.materials.load_shipped`) with its own Yeoh fit over the
+  working range (stretch <= 3 by default), not paper B's constants. It is softer
+  than paper B's fit at small strains and stiffer at large ones, so a
+  simulation-trained model drifts as the pressure rises, as paper B saw.
+* **Fabrication.** Each actuator's wall ``t`` and bottom layer ``b`` are off
+  nominal by a seeded uniform error (default +/-0.2 mm); the file records the
+  nominal design, as a lab would.
+* **Hysteresis.** Rate-independent: the loading branch lies below the elastic
+  curve and the unloading branch above it by ``h·4s(1 - s)`` of the angle,
+  ``s = p/p_top``; the branches meet at 0 and at the top pressure and differ by
+  at most ``2h`` (default h = 0.02: 4 %, paper B measured < 5 %).
+* **Camera.** Gaussian reading noise (default 1°).
+
+The elastic curve is the finite-element model of the actuator as built (or,
+for fast checks, the analytical model). Every file the lab writes says that it
+is synthetic and lists the gap's parameters in its header.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable
+from dataclasses import asdict, dataclass, field, replace
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+import pandas as pd
+
+from softbend._validation import check_choice, check_int, check_range
+from softbend.design import PARAMETERS, SFRBADesign
+from softbend.materials.fit import fit_model
+from softbend.materials.presets import DRAGON_SKIN_30, Material
+from softbend.materials.tensile import load_shipped, shipped_tensile_tests
+from softbend.models import BendingModel, default_pressures_mpa
+from softbend.transfer.measurements import Measurements
+
+__all__ = ["LAB_ACTUATORS", "PLANTS", "VirtualLab", "actuator_id", "shipped_measurements"]
+
+_OWNER = "VirtualLab"
+
+#: The seven actuators of paper B Fig. 7, (l, r, t, b, φ, lc) in mm and degrees.
+LAB_ACTUATORS: tuple[SFRBADesign, ...] = tuple(
+    SFRBADesign(*values)
+    for values in (
+        (100, 6, 2, 2, 5, 8),
+        (120, 6, 2, 2, 5, 8),
+        (100, 8, 2, 2, 5, 8),
+        (100, 6, 3, 2, 5, 8),
+        (100, 6, 2, 3, 5, 8),
+        (100, 6, 2, 2, 10, 8),
+        (100, 6, 2, 2, 5, 10),
+    )
+)
+
+#: Models that can play the lab's actuators.
+PLANTS: tuple[str, ...] = ("fem", "analytical")
+
+
+def actuator_id(design: SFRBADesign) -> str:
+    """The design as ``"l,r,t,b,phi,lc"`` with ``%g`` numbers, e.g. ``"100,6,2,2,5,8"``."""
+    return ",".join(f"{getattr(design, name):g}" for name in PARAMETERS)
+
+
+#: CSV column of each design parameter (the measurement files' names).
+_COLUMNS = dict(zip(PARAMETERS, ("l", "r", "t", "b", "phi", "lc"), strict=True))
+
+
+@dataclass(frozen=True)
+class VirtualLab:
+    """Settings of the virtual lab; :meth:`measure` runs it.
+
+    Parameters
+    ----------
+    actuators : tuple of SFRBADesign
+        Nominal designs measured, default :data:`LAB_ACTUATORS` (paper B Fig. 7).
+    plant : {"fem", "analytical"}
+        Model of the actuators as built: the 3D FEM (default) or the analytical
+        model (seconds instead of minutes, for checks).
+    elastomer : str
+        Shipped tensile test the lab's silicone is fitted to (Yeoh), default
+        ``"dragon-skin-30"``.
+    elastomer_max_stretch : float
+        Largest stretch of the tensile test used by the fit, > 1 (default 3: the
+        working range of the walls).
+    fabrication_error_mm : float
+        Half-width of the uniform error of ``t`` and ``b``, mm, in [0, 1).
+    hysteresis : float
+        ``h``: half the largest relative gap between the loading and unloading
+        branches, in [0, 0.25).
+    camera_noise_deg : float
+        Standard deviation of the angle reading, degrees, >= 0.
+    pressure_step_mpa : float
+        Increment of the set pressure, MPa (paper B: 0.01).
+    pmax_mpa : float
+        Highest pressure set, MPa (paper B went to 0.17, some actuators beyond 0.2).
+    max_angle_deg : float
+        The lab stops raising the pressure of an actuator once its angle passes
+        this, degrees, in (0, 300].
+    unloading : bool
+        Also read the unloading branch, from the top pressure back to 0.
+    cycles : int
+        Inflation (and deflation) cycles per actuator, >= 1.
+    seed : int
+        Seed of the fabrication errors and the camera noise, >= 0.
+    """
+
+    actuators: tuple[SFRBADesign, ...] = LAB_ACTUATORS
+    plant: str = "fem"
+    elastomer: str = "dragon-skin-30"
+    elastomer_max_stretch: float = 3.0
+    fabrication_error_mm: float = 0.2
+    hysteresis: float = 0.02
+    camera_noise_deg: float = 1.0
+    pressure_step_mpa: float = 0.01
+    pmax_mpa: float = 0.25
+    max_angle_deg: float = 270.0
+    unloading: bool = False
+    cycles: int = 1
+    seed: int = 0
+    _material: Material | None = field(default=None, init=False, repr=False, compare=False)
+
+    def __post_init__(self) -> None:
+        actuators = tuple(self.actuators)
+        if not actuators or not all(isinstance(a, SFRBADesign) for a in actuators):
+            raise ValueError(
+                f"The 'actuators' of {_OWNER} must be a non-empty sequence of SFRBADesign. "
+                f"Got {self.actuators!r} instead."
+            )
+        ids = [actuator_id(a) for a in actuators]
+        if len(set(ids)) != len(ids):
+            raise ValueError(
+                f"The 'actuators' of {_OWNER} must be distinct designs. Got {ids} instead."
+            )
+        object.__setattr__(self, "actuators", actuators)
+        check_choice(self.plant, "plant", _OWNER, PLANTS)
+        check_choice(self.elastomer, "elastomer", _OWNER, shipped_tensile_tests())
+        for name, low, high in (
+            ("elastomer_max_stretch", 1.0, 50.0),
+            ("fabrication_error_mm", 0.0, 1.0),
+            ("hysteresis", 0.0, 0.25),
+            ("pressure_step_mpa", 0.0, 0.1),
+            ("pmax_mpa", 0.0, 1.0),
+        ):
+            low_inclusive = name in ("fabrication_error_mm", "hysteresis")
+            value = check_range(
+                getattr(self, name),
+                name,
+                _OWNER,
+                low=low,
+                high=high,
+                low_inclusive=low_inclusive,
+                high_inclusive=name in ("pressure_step_mpa", "pmax_mpa"),
+            )
+            object.__setattr__(self, name, value)
+        noise = check_range(
+            self.camera_noise_deg, "camera_noise_deg", _OWNER, low=0.0, low_inclusive=True
+        )
+        object.__setattr__(self, "camera_noise_deg", noise)
+        angle = check_range(
+            self.max_angle_deg, "max_angle_deg", _OWNER, low=0.0, high=300.0, high_inclusive=True
+        )
+        object.__setattr__(self, "max_angle_deg", angle)
+        if not isinstance(self.unloading, bool):
+            raise ValueError(
+                f"The 'unloading' of {_OWNER} must be True or False. "
+                f"Got {self.unloading!r} instead."
+            )
+        object.__setattr__(self, "cycles", check_int(self.cycles, "cycles", _OWNER, low=1))
+        object.__setattr__(self, "seed", check_int(self.seed, "seed", _OWNER, low=0))
+        default_pressures_mpa(self.pmax_mpa, self.pressure_step_mpa)  # whole number of steps
+
+    # -- the gap -----------------------------------------------------------------
+
+    def elastomer_material(self) -> Material:
+        """The lab's silicone: a Yeoh fit of the shipped tensile test (density of DS30)."""
+        if self._material is None:
+            test = load_shipped(self.elastomer)
+            fit = fit_model(
+                "yeoh",
+                test.stretch,
+                test.engineering_stress_mpa,
+                max_stretch=self.elastomer_max_stretch,
+            )
+            material = Material(
+                name=f"{self.elastomer} (virtual lab fit)",
+                model=fit.model,
+                density_t_per_mm3=DRAGON_SKIN_30.density_t_per_mm3,
+                source=(
+                    f"Yeoh fit of the shipped {self.elastomer} tensile test, stretch <= "
+                    f"{self.elastomer_max_stretch:g} ({fit.n_points} points, RMSE "
+                    f"{fit.rmse_mpa:.3g} MPa)"
+                ),
+            )
+            object.__setattr__(self, "_material", material)
+        return self._material  # type: ignore[return-value]
+
+    def as_built(self) -> tuple[SFRBADesign, ...]:
+        """Each actuator as fabricated: ``t`` and ``b`` off nominal by the seeded error."""
+        rng = np.random.default_rng([self.seed, 0])
+        built = []
+        for design in self.actuators:
+            dt, db = rng.uniform(-self.fabrication_error_mm, self.fabrication_error_mm, size=2)
+            built.append(
+                replace(design, t_mm=round(design.t_mm + dt, 4), b_mm=round(design.b_mm + db, 4))
+            )
+        return tuple(built)
+
+    def plant_model(self) -> BendingModel:
+        """The bending model of the actuators as built, with the lab's elastomer."""
+        if self.plant == "analytical":
+            from softbend.analytical import AnalyticalModel
+
+            return AnalyticalModel(material=self.elastomer_material())
+        from softbend.fem import FEMModel, FEMOptions
+
+        return FEMModel(FEMOptions(elastomer=self.elastomer_material()))
+
+    def metadata(self) -> dict[str, str]:
+        """Header lines of the lab's files: synthetic, the gap's parameters, the material."""
+        material = self.elastomer_material()
+        values = {k: v for k, v in asdict(self).items() if k not in ("actuators", "_material")}
+        meta = {
+            "synthetic": "true",
+            "note": "virtual-lab measurements (labelled-synthetic), not of a real actuator",
+            "generator": "softbend.transfer.VirtualLab",
+        }
+        meta.update({f"lab.{k}": str(v) for k, v in values.items()})
+        meta["lab.elastomer_model"] = (
+            f"Yeoh c10={material.model.c10_mpa:.5g} c20={material.model.c20_mpa:.5g} "
+            f"c30={material.model.c30_mpa:.5g} MPa"
+        )
+        meta["lab.as_built"] = "; ".join(
+            f"{actuator_id(n)} -> t={b.t_mm:g} b={b.b_mm:g} mm"
+            for n, b in zip(self.actuators, self.as_built(), strict=True)
+        )
+        return meta
+
+    # -- the measurement ---------------------------------------------------------
+
+    def measure(
+        self,
+        model: BendingModel | None = None,
+        *,
+        progress: Callable[[int, int, str], None] | None = None,
+    ) -> Measurements:
+        """Measure every actuator; returns labelled-synthetic :class:`Measurements`.
+
+        Parameters
+        ----------
+        model : BendingModel, optional
+            The elastic model of the actuators as built; default :meth:`plant_model`.
+        progress : callable, optional
+            ``progress(done, total, actuator_id)`` after each actuator.
+
+        Returns
+        -------
+        Measurements
+            Rows in the order measured, with ``actuator_id`` (the nominal design),
+            ``cycle`` and ``direction``; :meth:`metadata` as the file header.
+        """
+        model = self.plant_model() if model is None else model
+        grid = default_pressures_mpa(self.pmax_mpa, self.pressure_step_mpa)
+        noise_rng = np.random.default_rng([self.seed, 1])
+        frames = []
+        for done, (nominal, built) in enumerate(
+            zip(self.actuators, self.as_built(), strict=True), start=1
+        ):
+            sweep = model.sweep(built, grid)
+            reached = sweep.pressure_mpa[sweep.converged]
+            angle = sweep.angle_deg[sweep.converged]
+            keep = np.cumprod(angle <= self.max_angle_deg).astype(bool)
+            pressures, elastic = reached[keep], angle[keep]
+            if pressures.size < 2:
+                raise RuntimeError(
+                    f"The virtual lab could not load actuator {actuator_id(nominal)}: its "
+                    f"{model.name} model stopped at {float(reached.max(initial=0.0)):g} MPa."
+                )
+            frames.extend(self._readings(nominal, pressures, elastic, noise_rng))
+            if progress is not None:
+                progress(done, len(self.actuators), actuator_id(nominal))
+        frame = pd.concat(frames, ignore_index=True)
+        return Measurements.from_frame(
+            frame, metadata=self.metadata(), source=f"virtual lab ({self.plant}, seed {self.seed})"
+        )
+
+    def _readings(
+        self,
+        nominal: SFRBADesign,
+        pressures: np.ndarray,
+        elastic: np.ndarray,
+        rng: np.random.Generator,
+    ) -> list[pd.DataFrame]:
+        s = pressures / pressures[-1]
+        bump = 4.0 * s * (1.0 - s)
+        branches = [("loading", pressures, elastic * (1.0 - self.hysteresis * bump))]
+        if self.unloading:
+            back = slice(-2, None, -1)  # from below the top back to 0
+            branches.append(
+                ("unloading", pressures[back], (elastic * (1.0 + self.hysteresis * bump))[back])
+            )
+        out = []
+        for cycle in range(1, self.cycles + 1):
+            for direction, p, true_angle in branches:
+                reading = true_angle + rng.normal(0.0, self.camera_noise_deg, size=p.size)
+                row: dict[str, Any] = {
+                    _COLUMNS[name]: getattr(nominal, name) for name in PARAMETERS
+                }
+                out.append(
+                    pd.DataFrame(
+                        {
+                            **{k: np.full(p.size, float(v)) for k, v in row.items()},
+                            "pressure_mpa": p,
+                            "angle_deg": reading,
+                            "actuator_id": actuator_id(nominal),
+                            "cycle": cycle,
+                            "direction": direction,
+                        }
+                    )
+                )
+        return out
+
+
+def shipped_measurements() -> Measurements:
+    """The default virtual lab's measurements as shipped (``softbend lab measure``, seed 0, FEM).
+
+    120 labelled-synthetic readings of the seven actuators of paper B Fig. 7;
+    ``softbend lab measure --out virtual_lab.csv`` makes them again (about two
+    CPU minutes).
+    """
+    from importlib import resources
+
+    from softbend.transfer.measurements import load_measurements
+
+    return load_measurements(
+        Path(str(resources.files("softbend") / "data" / "transfer" / "virtual_lab.csv"))
+    )

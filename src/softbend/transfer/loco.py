@@ -1,0 +1,348 @@
+"""Leave-one-configuration-out evaluation of the refinement strategies (paper B Fig. 7).
+
+For every measured actuator, every strategy is fitted on the measurements of the
+other actuators and scored on the held-out one: RMSE, MAPE (the 0 MPa points
+included, as paper B; only exact zeros are left out), largest error, and for
+strategies with intervals the share of held-out readings inside the interval.
+A learning curve repeats this with 1, 2, ... of the other actuators measured.
+"""
+
+from __future__ import annotations
+
+import json
+import os
+import time
+from collections.abc import Callable, Sequence
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+import pandas as pd
+
+from softbend._io import write_text_atomic
+from softbend._validation import check_choice, check_int, check_range
+from softbend.metrics import rmse, thresholded_mape
+from softbend.transfer.measurements import Measurements
+from softbend.transfer.strategies import STRATEGIES, has_interval, make_strategy
+
+__all__ = ["DEFAULT_STRATEGIES", "LocoResult", "leave_one_configuration_out"]
+
+#: The strategies of a default evaluation: all of them.
+DEFAULT_STRATEGIES: tuple[str, ...] = STRATEGIES
+
+#: Strategies left out of the learning curve (the longest training).
+_SLOW = ("experimental", "refined-ensemble")
+
+_OWNER = "leave_one_configuration_out"
+
+
+@dataclass(frozen=True)
+class LocoResult:
+    """What :func:`leave_one_configuration_out` measured.
+
+    Attributes
+    ----------
+    per_actuator : DataFrame
+        One row per (strategy, held-out actuator): ``n_points``, ``rmse_deg``,
+        ``mape_pct``, ``max_error_deg``, ``coverage`` (share inside the interval,
+        NaN without one), ``fit_s``.
+    summary : DataFrame
+        One row per strategy: the means over actuators, the worst actuator and
+        its RMSE and MAPE.
+    predictions : DataFrame
+        Every held-out reading with each strategy's prediction (``lo``/``hi`` for
+        interval strategies).
+    learning_curve : DataFrame
+        ``strategy, n_actuators, held_out, rmse_deg, mape_pct``: fitted on the
+        first ``n`` of the other actuators in a seeded order.
+    loss_curves : dict of str to ndarray
+        Training MSE per epoch (deg²) of the MLP strategies fitted on all
+        actuators (paper B Fig. 6).
+    level : float
+        Probability of the intervals.
+    settings : dict
+        Strategies, seed, interval level, time taken.
+    """
+
+    per_actuator: pd.DataFrame
+    summary: pd.DataFrame
+    predictions: pd.DataFrame
+    learning_curve: pd.DataFrame
+    loss_curves: dict[str, np.ndarray] = field(default_factory=dict)
+    level: float = 0.9
+    settings: dict[str, Any] = field(default_factory=dict)
+
+    def best(self) -> str:
+        """The strategy with the lowest mean RMSE."""
+        return str(self.summary.sort_values("rmse_deg").iloc[0]["strategy"])
+
+    def write(self, out: str | os.PathLike[str]) -> dict[str, str]:
+        """Write the tables (CSV) and ``loco.json`` into the folder ``out``; returns the paths."""
+        folder = Path(out)
+        folder.mkdir(parents=True, exist_ok=True)
+        files = {}
+        for name in ("summary", "per_actuator", "predictions", "learning_curve"):
+            path = folder / f"{name}.csv"
+            write_text_atomic(path, getattr(self, name).to_csv(index=False))
+            files[name] = str(path)
+        curves = pd.DataFrame({k: pd.Series(v) for k, v in self.loss_curves.items()})
+        curves.index = pd.RangeIndex(1, len(curves) + 1, name="epoch")
+        write_text_atomic(folder / "loss_curves_deg2.csv", curves.to_csv())
+        files["loss_curves"] = str(folder / "loss_curves_deg2.csv")
+        payload = json.dumps(_plain(self.to_dict()), indent=2, allow_nan=False)
+        write_text_atomic(folder / "loco.json", payload + "\n")
+        files["json"] = str(folder / "loco.json")
+        return files
+
+    def to_dict(self) -> dict[str, Any]:
+        """JSON-friendly: summary and per-actuator rows, learning curve, settings."""
+        return {
+            "summary": self.summary.to_dict(orient="records"),
+            "per_actuator": self.per_actuator.to_dict(orient="records"),
+            "learning_curve": self.learning_curve.to_dict(orient="records"),
+            "final_loss_deg2": {k: float(v[-1]) for k, v in self.loss_curves.items()},
+            "level": self.level,
+            "settings": self.settings,
+        }
+
+
+def _plain(value: Any) -> Any:
+    """JSON-ready: NumPy scalars as Python numbers, NaN as null."""
+    if isinstance(value, dict):
+        return {str(k): _plain(v) for k, v in value.items()}
+    if isinstance(value, list | tuple):
+        return [_plain(v) for v in value]
+    if isinstance(value, np.ndarray):
+        return _plain(value.tolist())
+    if isinstance(value, np.generic):
+        value = value.item()
+    if isinstance(value, float) and not np.isfinite(value):
+        return None
+    return value
+
+
+def _score(
+    strategy: str, held_out: str, y: np.ndarray, pred: np.ndarray, interval: Any
+) -> dict[str, Any]:
+    ok = np.isfinite(pred)
+    row: dict[str, Any] = {
+        "strategy": strategy,
+        "actuator_id": held_out,
+        "n_points": int(y.size),
+        "n_predicted": int(ok.sum()),
+    }
+    if ok.any():
+        err = pred[ok] - y[ok]
+        row["rmse_deg"] = rmse(y[ok], pred[ok])
+        row["mape_pct"] = thresholded_mape(y[ok], pred[ok], threshold=0.0)[0]
+        row["max_error_deg"] = float(np.max(np.abs(err)))
+    else:
+        row.update(rmse_deg=np.nan, mape_pct=np.nan, max_error_deg=np.nan)
+    if interval is not None:
+        lo, hi = interval
+        row["coverage"] = float(np.mean((y >= lo) & (y <= hi)))
+    else:
+        row["coverage"] = np.nan
+    return row
+
+
+def _fit_all(
+    name: str,
+    base: Any,
+    options: dict[str, Any],
+    seed: int,
+    X: np.ndarray,
+    y: np.ndarray,
+    row_sets: list[np.ndarray],
+) -> tuple[list[Any], float]:
+    """Fit one fresh ``name`` strategy per row set; batched where the strategy can."""
+    start = time.perf_counter()
+    models = [make_strategy(name, base, seed=seed, **options) for _ in row_sets]
+    fit_batch = getattr(type(models[0]), "fit_batch", None)
+    if fit_batch is not None:
+        fit_batch(models, X, y, row_sets)
+    else:
+        for model, rows in zip(models, row_sets, strict=True):
+            model.fit(X[rows], y[rows])
+    return models, (time.perf_counter() - start) / len(row_sets)
+
+
+def leave_one_configuration_out(
+    measurements: Measurements,
+    base: Any,
+    strategies: Sequence[str] = DEFAULT_STRATEGIES,
+    *,
+    level: float = 0.9,
+    learning_curve: bool = True,
+    seed: int = 0,
+    options: dict[str, dict[str, Any]] | None = None,
+    progress: Callable[[int, int, str], None] | None = None,
+) -> LocoResult:
+    """Score every strategy on every held-out actuator, trained on the others.
+
+    Parameters
+    ----------
+    measurements : Measurements
+        At least two actuators.
+    base : estimator
+        The simulation-trained surrogate the strategies start from (an ``mlp``
+        surrogate for ``refined``, ``refined-ensemble``).
+    strategies : sequence of str
+        Names among :data:`~softbend.transfer.strategies.STRATEGIES`.
+    level : float, default 0.9
+        Probability of the prediction intervals, in (0, 1).
+    learning_curve : bool, default True
+        Also fit on 1, 2, ..., n−2 of the other actuators (n−1 is the main
+        evaluation); not ``experimental`` and ``refined-ensemble``, whose
+        training would dominate the time.
+    seed : int, default 0
+        Seed of the strategies and of the learning curve's actuator order.
+    options : dict, optional
+        Constructor options per strategy name, e.g. ``{"refined": {"epochs": 500}}``.
+    progress : callable, optional
+        ``progress(done, total, strategy)`` after each strategy's fits.
+
+    Returns
+    -------
+    LocoResult
+    """
+    if not isinstance(measurements, Measurements):
+        raise ValueError(
+            f"The 'measurements' of {_OWNER} must be Measurements (see load_measurements). "
+            f"Got {type(measurements).__name__} instead."
+        )
+    names = tuple(strategies)
+    if not names:
+        raise ValueError(f"The 'strategies' of {_OWNER} must name at least one of {STRATEGIES}.")
+    for name in names:
+        check_choice(name, "strategy", _OWNER, STRATEGIES)
+    if len(set(names)) != len(names):
+        raise ValueError(f"The 'strategies' of {_OWNER} must be distinct. Got {list(names)}.")
+    level = check_range(level, "level", _OWNER, low=0.0, high=1.0)
+    seed = check_int(seed, "seed", _OWNER, low=0)
+    options = dict(options or {})
+    for name in options:
+        check_choice(name, "options", _OWNER, STRATEGIES)
+    ids = measurements.actuator_ids
+    if len(ids) < 2:
+        raise ValueError(
+            f"The 'measurements' of {_OWNER} must cover at least 2 actuators. "
+            f"Got {len(ids)} ({', '.join(ids)}) instead."
+        )
+    X, y, groups = measurements.features, measurements.angle_deg, measurements.groups
+    rng = np.random.default_rng([seed, 3])
+    curve_names = [n for n in names if n not in _SLOW] if learning_curve else []
+    start = time.perf_counter()
+
+    # Every fit is a task: (kind, held-out actuator, n actuators, strategy, train, test rows).
+    tasks: list[tuple[str, str, int, str, np.ndarray, np.ndarray]] = []
+    for held_out in ids:
+        test = np.flatnonzero(groups == held_out)
+        train = np.flatnonzero(groups != held_out)
+        tasks += [("loco", held_out, len(ids) - 1, n, train, test) for n in names]
+        others = [a for a in ids if a != held_out]
+        order = [others[i] for i in rng.permutation(len(others))]
+        for size in range(1, len(ids) - 1):
+            rows = np.flatnonzero(np.isin(groups, order[:size]))
+            tasks += [("curve", held_out, size, n, rows, test) for n in curve_names]
+    everything = np.arange(len(y))
+    tasks += [("all", "", len(ids), n, everything, everything[:0]) for n in names]
+    results: list[dict[str, Any]] = [{} for _ in tasks]
+    done = 0
+    for name in names:
+        mine = [i for i, task in enumerate(tasks) if task[3] == name]
+        models, fit_s = _fit_all(
+            name, base, options.get(name, {}), seed, X, y, [tasks[i][4] for i in mine]
+        )
+        for i, model in zip(mine, models, strict=True):
+            test = tasks[i][5]
+            out: dict[str, Any] = {"fit_s": fit_s}
+            if test.size:
+                out["pred"] = np.asarray(model.predict(X[test]), dtype=np.float64)
+                out["interval"] = (
+                    model.predict_interval(X[test], level) if has_interval(model) else None
+                )
+            if hasattr(model, "loss_curve_"):
+                out["loss_curve"] = np.asarray(model.loss_curve_)
+            results[i] = out
+        done += len(mine)
+        if progress is not None:
+            progress(done, len(tasks), name)
+
+    scores, predictions, curve = [], [], []
+    loss_curves: dict[str, np.ndarray] = {}
+    for (kind, held_out, size, name, _, test), out in zip(tasks, results, strict=True):
+        if kind == "all":
+            if "loss_curve" in out:
+                loss_curves[name] = out["loss_curve"]
+            continue
+        row = _score(name, held_out, y[test], out["pred"], out["interval"])
+        if kind == "loco":
+            row["fit_s"] = out["fit_s"]
+            scores.append(row)
+            part = measurements.frame.iloc[test].assign(strategy=name, predicted_deg=out["pred"])
+            if out["interval"] is not None:
+                part = part.assign(lo_deg=out["interval"][0], hi_deg=out["interval"][1])
+            predictions.append(part)
+        if kind == "curve" or (kind == "loco" and name in curve_names):
+            curve.append(
+                {
+                    "strategy": name,
+                    "n_actuators": size,
+                    "held_out": held_out,
+                    "rmse_deg": row["rmse_deg"],
+                    "mape_pct": row["mape_pct"],
+                }
+            )
+    if hasattr(base, "loss_curve_") and hasattr(base, "y_scale_") and "fem-only" in names:
+        loss_curves["fem-only"] = np.asarray(base.loss_curve_) * base.y_scale_**2
+
+    per_actuator = pd.DataFrame(scores)
+    return LocoResult(
+        per_actuator=per_actuator,
+        summary=_summarize(per_actuator, names),
+        predictions=pd.concat(predictions, ignore_index=True),
+        learning_curve=pd.DataFrame(
+            curve, columns=["strategy", "n_actuators", "held_out", "rmse_deg", "mape_pct"]
+        )
+        .sort_values(["strategy", "n_actuators", "held_out"], kind="stable")
+        .reset_index(drop=True),
+        loss_curves=loss_curves,
+        level=level,
+        settings={
+            "strategies": list(names),
+            "seed": seed,
+            "level": level,
+            "actuators": list(ids),
+            "n_measurements": len(measurements),
+            "options": options,
+            "fits": len(tasks),
+            "wall_time_s": time.perf_counter() - start,
+        },
+    )
+
+
+def _summarize(per_actuator: pd.DataFrame, names: Sequence[str]) -> pd.DataFrame:
+    rows = []
+    for name in names:
+        part = per_actuator[per_actuator["strategy"] == name]
+        worst = part.loc[part["rmse_deg"].idxmax()] if part["rmse_deg"].notna().any() else None
+        rows.append(
+            {
+                "strategy": name,
+                "rmse_deg": float(part["rmse_deg"].mean()),
+                "mape_pct": float(part["mape_pct"].mean()),
+                "max_error_deg": float(part["max_error_deg"].max()),
+                "coverage": float(
+                    (part["coverage"] * part["n_points"]).sum() / part["n_points"].sum()
+                )
+                if part["coverage"].notna().all()
+                else np.nan,
+                "worst_actuator": None if worst is None else worst["actuator_id"],
+                "worst_rmse_deg": np.nan if worst is None else float(worst["rmse_deg"]),
+                "worst_mape_pct": np.nan if worst is None else float(worst["mape_pct"]),
+                "fit_s": float(part["fit_s"].mean()),
+            }
+        )
+    return pd.DataFrame(rows)

@@ -1,0 +1,712 @@
+"""Measured bending angles of fiber-reinforced bending actuators and their CSV format.
+
+Transfer learning (paper B §4.2–4.3) refines a surrogate trained on simulations
+with a few measurements of built actuators. A measurement is one bending angle of
+one actuator at one gauge pressure; the actuator's design is the SFRBA tuple
+``(l, r, t, b, phi, lc)`` of :class:`softbend.design.SFRBADesign`.
+
+CSV format
+----------
+UTF-8, one header row and one row per measurement::
+
+    # softbend measurements CSV v1
+    # rig: bench 2
+    # operator: AB
+    l,r,t,b,phi,lc,pressure_mpa,angle_deg,actuator_id,cycle,direction
+    100.0,6.0,2.0,2.0,5.0,8.0,0.0,0.0,A1,1,loading
+    100.0,6.0,2.0,2.0,5.0,8.0,0.05,31.5,A1,1,loading
+
+Required columns: ``l``, ``r``, ``t``, ``b`` (mm), ``phi`` (deg), ``lc`` (mm),
+``pressure_mpa`` (gauge pressure, MPa, finite and >= 0) and ``angle_deg``
+(bending angle, degrees, finite). Optional columns: ``actuator_id`` (text;
+default: the design written ``"l,r,t,b,phi,lc"`` with ``%g`` numbers, e.g.
+``"100,6,2,2,5,8"``), ``cycle`` (integer >= 1; default 1) and ``direction``
+(``loading`` or ``unloading``; default ``loading``). Columns come in any order;
+their names are case-sensitive and no other column is allowed. Whitespace
+around cells is stripped; an empty cell is an error in every column.
+
+Lines starting with ``#`` are comments; a ``# key: value`` comment before the
+header row becomes an entry of :attr:`Measurements.metadata` (text split at the
+first colon, both sides stripped). Blank lines are skipped. Errors name the file
+and, where there is one, the line (numbered as an editor shows it, from 1,
+comments included) and the column.
+"""
+
+from __future__ import annotations
+
+import csv
+import io
+import logging
+import math
+import numbers
+import os
+from collections.abc import Callable, Iterable, Mapping
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+import pandas as pd
+
+from softbend._io import write_text_atomic
+from softbend.design import FEATURES, PARAMETERS, SFRBADesign
+from softbend.errors import DatasetError
+
+logger = logging.getLogger(__name__)
+
+#: Columns every measurement table has: the design (mm, mm, mm, mm, deg, mm),
+#: the gauge pressure (MPa) and the bending angle (deg), in the order written.
+MEASUREMENT_COLUMNS: tuple[str, ...] = (
+    "l",
+    "r",
+    "t",
+    "b",
+    "phi",
+    "lc",
+    "pressure_mpa",
+    "angle_deg",
+)
+#: Columns a file may leave out; :class:`Measurements` fills them with defaults.
+OPTIONAL_COLUMNS: tuple[str, ...] = ("actuator_id", "cycle", "direction")
+#: Allowed values of the ``direction`` column.
+DIRECTIONS: tuple[str, ...] = ("loading", "unloading")
+
+_DESIGN_COLUMNS: tuple[str, ...] = MEASUREMENT_COLUMNS[:6]
+_ALL_COLUMNS: tuple[str, ...] = MEASUREMENT_COLUMNS + OPTIONAL_COLUMNS
+_COLUMN_OF: dict[str, str] = {
+    **dict(zip(PARAMETERS, _DESIGN_COLUMNS, strict=True)),
+    "pressure_mpa": "pressure_mpa",
+}
+#: Columns of :attr:`Measurements.features`, in :data:`softbend.design.FEATURES` order.
+_FEATURE_COLUMNS: tuple[str, ...] = tuple(_COLUMN_OF[name] for name in FEATURES)
+_FORMAT_LINE = "softbend measurements CSV v1"
+_MAX_CYCLE = 2**53  # the largest integer a float64 holds exactly
+
+# (owner, where): owner names the file or frame; where(pos) names a row ("line 7").
+_Where = Callable[[int], str]
+
+
+class _CellError(Exception):
+    """A cell failed its check; the message says what it must be and what came in."""
+
+
+# ------------------------------------------------------------------ cell checks
+def _is_missing(value: Any) -> bool:
+    if value is None or value is pd.NA or value is pd.NaT:
+        return True
+    return isinstance(value, float) and math.isnan(value)
+
+
+def _got(value: Any) -> str:
+    if isinstance(value, np.generic):
+        value = value.item()  # np.float64(1.5) -> 1.5
+    if _is_missing(value):
+        return "a missing value"
+    if isinstance(value, str) and not value:
+        return "an empty cell"
+    return repr(value)
+
+
+def _to_float(value: Any) -> float:
+    """``value`` as a finite float: a real number (not a bool) or a numeric string."""
+    message = f"must be a finite number. Got {_got(value)} instead."
+    if isinstance(value, str):
+        try:
+            number = float(value.strip())
+        except ValueError:
+            raise _CellError(message) from None
+    elif isinstance(value, numbers.Real) and not isinstance(value, bool | np.bool_):
+        number = float(value)
+    else:
+        raise _CellError(message)
+    if not math.isfinite(number):
+        raise _CellError(message)
+    return number
+
+
+def _to_cycle(value: Any) -> int:
+    """``value`` as an integer >= 1 (``2`` and ``2.0`` pass, ``2.5`` does not)."""
+    message = f"must be an integer >= 1. Got {_got(value)} instead."
+    if isinstance(value, numbers.Integral) and not isinstance(value, bool | np.bool_):
+        number = int(value)
+    else:
+        try:
+            real = _to_float(value)
+        except _CellError:
+            raise _CellError(message) from None
+        if not real.is_integer() or abs(real) > _MAX_CYCLE:
+            raise _CellError(message)
+        number = int(real)
+    if not 1 <= number <= _MAX_CYCLE:
+        raise _CellError(message)
+    return number
+
+
+def _to_direction(value: Any) -> str:
+    text = value.strip() if isinstance(value, str) else None
+    if text not in DIRECTIONS:
+        allowed = ", ".join(repr(d) for d in DIRECTIONS)
+        raise _CellError(f"must be one of {allowed}. Got {_got(value)} instead.")
+    return text
+
+
+def _to_actuator_id(value: Any) -> str:
+    """A non-empty single-line string; integers are accepted and written as text."""
+    if isinstance(value, numbers.Integral) and not isinstance(value, bool | np.bool_):
+        return str(int(value))
+    text = value.strip() if isinstance(value, str) else ""
+    if not text or "\n" in text or "\r" in text:
+        raise _CellError(
+            f"must be a non-empty text on one line (or an integer). Got {_got(value)} instead."
+        )
+    return text
+
+
+def _convert(
+    values: np.ndarray, convert: Callable[[Any], Any], owner: str, where: _Where, column: str
+) -> list[Any]:
+    out = []
+    for pos, value in enumerate(values):
+        try:
+            out.append(convert(value))
+        except _CellError as exc:
+            raise DatasetError(f"{owner}, {where(pos)}, column '{column}': {exc}") from None
+    return out
+
+
+def _float_column(series: pd.Series, owner: str, where: _Where, column: str) -> np.ndarray:
+    """A column as finite float64 values, raising at the first bad cell."""
+    dtype = series.dtype
+    if pd.api.types.is_numeric_dtype(dtype) and not pd.api.types.is_bool_dtype(dtype):
+        values = series.to_numpy(dtype=float, na_value=np.nan)
+        bad = np.flatnonzero(~np.isfinite(values))
+        if bad.size:
+            pos = int(bad[0])
+            raw = series.iloc[pos]
+            raise DatasetError(
+                f"{owner}, {where(pos)}, column '{column}': must be a finite number. "
+                f"Got {_got(raw)} instead."
+            )
+        return values
+    raw = series.to_numpy(dtype=object)
+    return np.array(_convert(raw, _to_float, owner, where, column), dtype=float)
+
+
+# ---------------------------------------------------------------- frame checks
+def _check_columns(columns: list[Any], prefix: str) -> None:
+    """Raise unless ``columns`` holds each required column once and nothing unknown."""
+    allowed = ", ".join(_ALL_COLUMNS)
+    duplicates = [c for i, c in enumerate(columns) if c in columns[:i]]
+    if duplicates:
+        names = ", ".join(repr(c) for c in dict.fromkeys(duplicates))
+        raise DatasetError(f"{prefix}: duplicate column(s) {names}; each column may appear once.")
+    unknown = [c for c in columns if c not in _ALL_COLUMNS]
+    if unknown:
+        names = ", ".join(repr(c) for c in unknown)
+        raise DatasetError(
+            f"{prefix}: unknown column(s) {names}; the allowed columns are {allowed} "
+            "(names are case-sensitive)."
+        )
+    missing = [c for c in MEASUREMENT_COLUMNS if c not in columns]
+    if missing:
+        names = ", ".join(repr(c) for c in missing)
+        raise DatasetError(
+            f"{prefix}: missing required column(s) {names}; the required columns are "
+            f"{', '.join(MEASUREMENT_COLUMNS)} (optional: {', '.join(OPTIONAL_COLUMNS)})."
+        )
+
+
+def _design_text(values: Iterable[float]) -> str:
+    return ", ".join(f"{c}={float(v)!r}" for c, v in zip(_DESIGN_COLUMNS, values, strict=True))
+
+
+def _normalize(
+    frame: Any, owner: str, where: _Where
+) -> tuple[pd.DataFrame, dict[str, SFRBADesign]]:
+    """Check a table of measurements and return it in canonical form with its designs.
+
+    Parameters
+    ----------
+    frame : pandas.DataFrame
+        Required columns, optional columns or not; cells numbers or text.
+    owner : str
+        The file or frame the rows come from, first in every message.
+    where : callable
+        ``where(pos)`` names the row at position ``pos`` (``"line 7"``, ``"row 3"``).
+
+    Returns
+    -------
+    frame : pandas.DataFrame
+        All columns, in ``MEASUREMENT_COLUMNS + OPTIONAL_COLUMNS`` order, index 0..n-1.
+    designs : dict
+        ``{actuator_id: SFRBADesign}`` in order of first appearance.
+    """
+    if not isinstance(frame, pd.DataFrame):
+        raise DatasetError(
+            f"The 'frame' of {owner} must be a pandas DataFrame. "
+            f"Got {type(frame).__name__} instead."
+        )
+    _check_columns(list(frame.columns), owner)
+    n = len(frame)
+    if n == 0:
+        raise DatasetError(f"{owner}: no data rows; at least one measurement is required.")
+
+    data: dict[str, Any] = {}
+    for column in MEASUREMENT_COLUMNS:
+        data[column] = _float_column(frame[column], owner, where, column)
+    negative = np.flatnonzero(data["pressure_mpa"] < 0)
+    if negative.size:
+        pos = int(negative[0])
+        raise DatasetError(
+            f"{owner}, {where(pos)}, column 'pressure_mpa': must be a gauge pressure >= 0 MPa. "
+            f"Got {float(data['pressure_mpa'][pos])!r} instead."
+        )
+
+    # Designs: check each distinct tuple once, at its first row.
+    design_values = np.column_stack([data[c] for c in _DESIGN_COLUMNS])
+    _, first_rows, codes = np.unique(design_values, axis=0, return_index=True, return_inverse=True)
+    codes = codes.reshape(-1)
+    design_of_code: list[SFRBADesign] = []
+    for pos in first_rows:
+        try:
+            design_of_code.append(SFRBADesign(*design_values[pos].tolist()))
+        except ValueError as exc:
+            column = next(
+                (
+                    c
+                    for p, c in zip(PARAMETERS, _DESIGN_COLUMNS, strict=True)
+                    if f"'{p}'" in str(exc)
+                ),
+                None,
+            )
+            at = f", column '{column}'" if column else ""
+            raise DatasetError(f"{owner}, {where(int(pos))}{at}: {exc}") from None
+
+    if "actuator_id" in frame.columns:
+        raw = frame["actuator_id"].to_numpy(dtype=object)
+        ids = np.array(_convert(raw, _to_actuator_id, owner, where, "actuator_id"), dtype=object)
+        defaulted = False
+    else:
+        labels = np.array([str(d) for d in design_of_code], dtype=object)
+        ids = labels[codes]
+        defaulted = True
+
+    # One design per actuator: compare each row's design with its actuator's first row.
+    _, first_of_id, id_codes = np.unique(ids, return_index=True, return_inverse=True)
+    id_codes = id_codes.reshape(-1)
+    first_row = first_of_id[id_codes]
+    conflicts = np.flatnonzero(codes != codes[first_row])
+    if conflicts.size:
+        pos = int(conflicts[0])
+        first = int(first_row[pos])
+        hint = (
+            " (no actuator_id column: the ids were written from the designs with %g, which "
+            "rounds to 6 significant digits; add an actuator_id column)"
+            if defaulted
+            else ""
+        )
+        raise DatasetError(
+            f"{owner}, {where(pos)}, column 'actuator_id': the actuator {ids[pos]!r} has the "
+            f"design ({_design_text(design_values[pos])}) here but "
+            f"({_design_text(design_values[first])}) on {where(first)}; one actuator_id "
+            f"must keep one design{hint}."
+        )
+    order = np.sort(first_of_id)
+    designs = {str(ids[pos]): design_of_code[codes[pos]] for pos in order}
+
+    if "cycle" in frame.columns:
+        series = frame["cycle"]
+        if pd.api.types.is_integer_dtype(series.dtype) and not series.isna().any():
+            values = series.to_numpy(dtype=np.int64)
+            bad = np.flatnonzero(values < 1)
+            if bad.size:
+                pos = int(bad[0])
+                raise DatasetError(
+                    f"{owner}, {where(pos)}, column 'cycle': must be an integer >= 1. "
+                    f"Got {int(values[pos])!r} instead."
+                )
+            cycle = values
+        else:
+            raw = series.to_numpy(dtype=object)
+            cycle = np.array(_convert(raw, _to_cycle, owner, where, "cycle"), dtype=np.int64)
+    else:
+        cycle = np.ones(n, dtype=np.int64)
+
+    if "direction" in frame.columns:
+        raw = frame["direction"].to_numpy(dtype=object)
+        direction = np.array(_convert(raw, _to_direction, owner, where, "direction"), dtype=object)
+    else:
+        direction = np.full(n, DIRECTIONS[0], dtype=object)
+
+    columns: dict[str, pd.Series] = {
+        c: pd.Series(data[c], dtype=np.float64) for c in MEASUREMENT_COLUMNS
+    }
+    columns["actuator_id"] = pd.Series(ids, dtype=object)
+    columns["cycle"] = pd.Series(cycle, dtype=np.int64)
+    columns["direction"] = pd.Series(direction, dtype=object)
+    return pd.DataFrame(columns, columns=list(_ALL_COLUMNS)), designs
+
+
+def _check_metadata(metadata: Mapping[str, Any], owner: str) -> dict[str, str]:
+    """A stripped ``{str: str}`` copy that a ``# key: value`` line writes and reads back."""
+    if not isinstance(metadata, Mapping):
+        raise ValueError(
+            f"The 'metadata' of {owner} must be a mapping of text to text. "
+            f"Got {type(metadata).__name__} instead."
+        )
+    out: dict[str, str] = {}
+    for key, value in metadata.items():
+        if not isinstance(key, str):
+            raise ValueError(f"The 'metadata' keys of {owner} must be text. Got {key!r} instead.")
+        name, text = key.strip(), str(value).strip()
+        if not name or ":" in name or any(ch in name for ch in "\r\n"):
+            raise ValueError(
+                f"The 'metadata' keys of {owner} must be non-empty text on one line "
+                f"without ':'. Got {key!r} instead."
+            )
+        if any(ch in text for ch in "\r\n"):
+            raise ValueError(
+                f"The 'metadata' value {name!r} of {owner} must be text on one line. "
+                f"Got {value!r} instead."
+            )
+        if name in out:
+            raise ValueError(
+                f"The 'metadata' keys of {owner} must be unique after stripping. Got {key!r} twice."
+            )
+        out[name] = text
+    return out
+
+
+def _row_label(index: pd.Index) -> _Where:
+    def where(pos: int) -> str:
+        label = index[pos]
+        return f"row {label}" if isinstance(label, numbers.Integral) else f"row {label!r}"
+
+    return where
+
+
+# ---------------------------------------------------------------- Measurements
+@dataclass(frozen=True, eq=False, repr=False)
+class Measurements:
+    """Measured bending angles of one or more actuators, one row per measurement.
+
+    Parameters
+    ----------
+    frame : pandas.DataFrame
+        Columns :data:`MEASUREMENT_COLUMNS` (``l``, ``r``, ``t``, ``b`` in mm,
+        ``phi`` in deg, ``lc`` in mm, ``pressure_mpa`` in MPa gauge,
+        ``angle_deg`` in deg) and any of :data:`OPTIONAL_COLUMNS`. It is
+        checked and stored as a copy with every column, in the order
+        ``MEASUREMENT_COLUMNS + OPTIONAL_COLUMNS``: floats as float64,
+        ``cycle`` as int64, ``actuator_id`` and ``direction`` as ``object``
+        columns of ``str``; index 0..n-1. Missing optional columns get their
+        defaults (see the module docstring).
+    metadata : mapping of str to str
+        Free-form provenance (the ``# key: value`` lines of a file); stored as
+        a ``dict`` copy with keys and values stripped, values converted to text.
+    source : str
+        The file the measurements came from, or a description; path-likes are
+        converted to text.
+
+    Raises
+    ------
+    DatasetError
+        One line naming the ``source`` (or "the Measurements frame"), the row
+        (by index label) and the column: a missing, duplicate or unknown
+        column, no rows, a non-numeric or non-finite number, a negative
+        pressure, a cycle that is not an integer >= 1, a direction not in
+        :data:`DIRECTIONS`, an empty actuator id, a design
+        :class:`~softbend.design.SFRBADesign` rejects, or one actuator id with
+        two designs.
+    ValueError
+        Metadata that is not a mapping of single-line text (keys without ':').
+
+    Notes
+    -----
+    Two instances compare equal when their frames are equal
+    (:meth:`pandas.DataFrame.equals`) and their metadata are; ``source`` is
+    provenance and is not compared, so ``load_measurements(save_measurements(m, p)) == m``.
+    """
+
+    frame: pd.DataFrame
+    metadata: Mapping[str, str] = field(default_factory=dict)
+    source: str = ""
+    _designs: dict[str, SFRBADesign] = field(init=False, repr=False, compare=False)
+
+    def __post_init__(self) -> None:
+        source = os.fspath(self.source) if isinstance(self.source, os.PathLike) else self.source
+        if not isinstance(source, str):
+            raise ValueError(
+                f"The 'source' of Measurements must be text. Got {type(source).__name__} instead."
+            )
+        owner = source or "the Measurements frame"
+        where = _row_label(self.frame.index) if isinstance(self.frame, pd.DataFrame) else str
+        frame, designs = _normalize(self.frame, owner, where)
+        object.__setattr__(self, "source", source)
+        object.__setattr__(self, "frame", frame)
+        object.__setattr__(self, "metadata", _check_metadata(self.metadata, "Measurements"))
+        object.__setattr__(self, "_designs", designs)
+
+    @classmethod
+    def from_frame(
+        cls,
+        frame: pd.DataFrame,
+        *,
+        metadata: Mapping[str, str] | None = None,
+        source: str = "",
+    ) -> Measurements:
+        """Check ``frame``, fill the optional columns with their defaults and wrap it.
+
+        Parameters
+        ----------
+        frame : pandas.DataFrame
+            The required columns and any optional ones; cells may be numbers or
+            numeric text. Errors name rows by their index label (``row 3``).
+        metadata : mapping of str to str, optional
+            Provenance; default none.
+        source : str
+            Where the rows come from, first in error messages.
+        """
+        return cls(frame, metadata=dict(metadata or {}), source=source)
+
+    def __len__(self) -> int:
+        return len(self.frame)
+
+    def __eq__(self, other: object) -> bool:
+        if not isinstance(other, Measurements):
+            return NotImplemented
+        return self.frame.equals(other.frame) and dict(self.metadata) == dict(other.metadata)
+
+    def __repr__(self) -> str:
+        return (
+            f"Measurements(n={len(self)}, actuators={len(self._designs)}, source={self.source!r})"
+        )
+
+    @property
+    def actuator_ids(self) -> tuple[str, ...]:
+        """Actuator ids in order of first appearance."""
+        return tuple(self._designs)
+
+    def design_of(self, actuator_id: str) -> SFRBADesign:
+        """The design of one actuator.
+
+        Raises
+        ------
+        ValueError
+            ``actuator_id`` is not one of :attr:`actuator_ids`.
+        """
+        try:
+            return self._designs[actuator_id]
+        except (KeyError, TypeError):
+            known = ", ".join(repr(a) for a in self._designs)
+            raise ValueError(
+                f"The 'actuator_id' of Measurements.design_of must be one of {known}. "
+                f"Got {actuator_id!r} instead."
+            ) from None
+
+    @property
+    def designs(self) -> tuple[SFRBADesign, ...]:
+        """One design per actuator, in :attr:`actuator_ids` order."""
+        return tuple(self._designs.values())
+
+    @property
+    def features(self) -> np.ndarray:
+        """Model inputs, shape (n, 7): :data:`softbend.design.FEATURES` order (mm, deg, MPa).
+
+        Columns ``l``, ``r``, ``t``, ``b`` (mm), ``phi`` (deg), ``lc`` (mm),
+        ``pressure_mpa`` (MPa); a new float64 array on every call.
+        """
+        return self.frame[list(_FEATURE_COLUMNS)].to_numpy(dtype=np.float64, copy=True)
+
+    @property
+    def angle_deg(self) -> np.ndarray:
+        """Measured bending angles, degrees, shape (n,); a new array on every call."""
+        return self.frame["angle_deg"].to_numpy(dtype=np.float64, copy=True)
+
+    @property
+    def groups(self) -> np.ndarray:
+        """Actuator id of each row, shape (n,), for ``LeaveOneGroupOut``."""
+        return self.frame["actuator_id"].to_numpy(dtype=object, copy=True)
+
+    def subset(self, actuator_ids: Iterable[str]) -> Measurements:
+        """The rows of some actuators, in their original order.
+
+        Parameters
+        ----------
+        actuator_ids : iterable of str
+            Ids from :attr:`actuator_ids` (a single ``str`` is one id).
+
+        Raises
+        ------
+        ValueError
+            No id, or an id that is not in :attr:`actuator_ids`.
+        """
+        wanted = [actuator_ids] if isinstance(actuator_ids, str) else list(actuator_ids)
+        unknown = [a for a in wanted if not isinstance(a, str) or a not in self._designs]
+        if unknown:
+            known = ", ".join(repr(a) for a in self._designs)
+            raise ValueError(
+                f"The 'actuator_ids' of Measurements.subset must be among {known}. "
+                f"Got unknown {', '.join(repr(a) for a in unknown)}."
+            )
+        if not wanted:
+            raise ValueError(
+                "The 'actuator_ids' of Measurements.subset must name at least one actuator. "
+                "Got none."
+            )
+        mask = self.frame["actuator_id"].isin(wanted).to_numpy()
+        frame = self.frame.loc[mask].reset_index(drop=True)
+        return Measurements(frame, metadata=dict(self.metadata), source=self.source)
+
+
+# --------------------------------------------------------------------- loading
+def load_measurements(path: str | os.PathLike[str]) -> Measurements:
+    """Read measurements from a CSV file in the format of this module.
+
+    Parameters
+    ----------
+    path : str or path-like
+        The CSV file.
+
+    Returns
+    -------
+    Measurements
+        With the file's ``# key: value`` header comments as metadata and the
+        path as ``source``.
+
+    Raises
+    ------
+    DatasetError
+        One line naming the file and, where it applies, the line (as an editor
+        numbers them, from 1) and the column: file not found or a folder, not
+        UTF-8, no header row, a missing, duplicate or unknown column, a row with
+        the wrong number of cells, no data rows, a metadata key given twice, or
+        any cell check of :class:`Measurements`.
+    """
+    source = Path(path)
+    if not source.exists():
+        raise DatasetError(f"Measurement file not found: {source}.")
+    if source.is_dir():
+        raise DatasetError(f"{source} is a folder; a measurement CSV file is required.")
+    try:
+        text = source.read_text(encoding="utf-8-sig")
+    except UnicodeDecodeError as exc:
+        raise DatasetError(
+            f"{source} is not a UTF-8 text file (invalid byte at offset {exc.start})."
+        ) from None
+
+    metadata: dict[str, str] = {}
+    metadata_line: dict[str, int] = {}
+    columns: list[str] | None = None
+    header_line = 0
+    rows: list[list[str]] = []
+    line_of_row: list[int] = []
+    lines = text.replace("\r\n", "\n").replace("\r", "\n").split("\n")
+    for number, line in enumerate(lines, start=1):
+        stripped = line.strip()
+        if not stripped:
+            continue
+        if stripped.startswith("#"):
+            key, sep, value = stripped[1:].partition(":")
+            key = key.strip()
+            if columns is None and sep and key:
+                if key in metadata:
+                    raise DatasetError(
+                        f"{source}, line {number}: the metadata key {key!r} was already set "
+                        f"on line {metadata_line[key]}; each key may appear once."
+                    )
+                metadata[key] = value.strip()
+                metadata_line[key] = number
+            continue
+        cells = [cell.strip() for cell in next(csv.reader([line]))]
+        if columns is None:
+            _check_columns(cells, f"{source}, line {number}")
+            columns, header_line = cells, number
+            continue
+        if len(cells) != len(columns):
+            raise DatasetError(
+                f"{source}, line {number}: {len(cells)} cells, but the header (line "
+                f"{header_line}) has {len(columns)} columns."
+            )
+        rows.append(cells)
+        line_of_row.append(number)
+
+    if columns is None:
+        raise DatasetError(
+            f"{source} has no header row: expected the columns {', '.join(MEASUREMENT_COLUMNS)} "
+            f"(optional: {', '.join(OPTIONAL_COLUMNS)})."
+        )
+    if not rows:
+        raise DatasetError(
+            f"{source}, line {header_line}: the header row is followed by no data rows."
+        )
+    raw = pd.DataFrame(rows, columns=columns, dtype=object)
+    frame, _ = _normalize(raw, str(source), lambda pos: f"line {line_of_row[pos]}")
+    measurements = Measurements(frame, metadata=metadata, source=str(source))
+    logger.debug(
+        "Loaded %d measurement(s) of %d actuator(s) from %s.",
+        len(measurements),
+        len(measurements.actuator_ids),
+        source,
+    )
+    return measurements
+
+
+# ---------------------------------------------------------------------- saving
+def _format_float(value: float) -> str:
+    """Shortest text that parses back to the identical float."""
+    return repr(float(value))
+
+
+def save_measurements(measurements: Measurements, path: str | os.PathLike[str]) -> Path:
+    """Write measurements to a CSV file that :func:`load_measurements` reads back equal.
+
+    Parameters
+    ----------
+    measurements : Measurements
+        What to write.
+    path : str or path-like
+        The CSV file; its folder is created if needed, an existing file replaced.
+
+    Returns
+    -------
+    pathlib.Path
+        The file written.
+
+    Notes
+    -----
+    The file starts with a format comment and the metadata as ``# key: value``
+    lines, then the header with every column (``MEASUREMENT_COLUMNS +
+    OPTIONAL_COLUMNS``). Floats are written with :func:`repr`, the shortest text
+    that parses back to the same float, so the round trip is exact. The text is
+    written to a temporary file in the same folder and moved into place, so a
+    reader never sees half a file.
+    """
+    if not isinstance(measurements, Measurements):
+        raise ValueError(
+            "The 'measurements' of save_measurements must be a Measurements object. "
+            f"Got {type(measurements).__name__} instead."
+        )
+    buffer = io.StringIO()
+    buffer.write(f"# {_FORMAT_LINE}\n")
+    for key, value in measurements.metadata.items():
+        buffer.write(f"# {key}: {value}\n")
+    writer = csv.writer(buffer, lineterminator="\n")
+    writer.writerow(_ALL_COLUMNS)
+    frame = measurements.frame
+    floats = [frame[c].to_numpy(dtype=np.float64) for c in MEASUREMENT_COLUMNS]
+    ids = frame["actuator_id"].to_numpy(dtype=object)
+    cycles = frame["cycle"].to_numpy(dtype=np.int64)
+    directions = frame["direction"].to_numpy(dtype=object)
+    for i in range(len(frame)):
+        writer.writerow(
+            [
+                *(_format_float(column[i]) for column in floats),
+                ids[i],
+                int(cycles[i]),
+                directions[i],
+            ]
+        )
+    target = write_text_atomic(path, buffer.getvalue())
+    logger.debug("Saved %d measurement(s) to %s.", len(measurements), target)
+    return target

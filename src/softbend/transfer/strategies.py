@@ -1,0 +1,598 @@
+"""Ways to correct a simulation-trained surrogate with a few measurements (paper B §4.2).
+
+Every strategy is a scikit-learn regressor on the rows of
+:data:`softbend.design.FEATURES` (mm, deg, MPa) → bending angle (degrees) that
+starts from a fitted *base* surrogate (any estimator with ``predict``; the MLP
+trained on the FEM dataset by default):
+
+=================  ============================================================
+``fem-only``       the base, unchanged (paper B's "NMLPR"), a baseline
+``analytical``     the analytical model of the actuator, a baseline (no base)
+``refined``        paper B's refined MLP: every layer trained further from the
+                   base's weights on the measurements, input scaling kept
+``experimental``   paper B's experimental MLP: from scratch, measurements only
+``residual-gp``    the base frozen, a Gaussian process on its error with a
+                   noise term; gives prediction intervals
+``scale-offset``   the base frozen, ``θ = a·θ_base + c`` by least squares
+``refined-ensemble``  refined MLPs on bootstrap draws of the measured
+                   actuators; mean, and an interval from their spread
+=================  ============================================================
+
+Strategies with intervals have ``predict_interval(X, level)``.
+"""
+
+from __future__ import annotations
+
+import warnings
+from typing import Any
+
+import numpy as np
+from numpy.typing import ArrayLike
+from scipy.stats import norm
+from sklearn.base import BaseEstimator, RegressorMixin
+from sklearn.exceptions import ConvergenceWarning
+from sklearn.gaussian_process import GaussianProcessRegressor
+from sklearn.gaussian_process.kernels import RBF, ConstantKernel, WhiteKernel
+from sklearn.utils.validation import check_is_fitted, validate_data
+
+from softbend._validation import check_choice, check_int, check_range
+from softbend.design import FEATURES, SFRBADesign
+from softbend.transfer.finetune import fine_tune_many, row_weights
+
+__all__ = [
+    "STRATEGIES",
+    "AnalyticalBaseline",
+    "BaseOnly",
+    "ExperimentalMLP",
+    "RefinedEnsemble",
+    "RefinedMLP",
+    "ResidualGP",
+    "ScaleOffset",
+    "has_interval",
+    "make_strategy",
+]
+
+#: Names of the strategies, in the order of the tables.
+STRATEGIES: tuple[str, ...] = (
+    "fem-only",
+    "analytical",
+    "experimental",
+    "refined",
+    "scale-offset",
+    "residual-gp",
+    "refined-ensemble",
+)
+
+
+def _check_base(base: Any, owner: str) -> Any:
+    if not callable(getattr(base, "predict", None)):
+        raise ValueError(
+            f"The 'base' of {owner} must be a fitted surrogate with a 'predict' method. "
+            f"Got {type(base).__name__} instead."
+        )
+    return base
+
+
+def _check_mlp_base(base: Any, owner: str) -> Any:
+    from softbend.surrogates.mlp import NormalizedMLPRegressor
+
+    if not isinstance(base, NormalizedMLPRegressor):
+        raise ValueError(
+            f"The 'base' of {owner} must be a fitted NormalizedMLPRegressor (an 'mlp' "
+            f"surrogate): its weights are trained further. Got {type(base).__name__} instead."
+        )
+    check_is_fitted(base)
+    return base
+
+
+def _check_same(estimators: list, names: tuple[str, ...], owner: str) -> None:
+    first = estimators[0]
+    for estimator in estimators[1:]:
+        for name in names:
+            if getattr(estimator, name) is not getattr(first, name) and getattr(
+                estimator, name
+            ) != getattr(first, name):
+                raise ValueError(
+                    f"The estimators of {owner}.fit_batch must share '{name}'. "
+                    f"Got {getattr(first, name)!r} and {getattr(estimator, name)!r}."
+                )
+
+
+def _check_level(level: float, owner: str) -> float:
+    return check_range(level, "level", f"{owner}.predict_interval", low=0.0, high=1.0)
+
+
+class _Strategy(RegressorMixin, BaseEstimator):
+    """Validation shared by the strategies: 7 finite features, finite angles."""
+
+    def _check_fit_data(self, X: ArrayLike, y: ArrayLike) -> tuple[np.ndarray, np.ndarray]:
+        X, y = validate_data(self, X, y, dtype=np.float64, y_numeric=True)
+        if X.shape[1] != len(FEATURES):
+            raise ValueError(
+                f"The 'X' of {type(self).__name__}.fit must have the {len(FEATURES)} columns "
+                f"{', '.join(FEATURES)}. Got {X.shape[1]} columns instead."
+            )
+        return X, y
+
+    def _check_rows(self, X: ArrayLike) -> np.ndarray:
+        check_is_fitted(self)
+        return validate_data(self, X, reset=False, dtype=np.float64)
+
+
+class BaseOnly(_Strategy):
+    """The base surrogate as it is ("fem-only"); ``fit`` only records the features."""
+
+    def __init__(self, base: Any = None) -> None:
+        self.base = base
+
+    def fit(self, X: ArrayLike, y: ArrayLike) -> BaseOnly:
+        """Check the data; nothing is learned from it."""
+        _check_base(self.base, type(self).__name__)
+        self._check_fit_data(X, y)
+        self.fitted_ = True
+        return self
+
+    def predict(self, X: ArrayLike) -> np.ndarray:
+        """The base's angle, degrees."""
+        return np.asarray(self.base.predict(self._check_rows(X)), dtype=np.float64)
+
+
+class AnalyticalBaseline(_Strategy):
+    """A bending model answered row by row (default: the analytical model; no training).
+
+    Rows are grouped by design and each design is swept once over its sorted
+    pressures. A pressure beyond where the model stops predicts NaN.
+
+    Parameters
+    ----------
+    model : BendingModel, optional
+        Default :class:`softbend.analytical.AnalyticalModel` (Dragon Skin 30 of
+        paper B, no gravity).
+    """
+
+    def __init__(self, model: Any = None) -> None:
+        self.model = model
+
+    def fit(self, X: ArrayLike, y: ArrayLike) -> AnalyticalBaseline:
+        """Check the data; nothing is learned from it."""
+        self._check_fit_data(X, y)
+        if self.model is None:
+            from softbend.analytical import AnalyticalModel
+
+            self.model_ = AnalyticalModel()
+        else:
+            self.model_ = self.model
+        return self
+
+    def predict(self, X: ArrayLike) -> np.ndarray:
+        """The model's angle at each row, degrees (NaN beyond where it stops)."""
+        X = self._check_rows(X)
+        out = np.full(X.shape[0], np.nan)
+        designs, inverse = np.unique(X[:, :-1], axis=0, return_inverse=True)
+        for k, values in enumerate(designs):
+            rows = np.flatnonzero(inverse.ravel() == k)
+            pressures, where = np.unique(X[rows, -1], return_inverse=True)
+            result = self.model_.sweep(SFRBADesign.from_sequence(values), pressures)
+            angle = np.full(pressures.size, np.nan)
+            done = np.asarray(result.converged, dtype=bool)
+            angle[: done.size][done] = np.asarray(result.angle_deg)[done]
+            out[rows] = angle[where.ravel()]
+        return out
+
+
+class RefinedMLP(_Strategy):
+    """Paper B's refined MLP: the FEM-trained MLP trained further on the measurements.
+
+    All layers are trained (paper B names no frozen layers) from the base's
+    weights with the base's input and target scaling kept; Adam, full batch
+    (paper B's batches of 1024 rows hold any set of measurements).
+
+    Parameters
+    ----------
+    base : NormalizedMLPRegressor
+        The FEM-trained MLP.
+    epochs : int, default 1000
+        Adam steps over the measurements (paper B Fig. 6: 1000 epochs).
+    learning_rate : float, default 6e-4
+        Adam step size (paper B's).
+    seed : int, default 0
+        Unused (full-batch training draws nothing); kept for a uniform interface.
+
+    Attributes
+    ----------
+    model_ : NormalizedMLPRegressor
+        The refined network; saves and loads as an ``mlp`` surrogate.
+    loss_curve_ : ndarray
+        Training MSE per epoch, deg².
+    """
+
+    def __init__(
+        self,
+        base: Any = None,
+        *,
+        epochs: int = 1000,
+        learning_rate: float = 6e-4,
+        seed: int = 0,
+    ) -> None:
+        self.base = base
+        self.epochs = epochs
+        self.learning_rate = learning_rate
+        self.seed = seed
+
+    def fit(self, X: ArrayLike, y: ArrayLike) -> RefinedMLP:
+        """Refine the base on the rows (mm, deg, MPa → degrees)."""
+        X, y = self._check_fit_data(X, y)
+        return type(self).fit_batch([self], X, y, [np.arange(y.size)])[0]
+
+    @classmethod
+    def fit_batch(
+        cls, estimators: list[RefinedMLP], X: np.ndarray, y: np.ndarray, row_sets: list
+    ) -> list[RefinedMLP]:
+        """Fit each estimator on its rows of ``X, y``, all trained at once.
+
+        The same result as fitting each alone (up to rounding): see
+        :mod:`softbend.transfer.finetune`. The estimators must share base,
+        epochs and learning rate.
+        """
+        first = estimators[0]
+        _check_mlp_base(first.base, cls.__name__)
+        _check_same(estimators, ("base", "epochs", "learning_rate"), cls.__name__)
+        models = fine_tune_many(
+            first.base,
+            X,
+            y,
+            row_weights(row_sets, len(y)),
+            epochs=first.epochs,
+            learning_rate=first.learning_rate,
+        )
+        for estimator, model in zip(estimators, models, strict=True):
+            estimator._set(model, X)
+        return estimators
+
+    def _set(self, model: Any, X: np.ndarray) -> None:
+        self.model_ = model
+        self.loss_curve_ = np.asarray(model.loss_curve_) * model.y_scale_**2
+        self.n_features_in_ = X.shape[1]
+
+    def predict(self, X: ArrayLike) -> np.ndarray:
+        """Refined angle, degrees."""
+        return self.model_.predict(self._check_rows(X))
+
+
+class ExperimentalMLP(_Strategy):
+    """Paper B's experimental MLP: the same network from scratch on the measurements.
+
+    Parameters
+    ----------
+    hidden_sizes : tuple of int, default (63, 65)
+        Paper B's MLP.
+    epochs : int, default 15000
+        Paper B Fig. 6.
+    learning_rate : float, default 6e-4
+        Adam step size (paper B's).
+    seed : int, default 0
+        Seed of the initial weights.
+
+    Attributes
+    ----------
+    model_ : NormalizedMLPRegressor
+    loss_curve_ : ndarray
+        Training MSE per epoch, deg².
+    """
+
+    def __init__(
+        self,
+        *,
+        hidden_sizes: tuple[int, int] = (63, 65),
+        epochs: int = 15000,
+        learning_rate: float = 6e-4,
+        seed: int = 0,
+    ) -> None:
+        self.hidden_sizes = hidden_sizes
+        self.epochs = epochs
+        self.learning_rate = learning_rate
+        self.seed = seed
+
+    def fit(self, X: ArrayLike, y: ArrayLike) -> ExperimentalMLP:
+        """Train from a seeded random initialization on the rows."""
+        X, y = self._check_fit_data(X, y)
+        return type(self).fit_batch([self], X, y, [np.arange(y.size)])[0]
+
+    @classmethod
+    def fit_batch(
+        cls, estimators: list[ExperimentalMLP], X: np.ndarray, y: np.ndarray, row_sets: list
+    ) -> list[ExperimentalMLP]:
+        """Fit each estimator on its rows, all trained at once (full batch).
+
+        Estimator k standardizes inputs and target on its own rows and draws its
+        initial weights as the grid trainer's split k does (stream
+        ``(seed, h1, h2, k)``, :func:`~softbend.surrogates.mlp_core.init_parameters`);
+        the first is what :meth:`fit` gives. Paper B's batches of 1024 rows hold
+        any set of measurements, so every epoch is one full-batch Adam step.
+        The estimators must share every parameter.
+        """
+        from softbend.surrogates.mlp import NormalizedMLPRegressor
+        from softbend.surrogates.mlp_core import init_parameters, model_rng, standardization
+
+        first = estimators[0]
+        _check_same(estimators, ("hidden_sizes", "epochs", "learning_rate", "seed"), cls.__name__)
+        h1, h2 = (int(h) for h in first.hidden_sizes)
+        starts = []
+        for k, rows in enumerate(row_sets):
+            coefs, intercepts = init_parameters(
+                model_rng(first.seed, h1, h2, k), X.shape[1], h1, h2
+            )
+            x_mean, x_scale = standardization(X[rows])
+            y_mean, y_scale = standardization(y[rows])
+            starts.append(
+                NormalizedMLPRegressor.from_arrays(
+                    x_mean=x_mean,
+                    x_scale=x_scale,
+                    y_mean=float(y_mean),
+                    y_scale=float(y_scale),
+                    coefs=coefs,
+                    intercepts=intercepts,
+                )
+            )
+        models = fine_tune_many(
+            starts,
+            X,
+            y,
+            row_weights(row_sets, len(y)),
+            epochs=first.epochs,
+            learning_rate=first.learning_rate,
+        )
+        for estimator, model in zip(estimators, models, strict=True):
+            estimator.model_ = model
+            estimator.loss_curve_ = np.asarray(model.loss_curve_) * model.y_scale_**2
+            estimator.n_features_in_ = X.shape[1]
+        return estimators
+
+    def predict(self, X: ArrayLike) -> np.ndarray:
+        """Angle, degrees."""
+        return self.model_.predict(self._check_rows(X))
+
+
+class ScaleOffset(_Strategy):
+    """The base frozen and corrected linearly: ``θ = a·θ_base + c`` (least squares).
+
+    Two numbers learned from the measurements: robust with one measured
+    actuator, and it keeps the base's shape of θ(p). The interval is Gaussian
+    with the residual standard deviation of the fit.
+    """
+
+    def __init__(self, base: Any = None) -> None:
+        self.base = base
+
+    def fit(self, X: ArrayLike, y: ArrayLike) -> ScaleOffset:
+        """Fit ``a`` and ``c`` on the rows."""
+        _check_base(self.base, type(self).__name__)
+        X, y = self._check_fit_data(X, y)
+        theta = np.asarray(self.base.predict(X), dtype=np.float64)
+        A = np.column_stack([theta, np.ones_like(theta)])
+        (self.scale_, self.offset_), *_ = np.linalg.lstsq(A, y, rcond=None)
+        dof = max(y.size - 2, 1)
+        self.residual_std_ = float(
+            np.sqrt(np.sum((A @ [self.scale_, self.offset_] - y) ** 2) / dof)
+        )
+        return self
+
+    def predict(self, X: ArrayLike) -> np.ndarray:
+        """Corrected angle, degrees."""
+        return self.scale_ * np.asarray(self.base.predict(self._check_rows(X))) + self.offset_
+
+    def predict_interval(self, X: ArrayLike, level: float = 0.9) -> tuple[np.ndarray, np.ndarray]:
+        """Central interval of probability ``level`` (Gaussian residuals), degrees."""
+        level = _check_level(level, type(self).__name__)
+        mean = self.predict(X)
+        half = norm.ppf(0.5 + level / 2) * self.residual_std_
+        return mean - half, mean + half
+
+
+class ResidualGP(_Strategy):
+    """The base frozen, a Gaussian process on its error (scikit-learn, with a noise term).
+
+    The GP sees the standardized features and the base's angle (so an error that
+    grows with the angle is a smooth function of one input); its kernel is a
+    constant times an anisotropic RBF plus white noise, hyperparameters by
+    marginal likelihood (``n_restarts`` seeded restarts). Prediction intervals
+    include the noise term, so they are intervals for a new reading.
+
+    Parameters
+    ----------
+    base : estimator
+        Any fitted surrogate.
+    n_restarts : int, default 3
+        Restarts of the hyperparameter optimizer, >= 0.
+    seed : int, default 0
+        Seed of the restarts.
+    """
+
+    def __init__(self, base: Any = None, *, n_restarts: int = 3, seed: int = 0) -> None:
+        self.base = base
+        self.n_restarts = n_restarts
+        self.seed = seed
+
+    def _inputs(self, X: np.ndarray) -> np.ndarray:
+        theta = np.asarray(self.base.predict(X), dtype=np.float64)
+        Z = np.column_stack([X, theta])
+        return (Z - self.z_mean_) / self.z_scale_
+
+    def fit(self, X: ArrayLike, y: ArrayLike) -> ResidualGP:
+        """Fit the GP to ``y − base(X)``."""
+        _check_base(self.base, type(self).__name__)
+        n_restarts = check_int(self.n_restarts, "n_restarts", type(self).__name__, low=0)
+        X, y = self._check_fit_data(X, y)
+        theta = np.asarray(self.base.predict(X), dtype=np.float64)
+        Z = np.column_stack([X, theta])
+        self.z_mean_ = Z.mean(axis=0)
+        scale = Z.std(axis=0)
+        self.z_scale_ = np.where(scale > 0, scale, 1.0)
+        d = Z.shape[1]
+        # A length scale at its upper bound means "this input does not matter": a
+        # normal outcome with six actuators, so the optimizer's warning is muted.
+        kernel = ConstantKernel(1.0, (1e-3, 1e3)) * RBF(np.ones(d), (1e-1, 1e5)) + WhiteKernel(
+            0.1, (1e-5, 10.0)
+        )
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore", ConvergenceWarning)
+            self.gp_ = GaussianProcessRegressor(
+                kernel=kernel,
+                normalize_y=True,
+                n_restarts_optimizer=n_restarts,
+                random_state=self.seed,
+            ).fit((Z - self.z_mean_) / self.z_scale_, y - theta)
+        return self
+
+    def predict(
+        self, X: ArrayLike, return_std: bool = False
+    ) -> np.ndarray | tuple[np.ndarray, np.ndarray]:
+        """Corrected angle, degrees (and the predictive standard deviation)."""
+        X = self._check_rows(X)
+        theta = np.asarray(self.base.predict(X), dtype=np.float64)
+        mean, std = self.gp_.predict(self._inputs(X), return_std=True)
+        return (theta + mean, std) if return_std else theta + mean
+
+    def predict_interval(self, X: ArrayLike, level: float = 0.9) -> tuple[np.ndarray, np.ndarray]:
+        """Central interval of probability ``level`` for a new reading, degrees."""
+        level = _check_level(level, type(self).__name__)
+        mean, std = self.predict(X, return_std=True)
+        half = norm.ppf(0.5 + level / 2) * std
+        return mean - half, mean + half
+
+
+class RefinedEnsemble(_Strategy):
+    """Refined MLPs on bootstrap draws of the measured actuators.
+
+    Each member is :class:`RefinedMLP` on a draw (with replacement) of the
+    actuators, identified by their design columns; the prediction is the members'
+    mean and the interval is Gaussian with the members' spread plus the
+    residual noise of the mean on the training rows.
+
+    Parameters
+    ----------
+    base : NormalizedMLPRegressor
+    n_members : int, default 5
+        Refined networks, >= 2.
+    epochs, learning_rate
+        As :class:`RefinedMLP`.
+    seed : int, default 0
+        Seed of the draws.
+    """
+
+    def __init__(
+        self,
+        base: Any = None,
+        *,
+        n_members: int = 5,
+        epochs: int = 1000,
+        learning_rate: float = 6e-4,
+        seed: int = 0,
+    ) -> None:
+        self.base = base
+        self.n_members = n_members
+        self.epochs = epochs
+        self.learning_rate = learning_rate
+        self.seed = seed
+
+    def fit(self, X: ArrayLike, y: ArrayLike) -> RefinedEnsemble:
+        """Refine ``n_members`` networks on bootstrap draws of the actuators."""
+        X, y = self._check_fit_data(X, y)
+        return type(self).fit_batch([self], X, y, [np.arange(y.size)])[0]
+
+    def _draws(self, X: np.ndarray, rows: np.ndarray) -> list[np.ndarray]:
+        """The members' rows: a seeded draw, with replacement, of the actuators in ``rows``."""
+        n_members = check_int(self.n_members, "n_members", type(self).__name__, low=2)
+        _, group = np.unique(X[rows, :-1], axis=0, return_inverse=True)
+        group = group.ravel()
+        n_groups = int(group.max()) + 1
+        rng = np.random.default_rng([self.seed, 7])
+        draws = []
+        for _ in range(n_members):
+            picked = rng.integers(0, n_groups, size=n_groups)
+            draws.append(np.concatenate([rows[group == g] for g in picked]))
+        return draws
+
+    @classmethod
+    def fit_batch(
+        cls, estimators: list[RefinedEnsemble], X: np.ndarray, y: np.ndarray, row_sets: list
+    ) -> list[RefinedEnsemble]:
+        """Fit each ensemble on its rows; every member of every ensemble trained at once."""
+        first = estimators[0]
+        _check_mlp_base(first.base, cls.__name__)
+        _check_same(estimators, ("base", "epochs", "learning_rate", "n_members"), cls.__name__)
+        draws = [
+            est._draws(X, np.asarray(rows)) for est, rows in zip(estimators, row_sets, strict=True)
+        ]
+        flat = [d for member_rows in draws for d in member_rows]
+        models = fine_tune_many(
+            first.base,
+            X,
+            y,
+            row_weights(flat, len(y)),
+            epochs=first.epochs,
+            learning_rate=first.learning_rate,
+        )
+        for i, (estimator, rows) in enumerate(zip(estimators, row_sets, strict=True)):
+            members = models[i * first.n_members : (i + 1) * first.n_members]
+            estimator.members_ = members
+            estimator.n_features_in_ = X.shape[1]
+            mean = np.mean([m.predict(X[rows]) for m in members], axis=0)
+            estimator.residual_std_ = float(np.sqrt(np.mean((mean - y[rows]) ** 2)))
+        return estimators
+
+    def _spread(self, X: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        preds = np.array([m.predict(X) for m in self.members_])
+        return preds.mean(axis=0), preds.std(axis=0, ddof=1)
+
+    def predict(self, X: ArrayLike) -> np.ndarray:
+        """Members' mean angle, degrees."""
+        return self._spread(self._check_rows(X))[0]
+
+    def predict_interval(self, X: ArrayLike, level: float = 0.9) -> tuple[np.ndarray, np.ndarray]:
+        """Central interval of probability ``level`` (spread and noise, Gaussian), degrees."""
+        level = _check_level(level, type(self).__name__)
+        mean, spread = self._spread(self._check_rows(X))
+        half = norm.ppf(0.5 + level / 2) * np.sqrt(spread**2 + self.residual_std_**2)
+        return mean - half, mean + half
+
+
+def make_strategy(name: str, base: Any = None, *, seed: int = 0, **options: Any) -> _Strategy:
+    """A fresh, unfitted strategy by name.
+
+    Parameters
+    ----------
+    name : str
+        One of :data:`STRATEGIES`.
+    base : estimator, optional
+        The simulation-trained surrogate (not used by ``analytical`` and
+        ``experimental``).
+    seed : int, default 0
+        Seed of the strategy's random choices.
+    **options
+        Constructor parameters of the strategy (e.g. ``epochs``).
+
+    Raises
+    ------
+    ValueError
+        An unknown name (listing :data:`STRATEGIES`).
+    """
+    check_choice(name, "strategy", "make_strategy", STRATEGIES)
+    if name == "fem-only":
+        return BaseOnly(base, **options)
+    if name == "analytical":
+        return AnalyticalBaseline(**options)
+    if name == "experimental":
+        return ExperimentalMLP(seed=seed, **options)
+    if name == "refined":
+        return RefinedMLP(base, seed=seed, **options)
+    if name == "scale-offset":
+        return ScaleOffset(base, **options)
+    if name == "residual-gp":
+        return ResidualGP(base, seed=seed, **options)
+    return RefinedEnsemble(base, seed=seed, **options)
+
+
+def has_interval(estimator: Any) -> bool:
+    """Whether the strategy gives prediction intervals."""
+    return callable(getattr(estimator, "predict_interval", None))

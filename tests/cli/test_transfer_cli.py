@@ -1,0 +1,178 @@
+"""``softbend lab`` and ``softbend transfer``: files written, bad input as one line."""
+
+from __future__ import annotations
+
+import json
+
+import pytest
+
+from softbend.cli import main
+
+from .conftest import one_error_line
+
+GOOD_HEADER = "l,r,t,b,phi,lc,pressure_mpa,angle_deg\n"
+
+
+@pytest.fixture(scope="module")
+def lab_csv(tmp_path_factory):
+    out = tmp_path_factory.mktemp("lab") / "lab.csv"
+    code = main(
+        ["lab", "measure", "--plant", "analytical", "--pmax", "0.12", "--out", str(out), "--json"]
+    )
+    assert code == 0
+    return out
+
+
+def test_lab_measure_writes_a_synthetic_csv_and_its_figure(lab_csv):
+    text = lab_csv.read_text()
+    assert "# synthetic: true" in text and "# lab.fabrication_error_mm: 0.2" in text
+    assert lab_csv.with_suffix(".png").is_file()
+
+
+def test_lab_measure_json_summary(tmp_path, capsys):
+    out = tmp_path / "lab.csv"
+    assert (
+        main(
+            [
+                "lab",
+                "measure",
+                "--plant",
+                "analytical",
+                "--pmax",
+                "0.05",
+                "--out",
+                str(out),
+                "--json",
+            ]
+        )
+        == 0
+    )
+    summary = json.loads(capsys.readouterr().out)
+    assert summary["synthetic"] is True and len(summary["actuators"]) == 7
+    assert summary["n_measurements"] == sum(a["points"] for a in summary["actuators"])
+
+
+def test_loco_then_refine_then_predict(lab_csv, tmp_path, capsys, small_base_file):
+    out = tmp_path / "loco"
+    code = main(
+        [
+            "transfer",
+            "loco",
+            str(lab_csv),
+            "--base",
+            str(small_base_file),
+            "--out",
+            str(out),
+            "--strategies",
+            "fem-only,scale-offset",
+            "--json",
+        ]
+    )
+    assert code == 0
+    payload = json.loads(capsys.readouterr().out)
+    assert {r["strategy"] for r in payload["summary"]} == {"fem-only", "scale-offset"}
+    assert payload["synthetic"] is True
+    for name in (
+        "summary.csv",
+        "loco.json",
+        "fig7_actuators.png",
+        "fig6_loss_curves.png",
+        "learning_curve.png",
+    ):
+        assert (out / name).is_file(), name
+    model = tmp_path / "refined.json"
+    assert (
+        main(
+            [
+                "transfer",
+                "refine",
+                str(small_base_file),
+                str(lab_csv),
+                "--out",
+                str(model),
+                "--epochs",
+                "20",
+            ]
+        )
+        == 0
+    )
+    capsys.readouterr()
+    assert (
+        main(["predict", str(model), "--design", "100,6,2,2,5,8", "--pressure", "0.05", "--json"])
+        == 0
+    )
+    angle = json.loads(capsys.readouterr().out)["angle_deg"][0]
+    assert 0.0 < angle < 180.0
+
+
+@pytest.mark.parametrize(
+    ("body", "needle"),
+    [
+        ("", "no header row"),
+        ("l,r,t,b,phi,lc,pressure_mpa\n100,6,2,2,5,8,0.1\n", "angle_deg"),
+        (GOOD_HEADER + "100,6,2,2,5,8,0.1,nan\n", "angle_deg"),
+        (GOOD_HEADER + "100,6,2,2,5,8,-0.1,20\n", "pressure_mpa"),
+        (GOOD_HEADER + "100,6,2,2,5,8,abc,20\n", "pressure_mpa"),
+        (GOOD_HEADER + "100,-6,2,2,5,8,0.1,20\n", "'r'"),
+        (GOOD_HEADER + "100,6,2,2,5,8,0.1\n", "line 2"),
+        ("l,r,t,b,phi,lc,pressure_mpa,angle_deg,colour\n100,6,2,2,5,8,0.1,20,red\n", "colour"),
+        (GOOD_HEADER.strip() + ",direction\n100,6,2,2,5,8,0.1,20,sideways\n", "direction"),
+    ],
+)
+def test_bad_measurement_files_are_one_line_exit_2(tmp_path, capsys, body, needle, small_base_file):
+    path = tmp_path / "bad.csv"
+    path.write_text(body)
+    code = main(
+        [
+            "transfer",
+            "loco",
+            str(path),
+            "--base",
+            str(small_base_file),
+            "--out",
+            str(tmp_path / "o"),
+        ]
+    )
+    assert code == 2
+    line = one_error_line(capsys)
+    assert "bad.csv" in line and needle in line
+
+
+def test_unknown_strategy_and_bad_out_are_refused_before_work(
+    lab_csv, tmp_path, capsys, small_base_file
+):
+    code = main(
+        [
+            "transfer",
+            "loco",
+            str(lab_csv),
+            "--base",
+            str(small_base_file),
+            "--out",
+            str(tmp_path / "o"),
+            "--strategies",
+            "magic",
+        ]
+    )
+    assert code == 2 and "'strategy'" in one_error_line(capsys)
+    a_file = tmp_path / "file.txt"
+    a_file.write_text("x")
+    code = main(
+        ["transfer", "loco", str(lab_csv), "--base", str(small_base_file), "--out", str(a_file)]
+    )
+    assert code == 2 and "--out" in one_error_line(capsys)
+    code = main(["lab", "measure", "--plant", "abaqus", "--out", str(tmp_path / "x.csv")])
+    assert code == 2 and "'plant'" in one_error_line(capsys)
+    code = main(
+        [
+            "transfer",
+            "refine",
+            str(small_base_file),
+            str(lab_csv),
+            "--out",
+            str(tmp_path / "m.json"),
+            "--strategy",
+            "residual-gp",
+        ]
+    )
+    assert code == 2 and "'strategy'" in one_error_line(capsys)

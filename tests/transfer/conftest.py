@@ -1,0 +1,56 @@
+"""Shared pieces of the transfer tests: a quick virtual lab and a small MLP base."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from softbend.analytical import AnalyticalModel
+from softbend.design import SFRBADesign
+from softbend.models import default_pressures_mpa
+from softbend.transfer.lab import LAB_ACTUATORS, VirtualLab
+
+
+@pytest.fixture(scope="session")
+def quick_lab():
+    """Four actuators of Fig. 7 measured on the analytical plant (seconds, not minutes)."""
+    return VirtualLab(actuators=LAB_ACTUATORS[:4], plant="analytical", pmax_mpa=0.15)
+
+
+@pytest.fixture(scope="session")
+def quick_measurements(quick_lab):
+    return quick_lab.measure()
+
+
+@pytest.fixture(scope="session")
+def small_base():
+    """An MLP trained briefly on paper B's analytical model over a few designs.
+
+    Stands in for the FEM-trained MLP: refining it must still help, and the
+    tests do not depend on the shipped model.
+    """
+    from softbend.surrogates.mlp import NormalizedMLPRegressor
+
+    model = AnalyticalModel()
+    rows, angles = [], []
+    grid = default_pressures_mpa(0.2, 0.01)
+    for values in [
+        (100, 6, 2, 2, 5, 8),
+        (120, 6, 2, 2, 5, 8),
+        (100, 8, 2, 2, 5, 8),
+        (100, 6, 3, 2, 5, 8),
+        (100, 6, 2, 3, 5, 8),
+        (100, 6, 2, 2, 10, 8),
+        (100, 6, 2, 2, 5, 10),
+        (140, 8, 3, 3, 10, 10),
+        (110, 7, 2.5, 2.5, 8, 9),
+    ]:
+        design = SFRBADesign(*values)
+        sweep = model.sweep(design, grid)
+        ok = np.asarray(sweep.converged, dtype=bool)
+        rows.append(design.feature_rows(sweep.pressure_mpa[ok]))
+        angles.append(sweep.angle_deg[ok])
+    X, y = np.vstack(rows), np.concatenate(angles)
+    return NormalizedMLPRegressor(
+        hidden_sizes=(16, 16), epochs=300, batch_size=64, learning_rate=3e-3, seed=0, device="cpu"
+    ).fit(X, y)

@@ -1,0 +1,131 @@
+"""Leave-one-configuration-out: the right folds, honest scores, files written."""
+
+from __future__ import annotations
+
+import json
+
+import numpy as np
+import pytest
+
+from softbend.metrics import rmse
+from softbend.transfer.loco import leave_one_configuration_out
+
+FAST = {
+    "refined": {"epochs": 30},
+    "refined-ensemble": {"epochs": 30, "n_members": 2},
+    "residual-gp": {"n_restarts": 0},
+}
+
+
+@pytest.fixture(scope="module")
+def result(small_base, quick_measurements):
+    return leave_one_configuration_out(
+        quick_measurements,
+        small_base,
+        ["fem-only", "refined", "scale-offset", "residual-gp", "refined-ensemble"],
+        options=FAST,
+    )
+
+
+def test_every_strategy_is_scored_on_every_held_out_actuator(result, quick_measurements):
+    ids = quick_measurements.actuator_ids
+    assert len(result.per_actuator) == 5 * len(ids)
+    for _, row in result.per_actuator.iterrows():
+        assert row["n_points"] == int(np.sum(quick_measurements.groups == row["actuator_id"]))
+    assert set(result.summary["strategy"]) == set(result.per_actuator["strategy"])
+
+
+def test_fem_only_scores_are_the_base_error(result, small_base, quick_measurements):
+    for actuator in quick_measurements.actuator_ids:
+        rows = quick_measurements.groups == actuator
+        expected = rmse(
+            quick_measurements.angle_deg[rows],
+            small_base.predict(quick_measurements.features[rows]),
+        )
+        got = result.per_actuator.query("strategy == 'fem-only' and actuator_id == @actuator")
+        assert float(got["rmse_deg"].iloc[0]) == pytest.approx(expected)
+
+
+def test_a_held_out_actuator_never_trains_its_own_model(small_base, quick_measurements):
+    # Refit one fold by hand: training on the others must give the reported score.
+    from softbend.transfer.strategies import ScaleOffset
+
+    result = leave_one_configuration_out(quick_measurements, small_base, ["scale-offset"])
+    held = quick_measurements.actuator_ids[1]
+    test = quick_measurements.groups == held
+    X, y = quick_measurements.features, quick_measurements.angle_deg
+    model = ScaleOffset(small_base).fit(X[~test], y[~test])
+    expected = rmse(y[test], model.predict(X[test]))
+    got = result.per_actuator.query("actuator_id == @held")["rmse_deg"].iloc[0]
+    assert got == pytest.approx(expected)
+
+
+def test_intervals_report_a_coverage_and_point_models_do_not(result):
+    summary = result.summary.set_index("strategy")
+    assert np.isnan(summary.loc["fem-only", "coverage"])
+    for name in ("scale-offset", "residual-gp", "refined-ensemble"):
+        assert 0.0 <= summary.loc[name, "coverage"] <= 1.0
+
+
+def test_learning_curve_covers_one_to_n_minus_one_actuators(result, quick_measurements):
+    n = len(quick_measurements.actuator_ids)
+    curve = result.learning_curve
+    assert "refined-ensemble" not in set(curve["strategy"])  # too slow for the curve
+    for name, part in curve.groupby("strategy"):
+        assert sorted(set(part["n_actuators"])) == list(range(1, n)), name
+        assert len(part) == n * (n - 1)
+
+
+def test_same_seed_same_numbers(small_base, quick_measurements, result):
+    names = ["refined", "refined-ensemble"]
+    again = leave_one_configuration_out(
+        quick_measurements, small_base, names, options=FAST, learning_curve=False
+    )
+    cols = ["rmse_deg", "mape_pct", "max_error_deg", "coverage"]
+    before = result.per_actuator[result.per_actuator["strategy"].isin(names)]
+    np.testing.assert_array_equal(again.per_actuator[cols], before[cols])
+
+
+def test_refining_beats_the_base_on_a_systematic_gap(small_base, quick_measurements):
+    # The lab's elastomer is not the base's: correcting with measurements must help.
+    result = leave_one_configuration_out(
+        quick_measurements,
+        small_base,
+        ["fem-only", "scale-offset", "refined"],
+        options={"refined": {"epochs": 300}},
+        learning_curve=False,
+    )
+    summary = result.summary.set_index("strategy")["rmse_deg"]
+    assert summary["scale-offset"] < summary["fem-only"]
+    assert summary["refined"] < summary["fem-only"]
+
+
+def test_written_files_are_tables_and_strict_json(result, tmp_path):
+    files = result.write(tmp_path / "out")
+    for key in ("summary", "per_actuator", "predictions", "learning_curve", "loss_curves"):
+        assert (tmp_path / "out").joinpath(files[key].split("/")[-1]).is_file()
+    payload = json.loads((tmp_path / "out" / "loco.json").read_text())  # no NaN tokens
+    assert {r["strategy"] for r in payload["summary"]} == set(result.summary["strategy"])
+    assert payload["summary"][0]["coverage"] is None  # fem-only: no interval
+
+
+@pytest.mark.parametrize(
+    ("kwargs", "match"),
+    [
+        ({"strategies": []}, "at least one"),
+        ({"strategies": ["refined", "refined"]}, "distinct"),
+        ({"strategies": ["magic"]}, "'strategy'"),
+        ({"level": 1.0}, "'level'"),
+        ({"seed": -1}, "'seed'"),
+        ({"options": {"magic": {}}}, "'options'"),
+    ],
+)
+def test_bad_arguments_name_the_field(small_base, quick_measurements, kwargs, match):
+    with pytest.raises(ValueError, match=match):
+        leave_one_configuration_out(quick_measurements, small_base, **kwargs)
+
+
+def test_one_actuator_is_not_enough(small_base, quick_measurements):
+    one = quick_measurements.subset([quick_measurements.actuator_ids[0]])
+    with pytest.raises(ValueError, match="at least 2 actuators"):
+        leave_one_configuration_out(one, small_base, ["fem-only"])

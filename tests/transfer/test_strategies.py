@@ -1,0 +1,147 @@
+"""Refinement strategies: each does what it claims on cases with a known answer."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from softbend.transfer.finetune import fine_tune_many, fine_tune_mlp, row_weights
+from softbend.transfer.strategies import (
+    STRATEGIES,
+    AnalyticalBaseline,
+    ExperimentalMLP,
+    RefinedEnsemble,
+    RefinedMLP,
+    ResidualGP,
+    ScaleOffset,
+    has_interval,
+    make_strategy,
+)
+
+
+def test_every_named_strategy_fits_and_predicts(small_base, quick_measurements):
+    X, y = quick_measurements.features, quick_measurements.angle_deg
+    for name in STRATEGIES:
+        options = {"epochs": 20} if name in ("refined", "experimental", "refined-ensemble") else {}
+        model = make_strategy(name, small_base, **options).fit(X, y)
+        pred = model.predict(X)
+        assert pred.shape == y.shape and np.isfinite(pred).all(), name
+        if has_interval(model):
+            lo, hi = model.predict_interval(X, 0.9)
+            assert np.all(lo <= pred) and np.all(pred <= hi)
+
+
+def test_unknown_strategy_lists_the_allowed_ones():
+    with pytest.raises(ValueError, match=r"'strategy'.*'refined'.*'residual-gp'"):
+        make_strategy("transfer-magic")
+
+
+def test_refining_needs_an_mlp_base(quick_measurements):
+    with pytest.raises(ValueError, match="'base' of RefinedMLP must be a fitted NormalizedMLP"):
+        RefinedMLP(ScaleOffset()).fit(quick_measurements.features, quick_measurements.angle_deg)
+
+
+def test_refined_mlp_keeps_the_base_scaling_and_lowers_the_training_loss(
+    small_base, quick_measurements
+):
+    X, y = quick_measurements.features, quick_measurements.angle_deg
+    model = RefinedMLP(small_base, epochs=300).fit(X, y)
+    np.testing.assert_array_equal(model.model_.x_mean_, small_base.x_mean_)
+    np.testing.assert_array_equal(model.model_.x_scale_, small_base.x_scale_)
+    assert model.model_.y_scale_ == small_base.y_scale_
+    before = np.mean((small_base.predict(X) - y) ** 2)
+    # the first epoch's loss is the base's own error on the rows, in deg²
+    assert model.loss_curve_[0] == pytest.approx(before, rel=1e-9)
+    assert model.loss_curve_[-1] < 0.5 * before
+    assert np.mean((model.predict(X) - y) ** 2) == pytest.approx(model.loss_curve_[-1], rel=0.2)
+
+
+def test_refining_on_the_base_own_predictions_barely_moves_it(small_base, quick_measurements):
+    # No gap to learn: the gradient starts at rounding level, and Adam's normalized
+    # steps (learning rate 6e-4 per weight) can only wander a little.
+    X = quick_measurements.features
+    model = fine_tune_mlp(small_base, X, small_base.predict(X), epochs=50)
+    assert model.loss_curve_[0] < 1e-20
+    np.testing.assert_allclose(model.predict(X), small_base.predict(X), atol=0.5)
+
+
+def test_batched_refinement_equals_one_at_a_time(small_base, quick_measurements):
+    X, y = quick_measurements.features, quick_measurements.angle_deg
+    rng = np.random.default_rng(0)
+    sets = [np.arange(40), rng.choice(len(y), size=60, replace=True), np.arange(len(y))]
+    together = fine_tune_many(small_base, X, y, row_weights(sets, len(y)), epochs=40)
+    for rows, model in zip(sets, together, strict=True):
+        alone = fine_tune_mlp(small_base, X[rows], y[rows], epochs=40)
+        np.testing.assert_allclose(model.predict(X), alone.predict(X), rtol=1e-9, atol=1e-9)
+
+
+def test_experimental_batch_equals_single_fit(quick_measurements):
+    X, y = quick_measurements.features, quick_measurements.angle_deg
+    single = ExperimentalMLP(epochs=30, hidden_sizes=(8, 8)).fit(X, y)
+    batch = ExperimentalMLP.fit_batch(
+        [ExperimentalMLP(epochs=30, hidden_sizes=(8, 8)) for _ in range(2)],
+        X,
+        y,
+        [np.arange(len(y)), np.arange(30)],
+    )
+    np.testing.assert_allclose(batch[0].predict(X), single.predict(X), rtol=1e-12)
+    assert not np.allclose(batch[1].predict(X), single.predict(X))
+
+
+def test_scale_offset_recovers_a_known_linear_gap(small_base, quick_measurements):
+    X = quick_measurements.features
+    y = 0.8 * small_base.predict(X) + 3.0
+    model = ScaleOffset(small_base).fit(X, y)
+    assert model.scale_ == pytest.approx(0.8) and model.offset_ == pytest.approx(3.0)
+    assert model.residual_std_ == pytest.approx(0.0, abs=1e-9)
+
+
+def test_residual_gp_on_pure_noise_stays_on_the_base_and_covers(small_base, quick_measurements):
+    X = quick_measurements.features
+    noise = np.random.default_rng(1).normal(0.0, 1.0, size=len(X))
+    model = ResidualGP(small_base).fit(X, small_base.predict(X) + noise)
+    pred = model.predict(X)
+    assert np.sqrt(np.mean((pred - small_base.predict(X)) ** 2)) < 0.5
+    fresh = small_base.predict(X) + np.random.default_rng(2).normal(0.0, 1.0, size=len(X))
+    lo, hi = model.predict_interval(X, 0.9)
+    assert 0.8 <= np.mean((fresh >= lo) & (fresh <= hi)) <= 0.99
+    wide = model.predict_interval(X, 0.99)
+    assert np.all(wide[1] - wide[0] > hi - lo)
+
+
+def test_ensemble_members_differ_and_their_spread_widens_the_interval(
+    small_base, quick_measurements
+):
+    X, y = quick_measurements.features, quick_measurements.angle_deg
+    model = RefinedEnsemble(small_base, n_members=3, epochs=50).fit(X, y)
+    preds = np.array([m.predict(X) for m in model.members_])
+    assert preds.std(axis=0).max() > 0.0
+    lo, hi = model.predict_interval(X, 0.9)
+    assert np.all(hi - lo >= 2 * 1.6448 * model.residual_std_ - 1e-9)
+
+
+def test_analytical_baseline_is_the_analytical_sweep(quick_measurements):
+    from softbend.analytical import AnalyticalModel
+
+    X = quick_measurements.features
+    model = AnalyticalBaseline().fit(X, quick_measurements.angle_deg)
+    design = quick_measurements.designs[0]
+    rows = quick_measurements.groups == quick_measurements.actuator_ids[0]
+    sweep = AnalyticalModel().sweep(design, X[rows, -1])
+    np.testing.assert_allclose(model.predict(X[rows]), sweep.angle_deg)
+
+
+@pytest.mark.parametrize("level", [0.0, 1.0, 1.5, float("nan")])
+def test_interval_level_must_be_a_probability(small_base, quick_measurements, level):
+    model = ScaleOffset(small_base).fit(quick_measurements.features, quick_measurements.angle_deg)
+    with pytest.raises(ValueError, match="'level'"):
+        model.predict_interval(quick_measurements.features, level)
+
+
+def test_fit_rejects_wrong_columns_and_nan(small_base):
+    with pytest.raises(ValueError, match="7 columns"):
+        ScaleOffset(small_base).fit(np.ones((5, 3)), np.ones(5))
+    X = np.ones((5, 7))
+    y = np.array([1.0, np.nan, 2.0, 3.0, 4.0])
+    with pytest.raises(ValueError):
+        ScaleOffset(small_base).fit(X, y)
