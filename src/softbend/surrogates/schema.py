@@ -1,0 +1,355 @@
+"""The schema of a saved surrogate's ``params`` and ``state``: one rule per key.
+
+Loading (:func:`softbend.surrogates.load_surrogate`) validates every value before
+it reaches the estimator: each kind has a fixed set of parameter and state keys,
+each with a rule (type, dtype, dimensions, finiteness, bounds), then rules
+across keys (chained shapes). Only a key of the schema is ever set on a model.
+"""
+
+from __future__ import annotations
+
+import json
+import math
+from collections.abc import Callable
+from dataclasses import dataclass
+from typing import Any
+
+import numpy as np
+
+from softbend.surrogates.features import FEATURES
+
+__all__ = ["SCHEMAS", "Rule", "RuleError", "shown"]
+
+
+class RuleError(Exception):
+    """A value breaks its rule; the message says how (the caller names the file and the key)."""
+
+
+Rule = Callable[[Any], Any]
+
+_FLOAT = "float64"
+_INT = "int64"
+
+
+def shown(value: Any) -> str:
+    """A short picture of a JSON value for a message."""
+    try:
+        text = json.dumps(value)
+    except (TypeError, ValueError):
+        text = repr(value)
+    return text if len(text) <= 60 else text[:57] + "..."
+
+
+def _is_real(value: Any) -> bool:
+    return type(value) in (int, float)  # not bool
+
+
+def _scalar(value: Any, dtype: str, what: str) -> Any:
+    """A plain JSON number, or a ``{"__scalar__", "dtype"}`` of ``dtype``, decoded."""
+    ok = _is_real if dtype == _FLOAT else (lambda v: type(v) is int)
+    if ok(value):
+        return float(value) if dtype == _FLOAT else value
+    if isinstance(value, dict) and set(value) == {"__scalar__", "dtype"}:
+        if value["dtype"] == dtype and ok(value["__scalar__"]):
+            try:
+                return np.dtype(dtype).type(value["__scalar__"])
+            except OverflowError:
+                raise RuleError(f"must be {what} within {dtype}; got {shown(value)}") from None
+        raise RuleError(f"must be {what} of dtype {dtype}; got {shown(value)}")
+    raise RuleError(f"must be {what}; got {shown(value)}")
+
+
+def _bounds(low: float | None, strict: bool) -> str:
+    return "" if low is None else f" {'>' if strict else '>='} {low:g}"
+
+
+def _real(*, low: float | None = None, strict: bool = False, finite: bool = True) -> Rule:
+    what = ("a finite number" if finite else "a number") + _bounds(low, strict)
+
+    def rule(value: Any) -> Any:
+        decoded = _scalar(value, _FLOAT, what)
+        x = float(decoded)
+        if (finite and not math.isfinite(x)) or math.isnan(x):
+            raise RuleError(f"must be {what}; got {x}")
+        if low is not None and not (x > low if strict else x >= low):
+            raise RuleError(f"must be {what}; got {x:g}")
+        return decoded
+
+    return rule
+
+
+def _integer(low: int) -> Rule:
+    what = f"an integer >= {low}"
+
+    def rule(value: Any) -> Any:
+        decoded = _scalar(value, _INT, what)
+        if int(decoded) < low:
+            raise RuleError(f"must be {what}; got {int(decoded)}")
+        return decoded
+
+    return rule
+
+
+def _string(choices: tuple[str, ...] | None = None) -> Rule:
+    what = "a string" if choices is None else f"one of {', '.join(map(repr, choices))}"
+
+    def rule(value: Any) -> Any:
+        decoded = value
+        if (
+            isinstance(value, dict)
+            and set(value) == {"__scalar__", "dtype"}
+            and value["dtype"] == "str"
+            and isinstance(value["__scalar__"], str)
+        ):
+            decoded = np.str_(value["__scalar__"])
+        if not isinstance(decoded, str) or (choices is not None and decoded not in choices):
+            raise RuleError(f"must be {what}; got {shown(value)}")
+        return decoded
+
+    return rule
+
+
+def _leaves(nested: Any, shape: list[int]) -> list[Any]:
+    """The elements of a nested list of ``shape``, in order; raise if it has another shape."""
+    items = [nested]
+    for depth, size in enumerate(shape):
+        deeper: list[Any] = []
+        for item in items:
+            if not isinstance(item, list) or len(item) != size:
+                found = f"{len(item)} items" if isinstance(item, list) else shown(item)
+                raise RuleError(
+                    f"must hold nested lists of its shape {shape}; got {found} at depth {depth}"
+                )
+            deeper.extend(item)
+        items = deeper
+    return items
+
+
+def _array(dtype: str, ndim: int, *, low: float | None = None, strict: bool = False) -> Rule:
+    """A ``{"__ndarray__", "dtype", "shape"}`` of ``dtype`` and ``ndim``; floats finite."""
+    element = {_FLOAT: "finite numbers", _INT: "integers", "str": "strings"}[dtype]
+    what = f"a {ndim}-D {dtype} array"
+
+    def rule(value: Any) -> np.ndarray:
+        if not (isinstance(value, dict) and set(value) == {"__ndarray__", "dtype", "shape"}):
+            raise RuleError(
+                f"must be {what} ({{'__ndarray__': ..., 'dtype': ..., 'shape': ...}}); "
+                f"got {shown(value)}"
+            )
+        if value["dtype"] != dtype:
+            raise RuleError(f"must be {what}; got dtype {shown(value['dtype'])}")
+        shape = value["shape"]
+        if not (
+            isinstance(shape, list)
+            and len(shape) == ndim
+            and all(type(n) is int and n >= 0 for n in shape)
+        ):
+            raise RuleError(f"must be {what}; got shape {shown(shape)}")
+        leaves = _leaves(value["__ndarray__"], shape)
+        ok = {_FLOAT: _is_real, _INT: lambda v: type(v) is int, "str": lambda v: type(v) is str}
+        good = ok[dtype]
+        bad = next((i for i, v in enumerate(leaves) if not good(v)), None)
+        if bad is not None:
+            raise RuleError(f"must hold only {element}; got {shown(leaves[bad])}")
+        try:
+            array = np.asarray(leaves, dtype=object if dtype == "str" else np.dtype(dtype))
+        except OverflowError:
+            raise RuleError(f"must hold integers within {dtype}") from None
+        array = np.ascontiguousarray(array.reshape(shape))
+        if dtype == _FLOAT:
+            finite = np.isfinite(array)
+            if not finite.all():
+                where = tuple(int(i) for i in np.argwhere(~finite)[0])
+                raise RuleError(f"must hold only finite numbers; got {array[where]} at {where}")
+        if low is not None:
+            above = array > low if strict else array >= low
+            if not above.all():
+                where = tuple(int(i) for i in np.argwhere(~above)[0])
+                raise RuleError(
+                    f"must hold only values{_bounds(low, strict)}; got {array[where]} at {where}"
+                )
+        return array
+
+    return rule
+
+
+def _arrays(count: int, ndim: int) -> Rule:
+    """A list of ``count`` float64 arrays of ``ndim`` dimensions."""
+    item = _array(_FLOAT, ndim)
+
+    def rule(value: Any) -> list[np.ndarray]:
+        if not isinstance(value, list) or len(value) != count:
+            found = f"{len(value)} items" if isinstance(value, list) else shown(value)
+            raise RuleError(f"must be a list of {count} {ndim}-D float64 arrays; got {found}")
+        arrays = []
+        for i, entry in enumerate(value):
+            try:
+                arrays.append(item(entry))
+            except RuleError as err:
+                raise RuleError(f"item {i} {err}") from None
+        return arrays
+
+    return rule
+
+
+def _numbers(value: Any) -> list[float]:
+    """A list of numbers (a diagnostic such as a loss curve: NaN and inf allowed)."""
+    if not isinstance(value, list) or not all(_is_real(v) for v in value):
+        raise RuleError(f"must be a list of numbers; got {shown(value)}")
+    return [float(v) for v in value]
+
+
+def _int_pair(value: Any) -> Any:
+    """Two integers >= 1, as a tuple (``{"__tuple__": [...]}``) or a list."""
+    items = (
+        value.get("__tuple__") if isinstance(value, dict) and set(value) == {"__tuple__"} else value
+    )
+    if not isinstance(items, list) or len(items) != 2:
+        raise RuleError(f"must be two integers >= 1; got {shown(value)}")
+    pair = [_integer(1)(v) for v in items]
+    return tuple(pair) if items is not value else pair
+
+
+def _booster(value: Any) -> str:
+    """XGBoost's JSON model as text: an object with a ``learner``, finite numbers only."""
+
+    def refuse(constant: str) -> None:
+        raise RuleError(f"must hold only finite numbers; got {constant}")
+
+    if not isinstance(value, str):
+        raise RuleError(f"must be XGBoost's JSON model as a string; got {shown(value)}")
+    try:
+        model = json.loads(value, parse_constant=refuse)
+    except json.JSONDecodeError as err:
+        raise RuleError(f"must be XGBoost's JSON model; not valid JSON ({err})") from None
+    learner = model.get("learner") if isinstance(model, dict) else None
+    if not isinstance(learner, dict):
+        raise RuleError("must be XGBoost's JSON model; no 'learner' object")
+    param = learner.get("learner_model_param")
+    n_features = param.get("num_feature") if isinstance(param, dict) else None
+    if n_features is not None and str(n_features) != str(len(FEATURES)):
+        raise RuleError(
+            f"must take the {len(FEATURES)} surrogate inputs; got {n_features} features"
+        )
+    return value
+
+
+def _check_inputs(state: dict[str, Any]) -> None:
+    """Rules across keys shared by the polynomial and the MLP: the input standardization."""
+    d = len(FEATURES)
+    if int(state["n_features_in_"]) != d:
+        raise RuleError(
+            f"state key 'n_features_in_' must be {d} (the inputs {', '.join(FEATURES)}); "
+            f"got {state['n_features_in_']}"
+        )
+    for key in ("x_mean_", "x_scale_"):
+        if state[key].shape != (d,):
+            raise RuleError(f"state key '{key}' must have shape ({d},); got {state[key].shape}")
+    names = state.get("feature_names_in_")
+    if names is not None and [str(n) for n in names] != list(FEATURES):
+        raise RuleError(
+            f"state key 'feature_names_in_' must be {', '.join(FEATURES)}; "
+            f"got {', '.join(map(str, names))}"
+        )
+
+
+def _check_polynomial(state: dict[str, Any]) -> None:
+    _check_inputs(state)
+    powers, coef = state["powers_"], state["coef_"]
+    if powers.shape[0] < 1 or powers.shape[1] != len(FEATURES):
+        raise RuleError(
+            f"state key 'powers_' must have shape (n_terms >= 1, {len(FEATURES)}); "
+            f"got {powers.shape}"
+        )
+    if coef.shape != (powers.shape[0],):
+        raise RuleError(
+            f"state key 'coef_' must have shape ({powers.shape[0]},) (one per row of "
+            f"'powers_'); got {coef.shape}"
+        )
+    from softbend.surrogates.polynomial import _plan
+
+    try:
+        _plan(powers)
+    except ValueError:
+        raise RuleError(
+            "state key 'powers_' must be a complete exponent table (one constant row and, "
+            "with every monomial, the monomial with one factor fewer)"
+        ) from None
+
+
+def _check_mlp(state: dict[str, Any]) -> None:
+    _check_inputs(state)
+    coefs, intercepts = state["coefs_"], state["intercepts_"]
+    d, h1, h2 = len(FEATURES), coefs[0].shape[1], coefs[1].shape[1]
+    expected = [(d, h1), (h1, h2), (h2, 1)]
+    if [c.shape for c in coefs] != expected or 0 in (h1, h2):
+        raise RuleError(
+            f"state key 'coefs_' must have the chained shapes (d, h1), (h1, h2), (h2, 1) with "
+            f"d = {d}, h1, h2 >= 1; got {', '.join(str(c.shape) for c in coefs)}"
+        )
+    if [b.shape for b in intercepts] != [(h1,), (h2,), (1,)]:
+        raise RuleError(
+            f"state key 'intercepts_' must have the shapes ({h1},), ({h2},), (1,) of the "
+            f"layers of 'coefs_'; got {', '.join(str(b.shape) for b in intercepts)}"
+        )
+
+
+def _no_check(state: dict[str, Any]) -> None:
+    return None
+
+
+@dataclass(frozen=True)
+class _Schema:
+    """What a saved surrogate of one kind may hold, and the rule of each value."""
+
+    params: dict[str, Rule] | None  # None: the constructor's keys, values decoded as saved
+    state: dict[str, Rule]
+    check: Callable[[dict[str, Any]], None]
+
+
+_INPUT_STATE: dict[str, Rule] = {
+    "n_features_in_": _integer(1),
+    "feature_names_in_": _array("str", 1),
+    "x_mean_": _array(_FLOAT, 1),
+    "x_scale_": _array(_FLOAT, 1, low=0.0, strict=True),
+    "y_mean_": _real(),
+    "y_scale_": _real(low=0.0, strict=True),
+}
+
+SCHEMAS: dict[str, _Schema] = {
+    "polynomial": _Schema(
+        params={
+            "degree": _integer(1),
+            "alpha": _real(low=0.0),
+            "chunk_rows": _integer(1),
+            "max_memory_mb": _real(low=0.0, strict=True, finite=False),
+        },
+        state={
+            **_INPUT_STATE,
+            "powers_": _array(_INT, 2, low=0),
+            "coef_": _array(_FLOAT, 1),
+            "solver_": _string(),
+            "rank_": _integer(0),
+        },
+        check=_check_polynomial,
+    ),
+    "mlp": _Schema(
+        params={
+            "hidden_sizes": _int_pair,
+            "epochs": _integer(1),
+            "batch_size": _integer(1),
+            "learning_rate": _real(low=0.0, strict=True),
+            "seed": _integer(0),
+            "device": _string(("auto", "cpu", "cuda")),
+        },
+        state={
+            **_INPUT_STATE,
+            "coefs_": _arrays(3, 2),
+            "intercepts_": _arrays(3, 1),
+            "loss_curve_": _numbers,
+            "device_": _string(("cpu", "cuda")),
+        },
+        check=_check_mlp,
+    ),
+    "xgboost": _Schema(params=None, state={"booster": _booster}, check=_no_check),
+}
