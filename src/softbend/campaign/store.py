@@ -688,7 +688,9 @@ class CampaignStore:
             "failures": [
                 {
                     "design_id": row[0],
-                    "design": str(SFRBADesign(*row[1:7])),
+                    # Formatted from the stored values, not rebuilt: a database of an
+                    # older softbend may hold a design today's rules refuse (t >= r).
+                    "design": ",".join(f"{float(v):g}" for v in row[1:7]),
                     "error": row[7],
                 }
                 for row in failures

@@ -25,7 +25,6 @@ from __future__ import annotations
 import copy
 import json
 import os
-import tempfile
 from pathlib import Path
 from typing import Any
 
@@ -34,6 +33,7 @@ from numpy.typing import ArrayLike
 
 from softbend import __version__
 from softbend._extras import require
+from softbend._io import write_bytes_atomic
 from softbend.surrogates.features import FEATURES, TARGET, UNITS, check_features
 from softbend.surrogates.persistence import check_fitted_surrogate
 
@@ -304,15 +304,4 @@ def save_onnx(model: Any, path: str | os.PathLike[str], *, opset: int | None = N
     Path
         The written file.
     """
-    data = to_onnx(model, opset=opset).SerializeToString()
-    path = Path(path)
-    path.parent.mkdir(parents=True, exist_ok=True)
-    fd, tmp = tempfile.mkstemp(dir=path.parent, prefix=f".{path.name}.", suffix=".tmp")
-    try:
-        with os.fdopen(fd, "wb") as handle:
-            handle.write(data)
-        os.replace(tmp, path)
-    except BaseException:
-        Path(tmp).unlink(missing_ok=True)
-        raise
-    return path
+    return write_bytes_atomic(path, to_onnx(model, opset=opset).SerializeToString())
