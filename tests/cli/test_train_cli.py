@@ -96,3 +96,28 @@ def test_predict_not_a_model(tmp_path, capsys):
         ["predict", str(fake), "--design", "100,6,2,2,5,8", "--pressure", "0.1"], capsys
     )
     assert code == 2 and len(err.strip().splitlines()) == 1
+
+
+def test_predict_warns_outside_the_training_ranges_and_strict_refuses(tmp_path, capsys):
+    import numpy as np
+
+    from softbend.surrogates.features import training_ranges
+    from softbend.surrogates.persistence import save_surrogate
+    from softbend.surrogates.polynomial import PolynomialRegressor
+
+    rng = np.random.default_rng(0)
+    low = np.array([100.0, 6.0, 2.0, 2.0, 5.0, 8.0, 0.0])
+    high = np.array([160.0, 10.0, 4.0, 4.0, 15.0, 12.0, 0.3])
+    X = low + (high - low) * rng.random((200, 7))
+    model = PolynomialRegressor(degree=2).fit(X, 300 * X[:, 6])
+    path = save_surrogate(
+        model, tmp_path / "m.json", metadata={"training_ranges": training_ranges(X)}
+    )
+    args = ["predict", str(path), "--design", "130,8,3,3,10,10"]
+    assert main([*args, "--pressure", "0.1"]) == 0
+    assert "warning" not in capsys.readouterr().err
+    assert main([*args, "--pressure", "1e308", "--json"]) == 0
+    captured = capsys.readouterr()
+    assert "softbend: warning:" in captured.err and "pressure_mpa 1e+308 outside" in captured.err
+    assert main([*args, "--pressure", "1e308", "--strict"]) == 2
+    assert "pressure_mpa" in capsys.readouterr().err

@@ -41,6 +41,7 @@ __all__ = [
     "print_json",
     "print_table",
     "progress_bar",
+    "warning_line",
 ]
 
 console = Console()
@@ -78,6 +79,12 @@ def _jsonable(value: Any) -> Any:
 def json_text(payload: Any) -> str:
     """``payload`` as indented JSON text (NumPy values converted, NaN and inf as null)."""
     return json.dumps(_jsonable(payload), indent=2, allow_nan=False)
+
+
+def warning_line(message: str) -> None:
+    """One ``softbend: warning: …`` line on stderr (the command goes on)."""
+    text = " ".join(str(message).split())
+    err_console.print(f"softbend: warning: {text}", markup=False, highlight=False, soft_wrap=True)
 
 
 def print_json(payload: Any) -> None:

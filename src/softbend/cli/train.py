@@ -120,9 +120,17 @@ def predict(
     model: Path = typer.Argument(..., help="A model saved by 'softbend train' (models/*.json)."),
     design: str = typer.Option(..., help="l,r,t,b,phi,lc in mm and degrees, e.g. 100,6,2,2,5,8."),
     pressure: str = typer.Option(..., help="Pressures in MPa, comma-separated, e.g. 0.05,0.1."),
+    strict: bool = typer.Option(
+        False, "--strict", help="Refuse a design or pressure outside the model's training data."
+    ),
     as_json: bool = typer.Option(False, "--json", help="Print the predictions as JSON."),
 ) -> None:
-    """Predict the bending angle of a design at the given pressures."""
+    """Predict the bending angle of a design at the given pressures.
+
+    A design or pressure outside the ranges the model was trained on (recorded in
+    the model file) is a warning on stderr, or with ``--strict`` an error: a
+    surrogate extrapolates without knowing it.
+    """
     import numpy as np
 
     from softbend.design import SFRBADesign
@@ -138,8 +146,25 @@ def predict(
     pressures = np.asarray(_floats(pressure, "pressure"))
     if not np.all(np.isfinite(pressures)) or np.any(pressures < 0):
         raise ValueError(f"The 'pressure' must be finite and >= 0 MPa. Got {pressure!r} instead.")
+    from softbend.surrogates.features import outside_training_ranges
+
     saved = load_surrogate(model)
-    angles = saved.model.predict(checked.feature_rows(pressures))
+    rows = checked.feature_rows(pressures)
+    ranges = saved.metadata.get("training_ranges")
+    outside = outside_training_ranges(ranges, rows) if isinstance(ranges, dict) else []
+    if outside:
+        message = f"{model} was not trained there: {'; '.join(outside)}"
+        if strict:
+            raise ValueError(
+                f"The 'design' and 'pressure' must lie in the training data: {message}."
+            )
+        _common.warning_line(f"{message}; the prediction is an extrapolation (--strict refuses).")
+    elif strict and not isinstance(ranges, dict):
+        raise ValueError(
+            f"The model {model} records no training ranges (saved by an older softbend); "
+            "--strict cannot check it."
+        )
+    angles = saved.model.predict(rows)
     if as_json:
         _common.print_json(
             {
@@ -148,6 +173,7 @@ def predict(
                 "design": checked.as_dict(),
                 "pressure_mpa": pressures.tolist(),
                 "angle_deg": angles.tolist(),
+                "outside_training_ranges": outside,
             }
         )
         return

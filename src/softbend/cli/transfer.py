@@ -106,8 +106,9 @@ def base(
 ) -> None:
     """Train paper B's MLP (63, 65) on the shipped Table 1 FEM dataset and save it."""
     from softbend.datasets import table1_fem_provenance
+    from softbend.surrogates.features import training_ranges
     from softbend.surrogates.persistence import save_surrogate
-    from softbend.transfer.base import BASE_HIDDEN_SIZES, train_base_mlp
+    from softbend.transfer.base import BASE_HIDDEN_SIZES, fem_rows, train_base_mlp
 
     _common.check_output_file(out, "--out", kind="json")
     with _common.progress_bar("training the FEM MLP (epochs)", epochs) as advance:
@@ -133,6 +134,7 @@ def base(
             "seed": seed,
             "command": f"softbend transfer base --out {out.name} --epochs {epochs} --seed {seed}",
             "final_training_mse_deg2": float(model.loss_curve_[-1]) * model.y_scale_**2,
+            "training_ranges": training_ranges(fem_rows()),
         },
     )
     _common.console.print(
@@ -231,7 +233,6 @@ def refine(
     """Fit a strategy on all measurements and save it like the other surrogates."""
     from softbend._validation import check_choice
     from softbend.surrogates.persistence import save_surrogate
-    from softbend.transfer.base import load_base
     from softbend.transfer.measurements import load_measurements
     from softbend.transfer.strategies import make_strategy
 
@@ -239,8 +240,21 @@ def refine(
     _common.check_output_file(out, "--out", inputs=(base, measurements), kind="json")
     data = load_measurements(measurements)
     options = {} if epochs is None else {"epochs": epochs}
-    model = make_strategy(strategy, load_base(base), seed=seed, **options)
+    from softbend.surrogates.features import training_ranges
+    from softbend.surrogates.persistence import load_surrogate
+
+    start = load_surrogate(base)
+    model = make_strategy(strategy, start.model, seed=seed, **options)
     model.fit(data.features, data.angle_deg)
+    ranges = training_ranges(data.features)
+    if strategy == "refined" and isinstance(start.metadata.get("training_ranges"), dict):
+        ranges = {  # the base's simulations and the measurements
+            k: [
+                min(v[0], start.metadata["training_ranges"][k][0]),
+                max(v[1], start.metadata["training_ranges"][k][1]),
+            ]
+            for k, v in ranges.items()
+        }
     path = save_surrogate(
         model.model_,
         out,
@@ -252,6 +266,7 @@ def refine(
             "actuators": list(data.actuator_ids),
             "synthetic_measurements": str(data.metadata.get("synthetic", "false")),
             "final_training_mse_deg2": float(model.loss_curve_[-1]),
+            "training_ranges": ranges,
         },
     )
     _common.console.print(

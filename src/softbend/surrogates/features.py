@@ -162,3 +162,39 @@ def check_features(X: ArrayLike, owner: str) -> np.ndarray:
             f"'{FEATURES[col]}' of row {row}."
         )
     return array
+
+
+def training_ranges(X: ArrayLike) -> dict[str, list[float]]:
+    """``{feature: [min, max]}`` of the rows a surrogate was trained on (mm, deg, MPa).
+
+    Saved with a model (``metadata["training_ranges"]``) so that a prediction
+    outside them can be flagged (:func:`outside_training_ranges`).
+    """
+    array = check_features(X, "training_ranges")
+    return {
+        name: [float(array[:, j].min()), float(array[:, j].max())]
+        for j, name in enumerate(FEATURES)
+    }
+
+
+def outside_training_ranges(ranges: dict[str, list[float]], X: ArrayLike) -> list[str]:
+    """One phrase per feature whose values in ``X`` leave ``ranges``; empty when all inside.
+
+    Parameters
+    ----------
+    ranges : dict
+        As :func:`training_ranges` returns (features missing from it are not checked).
+    X : array_like of shape (n, 7)
+        Rows to predict.
+    """
+    array = check_features(X, "outside_training_ranges")
+    out = []
+    for j, name in enumerate(FEATURES):
+        if name not in ranges:
+            continue
+        low, high = (float(v) for v in ranges[name])
+        column = array[:, j]
+        if column.min() < low or column.max() > high:
+            worst = column.min() if column.min() < low else column.max()
+            out.append(f"{name} {worst:g} outside [{low:g}, {high:g}]")
+    return out

@@ -92,6 +92,7 @@ def train_surrogates(
         JSON-friendly headline figures, per family and paper B's beside them,
         and the files written.
     """
+    from softbend.surrogates.features import training_ranges
     from softbend.surrogates.persistence import save_surrogate
 
     data = _load_data(source)
@@ -119,6 +120,7 @@ def train_surrogates(
             "n_designs": data.n_groups,
             "cv": {k: float(v) for k, v in fam.cv.items()},
             "search": {**result.settings, "params": describe(fam.params)},
+            "training_ranges": training_ranges(data.X),
         }
         files[f"{name}_model"] = str(
             save_surrogate(fam.model, out / "models" / f"{name}.json", metadata=metadata)

@@ -21,7 +21,7 @@ import numpy as np
 from softbend.design import FEATURES
 from softbend.errors import DatasetError
 
-__all__ = ["BASE_HIDDEN_SIZES", "load_base", "shipped_base_path", "train_base_mlp"]
+__all__ = ["BASE_HIDDEN_SIZES", "fem_rows", "load_base", "shipped_base_path", "train_base_mlp"]
 
 #: Paper B's MLP (§4.1, Fig. 5): hidden layers of 63 and 65 units.
 BASE_HIDDEN_SIZES: tuple[int, int] = (63, 65)
@@ -32,6 +32,15 @@ _SHIPPED = "table1_fem_mlp.json"
 def shipped_base_path() -> Path:
     """Path of the shipped FEM-trained MLP (``softbend/data/transfer/table1_fem_mlp.json``)."""
     return Path(str(resources.files("softbend") / "data" / "transfer" / _SHIPPED))
+
+
+def fem_rows(samples: Any = None) -> np.ndarray:
+    """The converged rows of :data:`FEATURES` of FEM samples (default: the shipped dataset)."""
+    from softbend.datasets import table1_fem
+
+    frame = table1_fem() if samples is None else samples
+    frame = frame[frame["converged"].astype(bool)]
+    return frame[list(FEATURES)].to_numpy(dtype=np.float64)
 
 
 def train_base_mlp(
