@@ -371,6 +371,42 @@ def _run_serial(
         recorder.record([_sweep_one(backend, design, pressures)], running=0)
 
 
+def _run_isolated(
+    backend: Backend,
+    suspects: deque[SFRBADesign],
+    pressures: np.ndarray,
+    context: Any,
+    recorder: _Recorder,
+) -> None:
+    """Run each design that was in flight when a worker died alone, in its own process.
+
+    A worker that dies takes every pending task of its pool with it, so those
+    designs cannot be blamed: each is run again by itself, and only a design
+    whose own process dies is recorded as failed (with that reason).
+    """
+    while suspects:
+        design = suspects.popleft()
+        recorder.set_running(1)
+        pool = ProcessPoolExecutor(max_workers=1, mp_context=context)
+        try:
+            outcomes = pool.submit(_sweep_chunk, backend, [design], pressures).result()
+        except BrokenProcessPool:
+            outcomes = [
+                _Outcome(
+                    design,
+                    None,
+                    "BrokenProcessPool: the worker process died while sweeping this design "
+                    "alone (killed, out of memory or crashed)",
+                    float("nan"),
+                )
+            ]
+        except Exception as exc:
+            outcomes = _lost_chunk([design], exc)
+        finally:
+            pool.shutdown(wait=True, cancel_futures=True)
+        recorder.record(outcomes, running=0)
+
+
 def _run_local(
     backend: Backend,
     chunks: deque[list[SFRBADesign]],
@@ -380,7 +416,11 @@ def _run_local(
 ) -> None:
     context = _mp_context()
     restarts = 0
-    while chunks:
+    suspects: deque[SFRBADesign] = deque()
+    while chunks or suspects:
+        _run_isolated(backend, suspects, pressures, context, recorder)
+        if not chunks:
+            break
         pool = ProcessPoolExecutor(max_workers=workers, mp_context=context)
         pending: dict[Any, list[SFRBADesign]] = {}
         broken = False
@@ -404,23 +444,27 @@ def _run_local(
                     chunk = pending.pop(future)
                     try:
                         outcomes = future.result()
-                    except BrokenProcessPool as exc:
+                    except BrokenProcessPool:
                         broken = True
-                        outcomes = _lost_chunk(chunk, exc)
+                        suspects.extend(chunk)  # not blamed yet: rerun alone
+                        continue
                     except Exception as exc:
                         outcomes = _lost_chunk(chunk, exc)
                     recorder.record(outcomes, running=sum(len(c) for c in pending.values()))
             clean = True
         finally:
             pool.shutdown(wait=clean, cancel_futures=True)
-        if broken and chunks:
+        if broken:
             restarts += 1
             if restarts > _MAX_POOL_RESTARTS:
                 raise SoftbendError(
                     f"Worker processes died {restarts} times; {sum(map(len, chunks))} designs "
                     "were not run. Check memory and the backend, then re-run to resume."
                 )
-            logger.warning("a worker process died; restarting the process pool")
+            logger.warning(
+                "a worker process died; rerunning the %d designs it took down one by one",
+                len(suspects),
+            )
 
 
 def _connect(address: str, timeout_s: float) -> Any:
