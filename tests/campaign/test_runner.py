@@ -457,3 +457,48 @@ def test_space_name_and_plan_are_stored(tmp_path, grid):
         status = store.status_summary()
     assert status["space"] == "lhs-3-seed5" and status["n_designs_planned"] == 3
     assert status["done"] == 3
+
+
+@pytest.mark.parametrize("answer", [None, b"HTTP/1.1 200 OK\r\nContent-Length: 5\r\n\r\nhello"])
+def test_a_scheduler_address_that_is_not_dask_ends_in_one_line_within_the_deadline(
+    tmp_path, designs, grid, answer
+):
+    import socket
+    import threading
+
+    from softbend.errors import SoftbendError
+
+    server = socket.socket()
+    server.bind(("127.0.0.1", 0))
+    server.listen()
+    port = server.getsockname()[1]
+    stop = threading.Event()
+
+    def serve() -> None:  # a silent listener, or a web server answering garbage
+        server.settimeout(0.2)
+        while not stop.is_set():
+            try:
+                conn, _ = server.accept()
+            except OSError:
+                continue
+            if answer is not None:
+                conn.sendall(answer)
+                conn.close()
+
+    thread = threading.Thread(target=serve, daemon=True)
+    thread.start()
+    try:  # before the fix, the silent listener hung here far past the timeout
+        with pytest.raises(SoftbendError, match=f"127.0.0.1:{port}") as info:
+            run_campaign(
+                tmp_path / "c.duckdb",
+                designs[:2],
+                backend="analytical",
+                pressures_mpa=grid,
+                scheduler=f"tcp://127.0.0.1:{port}",
+                connect_timeout_s=1.0,
+            )
+    finally:
+        stop.set()
+        thread.join()
+        server.close()
+    assert "\n" not in str(info.value)

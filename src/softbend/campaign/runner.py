@@ -45,6 +45,7 @@ import multiprocessing
 import os
 import re
 import socket
+import threading
 import time
 from collections import deque
 from collections.abc import Callable, Iterable, Sequence
@@ -468,15 +469,40 @@ def _run_local(
 
 
 def _connect(address: str, timeout_s: float) -> Any:
+    """A Dask client of the scheduler at ``address``, or one line within the deadline.
+
+    Every wait has a deadline: something that accepts TCP but is not a Dask
+    scheduler (a web server, a silent listener) may never finish Dask's
+    handshake, so the connection runs in a helper thread that is given up after
+    ``timeout_s`` (plus a grace of 5 s).
+    """
     Client = require("distributed", "A campaign on a Dask cluster (--scheduler)").Client
 
     _probe(address, timeout_s)
-    try:
-        client = Client(address, timeout=timeout_s, set_as_default=False)
-    except (OSError, TimeoutError) as exc:
+    box: dict[str, Any] = {}
+
+    def attempt() -> None:
+        try:
+            box["client"] = Client(address, timeout=timeout_s, set_as_default=False)
+        except BaseException as exc:  # reported below, in the caller's thread
+            box["error"] = exc
+
+    thread = threading.Thread(target=attempt, name="softbend-dask-connect", daemon=True)
+    thread.start()
+    thread.join(timeout_s + 5.0)
+    if thread.is_alive():
         raise SoftbendError(
-            f"Cannot connect to the Dask scheduler at {address}: {' '.join(str(exc).split())}"
+            f"The Dask scheduler at {address} did not answer within {timeout_s:g} s: something "
+            "listens there but does not speak Dask's protocol; check --scheduler."
+        )
+    if "error" in box:
+        exc = box["error"]
+        reason = " ".join(str(exc).split()) or type(exc).__name__
+        raise SoftbendError(
+            f"Cannot connect to the Dask scheduler at {address}: {type(exc).__name__}: "
+            f"{reason[:200]}"
         ) from None
+    client = box["client"]
     try:
         client.wait_for_workers(1, timeout=timeout_s)
     except Exception:
