@@ -33,6 +33,7 @@ def _register() -> None:
     from softbend.cli import (
         analyze,
         campaign,
+        control,
         curling,
         fem,
         materials,
@@ -47,6 +48,7 @@ def _register() -> None:
     app.add_typer(fem.app, name="fem")
     app.add_typer(transfer.lab_app, name="lab")
     app.add_typer(transfer.app, name="transfer")
+    app.add_typer(control.app, name="control")
     app.command("analyze")(analyze.analyze)
     app.command("train")(train.train)
     app.command("predict")(train.predict)

@@ -1,0 +1,332 @@
+"""Controllers of the on/off valves: one small, pure interface.
+
+``controller.step(measurement_mpa, reference_deg, t_s) -> ValveCommand`` takes the
+latest pressure-sensor reading (gauge MPa, held between samples), the reference
+angle and the time, and returns which valves to open. The loop calls it at every
+step of the rig (1 ms: the PLC's timing), so a controller can time PWM pulses
+finer than the 100 Hz sensor; each controller decides on its own sample period
+``period_s`` (paper B: 100 Hz) and holds its decision in between. No I/O;
+``reset()`` forgets all state.
+
+- :class:`BangBang`: paper B §5 eq. (1), a deadzone relay on the angle error
+  ``θd = θr − θp`` with θp the virtual angle sensor ``f(p)`` (the MLP);
+- :class:`PressurePI`: the surrogate inverted to a target pressure, PI on the
+  pressure with anti-windup, PWM of the valves;
+- :class:`PressureRelay`: the same target pressure, a three-state relay with
+  hysteresis that closes the valve early by the pressure it will still gain
+  during the valve delay, with a minimum on-time.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Callable
+from typing import Any, NamedTuple, Protocol, runtime_checkable
+
+import numpy as np
+
+from softbend._validation import check_choice, check_range
+from softbend.design import SFRBADesign
+
+__all__ = [
+    "CONTROLLERS",
+    "BangBang",
+    "Controller",
+    "PressurePI",
+    "PressureRelay",
+    "ValveCommand",
+    "mlp_virtual_sensor",
+]
+
+
+class ValveCommand(NamedTuple):
+    """Valve states to apply: ``True`` = open."""
+
+    inlet: bool
+    outlet: bool
+
+
+_CLOSED = ValveCommand(False, False)
+_FILL = ValveCommand(True, False)
+_VENT = ValveCommand(False, True)
+
+
+@runtime_checkable
+class Controller(Protocol):
+    """The interface every controller answers."""
+
+    predicted_deg: float
+
+    def step(self, measurement_mpa: float, reference_deg: float, t_s: float) -> ValveCommand: ...
+
+    def reset(self) -> None: ...
+
+
+def mlp_virtual_sensor(model: Any, design: SFRBADesign) -> Callable[[float], float]:
+    """Paper B's virtual angle sensor: θp = MLP(design, p), one fast call per reading.
+
+    ``model`` is a fitted :class:`softbend.surrogates.mlp.NormalizedMLPRegressor`
+    (its ``.predictor()`` is used); returns ``f(p_mpa) -> degrees``.
+    """
+    predict = model.predictor()
+    row = np.empty(7)
+    row[:6] = design.as_array()
+
+    def sensor(p_mpa: float) -> float:
+        row[6] = p_mpa
+        return predict(row)
+
+    return sensor
+
+
+def _period(value: float, owner: str) -> float:
+    return check_range(value, "period_s", owner, low=0.0, high=1.0, high_inclusive=True)
+
+
+class BangBang:
+    """Paper B's deadzone bang-bang controller on the virtual angle (§5, eq. 1).
+
+    Every ``period_s`` (100 Hz): ``θp = virtual_sensor(p)``, ``θd = θr − θp``,
+    ``dz = deadzone_fraction·|θr|``; ``θd > dz`` → inlet open, outlet closed;
+    ``θd < −dz`` → outlet open, inlet closed; inside the deadzone the valves keep
+    their last state (``mode="hold"``) or both close (``mode="closed"``): paper B
+    "allowed the state of the valves to remain unchanged", read both ways.
+
+    Parameters
+    ----------
+    virtual_sensor : callable
+        Gauge MPa → degrees (:func:`mlp_virtual_sensor`, or an angle table).
+    deadzone_fraction : float, default 0.05
+    mode : {"hold", "closed"}, default "hold"
+    period_s : float, default 0.01
+    """
+
+    def __init__(
+        self,
+        virtual_sensor: Callable[[float], float],
+        *,
+        deadzone_fraction: float = 0.05,
+        mode: str = "hold",
+        period_s: float = 0.01,
+    ) -> None:
+        owner = "BangBang"
+        if not callable(virtual_sensor):
+            raise ValueError(
+                f"The 'virtual_sensor' of {owner} must be callable. Got {virtual_sensor!r} instead."
+            )
+        self.virtual_sensor = virtual_sensor
+        self.deadzone_fraction = check_range(
+            deadzone_fraction, "deadzone_fraction", owner, low=0.0, high=1.0, low_inclusive=True
+        )
+        self.mode = check_choice(mode, "mode", owner, ("hold", "closed"))
+        self.period_s = _period(period_s, owner)
+        self.reset()
+
+    def reset(self) -> None:
+        self._command = _CLOSED
+        self._next_s = -math.inf
+        self.predicted_deg = math.nan
+
+    def step(self, measurement_mpa: float, reference_deg: float, t_s: float) -> ValveCommand:
+        if t_s < self._next_s:
+            return self._command
+        self._next_s = t_s + self.period_s - 1e-9
+        theta = self.virtual_sensor(measurement_mpa)
+        self.predicted_deg = theta
+        error = reference_deg - theta
+        band = self.deadzone_fraction * abs(reference_deg)
+        if error > band:
+            self._command = _FILL
+        elif error < -band:
+            self._command = _VENT
+        elif self.mode == "closed":
+            self._command = _CLOSED
+        return self._command
+
+
+class _PressureTarget:
+    """Shared part: θr → target pressure by the inverse of an angle table."""
+
+    def __init__(self, angle_table: Any, owner: str) -> None:
+        if not (callable(angle_table) and hasattr(angle_table, "inverse")):
+            raise ValueError(
+                f"The 'angle_table' of {owner} must be an AngleTable (callable with .inverse). "
+                f"Got {angle_table!r} instead."
+            )
+        self.angle_table = angle_table
+        self._ref = math.nan
+        self._target = 0.0
+
+    def target_mpa(self, reference_deg: float) -> float:
+        if reference_deg != self._ref:
+            self._ref = reference_deg
+            self._target = self.angle_table.inverse(reference_deg)
+        return self._target
+
+
+class PressurePI(_PressureTarget):
+    """PI control of the pressure toward the surrogate's inverse θr → p*, by PWM of the valves.
+
+    Every ``period_s`` the PI output ``u = kp·e + ki·∫e`` (``e = p* − p`` in MPa)
+    is computed; ``|e| <= deadband_mpa`` gives ``u = 0`` (valves shut at rest).
+    The integral is frozen while ``|u| >= 1`` or inside the deadband (conditional
+    integration: anti-windup) and clamped to ``±1/ki``. Every
+    ``pwm_period_s`` the duty ``|u|`` (clipped to 1) is latched; the inlet
+    (``u > 0``) or outlet (``u < 0``) is open for the first ``duty·pwm_period_s``
+    of the PWM period, timed at the resolution of the calls (the rig's step).
+
+    Parameters
+    ----------
+    angle_table : AngleTable
+        θ(p) of the controlled actuator (the surrogate), inverted on its rising branch.
+    kp_per_mpa : float, default 50
+        Full duty from 0.02 MPa of error (tuned on the default rig: about twice
+        the gain that would close a PWM period's error in one period).
+    ki_per_mpa_s : float, default 5
+    deadband_mpa : float, default 0.002
+        About 4× the sensor noise, so the valves stay shut at rest (≈ 3° at 90°).
+    pwm_period_s : float, default 0.02
+    period_s : float, default 0.01
+        Sample period of the PI (the sensor's rate).
+    """
+
+    def __init__(
+        self,
+        angle_table: Any,
+        *,
+        kp_per_mpa: float = 50.0,
+        ki_per_mpa_s: float = 5.0,
+        deadband_mpa: float = 0.002,
+        pwm_period_s: float = 0.02,
+        period_s: float = 0.01,
+    ) -> None:
+        owner = "PressurePI"
+        super().__init__(angle_table, owner)
+        self.kp_per_mpa = check_range(kp_per_mpa, "kp_per_mpa", owner, low=0.0)
+        self.ki_per_mpa_s = check_range(
+            ki_per_mpa_s, "ki_per_mpa_s", owner, low=0.0, low_inclusive=True
+        )
+        self.deadband_mpa = check_range(
+            deadband_mpa, "deadband_mpa", owner, low=0.0, low_inclusive=True
+        )
+        self.pwm_period_s = check_range(
+            pwm_period_s, "pwm_period_s", owner, low=0.0, high=1.0, high_inclusive=True
+        )
+        self.period_s = _period(period_s, owner)
+        self.reset()
+
+    def reset(self) -> None:
+        self._integral = 0.0
+        self._u = 0.0
+        self._next_s = -math.inf
+        self._pwm_start = -math.inf
+        self._on_s = 0.0
+        self._open = _CLOSED
+        self.predicted_deg = math.nan
+
+    def step(self, measurement_mpa: float, reference_deg: float, t_s: float) -> ValveCommand:
+        if t_s >= self._next_s:
+            self._next_s = t_s + self.period_s - 1e-9
+            self.predicted_deg = self.angle_table(measurement_mpa)
+            error = self.target_mpa(reference_deg) - measurement_mpa
+            if abs(error) <= self.deadband_mpa:
+                u = 0.0
+            else:
+                u = self.kp_per_mpa * error + self.ki_per_mpa_s * self._integral
+                if abs(u) < 1.0 and self.ki_per_mpa_s > 0.0:
+                    self._integral += error * self.period_s
+                    limit = 1.0 / self.ki_per_mpa_s
+                    self._integral = min(max(self._integral, -limit), limit)
+            # a reversal of sign ends the running pulse at once
+            if u * self._u < 0.0:
+                self._pwm_start = -math.inf
+            self._u = u
+        if t_s >= self._pwm_start + self.pwm_period_s - 1e-9:
+            self._pwm_start = t_s
+            u = self._u
+            self._on_s = min(abs(u), 1.0) * self.pwm_period_s
+            self._open = _FILL if u > 0.0 else _VENT if u < 0.0 else _CLOSED
+        if t_s - self._pwm_start < self._on_s - 1e-9:
+            return self._open
+        return _CLOSED
+
+
+class PressureRelay(_PressureTarget):
+    """A three-state relay on the pressure toward the target p*, with lead and hysteresis.
+
+    Every ``period_s``: with ``e = p* − p`` and the rate ``ṗ`` estimated from the
+    last two samples, the valve opens when ``|e| > hysteresis_mpa`` and closes
+    when the pressure it will still gain before the valve shuts
+    (``ṗ·lead_s``) would reach the target; a valve once opened stays open for at
+    least ``min_on_s``.
+
+    Parameters
+    ----------
+    angle_table : AngleTable
+    hysteresis_mpa : float, default 0.002
+    lead_s : float, default 0.012
+        Valve delay plus half a sample: how long the pressure keeps moving after a close.
+    min_on_s : float, default 0.0
+    period_s : float, default 0.01
+    """
+
+    def __init__(
+        self,
+        angle_table: Any,
+        *,
+        hysteresis_mpa: float = 0.002,
+        lead_s: float = 0.012,
+        min_on_s: float = 0.0,
+        period_s: float = 0.01,
+    ) -> None:
+        owner = "PressureRelay"
+        super().__init__(angle_table, owner)
+        self.hysteresis_mpa = check_range(
+            hysteresis_mpa, "hysteresis_mpa", owner, low=0.0, low_inclusive=True
+        )
+        self.lead_s = check_range(lead_s, "lead_s", owner, low=0.0, high=1.0, low_inclusive=True)
+        self.min_on_s = check_range(
+            min_on_s, "min_on_s", owner, low=0.0, high=1.0, low_inclusive=True
+        )
+        self.period_s = _period(period_s, owner)
+        self.reset()
+
+    def reset(self) -> None:
+        self._command = _CLOSED
+        self._opened_s = -math.inf
+        self._next_s = -math.inf
+        self._last_p = math.nan
+        self._last_t = math.nan
+        self.predicted_deg = math.nan
+
+    def step(self, measurement_mpa: float, reference_deg: float, t_s: float) -> ValveCommand:
+        if t_s < self._next_s:
+            return self._command
+        self._next_s = t_s + self.period_s - 1e-9
+        self.predicted_deg = self.angle_table(measurement_mpa)
+        rate = 0.0
+        if self._last_t == self._last_t and t_s > self._last_t:
+            rate = (measurement_mpa - self._last_p) / (t_s - self._last_t)
+        self._last_p, self._last_t = measurement_mpa, t_s
+        error = self.target_mpa(reference_deg) - measurement_mpa
+        ahead = error - rate * self.lead_s  # error left once the valve really shuts
+        command = self._command
+        held = t_s - self._opened_s < self.min_on_s - 1e-9
+        if command is _FILL:
+            if ahead <= 0.0 and not held:
+                command = _CLOSED
+        elif command is _VENT and ahead >= 0.0 and not held:
+            command = _CLOSED
+        if command is _CLOSED:
+            if error > self.hysteresis_mpa and ahead > 0.0:
+                command = _FILL
+            elif error < -self.hysteresis_mpa and ahead < 0.0:
+                command = _VENT
+            if command is not _CLOSED:
+                self._opened_s = t_s
+        self._command = command
+        return command
+
+
+#: Names used on the CLI.
+CONTROLLERS: tuple[str, ...] = ("bang-bang", "bang-bang-closed", "pressure-pi", "pressure-relay")

@@ -1,0 +1,535 @@
+"""A simulated pneumatic rig of paper B §5 (Fig. 8): supply, two on/off valves, chamber, sensors.
+
+The hardware of paper B: compressor → reducing valve → flow-control valve → inlet
+on/off valve → actuator; actuator → outlet on/off valve → flow-control valve →
+atmosphere; a pressure sensor read at 100 Hz; a high-speed camera that records
+the true angle for evaluation only. Paper B does not give the supply pressure,
+the flow settings, the chamber volume or the camera rate, so this rig states its
+own (every one a field of :class:`RigParams`, with its unit in its name):
+
+- supply 0.2 MPa gauge (the shipped MLP bends the (100,6,2,2,5,8) actuator to about 370° there,
+  more than any reference used), atmosphere 0.101325 MPa absolute, air at
+  293.15 K;
+- each valve with its flow-control valve in series is one ISO 6358 restriction
+  (:func:`iso6358_mass_flow_kg_s`) of sonic conductance 4e-10 m³/(s·Pa)
+  (0.04 dm³/(s·bar): a throttled needle valve) and critical pressure ratio 0.3;
+  with these, paper B's bang-bang takes the actuator from rest to 90° in about
+  0.1 s, the order of paper B's 0.104 s rise time;
+- the valves switch 5 ms after the command;
+- the chamber holds ideal gas in ``V(p) = V0 + (dV/dp)·p`` (p gauge); ``V0`` =
+  7655 mm³ = the semicircular cavity ½·π·r²·l of the (100,6,2,2,5,8) actuator
+  (5655 mm³) plus 2000 mm³ of tubing (:meth:`RigParams.for_design` recomputes
+  it for another design); ``dV/dp`` = 20 000 mm³/MPa (the cavity grows by about
+  half at 0.2 MPa); isothermal (polytropic exponent 1.0) unless set;
+- the angle follows the quasi-static θ(p) through a first-order lag of 30 ms;
+- the pressure sensor has 0.5 kPa Gaussian noise and 12-bit quantisation over
+  0–0.5 MPa gauge; the camera runs at 240 fps, no latency, 0.2° noise.
+
+Integration uses a fixed step (1 ms default): Heun's method for the chamber
+pressure, clamped to [atmosphere, supply] (no valve can push the chamber beyond
+its sources, so the clamp keeps a choked fill into a small volume from
+overshooting), and the exact discretisation of the angle lag. Pressures are in
+pascal inside the rig and in MPa gauge at its interface.
+"""
+
+from __future__ import annotations
+
+import math
+import random
+from collections.abc import Callable
+from dataclasses import dataclass, fields, replace
+from typing import Any, Protocol, runtime_checkable
+
+import numpy as np
+
+from softbend._validation import check_int, check_range
+from softbend.design import SFRBADesign
+
+__all__ = [
+    "ANR_DENSITY_KG_M3",
+    "ANR_TEMPERATURE_K",
+    "GAS_CONSTANT_J_KG_K",
+    "AngleTable",
+    "Rig",
+    "RigParams",
+    "SimulatedRig",
+    "chamber_pressure_rate_pa_s",
+    "iso6358_mass_flow_kg_s",
+    "shipped_angle_table",
+]
+
+#: Specific gas constant of dry air, J/(kg·K).
+GAS_CONSTANT_J_KG_K = 287.05
+#: ISO 6358 reference (ANR) conditions: 293.15 K, 100 kPa, 1.185 kg/m³.
+ANR_TEMPERATURE_K = 293.15
+ANR_DENSITY_KG_M3 = 1.185
+
+
+def iso6358_mass_flow_kg_s(
+    p_up_pa: float,
+    p_down_pa: float,
+    conductance_m3_s_pa: float,
+    critical_ratio: float,
+    temperature_k: float = ANR_TEMPERATURE_K,
+) -> float:
+    """Mass flow through a restriction by ISO 6358, kg/s, from ``p_up`` to ``p_down``.
+
+    Choked when ``p_down/p_up <= b``: ``q = C·p_up·ρ0·sqrt(T0/T)``, independent
+    of the downstream pressure; subsonic otherwise: that times
+    ``sqrt(1 - ((p_down/p_up - b)/(1 - b))²)``, which is continuous at the
+    critical ratio and zero at equal pressures. Reverse flow (``p_down > p_up``)
+    is returned negative with the roles swapped.
+
+    Parameters
+    ----------
+    p_up_pa, p_down_pa : float
+        Absolute pressures, Pa.
+    conductance_m3_s_pa : float
+        Sonic conductance C, m³/(s·Pa) (ANR).
+    critical_ratio : float
+        Critical pressure ratio b, in [0, 1).
+    temperature_k : float
+        Upstream temperature, K.
+    """
+    if p_down_pa > p_up_pa:
+        return -iso6358_mass_flow_kg_s(
+            p_down_pa, p_up_pa, conductance_m3_s_pa, critical_ratio, temperature_k
+        )
+    if p_up_pa <= 0.0 or p_down_pa == p_up_pa:
+        return 0.0
+    choked = (
+        conductance_m3_s_pa
+        * p_up_pa
+        * ANR_DENSITY_KG_M3
+        * math.sqrt(ANR_TEMPERATURE_K / temperature_k)
+    )
+    ratio = p_down_pa / p_up_pa
+    if ratio <= critical_ratio:
+        return choked
+    x = (ratio - critical_ratio) / (1.0 - critical_ratio)
+    return choked * math.sqrt(max(0.0, 1.0 - x * x))
+
+
+def chamber_pressure_rate_pa_s(
+    p_pa: float,
+    mass_flow_kg_s: float,
+    *,
+    atmosphere_pa: float,
+    volume_m3: float,
+    compliance_m3_pa: float,
+    temperature_k: float = ANR_TEMPERATURE_K,
+    polytropic_exponent: float = 1.0,
+) -> float:
+    """dp/dt of gas in a compliant chamber, Pa/s.
+
+    With ``V = V0 + k·(p - p_atm)`` and ``p·V = m·R·T`` (isothermal, ``n = 1``),
+    ``d(pV)/dt = R·T·ṁ`` gives ``dp/dt = R·T·ṁ / (V + p·k)``. For a polytropic
+    exponent ``n`` this uses ``dp/dt = n·(R·T·ṁ − p·dV/dt)/V``, i.e.
+    ``n·R·T·ṁ / (V + n·p·k)``, with the gas temperature held at ``T`` (a common
+    simplification: the wall exchanges heat, the fill compresses).
+    """
+    volume = volume_m3 + compliance_m3_pa * (p_pa - atmosphere_pa)
+    n = polytropic_exponent
+    return (
+        n
+        * GAS_CONSTANT_J_KG_K
+        * temperature_k
+        * mass_flow_kg_s
+        / (volume + n * p_pa * compliance_m3_pa)
+    )
+
+
+_OWNER = "RigParams"
+
+
+@dataclass(frozen=True)
+class RigParams:
+    """Every parameter of :class:`SimulatedRig`, with units in the names (see the module doc)."""
+
+    supply_gauge_mpa: float = 0.2
+    atmosphere_mpa: float = 0.101325
+    temperature_k: float = ANR_TEMPERATURE_K
+    inlet_conductance_m3_s_pa: float = 4e-10
+    outlet_conductance_m3_s_pa: float = 4e-10
+    critical_ratio: float = 0.3
+    valve_delay_s: float = 0.005
+    volume_mm3: float = 7655.0
+    compliance_mm3_per_mpa: float = 20_000.0
+    polytropic_exponent: float = 1.0
+    angle_time_constant_s: float = 0.03
+    sensor_noise_mpa: float = 0.0005
+    sensor_bits: int = 12
+    sensor_range_mpa: float = 0.5
+    camera_fps: float = 240.0
+    camera_latency_s: float = 0.0
+    camera_noise_deg: float = 0.2
+    step_s: float = 0.001
+
+    def __post_init__(self) -> None:
+        positive = (
+            "supply_gauge_mpa",
+            "atmosphere_mpa",
+            "temperature_k",
+            "inlet_conductance_m3_s_pa",
+            "outlet_conductance_m3_s_pa",
+            "volume_mm3",
+            "sensor_range_mpa",
+            "camera_fps",
+        )
+        for name in positive:
+            object.__setattr__(self, name, check_range(getattr(self, name), name, _OWNER, low=0.0))
+        nonneg = (
+            "valve_delay_s",
+            "compliance_mm3_per_mpa",
+            "angle_time_constant_s",
+            "sensor_noise_mpa",
+            "camera_latency_s",
+            "camera_noise_deg",
+        )
+        for name in nonneg:
+            value = check_range(getattr(self, name), name, _OWNER, low=0.0, low_inclusive=True)
+            object.__setattr__(self, name, value)
+        object.__setattr__(
+            self,
+            "critical_ratio",
+            check_range(
+                self.critical_ratio, "critical_ratio", _OWNER, low=0.0, high=1.0, low_inclusive=True
+            ),
+        )
+        object.__setattr__(
+            self,
+            "polytropic_exponent",
+            check_range(
+                self.polytropic_exponent,
+                "polytropic_exponent",
+                _OWNER,
+                low=1.0,
+                high=1.4,
+                low_inclusive=True,
+                high_inclusive=True,
+            ),
+        )
+        object.__setattr__(
+            self,
+            "step_s",
+            check_range(self.step_s, "step_s", _OWNER, low=0.0, high=0.01, high_inclusive=True),
+        )
+        bits = check_int(self.sensor_bits, "sensor_bits", _OWNER, low=0)
+        if bits > 32:
+            raise ValueError(
+                f"The 'sensor_bits' of {_OWNER} must be an integer in [0, 32] (0: no "
+                f"quantisation). Got {self.sensor_bits!r} instead."
+            )
+
+    @classmethod
+    def for_design(
+        cls, design: SFRBADesign, *, tubing_mm3: float = 2000.0, **kwargs: Any
+    ) -> RigParams:
+        """Parameters with ``volume_mm3`` = ½·π·r²·l of ``design`` plus ``tubing_mm3``."""
+        tubing = check_range(
+            tubing_mm3, "tubing_mm3", "RigParams.for_design", low=0.0, low_inclusive=True
+        )
+        volume = 0.5 * math.pi * design.r_mm**2 * design.l_mm + tubing
+        return cls(volume_mm3=volume, **kwargs)
+
+    def replace(self, **changes: Any) -> RigParams:
+        """A copy with some fields changed (validated again)."""
+        return replace(self, **changes)
+
+    def as_dict(self) -> dict[str, float]:
+        return {f.name: getattr(self, f.name) for f in fields(self)}
+
+
+class AngleTable:
+    """A quasi-static angle map θ(p) as a uniform lookup table over ``[0, pmax]`` MPa gauge.
+
+    The plant reads it every integration step, so a lookup is plain-float linear
+    interpolation (clamped at the ends), far cheaper than a network call.
+    :meth:`inverse` gives the pressure of an angle on the rising branch (up to
+    the largest angle), by interpolation of the table.
+    """
+
+    def __init__(self, pressures_mpa: np.ndarray, angles_deg: np.ndarray) -> None:
+        p = np.asarray(pressures_mpa, dtype=float)
+        a = np.asarray(angles_deg, dtype=float)
+        if p.ndim != 1 or p.size < 2 or a.shape != p.shape:
+            raise ValueError(
+                "The 'pressures_mpa' and 'angles_deg' of AngleTable must be 1-D of the same "
+                f"length >= 2. Got shapes {p.shape} and {a.shape} instead."
+            )
+        if not (np.all(np.isfinite(p)) and np.all(np.isfinite(a))):
+            raise ValueError("The 'angles_deg' of AngleTable must be finite. Got NaN or inf.")
+        steps = np.diff(p)
+        if p[0] != 0.0 or not np.allclose(steps, steps[0], rtol=1e-9, atol=1e-15) or steps[0] <= 0:
+            raise ValueError(
+                "The 'pressures_mpa' of AngleTable must be a uniform increasing grid from 0. "
+                f"Got {p[:3].tolist()}... instead."
+            )
+        self.pressures_mpa = p
+        self.angles_deg = a
+        self.pmax_mpa = float(p[-1])
+        self._step = float(steps[0])
+        self._values = a.tolist()
+        self._last = len(self._values) - 1
+        peak = int(np.argmax(a))
+        # rising branch, made strictly increasing for the inverse
+        rise = np.maximum.accumulate(a[: peak + 1])
+        self._rise_p = p[: peak + 1]
+        self._rise_a = rise
+        self.max_angle_deg = float(a[peak])
+        self.min_angle_deg = float(a[0])
+
+    @classmethod
+    def from_callable(
+        cls,
+        angle_of_pressure: Callable[[np.ndarray], Any],
+        pmax_mpa: float = 0.5,
+        points: int = 501,
+    ) -> AngleTable:
+        """Tabulate a vectorised ``θ(p)`` (array of MPa gauge → degrees) on ``points`` values."""
+        pmax = check_range(pmax_mpa, "pmax_mpa", "AngleTable.from_callable", low=0.0)
+        n = check_int(points, "points", "AngleTable.from_callable", low=2)
+        p = np.linspace(0.0, pmax, n)
+        return cls(p, np.asarray(angle_of_pressure(p), dtype=float).reshape(-1))
+
+    @classmethod
+    def from_surrogate(
+        cls, model: Any, design: SFRBADesign, pmax_mpa: float = 0.5, points: int = 501
+    ) -> AngleTable:
+        """Tabulate a fitted surrogate (``.predict`` on :data:`softbend.design.FEATURES` rows)."""
+        return cls.from_callable(
+            lambda p: model.predict(design.feature_rows(p)), pmax_mpa=pmax_mpa, points=points
+        )
+
+    @classmethod
+    def from_bending_model(
+        cls, model: Any, design: SFRBADesign, pmax_mpa: float = 0.5, points: int = 101
+    ) -> AngleTable:
+        """Tabulate a :class:`softbend.models.BendingModel` by one sweep (converged at every p)."""
+        p = np.round(np.linspace(0.0, pmax_mpa, points), 12)
+        sweep = model.sweep(design, p)
+        angles = np.asarray(sweep.angle_deg, dtype=float)
+        if angles.shape != p.shape or not np.all(np.isfinite(angles)):
+            raise ValueError(
+                f"The bending model must converge on the whole grid 0–{pmax_mpa:g} MPa to "
+                f"tabulate θ(p); it stopped after {int(np.isfinite(angles).sum())} of "
+                f"{p.size} pressures."
+            )
+        return cls(p, angles)
+
+    def __call__(self, p_mpa: float) -> float:
+        """θ at gauge pressure ``p_mpa`` (clamped to the table), degrees."""
+        x = p_mpa / self._step
+        if x <= 0.0:
+            return self._values[0]
+        i = int(x)
+        if i >= self._last:
+            return self._values[self._last]
+        lo = self._values[i]
+        return lo + (x - i) * (self._values[i + 1] - lo)
+
+    def inverse(self, angle_deg: float) -> float:
+        """Gauge pressure (MPa) of ``angle_deg`` on the rising branch, clamped to it."""
+        return float(np.interp(angle_deg, self._rise_a, self._rise_p))
+
+
+def shipped_angle_table(
+    design: SFRBADesign, pmax_mpa: float = 0.5, points: int = 501
+) -> AngleTable:
+    """θ(p) of ``design`` from the shipped FEM-trained MLP (``transfer.base.load_base``)."""
+    from softbend.transfer.base import load_base
+
+    return AngleTable.from_surrogate(load_base(), design, pmax_mpa=pmax_mpa, points=points)
+
+
+@runtime_checkable
+class Rig(Protocol):
+    """What a closed loop needs from a rig, simulated or real.
+
+    ``reset(seed)`` starts over at rest; ``read_pressure_mpa()`` is one sensor
+    reading (gauge); ``command(inlet, outlet)`` sets the valves; ``advance(n)``
+    lets ``n`` steps of ``step_s`` pass (a simulation integrates, hardware waits);
+    ``camera_angle_deg()`` is the latest camera reading, for evaluation only.
+    """
+
+    step_s: float
+
+    def reset(self, seed: int | None = None) -> None: ...
+
+    def read_pressure_mpa(self) -> float: ...
+
+    def command(self, inlet: bool, outlet: bool) -> None: ...
+
+    def advance(self, steps: int = 1) -> None: ...
+
+    def camera_angle_deg(self) -> float: ...
+
+
+class SimulatedRig:
+    """The simulated rig: state, one fixed-step integrator, sensors.
+
+    Parameters
+    ----------
+    angle_map : callable
+        Quasi-static θ(p), gauge MPa → degrees; an :class:`AngleTable` is fastest
+        (:func:`shipped_angle_table` gives the shipped MLP's).
+    params : RigParams, optional
+    seed : int
+        Seed of the sensor and camera noise.
+
+    Attributes (state, SI inside): ``t_s``, ``p_pa`` (absolute), ``angle_deg``
+    (true), ``inlet_open``, ``outlet_open`` (actual valve states), ``air_used_kg``
+    (mass drawn from the supply), ``switches`` (valve state changes).
+    """
+
+    def __init__(
+        self, angle_map: Callable[[float], float], params: RigParams | None = None, *, seed: int = 0
+    ) -> None:
+        if not callable(angle_map):
+            raise ValueError(
+                f"The 'angle_map' of SimulatedRig must be callable. Got {angle_map!r} instead."
+            )
+        self.params = RigParams() if params is None else params
+        self.angle_map = angle_map
+        self.step_s = self.params.step_s
+        self.seed = check_int(seed, "seed", "SimulatedRig", low=0)
+        self._derive()
+        self.reset(seed)
+
+    def _derive(self) -> None:
+        q = self.params
+        self._patm = q.atmosphere_mpa * 1e6
+        self._psup = (q.atmosphere_mpa + q.supply_gauge_mpa) * 1e6
+        scale = ANR_DENSITY_KG_M3 * math.sqrt(ANR_TEMPERATURE_K / q.temperature_k)
+        self._cin = q.inlet_conductance_m3_s_pa * scale
+        self._cout = q.outlet_conductance_m3_s_pa * scale
+        self._b = q.critical_ratio
+        self._v0 = q.volume_mm3 * 1e-9
+        self._k = q.compliance_mm3_per_mpa * 1e-9 * 1e-6  # m³/Pa
+        self._n = q.polytropic_exponent
+        self._rt = GAS_CONSTANT_J_KG_K * q.temperature_k
+        self._lag = (
+            1.0 - math.exp(-q.step_s / q.angle_time_constant_s)
+            if q.angle_time_constant_s > 0
+            else 1.0
+        )
+        self._delay_steps = round(q.valve_delay_s / q.step_s)
+        self._lsb = q.sensor_range_mpa / (2**q.sensor_bits - 1) if q.sensor_bits > 0 else 0.0
+        self._frame_s = 1.0 / q.camera_fps
+        self._latency_steps = round(q.camera_latency_s / q.step_s)
+
+    def reset(self, seed: int | None = None) -> None:
+        """Back to rest: atmospheric pressure, valves closed, angle at θ(0), time 0."""
+        self._rng = random.Random(self.seed if seed is None else seed)
+        self.t_s = 0.0
+        self._i = 0
+        self.p_pa = self._patm
+        self.angle_deg = float(self.angle_map(0.0))
+        self.inlet_open = False
+        self.outlet_open = False
+        self._pending: list[tuple[int, bool, bool]] = []
+        self.air_used_kg = 0.0
+        self.switches = 0
+        self._frames: list[tuple[int, float]] = []
+        self._camera = math.nan
+        self._next_frame = 0.0
+        self._frame_now()
+
+    @property
+    def pressure_mpa(self) -> float:
+        """True gauge pressure, MPa."""
+        return (self.p_pa - self._patm) * 1e-6
+
+    def read_pressure_mpa(self) -> float:
+        """One sensor reading: gauge MPa + noise, quantised, clipped to the range."""
+        q = self.params
+        value = (self.p_pa - self._patm) * 1e-6
+        if q.sensor_noise_mpa > 0.0:
+            value += self._rng.gauss(0.0, q.sensor_noise_mpa)
+        if self._lsb > 0.0:
+            value = round(value / self._lsb) * self._lsb
+        return min(max(value, 0.0), q.sensor_range_mpa)
+
+    def command(self, inlet: bool, outlet: bool) -> None:
+        """Command the valves; they switch ``valve_delay_s`` later."""
+        if self._delay_steps == 0:
+            self._apply(bool(inlet), bool(outlet))
+        else:
+            self._pending.append((self._i + self._delay_steps, bool(inlet), bool(outlet)))
+
+    def _apply(self, inlet: bool, outlet: bool) -> None:
+        self.switches += (inlet != self.inlet_open) + (outlet != self.outlet_open)
+        self.inlet_open = inlet
+        self.outlet_open = outlet
+
+    def advance(self, steps: int = 1) -> None:
+        """Integrate ``steps`` fixed steps of ``step_s``."""
+        h = self.step_s
+        lo, hi = self._patm, self._psup
+        angle_map = self.angle_map
+        lag = self._lag
+        b = self._b
+        span = 1.0 - b
+        cin, cout = self._cin, self._cout
+        v0, k, n = self._v0, self._k, self._n
+        nrt = n * self._rt
+        sqrt = math.sqrt
+        for _ in range(steps):
+            pending = self._pending
+            while pending and pending[0][0] <= self._i:
+                _, inlet, outlet = pending.pop(0)
+                self._apply(inlet, outlet)
+            inlet, outlet = self.inlet_open, self.outlet_open
+            p = self.p_pa
+            if inlet or outlet:
+                # Heun's method on dp/dt (chamber_pressure_rate_pa_s) with the flows of
+                # iso6358_mass_flow_kg_s: supply -> chamber (p <= supply, so never
+                # reversed) and chamber -> atmosphere (p >= atmosphere).
+                rate0 = flow0 = 0.0
+                q = p
+                for stage in (0, 1):
+                    qin = 0.0
+                    if inlet and q < hi:
+                        r = q / hi
+                        qin = cin * hi
+                        if r > b:
+                            x = (r - b) / span
+                            qin *= sqrt(max(0.0, 1.0 - x * x))
+                    qout = 0.0
+                    if outlet and q > lo:
+                        r = lo / q
+                        qout = cout * q
+                        if r > b:
+                            x = (r - b) / span
+                            qout *= sqrt(max(0.0, 1.0 - x * x))
+                    rate = nrt * (qin - qout) / (v0 + k * (q - lo) + n * q * k)
+                    if stage == 0:
+                        rate0, flow0 = rate, qin
+                        q = min(max(p + h * rate, lo), hi)
+                p = min(max(p + 0.5 * h * (rate0 + rate), lo), hi)
+                self.air_used_kg += 0.5 * h * (flow0 + qin)
+                self.p_pa = p
+            target = angle_map((p - lo) * 1e-6)
+            self.angle_deg += lag * (target - self.angle_deg)
+            self._i += 1
+            self.t_s = self._i * h
+            if self.t_s >= self._next_frame - 1e-12:
+                self._frame_now()
+            elif self._frames and self._frames[0][0] <= self._i:
+                self._camera = self._frames.pop(0)[1]
+
+    def _frame_now(self) -> None:
+        noise = self.params.camera_noise_deg
+        value = self.angle_deg + (self._rng.gauss(0.0, noise) if noise > 0.0 else 0.0)
+        self._next_frame += self._frame_s
+        if self._latency_steps == 0:
+            self._camera = value
+        else:
+            self._frames.append((self._i + self._latency_steps, value))
+        frames = self._frames
+        while frames and frames[0][0] <= self._i:
+            self._camera = frames.pop(0)[1]
+
+    def camera_angle_deg(self) -> float:
+        """The latest camera frame available now (NaN before the first), degrees."""
+        return self._camera

@@ -1,0 +1,130 @@
+import math
+
+import numpy as np
+import pytest
+
+from softbend.control.rig import (
+    AngleTable,
+    RigParams,
+    SimulatedRig,
+    chamber_pressure_rate_pa_s,
+    iso6358_mass_flow_kg_s,
+)
+from softbend.design import SFRBADesign
+
+C, B = 4e-10, 0.3
+
+
+def test_flow_zero_at_equal_pressures_and_reverses():
+    assert iso6358_mass_flow_kg_s(2e5, 2e5, C, B) == 0.0
+    forward = iso6358_mass_flow_kg_s(3e5, 2e5, C, B)
+    assert forward > 0
+    assert iso6358_mass_flow_kg_s(2e5, 3e5, C, B) == pytest.approx(-forward)
+
+
+def test_choked_flow_independent_of_downstream():
+    up = 3e5
+    choked = C * up * 1.185
+    for down in (0.0, 0.1 * up, 0.2 * up, B * up):
+        assert iso6358_mass_flow_kg_s(up, down, C, B) == pytest.approx(choked, rel=1e-12)
+    # doubling the upstream pressure doubles the choked flow
+    assert iso6358_mass_flow_kg_s(2 * up, 0.0, C, B) == pytest.approx(2 * choked)
+
+
+def test_flow_continuous_at_critical_ratio_and_decreasing_after():
+    up = 3e5
+    at = iso6358_mass_flow_kg_s(up, B * up, C, B)
+    just_after = iso6358_mass_flow_kg_s(up, (B + 1e-9) * up, C, B)
+    assert just_after == pytest.approx(at, rel=1e-6)
+    ratios = np.linspace(B, 1.0, 50)
+    flows = [iso6358_mass_flow_kg_s(up, r * up, C, B) for r in ratios]
+    assert np.all(np.diff(flows) <= 0) and flows[-1] == 0.0
+
+
+def test_chamber_rate_isothermal_closed_form():
+    # rigid volume: dp/dt = R T mdot / V
+    rate = chamber_pressure_rate_pa_s(
+        2e5, 1e-5, atmosphere_pa=1e5, volume_m3=1e-5, compliance_m3_pa=0.0
+    )
+    assert rate == pytest.approx(287.05 * 293.15 * 1e-5 / 1e-5)
+
+
+def _held(table, inlet, outlet, start_mpa=0.0, steps=3000):
+    rig = SimulatedRig(table, seed=0)
+    rig.p_pa = rig._patm + start_mpa * 1e6
+    rig.command(inlet, outlet)
+    pressures = []
+    for _ in range(steps):
+        rig.advance(1)
+        pressures.append(rig.pressure_mpa)
+    return rig, np.array(pressures)
+
+
+def test_fills_toward_supply_monotonically(table):
+    rig, p = _held(table, True, False)
+    assert np.all(np.diff(p) >= 0)
+    assert p[-1] == pytest.approx(rig.params.supply_gauge_mpa, abs=1e-4)
+    assert p[-1] <= rig.params.supply_gauge_mpa
+    assert rig.air_used_kg > 0 and rig.switches == 1
+
+
+def test_vents_toward_atmosphere_monotonically(table):
+    rig, p = _held(table, False, True, start_mpa=0.15)
+    assert np.all(np.diff(p) <= 0)
+    assert p[-1] == pytest.approx(0.0, abs=1e-4)
+    assert p[-1] >= 0.0 and rig.air_used_kg == 0.0
+
+
+def test_valve_delay(table):
+    rig = SimulatedRig(table, seed=0)
+    rig.command(True, False)
+    rig.advance(4)
+    assert not rig.inlet_open and rig.pressure_mpa == 0.0
+    rig.advance(2)
+    assert rig.inlet_open and rig.pressure_mpa > 0.0
+
+
+def test_angle_lag_reaches_63_percent_at_time_constant():
+    # a step of θ(p): 0° below 1 kPa, 100° above; a quick fill crosses it at once
+    table = AngleTable.from_callable(lambda p: np.where(p > 0.0, 100.0, 0.0), 0.5, 501)
+    params = RigParams(valve_delay_s=0.0, inlet_conductance_m3_s_pa=1e-7)
+    rig = SimulatedRig(table, params, seed=0)
+    rig.command(True, False)
+    rig.advance(1)  # pressure jumps past the first table step
+    start_t, start_angle = rig.t_s, rig.angle_deg
+    tau = params.angle_time_constant_s
+    rig.advance(round(tau / params.step_s))
+    fraction = (rig.angle_deg - start_angle) / (100.0 - start_angle)
+    assert rig.t_s - start_t == pytest.approx(tau)
+    assert fraction == pytest.approx(1 - math.exp(-1), abs=1e-9)
+
+
+def test_sensor_quantised_and_seeded(table):
+    rig = SimulatedRig(table, seed=3)
+    lsb = 0.5 / 4095
+    readings = [rig.read_pressure_mpa() for _ in range(50)]
+    assert all(abs(r / lsb - round(r / lsb)) < 1e-9 for r in readings)
+    rig.reset(3)
+    assert [rig.read_pressure_mpa() for _ in range(50)] == readings
+
+
+def test_params_validation_names_field():
+    with pytest.raises(
+        ValueError, match="'valve_delay_s' of RigParams must be a number in \\[0, inf\\)"
+    ):
+        RigParams(valve_delay_s=-1)
+    with pytest.raises(ValueError, match="'polytropic_exponent' of RigParams"):
+        RigParams(polytropic_exponent=2.0)
+    with pytest.raises(ValueError, match="'sensor_bits' of RigParams"):
+        RigParams(sensor_bits=1.5)
+
+
+def test_for_design_volume():
+    params = RigParams.for_design(SFRBADesign(100, 6, 2, 2, 5, 8))
+    assert params.volume_mm3 == pytest.approx(0.5 * math.pi * 36 * 100 + 2000)
+
+
+def test_angle_table_inverse_round_trip(table):
+    for angle in (10.0, 90.0, 300.0):
+        assert table(table.inverse(angle)) == pytest.approx(angle)
+    assert table.inverse(0.0) == 0.0  # below θ(0): clamped
