@@ -8,6 +8,7 @@ temporary file from :func:`tempfile.mkstemp` alone would be ``0o600``).
 from __future__ import annotations
 
 import os
+import shutil
 import stat
 import tempfile
 from collections.abc import Iterator
@@ -15,7 +16,13 @@ from contextlib import contextmanager
 from pathlib import Path
 from typing import IO
 
-__all__ = ["atomic_file", "new_file_mode", "write_bytes_atomic", "write_text_atomic"]
+__all__ = [
+    "atomic_file",
+    "new_file_mode",
+    "staged_dir",
+    "write_bytes_atomic",
+    "write_text_atomic",
+]
 
 
 def _umask() -> int:
@@ -77,3 +84,33 @@ def write_bytes_atomic(path: str | os.PathLike[str], data: bytes) -> Path:
     with atomic_file(path, "wb") as handle:
         handle.write(data)
     return Path(path)
+
+
+@contextmanager
+def staged_dir(path: str | os.PathLike[str]) -> Iterator[Path]:
+    """Yield a fresh folder beside ``path`` that replaces ``path`` when the block ends.
+
+    Everything is written into the staging folder; only when the block finishes
+    is the old ``path`` (if any) moved aside, the staging folder renamed to
+    ``path`` and the old one removed. If the block raises (or the process is
+    killed), ``path`` is untouched and the staging folder is removed (or left as
+    a hidden ``.NAME.*.new`` folder), so ``path`` is never a mix of an old and a
+    new run. The two renames are not one atomic step: a kill between them leaves
+    the old folder as ``.NAME.old-PID`` beside a missing ``path``.
+    """
+    path = Path(path)
+    path.parent.mkdir(parents=True, exist_ok=True)
+    staging = Path(tempfile.mkdtemp(dir=path.parent, prefix=f".{path.name}.", suffix=".new"))
+    os.chmod(staging, 0o777 & ~_umask())
+    try:
+        yield staging
+    except BaseException:
+        shutil.rmtree(staging, ignore_errors=True)
+        raise
+    old = None
+    if path.exists():
+        old = path.with_name(f".{path.name}.old-{os.getpid()}")
+        os.replace(path, old)
+    os.replace(staging, path)
+    if old is not None:
+        shutil.rmtree(old, ignore_errors=True)

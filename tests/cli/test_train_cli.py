@@ -121,3 +121,32 @@ def test_predict_warns_outside_the_training_ranges_and_strict_refuses(tmp_path, 
     assert "softbend: warning:" in captured.err and "pressure_mpa 1e+308 outside" in captured.err
     assert main([*args, "--pressure", "1e308", "--strict"]) == 2
     assert "pressure_mpa" in capsys.readouterr().err
+
+
+@pytest.mark.parametrize("fault", [KeyboardInterrupt, OSError(28, "No space left on device")])
+def test_an_interrupted_train_leaves_the_previous_output_folder_whole(
+    small_campaign, tmp_path, capsys, monkeypatch, fault
+):
+    out = tmp_path / "surrogates"
+    args = ["train", str(small_campaign), "--out", str(out), "--models", "plr", "--no-onnx"]
+    assert main([*args, "--json"]) == 0
+    capsys.readouterr()
+    before = {p.relative_to(out): p.read_bytes() for p in out.rglob("*") if p.is_file()}
+
+    import softbend.surrogates.workflow as workflow
+
+    real = workflow.train_surrogates
+
+    def half_done(db, stage, **kwargs):  # new models written, then the run dies
+        real(db, stage, **kwargs)
+        raise fault
+
+    monkeypatch.setattr(workflow, "train_surrogates", half_done)
+    if fault is KeyboardInterrupt:  # Ctrl-C: the CLI says "aborted", exit 130
+        assert main([*args, "--folds", "3"]) == 130
+    else:
+        assert main([*args, "--folds", "3"]) == 2
+        assert "--out" in capsys.readouterr().err
+    after = {p.relative_to(out): p.read_bytes() for p in out.rglob("*") if p.is_file()}
+    assert after == before
+    assert [p.name for p in tmp_path.iterdir()] == ["surrogates"]  # no staging folder left

@@ -45,6 +45,7 @@ def train(
     as_json: bool = typer.Option(False, "--json", help="Print the results as JSON."),
 ) -> None:
     """Grid-search the surrogates with grouped K-fold CV, refit the best, save and plot."""
+    from softbend._io import staged_dir
     from softbend._validation import check_int
     from softbend.reports.surrogate_figures import training_figures
     from softbend.surrogates.workflow import train_surrogates
@@ -53,13 +54,16 @@ def train(
         check_int(jobs, "--jobs", "softbend train", low=1)
     _common.check_output_dir(out, "--out", inputs=(db,))
     names = [m.strip() for m in models.split(",") if m.strip()]
+    # Built beside --out and swapped in at the end: an interrupted search leaves the
+    # previous folder as it was, never old models beside new ones.
     with (
         _common.output_errors(out, "--out"),
+        staged_dir(out) as stage,
         _common.phase_progress(enabled=not as_json) as progress,
     ):
         result, summary = train_surrogates(
             db,
-            out,
+            stage,
             models=names,
             grid_name=grid,
             folds=folds,
@@ -72,8 +76,13 @@ def train(
             cv=cv,
             halving=halving,
         )
-    with _common.output_errors(out, "--out"):
-        summary["files"].update(training_figures(result, out))
+        summary["files"].update(training_figures(result, stage))
+    summary["files"] = {
+        key: str(Path(out) / Path(value).relative_to(stage))
+        if str(value).startswith(str(stage))
+        else value
+        for key, value in summary["files"].items()
+    }
     if as_json:
         _common.print_json(summary)
         return
