@@ -288,3 +288,21 @@ def test_unreachable_tip_is_a_dataset_error(tmp_path):
 def test_bad_rest_length_argument(tmp_path):
     with pytest.raises(ValueError, match=r"'rest_length_mm' of load_experiments.*\(0, inf\)"):
         load_experiments(_write(tmp_path / "g.csv", GOOD), rest_length_mm=0.0)
+
+
+def test_saved_experiment_files_get_the_mode_of_a_plain_write(tmp_path):
+    import os
+
+    from softbend.identification.data import load_experiments, save_experiments
+
+    source = tmp_path / "a"
+    source.mkdir()
+    (source / "e1.csv").write_text(
+        "time_s,pressure_kpa,x_mm,y_mm\n0,0,0.5,15.2\n0.02,1,1.0,15.1\n0.04,2,1.5,15.0\n"
+    )
+    old = os.umask(0o022)
+    try:
+        paths = save_experiments(load_experiments(source, rest_length_mm=15.25), tmp_path / "out")
+    finally:
+        os.umask(old)
+    assert all(oct(p.stat().st_mode & 0o777) == oct(0o644) for p in paths)

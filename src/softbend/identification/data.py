@@ -41,6 +41,7 @@ from typing import TYPE_CHECKING, Any, Literal
 
 import numpy as np
 
+from softbend._io import new_file_mode
 from softbend._validation import check_range
 from softbend.errors import DatasetError
 from softbend.kinematics import bending_from_tip
@@ -536,6 +537,7 @@ def save_experiments(
         header = list(REQUIRED_COLUMNS) + ([EXPERIMENT_COLUMN] if named else [])
         descriptor, temporary = tempfile.mkstemp(prefix=f".{stem}.", suffix=".tmp", dir=folder)
         try:
+            os.chmod(temporary, new_file_mode(target))  # as a plain open would, not 0600
             with os.fdopen(descriptor, "w", encoding="utf-8", newline="") as handle:
                 for line in _header_lines(item):
                     handle.write(line + "\n")
