@@ -140,10 +140,8 @@ def predict(
     the model file) is a warning on stderr, or with ``--strict`` an error: a
     surrogate extrapolates without knowing it.
     """
-    import numpy as np
-
     from softbend.design import SFRBADesign
-    from softbend.surrogates.persistence import load_surrogate
+    from softbend.surrogates.predict import predict_angles
 
     values = _floats(design, "design")
     if len(values) != 6:
@@ -152,33 +150,22 @@ def predict(
             f"Got {len(values)}: {design!r}."
         )
     checked = SFRBADesign(*values)  # validates the ranges, names the parameter
-    pressures = np.asarray(_floats(pressure, "pressure"))
-    if not np.all(np.isfinite(pressures)) or np.any(pressures < 0):
-        raise ValueError(f"The 'pressure' must be finite and >= 0 MPa. Got {pressure!r} instead.")
-    from softbend.surrogates.features import outside_training_ranges
-
-    saved = load_surrogate(model)
-    rows = checked.feature_rows(pressures)
-    ranges = saved.metadata.get("training_ranges")
-    outside = outside_training_ranges(ranges, rows) if isinstance(ranges, dict) else []
+    result = predict_angles(model, checked, _floats(pressure, "pressure"), strict=strict)
+    pressures, angles, outside = (
+        result.pressure_mpa,
+        result.angle_deg,
+        result.outside_training_ranges,
+    )
     if outside:
-        message = f"{model} was not trained there: {'; '.join(outside)}"
-        if strict:
-            raise ValueError(
-                f"The 'design' and 'pressure' must lie in the training data: {message}."
-            )
-        _common.warning_line(f"{message}; the prediction is an extrapolation (--strict refuses).")
-    elif strict and not isinstance(ranges, dict):
-        raise ValueError(
-            f"The model {model} records no training ranges (saved by an older softbend); "
-            "--strict cannot check it."
+        _common.warning_line(
+            f"{model} was not trained there: {'; '.join(outside)}; the prediction is an "
+            "extrapolation (--strict refuses)."
         )
-    angles = saved.model.predict(rows)
     if as_json:
         _common.print_json(
             {
                 "model": str(model),
-                "kind": saved.kind,
+                "kind": result.kind,
                 "design": checked.as_dict(),
                 "pressure_mpa": pressures.tolist(),
                 "angle_deg": angles.tolist(),
@@ -187,7 +174,7 @@ def predict(
         )
         return
     _common.print_table(
-        f"{saved.kind} surrogate, design {checked.design_id}",
+        f"{result.kind} surrogate, design {checked.design_id}",
         ["pressure (MPa)", "angle (°)"],
         [[f"{p:g}", f"{a:.2f}"] for p, a in zip(pressures, angles, strict=True)],
     )

@@ -28,6 +28,8 @@ _EXPORTS = {
     "SearchResult": "search",
     "train_surrogates": "workflow",
     "SurrogateModel": "model",
+    "predict_angles": "predict",
+    "Prediction": "predict",
     "save_surrogate": "persistence",
     "load_surrogate": "persistence",
     "to_onnx": "onnx_export",

@@ -1,0 +1,100 @@
+"""One call from a saved surrogate, a design and pressures to angles, extrapolation flagged."""
+
+from __future__ import annotations
+
+import os
+from dataclasses import dataclass, field
+
+import numpy as np
+from numpy.typing import ArrayLike
+
+from softbend.design import SFRBADesign
+from softbend.models import check_pressures_mpa
+
+__all__ = ["Prediction", "predict_angles"]
+
+
+@dataclass(frozen=True)
+class Prediction:
+    """Angles predicted by a saved surrogate for one design.
+
+    Attributes
+    ----------
+    kind : str
+        The surrogate's kind (``"mlp"``, ``"polynomial"``, ``"xgboost"``).
+    design : SFRBADesign
+    pressure_mpa, angle_deg : ndarray
+        The pressures asked for (MPa) and the predicted angles (degrees).
+    outside_training_ranges : list of str
+        One phrase per input outside the ranges the model was trained on
+        (empty inside them, or when the file records none).
+    has_training_ranges : bool
+        Whether the file records its training ranges.
+    """
+
+    kind: str
+    design: SFRBADesign
+    pressure_mpa: np.ndarray
+    angle_deg: np.ndarray
+    outside_training_ranges: list[str] = field(default_factory=list)
+    has_training_ranges: bool = False
+
+
+def predict_angles(
+    path: str | os.PathLike[str],
+    design: SFRBADesign,
+    pressures_mpa: ArrayLike,
+    *,
+    strict: bool = False,
+) -> Prediction:
+    """Load a saved surrogate and predict ``design``'s angle at each pressure.
+
+    Parameters
+    ----------
+    path : path
+        A file written by :func:`softbend.surrogates.save_surrogate`.
+    design : SFRBADesign
+    pressures_mpa : array_like
+        Gauge pressures, MPa, finite and >= 0 (any order).
+    strict : bool, default False
+        Refuse inputs outside the model's training ranges (and models that
+        record none) instead of flagging them.
+
+    Raises
+    ------
+    ValueError
+        Bad pressures, or with ``strict`` an extrapolation (naming the inputs).
+    FileNotFoundError, softbend.errors.SchemaError
+        As :func:`softbend.surrogates.load_surrogate`.
+    """
+    from softbend.surrogates.features import outside_training_ranges
+    from softbend.surrogates.persistence import load_surrogate
+
+    if not isinstance(design, SFRBADesign):
+        raise ValueError(
+            f"The 'design' of predict_angles must be an SFRBADesign. Got {design!r} instead."
+        )
+    pressures = np.asarray(pressures_mpa, dtype=float).ravel()
+    if pressures.size == 0 or not np.all(np.isfinite(pressures)) or np.any(pressures < 0):
+        raise ValueError(
+            "The 'pressure' must be finite and >= 0 MPa. "
+            f"Got {np.asarray(pressures_mpa).tolist()!r} instead."
+        )
+    check_pressures_mpa(np.unique(pressures), "predict_angles", "pressure")
+    saved = load_surrogate(path)
+    rows = design.feature_rows(pressures)
+    ranges = saved.metadata.get("training_ranges")
+    has_ranges = isinstance(ranges, dict)
+    outside = outside_training_ranges(ranges, rows) if has_ranges else []
+    if strict and outside:
+        raise ValueError(
+            f"The 'design' and 'pressure' must lie in the training data of {path}: "
+            f"{'; '.join(outside)}."
+        )
+    if strict and not has_ranges:
+        raise ValueError(
+            f"The model {path} records no training ranges (saved by an older softbend); "
+            "--strict cannot check it."
+        )
+    angles = np.asarray(saved.model.predict(rows), dtype=float)
+    return Prediction(saved.kind, design, pressures, angles, outside, has_ranges)
