@@ -150,6 +150,7 @@ def run(
         _common.err_console.print(
             f"resuming {db}: {len(designs) - n_todo} of {len(designs)} designs already recorded",
             highlight=False,
+            soft_wrap=True,  # one line whatever the path's length (logs, tests)
         )
     with ExitStack() as stack:
         # The bar opens with the first report, so errors before any work print no bar.
