@@ -10,9 +10,11 @@ from softbend.identification.kernels import (
     ShapeClippedWarning,
     _shape_from_kurtosis,
     estimate_gg_shape,
+    estimate_kernel_shape,
     generalized_gaussian_kernel,
     gg_kurtosis,
     gg_normalization,
+    gg_radial_kurtosis,
     gg_scale,
 )
 
@@ -239,3 +241,133 @@ def test_estimate_rejects_bad_weights():
         estimate_gg_shape(samples, sample_weight=np.ones(9))
     with pytest.raises(ValueError, match="n_samples = 2"):
         estimate_gg_shape(samples, sample_weight=np.r_[1.0, 1.0, np.zeros(8)])
+
+
+# --- the kernel's argument: radial fourth moments (estimate_kernel_shape) ---------------
+
+
+def _elliptical_gg(n, dim, shape, rng, mixing=None):
+    """Samples of the d-dimensional generalized Gaussian exp(-|x|^shape), mixed linearly.
+
+    The radius R has density ∝ r^(d-1) exp(-r^shape): R^shape ~ Gamma(d/shape).
+    """
+    radius = rng.gamma(dim / shape, size=n) ** (1.0 / shape)
+    direction = rng.normal(size=(n, dim))
+    direction /= np.linalg.norm(direction, axis=1)[:, None]
+    samples = radius[:, None] * direction
+    return samples if mixing is None else samples @ mixing.T
+
+
+MIXING = np.array([[1.0, 0.5, 0.0], [0.0, 2.0, 0.3], [0.2, 0.0, 0.5]])
+
+
+@pytest.mark.parametrize("dim", [1.0, 2.0, 4.0, 7.5])
+def test_radial_kurtosis_reduces_to_eq_24_and_has_the_gaussian_and_uniform_limits(dim):
+    assert gg_radial_kurtosis(2.0, dim) == pytest.approx((dim + 2) / dim, rel=1e-12)
+    assert gg_radial_kurtosis(1e5, dim) == pytest.approx(
+        (dim + 2) ** 2 / (dim * (dim + 4)), rel=1e-3
+    )
+    shapes = np.geomspace(0.1, 50.0, 100)
+    assert np.all(np.diff(gg_radial_kurtosis(shapes, dim)) < 0.0)
+    np.testing.assert_allclose(gg_radial_kurtosis(shapes, 1.0), gg_kurtosis(shapes), rtol=1e-12)
+
+
+@pytest.mark.parametrize("shape", [0.7, 1.0, 1.5])
+def test_radial_kurtosis_is_the_moment_ratio_of_the_radius(shape):
+    dim = 3.0
+
+    def moment(k):  # of the radius, density ∝ r^(d-1) exp(-r^shape)
+        return integrate.quad(lambda r: r ** (dim - 1 + k) * math.exp(-(r**shape)), 0, np.inf)[0]
+
+    ratio = moment(4) * moment(0) / moment(2) ** 2
+    assert gg_radial_kurtosis(shape, dim) == pytest.approx(ratio, rel=1e-8)
+
+
+@pytest.mark.parametrize("dim", [1, 3])
+@pytest.mark.parametrize("shape", [0.7, 1.0, 1.5])
+def test_moments_of_regressors_recover_the_shape_of_an_elliptical_generalized_gaussian(dim, shape):
+    rng = np.random.default_rng(20 + dim)
+    mixing = None if dim == 1 else MIXING
+    samples = _elliptical_gg(200_000, dim, shape, rng, mixing) + 3.0  # shift: centred inside
+    estimate = estimate_kernel_shape(samples, moments_of="regressors")
+    assert estimate.shape == pytest.approx(shape, rel=0.05)
+    assert not estimate.clipped
+    assert estimate.relative_kurtosis > 1.0 and "heavier tails" in estimate.reason
+
+
+def test_moments_of_differences_match_their_closed_form_for_iid_rows():
+    # For i.i.d. rows the ratio of x - z is the mean of the rows' ratio and the
+    # Gaussian one (1 + 2/d for isotropic rows): the differences are closer to Gaussian.
+    dim, shape = 3, 1.0
+    samples = _elliptical_gg(200_000, dim, shape, np.random.default_rng(4))
+    estimate = estimate_kernel_shape(samples, moments_of="differences")
+    expected = 0.5 * (gg_radial_kurtosis(shape, dim) + (dim + 2) / dim)
+    assert estimate.kurtosis == pytest.approx(expected, rel=0.03)
+    assert estimate.gaussian_kurtosis == pytest.approx((dim + 2) / dim, rel=0.01)
+    assert shape < estimate.shape < 2.0
+
+
+def test_moments_of_differences_equal_the_brute_force_over_all_pairs():
+    rng = np.random.default_rng(6)
+    X = rng.laplace(size=(40, 3)) * np.array([1.0, 3.0, 0.5])
+    weight = rng.integers(1, 4, size=40).astype(float)
+    estimate = estimate_kernel_shape(X, sample_weight=weight, moments_of="differences")
+    diff = X[:, None, :] - X[None, :, :]
+    pair_weight = (weight[:, None] * weight[None, :]).ravel()
+    squared = np.sum(diff**2, axis=-1).ravel()
+    ratio = (
+        np.average(squared**2, weights=pair_weight) / np.average(squared, weights=pair_weight) ** 2
+    )
+    assert estimate.kurtosis == pytest.approx(ratio, rel=1e-12)
+    # d_eff from the covariance of the differences (twice that of the rows)
+    covariance = np.cov(X.T, aweights=weight, bias=True)
+    d_eff = np.trace(covariance) ** 2 / np.sum(covariance**2)
+    assert estimate.effective_dimension == pytest.approx(d_eff, rel=1e-12)
+    assert estimate.sigma == pytest.approx(estimate_gg_shape(X, sample_weight=weight)[0], rel=1e-12)
+
+
+@pytest.mark.parametrize("moments_of", ["differences", "regressors"])
+def test_gaussian_rows_of_any_covariance_give_shape_two(moments_of):
+    rng = np.random.default_rng(9)
+    rows = rng.normal(size=(200_000, 3)) @ MIXING.T
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", ShapeClippedWarning)  # may fall just above 2
+        estimate = estimate_kernel_shape(rows, moments_of=moments_of)
+    assert estimate.relative_kurtosis == pytest.approx(1.0, abs=0.02)
+    assert estimate.shape == pytest.approx(2.0, abs=0.1)
+
+
+@pytest.mark.parametrize("moments_of", ["differences", "regressors", "components"])
+def test_light_tailed_rows_are_clipped_to_two_with_the_reason(moments_of):
+    rows = np.random.default_rng(1).uniform(-1.0, 1.0, size=(20_000, 4))
+    with pytest.warns(ShapeClippedWarning, match="clipped to 2"):
+        estimate = estimate_kernel_shape(rows, moments_of=moments_of)
+    assert estimate.shape == 2.0 and estimate.clipped
+    assert estimate.unclipped_shape > 2.0
+    assert estimate.relative_kurtosis < 1.0
+    assert "lighter tails" in estimate.reason and "clipped to 2" in estimate.reason
+
+
+def test_components_reading_is_the_pooled_estimator_of_paper_a():
+    rows = np.random.default_rng(3).laplace(size=(5_000, 3))
+    estimate = estimate_kernel_shape(rows, moments_of="components")
+    assert (estimate.sigma, estimate.shape) == pytest.approx(estimate_gg_shape(rows), rel=1e-12)
+    assert estimate.gaussian_kurtosis == 3.0 and estimate.dimension == 1
+
+
+@pytest.mark.parametrize("moments_of", ["differences", "regressors"])
+def test_radial_integer_weights_equal_repeated_rows(moments_of):
+    rng = np.random.default_rng(2)
+    rows = rng.laplace(size=(40, 3))
+    weights = rng.integers(0, 4, size=40)
+    weighted = estimate_kernel_shape(rows, sample_weight=weights, moments_of=moments_of)
+    repeated = estimate_kernel_shape(np.repeat(rows, weights, axis=0), moments_of=moments_of)
+    assert weighted.kurtosis == pytest.approx(repeated.kurtosis, rel=1e-12)
+    assert weighted.shape == pytest.approx(repeated.shape, rel=1e-10)
+
+
+def test_estimate_kernel_shape_rejects_an_unknown_reading():
+    with pytest.raises(ValueError, match="'moments_of' of estimate_kernel_shape must be one of"):
+        estimate_kernel_shape(np.arange(10.0), moments_of="pairs")
+    with pytest.raises(ValueError, match="'dim' of gg_radial_kurtosis"):
+        gg_radial_kurtosis(1.0, 0.0)

@@ -131,6 +131,16 @@ _CORRUPTIONS = [
     ("other estimator", lambda d: d["estimator"].update({"class": "SVR"}), "'estimator.class'"),
     ("bad C", lambda d: d["estimator"]["params"].update(C=-1), "'estimator.params.C'"),
     (
+        "bad moments_of",
+        lambda d: d["estimator"]["params"].update(moments_of="pairs"),
+        "'estimator.params.moments_of' must be one of 'differences'",
+    ),
+    (
+        "bad max_working_set",
+        lambda d: d["estimator"]["params"].update(max_working_set=2),
+        "'estimator.params.max_working_set' must be an integer >= 8",
+    ),
+    (
         "unknown estimator key",
         lambda d: d["estimator"].update(predict=1),
         "unknown key.*'predict' in 'estimator'; allowed keys: class",
@@ -197,4 +207,29 @@ def test_json_that_is_not_an_object_is_refused(tmp_path, text):
     path = tmp_path / "m.json"
     path.write_text(text)
     with pytest.raises(SchemaError, match=f"Not a saved softbend NARX model: {path}"):
+        load_narx(path)
+
+
+def test_version_1_files_load_with_the_reading_they_were_fitted_with(tmp_path):
+    # Version 1 had no moments_of / max_working_set: its shapes came from the pooled
+    # standardized components, which is what a refit of the loaded model must use.
+    u, y = _system(0)
+    model = NARXRegressor(estimator=GeneralizedGaussianSVR(shape=1.3)).fit(u, y)
+    path = save_narx(model, tmp_path / "m.json")
+    data = json.loads(path.read_text())
+    assert data["schema_version"] == 2
+    data["schema_version"] = 1
+    for key in ("moments_of", "max_working_set"):
+        del data["estimator"]["params"][key]
+    path.write_text(json.dumps(data))
+    loaded, _ = load_narx(path)
+    params = loaded.estimator_.get_params()
+    assert params["moments_of"] == "components" and params["max_working_set"] == 4096
+    assert loaded.estimator_.shape_estimate_ is None
+    u_test, y_test = _system(1)
+    np.testing.assert_array_equal(model.simulate(u_test, y_test), loaded.simulate(u_test, y_test))
+    # A version 2 file must carry the keys.
+    data["schema_version"] = 2
+    path.write_text(json.dumps(data))
+    with pytest.raises(SchemaError, match=r"lacks the key.*moments_of"):
         load_narx(path)

@@ -63,6 +63,29 @@ def test_final_models_are_trained_on_every_experiment_of_their_sign(small_result
         assert 0 < params["shape"] <= 2 and params["sigma"] > 0
 
 
+def test_kernel_report_says_which_shape_each_model_used_and_why(small_result):
+    # Paper A's layout (mixed excitation): regressors lighter-tailed than Gaussian.
+    result, _ = small_result
+    for params in result.kernel_params.values():
+        assert params["shape_source"] == "moments" and params["moments_of"] == "differences"
+        assert params["shape"] == 2.0 and params["shape_clipped"]
+        assert params["kurtosis"] < params["gaussian_kurtosis"]
+        assert "lighter tails" in params["shape_reason"]
+        assert "clipped to 2" in params["shape_reason"]
+
+
+def test_impulsive_data_get_a_shape_below_two_and_cv_says_it_chose(small_dataset):
+    impulsive = synthetic_dataset(n_experiments=2, n_samples=200, seed=1, excitation="impulsive")
+    result = identify(impulsive["negative"])
+    params = result.kernel_params[("negative", "rho")]
+    assert params["shape"] < 1.5 and not params["shape_clipped"]
+    assert "heavier tails" in params["shape_reason"]
+    chosen = identify(small_dataset[-2:], IdentificationConfig(kernel="cv"))
+    params = chosen.kernel_params[("negative", "rho")]
+    assert params["shape_source"] == "cv" and params["kurtosis"] is None
+    assert "cross-validation" in params["shape_reason"]
+
+
 def test_identification_is_deterministic(small_dataset):
     subset = [e for e in small_dataset if e.sign == "negative"][:2]
     a = identify(subset).metrics
@@ -83,7 +106,14 @@ def test_split_by_sign_keeps_order(small_dataset):
 
 
 @pytest.mark.parametrize(
-    ("field", "value"), [("C", 0.0), ("epsilon", -0.1), ("output_lags", 0), ("kernel", "grid")]
+    ("field", "value"),
+    [
+        ("C", 0.0),
+        ("epsilon", -0.1),
+        ("output_lags", 0),
+        ("kernel", "grid"),
+        ("moments_of", "pairs"),
+    ],
 )
 def test_bad_configuration_names_the_field(field, value):
     with pytest.raises(ValueError, match=f"'{field}' of IdentificationConfig"):

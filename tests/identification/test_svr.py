@@ -1,9 +1,10 @@
+import tracemalloc
 import warnings
 
 import numpy as np
 import pytest
 from scipy.spatial.distance import cdist
-from sklearn.exceptions import NotFittedError
+from sklearn.exceptions import ConvergenceWarning, NotFittedError
 from sklearn.metrics import r2_score
 from sklearn.svm import SVR
 from sklearn.utils.estimator_checks import parametrize_with_checks
@@ -11,10 +12,11 @@ from sklearn.utils.estimator_checks import parametrize_with_checks
 from softbend.identification.kernels import (
     ShapeClippedWarning,
     estimate_gg_shape,
+    estimate_kernel_shape,
     generalized_gaussian_kernel,
     gg_normalization,
 )
-from softbend.identification.svr import GeneralizedGaussianSVR
+from softbend.identification.svr import GeneralizedGaussianSVR, _merge_duplicates
 
 # Random inputs are often lighter-tailed than Gaussian: the shape estimate is clipped to 2
 # with a warning. The tests about that warning check for it explicitly.
@@ -125,15 +127,27 @@ def test_missing_sigma_and_shape_are_estimated_from_the_training_inputs():
     rng = np.random.default_rng(8)
     X = rng.laplace(size=(400, 3))
     y = np.tanh(X[:, 0]) + 0.1 * X[:, 1]
-    sigma, shape = estimate_gg_shape(X)
+    estimate = estimate_kernel_shape(X)  # the kernel's argument x - z, the default
     model = GeneralizedGaussianSVR().fit(X, y)
-    assert (model.sigma_, model.shape_) == (pytest.approx(sigma), pytest.approx(shape))
-    assert 0.7 < model.shape_ < 1.3  # Laplacian inputs
+    assert (model.sigma_, model.shape_) == (
+        pytest.approx(estimate.sigma),
+        pytest.approx(estimate.shape),
+    )
+    assert model.shape_estimate_.moments_of == "differences"
+    assert model.shape_estimate_.kurtosis == pytest.approx(estimate.kurtosis, rel=1e-12)
+    assert 0.9 < model.shape_ < 1.6  # Laplacian inputs: heavier tails than Gaussian
+
+    # The earlier reading (pooled standardized components) stays reachable.
+    sigma, shape = estimate_gg_shape(X)
+    components = GeneralizedGaussianSVR(moments_of="components").fit(X, y)
+    assert (components.sigma_, components.shape_) == (pytest.approx(sigma), pytest.approx(shape))
+    assert components.sigma_ == pytest.approx(model.sigma_, rel=1e-12)  # σ: same in every reading
 
     partly = GeneralizedGaussianSVR(sigma=0.4).fit(X, y)
     assert partly.sigma_ == 0.4
-    assert partly.shape_ == pytest.approx(shape)
+    assert partly.shape_ == pytest.approx(estimate.shape)
     assert GeneralizedGaussianSVR(sigma=0.4).get_params()["sigma"] == 0.4  # unchanged
+    assert GeneralizedGaussianSVR(sigma=0.4, shape=1.0).fit(X, y).shape_estimate_ is None
 
 
 def test_clipped_estimate_warns_but_an_explicit_shape_does_not():
@@ -230,3 +244,116 @@ def test_prediction_uses_the_same_kernel_as_a_direct_distance_computation():
     distance = cdist(X[:5], model.support_vectors_)
     expected = np.exp(-((model._rate**0.5 * distance) ** 0.7)) @ model.dual_coef_ + model.intercept_
     np.testing.assert_allclose(model.predict(X[:5]), expected, rtol=1e-12, atol=1e-12)
+
+
+# --- solvers without a dense Gram matrix ------------------------------------------------
+
+
+def _dense_reference(X, y, *, sigma, shape, C, epsilon, tol, sample_weight=None):
+    """The formulation the estimator replaces: LIBSVM on the full precomputed Gram matrix."""
+    X_fit, y_fit, w_fit = _merge_duplicates(
+        X, y, np.ones(len(y)) if sample_weight is None else sample_weight
+    )
+    gram = generalized_gaussian_kernel(X_fit, sigma=sigma, shape=shape)
+    svr = SVR(kernel="precomputed", C=C, epsilon=epsilon, tol=tol)
+    svr.fit(gram, y_fit, sample_weight=None if np.all(w_fit == 1.0) else w_fit)
+    return lambda X_new: svr.predict(
+        generalized_gaussian_kernel(X_new, X_fit, sigma=sigma, shape=shape)
+    ), svr.support_.size
+
+
+@pytest.mark.parametrize("shape", [0.6, 1.0, 1.5])
+@pytest.mark.parametrize(("C", "max_working_set"), [(100.0, 4096), (100.0, 16), (0.5, 16)])
+def test_active_set_solver_equals_the_dense_gram_formulation(shape, C, max_working_set):
+    # max_working_set=16 forces many rounds, support vectors outside the working set and
+    # the auxiliary variable that keeps sum(alpha) = 0; C=0.5 puts many of them at the bound.
+    X, y = _nonlinear_problem(n_samples=300)
+    X_test, _ = _nonlinear_problem(n_samples=80, seed=1)
+    tol = 1e-6
+    reference, n_support = _dense_reference(X, y, sigma=0.9, shape=shape, C=C, epsilon=0.1, tol=tol)
+    model = GeneralizedGaussianSVR(
+        sigma=0.9, shape=shape, C=C, epsilon=0.1, tol=tol, max_working_set=max_working_set
+    ).fit(X, y)
+    if max_working_set < 4096:
+        assert model.n_support_ > max_working_set  # the over-capacity path ran
+    np.testing.assert_allclose(model.predict(X_test), reference(X_test), rtol=0, atol=1e-4)
+    assert abs(model.n_support_ - n_support) <= 0.02 * n_support + 1
+
+
+def test_active_set_solver_with_weights_equals_the_dense_formulation():
+    X, y = _nonlinear_problem(n_samples=200)
+    weights = np.random.default_rng(3).uniform(0.2, 3.0, size=200)
+    reference, _ = _dense_reference(
+        X, y, sigma=1.1, shape=1.2, C=2.0, epsilon=0.05, tol=1e-6, sample_weight=weights
+    )
+    model = GeneralizedGaussianSVR(
+        sigma=1.1, shape=1.2, C=2.0, epsilon=0.05, tol=1e-6, max_working_set=32
+    ).fit(X, y, sample_weight=weights)
+    np.testing.assert_allclose(model.predict(X), reference(X), rtol=0, atol=1e-4)
+
+
+@pytest.mark.parametrize("shape", [2.0, 1.5])
+def test_fit_never_holds_an_n_by_n_matrix(shape):
+    # 8 000 rows: a dense float64 Gram matrix would take 512 MB. NumPy's allocations are
+    # traced (the active-set solver's column cache reserves cache_size MB); LIBSVM's own
+    # (its kernel cache, cache_size MB) are not, and are bounded anyway.
+    rng = np.random.default_rng(0)
+    X = rng.normal(size=(8_000, 3))
+    y = np.sin(X[:, 0]) + 0.5 * X[:, 1] + 0.05 * rng.normal(size=8_000)
+    model = GeneralizedGaussianSVR(sigma=1.0, shape=shape, epsilon=0.1, cache_size=50.0)
+    tracemalloc.start()
+    try:
+        model.fit(X, y)
+        peak = tracemalloc.get_traced_memory()[1]
+    finally:
+        tracemalloc.stop()
+    assert peak < 100 * 2**20
+    assert r2_score(y, model.predict(X)) > 0.95
+
+
+def test_gaussian_shape_runs_libsvm_rbf_and_other_shapes_the_active_set(monkeypatch):
+    import softbend.identification.svr as svr_module
+
+    X, y = _nonlinear_problem(n_samples=60)
+
+    def refuse(*args, **kwargs):
+        raise AssertionError("the active-set solver must not run at shape 2")
+
+    monkeypatch.setattr(svr_module, "_solve_active_set", refuse)
+    GeneralizedGaussianSVR(shape=2.0).fit(X, y)
+    with pytest.raises(AssertionError, match="must not run"):
+        GeneralizedGaussianSVR(shape=1.5).fit(X, y)
+
+
+def test_active_set_solver_that_runs_out_of_rounds_warns(monkeypatch):
+    import softbend.identification.svr as svr_module
+
+    monkeypatch.setattr(svr_module, "_MAX_ROUNDS", 1)
+    monkeypatch.setattr(svr_module, "_ROUNDS_PER_CHUNK", 0)
+    X, y = _nonlinear_problem(n_samples=800)
+    with pytest.warns(ConvergenceWarning, match="stopped after 1 rounds"):
+        GeneralizedGaussianSVR(sigma=1.0, shape=1.5, max_working_set=16).fit(X, y)
+
+
+def test_prediction_in_row_blocks_equals_one_block(monkeypatch):
+    import softbend.identification.svr as svr_module
+
+    X, y = _nonlinear_problem(n_samples=200)
+    model = GeneralizedGaussianSVR(sigma=1.0, shape=1.3).fit(X, y)
+    whole = model.predict(X)
+    monkeypatch.setattr(svr_module, "_BLOCK_BYTES", 8 * model.n_support_ * 7)  # 7 rows a block
+    np.testing.assert_allclose(model.predict(X), whole, rtol=0, atol=1e-13)
+
+
+@pytest.mark.parametrize(
+    ("params", "match"),
+    [
+        ({"max_working_set": 4}, r"'max_working_set' of GeneralizedGaussianSVR .*\[8, inf\)"),
+        ({"max_working_set": 100.5}, "'max_working_set'"),
+        ({"moments_of": "pairs"}, "'moments_of' of GeneralizedGaussianSVR must be one of"),
+    ],
+)
+def test_bad_solver_and_estimation_settings_raise_naming_the_field(params, match):
+    X, y = _nonlinear_problem(n_samples=30)
+    with pytest.raises(ValueError, match=match):
+        GeneralizedGaussianSVR(**params).fit(X, y)

@@ -5,6 +5,7 @@ import pytest
 
 from softbend.identification.data import load_experiments, save_experiments
 from softbend.identification.synthetic import (
+    ALL_PROFILE_KINDS,
     PROFILE_KINDS,
     CurlingActuator,
     pressure_profile,
@@ -235,7 +236,7 @@ def test_same_seed_same_arrays_other_seed_other_noise():
 
 
 # ---------------------------------------------------------------------- profiles
-@pytest.mark.parametrize("kind", PROFILE_KINDS)
+@pytest.mark.parametrize("kind", ALL_PROFILE_KINDS)
 @pytest.mark.parametrize("peak", [100.0, -80.0])
 def test_every_profile_starts_at_rest_and_spans_the_range(kind, peak):
     time, pressure = pressure_profile(kind, 512, 0.02, peak, seed=9)
@@ -365,7 +366,42 @@ def test_bad_profiles_and_datasets_are_refused():
         synthetic_dataset(n_experiments=0)
     with pytest.raises(ValueError, match="'actuator' of synthetic_dataset"):
         synthetic_dataset(actuator="soft")
+    with pytest.raises(ValueError, match="'excitation' of synthetic_dataset must be one of"):
+        synthetic_dataset(excitation="uniform")
     with pytest.raises(ValueError, match=r"'time_s' of CurlingActuator\.response must increase"):
         CurlingActuator().response([0.0, 0.1, 0.1], [0.0, 1.0, 2.0])
     with pytest.raises(ValueError, match="equal length"):
         CurlingActuator().response([0.0, 0.1, 0.2], [0.0, 1.0])
+
+
+# ------------------------------------------------------------ impulsive excitation
+def _standardized_regressors(experiments, output="rho"):
+    from softbend.identification.narx import lagged_matrix
+
+    u = np.concatenate([e.pressure_kpa for e in experiments])
+    y = np.concatenate([getattr(e, output) for e in experiments])
+    groups = np.concatenate([np.full(e.n_samples, i) for i, e in enumerate(experiments)])
+    X, _, _ = lagged_matrix((u - u.mean()) / u.std(), (y - y.mean()) / y.std(), groups)
+    return X
+
+
+def test_impulsive_excitation_gives_heavy_tailed_regressors_and_mixed_light_tailed(dataset):
+    import warnings
+
+    from softbend.identification.kernels import ShapeClippedWarning, estimate_kernel_shape
+
+    impulsive = synthetic_dataset(n_experiments=3, seed=4, excitation="impulsive")
+    for sign, experiments in impulsive.items():
+        assert {e.metadata["profile"] for e in experiments} == {"impulsive"}
+        assert all(e.metadata["excitation"] == "impulsive" for e in experiments)
+        pressure = np.concatenate([e.pressure_kpa for e in experiments])
+        peak = 100.0 if sign == "positive" else -80.0
+        # Most samples near the operating point (20-34 % of the peak), a few pulses beyond.
+        near = (pressure / peak > 0.15) & (pressure / peak < 0.35)
+        assert 0.7 < near.mean() < 0.97
+        estimate = estimate_kernel_shape(_standardized_regressors(experiments))
+        assert estimate.relative_kurtosis > 1.5 and estimate.shape < 1.0
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", ShapeClippedWarning)
+        mixed = estimate_kernel_shape(_standardized_regressors(dataset["positive"]))
+    assert mixed.clipped and mixed.shape == 2.0 and mixed.relative_kurtosis < 1.0

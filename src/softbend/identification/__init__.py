@@ -12,6 +12,7 @@ from typing import Any
 
 _EXPORTS = {
     "estimate_gg_shape": "kernels",
+    "estimate_kernel_shape": "kernels",
     "generalized_gaussian_kernel": "kernels",
     "GeneralizedGaussianSVR": "svr",
     "NARXRegressor": "narx",
@@ -20,6 +21,7 @@ _EXPORTS = {
     "save_experiments": "data",
     "CurlingActuator": "synthetic",
     "synthetic_dataset": "synthetic",
+    "check_identify_memory": "resources",
 }
 
 __all__ = sorted(_EXPORTS)

@@ -20,11 +20,16 @@ from sklearn.preprocessing import StandardScaler
 from softbend import __version__
 from softbend._io import write_text_atomic
 from softbend.errors import SchemaError
+from softbend.identification.kernels import MOMENTS_OF
 from softbend.identification.narx import NARXRegressor, _lag_structure, _regressor_names
-from softbend.identification.svr import GeneralizedGaussianSVR
+from softbend.identification.svr import DEFAULT_MAX_WORKING_SET, GeneralizedGaussianSVR
 
 FORMAT = "softbend.narx-gg-svr"
-SCHEMA_VERSION = 1
+#: 2: the estimator parameters gained ``moments_of`` and ``max_working_set``. Version 1
+#: files are read with ``moments_of="components"`` (how their shape was estimated) and
+#: the default ``max_working_set``.
+SCHEMA_VERSION = 2
+_V1_DEFAULTS = {"moments_of": "components", "max_working_set": DEFAULT_MAX_WORKING_SET}
 
 
 def _scaler_state(scaler: StandardScaler | None) -> dict[str, list[float]] | None:
@@ -258,6 +263,12 @@ def _svr_params(value: Any) -> dict[str, Any]:
         _real(params["shape"], f"{where}.shape", low=0.0, strict=True, high=2.0)
     _bool(params["normalize"], f"{where}.normalize")
     _int(params["max_iter"], f"{where}.max_iter", -1)
+    _int(params["max_working_set"], f"{where}.max_working_set", 8)
+    if params["moments_of"] not in MOMENTS_OF:
+        raise _RuleError(
+            f"'{where}.moments_of' must be one of {', '.join(map(repr, MOMENTS_OF))}; "
+            f"got {_shown(params['moments_of'])}"
+        )
     return params
 
 
@@ -342,6 +353,10 @@ def narx_from_dict(data: dict[str, Any], *, source: str = "the saved model") -> 
             f"{source} has schema version {version}; this softbend ({__version__}) "
             f"reads versions up to {SCHEMA_VERSION}. Upgrade softbend to load it."
         )
+    estimator = data.get("estimator")
+    if version == 1 and isinstance(estimator, dict) and isinstance(estimator.get("params"), dict):
+        data = {**data, "estimator": {**estimator}}  # the caller's dict stays as it was
+        data["estimator"]["params"] = {**_V1_DEFAULTS, **estimator["params"]}
     try:
         _check_document(data)
     except _RuleError as err:
@@ -360,6 +375,7 @@ def narx_from_dict(data: dict[str, Any], *, source: str = "the saved model") -> 
         np.asarray(state["support_vectors"], dtype=float).reshape(-1, svr.n_features_in_)
     )
     svr.n_support_ = int(svr.dual_coef_.size)
+    svr.shape_estimate_ = None  # the moment diagnostics are not stored
     svr._precompute()
 
     narx_state = data["narx"]

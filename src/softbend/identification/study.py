@@ -26,7 +26,7 @@ import pandas as pd
 from softbend._validation import check_choice, check_int, check_range
 from softbend.errors import DatasetError
 from softbend.identification.data import Experiment
-from softbend.identification.kernels import ShapeClippedWarning
+from softbend.identification.kernels import MOMENTS_OF, ShapeClippedWarning
 from softbend.identification.narx import NARXRegressor
 from softbend.metrics import regression_metrics
 
@@ -57,6 +57,11 @@ class IdentificationConfig:
         them from the standardized regressors by the fourth-moment method (paper
         A); ``"cv"`` picks them by grouped cross-validation of the one-step error
         over a small grid (experiments never split across folds).
+    moments_of : {"differences", "regressors", "components"}
+        What the fourth-moment method measures with ``kernel="moments"``: the
+        kernel's argument x − z over all pairs of training rows (default), the
+        centred regressor vectors, or the pooled standardized components (the
+        earlier behaviour); see :mod:`softbend.identification.kernels`.
     """
 
     C: float = 100.0
@@ -64,6 +69,7 @@ class IdentificationConfig:
     output_lags: int = 2
     input_lags: int = 2
     kernel: Literal["moments", "cv"] = "moments"
+    moments_of: Literal["differences", "regressors", "components"] = "differences"
 
     def __post_init__(self) -> None:
         check_range(self.C, "C", "IdentificationConfig", low=0.0)
@@ -71,6 +77,7 @@ class IdentificationConfig:
         for name in ("output_lags", "input_lags"):
             check_int(getattr(self, name), name, "IdentificationConfig", low=1)
         check_choice(self.kernel, "kernel", "IdentificationConfig", ("moments", "cv"))
+        check_choice(self.moments_of, "moments_of", "IdentificationConfig", MOMENTS_OF)
 
 
 @dataclass
@@ -91,9 +98,13 @@ class IdentificationResult:
         ``{sign: [Experiment, ...]}`` as used.
     config : IdentificationConfig
     kernel_params : dict
-        ``{(sign, output): {"sigma", "shape", "shape_clipped", "n_support"}}`` of the
-        final models; ``shape_clipped`` is True when the moment estimate asked for a
-        shape above 2 (regressors flatter than Gaussian) and 2 was used.
+        ``{(sign, output): {...}}`` of the final models: ``sigma``, ``shape``,
+        ``n_support``; ``shape_source`` ("moments" or "cv"); ``shape_clipped``
+        (True when the moment estimate asked for a shape above 2, regressors
+        flatter than Gaussian, and 2 was used); ``moments_of``, ``kurtosis`` and
+        ``gaussian_kurtosis`` (the measured fourth-moment ratio and its value for
+        Gaussian data; None with "cv"); and ``shape_reason``, one sentence saying
+        why the shape is what it is.
     """
 
     metrics: pd.DataFrame
@@ -141,7 +152,13 @@ def _stack(experiments: Sequence[Experiment], output: str):
 def _make_model(config: IdentificationConfig, sigma: float | None, shape: float | None):
     from softbend.identification.svr import GeneralizedGaussianSVR
 
-    svr = GeneralizedGaussianSVR(C=config.C, epsilon=config.epsilon, sigma=sigma, shape=shape)
+    svr = GeneralizedGaussianSVR(
+        C=config.C,
+        epsilon=config.epsilon,
+        sigma=sigma,
+        shape=shape,
+        moments_of=config.moments_of,
+    )
     return NARXRegressor(
         estimator=svr, output_lags=config.output_lags, input_lags=config.input_lags
     )
@@ -173,6 +190,31 @@ def select_kernel_by_cv(
             if best is None or score < best[0]:
                 best = (score, {"sigma": sigma, "shape": shape})
     return best[1] if best is not None else {"sigma": 1.0, "shape": 2.0}
+
+
+def _kernel_report(svr: Any, config: IdentificationConfig) -> dict[str, Any]:
+    """Kernel of a fitted final model and why it has its shape (``kernel_params`` entry)."""
+    estimate = svr.shape_estimate_ if config.kernel == "moments" else None
+    if estimate is not None:
+        reason = estimate.reason
+    else:
+        grid = ", ".join(
+            f"{k} in {{{', '.join(f'{v:g}' for v in vs)}}}" for k, vs in CV_GRID.items()
+        )
+        reason = (
+            f"chosen by leave-one-experiment-out cross-validation of the one-step RMSE over {grid}"
+        )
+    return {
+        "sigma": float(svr.sigma_),
+        "shape": float(svr.shape_),
+        "shape_source": config.kernel,
+        "shape_clipped": bool(estimate is not None and estimate.clipped),
+        "moments_of": None if estimate is None else estimate.moments_of,
+        "kurtosis": None if estimate is None else float(estimate.kurtosis),
+        "gaussian_kurtosis": None if estimate is None else float(estimate.gaussian_kurtosis),
+        "shape_reason": reason,
+        "n_support": len(svr.dual_coef_),
+    }
 
 
 def identify(
@@ -246,29 +288,14 @@ def identify(
                 if progress is not None:
                     progress(f"{sign} {output} held-out {held_out.name}")
             u_all, y_all, g_all = _stack(group, output)
-            with warnings.catch_warnings(record=True) as caught:
-                warnings.simplefilter("always", ShapeClippedWarning)
+            with warnings.catch_warnings():
+                # Reported once, in kernel_params, with the reason.
+                warnings.simplefilter("ignore", ShapeClippedWarning)
                 final = _make_model(config, sigma, shape).fit(u_all, y_all, groups=g_all)
-            clipped = any(issubclass(w.category, ShapeClippedWarning) for w in caught)
-            for w in caught:
-                if not issubclass(w.category, ShapeClippedWarning):
-                    warnings.warn_explicit(w.message, w.category, w.filename, w.lineno)
-            if clipped:
-                logger.info(
-                    "%s %s: regressor kurtosis below 3 (flatter than Gaussian); "
-                    "kernel shape clipped to 2",
-                    sign,
-                    output,
-                )
             models[(sign, output)] = final
-            inner = final.estimator_
-            kernel_params[(sign, output)] = {
-                "sigma": float(inner.sigma_),
-                "shape": float(inner.shape_),
-                "shape_clipped": clipped,
-                "n_support": len(inner.dual_coef_),
-            }
-            logger.info("fitted %s %s: %s", sign, output, kernel_params[(sign, output)])
+            report = _kernel_report(final.estimator_, config)
+            kernel_params[(sign, output)] = report
+            logger.info("fitted %s %s: %s", sign, output, report)
             if progress is not None:
                 progress(f"{sign} {output} final model")
     metrics = pd.DataFrame(rows)

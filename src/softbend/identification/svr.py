@@ -1,32 +1,60 @@
 """Support vector regression with the generalized-Gaussian kernel (paper A §4).
 
 The kernel's hyperparameters (σ, γ) are estimator parameters, so grid search
-and ``get_params`` see them: the estimator computes the Gram matrix itself and
-fits :class:`sklearn.svm.SVR` on it (``kernel="precomputed"``). Prediction is a
-plain NumPy kernel expansion over the stored support vectors, and
-:meth:`GeneralizedGaussianSVR.predict_one` is a low-overhead path for control
-loops and free-run simulation.
+and ``get_params`` see them. How the ε-SVR dual is solved depends on the shape:
+
+* **γ = 2** is the Gaussian kernel, exp(−‖x − z‖²/(2σ²)): LIBSVM's own RBF
+  kernel solves it (:class:`sklearn.svm.SVR`, ``kernel="rbf"``). The density's
+  normalization c is a constant factor of the kernel, equivalent to the penalty
+  c·C (the dual coefficients are divided by c), so this is the same model as
+  the precomputed-Gram formulation, to solver tolerance. LIBSVM computes kernel
+  rows on demand into a cache of ``cache_size`` MB: memory grows as n, not n².
+* **γ ≠ 2** has no LIBSVM kernel. An active-set (chunking) decomposition keeps
+  the dense n × n Gram matrix out of memory: LIBSVM solves the dual restricted
+  to a working set W of at most ``max_working_set`` rows on its precomputed
+  Gram block, the rows outside W keep their coefficients, and W is rebuilt from
+  the support vectors and the rows that violate the optimality (KKT) conditions
+  most, until none outside W violates them by more than ``tol``. Kernel columns
+  of the support vectors over all rows are computed in blocks of bounded size
+  and cached (up to ``cache_size`` MB). The SVR dual is sparse (paper A's data:
+  about 40 support vectors of 3 060 rows), so W stays small and the fit is
+  exact to solver tolerance, as the dense formulation is; memory is at most
+  about 16·|W|² bytes (256 MiB at 4 096 rows) plus the two caches. When the
+  support vectors and the violators do not fit in ``max_working_set`` rows, W
+  is the set of most violating rows (Joachims' SVMlight selection), the other
+  rows keep their coefficients, and the equality constraint of the dual is kept
+  with one auxiliary variable (see :func:`_solve_active_set`); this converges
+  more slowly.
+
+Prediction is a NumPy kernel expansion over the stored support vectors, in
+row blocks of bounded size, and :meth:`GeneralizedGaussianSVR.predict_one` is a
+low-overhead path for control loops and free-run simulation.
 """
 
 from __future__ import annotations
 
 import logging
 import math
+import warnings
 from numbers import Integral
+from typing import NamedTuple
 
 import numpy as np
-from scipy.spatial.distance import cdist, pdist, squareform
+from scipy.spatial.distance import cdist
 from sklearn.base import BaseEstimator, RegressorMixin
-from sklearn.exceptions import NotFittedError
+from sklearn.exceptions import ConvergenceWarning, NotFittedError
 from sklearn.svm import SVR
 from sklearn.utils.validation import _check_sample_weight, check_is_fitted, validate_data
 
-from softbend._validation import check_choice, check_range
+from softbend._validation import check_choice, check_int, check_range
 from softbend.errors import ConvergenceError
 from softbend.identification.kernels import (
+    MOMENTS_OF,
+    ShapeEstimate,
+    _kernel_block,
     _kernel_from_sqdist,
-    _pooled_moments,
-    _shape_from_kurtosis,
+    _kernel_shape_estimate,
+    _warn_clipped,
     gg_normalization,
     gg_scale,
 )
@@ -36,6 +64,19 @@ logger = logging.getLogger(__name__)
 __all__ = ["GeneralizedGaussianSVR"]
 
 _OWNER = "GeneralizedGaussianSVR"
+
+#: Default cap on the working set of the γ ≠ 2 solver: 8·4096² bytes = 128 MiB of Gram.
+DEFAULT_MAX_WORKING_SET = 4096
+#: Size of the first working set (a fixed-seed random subset of the rows).
+_INITIAL_WORKING_SET = 512
+#: Most violating rows added to the working set per round (bounds the Gram block).
+_MAX_ADDED = 512
+#: Rounds of the active-set loop before it gives up with a ConvergenceWarning: this
+#: many, plus _ROUNDS_PER_CHUNK per max_working_set rows (a small working set needs more).
+_MAX_ROUNDS = 200
+_ROUNDS_PER_CHUNK = 50
+#: Bytes of one block of kernel values (rows × support vectors) in fit and predict.
+_BLOCK_BYTES = 32 * 2**20
 
 
 def _check_max_iter(value: object) -> int:
@@ -59,20 +100,319 @@ def _merge_duplicates(
     """
     keep = weight > 0.0
     rows = np.column_stack([X[keep], y[keep]])
-    unique, inverse = np.unique(rows, axis=0, return_inverse=True)
-    merged_weight = np.bincount(inverse.ravel(), weights=weight[keep], minlength=len(unique))
+    order = np.lexsort(rows.T[::-1])  # first column primary, as np.unique(axis=0) sorts
+    rows = rows[order]
+    starts = np.flatnonzero(np.concatenate(([True], np.any(rows[1:] != rows[:-1], axis=1))))
+    merged_weight = np.add.reduceat(weight[keep][order], starts)
+    unique = rows[starts]
     return np.ascontiguousarray(unique[:, :-1]), unique[:, -1].copy(), merged_weight
+
+
+class _Solution(NamedTuple):
+    """Dual solution for the unnormalized kernel: f(x) = Σ alpha_i K(x_i, x) + intercept."""
+
+    support: np.ndarray  # indices of the rows with alpha != 0, ascending
+    alpha: np.ndarray  # their coefficients, target units
+    intercept: float
+    n_iter: int
+
+
+def _libsvm_weights(weight: np.ndarray) -> np.ndarray | None:
+    """Per-row weights for LIBSVM (its box is C_i = C·w_i), or None when all are 1."""
+    return None if bool(np.all(weight == 1.0)) else weight
+
+
+def _solve_rbf(
+    X: np.ndarray,
+    y: np.ndarray,
+    weight: np.ndarray,
+    *,
+    C: float,
+    epsilon: float,
+    gamma: float,
+    tol: float,
+    cache_size: float,
+    max_iter: int,
+) -> _Solution:
+    """ε-SVR with LIBSVM's RBF kernel exp(−gamma·‖x − z‖²) and box C·w_i."""
+    svr = SVR(
+        kernel="rbf",
+        gamma=gamma,
+        C=C,
+        epsilon=epsilon,
+        tol=tol,
+        cache_size=cache_size,
+        max_iter=max_iter,
+    )
+    svr.fit(X, y, sample_weight=_libsvm_weights(weight))
+    return _Solution(
+        support=np.asarray(svr.support_, dtype=np.intp),
+        alpha=np.asarray(svr.dual_coef_, dtype=float).ravel(),
+        intercept=float(np.asarray(svr.intercept_).ravel()[0]),
+        n_iter=int(np.asarray(svr.n_iter_).ravel()[0]),
+    )
+
+
+def _block_rows(n_columns: int) -> int:
+    """Rows per block so that a float64 block of ``n_columns`` stays near _BLOCK_BYTES."""
+    return max(1, _BLOCK_BYTES // (8 * max(1, n_columns)))
+
+
+class _KernelColumns:
+    """Columns K(X, x_j) of the unnormalized kernel over all training rows, cached.
+
+    The active-set solver needs, every round, the Gram block of its working set
+    and the products K(X, X_moved)·Δα. Columns of rows that moved (support
+    vectors, mostly the same from round to round) are kept, one contiguous row
+    per column in a (capacity, n) array of at most ``budget_bytes`` (its memory
+    is touched only as columns are stored); columns beyond it are computed in
+    row blocks of bounded size and dropped.
+    """
+
+    def __init__(self, X: np.ndarray, *, sigma: float, shape: float, budget_bytes: float) -> None:
+        self.X = X
+        self.sigma = sigma
+        self.shape = shape
+        n = X.shape[0]
+        self.capacity = int(min(n, budget_bytes // (8 * n)))
+        self.store = np.empty((self.capacity, n))
+        self.slot = np.full(n, -1, dtype=np.intp)
+        self.used = 0
+
+    def _compute(
+        self, rows: slice | np.ndarray, cols: np.ndarray, *, single: bool = False
+    ) -> np.ndarray:
+        return _kernel_block(
+            self.X[rows], self.X[cols], sigma=self.sigma, shape=self.shape, single=single
+        )
+
+    def _remember(self, cols: np.ndarray) -> None:
+        """Compute and store the columns of ``cols`` that are missing, while room is left."""
+        missing = cols[self.slot[cols] < 0][: self.capacity - self.used]
+        if missing.size == 0:
+            return
+        slots = np.arange(self.used, self.used + missing.size)
+        n = self.X.shape[0]
+        step = _block_rows(missing.size)
+        for start in range(0, n, step):
+            rows = slice(start, min(n, start + step))
+            self.store[self.used : self.used + missing.size, rows] = self._compute(rows, missing).T
+        self.slot[missing] = slots
+        self.used += missing.size
+
+    def gram(self, rows: np.ndarray) -> np.ndarray:
+        """K(X[rows], X[rows]) for LIBSVM, from stored columns where possible.
+
+        Columns not stored are evaluated in float32: LIBSVM keeps its kernel
+        values in single precision (``Qfloat``) in any case. Products with the
+        coefficients use only stored (float64) columns as long as the store
+        holds every row with a nonzero coefficient.
+        """
+        slots = self.slot[rows]
+        known = slots >= 0
+        if not known.any():
+            return self._compute(rows, rows, single=True)
+        gram = np.empty((rows.size, rows.size))
+        gram[:, known] = self.store[np.ix_(slots[known], rows)].T
+        if not known.all():
+            gram[:, ~known] = self._compute(rows, rows[~known], single=True)
+        return gram
+
+    def add_product(self, target: np.ndarray, cols: np.ndarray, coef: np.ndarray) -> None:
+        """target += K(X, X[cols]) @ coef."""
+        self._remember(cols)
+        slots = self.slot[cols]
+        known = slots >= 0
+        if known.any():
+            weights = np.zeros(self.used)
+            np.add.at(weights, slots[known], coef[known])
+            target += weights @ self.store[: self.used]
+        if not known.all():
+            rest, rest_coef = cols[~known], coef[~known]
+            n = self.X.shape[0]
+            step = _block_rows(rest.size)
+            for start in range(0, n, step):
+                rows = slice(start, min(n, start + step))
+                target[rows] += self._compute(rows, rest) @ rest_coef
+
+
+def _most_violating(up: np.ndarray, low: np.ndarray, size: int) -> np.ndarray:
+    """Working set of the decomposition method (Joachims' SVMlight selection).
+
+    Half of the rows with the largest up values and half with the smallest low
+    values (the two ends of the maximal violating pairs), ``size`` rows in all.
+    """
+    by_up = np.argsort(-up, kind="stable")
+    by_low = np.argsort(low, kind="stable")
+    chosen = np.zeros(up.size, dtype=bool)
+    count = 0
+    for i, j in zip(by_up, by_low, strict=True):
+        for row in (i, j):
+            if not chosen[row] and count < size:
+                chosen[row] = True
+                count += 1
+        if count >= size:
+            break
+    return np.flatnonzero(chosen)
+
+
+def _solve_active_set(
+    X: np.ndarray,
+    y: np.ndarray,
+    weight: np.ndarray,
+    *,
+    C: float,
+    epsilon: float,
+    sigma: float,
+    shape: float,
+    tol: float,
+    cache_size: float,
+    max_iter: int,
+    max_working_set: int,
+) -> _Solution:
+    """ε-SVR with the unnormalized GG kernel without forming the n × n Gram matrix.
+
+    The dual, for α_i = α⁺_i − α⁻_i, is
+
+        min ½ αᵀKα − yᵀα + ε‖α‖₁   s.t.   Σ α_i = 0,  |α_i| ≤ B_i = C·w_i.
+
+    With e_i = y_i − (Kα)_i, a row offers the "up" value e_i + ε if α_i < 0, else
+    e_i − ε if α_i < B_i, and the "low" value e_i − ε if α_i > 0, else e_i + ε if
+    α_i > −B_i (LIBSVM's −y∇f of the variables that may move up or down); α is
+    optimal when max(up) − min(low) ≤ tol (LIBSVM's stopping rule). Each round
+    solves the dual over the working set W with LIBSVM on the Gram block K_WW,
+    the rows N outside W held fixed: the linear term becomes y_W − K_WN α_N and
+    the equality constraint Σ_W α_i = −Σ_N α_i =: s. LIBSVM's SVR only knows
+    s = 0, so when s ≠ 0 one auxiliary row p is appended, orthogonal to W
+    (K_pW = 0, K_pp = 1), with box |s| and a target of sign −s larger than
+    |s| + 2ε + max|y_W − K_WN α_N| + Σ_W B_i, a bound on the subproblem's offset
+    b, so that its coefficient sits at its bound −s (checked after the solve):
+    the constraint Σ_W α + α_p = 0 is then Σ_W α = s. Rows outside W whose up
+    (low) value exceeds (falls below) W's min(low) (max(up)) by more than ``tol``
+    join W, the most violating first, with W's support vectors; without such
+    rows, α is optimal to the
+    tolerance LIBSVM reached on W. Every round lowers the dual objective (the
+    previous α_W is feasible for it), so the loop cannot cycle. The first W is a
+    fixed-seed random subset of :data:`_INITIAL_WORKING_SET` rows; at most
+    :data:`_MAX_ADDED` violators join per round; when the support vectors and the
+    violators exceed ``max_working_set``, W is chosen by :func:`_most_violating`.
+    """
+    n = y.size
+    box = C * weight
+    alpha = np.zeros(n)
+    kernel_alpha = np.zeros(n)  # (K α)_i, kept up to date with the blocked products
+    columns = _KernelColumns(X, sigma=sigma, shape=shape, budget_bytes=cache_size * 2**20)
+    limit = min(n, max_working_set)
+    first = min(limit, _INITIAL_WORKING_SET)
+    if first >= n:
+        work = np.arange(n)
+    else:
+        work = np.sort(np.random.default_rng(0).choice(n, size=first, replace=False))
+    n_iter = 0
+    converged = False
+    max_rounds = _MAX_ROUNDS + _ROUNDS_PER_CHUNK * math.ceil(n / limit)
+    for _ in range(max_rounds):
+        inside = np.zeros(n, dtype=bool)
+        inside[work] = True
+        gram = columns.gram(work)
+        alpha_work = alpha[work]
+        target = y[work] - (kernel_alpha[work] - gram @ alpha_work)
+        weights = weight[work]
+        total = -float(alpha[~inside].sum())  # s, the sum the working set must keep
+        auxiliary = total != 0.0
+        if auxiliary:
+            size = work.size
+            padded = np.zeros((size + 1, size + 1))
+            padded[:size, :size] = gram
+            padded[size, size] = 1.0
+            gram = padded
+            push = abs(total) + 2.0 * epsilon + float(np.abs(target).max()) + float(box[work].sum())
+            target = np.append(target, -math.copysign(push + 1.0, total))
+            weights = np.append(weights, abs(total) / C)
+        svr = SVR(
+            kernel="precomputed",
+            C=C,
+            epsilon=epsilon,
+            tol=tol,
+            cache_size=cache_size,
+            max_iter=max_iter,
+        )
+        svr.fit(gram, target, sample_weight=_libsvm_weights(weights))
+        del gram
+        solved = np.zeros(target.size)
+        solved[svr.support_] = np.asarray(svr.dual_coef_, dtype=float).ravel()
+        n_iter += int(np.asarray(svr.n_iter_).ravel()[0])
+        if auxiliary:
+            if not math.isclose(solved[-1], -total, rel_tol=1e-9, abs_tol=1e-12 * C):
+                raise ConvergenceError(
+                    f"The active-set solver of {_OWNER} could not keep the equality "
+                    f"constraint (auxiliary coefficient {solved[-1]!r}, expected {-total!r}); "
+                    "raise max_working_set."
+                )
+            solved = solved[:-1]
+        change = solved - alpha_work
+        moved = np.flatnonzero(change)
+        if moved.size:
+            columns.add_product(kernel_alpha, work[moved], change[moved])
+        alpha[work] = solved
+
+        residual = y - kernel_alpha
+        up = np.where(alpha < 0.0, residual + epsilon, residual - epsilon)
+        up[alpha >= box] = -np.inf
+        low = np.where(alpha > 0.0, residual - epsilon, residual + epsilon)
+        low[alpha <= -box] = np.inf
+        highest_up = float(up[work].max())
+        lowest_low = float(low[work].min())
+        violation = np.maximum(up - lowest_low, highest_up - low)
+        violation[inside] = -np.inf
+        candidates = np.flatnonzero(violation > tol)
+        if candidates.size == 0:
+            converged = True
+            break
+        support = work[solved != 0.0]
+        if candidates.size > _MAX_ADDED:
+            worst = np.argpartition(-violation[candidates], _MAX_ADDED)[:_MAX_ADDED]
+            candidates = candidates[worst]
+        if support.size + candidates.size <= limit:
+            # Sparse case (the usual one): the support vectors and the worst violators fit.
+            work = np.sort(np.concatenate([support, candidates]))
+        else:
+            work = _most_violating(up, low, limit)
+    if not converged:
+        warnings.warn(
+            f"The active-set solver of {_OWNER} stopped after {max_rounds} rounds with rows "
+            "still violating the optimality conditions; the fit may be inaccurate. Raise "
+            "max_working_set or tol.",
+            ConvergenceWarning,
+            stacklevel=3,
+        )
+
+    residual = y - kernel_alpha
+    support = np.flatnonzero(alpha)
+    free = support[np.abs(alpha[support]) < box[support]]
+    if free.size:
+        intercept = float(np.mean(residual[free] - epsilon * np.sign(alpha[free])))
+    else:  # LIBSVM's rule: the middle of the interval of feasible offsets
+        up = np.where(alpha < 0.0, residual + epsilon, residual - epsilon)
+        up[alpha >= box] = -np.inf
+        low = np.where(alpha > 0.0, residual - epsilon, residual + epsilon)
+        low[alpha <= -box] = np.inf
+        intercept = 0.5 * (float(up.max()) + float(low.min()))
+    return _Solution(support=support, alpha=alpha[support], intercept=intercept, n_iter=n_iter)
 
 
 class GeneralizedGaussianSVR(RegressorMixin, BaseEstimator):
     """ε-SVR with the generalized-Gaussian kernel K = c·exp(−(g(γ)‖x − z‖/σ)^γ).
 
-    The model is f(x) = Σᵢ βᵢ K(sᵢ, x) + b over the support vectors sᵢ, fitted
-    by LIBSVM's ε-insensitive dual on a precomputed Gram matrix (paper A §4).
-    When ``sigma`` or ``shape`` is None it is estimated from the training inputs
-    by the fourth-moment method of :func:`~softbend.identification.kernels.estimate_gg_shape`
-    (pooled per-feature variance for σ, pooled standardized kurtosis for γ,
-    clipped to γ ≤ 2 with a ``ShapeClippedWarning``).
+    The model is f(x) = Σᵢ βᵢ K(sᵢ, x) + b over the support vectors sᵢ, the
+    solution of LIBSVM's ε-insensitive dual (paper A §4): with LIBSVM's RBF
+    kernel at γ = 2, and by an active-set decomposition over Gram blocks of at
+    most ``max_working_set`` rows otherwise (see the module docstring); neither
+    forms the n × n Gram matrix. When ``sigma`` or ``shape`` is None it is
+    estimated from the training inputs by the fourth-moment method of
+    :func:`~softbend.identification.kernels.estimate_kernel_shape` applied to
+    what ``moments_of`` names (σ: pooled per-feature standard deviation; γ
+    clipped to (0.05, 2] with a ``ShapeClippedWarning``).
 
     Parameters
     ----------
@@ -88,14 +428,23 @@ class GeneralizedGaussianSVR(RegressorMixin, BaseEstimator):
     shape : float or None, default None
         Kernel shape γ in (0, 2] (2 Gaussian, 1 Laplacian); estimated when None.
         Values above 2 are rejected: the kernel would not be positive definite.
+    moments_of : {"differences", "regressors", "components"}, default "differences"
+        What the fourth-moment estimate of the shape measures: the kernel's
+        argument x − z over all pairs of training rows (default), the centred
+        rows, or the pooled standardized components (the earlier behaviour).
+        Only used when ``shape`` or ``sigma`` is None.
     normalize : bool, default True
         Multiply the kernel by the density normalization c = g(γ)γ/(2σΓ(1/γ)).
     tol : float, default 1e-3
-        Stopping tolerance of the LIBSVM solver, > 0.
+        Stopping tolerance of the solver (LIBSVM's, on the dual's optimality
+        conditions), > 0.
     cache_size : float, default 200.0
-        Kernel cache of the solver, MB, > 0.
+        Kernel cache of LIBSVM, MB, > 0.
     max_iter : int, default -1
-        Solver iteration limit, -1 for none.
+        Iteration limit of each LIBSVM solve, -1 for none.
+    max_working_set : int, default 4096
+        Most rows whose Gram block the γ ≠ 2 solver holds at once, ≥ 8; its memory
+        is about 8·max_working_set² bytes (128 MiB at 4096). Not used at γ = 2.
 
     Attributes
     ----------
@@ -103,6 +452,9 @@ class GeneralizedGaussianSVR(RegressorMixin, BaseEstimator):
         Kernel width used, input units.
     shape_ : float
         Kernel shape used.
+    shape_estimate_ : ShapeEstimate or None
+        The moment estimate (measured ratio, its Gaussian value, ``reason``) when
+        σ or γ was estimated, else None.
     kernel_scale_ : float
         Constant factor c of the kernel (1 when ``normalize=False``).
     support_vectors_ : ndarray of shape (n_sv, n_features)
@@ -114,7 +466,7 @@ class GeneralizedGaussianSVR(RegressorMixin, BaseEstimator):
     n_support_ : int
         Number of support vectors.
     n_iter_ : int
-        Solver iterations.
+        Solver iterations (summed over the rounds of the γ ≠ 2 solver).
     n_features_in_ : int
         Number of input features.
     feature_names_in_ : ndarray of str
@@ -135,19 +487,23 @@ class GeneralizedGaussianSVR(RegressorMixin, BaseEstimator):
         epsilon: float = 0.1,
         sigma: float | None = None,
         shape: float | None = None,
+        moments_of: str = "differences",
         normalize: bool = True,
         tol: float = 1e-3,
         cache_size: float = 200.0,
         max_iter: int = -1,
+        max_working_set: int = DEFAULT_MAX_WORKING_SET,
     ) -> None:
         self.C = C
         self.epsilon = epsilon
         self.sigma = sigma
         self.shape = shape
+        self.moments_of = moments_of
         self.normalize = normalize
         self.tol = tol
         self.cache_size = cache_size
         self.max_iter = max_iter
+        self.max_working_set = max_working_set
 
     def fit(
         self, X: np.ndarray, y: np.ndarray, sample_weight: np.ndarray | None = None
@@ -181,7 +537,9 @@ class GeneralizedGaussianSVR(RegressorMixin, BaseEstimator):
         tol = check_range(self.tol, "tol", _OWNER, low=0.0)
         cache_size = check_range(self.cache_size, "cache_size", _OWNER, low=0.0)
         max_iter = _check_max_iter(self.max_iter)
+        max_working_set = check_int(self.max_working_set, "max_working_set", _OWNER, low=8)
         normalize = bool(check_choice(self.normalize, "normalize", _OWNER, (True, False)))
+        moments_of = check_choice(self.moments_of, "moments_of", _OWNER, MOMENTS_OF)
         sigma = None if self.sigma is None else check_range(self.sigma, "sigma", _OWNER, low=0.0)
         shape = (
             None
@@ -193,6 +551,7 @@ class GeneralizedGaussianSVR(RegressorMixin, BaseEstimator):
         weight = _check_sample_weight(sample_weight, X, dtype=np.float64, ensure_non_negative=True)
         X_fit, y_fit, w_fit = _merge_duplicates(X, y, weight)
 
+        estimate: ShapeEstimate | None = None
         if sigma is None or shape is None:
             n_distinct = X_fit.shape[0]
             if n_distinct < 4:
@@ -201,32 +560,49 @@ class GeneralizedGaussianSVR(RegressorMixin, BaseEstimator):
                     f"estimate sigma/shape (or pass both). Got n_samples = {n_distinct} instead."
                 )
             try:
-                sigma_hat, kurtosis = _pooled_moments(X_fit, w_fit, _OWNER, name="X")
+                estimate = _kernel_shape_estimate(X_fit, w_fit, moments_of, _OWNER)
             except ValueError as err:
                 raise ValueError(f"{err} Pass sigma and shape explicitly.") from None
             if sigma is None:
-                sigma = sigma_hat
+                sigma = estimate.sigma
             if shape is None:
-                shape = _shape_from_kurtosis(kurtosis)
+                shape = estimate.shape
+                if estimate.clipped:
+                    _warn_clipped(estimate, stacklevel=3)
             logger.debug("%s: kernel sigma=%.6g shape=%.6g", _OWNER, sigma, shape)
 
+        # The normalization c multiplies the kernel; the dual with Gram c·K and box C
+        # is the dual with Gram K and box c·C, its coefficients scaled by c.
         scale = gg_normalization(sigma, shape) if normalize else 1.0
-        sqdist = squareform(pdist(X_fit, "sqeuclidean"))
-        gram = _kernel_from_sqdist(sqdist, sigma=sigma, shape=shape, scale=scale)
+        if shape == 2.0:
+            solution = _solve_rbf(
+                X_fit,
+                y_fit,
+                w_fit,
+                C=C * scale,
+                epsilon=epsilon,
+                gamma=gg_scale(2.0) ** 2 / sigma**2,
+                tol=tol,
+                cache_size=cache_size,
+                max_iter=max_iter,
+            )
+        else:
+            solution = _solve_active_set(
+                X_fit,
+                y_fit,
+                w_fit,
+                C=C * scale,
+                epsilon=epsilon,
+                sigma=sigma,
+                shape=shape,
+                tol=tol,
+                cache_size=cache_size,
+                max_iter=max_iter,
+                max_working_set=max_working_set,
+            )
 
-        svr = SVR(
-            kernel="precomputed",
-            C=C,
-            epsilon=epsilon,
-            tol=tol,
-            cache_size=cache_size,
-            max_iter=max_iter,
-        )
-        unit_weights = bool(np.all(w_fit == 1.0))
-        svr.fit(gram, y_fit, sample_weight=None if unit_weights else w_fit)
-
-        dual_coef = np.asarray(svr.dual_coef_, dtype=float).ravel()
-        intercept = float(np.asarray(svr.intercept_).ravel()[0])
+        dual_coef = solution.alpha / scale
+        intercept = solution.intercept
         if not (np.all(np.isfinite(dual_coef)) and math.isfinite(intercept)):
             raise ConvergenceError(
                 f"The SVR solver of {_OWNER} returned non-finite coefficients; "
@@ -235,12 +611,13 @@ class GeneralizedGaussianSVR(RegressorMixin, BaseEstimator):
 
         self.sigma_ = float(sigma)
         self.shape_ = float(shape)
+        self.shape_estimate_ = estimate
         self.kernel_scale_ = float(scale)
-        self.support_vectors_ = np.ascontiguousarray(X_fit[svr.support_])
+        self.support_vectors_ = np.ascontiguousarray(X_fit[solution.support])
         self.dual_coef_ = dual_coef
         self.intercept_ = intercept
         self.n_support_ = int(dual_coef.size)
-        self.n_iter_ = int(np.asarray(svr.n_iter_).ravel()[0])
+        self.n_iter_ = solution.n_iter
         self._precompute()
         return self
 
@@ -255,9 +632,16 @@ class GeneralizedGaussianSVR(RegressorMixin, BaseEstimator):
         self._coef = self.dual_coef_ * self.kernel_scale_
         self._x_shape = (self.n_features_in_,)
 
-    def _expansion(self, sqdist: np.ndarray) -> np.ndarray:
-        kernel = _kernel_from_sqdist(sqdist, sigma=self.sigma_, shape=self.shape_, scale=1.0)
-        return kernel @ self._coef + self.intercept_
+    def _expansion(self, X: np.ndarray) -> np.ndarray:
+        """Σ βᵢ c K(sᵢ, x) + b for every row of X, in row blocks of bounded memory."""
+        out = np.empty(X.shape[0])
+        step = _block_rows(self.support_vectors_.shape[0])
+        for start in range(0, X.shape[0], step):
+            sqdist = cdist(X[start : start + step], self.support_vectors_, "sqeuclidean")
+            kernel = _kernel_from_sqdist(sqdist, sigma=self.sigma_, shape=self.shape_, scale=1.0)
+            out[start : start + step] = kernel @ self._coef
+        out += self.intercept_
+        return out
 
     def predict(self, X: np.ndarray) -> np.ndarray:
         """Predict targets by the kernel expansion f(x) = Σ βᵢ K(sᵢ, x) + b.
@@ -274,7 +658,7 @@ class GeneralizedGaussianSVR(RegressorMixin, BaseEstimator):
         """
         check_is_fitted(self)
         X = validate_data(self, X, reset=False, dtype=np.float64)
-        return self._expansion(cdist(X, self.support_vectors_, "sqeuclidean"))
+        return self._expansion(X)
 
     def predict_one(self, x: np.ndarray) -> float:
         """Predict the target of one sample with minimal overhead.

@@ -65,9 +65,16 @@ import numpy as np
 from softbend._validation import check_choice, check_range
 from softbend.identification.data import Experiment
 
-#: Profile kinds understood by :func:`pressure_profile`, in the order
-#: :func:`synthetic_dataset` cycles through them.
+#: Profile kinds of the ``"mixed"`` excitation, in the order :func:`synthetic_dataset`
+#: cycles through them.
 PROFILE_KINDS: tuple[str, ...] = ("random_hold", "staircase", "triangle", "step", "sine", "ramp")
+#: Every kind :func:`pressure_profile` understands: the mixed ones and ``"impulsive"``.
+ALL_PROFILE_KINDS: tuple[str, ...] = (*PROFILE_KINDS, "impulsive")
+#: Excitations of :func:`synthetic_dataset`: ``"mixed"`` cycles through
+#: :data:`PROFILE_KINDS` (uniform-like coverage of the pressure range, paper A's
+#: layout); ``"impulsive"`` holds an operating point and adds rare short pulses,
+#: which gives heavy-tailed regressors.
+EXCITATIONS: tuple[str, ...] = ("mixed", "impulsive")
 
 #: Text that marks generated data everywhere it is stored.
 SYNTHETIC_LABEL = (
@@ -75,7 +82,8 @@ SYNTHETIC_LABEL = (
     "not a measurement (paper A's data are not public)"
 )
 
-ProfileKind = Literal["random_hold", "staircase", "triangle", "step", "sine", "ramp"]
+ProfileKind = Literal["random_hold", "staircase", "triangle", "step", "sine", "ramp", "impulsive"]
+Excitation = Literal["mixed", "impulsive"]
 _OWNER = "CurlingActuator"
 
 
@@ -493,7 +501,7 @@ def pressure_profile(
 
     Parameters
     ----------
-    kind : {"random_hold", "staircase", "triangle", "step", "sine", "ramp"}
+    kind : {"random_hold", "staircase", "triangle", "step", "sine", "ramp", "impulsive"}
         ``"random_hold"``: random levels held for random durations (0.1–0.8 s),
         the usual amplitude-modulated random sequence for NARX identification.
         ``"staircase"``: equal steps up to the peak and back down (a quasi-static
@@ -501,7 +509,12 @@ def pressure_profile(
         (2.5–4 s). ``"step"``: steps from 0 to random levels and back, like paper
         A's fixed-pressure tests. ``"sine"``: ``(1 - cos)/2`` swept in frequency
         (chirp) from about 0.15 Hz to about 1 Hz. ``"ramp"``: trapezoids with
-        random slopes, levels and hold times.
+        random slopes, levels and hold times. ``"impulsive"``: an operating point
+        at 20–30 % of the peak, held with small random steps (±4 % of the peak,
+        0.2–1 s), disturbed by rare short pulses (0.5 per second on average, 0.04–
+        0.2 s long, 50–100 % of the peak, one at full scale): most samples sit near
+        the operating point, a few far from it, so the regressors are heavy-tailed
+        (kurtosis well above the Gaussian 3), unlike the other kinds.
     n_samples : int
         Number of samples (>= 16).
     dt_s : float
@@ -519,7 +532,7 @@ def pressure_profile(
     pressure_kpa : numpy.ndarray
         Commanded pressure, kPa.
     """
-    check_choice(kind, "kind", "pressure_profile", PROFILE_KINDS)
+    check_choice(kind, "kind", "pressure_profile", ALL_PROFILE_KINDS)
     n = int(
         check_range(
             n_samples, "n_samples", "pressure_profile", low=16, high=math.inf, low_inclusive=True
@@ -572,6 +585,17 @@ def pressure_profile(
         shape = 0.5 * (1.0 - np.cos(phase))
         # Sampled crests fall just short of 1: make the highest sample exactly full scale.
         shape[np.argmax(shape)] = 1.0
+    elif kind == "impulsive":
+        base = rng.uniform(0.2, 0.3)
+        for a, b in _hold_levels(rng, body, dt, 0.2, 1.0):
+            shape[a:b] = base + rng.uniform(-0.04, 0.04)
+        n_pulses = max(1, int(rng.poisson(0.5 * body * dt)))
+        starts = rng.integers(0, body, size=n_pulses)
+        heights = rng.uniform(0.5, 1.0, size=n_pulses)
+        heights[0] = 1.0
+        for start, height in zip(starts, heights, strict=True):
+            width = max(1, round(rng.uniform(0.04, 0.2) / dt))
+            shape[start : start + width] = np.maximum(shape[start : start + width], height)
     else:  # ramp
         position = 0
         index = 0
@@ -606,14 +630,19 @@ def synthetic_dataset(
     dt_s: float = 0.02,
     seed: int = 0,
     actuator: CurlingActuator | None = None,
+    excitation: Excitation = "mixed",
 ) -> dict[str, list[Experiment]]:
     """Labelled-synthetic identification data in the layout of paper A.
 
     Paper A trains each model on 6 experiments of 512 samples, separately for
     positive pressure and for vacuum. This builds the same: for each sign,
-    ``n_experiments`` experiments cycling through :data:`PROFILE_KINDS` (so the
-    default six use each kind once), every one spanning the full pressure range
-    of its sign, so that any experiment held out is covered by the others.
+    ``n_experiments`` experiments, every one spanning the full pressure range of
+    its sign, so that any experiment held out is covered by the others. The
+    ``"mixed"`` excitation cycles through :data:`PROFILE_KINDS` (the default six
+    use each kind once); its regressors are lighter-tailed than Gaussian, so the
+    moment estimate of the kernel shape is 2 there. The ``"impulsive"``
+    excitation gives every experiment the ``"impulsive"`` profile (an operating
+    point with rare pulses), whose regressors are heavy-tailed.
 
     Parameters
     ----------
@@ -628,6 +657,8 @@ def synthetic_dataset(
         (:class:`numpy.random.SeedSequence`). Same seed, identical arrays.
     actuator : CurlingActuator, optional
         The simulated actuator; defaults to ``CurlingActuator()``.
+    excitation : {"mixed", "impulsive"}, default "mixed"
+        Which pressure profiles drive the experiments (see :data:`EXCITATIONS`).
 
     Returns
     -------
@@ -650,6 +681,7 @@ def synthetic_dataset(
             f"Got {n_experiments!r} instead."
         )
     count = int(count)
+    check_choice(excitation, "excitation", "synthetic_dataset", EXCITATIONS)
     plant = CurlingActuator() if actuator is None else actuator
     if not isinstance(plant, CurlingActuator):
         raise ValueError(
@@ -663,7 +695,7 @@ def synthetic_dataset(
     ):
         experiments = []
         for i in range(count):
-            kind = PROFILE_KINDS[i % len(PROFILE_KINDS)]
+            kind = PROFILE_KINDS[i % len(PROFILE_KINDS)] if excitation == "mixed" else excitation
             profile_seed, noise_seed = (int(v) for v in children[s, i])
             time, pressure = pressure_profile(kind, n_samples, dt_s, peak, seed=profile_seed)
             experiments.append(
@@ -672,7 +704,12 @@ def synthetic_dataset(
                     pressure,
                     seed=noise_seed,
                     name=f"{sign}-{i + 1:02d}",
-                    metadata={"profile": kind, "profile_seed": profile_seed, "master_seed": seed},
+                    metadata={
+                        "profile": kind,
+                        "profile_seed": profile_seed,
+                        "master_seed": seed,
+                        "excitation": excitation,
+                    },
                 )
             )
         dataset[sign] = experiments
