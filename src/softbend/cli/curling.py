@@ -21,6 +21,9 @@ def simulate(
     samples: int = typer.Option(512, help="Samples per experiment."),
     dt: float = typer.Option(0.02, "--dt", help="Sample period in s."),
     seed: int = typer.Option(0, help="Seed of the experiment design and the camera noise."),
+    excitation: str = typer.Option(
+        "mixed", help="Pressure profiles: mixed (paper A-like) or impulsive (rare short pulses)."
+    ),
     as_json: bool = typer.Option(False, "--json", help="Print a JSON summary instead of a table."),
 ) -> None:
     """Write synthetic curling-actuator experiments (positive and negative pressure) as CSV."""
@@ -28,7 +31,9 @@ def simulate(
     from softbend.identification.synthetic import synthetic_dataset
 
     _common.check_output_dir(out, "--out")
-    dataset = synthetic_dataset(n_experiments=experiments, n_samples=samples, dt_s=dt, seed=seed)
+    dataset = synthetic_dataset(
+        n_experiments=experiments, n_samples=samples, dt_s=dt, seed=seed, excitation=excitation
+    )
     all_experiments = [e for group in dataset.values() for e in group]
     with _common.output_errors(out, "--out"):
         paths = save_experiments(all_experiments, out)
@@ -74,6 +79,11 @@ def identify(
     kernel: str = typer.Option(
         "moments", help="Kernel width/shape: 'moments' (paper A) or 'cv' (cross-validated)."
     ),
+    moments_of: str = typer.Option(
+        "differences",
+        help="What the fourth-moment shape is measured on: differences (the kernel's "
+        "arguments x - z), regressors, or components (the pooled regressors, before).",
+    ),
     max_memory_mb: float | None = typer.Option(
         None,
         "--max-memory-mb",
@@ -90,7 +100,12 @@ def identify(
     from softbend.reports.paper_a import write_identification_outputs
 
     config = IdentificationConfig(
-        C=c, epsilon=epsilon, output_lags=output_lags, input_lags=input_lags, kernel=kernel
+        C=c,
+        epsilon=epsilon,
+        output_lags=output_lags,
+        input_lags=input_lags,
+        kernel=kernel,
+        moments_of=moments_of,
     )
     csvs = [p for p in data.iterdir() if p.suffix.lower() == ".csv"] if data.is_dir() else []
     inputs = (data, *csvs)

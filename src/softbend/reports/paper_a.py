@@ -92,7 +92,7 @@ def add_section(
         caption="Held-out accuracy, mean and worst over experiments",
     )
     section.table(
-        ["model", "σ (std units)", "shape γ", "clipped to 2", "support vectors"],
+        ["model", "σ (std units)", "shape γ", "clipped to 2", "support vectors", "why this shape"],
         [
             [
                 f"{sign} {output}",
@@ -100,6 +100,7 @@ def add_section(
                 p["shape"],
                 "yes" if p["shape_clipped"] else "no",
                 p["n_support"],
+                p.get("shape_reason") or p.get("shape_source", ""),
             ]
             for (sign, output), p in result.kernel_params.items()
         ],
