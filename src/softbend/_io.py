@@ -10,6 +10,7 @@ from __future__ import annotations
 import os
 import shutil
 import stat
+import sys
 import tempfile
 from collections.abc import Iterator
 from contextlib import contextmanager
@@ -95,8 +96,9 @@ def staged_dir(path: str | os.PathLike[str]) -> Iterator[Path]:
     ``path`` and the old one removed. If the block raises (or the process is
     killed), ``path`` is untouched and the staging folder is removed (or left as
     a hidden ``.NAME.*.new`` folder), so ``path`` is never a mix of an old and a
-    new run. The two renames are not one atomic step: a kill between them leaves
-    the old folder as ``.NAME.old-PID`` beside a missing ``path``.
+    new run. On Linux the swap is one atomic ``renameat2(RENAME_EXCHANGE)``;
+    elsewhere it is two renames, and a kill between them leaves the old folder as
+    ``.NAME.old-PID`` beside a missing ``path``.
     """
     path = Path(path)
     path.parent.mkdir(parents=True, exist_ok=True)
@@ -107,6 +109,9 @@ def staged_dir(path: str | os.PathLike[str]) -> Iterator[Path]:
     except BaseException:
         shutil.rmtree(staging, ignore_errors=True)
         raise
+    if path.exists() and _exchange(staging, path):
+        shutil.rmtree(staging, ignore_errors=True)  # now holds the old folder
+        return
     old = None
     if path.exists():
         old = path.with_name(f".{path.name}.old-{os.getpid()}")
@@ -114,3 +119,19 @@ def staged_dir(path: str | os.PathLike[str]) -> Iterator[Path]:
     os.replace(staging, path)
     if old is not None:
         shutil.rmtree(old, ignore_errors=True)
+
+
+def _exchange(a: Path, b: Path) -> bool:
+    """Swap two paths atomically (Linux ``renameat2(RENAME_EXCHANGE)``); False if unsupported."""
+    if not sys.platform.startswith("linux"):
+        return False
+    import ctypes
+
+    try:
+        libc = ctypes.CDLL(None, use_errno=True)
+        renameat2 = libc.renameat2
+    except (OSError, AttributeError):
+        return False
+    at_fdcwd, rename_exchange = -100, 2
+    result = renameat2(at_fdcwd, os.fsencode(a), at_fdcwd, os.fsencode(b), rename_exchange)
+    return result == 0

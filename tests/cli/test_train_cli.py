@@ -150,3 +150,46 @@ def test_an_interrupted_train_leaves_the_previous_output_folder_whole(
     after = {p.relative_to(out): p.read_bytes() for p in out.rglob("*") if p.is_file()}
     assert after == before
     assert [p.name for p in tmp_path.iterdir()] == ["surrogates"]  # no staging folder left
+
+
+def test_train_killed_at_random_moments_leaves_the_old_folder_or_the_new_one(
+    small_campaign, tmp_path
+):
+    import json
+    import os
+    import signal
+    import subprocess
+    import sys
+    import time
+
+    import pandas as pd
+
+    out = tmp_path / "surrogates"
+    cli = [sys.executable, "-c", "import sys; from softbend.cli import main; sys.exit(main())"]
+    args = [*cli, "train", str(small_campaign), "--out", str(out), "--models", "plr"]
+    args += ["--no-onnx", "--folds"]
+
+    def consistent() -> int:
+        """The folds of one whole run: the model, the summary and the CV table agree."""
+        meta = json.loads((out / "models" / "plr.json").read_text())["metadata"]
+        summary = pd.read_csv(out / "summary.csv").set_index("model")
+        assert summary.loc["plr", "rmse_deg"] == pytest.approx(meta["cv"]["rmse_deg"])
+        return int(meta["search"]["folds"])
+
+    first = subprocess.run([*args, "3"], capture_output=True, check=False)
+    assert first.returncode == 0, first.stderr.decode()[-500:]
+    assert consistent() == 3
+    rng = np.random.default_rng(7)
+    for k, delay in enumerate(rng.uniform(0.5, 6.0, size=4)):
+        folds = str(4 + k % 2)  # each run differs from the one before
+        child = subprocess.Popen(
+            [*args, folds],
+            start_new_session=True,
+            stdout=subprocess.DEVNULL,
+            stderr=subprocess.DEVNULL,
+        )
+        time.sleep(float(delay))
+        if child.poll() is None:
+            os.killpg(child.pid, signal.SIGKILL)
+        child.wait()
+        assert consistent() in (3, 4, 5), f"a mix after a kill at {delay:.2f} s"
