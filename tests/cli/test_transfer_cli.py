@@ -176,3 +176,30 @@ def test_unknown_strategy_and_bad_out_are_refused_before_work(
         ]
     )
     assert code == 2 and "'strategy'" in one_error_line(capsys)
+
+
+def test_transfer_base_and_refine_bad_input_is_one_line(tmp_path, capsys, small_base_file, lab_csv):
+    code = main(["transfer", "base", "--out", str(tmp_path / "b.json"), "--epochs", "0"])
+    assert code == 2 and "epochs" in one_error_line(capsys)
+    code = main(
+        [
+            "transfer",
+            "refine",
+            str(small_base_file),
+            str(tmp_path / "missing.csv"),
+            "--out",
+            str(tmp_path / "r.json"),
+        ]
+    )
+    assert code == 2 and "missing.csv" in one_error_line(capsys)
+    code = main(
+        [
+            "transfer",
+            "refine",
+            str(tmp_path / "nobase.json"),
+            str(lab_csv),
+            "--out",
+            str(tmp_path / "r.json"),
+        ]
+    )
+    assert code == 2 and "nobase.json" in one_error_line(capsys)
