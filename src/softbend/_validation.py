@@ -112,3 +112,14 @@ def check_finite_array(values: Any, name: str, owner: str) -> np.ndarray:
             f"at position {first} ({int(bad.sum())} non-finite values in all)."
         )
     return array
+
+
+def short_repr(value: Any, limit: int = 60) -> str:
+    """A value as JSON (else its repr), cut to ``limit`` characters, for error messages."""
+    import json
+
+    try:
+        text = json.dumps(value)
+    except (TypeError, ValueError):
+        text = repr(value)
+    return text if len(text) <= limit else text[: limit - 3] + "..."

@@ -170,6 +170,22 @@ class SFRBADesign:
         return ",".join(f"{getattr(self, n):g}" for n in PARAMETERS)
 
 
+#: The seven actuators paper B measured (Fig. 7), nominal (l, r, t, b, φ, lc) in mm and
+#: degrees: the reference (100, 6, 2, 2, 5, 8) and one parameter changed at a time.
+PAPER_B_FIG7_DESIGNS: tuple[SFRBADesign, ...] = tuple(
+    SFRBADesign(*values)
+    for values in (
+        (100, 6, 2, 2, 5, 8),
+        (120, 6, 2, 2, 5, 8),
+        (100, 8, 2, 2, 5, 8),
+        (100, 6, 3, 2, 5, 8),
+        (100, 6, 2, 3, 5, 8),
+        (100, 6, 2, 2, 10, 8),
+        (100, 6, 2, 2, 5, 10),
+    )
+)
+
+
 @dataclass(frozen=True)
 class DesignSpace:
     """A finite set of designs.

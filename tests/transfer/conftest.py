@@ -34,18 +34,8 @@ def small_base():
     model = AnalyticalModel()
     rows, angles = [], []
     grid = default_pressures_mpa(0.2, 0.01)
-    for values in [
-        (100, 6, 2, 2, 5, 8),
-        (120, 6, 2, 2, 5, 8),
-        (100, 8, 2, 2, 5, 8),
-        (100, 6, 3, 2, 5, 8),
-        (100, 6, 2, 3, 5, 8),
-        (100, 6, 2, 2, 10, 8),
-        (100, 6, 2, 2, 5, 10),
-        (140, 8, 3, 3, 10, 10),
-        (110, 7, 2.5, 2.5, 8, 9),
-    ]:
-        design = SFRBADesign(*values)
+    others = [SFRBADesign(140, 8, 3, 3, 10, 10), SFRBADesign(110, 7, 2.5, 2.5, 8, 9)]
+    for design in [*LAB_ACTUATORS, *others]:
         sweep = model.sweep(design, grid)
         ok = np.asarray(sweep.converged, dtype=bool)
         rows.append(design.feature_rows(sweep.pressure_mpa[ok]))

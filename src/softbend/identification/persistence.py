@@ -19,6 +19,7 @@ from sklearn.preprocessing import StandardScaler
 
 from softbend import __version__
 from softbend._io import write_text_atomic
+from softbend._validation import short_repr
 from softbend.errors import SchemaError
 from softbend.identification.kernels import MOMENTS_OF
 from softbend.identification.narx import NARXRegressor, _lag_structure, _regressor_names
@@ -111,21 +112,13 @@ class _RuleError(Exception):
     """A value breaks its rule; the message names the key and the rule (not the file)."""
 
 
-def _shown(value: Any) -> str:
-    try:
-        text = json.dumps(value)
-    except (TypeError, ValueError):
-        text = repr(value)
-    return text if len(text) <= 60 else text[:57] + "..."
-
-
 def _is_real(value: Any) -> bool:
     return type(value) in (int, float)  # JSON numbers, not bool
 
 
 def _object(value: Any, where: str, keys: tuple[str, ...]) -> dict[str, Any]:
     if not isinstance(value, dict):
-        raise _RuleError(f"'{where}' must be a JSON object; got {_shown(value)}")
+        raise _RuleError(f"'{where}' must be a JSON object; got {short_repr(value)}")
     unknown = [key for key in value if key not in keys]
     if unknown:
         raise _RuleError(
@@ -140,13 +133,13 @@ def _object(value: Any, where: str, keys: tuple[str, ...]) -> dict[str, Any]:
 
 def _int(value: Any, where: str, low: int) -> int:
     if type(value) is not int or value < low:
-        raise _RuleError(f"'{where}' must be an integer >= {low}; got {_shown(value)}")
+        raise _RuleError(f"'{where}' must be an integer >= {low}; got {short_repr(value)}")
     return value
 
 
 def _bool(value: Any, where: str) -> bool:
     if not isinstance(value, bool):
-        raise _RuleError(f"'{where}' must be true or false; got {_shown(value)}")
+        raise _RuleError(f"'{where}' must be true or false; got {short_repr(value)}")
     return value
 
 
@@ -169,7 +162,7 @@ def _real(
     if ok and high is not None:
         ok = value <= high
     if not ok:
-        raise _RuleError(f"'{where}' must be {rule}; got {_shown(value)}")
+        raise _RuleError(f"'{where}' must be {rule}; got {short_repr(value)}")
     return float(value)
 
 
@@ -183,7 +176,7 @@ def _vector(
 ) -> np.ndarray:
     if not isinstance(value, list) or (length is not None and len(value) != length):
         size = f"{length} " if length is not None else ""
-        raise _RuleError(f"'{where}' must be a list of {size}numbers; got {_shown(value)}")
+        raise _RuleError(f"'{where}' must be a list of {size}numbers; got {short_repr(value)}")
     for i, item in enumerate(value):
         _real(item, f"{where}[{i}]", low=low, strict=strict)
     return np.asarray(value, dtype=float)
@@ -191,7 +184,7 @@ def _vector(
 
 def _int_vector(value: Any, where: str) -> np.ndarray:
     if not isinstance(value, list):
-        raise _RuleError(f"'{where}' must be a list of integers; got {_shown(value)}")
+        raise _RuleError(f"'{where}' must be a list of integers; got {short_repr(value)}")
     for i, item in enumerate(value):
         _int(item, f"{where}[{i}]", 0)
     return np.asarray(value, dtype=int)
@@ -201,7 +194,7 @@ def _matrix(value: Any, where: str, rows: int, columns: int) -> np.ndarray:
     if not isinstance(value, list) or len(value) != rows:
         raise _RuleError(
             f"'{where}' must be a list of {rows} rows (one per dual coefficient); "
-            f"got {_shown(value)}"
+            f"got {short_repr(value)}"
         )
     for i, row in enumerate(value):
         _vector(row, f"{where}[{i}]", columns)
@@ -267,7 +260,7 @@ def _svr_params(value: Any) -> dict[str, Any]:
     if params["moments_of"] not in MOMENTS_OF:
         raise _RuleError(
             f"'{where}.moments_of' must be one of {', '.join(map(repr, MOMENTS_OF))}; "
-            f"got {_shown(params['moments_of'])}"
+            f"got {short_repr(params['moments_of'])}"
         )
     return params
 
@@ -277,10 +270,10 @@ def _check_document(data: dict[str, Any]) -> None:
     _object(data, "(top level)", _TOP_KEYS)
     if not isinstance(data["softbend_version"], str):
         raise _RuleError(
-            f"'softbend_version' must be a string; got {_shown(data['softbend_version'])}"
+            f"'softbend_version' must be a string; got {short_repr(data['softbend_version'])}"
         )
     if not isinstance(data["metadata"], dict):
-        raise _RuleError(f"'metadata' must be a JSON object; got {_shown(data['metadata'])}")
+        raise _RuleError(f"'metadata' must be a JSON object; got {short_repr(data['metadata'])}")
 
     narx = _object(data["narx"], "narx", _NARX_KEYS)
     params = _object(narx["params"], "narx.params", _NARX_PARAMS)
@@ -303,7 +296,7 @@ def _check_document(data: dict[str, Any]) -> None:
         if found != expected:
             raise _RuleError(
                 f"'narx.{key}' must be {expected} for output_lags={na}, input_lags={nb}, "
-                f"include_current_input={str(current).lower()}; got {_shown(found)}"
+                f"include_current_input={str(current).lower()}; got {short_repr(found)}"
             )
     _int(narx["n_train_rows"], "narx.n_train_rows", 0)
     _int(narx["n_experiments"], "narx.n_experiments", 0)
@@ -313,14 +306,15 @@ def _check_document(data: dict[str, Any]) -> None:
     estimator = _object(data["estimator"], "estimator", _ESTIMATOR_KEYS)
     if estimator["class"] != "GeneralizedGaussianSVR":
         raise _RuleError(
-            f"'estimator.class' must be 'GeneralizedGaussianSVR'; got {_shown(estimator['class'])}"
+            "'estimator.class' must be 'GeneralizedGaussianSVR'; "
+            f"got {short_repr(estimator['class'])}"
         )
     _svr_params(estimator["params"])
     n_features = na + n_inputs * nb
     if estimator["n_features_in"] != n_features or type(estimator["n_features_in"]) is not int:
         raise _RuleError(
             f"'estimator.n_features_in' must be {n_features} (output_lags + n_inputs x "
-            f"input_lags); got {_shown(estimator['n_features_in'])}"
+            f"input_lags); got {short_repr(estimator['n_features_in'])}"
         )
     _real(estimator["sigma"], "estimator.sigma", low=0.0, strict=True)
     _real(estimator["shape"], "estimator.shape", low=0.0, strict=True, high=2.0)

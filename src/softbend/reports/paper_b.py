@@ -24,17 +24,6 @@ PAPER_B_FIG4 = {
 #: Samples of paper B's FEM dataset (§3.3).
 PAPER_B_SAMPLES = 29577
 
-#: The seven actuators measured in paper B Fig. 7 (l, r, t, b, phi, lc).
-FIG7_DESIGNS: tuple[tuple[float, ...], ...] = (
-    (100, 6, 2, 2, 5, 8),
-    (120, 6, 2, 2, 5, 8),
-    (100, 8, 2, 2, 5, 8),
-    (100, 6, 3, 2, 5, 8),
-    (100, 6, 2, 3, 5, 8),
-    (100, 6, 2, 2, 10, 8),
-    (100, 6, 2, 2, 5, 10),
-)
-
 
 def angle_curves(
     samples: pd.DataFrame, designs: list[str], path: Path, *, backend: str = "analytical"
@@ -195,10 +184,10 @@ def fit_rows(regression: RegressionReport) -> list[list[Any]]:
 
 
 def fig7_design_ids() -> list[str]:
-    """Design ids of :data:`FIG7_DESIGNS`."""
-    from softbend.design import SFRBADesign
+    """Design ids of :data:`softbend.design.PAPER_B_FIG7_DESIGNS`."""
+    from softbend.design import PAPER_B_FIG7_DESIGNS
 
-    return [SFRBADesign(*values).design_id for values in FIG7_DESIGNS]
+    return [design.design_id for design in PAPER_B_FIG7_DESIGNS]
 
 
 def add_surrogate_section(report: Report, summary: dict[str, Any], *, root: Path) -> None:

@@ -51,9 +51,10 @@ from sklearn.exceptions import NotFittedError
 from softbend import __version__
 from softbend._extras import require
 from softbend._io import write_text_atomic
+from softbend._validation import short_repr
 from softbend.errors import SchemaError
 from softbend.surrogates.features import FEATURES, TARGET, UNITS
-from softbend.surrogates.schema import SCHEMAS, Rule, RuleError, shown
+from softbend.surrogates.schema import SCHEMAS, Rule, RuleError
 
 logger = logging.getLogger(__name__)
 
@@ -445,7 +446,7 @@ def _read_document(path: Path) -> dict[str, Any]:
             raise SchemaError(f"{path}: '{key}' must be a JSON object.")
     for key in ("softbend_version", "created_utc"):
         if not isinstance(document[key], str):
-            raise SchemaError(f"{path}: '{key}' must be a string; got {shown(document[key])}.")
+            raise SchemaError(f"{path}: '{key}' must be a string; got {short_repr(document[key])}.")
     return document
 
 

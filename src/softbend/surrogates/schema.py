@@ -16,9 +16,10 @@ from typing import Any
 
 import numpy as np
 
+from softbend._validation import short_repr
 from softbend.surrogates.features import FEATURES
 
-__all__ = ["SCHEMAS", "Rule", "RuleError", "shown"]
+__all__ = ["SCHEMAS", "Rule", "RuleError"]
 
 
 class RuleError(Exception):
@@ -29,15 +30,6 @@ Rule = Callable[[Any], Any]
 
 _FLOAT = "float64"
 _INT = "int64"
-
-
-def shown(value: Any) -> str:
-    """A short picture of a JSON value for a message."""
-    try:
-        text = json.dumps(value)
-    except (TypeError, ValueError):
-        text = repr(value)
-    return text if len(text) <= 60 else text[:57] + "..."
 
 
 def _is_real(value: Any) -> bool:
@@ -54,9 +46,9 @@ def _scalar(value: Any, dtype: str, what: str) -> Any:
             try:
                 return np.dtype(dtype).type(value["__scalar__"])
             except OverflowError:
-                raise RuleError(f"must be {what} within {dtype}; got {shown(value)}") from None
-        raise RuleError(f"must be {what} of dtype {dtype}; got {shown(value)}")
-    raise RuleError(f"must be {what}; got {shown(value)}")
+                raise RuleError(f"must be {what} within {dtype}; got {short_repr(value)}") from None
+        raise RuleError(f"must be {what} of dtype {dtype}; got {short_repr(value)}")
+    raise RuleError(f"must be {what}; got {short_repr(value)}")
 
 
 def _bounds(low: float | None, strict: bool) -> str:
@@ -103,7 +95,7 @@ def _string(choices: tuple[str, ...] | None = None) -> Rule:
         ):
             decoded = np.str_(value["__scalar__"])
         if not isinstance(decoded, str) or (choices is not None and decoded not in choices):
-            raise RuleError(f"must be {what}; got {shown(value)}")
+            raise RuleError(f"must be {what}; got {short_repr(value)}")
         return decoded
 
     return rule
@@ -116,7 +108,7 @@ def _leaves(nested: Any, shape: list[int]) -> list[Any]:
         deeper: list[Any] = []
         for item in items:
             if not isinstance(item, list) or len(item) != size:
-                found = f"{len(item)} items" if isinstance(item, list) else shown(item)
+                found = f"{len(item)} items" if isinstance(item, list) else short_repr(item)
                 raise RuleError(
                     f"must hold nested lists of its shape {shape}; got {found} at depth {depth}"
                 )
@@ -134,23 +126,23 @@ def _array(dtype: str, ndim: int, *, low: float | None = None, strict: bool = Fa
         if not (isinstance(value, dict) and set(value) == {"__ndarray__", "dtype", "shape"}):
             raise RuleError(
                 f"must be {what} ({{'__ndarray__': ..., 'dtype': ..., 'shape': ...}}); "
-                f"got {shown(value)}"
+                f"got {short_repr(value)}"
             )
         if value["dtype"] != dtype:
-            raise RuleError(f"must be {what}; got dtype {shown(value['dtype'])}")
+            raise RuleError(f"must be {what}; got dtype {short_repr(value['dtype'])}")
         shape = value["shape"]
         if not (
             isinstance(shape, list)
             and len(shape) == ndim
             and all(type(n) is int and n >= 0 for n in shape)
         ):
-            raise RuleError(f"must be {what}; got shape {shown(shape)}")
+            raise RuleError(f"must be {what}; got shape {short_repr(shape)}")
         leaves = _leaves(value["__ndarray__"], shape)
         ok = {_FLOAT: _is_real, _INT: lambda v: type(v) is int, "str": lambda v: type(v) is str}
         good = ok[dtype]
         bad = next((i for i, v in enumerate(leaves) if not good(v)), None)
         if bad is not None:
-            raise RuleError(f"must hold only {element}; got {shown(leaves[bad])}")
+            raise RuleError(f"must hold only {element}; got {short_repr(leaves[bad])}")
         try:
             array = np.asarray(leaves, dtype=object if dtype == "str" else np.dtype(dtype))
         except OverflowError:
@@ -179,7 +171,7 @@ def _arrays(count: int, ndim: int) -> Rule:
 
     def rule(value: Any) -> list[np.ndarray]:
         if not isinstance(value, list) or len(value) != count:
-            found = f"{len(value)} items" if isinstance(value, list) else shown(value)
+            found = f"{len(value)} items" if isinstance(value, list) else short_repr(value)
             raise RuleError(f"must be a list of {count} {ndim}-D float64 arrays; got {found}")
         arrays = []
         for i, entry in enumerate(value):
@@ -195,7 +187,7 @@ def _arrays(count: int, ndim: int) -> Rule:
 def _numbers(value: Any) -> list[float]:
     """A list of numbers (a diagnostic such as a loss curve: NaN and inf allowed)."""
     if not isinstance(value, list) or not all(_is_real(v) for v in value):
-        raise RuleError(f"must be a list of numbers; got {shown(value)}")
+        raise RuleError(f"must be a list of numbers; got {short_repr(value)}")
     return [float(v) for v in value]
 
 
@@ -205,7 +197,7 @@ def _int_pair(value: Any) -> Any:
         value.get("__tuple__") if isinstance(value, dict) and set(value) == {"__tuple__"} else value
     )
     if not isinstance(items, list) or len(items) != 2:
-        raise RuleError(f"must be two integers >= 1; got {shown(value)}")
+        raise RuleError(f"must be two integers >= 1; got {short_repr(value)}")
     pair = [_integer(1)(v) for v in items]
     return tuple(pair) if items is not value else pair
 
@@ -217,7 +209,7 @@ def _booster(value: Any) -> str:
         raise RuleError(f"must hold only finite numbers; got {constant}")
 
     if not isinstance(value, str):
-        raise RuleError(f"must be XGBoost's JSON model as a string; got {shown(value)}")
+        raise RuleError(f"must be XGBoost's JSON model as a string; got {short_repr(value)}")
     try:
         model = json.loads(value, parse_constant=refuse)
     except json.JSONDecodeError as err:

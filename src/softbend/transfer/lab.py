@@ -36,7 +36,7 @@ import numpy as np
 import pandas as pd
 
 from softbend._validation import check_choice, check_int, check_range
-from softbend.design import PARAMETERS, SFRBADesign
+from softbend.design import PAPER_B_FIG7_DESIGNS, PARAMETERS, SFRBADesign
 from softbend.materials.fit import fit_model
 from softbend.materials.presets import DRAGON_SKIN_30, Material
 from softbend.materials.tensile import load_shipped, shipped_tensile_tests
@@ -47,19 +47,8 @@ __all__ = ["LAB_ACTUATORS", "PLANTS", "VirtualLab", "actuator_id", "shipped_meas
 
 _OWNER = "VirtualLab"
 
-#: The seven actuators of paper B Fig. 7, (l, r, t, b, φ, lc) in mm and degrees.
-LAB_ACTUATORS: tuple[SFRBADesign, ...] = tuple(
-    SFRBADesign(*values)
-    for values in (
-        (100, 6, 2, 2, 5, 8),
-        (120, 6, 2, 2, 5, 8),
-        (100, 8, 2, 2, 5, 8),
-        (100, 6, 3, 2, 5, 8),
-        (100, 6, 2, 3, 5, 8),
-        (100, 6, 2, 2, 10, 8),
-        (100, 6, 2, 2, 5, 10),
-    )
-)
+#: The seven actuators of paper B Fig. 7 (:data:`softbend.design.PAPER_B_FIG7_DESIGNS`).
+LAB_ACTUATORS: tuple[SFRBADesign, ...] = PAPER_B_FIG7_DESIGNS
 
 #: Models that can play the lab's actuators.
 PLANTS: tuple[str, ...] = ("fem", "analytical")
