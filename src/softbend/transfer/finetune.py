@@ -20,10 +20,11 @@ from numpy.typing import ArrayLike
 from softbend._validation import check_int, check_range
 from softbend.errors import ConvergenceError
 
-__all__ = ["fine_tune_many", "fine_tune_mlp", "row_weights"]
+__all__ = ["check_mlp", "fine_tune_many", "fine_tune_mlp", "row_weights"]
 
 
-def _check_mlp(base: Any, owner: str) -> Any:
+def check_mlp(base: Any, owner: str) -> Any:
+    """``base`` if it is a fitted NormalizedMLPRegressor, else one ``ValueError`` naming it."""
     from sklearn.utils.validation import check_is_fitted
 
     from softbend.surrogates.mlp import NormalizedMLPRegressor
@@ -81,7 +82,7 @@ def fine_tune_many(
     from softbend.surrogates.mlp import NormalizedMLPRegressor
 
     owner = "fine_tune_many"
-    starts = [_check_mlp(b, owner) for b in (base if isinstance(base, list) else [base])]
+    starts = [check_mlp(b, owner) for b in (base if isinstance(base, list) else [base])]
     base = starts[0]
     epochs = check_int(epochs, "epochs", owner, low=1)
     learning_rate = check_range(learning_rate, "learning_rate", owner, low=0.0)

@@ -37,7 +37,7 @@ from sklearn.utils.validation import check_is_fitted, validate_data
 
 from softbend._validation import check_choice, check_int, check_range
 from softbend.design import FEATURES, SFRBADesign
-from softbend.transfer.finetune import fine_tune_many, row_weights
+from softbend.transfer.finetune import check_mlp, fine_tune_many, row_weights
 
 __all__ = [
     "STRATEGIES",
@@ -70,18 +70,6 @@ def _check_base(base: Any, owner: str) -> Any:
             f"The 'base' of {owner} must be a fitted surrogate with a 'predict' method. "
             f"Got {type(base).__name__} instead."
         )
-    return base
-
-
-def _check_mlp_base(base: Any, owner: str) -> Any:
-    from softbend.surrogates.mlp import NormalizedMLPRegressor
-
-    if not isinstance(base, NormalizedMLPRegressor):
-        raise ValueError(
-            f"The 'base' of {owner} must be a fitted NormalizedMLPRegressor (an 'mlp' "
-            f"surrogate): its weights are trained further. Got {type(base).__name__} instead."
-        )
-    check_is_fitted(base)
     return base
 
 
@@ -235,7 +223,7 @@ class RefinedMLP(_Strategy):
         epochs and learning rate.
         """
         first = estimators[0]
-        _check_mlp_base(first.base, cls.__name__)
+        check_mlp(first.base, cls.__name__)
         _check_same(estimators, ("base", "epochs", "learning_rate"), cls.__name__)
         models = fine_tune_many(
             first.base,
@@ -519,7 +507,7 @@ class RefinedEnsemble(_Strategy):
     ) -> list[RefinedEnsemble]:
         """Fit each ensemble on its rows; every member of every ensemble trained at once."""
         first = estimators[0]
-        _check_mlp_base(first.base, cls.__name__)
+        check_mlp(first.base, cls.__name__)
         _check_same(estimators, ("base", "epochs", "learning_rate", "n_members"), cls.__name__)
         draws = [
             est._draws(X, np.asarray(rows)) for est, rows in zip(estimators, row_sets, strict=True)
