@@ -327,6 +327,174 @@ def test_paper_sized_problem_six_experiments_of_512_samples():
     assert nrmse(y_test[keep], simulated[keep]) < 0.05
 
 
+# -------------------------------------------------------------------- several inputs
+
+#: Input gains of ``multi_input_system``; opposite signs, so swapped columns show.
+INPUT_GAINS = (0.3, -0.2, 0.15)
+
+
+def multi_input_step(y1, u_past):
+    """y(t) = 0.6 y(t−1) + Σ c_i u_i(t−1) + 0.1 u_0(t−1) u_last(t−1).
+
+    ``u_past`` holds u(t−1), one column per input. With one input the product
+    is 0.1 u(t−1)²; with two, y(t) = 0.6 y(t−1) + 0.3 u1 − 0.2 u2 + 0.1 u1 u2.
+    ∂f/∂y(t−1) = 0.6 everywhere, so the system contracts with factor 0.6.
+    """
+    u_past = np.atleast_2d(u_past)
+    gains = np.asarray(INPUT_GAINS[: u_past.shape[1]])
+    return 0.6 * y1 + u_past @ gains + 0.1 * u_past[:, 0] * u_past[:, -1]
+
+
+def multi_input_system(U):
+    y = np.zeros(U.shape[0])
+    for t in range(1, U.shape[0]):
+        y[t] = multi_input_step(y[t - 1], U[t - 1 : t])[0]
+    return y
+
+
+def multi_inputs(n, seed, n_inputs):
+    """Independent random-hold inputs, one column each (different seeds)."""
+    return np.column_stack([hold_input(n, seed + 1000 * i) for i in range(n_inputs)])
+
+
+class TrueMultiInputMap(RegressorMixin, BaseEstimator):
+    """The exact map of ``multi_input_system`` on unscaled default-lag rows.
+
+    Rows are [y(t−1), y(t−2), u0(t), u0(t−1), u1(t), u1(t−1), …]: the map reads
+    y(t−1) and every u_i(t−1), ignoring the other columns.
+    """
+
+    def fit(self, X, y):
+        self.n_inputs_ = (np.shape(X)[1] - 2) // 2
+        self.single_calls_ = 0
+        return self
+
+    def predict(self, X):
+        X = np.asarray(X)
+        assert X.shape[1] == 2 + 2 * self.n_inputs_
+        return multi_input_step(X[:, 0], X[:, 3::2])
+
+    def predict_one(self, x):
+        self.single_calls_ += 1
+        return float(self.predict(np.asarray(x)[None, :])[0])
+
+
+@pytest.mark.parametrize("n_inputs", [1, 2, 3])
+def test_free_run_of_the_exact_map_with_several_inputs_reproduces_the_system(n_inputs):
+    # The estimator is the true one-step map, so the free run must reproduce the
+    # noiseless output up to rounding (1e-12): any misplaced input column or lag
+    # would change it by O(1). One input is the case that always worked.
+    lengths = [150, 60, 110]
+    Us = [multi_inputs(n, 10 + k, n_inputs) for k, n in enumerate(lengths)]
+    ys = [multi_input_system(U) for U in Us]
+    groups = np.repeat(np.arange(len(lengths)), lengths)
+    U, y = np.vstack(Us), np.concatenate(ys)
+    model = NARXRegressor(estimator=TrueMultiInputMap(), scale=False).fit(U, y, groups=groups)
+    assert model.n_inputs_ == n_inputs
+    symbols = ["u"] if n_inputs == 1 else [f"u{i}" for i in range(n_inputs)]
+    input_names = [name for s in symbols for name in (f"{s}(t)", f"{s}(t-1)")]
+    expected_names = ("y(t-1)", "y(t-2)", *input_names)
+    assert model.regressor_names_ == expected_names
+
+    simulated = model.simulate(U, y, groups=groups)
+    assert simulated.shape == (y.size,)
+    np.testing.assert_allclose(simulated, y, rtol=1e-12, atol=1e-12)
+    np.testing.assert_allclose(
+        model.predict_one_step(U, y, groups=groups), y, rtol=1e-12, atol=1e-12
+    )
+    # A single experiment takes the predict_one path with the same rows (the
+    # grouped run above also used it where the longest experiment ran alone).
+    calls_before = model.estimator_.single_calls_
+    single = model.simulate(Us[0], ys[0])
+    assert model.estimator_.single_calls_ - calls_before == lengths[0] - model.max_lag_
+    np.testing.assert_allclose(single, ys[0], rtol=1e-12, atol=1e-12)
+
+
+def test_linear_two_input_arx_is_recovered_exactly_in_free_run_with_scaling():
+    # Inputs in different units (kPa-like and unit-range) exercise the per-input
+    # scaling. The data are noiseless and the regressor contains the true terms,
+    # so least squares is exact and only rounding remains: 1e-8 of the range.
+    def linear_system(U):
+        y = np.zeros(U.shape[0])
+        for t in range(1, U.shape[0]):
+            y[t] = 0.6 * y[t - 1] + 0.3 * U[t - 1, 0] - 0.2 * U[t - 1, 1]
+        return y
+
+    def plant_inputs(n, seed):
+        U = multi_inputs(n, seed, 2)
+        return np.column_stack([40.0 * U[:, 0] + 50.0, U[:, 1]]), U
+
+    Us = [plant_inputs(200, seed) for seed in (1, 2, 3)]
+    U = np.vstack([measured for measured, _ in Us])
+    y = np.concatenate([linear_system(raw) for _, raw in Us])
+    groups = np.repeat([0, 1, 2], 200)
+    model = NARXRegressor(
+        estimator=LinearRegression(), output_lags=1, input_lags=1, include_current_input=False
+    ).fit(U, y, groups=groups)
+    U_test, raw_test = plant_inputs(300, 77)
+    y_test = linear_system(raw_test)
+    simulated = model.simulate(U_test, y_test)
+    assert simulated.shape == y_test.shape
+    np.testing.assert_allclose(simulated, y_test, atol=1e-8 * np.ptp(y_test))
+
+
+@pytest.fixture(scope="module")
+def two_input_svr_fit():
+    Us = [multi_inputs(400, seed, 2) for seed in (1, 2, 3, 4)]
+    U = np.vstack(Us)
+    y = np.concatenate([multi_input_system(Uk) for Uk in Us])
+    groups = np.repeat([0, 1, 2, 3], 400)
+    model = NARXRegressor(
+        estimator=SVR(C=100.0, epsilon=0.01),
+        output_lags=1,
+        input_lags=1,
+        include_current_input=False,
+    ).fit(U, y, groups=groups)
+    return model
+
+
+@pytest.mark.parametrize("seed", [5, 99])
+def test_svr_narx_with_two_inputs_reproduces_the_system_in_free_run(two_input_svr_fit, seed):
+    model = two_input_svr_fit
+    U_test = multi_inputs(400, seed, 2)  # fresh inputs, not seen in fit
+    y_test = multi_input_system(U_test)
+    keep = ~model.warmup_mask(y_test.size)
+    simulated = model.simulate(U_test, y_test)
+    assert simulated.shape == (400,)
+    one_step = model.predict_one_step(U_test, y_test)
+    # The system contracts with ∂f/∂y(t−1) = 0.6, so a per-step model error δ
+    # accumulates in free run to at most δ / (1 − 0.6) = 2.5 δ. The one-step
+    # error on the measured trajectory estimates δ (the simulated states stay
+    # within a few hundredths of it, and the SVR is smooth).
+    free_error = np.max(np.abs(simulated[keep] - y_test[keep]))
+    assert free_error <= 2.5 * np.max(np.abs(one_step[keep] - y_test[keep]))
+    # In absolute terms: the ε-tube (0.01 std of y ≈ 0.25 % of the range) and
+    # its 2.5-fold accumulation leave well under 2 % of the range, while a
+    # model fed the inputs in the wrong columns is off by about 40 %.
+    assert nrmse(y_test[keep], simulated[keep]) < 0.02
+    swapped = model.simulate(U_test[:, ::-1], y_test)
+    assert nrmse(y_test[keep], swapped[keep]) > 0.2
+
+
+def test_a_wrong_number_of_input_columns_raises_one_clear_value_error():
+    Us = [multi_inputs(60, seed, 2) for seed in (1, 2)]
+    U = np.vstack(Us)
+    y = np.concatenate([multi_input_system(Uk) for Uk in Us])
+    groups = np.repeat([0, 1], 60)
+    model = NARXRegressor(estimator=LinearRegression()).fit(U, y, groups=groups)
+    # 1-D (read as one input), one column, three columns.
+    wrong = [U[:, 0], U[:, :1], np.column_stack([U, U[:, 0]])]
+    for method in ("simulate", "predict_one_step", "score"):
+        for X in wrong:
+            n_columns = 1 if X.ndim == 1 else X.shape[1]
+            pattern = (
+                rf"^The 'X' of NARXRegressor\.{method} must have 2 input column\(s\) as "
+                rf"in fit\. Got {n_columns} instead\.$"
+            )
+            with pytest.raises(ValueError, match=pattern):
+                getattr(model, method)(X, y, groups=groups)
+
+
 # ------------------------------------------------------------------------ divergence
 
 

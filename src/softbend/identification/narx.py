@@ -57,9 +57,21 @@ class _LagStructure:
     input_offsets: np.ndarray  # 0 … nb−1 (current input) or 1 … nb
     max_lag: int
 
-    @property
-    def n_features(self) -> int:
-        return self.output_offsets.size + self.input_offsets.size
+    def n_features(self, n_inputs: int) -> int:
+        """Number of regressor columns with ``n_inputs`` input signals.
+
+        Parameters
+        ----------
+        n_inputs : int
+            Number of input signals (columns of ``X``); each contributes one
+            column per input lag.
+
+        Returns
+        -------
+        int
+            na + n_inputs · nb, the width of the rows built by :func:`_rows`.
+        """
+        return self.output_offsets.size + n_inputs * self.input_offsets.size
 
 
 @dataclass(frozen=True)
@@ -534,7 +546,8 @@ class NARXRegressor(RegressorMixin, BaseEstimator):
 
         y_mean, y_std, u_mean, u_std = self._affine()
         index = _row_index(segments, m)
-        input_rows = np.empty((n_samples, structure.n_features - na))
+        n_features = structure.n_features(inputs.shape[1])
+        input_rows = np.empty((n_samples, n_features - na))
         input_rows[index] = _input_block((inputs - u_mean) / u_std, index, structure)
         state = np.full(n_samples, np.nan)
         for k, start in enumerate(segments.starts):
@@ -544,7 +557,7 @@ class NARXRegressor(RegressorMixin, BaseEstimator):
         predict_one = getattr(self.estimator_, "predict_one", None)
         starts, lengths = segments.starts, segments.lengths
         running = np.ones(starts.size, dtype=bool)
-        rows = np.empty((starts.size, structure.n_features))
+        rows = np.empty((starts.size, n_features))
         back = structure.output_offsets[None, :]
         for step in range(m, int(lengths.max())):
             active = np.flatnonzero(running & (lengths > step))
