@@ -11,6 +11,7 @@ extra      packages                                      needed by
 ``ml``     PyTorch, XGBoost, ONNX, ONNX Runtime,         the MLP and XGBoost surrogates,
            onnxmltools                                   the search, ONNX export
 ``dask``   Dask distributed                              campaigns on a Dask cluster
+``rig``    pymodbus                                      the Modbus rig (``softbend control run``)
 ``all``    all of the above
 =========  ============================================  ===============================
 """
@@ -34,6 +35,7 @@ EXTRAS: dict[str, tuple[str, str]] = {
     "onnxruntime": ("ONNX Runtime", "ml"),
     "onnxmltools": ("onnxmltools", "ml"),
     "distributed": ("Dask distributed", "dask"),
+    "pymodbus": ("pymodbus", "rig"),
 }
 
 

@@ -62,3 +62,19 @@ class MissingExtraError(SoftbendError, ImportError):
 
     The message names the extra that installs it, e.g. ``pip install 'softbend[fem]'``.
     """
+
+
+class RigError(SoftbendError, RuntimeError):
+    """A rig stopped answering sensibly: lost connection, timeout, garbage or stale reading.
+
+    Parameters
+    ----------
+    message : str
+        What happened, naming the rig.
+    kind : {"connection", "timeout", "garbage", "stale", "protocol"}
+        The class of fault, for logs and tests.
+    """
+
+    def __init__(self, message: str, *, kind: str = "connection") -> None:
+        self.kind = kind
+        super().__init__(message)

@@ -31,6 +31,23 @@ def build_controller(name: str, table, sensor):
     return PressureRelay(table)
 
 
+def _setup(command: str, controller: str, design: str, model: Path | None, supply: float):
+    """Design, rig parameters, θ(p) table and controller of a run (checked before any work)."""
+    from softbend._validation import check_choice
+    from softbend.control.controllers import CONTROLLERS, mlp_virtual_sensor
+    from softbend.control.rig import AngleTable, RigParams
+    from softbend.design import SFRBADesign
+    from softbend.transfer.base import load_base
+
+    check_choice(controller, "controller", command, CONTROLLERS)
+    actuator = SFRBADesign.parse(design)
+    params = RigParams.for_design(actuator, supply_gauge_mpa=supply)
+    surrogate = load_base(model)
+    table = AngleTable.from_surrogate(surrogate, actuator)
+    sensor = mlp_virtual_sensor(surrogate, actuator) if hasattr(surrogate, "predictor") else table
+    return actuator, params, table, build_controller(controller, table, sensor)
+
+
 def _figure(run, path: Path, title: str) -> Path | None:
     try:
         import matplotlib
@@ -81,22 +98,14 @@ def simulate_cmd(
     as_json: bool = typer.Option(False, "--json", help="Print the metrics as JSON."),
 ) -> None:
     """Run a controller on the simulated rig and score it as paper B's Fig. 9 (synthetic)."""
-    from softbend._validation import check_choice
-    from softbend.control.controllers import CONTROLLERS, mlp_virtual_sensor
     from softbend.control.experiments import parse_reference, run_metrics, simulate
-    from softbend.control.rig import AngleTable, RigParams, SimulatedRig
-    from softbend.design import SFRBADesign
-    from softbend.transfer.base import load_base
+    from softbend.control.rig import SimulatedRig
 
-    check_choice(controller, "controller", "softbend control simulate", CONTROLLERS)
     ref = parse_reference(reference)
-    actuator = SFRBADesign.parse(design)
-    params = RigParams.for_design(actuator, supply_gauge_mpa=supply)
+    actuator, params, table, ctrl = _setup(
+        "softbend control simulate", controller, design, model, supply
+    )
     _common.check_output_dir(out, "--out", files=_FILES)
-    surrogate = load_base(model)
-    table = AngleTable.from_surrogate(surrogate, actuator)
-    sensor = mlp_virtual_sensor(surrogate, actuator) if hasattr(surrogate, "predictor") else table
-    ctrl = build_controller(controller, table, sensor)
     rig = SimulatedRig(table, params, seed=seed)
     run = simulate(rig, ctrl, ref, duration, seed=seed)
     metrics = run_metrics(run)
@@ -131,4 +140,246 @@ def simulate_cmd(
     _common.console.print(f"run written to {out}")
 
 
-__all__ = ["app", "build_controller"]
+RIGS: tuple[str, ...] = ("sim", "sim-realtime", "modbus")
+_LOG_FORMATS = ("csv", "parquet")
+
+
+@app.command("run")
+def run_cmd(
+    out: Path = typer.Option(
+        ..., "--out", help="Folder for ticks.csv|parquet, run.json and run.png."
+    ),
+    rig: str = typer.Option(
+        "sim",
+        help="sim (simulated time), sim-realtime (simulated, on the wall clock) or modbus.",
+    ),
+    config: Path = typer.Option(
+        None,
+        "--config",
+        help="Rig TOML: connection, register map, scaling, safety, period "
+        "(required for --rig modbus; its [safety] and [loop] apply to every rig).",
+    ),
+    reference: str = typer.Option(
+        "step:90",
+        help="step:AMP[:T0_S], square:AMP:PERIOD_S[:LOW] or triangle:FREQ_HZ:AMP[:LOW] (degrees).",
+    ),
+    controller: str = typer.Option(
+        "bang-bang", help="bang-bang, bang-bang-closed, pressure-pi or pressure-relay."
+    ),
+    design: str = typer.Option("100,6,2,2,5,8", help="Actuator l,r,t,b,phi,lc (mm, deg)."),
+    model: Path = typer.Option(
+        None, "--model", help="Saved surrogate for θ(p) (default: the shipped FEM-trained MLP)."
+    ),
+    duration: float = typer.Option(10.0, help="Run time, s."),
+    period: float = typer.Option(
+        None, help="Loop period, s (default: the config's [loop] period_s, 0.01)."
+    ),
+    supply: float = typer.Option(0.2, help="Supply pressure of a simulated rig, MPa gauge."),
+    seed: int = typer.Option(0, help="Seed of a simulated rig's sensor and camera noise."),
+    log_format: str = typer.Option("csv", help="Tick log format: csv (streamed) or parquet."),
+    as_json: bool = typer.Option(False, "--json", help="Print the summary as JSON."),
+) -> None:
+    """Run a controller in the fixed-period loop on a rig, with its safety limits and tick log.
+
+    The same controller object as `control simulate`, called once per tick (paper B:
+    100 Hz) with the pressure reading. Over-pressure, missed or stale readings vent
+    the actuator and stop the run; so does Ctrl-C. Exit 0 when the run completed, 1
+    when a fault stopped it (the log keeps every tick up to the fault), 130 on Ctrl-C.
+    """
+    from softbend._validation import check_choice, check_range
+    from softbend.control.experiments import parse_reference
+    from softbend.control.loop import run_loop
+    from softbend.control.rigconfig import RigConfig, load_rig_config
+
+    command = "softbend control run"
+    check_choice(rig, "rig", command, RIGS)
+    check_choice(log_format, "log_format", command, _LOG_FORMATS)
+    ref = parse_reference(reference)
+    if rig == "modbus" and config is None:
+        raise ValueError(
+            "The '--config' of softbend control run must name a rig TOML file with --rig "
+            "modbus (write a template with 'softbend control rig-config --out rig.toml')."
+        )
+    settings = load_rig_config(config) if config is not None else RigConfig()
+    loop_period = settings.period_s if period is None else period
+    actuator, params, table, ctrl = _setup(command, controller, design, model, supply)
+    log_name = f"ticks.{log_format}"
+    _common.check_output_dir(out, "--out", files=(log_name, "run.json", "run.png"))
+    with _common.output_errors(out, "--out"):
+        out.mkdir(parents=True, exist_ok=True)
+    check_range(duration, "duration", command, low=0.0, high=86400.0, high_inclusive=True)
+    check_range(loop_period, "period", command, low=0.0, high=1.0, high_inclusive=True)
+    ticks = max(1, round(duration / loop_period))
+    plant = _make_rig(rig, settings, table, params, seed)
+    done = [0]
+
+    def report(n: int, _total: int) -> None:
+        advance(n - done[0])
+        done[0] = n
+
+    try:
+        with _common.progress_bar("control loop", ticks, enabled=not as_json) as advance:
+            result = run_loop(
+                plant,
+                ctrl,
+                ref,
+                duration,
+                period_s=loop_period,
+                limits=settings.safety,
+                log_path=out / log_name,
+                progress=report,
+            )
+    finally:
+        plant.close()
+    jitter = result.jitter()
+    metrics = result.metrics()
+    payload = {
+        "synthetic": rig != "modbus",
+        "rig": rig,
+        "where": settings.connection.where if rig == "modbus" else "simulated",
+        "reference": reference,
+        "controller": controller,
+        "design": str(actuator),
+        "duration_s": duration,
+        "period_s": loop_period,
+        "seed": seed,
+        "completed": result.completed,
+        "stop_reason": result.stop_reason,
+        "fault_kind": result.fault_kind,
+        "vented": result.vented,
+        "jitter": jitter,
+        "metrics": metrics,
+        "rig_config": settings.to_toml(),
+        "rig_params": params.as_dict() if rig != "modbus" else None,
+    }
+    if rig == "modbus":
+        trips = plant.round_trips_s
+        payload["round_trip_ms"] = _percentiles_ms(trips)
+    with _common.output_errors(out, "--out"):
+        from softbend._io import write_text_atomic
+
+        write_text_atomic(out / "run.json", _common.json_text(payload) + "\n")
+        figure = _figure(
+            result.control_run(),
+            out / "run.png",
+            f"{controller} on {actuator}, {reference}, rig {rig} (loop at {1 / loop_period:g} Hz)",
+        )
+    payload["files"] = [str(out / log_name), str(out / "run.json")] + (
+        [str(figure)] if figure else []
+    )
+    if as_json:
+        _common.print_json(payload)
+    else:
+        rows = [[k, v] for k, v in {**metrics, **jitter}.items()]
+        _common.print_table(
+            f"{controller} on {actuator}, {reference}, rig {rig}", ["metric", "value"], rows
+        )
+        _common.console.print(f"run written to {out}")
+    if result.fault_kind == "interrupted":
+        _common.error_line(result.stop_reason)
+        raise typer.Exit(130)
+    if not result.completed:
+        _common.error_line(result.stop_reason)
+        raise typer.Exit(1)
+
+
+def _percentiles_ms(values: list[float]) -> dict[str, float]:
+    import numpy as np
+
+    if not values:
+        return {}
+    ms = np.asarray(values) * 1e3
+    return {"p50": float(np.percentile(ms, 50)), "p99": float(np.percentile(ms, 99))}
+
+
+def _make_rig(kind: str, settings, table, params, seed: int):
+    from softbend.control.rig import SimulatedRig
+
+    if kind == "modbus":
+        from softbend.control.modbus import ModbusRig
+
+        return ModbusRig(settings).connect()
+    simulated = SimulatedRig(table, params, seed=seed)
+    if kind == "sim":
+        return simulated
+    from softbend.control.realtime import WallClockRig
+
+    return WallClockRig(simulated)
+
+
+@app.command("serve")
+def serve_cmd(
+    config: Path = typer.Option(
+        None, "--config", help="Rig TOML whose register map to serve (default: the built-in map)."
+    ),
+    host: str = typer.Option("127.0.0.1", help="Address to listen on."),
+    port: int = typer.Option(None, help="TCP port (default: the config's, else 5020)."),
+    design: str = typer.Option("100,6,2,2,5,8", help="Actuator l,r,t,b,phi,lc (mm, deg)."),
+    model: Path = typer.Option(
+        None, "--model", help="Saved surrogate for θ(p) (default: the shipped FEM-trained MLP)."
+    ),
+    supply: float = typer.Option(0.2, help="Supply pressure, MPa gauge."),
+    seed: int = typer.Option(0, help="Seed of the sensor and camera noise."),
+    duration: float = typer.Option(0.0, help="Serve for this long, s (0: until Ctrl-C)."),
+) -> None:
+    """Serve the simulated rig as a Modbus TCP device, to rehearse `control run --rig modbus`.
+
+    Registers as in the config; the actuator is vented when no request came for 0.25 s.
+    """
+    import time
+
+    from softbend._validation import check_range
+    from softbend.control.modbus_server import SimulatedModbusServer
+    from softbend.control.rig import SimulatedRig
+    from softbend.control.rigconfig import RigConfig, load_rig_config
+
+    settings = load_rig_config(config) if config is not None else RigConfig()
+    listen = (
+        port if port is not None else (settings.connection.port if config is not None else 5020)
+    )
+    check_range(duration, "duration", "softbend control serve", low=0.0, low_inclusive=True)
+    _, params, table, _ = _setup("softbend control serve", "bang-bang", design, model, supply)
+    server = SimulatedModbusServer(
+        SimulatedRig(table, params, seed=seed), settings, host=host, port=listen
+    )
+    server.start()
+    _common.console.print(
+        f"simulated rig {design} serving on {server.config.connection.where} "
+        f"({'Ctrl-C to stop' if duration == 0 else f'for {duration:g} s'})"
+    )
+    try:
+        end = time.monotonic() + (duration if duration > 0 else float("inf"))
+        while time.monotonic() < end:
+            time.sleep(min(0.2, max(0.0, end - time.monotonic())))
+    except KeyboardInterrupt:
+        pass
+    finally:
+        server.stop()
+    _common.console.print(f"served {server.requests} requests; valves left vented")
+
+
+@app.command("rig-config")
+def rig_config_cmd(
+    out: Path = typer.Option(..., "--out", help="The TOML file to write."),
+    host: str = typer.Option("127.0.0.1", help="Modbus TCP host."),
+    port: int = typer.Option(5020, help="Modbus TCP port."),
+) -> None:
+    """Write a rig TOML template (the built-in register map of `control serve`) to edit."""
+    from dataclasses import replace
+
+    from softbend._io import write_text_atomic
+    from softbend.control.rigconfig import RigConfig
+
+    settings = RigConfig()
+    settings = replace(settings, connection=replace(settings.connection, host=host, port=port))
+    _common.check_output_file(out, "--out")
+    header = (
+        "# softbend rig: connection, register map, scaling (value = offset + scale*count),\n"
+        "# safety limits and loop period. Units: MPa gauge, degrees, seconds.\n\n"
+    )
+    with _common.output_errors(out, "--out"):
+        write_text_atomic(out, header + settings.to_toml())
+    _common.console.print(f"rig config written to {out}")
+
+
+__all__ = ["RIGS", "app", "build_controller"]

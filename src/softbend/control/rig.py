@@ -344,25 +344,33 @@ def shipped_angle_table(
 
 @runtime_checkable
 class Rig(Protocol):
-    """What a closed loop needs from a rig, simulated or real.
+    """What the fixed-period loop (:func:`softbend.control.loop.run_loop`) needs from a rig.
 
-    ``reset(seed)`` starts over at rest; ``read_pressure_mpa()`` is one sensor
-    reading (gauge); ``command(inlet, outlet)`` sets the valves; ``advance(n)``
-    lets ``n`` steps of ``step_s`` pass (a simulation integrates, hardware waits);
-    ``camera_angle_deg()`` is the latest camera reading, for evaluation only.
+    Implemented by :class:`SimulatedRig` (simulated time: ``sleep_until``
+    integrates), :class:`softbend.control.realtime.WallClockRig` (the simulation
+    kept in step with the wall clock) and :class:`softbend.control.modbus.ModbusRig`
+    (hardware over Modbus: ``sleep_until`` waits).
+
+    ``clock_s()`` is the rig's time, s; ``sleep_until(t)`` returns at rig time
+    ``t`` or just after; ``read_pressure_mpa()`` is one sensor reading, gauge
+    MPa (a failed, garbage or stale reading raises
+    :class:`softbend.errors.RigError`); ``read_angle_deg()`` is the latest angle
+    of an evaluation sensor (camera), NaN where the rig has none;
+    ``command(inlet, outlet)`` sets the valves (``True`` = open); ``close()``
+    releases the rig (the loop vents it first).
     """
 
-    step_s: float
+    def clock_s(self) -> float: ...
 
-    def reset(self, seed: int | None = None) -> None: ...
+    def sleep_until(self, t_s: float) -> None: ...
 
     def read_pressure_mpa(self) -> float: ...
 
+    def read_angle_deg(self) -> float: ...
+
     def command(self, inlet: bool, outlet: bool) -> None: ...
 
-    def advance(self, steps: int = 1) -> None: ...
-
-    def camera_angle_deg(self) -> float: ...
+    def close(self) -> None: ...
 
 
 class SimulatedRig:
@@ -533,3 +541,22 @@ class SimulatedRig:
     def camera_angle_deg(self) -> float:
         """The latest camera frame available now (NaN before the first), degrees."""
         return self._camera
+
+    # The Rig protocol of the fixed-period loop, in simulated time.
+
+    def clock_s(self) -> float:
+        """Simulated time since :meth:`reset`, s."""
+        return self.t_s
+
+    def sleep_until(self, t_s: float) -> None:
+        """Integrate up to simulated time ``t_s`` (the first step boundary at or after it)."""
+        steps = math.ceil((t_s - self.t_s) / self.step_s - 1e-9)
+        if steps > 0:
+            self.advance(steps)
+
+    def read_angle_deg(self) -> float:
+        """The camera angle (:meth:`camera_angle_deg`), degrees."""
+        return self._camera
+
+    def close(self) -> None:
+        """Nothing to release."""

@@ -1,0 +1,372 @@
+"""The fixed-period control loop on any :class:`~softbend.control.rig.Rig`, with its safety.
+
+:func:`run_loop` runs one controller on one rig for a set time at a fixed
+period (paper B: 100 Hz). Each tick, at its scheduled time ``k·period_s``:
+
+1. read the pressure (and, on a Modbus rig, the angle in the same request);
+2. check it: a failed, garbage or stale reading is a *missed read*, which
+   closes the inlet at once (the outlet is left as it is); ``max_missed_reads``
+   in a row, or no good reading for ``stale_after_s``, vents and stops the run;
+   a reading above ``max_pressure_mpa`` vents and stops the run;
+3. call ``controller.step(reading, θr(k·period_s), k·period_s)`` and send its
+   valve command when it changed.
+
+Every tick is one row of the log: the scheduled and actual times, the reading,
+the reference, the controller's predicted angle, the valve command, the angle
+sensor and a status. With ``log_path`` the rows stream to a CSV file as they
+come (flushed every ``flush_every`` ticks, so a killed process keeps its ticks
+in ``<log>.partial``), which is moved into place at the end; a ``.parquet``
+path is written from the finished table.
+
+However the run ends (its duration reached, a fault, an exception, Ctrl-C)
+the loop vents the actuator: inlet closed, outlet open. If the rig cannot be
+reached to do that, the stop reason says so: the rig's own watchdog must vent
+it.
+
+Period jitter is ``|Δt − period_s|`` over consecutive actual tick times;
+lateness is the actual minus the scheduled time of each tick.
+"""
+
+from __future__ import annotations
+
+import math
+import os
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from softbend._io import atomic_file
+from softbend._validation import check_int, check_range
+from softbend.control.experiments import ControlRun, Reference, parse_reference, run_metrics
+from softbend.control.rigconfig import SafetyLimits
+from softbend.errors import RigError
+
+__all__ = ["COLUMNS", "LoopRun", "run_loop"]
+
+#: The columns of a loop's log, one row per tick.
+COLUMNS: tuple[str, ...] = (
+    "tick",
+    "t_target_s",
+    "t_s",
+    "lateness_s",
+    "measured_mpa",
+    "reference_deg",
+    "predicted_deg",
+    "inlet",
+    "outlet",
+    "angle_deg",
+    "status",
+)
+
+_VENT = (False, True)
+
+
+@dataclass(eq=False)
+class LoopRun:
+    """The ticks of one loop run and how it ended.
+
+    Attributes
+    ----------
+    ticks : pandas.DataFrame
+        One row per tick, columns :data:`COLUMNS`.
+    period_s : float
+        The loop's period, s.
+    completed : bool
+        True when the run reached its duration.
+    stop_reason : str
+        ``"completed"``, or the fault, exception or interruption that ended it.
+    fault_kind : str or None
+        The :class:`~softbend.errors.RigError` kind, ``"over-pressure"``,
+        ``"interrupted"``, ``"error"``, or None when completed.
+    vented : bool
+        Whether the final vent command reached the rig.
+    switches : int
+        Valve state changes commanded.
+    reference : Reference
+    metadata : dict
+        Anything the caller adds (rig, controller, versions...).
+    """
+
+    ticks: Any
+    period_s: float
+    completed: bool
+    stop_reason: str
+    fault_kind: str | None
+    vented: bool
+    switches: int
+    reference: Reference
+    metadata: dict[str, Any] = field(default_factory=dict)
+
+    def jitter(self) -> dict[str, float]:
+        """Period jitter and lateness percentiles, ms."""
+        t = self.ticks["t_s"].to_numpy(dtype=float)
+        late = self.ticks["lateness_s"].to_numpy(dtype=float)
+        out = {"ticks": int(t.size)}
+        if t.size >= 2:
+            dev = np.round(np.abs(np.diff(t) - self.period_s) * 1e3, 6)  # ns resolution
+            out["period_jitter_p50_ms"] = float(np.percentile(dev, 50))
+            out["period_jitter_p99_ms"] = float(np.percentile(dev, 99))
+            out["period_jitter_max_ms"] = float(np.max(dev))
+        if late.size:
+            out["lateness_p50_ms"] = float(np.percentile(late, 50) * 1e3)
+            out["lateness_p99_ms"] = float(np.percentile(late, 99) * 1e3)
+        return out
+
+    def control_run(self) -> ControlRun:
+        """The ticks as a :class:`ControlRun` on the scheduled times (for :func:`run_metrics`)."""
+        ticks = self.ticks
+        angle = ticks["angle_deg"].to_numpy(dtype=float)
+        measured = ticks["measured_mpa"].to_numpy(dtype=float)
+        return ControlRun(
+            t_s=ticks["t_target_s"].to_numpy(dtype=float),
+            reference_deg=ticks["reference_deg"].to_numpy(dtype=float),
+            angle_deg=angle,
+            camera_deg=angle,
+            predicted_deg=ticks["predicted_deg"].to_numpy(dtype=float),
+            pressure_mpa=measured,
+            measured_mpa=measured,
+            inlet=ticks["inlet"].to_numpy(dtype=bool),
+            outlet=ticks["outlet"].to_numpy(dtype=bool),
+            air_used_kg=math.nan,
+            switches=self.switches,
+            wall_s=math.nan,
+            reference=self.reference,
+        )
+
+    def metrics(self) -> dict[str, float]:
+        """:func:`run_metrics` on the angle sensor's readings (NaN without one)."""
+        out = run_metrics(self.control_run())
+        for key in ("air_used_kg", "realtime_factor"):
+            out.pop(key, None)
+        return out
+
+
+class _Log:
+    """The tick rows, kept in memory and streamed to ``<path>.partial`` as CSV."""
+
+    def __init__(self, path: Path | None, flush_every: int) -> None:
+        self.rows: list[tuple] = []
+        self.path = path
+        self.flush_every = flush_every
+        self._file = None
+        if path is not None and path.suffix.lower() == ".csv":
+            self.partial = path.with_name(path.name + ".partial")
+            self._file = open(self.partial, "w", encoding="utf-8", newline="")  # noqa: SIM115
+            self._file.write(",".join(COLUMNS) + "\n")
+
+    def add(self, row: tuple) -> None:
+        self.rows.append(row)
+        if self._file is not None:
+            self._file.write(",".join(_cell(v) for v in row) + "\n")
+            if len(self.rows) % self.flush_every == 0:
+                self._file.flush()
+
+    def finish(self):  # -> pandas.DataFrame
+        import pandas as pd
+
+        frame = pd.DataFrame(self.rows, columns=list(COLUMNS))
+        if self._file is not None:
+            self._file.flush()
+            os.fsync(self._file.fileno())
+            self._file.close()
+            os.replace(self.partial, self.path)
+        elif self.path is not None:
+            with atomic_file(self.path, "wb") as fh:
+                frame.to_parquet(fh, index=False)
+        return frame
+
+
+def _cell(value: Any) -> str:
+    if isinstance(value, bool):
+        return "1" if value else "0"
+    if isinstance(value, float):
+        return "" if math.isnan(value) else repr(value)
+    text = str(value)
+    return '"' + text.replace('"', '""') + '"' if ("," in text or '"' in text) else text
+
+
+def run_loop(
+    rig: Any,
+    controller: Any,
+    reference: Reference | str,
+    duration_s: float,
+    *,
+    period_s: float = 0.01,
+    limits: SafetyLimits | None = None,
+    log_path: str | os.PathLike[str] | None = None,
+    flush_every: int = 100,
+    progress: Any = None,
+) -> LoopRun:
+    """Run ``controller`` on ``rig`` at a fixed period for ``duration_s``, safely.
+
+    Parameters
+    ----------
+    rig : Rig
+        Any :class:`~softbend.control.rig.Rig` (simulated, wall-clock, Modbus).
+        It should be at rest; the loop does not reset it.
+    controller : Controller
+        Reset first; called once per tick with the reading and the tick's
+        scheduled time.
+    reference : Reference or str
+        θr(t), degrees (a spec as in :func:`~softbend.control.experiments.parse_reference`).
+    duration_s : float
+        Run time, s (``round(duration_s/period_s)`` ticks).
+    period_s : float, default 0.01
+    limits : SafetyLimits, optional
+        Over-pressure, missed-read and staleness limits (default :class:`SafetyLimits`).
+    log_path : path, optional
+        ``.csv`` (streamed) or ``.parquet`` (written at the end).
+    flush_every : int, default 100
+        Ticks between flushes of a CSV log.
+    progress : callable, optional
+        ``progress(done_ticks, total_ticks)``, called about once a second of run time.
+
+    Returns
+    -------
+    LoopRun
+        Its ``stop_reason`` says why it ended; it is not an exception: a fault
+        is a result, with every tick before it logged.
+
+    Raises
+    ------
+    KeyboardInterrupt
+        Never: Ctrl-C ends the run as ``fault_kind="interrupted"``, vented.
+    """
+    ref = parse_reference(reference) if isinstance(reference, str) else reference
+    period = check_range(period_s, "period_s", "run_loop", low=0.0, high=1.0, high_inclusive=True)
+    duration = check_range(
+        duration_s, "duration_s", "run_loop", low=0.0, high=86400.0, high_inclusive=True
+    )
+    flush = check_int(flush_every, "flush_every", "run_loop", low=1)
+    limits = SafetyLimits() if limits is None else limits
+    path = None if log_path is None else Path(log_path)
+    if path is not None and path.suffix.lower() not in (".csv", ".parquet"):
+        raise ValueError(
+            f"The 'log_path' of run_loop must end in .csv or .parquet. Got {str(path)!r} instead."
+        )
+    n = max(1, round(duration / period))
+    log = _Log(path, flush)
+    controller.reset()
+    state = (False, False)
+    switches = 0
+    missed = 0
+    last_good = None
+    reason, kind = "completed", None
+    report_every = max(1, round(1.0 / period))
+
+    def send(command: tuple[bool, bool]) -> None:
+        nonlocal state, switches
+        if command != state:
+            rig.command(command[0], command[1])
+            switches += (command[0] != state[0]) + (command[1] != state[1])
+            state = command
+
+    try:
+        t_start = rig.clock_s()
+        last_good = t_start
+        for k in range(n):
+            target = t_start + k * period
+            rig.sleep_until(target)
+            now = rig.clock_s()
+            status = "ok"
+            try:
+                reading = float(rig.read_pressure_mpa())
+                if not math.isfinite(reading):
+                    raise RigError(f"The pressure reading is {reading}.", kind="garbage")
+            except RigError as exc:
+                missed += 1
+                reading = math.nan
+                status = f"missed ({exc.kind})"
+                stale = rig.clock_s() - last_good > limits.stale_after_s
+                if missed >= limits.max_missed_reads or stale:
+                    why = (
+                        f"{missed} missed reads in a row"
+                        if missed >= limits.max_missed_reads
+                        else f"no good reading for {rig.clock_s() - last_good:.3f} s"
+                    )
+                    reason, kind = f"{exc} ({why}; vented and stopped)", exc.kind
+                    log.add(_row(k, target - t_start, now - t_start, reading, ref, controller,
+                                 state, rig, status))  # fmt: skip
+                    break
+                send((False, state[1]))  # close the inlet at once
+            else:
+                missed = 0
+                last_good = rig.clock_s()
+                if reading > limits.max_pressure_mpa:
+                    status = "over-pressure"
+                    reason = (
+                        f"Over-pressure: {reading:.4f} MPa read, above max_pressure_mpa "
+                        f"{limits.max_pressure_mpa:g} (vented and stopped)."
+                    )
+                    kind = "over-pressure"
+                    log.add(_row(k, target - t_start, now - t_start, reading, ref, controller,
+                                 state, rig, status))  # fmt: skip
+                    break
+                theta_r = float(ref.values(np.array([target - t_start]))[0])
+                command = controller.step(reading, theta_r, target - t_start)
+                send((bool(command[0]), bool(command[1])))
+            log.add(_row(k, target - t_start, now - t_start, reading, ref, controller, state, rig,
+                         status))  # fmt: skip
+            if progress is not None and (k + 1) % report_every == 0:
+                progress(k + 1, n)
+    except KeyboardInterrupt:
+        reason, kind = "Interrupted (Ctrl-C); vented and stopped.", "interrupted"
+    except RigError as exc:  # a command that did not reach the rig
+        reason, kind = f"{exc} (vented and stopped)", exc.kind
+    except Exception as exc:  # a controller or rig bug: still leave the valves safe
+        reason, kind = f"Stopped by an error: {type(exc).__name__}: {exc} (vented).", "error"
+    vented = True
+    try:
+        rig.command(*_VENT)
+        if state != _VENT:
+            switches += (state[0] != _VENT[0]) + (state[1] != _VENT[1])
+    except Exception as exc:
+        vented = False
+        reason += (
+            f" Could not vent the rig ({exc}): its own watchdog must vent it; check the "
+            f"valves by hand."
+        )
+    frame = log.finish()
+    return LoopRun(
+        ticks=frame,
+        period_s=period,
+        completed=kind is None,
+        stop_reason=reason,
+        fault_kind=kind,
+        vented=vented,
+        switches=switches,
+        reference=ref,
+    )
+
+
+def _row(
+    k: int,
+    target: float,
+    actual: float,
+    reading: float,
+    ref: Reference,
+    controller: Any,
+    state: tuple[bool, bool],
+    rig: Any,
+    status: str,
+) -> tuple:
+    theta_r = float(ref.values(np.array([target]))[0])
+    try:
+        angle = float(rig.read_angle_deg())
+    except Exception:
+        angle = math.nan
+    return (
+        k,
+        target,
+        actual,
+        actual - target,
+        reading,
+        theta_r,
+        float(getattr(controller, "predicted_deg", math.nan)),
+        state[0],
+        state[1],
+        angle,
+        status,
+    )

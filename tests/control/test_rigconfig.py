@@ -1,0 +1,79 @@
+"""The rig TOML: round trip, scaling, and one clear error per bad field."""
+
+import pytest
+
+from softbend.control.rigconfig import RegisterConfig, RigConfig, load_rig_config
+from softbend.errors import DatasetError
+
+
+def test_default_config_round_trips_through_toml(tmp_path):
+    config = RigConfig()
+    path = tmp_path / "rig.toml"
+    path.write_text(config.to_toml())
+    assert load_rig_config(path) == config
+
+
+def test_config_without_angle_round_trips(tmp_path):
+    config = RigConfig(angle=None, period_s=0.005)
+    path = tmp_path / "rig.toml"
+    path.write_text(config.to_toml())
+    loaded = load_rig_config(path)
+    assert loaded.angle is None and loaded.period_s == 0.005
+
+
+@pytest.mark.parametrize(
+    ("signed", "value", "raw"),
+    [(False, 0.1234, 1234), (False, -1.0, 0), (False, 99.0, 0xFFFF), (True, -0.5, 0xFFCE)],
+)
+def test_register_encoding_rounds_and_saturates(signed, value, raw):
+    reg = RegisterConfig(signed=signed, scale=0.01 if signed else 1e-4)
+    assert reg.encode(value) == raw
+
+
+def test_signed_register_decodes_twos_complement():
+    reg = RegisterConfig(signed=True, scale=0.01, offset=10.0)
+    assert reg.decode(0xFFFF) == pytest.approx(10.0 - 0.01)
+    assert reg.decode(reg.encode(-123.45)) == pytest.approx(-123.45)
+
+
+def _write(tmp_path, text):
+    path = tmp_path / "rig.toml"
+    path.write_text(text)
+    return path
+
+
+@pytest.mark.parametrize(
+    ("text", "needle"),
+    [
+        ("[pressure]\naddress = 0\n[valvez]\n", "section 'valvez'"),
+        ("[pressure]\nadress = 0\n", "key 'adress' of [pressure]"),
+        ("[connection]\nport = 5\n", "must have a [pressure] section"),
+        ('[pressure]\n[connection]\ntransport = "udp"\n', "'transport' of [connection]"),
+        ('[pressure]\n[connection]\ntransport = "rtu"\n', "'serial_port' of [connection]"),
+        ("[pressure]\nscale = 0\n", "'scale' of [pressure]"),
+        ("[pressure]\naddress = 70000\n", "'address' of [pressure]"),
+        ("[pressure]\naddress = 1\n[angle]\naddress = 1\n", "must not share input register 1"),
+        ("[pressure]\n[valves]\ninlet_coil = 3\noutlet_coil = 3\n", "'outlet_coil' of [valves]"),
+        ("[pressure]\n[safety]\nmax_pressure_mpa = 0.7\n", "valid_min_mpa < max_pressure_mpa"),
+        ("[pressure]\n[loop]\nperiod_s = -0.01\n", "'period_s' of [loop]"),
+        ("[pressure]\n[connection]\ndevice_id = 300\n", "'device_id' of [connection]"),
+    ],
+)
+def test_bad_config_is_one_error_naming_the_field(tmp_path, text, needle):
+    with pytest.raises(ValueError) as info:
+        load_rig_config(_write(tmp_path, text))
+    assert needle in str(info.value)
+    assert "\n" not in str(info.value)
+
+
+def test_transport_error_lists_the_allowed_values(tmp_path):
+    with pytest.raises(ValueError) as info:
+        load_rig_config(_write(tmp_path, '[pressure]\n[connection]\ntransport = "udp"\n'))
+    assert "'tcp', 'rtu'" in str(info.value)
+
+
+def test_invalid_toml_and_missing_file(tmp_path):
+    with pytest.raises(DatasetError, match="not valid TOML"):
+        load_rig_config(_write(tmp_path, "[pressure\n"))
+    with pytest.raises(FileNotFoundError, match="does not exist"):
+        load_rig_config(tmp_path / "nope.toml")
