@@ -172,7 +172,11 @@ def run_cmd(
     ),
     duration: float = typer.Option(10.0, help="Run time, s."),
     period: float = typer.Option(
-        None, help="Loop period, s (default: the config's [loop] period_s, 0.01)."
+        None, help="Loop tick (controller, valves), s (default: the config's period_s, 0.001)."
+    ),
+    sensor_period: float = typer.Option(
+        None,
+        help="Pressure reading period, s (default: the config's sensor_period_s, 0.01: 100 Hz).",
     ),
     supply: float = typer.Option(0.2, help="Supply pressure of a simulated rig, MPa gauge."),
     seed: int = typer.Option(0, help="Seed of a simulated rig's sensor and camera noise."),
@@ -181,10 +185,11 @@ def run_cmd(
 ) -> None:
     """Run a controller in the fixed-period loop on a rig, with its safety limits and tick log.
 
-    The same controller object as `control simulate`, called once per tick (paper B:
-    100 Hz) with the pressure reading. Over-pressure, missed or stale readings vent
-    the actuator and stop the run; so does Ctrl-C. Exit 0 when the run completed, 1
-    when a fault stopped it (the log keeps every tick up to the fault), 130 on Ctrl-C.
+    The same controller object as `control simulate`, called every tick (1 ms) with
+    the latest pressure reading (read every 10 ms: paper B's 100 Hz). Over-pressure,
+    missed or stale readings vent the actuator and stop the run; so does Ctrl-C. Exit 0
+    when the run completed, 1 when a fault stopped it (the log keeps every tick up to
+    the fault), 130 on Ctrl-C.
     """
     from softbend._validation import check_choice, check_range
     from softbend.control.experiments import parse_reference
@@ -202,6 +207,7 @@ def run_cmd(
         )
     settings = load_rig_config(config) if config is not None else RigConfig()
     loop_period = settings.period_s if period is None else period
+    sensor_every = settings.sensor_period_s if sensor_period is None else sensor_period
     actuator, params, table, ctrl = _setup(command, controller, design, model, supply)
     log_name = f"ticks.{log_format}"
     _common.check_output_dir(out, "--out", files=(log_name, "run.json", "run.png"))
@@ -209,6 +215,10 @@ def run_cmd(
         out.mkdir(parents=True, exist_ok=True)
     check_range(duration, "duration", command, low=0.0, high=86400.0, high_inclusive=True)
     check_range(loop_period, "period", command, low=0.0, high=1.0, high_inclusive=True)
+    check_range(
+        sensor_every, "sensor_period", command, low=loop_period, high=10.0,
+        low_inclusive=True, high_inclusive=True,
+    )  # fmt: skip
     ticks = max(1, round(duration / loop_period))
     plant = _make_rig(rig, settings, table, params, seed)
     done = [0]
@@ -225,6 +235,7 @@ def run_cmd(
                 ref,
                 duration,
                 period_s=loop_period,
+                sensor_period_s=sensor_every,
                 limits=settings.safety,
                 log_path=out / log_name,
                 progress=report,
@@ -242,6 +253,7 @@ def run_cmd(
         "design": str(actuator),
         "duration_s": duration,
         "period_s": loop_period,
+        "sensor_period_s": sensor_every,
         "seed": seed,
         "completed": result.completed,
         "stop_reason": result.stop_reason,
@@ -262,7 +274,8 @@ def run_cmd(
         figure = _figure(
             result.control_run(),
             out / "run.png",
-            f"{controller} on {actuator}, {reference}, rig {rig} (loop at {1 / loop_period:g} Hz)",
+            f"{controller} on {actuator}, {reference}, rig {rig} "
+            f"(tick {loop_period * 1e3:g} ms, sensor {sensor_every * 1e3:g} ms)",
         )
     payload["files"] = [str(out / log_name), str(out / "run.json")] + (
         [str(figure)] if figure else []

@@ -1,22 +1,29 @@
 """The fixed-period control loop on any :class:`~softbend.control.rig.Rig`, with its safety.
 
-:func:`run_loop` runs one controller on one rig for a set time at a fixed
-period (paper B: 100 Hz). Each tick, at its scheduled time ``k·period_s``:
+:func:`run_loop` runs one controller on one rig for a set time. The loop ticks
+every ``period_s`` (1 ms: the valve timing of a PLC) and reads the pressure
+sensor every ``sensor_period_s`` (paper B: 100 Hz), exactly as
+:func:`~softbend.control.experiments.simulate` does in simulated time, so a
+controller that times its valve pulses finer than the sensor (PWM, a relay's
+early close) behaves the same on a rig. Each tick, at its scheduled time
+``k·period_s``:
 
-1. read the pressure (and, on a Modbus rig, the angle in the same request);
-2. check it: a failed, garbage or stale reading is a *missed read*, which
-   closes the inlet at once (the outlet is left as it is); ``max_missed_reads``
-   in a row, or no good reading for ``stale_after_s``, vents and stops the run;
-   a reading above ``max_pressure_mpa`` vents and stops the run;
-3. call ``controller.step(reading, θr(k·period_s), k·period_s)`` and send its
-   valve command when it changed.
+1. on a sensor tick, read the pressure (and, on a Modbus rig, the angle in the
+   same request) and check it: a failed, garbage or stale reading is a *missed
+   read*, which closes the inlet at once (the outlet is left as it is) and
+   keeps the controller out until a good reading; ``max_missed_reads`` in a
+   row, or no good reading for ``stale_after_s``, vents and stops the run; a
+   reading above ``max_pressure_mpa`` vents and stops the run;
+2. call ``controller.step(reading, θr(k·period_s), k·period_s)`` with the
+   latest good reading and send its valve command when it changed.
 
-Every tick is one row of the log: the scheduled and actual times, the reading,
-the reference, the controller's predicted angle, the valve command, the angle
-sensor and a status. With ``log_path`` the rows stream to a CSV file as they
-come (flushed every ``flush_every`` ticks, so a killed process keeps its ticks
-in ``<log>.partial``), which is moved into place at the end; a ``.parquet``
-path is written from the finished table.
+Every tick is one row of the log: the scheduled and actual times, the reading
+(``status`` ``ok`` when read on that tick, ``held`` in between), the
+reference, the controller's predicted angle, the valve command and the angle
+sensor. With ``log_path`` the rows stream to a CSV file as they come (flushed
+every ``flush_every`` ticks, so a killed process keeps its ticks in
+``<log>.partial``), which is moved into place at the end; a ``.parquet`` path is
+written from the finished table.
 
 However the run ends (its duration reached, a fault, an exception, Ctrl-C)
 the loop vents the actuator: inlet closed, outlet open. If the rig cannot be
@@ -72,7 +79,7 @@ class LoopRun:
     ticks : pandas.DataFrame
         One row per tick, columns :data:`COLUMNS`.
     period_s : float
-        The loop's period, s.
+        The loop's tick, s.
     completed : bool
         True when the run reached its duration.
     stop_reason : str
@@ -193,10 +200,11 @@ def run_loop(
     reference: Reference | str,
     duration_s: float,
     *,
-    period_s: float = 0.01,
+    period_s: float = 0.001,
+    sensor_period_s: float = 0.01,
     limits: SafetyLimits | None = None,
     log_path: str | os.PathLike[str] | None = None,
-    flush_every: int = 100,
+    flush_every: int = 1000,
     progress: Any = None,
 ) -> LoopRun:
     """Run ``controller`` on ``rig`` at a fixed period for ``duration_s``, safely.
@@ -207,18 +215,21 @@ def run_loop(
         Any :class:`~softbend.control.rig.Rig` (simulated, wall-clock, Modbus).
         It should be at rest; the loop does not reset it.
     controller : Controller
-        Reset first; called once per tick with the reading and the tick's
-        scheduled time.
+        Reset first; called once per tick with the latest good reading and the
+        tick's scheduled time.
     reference : Reference or str
         θr(t), degrees (a spec as in :func:`~softbend.control.experiments.parse_reference`).
     duration_s : float
         Run time, s (``round(duration_s/period_s)`` ticks).
-    period_s : float, default 0.01
+    period_s : float, default 0.001
+        Tick of the controller and the valves, s.
+    sensor_period_s : float, default 0.01
+        Period of the pressure readings, s; rounded to a whole number of ticks.
     limits : SafetyLimits, optional
         Over-pressure, missed-read and staleness limits (default :class:`SafetyLimits`).
     log_path : path, optional
         ``.csv`` (streamed) or ``.parquet`` (written at the end).
-    flush_every : int, default 100
+    flush_every : int, default 1000
         Ticks between flushes of a CSV log.
     progress : callable, optional
         ``progress(done_ticks, total_ticks)``, called about once a second of run time.
@@ -236,6 +247,10 @@ def run_loop(
     """
     ref = parse_reference(reference) if isinstance(reference, str) else reference
     period = check_range(period_s, "period_s", "run_loop", low=0.0, high=1.0, high_inclusive=True)
+    sensor = check_range(
+        sensor_period_s, "sensor_period_s", "run_loop", low=period, high=10.0,
+        low_inclusive=True, high_inclusive=True,
+    )  # fmt: skip
     duration = check_range(
         duration_s, "duration_s", "run_loop", low=0.0, high=86400.0, high_inclusive=True
     )
@@ -247,12 +262,13 @@ def run_loop(
             f"The 'log_path' of run_loop must end in .csv or .parquet. Got {str(path)!r} instead."
         )
     n = max(1, round(duration / period))
+    sensor_every = max(1, round(sensor / period))
     log = _Log(path, flush)
     controller.reset()
     state = (False, False)
     switches = 0
     missed = 0
-    last_good = None
+    held = math.nan  # the latest good reading; NaN after a missed read
     reason, kind = "completed", None
     report_every = max(1, round(1.0 / period))
 
@@ -263,52 +279,54 @@ def run_loop(
             switches += (command[0] != state[0]) + (command[1] != state[1])
             state = command
 
+    def row(k: int, now: float, status: str) -> tuple:
+        return _row(k, k * period, now - t_start, held, ref, controller, state, rig, status)
+
     try:
         t_start = rig.clock_s()
         last_good = t_start
         for k in range(n):
-            target = t_start + k * period
-            rig.sleep_until(target)
+            rig.sleep_until(t_start + k * period)
             now = rig.clock_s()
-            status = "ok"
-            try:
-                reading = float(rig.read_pressure_mpa())
-                if not math.isfinite(reading):
-                    raise RigError(f"The pressure reading is {reading}.", kind="garbage")
-            except RigError as exc:
-                missed += 1
-                reading = math.nan
-                status = f"missed ({exc.kind})"
-                stale = rig.clock_s() - last_good > limits.stale_after_s
-                if missed >= limits.max_missed_reads or stale:
-                    why = (
-                        f"{missed} missed reads in a row"
-                        if missed >= limits.max_missed_reads
-                        else f"no good reading for {rig.clock_s() - last_good:.3f} s"
-                    )
-                    reason, kind = f"{exc} ({why}; vented and stopped)", exc.kind
-                    log.add(_row(k, target - t_start, now - t_start, reading, ref, controller,
-                                 state, rig, status))  # fmt: skip
-                    break
-                send((False, state[1]))  # close the inlet at once
-            else:
-                missed = 0
-                last_good = rig.clock_s()
-                if reading > limits.max_pressure_mpa:
-                    status = "over-pressure"
-                    reason = (
-                        f"Over-pressure: {reading:.4f} MPa read, above max_pressure_mpa "
-                        f"{limits.max_pressure_mpa:g} (vented and stopped)."
-                    )
-                    kind = "over-pressure"
-                    log.add(_row(k, target - t_start, now - t_start, reading, ref, controller,
-                                 state, rig, status))  # fmt: skip
-                    break
-                theta_r = float(ref.values(np.array([target - t_start]))[0])
-                command = controller.step(reading, theta_r, target - t_start)
+            status = "held"
+            if k % sensor_every == 0:
+                status = "ok"
+                try:
+                    reading = float(rig.read_pressure_mpa())
+                    if not math.isfinite(reading):
+                        raise RigError(f"The pressure reading is {reading}.", kind="garbage")
+                except RigError as exc:
+                    missed += 1
+                    held = math.nan
+                    status = f"missed ({exc.kind})"
+                    quiet = rig.clock_s() - last_good
+                    if missed >= limits.max_missed_reads or quiet > limits.stale_after_s:
+                        why = (
+                            f"{missed} missed reads in a row"
+                            if missed >= limits.max_missed_reads
+                            else f"no good reading for {quiet:.3f} s"
+                        )
+                        reason, kind = f"{exc} ({why}; vented and stopped)", exc.kind
+                        log.add(row(k, now, status))
+                        break
+                    send((False, state[1]))  # close the inlet at once
+                else:
+                    missed = 0
+                    held = reading
+                    last_good = rig.clock_s()
+                    if reading > limits.max_pressure_mpa:
+                        reason = (
+                            f"Over-pressure: {reading:.4f} MPa read, above max_pressure_mpa "
+                            f"{limits.max_pressure_mpa:g} (vented and stopped)."
+                        )
+                        kind = "over-pressure"
+                        log.add(row(k, now, "over-pressure"))
+                        break
+            if held == held:  # a good reading to act on
+                theta_r = float(ref.values(np.array([k * period]))[0])
+                command = controller.step(held, theta_r, k * period)
                 send((bool(command[0]), bool(command[1])))
-            log.add(_row(k, target - t_start, now - t_start, reading, ref, controller, state, rig,
-                         status))  # fmt: skip
+            log.add(row(k, now, status))
             if progress is not None and (k + 1) % report_every == 0:
                 progress(k + 1, n)
     except KeyboardInterrupt:

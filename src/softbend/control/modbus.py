@@ -18,6 +18,7 @@ Everything that goes wrong on the wire becomes one
 from __future__ import annotations
 
 import contextlib
+import logging
 import math
 import time
 from typing import Any
@@ -35,6 +36,10 @@ _SPAN = 16  # registers read in one request at most
 def _client(config: RigConfig) -> Any:
     require("pymodbus", "The Modbus rig (softbend control run --rig modbus)")
     from pymodbus.client import ModbusSerialClient, ModbusTcpClient
+
+    quiet = logging.getLogger("pymodbus")
+    if quiet.level == logging.NOTSET:  # failures come back as one RigError, not a log
+        quiet.setLevel(logging.CRITICAL)
 
     c = config.connection
     if c.transport == "tcp":

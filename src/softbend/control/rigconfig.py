@@ -44,7 +44,8 @@ stop the loop. Every value has a unit in its name or its comment::
     max_missed_reads = 3      # consecutive failed reads before the loop stops
 
     [loop]
-    period_s = 0.01           # paper B: 100 Hz
+    period_s = 0.001          # tick of the controller and the valves, s
+    sensor_period_s = 0.01    # pressure readings, s (paper B: 100 Hz)
 
 :func:`load_rig_config` reads and checks a file (unknown sections or keys, a
 wrong type, a value out of range: one error naming the field and the allowed
@@ -229,7 +230,7 @@ class SafetyLimits:
 
 @dataclass(frozen=True)
 class RigConfig:
-    """A whole rig: connection, registers, valves, safety limits and loop period (s)."""
+    """A whole rig: connection, registers, valves, safety, loop tick and sensor period (s)."""
 
     connection: ConnectionConfig = field(default_factory=ConnectionConfig)
     pressure: RegisterConfig = field(
@@ -240,12 +241,15 @@ class RigConfig:
     )
     valves: ValveConfig = field(default_factory=ValveConfig)
     safety: SafetyLimits = field(default_factory=SafetyLimits)
-    period_s: float = 0.01
+    period_s: float = 0.001
+    sensor_period_s: float = 0.01
 
     def __post_init__(self) -> None:
+        loop = f"[loop] of the {_OWNER}"
+        check_range(self.period_s, "period_s", loop, low=0.0, high=1.0, high_inclusive=True)
         check_range(
-            self.period_s, "period_s", f"[loop] of the {_OWNER}", low=0.0, high=1.0,
-            high_inclusive=True,
+            self.sensor_period_s, "sensor_period_s", loop, low=self.period_s, high=10.0,
+            low_inclusive=True, high_inclusive=True,
         )  # fmt: skip
         used = {(self.pressure.table, self.pressure.address): "[pressure] address"}
         others = []
@@ -282,14 +286,15 @@ class RigConfig:
             return kind(**table, **(extra or {}))
 
         loop = data.get("loop", {})
-        _check_keys(loop, {"period_s"}, f"[loop] of the {_OWNER}", "key")
+        _check_keys(loop, {"period_s", "sensor_period_s"}, f"[loop] of the {_OWNER}", "key")
         return cls(
             connection=build(ConnectionConfig, "connection"),
             pressure=build(RegisterConfig, "pressure", {"section": "pressure"}),
             angle=build(RegisterConfig, "angle", {"section": "angle"}) if "angle" in data else None,
             valves=build(ValveConfig, "valves"),
             safety=build(SafetyLimits, "safety"),
-            period_s=loop.get("period_s", 0.01),
+            period_s=loop.get("period_s", 0.001),
+            sensor_period_s=loop.get("sensor_period_s", 0.01),
         )
 
     def to_toml(self) -> str:
@@ -311,7 +316,12 @@ class RigConfig:
             section("angle", self.angle)
         section("valves", self.valves)
         section("safety", self.safety)
-        lines += ["[loop]", f"period_s = {_toml_value(self.period_s)}", ""]
+        lines += [
+            "[loop]",
+            f"period_s = {_toml_value(self.period_s)}",
+            f"sensor_period_s = {_toml_value(self.sensor_period_s)}",
+            "",
+        ]
         return "\n".join(lines)
 
 
