@@ -1,6 +1,7 @@
 import itertools
 
 import numpy as np
+import pandas as pd
 import pytest
 
 from softbend.surrogates.search import grid, grouped_splits, search
@@ -169,3 +170,115 @@ def test_random_folds_mix_the_designs(small_data):
     assert result.settings["cv"] == "random"
     with pytest.raises(ValueError, match="'cv'"):
         search(small_data, models=["plr"], cv="loo")
+
+
+#: A search small enough to run four times: every family, MLP halving in two rungs.
+RESUME = {
+    "models": ["plr", "xgb", "mlp"],
+    "param_grid": {
+        "plr": [{"degree": 1}, {"degree": 2}],
+        "xgb": [{"max_depth": 2, "learning_rate": 0.3}, {"max_depth": 3, "learning_rate": 0.3}],
+        "mlp": [{"hidden_sizes": (h, h + 1)} for h in (3, 4, 5, 6)],
+    },
+    "folds": 3,
+    "seed": 1,
+    "epochs": 8,
+    "halving": 2,  # rungs: 4 configurations x 4 epochs, then 2 x 8
+    "device": "cpu",
+    "n_jobs": 1,
+}
+
+
+class _KilledError(Exception):
+    """Stands for a kill: raised from the progress callback."""
+
+
+def _stop_at(phase_start: str, done: int):
+    def progress(phase, count, _total):
+        if phase.startswith(phase_start) and count >= done:
+            raise _KilledError(phase)
+
+    return progress
+
+
+def _assert_same_search(a, b):
+    timing = ["fit_s_per_config"]
+    pd.testing.assert_frame_equal(
+        a.cv_results.drop(columns=timing), b.cv_results.drop(columns=timing)
+    )
+    assert a.settings == b.settings
+    assert list(a.families) == list(b.families)
+    for name, fam in a.families.items():
+        other = b.families[name]
+        assert fam.params == other.params and fam.cv == other.cv
+        np.testing.assert_array_equal(fam.oof_pred, other.oof_pred)
+        np.testing.assert_array_equal(fam.model.predict(a.data.X), other.model.predict(a.data.X))
+
+
+def test_an_interrupted_search_resumes_from_its_finished_folds(small_data, tmp_path, monkeypatch):
+    import softbend.surrogates.batched as batched
+    import softbend.surrogates.search as search_module
+    from softbend.surrogates.checkpoint import SearchCheckpoint
+
+    reference = search(small_data, **RESUME)
+    path = tmp_path / "search.jsonl"
+    made: list[str] = []
+    trainings: list[int] = []
+    real_make, real_grid = search_module._make, batched.train_mlp_grid
+
+    def counting_make(model, params, **kwargs):
+        made.append(model)
+        return real_make(model, params, **kwargs)
+
+    def counting_grid(*args, **kwargs):
+        trainings.append(kwargs["epochs"])
+        return real_grid(*args, **kwargs)
+
+    monkeypatch.setattr(search_module, "_make", counting_make)
+    monkeypatch.setattr(batched, "train_mlp_grid", counting_grid)
+
+    # Killed in the middle of XGBoost, after 2 of its 6 folds.
+    with SearchCheckpoint(path) as checkpoint, pytest.raises(_KilledError):
+        search(small_data, **RESUME, checkpoint=checkpoint, progress=_stop_at("xgb", 2))
+    # Resumed, then killed in the MLP's second rung: the first rung's folds are saved.
+    made.clear()
+    said: list[str] = []
+    with SearchCheckpoint(path, on_resume=said.append) as checkpoint, pytest.raises(_KilledError):
+        search(small_data, **RESUME, checkpoint=checkpoint, progress=_stop_at("mlp", 5))
+    assert len(said) == 1 and "8 configuration-folds" in said[0]  # 6 plr + 2 xgb
+    assert made == ["plr"] + ["xgb"] * 5  # the refit of plr, 4 xgb folds and its refit
+    assert trainings == [4, 8]
+    # The last run trains only the second rung and the refits.
+    made.clear()
+    trainings.clear()
+    with SearchCheckpoint(path) as checkpoint:
+        resumed = search(small_data, **RESUME, checkpoint=checkpoint)
+        assert checkpoint.n_records == 6 + 6 + 4 * 3 + 2 * 3
+    assert made == ["plr", "xgb", "mlp"] and trainings == [8]
+    assert resumed.resumed == 6 + 6 + 4 * 3
+    assert reference.resumed == 0
+    _assert_same_search(resumed, reference)
+    assert path.is_file()  # the caller removes it when the results are safe
+
+    # Once more: everything comes from the checkpoint, nothing is trained but the refits.
+    made.clear()
+    trainings.clear()
+    with SearchCheckpoint(path) as checkpoint:
+        again = search(small_data, **RESUME, checkpoint=checkpoint)
+    assert made == ["plr", "xgb", "mlp"] and trainings == []
+    assert again.resumed == 6 + 6 + 4 * 3 + 2 * 3
+    _assert_same_search(again, reference)
+
+
+def test_a_checkpoint_of_other_settings_is_not_reused(small_data, tmp_path):
+    from softbend.surrogates.checkpoint import SearchCheckpoint
+
+    path = tmp_path / "search.jsonl"
+    common = {"models": ["plr"], "param_grid": {"plr": [{"degree": 1}, {"degree": 2}]}}
+    with SearchCheckpoint(path) as checkpoint:
+        search(small_data, **common, folds=3, checkpoint=checkpoint)
+    said: list[str] = []
+    with SearchCheckpoint(path, on_discard=said.append) as checkpoint:
+        result = search(small_data, **common, folds=4, checkpoint=checkpoint)
+    assert result.resumed == 0 and result.settings["folds"] == 4
+    assert len(said) == 1 and "folds" in said[0] and "splits" in said[0]

@@ -24,16 +24,24 @@ method. The MLP trains with batch 1024 and Adam lr 6e-4 (paper B) for 1000
 epochs in the ``paper`` grid (paper B) and 200 in the ``quick`` grid (about a
 tenth of the time on a laptop CPU, at some cost in accuracy), unless ``epochs``
 is given.
+
+Resume: given a :class:`~softbend.surrogates.checkpoint.SearchCheckpoint`, the
+search appends every finished (family, configuration, fold) to it durably and,
+run again with the same data and settings, loads the folds it holds instead of
+refitting them, so a killed search resumes where it stopped and ends with the
+same results. The MLP configurations train together, so their folds are saved
+together when a training (a rung of successive halving) ends.
 """
 
 from __future__ import annotations
 
+import hashlib
 import logging
 import math
 import time
 from collections.abc import Callable
 from dataclasses import dataclass, field
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 import pandas as pd
@@ -42,6 +50,9 @@ from softbend._extras import require
 from softbend._validation import check_choice, check_int, check_range
 from softbend.surrogates.features import TrainingData
 from softbend.surrogates.metrics import MAPE_THRESHOLD_DEG, accuracy, inference_time
+
+if TYPE_CHECKING:
+    from softbend.surrogates.checkpoint import SearchCheckpoint
 
 logger = logging.getLogger(__name__)
 
@@ -209,12 +220,16 @@ class SearchResult:
         The data used.
     settings : dict
         Grid, folds, seed, device, epochs.
+    resumed : int
+        Configuration-folds loaded from a checkpoint instead of fitted (0 for a
+        search that started afresh).
     """
 
     cv_results: pd.DataFrame
     families: dict[str, FamilyResult]
     data: TrainingData
     settings: dict[str, Any] = field(default_factory=dict)
+    resumed: int = 0
 
     def summary(self) -> pd.DataFrame:
         """One row per family: best configuration, CV accuracy, inference time."""
@@ -288,17 +303,37 @@ def _cv_sequential(
     splits: list[tuple[np.ndarray, np.ndarray]],
     make: Callable[[dict[str, Any]], Any],
     tick: Callable[[], None],
-) -> list[tuple[dict[str, Any], np.ndarray | None, float, str]]:
-    """(params, oof predictions or None, fit seconds, status) per configuration."""
+    checkpoint: SearchCheckpoint | None = None,
+) -> tuple[list[tuple[dict[str, Any], np.ndarray | None, float, str]], int]:
+    """(params, oof predictions or None, fit seconds, status) per configuration.
+
+    Also returns the number of folds loaded from ``checkpoint``; every fold
+    fitted is added to it before ``tick`` reports it.
+    """
     out = []
+    resumed = 0
     for params in configs:
         pred = np.empty_like(data.y)
-        start = time.perf_counter()
+        seconds = 0.0
         fitted = 0
         try:
-            for train, val in splits:
-                estimator = make(params).fit(data.X[train], data.y[train])
-                pred[val] = estimator.predict(data.X[val])
+            for fold, (train, val) in enumerate(splits):
+                start = time.perf_counter()
+                saved = (
+                    checkpoint.get(model, params, fold, size=val.size)
+                    if checkpoint is not None
+                    else None
+                )
+                if saved is not None:
+                    pred[val], spent = saved
+                    resumed += 1
+                else:
+                    estimator = make(params).fit(data.X[train], data.y[train])
+                    pred[val] = estimator.predict(data.X[val])
+                    spent = time.perf_counter() - start
+                    if checkpoint is not None:
+                        checkpoint.add(model, params, fold, pred[val], spent)
+                seconds += spent
                 fitted += 1
                 tick()
         except ValueError as exc:
@@ -308,10 +343,11 @@ def _cv_sequential(
             logger.warning("%s %s skipped: %s", model, describe(params), exc)
             for _ in range(len(splits) - fitted):
                 tick()
-            out.append((params, None, time.perf_counter() - start, f"skipped: {exc}"))
+            seconds += time.perf_counter() - start
+            out.append((params, None, seconds, f"skipped: {exc}"))
             continue
-        out.append((params, pred, time.perf_counter() - start, "ok"))
-    return out
+        out.append((params, pred, seconds, "ok"))
+    return out, resumed
 
 
 def halving_rungs(n_configs: int, epochs: int, eta: int) -> list[tuple[int, int]]:
@@ -336,6 +372,35 @@ def halving_rungs(n_configs: int, epochs: int, eta: int) -> list[tuple[int, int]
     return out
 
 
+def _load_training(
+    checkpoint: SearchCheckpoint | None,
+    configs: list[dict[str, Any]],
+    splits: list[tuple[np.ndarray, np.ndarray]],
+    y: np.ndarray,
+    epochs: int,
+    group: str,
+) -> list[tuple[np.ndarray, float]] | None:
+    """Each configuration's (out-of-fold predictions, seconds) of a saved MLP training.
+
+    None unless ``checkpoint`` holds every fold of every configuration trained
+    together for ``epochs`` in the batch ``group``.
+    """
+    if checkpoint is None:
+        return None
+    out = []
+    for params in configs:
+        pred = np.empty_like(y)
+        seconds = 0.0
+        for fold, (_, val) in enumerate(splits):
+            saved = checkpoint.get("mlp", params, fold, size=val.size, epochs=epochs, group=group)
+            if saved is None:
+                return None
+            pred[val] = saved[0]
+            seconds += saved[1]
+        out.append((pred, seconds))
+    return out
+
+
 def _cv_mlp_batched(
     configs: list[dict[str, Any]],
     data: TrainingData,
@@ -346,7 +411,8 @@ def _cv_mlp_batched(
     device: str,
     progress: Callable[[int, int], None] | None,
     halving: int | None = None,
-) -> list[tuple[dict[str, Any], np.ndarray | None, float, str]]:
+    checkpoint: SearchCheckpoint | None = None,
+) -> tuple[list[tuple[dict[str, Any], np.ndarray | None, float, str]], int]:
     """Cross-validated predictions of every MLP configuration, all trained at once.
 
     With ``halving=eta`` the configurations race by successive halving
@@ -356,8 +422,14 @@ def _cv_mlp_batched(
     configuration that reaches the last rung is the model the exhaustive search
     would have trained. A configuration that stops earlier keeps the scores of
     its last rung and says so in its status.
+
+    With a ``checkpoint``, the folds of each training (each rung) are saved
+    when it ends, and a training whose every fold the checkpoint holds (same
+    configurations trained together, same epochs) is loaded, not repeated. Also
+    returns the number of folds loaded.
     """
     from softbend.surrogates.batched import train_mlp_grid
+    from softbend.surrogates.checkpoint import group_id
 
     rungs = (
         [(len(configs), epochs)] if not halving else halving_rungs(len(configs), epochs, halving)
@@ -366,6 +438,7 @@ def _cv_mlp_batched(
     done_before = 0
     alive = list(range(len(configs)))
     out: dict[int, tuple[dict[str, Any], np.ndarray, float, str]] = {}
+    resumed = 0
     for rung, (_, rung_epochs) in enumerate(rungs):
         sizes = [tuple(configs[i]["hidden_sizes"]) for i in alive]
 
@@ -373,26 +446,49 @@ def _cv_mlp_batched(
             if progress is not None:
                 progress(offset + done, total)
 
-        start = time.perf_counter()
-        result = train_mlp_grid(
-            data.X,
-            data.y,
-            splits,
-            sizes,
-            epochs=rung_epochs,
-            seed=seed,
-            device=device,
-            progress=forward,
+        # The configurations trained together share padded tensors: a fold is only
+        # reused from a training of the same configurations (its group) and epochs.
+        group = group_id(sizes)
+        loaded = _load_training(
+            checkpoint, [configs[i] for i in alive], splits, data.y, rung_epochs, group
         )
-        seconds = (time.perf_counter() - start) / max(1, len(alive))
+        if loaded is not None:
+            preds = [pred for pred, _ in loaded]
+            seconds_each = [spent for _, spent in loaded]
+            resumed += len(alive) * len(splits)
+            forward(rung_epochs, rung_epochs)
+        else:
+            start = time.perf_counter()
+            result = train_mlp_grid(
+                data.X,
+                data.y,
+                splits,
+                sizes,
+                epochs=rung_epochs,
+                seed=seed,
+                device=device,
+                progress=forward,
+            )
+            seconds = (time.perf_counter() - start) / max(1, len(alive))
+            seconds_each = [seconds] * len(alive)
+            preds = []
+            for k in range(len(alive)):
+                pred = np.empty_like(data.y)
+                for j in range(len(splits)):
+                    trained = result.model(k, j)
+                    pred[trained.val_index] = trained.val_pred_deg
+                preds.append(pred)
+            if checkpoint is not None:
+                checkpoint.add_many(
+                    ("mlp", configs[i], j, pred[val], seconds / len(splits), rung_epochs, group)
+                    for i, pred in zip(alive, preds, strict=True)
+                    for j, (_, val) in enumerate(splits)
+                )
         done_before += rung_epochs
         scores = []
         last = rung == len(rungs) - 1
         for k, i in enumerate(alive):
-            pred = np.empty_like(data.y)
-            for j in range(len(splits)):
-                trained = result.model(k, j)
-                pred[trained.val_index] = trained.val_pred_deg
+            pred, seconds = preds[k], seconds_each[k]
             status = "ok" if last else f"stopped after {rung_epochs} epochs (successive halving)"
             previous = out.get(i, (None, None, 0.0, ""))[2]
             out[i] = (configs[i], pred, previous + seconds, status)
@@ -404,7 +500,7 @@ def _cv_mlp_batched(
             keep = rungs[rung + 1][0]
             alive = sorted(i for _, i in sorted(scores)[:keep])
             logger.info("successive halving: %d of %d configurations go on", keep, len(scores))
-    return [out[i] for i in range(len(configs))]
+    return [out[i] for i in range(len(configs))], resumed
 
 
 def search(
@@ -422,6 +518,7 @@ def search(
     progress: Progress | None = None,
     cv: str = "grouped",
     halving: int | None = None,
+    checkpoint: SearchCheckpoint | None = None,
 ) -> SearchResult:
     """Grouped K-fold grid search of each model family, then a refit of the best.
 
@@ -458,10 +555,17 @@ def search(
         (e.g. 3; :func:`halving_rungs`) instead of training each for all the
         epochs: the paper grid then costs a fraction of the exhaustive search.
         The best configuration is chosen among those that reach the full epochs.
+    checkpoint : SearchCheckpoint, optional
+        Durable record of the finished configuration-folds
+        (:mod:`softbend.surrogates.checkpoint`): started with the fingerprint of
+        this search, it hands back the folds of an interrupted run of the same
+        search, which are loaded instead of fitted, and receives every fold
+        fitted. The caller removes it when the results are safe.
 
     Returns
     -------
     SearchResult
+        With ``resumed``, the configuration-folds loaded from ``checkpoint``.
     """
     owner = "surrogate search"
     models = list(dict.fromkeys(models))
@@ -491,8 +595,24 @@ def search(
     param_grid = dict(param_grid or {})
     for name in param_grid:
         check_choice(name, "param_grid", owner, MODEL_NAMES)
-    for model in models:
-        configs = list(param_grid.get(model) or grid(grid_name, model))
+    plan = {model: list(param_grid.get(model) or grid(grid_name, model)) for model in models}
+    if checkpoint is not None:
+        checkpoint.start(
+            search_fingerprint(
+                data,
+                splits,
+                plan,
+                grid_name=grid_name,
+                cv=cv,
+                seed=seed,
+                epochs=epochs,
+                halving=halving,
+                device=device,
+                n_jobs=n_jobs,
+            )
+        )
+    resumed = 0
+    for model, configs in plan.items():
         phase = f"{model}: {len(configs)} configurations x {len(splits)} folds"
         started = time.perf_counter()
 
@@ -505,7 +625,7 @@ def search(
                 if progress is not None:
                     progress(phase, done, total_epochs)
 
-            outcomes = _cv_mlp_batched(
+            outcomes, loaded = _cv_mlp_batched(
                 configs,
                 data,
                 splits,
@@ -514,6 +634,7 @@ def search(
                 device=device,
                 progress=on_epoch,
                 halving=halving,
+                checkpoint=checkpoint,
             )
         else:
             total = len(configs) * len(splits)
@@ -527,7 +648,8 @@ def search(
 
             if progress is not None:
                 progress(phase, 0, total)
-            outcomes = _cv_sequential(model, configs, data, splits, make, tick)
+            outcomes, loaded = _cv_sequential(model, configs, data, splits, make, tick, checkpoint)
+        resumed += loaded
         best: tuple[float, dict[str, Any], np.ndarray, dict[str, float]] | None = None
         for params, pred, seconds, status in outcomes:
             row: dict[str, Any] = {
@@ -578,5 +700,70 @@ def search(
         "data_hash": data.data_hash,
     }
     return SearchResult(
-        cv_results=pd.DataFrame(rows), families=families, data=data, settings=settings
+        cv_results=pd.DataFrame(rows),
+        families=families,
+        data=data,
+        settings=settings,
+        resumed=resumed,
     )
+
+
+def search_fingerprint(
+    data: TrainingData,
+    splits: list[tuple[np.ndarray, np.ndarray]],
+    plan: dict[str, list[dict[str, Any]]],
+    *,
+    grid_name: str,
+    cv: str,
+    seed: int,
+    epochs: int,
+    halving: int | None,
+    device: str,
+    n_jobs: int | None,
+) -> dict[str, Any]:
+    """Everything that determines the scores of a search, for its checkpoint.
+
+    The data hash, the folds (the hash of their validation rows, which follows
+    from the data, ``cv``, the number of folds and the seed), the seed, the
+    configurations of each family, the MLP epochs, halving and resolved device,
+    the XGBoost trees and threads, and the versions of softbend and the
+    libraries that fit the models. A checkpoint written under any other value
+    is not reused.
+    """
+    from importlib.metadata import PackageNotFoundError, version
+
+    import softbend
+
+    digest = hashlib.sha256()
+    for _, val in splits:
+        digest.update(np.ascontiguousarray(val, dtype="<i8").tobytes())
+        digest.update(b"|")
+    versions: dict[str, str | None] = {"softbend": softbend.__version__}
+    for package in ("numpy", "scikit-learn", "xgboost", "torch"):
+        try:
+            versions[package] = version(package)
+        except PackageNotFoundError:
+            versions[package] = None
+    fingerprint: dict[str, Any] = {
+        "data_hash": data.data_hash,
+        "n_samples": data.n_samples,
+        "cv": cv,
+        "folds": len(splits),
+        "splits": digest.hexdigest()[:16],
+        "seed": seed,
+        "grid": grid_name,
+        "families": list(plan),
+        "configs": plan,
+        "versions": versions,
+    }
+    if "xgb" in plan:
+        fingerprint["xgb"] = {"trees": XGB_TREES, "threads": n_jobs}
+    if "mlp" in plan:
+        from softbend.surrogates.mlp_core import resolve_device
+
+        fingerprint["mlp"] = {
+            "epochs": epochs,
+            "halving": halving,
+            "device": resolve_device(device, "surrogate search"),
+        }
+    return fingerprint

@@ -18,7 +18,7 @@ from __future__ import annotations
 
 import os
 from pathlib import Path
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 import pandas as pd
@@ -26,6 +26,9 @@ import pandas as pd
 from softbend._io import write_text_atomic
 from softbend.surrogates.features import TrainingData, training_data
 from softbend.surrogates.search import MODEL_NAMES, Progress, SearchResult, describe, search
+
+if TYPE_CHECKING:
+    from softbend.surrogates.checkpoint import SearchCheckpoint
 
 #: Paper B §4.1 (Fig. 5): best configuration of each family, 5-fold CV on its FEM data.
 PAPER_B_FIG5: dict[str, dict[str, Any]] = {
@@ -68,6 +71,7 @@ def train_surrogates(
     progress: Progress | None = None,
     cv: str = "grouped",
     halving: int | None = None,
+    checkpoint: SearchCheckpoint | None = None,
 ) -> tuple[SearchResult, dict[str, Any]]:
     """Search, refit, save and export the surrogates of a campaign.
 
@@ -84,13 +88,18 @@ def train_surrogates(
     cv : {"grouped", "random"}, halving : int, optional
         Cross-validation protocol and successive halving of the MLP grid (see
         :func:`softbend.surrogates.search.search`).
+    checkpoint : SearchCheckpoint, optional
+        Where the search saves its finished configuration-folds and from which
+        an interrupted search resumes (see :func:`softbend.surrogates.search.search`);
+        left in place: the caller removes it once ``out_dir`` is safe.
 
     Returns
     -------
     result : SearchResult
     summary : dict
         JSON-friendly headline figures, per family and paper B's beside them,
-        and the files written.
+        the files written, and ``resumed_config_folds`` (folds loaded from
+        ``checkpoint``).
     """
     from softbend.surrogates.features import training_ranges
     from softbend.surrogates.persistence import save_surrogate
@@ -108,6 +117,7 @@ def train_surrogates(
         progress=progress,
         cv=cv,
         halving=halving,
+        checkpoint=checkpoint,
     )
     out = Path(out_dir)
     (out / "models").mkdir(parents=True, exist_ok=True)
@@ -163,6 +173,7 @@ def train_surrogates(
         "settings": result.settings,
         "models": families,
         "best_by_mape": best,
+        "resumed_config_folds": result.resumed,
         "files": files,
     }
     return result, summary
