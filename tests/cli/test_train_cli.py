@@ -149,7 +149,9 @@ def test_an_interrupted_train_leaves_the_previous_output_folder_whole(
         assert "--out" in capsys.readouterr().err
     after = {p.relative_to(out): p.read_bytes() for p in out.rglob("*") if p.is_file()}
     assert after == before
-    assert [p.name for p in tmp_path.iterdir()] == ["surrogates"]  # no staging folder left
+    # No staging folder left; the interrupted search's checkpoint stays for a resume.
+    left = sorted(p.name for p in tmp_path.iterdir())
+    assert left == [".surrogates.train-checkpoint.jsonl", "surrogates"]
 
 
 def test_train_killed_at_random_moments_leaves_the_old_folder_or_the_new_one(
@@ -193,3 +195,125 @@ def test_train_killed_at_random_moments_leaves_the_old_folder_or_the_new_one(
             os.killpg(child.pid, signal.SIGKILL)
         child.wait()
         assert consistent() in (3, 4, 5), f"a mix after a kill at {delay:.2f} s"
+
+
+def _scores(out):
+    """The cross-validated results of a train output, without the timings."""
+    import pandas as pd
+
+    cv = pd.read_csv(out / "cv_results.csv").drop(columns=["fit_s_per_config"])
+    summary = pd.read_csv(out / "summary.csv")
+    summary = summary[["model", "params", "r2", "rmse_deg", "mape_pct", "max_abs_error_deg"]]
+    models = {
+        p.name: json.loads(p.read_text())["metadata"]["cv"] for p in (out / "models").glob("*.json")
+    }
+    return cv, summary, models
+
+
+def test_a_killed_train_resumes_from_its_finished_folds(small_campaign, tmp_path, capsys):
+    import os
+    import signal
+    import subprocess
+    import sys
+    import time
+
+    import pandas as pd
+
+    from softbend.surrogates.checkpoint import checkpoint_path
+
+    out = tmp_path / "surrogates"
+    checkpoint = checkpoint_path(out)
+    options = ["--models", "xgb", "--folds", "3", "--jobs", "1", "--no-onnx"]
+    cli = [sys.executable, "-c", "import sys; from softbend.cli import main; sys.exit(main())"]
+    child = subprocess.Popen(
+        [*cli, "train", str(small_campaign), "--out", str(out), *options],
+        start_new_session=True,
+        stdout=subprocess.DEVNULL,
+        stderr=subprocess.DEVNULL,
+    )
+    try:
+        # Killed once the checkpoint holds 4 of the 4 x 3 configuration-folds.
+        deadline = time.monotonic() + 120
+        while time.monotonic() < deadline and child.poll() is None:
+            if checkpoint.is_file() and checkpoint.read_bytes().count(b"\n") >= 1 + 4:
+                break
+            time.sleep(0.01)
+        os.killpg(child.pid, signal.SIGKILL)
+    finally:
+        child.wait()
+    assert child.returncode == -signal.SIGKILL, "the search ended before it was killed"
+    assert not out.exists()
+    saved = checkpoint.read_bytes().count(b"\n") - 1
+    assert saved >= 4
+
+    args = ["train", str(small_campaign), "--out", str(out), *options]
+    code, _, err = _run(args, capsys)
+    assert code == 0, err
+    resumed = [line for line in err.splitlines() if line.startswith("resuming from")]
+    assert len(resumed) == 1 and str(checkpoint) in resumed[0]
+    assert int(resumed[0].split(": ")[1].split()[0]) >= saved - 1  # a line cut by the kill
+    assert not checkpoint.exists()  # removed once the new folder is in place
+
+    reference = tmp_path / "reference"
+    code, out_json, _ = _run(
+        ["train", str(small_campaign), "--out", str(reference), *options, "--json"], capsys
+    )
+    assert code == 0 and json.loads(out_json)["resumed_config_folds"] == 0
+    for got, expected in zip(_scores(out), _scores(reference), strict=True):
+        if isinstance(got, pd.DataFrame):
+            pd.testing.assert_frame_equal(got, expected)
+        else:
+            assert got == expected
+    # Beside them only the (empty) staging folder of the killed run (see staged_dir).
+    left = sorted(p.name for p in tmp_path.iterdir() if not p.name.endswith(".new"))
+    assert left == ["reference", "surrogates"]
+
+
+def test_train_with_other_settings_discards_the_checkpoint_with_a_warning(
+    small_campaign, tmp_path, capsys, monkeypatch
+):
+    import softbend.surrogates.search as search_module
+    from softbend.surrogates.checkpoint import checkpoint_path
+
+    out = tmp_path / "surrogates"
+    args = ["train", str(small_campaign), "--out", str(out), "--models", "xgb", "--no-onnx"]
+    real = search_module._make
+    fits = 0
+
+    def dies_after_four_fits(model, params, **kwargs):
+        nonlocal fits
+        fits += 1
+        if fits > 4:
+            raise KeyboardInterrupt  # Ctrl-C in the fifth fit
+        return real(model, params, **kwargs)
+
+    monkeypatch.setattr(search_module, "_make", dies_after_four_fits)
+    assert main([*args, "--folds", "3"]) == 130
+    capsys.readouterr()
+    assert checkpoint_path(out).is_file() and not out.exists()
+    monkeypatch.setattr(search_module, "_make", real)
+
+    code, out_json, err = _run([*args, "--folds", "4", "--json"], capsys)
+    assert code == 0
+    warnings = [line for line in err.splitlines() if line.startswith("softbend: warning:")]
+    assert len(warnings) == 1
+    assert "discarded" in warnings[0] and "other settings (folds, splits)" in warnings[0]
+    assert json.loads(out_json)["resumed_config_folds"] == 0
+    assert not checkpoint_path(out).exists()
+
+
+def test_a_second_train_into_the_same_folder_is_refused_while_one_runs(
+    small_campaign, tmp_path, capsys
+):
+    from softbend.surrogates.checkpoint import SearchCheckpoint, checkpoint_path
+
+    out = tmp_path / "surrogates"
+    with SearchCheckpoint(checkpoint_path(out)) as running:
+        running.start({"another": "search"})
+        code, _, err = _run(
+            ["train", str(small_campaign), "--out", str(out), "--models", "plr"], capsys
+        )
+    assert code == 2
+    lines = err.strip().splitlines()
+    assert len(lines) == 1 and "Another search is writing the checkpoint" in lines[0]
+    assert not out.exists()

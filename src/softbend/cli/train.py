@@ -44,39 +44,55 @@ def train(
     no_onnx: bool = typer.Option(False, "--no-onnx", help="Skip the ONNX export."),
     as_json: bool = typer.Option(False, "--json", help="Print the results as JSON."),
 ) -> None:
-    """Grid-search the surrogates with grouped K-fold CV, refit the best, save and plot."""
+    """Grid-search the surrogates with grouped K-fold CV, refit the best, save and plot.
+
+    Every finished configuration-fold is saved in ``.OUT.train-checkpoint.jsonl``
+    beside ``--out``; the same command run again after an interruption resumes
+    from it (a checkpoint of other settings is discarded with a warning). It is
+    removed when the new ``--out`` is in place.
+    """
     from softbend._io import staged_dir
     from softbend._validation import check_int
     from softbend.reports.surrogate_figures import training_figures
+    from softbend.surrogates.checkpoint import SearchCheckpoint, checkpoint_path
     from softbend.surrogates.workflow import train_surrogates
 
     if jobs is not None:
         check_int(jobs, "--jobs", "softbend train", low=1)
     _common.check_output_dir(out, "--out", inputs=(db,))
     names = [m.strip() for m in models.split(",") if m.strip()]
+
+    def resuming(line: str) -> None:
+        _common.err_console.print(line, highlight=False, soft_wrap=True)
+
+    checkpoint = SearchCheckpoint(
+        checkpoint_path(out),
+        on_resume=None if as_json else resuming,
+        on_discard=_common.warning_line,
+    )
     # Built beside --out and swapped in at the end: an interrupted search leaves the
-    # previous folder as it was, never old models beside new ones.
-    with (
-        _common.output_errors(out, "--out"),
-        staged_dir(out) as stage,
-        _common.phase_progress(enabled=not as_json) as progress,
-    ):
-        result, summary = train_surrogates(
-            db,
-            stage,
-            models=names,
-            grid_name=grid,
-            folds=folds,
-            seed=seed,
-            device=device,
-            n_jobs=jobs,
-            epochs=epochs,
-            export_onnx=not no_onnx,
-            progress=progress,
-            cv=cv,
-            halving=halving,
-        )
-        summary["files"].update(training_figures(result, stage))
+    # previous folder as it was, never old models beside new ones, and its finished
+    # configuration-folds in the checkpoint for the next run.
+    with _common.output_errors(out, "--out"), checkpoint:
+        with staged_dir(out) as stage, _common.phase_progress(enabled=not as_json) as progress:
+            result, summary = train_surrogates(
+                db,
+                stage,
+                models=names,
+                grid_name=grid,
+                folds=folds,
+                seed=seed,
+                device=device,
+                n_jobs=jobs,
+                epochs=epochs,
+                export_onnx=not no_onnx,
+                progress=progress,
+                cv=cv,
+                halving=halving,
+                checkpoint=checkpoint,
+            )
+            summary["files"].update(training_figures(result, stage))
+        checkpoint.remove()  # the new folder is in place
     summary["files"] = {
         key: str(Path(out) / Path(value).relative_to(stage))
         if str(value).startswith(str(stage))
