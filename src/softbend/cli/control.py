@@ -31,21 +31,44 @@ def build_controller(name: str, table, sensor):
     return PressureRelay(table)
 
 
-def _setup(command: str, controller: str, design: str, model: Path | None, supply: float):
-    """Design, rig parameters, θ(p) table and controller of a run (checked before any work)."""
+#: What plays the actuator: the controller's own model, its FEM sweep, or its lab measurements.
+PLANTS: tuple[str, ...] = ("surrogate", "fem", "lab")
+
+
+def _setup(
+    command: str,
+    controller: str,
+    design: str,
+    model: Path | None,
+    supply: float,
+    plant: str = "surrogate",
+):
+    """Design, rig parameters, plant θ(p) table and controller of a run (checked first).
+
+    The controller's virtual sensor and inverse come from ``model``; the plant's
+    θ(p) from the same model (``surrogate``), the design's FEM sweep in the
+    shipped dataset (``fem``) or its virtual-lab readings (``lab``: the reality
+    gap the controller meets on a real actuator).
+    """
     from softbend._validation import check_choice
     from softbend.control.controllers import CONTROLLERS, mlp_virtual_sensor
-    from softbend.control.rig import AngleTable, RigParams
+    from softbend.control.rig import AngleTable, RigParams, fem_angle_table, lab_angle_table
     from softbend.design import SFRBADesign
     from softbend.transfer.base import load_base
 
     check_choice(controller, "controller", command, CONTROLLERS)
+    check_choice(plant, "plant", command, PLANTS)
     actuator = SFRBADesign.parse(design)
     params = RigParams.for_design(actuator, supply_gauge_mpa=supply)
     surrogate = load_base(model)
     table = AngleTable.from_surrogate(surrogate, actuator)
     sensor = mlp_virtual_sensor(surrogate, actuator) if hasattr(surrogate, "predictor") else table
-    return actuator, params, table, build_controller(controller, table, sensor)
+    plant_table = {
+        "surrogate": lambda: table,
+        "fem": lambda: fem_angle_table(actuator),
+        "lab": lambda: lab_angle_table(actuator),
+    }[plant]()
+    return actuator, params, plant_table, build_controller(controller, table, sensor)
 
 
 def _figure(run, path: Path, title: str) -> Path | None:
@@ -92,6 +115,11 @@ def simulate_cmd(
     model: Path = typer.Option(
         None, "--model", help="Saved surrogate for θ(p) (default: the shipped FEM-trained MLP)."
     ),
+    plant: str = typer.Option(
+        "surrogate",
+        help="θ(p) of the actuator: surrogate (the controller's own model), fem (the design's "
+        "FEM sweep) or lab (its virtual-lab readings: model mismatch).",
+    ),
     duration: float = typer.Option(10.0, help="Simulated time, s."),
     supply: float = typer.Option(0.2, help="Supply pressure, MPa gauge."),
     seed: int = typer.Option(0, help="Seed of the sensor and camera noise."),
@@ -103,7 +131,7 @@ def simulate_cmd(
 
     ref = parse_reference(reference)
     actuator, params, table, ctrl = _setup(
-        "softbend control simulate", controller, design, model, supply
+        "softbend control simulate", controller, design, model, supply, plant
     )
     _common.check_output_dir(out, "--out", files=_FILES)
     rig = SimulatedRig(table, params, seed=seed)
@@ -113,6 +141,7 @@ def simulate_cmd(
         "synthetic": True,
         "reference": reference,
         "controller": controller,
+        "plant": plant,
         "design": str(actuator),
         "duration_s": duration,
         "seed": seed,
@@ -170,6 +199,11 @@ def run_cmd(
     model: Path = typer.Option(
         None, "--model", help="Saved surrogate for θ(p) (default: the shipped FEM-trained MLP)."
     ),
+    plant: str = typer.Option(
+        "surrogate",
+        help="θ(p) of the actuator: surrogate (the controller's own model), fem (the design's "
+        "FEM sweep) or lab (its virtual-lab readings: model mismatch).",
+    ),
     duration: float = typer.Option(10.0, help="Run time, s."),
     period: float = typer.Option(
         None, help="Loop tick (controller, valves), s (default: the config's period_s, 0.001)."
@@ -208,7 +242,7 @@ def run_cmd(
     settings = load_rig_config(config) if config is not None else RigConfig()
     loop_period = settings.period_s if period is None else period
     sensor_every = settings.sensor_period_s if sensor_period is None else sensor_period
-    actuator, params, table, ctrl = _setup(command, controller, design, model, supply)
+    actuator, params, table, ctrl = _setup(command, controller, design, model, supply, plant)
     log_name = f"ticks.{log_format}"
     _common.check_output_dir(out, "--out", files=(log_name, "run.json", "run.png"))
     with _common.output_errors(out, "--out"):
@@ -250,6 +284,7 @@ def run_cmd(
         "where": settings.connection.where if rig == "modbus" else "simulated",
         "reference": reference,
         "controller": controller,
+        "plant": plant if rig != "modbus" else "the rig",
         "design": str(actuator),
         "duration_s": duration,
         "period_s": loop_period,
@@ -331,6 +366,11 @@ def serve_cmd(
     model: Path = typer.Option(
         None, "--model", help="Saved surrogate for θ(p) (default: the shipped FEM-trained MLP)."
     ),
+    plant: str = typer.Option(
+        "surrogate",
+        help="θ(p) of the actuator: surrogate (the controller's own model), fem (the design's "
+        "FEM sweep) or lab (its virtual-lab readings: model mismatch).",
+    ),
     supply: float = typer.Option(0.2, help="Supply pressure, MPa gauge."),
     seed: int = typer.Option(0, help="Seed of the sensor and camera noise."),
     duration: float = typer.Option(0.0, help="Serve for this long, s (0: until Ctrl-C)."),
@@ -395,4 +435,4 @@ def rig_config_cmd(
     _common.console.print(f"rig config written to {out}")
 
 
-__all__ = ["RIGS", "app", "build_controller"]
+__all__ = ["PLANTS", "RIGS", "app", "build_controller"]

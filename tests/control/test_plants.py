@@ -1,0 +1,82 @@
+"""Plants unlike the controller's model: the FEM sweep, the lab readings, model mismatch."""
+
+import numpy as np
+import pytest
+
+from softbend.cli import main
+from softbend.control.controllers import PressureRelay
+from softbend.control.experiments import simulate
+from softbend.control.rig import (
+    AngleTable,
+    RigParams,
+    SimulatedRig,
+    fem_angle_table,
+    lab_angle_table,
+)
+from softbend.datasets import table1_fem
+from softbend.design import SFRBADesign
+from softbend.transfer.lab import shipped_measurements
+
+DESIGN = SFRBADesign(100, 6, 2, 2, 5, 8)
+
+
+def test_fem_plant_passes_through_the_sweep_and_extends_it_linearly():
+    table = fem_angle_table(DESIGN)
+    data = table1_fem()
+    rows = data[data["design_id"] == data.loc[_design_rows(data).index[0], "design_id"]]
+    rows = rows[rows["converged"]]
+    for p, a in zip(rows["pressure_mpa"], rows["angle_deg"], strict=True):
+        assert table(p) == pytest.approx(a, abs=1e-6)
+    p = rows["pressure_mpa"].to_numpy()
+    a = rows["angle_deg"].to_numpy()
+    slope = (a[-1] - a[-2]) / (p[-1] - p[-2])
+    assert table(p[-1] + 0.02) == pytest.approx(a[-1] + 0.02 * slope, rel=1e-6)
+
+
+def _design_rows(data):
+    mask = np.ones(len(data), dtype=bool)
+    for name, value in DESIGN.as_dict().items():
+        mask &= np.isclose(data[name], value)
+    return data[mask]
+
+
+def test_fem_plant_of_a_design_outside_table1_is_one_error():
+    with pytest.raises(ValueError, match=r"not in the FEM dataset \(Table 1: l_mm in 100, 120"):
+        fem_angle_table(SFRBADesign(105, 6, 2, 2, 5, 8))
+
+
+def test_lab_plant_follows_the_readings_within_the_camera_noise():
+    table = lab_angle_table(DESIGN)
+    frame = shipped_measurements().frame
+    rows = frame[(frame["actuator_id"] == "100,6,2,2,5,8") & (frame["direction"] == "loading")]
+    residual = np.array([table(p) for p in rows["pressure_mpa"]]) - rows["angle_deg"].to_numpy()
+    assert np.sqrt(np.mean(residual**2)) < 2.0  # the lab's camera noise is 1°
+    with pytest.raises(ValueError, match="has no measured loading curve"):
+        lab_angle_table(SFRBADesign(160, 10, 4, 4, 15, 12))
+
+
+def test_model_mismatch_sets_the_steady_state_of_a_pressure_controller():
+    """The relay regulates p* = model⁻¹(θr), so the actuator settles at plant(p*), not θr."""
+    model = AngleTable.from_callable(lambda p: 6.0 + 1000.0 * p)
+    plant = AngleTable.from_callable(lambda p: 6.0 + 1150.0 * p)  # 15 % more bend per MPa
+    run = simulate(
+        SimulatedRig(plant, RigParams(), seed=0), PressureRelay(model), "step:90:0.2", 3.0
+    )
+    p_star = (90.0 - 6.0) / 1000.0
+    expected = 6.0 + 1150.0 * p_star
+    late = run.t_s > 2.0
+    assert np.mean(run.angle_deg[late]) == pytest.approx(expected, abs=1.5)
+    assert np.mean(run.angle_deg[late]) - 90.0 > 10.0  # the error is the model's, not noise
+
+
+def test_cli_plant_option(tmp_path, capsys):
+    import json
+
+    out = tmp_path / "lab"
+    args = ["control", "simulate", "--plant", "lab", "--controller", "pressure-relay"]
+    assert main([*args, "--duration", "2", "--out", str(out), "--json"]) == 0
+    payload = json.loads(capsys.readouterr().out)
+    assert payload["plant"] == "lab" and payload["metrics"]["mape_pct"] > 8.0
+    assert main(["control", "simulate", "--plant", "camera", "--out", str(out)]) == 2
+    err = capsys.readouterr().err
+    assert "'plant'" in err and "'lab'" in err and len(err.strip().splitlines()) == 1
