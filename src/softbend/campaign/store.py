@@ -1,24 +1,9 @@
 """The campaign database: one DuckDB file per campaign.
 
-Tables (schema version :data:`SCHEMA_VERSION`):
-
-``meta(key, value)``
-    ``schema_version``, ``softbend_version`` and ``created_at`` (set on creation),
-    ``backend`` and ``pressures_mpa`` (JSON list; set by the first run and checked
-    by every later one, so a resumed campaign cannot mix models or grids),
-    ``space`` and ``n_designs_planned`` (of the latest run).
-``designs``
-    One row per attempted design: its parameters (``l_mm`` ... ``lc_mm``),
-    ``status`` ``'done'`` or ``'failed'``, ``error`` (``"ExceptionType: message"``
-    for failed designs), ``wall_time_s``, ``n_samples`` (rows in ``samples``,
-    including the final non-converged pressure), ``max_pressure_mpa`` and
-    ``max_angle_deg`` (over converged pressures), ``newton_iterations_total``,
-    ``mesh_size``, ``backend``, ``softbend_version``, ``schema_version``,
-    ``finished_at`` (UTC) and ``stats`` (backend details as JSON).
-``samples``
-    One row per applied pressure of a done design: ``pressure_mpa``,
-    ``angle_deg``, ``tip_x_mm``, ``tip_z_mm`` (NULL where not converged),
-    ``converged``, ``newton_iterations``; primary key ``(design_id, pressure_mpa)``.
+:class:`CampaignStore` opens (or creates) the file, binds it to one backend and
+pressure grid, records designs, merges shards and reads the data back. The
+tables, their schema version and the checks of an existing file live in
+:mod:`softbend.campaign.schema`.
 
 Every design is written in one transaction (its ``designs`` row and all its
 ``samples`` rows, or nothing), so a campaign killed at any instant leaves only
@@ -34,19 +19,28 @@ import json
 import logging
 import math
 import os
-import re
 import uuid
-from collections.abc import Iterator
-from contextlib import contextmanager
-from datetime import UTC, datetime
 from pathlib import Path
 from typing import TYPE_CHECKING, Any, Literal
 
 import numpy as np
 
 from softbend._validation import check_choice
+from softbend.campaign.schema import (
+    DESIGN_COLUMNS,
+    SCHEMA_VERSION,
+    check_complete,
+    ensure_schema,
+    first_line,
+    open_error,
+    softbend_version,
+    transaction,
+    unreadable,
+    utc_now,
+)
+from softbend.campaign.schema import SAMPLE_COLUMNS as SAMPLE_COLUMNS
 from softbend.design import PARAMETERS, SFRBADesign
-from softbend.errors import SchemaError, SoftbendError
+from softbend.errors import SoftbendError
 from softbend.models import SweepResult, check_pressures_mpa
 
 if TYPE_CHECKING:
@@ -56,86 +50,9 @@ __all__ = ["SCHEMA_VERSION", "CampaignStore", "load_designs", "load_samples"]
 
 logger = logging.getLogger(__name__)
 
-#: Version of the table layout written by this softbend. A database with a newer
-#: version is refused with :class:`~softbend.errors.SchemaError`.
-SCHEMA_VERSION = 1
-
-#: Columns of :meth:`CampaignStore.load_samples`.
-SAMPLE_COLUMNS: tuple[str, ...] = (
-    "design_id",
-    *PARAMETERS,
-    "pressure_mpa",
-    "angle_deg",
-    "tip_x_mm",
-    "tip_z_mm",
-    "converged",
-)
-
-_DDL = (
-    """
-    CREATE TABLE IF NOT EXISTS meta (
-        key VARCHAR PRIMARY KEY,
-        value VARCHAR NOT NULL
-    )
-    """,
-    """
-    CREATE TABLE IF NOT EXISTS designs (
-        design_id VARCHAR PRIMARY KEY,
-        l_mm DOUBLE NOT NULL,
-        r_mm DOUBLE NOT NULL,
-        t_mm DOUBLE NOT NULL,
-        b_mm DOUBLE NOT NULL,
-        phi_deg DOUBLE NOT NULL,
-        lc_mm DOUBLE NOT NULL,
-        status VARCHAR NOT NULL CHECK (status IN ('done', 'failed')),
-        error VARCHAR,
-        wall_time_s DOUBLE,
-        n_samples INTEGER NOT NULL,
-        max_pressure_mpa DOUBLE,
-        max_angle_deg DOUBLE,
-        newton_iterations_total BIGINT,
-        mesh_size BIGINT,
-        backend VARCHAR NOT NULL,
-        softbend_version VARCHAR NOT NULL,
-        schema_version INTEGER NOT NULL,
-        finished_at TIMESTAMP NOT NULL,
-        stats VARCHAR
-    )
-    """,
-    """
-    CREATE TABLE IF NOT EXISTS samples (
-        design_id VARCHAR NOT NULL,
-        pressure_mpa DOUBLE NOT NULL,
-        angle_deg DOUBLE,
-        tip_x_mm DOUBLE,
-        tip_z_mm DOUBLE,
-        converged BOOLEAN NOT NULL,
-        newton_iterations INTEGER,
-        PRIMARY KEY (design_id, pressure_mpa)
-    )
-    """,
-)
-
-_DESIGN_COLUMNS = (
-    "design_id",
-    *PARAMETERS,
-    "status",
-    "error",
-    "wall_time_s",
-    "n_samples",
-    "max_pressure_mpa",
-    "max_angle_deg",
-    "newton_iterations_total",
-    "mesh_size",
-    "backend",
-    "softbend_version",
-    "schema_version",
-    "finished_at",
-    "stats",
-)
 _INSERT_DESIGN = (
-    f"INSERT INTO designs ({', '.join(_DESIGN_COLUMNS)}) "
-    f"VALUES ({', '.join('?' for _ in _DESIGN_COLUMNS)})"
+    f"INSERT INTO designs ({', '.join(DESIGN_COLUMNS)}) "
+    f"VALUES ({', '.join('?' for _ in DESIGN_COLUMNS)})"
 )
 # One statement for all samples of a design: parallel lists unnested row-wise.
 _INSERT_SAMPLES = (
@@ -148,16 +65,6 @@ _SAMPLES_QUERY = (
     "FROM samples s JOIN designs d USING (design_id) "
     "ORDER BY s.design_id, s.pressure_mpa"
 )
-
-
-def _softbend_version() -> str:
-    from softbend import __version__
-
-    return __version__
-
-
-def _utc_now() -> datetime:
-    return datetime.now(UTC).replace(tzinfo=None)
 
 
 def _nullable(values: np.ndarray) -> list[float | None]:
@@ -214,86 +121,25 @@ class CampaignStore:
         try:
             self._con = duckdb.connect(str(self.path), read_only=self.read_only)
         except duckdb.Error as exc:
-            raise _open_error(self.path, exc) from None
+            raise open_error(self.path, exc) from None
         # Every DuckDB error while reading what opening needs (a truncated or corrupt file
         # fails here, at connect or on the first reads) is one SchemaError naming the file.
         try:
             # No progress bar of DuckDB's own on a long query: it would write to stdout.
             self._con.execute("SET enable_progress_bar = false")
             if existed:
-                _check_complete(self._con, self.path)
-            self._init_schema()
+                check_complete(self._con, self.path)
+            ensure_schema(self._con, self.path, read_only=self.read_only)
             self._load_binding()
             self._recorded: set[str] = {
                 row[0] for row in self._con.execute("SELECT design_id FROM designs").fetchall()
             }
         except duckdb.Error as exc:
             self._con.close()
-            raise _unreadable(self.path, _first_line(exc)) from None
+            raise unreadable(self.path, first_line(exc)) from None
         except BaseException:
             self._con.close()
             raise
-
-    # -- opening -----------------------------------------------------------------
-    def _init_schema(self) -> None:
-        tables = {
-            row[0]
-            for row in self._con.execute(
-                "SELECT table_name FROM information_schema.tables WHERE table_schema = 'main'"
-            ).fetchall()
-        }
-        if "meta" not in tables:
-            if tables or self.read_only:
-                found = ", ".join(sorted(tables)) or "no tables"
-                raise SchemaError(
-                    f"{str(self.path)!r} is not a softbend campaign database "
-                    f"(no 'meta' table; found {found})."
-                )
-            self._create()
-            return
-        version_text = self.meta().get("schema_version")
-        try:
-            version = int(version_text) if version_text is not None else None
-        except ValueError:
-            version = None
-        if version is None or version < 1:
-            raise SchemaError(
-                f"The campaign database {str(self.path)!r} has an unknown schema version "
-                f"{version_text!r}; this softbend reads version {SCHEMA_VERSION}."
-            )
-        if version > SCHEMA_VERSION:
-            raise SchemaError(
-                f"The campaign database {str(self.path)!r} has schema version {version}, newer "
-                f"than this softbend supports ({SCHEMA_VERSION}); upgrade softbend to read it."
-            )
-        missing = {"designs", "samples"} - tables
-        if missing:
-            raise SchemaError(
-                f"The campaign database {str(self.path)!r} lacks the table(s) "
-                f"{', '.join(sorted(missing))}."
-            )
-
-    def _create(self) -> None:
-        with self._transaction():
-            for statement in _DDL:
-                self._con.execute(statement)
-            for key, value in (
-                ("schema_version", str(SCHEMA_VERSION)),
-                ("softbend_version", _softbend_version()),
-                ("created_at", _utc_now().isoformat(timespec="seconds") + "Z"),
-            ):
-                self._con.execute("INSERT INTO meta VALUES (?, ?)", [key, value])
-        logger.info("created campaign database %s (schema %d)", self.path, SCHEMA_VERSION)
-
-    @contextmanager
-    def _transaction(self) -> Iterator[None]:
-        self._con.execute("BEGIN TRANSACTION")
-        try:
-            yield
-        except BaseException:
-            self._con.execute("ROLLBACK")
-            raise
-        self._con.execute("COMMIT")
 
     def close(self) -> None:
         """Close the connection (checkpointing the write-ahead log)."""
@@ -378,7 +224,7 @@ class CampaignStore:
                 f"{_describe_grid(stored_grid)}. Got {_describe_grid(grid)} instead; "
                 "use a new database for another pressure grid."
             )
-        with self._transaction():
+        with transaction(self._con):
             if stored_backend is None:
                 self._set_meta("backend", backend)
             if stored_grid is None:
@@ -396,7 +242,7 @@ class CampaignStore:
     def log_run(self, run: dict[str, Any]) -> None:
         """Append one run's record (executor, cores, counts, times) to the ``runs`` metadata."""
         runs = [*self.runs(), run]
-        with self._transaction():
+        with transaction(self._con):
             self._set_meta("runs", json.dumps(runs, default=str))
 
     def merge(self, source: str | os.PathLike[str]) -> dict[str, int]:
@@ -452,7 +298,7 @@ class CampaignStore:
         replaced = sum(i in mine for i in take)
         self._con.execute(f"ATTACH '{_sql_text(source_path)}' AS merge_src (READ_ONLY)")
         try:
-            with self._transaction():
+            with transaction(self._con):
                 self._con.execute("CREATE TEMP TABLE merge_ids (design_id VARCHAR)")
                 if take:
                     self._con.executemany("INSERT INTO merge_ids VALUES (?)", [[i] for i in take])
@@ -462,7 +308,7 @@ class CampaignStore:
                 self._con.execute(
                     "DELETE FROM designs WHERE design_id IN (SELECT * FROM merge_ids)"
                 )
-                columns = ", ".join(_DESIGN_COLUMNS)
+                columns = ", ".join(DESIGN_COLUMNS)
                 self._con.execute(
                     f"INSERT INTO designs ({columns}) SELECT {columns} FROM merge_src.designs "
                     "WHERE design_id IN (SELECT * FROM merge_ids)"
@@ -522,12 +368,12 @@ class CampaignStore:
             int(result.newton_iterations.sum()),
             result.mesh_size,
             backend,
-            _softbend_version(),
+            softbend_version(),
             SCHEMA_VERSION,
-            _utc_now(),
+            utc_now(),
             stats,
         ]
-        with self._transaction():
+        with transaction(self._con):
             self._delete(design.design_id)
             self._con.execute(_INSERT_DESIGN, row)
             if len(result.pressure_mpa):
@@ -585,12 +431,12 @@ class CampaignStore:
             None,
             None,
             backend,
-            _softbend_version(),
+            softbend_version(),
             SCHEMA_VERSION,
-            _utc_now(),
+            utc_now(),
             None,
         ]
-        with self._transaction():
+        with transaction(self._con):
             self._delete(design.design_id)
             self._con.execute(_INSERT_DESIGN, row)
         self._recorded.add(design.design_id)
@@ -716,7 +562,7 @@ class CampaignStore:
     def load_designs(self) -> pd.DataFrame:
         """The ``designs`` table (done and failed), sorted by ``design_id``."""
         return self._con.execute(
-            f"SELECT {', '.join(_DESIGN_COLUMNS)} FROM designs ORDER BY design_id"
+            f"SELECT {', '.join(DESIGN_COLUMNS)} FROM designs ORDER BY design_id"
         ).df()
 
     def export(
@@ -758,7 +604,7 @@ class CampaignStore:
         query = (
             _SAMPLES_QUERY
             if table == "samples"
-            else f"SELECT {', '.join(_DESIGN_COLUMNS)} FROM designs ORDER BY design_id"
+            else f"SELECT {', '.join(DESIGN_COLUMNS)} FROM designs ORDER BY design_id"
         )
         tmp = target.with_name(f".{target.name}.{uuid.uuid4().hex}.tmp")
         try:
@@ -783,66 +629,6 @@ def _describe_grid(grid: np.ndarray) -> str:
     if len(grid) == 0:
         return "an empty grid"
     return f"{len(grid)} pressures from {grid[0]:g} to {grid[-1]:g} MPa"
-
-
-#: Bytes before the first block of a DuckDB file: its main header and two database headers.
-_DUCKDB_HEADER_BYTES = 3 * 4096
-
-
-def _first_line(exc: Exception, limit: int = 200) -> str:
-    """The first line of an error's message, at most ``limit`` characters."""
-    lines = str(exc).strip().splitlines()
-    text = lines[0] if lines else type(exc).__name__
-    return text if len(text) <= limit else text[: limit - 3] + "..."
-
-
-def _unreadable(path: Path, reason: str) -> SchemaError:
-    return SchemaError(
-        f"{str(path)!r} is not a readable softbend campaign database ({reason.rstrip('.!')})."
-    )
-
-
-def _check_complete(con: Any, path: Path) -> None:
-    """Raise unless the file holds every block of the database, each one readable.
-
-    DuckDB reads a block only when a query needs it, so a truncated or partly
-    overwritten file opens and then fails on some later query. Here the file must
-    be long enough for its headers and all blocks in use (DuckDB cuts trailing
-    free blocks off), and every table is read once in full, which loads and
-    checksums each of its blocks (a fraction of a second for millions of samples).
-    A DuckDB error raised here is turned into one line by the caller.
-    """
-    size = path.stat().st_size
-    block_size, total, free = con.execute(
-        "SELECT block_size, total_blocks, free_blocks FROM pragma_database_size()"
-    ).fetchone()
-    needed = _DUCKDB_HEADER_BYTES + block_size * (total - free)
-    if size < needed:
-        raise _unreadable(path, f"truncated: {size} bytes, its blocks in use need {needed}")
-    tables = con.execute(
-        "SELECT schema_name, table_name FROM duckdb_tables() "
-        "WHERE database_name = current_database() AND NOT temporary"
-    ).fetchall()
-    for schema, table in tables:
-        name = '"{}"."{}"'.format(schema.replace('"', '""'), table.replace('"', '""'))
-        con.execute(f"SELECT max(hash(COLUMNS(*))) FROM {name}").fetchall()
-
-
-def _open_error(path: Path, exc: Exception) -> SoftbendError:
-    text = str(exc)
-    if re.search(r"\block\b", text, re.IGNORECASE):  # a lock, not a "block"
-        return SoftbendError(
-            f"The campaign database {str(path)!r} is in use by another process (a running "
-            "campaign?); DuckDB allows one writer and no reader meanwhile."
-        )
-    if "different configuration" in text:
-        return SoftbendError(
-            f"The campaign database {str(path)!r} is already open in this process in another "
-            "mode; close that CampaignStore first."
-        )
-    if "not a valid DuckDB database" in text:
-        return _unreadable(path, "not a DuckDB database file")
-    return _unreadable(path, _first_line(exc))
 
 
 def load_samples(db_path: str | os.PathLike[str]) -> pd.DataFrame:

@@ -1,0 +1,303 @@
+"""The layout of a campaign database and the checks of a file before it is used.
+
+Tables (schema version :data:`SCHEMA_VERSION`):
+
+``meta(key, value)``
+    ``schema_version``, ``softbend_version`` and ``created_at`` (set on creation),
+    ``backend`` and ``pressures_mpa`` (JSON list; set by the first run and checked
+    by every later one, so a resumed campaign cannot mix models or grids),
+    ``space`` and ``n_designs_planned`` (of the latest run).
+``designs``
+    One row per attempted design: its parameters (``l_mm`` ... ``lc_mm``),
+    ``status`` ``'done'`` or ``'failed'``, ``error`` (``"ExceptionType: message"``
+    for failed designs), ``wall_time_s``, ``n_samples`` (rows in ``samples``,
+    including the final non-converged pressure), ``max_pressure_mpa`` and
+    ``max_angle_deg`` (over converged pressures), ``newton_iterations_total``,
+    ``mesh_size``, ``backend``, ``softbend_version``, ``schema_version``,
+    ``finished_at`` (UTC) and ``stats`` (backend details as JSON).
+``samples``
+    One row per applied pressure of a done design: ``pressure_mpa``,
+    ``angle_deg``, ``tip_x_mm``, ``tip_z_mm`` (NULL where not converged),
+    ``converged``, ``newton_iterations``; primary key ``(design_id, pressure_mpa)``.
+
+:func:`ensure_schema` creates these tables in a new file and checks those of an
+existing one (a softbend campaign, of a version this softbend reads);
+:func:`check_complete` reads every block of an existing file once, so a
+truncated or damaged file is refused on opening rather than on a later query;
+:func:`open_error` and :func:`unreadable` turn DuckDB's errors into one line
+naming the file. The queries and writes live in :mod:`softbend.campaign.store`.
+"""
+
+from __future__ import annotations
+
+import logging
+import re
+from collections.abc import Iterator
+from contextlib import contextmanager
+from datetime import UTC, datetime
+from pathlib import Path
+from typing import Any
+
+from softbend.design import PARAMETERS
+from softbend.errors import SchemaError, SoftbendError
+
+__all__ = [
+    "DESIGN_COLUMNS",
+    "SAMPLE_COLUMNS",
+    "SCHEMA_VERSION",
+    "check_complete",
+    "ensure_schema",
+    "first_line",
+    "open_error",
+    "softbend_version",
+    "transaction",
+    "unreadable",
+    "utc_now",
+]
+
+logger = logging.getLogger(__name__)
+
+#: Version of the table layout written by this softbend. A database with a newer
+#: version is refused with :class:`~softbend.errors.SchemaError`.
+SCHEMA_VERSION = 1
+
+#: Columns of :meth:`CampaignStore.load_samples`.
+SAMPLE_COLUMNS: tuple[str, ...] = (
+    "design_id",
+    *PARAMETERS,
+    "pressure_mpa",
+    "angle_deg",
+    "tip_x_mm",
+    "tip_z_mm",
+    "converged",
+)
+
+#: Columns of the ``designs`` table, in the order of its definition.
+DESIGN_COLUMNS: tuple[str, ...] = (
+    "design_id",
+    *PARAMETERS,
+    "status",
+    "error",
+    "wall_time_s",
+    "n_samples",
+    "max_pressure_mpa",
+    "max_angle_deg",
+    "newton_iterations_total",
+    "mesh_size",
+    "backend",
+    "softbend_version",
+    "schema_version",
+    "finished_at",
+    "stats",
+)
+
+_DDL = (
+    """
+    CREATE TABLE IF NOT EXISTS meta (
+        key VARCHAR PRIMARY KEY,
+        value VARCHAR NOT NULL
+    )
+    """,
+    """
+    CREATE TABLE IF NOT EXISTS designs (
+        design_id VARCHAR PRIMARY KEY,
+        l_mm DOUBLE NOT NULL,
+        r_mm DOUBLE NOT NULL,
+        t_mm DOUBLE NOT NULL,
+        b_mm DOUBLE NOT NULL,
+        phi_deg DOUBLE NOT NULL,
+        lc_mm DOUBLE NOT NULL,
+        status VARCHAR NOT NULL CHECK (status IN ('done', 'failed')),
+        error VARCHAR,
+        wall_time_s DOUBLE,
+        n_samples INTEGER NOT NULL,
+        max_pressure_mpa DOUBLE,
+        max_angle_deg DOUBLE,
+        newton_iterations_total BIGINT,
+        mesh_size BIGINT,
+        backend VARCHAR NOT NULL,
+        softbend_version VARCHAR NOT NULL,
+        schema_version INTEGER NOT NULL,
+        finished_at TIMESTAMP NOT NULL,
+        stats VARCHAR
+    )
+    """,
+    """
+    CREATE TABLE IF NOT EXISTS samples (
+        design_id VARCHAR NOT NULL,
+        pressure_mpa DOUBLE NOT NULL,
+        angle_deg DOUBLE,
+        tip_x_mm DOUBLE,
+        tip_z_mm DOUBLE,
+        converged BOOLEAN NOT NULL,
+        newton_iterations INTEGER,
+        PRIMARY KEY (design_id, pressure_mpa)
+    )
+    """,
+)
+
+#: Bytes before the first block of a DuckDB file: its main header and two database headers.
+_DUCKDB_HEADER_BYTES = 3 * 4096
+
+
+def softbend_version() -> str:
+    """The version of softbend stamped on the database and on every design row."""
+    from softbend import __version__
+
+    return __version__
+
+
+def utc_now() -> datetime:
+    """The current UTC time without a time zone, as DuckDB's ``TIMESTAMP`` stores it."""
+    return datetime.now(UTC).replace(tzinfo=None)
+
+
+@contextmanager
+def transaction(con: Any) -> Iterator[None]:
+    """Run the body in one transaction of the DuckDB connection ``con``.
+
+    Committed when the body returns, rolled back when it raises (anything,
+    ``KeyboardInterrupt`` included).
+    """
+    con.execute("BEGIN TRANSACTION")
+    try:
+        yield
+    except BaseException:
+        con.execute("ROLLBACK")
+        raise
+    con.execute("COMMIT")
+
+
+# -- creating a database or checking an existing one -------------------------------
+
+
+def ensure_schema(con: Any, path: Path, *, read_only: bool) -> None:
+    """Create the tables of a new campaign database, or check those of an existing one.
+
+    Parameters
+    ----------
+    con : duckdb.DuckDBPyConnection
+        Open connection to the file.
+    path : pathlib.Path
+        The file, for messages.
+    read_only : bool
+        The connection is read-only: a file without tables is refused rather
+        than created.
+
+    Raises
+    ------
+    SchemaError
+        Tables but no ``meta`` table (not a softbend campaign), no tables and
+        ``read_only``, an unknown or newer schema version, or a missing
+        ``designs`` or ``samples`` table.
+    """
+    tables = {
+        row[0]
+        for row in con.execute(
+            "SELECT table_name FROM information_schema.tables WHERE table_schema = 'main'"
+        ).fetchall()
+    }
+    if "meta" not in tables:
+        if tables or read_only:
+            found = ", ".join(sorted(tables)) or "no tables"
+            raise SchemaError(
+                f"{str(path)!r} is not a softbend campaign database "
+                f"(no 'meta' table; found {found})."
+            )
+        _create(con, path)
+        return
+    meta = dict(con.execute("SELECT key, value FROM meta").fetchall())
+    version_text = meta.get("schema_version")
+    try:
+        version = int(version_text) if version_text is not None else None
+    except ValueError:
+        version = None
+    if version is None or version < 1:
+        raise SchemaError(
+            f"The campaign database {str(path)!r} has an unknown schema version "
+            f"{version_text!r}; this softbend reads version {SCHEMA_VERSION}."
+        )
+    if version > SCHEMA_VERSION:
+        raise SchemaError(
+            f"The campaign database {str(path)!r} has schema version {version}, newer "
+            f"than this softbend supports ({SCHEMA_VERSION}); upgrade softbend to read it."
+        )
+    missing = {"designs", "samples"} - tables
+    if missing:
+        raise SchemaError(
+            f"The campaign database {str(path)!r} lacks the table(s) {', '.join(sorted(missing))}."
+        )
+
+
+def _create(con: Any, path: Path) -> None:
+    with transaction(con):
+        for statement in _DDL:
+            con.execute(statement)
+        for key, value in (
+            ("schema_version", str(SCHEMA_VERSION)),
+            ("softbend_version", softbend_version()),
+            ("created_at", utc_now().isoformat(timespec="seconds") + "Z"),
+        ):
+            con.execute("INSERT INTO meta VALUES (?, ?)", [key, value])
+    logger.info("created campaign database %s (schema %d)", path, SCHEMA_VERSION)
+
+
+def check_complete(con: Any, path: Path) -> None:
+    """Raise unless the file holds every block of the database, each one readable.
+
+    DuckDB reads a block only when a query needs it, so a truncated or partly
+    overwritten file opens and then fails on some later query. Here the file must
+    be long enough for its headers and all blocks in use (DuckDB cuts trailing
+    free blocks off), and every table is read once in full, which loads and
+    checksums each of its blocks (a fraction of a second for millions of samples).
+    A DuckDB error raised here is turned into one line by the caller.
+    """
+    size = path.stat().st_size
+    block_size, total, free = con.execute(
+        "SELECT block_size, total_blocks, free_blocks FROM pragma_database_size()"
+    ).fetchone()
+    needed = _DUCKDB_HEADER_BYTES + block_size * (total - free)
+    if size < needed:
+        raise unreadable(path, f"truncated: {size} bytes, its blocks in use need {needed}")
+    tables = con.execute(
+        "SELECT schema_name, table_name FROM duckdb_tables() "
+        "WHERE database_name = current_database() AND NOT temporary"
+    ).fetchall()
+    for schema, table in tables:
+        name = '"{}"."{}"'.format(schema.replace('"', '""'), table.replace('"', '""'))
+        con.execute(f"SELECT max(hash(COLUMNS(*))) FROM {name}").fetchall()
+
+
+# -- one line per error of opening -------------------------------------------------
+
+
+def first_line(exc: Exception, limit: int = 200) -> str:
+    """The first line of an error's message, at most ``limit`` characters."""
+    lines = str(exc).strip().splitlines()
+    text = lines[0] if lines else type(exc).__name__
+    return text if len(text) <= limit else text[: limit - 3] + "..."
+
+
+def unreadable(path: Path, reason: str) -> SchemaError:
+    """The error of a file that is not a readable campaign database, and why."""
+    return SchemaError(
+        f"{str(path)!r} is not a readable softbend campaign database ({reason.rstrip('.!')})."
+    )
+
+
+def open_error(path: Path, exc: Exception) -> SoftbendError:
+    """The one-line error for a DuckDB error raised while connecting to ``path``."""
+    text = str(exc)
+    if re.search(r"\block\b", text, re.IGNORECASE):  # a lock, not a "block"
+        return SoftbendError(
+            f"The campaign database {str(path)!r} is in use by another process (a running "
+            "campaign?); DuckDB allows one writer and no reader meanwhile."
+        )
+    if "different configuration" in text:
+        return SoftbendError(
+            f"The campaign database {str(path)!r} is already open in this process in another "
+            "mode; close that CampaignStore first."
+        )
+    if "not a valid DuckDB database" in text:
+        return unreadable(path, "not a DuckDB database file")
+    return unreadable(path, first_line(exc))
