@@ -2,9 +2,13 @@
 
 * :mod:`~softbend.campaign.backends` — what computes one sweep (analytical model,
   FEM) behind one protocol and a registry;
+* :mod:`~softbend.campaign.schema` — the tables of a campaign database, their
+  version and the checks of an existing file;
 * :mod:`~softbend.campaign.store` — the DuckDB database, one transaction per design;
-* :mod:`~softbend.campaign.runner` — local processes or a Dask cluster, resume,
-  failure recording, progress.
+* :mod:`~softbend.campaign.runner` — :func:`run_campaign`: plans a run
+  (:mod:`~softbend.campaign.planning`: resume, the designs left, the executor) and
+  runs it (:mod:`~softbend.campaign.executors`: serial, local processes or a Dask
+  cluster, failure recording, progress).
 
 Example::
 

@@ -3,7 +3,10 @@
 :func:`run_campaign` is the whole orchestration. The coordinating process (the one
 calling it) owns the database; worker processes only compute sweeps and send
 back :class:`~softbend.campaign.backends.SweepResult` objects, which the
-coordinator writes one transaction per design as they arrive. Three ways to run:
+coordinator writes one transaction per design as they arrive. What a run has to
+do (the designs left, the executor) is worked out in
+:mod:`~softbend.campaign.planning`; the executors live in
+:mod:`~softbend.campaign.executors`. Three ways to run:
 
 * ``workers`` 0 or 1: in-process and serial (debugging, tests, tiny campaigns);
 * default: a local :class:`concurrent.futures.ProcessPoolExecutor` with
@@ -38,19 +41,11 @@ that succeeds replaces the failed row; pass ``retry_failed=False`` to keep them.
 
 from __future__ import annotations
 
-import json
 import logging
-import math
-import multiprocessing
 import os
-import re
 import socket
-import threading
 import time
-from collections import deque
-from collections.abc import Callable, Iterable, Sequence
-from concurrent.futures import FIRST_COMPLETED, ProcessPoolExecutor, wait
-from concurrent.futures.process import BrokenProcessPool
+from collections.abc import Iterable
 from dataclasses import asdict, dataclass, field
 from pathlib import Path
 from typing import Any
@@ -59,37 +54,33 @@ import numpy as np
 from numpy.typing import ArrayLike
 
 from softbend import __version__
-from softbend._extras import require
-from softbend._validation import check_range
-from softbend.campaign.backends import (
-    Backend,
-    SweepResult,
-    check_pressures_mpa,
-    default_pressures_mpa,
-    get_backend,
+from softbend.campaign.backends import Backend, check_pressures_mpa, default_pressures_mpa
+from softbend.campaign.executors import (
+    ProgressCallback,
+    Recorder,
+    connect,
+    parse_scheduler_address,
+    run_dask,
+    run_local,
+    run_serial,
+)
+from softbend.campaign.planning import (
+    RunPlan,
+    auto_chunk_size,
+    check_designs,
+    check_run_options,
+    chunks,
+    plan_run,
+    resolve_backend,
 )
 from softbend.campaign.store import CampaignStore
 from softbend.design import SFRBADesign
-from softbend.errors import SoftbendError
 
 __all__ = ["CampaignSummary", "parse_scheduler_address", "run_campaign"]
 
 logger = logging.getLogger(__name__)
 
-#: ``progress(done, failed, running, total)``: designs finished and failed in this
-#: run, designs handed to workers and not yet back, designs this run has to do.
-ProgressCallback = Callable[[int, int, int, int], None]
-
 _OWNER = "run_campaign"
-_ADDRESS = re.compile(
-    r"^(?P<protocol>tcp|tls)://(?P<host>\[[0-9A-Fa-f:.]+\]|[A-Za-z0-9._-]+):(?P<port>\d{1,5})$"
-)
-# Largest batch sent to a worker in one task when the backend states no preference.
-_MAX_AUTO_CHUNK = 16
-# Tasks in flight per worker: enough to keep workers busy while results are recorded.
-_TASKS_PER_WORKER = 2
-# A local pool whose worker processes keep dying is restarted at most this often.
-_MAX_POOL_RESTARTS = 3
 
 
 @dataclass(frozen=True)
@@ -154,400 +145,6 @@ class CampaignSummary:
         data["n_run"] = self.n_run
         data["designs_per_s"] = self.designs_per_s
         return data
-
-
-@dataclass(frozen=True)
-class _Outcome:
-    """One design's sweep, as sent back by a worker."""
-
-    design: SFRBADesign
-    result: SweepResult | None
-    error: str | None
-    wall_time_s: float
-
-
-def _error_text(exc: BaseException) -> str:
-    message = " ".join(str(exc).split())
-    return f"{type(exc).__name__}: {message}" if message else type(exc).__name__
-
-
-def _sweep_one(backend: Backend, design: SFRBADesign, pressures_mpa: np.ndarray) -> _Outcome:
-    start = time.perf_counter()
-    try:
-        result = backend.sweep(design, pressures_mpa)
-        if not isinstance(result, SweepResult):
-            raise SoftbendError(
-                f"backend {backend.name!r} returned {type(result).__name__}, not a SweepResult"
-            )
-        if result.design.design_id != design.design_id:
-            raise SoftbendError(
-                f"backend {backend.name!r} returned the sweep of design {result.design} "
-                f"for design {design}"
-            )
-    except Exception as exc:
-        return _Outcome(design, None, _error_text(exc), time.perf_counter() - start)
-    return _Outcome(design, result, None, result.wall_time_s)
-
-
-def _sweep_chunk(
-    backend: Backend, designs: Sequence[SFRBADesign], pressures_mpa: np.ndarray
-) -> list[_Outcome]:
-    """Worker task: sweep each design of the chunk independently."""
-    return [_sweep_one(backend, design, pressures_mpa) for design in designs]
-
-
-def _lost_chunk(designs: Sequence[SFRBADesign], exc: BaseException) -> list[_Outcome]:
-    text = _error_text(exc)
-    if isinstance(exc, BrokenProcessPool):
-        text = (
-            "BrokenProcessPool: a worker process died while this design's task was pending "
-            "(killed, out of memory or crashed)"
-        )
-    return [_Outcome(design, None, text, float("nan")) for design in designs]
-
-
-class _Recorder:
-    """Writes outcomes to the store as they arrive and reports progress."""
-
-    def __init__(
-        self, store: CampaignStore, backend: str, total: int, progress: ProgressCallback | None
-    ) -> None:
-        self.store = store
-        self.backend = backend
-        self.total = total
-        self.progress = progress
-        self.done = 0
-        self.failed = 0
-        self.running = 0
-        self.sweep_time_s = 0.0
-        self.failures: list[tuple[str, str]] = []
-
-    def report(self) -> None:
-        if self.progress is not None:
-            self.progress(self.done, self.failed, self.running, self.total)
-
-    def set_running(self, running: int) -> None:
-        if running != self.running:
-            self.running = running
-            self.report()
-
-    def record(self, outcomes: Iterable[_Outcome], running: int) -> None:
-        for outcome in outcomes:
-            error = outcome.error
-            if outcome.result is not None:
-                try:
-                    self.store.record_success(outcome.result, backend=self.backend)
-                except ValueError as exc:  # a result off the campaign grid
-                    error = _error_text(exc)
-            if error is not None:
-                self.store.record_failure(
-                    outcome.design, error, outcome.wall_time_s, backend=self.backend
-                )
-                self.failed += 1
-                self.failures.append((outcome.design.design_id, error))
-                logger.warning("design %s failed: %s", outcome.design, error)
-            else:
-                self.done += 1
-            if math.isfinite(outcome.wall_time_s):
-                self.sweep_time_s += outcome.wall_time_s
-        self.running = running
-        self.report()
-
-
-def parse_scheduler_address(scheduler: str) -> str:
-    """Check a Dask scheduler address ``tcp://HOST:PORT`` (or ``tls://``) and return it.
-
-    A path to an existing JSON scheduler file (written by ``dask scheduler
-    --scheduler-file``) is read and its ``address`` returned.
-
-    Raises
-    ------
-    ValueError
-        Naming ``--scheduler``, the expected form and the value received.
-    """
-    text = str(scheduler).strip()
-    if text.endswith(".json") and "://" not in text:
-        path = Path(text)
-        if not path.is_file():
-            raise FileNotFoundError(f"No Dask scheduler file at {text!r} (--scheduler).")
-        try:
-            text = str(json.loads(path.read_text())["address"])
-        except (ValueError, KeyError, TypeError):
-            raise ValueError(
-                f"The Dask scheduler file {str(path)!r} (--scheduler) has no 'address'."
-            ) from None
-    match = _ADDRESS.match(text)
-    if match is None or not 1 <= int(match["port"]) <= 65535:
-        raise ValueError(
-            f"The 'scheduler' (--scheduler) of {_OWNER} must be an address of the form "
-            f"tcp://HOST:PORT (PORT 1-65535) or a Dask scheduler file. Got {scheduler!r} instead."
-        )
-    return text
-
-
-def _probe(address: str, timeout_s: float) -> None:
-    """Fail fast, with one clear line, when nothing listens at the scheduler address."""
-    match = _ADDRESS.match(parse_scheduler_address(address))
-    host = match["host"].strip("[]")
-    try:
-        with socket.create_connection((host, int(match["port"])), timeout=timeout_s):
-            pass
-    except OSError as exc:
-        reason = exc.strerror or type(exc).__name__
-        raise SoftbendError(
-            f"Cannot reach the Dask scheduler at {address} ({reason}); start it with "
-            "'dask scheduler' or check --scheduler."
-        ) from None
-
-
-def _check_designs(designs: Iterable[SFRBADesign]) -> list[SFRBADesign]:
-    if isinstance(designs, SFRBADesign):
-        designs = [designs]
-    try:
-        items = list(designs)
-    except TypeError:
-        raise ValueError(
-            f"The 'designs' of {_OWNER} must be an iterable of SFRBADesign. "
-            f"Got {designs!r} instead."
-        ) from None
-    if not items:
-        raise ValueError(f"The 'designs' of {_OWNER} must not be empty. Got 0 designs.")
-    for i, design in enumerate(items):
-        if not isinstance(design, SFRBADesign):
-            raise ValueError(
-                f"The 'designs' of {_OWNER} must all be SFRBADesign. "
-                f"Got {design!r} at position {i} instead."
-            )
-    ids = [d.design_id for d in items]
-    if len(set(ids)) != len(ids):
-        raise ValueError(
-            f"The 'designs' of {_OWNER} must be unique. Got {len(ids) - len(set(ids))} duplicates."
-        )
-    return items
-
-
-def _resolve_backend(backend: str | Backend, options: dict[str, Any] | None) -> Backend:
-    if isinstance(backend, str):
-        return get_backend(backend, **dict(options or {}))
-    if not isinstance(backend, Backend):
-        raise ValueError(
-            f"The 'backend' of {_OWNER} must be a backend name or an object with 'name' and "
-            f"'sweep'. Got {backend!r} instead."
-        )
-    if options:
-        raise ValueError(
-            f"The 'backend_options' of {_OWNER} apply to a backend name only. "
-            f"Got {sorted(options)} with a backend object."
-        )
-    return backend
-
-
-def _mp_context() -> multiprocessing.context.BaseContext:
-    if "forkserver" in multiprocessing.get_all_start_methods():
-        context = multiprocessing.get_context("forkserver")
-        # Workers fork from a server that has already imported the model code.
-        context.set_forkserver_preload(
-            ["__main__", "softbend.campaign.runner", "softbend.analytical"]
-        )
-        return context
-    return multiprocessing.get_context("spawn")
-
-
-def _auto_chunk_size(backend: Backend, n_designs: int, n_slots: int) -> int:
-    preferred = getattr(backend, "preferred_chunk_size", None)
-    if preferred:
-        return max(1, int(preferred))
-    return max(1, min(_MAX_AUTO_CHUNK, math.ceil(n_designs / (8 * max(1, n_slots)))))
-
-
-def _chunks(designs: Sequence[SFRBADesign], size: int) -> deque[list[SFRBADesign]]:
-    return deque(list(designs[i : i + size]) for i in range(0, len(designs), size))
-
-
-def _run_serial(
-    backend: Backend, todo: Sequence[SFRBADesign], pressures: np.ndarray, recorder: _Recorder
-) -> None:
-    for design in todo:
-        recorder.set_running(1)
-        recorder.record([_sweep_one(backend, design, pressures)], running=0)
-
-
-def _run_isolated(
-    backend: Backend,
-    suspects: deque[SFRBADesign],
-    pressures: np.ndarray,
-    context: Any,
-    recorder: _Recorder,
-) -> None:
-    """Run each design that was in flight when a worker died alone, in its own process.
-
-    A worker that dies takes every pending task of its pool with it, so those
-    designs cannot be blamed: each is run again by itself, and only a design
-    whose own process dies is recorded as failed (with that reason).
-    """
-    while suspects:
-        design = suspects.popleft()
-        recorder.set_running(1)
-        pool = ProcessPoolExecutor(max_workers=1, mp_context=context)
-        try:
-            outcomes = pool.submit(_sweep_chunk, backend, [design], pressures).result()
-        except BrokenProcessPool:
-            outcomes = [
-                _Outcome(
-                    design,
-                    None,
-                    "BrokenProcessPool: the worker process died while sweeping this design "
-                    "alone (killed, out of memory or crashed)",
-                    float("nan"),
-                )
-            ]
-        except Exception as exc:
-            outcomes = _lost_chunk([design], exc)
-        finally:
-            pool.shutdown(wait=True, cancel_futures=True)
-        recorder.record(outcomes, running=0)
-
-
-def _run_local(
-    backend: Backend,
-    chunks: deque[list[SFRBADesign]],
-    pressures: np.ndarray,
-    workers: int,
-    recorder: _Recorder,
-) -> None:
-    context = _mp_context()
-    restarts = 0
-    suspects: deque[SFRBADesign] = deque()
-    while chunks or suspects:
-        _run_isolated(backend, suspects, pressures, context, recorder)
-        if not chunks:
-            break
-        pool = ProcessPoolExecutor(max_workers=workers, mp_context=context)
-        pending: dict[Any, list[SFRBADesign]] = {}
-        broken = False
-        clean = False
-        try:
-            while chunks or pending:
-                while chunks and not broken and len(pending) < _TASKS_PER_WORKER * workers:
-                    chunk = chunks.popleft()
-                    try:
-                        future = pool.submit(_sweep_chunk, backend, chunk, pressures)
-                    except BrokenProcessPool:
-                        chunks.appendleft(chunk)
-                        broken = True
-                        break
-                    pending[future] = chunk
-                recorder.set_running(sum(len(c) for c in pending.values()))
-                if not pending:
-                    break
-                finished, _ = wait(pending, return_when=FIRST_COMPLETED)
-                for future in finished:
-                    chunk = pending.pop(future)
-                    try:
-                        outcomes = future.result()
-                    except BrokenProcessPool:
-                        broken = True
-                        suspects.extend(chunk)  # not blamed yet: rerun alone
-                        continue
-                    except Exception as exc:
-                        outcomes = _lost_chunk(chunk, exc)
-                    recorder.record(outcomes, running=sum(len(c) for c in pending.values()))
-            clean = True
-        finally:
-            pool.shutdown(wait=clean, cancel_futures=True)
-        if broken:
-            restarts += 1
-            if restarts > _MAX_POOL_RESTARTS:
-                raise SoftbendError(
-                    f"Worker processes died {restarts} times; {sum(map(len, chunks))} designs "
-                    "were not run. Check memory and the backend, then re-run to resume."
-                )
-            logger.warning(
-                "a worker process died; rerunning the %d designs it took down one by one",
-                len(suspects),
-            )
-
-
-def _connect(address: str, timeout_s: float) -> Any:
-    """A Dask client of the scheduler at ``address``, or one line within the deadline.
-
-    Every wait has a deadline: something that accepts TCP but is not a Dask
-    scheduler (a web server, a silent listener) may never finish Dask's
-    handshake, so the connection runs in a helper thread that is given up after
-    ``timeout_s`` (plus a grace of 5 s).
-    """
-    Client = require("distributed", "A campaign on a Dask cluster (--scheduler)").Client
-
-    _probe(address, timeout_s)
-    box: dict[str, Any] = {}
-
-    def attempt() -> None:
-        try:
-            box["client"] = Client(address, timeout=timeout_s, set_as_default=False)
-        except BaseException as exc:  # reported below, in the caller's thread
-            box["error"] = exc
-
-    thread = threading.Thread(target=attempt, name="softbend-dask-connect", daemon=True)
-    thread.start()
-    thread.join(timeout_s + 5.0)
-    if thread.is_alive():
-        raise SoftbendError(
-            f"The Dask scheduler at {address} did not answer within {timeout_s:g} s: something "
-            "listens there but does not speak Dask's protocol; check --scheduler."
-        )
-    if "error" in box:
-        exc = box["error"]
-        reason = " ".join(str(exc).split()) or type(exc).__name__
-        raise SoftbendError(
-            f"Cannot connect to the Dask scheduler at {address}: {type(exc).__name__}: "
-            f"{reason[:200]}"
-        ) from None
-    client = box["client"]
-    try:
-        client.wait_for_workers(1, timeout=timeout_s)
-    except Exception:
-        client.close()
-        raise SoftbendError(
-            f"The Dask scheduler at {address} has no workers (waited {timeout_s:g} s); "
-            "start some with 'dask worker ADDRESS'."
-        ) from None
-    return client
-
-
-def _run_dask(
-    backend: Backend,
-    chunks: deque[list[SFRBADesign]],
-    pressures: np.ndarray,
-    client: Any,
-    recorder: _Recorder,
-) -> None:
-    from distributed import as_completed
-
-    n_threads = max(1, sum(client.nthreads().values()))
-    pending: dict[Any, list[SFRBADesign]] = {}
-
-    def submit() -> Any:
-        chunk = chunks.popleft()
-        future = client.submit(_sweep_chunk, backend, chunk, pressures, pure=False)
-        pending[future] = chunk
-        return future
-
-    initial = [submit() for _ in range(min(len(chunks), _TASKS_PER_WORKER * n_threads))]
-    recorder.set_running(sum(len(c) for c in pending.values()))
-    queue = as_completed(initial, loop=client.loop)
-    try:
-        for future in queue:
-            chunk = pending.pop(future)
-            try:
-                outcomes = future.result()
-            except Exception as exc:  # task lost: KilledWorker, unpicklable result, ...
-                outcomes = _lost_chunk(chunk, exc)
-            if chunks:
-                queue.add(submit())
-            recorder.record(outcomes, running=sum(len(c) for c in pending.values()))
-    finally:
-        if pending:
-            client.cancel(list(pending))
 
 
 def run_campaign(
@@ -618,101 +215,36 @@ def run_campaign(
         or has no workers, or local workers keep dying.
     """
     start = time.perf_counter()
-    backend_obj = _resolve_backend(backend, backend_options)
-    design_list = _check_designs(designs)
+    backend_obj = resolve_backend(backend, backend_options)
+    design_list = check_designs(designs)
     grid = check_pressures_mpa(
         default_pressures_mpa() if pressures_mpa is None else pressures_mpa, _OWNER
     )
-    if workers is None:
-        workers = os.cpu_count() or 1
-    workers = int(
-        check_range(
-            workers, "workers", _OWNER, low=0, low_inclusive=True, high=4096, high_inclusive=True
-        )
-    )
-    if chunk_size is not None:
-        chunk_size = int(
-            check_range(
-                chunk_size,
-                "chunk_size",
-                _OWNER,
-                low=1,
-                low_inclusive=True,
-                high=100_000,
-                high_inclusive=True,
-            )
-        )
-    timeout_s = check_range(
-        connect_timeout_s, "connect_timeout_s", _OWNER, low=0.0, high=600.0, high_inclusive=True
-    )
+    workers, chunk_size, timeout_s = check_run_options(workers, chunk_size, connect_timeout_s)
     address = parse_scheduler_address(scheduler) if scheduler is not None else None
     if progress is not None and not callable(progress):
         raise ValueError(f"The 'progress' of {_OWNER} must be callable. Got {progress!r} instead.")
+    space = getattr(designs, "name", None)
 
     # Connect first: an unreachable cluster fails before the database is touched.
-    client = _connect(address, timeout_s) if address is not None else None
+    client = connect(address, timeout_s) if address is not None else None
     try:
         with CampaignStore(db_path) as store:
-            store.bind(
+            plan = plan_run(
+                store,
                 backend_obj.name,
                 grid,
-                space=getattr(designs, "name", None),
-                n_designs_planned=len(design_list),
+                design_list,
+                space=space,
+                retry_failed=retry_failed,
+                workers=workers,
+                address=address,
             )
-            done_ids = store.finished_ids()
-            failed_ids = store.failed_ids()
-            todo = [
-                d
-                for d in design_list
-                if d.design_id not in done_ids and (retry_failed or d.design_id not in failed_ids)
-            ]
-            n_skipped_done = sum(d.design_id in done_ids for d in design_list)
-            n_skipped_failed = len(design_list) - n_skipped_done - len(todo)
-            if address is not None:
-                executor = address
-            elif workers <= 1 or len(todo) <= 1:
-                executor = "serial"
-            else:
-                workers = min(workers, len(todo))
-                executor = f"processes:{workers}"
-            logger.info(
-                "campaign %s: %d designs, %d already done, %d failed before and %s; "
-                "%d to run on %s",
-                store.path,
-                len(design_list),
-                n_skipped_done,
-                sum(d.design_id in failed_ids for d in design_list),
-                "retried" if retry_failed else "kept",
-                len(todo),
-                executor,
-            )
-            recorder = _Recorder(store, backend_obj.name, len(todo), progress)
+            recorder = Recorder(store, backend_obj.name, len(plan.todo), progress)
             recorder.report()
-            if executor == "serial":
-                chunk_size = 1
-                _run_serial(backend_obj, todo, grid, recorder)
-            elif client is None:
-                chunk_size = chunk_size or _auto_chunk_size(backend_obj, len(todo), workers)
-                _run_local(backend_obj, _chunks(todo, chunk_size), grid, workers, recorder)
-            elif todo:
-                n_threads = max(1, sum(client.nthreads().values()))
-                chunk_size = chunk_size or _auto_chunk_size(backend_obj, len(todo), n_threads)
-                _run_dask(backend_obj, _chunks(todo, chunk_size), grid, client, recorder)
+            chunk_size = _execute(plan, backend_obj, grid, client, chunk_size, recorder)
             if recorder.done or recorder.failed:
-                store.log_run(
-                    {
-                        "space": getattr(designs, "name", None),
-                        "executor": executor,
-                        "host": socket.gethostname(),
-                        "cpu_count": os.cpu_count(),
-                        "softbend_version": __version__,
-                        "done": recorder.done,
-                        "failed": recorder.failed,
-                        "sweep_time_s": recorder.sweep_time_s,
-                        "wall_time_s": time.perf_counter() - start,
-                        "finished_at": time.strftime("%Y-%m-%dT%H:%M:%SZ", time.gmtime()),
-                    }
-                )
+                store.log_run(_run_record(space, plan.executor, recorder, start))
     finally:
         if client is not None:
             client.close()
@@ -720,10 +252,10 @@ def run_campaign(
     summary = CampaignSummary(
         db_path=str(Path(db_path)),
         backend=backend_obj.name,
-        executor=executor,
+        executor=plan.executor,
         n_designs=len(design_list),
-        n_skipped_done=n_skipped_done,
-        n_skipped_failed=n_skipped_failed,
+        n_skipped_done=plan.n_skipped_done,
+        n_skipped_failed=plan.n_skipped_failed,
         n_done=recorder.done,
         n_failed=recorder.failed,
         wall_time_s=time.perf_counter() - start,
@@ -739,3 +271,51 @@ def run_campaign(
         summary.wall_time_s,
     )
     return summary
+
+
+def _execute(
+    plan: RunPlan,
+    backend: Backend,
+    grid: np.ndarray,
+    client: Any,
+    chunk_size: int | None,
+    recorder: Recorder,
+) -> int | None:
+    """Sweep the designs of the plan on its executor; return the designs per task used.
+
+    Serial: one design at a time. Local processes or Dask: ``chunk_size``
+    designs per task, by default :func:`~softbend.campaign.planning.auto_chunk_size`
+    for the workers (local) or the threads of the cluster (Dask). Nothing runs on
+    Dask when no design is left.
+    """
+    if plan.executor == "serial":
+        run_serial(backend, plan.todo, grid, recorder)
+        return 1
+    if client is None:
+        size = chunk_size or auto_chunk_size(backend, len(plan.todo), plan.workers)
+        run_local(backend, chunks(plan.todo, size), grid, plan.workers, recorder)
+        return size
+    if plan.todo:
+        n_threads = max(1, sum(client.nthreads().values()))
+        size = chunk_size or auto_chunk_size(backend, len(plan.todo), n_threads)
+        run_dask(backend, chunks(plan.todo, size), grid, client, recorder)
+        return size
+    return chunk_size
+
+
+def _run_record(
+    space: str | None, executor: str, recorder: Recorder, start: float
+) -> dict[str, Any]:
+    """The record of this run kept in the campaign's ``runs`` metadata."""
+    return {
+        "space": space,
+        "executor": executor,
+        "host": socket.gethostname(),
+        "cpu_count": os.cpu_count(),
+        "softbend_version": __version__,
+        "done": recorder.done,
+        "failed": recorder.failed,
+        "sweep_time_s": recorder.sweep_time_s,
+        "wall_time_s": time.perf_counter() - start,
+        "finished_at": time.strftime("%Y-%m-%dT%H:%M:%SZ", time.gmtime()),
+    }

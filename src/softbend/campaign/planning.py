@@ -1,0 +1,261 @@
+"""What one campaign run has to do: its checked inputs, the designs left, the executor.
+
+:func:`check_designs`, :func:`resolve_backend` and :func:`check_run_options`
+check the arguments of :func:`~softbend.campaign.runner.run_campaign`;
+:func:`plan_run` binds the database to the backend and pressure grid (or checks
+them on resume), leaves out the designs already done (and those that failed
+before, unless they are retried) and names the executor; :func:`auto_chunk_size`
+and :func:`chunks` cut the designs left into worker tasks.
+"""
+
+from __future__ import annotations
+
+import logging
+import math
+import os
+from collections import deque
+from collections.abc import Iterable, Sequence
+from dataclasses import dataclass
+from typing import TYPE_CHECKING, Any
+
+import numpy as np
+
+from softbend._validation import check_range
+from softbend.campaign.backends import Backend, get_backend
+from softbend.design import SFRBADesign
+
+if TYPE_CHECKING:
+    from softbend.campaign.store import CampaignStore
+
+__all__ = [
+    "RunPlan",
+    "auto_chunk_size",
+    "check_designs",
+    "check_run_options",
+    "chunks",
+    "plan_run",
+    "resolve_backend",
+]
+
+logger = logging.getLogger(__name__)
+
+_OWNER = "run_campaign"
+# Largest batch sent to a worker in one task when the backend states no preference.
+_MAX_AUTO_CHUNK = 16
+
+
+@dataclass(frozen=True)
+class RunPlan:
+    """What one run of a campaign does.
+
+    Attributes
+    ----------
+    todo : list of SFRBADesign
+        The designs to sweep, in the order asked for.
+    n_skipped_done : int
+        Designs already done in the database (not re-run).
+    n_skipped_failed : int
+        Designs recorded as failed before and not retried.
+    executor : str
+        ``"serial"``, ``"processes:N"`` or the Dask scheduler address.
+    workers : int
+        Local worker processes: those asked for, at most one per design left
+        when the designs run in local processes.
+    """
+
+    todo: list[SFRBADesign]
+    n_skipped_done: int
+    n_skipped_failed: int
+    executor: str
+    workers: int
+
+
+# -- the arguments -------------------------------------------------------------------
+
+
+def check_designs(designs: Iterable[SFRBADesign]) -> list[SFRBADesign]:
+    """The designs as a list: non-empty, all :class:`SFRBADesign`, no two alike.
+
+    Raises
+    ------
+    ValueError
+        Not an iterable of designs, empty, or with duplicates.
+    """
+    if isinstance(designs, SFRBADesign):
+        designs = [designs]
+    try:
+        items = list(designs)
+    except TypeError:
+        raise ValueError(
+            f"The 'designs' of {_OWNER} must be an iterable of SFRBADesign. "
+            f"Got {designs!r} instead."
+        ) from None
+    if not items:
+        raise ValueError(f"The 'designs' of {_OWNER} must not be empty. Got 0 designs.")
+    for i, design in enumerate(items):
+        if not isinstance(design, SFRBADesign):
+            raise ValueError(
+                f"The 'designs' of {_OWNER} must all be SFRBADesign. "
+                f"Got {design!r} at position {i} instead."
+            )
+    ids = [d.design_id for d in items]
+    if len(set(ids)) != len(ids):
+        raise ValueError(
+            f"The 'designs' of {_OWNER} must be unique. Got {len(ids) - len(set(ids))} duplicates."
+        )
+    return items
+
+
+def resolve_backend(backend: str | Backend, options: dict[str, Any] | None) -> Backend:
+    """The backend object of a registered name (with its options), or ``backend`` itself.
+
+    Raises
+    ------
+    ValueError
+        Neither a name nor a backend object, or options given with an object.
+    """
+    if isinstance(backend, str):
+        return get_backend(backend, **dict(options or {}))
+    if not isinstance(backend, Backend):
+        raise ValueError(
+            f"The 'backend' of {_OWNER} must be a backend name or an object with 'name' and "
+            f"'sweep'. Got {backend!r} instead."
+        )
+    if options:
+        raise ValueError(
+            f"The 'backend_options' of {_OWNER} apply to a backend name only. "
+            f"Got {sorted(options)} with a backend object."
+        )
+    return backend
+
+
+def check_run_options(
+    workers: int | None, chunk_size: int | None, connect_timeout_s: float
+) -> tuple[int, int | None, float]:
+    """Checked ``(workers, chunk_size, connect_timeout_s)``; ``workers`` None is every core.
+
+    Raises
+    ------
+    ValueError
+        ``workers`` outside 0..4096, ``chunk_size`` outside 1..100000 or
+        ``connect_timeout_s`` outside (0, 600].
+    """
+    if workers is None:
+        workers = os.cpu_count() or 1
+    workers = int(
+        check_range(
+            workers, "workers", _OWNER, low=0, low_inclusive=True, high=4096, high_inclusive=True
+        )
+    )
+    if chunk_size is not None:
+        chunk_size = int(
+            check_range(
+                chunk_size,
+                "chunk_size",
+                _OWNER,
+                low=1,
+                low_inclusive=True,
+                high=100_000,
+                high_inclusive=True,
+            )
+        )
+    timeout_s = check_range(
+        connect_timeout_s, "connect_timeout_s", _OWNER, low=0.0, high=600.0, high_inclusive=True
+    )
+    return workers, chunk_size, timeout_s
+
+
+# -- the designs left and who runs them ----------------------------------------------
+
+
+def plan_run(
+    store: CampaignStore,
+    backend: str,
+    pressures_mpa: np.ndarray,
+    designs: Sequence[SFRBADesign],
+    *,
+    space: str | None,
+    retry_failed: bool,
+    workers: int,
+    address: str | None,
+) -> RunPlan:
+    """Bind the campaign, find the designs left and name the executor.
+
+    Parameters
+    ----------
+    store : CampaignStore
+        The campaign database, open for writing.
+    backend : str
+        Backend name.
+    pressures_mpa : numpy.ndarray
+        Checked sweep grid, MPa.
+    designs : sequence of SFRBADesign
+        The designs asked for (checked by :func:`check_designs`).
+    space : str, optional
+        Label of the design space, stored for reports.
+    retry_failed : bool
+        Run the designs recorded as failed again.
+    workers : int
+        Local worker processes asked for (checked).
+    address : str, optional
+        Dask scheduler address (checked); None for this machine.
+
+    Returns
+    -------
+    RunPlan
+        The designs to sweep, the designs skipped and the executor.
+
+    Raises
+    ------
+    ValueError
+        The database holds a campaign with another backend or grid.
+    """
+    store.bind(backend, pressures_mpa, space=space, n_designs_planned=len(designs))
+    done_ids = store.finished_ids()
+    failed_ids = store.failed_ids()
+    todo = [
+        d
+        for d in designs
+        if d.design_id not in done_ids and (retry_failed or d.design_id not in failed_ids)
+    ]
+    n_skipped_done = sum(d.design_id in done_ids for d in designs)
+    if address is not None:
+        executor = address
+    elif workers <= 1 or len(todo) <= 1:
+        executor = "serial"
+    else:
+        workers = min(workers, len(todo))
+        executor = f"processes:{workers}"
+    logger.info(
+        "campaign %s: %d designs, %d already done, %d failed before and %s; %d to run on %s",
+        store.path,
+        len(designs),
+        n_skipped_done,
+        sum(d.design_id in failed_ids for d in designs),
+        "retried" if retry_failed else "kept",
+        len(todo),
+        executor,
+    )
+    return RunPlan(
+        todo=todo,
+        n_skipped_done=n_skipped_done,
+        n_skipped_failed=len(designs) - n_skipped_done - len(todo),
+        executor=executor,
+        workers=workers,
+    )
+
+
+def auto_chunk_size(backend: Backend, n_designs: int, n_slots: int) -> int:
+    """Designs per task: the backend's ``preferred_chunk_size``, else about eight tasks a slot.
+
+    At most 16 designs per task when the backend states no preference.
+    """
+    preferred = getattr(backend, "preferred_chunk_size", None)
+    if preferred:
+        return max(1, int(preferred))
+    return max(1, min(_MAX_AUTO_CHUNK, math.ceil(n_designs / (8 * max(1, n_slots)))))
+
+
+def chunks(designs: Sequence[SFRBADesign], size: int) -> deque[list[SFRBADesign]]:
+    """The designs cut into consecutive tasks of ``size`` designs (the last may be shorter)."""
+    return deque(list(designs[i : i + size]) for i in range(0, len(designs), size))
