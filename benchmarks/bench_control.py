@@ -5,10 +5,13 @@ MLP as θ(p) (plant table and, for bang-bang, the virtual sensor), prints the
 metrics of a ``step:90``, a ``square:90:4`` and a 0.2 Hz triangle
 (``triangle:0.2:90:20``) run of 10 s, the real-time factor (simulated s per
 wall s, one core) and the latency of one controller decision (p50/p99 in µs,
-over calls at fresh samples: the costly ones). Paper B, bang-bang: squares MAPE
+over calls at fresh samples: the costly ones). ``--plant lab`` makes the
+actuator the virtual lab's measured one (model mismatch); ``--model`` gives the
+controllers another surrogate (e.g. one refined on the lab's readings).
+Paper B, bang-bang: squares MAPE
 5.5 %, convergence 0.7 s, rise 0.104 s; triangle MAPE 5.3 %, delay 0.0875 s. Run::
 
-    .venv/bin/python benchmarks/bench_control.py [--duration 10] [--json]
+    .venv/bin/python benchmarks/bench_control.py [--duration 10] [--plant lab] [--model M] [--json]
 """
 
 from __future__ import annotations
@@ -26,7 +29,14 @@ from softbend.control.controllers import (
     mlp_virtual_sensor,
 )
 from softbend.control.experiments import run_metrics, simulate
-from softbend.control.rig import AngleTable, RigParams, SimulatedRig
+from softbend.control.predictive import PredictivePulse
+from softbend.control.rig import (
+    AngleTable,
+    RigParams,
+    SimulatedRig,
+    fem_angle_table,
+    lab_angle_table,
+)
 from softbend.design import SFRBADesign
 from softbend.transfer.base import load_base
 
@@ -51,9 +61,16 @@ def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--duration", type=float, default=10.0)
     parser.add_argument("--json", action="store_true")
+    parser.add_argument(
+        "--plant",
+        choices=("surrogate", "fem", "lab"),
+        default="surrogate",
+        help="θ(p) of the actuator: the controllers' model, the FEM sweep, or the lab readings",
+    )
+    parser.add_argument("--model", default=None, help="the controllers' surrogate (JSON)")
     args = parser.parse_args()
     design = SFRBADesign(100, 6, 2, 2, 5, 8)
-    model = load_base()
+    model = load_base(args.model)
     table = AngleTable.from_surrogate(model, design)
     sensor = mlp_virtual_sensor(model, design)
     controllers = {
@@ -61,8 +78,15 @@ def main() -> None:
         "bang-bang-closed": lambda: BangBang(sensor, mode="closed"),
         "pressure-pi": lambda: PressurePI(table),
         "pressure-relay": lambda: PressureRelay(table),
+        "predictive": lambda: PredictivePulse(table, params),
     }
-    rig = SimulatedRig(table, RigParams.for_design(design), seed=0)
+    params = RigParams.for_design(design)
+    plant = {
+        "surrogate": lambda: table,
+        "fem": lambda: fem_angle_table(design),
+        "lab": lambda: lab_angle_table(design),
+    }[args.plant]()
+    rig = SimulatedRig(plant, params, seed=0)
     results = []
     for name, make in controllers.items():
         p50, p99 = _latency_us(make())

@@ -31,6 +31,7 @@ from softbend.control.experiments import run_metrics, simulate
 from softbend.control.loop import run_loop
 from softbend.control.modbus import ModbusRig
 from softbend.control.modbus_server import free_tcp_port
+from softbend.control.predictive import PredictivePulse
 from softbend.control.rig import AngleTable, RigParams, SimulatedRig
 from softbend.control.rigconfig import RigConfig
 from softbend.design import SFRBADesign
@@ -53,6 +54,7 @@ def main() -> None:
     controllers = {
         "bang-bang": lambda: BangBang(sensor, mode="hold"),
         "pressure-relay": lambda: PressureRelay(table),
+        "predictive": lambda: PredictivePulse(table, params),
     }
     config = RigConfig()
     config = replace(config, connection=replace(config.connection, port=free_tcp_port()))

@@ -15,9 +15,32 @@ app = typer.Typer(
 
 _FILES = ("run.csv", "metrics.json", "run.png")
 
+# Options shared by simulate, run and serve.
+_REFERENCE = typer.Option(
+    "step:90",
+    help="step:AMP[:T0_S], square:AMP:PERIOD_S[:LOW] or triangle:FREQ_HZ:AMP[:LOW] (degrees).",
+)
+_CONTROLLER = typer.Option(
+    "bang-bang",
+    help="bang-bang, bang-bang-closed, pressure-pi, pressure-relay or predictive.",
+)
+_DESIGN = typer.Option("100,6,2,2,5,8", help="Actuator l,r,t,b,phi,lc (mm, deg).")
+_MODEL = typer.Option(
+    None, "--model", help="Saved surrogate for θ(p) (default: the shipped FEM-trained MLP)."
+)
+_PLANT = typer.Option(
+    "surrogate",
+    help="θ(p) of the actuator: surrogate (the controller's own model), fem (the design's "
+    "FEM sweep) or lab (its virtual-lab readings: model mismatch).",
+)
 
-def build_controller(name: str, table, sensor):
-    """The controller called ``name`` (see :data:`softbend.control.controllers.CONTROLLERS`)."""
+
+def build_controller(name: str, table, sensor, params=None):
+    """The controller called ``name`` (see :data:`softbend.control.controllers.CONTROLLERS`).
+
+    ``params`` (a :class:`~softbend.control.rig.RigParams`) is the rig model of
+    the ``predictive`` controller.
+    """
     from softbend._validation import check_choice
     from softbend.control.controllers import CONTROLLERS, BangBang, PressurePI, PressureRelay
 
@@ -28,7 +51,11 @@ def build_controller(name: str, table, sensor):
         return BangBang(sensor, mode="closed")
     if name == "pressure-pi":
         return PressurePI(table)
-    return PressureRelay(table)
+    if name == "pressure-relay":
+        return PressureRelay(table)
+    from softbend.control.predictive import PredictivePulse
+
+    return PredictivePulse(table, params)
 
 
 #: What plays the actuator: the controller's own model, its FEM sweep, or its lab measurements.
@@ -68,7 +95,7 @@ def _setup(
         "fem": lambda: fem_angle_table(actuator),
         "lab": lambda: lab_angle_table(actuator),
     }[plant]()
-    return actuator, params, plant_table, build_controller(controller, table, sensor)
+    return actuator, params, plant_table, build_controller(controller, table, sensor, params)
 
 
 def _figure(run, path: Path, title: str) -> Path | None:
@@ -104,22 +131,11 @@ def _figure(run, path: Path, title: str) -> Path | None:
 @app.command("simulate")
 def simulate_cmd(
     out: Path = typer.Option(..., "--out", help="Folder for run.csv, metrics.json and run.png."),
-    reference: str = typer.Option(
-        "step:90",
-        help="step:AMP[:T0_S], square:AMP:PERIOD_S[:LOW] or triangle:FREQ_HZ:AMP[:LOW] (degrees).",
-    ),
-    controller: str = typer.Option(
-        "bang-bang", help="bang-bang, bang-bang-closed, pressure-pi or pressure-relay."
-    ),
-    design: str = typer.Option("100,6,2,2,5,8", help="Actuator l,r,t,b,phi,lc (mm, deg)."),
-    model: Path = typer.Option(
-        None, "--model", help="Saved surrogate for θ(p) (default: the shipped FEM-trained MLP)."
-    ),
-    plant: str = typer.Option(
-        "surrogate",
-        help="θ(p) of the actuator: surrogate (the controller's own model), fem (the design's "
-        "FEM sweep) or lab (its virtual-lab readings: model mismatch).",
-    ),
+    reference: str = _REFERENCE,
+    controller: str = _CONTROLLER,
+    design: str = _DESIGN,
+    model: Path = _MODEL,
+    plant: str = _PLANT,
     duration: float = typer.Option(10.0, help="Simulated time, s."),
     supply: float = typer.Option(0.2, help="Supply pressure, MPa gauge."),
     seed: int = typer.Option(0, help="Seed of the sensor and camera noise."),
@@ -188,22 +204,11 @@ def run_cmd(
         help="Rig TOML: connection, register map, scaling, safety, period "
         "(required for --rig modbus; its [safety] and [loop] apply to every rig).",
     ),
-    reference: str = typer.Option(
-        "step:90",
-        help="step:AMP[:T0_S], square:AMP:PERIOD_S[:LOW] or triangle:FREQ_HZ:AMP[:LOW] (degrees).",
-    ),
-    controller: str = typer.Option(
-        "bang-bang", help="bang-bang, bang-bang-closed, pressure-pi or pressure-relay."
-    ),
-    design: str = typer.Option("100,6,2,2,5,8", help="Actuator l,r,t,b,phi,lc (mm, deg)."),
-    model: Path = typer.Option(
-        None, "--model", help="Saved surrogate for θ(p) (default: the shipped FEM-trained MLP)."
-    ),
-    plant: str = typer.Option(
-        "surrogate",
-        help="θ(p) of the actuator: surrogate (the controller's own model), fem (the design's "
-        "FEM sweep) or lab (its virtual-lab readings: model mismatch).",
-    ),
+    reference: str = _REFERENCE,
+    controller: str = _CONTROLLER,
+    design: str = _DESIGN,
+    model: Path = _MODEL,
+    plant: str = _PLANT,
     duration: float = typer.Option(10.0, help="Run time, s."),
     period: float = typer.Option(
         None, help="Loop tick (controller, valves), s (default: the config's period_s, 0.001)."
@@ -362,15 +367,9 @@ def serve_cmd(
     ),
     host: str = typer.Option("127.0.0.1", help="Address to listen on."),
     port: int = typer.Option(None, help="TCP port (default: the config's, else 5020)."),
-    design: str = typer.Option("100,6,2,2,5,8", help="Actuator l,r,t,b,phi,lc (mm, deg)."),
-    model: Path = typer.Option(
-        None, "--model", help="Saved surrogate for θ(p) (default: the shipped FEM-trained MLP)."
-    ),
-    plant: str = typer.Option(
-        "surrogate",
-        help="θ(p) of the actuator: surrogate (the controller's own model), fem (the design's "
-        "FEM sweep) or lab (its virtual-lab readings: model mismatch).",
-    ),
+    design: str = _DESIGN,
+    model: Path = _MODEL,
+    plant: str = _PLANT,
     supply: float = typer.Option(0.2, help="Supply pressure, MPa gauge."),
     seed: int = typer.Option(0, help="Seed of the sensor and camera noise."),
     duration: float = typer.Option(0.0, help="Serve for this long, s (0: until Ctrl-C)."),

@@ -329,4 +329,10 @@ class PressureRelay(_PressureTarget):
 
 
 #: Names used on the CLI.
-CONTROLLERS: tuple[str, ...] = ("bang-bang", "bang-bang-closed", "pressure-pi", "pressure-relay")
+CONTROLLERS: tuple[str, ...] = (
+    "bang-bang",
+    "bang-bang-closed",
+    "pressure-pi",
+    "pressure-relay",
+    "predictive",
+)

@@ -36,6 +36,7 @@ from __future__ import annotations
 
 import math
 import random
+from bisect import bisect_right
 from collections.abc import Callable
 from dataclasses import dataclass, fields, replace
 from typing import Any, Protocol, runtime_checkable
@@ -278,6 +279,8 @@ class AngleTable:
         rise = np.maximum.accumulate(a[: peak + 1])
         self._rise_p = p[: peak + 1]
         self._rise_a = rise
+        self._rise_p_list = self._rise_p.tolist()
+        self._rise_a_list = rise.tolist()
         self.max_angle_deg = float(a[peak])
         self.min_angle_deg = float(a[0])
 
@@ -331,8 +334,21 @@ class AngleTable:
         return lo + (x - i) * (self._values[i + 1] - lo)
 
     def inverse(self, angle_deg: float) -> float:
-        """Gauge pressure (MPa) of ``angle_deg`` on the rising branch, clamped to it."""
-        return float(np.interp(angle_deg, self._rise_a, self._rise_p))
+        """Gauge pressure (MPa) of ``angle_deg`` on the rising branch, clamped to it.
+
+        Plain-float bisection (a controller calls it at every change of a ramping
+        reference); equal to ``numpy.interp`` on the branch.
+        """
+        a, p = self._rise_a_list, self._rise_p_list
+        if not angle_deg > a[0]:
+            return p[0]
+        if angle_deg >= a[-1]:
+            return p[-1]
+        i = bisect_right(a, angle_deg)
+        a0, a1 = a[i - 1], a[i]
+        if a1 == a0:
+            return p[i]
+        return p[i - 1] + (angle_deg - a0) / (a1 - a0) * (p[i] - p[i - 1])
 
 
 def shipped_angle_table(
