@@ -6,6 +6,7 @@ import json
 import logging
 import math
 import os
+import warnings
 from collections.abc import Callable, Iterator
 from contextlib import contextmanager
 from pathlib import Path
@@ -53,7 +54,22 @@ def configure_logging(verbose: bool) -> None:
     logger = logging.getLogger("softbend")
     logger.handlers[:] = [RichHandler(console=err_console, show_path=False)]
     logger.setLevel(logging.INFO if verbose else logging.WARNING)
-    logging.captureWarnings(True)
+
+
+@contextmanager
+def warnings_as_lines() -> Iterator[None]:
+    """Within, every Python warning is one :func:`warning_line` (restored on exit).
+
+    Scoped, not global: a command run in-process (tests, a notebook) leaves the
+    caller's warning filters and display as they were.
+    """
+    with warnings.catch_warnings():  # the filters stay as the caller set them
+
+        def show(message, category, filename, lineno, file=None, line=None) -> None:
+            warning_line(f"{message} ({category.__name__})")
+
+        warnings.showwarning = show
+        yield
 
 
 def error_line(message: str) -> None:
