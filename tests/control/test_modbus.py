@@ -162,14 +162,30 @@ def test_cli_run_through_the_server_writes_log_and_jitter(server, tmp_path, caps
 def test_cli_run_stops_with_exit_1_on_a_fault(server, tmp_path, capsys):
     config = tmp_path / "rig.toml"
     config.write_text(server.config.to_toml())
-    server.inject("garbage")
     args = ["control", "run", "--rig", "modbus", "--config", str(config)]
-    code = main([*args, "--out", str(tmp_path / "o"), "--duration", "2"])
+    timer = threading.Timer(0.5, server.inject, args=("garbage",))
+    timer.start()
+    code = main([*args, "--out", str(tmp_path / "o"), "--duration", "5"])
+    timer.join()
     server.inject(None)
     assert code == 1
     err = capsys.readouterr().err.strip().splitlines()
     assert "garbage" in err[-1] and "vented and stopped" in err[-1]
     assert (tmp_path / "o" / "ticks.csv").exists()
+
+
+def test_cli_run_refuses_a_rig_whose_first_reading_is_garbage(server, tmp_path, capsys):
+    config = tmp_path / "rig.toml"
+    config.write_text(server.config.to_toml())
+    server.inject("garbage")
+    args = ["control", "run", "--rig", "modbus", "--config", str(config)]
+    code = main([*args, "--out", str(tmp_path / "o"), "--duration", "2"])
+    server.inject(None)
+    assert code == 2
+    err = capsys.readouterr().err.strip().splitlines()
+    assert len(err) == 1 and "is garbage" in err[0]
+    assert not (tmp_path / "o" / "ticks.csv").exists()
+    assert server.valves == (False, False)  # no valve was ever opened
 
 
 @pytest.mark.skipif(sys.platform == "win32", reason="SIGINT to a child")

@@ -110,8 +110,12 @@ class ModbusRig:
 
     # -- connection -------------------------------------------------------
 
-    def connect(self) -> ModbusRig:
-        """Open the link; a rig that does not answer raises :class:`RigError`."""
+    def connect(self, *, probe: bool = True) -> ModbusRig:
+        """Open the link and, with ``probe``, take one reading to check the register map.
+
+        A rig that does not answer, or whose first reading is garbage, raises
+        :class:`RigError` before any valve is touched.
+        """
         try:
             ok = self._client.connect()
         except Exception as exc:  # pymodbus and serial raise many kinds
@@ -123,6 +127,9 @@ class ModbusRig:
             )
         self._t0 = time.monotonic()
         self._counter = None
+        if probe:
+            self.read_pressure_mpa()
+            self.round_trips_s.clear()
         return self
 
     def close(self) -> None:
