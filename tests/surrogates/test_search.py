@@ -282,3 +282,17 @@ def test_a_checkpoint_of_other_settings_is_not_reused(small_data, tmp_path):
         result = search(small_data, **common, folds=4, checkpoint=checkpoint)
     assert result.resumed == 0 and result.settings["folds"] == 4
     assert len(said) == 1 and "folds" in said[0] and "splits" in said[0]
+
+
+def test_scoring_without_refit_gives_the_same_cv_and_no_model(small_data):
+    chosen = {"plr": [{"degree": 2}], "xgb": [{"max_depth": 3, "learning_rate": 0.3}]}
+    kwargs = {"models": ["plr", "xgb"], "param_grid": chosen, "seed": 0, "cv": "random"}
+    full = search(small_data, **kwargs)
+    scored = search(small_data, refit=False, **kwargs)
+    for name in chosen:
+        assert scored.families[name].cv == full.families[name].cv
+        np.testing.assert_array_equal(scored.families[name].oof_pred, full.families[name].oof_pred)
+        assert scored.families[name].model is None and scored.families[name].fit_s == 0.0
+        assert full.families[name].model is not None
+    summary = scored.summary()
+    assert summary["single_us"].isna().all() and (summary["mape_pct"] > 0).all()

@@ -184,8 +184,8 @@ class FamilyResult:
     oof_pred : ndarray
         Out-of-fold predictions of the best configuration, degrees (each row
         predicted by the model that did not see its design).
-    model : estimator
-        The best configuration refitted on all rows.
+    model : estimator or None
+        The best configuration refitted on all rows (None with ``refit=False``).
     timing : dict
         :func:`softbend.surrogates.metrics.inference_time` of ``model``.
     fit_s : float
@@ -519,6 +519,7 @@ def search(
     cv: str = "grouped",
     halving: int | None = None,
     checkpoint: SearchCheckpoint | None = None,
+    refit: bool = True,
 ) -> SearchResult:
     """Grouped K-fold grid search of each model family, then a refit of the best.
 
@@ -561,6 +562,10 @@ def search(
         this search, it hands back the folds of an interrupted run of the same
         search, which are loaded instead of fitted, and receives every fold
         fitted. The caller removes it when the results are safe.
+    refit : bool, default True
+        Refit each family's best configuration on all rows (``model``,
+        ``timing``, ``fit_s`` of its :class:`FamilyResult`); ``False`` scores
+        only (``model`` None, timings NaN), e.g. for a second CV protocol.
 
     Returns
     -------
@@ -670,16 +675,19 @@ def search(
             logger.warning("no configuration of %s could be fitted", model)
             continue
         _, params, pred, scores = best
-        start = time.perf_counter()
-        final = make(params).fit(data.X, data.y)
-        fit_s = time.perf_counter() - start
+        final, timing, fit_s = None, {"single_us": math.nan, "batch_ms": math.nan}, 0.0
+        if refit:
+            start = time.perf_counter()
+            final = make(params).fit(data.X, data.y)
+            fit_s = time.perf_counter() - start
+            timing = inference_time(final, data.X, seed=seed)
         families[model] = FamilyResult(
             name=model,
             params=params,
             cv=scores,
             oof_pred=pred,
             model=final,
-            timing=inference_time(final, data.X, seed=seed),
+            timing=timing,
             fit_s=fit_s,
             search_s=search_s,
         )
