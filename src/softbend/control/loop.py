@@ -265,7 +265,7 @@ def run_loop(
     sensor_every = max(1, round(sensor / period))
     log = _Log(path, flush)
     controller.reset()
-    state = (False, False)
+    state: tuple[bool, bool] | None = None  # unknown: the first command is always sent
     switches = 0
     missed = 0
     held = math.nan  # the latest good reading; NaN after a missed read
@@ -276,11 +276,13 @@ def run_loop(
         nonlocal state, switches
         if command != state:
             rig.command(command[0], command[1])
-            switches += (command[0] != state[0]) + (command[1] != state[1])
+            if state is not None:
+                switches += (command[0] != state[0]) + (command[1] != state[1])
             state = command
 
     def row(k: int, now: float, status: str) -> tuple:
-        return _row(k, k * period, now - t_start, held, ref, controller, state, rig, status)
+        shown = state if state is not None else (False, False)
+        return _row(k, k * period, now - t_start, held, ref, controller, shown, rig, status)
 
     try:
         t_start = rig.clock_s()
@@ -309,7 +311,7 @@ def run_loop(
                         reason, kind = f"{exc} ({why}; vented and stopped)", exc.kind
                         log.add(row(k, now, status))
                         break
-                    send((False, state[1]))  # close the inlet at once
+                    send((False, True if state is None else state[1]))  # inlet shut at once
                 else:
                     missed = 0
                     held = reading
@@ -338,7 +340,7 @@ def run_loop(
     vented = True
     try:
         rig.command(*_VENT)
-        if state != _VENT:
+        if state is not None and state != _VENT:
             switches += (state[0] != _VENT[0]) + (state[1] != _VENT[1])
     except Exception as exc:
         vented = False

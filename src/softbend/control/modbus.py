@@ -111,10 +111,13 @@ class ModbusRig:
     # -- connection -------------------------------------------------------
 
     def connect(self, *, probe: bool = True) -> ModbusRig:
-        """Open the link and, with ``probe``, take one reading to check the register map.
+        """Open the link and, with ``probe``, check the register map and vent.
 
-        A rig that does not answer, or whose first reading is garbage, raises
-        :class:`RigError` before any valve is touched.
+        The probe takes one reading (a rig that does not answer, or whose first
+        reading is garbage, raises :class:`RigError` before any valve is
+        touched), then commands the safe state (inlet closed, outlet open), so
+        the rig starts from rest and the first requests of each kind are
+        answered before the loop's clock starts.
         """
         try:
             ok = self._client.connect()
@@ -129,6 +132,7 @@ class ModbusRig:
         self._counter = None
         if probe:
             self.read_pressure_mpa()
+            self.command(False, True)
             self.round_trips_s.clear()
         return self
 
