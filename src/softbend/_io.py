@@ -7,6 +7,7 @@ temporary file from :func:`tempfile.mkstemp` alone would be ``0o600``).
 
 from __future__ import annotations
 
+import glob
 import os
 import shutil
 import stat
@@ -20,6 +21,7 @@ from typing import IO
 __all__ = [
     "atomic_file",
     "new_file_mode",
+    "remove_stale_staging",
     "staged_dir",
     "write_bytes_atomic",
     "write_text_atomic",
@@ -95,14 +97,18 @@ def staged_dir(path: str | os.PathLike[str]) -> Iterator[Path]:
     is the old ``path`` (if any) moved aside, the staging folder renamed to
     ``path`` and the old one removed. If the block raises (or the process is
     killed), ``path`` is untouched and the staging folder is removed (or left as
-    a hidden ``.NAME.*.new`` folder), so ``path`` is never a mix of an old and a
-    new run. On Linux the swap is one atomic ``renameat2(RENAME_EXCHANGE)``;
+    a hidden ``.NAME.PID-*.new`` folder, which the next run beside ``path``
+    removes once process PID is gone), so ``path`` is never a mix of an old and
+    a new run. On Linux the swap is one atomic ``renameat2(RENAME_EXCHANGE)``;
     elsewhere it is two renames, and a kill between them leaves the old folder as
     ``.NAME.old-PID`` beside a missing ``path``.
     """
     path = Path(path)
     path.parent.mkdir(parents=True, exist_ok=True)
-    staging = Path(tempfile.mkdtemp(dir=path.parent, prefix=f".{path.name}.", suffix=".new"))
+    remove_stale_staging(path)
+    staging = Path(
+        tempfile.mkdtemp(dir=path.parent, prefix=f".{path.name}.{os.getpid()}-", suffix=".new")
+    )
     os.chmod(staging, 0o777 & ~_umask())
     try:
         yield staging
@@ -119,6 +125,34 @@ def staged_dir(path: str | os.PathLike[str]) -> Iterator[Path]:
     os.replace(staging, path)
     if old is not None:
         shutil.rmtree(old, ignore_errors=True)
+
+
+def remove_stale_staging(path: str | os.PathLike[str]) -> list[Path]:
+    """Remove the staging folders of :func:`staged_dir` left beside ``path`` by dead processes.
+
+    A folder ``.NAME.PID-*.new`` is removed when no process PID exists; one of a
+    live process (a run still going, or an unrelated process that reuses the
+    PID) is kept. Returns the folders removed.
+    """
+    path = Path(path)
+    removed = []
+    for folder in path.parent.glob(f".{glob.escape(path.name)}.*-*.new"):
+        pid_text = folder.name[len(path.name) + 2 :].split("-", 1)[0]
+        if not pid_text.isdigit() or not folder.is_dir() or _alive(int(pid_text)):
+            continue
+        shutil.rmtree(folder, ignore_errors=True)
+        removed.append(folder)
+    return removed
+
+
+def _alive(pid: int) -> bool:
+    try:
+        os.kill(pid, 0)
+    except (ProcessLookupError, OverflowError):  # no such process (or no such PID at all)
+        return False
+    except PermissionError:  # someone else's process
+        return True
+    return True
 
 
 def _exchange(a: Path, b: Path) -> bool:
