@@ -189,3 +189,11 @@ def test_bad_arguments_are_one_line(table):
         run_loop(rig, BangBang(table), "step:90", 1.0, period_s=0)
     with pytest.raises(ValueError, match=r"'log_path' of run_loop must end in \.csv"):
         run_loop(rig, BangBang(table), "step:90", 1.0, log_path="x.txt")
+
+
+def test_the_garbage_collector_is_paused_only_during_the_run(table):
+    import gc
+
+    assert gc.isenabled()
+    run_loop(SimulatedRig(table), Always(fail_at_s=0.1, exc=ZeroDivisionError("x")), "step:90", 1.0)
+    assert gc.isenabled()
