@@ -71,6 +71,7 @@ def first_run(tmp_path_factory, fem_dataset):
         fem_dataset=fem_dataset,
         fem_dataset_epochs=5,
         transfer_options=QUICK_TRANSFER,
+        control_options={"duration_s": 1.5, "refine_epochs": 20},
     )
     return out, summary, phases
 
@@ -160,6 +161,7 @@ def test_second_run_resumes_the_campaign(first_run, fem_dataset):
         fem_dataset=fem_dataset,
         fem_dataset_epochs=5,
         transfer_options=QUICK_TRANSFER,
+        control_options={"duration_s": 1.5, "refine_epochs": 20},
     )
     b = again["paper_b"]
     assert b["run_now"] == 0 and b["resumed_done"] == 8
@@ -202,6 +204,20 @@ def test_transfer_section_is_labelled_synthetic_and_beside_paper_b(first_run):
     assert "SYNTHETIC" in html and "paper B refined MLP" in html and "7.935" in html
     for name in ("fig6_loss_curves.png", "fig7_actuators.png", "learning_curve.png"):
         assert (out / "transfer" / name).is_file()
+
+
+def test_control_section_puts_paper_b_beside_and_shows_the_mismatch(first_run):
+    out, summary, _ = first_run
+    section = summary["control"]
+    rig = {(r["controller"], r["reference"]): r for r in section["rig"]}
+    assert {c for c, _ in rig} == {"bang-bang", "pressure-relay", "predictive"}
+    # the predictive controller switches far less than paper B's bang-bang on the step
+    assert rig[("predictive", "step:90")]["switches"] < rig[("bang-bang", "step:90")]["switches"]
+    html = (out / "index.html").read_text(encoding="utf-8")
+    assert "closed-loop control" in html and "paper B bang-bang (its rig)" in html
+    assert "SIMULATED rig" in html and "5.5" in html
+    for name in ("fig9_square.png", "fig9_triangle.png", "lab_square.png", "metrics_rig.csv"):
+        assert (out / "control" / name).is_file()
 
 
 def test_the_report_as_a_user_sees_it_in_chromium(first_run, tmp_path):

@@ -35,31 +35,15 @@ _PLANT = typer.Option(
 )
 
 
-def build_controller(name: str, table, sensor, params=None):
-    """The controller called ``name`` (see :data:`softbend.control.controllers.CONTROLLERS`).
-
-    ``params`` (a :class:`~softbend.control.rig.RigParams`) is the rig model of
-    the ``predictive`` controller.
-    """
-    from softbend._validation import check_choice
-    from softbend.control.controllers import CONTROLLERS, BangBang, PressurePI, PressureRelay
-
-    check_choice(name, "controller", "softbend control simulate", CONTROLLERS)
-    if name == "bang-bang":
-        return BangBang(sensor, mode="hold")
-    if name == "bang-bang-closed":
-        return BangBang(sensor, mode="closed")
-    if name == "pressure-pi":
-        return PressurePI(table)
-    if name == "pressure-relay":
-        return PressureRelay(table)
-    from softbend.control.predictive import PredictivePulse
-
-    return PredictivePulse(table, params)
-
-
 #: What plays the actuator: the controller's own model, its FEM sweep, or its lab measurements.
 PLANTS: tuple[str, ...] = ("surrogate", "fem", "lab")
+
+
+def run_figure(run, path: Path, title: str) -> Path | None:
+    """Paper B's Fig. 9 of one run (:func:`softbend.reports.control_figures.run_figure`)."""
+    from softbend.reports.control_figures import run_figure as draw
+
+    return draw(run, path, title)
 
 
 def _setup(
@@ -78,7 +62,7 @@ def _setup(
     gap the controller meets on a real actuator).
     """
     from softbend._validation import check_choice
-    from softbend.control.controllers import CONTROLLERS, mlp_virtual_sensor
+    from softbend.control.controllers import CONTROLLERS, make_controller, mlp_virtual_sensor
     from softbend.control.rig import AngleTable, RigParams, fem_angle_table, lab_angle_table
     from softbend.design import SFRBADesign
     from softbend.transfer.base import load_base
@@ -95,37 +79,7 @@ def _setup(
         "fem": lambda: fem_angle_table(actuator),
         "lab": lambda: lab_angle_table(actuator),
     }[plant]()
-    return actuator, params, plant_table, build_controller(controller, table, sensor, params)
-
-
-def _figure(run, path: Path, title: str) -> Path | None:
-    try:
-        import matplotlib
-
-        matplotlib.use("Agg")
-        import matplotlib.pyplot as plt
-    except ImportError:  # pragma: no cover - matplotlib is optional here
-        return None
-    fig, axes = plt.subplots(3, 1, figsize=(8, 7), sharex=True, height_ratios=(3, 1, 2))
-    axes[0].plot(run.t_s, run.reference_deg, "k--", lw=1, label="reference θr")
-    axes[0].plot(run.t_s, run.camera_deg, lw=1.2, label="true angle θe (camera)")
-    axes[0].plot(run.t_s, run.predicted_deg, lw=0.8, alpha=0.8, label="predicted θp (MLP)")
-    axes[0].set_ylabel("angle (°)")
-    axes[0].legend(loc="upper right", fontsize=8)
-    axes[0].set_title(title, fontsize=9)
-    axes[1].step(run.t_s, run.inlet.astype(float) + 1.2, where="post", lw=0.8, label="inlet")
-    axes[1].step(run.t_s, run.outlet.astype(float), where="post", lw=0.8, label="outlet")
-    axes[1].set_yticks([0, 1, 1.2, 2.2], ["shut", "open", "shut", "open"], fontsize=7)
-    axes[1].legend(loc="upper right", fontsize=7)
-    axes[2].plot(run.t_s, run.pressure_mpa, lw=1, label="true")
-    axes[2].plot(run.t_s, run.measured_mpa, lw=0.6, alpha=0.7, label="sensor")
-    axes[2].set_ylabel("pressure (MPa, gauge)")
-    axes[2].set_xlabel("time (s)")
-    axes[2].legend(loc="upper right", fontsize=8)
-    fig.tight_layout()
-    fig.savefig(path, dpi=120)
-    plt.close(fig)
-    return path
+    return actuator, params, plant_table, make_controller(controller, table, sensor, params)
 
 
 @app.command("simulate")
@@ -168,7 +122,7 @@ def simulate_cmd(
         out.mkdir(parents=True, exist_ok=True)
         run.frame().to_csv(out / "run.csv", index=False)
         (out / "metrics.json").write_text(_common.json_text(payload) + "\n", encoding="utf-8")
-        figure = _figure(
+        figure = run_figure(
             run, out / "run.png", f"{controller} on {actuator}, {reference} (simulated)"
         )
     payload["files"] = [str(out / "run.csv"), str(out / "metrics.json")] + (
@@ -311,7 +265,7 @@ def run_cmd(
         from softbend._io import write_text_atomic
 
         write_text_atomic(out / "run.json", _common.json_text(payload) + "\n")
-        figure = _figure(
+        figure = run_figure(
             result.control_run(),
             out / "run.png",
             f"{controller} on {actuator}, {reference}, rig {rig} "
@@ -434,4 +388,4 @@ def rig_config_cmd(
     _common.console.print(f"rig config written to {out}")
 
 
-__all__ = ["PLANTS", "RIGS", "app", "build_controller"]
+__all__ = ["PLANTS", "RIGS", "app"]

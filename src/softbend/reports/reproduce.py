@@ -11,6 +11,8 @@ softbend can reproduce, and the data, models and figures beside it:
 - ``paper_b_fem/``: the FEM sweep of the Fig. 2 design and Figs. 4 and 5 on the
   shipped FEM dataset.
 - ``transfer/``: transfer learning on the shipped virtual lab (Figs. 6 and 7).
+- ``control/``: closed-loop control on the simulated rig, with the lab actuator as a
+  mismatched plant (Figs. 8 and 9).
 """
 
 from __future__ import annotations
@@ -200,6 +202,7 @@ def run_reproduce(
     fem_dataset: str | Path | None = None,
     fem_dataset_epochs: int | None = None,
     transfer_options: dict[str, dict[str, Any]] | None = None,
+    control_options: dict[str, Any] | None = None,
     command: str | None = None,
 ) -> dict[str, Any]:
     """Run every reproducible section and write ``out_dir/index.html``.
@@ -227,6 +230,9 @@ def run_reproduce(
     transfer_options : dict, optional
         Options per transfer-learning strategy (e.g. ``{"refined": {"epochs": 30}}``
         for a quick run); default paper B's settings.
+    control_options : dict, optional
+        Options of the control section (:func:`softbend.reports.control_section.add_section`,
+        e.g. ``{"duration_s": 2, "refine_epochs": 20}`` for a quick run).
     command : str, optional
         The command line that started the run, shown in the report's provenance.
 
@@ -281,6 +287,11 @@ def run_reproduce(
 
     summary["transfer"] = transfer_section.add_section(
         report, out_dir, seed, progress, options=transfer_options
+    )
+    from softbend.reports import control_section
+
+    summary["control"] = control_section.add_section(
+        report, out_dir, seed, progress, **(control_options or {})
     )
     finished = datetime.now(UTC)
     summary["seconds"] = (finished - started).total_seconds()
