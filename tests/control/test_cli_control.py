@@ -40,3 +40,55 @@ def test_simulate_writes_run(tmp_path, capsys, controller):
     assert payload["synthetic"] is True and payload["metrics"]["rising_edges"] == 1
     assert (out / "run.csv").read_text().startswith("t_s,reference_deg,angle_deg")
     assert json.loads((out / "metrics.json").read_text())["controller"] == controller
+
+
+@pytest.mark.parametrize(
+    ("args", "needles"),
+    [
+        (["run", "--rig", "usb"], ["'rig' of softbend control run", "'modbus'"]),
+        (["run", "--rig", "modbus"], ["'--config' of softbend control run"]),
+        (["run", "--log-format", "xml"], ["'log_format'", "'parquet'"]),
+        (["run", "--period", "0.02", "--sensor-period", "0.01"], ["'sensor_period'"]),
+        (["run", "--duration", "-1"], ["'duration'"]),
+        (["run", "--rig", "modbus", "--config", "nope.toml"], ["does not exist"]),
+        (["serve", "--config", "nope.toml"], ["does not exist"]),
+        (["serve", "--duration", "-2"], ["'duration'"]),
+        (["simulate", "--plant", "lab", "--design", "160,10,4,4,15,12"], ["no measured"]),
+        (["simulate", "--plant", "fem", "--design", "105,6,2,2,5,8"], ["not in the FEM dataset"]),
+    ],
+)
+def test_bad_input_of_every_control_command_is_one_line(tmp_path, capsys, args, needles):
+    out = [] if args[0] == "serve" else ["--out", str(tmp_path / "o")]
+    code = main(["control", *args, *out])
+    assert code == 2
+    err = capsys.readouterr().err.strip().splitlines()
+    assert len(err) == 1, err
+    for needle in needles:
+        assert needle in err[0]
+
+
+def test_a_rig_config_with_an_unknown_key_is_one_line(tmp_path, capsys):
+    config = tmp_path / "rig.toml"
+    config.write_text("[pressure]\nadress = 3\n")
+    code = main(["control", "run", "--rig", "modbus", "--config", str(config), "--out", "o"])
+    assert code == 2
+    assert "key 'adress' of [pressure]" in capsys.readouterr().err
+
+
+def test_rig_config_writes_a_template_that_loads_and_refuses_a_folder(tmp_path, capsys):
+    from softbend.control.rigconfig import load_rig_config
+
+    path = tmp_path / "rig.toml"
+    assert main(["control", "rig-config", "--out", str(path), "--port", "5099"]) == 0
+    assert load_rig_config(path).connection.port == 5099
+    assert main(["control", "rig-config", "--out", str(tmp_path)]) == 2
+    assert "--out" in capsys.readouterr().err
+
+
+def test_run_on_the_simulated_rig_writes_its_log(tmp_path, capsys):
+    out = tmp_path / "run"
+    args = ["control", "run", "--controller", "predictive", "--duration", "1", "--out", str(out)]
+    assert main([*args, "--log-format", "parquet", "--json"]) == 0
+    payload = json.loads(capsys.readouterr().out)
+    assert payload["completed"] and payload["rig"] == "sim"
+    assert (out / "ticks.parquet").is_file() and (out / "run.png").is_file()

@@ -213,7 +213,7 @@ def run_cmd(
         low_inclusive=True, high_inclusive=True,
     )  # fmt: skip
     ticks = max(1, round(duration / loop_period))
-    plant = _make_rig(rig, settings, table, params, seed)
+    device = _make_rig(rig, settings, table, params, seed)
     done = [0]
 
     def report(n: int, _total: int) -> None:
@@ -223,7 +223,7 @@ def run_cmd(
     try:
         with _common.progress_bar("control loop", ticks, enabled=not as_json) as advance:
             result = run_loop(
-                plant,
+                device,
                 ctrl,
                 ref,
                 duration,
@@ -234,7 +234,7 @@ def run_cmd(
                 progress=report,
             )
     finally:
-        plant.close()
+        device.close()
     jitter = result.jitter()
     metrics = result.metrics()
     payload = {
@@ -259,7 +259,7 @@ def run_cmd(
         "rig_params": params.as_dict() if rig != "modbus" else None,
     }
     if rig == "modbus":
-        trips = plant.round_trips_s
+        trips = device.round_trips_s
         payload["round_trip_ms"] = _percentiles_ms(trips)
     with _common.output_errors(out, "--out"):
         from softbend._io import write_text_atomic
