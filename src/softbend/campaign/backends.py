@@ -48,10 +48,12 @@ from softbend.models import (
 __all__ = [
     "DEFAULT_PMAX_MPA",
     "DEFAULT_PSTEP_MPA",
+    "INTERNAL_BACKENDS",
     "AnalyticalBackend",
     "Backend",
     "BendingModel",
     "FaultInjectionBackend",
+    "INTERNAL_BACKENDS",
     "SweepResult",
     "available_backends",
     "check_pressures_mpa",
@@ -192,6 +194,9 @@ def _id_set(ids: Any) -> frozenset[str]:
         ids = [ids]
     return frozenset(str(i) for i in ids)
 
+
+#: Registered for tests and the library, not offered on the command line.
+INTERNAL_BACKENDS: tuple[str, ...] = ("fault-injection",)
 
 _REGISTRY: dict[str, Callable[..., Backend]] = {
     "analytical": AnalyticalModel,

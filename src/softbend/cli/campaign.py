@@ -124,11 +124,10 @@ def run(
         backend_obj = SurrogateModel.load(model)
     else:
         from softbend._validation import check_choice
-        from softbend.campaign.backends import available_backends
+        from softbend.campaign.backends import INTERNAL_BACKENDS, available_backends
 
-        check_choice(
-            backend, "--backend", "softbend campaign run", (*available_backends(), "surrogate")
-        )
+        public = [name for name in available_backends() if name not in INTERNAL_BACKENDS]
+        check_choice(backend, "--backend", "softbend campaign run", (*public, "surrogate"))
         backend_obj = get_backend(backend)
     if scheduler is not None:
         parse_scheduler_address(scheduler)
