@@ -128,3 +128,45 @@ def test_angle_table_inverse_round_trip(table):
     for angle in (10.0, 90.0, 300.0):
         assert table(table.inverse(angle)) == pytest.approx(angle)
     assert table.inverse(0.0) == 0.0  # below θ(0): clamped
+
+
+def test_cavity_compliance_of_a_constant_and_a_linear_dv_dp():
+    from softbend.control.rig import cavity_compliance_mm3_per_mpa
+
+    p = np.linspace(0.0, 0.2, 41)
+    assert cavity_compliance_mm3_per_mpa(p, np.full_like(p, 30_000.0), 0.2) == pytest.approx(
+        30_000.0
+    )
+    # dV/dp = a + b·p gives V = a·p + b·p²/2; the least-squares line through 0 on [0, P]
+    # of a uniform grid has slope a + (b/2)·Σp³/Σp²
+    a, b = 40_000.0, 100_000.0
+    expected = a + 0.5 * b * np.sum(p**3) / np.sum(p**2)
+    assert cavity_compliance_mm3_per_mpa(p, a + b * p, 0.2) == pytest.approx(expected, rel=1e-4)
+    # only the steps up to the supply count
+    assert cavity_compliance_mm3_per_mpa(p, a + b * p, 0.1) < expected
+    with pytest.raises(ValueError, match="at least two converged steps"):
+        cavity_compliance_mm3_per_mpa([0.0], [1.0], 0.2)
+
+
+@pytest.mark.slow
+def test_default_compliance_is_the_fem_cavity_of_the_default_design():
+    pytest.importorskip("ngsolve")
+    from softbend.design import SFRBADesign
+    from softbend.fem.model import FEMModel
+
+    design = SFRBADesign(100, 6, 2, 2, 5, 8)
+    result = FEMModel().sweep(design, np.round(np.linspace(0.0, 0.2, 21), 4))
+    params = RigParams.from_fem_sweep(result)
+    assert params.compliance_mm3_per_mpa == pytest.approx(
+        RigParams().compliance_mm3_per_mpa, rel=0.01
+    )
+    assert params.volume_mm3 == pytest.approx(RigParams().volume_mm3, rel=1e-3)
+
+
+def test_from_fem_sweep_refuses_a_result_without_volumes():
+    from softbend.analytical import AnalyticalModel
+    from softbend.design import SFRBADesign
+
+    result = AnalyticalModel().sweep(SFRBADesign(100, 6, 2, 2, 5, 8), [0.0, 0.05, 0.1])
+    with pytest.raises(ValueError, match="must be an FEM sweep"):
+        RigParams.from_fem_sweep(result)

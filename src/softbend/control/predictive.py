@@ -36,7 +36,7 @@ but decides, at every call (the loop's 1 ms tick), on a *prediction*:
 
 The model is the rig's nominal model: on hardware, its parameters come from a
 fill test (conductance, critical ratio, volume). Sensor noise enters only
-through the samples; the deadband (three times the default sensor noise)
+through the samples; the deadband (four times the default sensor noise)
 keeps the valves shut at rest.
 """
 
@@ -166,8 +166,11 @@ class PredictivePulse(_PressureTarget):
     params : RigParams, optional
         The rig model (default :class:`RigParams`); its ``valve_delay_s`` is the
         prediction horizon.
-    deadband_mpa : float, default 0.0015
-        Three times the default sensor noise: no pulse for a smaller error.
+    deadband_mpa : float, default 0.002
+        Four times the default sensor noise: no pulse for a smaller error (on a
+        ramp, the size of the pulses: a trade of tracking error for switches;
+        on the default rig 0.0015 gives triangle MAPE 2.3 % with 302 switches,
+        0.002 2.85 % with 224).
     observer_gain : float, default 0.3
         Weight of a new sample against the prediction, in (0, 1].
     preview_s : float, optional
@@ -182,7 +185,7 @@ class PredictivePulse(_PressureTarget):
         angle_table: Any,
         params: RigParams | None = None,
         *,
-        deadband_mpa: float = 0.0015,
+        deadband_mpa: float = 0.002,
         observer_gain: float = 0.3,
         preview_s: float | None = None,
         tick_s: float = 0.001,

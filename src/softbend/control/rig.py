@@ -19,8 +19,11 @@ own (every one a field of :class:`RigParams`, with its unit in its name):
 - the chamber holds ideal gas in ``V(p) = V0 + (dV/dp)·p`` (p gauge); ``V0`` =
   7655 mm³ = the semicircular cavity ½·π·r²·l of the (100,6,2,2,5,8) actuator
   (5655 mm³) plus 2000 mm³ of tubing (:meth:`RigParams.for_design` recomputes
-  it for another design); ``dV/dp`` = 20 000 mm³/MPa (the cavity grows by about
-  half at 0.2 MPa); isothermal (polytropic exponent 1.0) unless set;
+  it for another design); ``dV/dp`` = 50 600 mm³/MPa, the FEM's: the cavity
+  volume of the (100,6,2,2,5,8) actuator integrated from its FEM sweep's dV/dp
+  and fitted by a line up to the supply (:func:`cavity_compliance_mm3_per_mpa`,
+  :meth:`RigParams.from_fem_sweep`; the cavity grows 2.7-fold by 0.18 MPa);
+  isothermal (polytropic exponent 1.0) unless set;
 - the angle follows the quasi-static θ(p) through a first-order lag of 30 ms;
 - the pressure sensor has 0.5 kPa Gaussian noise and 12-bit quantisation over
   0–0.5 MPa gauge; the camera runs at 240 fps, no latency, 0.2° noise.
@@ -54,6 +57,7 @@ __all__ = [
     "Rig",
     "RigParams",
     "SimulatedRig",
+    "cavity_compliance_mm3_per_mpa",
     "chamber_pressure_rate_pa_s",
     "fem_angle_table",
     "iso6358_mass_flow_kg_s",
@@ -142,6 +146,33 @@ def chamber_pressure_rate_pa_s(
     )
 
 
+def cavity_compliance_mm3_per_mpa(
+    pressures_mpa: Any, volume_rates_mm3_per_mpa: Any, up_to_mpa: float
+) -> float:
+    """The slope k of ``V(p) ≈ V0 + k·p`` fitted to an FEM sweep's cavity volume, mm³/MPa.
+
+    ``V(p) − V(0)`` is integrated from the sweep's ``dV/dp`` at its converged
+    steps (trapezoids) and fitted by least squares through the origin on the
+    steps up to ``up_to_mpa`` (the supply). The FEM's dV/dp varies along the
+    sweep (stiff at first, softer as the walls thin): this is the best straight
+    line over the range the rig uses.
+    """
+    p = np.asarray(pressures_mpa, dtype=float)
+    rate = np.asarray(volume_rates_mm3_per_mpa, dtype=float)
+    keep = np.isfinite(p) & np.isfinite(rate)
+    p, rate = p[keep], rate[keep]
+    if p.size < 2:
+        raise ValueError(
+            "The FEM sweep must have at least two converged steps with a cavity dV/dp to fit "
+            f"the rig's compliance. Got {p.size} instead."
+        )
+    volume = np.concatenate([[0.0], np.cumsum(0.5 * (rate[1:] + rate[:-1]) * np.diff(p))])
+    volume -= np.interp(0.0, p, volume)
+    inside = p <= up_to_mpa + 1e-12
+    q, v = p[inside], volume[inside]
+    return float(np.dot(q, v) / np.dot(q, q))
+
+
 _OWNER = "RigParams"
 
 
@@ -157,7 +188,7 @@ class RigParams:
     critical_ratio: float = 0.3
     valve_delay_s: float = 0.005
     volume_mm3: float = 7655.0
-    compliance_mm3_per_mpa: float = 20_000.0
+    compliance_mm3_per_mpa: float = 50_600.0
     polytropic_exponent: float = 1.0
     angle_time_constant_s: float = 0.03
     sensor_noise_mpa: float = 0.0005
@@ -223,6 +254,30 @@ class RigParams:
                 f"The 'sensor_bits' of {_OWNER} must be an integer in [0, 32] (0: no "
                 f"quantisation). Got {self.sensor_bits!r} instead."
             )
+
+    @classmethod
+    def from_fem_sweep(
+        cls, result: Any, *, tubing_mm3: float = 2000.0, **kwargs: Any
+    ) -> RigParams:
+        """Parameters whose chamber is the FEM's: ``V0`` of the design, ``dV/dp`` of its sweep.
+
+        ``result`` is a :class:`softbend.models.SweepResult` of the FEM (its
+        ``stats`` hold the steps' pressures and cavity ``dV/dp``); the compliance
+        is :func:`cavity_compliance_mm3_per_mpa` up to the supply pressure.
+        """
+        stats = getattr(result, "stats", None) or {}
+        if "step_volume_rate_mm3_per_mpa" not in stats:
+            raise ValueError(
+                "The 'result' of RigParams.from_fem_sweep must be an FEM sweep (its stats "
+                "record step_volume_rate_mm3_per_mpa); this one does not."
+            )
+        supply = kwargs.get("supply_gauge_mpa", cls.supply_gauge_mpa)
+        compliance = cavity_compliance_mm3_per_mpa(
+            stats["steps_mpa"], stats["step_volume_rate_mm3_per_mpa"], supply
+        )
+        return cls.for_design(
+            result.design, tubing_mm3=tubing_mm3, compliance_mm3_per_mpa=compliance, **kwargs
+        )
 
     @classmethod
     def for_design(
