@@ -142,8 +142,7 @@ def _closed_port() -> int:
     [
         (
             ["--backend", "abaqus"],
-            "'--backend' of softbend campaign run must be one of 'analytical', 'fem', "
-            "'surrogate'",
+            "'--backend' of softbend campaign run must be one of 'analytical', 'fem', 'surrogate'",
         ),
         (["--backend", "fault-injection"], "must be one of 'analytical', 'fem', 'surrogate'"),
         (["--space", "grid:5"], "'--space' of softbend campaign run must be one of table1"),

@@ -53,7 +53,6 @@ __all__ = [
     "Backend",
     "BendingModel",
     "FaultInjectionBackend",
-    "INTERNAL_BACKENDS",
     "SweepResult",
     "available_backends",
     "check_pressures_mpa",

@@ -256,9 +256,7 @@ class RigParams:
             )
 
     @classmethod
-    def from_fem_sweep(
-        cls, result: Any, *, tubing_mm3: float = 2000.0, **kwargs: Any
-    ) -> RigParams:
+    def from_fem_sweep(cls, result: Any, *, tubing_mm3: float = 2000.0, **kwargs: Any) -> RigParams:
         """Parameters whose chamber is the FEM's: ``V0`` of the design, ``dV/dp`` of its sweep.
 
         ``result`` is a :class:`softbend.models.SweepResult` of the FEM (its
