@@ -188,19 +188,31 @@ def test_cli_run_refuses_a_rig_whose_first_reading_is_garbage(server, tmp_path, 
     assert server.valves == (False, False)  # no valve was ever opened
 
 
-@pytest.mark.skipif(sys.platform == "win32", reason="SIGINT to a child")
-def test_ctrl_c_leaves_the_valves_vented(server, tmp_path):
+def _default_signals() -> None:
+    """In the child: SIGINT as at a terminal, even when the test runs as a background job."""
+    signal.signal(signal.SIGINT, signal.SIG_DFL)
+
+
+@pytest.mark.skipif(sys.platform == "win32", reason="POSIX signals to a child")
+@pytest.mark.parametrize("signum", [signal.SIGINT, signal.SIGTERM])
+def test_ctrl_c_or_sigterm_leaves_the_valves_vented(server, tmp_path, signum):
     config = tmp_path / "rig.toml"
     config.write_text(replace(server.config).to_toml())
     server.watchdog_s = 0.0  # only the loop may vent: prove it does
     softbend = Path(sys.executable).with_name("softbend")  # the console script
     cmd = [str(softbend), "control", "run", "--rig", "modbus"]
     cmd += ["--config", str(config), "--out", str(tmp_path / "o"), "--duration", "30"]
-    child = subprocess.Popen(cmd, stderr=subprocess.PIPE, text=True, env=os.environ.copy())
-    assert wait_for(lambda: server.valves[0], timeout=30.0), "the loop never opened the inlet"
-    child.send_signal(signal.SIGINT)
-    _, err = child.communicate(timeout=30)
+    child = subprocess.Popen(
+        cmd, stderr=subprocess.PIPE, text=True, env=os.environ.copy(),
+        preexec_fn=_default_signals,
+    )  # fmt: skip
+    try:
+        assert wait_for(lambda: server.valves[0], timeout=30.0), "the loop never opened the inlet"
+        child.send_signal(signum)
+        _, err = child.communicate(timeout=30)
+    finally:
+        child.kill()
     assert child.returncode == 130
-    assert "Interrupted (Ctrl-C)" in err.strip().splitlines()[-1]
+    assert "Interrupted (Ctrl-C or SIGTERM)" in err.strip().splitlines()[-1]
     assert wait_for(lambda: server.valves == (False, True), timeout=1.0)
     assert (tmp_path / "o" / "ticks.csv").exists()

@@ -2,7 +2,10 @@
 
 from __future__ import annotations
 
+import signal
+import threading
 from pathlib import Path
+from typing import Any
 
 import typer
 
@@ -62,7 +65,8 @@ def _setup(
     gap the controller meets on a real actuator).
     """
     from softbend._validation import check_choice
-    from softbend.control.controllers import CONTROLLERS, make_controller, mlp_virtual_sensor
+    from softbend.control.controllers import CONTROLLERS, mlp_virtual_sensor
+    from softbend.control.factory import make_controller
     from softbend.control.rig import AngleTable, RigParams, fem_angle_table, lab_angle_table
     from softbend.design import SFRBADesign
     from softbend.transfer.base import load_base
@@ -180,7 +184,7 @@ def run_cmd(
 
     The same controller object as `control simulate`, called every tick (1 ms) with
     the latest pressure reading (read every 10 ms: paper B's 100 Hz). Over-pressure,
-    missed or stale readings vent the actuator and stop the run; so does Ctrl-C. Exit 0
+    missed or stale readings vent the actuator and stop the run; so do Ctrl-C and SIGTERM. Exit 0
     when the run completed, 1 when a fault stopped it (the log keeps every tick up to
     the fault), 130 on Ctrl-C.
     """
@@ -220,6 +224,7 @@ def run_cmd(
         advance(n - done[0])
         done[0] = n
 
+    previous = _terminate_as_interrupt()
     try:
         with _common.progress_bar("control loop", ticks, enabled=not as_json) as advance:
             result = run_loop(
@@ -235,6 +240,8 @@ def run_cmd(
             )
     finally:
         device.close()
+        if previous is not None:
+            signal.signal(signal.SIGTERM, previous)
     jitter = result.jitter()
     metrics = result.metrics()
     payload = {
@@ -288,6 +295,21 @@ def run_cmd(
     if not result.completed:
         _common.error_line(result.stop_reason)
         raise typer.Exit(1)
+
+
+def _terminate_as_interrupt() -> Any:
+    """Make SIGTERM (``kill``, a service stop) end the loop as Ctrl-C does: vented.
+
+    Returns the previous handler (None off the main thread, where signals
+    cannot be set).
+    """
+    if threading.current_thread() is not threading.main_thread():
+        return None
+
+    def interrupt(signum: int, frame: Any) -> None:
+        raise KeyboardInterrupt
+
+    return signal.signal(signal.SIGTERM, interrupt)
 
 
 def _percentiles_ms(values: list[float]) -> dict[str, float]:

@@ -35,7 +35,6 @@ __all__ = [
     "PressurePI",
     "PressureRelay",
     "ValveCommand",
-    "make_controller",
     "mlp_virtual_sensor",
 ]
 
@@ -337,37 +336,3 @@ CONTROLLERS: tuple[str, ...] = (
     "pressure-relay",
     "predictive",
 )
-
-
-def make_controller(
-    name: str,
-    angle_table: Any,
-    virtual_sensor: Callable[[float], float] | None = None,
-    params: Any = None,
-) -> Any:
-    """The controller called ``name`` (one of :data:`CONTROLLERS`), with its defaults.
-
-    Parameters
-    ----------
-    name : str
-    angle_table : AngleTable
-        θ(p) of the controller's model (inverted by the pressure controllers).
-    virtual_sensor : callable, optional
-        θp(p) of the bang-bang controllers (default ``angle_table``; paper B:
-        :func:`mlp_virtual_sensor`).
-    params : RigParams, optional
-        The rig model of ``predictive`` (default :class:`~softbend.control.rig.RigParams`).
-    """
-    check_choice(name, "controller", "make_controller", CONTROLLERS)
-    sensor = angle_table if virtual_sensor is None else virtual_sensor
-    if name == "bang-bang":
-        return BangBang(sensor, mode="hold")
-    if name == "bang-bang-closed":
-        return BangBang(sensor, mode="closed")
-    if name == "pressure-pi":
-        return PressurePI(angle_table)
-    if name == "pressure-relay":
-        return PressureRelay(angle_table)
-    from softbend.control.predictive import PredictivePulse
-
-    return PredictivePulse(angle_table, params)

@@ -339,7 +339,7 @@ def run_loop(
             if progress is not None and (k + 1) % report_every == 0:
                 progress(k + 1, n)
     except KeyboardInterrupt:
-        reason, kind = "Interrupted (Ctrl-C); vented and stopped.", "interrupted"
+        reason, kind = "Interrupted (Ctrl-C or SIGTERM); vented and stopped.", "interrupted"
     except RigError as exc:  # a command that did not reach the rig
         reason, kind = f"{exc} (vented and stopped)", exc.kind
     except Exception as exc:  # a controller or rig bug: still leave the valves safe

@@ -18,8 +18,9 @@ from typing import Any
 
 import pandas as pd
 
-from softbend.control.controllers import make_controller, mlp_virtual_sensor
+from softbend.control.controllers import mlp_virtual_sensor
 from softbend.control.experiments import ControlRun, run_metrics, simulate
+from softbend.control.factory import make_controller
 from softbend.control.rig import AngleTable, RigParams, SimulatedRig
 from softbend.design import SFRBADesign
 
