@@ -22,21 +22,11 @@ import time
 
 import numpy as np
 
-from softbend.control.controllers import (
-    BangBang,
-    PressurePI,
-    PressureRelay,
-    mlp_virtual_sensor,
-)
+from softbend.control.controllers import CONTROLLERS, mlp_virtual_sensor
 from softbend.control.experiments import run_metrics, simulate
-from softbend.control.predictive import PredictivePulse
-from softbend.control.rig import (
-    AngleTable,
-    RigParams,
-    SimulatedRig,
-    fem_angle_table,
-    lab_angle_table,
-)
+from softbend.control.factory import make_controller
+from softbend.control.plants import PLANTS, plant_table
+from softbend.control.rig import AngleTable, RigParams, SimulatedRig
 from softbend.design import SFRBADesign
 from softbend.transfer.base import load_base
 
@@ -63,7 +53,7 @@ def main() -> None:
     parser.add_argument("--json", action="store_true")
     parser.add_argument(
         "--plant",
-        choices=("surrogate", "fem", "lab"),
+        choices=PLANTS,
         default="surrogate",
         help="θ(p) of the actuator: the controllers' model, the FEM sweep, or the lab readings",
     )
@@ -73,19 +63,12 @@ def main() -> None:
     model = load_base(args.model)
     table = AngleTable.from_surrogate(model, design)
     sensor = mlp_virtual_sensor(model, design)
-    controllers = {
-        "bang-bang": lambda: BangBang(sensor, mode="hold"),
-        "bang-bang-closed": lambda: BangBang(sensor, mode="closed"),
-        "pressure-pi": lambda: PressurePI(table),
-        "pressure-relay": lambda: PressureRelay(table),
-        "predictive": lambda: PredictivePulse(table, params),
-    }
     params = RigParams.for_design(design)
-    plant = {
-        "surrogate": lambda: table,
-        "fem": lambda: fem_angle_table(design),
-        "lab": lambda: lab_angle_table(design),
-    }[args.plant]()
+    controllers = {
+        name: (lambda name=name: make_controller(name, table, sensor, params))
+        for name in CONTROLLERS
+    }
+    plant = plant_table(args.plant, design, table)
     rig = SimulatedRig(plant, params, seed=0)
     results = []
     for name, make in controllers.items():

@@ -26,12 +26,12 @@ from pathlib import Path
 
 import numpy as np
 
-from softbend.control.controllers import BangBang, PressureRelay, mlp_virtual_sensor
+from softbend.control.controllers import mlp_virtual_sensor
 from softbend.control.experiments import run_metrics, simulate
+from softbend.control.factory import make_controller
 from softbend.control.loop import run_loop
 from softbend.control.modbus import ModbusRig
 from softbend.control.modbus_server import free_tcp_port
-from softbend.control.predictive import PredictivePulse
 from softbend.control.rig import AngleTable, RigParams, SimulatedRig
 from softbend.control.rigconfig import RigConfig
 from softbend.design import SFRBADesign
@@ -52,9 +52,8 @@ def main() -> None:
     sensor = mlp_virtual_sensor(model, design)
     params = RigParams.for_design(design)
     controllers = {
-        "bang-bang": lambda: BangBang(sensor, mode="hold"),
-        "pressure-relay": lambda: PressureRelay(table),
-        "predictive": lambda: PredictivePulse(table, params),
+        name: (lambda name=name: make_controller(name, table, sensor, params))
+        for name in ("bang-bang", "pressure-relay", "predictive")
     }
     config = RigConfig()
     config = replace(config, connection=replace(config.connection, port=free_tcp_port()))

@@ -6,13 +6,8 @@ import pytest
 from softbend.cli import main
 from softbend.control.controllers import PressureRelay
 from softbend.control.experiments import simulate
-from softbend.control.rig import (
-    AngleTable,
-    RigParams,
-    SimulatedRig,
-    fem_angle_table,
-    lab_angle_table,
-)
+from softbend.control.plants import fem_angle_table, lab_angle_table, plant_table
+from softbend.control.rig import AngleTable, RigParams, SimulatedRig
 from softbend.datasets import table1_fem
 from softbend.design import SFRBADesign
 from softbend.transfer.lab import shipped_measurements
@@ -80,3 +75,20 @@ def test_cli_plant_option(tmp_path, capsys):
     assert main(["control", "simulate", "--plant", "camera", "--out", str(out)]) == 2
     err = capsys.readouterr().err
     assert "'plant'" in err and "'lab'" in err and len(err.strip().splitlines()) == 1
+
+
+def test_plant_table_by_name():
+    model = AngleTable.from_callable(lambda p: 6.0 + 1000.0 * p)
+    assert plant_table("surrogate", DESIGN, model) is model
+    assert plant_table("fem", DESIGN, model)(0.1) == pytest.approx(fem_angle_table(DESIGN)(0.1))
+    assert plant_table("lab", DESIGN, model)(0.1) == pytest.approx(lab_angle_table(DESIGN)(0.1))
+    with pytest.raises(ValueError, match="'plant' of plant_table must be one of"):
+        plant_table("camera", DESIGN, model)
+
+
+def test_serve_checks_its_plant(capsys):
+    # --plant was once accepted by serve and ignored
+    assert main(["control", "serve", "--plant", "camera", "--duration", "0.1"]) == 2
+    assert "'plant' of softbend control serve" in capsys.readouterr().err
+    code = main(["control", "serve", "--plant", "lab", "--design", "160,10,4,4,15,12"])
+    assert code == 2 and "no measured loading curve" in capsys.readouterr().err

@@ -170,3 +170,13 @@ def test_from_fem_sweep_refuses_a_result_without_volumes():
     result = AnalyticalModel().sweep(SFRBADesign(100, 6, 2, 2, 5, 8), [0.0, 0.05, 0.1])
     with pytest.raises(ValueError, match="must be an FEM sweep"):
         RigParams.from_fem_sweep(result)
+
+
+def test_commanded_is_the_latest_command_before_the_valves_switch(table):
+    rig = SimulatedRig(table, RigParams(valve_delay_s=0.005))
+    rig.command(True, False)
+    assert rig.commanded == (True, False) and not rig.inlet_open
+    rig.command(False, True)
+    assert rig.commanded == (False, True)
+    rig.advance(10)
+    assert (rig.inlet_open, rig.outlet_open) == rig.commanded == (False, True)

@@ -38,17 +38,6 @@ _PLANT = typer.Option(
 )
 
 
-#: What plays the actuator: the controller's own model, its FEM sweep, or its lab measurements.
-PLANTS: tuple[str, ...] = ("surrogate", "fem", "lab")
-
-
-def run_figure(run, path: Path, title: str) -> Path | None:
-    """Paper B's Fig. 9 of one run (:func:`softbend.reports.control_figures.run_figure`)."""
-    from softbend.reports.control_figures import run_figure as draw
-
-    return draw(run, path, title)
-
-
 def _setup(
     command: str,
     controller: str,
@@ -67,7 +56,8 @@ def _setup(
     from softbend._validation import check_choice
     from softbend.control.controllers import CONTROLLERS, mlp_virtual_sensor
     from softbend.control.factory import make_controller
-    from softbend.control.rig import AngleTable, RigParams, fem_angle_table, lab_angle_table
+    from softbend.control.plants import PLANTS, plant_table
+    from softbend.control.rig import AngleTable, RigParams
     from softbend.design import SFRBADesign
     from softbend.transfer.base import load_base
 
@@ -78,12 +68,8 @@ def _setup(
     surrogate = load_base(model)
     table = AngleTable.from_surrogate(surrogate, actuator)
     sensor = mlp_virtual_sensor(surrogate, actuator) if hasattr(surrogate, "predictor") else table
-    plant_table = {
-        "surrogate": lambda: table,
-        "fem": lambda: fem_angle_table(actuator),
-        "lab": lambda: lab_angle_table(actuator),
-    }[plant]()
-    return actuator, params, plant_table, make_controller(controller, table, sensor, params)
+    actuator_table = plant_table(plant, actuator, table)
+    return actuator, params, actuator_table, make_controller(controller, table, sensor, params)
 
 
 @app.command("simulate")
@@ -102,6 +88,7 @@ def simulate_cmd(
     """Run a controller on the simulated rig and score it as paper B's Fig. 9 (synthetic)."""
     from softbend.control.experiments import parse_reference, run_metrics, simulate
     from softbend.control.rig import SimulatedRig
+    from softbend.reports import control_figures
 
     ref = parse_reference(reference)
     actuator, params, table, ctrl = _setup(
@@ -126,7 +113,7 @@ def simulate_cmd(
         out.mkdir(parents=True, exist_ok=True)
         run.frame().to_csv(out / "run.csv", index=False)
         (out / "metrics.json").write_text(_common.json_text(payload) + "\n", encoding="utf-8")
-        figure = run_figure(
+        figure = control_figures.run_figure(
             run, out / "run.png", f"{controller} on {actuator}, {reference} (simulated)"
         )
     payload["files"] = [str(out / "run.csv"), str(out / "metrics.json")] + (
@@ -192,6 +179,7 @@ def run_cmd(
     from softbend.control.experiments import parse_reference
     from softbend.control.loop import run_loop
     from softbend.control.rigconfig import RigConfig, load_rig_config
+    from softbend.reports import control_figures
 
     command = "softbend control run"
     check_choice(rig, "rig", command, RIGS)
@@ -272,7 +260,7 @@ def run_cmd(
         from softbend._io import write_text_atomic
 
         write_text_atomic(out / "run.json", _common.json_text(payload) + "\n")
-        figure = run_figure(
+        figure = control_figures.run_figure(
             result.control_run(),
             out / "run.png",
             f"{controller} on {actuator}, {reference}, rig {rig} "
@@ -366,7 +354,9 @@ def serve_cmd(
         port if port is not None else (settings.connection.port if config is not None else 5020)
     )
     check_range(duration, "duration", "softbend control serve", low=0.0, low_inclusive=True)
-    _, params, table, _ = _setup("softbend control serve", "bang-bang", design, model, supply)
+    _, params, table, _ = _setup(
+        "softbend control serve", "bang-bang", design, model, supply, plant
+    )
     server = SimulatedModbusServer(
         SimulatedRig(table, params, seed=seed), settings, host=host, port=listen
     )
@@ -410,4 +400,4 @@ def rig_config_cmd(
     _common.console.print(f"rig config written to {out}")
 
 
-__all__ = ["PLANTS", "RIGS", "app"]
+__all__ = ["RIGS", "app"]

@@ -271,9 +271,7 @@ class SimulatedModbusServer:
         with self.plant.lock:
             self.plant.catch_up()
             rig = self.plant.rig
-            inlet, outlet = rig.inlet_open, rig.outlet_open
-            for pending in rig._pending:  # the latest command, not yet applied
-                inlet, outlet = pending[1], pending[2]
+            inlet, outlet = rig.commanded
             for offset, value in enumerate(values):
                 if address + offset == v.inlet_coil:
                     inlet = bool(value)

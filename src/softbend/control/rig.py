@@ -59,10 +59,7 @@ __all__ = [
     "SimulatedRig",
     "cavity_compliance_mm3_per_mpa",
     "chamber_pressure_rate_pa_s",
-    "fem_angle_table",
     "iso6358_mass_flow_kg_s",
-    "lab_angle_table",
-    "shipped_angle_table",
 ]
 
 #: Specific gas constant of dry air, J/(kg·K).
@@ -404,110 +401,6 @@ class AngleTable:
         return p[i - 1] + (angle_deg - a0) / (a1 - a0) * (p[i] - p[i - 1])
 
 
-def shipped_angle_table(
-    design: SFRBADesign, pmax_mpa: float = 0.5, points: int = 501
-) -> AngleTable:
-    """θ(p) of ``design`` from the shipped FEM-trained MLP (``transfer.base.load_base``)."""
-    from softbend.transfer.base import load_base
-
-    return AngleTable.from_surrogate(load_base(), design, pmax_mpa=pmax_mpa, points=points)
-
-
-def fem_angle_table(
-    design: SFRBADesign, pmax_mpa: float = 0.5, points: int = 501, data: Any = None
-) -> AngleTable:
-    """θ(p) of ``design`` from its FEM sweep in the shipped Table 1 dataset: a plant unlike the MLP.
-
-    With this as the rig's angle map and the MLP as the controller's virtual
-    sensor, the controller meets the model error it would meet on a real
-    actuator. The converged samples of the sweep are interpolated linearly onto
-    the table's grid; beyond the sweep's last pressure (it stops at 300° or an
-    instability) θ is extrapolated linearly with the slope of its last two
-    samples, which the references used here (≤ 90°) only reach in overshoot.
-
-    Parameters
-    ----------
-    design : SFRBADesign
-        One of the 972 designs of Table 1.
-    pmax_mpa, points : float, int
-        The table's grid, as :meth:`AngleTable.from_callable`.
-    data : pandas.DataFrame, optional
-        The dataset (default :func:`softbend.datasets.table1_fem`).
-    """
-    from softbend.datasets import table1_fem
-
-    frame = table1_fem() if data is None else data
-    mask = np.ones(len(frame), dtype=bool)
-    for name, value in design.as_dict().items():
-        mask &= np.isclose(frame[name].to_numpy(dtype=float), value)
-    rows = frame[mask & frame["converged"].to_numpy(dtype=bool)].sort_values("pressure_mpa")
-    if len(rows) < 2:
-        levels = {name: sorted(float(v) for v in frame[name].unique()) for name in design.as_dict()}
-        allowed = "; ".join(
-            f"{k} in {', '.join(f'{v:g}' for v in vals)}" for k, vals in levels.items()
-        )
-        raise ValueError(
-            f"The design {design} is not in the FEM dataset (Table 1: {allowed}); use a "
-            "surrogate plant for it."
-        )
-    p = rows["pressure_mpa"].to_numpy(dtype=float)
-    a = rows["angle_deg"].to_numpy(dtype=float)
-    return AngleTable.from_callable(_extrapolated(p, a), pmax_mpa=pmax_mpa, points=points)
-
-
-def _extrapolated(p: np.ndarray, a: np.ndarray) -> Callable[[np.ndarray], np.ndarray]:
-    """Linear interpolation of (p, a), extended past ``p[-1]`` with the last segment's slope."""
-    slope = (a[-1] - a[-2]) / (p[-1] - p[-2])
-
-    def angle(q: np.ndarray) -> np.ndarray:
-        return np.where(q > p[-1], a[-1] + slope * (q - p[-1]), np.interp(q, p, a))
-
-    return angle
-
-
-def lab_angle_table(
-    design: SFRBADesign,
-    pmax_mpa: float = 0.5,
-    points: int = 501,
-    measurements: Any = None,
-    degree: int = 3,
-) -> AngleTable:
-    """θ(p) of ``design`` as measured: the virtual lab's loading readings, smoothed.
-
-    The plant of a control run that meets the reality gap (another elastomer fit,
-    fabrication error, hysteresis: :mod:`softbend.transfer.lab`) while the
-    controller's model is the FEM-trained MLP. The loading-branch readings of
-    the design are fitted by a least-squares polynomial of ``degree`` in p
-    (removing the camera noise), tabulated up to the last reading, and extended
-    past it linearly with the end slope.
-
-    Parameters
-    ----------
-    design : SFRBADesign
-        One of the measured actuators (paper B Fig. 7).
-    measurements : Measurements, optional
-        Default: the shipped virtual-lab readings
-        (:func:`softbend.transfer.lab.shipped_measurements`).
-    degree : int, default 3
-    """
-    from softbend.transfer.lab import actuator_id, shipped_measurements
-
-    data = (shipped_measurements() if measurements is None else measurements).frame
-    key = actuator_id(design)
-    rows = data[(data["actuator_id"] == key) & (data["direction"] == "loading")]
-    if len(rows) <= degree:
-        known = ", ".join(sorted(str(v) for v in data["actuator_id"].unique()))
-        raise ValueError(
-            f"The design {key} has no measured loading curve (measured: {known}); use the "
-            "'surrogate' or 'fem' plant for it."
-        )
-    p = rows["pressure_mpa"].to_numpy(dtype=float)
-    coef = np.polynomial.polynomial.polyfit(p, rows["angle_deg"].to_numpy(dtype=float), degree)
-    grid = np.linspace(0.0, float(p.max()), 64)
-    smooth = np.polynomial.polynomial.polyval(grid, coef)
-    return AngleTable.from_callable(_extrapolated(grid, smooth), pmax_mpa=pmax_mpa, points=points)
-
-
 @runtime_checkable
 class Rig(Protocol):
     """What the fixed-period loop (:func:`softbend.control.loop.run_loop`) needs from a rig.
@@ -546,7 +439,7 @@ class SimulatedRig:
     ----------
     angle_map : callable
         Quasi-static θ(p), gauge MPa → degrees; an :class:`AngleTable` is fastest
-        (:func:`shipped_angle_table` gives the shipped MLP's).
+        (:func:`softbend.control.plants.shipped_angle_table` gives the shipped MLP's).
     params : RigParams, optional
     seed : int
         Seed of the sensor and camera noise.
@@ -623,6 +516,13 @@ class SimulatedRig:
         if self._lsb > 0.0:
             value = round(value / self._lsb) * self._lsb
         return min(max(value, 0.0), q.sensor_range_mpa)
+
+    @property
+    def commanded(self) -> tuple[bool, bool]:
+        """The latest commanded (inlet, outlet), applied or still within the valve delay."""
+        if self._pending:
+            return self._pending[-1][1], self._pending[-1][2]
+        return self.inlet_open, self.outlet_open
 
     def command(self, inlet: bool, outlet: bool) -> None:
         """Command the valves; they switch ``valve_delay_s`` later."""

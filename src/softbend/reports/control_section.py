@@ -67,7 +67,7 @@ def add_section(
     refine_epochs : int, optional
         Epochs of the refined MLP (default: the strategy's; fewer for a quick run).
     """
-    from softbend.control.rig import lab_angle_table
+    from softbend.control.plants import lab_angle_table
     from softbend.control.study import PAPER_B_CONTROL, STUDY_REFERENCES, control_study
     from softbend.design import SFRBADesign
     from softbend.reports.control_figures import runs_figure
