@@ -145,3 +145,13 @@ def test_fit_rejects_wrong_columns_and_nan(small_base):
     y = np.array([1.0, np.nan, 2.0, 3.0, 4.0])
     with pytest.raises(ValueError):
         ScaleOffset(small_base).fit(X, y)
+
+
+def test_fit_strategy_is_make_then_fit_on_all_readings(small_base, quick_measurements):
+    from softbend.transfer.strategies import fit_strategy
+
+    X, y = quick_measurements.features, quick_measurements.angle_deg
+    fitted = fit_strategy("refined", small_base, quick_measurements, seed=3, epochs=40)
+    by_hand = make_strategy("refined", small_base, seed=3, epochs=40).fit(X, y)
+    assert len(fitted.loss_curve_) == 40
+    np.testing.assert_array_equal(fitted.predict(X), by_hand.predict(X))

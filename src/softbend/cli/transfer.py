@@ -234,18 +234,16 @@ def refine(
     from softbend._validation import check_choice
     from softbend.surrogates.persistence import save_surrogate
     from softbend.transfer.measurements import load_measurements
-    from softbend.transfer.strategies import make_strategy
+    from softbend.transfer.strategies import fit_strategy
 
     check_choice(strategy, "strategy", "softbend transfer refine", ("refined", "experimental"))
     _common.check_output_file(out, "--out", inputs=(base, measurements), kind="json")
     data = load_measurements(measurements)
-    options = {} if epochs is None else {"epochs": epochs}
     from softbend.surrogates.features import training_ranges
     from softbend.surrogates.persistence import load_surrogate
 
     start = load_surrogate(base)
-    model = make_strategy(strategy, start.model, seed=seed, **options)
-    model.fit(data.features, data.angle_deg)
+    model = fit_strategy(strategy, start.model, data, seed=seed, epochs=epochs)
     ranges = training_ranges(data.features)
     if strategy == "refined" and isinstance(start.metadata.get("training_ranges"), dict):
         ranges = {  # the base's simulations and the measurements

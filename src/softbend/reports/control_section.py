@@ -28,13 +28,9 @@ CONTROL_DESIGN = "100,6,2,2,5,8"
 def _refined(base: Any, seed: int, epochs: int | None) -> Any:
     """The shipped MLP refined on all the shipped lab readings (``transfer refine``)."""
     from softbend.transfer.lab import shipped_measurements
-    from softbend.transfer.strategies import make_strategy
+    from softbend.transfer.strategies import fit_strategy
 
-    data = shipped_measurements()
-    options = {} if epochs is None else {"epochs": epochs}
-    strategy = make_strategy("refined", base, seed=seed, **options)
-    strategy.fit(data.features, data.angle_deg)
-    return strategy.model_
+    return fit_strategy("refined", base, shipped_measurements(), seed=seed, epochs=epochs).model_
 
 
 def _cell(metrics: Any, controller: str, reference: str, name: str) -> float | str:

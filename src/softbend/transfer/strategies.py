@@ -48,6 +48,7 @@ __all__ = [
     "RefinedMLP",
     "ResidualGP",
     "ScaleOffset",
+    "fit_strategy",
     "has_interval",
     "make_strategy",
 ]
@@ -579,6 +580,26 @@ def make_strategy(name: str, base: Any = None, *, seed: int = 0, **options: Any)
     if name == "residual-gp":
         return ResidualGP(base, seed=seed, **options)
     return RefinedEnsemble(base, seed=seed, **options)
+
+
+def fit_strategy(
+    name: str,
+    base: Any,
+    measurements: Any,
+    *,
+    seed: int = 0,
+    epochs: int | None = None,
+    **options: Any,
+) -> _Strategy:
+    """:func:`make_strategy` fitted on all of ``measurements`` (a :class:`Measurements`).
+
+    ``epochs`` (None: the strategy's default) is passed on with the other options.
+    """
+    if epochs is not None:
+        options["epochs"] = epochs
+    strategy = make_strategy(name, base, seed=seed, **options)
+    strategy.fit(measurements.features, measurements.angle_deg)
+    return strategy
 
 
 def has_interval(estimator: Any) -> bool:
