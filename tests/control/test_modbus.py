@@ -227,3 +227,10 @@ def test_ctrl_c_or_sigterm_leaves_the_valves_vented(server, tmp_path, signum):
     assert "Interrupted (Ctrl-C or SIGTERM)" in err.strip().splitlines()[-1]
     assert wait_for(lambda: server.valves == (False, True), timeout=1.0)
     assert (tmp_path / "o" / "ticks.csv").exists()
+
+
+def test_serve_on_a_port_in_use_is_one_line(server, capsys):
+    code = main(["control", "serve", "--port", str(server.port), "--duration", "0.2"])
+    assert code == 2
+    err = capsys.readouterr().err.strip().splitlines()
+    assert len(err) == 1 and f"cannot listen on tcp://127.0.0.1:{server.port}" in err[0]

@@ -28,18 +28,23 @@ from softbend.control.realtime import sleep_until_monotonic
 from softbend.control.rigconfig import RegisterConfig, RigConfig
 from softbend.errors import RigError
 
-__all__ = ["ModbusRig"]
+__all__ = ["ModbusRig", "quiet_pymodbus"]
 
 _SPAN = 16  # registers read in one request at most
+
+
+def quiet_pymodbus() -> None:
+    """Silence pymodbus's own log (unless configured): its failures come back as RigError."""
+    logger = logging.getLogger("pymodbus")
+    if logger.level == logging.NOTSET:
+        logger.setLevel(logging.CRITICAL)
 
 
 def _client(config: RigConfig) -> Any:
     require("pymodbus", "The Modbus rig (softbend control run --rig modbus)")
     from pymodbus.client import ModbusSerialClient, ModbusTcpClient
 
-    quiet = logging.getLogger("pymodbus")
-    if quiet.level == logging.NOTSET:  # failures come back as one RigError, not a log
-        quiet.setLevel(logging.CRITICAL)
+    quiet_pymodbus()
 
     c = config.connection
     if c.transport == "tcp":

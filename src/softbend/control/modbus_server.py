@@ -31,9 +31,11 @@ from dataclasses import replace
 from typing import Any
 
 from softbend._extras import require
+from softbend.control.modbus import quiet_pymodbus
 from softbend.control.realtime import WallClockRig
 from softbend.control.rig import SimulatedRig
 from softbend.control.rigconfig import ConnectionConfig, RigConfig
+from softbend.errors import RigError
 
 __all__ = ["FAULTS", "SimulatedModbusServer", "free_tcp_port"]
 
@@ -85,6 +87,7 @@ class SimulatedModbusServer:
         timeout_delay_s: float = 0.5,
     ) -> None:
         require("pymodbus", "The simulated Modbus rig (softbend control serve)")
+        quiet_pymodbus()
         base = RigConfig() if config is None else config
         self.port = port or free_tcp_port(host)
         self.config = replace(
@@ -120,9 +123,10 @@ class SimulatedModbusServer:
         self._thread = threading.Thread(target=self._serve, name="softbend-modbus", daemon=True)
         self._thread.start()
         if not self._ready.wait(10.0) or self._error is not None:
-            raise RuntimeError(
-                f"The simulated Modbus rig could not listen on "
-                f"{self.config.connection.where}: {self._error}."
+            raise RigError(
+                f"The simulated Modbus rig cannot listen on {self.config.connection.where} "
+                "(the port is in use, or the host is not an address of this machine); "
+                "choose another --port or --host."
             )
         return self
 
