@@ -53,6 +53,7 @@ def test_simulate_writes_run(tmp_path, capsys, controller):
         (["run", "--rig", "modbus", "--config", "nope.toml"], ["does not exist"]),
         (["serve", "--config", "nope.toml"], ["does not exist"]),
         (["serve", "--duration", "-2"], ["'duration'"]),
+        (["serve", "--port", "70000"], ["'--port' of softbend control serve"]),
         (["simulate", "--plant", "lab", "--design", "160,10,4,4,15,12"], ["no measured"]),
         (["simulate", "--plant", "fem", "--design", "105,6,2,2,5,8"], ["not in the FEM dataset"]),
     ],

@@ -354,6 +354,11 @@ def serve_cmd(
         port if port is not None else (settings.connection.port if config is not None else 5020)
     )
     check_range(duration, "duration", "softbend control serve", low=0.0, low_inclusive=True)
+    if not 0 <= listen <= 65535:
+        raise ValueError(
+            f"The '--port' of softbend control serve must be an integer in [0, 65535]. "
+            f"Got {listen} instead."
+        )
     _, params, table, _ = _setup(
         "softbend control serve", "bang-bang", design, model, supply, plant
     )
