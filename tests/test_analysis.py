@@ -13,8 +13,11 @@ import statsmodels.api as sm
 
 from softbend.analysis import (
     DEFAULT_FEATURES,
+    DEFAULT_TARGET,
+    CampaignAnalysis,
     ConstantFeatureWarning,
     RegressionReport,
+    analyze_samples,
     correlation_matrix,
     significance_stars,
     standardized_regression,
@@ -22,6 +25,7 @@ from softbend.analysis import (
 )
 from softbend.errors import DatasetError
 from softbend.reports.analysis_figures import (
+    campaign_analysis_figures,
     column_label,
     correlation_heatmap,
     loadings_bar,
@@ -276,6 +280,76 @@ def test_correlation_matrix_bad_input():
         correlation_matrix(df.iloc[:1], ["x1", "x2"])
     with pytest.raises(DatasetError, match="pressure_mpa"):
         correlation_matrix(df)
+
+
+# ----------------------------------------------------------------------------- both at once
+
+
+def test_analyze_samples_equals_the_separate_analyses():
+    df = _campaign_like_frame()
+    result = analyze_samples(df, mape_threshold=2.0)
+    assert isinstance(result, CampaignAnalysis)
+    report = standardized_regression(df, mape_threshold=2.0)
+    assert result.regression.to_dict(include_samples=True) == report.to_dict(include_samples=True)
+    pd.testing.assert_frame_equal(
+        result.correlation, correlation_matrix(df, [*DEFAULT_FEATURES, DEFAULT_TARGET])
+    )
+
+
+def test_analyze_samples_with_chosen_columns():
+    df = _linear_frame(noise=0.1)
+    result = analyze_samples(df, ["x1", "x2"], "y")
+    assert result.regression.features == ("x1", "x2") and result.regression.target == "y"
+    assert list(result.correlation.columns) == ["x1", "x2", "y"]
+    np.testing.assert_array_equal(
+        result.correlation.to_numpy(), correlation_matrix(df, ["x1", "x2", "y"]).to_numpy()
+    )
+
+
+def test_analysis_to_dict_is_the_report_plus_correlations_and_round_trips_json():
+    df = _campaign_like_frame().assign(b_mm=3.0)  # a constant column: NaN correlations
+    with pytest.warns(ConstantFeatureWarning, match="b_mm"):
+        result = analyze_samples(df)
+    out = result.to_dict()
+    assert list(out) == [*result.regression.to_dict(), "correlation"]
+    assert {k: v for k, v in out.items() if k != "correlation"} == result.regression.to_dict()
+    corr = out["correlation"]
+    assert list(corr) == [*DEFAULT_FEATURES, DEFAULT_TARGET]
+    assert corr["pressure_mpa"]["angle_deg"] == float(
+        result.correlation.loc["pressure_mpa", "angle_deg"]
+    )
+    assert math.isnan(corr["b_mm"]["b_mm"])
+    back = json.loads(json.dumps(out))
+    assert back["coefficients"] == out["coefficients"]
+    np.testing.assert_equal(back["correlation"], corr)  # NaN as NaN
+    assert "fitted" in result.to_dict(include_samples=True)
+
+
+def test_analyze_samples_rejects_empty_and_bad_samples():
+    with pytest.raises(DatasetError, match="no rows"):
+        analyze_samples(_campaign_like_frame().iloc[:0])
+    with pytest.raises(DatasetError, match="lack the column"):
+        analyze_samples(_linear_frame())
+    with pytest.raises(ValueError, match="mape_threshold"):
+        analyze_samples(_campaign_like_frame(), mape_threshold=-1.0)
+
+
+def test_campaign_analysis_figures_writes_three_named_pngs(tmp_path):
+    result = analyze_samples(_campaign_like_frame())
+    paths = campaign_analysis_figures(
+        result,
+        tmp_path / "new",
+        correlation_png="a.png",
+        loadings_png="b.png",
+        parity_png="c.png",
+    )
+    assert paths == {
+        "correlation": tmp_path / "new" / "a.png",
+        "loadings": tmp_path / "new" / "b.png",
+        "parity": tmp_path / "new" / "c.png",
+    }
+    assert all(_is_png(path) for path in paths.values())
+    assert sorted(p.name for p in (tmp_path / "new").iterdir()) == ["a.png", "b.png", "c.png"]
 
 
 # ----------------------------------------------------------------------------- figures

@@ -10,7 +10,9 @@ Two views of the campaign samples (one row per design and pressure):
   standard deviations, per standard deviation of one input with the others
   held fixed. Each comes with its standard error, t-statistic and two-sided
   p-value; the fit comes with R², adjusted R², the overall F-test, and the
-  MAPE and RMSE of the fitted angle in degrees (Fig. 4c).
+  MAPE and RMSE of the fitted angle in degrees (Fig. 4c);
+* :func:`analyze_samples` — both of the above with the same features and
+  target, as one :class:`CampaignAnalysis` (what ``softbend analyze`` prints).
 
 Paper B reports, on its 29577 FEM samples, a pressure loading of 0.832, a top
 wall loading of −0.369, a bottom wall loading of −0.005, R² = 0.8893,
@@ -42,12 +44,13 @@ Modelling choices, stated once:
 
 Modules: :mod:`~softbend.analysis.samples` (default columns, cleaning),
 :mod:`~softbend.analysis.correlation`, :mod:`~softbend.analysis.ols` (z-scored
-least squares and its tests) and :mod:`~softbend.analysis.regression` (the
-report).
+least squares and its tests), :mod:`~softbend.analysis.regression` (the report)
+and :mod:`~softbend.analysis.campaign_analysis`.
 """
 
 from __future__ import annotations
 
+from softbend.analysis.campaign_analysis import CampaignAnalysis, analyze_samples
 from softbend.analysis.correlation import correlation_matrix
 from softbend.analysis.ols import significance_stars
 from softbend.analysis.regression import (
@@ -61,8 +64,10 @@ from softbend.metrics import thresholded_mape
 __all__ = [
     "DEFAULT_FEATURES",
     "DEFAULT_TARGET",
+    "CampaignAnalysis",
     "ConstantFeatureWarning",
     "RegressionReport",
+    "analyze_samples",
     "correlation_matrix",
     "significance_stars",
     "standardized_regression",

@@ -41,9 +41,9 @@ def analyze(
     coefficients.csv and correlation.csv into OUT.
     """
     from softbend._io import write_text_atomic
-    from softbend.analysis import correlation_matrix, standardized_regression
+    from softbend.analysis import analyze_samples
     from softbend.errors import DatasetError
-    from softbend.reports.analysis_figures import correlation_heatmap, loadings_bar, parity_plot
+    from softbend.reports.analysis_figures import campaign_analysis_figures
 
     if not db.exists():
         raise FileNotFoundError(f"Campaign database {str(db)!r} does not exist.")
@@ -58,26 +58,27 @@ def analyze(
     if len(samples) == 0:
         raise DatasetError(f"Campaign database {str(db)!r} holds no samples to analyze.")
 
-    report = standardized_regression(samples, mape_threshold=mape_threshold_deg)
-    corr = correlation_matrix(samples)
+    analysis = analyze_samples(samples, mape_threshold=mape_threshold_deg)
+    report, corr = analysis.regression, analysis.correlation
 
     with _common.output_errors(out, "--out"):
         out.mkdir(parents=True, exist_ok=True)
-        figures = {
-            "correlation": correlation_heatmap(corr, out / CORRELATION_PNG),
-            "loadings": loadings_bar(report, out / LOADINGS_PNG),
-            "parity": parity_plot(report, out / PARITY_PNG),
-        }
+        figures = campaign_analysis_figures(
+            analysis,
+            out,
+            correlation_png=CORRELATION_PNG,
+            loadings_png=LOADINGS_PNG,
+            parity_png=PARITY_PNG,
+        )
         tables = {"coefficients": out / COEFFICIENTS_CSV, "correlation": out / CORRELATION_CSV}
         write_text_atomic(tables["coefficients"], report.coefficients.to_csv(float_format="%.10g"))
         write_text_atomic(tables["correlation"], corr.to_csv(float_format="%.10g"))
 
     if json_output:
-        payload = report.to_dict()
+        payload = analysis.to_dict()
+        correlation = payload.pop("correlation")  # printed after "database", as before
         payload["database"] = str(db)
-        payload["correlation"] = {
-            str(row): {str(col): float(v) for col, v in corr.loc[row].items()} for row in corr.index
-        }
+        payload["correlation"] = correlation
         payload["files"] = {k: str(v) for k, v in {**figures, **tables}.items()}
         _common.print_json(payload)
         return

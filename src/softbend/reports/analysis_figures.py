@@ -4,7 +4,9 @@
 * :func:`loadings_bar` — standardized regression coefficients with
   significance stars (Fig. 4b);
 * :func:`parity_plot` — angle fitted by the linear model against the observed
-  angle (Fig. 4c).
+  angle (Fig. 4c);
+* :func:`campaign_analysis_figures` — the three of a
+  :class:`~softbend.analysis.CampaignAnalysis` into one folder.
 
 Each function draws on a matplotlib ``Figure`` with the Agg canvas (matplotlib
 imported inside the functions, pyplot's global figure registry never touched),
@@ -23,9 +25,15 @@ import numpy as np
 if TYPE_CHECKING:
     import pandas as pd
 
-    from softbend.analysis import RegressionReport
+    from softbend.analysis import CampaignAnalysis, RegressionReport
 
-__all__ = ["column_label", "correlation_heatmap", "loadings_bar", "parity_plot"]
+__all__ = [
+    "campaign_analysis_figures",
+    "column_label",
+    "correlation_heatmap",
+    "loadings_bar",
+    "parity_plot",
+]
 
 _DPI = 150
 
@@ -241,3 +249,37 @@ def parity_plot(report: RegressionReport, path: str | Path) -> Path:
     ax.legend(loc="upper left", fontsize=8, framealpha=0.9, markerscale=markerscale)
     ax.grid(alpha=0.3)
     return _save(fig, path)
+
+
+def campaign_analysis_figures(
+    analysis: CampaignAnalysis,
+    folder: str | Path,
+    *,
+    correlation_png: str = "correlation.png",
+    loadings_png: str = "loadings.png",
+    parity_png: str = "parity.png",
+) -> dict[str, Path]:
+    """Draw the three figures of paper B Fig. 4 of a campaign analysis into ``folder``.
+
+    Parameters
+    ----------
+    analysis : CampaignAnalysis
+        From :func:`softbend.analysis.analyze_samples`.
+    folder : str or pathlib.Path
+        Folder for the PNG files (created if missing).
+    correlation_png, loadings_png, parity_png : str
+        File names of :func:`correlation_heatmap`, :func:`loadings_bar` and
+        :func:`parity_plot`, drawn in this order.
+
+    Returns
+    -------
+    dict of str to pathlib.Path
+        The files written, under the keys ``"correlation"``, ``"loadings"`` and
+        ``"parity"``.
+    """
+    folder = Path(folder)
+    return {
+        "correlation": correlation_heatmap(analysis.correlation, folder / correlation_png),
+        "loadings": loadings_bar(analysis.regression, folder / loadings_png),
+        "parity": parity_plot(analysis.regression, folder / parity_png),
+    }
