@@ -25,6 +25,9 @@ Each model is exactly what it would be if trained alone (the tests check this):
 
 Gradients are computed by hand (three layers, closed form), not by autograd:
 that keeps memory at one set of activations and makes the masking explicit. The
+network, its gradients and Adam are :class:`~softbend.surrogates.batched_net.BatchedMLP`;
+the memory a pass needs is :mod:`~softbend.surrogates.batched_memory`'s, and the
+arguments are checked by :mod:`~softbend.surrogates.batched_checks`. The
 random streams come from NumPy (``numpy.random.SeedSequence``), so results do
 not depend on torch's global RNG state, and CPU runs with the same seed give
 identical weights.
@@ -34,7 +37,6 @@ from __future__ import annotations
 
 import logging
 import math
-import os
 import time
 from collections.abc import Callable, Iterator, Sequence
 from contextlib import contextmanager
@@ -46,8 +48,16 @@ from numpy.typing import ArrayLike
 from softbend._torch import require_torch
 from softbend._validation import check_int, check_range
 from softbend.errors import ConvergenceError
+from softbend.surrogates.batched_checks import (
+    check_data,
+    check_dtype,
+    check_hidden_sizes,
+    check_splits,
+)
+from softbend.surrogates.batched_epochs import MiniBatches, final_train_loss, run_epochs
+from softbend.surrogates.batched_memory import estimate_pass_bytes, models_per_pass
+from softbend.surrogates.batched_net import BatchedMLP
 from softbend.surrogates.mlp_core import (
-    check_hidden_pair,
     init_parameters,
     mlp_forward,
     model_rng,
@@ -66,260 +76,10 @@ __all__ = [
     "train_mlp_grid",
 ]
 
+#: The batched network, under the name this module gave it before it had its own module.
+_BatchedMLP = BatchedMLP
+
 _OWNER = "train_mlp_grid"
-_BETA1 = 0.9
-_BETA2 = 0.999
-_EPS = 1e-8
-_DTYPES = {"float32": torch.float32, "float64": torch.float64}
-
-
-# --- validation ------------------------------------------------------------------------
-
-
-def _check_dtype(dtype: object) -> torch.dtype:
-    if dtype in (torch.float32, torch.float64):
-        return dtype  # type: ignore[return-value]
-    if isinstance(dtype, str) and dtype in _DTYPES:
-        return _DTYPES[dtype]
-    raise ValueError(
-        f"The 'dtype' of {_OWNER} must be one of torch.float32, torch.float64. "
-        f"Got {dtype!r} instead."
-    )
-
-
-def _check_data(X: ArrayLike, y: ArrayLike) -> tuple[np.ndarray, np.ndarray]:
-    X = np.array(X, dtype=np.float64, copy=True)
-    y = np.array(y, dtype=np.float64, copy=True)
-    if X.ndim != 2 or X.shape[0] == 0 or X.shape[1] == 0:
-        raise ValueError(
-            f"The 'X' of {_OWNER} must be a non-empty 2-D array (n_samples, n_features). "
-            f"Got shape {X.shape} instead."
-        )
-    if y.shape != (X.shape[0],):
-        raise ValueError(
-            f"The 'y' of {_OWNER} must have shape ({X.shape[0]},) to match X. "
-            f"Got shape {y.shape} instead."
-        )
-    for name, array in (("X", X), ("y", y)):
-        bad = ~np.isfinite(array)
-        if bad.any():
-            first = int(np.flatnonzero(bad.ravel())[0])
-            raise ValueError(
-                f"The '{name}' of {_OWNER} must be finite (no NaN or inf). "
-                f"Got {array.ravel()[first]!r} at flat position {first}."
-            )
-    return X, y
-
-
-def _check_splits(splits: object, n_samples: int) -> list[tuple[np.ndarray, np.ndarray]]:
-    message = (
-        f"The 'splits' of {_OWNER} must be a non-empty list of (train_idx, val_idx) pairs of "
-        f"integer index arrays in [0, {n_samples}), train_idx non-empty."
-    )
-    try:
-        pairs = list(splits)  # type: ignore[call-overload]
-    except TypeError:
-        raise ValueError(f"{message} Got {type(splits).__name__} instead.") from None
-    if not pairs:
-        raise ValueError(f"{message} Got an empty list instead.")
-    checked = []
-    for k, pair in enumerate(pairs):
-        try:
-            train, val = pair
-        except (TypeError, ValueError):
-            raise ValueError(f"{message} Split {k} is {pair!r}.") from None
-        arrays = []
-        for part, idx in (("train", train), ("val", val)):
-            arr = np.asarray(idx)
-            if arr.size == 0:
-                arr = arr.astype(np.int64)
-            if arr.ndim != 1 or arr.dtype.kind not in "iu":
-                raise ValueError(
-                    f"{message} The {part} indices of split {k} have dtype {arr.dtype} "
-                    f"and shape {arr.shape}."
-                )
-            if arr.size and (arr.min() < 0 or arr.max() >= n_samples):
-                raise ValueError(
-                    f"{message} The {part} indices of split {k} span [{arr.min()}, {arr.max()}]."
-                )
-            arrays.append(arr.astype(np.int64))
-        if arrays[0].size == 0:
-            raise ValueError(f"{message} Split {k} has no training row.")
-        checked.append((arrays[0], arrays[1]))
-    return checked
-
-
-# --- per-model pieces -------------------------------------------------------------------
-
-
-# --- the batched network ----------------------------------------------------------------
-
-
-class _BatchedMLP:
-    """M padded two-hidden-layer tanh networks with hand-written backward pass and Adam.
-
-    Parameters are tensors ``W[l]`` of shape (M, fan_in, fan_out) and biases
-    ``b[l]`` of shape (M, 1, fan_out); ``mask1`` (M, 1, H1) and ``mask2`` (M, 1, H2)
-    are 1 for a model's real hidden units and 0 for padding.
-    """
-
-    def __init__(
-        self,
-        coefs: Sequence[Sequence[np.ndarray]],
-        intercepts: Sequence[Sequence[np.ndarray]],
-        h1_max: int,
-        h2_max: int,
-        *,
-        device: str,
-        dtype: torch.dtype,
-    ) -> None:
-        n_models = len(coefs)
-        d = coefs[0][0].shape[0]
-        shapes = ((d, h1_max), (h1_max, h2_max), (h2_max, 1))
-        W = [np.zeros((n_models, *s)) for s in shapes]
-        b = [np.zeros((n_models, 1, s[1])) for s in shapes]
-        mask1 = np.zeros((n_models, 1, h1_max))
-        mask2 = np.zeros((n_models, 1, h2_max))
-        for m in range(n_models):
-            for layer in range(3):
-                rows, cols = coefs[m][layer].shape
-                W[layer][m, :rows, :cols] = coefs[m][layer]
-                b[layer][m, 0, :cols] = intercepts[m][layer]
-            mask1[m, 0, : coefs[m][0].shape[1]] = 1.0
-            mask2[m, 0, : coefs[m][1].shape[1]] = 1.0
-
-        def tensor(a: np.ndarray) -> torch.Tensor:
-            return torch.tensor(a, dtype=dtype, device=device)
-
-        self.params = [tensor(W[0]), tensor(b[0]), tensor(W[1]), tensor(b[1])]
-        self.params += [tensor(W[2]), tensor(b[2])]
-        self.mask1, self.mask2 = tensor(mask1), tensor(mask2)
-        self.exp_avg = [torch.zeros_like(p) for p in self.params]
-        self.exp_avg_sq = [torch.zeros_like(p) for p in self.params]
-        self.steps = torch.zeros(n_models, dtype=torch.float64, device=device)
-
-    def forward(self, Z: torch.Tensor) -> tuple[torch.Tensor, torch.Tensor, torch.Tensor]:
-        """Hidden activations A1 (M, B, H1), A2 (M, B, H2) and output (M, B)."""
-        W1, b1, W2, b2, W3, b3 = self.params
-        A1 = torch.baddbmm(b1, Z, W1).tanh_().mul_(self.mask1)
-        A2 = torch.baddbmm(b2, A1, W2).tanh_().mul_(self.mask2)
-        out = torch.baddbmm(b3, A2, W3).squeeze(-1)
-        return A1, A2, out
-
-    def gradients(
-        self, Z: torch.Tensor, target: torch.Tensor, weight: torch.Tensor, count: torch.Tensor
-    ) -> tuple[list[torch.Tensor], torch.Tensor]:
-        """Gradients of each model's mean squared error and its sum of squared errors.
-
-        ``weight`` (M, B) is 1 for a real row and 0 for padding; ``count`` (M,) is the
-        model's number of real rows (clamped to >= 1).
-        """
-        W2, W3 = self.params[2], self.params[4]
-        A1, A2, out = self.forward(Z)
-        residual = (out - target).mul_(weight)
-        sse = (residual * residual).sum(dim=1)
-        G = residual.mul_((2.0 / count).unsqueeze(1)).unsqueeze(-1)  # (M, B, 1)
-        gW3 = torch.bmm(A2.transpose(1, 2), G)
-        gb3 = G.sum(dim=1, keepdim=True)
-        dP2 = G * (W3.transpose(1, 2) * self.mask2)  # (M, B, H2); zero on padded units
-        dP2.mul_(torch.square(A2).neg_().add_(1.0))
-        gW2 = torch.bmm(A1.transpose(1, 2), dP2)
-        gb2 = dP2.sum(dim=1, keepdim=True)
-        dP1 = torch.bmm(dP2, (W2 * self.mask1.transpose(1, 2)).transpose(1, 2))
-        dP1.mul_(torch.square(A1).neg_().add_(1.0))
-        gW1 = torch.bmm(Z.transpose(1, 2), dP1)
-        gb1 = dP1.sum(dim=1, keepdim=True)
-        return [gW1, gb1, gW2, gb2, gW3, gb3], sse
-
-    def adam_step(self, grads: list[torch.Tensor], active: torch.Tensor, lr: float) -> None:
-        """One Adam update (torch.optim.Adam's formula) of the active models only."""
-        self.steps += active.to(torch.float64)
-        steps = self.steps.clamp(min=1.0)
-        step_size = lr / (1.0 - _BETA1**steps)
-        bc2_sqrt = torch.sqrt(1.0 - _BETA2**steps)
-        dtype = self.params[0].dtype
-        keep = active.view(-1, 1, 1)
-        step_size = step_size.to(dtype).view(-1, 1, 1)
-        bc2_sqrt = bc2_sqrt.to(dtype).view(-1, 1, 1)
-        for p, m, v, g in zip(self.params, self.exp_avg, self.exp_avg_sq, grads, strict=True):
-            m_new = torch.lerp(m, g, 1.0 - _BETA1)
-            v_new = (v * _BETA2).addcmul_(g, g, value=1.0 - _BETA2)
-            denom = (v_new.sqrt() / bc2_sqrt).add_(_EPS)
-            p_new = p - step_size * m_new / denom
-            m.copy_(torch.where(keep, m_new, m))
-            v.copy_(torch.where(keep, v_new, v))
-            p.copy_(torch.where(keep, p_new, p))
-
-    def extract(self, m: int, h1: int, h2: int) -> tuple[list[np.ndarray], list[np.ndarray]]:
-        """Model ``m``'s parameters, unpadded, as float64 arrays (contract shapes)."""
-        W1, b1, W2, b2, W3, b3 = (p[m].detach().to("cpu", torch.float64) for p in self.params)
-        coefs = [W1[:, :h1].numpy().copy(), W2[:h1, :h2].numpy().copy()]
-        coefs.append(W3[:h2, :].numpy().copy())
-        intercepts = [b1[0, :h1].numpy().copy(), b2[0, :h2].numpy().copy()]
-        intercepts.append(b3[0, :].numpy().copy())
-        return coefs, intercepts
-
-
-# --- memory -----------------------------------------------------------------------------
-
-
-def estimate_pass_bytes(
-    n_models: int,
-    n_features: int,
-    h1_max: int,
-    h2_max: int,
-    batch_size: int,
-    n_rows_max: int,
-    itemsize: int = 4,
-) -> int:
-    """Rough peak memory of one training pass of :func:`train_mlp_grid`, bytes.
-
-    Counts parameters with their gradients, Adam moments and update temporaries,
-    the activations and backward temporaries of one (M, B, ·) mini-batch, the
-    gathered float64 inputs and the per-epoch (M, n_rows_max) row-index table,
-    plus 25 % for allocator slack.
-
-    Parameters
-    ----------
-    n_models : int
-        Models trained at once (M).
-    n_features : int
-        Inputs per sample (d).
-    h1_max, h2_max : int
-        Padded hidden layer sizes.
-    batch_size : int
-        Rows per mini-batch (B).
-    n_rows_max : int
-        Largest training set of the models, rows.
-    itemsize : int
-        Bytes per training float (4 for float32, 8 for float64).
-
-    Returns
-    -------
-    int
-        Estimated bytes.
-    """
-    n_params = n_features * h1_max + h1_max + h1_max * h2_max + 2 * h2_max + 1
-    params = 8 * n_models * n_params * itemsize
-    rows = n_models * batch_size
-    activations = rows * (4 * (h1_max + h2_max) + n_features + 4) * itemsize
-    gathered = rows * (2 * n_features + 2) * 8
-    n_cols = math.ceil(n_rows_max / batch_size) * batch_size
-    index = n_models * n_cols * (2 * 8 + itemsize)
-    return int(1.25 * (params + activations + gathered + index))
-
-
-def _available_bytes(device: str) -> int:
-    if device == "cuda":
-        return int(torch.cuda.mem_get_info()[0])
-    try:
-        with open("/proc/meminfo", encoding="ascii") as handle:
-            for line in handle:
-                if line.startswith("MemAvailable:"):
-                    return int(line.split()[1]) * 1024
-    except OSError:
-        pass
-    return int(os.sysconf("SC_PAGE_SIZE") * os.sysconf("SC_AVPHYS_PAGES"))
 
 
 # --- results ----------------------------------------------------------------------------
@@ -441,6 +201,20 @@ class _Job:
     val_idx: np.ndarray
 
 
+@dataclass(frozen=True)
+class _PassSettings:
+    """The training settings every pass of one :func:`train_mlp_grid` call shares."""
+
+    h1_max: int
+    h2_max: int
+    epochs: int
+    batch_size: int
+    learning_rate: float
+    seed: int
+    device: str
+    dtype: torch.dtype
+
+
 @contextmanager
 def _cpu_settings(num_threads: int | None) -> Iterator[None]:
     """Torch intra-op threads (if given) and flush-to-zero of subnormal floats while training.
@@ -532,23 +306,15 @@ def train_mlp_grid(
     ConvergenceError
         If a model's parameters became non-finite.
     """
-    X, y = _check_data(X, y)
-    split_list = _check_splits(splits, X.shape[0])
-    try:
-        configs = [check_hidden_pair(h, "hidden_sizes", _OWNER) for h in hidden_sizes]
-    except TypeError:
-        configs = []
-    if not configs:
-        raise ValueError(
-            f"The 'hidden_sizes' of {_OWNER} must be a non-empty list of (h1, h2) pairs of "
-            f"positive integers. Got {hidden_sizes!r} instead."
-        )
+    X, y = check_data(X, y)
+    split_list = check_splits(splits, X.shape[0])
+    configs = check_hidden_sizes(hidden_sizes)
     epochs = check_int(epochs, "epochs", _OWNER, low=1)
     batch_size = check_int(batch_size, "batch_size", _OWNER, low=1)
     learning_rate = check_range(learning_rate, "learning_rate", _OWNER, low=0.0, high=math.inf)
     seed = check_int(seed, "seed", _OWNER, low=0)
     device = resolve_device(device)
-    dtype = _check_dtype(dtype)
+    dtype = check_dtype(dtype)
     if progress is not None and not callable(progress):
         raise ValueError(
             f"The 'progress' of {_OWNER} must be a callable or None. Got {progress!r} instead."
@@ -565,64 +331,34 @@ def train_mlp_grid(
         for c, (h1, h2) in enumerate(configs)
         for s, (train, val) in enumerate(split_list)
     ]
-    n_models = len(jobs)
-    h1_max = max(h1 for h1, _ in configs)
-    h2_max = max(h2 for _, h2 in configs)
-    per_pass = n_models if max_models_per_pass is None else min(max_models_per_pass, n_models)
-    itemsize = torch.empty((), dtype=dtype).element_size()
-    n_rows_max = max(job.train_idx.size for job in jobs)
-    budget = 0.8 * _available_bytes(device) if max_memory_mb is None else max_memory_mb * 1024.0**2
-
-    def need(count: int) -> int:
-        return estimate_pass_bytes(
-            count, X.shape[1], h1_max, h2_max, batch_size, n_rows_max, itemsize
-        )
-
-    if need(per_pass) > budget:
-        fitting = [k for k in range(per_pass, 0, -1) if need(k) <= budget][:1]
-        hint = (
-            f"set 'max_models_per_pass' of {_OWNER} to {fitting[0]} or fewer"
-            if fitting
-            else "even one model does not fit: lower 'batch_size'"
-        )
-        raise ValueError(
-            f"Training {per_pass} MLPs at once needs about {need(per_pass) / 1024**2:.3g} MB "
-            f"on {device}, more than the {budget / 1024**2:.3g} MB allowed; {hint} "
-            f"(train fewer configurations at a time)."
-        )
-
+    settings = _PassSettings(
+        h1_max=max(h1 for h1, _ in configs),
+        h2_max=max(h2 for _, h2 in configs),
+        epochs=epochs,
+        batch_size=batch_size,
+        learning_rate=learning_rate,
+        seed=seed,
+        device=device,
+        dtype=dtype,
+    )
+    per_pass = models_per_pass(
+        len(jobs),
+        X.shape[1],
+        settings.h1_max,
+        settings.h2_max,
+        batch_size,
+        max(job.train_idx.size for job in jobs),
+        device=device,
+        dtype=dtype,
+        max_models_per_pass=max_models_per_pass,
+        max_memory_mb=max_memory_mb,
+        owner=_OWNER,
+    )
     X_dev = torch.tensor(X, dtype=torch.float64, device=device)
     y_dev = torch.tensor(y, dtype=torch.float64, device=device)
-    n_passes = math.ceil(n_models / per_pass)
-    trained: list[TrainedMLP] = []
     start = time.perf_counter()
     with _cpu_settings(num_threads):
-        for p in range(n_passes):
-            chunk = jobs[p * per_pass : (p + 1) * per_pass]
-            logger.debug(
-                "%s: pass %d/%d, %d models on %s", _OWNER, p + 1, n_passes, len(chunk), device
-            )
-
-            def report(epoch: int, pass_index: int = p) -> None:
-                if progress is not None:
-                    progress(pass_index * epochs + epoch, n_passes * epochs)
-
-            trained += _train_pass(
-                chunk,
-                X,
-                y,
-                X_dev,
-                y_dev,
-                h1_max=h1_max,
-                h2_max=h2_max,
-                epochs=epochs,
-                batch_size=batch_size,
-                learning_rate=learning_rate,
-                seed=seed,
-                device=device,
-                dtype=dtype,
-                report=report,
-            )
+        trained = _train_in_passes(jobs, X, y, X_dev, y_dev, per_pass, settings, progress)
     elapsed = time.perf_counter() - start
     return GridTrainingResult(
         models=tuple(trained),
@@ -634,9 +370,37 @@ def train_mlp_grid(
         seed=seed,
         device=device,
         dtype=str(dtype).removeprefix("torch."),
-        n_passes=n_passes,
+        n_passes=math.ceil(len(jobs) / per_pass),
         elapsed_s=elapsed,
     )
+
+
+def _train_in_passes(
+    jobs: list[_Job],
+    X: np.ndarray,
+    y: np.ndarray,
+    X_dev: torch.Tensor,
+    y_dev: torch.Tensor,
+    per_pass: int,
+    settings: _PassSettings,
+    progress: Callable[[int, int], object] | None,
+) -> list[TrainedMLP]:
+    """Train ``jobs`` ``per_pass`` at a time, calling ``progress`` after every epoch."""
+    n_passes = math.ceil(len(jobs) / per_pass)
+    epochs = settings.epochs
+    trained: list[TrainedMLP] = []
+    for p in range(n_passes):
+        chunk = jobs[p * per_pass : (p + 1) * per_pass]
+        logger.debug(
+            "%s: pass %d/%d, %d models on %s", _OWNER, p + 1, n_passes, len(chunk), settings.device
+        )
+
+        def report(epoch: int, pass_index: int = p) -> None:
+            if progress is not None:
+                progress(pass_index * epochs + epoch, n_passes * epochs)
+
+        trained += _train_pass(chunk, X, y, X_dev, y_dev, settings, report)
+    return trained
 
 
 def _train_pass(
@@ -645,93 +409,35 @@ def _train_pass(
     y: np.ndarray,
     X_dev: torch.Tensor,
     y_dev: torch.Tensor,
-    *,
-    h1_max: int,
-    h2_max: int,
-    epochs: int,
-    batch_size: int,
-    learning_rate: float,
-    seed: int,
-    device: str,
-    dtype: torch.dtype,
+    settings: _PassSettings,
     report: Callable[[int], None],
 ) -> list[TrainedMLP]:
     """Train one group of models together and collect their results."""
-    n_models, d, B = len(jobs), X.shape[1], batch_size
-    rngs = [model_rng(seed, job.h1, job.h2, job.split_index) for job in jobs]
-    coefs, intercepts, x_stats, y_stats = [], [], [], []
-    for job, rng in zip(jobs, rngs, strict=True):
-        c, b = init_parameters(rng, d, job.h1, job.h2)
-        coefs.append(c)
-        intercepts.append(b)
-        x_stats.append(standardization(X[job.train_idx]))
-        y_mean, y_scale = standardization(y[job.train_idx])
-        y_stats.append((float(y_mean), float(y_scale)))
-    net = _BatchedMLP(coefs, intercepts, h1_max, h2_max, device=device, dtype=dtype)
-
-    x_mean = torch.tensor(np.stack([s[0] for s in x_stats])[:, None, :], device=device)
-    x_scale = torch.tensor(np.stack([s[1] for s in x_stats])[:, None, :], device=device)
-    y_mean = torch.tensor([[s[0]] for s in y_stats], dtype=torch.float64, device=device)
-    y_scale = torch.tensor([[s[1]] for s in y_stats], dtype=torch.float64, device=device)
-
-    n_train = np.array([job.train_idx.size for job in jobs])
-    n_steps = math.ceil(n_train.max() / B)
-    n_cols = n_steps * B
-    valid = torch.tensor(np.arange(n_cols)[None, :] < n_train[:, None], dtype=dtype, device=device)
-    # rows of step s for model m: min(B, n_m - s*B), 0 once the model's epoch is over
-    counts_np = np.clip(n_train[None, :] - B * np.arange(n_steps)[:, None], 0, B)
-    counts = torch.tensor(counts_np, dtype=dtype, device=device)
-    actives = torch.tensor(counts_np > 0, device=device)
-    counts = counts.clamp(min=1.0)
-    losses = torch.zeros((epochs, n_models), dtype=torch.float64, device=device)
-    n_train_dev = torch.tensor(n_train, dtype=torch.float64, device=device)
-
-    def batch(rows: torch.Tensor) -> tuple[torch.Tensor, torch.Tensor]:
-        Z = ((X_dev[rows] - x_mean) / x_scale).to(dtype)
-        target = ((y_dev[rows] - y_mean) / y_scale).to(dtype)
-        return Z, target
-
-    order = np.zeros((n_models, n_cols), dtype=np.int64)
+    rngs = [model_rng(settings.seed, job.h1, job.h2, job.split_index) for job in jobs]
+    net, x_stats, y_stats = _init_models(jobs, rngs, X, y, settings)
+    batches = MiniBatches.build(
+        [job.train_idx for job in jobs],
+        x_stats,
+        y_stats,
+        X_dev,
+        y_dev,
+        batch_size=settings.batch_size,
+        device=settings.device,
+        dtype=settings.dtype,
+    )
     with torch.no_grad():
-        for epoch in range(epochs):
-            for m, (job, rng) in enumerate(zip(jobs, rngs, strict=True)):
-                order[m, : job.train_idx.size] = job.train_idx[rng.permutation(job.train_idx.size)]
-            rows_all = torch.from_numpy(order).to(device)
-            sse_epoch = torch.zeros(n_models, dtype=torch.float64, device=device)
-            for s in range(n_steps):
-                cols = slice(s * B, (s + 1) * B)
-                Z, target = batch(rows_all[:, cols])
-                grads, sse = net.gradients(Z, target, valid[:, cols], counts[s])
-                net.adam_step(grads, actives[s], learning_rate)
-                sse_epoch += sse.to(torch.float64)
-            losses[epoch] = sse_epoch / n_train_dev
-            report(epoch + 1)
-
-        # final training loss of every model, on all its rows in their natural order
-        for m, job in enumerate(jobs):
-            order[m, : job.train_idx.size] = job.train_idx
-        rows_all = torch.from_numpy(order).to(device)
-        sse_final = torch.zeros(n_models, dtype=torch.float64, device=device)
-        for s in range(n_steps):
-            cols = slice(s * B, (s + 1) * B)
-            Z, target = batch(rows_all[:, cols])
-            out = net.forward(Z)[2]
-            residual = (out - target) * valid[:, cols]
-            sse_final += (residual * residual).sum(dim=1).to(torch.float64)
-        finite = torch.ones(n_models, dtype=torch.bool, device=device)
-        for param in net.params:
-            finite &= torch.isfinite(param).flatten(1).all(dim=1)
-
-    bad = np.flatnonzero(~finite.cpu().numpy())
-    if bad.size:
-        which = ", ".join(
-            f"hidden_sizes={(jobs[m].h1, jobs[m].h2)} split={jobs[m].split_index}" for m in bad[:5]
+        losses = run_epochs(
+            net,
+            batches,
+            rngs,
+            epochs=settings.epochs,
+            learning_rate=settings.learning_rate,
+            report=report,
         )
-        raise ConvergenceError(
-            f"Adam produced non-finite MLP weights for {bad.size} model(s) ({which}); "
-            "lower 'learning_rate' or check the scaling of X and y."
-        )
-    train_loss = (sse_final / n_train_dev).cpu().numpy()
+        final_loss = final_train_loss(net, batches)
+        _check_finite(net, jobs)
+
+    train_loss = final_loss.cpu().numpy()
     loss_curves = losses.cpu().numpy()
     results = []
     for m, job in enumerate(jobs):
@@ -757,3 +463,51 @@ def _train_pass(
             )
         )
     return results
+
+
+def _init_models(
+    jobs: list[_Job],
+    rngs: list[np.random.Generator],
+    X: np.ndarray,
+    y: np.ndarray,
+    settings: _PassSettings,
+) -> tuple[BatchedMLP, list[tuple[np.ndarray, np.ndarray]], list[tuple[float, float]]]:
+    """The batched network with each model's initial weights, and each model's standardization.
+
+    Each model draws its weights from its own stream and is standardized with the
+    mean and standard deviation of its own training rows.
+    """
+    d = X.shape[1]
+    coefs, intercepts, x_stats, y_stats = [], [], [], []
+    for job, rng in zip(jobs, rngs, strict=True):
+        c, b = init_parameters(rng, d, job.h1, job.h2)
+        coefs.append(c)
+        intercepts.append(b)
+        x_stats.append(standardization(X[job.train_idx]))
+        y_mean, y_scale = standardization(y[job.train_idx])
+        y_stats.append((float(y_mean), float(y_scale)))
+    net = BatchedMLP(
+        coefs,
+        intercepts,
+        settings.h1_max,
+        settings.h2_max,
+        device=settings.device,
+        dtype=settings.dtype,
+    )
+    return net, x_stats, y_stats
+
+
+def _check_finite(net: BatchedMLP, jobs: list[_Job]) -> None:
+    """Raise :class:`ConvergenceError` naming the models whose parameters are not finite."""
+    finite = torch.ones(len(jobs), dtype=torch.bool, device=net.params[0].device)
+    for param in net.params:
+        finite &= torch.isfinite(param).flatten(1).all(dim=1)
+    bad = np.flatnonzero(~finite.cpu().numpy())
+    if bad.size:
+        which = ", ".join(
+            f"hidden_sizes={(jobs[m].h1, jobs[m].h2)} split={jobs[m].split_index}" for m in bad[:5]
+        )
+        raise ConvergenceError(
+            f"Adam produced non-finite MLP weights for {bad.size} model(s) ({which}); "
+            "lower 'learning_rate' or check the scaling of X and y."
+        )

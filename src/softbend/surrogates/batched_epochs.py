@@ -1,0 +1,180 @@
+"""The epochs of one batched training pass: mini-batch tables, Adam steps, final loss.
+
+:class:`MiniBatches` holds the row tables of M models that each train on their
+own rows: model m's rows fill the first ``n_m`` columns of an (M, n_steps * B)
+table, the rest is padding with weight 0. :func:`run_epochs` trains a
+:class:`~softbend.surrogates.batched_net.BatchedMLP` on them; every epoch each
+model visits its rows in the order its own random stream draws, and a model whose
+epoch has run out of mini-batches is not updated. :func:`final_train_loss` is
+each model's MSE on all its rows afterwards.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Callable
+from dataclasses import dataclass
+
+import numpy as np
+
+from softbend._torch import require_torch
+from softbend.surrogates.batched_net import BatchedMLP
+
+torch = require_torch("the MLP surrogate (softbend.surrogates)")
+
+__all__ = ["MiniBatches", "final_train_loss", "run_epochs"]
+
+
+@dataclass(frozen=True)
+class MiniBatches:
+    """The standardized mini-batches of one pass of M models, each over its own rows.
+
+    The row table has shape (M, n_steps * batch_size): model m's rows fill its first
+    ``n_train[m]`` columns. ``valid`` (M, columns) is 1 on those and 0 on padding;
+    ``counts[s]`` (M,) is each model's rows in step s, clamped to >= 1, and
+    ``actives[s]`` whether it has any (once a model's epoch is over, it is not updated).
+    """
+
+    X_dev: torch.Tensor
+    y_dev: torch.Tensor
+    x_mean: torch.Tensor
+    x_scale: torch.Tensor
+    y_mean: torch.Tensor
+    y_scale: torch.Tensor
+    valid: torch.Tensor
+    counts: torch.Tensor
+    actives: torch.Tensor
+    n_train: torch.Tensor
+    n_steps: int
+    batch_size: int
+    device: str
+    dtype: torch.dtype
+    order: np.ndarray
+    train_idx: list[np.ndarray]
+
+    @classmethod
+    def build(
+        cls,
+        train_idx: list[np.ndarray],
+        x_stats: list[tuple[np.ndarray, np.ndarray]],
+        y_stats: list[tuple[float, float]],
+        X_dev: torch.Tensor,
+        y_dev: torch.Tensor,
+        *,
+        batch_size: int,
+        device: str,
+        dtype: torch.dtype,
+    ) -> MiniBatches:
+        """The tables of models training on ``train_idx`` (rows of ``X_dev``), one per model.
+
+        Parameters
+        ----------
+        train_idx : list of ndarray of int
+            Each model's training rows.
+        x_stats, y_stats : list
+            Each model's input (mean, scale) arrays and target (mean, scale).
+        X_dev, y_dev : torch.Tensor
+            All inputs and targets, float64, on ``device``.
+        batch_size : int
+            Rows per mini-batch.
+        device : str
+            "cpu" or "cuda".
+        dtype : torch.dtype
+            Training precision of the batches.
+        """
+        B = batch_size
+        x_mean = torch.tensor(np.stack([s[0] for s in x_stats])[:, None, :], device=device)
+        x_scale = torch.tensor(np.stack([s[1] for s in x_stats])[:, None, :], device=device)
+        y_mean = torch.tensor([[s[0]] for s in y_stats], dtype=torch.float64, device=device)
+        y_scale = torch.tensor([[s[1]] for s in y_stats], dtype=torch.float64, device=device)
+
+        n_train = np.array([idx.size for idx in train_idx])
+        n_steps = math.ceil(n_train.max() / B)
+        n_cols = n_steps * B
+        valid = torch.tensor(
+            np.arange(n_cols)[None, :] < n_train[:, None], dtype=dtype, device=device
+        )
+        # rows of step s for model m: min(B, n_m - s*B), 0 once the model's epoch is over
+        counts_np = np.clip(n_train[None, :] - B * np.arange(n_steps)[:, None], 0, B)
+        counts = torch.tensor(counts_np, dtype=dtype, device=device)
+        actives = torch.tensor(counts_np > 0, device=device)
+        return cls(
+            X_dev=X_dev,
+            y_dev=y_dev,
+            x_mean=x_mean,
+            x_scale=x_scale,
+            y_mean=y_mean,
+            y_scale=y_scale,
+            valid=valid,
+            counts=counts.clamp(min=1.0),
+            actives=actives,
+            n_train=torch.tensor(n_train, dtype=torch.float64, device=device),
+            n_steps=n_steps,
+            batch_size=B,
+            device=device,
+            dtype=dtype,
+            order=np.zeros((len(train_idx), n_cols), dtype=np.int64),
+            train_idx=list(train_idx),
+        )
+
+    def rows(self, rngs: list[np.random.Generator] | None = None) -> torch.Tensor:
+        """The row table: each model's training rows, shuffled by its stream if ``rngs``."""
+        for m, idx in enumerate(self.train_idx):
+            if rngs is None:
+                self.order[m, : idx.size] = idx
+            else:
+                self.order[m, : idx.size] = idx[rngs[m].permutation(idx.size)]
+        return torch.from_numpy(self.order).to(self.device)
+
+    def step(
+        self, rows_all: torch.Tensor, s: int
+    ) -> tuple[torch.Tensor, torch.Tensor, torch.Tensor]:
+        """Standardized inputs (M, B, d), target (M, B) and row weights (M, B) of step ``s``."""
+        cols = slice(s * self.batch_size, (s + 1) * self.batch_size)
+        rows = rows_all[:, cols]
+        Z = ((self.X_dev[rows] - self.x_mean) / self.x_scale).to(self.dtype)
+        target = ((self.y_dev[rows] - self.y_mean) / self.y_scale).to(self.dtype)
+        return Z, target, self.valid[:, cols]
+
+
+def run_epochs(
+    net: BatchedMLP,
+    batches: MiniBatches,
+    rngs: list[np.random.Generator],
+    *,
+    epochs: int,
+    learning_rate: float,
+    report: Callable[[int], None],
+) -> torch.Tensor:
+    """Train ``epochs`` epochs; the training MSE of each, (epochs, M), standardized units.
+
+    Every epoch each model visits its own training rows once, in the order its own
+    stream draws; the loss of an epoch sums the squared errors of its mini-batches
+    (before the update that used them) over the model's training rows.
+    """
+    n_models = len(batches.train_idx)
+    device = batches.device
+    losses = torch.zeros((epochs, n_models), dtype=torch.float64, device=device)
+    for epoch in range(epochs):
+        rows_all = batches.rows(rngs)
+        sse_epoch = torch.zeros(n_models, dtype=torch.float64, device=device)
+        for s in range(batches.n_steps):
+            Z, target, valid = batches.step(rows_all, s)
+            grads, sse = net.gradients(Z, target, valid, batches.counts[s])
+            net.adam_step(grads, batches.actives[s], learning_rate)
+            sse_epoch += sse.to(torch.float64)
+        losses[epoch] = sse_epoch / batches.n_train
+        report(epoch + 1)
+    return losses
+
+
+def final_train_loss(net: BatchedMLP, batches: MiniBatches) -> torch.Tensor:
+    """MSE of every model on all its training rows in their natural order, standardized units."""
+    rows_all = batches.rows()
+    sse_final = torch.zeros(len(batches.train_idx), dtype=torch.float64, device=batches.device)
+    for s in range(batches.n_steps):
+        Z, target, valid = batches.step(rows_all, s)
+        out = net.forward(Z)[2]
+        residual = (out - target) * valid
+        sse_final += (residual * residual).sum(dim=1).to(torch.float64)
+    return sse_final / batches.n_train
