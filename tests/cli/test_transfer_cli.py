@@ -172,10 +172,25 @@ def test_unknown_strategy_and_bad_out_are_refused_before_work(
             "--out",
             str(tmp_path / "m.json"),
             "--strategy",
-            "residual-gp",
+            "analytical",
         ]
     )
     assert code == 2 and "'strategy'" in one_error_line(capsys)
+    code = main(
+        [
+            "transfer",
+            "refine",
+            str(small_base_file),
+            str(lab_csv),
+            "--out",
+            str(tmp_path / "m.json"),
+            "--strategy",
+            "residual-gp",
+            "--epochs",
+            "5",
+        ]
+    )
+    assert code == 2 and "--epochs" in one_error_line(capsys)
 
 
 def test_transfer_base_and_refine_bad_input_is_one_line(tmp_path, capsys, small_base_file, lab_csv):
@@ -203,3 +218,37 @@ def test_transfer_base_and_refine_bad_input_is_one_line(tmp_path, capsys, small_
         ]
     )
     assert code == 2 and "nobase.json" in one_error_line(capsys)
+
+
+@pytest.mark.parametrize(
+    ("strategy", "options", "interval"),
+    [
+        ("experimental", ["--epochs", "20"], False),
+        ("scale-offset", [], True),
+        ("residual-gp", [], True),
+        ("refined-ensemble", ["--epochs", "20"], True),
+    ],
+)
+def test_every_refine_strategy_saves_a_model_that_predicts(
+    strategy, options, interval, lab_csv, tmp_path, capsys, small_base_file
+):
+    model = tmp_path / f"{strategy}.json"
+    argv = ["transfer", "refine", str(small_base_file), str(lab_csv), "--out", str(model)]
+    assert main([*argv, "--strategy", strategy, *options]) == 0
+    capsys.readouterr()
+    saved = json.loads(model.read_text())
+    assert saved["metadata"]["strategy"] == strategy
+    assert saved["metadata"]["training_rmse_deg"] >= 0.0
+    argv = ["predict", str(model), "--design", "100,6,2,2,5,8", "--pressure", "0,0.05", "--json"]
+    assert main(argv) == 0
+    result = json.loads(capsys.readouterr().out)
+    assert ("interval_low_deg" in result) is interval
+    if interval:
+        low, high, angle = (
+            result[k] for k in ("interval_low_deg", "interval_high_deg", "angle_deg")
+        )
+        assert all(lo < a < hi for lo, a, hi in zip(low, angle, high, strict=True))
+        assert result["interval_level"] == 0.9
+        # The table shows the interval too.
+        assert main(["predict", str(model), "--design", "100,6,2,2,5,8", "--pressure", "0.05"]) == 0
+        assert "90% interval" in capsys.readouterr().out

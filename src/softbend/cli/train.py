@@ -157,7 +157,7 @@ def predict(
     surrogate extrapolates without knowing it.
     """
     from softbend.design import SFRBADesign
-    from softbend.surrogates.predict import predict_angles
+    from softbend.surrogates.predict import INTERVAL_LEVEL, predict_angles
 
     values = _floats(design, "design")
     if len(values) != 6:
@@ -177,20 +177,26 @@ def predict(
             f"{model} was not trained there: {'; '.join(outside)}; the prediction is an "
             "extrapolation (--strict refuses)."
         )
+    interval = result.interval_deg
     if as_json:
-        _common.print_json(
-            {
-                "model": str(model),
-                "kind": result.kind,
-                "design": checked.as_dict(),
-                "pressure_mpa": pressures.tolist(),
-                "angle_deg": angles.tolist(),
-                "outside_training_ranges": outside,
-            }
-        )
+        payload = {
+            "model": str(model),
+            "kind": result.kind,
+            "design": checked.as_dict(),
+            "pressure_mpa": pressures.tolist(),
+            "angle_deg": angles.tolist(),
+            "outside_training_ranges": outside,
+        }
+        if interval is not None:
+            payload["interval_level"] = INTERVAL_LEVEL
+            payload["interval_low_deg"] = interval[0].tolist()
+            payload["interval_high_deg"] = interval[1].tolist()
+        _common.print_json(payload)
         return
-    _common.print_table(
-        f"{result.kind} surrogate, design {checked.design_id}",
-        ["pressure (MPa)", "angle (°)"],
-        [[f"{p:g}", f"{a:.2f}"] for p, a in zip(pressures, angles, strict=True)],
-    )
+    columns = ["pressure (MPa)", "angle (°)"]
+    rows = [[f"{p:g}", f"{a:.2f}"] for p, a in zip(pressures, angles, strict=True)]
+    if interval is not None:
+        columns.append(f"{INTERVAL_LEVEL:.0%} interval (°)")
+        for row, low, high in zip(rows, *interval, strict=True):
+            row.append(f"{low:.2f} to {high:.2f}")
+    _common.print_table(f"{result.kind} surrogate, design {checked.design_id}", columns, rows)

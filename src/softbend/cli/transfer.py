@@ -221,22 +221,45 @@ def print_loco_summary(result: LocoResult) -> None:
     )
 
 
+#: Strategies that ``transfer refine`` fits and saves (the baselines learn nothing).
+REFINE_STRATEGIES: tuple[str, ...] = (
+    "refined",
+    "experimental",
+    "scale-offset",
+    "residual-gp",
+    "refined-ensemble",
+)
+
+
 @app.command("refine")
 def refine(
     base: Path = typer.Argument(..., help="Saved surrogate to start from (an mlp for 'refined')."),
     measurements: Path = typer.Argument(..., help="Measurements CSV."),
     out: Path = typer.Option(..., "--out", help="File for the refined model (JSON)."),
-    strategy: str = typer.Option("refined", help="Strategy: refined or experimental."),
-    epochs: int | None = typer.Option(None, help="Epochs (default: the strategy's)."),
+    strategy: str = typer.Option("refined", help=f"Strategy: {', '.join(REFINE_STRATEGIES)}."),
+    epochs: int | None = typer.Option(
+        None, help="Epochs of the MLP strategies (default: the strategy's)."
+    ),
     seed: int = typer.Option(0, help="Seed of the training."),
 ) -> None:
-    """Fit a strategy on all measurements and save it like the other surrogates."""
+    """Fit a strategy on all measurements and save it like the other surrogates.
+
+    The saved model plugs into ``softbend predict``; the strategies with
+    intervals (scale-offset, residual-gp, refined-ensemble) save them too.
+    """
+    import numpy as np
+
     from softbend._validation import check_choice
     from softbend.surrogates.persistence import save_surrogate
     from softbend.transfer.measurements import load_measurements
     from softbend.transfer.strategies import fit_strategy
 
-    check_choice(strategy, "strategy", "softbend transfer refine", ("refined", "experimental"))
+    check_choice(strategy, "strategy", "softbend transfer refine", REFINE_STRATEGIES)
+    if epochs is not None and strategy not in ("refined", "experimental", "refined-ensemble"):
+        raise ValueError(
+            f"The '--epochs' option applies to the MLP strategies (refined, experimental, "
+            f"refined-ensemble); {strategy!r} trains no network."
+        )
     _common.check_output_file(out, "--out", inputs=(base, measurements), kind="json")
     data = load_measurements(measurements)
     from softbend.surrogates.features import training_ranges
@@ -245,7 +268,7 @@ def refine(
     start = load_surrogate(base)
     model = fit_strategy(strategy, start.model, data, seed=seed, epochs=epochs)
     ranges = training_ranges(data.features)
-    if strategy == "refined" and isinstance(start.metadata.get("training_ranges"), dict):
+    if strategy != "experimental" and isinstance(start.metadata.get("training_ranges"), dict):
         ranges = {  # the base's simulations and the measurements
             k: [
                 min(v[0], start.metadata["training_ranges"][k][0]),
@@ -253,22 +276,22 @@ def refine(
             ]
             for k, v in ranges.items()
         }
-    path = save_surrogate(
-        model.model_,
-        out,
-        metadata={
-            "strategy": strategy,
-            "base": str(base),
-            "measurements": str(measurements),
-            "n_measurements": len(data),
-            "actuators": list(data.actuator_ids),
-            "synthetic_measurements": str(data.metadata.get("synthetic", "false")),
-            "final_training_mse_deg2": float(model.loss_curve_[-1]),
-            "training_ranges": ranges,
-        },
-    )
+    residual = data.angle_deg - model.predict(data.features)
+    metadata = {
+        "strategy": strategy,
+        "base": str(base),
+        "measurements": str(measurements),
+        "n_measurements": len(data),
+        "actuators": list(data.actuator_ids),
+        "synthetic_measurements": str(data.metadata.get("synthetic", "false")),
+        "training_rmse_deg": float(np.sqrt(np.mean(residual**2))),
+        "training_ranges": ranges,
+    }
+    if hasattr(model, "loss_curve_"):
+        metadata["final_training_mse_deg2"] = float(model.loss_curve_[-1])
+    path = save_surrogate(model.model_, out, metadata=metadata)
     _common.console.print(
         f"{strategy} model on {len(data)} readings of {len(data.actuator_ids)} actuators "
-        f"written to {path} (final training MSE {model.loss_curve_[-1]:.4g} deg²); "
+        f"written to {path} (training RMSE {metadata['training_rmse_deg']:.3g}°); "
         f"use it with 'softbend predict {path}'"
     )

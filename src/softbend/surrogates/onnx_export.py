@@ -35,7 +35,7 @@ from softbend import __version__
 from softbend._extras import require
 from softbend._io import write_bytes_atomic
 from softbend.surrogates.features import FEATURES, TARGET, UNITS, check_features
-from softbend.surrogates.persistence import check_fitted_surrogate
+from softbend.surrogates.persistence import COMPOSITE_KINDS, check_fitted_surrogate
 
 onnx = require("onnx", "ONNX export (softbend.surrogates.onnx_export)")
 TensorProto, helper, numpy_helper = onnx.TensorProto, onnx.helper, onnx.numpy_helper
@@ -208,6 +208,12 @@ def to_onnx(model: Any, *, opset: int | None = None) -> onnx.ModelProto:
         If the model is not fitted.
     """
     kind = check_fitted_surrogate(model, "to_onnx")
+    if kind in COMPOSITE_KINDS:
+        raise ValueError(
+            f"The 'model' of to_onnx must be a polynomial, MLP or XGBoost surrogate. Got a "
+            f"{kind} surrogate ({type(model).__name__}), which has no ONNX export; export "
+            "its base instead."
+        )
     if kind == "xgboost":
         proto = _xgboost_graph(model, opset)
     else:

@@ -59,6 +59,8 @@ from softbend.surrogates.schema import SCHEMAS, Rule, RuleError
 logger = logging.getLogger(__name__)
 
 __all__ = [
+    "BASE_KINDS",
+    "COMPOSITE_KINDS",
     "FORMAT",
     "KINDS",
     "SCHEMA_VERSION",
@@ -80,10 +82,23 @@ _CLASSES: dict[str, tuple[str, str]] = {
     "polynomial": ("softbend.surrogates.polynomial", "PolynomialRegressor"),
     "mlp": ("softbend.surrogates.mlp", "NormalizedMLPRegressor"),
     "xgboost": ("xgboost", "XGBRegressor"),
+    "affine-corrected": ("softbend.surrogates.corrected", "AffineCorrected"),
+    "gp-corrected": ("softbend.surrogates.corrected", "GPCorrected"),
+    "ensemble": ("softbend.surrogates.corrected", "MeanEnsemble"),
 }
+
+#: Kinds built on other surrogates (:mod:`softbend.surrogates.corrected`): their
+#: ``state`` holds the inner surrogates as whole documents (``base``, ``members``).
+COMPOSITE_KINDS: tuple[str, ...] = ("affine-corrected", "gp-corrected", "ensemble")
+
+#: Inner surrogates nest at most this deep (a corrected ensemble of corrected MLPs).
+_MAX_DEPTH = 4
 
 #: Kinds of surrogate that can be saved.
 KINDS: tuple[str, ...] = tuple(_CLASSES)
+
+#: Kinds trained on data directly (the three families of paper B).
+BASE_KINDS: tuple[str, ...] = tuple(k for k in KINDS if k not in COMPOSITE_KINDS)
 
 #: Fitted attributes that prediction needs (the surrogate contract), per kind.
 _REQUIRED_STATE: dict[str, tuple[str, ...]] = {
@@ -106,6 +121,9 @@ _REQUIRED_STATE: dict[str, tuple[str, ...]] = {
         "intercepts_",
     ),
     "xgboost": ("booster",),
+    "affine-corrected": ("base", "scale_", "offset_", "residual_std_"),
+    "gp-corrected": ("base", "z_mean_", "z_scale_", "kernel_theta_", "inputs_", "targets_"),
+    "ensemble": ("members", "residual_std_"),
 }
 
 _HEADER_KEYS = (
@@ -223,6 +241,8 @@ def check_fitted_surrogate(model: Any, owner: str) -> str:
     name = type(model).__name__
     if kind == "xgboost":
         fitted = model.__sklearn_is_fitted__()
+    elif kind in COMPOSITE_KINDS:
+        fitted = True  # built from fitted surrogates, each checked when saved
     else:
         fitted = all(hasattr(model, key) for key in _REQUIRED_STATE[kind])
     if not fitted:
@@ -315,7 +335,44 @@ def _params(model: Any) -> dict[str, Any]:
     return params
 
 
-def _state(model: Any, kind: str) -> dict[str, Any]:
+def _document(model: Any, kind: str, depth: int = 0) -> dict[str, Any]:
+    """The saved form of a checked model, without ``metadata``."""
+    return {
+        "format": FORMAT,
+        "schema_version": SCHEMA_VERSION,
+        "kind": kind,
+        "features": list(FEATURES),
+        "units": {name: UNITS[name] for name in (*FEATURES, TARGET)},
+        "target": TARGET,
+        "softbend_version": __version__,
+        "created_utc": datetime.now(UTC).isoformat(timespec="seconds"),
+        "params": {} if kind in COMPOSITE_KINDS else _params(model),
+        "state": _state(model, kind, depth),
+    }
+
+
+def _inner(model: Any, depth: int) -> dict[str, Any]:
+    """An inner surrogate of a composite as a whole document (empty metadata)."""
+    if depth >= _MAX_DEPTH:
+        raise ValueError(
+            f"save_surrogate nests surrogates at most {_MAX_DEPTH} deep; this model nests deeper."
+        )
+    kind = check_fitted_surrogate(model, "save_surrogate")
+    return {**_document(model, kind, depth + 1), "metadata": {}}
+
+
+def _composite_state(model: Any, kind: str, depth: int) -> dict[str, Any]:
+    if kind == "ensemble":
+        state = {"members": [_inner(m, depth) for m in model.members_]}
+    else:
+        state = {"base": _inner(model.base, depth)}
+    names = [key for key in _REQUIRED_STATE[kind] if key not in ("base", "members")]
+    return state | {key: _encode(getattr(model, key), key) for key in names}
+
+
+def _state(model: Any, kind: str, depth: int = 0) -> dict[str, Any]:
+    if kind in COMPOSITE_KINDS:
+        return _composite_state(model, kind, depth)
     if kind == "xgboost":
         return {"booster": bytes(model.get_booster().save_raw("json")).decode("utf-8")}
     state = {}
@@ -376,18 +433,7 @@ def save_surrogate(model: Any, path: str | Path, *, metadata: dict[str, Any] | N
         raise ValueError(
             f"The 'metadata' of save_surrogate must be JSON-serializable. Got an error: {err}."
         ) from None
-    document = {
-        "format": FORMAT,
-        "schema_version": SCHEMA_VERSION,
-        "kind": kind,
-        "features": list(FEATURES),
-        "units": {name: UNITS[name] for name in (*FEATURES, TARGET)},
-        "target": TARGET,
-        "softbend_version": __version__,
-        "created_utc": datetime.now(UTC).isoformat(timespec="seconds"),
-        "params": _params(model),
-        "state": _state(model, kind),
-    }
+    document = _document(model, kind)
     # One top-level key per line: the header stays readable, big arrays stay on one line.
     lines = [f"{json.dumps(key)}: {json.dumps(value)}" for key, value in document.items()]
     lines.insert(-2, f'"metadata": {metadata_json}')
@@ -404,6 +450,11 @@ def _read_document(path: Path) -> dict[str, Any]:
         document = json.loads(path.read_text(encoding="utf-8"))
     except (json.JSONDecodeError, UnicodeDecodeError) as err:
         raise SchemaError(f"{path} is not a softbend surrogate: not valid JSON ({err}).") from None
+    return _checked_document(document, str(path))
+
+
+def _checked_document(document: Any, path: str) -> dict[str, Any]:
+    """``document`` if its header is that of a softbend surrogate (``path`` names it)."""
     if not isinstance(document, dict) or document.get("format") != FORMAT:
         found = document.get("format") if isinstance(document, dict) else type(document).__name__
         raise SchemaError(
@@ -501,7 +552,43 @@ def _xgboost_params(params: dict[str, Any], path: Path) -> tuple[dict[str, Any],
     return decoded, standard
 
 
-def _restore(document: dict[str, Any], path: Path) -> Any:
+def _restore_inner(value: Any, path: str, key: str, depth: int) -> Any:
+    where = f"{path}, state key '{key}'"
+    if depth >= _MAX_DEPTH:
+        raise SchemaError(f"{where}: surrogates nest at most {_MAX_DEPTH} deep.")
+    return _restore(_checked_document(value, where), where, depth + 1)
+
+
+def _restore_composite(document: dict[str, Any], path: str, depth: int) -> Any:
+    """A composite's inner surrogates restored (and validated) first, then the composite."""
+    kind = document["kind"]
+    if document["params"]:
+        got = short_repr(document["params"])
+        raise SchemaError(f"{path}: the {kind} surrogate takes no params; got {got}.")
+    state = _validated(document["state"], SCHEMAS[kind].state, path, kind, "state")
+    try:
+        SCHEMAS[kind].check(state)
+    except RuleError as err:
+        raise SchemaError(f"{path}: the {kind} surrogate's {err}.") from None
+    cls = _class_of(kind)
+    if kind == "ensemble":
+        members = [
+            _restore_inner(m, path, f"members[{i}]", depth) for i, m in enumerate(state["members"])
+        ]
+        return cls(members, state["residual_std_"])
+    base = _restore_inner(state["base"], path, "base", depth)
+    if kind == "affine-corrected":
+        return cls(base, state["scale_"], state["offset_"], state["residual_std_"])
+    try:
+        return cls(
+            base,
+            *(state[k] for k in ("z_mean_", "z_scale_", "kernel_theta_", "inputs_", "targets_")),
+        )
+    except (ValueError, np.linalg.LinAlgError) as err:  # a kernel matrix that is not positive
+        raise SchemaError(f"{path}: cannot rebuild the {kind} surrogate ({err}).") from None
+
+
+def _restore(document: dict[str, Any], path: Path | str, depth: int = 0) -> Any:
     """The model of a document, every params and state value validated by its kind's schema."""
     kind = document["kind"]
     schema = SCHEMAS[kind]
@@ -512,6 +599,8 @@ def _restore(document: dict[str, Any], path: Path) -> Any:
             f"{path} is an incomplete softbend surrogate: state key(s) "
             f"{', '.join(missing)} missing for kind {kind!r}."
         )
+    if kind in COMPOSITE_KINDS:
+        return _restore_composite(document, str(path), depth)
     state = _validated(state, schema.state, path, kind, "state")
     try:
         schema.check(state)

@@ -11,7 +11,10 @@ from numpy.typing import ArrayLike
 from softbend.design import SFRBADesign
 from softbend.models import check_pressures_mpa
 
-__all__ = ["Prediction", "predict_angles"]
+__all__ = ["INTERVAL_LEVEL", "Prediction", "predict_angles"]
+
+#: Probability of the prediction intervals reported by :func:`predict_angles`.
+INTERVAL_LEVEL = 0.9
 
 
 @dataclass(frozen=True)
@@ -30,6 +33,10 @@ class Prediction:
         (empty inside them, or when the file records none).
     has_training_ranges : bool
         Whether the file records its training ranges.
+    interval_deg : tuple of ndarray or None
+        ``(low, high)``: the central 90 % interval for a new reading, degrees,
+        from models that give one (the transfer-learning corrections); None
+        otherwise.
     """
 
     kind: str
@@ -38,6 +45,7 @@ class Prediction:
     angle_deg: np.ndarray
     outside_training_ranges: list[str] = field(default_factory=list)
     has_training_ranges: bool = False
+    interval_deg: tuple[np.ndarray, np.ndarray] | None = None
 
 
 def predict_angles(
@@ -97,4 +105,8 @@ def predict_angles(
             "--strict cannot check it."
         )
     angles = np.asarray(saved.model.predict(rows), dtype=float)
-    return Prediction(saved.kind, design, pressures, angles, outside, has_ranges)
+    interval = None
+    if callable(getattr(saved.model, "predict_interval", None)):
+        low, high = saved.model.predict_interval(rows, INTERVAL_LEVEL)
+        interval = (np.asarray(low, dtype=float), np.asarray(high, dtype=float))
+    return Prediction(saved.kind, design, pressures, angles, outside, has_ranges, interval)

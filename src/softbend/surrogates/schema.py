@@ -290,6 +290,40 @@ def _no_check(state: dict[str, Any]) -> None:
     return None
 
 
+def _document(value: Any) -> Any:
+    """An inner surrogate: a JSON object (its own header and schema are checked on restore)."""
+    if not isinstance(value, dict):
+        raise RuleError(f"must be a saved surrogate (a JSON object); got {short_repr(value)}")
+    return value
+
+
+def _documents(value: Any) -> Any:
+    """Two or more inner surrogates."""
+    if not isinstance(value, list) or len(value) < 2:
+        raise RuleError(f"must be a list of 2 or more saved surrogates; got {short_repr(value)}")
+    return [_document(v) for v in value]
+
+
+def _check_gp(state: dict[str, Any]) -> None:
+    d = len(FEATURES) + 1  # the inputs and the base's angle
+    for key in ("z_mean_", "z_scale_"):
+        if state[key].shape != (d,):
+            raise RuleError(f"state key '{key}' must have shape ({d},); got {state[key].shape}")
+    if state["kernel_theta_"].shape != (d + 2,):
+        raise RuleError(
+            f"state key 'kernel_theta_' must have shape ({d + 2},) (constant, {d} length "
+            f"scales, noise); got {state['kernel_theta_'].shape}"
+        )
+    inputs, targets = state["inputs_"], state["targets_"]
+    if inputs.ndim != 2 or inputs.shape[1] != d or inputs.shape[0] < 1:
+        raise RuleError(f"state key 'inputs_' must have shape (n >= 1, {d}); got {inputs.shape}")
+    if targets.shape != (inputs.shape[0],):
+        raise RuleError(
+            f"state key 'targets_' must have shape ({inputs.shape[0]},) (one per row of "
+            f"'inputs_'); got {targets.shape}"
+        )
+
+
 @dataclass(frozen=True)
 class _Schema:
     """What a saved surrogate of one kind may hold, and the rule of each value."""
@@ -344,4 +378,31 @@ SCHEMAS: dict[str, _Schema] = {
         check=_check_mlp,
     ),
     "xgboost": _Schema(params=None, state={"booster": _booster}, check=_no_check),
+    "affine-corrected": _Schema(
+        params={},
+        state={
+            "base": _document,
+            "scale_": _real(),
+            "offset_": _real(),
+            "residual_std_": _real(low=0.0),
+        },
+        check=_no_check,
+    ),
+    "gp-corrected": _Schema(
+        params={},
+        state={
+            "base": _document,
+            "z_mean_": _array(_FLOAT, 1),
+            "z_scale_": _array(_FLOAT, 1, low=0.0, strict=True),
+            "kernel_theta_": _array(_FLOAT, 1),
+            "inputs_": _array(_FLOAT, 2),
+            "targets_": _array(_FLOAT, 1),
+        },
+        check=_check_gp,
+    ),
+    "ensemble": _Schema(
+        params={},
+        state={"members": _documents, "residual_std_": _real(low=0.0)},
+        check=_no_check,
+    ),
 }

@@ -28,15 +28,14 @@ from typing import Any
 
 import numpy as np
 from numpy.typing import ArrayLike
-from scipy.stats import norm
 from sklearn.base import BaseEstimator, RegressorMixin
 from sklearn.exceptions import ConvergenceWarning
 from sklearn.gaussian_process import GaussianProcessRegressor
-from sklearn.gaussian_process.kernels import RBF, ConstantKernel, WhiteKernel
 from sklearn.utils.validation import check_is_fitted, validate_data
 
 from softbend._validation import check_choice, check_int, check_range
 from softbend.design import FEATURES, SFRBADesign
+from softbend.surrogates.corrected import AffineCorrected, GPCorrected, MeanEnsemble, gp_kernel
 from softbend.transfer.finetune import check_mlp, fine_tune_many, row_weights
 
 __all__ = [
@@ -364,18 +363,17 @@ class ScaleOffset(_Strategy):
         self.residual_std_ = float(
             np.sqrt(np.sum((A @ [self.scale_, self.offset_] - y) ** 2) / dof)
         )
+        self.model_ = AffineCorrected(self.base, self.scale_, self.offset_, self.residual_std_)
         return self
 
     def predict(self, X: ArrayLike) -> np.ndarray:
         """Corrected angle, degrees."""
-        return self.scale_ * np.asarray(self.base.predict(self._check_rows(X))) + self.offset_
+        return self.model_.predict(self._check_rows(X))
 
     def predict_interval(self, X: ArrayLike, level: float = 0.9) -> tuple[np.ndarray, np.ndarray]:
         """Central interval of probability ``level`` (Gaussian residuals), degrees."""
         level = _check_level(level, type(self).__name__)
-        mean = self.predict(X)
-        half = norm.ppf(0.5 + level / 2) * self.residual_std_
-        return mean - half, mean + half
+        return self.model_.predict_interval(self._check_rows(X), level)
 
 
 class ResidualGP(_Strategy):
@@ -402,11 +400,6 @@ class ResidualGP(_Strategy):
         self.n_restarts = n_restarts
         self.seed = seed
 
-    def _inputs(self, X: np.ndarray) -> np.ndarray:
-        theta = np.asarray(self.base.predict(X), dtype=np.float64)
-        Z = np.column_stack([X, theta])
-        return (Z - self.z_mean_) / self.z_scale_
-
     def fit(self, X: ArrayLike, y: ArrayLike) -> ResidualGP:
         """Fit the GP to ``y − base(X)``."""
         _check_base(self.base, type(self).__name__)
@@ -414,40 +407,35 @@ class ResidualGP(_Strategy):
         X, y = self._check_fit_data(X, y)
         theta = np.asarray(self.base.predict(X), dtype=np.float64)
         Z = np.column_stack([X, theta])
-        self.z_mean_ = Z.mean(axis=0)
+        z_mean = Z.mean(axis=0)
         scale = Z.std(axis=0)
-        self.z_scale_ = np.where(scale > 0, scale, 1.0)
-        d = Z.shape[1]
+        z_scale = np.where(scale > 0, scale, 1.0)
+        inputs = (Z - z_mean) / z_scale
         # A length scale at its upper bound means "this input does not matter": a
         # normal outcome with six actuators, so the optimizer's warning is muted.
-        kernel = ConstantKernel(1.0, (1e-3, 1e3)) * RBF(np.ones(d), (1e-1, 1e5)) + WhiteKernel(
-            0.1, (1e-5, 10.0)
-        )
         with warnings.catch_warnings():
             warnings.simplefilter("ignore", ConvergenceWarning)
-            self.gp_ = GaussianProcessRegressor(
-                kernel=kernel,
+            gp = GaussianProcessRegressor(
+                kernel=gp_kernel(Z.shape[1]),
                 normalize_y=True,
                 n_restarts_optimizer=n_restarts,
                 random_state=self.seed,
-            ).fit((Z - self.z_mean_) / self.z_scale_, y - theta)
+            ).fit(inputs, y - theta)
+        # The chosen hyperparameters, fixed: the model saves and reloads as it predicts here.
+        self.model_ = GPCorrected(self.base, z_mean, z_scale, gp.kernel_.theta, inputs, y - theta)
+        self.z_mean_, self.z_scale_, self.gp_ = z_mean, z_scale, self.model_.gp_
         return self
 
     def predict(
         self, X: ArrayLike, return_std: bool = False
     ) -> np.ndarray | tuple[np.ndarray, np.ndarray]:
         """Corrected angle, degrees (and the predictive standard deviation)."""
-        X = self._check_rows(X)
-        theta = np.asarray(self.base.predict(X), dtype=np.float64)
-        mean, std = self.gp_.predict(self._inputs(X), return_std=True)
-        return (theta + mean, std) if return_std else theta + mean
+        return self.model_.predict(self._check_rows(X), return_std=return_std)
 
     def predict_interval(self, X: ArrayLike, level: float = 0.9) -> tuple[np.ndarray, np.ndarray]:
         """Central interval of probability ``level`` for a new reading, degrees."""
         level = _check_level(level, type(self).__name__)
-        mean, std = self.predict(X, return_std=True)
-        half = norm.ppf(0.5 + level / 2) * std
-        return mean - half, mean + half
+        return self.model_.predict_interval(self._check_rows(X), level)
 
 
 class RefinedEnsemble(_Strategy):
@@ -528,22 +516,17 @@ class RefinedEnsemble(_Strategy):
             estimator.n_features_in_ = X.shape[1]
             mean = np.mean([m.predict(X[rows]) for m in members], axis=0)
             estimator.residual_std_ = float(np.sqrt(np.mean((mean - y[rows]) ** 2)))
+            estimator.model_ = MeanEnsemble(members, estimator.residual_std_)
         return estimators
-
-    def _spread(self, X: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-        preds = np.array([m.predict(X) for m in self.members_])
-        return preds.mean(axis=0), preds.std(axis=0, ddof=1)
 
     def predict(self, X: ArrayLike) -> np.ndarray:
         """Members' mean angle, degrees."""
-        return self._spread(self._check_rows(X))[0]
+        return self.model_.predict(self._check_rows(X))
 
     def predict_interval(self, X: ArrayLike, level: float = 0.9) -> tuple[np.ndarray, np.ndarray]:
         """Central interval of probability ``level`` (spread and noise, Gaussian), degrees."""
         level = _check_level(level, type(self).__name__)
-        mean, spread = self._spread(self._check_rows(X))
-        half = norm.ppf(0.5 + level / 2) * np.sqrt(spread**2 + self.residual_std_**2)
-        return mean - half, mean + half
+        return self.model_.predict_interval(self._check_rows(X), level)
 
 
 def make_strategy(name: str, base: Any = None, *, seed: int = 0, **options: Any) -> _Strategy:

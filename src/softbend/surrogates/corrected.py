@@ -1,0 +1,211 @@
+"""Surrogates built on other surrogates: corrected by measurements, or averaged.
+
+Transfer learning (:mod:`softbend.transfer`) corrects a simulation-trained
+surrogate with a few measurements. Three of its corrections are models of
+their own that save, load and predict like any surrogate (on the rows of
+:data:`softbend.surrogates.features.FEATURES`, mm, deg, MPa → degrees), each
+with a prediction interval for a new reading:
+
+=====================  =========================================================
+``AffineCorrected``    ``θ = scale·θ_base + offset``; Gaussian interval of the
+                       fit's residual standard deviation
+``GPCorrected``        ``θ = θ_base + GP(z)``, a Gaussian process on the base's
+                       error over the standardized inputs and the base's angle;
+                       the GP's predictive interval (noise term included)
+``MeanEnsemble``       the mean of several surrogates; Gaussian interval of
+                       their spread and the residual noise of the mean
+=====================  =========================================================
+
+The Gaussian process is scikit-learn's. It is stored as its fitted
+log-hyperparameters and training set and rebuilt with them fixed, which gives
+back the same predictions.
+"""
+
+from __future__ import annotations
+
+from typing import Any
+
+import numpy as np
+from numpy.typing import ArrayLike
+from scipy.stats import norm
+
+from softbend._validation import check_range
+
+__all__ = [
+    "AffineCorrected",
+    "GPCorrected",
+    "MeanEnsemble",
+    "gp_kernel",
+]
+
+
+def _rows(X: ArrayLike, n_features: int, owner: str) -> np.ndarray:
+    rows = np.asarray(X, dtype=np.float64)
+    if rows.ndim != 2 or rows.shape[1] != n_features:
+        raise ValueError(
+            f"The 'X' of {owner} must have shape (n, {n_features}). Got {rows.shape} instead."
+        )
+    return rows
+
+
+def _half_width(level: float, std: np.ndarray | float, owner: str) -> np.ndarray | float:
+    """Half the central interval of probability ``level`` of a Gaussian of ``std``."""
+    level = check_range(level, "level", f"{owner}.predict_interval", low=0.0, high=1.0)
+    return norm.ppf(0.5 + level / 2) * std
+
+
+class AffineCorrected:
+    """A surrogate corrected linearly: ``θ = scale·θ_base + offset`` (degrees).
+
+    Parameters
+    ----------
+    base : estimator
+        A fitted surrogate on the 7 inputs.
+    scale : float
+        Factor on the base's angle (dimensionless).
+    offset : float
+        Added angle, degrees.
+    residual_std : float
+        Standard deviation of the fit's residuals, degrees (>= 0): the
+        interval's width.
+    """
+
+    def __init__(self, base: Any, scale: float, offset: float, residual_std: float) -> None:
+        self.base = base
+        self.scale_ = float(scale)
+        self.offset_ = float(offset)
+        self.residual_std_ = float(residual_std)
+        self.n_features_in_ = int(base.n_features_in_)
+
+    def predict(self, X: ArrayLike) -> np.ndarray:
+        """Corrected angle, degrees."""
+        rows = _rows(X, self.n_features_in_, type(self).__name__)
+        return self.scale_ * np.asarray(self.base.predict(rows), dtype=np.float64) + self.offset_
+
+    def predict_interval(self, X: ArrayLike, level: float = 0.9) -> tuple[np.ndarray, np.ndarray]:
+        """Central interval of probability ``level`` (Gaussian residuals), degrees."""
+        half = _half_width(level, self.residual_std_, type(self).__name__)
+        mean = self.predict(X)
+        return mean - half, mean + half
+
+
+def gp_kernel(n_inputs: int) -> Any:
+    """The kernel of :class:`GPCorrected`: constant × anisotropic RBF + white noise.
+
+    Hyperparameters start at 1 (0.1 for the noise) with bounds wide enough for
+    standardized inputs; their order in ``kernel.theta`` is constant, the
+    ``n_inputs`` length scales, noise.
+    """
+    from sklearn.gaussian_process.kernels import RBF, ConstantKernel, WhiteKernel
+
+    return ConstantKernel(1.0, (1e-3, 1e3)) * RBF(np.ones(n_inputs), (1e-1, 1e5)) + WhiteKernel(
+        0.1, (1e-5, 10.0)
+    )
+
+
+class GPCorrected:
+    """A surrogate plus a Gaussian process on its error: ``θ = θ_base + GP(z)``.
+
+    ``z`` is the rows with the base's angle appended, standardized by
+    ``z_mean`` and ``z_scale`` (so an error that grows with the angle is a
+    smooth function of one input). The GP (scikit-learn's, ``normalize_y``)
+    has the kernel :func:`gp_kernel` fixed at ``kernel_theta``; it is fitted
+    here, on ``inputs`` and ``targets``, without optimizing it again.
+
+    Parameters
+    ----------
+    base : estimator
+        A fitted surrogate on the 7 inputs.
+    z_mean, z_scale : ndarray of shape (8,)
+        Standardization of the GP's inputs (``z_scale`` > 0).
+    kernel_theta : ndarray of shape (10,)
+        The kernel's log-hyperparameters (``kernel.theta``: constant, 8 length
+        scales, noise), e.g. those the marginal likelihood chose.
+    inputs : ndarray of shape (n, 8)
+        Standardized ``z`` of the training rows.
+    targets : ndarray of shape (n,)
+        The base's error on them (measured minus base), degrees.
+    """
+
+    def __init__(
+        self,
+        base: Any,
+        z_mean: ArrayLike,
+        z_scale: ArrayLike,
+        kernel_theta: ArrayLike,
+        inputs: ArrayLike,
+        targets: ArrayLike,
+    ) -> None:
+        from sklearn.gaussian_process import GaussianProcessRegressor
+
+        self.base = base
+        self.z_mean_ = np.asarray(z_mean, dtype=np.float64)
+        self.z_scale_ = np.asarray(z_scale, dtype=np.float64)
+        self.inputs_ = np.asarray(inputs, dtype=np.float64)
+        self.targets_ = np.asarray(targets, dtype=np.float64)
+        kernel = gp_kernel(self.inputs_.shape[1])
+        kernel.theta = np.asarray(kernel_theta, dtype=np.float64)
+        self.gp_ = GaussianProcessRegressor(kernel=kernel, normalize_y=True, optimizer=None)
+        self.gp_.fit(self.inputs_, self.targets_)
+        self.n_features_in_ = int(base.n_features_in_)
+
+    @property
+    def kernel_theta_(self) -> np.ndarray:
+        """The kernel's log-hyperparameters (constant, length scales, noise)."""
+        return self.gp_.kernel_.theta
+
+    def _inputs(self, rows: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        theta = np.asarray(self.base.predict(rows), dtype=np.float64)
+        return theta, (np.column_stack([rows, theta]) - self.z_mean_) / self.z_scale_
+
+    def predict(
+        self, X: ArrayLike, return_std: bool = False
+    ) -> np.ndarray | tuple[np.ndarray, np.ndarray]:
+        """Corrected angle, degrees (and the predictive standard deviation, degrees)."""
+        theta, z = self._inputs(_rows(X, self.n_features_in_, type(self).__name__))
+        mean, std = self.gp_.predict(z, return_std=True)
+        return (theta + mean, std) if return_std else theta + mean
+
+    def predict_interval(self, X: ArrayLike, level: float = 0.9) -> tuple[np.ndarray, np.ndarray]:
+        """Central interval of probability ``level`` for a new reading, degrees."""
+        mean, std = self.predict(X, return_std=True)
+        half = _half_width(level, std, type(self).__name__)
+        return mean - half, mean + half
+
+
+class MeanEnsemble:
+    """The mean of several surrogates, with an interval from their spread.
+
+    Parameters
+    ----------
+    members : list of estimator
+        Two or more fitted surrogates on the 7 inputs.
+    residual_std : float
+        Residual standard deviation of the mean on its training rows, degrees
+        (>= 0); added in quadrature to the spread for the interval.
+    """
+
+    def __init__(self, members: list[Any], residual_std: float) -> None:
+        if len(members) < 2:
+            raise ValueError(
+                f"The 'members' of MeanEnsemble must be 2 or more surrogates. Got {len(members)}."
+            )
+        self.members_ = list(members)
+        self.residual_std_ = float(residual_std)
+        self.n_features_in_ = int(members[0].n_features_in_)
+
+    def spread(self, X: ArrayLike) -> tuple[np.ndarray, np.ndarray]:
+        """The members' mean and sample standard deviation, degrees."""
+        rows = _rows(X, self.n_features_in_, type(self).__name__)
+        predictions = np.array([m.predict(rows) for m in self.members_], dtype=np.float64)
+        return predictions.mean(axis=0), predictions.std(axis=0, ddof=1)
+
+    def predict(self, X: ArrayLike) -> np.ndarray:
+        """Members' mean angle, degrees."""
+        return self.spread(X)[0]
+
+    def predict_interval(self, X: ArrayLike, level: float = 0.9) -> tuple[np.ndarray, np.ndarray]:
+        """Central interval of probability ``level`` (spread and noise, Gaussian), degrees."""
+        mean, spread = self.spread(X)
+        half = _half_width(level, np.sqrt(spread**2 + self.residual_std_**2), type(self).__name__)
+        return mean - half, mean + half
