@@ -225,6 +225,23 @@ def test_too_few_distinct_samples_to_estimate_the_kernel():
     np.testing.assert_allclose(model.predict(np.eye(3)), [0.0, 1.0, 2.0], atol=0.01)
 
 
+@pytest.mark.parametrize(("sigma", "fast"), [(0.9, True), (0.05, False)])
+def test_predict_one_rbf_path_agrees_near_and_far_from_the_data(sigma, fast):
+    # The factored RBF path serves points near the support vectors of a model whose
+    # support is compact in kernel widths; far points, and a narrow kernel, take
+    # the direct sum. Both agree with predict.
+    X, y = _nonlinear_problem()
+    model = GeneralizedGaussianSVR(shape=2.0, sigma=sigma).fit(X, y)
+    assert model._fast is fast
+    rng = np.random.default_rng(5)
+    near = rng.normal(size=(40, 3))
+    far = 12.0 * sigma * rng.normal(size=(10, 3)) + 40.0  # rate·|x − m|² in the thousands
+    for rows in (near, far):
+        one_by_one = np.array([model.predict_one(row) for row in rows])
+        np.testing.assert_allclose(one_by_one, model.predict(rows), rtol=0, atol=1e-12)
+    np.testing.assert_allclose(model.predict_one(far[0]), model.intercept_, atol=1e-12)
+
+
 def test_predict_one_checks_shape_finiteness_and_fitting():
     with pytest.raises(NotFittedError):
         GeneralizedGaussianSVR().predict_one(np.zeros(3))

@@ -77,6 +77,9 @@ _MAX_ROUNDS = 200
 _ROUNDS_PER_CHUNK = 50
 #: Bytes of one block of kernel values (rows × support vectors) in fit and predict.
 _BLOCK_BYTES = 32 * 2**20
+#: predict_one's factored RBF path is used while rate·|s − m|² and rate·|x − m|² stay
+#: below this (so no exponent exceeds 2·50 and rounding stays ~1e-14 relative).
+_FAST_EXPONENT = 50.0
 
 
 def _check_max_iter(value: object) -> int:
@@ -631,6 +634,21 @@ class GeneralizedGaussianSVR(RegressorMixin, BaseEstimator):
         self._half_shape = 0.5 * self.shape_
         self._coef = self.dual_coef_ * self.kernel_scale_
         self._x_shape = (self.n_features_in_,)
+        # predict_one's RBF path (γ = 2) about the support vectors' centre m:
+        # −rate·|s − x|² = 2·rate·(s − m)·x − 2·rate·(s − m)·m − rate·|s − m|² − rate·|x − m|²,
+        # so one kernel row is a matrix-vector product, an add and an exp, the
+        # |s − m|² factor folded into the coefficients and the |x − m|² one a scalar.
+        # Used where every exponent stays small (error ~ exponent × 1e-16).
+        support = self.support_vectors_
+        center = support.mean(axis=0)
+        centred = support - center
+        spread = self._rate * np.einsum("ij,ij->i", centred, centred)
+        self._center = center.tolist()
+        self._fast = self._half_shape == 1.0 and bool(np.all(spread <= _FAST_EXPONENT))
+        if self._fast:
+            self._fast_matrix = np.ascontiguousarray(2.0 * self._rate * centred)
+            self._fast_bias = -(self._fast_matrix @ center)
+            self._fast_coef = self._coef * np.exp(-spread)
 
     def _expansion(self, X: np.ndarray) -> np.ndarray:
         """Σ βᵢ c K(sᵢ, x) + b for every row of X, in row blocks of bounded memory."""
@@ -690,8 +708,15 @@ class GeneralizedGaussianSVR(RegressorMixin, BaseEstimator):
                 f"The 'x' of {_OWNER}.predict_one must have shape {self._x_shape}. "
                 f"Got shape {x.shape} instead."
             )
-        if not all(map(math.isfinite, x.tolist())):
+        # |x − m|: NaN or inf for a non-finite x (math.dist is one C call).
+        far = self._rate * math.dist(x.tolist(), self._center) ** 2
+        if not math.isfinite(far):
             raise ValueError(f"The 'x' of {_OWNER}.predict_one must be finite. Got {x!r} instead.")
+        if self._fast and far <= _FAST_EXPONENT:
+            row = self._fast_matrix @ x
+            row += self._fast_bias
+            np.exp(row, out=row)
+            return float(row @ self._fast_coef) * math.exp(-far) + self.intercept_
         diff = support_vectors - x
         arg = np.einsum("ij,ij->i", diff, diff)
         arg *= self._rate
