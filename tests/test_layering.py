@@ -28,6 +28,7 @@ STAGES: tuple[tuple[str, ...], ...] = (
     ("surrogates",),
     ("identification",),
     ("transfer", "control"),
+    ("pipeline",),
     ("reports",),
     ("cli",),
 )

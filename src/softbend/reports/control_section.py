@@ -1,36 +1,25 @@
 """Paper B §5 (Figs. 8–9): closed-loop control on the simulated rig, with model mismatch.
 
-:func:`add_section` runs :func:`softbend.control.study.control_study` twice on
-paper B's (100,6,2,2,5,8) actuator: with the plant equal to the controllers'
-model (the shipped FEM-trained MLP), and with the virtual lab's measured
-actuator as the plant, once with the FEM-trained MLP and once with that MLP
-refined on the lab's readings (paper B's method), and reports paper B's numbers
-beside.
+:func:`softbend.pipeline.control.run_control` runs the studies on paper B's
+(100,6,2,2,5,8) actuator: with the plant equal to the controllers' model (the
+shipped FEM-trained MLP), and with the virtual lab's measured actuator as the
+plant, once with the FEM-trained MLP and once with that MLP refined on the lab's
+readings (paper B's method); :func:`add_section` draws them and reports paper
+B's numbers beside.
 """
 
 from __future__ import annotations
 
 import math
 import time
-from collections.abc import Callable
 from pathlib import Path
 from typing import Any
 
+from softbend.pipeline import Progress
+from softbend.pipeline.control import CONTROL_DESIGN, Control
 from softbend.reports.html import Report
 
-#: progress(phase, done, total)
-Progress = Callable[[str, int, int], None]
-
-#: The actuator of paper B's control experiments (its Fig. 2 design).
-CONTROL_DESIGN = "100,6,2,2,5,8"
-
-
-def _refined(base: Any, seed: int, epochs: int | None) -> Any:
-    """The shipped MLP refined on all the shipped lab readings (``transfer refine``)."""
-    from softbend.transfer.lab import shipped_measurements
-    from softbend.transfer.strategies import fit_strategy
-
-    return fit_strategy("refined", base, shipped_measurements(), seed=seed, epochs=epochs).model_
+__all__ = ["CONTROL_DESIGN", "add_control", "add_section"]
 
 
 def _cell(metrics: Any, controller: str, reference: str, name: str) -> float | str:
@@ -63,38 +52,34 @@ def add_section(
     refine_epochs : int, optional
         Epochs of the refined MLP (default: the strategy's; fewer for a quick run).
     """
-    from softbend.control.plants import lab_angle_table
-    from softbend.control.study import PAPER_B_CONTROL, STUDY_REFERENCES, control_study
-    from softbend.design import SFRBADesign
-    from softbend.reports.control_figures import runs_figure
-    from softbend.transfer.base import load_base
+    from softbend.pipeline.control import run_control
 
     start = time.perf_counter()
-    folder = out_dir / "control"
-    folder.mkdir(parents=True, exist_ok=True)
-    design = SFRBADesign.parse(CONTROL_DESIGN)
-    base = load_base()
+    control = run_control(
+        out_dir, seed, progress, duration_s=duration_s, refine_epochs=refine_epochs
+    )
+    figures = add_control(report, control, out_dir)
+    return {
+        **control.summary,
+        "seconds": time.perf_counter() - start,
+        "files": {k: str(v) for k, v in figures.items()},
+    }
 
-    def step(phase: str) -> Callable[[int, int], None]:
-        def forward(done: int, total: int) -> None:
-            if progress is not None:
-                progress(f"control: {phase}", done, total)
 
-        return forward
+def add_control(report: Report, control: Control, root: Path) -> dict[str, Path]:
+    """Draw Fig. 9 and the mismatch runs into ``root/control``; add the section.
 
-    nominal = control_study(base, design, duration_s=duration_s, seed=seed, progress=step("rig"))
-    lab = lab_angle_table(design)
-    mismatch = control_study(
-        base, design, plant_table=lab, plant="lab", duration_s=duration_s, seed=seed,
-        progress=step("lab, FEM-trained MLP"),
-    )  # fmt: skip
-    refined = control_study(
-        _refined(base, seed, refine_epochs), design, plant_table=lab, plant="lab",
-        duration_s=duration_s, seed=seed, progress=step("lab, refined MLP"),
-    )  # fmt: skip
-    nominal.metrics.to_csv(folder / "metrics_rig.csv", index=False)
-    mismatch.metrics.to_csv(folder / "metrics_lab_fem_mlp.csv", index=False)
-    refined.metrics.to_csv(folder / "metrics_lab_refined_mlp.csv", index=False)
+    Returns
+    -------
+    dict
+        ``{"square", "triangle", "lab"}`` paths of the figures.
+    """
+    from softbend.control.study import PAPER_B_CONTROL, STUDY_REFERENCES
+    from softbend.reports.control_figures import runs_figure
+
+    folder = root / "control"
+    nominal, mismatch, refined = control.nominal, control.mismatch, control.refined
+    duration_s, seed = control.duration_s, control.seed
     step_ref, square, triangle = STUDY_REFERENCES
     figures = {
         "square": runs_figure(
@@ -185,8 +170,8 @@ def add_section(
         f"avoids.",
         note=True,
     )
-    section.figure(figures["square"], "Fig. 9 (square wave), simulated rig", root=out_dir)
-    section.figure(figures["triangle"], "Fig. 9 (triangle), simulated rig", root=out_dir)
+    section.figure(figures["square"], "Fig. 9 (square wave), simulated rig", root=root)
+    section.figure(figures["triangle"], "Fig. 9 (triangle), simulated rig", root=root)
     lab_rows = []
     for c in mismatch.metrics["controller"].unique():
         lab_rows.append(
@@ -212,11 +197,5 @@ def add_section(
         "B refines its MLP before closing the loop with it.",
         note=True,
     )
-    section.figure(figures["lab"], "Model mismatch on the lab actuator", root=out_dir)
-    return {
-        "seconds": time.perf_counter() - start,
-        "rig": nominal.metrics.to_dict(orient="records"),
-        "lab_fem_mlp": mismatch.metrics.to_dict(orient="records"),
-        "lab_refined_mlp": refined.metrics.to_dict(orient="records"),
-        "files": {k: str(v) for k, v in figures.items()},
-    }
+    section.figure(figures["lab"], "Model mismatch on the lab actuator", root=root)
+    return figures

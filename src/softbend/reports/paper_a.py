@@ -5,7 +5,6 @@ from __future__ import annotations
 from pathlib import Path
 from typing import TYPE_CHECKING
 
-from softbend._io import write_text_atomic
 from softbend.reports import curling_figures
 from softbend.reports.html import Report
 
@@ -16,37 +15,17 @@ if TYPE_CHECKING:  # pragma: no cover
 def write_identification_outputs(result: IdentificationResult, out_dir: Path) -> dict[str, Path]:
     """Write metrics (CSV), the fitted models (JSON) and paper A Figs. 5–7, 9, 10.
 
+    The data are :func:`softbend.pipeline.paper_a.write_identification_data`'s.
+
     Returns
     -------
     dict
         ``{artefact name: path}``.
     """
-    from softbend.identification.persistence import save_narx
+    from softbend.pipeline.paper_a import write_identification_data
 
-    out_dir = Path(out_dir)
-    out_dir.mkdir(parents=True, exist_ok=True)
-    paths: dict[str, Path] = {}
-    paths["metrics"] = write_text_atomic(
-        out_dir / "metrics.csv", result.metrics.to_csv(index=False)
-    )
-    paths["summary"] = write_text_atomic(
-        out_dir / "summary.csv", result.summary().to_csv(index=False)
-    )
-    synthetic = any(e.synthetic for group in result.experiments.values() for e in group)
-    for (sign, output), model in result.models.items():
-        names = [e.name for e in result.experiments[sign]]
-        metadata = {
-            "sign": sign,
-            "output": output,
-            "input": "pressure_kpa",
-            "output_unit": "mm" if output == "length_mm" else "1",
-            "trained_on": names,
-            "synthetic_data": synthetic,
-        }
-        paths[f"model_{sign}_{output}"] = save_narx(
-            model, out_dir / "models" / f"{sign}_{output}.json", metadata=metadata
-        )
-    paths.update(curling_figures.all_figures(result, out_dir))
+    paths = write_identification_data(result, out_dir)
+    paths.update(curling_figures.all_figures(result, Path(out_dir)))
     return paths
 
 

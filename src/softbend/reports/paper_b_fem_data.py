@@ -1,77 +1,22 @@
 """Paper B Figs. 4 and 5 on the FEM dataset shipped with softbend (no campaign is rerun).
 
-:func:`add_section` reads :func:`softbend.datasets.table1_fem` (verified against
-its checksums), fits the standardized regression of paper B §3.3 (Fig. 4) and
-searches the three surrogate families with folds of whole designs (the honest
-score of an unseen actuator, primary), then scores each family's chosen
-configuration with samples shuffled across designs (paper B's protocol, for
-comparison; no second grid search, no refit). The FEM-trained models are saved
-under ``paper_b_fem/surrogates/models`` for later use (transfer learning,
-control).
+:func:`softbend.pipeline.paper_b_fem_data.run_fem_data` reads the dataset, fits
+paper B's regression and searches the surrogates under both protocols; this
+module draws Figs. 4 and 5 from its results and adds the section.
 """
 
 from __future__ import annotations
 
 import time
-from collections.abc import Callable
+from collections.abc import Sequence
 from pathlib import Path
 from typing import Any
 
+from softbend.pipeline import Progress
+from softbend.pipeline.paper_b_fem_data import TABLE1_DESIGNS, FEMData
 from softbend.reports.html import Report
 
-#: progress(phase, done, total)
-Progress = Callable[[str, int, int], None]
-
-#: Designs of paper B's Table 1.
-TABLE1_DESIGNS = 972
-
-
-def _surrogates(
-    samples: Any, folder: Path, seed: int, progress: Progress | None, epochs: int | None
-) -> tuple[dict[str, Any], dict[str, Any]]:
-    """Grouped search with saved models, then the chosen configurations under random folds."""
-    from softbend.reports.surrogate_figures import training_figures
-    from softbend.surrogates.features import training_data
-    from softbend.surrogates.search import search
-    from softbend.surrogates.workflow import train_surrogates
-
-    def on_progress(protocol: str) -> Progress:
-        def forward(phase: str, done: int, total: int) -> None:
-            if progress is not None:
-                progress(f"paper B FEM data: surrogates ({protocol} CV), {phase}", done, total)
-
-        return forward
-
-    data = training_data(samples)
-    result, grouped = train_surrogates(
-        data, folder, grid_name="quick", seed=seed, epochs=epochs, progress=on_progress("grouped")
-    )
-    grouped["files"].update(training_figures(result, folder))
-    started = time.perf_counter()
-    chosen = {name: [dict(fam.params)] for name, fam in result.families.items()}
-    shuffled = search(
-        data,
-        models=list(chosen),
-        grid_name="quick",
-        param_grid=chosen,
-        seed=seed,
-        epochs=epochs,
-        cv="random",
-        refit=False,
-        progress=on_progress("random"),
-    )
-    random_summary = {
-        "settings": shuffled.settings,
-        "seconds": time.perf_counter() - started,
-        "models": {
-            name: {
-                "params": row["params"],
-                **{k: float(row[k]) for k in ("r2", "rmse_deg", "mape_pct", "max_abs_error_deg")},
-            }
-            for name, row in shuffled.summary().set_index("model").iterrows()
-        },
-    }
-    return grouped, random_summary
+__all__ = ["TABLE1_DESIGNS", "add_fem_data", "add_section"]
 
 
 def add_section(
@@ -82,6 +27,7 @@ def add_section(
     *,
     dataset: str | Path | None = None,
     epochs: int | None = None,
+    models: Sequence[str] | None = None,
 ) -> dict[str, Any]:
     """Append Figs. 4 and 5 on the shipped FEM data to ``report``; return the headline figures.
 
@@ -97,14 +43,26 @@ def add_section(
         A dataset folder (default: the one shipped in the package).
     epochs : int, optional
         MLP epochs (default: the quick grid's).
+    models : sequence of str, optional
+        Surrogate families (default: all three of paper B).
     """
-    from softbend.analysis import (
-        DEFAULT_FEATURES,
-        DEFAULT_TARGET,
-        correlation_matrix,
-        standardized_regression,
-    )
-    from softbend.datasets import table1_fem, table1_fem_designs, table1_fem_provenance
+    from softbend.pipeline.paper_b_fem_data import run_fem_data
+
+    start = time.perf_counter()
+    fem_data = run_fem_data(out_dir, seed, progress, dataset=dataset, epochs=epochs, models=models)
+    add_fem_data(report, fem_data, out_dir)
+    return {**fem_data.summary, "seconds": time.perf_counter() - start}
+
+
+def add_fem_data(report: Report, fem_data: FEMData, root: Path) -> dict[str, Any]:
+    """Draw Figs. 4 and 5 of ``fem_data`` into ``root/paper_b_fem``; add the section.
+
+    Returns
+    -------
+    dict
+        ``{"correlation", "loadings", "parity"}`` paths of the Fig. 4 panels and
+        the surrogate figures (``"fig5"``, ``"mlp_loss"``) drawn.
+    """
     from softbend.reports import analysis_figures
     from softbend.reports.paper_b import (
         PAPER_B_FIG4,
@@ -112,26 +70,21 @@ def add_section(
         add_regression_tables,
         surrogate_cells,
     )
+    from softbend.reports.surrogate_figures import training_figures
     from softbend.surrogates.workflow import PAPER_B_FIG5
 
-    start = time.perf_counter()
-    folder = out_dir / "paper_b_fem"
-    folder.mkdir(parents=True, exist_ok=True)
-    samples = table1_fem(dataset)
-    designs = table1_fem_designs(dataset)
-    provenance = table1_fem_provenance(dataset)
-    converged = samples[samples["converged"]]
-    done = designs[designs["status"] == "done"]
-    regression = standardized_regression(samples)
-    features = [*DEFAULT_FEATURES, DEFAULT_TARGET]
-    figures = {
+    folder = root / "paper_b_fem"
+    designs, provenance, regression = fem_data.designs, fem_data.provenance, fem_data.regression
+    samples, converged, done = fem_data.samples, fem_data.converged, fem_data.done
+    grouped, shuffled = fem_data.grouped, fem_data.shuffled
+    figures: dict[str, Any] = {
         "correlation": analysis_figures.correlation_heatmap(
-            correlation_matrix(samples, features), folder / "fig4a_correlation_fem.png"
+            fem_data.correlation, folder / "fig4a_correlation_fem.png"
         ),
         "loadings": analysis_figures.loadings_bar(regression, folder / "fig4b_loadings_fem.png"),
         "parity": analysis_figures.parity_plot(regression, folder / "fig4c_parity_fem.png"),
     }
-    grouped, shuffled = _surrogates(samples, folder / "surrogates", seed, progress, epochs)
+    files = {**grouped["files"], **training_figures(fem_data.search, folder / "surrogates")}
 
     section = report.section("Paper B — Figs. 4 and 5 on softbend's FEM data")
     complete = len(done) == TABLE1_DESIGNS
@@ -181,7 +134,7 @@ def add_section(
         ("loadings", "Fig. 4b on FEM data — standardized loadings"),
         ("parity", "Fig. 4c on FEM data — linear model against the data"),
     ):
-        section.figure(figures[key], caption, root=out_dir)
+        section.figure(figures[key], caption, root=root)
 
     rows = []
     for name, m in grouped["models"].items():
@@ -227,28 +180,11 @@ def add_section(
         "column.",
         note=True,
     )
-    files = grouped["files"]
     if "fig5" in files:
         section.figure(
             Path(files["fig5"]),
             "Fig. 5 on FEM data — out-of-fold predictions (grouped CV) and error distribution",
-            root=out_dir,
+            root=root,
         )
-    return {
-        "seconds": time.perf_counter() - start,
-        "designs_done": len(done),
-        "samples_sha256": provenance["files"]["samples.parquet"]["sha256"],
-        "samples": len(samples),
-        "converged_samples": len(converged),
-        "stops": {str(k): int(v) for k, v in stops.items()},
-        "cpu_hours": provenance["cpu_time_s"] / 3600.0,
-        "r2": regression.r2,
-        "f_value": regression.f_value,
-        "mape_pct": regression.mape_pct,
-        "loadings": {str(k): float(v) for k, v in regression.coefficients["loading"].items()},
-        "surrogates_grouped": {
-            name: {k: m[k] for k in ("params", "r2", "rmse_deg", "mape_pct", "max_abs_error_deg")}
-            for name, m in grouped["models"].items()
-        },
-        "surrogates_random": shuffled["models"],
-    }
+    figures.update({k: files[k] for k in ("fig5", "mlp_loss") if k in files})
+    return figures

@@ -13,6 +13,10 @@ softbend can reproduce, and the data, models and figures beside it:
 - ``transfer/``: transfer learning on the shipped virtual lab (Figs. 6 and 7).
 - ``control/``: closed-loop control on the simulated rig, with the lab actuator as a
   mismatched plant (Figs. 8 and 9).
+
+Each section's computation is in :mod:`softbend.pipeline` (one module per
+section, returning its results); this module and the section modules of
+:mod:`softbend.reports` draw those results and write the HTML.
 """
 
 from __future__ import annotations
@@ -22,7 +26,6 @@ import logging
 import os
 import platform
 import time
-from collections.abc import Callable
 from datetime import UTC, datetime
 from pathlib import Path
 from typing import Any
@@ -31,50 +34,26 @@ from softbend import __version__
 from softbend._io import write_text_atomic
 from softbend._validation import check_range
 from softbend.design import DesignSpace
+from softbend.pipeline import Progress
 from softbend.reports.html import Report
 
 logger = logging.getLogger(__name__)
 
-#: progress(phase, done, total)
-Progress = Callable[[str, int, int], None]
+__all__ = ["Progress", "run_reproduce"]
 
 
 def _paper_a(report: Report, out_dir: Path, seed: int, progress: Progress | None) -> dict[str, Any]:
-    from softbend.identification.data import save_experiments
-    from softbend.identification.study import IdentificationConfig, identify, n_fits
-    from softbend.identification.synthetic import synthetic_dataset
-    from softbend.reports import paper_a
+    from softbend.pipeline.paper_a import run_paper_a
+    from softbend.reports import curling_figures, paper_a
 
-    phase = "paper A: identification"
     start = time.perf_counter()
-    dataset = synthetic_dataset(seed=seed)
-    experiments = [e for group in dataset.values() for e in group]
-    save_experiments(experiments, out_dir / "paper_a" / "data")
-    total = n_fits(experiments)
-    done = 0
-
-    def step(_label: str) -> None:
-        nonlocal done
-        done += 1
-        if progress is not None:
-            progress(phase, done, total)
-
-    if progress is not None:
-        progress(phase, 0, total)
-    result = identify(experiments, IdentificationConfig(), progress=step)
-    paths = paper_a.write_identification_outputs(result, out_dir / "paper_a")
-    paper_a.add_section(report, result, paths, root=out_dir)
-    summary = result.summary()
-    free_run = summary[summary["mode"] == "free-run"]
-    return {
-        "seconds": time.perf_counter() - start,
-        "free_run_nrmse_mean": {
-            f"{r.sign}/{r.output}": float(r.nrmse_mean) for r in free_run.itertuples()
-        },
-        "free_run_nrmse_worst": {
-            f"{r.sign}/{r.output}": float(r.nrmse_max) for r in free_run.itertuples()
-        },
+    identified = run_paper_a(out_dir, seed=seed, progress=progress)
+    paths = {
+        **identified.paths,
+        **curling_figures.all_figures(identified.result, out_dir / "paper_a"),
     }
+    paper_a.add_section(report, identified.result, paths, root=out_dir)
+    return {**identified.summary, "seconds": time.perf_counter() - start}
 
 
 def _paper_b(
@@ -90,56 +69,26 @@ def _paper_b(
         correlation_matrix,
         standardized_regression,
     )
-    from softbend.campaign import run_campaign
-    from softbend.campaign.store import CampaignStore
+    from softbend.pipeline.paper_b import run_campaign_section
     from softbend.reports import analysis_figures, paper_b
 
-    phase = "paper B: campaign (analytical)"
     folder = out_dir / "paper_b"
-    folder.mkdir(parents=True, exist_ok=True)
-    space = DesignSpace.table1() if space is None else space
-
-    def on_progress(done: int, failed: int, running: int, total: int) -> None:
-        if progress is not None:
-            progress(phase, done + failed, total)
-
-    summary = run_campaign(
-        folder / "campaign.duckdb",
-        space,
-        backend="analytical",
-        workers=workers,
-        progress=on_progress,
-    )
-    with CampaignStore(folder / "campaign.duckdb", read_only=True) as store:
-        samples = store.load_samples()
-        status = store.status_summary()
-        store.export(folder / "samples.parquet", format="parquet")
+    ran = run_campaign_section(out_dir, space=space, workers=workers, progress=progress)
+    samples, campaign = ran.samples, ran.summary
     regression = standardized_regression(samples)
     features = [*DEFAULT_FEATURES, DEFAULT_TARGET]
     figures = {
         "curves": paper_b.angle_curves(
             samples,
             paper_b.fig7_design_ids(),
-            folder / f"fig7_designs_{summary.backend}.png",
-            backend=summary.backend,
+            folder / f"fig7_designs_{campaign['backend']}.png",
+            backend=campaign["backend"],
         ),
         "correlation": analysis_figures.correlation_heatmap(
             correlation_matrix(samples, features), folder / "fig4a_correlation.png"
         ),
         "loadings": analysis_figures.loadings_bar(regression, folder / "fig4b_loadings.png"),
         "parity": analysis_figures.parity_plot(regression, folder / "fig4c_parity.png"),
-    }
-    campaign = {
-        "backend": summary.backend,
-        "n_designs": len(space),
-        "done": int(status["done"]),
-        "failed": int(status["failed"]),
-        "n_samples": len(samples),
-        "run_now": summary.n_run,
-        "resumed_done": summary.n_skipped_done,
-        "seconds": summary.wall_time_s,
-        # None (not NaN) when a resumed run had nothing left to do: JSON has no NaN.
-        "designs_per_s": summary.designs_per_s if summary.n_run else None,
     }
     paper_b.add_section(
         report, campaign=campaign, regression=regression, figures=figures, root=out_dir
@@ -157,37 +106,16 @@ def _paper_b(
 def _paper_b_surrogates(
     report: Report, out_dir: Path, seed: int, progress: Progress | None
 ) -> dict[str, Any]:
+    from softbend.pipeline.paper_b import train_campaign_surrogates
     from softbend.reports import paper_b
     from softbend.reports.surrogate_figures import training_figures
-    from softbend.surrogates.workflow import train_surrogates
-
-    folder = out_dir / "paper_b"
-
-    def on_progress(phase: str, done: int, total: int) -> None:
-        if progress is not None:
-            progress(f"paper B: surrogates, {phase}", done, total)
 
     start = time.perf_counter()
-    result, summary = train_surrogates(
-        folder / "campaign.duckdb",
-        folder / "surrogates",
-        grid_name="quick",
-        seed=seed,
-        progress=on_progress,
-    )
-    summary["files"].update(training_figures(result, folder / "surrogates"))
-    paper_b.add_surrogate_section(report, summary, root=out_dir)
-    return {
-        "seconds": time.perf_counter() - start,
-        "best_by_mape": summary["best_by_mape"],
-        "models": {
-            name: {
-                key: m[key]
-                for key in ("params", "r2", "rmse_deg", "mape_pct", "inference_single_us")
-            }
-            for name, m in summary["models"].items()
-        },
-    }
+    trained = train_campaign_surrogates(out_dir, seed=seed, progress=progress)
+    drawn = training_figures(trained.search, out_dir / "paper_b" / "surrogates")
+    training = {**trained.training, "files": {**trained.training["files"], **drawn}}
+    paper_b.add_surrogate_section(report, training, root=out_dir)
+    return {**trained.summary, "seconds": time.perf_counter() - start}
 
 
 def run_reproduce(

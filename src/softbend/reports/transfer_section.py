@@ -1,23 +1,22 @@
 """Paper B Figs. 6 and 7: transfer learning on the shipped virtual lab (no FEM is rerun).
 
-:func:`add_section` reads the shipped virtual-lab measurements
-(:func:`softbend.transfer.lab.shipped_measurements`, labelled synthetic) and the
-shipped FEM-trained MLP (:func:`softbend.transfer.base.load_base`), runs the
-leave-one-configuration-out evaluation of every strategy and reports it beside
-paper B's refined MLP.
+:func:`softbend.pipeline.transfer.run_transfer` runs the leave-one-configuration-
+out evaluation of every strategy on the shipped virtual lab; :func:`add_section`
+draws it and reports it beside paper B's refined MLP.
 """
 
 from __future__ import annotations
 
 import time
-from collections.abc import Callable
+from collections.abc import Sequence
 from pathlib import Path
 from typing import Any
 
+from softbend.pipeline import Progress
+from softbend.pipeline.transfer import Transfer
 from softbend.reports.html import Report
 
-#: progress(phase, done, total)
-Progress = Callable[[str, int, int], None]
+__all__ = ["PAPER_B_REFINED", "add_section", "add_transfer"]
 
 #: Paper B §4.3 (Fig. 7): the refined MLP, leave one configuration out.
 PAPER_B_REFINED = {
@@ -37,6 +36,7 @@ def add_section(
     progress: Progress | None = None,
     *,
     options: dict[str, dict[str, Any]] | None = None,
+    strategies: Sequence[str] | None = None,
 ) -> dict[str, Any]:
     """Append the transfer-learning section to ``report``; return the headline figures.
 
@@ -51,25 +51,30 @@ def add_section(
     options : dict, optional
         Constructor options per strategy (e.g. fewer epochs for a quick run);
         default paper B's settings.
+    strategies : sequence of str, optional
+        Default: every strategy.
     """
-    from softbend.reports import transfer_figures
-    from softbend.transfer.base import load_base, shipped_base_path
-    from softbend.transfer.lab import shipped_measurements
-    from softbend.transfer.loco import leave_one_configuration_out
+    from softbend.pipeline.transfer import run_transfer
 
     start = time.perf_counter()
-    folder = out_dir / "transfer"
-    measurements = shipped_measurements()
-    base = load_base()
+    transfer = run_transfer(out_dir, seed, progress, options=options, strategies=strategies)
+    add_transfer(report, transfer, out_dir)
+    return {**transfer.summary, "seconds": time.perf_counter() - start}
 
-    def on_progress(done: int, total: int, name: str) -> None:
-        if progress is not None:
-            progress("transfer: leave one configuration out", done, total)
 
-    result = leave_one_configuration_out(
-        measurements, base, seed=seed, options=options, progress=on_progress
-    )
-    files = result.write(folder)
+def add_transfer(report: Report, transfer: Transfer, root: Path) -> dict[str, Path]:
+    """Draw the virtual lab and Figs. 6 and 7 into ``root/transfer``; add the section.
+
+    Returns
+    -------
+    dict
+        ``{"lab", "fig6", "fig7", "curve"}`` paths of the figures.
+    """
+    from softbend.reports import transfer_figures
+    from softbend.transfer.base import shipped_base_path
+
+    folder = root / "transfer"
+    measurements, result = transfer.measurements, transfer.result
     figures = {
         "lab": transfer_figures.lab_measurements(measurements, folder / "virtual_lab.png"),
         "fig6": transfer_figures.loss_curves(result, folder / "fig6_loss_curves.png"),
@@ -92,7 +97,7 @@ def add_section(
         f"held-out actuator is predicted by models fitted on the other six.",
         note=True,
     )
-    section.figure(figures["lab"], "The virtual lab's readings (synthetic)", root=out_dir)
+    section.figure(figures["lab"], "The virtual lab's readings (synthetic)", root=root)
     rows = []
     for _, r in result.summary.iterrows():
         coverage = "" if r["coverage"] != r["coverage"] else f"{100 * r['coverage']:.1f} %"
@@ -157,22 +162,8 @@ def add_section(
         note=True,
     )
     section.figure(
-        figures["fig7"], "Fig. 7 — held-out actuators, measured and predicted", root=out_dir
+        figures["fig7"], "Fig. 7 — held-out actuators, measured and predicted", root=root
     )
-    section.figure(figures["fig6"], "Fig. 6 — training losses (deg²)", root=out_dir)
-    section.figure(
-        figures["curve"], "Learning curve — error against measured actuators", root=out_dir
-    )
-    return {
-        "seconds": time.perf_counter() - start,
-        "n_measurements": len(measurements),
-        "best": best,
-        "summary": {
-            str(r["strategy"]): {
-                k: (None if r[k] != r[k] else float(r[k]))
-                for k in ("rmse_deg", "mape_pct", "max_error_deg", "coverage")
-            }
-            for _, r in result.summary.iterrows()
-        },
-        "files": files,
-    }
+    section.figure(figures["fig6"], "Fig. 6 — training losses (deg²)", root=root)
+    section.figure(figures["curve"], "Learning curve — error against measured actuators", root=root)
+    return figures

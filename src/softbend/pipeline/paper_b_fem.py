@@ -1,0 +1,215 @@
+"""Paper B §3.1: the Dragon Skin 30 fit (Fig. 2a) and the FEM sweep of its Fig. 2 design."""
+
+from __future__ import annotations
+
+import time
+from collections.abc import Callable, Sequence
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import TYPE_CHECKING, Any
+
+import numpy as np
+
+from softbend.pipeline import Progress
+
+if TYPE_CHECKING:  # pragma: no cover
+    from softbend.materials import FitResult, TensileTest
+    from softbend.models import SweepResult
+
+__all__ = ["FIG2_DESIGN", "FIG2_PMAX_MPA", "FEMSweep", "Fig2", "run_fig2", "sweep_with_shapes"]
+
+#: Design and pressures of paper B Fig. 2b.
+FIG2_DESIGN = "100,6,2,2,5,10"
+FIG2_PMAX_MPA = 0.17
+
+
+@dataclass(frozen=True)
+class FEMSweep:
+    """One FEM sweep of :func:`sweep_with_shapes` and what it was compared with.
+
+    Attributes
+    ----------
+    result, analytical : SweepResult
+        The FEM sweep and the analytical model's on the same grid.
+    outlines : list of (float, ndarray)
+        ``(pressure MPa, closed outline (m, 2) in mm)`` in the bending plane at
+        the converged steps nearest to the requested shape pressures.
+    steps : int
+        Load steps of the sweep (the gravity step not counted).
+    files : dict
+        ``{"csv": path}``, and ``"vtk"`` (list of paths) when exported.
+    """
+
+    result: SweepResult
+    analytical: SweepResult
+    outlines: list[tuple[float, np.ndarray]]
+    steps: int
+    files: dict[str, Any] = field(default_factory=dict)
+
+    @property
+    def shape_pressures_mpa(self) -> list[float]:
+        """Pressures of the outlines, MPa."""
+        return [p for p, _ in self.outlines]
+
+
+def sweep_with_shapes(
+    design: Any,
+    pressures_mpa: Any,
+    options: Any,
+    out_dir: str | Path,
+    *,
+    shape_pressures_mpa: Sequence[float] | int,
+    prefix: str = "",
+    vtk: bool = False,
+    progress: Callable[[float, float, float], None] | None = None,
+) -> FEMSweep:
+    """Sweep one design with the FEM; keep the analytical curve and the deformed outlines.
+
+    Writes ``<prefix>sweep.csv`` (pressure, angle, tip, converged, Newton
+    iterations) and with ``vtk`` the shapes as ``vtk/shape_<kPa>kPa.vtu``.
+
+    Parameters
+    ----------
+    design : SFRBADesign
+    pressures_mpa : array_like
+        Output pressures, MPa, increasing.
+    options : FEMOptions or None
+    out_dir : path
+        Folder of the files (created).
+    shape_pressures_mpa : sequence of float or int
+        Where to take the shape, MPa; an integer ``n`` takes ``n`` shapes evenly
+        spaced from 0 to the last converged step.
+    prefix : str
+        Start of every file name.
+    vtk : bool
+        Also export the shapes as VTK.
+    progress : callable, optional
+        ``progress(pressure_mpa, angle_deg, target_mpa)`` after each load step.
+    """
+    from softbend.analytical import AnalyticalModel
+    from softbend.fem.export import silhouette_mm, write_sweep_csv, write_vtk
+    from softbend.fem.sweep import run_sweep
+
+    out = Path(out_dir)
+    out.mkdir(parents=True, exist_ok=True)
+    result, model, history = run_sweep(
+        design, pressures_mpa, options, progress=progress, keep_states=True
+    )
+    files: dict[str, Any] = {"csv": write_sweep_csv(result, out / f"{prefix}sweep.csv")}
+    analytical = AnalyticalModel().sweep(design, pressures_mpa)
+    if isinstance(shape_pressures_mpa, int):
+        shape_pressures_mpa = np.linspace(0.0, history.pressures[-1], shape_pressures_mpa)
+    outlines, vtk_files = [], []
+    for chosen in history.nearest_steps(shape_pressures_mpa):
+        model.set_state(chosen.state)
+        outlines.append((float(chosen.pressure_mpa), silhouette_mm(model)))
+        if vtk:
+            kpa = f"{1000 * chosen.pressure_mpa:06.2f}".replace(".", "p")
+            vtk_files.append(write_vtk(model, out / "vtk" / f"shape_{kpa}kPa.vtu"))
+    if vtk:
+        files["vtk"] = vtk_files
+    return FEMSweep(result, analytical, outlines, len(history.steps) - 1, files)
+
+
+@dataclass(frozen=True)
+class Fig2:
+    """What :func:`run_fig2` computed.
+
+    Attributes
+    ----------
+    test : TensileTest
+        The shipped Dragon Skin 30 uniaxial test.
+    fits : dict
+        ``{model name: FitResult}`` of the hyperelastic models fitted to it.
+    design : SFRBADesign
+        The swept design (:data:`FIG2_DESIGN`).
+    pmax_mpa : float
+        Last pressure of the sweep, MPa.
+    sweep : FEMSweep
+        The sweep, the analytical model on the same grid, the outlines.
+    angles : list of (float, float, float)
+        ``(pressure MPa, FEM angle °, analytical angle °)`` at the converged
+        outputs among 0, 0.05, 0.10, 0.15 MPa and ``pmax_mpa``.
+    summary : dict
+        Headline figures (fits, angles, FEM wall time and stop reason).
+    """
+
+    test: TensileTest
+    fits: dict[str, FitResult]
+    design: Any
+    pmax_mpa: float
+    sweep: FEMSweep
+    angles: list[tuple[float, float, float]]
+    summary: dict[str, Any]
+
+
+def _angles_at(sweep: FEMSweep, pmax_mpa: float) -> list[tuple[float, float, float]]:
+    """(pressure, FEM angle, analytical angle) at the round pressures the sweep converged on."""
+    result, analytical = sweep.result, sweep.analytical
+    picks = sorted({p for p in (0.0, 0.05, 0.10, 0.15, pmax_mpa) if p <= pmax_mpa})
+    rows = []
+    for p in picks:
+        i = int(abs(result.pressure_mpa - p).argmin())
+        if abs(result.pressure_mpa[i] - p) < 1e-9 and result.converged[i]:
+            rows.append((p, result.angle_deg[i], analytical.angle_deg[i]))
+    return rows
+
+
+def run_fig2(
+    out_dir: Path,
+    progress: Progress | None = None,
+    *,
+    options: Any = None,
+    pmax_mpa: float = FIG2_PMAX_MPA,
+) -> Fig2:
+    """Fit the shipped Dragon Skin 30 test and sweep the Fig. 2 design with the FEM.
+
+    Writes ``out_dir/paper_b_fem/fem_sweep.csv``. ``options``
+    (:class:`softbend.fem.FEMOptions`) and ``pmax_mpa`` default to the model's
+    defaults and paper B's 0.17 MPa; ``progress(phase, done, total)`` counts kPa.
+    """
+    from softbend.design import SFRBADesign
+    from softbend.materials import fit_models, load_shipped
+    from softbend.models import default_pressures_mpa
+
+    start = time.perf_counter()
+    folder = Path(out_dir) / "paper_b_fem"
+    test = load_shipped("dragon-skin-30")
+    fits = fit_models(test)
+    design = SFRBADesign.parse(FIG2_DESIGN)
+    pressures = default_pressures_mpa(pmax_mpa)
+    phase = "paper B: FEM sweep (kPa)"
+    total = round(1000 * pmax_mpa)
+
+    def on_step(pressure: float, _angle: float, _target: float) -> None:
+        if progress is not None:
+            progress(phase, round(1000 * pressure), total)
+
+    sweep = sweep_with_shapes(
+        design,
+        pressures,
+        options,
+        folder,
+        shape_pressures_mpa=[0.0, 0.05, 0.10, pmax_mpa],
+        prefix="fem_",
+        progress=on_step,
+    )
+    if progress is not None:
+        progress(phase, total, total)
+    angles = _angles_at(sweep, pmax_mpa)
+    result = sweep.result
+    yeoh = fits.get("yeoh")
+    summary = {
+        "seconds": time.perf_counter() - start,
+        "dragon_skin_30_fit": {
+            name: {"r2": r.r2, "rmse_mpa": r.rmse_mpa, "model": r.model.to_dict()}
+            for name, r in fits.items()
+        },
+        "yeoh_r2": None if yeoh is None else yeoh.r2,
+        "fem_design": str(design),
+        "fem_angles_deg": {f"{row[0]:g}": row[1] for row in angles},
+        "analytical_angles_deg": {f"{row[0]:g}": row[2] for row in angles},
+        "fem_wall_time_s": result.wall_time_s,
+        "fem_stop_reason": result.stats["stop_reason"],
+    }
+    return Fig2(test, fits, design, pmax_mpa, sweep, angles, summary)
