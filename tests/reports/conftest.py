@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import os
+import re
 import shutil
 from pathlib import Path
 from typing import Any
@@ -71,3 +72,27 @@ def open_in_browser(page_path: Path, screenshot: Path | None = None) -> dict[str
         finally:
             browser.close()
     return {**seen, "console_errors": errors}
+
+
+def stand_in_fem_dataset(folder: Path) -> Path:
+    """A small FEM dataset in the shipped format (analytical sweeps of 15 designs: fast)."""
+    from softbend.campaign import run_campaign
+    from softbend.datasets import write_dataset
+    from softbend.design import DesignSpace
+
+    db = folder / "stand_in.duckdb"
+    run_campaign(db, DesignSpace.sample(15, seed=4), backend="analytical", workers=0)
+    write_dataset(db, folder / "dataset", command="stand-in for the test")
+    return folder / "dataset"
+
+
+def only_section(report: Any) -> tuple[str, str]:
+    """The title and HTML of a report's one section (fails if it has another number)."""
+    assert len(report.sections) == 1, [s.title for s in report.sections]
+    section = report.sections[0]
+    return section.title, section.render()
+
+
+def figures_of(html: str) -> list[str]:
+    """The ``src`` of every ``<img>`` in ``html``, in order."""
+    return re.findall(r'<img src="([^"]+)"', html)
