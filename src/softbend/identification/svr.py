@@ -41,6 +41,7 @@ from typing import NamedTuple
 
 import numpy as np
 from scipy.spatial.distance import cdist
+from sklearn import config_context
 from sklearn.base import BaseEstimator, RegressorMixin
 from sklearn.exceptions import ConvergenceWarning, NotFittedError
 from sklearn.svm import SVR
@@ -68,7 +69,7 @@ _OWNER = "GeneralizedGaussianSVR"
 #: Default cap on the working set of the γ ≠ 2 solver: 8·4096² bytes = 128 MiB of Gram.
 DEFAULT_MAX_WORKING_SET = 4096
 #: Size of the first working set (a fixed-seed random subset of the rows).
-_INITIAL_WORKING_SET = 512
+_INITIAL_WORKING_SET = 256
 #: Most violating rows added to the working set per round (bounds the Gram block).
 _MAX_ADDED = 512
 #: Rounds of the active-set loop before it gives up with a ConvergenceWarning: this
@@ -340,7 +341,10 @@ def _solve_active_set(
             cache_size=cache_size,
             max_iter=max_iter,
         )
-        svr.fit(gram, target, sample_weight=_libsvm_weights(weights))
+        # The blocks are built here from validated data: scikit-learn's checks of
+        # parameters and finiteness would cost more than LIBSVM's solve of a small block.
+        with config_context(skip_parameter_validation=True, assume_finite=True):
+            svr.fit(gram, target, sample_weight=_libsvm_weights(weights))
         del gram
         solved = np.zeros(target.size)
         solved[svr.support_] = np.asarray(svr.dual_coef_, dtype=float).ravel()
