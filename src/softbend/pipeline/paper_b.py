@@ -14,6 +14,7 @@ from softbend.pipeline import Progress
 if TYPE_CHECKING:  # pragma: no cover
     import pandas as pd
 
+    from softbend.analysis import CampaignAnalysis
     from softbend.surrogates.search import SearchResult
 
 __all__ = ["Campaign", "Surrogates", "run_campaign_section", "train_campaign_surrogates"]
@@ -29,6 +30,9 @@ class Campaign:
         Every sample of the campaign database.
     database, parquet : Path
         The campaign database (DuckDB) and its Parquet export.
+    analysis : CampaignAnalysis
+        Paper B's preliminary analysis of the samples (Fig. 4): correlations and
+        the standardized regression.
     summary : dict
         ``backend``, ``n_designs``, ``done``, ``failed``, ``n_samples``,
         ``run_now``, ``resumed_done``, ``seconds`` and ``designs_per_s``
@@ -38,6 +42,7 @@ class Campaign:
     samples: pd.DataFrame
     database: Path
     parquet: Path
+    analysis: CampaignAnalysis
     summary: dict[str, Any]
 
 
@@ -84,6 +89,7 @@ def run_campaign_section(
     progress : callable, optional
         ``progress(phase, done, total)`` in designs finished or failed.
     """
+    from softbend.analysis import analyze_samples
     from softbend.campaign import run_campaign
     from softbend.campaign.store import CampaignStore
 
@@ -114,7 +120,13 @@ def run_campaign_section(
         # None (not NaN) when a resumed run had nothing left to do: JSON has no NaN.
         "designs_per_s": run.designs_per_s if run.n_run else None,
     }
-    return Campaign(samples=samples, database=database, parquet=Path(parquet), summary=summary)
+    return Campaign(
+        samples=samples,
+        database=database,
+        parquet=Path(parquet),
+        analysis=analyze_samples(samples),
+        summary=summary,
+    )
 
 
 def train_campaign_surrogates(

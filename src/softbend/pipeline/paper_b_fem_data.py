@@ -162,12 +162,7 @@ def run_fem_data(
     models : sequence of str, optional
         Surrogate families (default: all three of paper B).
     """
-    from softbend.analysis import (
-        DEFAULT_FEATURES,
-        DEFAULT_TARGET,
-        correlation_matrix,
-        standardized_regression,
-    )
+    from softbend.analysis import analyze_samples
     from softbend.datasets import table1_fem, table1_fem_designs, table1_fem_provenance
 
     start = time.perf_counter()
@@ -178,8 +173,8 @@ def run_fem_data(
     provenance = table1_fem_provenance(dataset)
     converged = samples[samples["converged"]]
     done = designs[designs["status"] == "done"]
-    regression = standardized_regression(samples)
-    correlation = correlation_matrix(samples, [*DEFAULT_FEATURES, DEFAULT_TARGET])
+    analysis = analyze_samples(samples)
+    regression, correlation = analysis.regression, analysis.correlation
     result, grouped, shuffled = _surrogates(
         samples, folder / "surrogates", seed, progress, epochs, models
     )

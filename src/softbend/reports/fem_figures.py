@@ -142,33 +142,30 @@ def sweep_with_files(
     progress : callable, optional
         ``progress(pressure_mpa, angle_deg, target_mpa)`` after each load step.
     """
-    from softbend.analytical import AnalyticalModel
-    from softbend.fem.export import silhouette_mm, write_sweep_csv, write_vtk
-    from softbend.fem.sweep import run_sweep
+    from softbend.pipeline.paper_b_fem import sweep_with_shapes
 
     out = Path(out_dir)
-    out.mkdir(parents=True, exist_ok=True)
-    result, model, history = run_sweep(
-        design, pressures_mpa, options, progress=progress, keep_states=True
+    sweep = sweep_with_shapes(
+        design,
+        pressures_mpa,
+        options,
+        out,
+        shape_pressures_mpa=shape_pressures_mpa,
+        prefix=prefix,
+        vtk=vtk,
+        progress=progress,
     )
-    files: dict[str, Any] = {"csv": write_sweep_csv(result, out / f"{prefix}sweep.csv")}
-    analytical = AnalyticalModel().sweep(design, pressures_mpa)
-    files["curve"] = angle_pressure_curve(
-        result, out / f"{prefix}angle_pressure.png", analytical=analytical
-    )
-    if isinstance(shape_pressures_mpa, int):
-        shape_pressures_mpa = np.linspace(0.0, history.pressures[-1], shape_pressures_mpa)
-    outlines, drawn, vtk_files = [], [], []
-    for chosen in history.nearest_steps(shape_pressures_mpa):
-        model.set_state(chosen.state)
-        outlines.append((chosen.pressure_mpa, silhouette_mm(model)))
-        drawn.append(float(chosen.pressure_mpa))
-        if vtk:
-            kpa = f"{1000 * chosen.pressure_mpa:06.2f}".replace(".", "p")
-            vtk_files.append(write_vtk(model, out / "vtk" / f"shape_{kpa}kPa.vtu"))
-    files["shapes"] = deformed_shapes(
-        outlines, out / f"{prefix}shapes.png", title=f"Design ({design}), FEM"
-    )
+    files = {
+        "csv": sweep.files["csv"],
+        "curve": angle_pressure_curve(
+            sweep.result, out / f"{prefix}angle_pressure.png", analytical=sweep.analytical
+        ),
+        "shapes": deformed_shapes(
+            sweep.outlines, out / f"{prefix}shapes.png", title=f"Design ({design}), FEM"
+        ),
+    }
     if vtk:
-        files["vtk"] = vtk_files
-    return FEMSweepFiles(result, analytical, drawn, len(history.steps) - 1, files)
+        files["vtk"] = sweep.files["vtk"]
+    return FEMSweepFiles(
+        sweep.result, sweep.analytical, sweep.shape_pressures_mpa, sweep.steps, files
+    )

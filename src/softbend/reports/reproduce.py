@@ -63,20 +63,13 @@ def _paper_b(
     progress: Progress | None,
     space: DesignSpace | None = None,
 ) -> dict[str, Any]:
-    from softbend.analysis import (
-        DEFAULT_FEATURES,
-        DEFAULT_TARGET,
-        correlation_matrix,
-        standardized_regression,
-    )
     from softbend.pipeline.paper_b import run_campaign_section
-    from softbend.reports import analysis_figures, paper_b
+    from softbend.reports import paper_b
+    from softbend.reports.analysis_figures import campaign_analysis_figures
 
     folder = out_dir / "paper_b"
     ran = run_campaign_section(out_dir, space=space, workers=workers, progress=progress)
-    samples, campaign = ran.samples, ran.summary
-    regression = standardized_regression(samples)
-    features = [*DEFAULT_FEATURES, DEFAULT_TARGET]
+    samples, campaign, regression = ran.samples, ran.summary, ran.analysis.regression
     figures = {
         "curves": paper_b.angle_curves(
             samples,
@@ -84,11 +77,13 @@ def _paper_b(
             folder / f"fig7_designs_{campaign['backend']}.png",
             backend=campaign["backend"],
         ),
-        "correlation": analysis_figures.correlation_heatmap(
-            correlation_matrix(samples, features), folder / "fig4a_correlation.png"
+        **campaign_analysis_figures(
+            ran.analysis,
+            folder,
+            correlation_png="fig4a_correlation.png",
+            loadings_png="fig4b_loadings.png",
+            parity_png="fig4c_parity.png",
         ),
-        "loadings": analysis_figures.loadings_bar(regression, folder / "fig4b_loadings.png"),
-        "parity": analysis_figures.parity_plot(regression, folder / "fig4c_parity.png"),
     }
     paper_b.add_section(
         report, campaign=campaign, regression=regression, figures=figures, root=out_dir
