@@ -8,6 +8,10 @@ in assembly (Hessian and residual) and factorisation. With ``--check-interpolati
 N`` it also re-runs N designs spread over the corners solving every 0.005 MPa
 output and reports the largest difference of the interpolated angles.
 
+The energy terms are compiled to machine code once for the run (NGSolve's
+``realcompile``, in the background while the first sweep runs; ``--no-compile``
+for the interpreted terms).
+
 Results are appended to a JSON-lines file as each design finishes, so an
 interrupted run resumes where it stopped::
 
@@ -35,7 +39,7 @@ import numpy as np
 
 from softbend.campaign.backends import default_pressures_mpa
 from softbend.design import DesignSpace
-from softbend.fem import FEMOptions, simulate
+from softbend.fem import FEMOptions, simulate, use_compiled
 
 
 def _row(result, seconds: float) -> dict:
@@ -167,7 +171,14 @@ def main(argv: list[str] | None = None) -> int:
     parser.add_argument(
         "--shard", default="0/1", metavar="K/N", help="Only designs i with i %% N == K."
     )
+    parser.add_argument(
+        "--no-compile",
+        action="store_true",
+        help="Interpreted energy terms (default: compiled once for the whole run, "
+        "softbend.fem.use_compiled; the first sweep pays the compilation).",
+    )
     args = parser.parse_args(argv)
+    use_compiled(not args.no_compile)
 
     os.environ.setdefault("OMP_NUM_THREADS", "1")
     options = FEMOptions(maxh_mm=args.maxh, threads=1)

@@ -80,7 +80,7 @@ def _import_fem() -> Any:
     return fem
 
 
-def _make_fem(options: Any = None, **fem_options: Any) -> BendingModel:
+def _make_fem(options: Any = None, *, compiled: bool = False, **fem_options: Any) -> BendingModel:
     fem = _import_fem()
     if fem_options:
         if options is not None:
@@ -95,7 +95,7 @@ def _make_fem(options: Any = None, **fem_options: Any) -> BendingModel:
                 f"has no FEMOptions to build them from keywords {sorted(fem_options)}."
             )
         options = make_options(**fem_options)
-    return fem.FEMModel(options=options)
+    return fem.FEMModel(options=options, compiled=compiled)
 
 
 @dataclass(frozen=True)

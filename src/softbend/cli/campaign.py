@@ -102,6 +102,12 @@ def run(
         help="Run a campaign estimated above 2 GiB of memory or 20 GiB of disk "
         "(one that does not fit the machine is refused anyway).",
     ),
+    compile_energy: bool = typer.Option(
+        True,
+        "--compile/--no-compile",
+        help="--backend fem: compile the energy to machine code once per worker "
+        "(about 25 CPU s in the background; then sweeps 1.2-1.4x faster, same results).",
+    ),
     json_output: bool = typer.Option(False, "--json", help="Print the summary as JSON."),
 ) -> None:
     """Sweep every design of a space not yet in DB; re-run the same command to resume."""
@@ -128,7 +134,11 @@ def run(
 
         public = [name for name in available_backends() if name not in INTERNAL_BACKENDS]
         check_choice(backend, "--backend", "softbend campaign run", (*public, "surrogate"))
-        backend_obj = get_backend(backend)
+        backend_obj = (
+            get_backend(backend, compiled=compile_energy)
+            if backend == "fem"
+            else get_backend(backend)
+        )
     if scheduler is not None:
         parse_scheduler_address(scheduler)
     k, count = shard_of or (0, 1)

@@ -29,14 +29,9 @@ from typing import Any
 import numpy as np
 
 from softbend.design import FIBER_DIAMETER_MM, SFRBADesign
+from softbend.fem.energy import energy_terms
 from softbend.fem.geometry import mesh_actuator
-from softbend.fem.mechanics import (
-    fiber_energy,
-    helix_stiffness_n_per_mm,
-    membrane_energy,
-    solid_energy,
-    volume_flux,
-)
+from softbend.fem.mechanics import helix_stiffness_n_per_mm
 from softbend.fem.newton import EnergySolver
 from softbend.fem.options import FEMOptions
 from softbend.kinematics import fit_arc
@@ -95,6 +90,7 @@ class ActuatorModel:
             max_iterations=options.max_iterations,
             load=self.weight_vector,
             load_factor=self.gravity_factor,
+            prepare=self._bind,
         )
         self._backbone_x = np.linspace(*self.geometry.chamber_mm, options.backbone_points)
         self._backbone_points = [self.mesh(float(x), 0.0, 0.0) for x in self._backbone_x]
@@ -157,38 +153,19 @@ class ActuatorModel:
         """The hyperelastic and pressure energy, the volume form and the weight vector."""
         import ngsolve as ngs
         from ngsolve import CoefficientFunction as CF  # noqa: N817
-        from ngsolve import Cross, Grad, Id, Norm, ds, dx, specialcf
+        from ngsolve import ds, dx
 
         o = self.options
-        u = self.fes.TrialFunction()
-        F = Id(3) + Grad(u)
-        Fs = Id(3) + Grad(u).Trace()
-        normal = specialcf.normal(3)
-        mu0 = o.elastomer.model.initial_shear_modulus_mpa
-        w_solid = solid_energy(F, o.elastomer.model, o.bulk_ratio * mu0)
-
-        ex, ey = CF((1.0, 0.0, 0.0)), CF((0.0, 1.0, 0.0))
-        w_layer = membrane_energy(Fs, (ex, ey), o.layer.model, o.layer_thickness_mm)
-
-        circumferential = Cross(normal, ex)
-        circumferential = circumferential / Norm(circumferential)
-        phi = math.radians(self.design.phi_deg)
-        stiffness = self.fiber_stiffness_n_per_mm()
-        w_fiber = 0.0
-        for sign in (1.0, -1.0):
-            direction = math.cos(phi) * circumferential + sign * math.sin(phi) * ex
-            w_fiber = w_fiber + fiber_energy(Fs, direction, stiffness, o.fiber_law)
-
-        position = CF((ngs.x, ngs.y, ngs.z)) + u.Trace()
-        flux = volume_flux(position, Fs, normal, axes=(0, 2))  # = −(cavity volume) density
-
+        self.terms = terms = energy_terms(self.fes, o)
+        self._fiber_stiffness = self.fiber_stiffness_n_per_mm()
+        self._bind()
         form = ngs.BilinearForm(self.fes, symmetric=True)
-        form += ngs.Variation(w_solid.Compile() * dx)
-        form += ngs.Variation(w_layer.Compile() * ds("bottom"))
-        form += ngs.Variation(w_fiber.Compile() * ds("outer|bottom"))
-        form += ngs.Variation((self.pressure * flux).Compile() * ds("cavity"))
+        form += ngs.Variation(terms.solid * dx)
+        form += ngs.Variation(terms.layer * ds("bottom"))
+        form += ngs.Variation(terms.fiber * ds("outer|bottom"))
+        form += ngs.Variation(terms.pressure_work * ds("cavity"))
         volume = ngs.BilinearForm(self.fes, symmetric=True)
-        volume += ngs.Variation(flux.Compile() * ds("cavity"))
+        volume += ngs.Variation(terms.flux * ds("cavity"))
 
         # Gravity is a dead load (its potential −ρ g·u is linear in u): assembled
         # once as a force vector and scaled by the gravity factor, instead of
@@ -202,6 +179,10 @@ class ActuatorModel:
         weight += fiber_mass * ngs.InnerProduct(g, v.Trace()) * ds("outer|bottom")
         weight.Assemble()
         return form, volume, weight.vec
+
+    def _bind(self) -> None:
+        """This model's pressure and fiber values into the (possibly shared) energy terms."""
+        self.terms.bind(self.pressure.Get(), self.design.phi_deg, self._fiber_stiffness)
 
     # -- loads and state -----------------------------------------------------------------
     @property
@@ -218,6 +199,7 @@ class ActuatorModel:
         """Set the cavity pressure (MPa) and the fraction of gravity applied."""
         self.pressure.Set(float(pressure_mpa))
         self.gravity_factor.Set(float(gravity_factor))
+        self._bind()
 
     def force_scale_n(self, pressure_mpa: float) -> float:
         """Load size for the Newton tolerance: pressure resultant on the half cavity + weight, N."""

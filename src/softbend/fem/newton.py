@@ -25,6 +25,7 @@ from __future__ import annotations
 import logging
 import math
 import time
+from collections.abc import Callable
 from dataclasses import dataclass, field
 from typing import Any
 
@@ -108,6 +109,10 @@ class EnergySolver:
     #: less than half or raises it, and goes on failing for 5–10 costly
     #: iterations (``math.inf`` turns the rule off).
     first_contraction: float = 0.1
+    #: Called before every evaluation of ``form`` (energy, residual, Hessian):
+    #: a model whose energy terms are shared with other models sets its own
+    #: parameter values there.
+    prepare: Callable[[], None] | None = None
     timings: _Timings = field(default_factory=_Timings)
 
     def __post_init__(self) -> None:
@@ -135,6 +140,8 @@ class EnergySolver:
     def energy(self, vec: Any = None) -> float:
         """Total potential energy at ``vec`` (default: the current state), mJ."""
         vec = self.gfu.vec if vec is None else vec
+        if self.prepare is not None:
+            self.prepare()
         value = float(self.form.Energy(vec))
         if self.load is not None:
             value -= self._load_scale() * float(self.load.InnerProduct(vec))
@@ -144,6 +151,8 @@ class EnergySolver:
         """Gradient of the energy at the current state (N); fixed dofs are not masked."""
         out = self._res if out is None else out
         start = time.perf_counter()
+        if self.prepare is not None:
+            self.prepare()
         self.form.Apply(self.gfu.vec, out)
         if self.load is not None:
             out.data -= self._load_scale() * self.load
@@ -157,6 +166,8 @@ class EnergySolver:
     def factorize(self) -> Any:
         """Assemble the Hessian at the current state and factorise it."""
         start = time.perf_counter()
+        if self.prepare is not None:
+            self.prepare()
         self.form.AssembleLinearization(self.gfu.vec)
         middle = time.perf_counter()
         if self._inverse is None:
