@@ -96,6 +96,9 @@ def test_pressure_enters_through_the_bound_parameter(interpreted):
 
 
 def test_fem_model_switches_compilation_for_its_process():
-    model = FEMModel(OPTIONS, compiled=True)
-    assert model.compiled
+    from softbend.campaign import get_backend
+
+    assert FEMModel(OPTIONS, compiled=True).compiled
     assert not FEMModel(OPTIONS).compiled
+    assert get_backend("fem", compiled=True, maxh_mm=6.0).compiled
+    assert not get_backend("fem").compiled
