@@ -102,3 +102,20 @@ def test_fem_model_switches_compilation_for_its_process():
     assert not FEMModel(OPTIONS).compiled
     assert get_backend("fem", compiled=True, maxh_mm=6.0).compiled
     assert not get_backend("fem").compiled
+
+
+def test_another_thread_compiles_terms_of_its_own(compiled):
+    """Threads do not share the parameters: a Dask worker may run two sweeps at once."""
+    import threading
+
+    a, _ = compiled
+    seen = []
+    worker = threading.Thread(target=lambda: seen.append(ActuatorModel(DESIGN_A, OPTIONS).terms))
+    use_compiled(True, wait=False)
+    try:
+        worker.start()
+        worker.join()
+    finally:
+        use_compiled(True, wait=True)
+    assert seen and seen[0] is not a.terms
+    assert seen[0].compiled

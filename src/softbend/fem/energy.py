@@ -13,12 +13,14 @@ built with the compiler NGSolve ships a wrapper for, ``ngscxx``). Compiled, the
 elastomer's Hessian assembles about 1.3 times faster, the fibers' twice and the
 residuals about twice; but each term takes 5–6 s to compile, more than it saves
 on one sweep of 10–20 s. With :func:`use_compiled` on, the terms are compiled
-once per process (the terms compile side by side, about 12 s on 2 cores) and
-shared by every later model of the same materials, whatever its mesh or design:
-a campaign worker or a benchmark sweeping many designs pays once. A model binds
-its own parameter values before every evaluation (:meth:`EnergyTerms.bind`), so
-models alive at the same time do not disturb each other. Where no compiler is
-found the terms are used as interpreted expressions, with a warning.
+once per thread (the five terms compile side by side, about 30 CPU seconds) and
+shared by every later model of the same materials in that thread, whatever its
+mesh or design: a campaign worker or a benchmark sweeping many designs pays
+once. A model binds its own parameter values before every evaluation
+(:meth:`EnergyTerms.bind`), so models alive at the same time do not disturb
+each other; models in other threads (a Dask worker running several tasks at
+once) get terms of their own. Where no compiler is found the terms are used as
+interpreted expressions, with a warning.
 """
 
 from __future__ import annotations
@@ -39,10 +41,10 @@ __all__ = ["EnergyTerms", "compiler_available", "energy_terms", "use_compiled"]
 
 logger = logging.getLogger(__name__)
 
-_lock = threading.Lock()
 _state = {"enabled": False, "wait": False, "warned": False}
-#: Compiled terms by the options they depend on (materials, fiber law, element order).
-_CACHE: dict[str, EnergyTerms] = {}
+#: Per thread (the parameters are shared state): compiled terms by the options
+#: they depend on (materials, fiber law, element order).
+_local = threading.local()
 
 
 @dataclass
@@ -110,8 +112,8 @@ def compiler_available() -> bool:
 def energy_terms(fes: Any, options: FEMOptions) -> EnergyTerms:
     """The energy terms for a model on ``fes`` (a 3D ``VectorH1`` space).
 
-    Interpreted terms of its own unless :func:`use_compiled` is on; then the
-    process-wide compiled terms for these materials, compiled on first use.
+    Interpreted terms of its own unless :func:`use_compiled` is on; then this
+    thread's compiled terms for these materials, compiled on first use.
     """
     if not _state["enabled"]:
         return _build(fes, options, compile_code=False)
@@ -120,11 +122,11 @@ def energy_terms(fes: Any, options: FEMOptions) -> EnergyTerms:
             logger.warning("no C++ compiler (ngscxx) found: the FEM energy is not compiled")
             _state["warned"] = True
         return _build(fes, options, compile_code=False)
+    cache = _local.__dict__.setdefault("terms", {})
     key = _key(fes, options)
-    with _lock:
-        if key not in _CACHE:
-            _CACHE[key] = _build(fes, options, compile_code=True)
-        return _CACHE[key]
+    if key not in cache:
+        cache[key] = _build(fes, options, compile_code=True)
+    return cache[key]
 
 
 def _key(fes: Any, options: FEMOptions) -> str:
