@@ -58,6 +58,7 @@ def test_train_writes_models_tables_figures_and_predicts(small_campaign, tmp_pat
         (["--folds", "1"], "folds"),
         (["--jobs", "0"], "The '--jobs' of softbend train must be an integer in [1, inf). Got 0"),
         (["--jobs", "-1"], "'--jobs' of softbend train must be an integer in [1, inf)"),
+        (["--halving-rungs", "0"], "'--halving-rungs' of softbend train must be an integer"),
     ],
 )
 def test_train_bad_input_is_one_line_exit_2(small_campaign, tmp_path, capsys, extra, needle):

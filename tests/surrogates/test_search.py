@@ -134,6 +134,13 @@ def test_halving_rungs_shrink_by_eta_and_end_at_the_full_epochs():
     assert halving_rungs(121, 1000, 3) == [(121, 37), (41, 111), (14, 333), (5, 1000)]
     assert halving_rungs(9, 90, 3) == [(9, 30), (3, 90)]
     assert halving_rungs(2, 50, 3) == [(2, 50)]  # too few to race
+    # One rung more than the default on paper B's grid: 8188 configuration-epochs, not 18 690.
+    five = halving_rungs(121, 1000, 3, rungs=5)
+    assert five == [(121, 12), (41, 37), (14, 111), (5, 333), (2, 1000)]
+    assert sum(n * e for n, e in five) == 8188
+    assert halving_rungs(9, 90, 3, rungs=1) == [(9, 90)]
+    with pytest.raises(ValueError, match="'rungs'"):
+        halving_rungs(9, 90, 3, rungs=0)
     for n, eta in ((121, 2), (40, 4), (7, 3)):
         rungs = halving_rungs(n, 1000, eta)
         assert rungs[0][0] == n and rungs[-1][1] == 1000
@@ -158,6 +165,12 @@ def test_successive_halving_keeps_the_exhaustive_models_of_its_survivors(small_d
     assert raced.settings["mlp_halving"] == 3
     with pytest.raises(ValueError, match="'halving'"):
         search(small_data, **common, halving=1)
+    # Three rungs instead of two: only the best of the second rung's three go on.
+    longer = search(small_data, **common, halving=3, halving_rungs=3)
+    status = longer.cv_results["status"]
+    assert (status == "ok").sum() == 1
+    assert status.str.contains("stopped after 7 epochs").sum() == 6
+    assert longer.settings["mlp_halving_rungs"] == 3
 
 
 def test_random_folds_mix_the_designs(small_data):

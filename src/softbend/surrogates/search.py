@@ -350,20 +350,28 @@ def _cv_sequential(
     return out, resumed
 
 
-def halving_rungs(n_configs: int, epochs: int, eta: int) -> list[tuple[int, int]]:
+def halving_rungs(
+    n_configs: int, epochs: int, eta: int, rungs: int | None = None
+) -> list[tuple[int, int]]:
     """(configurations kept, epochs) of each rung of successive halving.
 
     Every configuration trains ``epochs / eta^k`` epochs first; after each rung
     the best ``1/eta`` (rounded up) go on to ``eta`` times as many epochs, until
-    the survivors train the full ``epochs``. The number of rungs is chosen so
-    that the last rung keeps at least ``eta`` configurations and the first rung
-    trains at least 1/27 of the epochs (at most four rungs): a short first rung
-    ranks configurations by their early loss, which only loosely predicts the
-    final one.
+    the survivors train the full ``epochs``. By default the number of rungs is
+    chosen so that the last rung keeps at least ``eta`` configurations and the
+    first rung trains at least 1/27 of the epochs (at most four rungs): a short
+    first rung ranks configurations by their early loss, which only loosely
+    predicts the final one. ``rungs`` sets the number instead (>= 1; one more
+    rung than the default about halves the configuration-epochs of paper B's
+    grid, with a first rung of 1/81 of the epochs and two configurations in the
+    last).
     """
-    rungs = 1
-    while rungs < 4 and math.ceil(n_configs / eta**rungs) >= eta:
-        rungs += 1
+    if rungs is None:
+        rungs = 1
+        while rungs < 4 and math.ceil(n_configs / eta**rungs) >= eta:
+            rungs += 1
+    else:
+        rungs = check_int(rungs, "rungs", "halving_rungs", low=1)
     out = []
     kept = n_configs
     for k in range(rungs):
@@ -411,6 +419,7 @@ def _cv_mlp_batched(
     device: str,
     progress: Callable[[int, int], None] | None,
     halving: int | None = None,
+    n_rungs: int | None = None,
     checkpoint: SearchCheckpoint | None = None,
 ) -> tuple[list[tuple[dict[str, Any], np.ndarray | None, float, str]], int]:
     """Cross-validated predictions of every MLP configuration, all trained at once.
@@ -432,7 +441,9 @@ def _cv_mlp_batched(
     from softbend.surrogates.checkpoint import group_id
 
     rungs = (
-        [(len(configs), epochs)] if not halving else halving_rungs(len(configs), epochs, halving)
+        [(len(configs), epochs)]
+        if not halving
+        else halving_rungs(len(configs), epochs, halving, n_rungs)
     )
     total = sum(epochs_k for _, epochs_k in rungs)
     done_before = 0
@@ -518,6 +529,7 @@ def search(
     progress: Progress | None = None,
     cv: str = "grouped",
     halving: int | None = None,
+    halving_rungs: int | None = None,
     checkpoint: SearchCheckpoint | None = None,
     refit: bool = True,
 ) -> SearchResult:
@@ -556,6 +568,9 @@ def search(
         (e.g. 3; :func:`halving_rungs`) instead of training each for all the
         epochs: the paper grid then costs a fraction of the exhaustive search.
         The best configuration is chosen among those that reach the full epochs.
+    halving_rungs : int, optional
+        Number of rungs of the halving, >= 1 (default: :func:`halving_rungs`'
+        choice).
     checkpoint : SearchCheckpoint, optional
         Durable record of the finished configuration-folds
         (:mod:`softbend.surrogates.checkpoint`): started with the fingerprint of
@@ -590,6 +605,9 @@ def search(
     check_choice(cv, "cv", owner, CV_PROTOCOLS)
     if halving is not None:
         halving = check_int(halving, "halving", owner, low=2)
+    n_rungs = (
+        None if halving_rungs is None else check_int(halving_rungs, "halving_rungs", owner, low=1)
+    )
     splits = (
         grouped_splits(data.groups, folds, seed)
         if cv == "grouped"
@@ -612,6 +630,7 @@ def search(
                 seed=seed,
                 epochs=epochs,
                 halving=halving,
+                n_rungs=n_rungs,
                 device=device,
                 n_jobs=n_jobs,
             )
@@ -639,6 +658,7 @@ def search(
                 device=device,
                 progress=on_epoch,
                 halving=halving,
+                n_rungs=n_rungs,
                 checkpoint=checkpoint,
             )
         else:
@@ -698,6 +718,7 @@ def search(
         "folds": len(splits),
         "cv": cv,
         "mlp_halving": halving,
+        "mlp_halving_rungs": n_rungs if halving else None,
         "seed": seed,
         "device": device,
         "mlp_epochs": epochs,
@@ -728,6 +749,7 @@ def search_fingerprint(
     halving: int | None,
     device: str,
     n_jobs: int | None,
+    n_rungs: int | None = None,
 ) -> dict[str, Any]:
     """Everything that determines the scores of a search, for its checkpoint.
 
@@ -774,4 +796,6 @@ def search_fingerprint(
             "halving": halving,
             "device": resolve_device(device, "surrogate search"),
         }
+        if halving and n_rungs is not None:  # (absent: older checkpoints stay valid)
+            fingerprint["mlp"]["halving_rungs"] = n_rungs
     return fingerprint

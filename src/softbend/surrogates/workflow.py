@@ -71,6 +71,7 @@ def train_surrogates(
     progress: Progress | None = None,
     cv: str = "grouped",
     halving: int | None = None,
+    halving_rungs: int | None = None,
     checkpoint: SearchCheckpoint | None = None,
 ) -> tuple[SearchResult, dict[str, Any]]:
     """Search, refit, save and export the surrogates of a campaign.
@@ -85,7 +86,7 @@ def train_surrogates(
         As :func:`softbend.surrogates.search.search`.
     export_onnx : bool
         Also write and check ``models/<model>.onnx`` (default True).
-    cv : {"grouped", "random"}, halving : int, optional
+    cv : {"grouped", "random"}, halving : int, optional, halving_rungs : int
         Cross-validation protocol and successive halving of the MLP grid (see
         :func:`softbend.surrogates.search.search`).
     checkpoint : SearchCheckpoint, optional
@@ -117,6 +118,7 @@ def train_surrogates(
         progress=progress,
         cv=cv,
         halving=halving,
+        halving_rungs=halving_rungs,
         checkpoint=checkpoint,
     )
     out = Path(out_dir)
