@@ -16,6 +16,8 @@ exhaustive search, and the projected wall time of the whole paper grid (121
 configurations × 1000 epochs) both ways from the measured cost per model-epoch::
 
     .venv/bin/python benchmarks/bench_mlp_halving.py --configs 12 --epochs 100
+    .venv/bin/python benchmarks/bench_mlp_halving.py --configs 12 --epochs 100 \\
+        --rungs 3 --paper-rungs 5    # one rung more than the default rule, both ways
 """
 
 from __future__ import annotations
@@ -31,10 +33,10 @@ PAPER_CONFIGS = 121
 PAPER_EPOCHS = 1000
 
 
-def _model_epochs(n_configs: int, epochs: int, eta: int | None) -> int:
+def _model_epochs(n_configs: int, epochs: int, eta: int | None, rungs: int | None = None) -> int:
     if eta is None:
         return n_configs * epochs
-    return sum(n * e for n, e in halving_rungs(n_configs, epochs, eta))
+    return sum(n * e for n, e in halving_rungs(n_configs, epochs, eta, rungs))
 
 
 def main(argv: list[str] | None = None) -> int:
@@ -43,6 +45,15 @@ def main(argv: list[str] | None = None) -> int:
     parser.add_argument("--configs", type=int, default=12, help="Configurations of the subset.")
     parser.add_argument("--epochs", type=int, default=100)
     parser.add_argument("--eta", type=int, default=3)
+    parser.add_argument(
+        "--rungs", type=int, default=None, help="Rungs of the halving (default: its own rule)."
+    )
+    parser.add_argument(
+        "--paper-rungs",
+        type=int,
+        default=None,
+        help="Rungs assumed for the paper-grid projection (default: the halving's own rule).",
+    )
     parser.add_argument("--seed", type=int, default=0)
     parser.add_argument("--json", action="store_true")
     args = parser.parse_args(argv)
@@ -69,12 +80,12 @@ def main(argv: list[str] | None = None) -> int:
     runs = {}
     for label, eta in (("exhaustive", None), (f"halving eta={args.eta}", args.eta)):
         start = time.perf_counter()
-        result = search(data, halving=eta, **common)
+        result = search(data, halving=eta, halving_rungs=args.rungs if eta else None, **common)
         seconds = time.perf_counter() - start
         fam = result.families["mlp"]
         runs[label] = {
             "seconds": seconds,
-            "model_epochs": _model_epochs(len(subset), args.epochs, eta),
+            "model_epochs": _model_epochs(len(subset), args.epochs, eta, args.rungs),
             "pick": str(fam.params["hidden_sizes"]),
             "rmse_deg": fam.cv["rmse_deg"],
             "mape_pct": fam.cv["mape_pct"],
@@ -85,7 +96,9 @@ def main(argv: list[str] | None = None) -> int:
     rank = 1 + int(exhaustive.index[exhaustive["params"] == f"hidden_sizes={pick}"][0])
     per_model_epoch = runs["exhaustive"]["seconds"] / runs["exhaustive"]["model_epochs"]
     projection = {
-        label: per_model_epoch * _model_epochs(PAPER_CONFIGS, PAPER_EPOCHS, eta) / 3600.0
+        label: per_model_epoch
+        * _model_epochs(PAPER_CONFIGS, PAPER_EPOCHS, eta, args.paper_rungs)
+        / 3600.0
         for label, eta in (("exhaustive", None), ("halving", args.eta))
     }
     out = {
