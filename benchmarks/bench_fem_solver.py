@@ -4,7 +4,9 @@ Two measurements behind the solver's design choices (one thread):
 
 ``assembly``
     Hessian assembly time of each energy term of one design (default: the
-    largest corner), mean of repeats at a perturbed state. Also timed, for
+    largest corner), mean of repeats at a perturbed state, interpreted and
+    compiled to machine code (``softbend.fem.use_compiled``; the compilation
+    itself, about 30 CPU seconds, is not timed). Also timed, for
     comparison: gravity as a twice-differentiated ``Variation`` term (softbend
     assembles it once as a dead-load vector instead), and two other ways to
     give NGSolve the elastomer's tangent — the first variation ``P:∇v`` with
@@ -34,7 +36,7 @@ import numpy as np
 import softbend.fem  # noqa: F401  (loads PyTorch before NGSolve)
 from softbend.campaign.backends import default_pressures_mpa
 from softbend.design import SFRBADesign
-from softbend.fem import FEMOptions, simulate, sweep
+from softbend.fem import FEMOptions, simulate, sweep, use_compiled
 from softbend.fem.actuator import ActuatorModel
 from softbend.fem.mechanics import solid_energy
 
@@ -77,6 +79,25 @@ def assembly(design: str, repeats: int) -> None:
     print(f"  all terms together: {linearization_time(*terms):.3f} s")
     for name, term in zip(names, terms, strict=True):
         print(f"  {name}: {linearization_time(term):.3f} s")
+
+    # The same terms compiled to machine code (softbend.fem.energy), same state.
+    use_compiled(True, wait=True)
+    try:
+        fast = ActuatorModel(model.design, model.options)
+    finally:
+        use_compiled(False)
+    fast.set_state(model.state())
+    fast.set_load(0.05, 1.0)
+    print("  compiled (use_compiled), Hessian assembly interpreted -> compiled:")
+    for name, slow_term, fast_term in zip(names, terms, fast.form.integrators, strict=True):
+        print(
+            f"    {name}: {1e3 * linearization_time(slow_term):.1f} -> "
+            f"{1e3 * linearization_time(fast_term):.1f} ms"
+        )
+    residual = vec.CreateVector()
+    slow_s = _mean_time(lambda: model.form.Apply(vec, residual), repeats)
+    fast_s = _mean_time(lambda: fast.form.Apply(vec, residual), repeats)
+    print(f"    residual, all terms: {1e3 * slow_s:.1f} -> {1e3 * fast_s:.1f} ms")
 
     u, v = model.fes.TnT()
     g = ngs.CoefficientFunction(model._gravity_vector())

@@ -59,6 +59,8 @@ def test_train_writes_models_tables_figures_and_predicts(small_campaign, tmp_pat
         (["--jobs", "0"], "The '--jobs' of softbend train must be an integer in [1, inf). Got 0"),
         (["--jobs", "-1"], "'--jobs' of softbend train must be an integer in [1, inf)"),
         (["--halving-rungs", "0"], "'--halving-rungs' of softbend train must be an integer"),
+        (["--halving-rungs", "3"], "needs 'halving'"),
+        (["--halving", "3", "--halving-rungs", "40"], "'rungs' of halving_rungs must be at most"),
     ],
 )
 def test_train_bad_input_is_one_line_exit_2(small_campaign, tmp_path, capsys, extra, needle):

@@ -141,6 +141,12 @@ def test_halving_rungs_shrink_by_eta_and_end_at_the_full_epochs():
     assert halving_rungs(9, 90, 3, rungs=1) == [(9, 90)]
     with pytest.raises(ValueError, match="'rungs'"):
         halving_rungs(9, 90, 3, rungs=0)
+    # Past the point where the first rung has an epoch or a race has two contenders.
+    assert len(halving_rungs(121, 1000, 3, rungs=6)) == 6
+    with pytest.raises(ValueError, match=r"'rungs' of halving_rungs must be at most 6 .* Got 7"):
+        halving_rungs(121, 1000, 3, rungs=7)
+    with pytest.raises(ValueError, match="at most 2 for 9 configurations, 3 epochs"):
+        halving_rungs(9, 3, 3, rungs=3)
     for n, eta in ((121, 2), (40, 4), (7, 3)):
         rungs = halving_rungs(n, 1000, eta)
         assert rungs[0][0] == n and rungs[-1][1] == 1000
@@ -171,6 +177,10 @@ def test_successive_halving_keeps_the_exhaustive_models_of_its_survivors(small_d
     assert (status == "ok").sum() == 1
     assert status.str.contains("stopped after 7 epochs").sum() == 6
     assert longer.settings["mlp_halving_rungs"] == 3
+    with pytest.raises(ValueError, match=r"'halving_rungs' of .* needs 'halving'"):
+        search(small_data, **common, halving_rungs=3)
+    with pytest.raises(ValueError, match="'rungs' of halving_rungs must be at most 3"):
+        search(small_data, **common, halving=3, halving_rungs=4)
 
 
 def test_random_folds_mix_the_designs(small_data):

@@ -106,7 +106,8 @@ def run(
         True,
         "--compile/--no-compile",
         help="--backend fem: compile the energy to machine code once per worker "
-        "(about 25 CPU s in the background; then sweeps 1.2-1.4x faster, same results).",
+        "(about 30 CPU s in the background; then faster assembly, the same results; "
+        "see benchmarks/bench_fem.py).",
     ),
     json_output: bool = typer.Option(False, "--json", help="Print the summary as JSON."),
 ) -> None:

@@ -10,17 +10,17 @@ every design of a campaign.
 That is what makes NGSolve's compiled coefficient functions pay
 (``Compile(realcompile=True)``: the expression tree is written out as C++ and
 built with the compiler NGSolve ships a wrapper for, ``ngscxx``). Compiled, the
-elastomer's Hessian assembles about 1.3 times faster, the fibers' twice and the
-residuals about twice; but each term takes 5–6 s to compile, more than it saves
-on one sweep of 10–20 s. With :func:`use_compiled` on, the terms are compiled
-once per thread (the five terms compile side by side, about 30 CPU seconds) and
-shared by every later model of the same materials in that thread, whatever its
-mesh or design: a campaign worker or a benchmark sweeping many designs pays
-once. A model binds its own parameter values before every evaluation
-(:meth:`EnergyTerms.bind`), so models alive at the same time do not disturb
-each other; models in other threads (a Dask worker running several tasks at
-once) get terms of their own. Where no compiler is found the terms are used as
-interpreted expressions, with a warning.
+elastomer's Hessian assembles 1.3–1.7 times faster, the fibers' about three times
+and the residual about three times (``benchmarks/bench_fem_solver.py assembly``);
+but each term takes 5–6 s to compile, more than it saves on one sweep of 10–20 s.
+With :func:`use_compiled` on, the terms are compiled once per thread (the five
+terms compile side by side, about 30 CPU seconds) and shared by every later
+model of the same materials in that thread, whatever its mesh or design: a
+campaign worker or a benchmark sweeping many designs pays once. A model binds
+its own parameter values before every evaluation (:meth:`EnergyTerms.bind`), so
+models alive at the same time do not disturb each other; models in other
+threads (a Dask worker running several tasks at once) get terms of their own.
+Where no compiler is found the terms are used as interpreted expressions, with a warning.
 """
 
 from __future__ import annotations
@@ -181,7 +181,10 @@ def _build(fes: Any, options: FEMOptions, *, compile_code: bool) -> EnergyTerms:
             term.Compile(realcompile=True, wait=_state["wait"] and k == last)
             for k, term in enumerate(terms)
         ]
-        logger.info("FEM energy terms compiled to machine code (wait=%s)", _state["wait"])
+        logger.info(
+            "FEM energy terms compiling to machine code (%s)",
+            "waited for" if _state["wait"] else "in the background",
+        )
     else:
         terms = [term.Compile() for term in terms]
     return EnergyTerms(*terms, pressure, cos_phi, sin_phi, stiffness, compiled=compile_code)

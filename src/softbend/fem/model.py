@@ -25,8 +25,9 @@ class FEMModel:
         Mesh, materials, solver and stop rules; None for the defaults.
     compiled : bool, default False
         Compile the energy to machine code once per process and share it with
-        every later design (:mod:`softbend.fem.energy`): about 25 CPU seconds
-        of compilation in the background, then sweeps 1.2–1.4 times faster.
+        every later design (:mod:`softbend.fem.energy`): about 30 CPU seconds
+        of compilation in the background, then faster assembly
+        (``benchmarks/bench_fem.py`` compares whole sweeps).
         Worth it for a process that sweeps many designs (a campaign worker); the
         results are the same to round-off.
 

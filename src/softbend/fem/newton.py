@@ -133,6 +133,10 @@ class EnergySolver:
         """Whether a Hessian has been factorised yet."""
         return self._inverse is not None
 
+    def _prepare(self) -> None:
+        if self.prepare is not None:
+            self.prepare()
+
     # -- energy and its derivatives ---------------------------------------------------
     def _load_scale(self) -> float:
         return 1.0 if self.load_factor is None else float(self.load_factor.Get())
@@ -140,8 +144,7 @@ class EnergySolver:
     def energy(self, vec: Any = None) -> float:
         """Total potential energy at ``vec`` (default: the current state), mJ."""
         vec = self.gfu.vec if vec is None else vec
-        if self.prepare is not None:
-            self.prepare()
+        self._prepare()
         value = float(self.form.Energy(vec))
         if self.load is not None:
             value -= self._load_scale() * float(self.load.InnerProduct(vec))
@@ -151,8 +154,7 @@ class EnergySolver:
         """Gradient of the energy at the current state (N); fixed dofs are not masked."""
         out = self._res if out is None else out
         start = time.perf_counter()
-        if self.prepare is not None:
-            self.prepare()
+        self._prepare()
         self.form.Apply(self.gfu.vec, out)
         if self.load is not None:
             out.data -= self._load_scale() * self.load
@@ -166,8 +168,7 @@ class EnergySolver:
     def factorize(self) -> Any:
         """Assemble the Hessian at the current state and factorise it."""
         start = time.perf_counter()
-        if self.prepare is not None:
-            self.prepare()
+        self._prepare()
         self.form.AssembleLinearization(self.gfu.vec)
         middle = time.perf_counter()
         if self._inverse is None:

@@ -372,12 +372,32 @@ def halving_rungs(
             rungs += 1
     else:
         rungs = check_int(rungs, "rungs", "halving_rungs", low=1)
+        most = _most_rungs(n_configs, epochs, eta)
+        if rungs > most:
+            raise ValueError(
+                f"The 'rungs' of halving_rungs must be at most {most} for {n_configs} "
+                f"configurations, {epochs} epochs and factor {eta} (the first rung trains at "
+                f"least one epoch, the one before the last races at least two "
+                f"configurations). Got {rungs} instead."
+            )
     out = []
     kept = n_configs
     for k in range(rungs):
         out.append((kept, max(1, round(epochs / eta ** (rungs - 1 - k)))))
         kept = max(1, math.ceil(kept / eta))
     return out
+
+
+_halving_rungs = halving_rungs  # (search's argument of the same name hides the function)
+
+
+def _most_rungs(n_configs: int, epochs: int, eta: int) -> int:
+    """Rungs that still make sense: >= 1 epoch first, >= 2 configurations before the last."""
+    rungs, kept = 1, n_configs
+    while kept >= 2 and epochs / eta**rungs >= 1:
+        rungs += 1
+        kept = math.ceil(kept / eta)
+    return rungs
 
 
 def _load_training(
@@ -608,6 +628,11 @@ def search(
     n_rungs = (
         None if halving_rungs is None else check_int(halving_rungs, "halving_rungs", owner, low=1)
     )
+    if n_rungs is not None and halving is None:
+        raise ValueError(
+            f"The 'halving_rungs' of {owner} needs 'halving' (the factor, e.g. 3). "
+            f"Got halving_rungs={n_rungs} without it."
+        )
     splits = (
         grouped_splits(data.groups, folds, seed)
         if cv == "grouped"
@@ -619,6 +644,8 @@ def search(
     for name in param_grid:
         check_choice(name, "param_grid", owner, MODEL_NAMES)
     plan = {model: list(param_grid.get(model) or grid(grid_name, model)) for model in models}
+    if halving is not None and "mlp" in plan:
+        _halving_rungs(len(plan["mlp"]), epochs, halving, n_rungs)  # bad rungs: before any fit
     if checkpoint is not None:
         checkpoint.start(
             search_fingerprint(
