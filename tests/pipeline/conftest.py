@@ -1,38 +1,10 @@
-"""Quick settings of the pipeline sections (the ones tests/reports/test_reproduce.py uses)."""
+"""Helpers of the pipeline section tests (stand-in inputs are in tests/stand_ins.py)."""
 
 from __future__ import annotations
 
 from pathlib import Path
 
 import pytest
-
-from softbend.design import DesignSpace
-
-
-def small_space() -> DesignSpace:
-    """Two levels of l, t and b: enough for the regression, fast enough for CI (8 designs)."""
-    return DesignSpace.grid(
-        {
-            "l_mm": [100.0, 130.0],
-            "r_mm": [6.0],
-            "t_mm": [2.0, 3.0],
-            "b_mm": [2.0, 3.0],
-            "phi_deg": [5.0],
-            "lc_mm": [8.0],
-        },
-        name="small",
-    )
-
-
-def stand_in_fem_dataset(folder: Path) -> Path:
-    """A small dataset in the shipped format (analytical sweeps of 15 designs: fast, same table)."""
-    from softbend.campaign import run_campaign
-    from softbend.datasets import write_dataset
-
-    db = folder / "stand_in.duckdb"
-    run_campaign(db, DesignSpace.sample(15, seed=4), backend="analytical", workers=0)
-    write_dataset(db, folder / "dataset", command="stand-in for the test")
-    return folder / "dataset"
 
 
 class Phases:

@@ -8,7 +8,8 @@ import pytest
 
 from softbend.pipeline.paper_b import run_campaign_section, train_campaign_surrogates
 
-from .conftest import Phases, pictures, small_space
+from ..stand_ins import small_space
+from .conftest import Phases, pictures
 
 
 @pytest.fixture(scope="module")

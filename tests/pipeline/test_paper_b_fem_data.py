@@ -8,7 +8,8 @@ import pytest
 
 from softbend.pipeline.paper_b_fem_data import run_fem_data
 
-from .conftest import Phases, pictures, stand_in_fem_dataset
+from ..stand_ins import stand_in_fem_dataset
+from .conftest import Phases, pictures
 
 #: The surrogate search under both protocols takes most of a minute on two cores.
 pytestmark = pytest.mark.slow

@@ -74,18 +74,6 @@ def open_in_browser(page_path: Path, screenshot: Path | None = None) -> dict[str
     return {**seen, "console_errors": errors}
 
 
-def stand_in_fem_dataset(folder: Path) -> Path:
-    """A small FEM dataset in the shipped format (analytical sweeps of 15 designs: fast)."""
-    from softbend.campaign import run_campaign
-    from softbend.datasets import write_dataset
-    from softbend.design import DesignSpace
-
-    db = folder / "stand_in.duckdb"
-    run_campaign(db, DesignSpace.sample(15, seed=4), backend="analytical", workers=0)
-    write_dataset(db, folder / "dataset", command="stand-in for the test")
-    return folder / "dataset"
-
-
 def only_section(report: Any) -> tuple[str, str]:
     """The title and HTML of a report's one section (fails if it has another number)."""
     assert len(report.sections) == 1, [s.title for s in report.sections]

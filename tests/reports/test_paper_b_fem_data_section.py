@@ -7,7 +7,8 @@ import pytest
 from softbend.reports import paper_b_fem_data
 from softbend.reports.html import Report
 
-from .conftest import figures_of, only_section, stand_in_fem_dataset
+from ..stand_ins import stand_in_fem_dataset
+from .conftest import figures_of, only_section
 
 #: The surrogate search under both protocols takes most of a minute on two cores.
 pytestmark = pytest.mark.slow

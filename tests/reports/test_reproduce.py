@@ -7,36 +7,10 @@ import math
 
 import pytest
 
-from softbend.design import DesignSpace
 from softbend.fem import FEMOptions
 from softbend.reports.reproduce import run_reproduce
 
-
-def _small_space() -> DesignSpace:
-    # Two levels of l and t only: enough for the regression, fast enough for CI.
-    return DesignSpace.grid(
-        {
-            "l_mm": [100.0, 130.0],
-            "r_mm": [6.0],
-            "t_mm": [2.0, 3.0],
-            "b_mm": [2.0, 3.0],
-            "phi_deg": [5.0],
-            "lc_mm": [8.0],
-        },
-        name="small",
-    )
-
-
-def _stand_in_fem_dataset(folder):
-    """A small dataset in the shipped format (analytical sweeps: fast, same table)."""
-    from softbend.campaign import run_campaign
-    from softbend.datasets import write_dataset
-
-    db = folder / "stand_in.duckdb"
-    run_campaign(db, DesignSpace.sample(15, seed=4), backend="analytical", workers=0)
-    write_dataset(db, folder / "dataset", command="stand-in for the test")
-    return folder / "dataset"
-
+from ..stand_ins import small_space, stand_in_fem_dataset
 
 #: Transfer learning in seconds: few epochs, one ensemble pair, no GP restarts.
 QUICK_TRANSFER = {
@@ -49,7 +23,7 @@ QUICK_TRANSFER = {
 
 @pytest.fixture(scope="module")
 def fem_dataset(tmp_path_factory):
-    return _stand_in_fem_dataset(tmp_path_factory.mktemp("fem_dataset"))
+    return stand_in_fem_dataset(tmp_path_factory.mktemp("fem_dataset"))
 
 
 @pytest.fixture(scope="module")
@@ -65,7 +39,7 @@ def first_run(tmp_path_factory, fem_dataset):
         seed=0,
         workers=1,
         progress=progress,
-        design_space=_small_space(),
+        design_space=small_space(),
         fem_options=FEMOptions(maxh_mm=6.0),
         fem_pmax_mpa=0.02,
         fem_dataset=fem_dataset,
@@ -157,7 +131,7 @@ def test_second_run_resumes_the_campaign(first_run, fem_dataset):
         out,
         seed=0,
         workers=1,
-        design_space=_small_space(),
+        design_space=small_space(),
         fem_dataset=fem_dataset,
         fem_dataset_epochs=5,
         transfer_options=QUICK_TRANSFER,
