@@ -1,0 +1,103 @@
+"""Benchmark: how much the transfer-learning figures depend on the base MLP's training seed.
+
+Every strategy of ``softbend transfer loco`` starts from one FEM-trained MLP
+(paper B's (63, 65), 1000 epochs, trained with seed 0 and shipped). Another seed
+gives another network of the same training error, so the leave-one-configuration-out
+figures of the strategies that start from it are one draw each. This script trains
+the base again with each ``--seeds`` value on the shipped FEM dataset
+(:func:`softbend.transfer.base.train_base_mlp`, one thread per base, ``--jobs``
+bases at once), scores ``fem-only`` and ``refined`` by leave-one-configuration-out
+on the lab file (default: the shipped virtual lab) and prints, per seed and as mean
+and spread over the seeds, the mean held-out RMSE of each and their ratio. Also
+printed: the same figures for the members' mean of the refined MLPs of all seeds
+(an ensemble over base seeds).
+
+Bases are kept in ``--cache`` (default ``.bench_transfer_seeds/``), so a second
+run only refines::
+
+    .venv/bin/python benchmarks/bench_transfer_seeds.py --seeds 0 1 2 3 4 --jobs 2
+"""
+
+from __future__ import annotations
+
+import argparse
+import time
+from concurrent.futures import ProcessPoolExecutor
+from pathlib import Path
+
+import numpy as np
+
+from softbend.metrics import rmse
+from softbend.surrogates.persistence import load_surrogate, save_surrogate
+from softbend.transfer.base import train_base_mlp
+from softbend.transfer.measurements import load_measurements
+from softbend.transfer.strategies import RefinedMLP
+
+SHIPPED_LAB = Path(__file__).resolve().parents[1] / "src/softbend/data/transfer/virtual_lab.csv"
+
+
+def _train(seed: int, path: Path) -> tuple[int, float]:
+    start = time.perf_counter()
+    save_surrogate(train_base_mlp(seed=seed), path, metadata={"seed": seed})
+    return seed, time.perf_counter() - start
+
+
+def _bases(seeds: list[int], cache: Path, jobs: int) -> dict[int, object]:
+    cache.mkdir(parents=True, exist_ok=True)
+    paths = {seed: cache / f"base_seed{seed}.json" for seed in seeds}
+    missing = [seed for seed in seeds if not paths[seed].is_file()]
+    if missing:
+        with ProcessPoolExecutor(max_workers=jobs) as pool:
+            for seed, seconds in pool.map(_train, missing, [paths[s] for s in missing]):
+                print(f"base seed {seed}: trained in {seconds:.0f} s", flush=True)
+    return {seed: load_surrogate(paths[seed]).model for seed in seeds}
+
+
+def main(argv: list[str] | None = None) -> int:
+    parser = argparse.ArgumentParser(description=__doc__.split("\n")[0])
+    parser.add_argument("--seeds", type=int, nargs="+", default=[0, 1, 2, 3, 4])
+    parser.add_argument("--lab", type=Path, default=SHIPPED_LAB, help="Measurement CSV.")
+    parser.add_argument("--jobs", type=int, default=2, help="Bases trained at once.")
+    parser.add_argument("--cache", type=Path, default=Path(".bench_transfer_seeds"))
+    args = parser.parse_args(argv)
+
+    lab = load_measurements(args.lab)
+    X, y, groups = lab.features, lab.angle_deg, lab.groups
+    ids = list(lab.actuator_ids)
+    held_out = [groups == a for a in ids]
+    training = [np.flatnonzero(~mask) for mask in held_out]
+    bases = _bases(args.seeds, args.cache, args.jobs)
+
+    def mean_rmse(predictions: list[np.ndarray]) -> float:
+        return float(np.mean([rmse(y[m], p) for m, p in zip(held_out, predictions, strict=True)]))
+
+    print(f"{len(ids)} actuators, {y.size} readings ({args.lab.name}); refined: 1000 epochs")
+    print("seed  fem-only RMSE  refined RMSE  refined / fem-only")
+    fem, refined, refined_predictions = [], [], []
+    for seed, base in bases.items():
+        models = RefinedMLP.fit_batch([RefinedMLP(base) for _ in ids], X, y, training)
+        predictions = [model.predict(X[m]) for model, m in zip(models, held_out, strict=True)]
+        refined_predictions.append(predictions)
+        fem.append(mean_rmse([base.predict(X[m]) for m in held_out]))
+        refined.append(mean_rmse(predictions))
+        print(f"{seed:4d}  {fem[-1]:13.2f}  {refined[-1]:12.2f}  {refined[-1] / fem[-1]:18.3f}")
+    fem_a, refined_a = np.array(fem), np.array(refined)
+    ratio = refined_a / fem_a
+    if len(fem) > 1:
+        print(
+            f"mean  {fem_a.mean():13.2f}  {refined_a.mean():12.2f}  {ratio.mean():18.3f}\n"
+            f"sd    {fem_a.std(ddof=1):13.2f}  {refined_a.std(ddof=1):12.2f}  "
+            f"{ratio.std(ddof=1):18.3f}"
+        )
+        mean_of_members = [
+            np.mean([p[k] for p in refined_predictions], axis=0) for k in range(len(ids))
+        ]
+        print(
+            f"refined MLPs of all {len(fem)} seeds averaged: mean RMSE "
+            f"{mean_rmse(mean_of_members):.2f}"
+        )
+    return 0
+
+
+if __name__ == "__main__":
+    raise SystemExit(main())
