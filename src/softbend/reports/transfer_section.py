@@ -150,7 +150,10 @@ def add_transfer(report: Report, transfer: Transfer, root: Path) -> dict[str, Pa
         )
         + " The refined MLP is paper B's method; its figure here and paper B's differ in "
         "what they are measured on (a virtual lab with a stated gap, not their rig), so "
-        "they agree in kind, not to the digit."
+        "they agree in kind, not to the digit. Each figure is also one draw of the base "
+        "MLP's training seed: a base trained with another seed fits the FEM data about as "
+        "well but refines differently (benchmarks/bench_transfer_seeds.py measures the spread; "
+        "see the README)."
         + (
             f" The experimental MLP (the measurements alone) fails on held-out actuators, as in "
             f"paper B: {summary.loc['experimental', 'rmse_deg']:.1f}° against "
