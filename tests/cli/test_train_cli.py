@@ -59,6 +59,7 @@ def test_train_writes_models_tables_figures_and_predicts(small_campaign, tmp_pat
         (["--jobs", "0"], "The '--jobs' of softbend train must be an integer in [1, inf). Got 0"),
         (["--jobs", "-1"], "'--jobs' of softbend train must be an integer in [1, inf)"),
         (["--halving-rungs", "0"], "'--halving-rungs' of softbend train must be an integer"),
+        (["--plr-patience", "0"], "'--plr-patience' of softbend train must be an integer"),
         (["--halving-rungs", "3"], "needs 'halving'"),
         (["--halving", "3", "--halving-rungs", "40"], "'rungs' of halving_rungs must be at most"),
     ],

@@ -319,3 +319,35 @@ def test_scoring_without_refit_gives_the_same_cv_and_no_model(small_data):
         assert full.families[name].model is not None
     summary = scored.summary()
     assert summary["single_us"].isna().all() and (summary["mape_pct"] > 0).all()
+
+
+def test_plr_patience_stops_raising_the_degree_once_the_cv_error_rises(small_data):
+    """Degrees past the best are skipped; the ones fitted score as in the full search."""
+    degrees = [{"degree": d} for d in (1, 2, 3, 4, 5)]
+    common = {"models": ["plr"], "param_grid": {"plr": degrees}, "seed": 0, "refit": False}
+    full = search(small_data, **common).cv_results.set_index("params")
+    rmse = full["rmse_fold_mean"].to_numpy()
+    best = int(np.argmin(rmse))
+    assert 0 < best < len(degrees) - 2, "the test data must have an interior best degree"
+
+    early = search(small_data, plr_patience=1, **common)
+    table = early.cv_results.set_index("params")
+    fitted = table[table["status"] == "ok"]
+    # Fitted up to the first degree after the best that did not improve, then stopped.
+    assert list(fitted.index) == list(full.index[: best + 2])
+    assert fitted["rmse_fold_mean"].to_numpy() == pytest.approx(rmse[: best + 2], rel=1e-12)
+    skipped = table[table["status"] != "ok"]
+    assert len(skipped) == len(degrees) - best - 2
+    assert skipped["status"].str.contains("patience 1").all()
+    assert early.families["plr"].params == degrees[best]
+    assert early.settings["plr_patience"] == 1
+
+    # A patience longer than the grid changes nothing.
+    same = search(small_data, plr_patience=len(degrees), **common).cv_results
+    assert (same["status"] == "ok").all()
+
+
+@pytest.mark.parametrize("patience", [0, -1, 1.5, "2"])
+def test_plr_patience_must_be_a_positive_integer(small_data, patience):
+    with pytest.raises(ValueError, match="'plr_patience' of surrogate search must be an integer"):
+        search(small_data, models=["plr"], param_grid=SMALL_GRID, plr_patience=patience)

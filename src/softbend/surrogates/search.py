@@ -304,15 +304,27 @@ def _cv_sequential(
     make: Callable[[dict[str, Any]], Any],
     tick: Callable[[], None],
     checkpoint: SearchCheckpoint | None = None,
+    stop: Callable[[list[tuple[dict[str, Any], np.ndarray | None, float, str]]], str | None]
+    | None = None,
 ) -> tuple[list[tuple[dict[str, Any], np.ndarray | None, float, str]], int]:
     """(params, oof predictions or None, fit seconds, status) per configuration.
 
     Also returns the number of folds loaded from ``checkpoint``; every fold
-    fitted is added to it before ``tick`` reports it.
+    fitted is added to it before ``tick`` reports it. ``stop(outcomes)``, asked
+    after each configuration, returns why the remaining ones are not fitted
+    (they are listed as skipped for that reason), or None to go on.
     """
-    out = []
+    out: list[tuple[dict[str, Any], np.ndarray | None, float, str]] = []
     resumed = 0
-    for params in configs:
+    for index, params in enumerate(configs):
+        reason = stop(out) if stop is not None and out else None
+        if reason is not None:
+            logger.info("%s: %s", model, reason)
+            for rest in configs[index:]:
+                out.append((rest, None, 0.0, f"skipped: {reason}"))
+                for _ in splits:
+                    tick()
+            break
         pred = np.empty_like(data.y)
         seconds = 0.0
         fitted = 0
@@ -348,6 +360,33 @@ def _cv_sequential(
             continue
         out.append((params, pred, seconds, "ok"))
     return out, resumed
+
+
+def _patience_stop(
+    splits: list[tuple[np.ndarray, np.ndarray]], y: np.ndarray, patience: int
+) -> Callable[[list[tuple[dict[str, Any], np.ndarray | None, float, str]]], str | None]:
+    """A ``stop`` for :func:`_cv_sequential`: the last ``patience`` fitted did not improve.
+
+    Improvement is the mean held-out RMSE over the folds, as the search ranks.
+    """
+
+    def stop(outcomes: list[tuple[dict[str, Any], np.ndarray | None, float, str]]) -> str | None:
+        scores = [
+            float(np.mean([np.sqrt(np.mean((pred[val] - y[val]) ** 2)) for _, val in splits]))
+            for _, pred, _, status in outcomes
+            if pred is not None and status == "ok"
+        ]
+        if len(scores) <= patience:
+            return None
+        best_before = min(scores[:-patience])
+        if min(scores[-patience:]) < best_before:
+            return None
+        return (
+            f"the last {patience} configuration(s) did not improve on the best cross-validated "
+            f"RMSE {best_before:.4g} deg (patience {patience})"
+        )
+
+    return stop
 
 
 def halving_rungs(
@@ -550,6 +589,7 @@ def search(
     cv: str = "grouped",
     halving: int | None = None,
     halving_rungs: int | None = None,
+    plr_patience: int | None = None,
     checkpoint: SearchCheckpoint | None = None,
     refit: bool = True,
 ) -> SearchResult:
@@ -591,6 +631,13 @@ def search(
     halving_rungs : int, optional
         Number of rungs of the halving, >= 1 (default: :func:`halving_rungs`'
         choice).
+    plr_patience : int, optional
+        Stop raising the polynomial's degree (its configurations in grid order,
+        ascending in the named grids) once this many in a row have not lowered
+        the best cross-validated RMSE, >= 1; the higher degrees are listed as
+        skipped. The fit's cost grows steeply with the degree (paper grid on the
+        FEM data: degree 9 takes 20 times as long as degree 7), and past the
+        best degree the held-out error only grows. Default: every degree.
     checkpoint : SearchCheckpoint, optional
         Durable record of the finished configuration-folds
         (:mod:`softbend.surrogates.checkpoint`): started with the fingerprint of
@@ -628,6 +675,9 @@ def search(
     n_rungs = (
         None if halving_rungs is None else check_int(halving_rungs, "halving_rungs", owner, low=1)
     )
+    patience = (
+        None if plr_patience is None else check_int(plr_patience, "plr_patience", owner, low=1)
+    )
     if n_rungs is not None and halving is None:
         raise ValueError(
             f"The 'halving_rungs' of {owner} needs 'halving' (the factor, e.g. 3). "
@@ -660,7 +710,7 @@ def search(
                 n_rungs=n_rungs,
                 device=device,
                 n_jobs=n_jobs,
-            )
+            )  # (no plr_patience: it decides which folds are fitted, not their scores)
         )
     resumed = 0
     for model, configs in plan.items():
@@ -700,7 +750,14 @@ def search(
 
             if progress is not None:
                 progress(phase, 0, total)
-            outcomes, loaded = _cv_sequential(model, configs, data, splits, make, tick, checkpoint)
+            stop = (
+                _patience_stop(splits, data.y, patience)
+                if model == "plr" and patience is not None
+                else None
+            )
+            outcomes, loaded = _cv_sequential(
+                model, configs, data, splits, make, tick, checkpoint, stop
+            )
         resumed += loaded
         best: tuple[float, dict[str, Any], np.ndarray, dict[str, float]] | None = None
         for params, pred, seconds, status in outcomes:
@@ -746,6 +803,7 @@ def search(
         "cv": cv,
         "mlp_halving": halving,
         "mlp_halving_rungs": n_rungs if halving else None,
+        "plr_patience": patience,
         "seed": seed,
         "device": device,
         "mlp_epochs": epochs,

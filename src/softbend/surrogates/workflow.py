@@ -72,6 +72,7 @@ def train_surrogates(
     cv: str = "grouped",
     halving: int | None = None,
     halving_rungs: int | None = None,
+    plr_patience: int | None = None,
     checkpoint: SearchCheckpoint | None = None,
 ) -> tuple[SearchResult, dict[str, Any]]:
     """Search, refit, save and export the surrogates of a campaign.
@@ -86,9 +87,9 @@ def train_surrogates(
         As :func:`softbend.surrogates.search.search`.
     export_onnx : bool
         Also write and check ``models/<model>.onnx`` (default True).
-    cv : {"grouped", "random"}, halving : int, optional, halving_rungs : int
-        Cross-validation protocol and successive halving of the MLP grid (see
-        :func:`softbend.surrogates.search.search`).
+    cv : {"grouped", "random"}, halving : int, optional, halving_rungs : int, plr_patience : int
+        Cross-validation protocol, successive halving of the MLP grid and early
+        stop of the polynomial's degrees (see :func:`softbend.surrogates.search.search`).
     checkpoint : SearchCheckpoint, optional
         Where the search saves its finished configuration-folds and from which
         an interrupted search resumes (see :func:`softbend.surrogates.search.search`);
@@ -119,6 +120,7 @@ def train_surrogates(
         cv=cv,
         halving=halving,
         halving_rungs=halving_rungs,
+        plr_patience=plr_patience,
         checkpoint=checkpoint,
     )
     out = Path(out_dir)
