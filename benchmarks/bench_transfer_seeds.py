@@ -2,7 +2,7 @@
 
 Every strategy of ``softbend transfer loco`` starts from one FEM-trained MLP
 (paper B's (63, 65), 1000 epochs, trained with seed 0 and shipped). Another seed
-gives another network of the same training error, so the leave-one-configuration-out
+gives another network of about the same training error, so the leave-one-configuration-out
 figures of the strategies that start from it are one draw each. This script trains
 the base again with each ``--seeds`` value on the shipped FEM dataset
 (:func:`softbend.transfer.base.train_base_mlp`, one thread per base, ``--jobs``
@@ -28,6 +28,7 @@ from pathlib import Path
 
 import numpy as np
 
+from softbend.datasets import table1_fem
 from softbend.metrics import rmse
 from softbend.surrogates.persistence import load_surrogate, save_surrogate
 from softbend.transfer.base import fem_rows, train_base_mlp
@@ -73,8 +74,6 @@ def main(argv: list[str] | None = None) -> int:
         return float(np.mean([rmse(y[m], p) for m, p in zip(held_out, predictions, strict=True)]))
 
     print(f"{len(ids)} actuators, {y.size} readings ({args.lab.name}); refined: 1000 epochs")
-    from softbend.datasets import table1_fem
-
     samples = table1_fem()
     samples = samples[samples["converged"].astype(bool)]
     fem_X, fem_y = fem_rows(samples), samples["angle_deg"].to_numpy(dtype=float)
