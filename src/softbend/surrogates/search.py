@@ -367,12 +367,13 @@ def _patience_stop(
 ) -> Callable[[list[tuple[dict[str, Any], np.ndarray | None, float, str]]], str | None]:
     """A ``stop`` for :func:`_cv_sequential`: the last ``patience`` fitted did not improve.
 
-    Improvement is the mean held-out RMSE over the folds, as the search ranks.
+    Improvement is the mean held-out RMSE over the folds (``rmse_fold_mean`` of
+    :func:`_fold_scores`), by which the search ranks.
     """
 
     def stop(outcomes: list[tuple[dict[str, Any], np.ndarray | None, float, str]]) -> str | None:
         scores = [
-            float(np.mean([np.sqrt(np.mean((pred[val] - y[val]) ** 2)) for _, val in splits]))
+            _fold_scores(y, pred, splits, MAPE_THRESHOLD_DEG)["rmse_fold_mean"]
             for _, pred, _, status in outcomes
             if pred is not None and status == "ok"
         ]
