@@ -6,12 +6,13 @@ gives another network of about the same training error, so the leave-one-configu
 figures of the strategies that start from it are one draw each. This script trains
 the base again with each ``--seeds`` value on the shipped FEM dataset
 (:func:`softbend.transfer.base.train_base_mlp`, one thread per base, ``--jobs``
-bases at once), scores ``fem-only`` and ``refined`` by leave-one-configuration-out
-on the lab file (default: the shipped virtual lab) and prints, per seed and as mean
-and spread over the seeds, the base's RMSE on the FEM samples it was trained on, the
-mean held-out RMSE of each strategy and their ratio. Also
-printed: the same figures for the members' mean of the refined MLPs of all seeds
-(an ensemble over base seeds).
+bases at once), scores ``fem-only``, ``refined`` and ``scaled-refined`` by
+leave-one-configuration-out on the lab file (default: the shipped virtual lab)
+and prints, per seed and as mean and spread over the seeds, the base's RMSE on
+the FEM samples it was trained on, the mean held-out RMSE of each strategy and
+their ratio to ``fem-only``. Also
+printed: the same figures for the members' mean of each strategy's MLPs of all
+seeds (an ensemble over base seeds).
 
 Bases are kept in ``--cache`` (default ``.bench_transfer_seeds/``), so a second
 run only refines::
@@ -33,7 +34,10 @@ from softbend.metrics import rmse
 from softbend.surrogates.persistence import load_surrogate, save_surrogate
 from softbend.transfer.base import fem_rows, train_base_mlp
 from softbend.transfer.measurements import load_measurements
-from softbend.transfer.strategies import RefinedMLP
+from softbend.transfer.strategies import RefinedMLP, ScaledRefinedMLP
+
+#: The strategies scored for every base, by name.
+STRATEGIES = {"refined": RefinedMLP, "scaled-refined": ScaledRefinedMLP}
 
 SHIPPED_LAB = Path(__file__).resolve().parents[1] / "src/softbend/data/transfer/virtual_lab.csv"
 
@@ -77,35 +81,43 @@ def main(argv: list[str] | None = None) -> int:
     samples = table1_fem()
     samples = samples[samples["converged"].astype(bool)]
     fem_X, fem_y = fem_rows(samples), samples["angle_deg"].to_numpy(dtype=float)
-    print("seed  FEM-data RMSE  fem-only RMSE  refined RMSE  refined / fem-only")
-    fem, refined, refined_predictions, fit = [], [], [], []
+    print(
+        "seed  FEM-data RMSE  fem-only RMSE  refined RMSE  scaled-refined RMSE  ratios to fem-only"
+    )
+    fit, fem = [], []
+    held = {name: [] for name in STRATEGIES}  # per seed: the mean held-out RMSE
+    members = {name: [] for name in STRATEGIES}  # per seed: the held-out predictions
     for seed, base in bases.items():
         fit.append(rmse(fem_y, base.predict(fem_X)))
-        models = RefinedMLP.fit_batch([RefinedMLP(base) for _ in ids], X, y, training)
-        predictions = [model.predict(X[m]) for model, m in zip(models, held_out, strict=True)]
-        refined_predictions.append(predictions)
         fem.append(mean_rmse([base.predict(X[m]) for m in held_out]))
-        refined.append(mean_rmse(predictions))
+        for name, cls in STRATEGIES.items():
+            models = cls.fit_batch([cls(base) for _ in ids], X, y, training)
+            predictions = [model.predict(X[m]) for model, m in zip(models, held_out, strict=True)]
+            members[name].append(predictions)
+            held[name].append(mean_rmse(predictions))
         print(
-            f"{seed:4d}  {fit[-1]:13.2f}  {fem[-1]:13.2f}  {refined[-1]:12.2f}  "
-            f"{refined[-1] / fem[-1]:18.3f}"
+            f"{seed:4d}  {fit[-1]:13.2f}  {fem[-1]:13.2f}  {held['refined'][-1]:12.2f}  "
+            f"{held['scaled-refined'][-1]:19.2f}  "
+            f"{held['refined'][-1] / fem[-1]:.3f}, {held['scaled-refined'][-1] / fem[-1]:.3f}"
         )
-    fit_a, fem_a, refined_a = np.array(fit), np.array(fem), np.array(refined)
-    ratio = refined_a / fem_a
     if len(fem) > 1:
-        print(
-            f"mean  {fit_a.mean():13.2f}  {fem_a.mean():13.2f}  {refined_a.mean():12.2f}  "
-            f"{ratio.mean():18.3f}\n"
-            f"sd    {fit_a.std(ddof=1):13.2f}  {fem_a.std(ddof=1):13.2f}  "
-            f"{refined_a.std(ddof=1):12.2f}  {ratio.std(ddof=1):18.3f}"
-        )
-        mean_of_members = [
-            np.mean([p[k] for p in refined_predictions], axis=0) for k in range(len(ids))
-        ]
-        print(
-            f"refined MLPs of all {len(fem)} seeds averaged: mean RMSE "
-            f"{mean_rmse(mean_of_members):.2f}"
-        )
+        fit_a, fem_a = np.array(fit), np.array(fem)
+        for label, reduce in (("mean", np.mean), ("sd", lambda a: np.std(a, ddof=1))):
+            ratios = [reduce(np.array(held[n]) / fem_a) for n in STRATEGIES]
+            print(
+                f"{label:4s}  {reduce(fit_a):13.2f}  {reduce(fem_a):13.2f}  "
+                f"{reduce(np.array(held['refined'])):12.2f}  "
+                f"{reduce(np.array(held['scaled-refined'])):19.2f}  "
+                f"{ratios[0]:.3f}, {ratios[1]:.3f}"
+            )
+        for name in STRATEGIES:
+            mean_of_members = [
+                np.mean([p[k] for p in members[name]], axis=0) for k in range(len(ids))
+            ]
+            print(
+                f"{name} MLPs of all {len(fem)} seeds averaged: mean RMSE "
+                f"{mean_rmse(mean_of_members):.2f}"
+            )
     return 0
 
 

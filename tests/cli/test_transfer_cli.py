@@ -225,8 +225,10 @@ def test_transfer_base_and_refine_bad_input_is_one_line(tmp_path, capsys, small_
     [
         ("experimental", ["--epochs", "20"], False),
         ("scale-offset", [], True),
+        ("pressure-scale", [], True),
         ("residual-gp", [], True),
         ("refined-ensemble", ["--epochs", "20"], True),
+        ("scaled-refined", ["--epochs", "20"], False),
     ],
 )
 def test_every_refine_strategy_saves_a_model_that_predicts(

@@ -8,7 +8,13 @@ from scipy.stats import norm
 from sklearn.gaussian_process import GaussianProcessRegressor
 
 from softbend.errors import SchemaError
-from softbend.surrogates.corrected import AffineCorrected, GPCorrected, MeanEnsemble, gp_kernel
+from softbend.surrogates.corrected import (
+    AffineCorrected,
+    GPCorrected,
+    MeanEnsemble,
+    PressureScaled,
+    gp_kernel,
+)
 from softbend.surrogates.persistence import (
     COMPOSITE_KINDS,
     KINDS,
@@ -53,6 +59,7 @@ def composites(data, bases):
         "affine-corrected": AffineCorrected(bases[0], 1.1, -2.0, 0.5),
         "gp-corrected": _gp(bases[0], X[:60], y[:60])[0],
         "ensemble": MeanEnsemble(bases, 0.25),
+        "pressure-scaled": PressureScaled(bases[2], 1.2, 0.5),
     }
 
 
@@ -68,6 +75,20 @@ def test_affine_is_scale_times_base_plus_offset(data, bases):
     np.testing.assert_allclose(model.predict(X), 1.1 * bases[0].predict(X) - 2.0, rtol=1e-14)
     lo, hi = model.predict_interval(X, 0.9)
     np.testing.assert_allclose(hi - lo, 2 * norm.ppf(0.95) * 0.5, rtol=1e-12)
+
+
+def test_pressure_scaled_asks_the_base_at_the_scaled_pressure(data, bases):
+    X, _ = data
+    model = PressureScaled(bases[2], 1.2, 0.5)
+    scaled = X.copy()
+    scaled[:, -1] *= 1.2
+    np.testing.assert_array_equal(model.predict(X), bases[2].predict(scaled))
+    assert not np.allclose(model.predict(X), bases[2].predict(X))
+    lo, hi = model.predict_interval(X, 0.9)
+    np.testing.assert_allclose(hi - lo, 2 * norm.ppf(0.95) * 0.5, rtol=1e-12)
+    for bad in (0.0, -1.0, float("nan")):
+        with pytest.raises(ValueError, match="'scale' of PressureScaled"):
+            PressureScaled(bases[2], bad, 0.5)
 
 
 def test_gp_with_fixed_hyperparameters_predicts_as_the_optimized_gp(data, bases):
@@ -150,6 +171,8 @@ def _edit(path, change):
         ("gp-corrected", lambda d: d["state"]["targets_"]["shape"].__setitem__(0, 1), "targets_"),
         ("gp-corrected", lambda d: d["state"].update(kernel_theta_=1.0), "kernel_theta_"),
         ("ensemble", lambda d: d["state"].update(members=d["state"]["members"][:1]), "2 or more"),
+        ("pressure-scaled", lambda d: d["state"].update(scale_=0.0), "scale_"),
+        ("pressure-scaled", lambda d: d["state"].pop("scale_"), "state key.*scale_.*missing"),
         (
             "ensemble",
             lambda d: d["state"]["members"][1]["state"].update(x_scale_=0),

@@ -18,11 +18,13 @@ from softbend.transfer.strategies import (
     make_strategy,
 )
 
+MLP_STRATEGIES = ("refined", "experimental", "refined-ensemble", "scaled-refined")
+
 
 def test_every_named_strategy_fits_and_predicts(small_base, quick_measurements):
     X, y = quick_measurements.features, quick_measurements.angle_deg
     for name in STRATEGIES:
-        options = {"epochs": 20} if name in ("refined", "experimental", "refined-ensemble") else {}
+        options = {"epochs": 20} if name in MLP_STRATEGIES else {}
         model = make_strategy(name, small_base, **options).fit(X, y)
         pred = model.predict(X)
         assert pred.shape == y.shape and np.isfinite(pred).all(), name

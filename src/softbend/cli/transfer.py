@@ -226,9 +226,15 @@ REFINE_STRATEGIES: tuple[str, ...] = (
     "refined",
     "experimental",
     "scale-offset",
+    "pressure-scale",
     "residual-gp",
     "refined-ensemble",
+    "scaled-refined",
 )
+
+
+#: Strategies that train a network (``--epochs`` applies).
+_MLP_STRATEGIES: tuple[str, ...] = ("refined", "experimental", "refined-ensemble", "scaled-refined")
 
 
 @app.command("refine")
@@ -245,7 +251,7 @@ def refine(
     """Fit a strategy on all measurements and save it like the other surrogates.
 
     The saved model plugs into ``softbend predict``; the strategies with
-    intervals (scale-offset, residual-gp, refined-ensemble) save them too.
+    intervals (scale-offset, pressure-scale, residual-gp, refined-ensemble) save them too.
     """
     import numpy as np
 
@@ -255,10 +261,10 @@ def refine(
     from softbend.transfer.strategies import fit_strategy
 
     check_choice(strategy, "strategy", "softbend transfer refine", REFINE_STRATEGIES)
-    if epochs is not None and strategy not in ("refined", "experimental", "refined-ensemble"):
+    if epochs is not None and strategy not in _MLP_STRATEGIES:
         raise ValueError(
-            f"The '--epochs' option applies to the MLP strategies (refined, experimental, "
-            f"refined-ensemble); {strategy!r} trains no network."
+            f"The '--epochs' option applies to the MLP strategies "
+            f"({', '.join(_MLP_STRATEGIES)}); {strategy!r} trains no network."
         )
     _common.check_output_file(out, "--out", inputs=(base, measurements), kind="json")
     data = load_measurements(measurements)

@@ -34,8 +34,10 @@ _STYLE = {
     "experimental": ("tab:purple", "-."),
     "refined": ("tab:red", "-"),
     "scale-offset": ("tab:olive", "--"),
+    "pressure-scale": ("tab:cyan", "--"),
     "residual-gp": ("tab:blue", "-"),
     "refined-ensemble": ("tab:green", "-"),
+    "scaled-refined": ("tab:orange", "-"),
 }
 
 

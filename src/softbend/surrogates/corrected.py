@@ -14,6 +14,10 @@ with a prediction interval for a new reading:
                        the GP's predictive interval (noise term included)
 ``MeanEnsemble``       the mean of several surrogates; Gaussian interval of
                        their spread and the residual noise of the mean
+``PressureScaled``     ``θ = θ_base(design, s·p)``, the base asked at a scaled
+                       pressure (an elastomer ``1/s`` times as stiff, see
+                       :mod:`softbend.transfer.pressure_map`); Gaussian
+                       interval of the fit's residual standard deviation
 =====================  =========================================================
 
 The Gaussian process is scikit-learn's. It is stored as its fitted
@@ -35,6 +39,7 @@ __all__ = [
     "AffineCorrected",
     "GPCorrected",
     "MeanEnsemble",
+    "PressureScaled",
     "gp_kernel",
 ]
 
@@ -81,6 +86,40 @@ class AffineCorrected:
         """Corrected angle, degrees."""
         rows = _rows(X, self.n_features_in_, type(self).__name__)
         return self.scale_ * np.asarray(self.base.predict(rows), dtype=np.float64) + self.offset_
+
+    def predict_interval(self, X: ArrayLike, level: float = 0.9) -> tuple[np.ndarray, np.ndarray]:
+        """Central interval of probability ``level`` (Gaussian residuals), degrees."""
+        half = _half_width(level, self.residual_std_, type(self).__name__)
+        mean = self.predict(X)
+        return mean - half, mean + half
+
+
+class PressureScaled:
+    """A surrogate asked at a scaled pressure: ``θ = θ_base(design, scale·p)`` (degrees).
+
+    Parameters
+    ----------
+    base : estimator
+        A fitted surrogate on the 7 inputs (pressure last, MPa).
+    scale : float
+        Factor on the pressure, > 0 (dimensionless): the measured elastomer is
+        ``1/scale`` times as stiff as the simulated one.
+    residual_std : float
+        Standard deviation of the fit's residuals, degrees (>= 0): the
+        interval's width.
+    """
+
+    def __init__(self, base: Any, scale: float, residual_std: float) -> None:
+        self.base = base
+        self.scale_ = check_range(scale, "scale", type(self).__name__, low=0.0)
+        self.residual_std_ = float(residual_std)
+        self.n_features_in_ = int(base.n_features_in_)
+
+    def predict(self, X: ArrayLike) -> np.ndarray:
+        """The base's angle at the scaled pressure, degrees."""
+        rows = np.array(_rows(X, self.n_features_in_, type(self).__name__), copy=True)
+        rows[:, -1] *= self.scale_
+        return np.asarray(self.base.predict(rows), dtype=np.float64)
 
     def predict_interval(self, X: ArrayLike, level: float = 0.9) -> tuple[np.ndarray, np.ndarray]:
         """Central interval of probability ``level`` (Gaussian residuals), degrees."""

@@ -85,11 +85,17 @@ _CLASSES: dict[str, tuple[str, str]] = {
     "affine-corrected": ("softbend.surrogates.corrected", "AffineCorrected"),
     "gp-corrected": ("softbend.surrogates.corrected", "GPCorrected"),
     "ensemble": ("softbend.surrogates.corrected", "MeanEnsemble"),
+    "pressure-scaled": ("softbend.surrogates.corrected", "PressureScaled"),
 }
 
 #: Kinds built on other surrogates (:mod:`softbend.surrogates.corrected`): their
 #: ``state`` holds the inner surrogates as whole documents (``base``, ``members``).
-COMPOSITE_KINDS: tuple[str, ...] = ("affine-corrected", "gp-corrected", "ensemble")
+COMPOSITE_KINDS: tuple[str, ...] = (
+    "affine-corrected",
+    "gp-corrected",
+    "ensemble",
+    "pressure-scaled",
+)
 
 #: Inner surrogates nest at most this deep (a corrected ensemble of corrected MLPs).
 _MAX_DEPTH = 4
@@ -124,6 +130,7 @@ _REQUIRED_STATE: dict[str, tuple[str, ...]] = {
     "affine-corrected": ("base", "scale_", "offset_", "residual_std_"),
     "gp-corrected": ("base", "z_mean_", "z_scale_", "kernel_theta_", "inputs_", "targets_"),
     "ensemble": ("members", "residual_std_"),
+    "pressure-scaled": ("base", "scale_", "residual_std_"),
 }
 
 _HEADER_KEYS = (
@@ -579,6 +586,8 @@ def _restore_composite(document: dict[str, Any], path: str, depth: int) -> Any:
     base = _restore_inner(state["base"], path, "base", depth)
     if kind == "affine-corrected":
         return cls(base, state["scale_"], state["offset_"], state["residual_std_"])
+    if kind == "pressure-scaled":
+        return cls(base, state["scale_"], state["residual_std_"])
     try:
         return cls(
             base,

@@ -405,4 +405,13 @@ SCHEMAS: dict[str, _Schema] = {
         state={"members": _documents, "residual_std_": _real(low=0.0)},
         check=_no_check,
     ),
+    "pressure-scaled": _Schema(
+        params={},
+        state={
+            "base": _document,
+            "scale_": _real(low=0.0, strict=True),
+            "residual_std_": _real(low=0.0),
+        },
+        check=_no_check,
+    ),
 }

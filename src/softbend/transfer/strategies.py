@@ -14,8 +14,13 @@ trained on the FEM dataset by default):
 ``residual-gp``    the base frozen, a Gaussian process on its error with a
                    noise term; gives prediction intervals
 ``scale-offset``   the base frozen, ``θ = a·θ_base + c`` by least squares
+``pressure-scale``  the base frozen and asked at ``s·p``: one number for an
+                   elastomer softer or stiffer than the simulated one
+                   (:mod:`softbend.transfer.pressure_map`); gives intervals
 ``refined-ensemble``  refined MLPs on bootstrap draws of the measured
                    actuators; mean, and an interval from their spread
+``scaled-refined``  the pressure scale fitted first and folded into the MLP,
+                   then paper B's refinement from that start
 =================  ============================================================
 
 Strategies with intervals have ``predict_interval(X, level)``.
@@ -35,18 +40,27 @@ from sklearn.utils.validation import check_is_fitted, validate_data
 
 from softbend._validation import check_choice, check_int, check_range
 from softbend.design import FEATURES, SFRBADesign
-from softbend.surrogates.corrected import AffineCorrected, GPCorrected, MeanEnsemble, gp_kernel
+from softbend.surrogates.corrected import (
+    AffineCorrected,
+    GPCorrected,
+    MeanEnsemble,
+    PressureScaled,
+    gp_kernel,
+)
 from softbend.transfer.finetune import check_mlp, fine_tune_many, row_weights
+from softbend.transfer.pressure_map import fit_pressure_scale, scale_mlp_pressure
 
 __all__ = [
     "STRATEGIES",
     "AnalyticalBaseline",
     "BaseOnly",
     "ExperimentalMLP",
+    "PressureScale",
     "RefinedEnsemble",
     "RefinedMLP",
     "ResidualGP",
     "ScaleOffset",
+    "ScaledRefinedMLP",
     "fit_strategy",
     "has_interval",
     "make_strategy",
@@ -59,8 +73,10 @@ STRATEGIES: tuple[str, ...] = (
     "experimental",
     "refined",
     "scale-offset",
+    "pressure-scale",
     "residual-gp",
     "refined-ensemble",
+    "scaled-refined",
 )
 
 
@@ -376,6 +392,99 @@ class ScaleOffset(_Strategy):
         return self.model_.predict_interval(self._check_rows(X), level)
 
 
+class PressureScale(_Strategy):
+    """The base frozen and asked at a scaled pressure: ``θ = θ_base(design, s·p)``.
+
+    One number learned from the measurements, with a physical meaning: the
+    measured elastomer is ``1/s`` times as stiff as the simulated one (see
+    :mod:`softbend.transfer.pressure_map`, where the map is derived and its
+    limits stated). Works with any base surrogate. The interval is Gaussian
+    with the residual standard deviation of the fit.
+
+    Attributes
+    ----------
+    scale_ : float
+        The fitted pressure scale ``s``.
+    residual_std_ : float
+        Residual standard deviation on the training rows, degrees.
+    """
+
+    def __init__(self, base: Any = None) -> None:
+        self.base = base
+
+    def fit(self, X: ArrayLike, y: ArrayLike) -> PressureScale:
+        """Fit ``s`` by least squares on the rows."""
+        _check_base(self.base, type(self).__name__)
+        X, y = self._check_fit_data(X, y)
+        self.scale_ = fit_pressure_scale(self.base, X, y, owner=type(self).__name__)
+        residual = PressureScaled(self.base, self.scale_, 0.0).predict(X) - y
+        self.residual_std_ = float(np.sqrt(np.sum(residual**2) / max(y.size - 1, 1)))
+        self.model_ = PressureScaled(self.base, self.scale_, self.residual_std_)
+        return self
+
+    def predict(self, X: ArrayLike) -> np.ndarray:
+        """The base's angle at the scaled pressure, degrees."""
+        return self.model_.predict(self._check_rows(X))
+
+    def predict_interval(self, X: ArrayLike, level: float = 0.9) -> tuple[np.ndarray, np.ndarray]:
+        """Central interval of probability ``level`` (Gaussian residuals), degrees."""
+        level = _check_level(level, type(self).__name__)
+        return self.model_.predict_interval(self._check_rows(X), level)
+
+
+class ScaledRefinedMLP(RefinedMLP):
+    """Paper B's refinement started from the pressure-mapped MLP.
+
+    First the pressure scale ``s`` of :class:`PressureScale` is fitted on the
+    measurements with the base frozen and folded into the network's input
+    standardization (exact: the start predicts ``θ_base(design, s·p)``); then
+    every layer is trained further as in :class:`RefinedMLP`. The systematic
+    part of the gap (the elastomer's stiffness) is then in place before
+    training, and the few measurements are left to learn what one number cannot.
+
+    Parameters
+    ----------
+    base : NormalizedMLPRegressor
+    epochs, learning_rate, seed
+        As :class:`RefinedMLP`.
+
+    Attributes
+    ----------
+    pressure_scale_ : float
+        The fitted ``s`` of the start.
+    model_ : NormalizedMLPRegressor
+        The refined network (its input standardization holds ``s``); saves and
+        loads as an ``mlp`` surrogate.
+    loss_curve_ : ndarray
+        Training MSE per epoch, deg² (the first is the mapped start's error).
+    """
+
+    @classmethod
+    def fit_batch(
+        cls, estimators: list[RefinedMLP], X: np.ndarray, y: np.ndarray, row_sets: list
+    ) -> list[RefinedMLP]:
+        """Fit each estimator on its rows: its own scale, then all refined at once."""
+        first = estimators[0]
+        check_mlp(first.base, cls.__name__)
+        _check_same(estimators, ("base", "epochs", "learning_rate"), cls.__name__)
+        scales = [
+            fit_pressure_scale(first.base, X[rows], y[rows], owner=cls.__name__)
+            for rows in row_sets
+        ]
+        models = fine_tune_many(
+            [scale_mlp_pressure(first.base, s) for s in scales],
+            X,
+            y,
+            row_weights(row_sets, len(y)),
+            epochs=first.epochs,
+            learning_rate=first.learning_rate,
+        )
+        for estimator, model, scale in zip(estimators, models, scales, strict=True):
+            estimator._set(model, X)
+            estimator.pressure_scale_ = scale
+        return estimators
+
+
 class ResidualGP(_Strategy):
     """The base frozen, a Gaussian process on its error (scikit-learn, with a noise term).
 
@@ -560,8 +669,12 @@ def make_strategy(name: str, base: Any = None, *, seed: int = 0, **options: Any)
         return RefinedMLP(base, seed=seed, **options)
     if name == "scale-offset":
         return ScaleOffset(base, **options)
+    if name == "pressure-scale":
+        return PressureScale(base, **options)
     if name == "residual-gp":
         return ResidualGP(base, seed=seed, **options)
+    if name == "scaled-refined":
+        return ScaledRefinedMLP(base, seed=seed, **options)
     return RefinedEnsemble(base, seed=seed, **options)
 
 

@@ -1,0 +1,129 @@
+"""The pressure map: a simulation's actuator made as stiff as the measured one.
+
+If every elastic modulus of the elastomer is multiplied by ``k``, the total
+potential energy ``k·W(u) − p·V(u)`` has the same equilibria as
+``W(u) − (p/k)·V(u)``: the stiffer actuator at pressure ``p`` bends as the
+model does at ``p/k``. A surrogate trained on simulations of one elastomer
+therefore answers for an elastomer ``k`` times as stiff when it is asked at the
+scaled pressure ``s·p``, ``s = 1/k``. Gravity, the fibers and the
+strain-limiting layer do not scale with the elastomer, and a real elastomer's
+stress–stretch curve differs in shape, not only in scale, from the one
+simulated, so the map is a first-order correction: one number, fitted to the
+measurements by least squares, with a physical meaning (``s > 1``: the real
+elastomer is softer than the simulated one).
+
+:func:`fit_pressure_scale` fits ``s`` for any surrogate; :func:`scale_mlp_pressure`
+folds it into an MLP's input standardization exactly, so that a network can be
+trained further from the mapped start (the ``scaled-refined`` strategy).
+"""
+
+from __future__ import annotations
+
+from typing import Any
+
+import numpy as np
+from numpy.typing import ArrayLike
+from scipy.optimize import minimize_scalar
+
+__all__ = ["SCALE_BOUNDS", "fit_pressure_scale", "scale_mlp_pressure", "scaled_rows"]
+
+#: The pressure scale is searched in this range (the elastomer 4 times softer or stiffer).
+SCALE_BOUNDS: tuple[float, float] = (0.25, 4.0)
+
+
+def scaled_rows(X: ArrayLike, scale: float) -> np.ndarray:
+    """A copy of the rows with the pressure column (the last) multiplied by ``scale``."""
+    rows = np.array(X, dtype=np.float64, copy=True)
+    rows[:, -1] *= scale
+    return rows
+
+
+def fit_pressure_scale(base: Any, X: ArrayLike, y: ArrayLike, *, owner: str) -> float:
+    """The ``s`` that minimises ``Σ (base(design, s·p) − θ)²`` over the rows.
+
+    Parameters
+    ----------
+    base : estimator
+        A fitted surrogate on the rows of :data:`softbend.design.FEATURES`.
+    X : array_like of shape (n, 7)
+        Measured designs and pressures (mm, deg, MPa), finite.
+    y : array_like of shape (n,)
+        Measured angles, degrees.
+    owner : str
+        Name of the caller, for the error message.
+
+    Returns
+    -------
+    float
+        The pressure scale, dimensionless, within :data:`SCALE_BOUNDS`.
+
+    Raises
+    ------
+    ValueError
+        If no row has a positive pressure (the scale is then undetermined), or
+        the best scale lies on a bound of :data:`SCALE_BOUNDS` (the measured
+        actuators are not this model's actuator made softer or stiffer).
+    """
+    rows = np.asarray(X, dtype=np.float64)
+    angles = np.asarray(y, dtype=np.float64)
+    if not np.any(rows[:, -1] > 0.0):
+        raise ValueError(
+            f"The measurements of {owner} must include a pressure above 0 MPa: the pressure "
+            "scale is fitted on pressurized readings."
+        )
+    low, high = SCALE_BOUNDS
+
+    def loss(scale: float) -> float:
+        return float(np.sum((np.asarray(base.predict(scaled_rows(rows, scale))) - angles) ** 2))
+
+    # Brent's method on log(s): the loss is smooth and has one minimum near 1.
+    found = minimize_scalar(
+        lambda log_s: loss(float(np.exp(log_s))),
+        bounds=(np.log(low), np.log(high)),
+        method="bounded",
+        options={"xatol": 1e-7},
+    )
+    scale = float(np.exp(found.x))
+    if not low * 1.001 < scale < high / 1.001:
+        raise ValueError(
+            f"The pressure scale of {owner} lies on its bound ({scale:.3g}, allowed "
+            f"{low:g}–{high:g}): the measured actuators do not behave like the base's "
+            "actuator with a softer or stiffer elastomer. Check the units of the pressure "
+            "column (MPa) and that the base is a surrogate of the same actuator family."
+        )
+    return scale
+
+
+def scale_mlp_pressure(model: Any, scale: float) -> Any:
+    """A copy of a normalized MLP that answers ``model(design, scale·p)`` exactly.
+
+    The network standardizes its inputs as ``(x − mean)/scale_x``; asking it at
+    ``s·p`` is the same as standardizing ``p`` with mean ``mean_p/s`` and scale
+    ``scale_p/s``. Weights, biases and target scaling are shared unchanged.
+
+    Parameters
+    ----------
+    model : NormalizedMLPRegressor
+        Fitted on :data:`softbend.design.FEATURES` (pressure last).
+    scale : float
+        The pressure scale ``s`` > 0.
+
+    Returns
+    -------
+    NormalizedMLPRegressor
+    """
+    from softbend.surrogates.mlp import NormalizedMLPRegressor
+
+    x_mean = np.array(model.x_mean_, dtype=np.float64, copy=True)
+    x_scale = np.array(model.x_scale_, dtype=np.float64, copy=True)
+    x_mean[-1] /= scale
+    x_scale[-1] /= scale
+    return NormalizedMLPRegressor.from_arrays(
+        x_mean=x_mean,
+        x_scale=x_scale,
+        y_mean=float(model.y_mean_),
+        y_scale=float(model.y_scale_),
+        coefs=model.coefs_,
+        intercepts=model.intercepts_,
+        **{k: v for k, v in model.get_params().items() if k != "hidden_sizes"},
+    )
