@@ -123,6 +123,25 @@ class _Strategy(RegressorMixin, BaseEstimator):
         return validate_data(self, X, reset=False, dtype=np.float64)
 
 
+class _Corrected(_Strategy):
+    """A strategy whose fitted ``model_`` is a surrogate with an interval (``corrected``)."""
+
+    def predict(self, X: ArrayLike) -> np.ndarray:
+        """Corrected angle, degrees."""
+        return self.model_.predict(self._check_rows(X))
+
+    def predict_interval(self, X: ArrayLike, level: float = 0.9) -> tuple[np.ndarray, np.ndarray]:
+        """Central interval of probability ``level`` for a new reading, degrees.
+
+        Gaussian, with the width the model states: the fit's residual spread
+        (scale-offset, pressure-scale), the GP's predictive deviation with its
+        noise term (residual-gp), the members' spread and the residual noise
+        (refined-ensemble).
+        """
+        level = _check_level(level, type(self).__name__)
+        return self.model_.predict_interval(self._check_rows(X), level)
+
+
 class BaseOnly(_Strategy):
     """The base surrogate as it is ("fem-only"); ``fit`` only records the features."""
 
@@ -242,7 +261,7 @@ class RefinedMLP(_Strategy):
         check_mlp(first.base, cls.__name__)
         _check_same(estimators, ("base", "epochs", "learning_rate"), cls.__name__)
         models = fine_tune_many(
-            first.base,
+            cls._starts(first.base, X, y, row_sets),
             X,
             y,
             row_weights(row_sets, len(y)),
@@ -252,6 +271,11 @@ class RefinedMLP(_Strategy):
         for estimator, model in zip(estimators, models, strict=True):
             estimator._set(model, X)
         return estimators
+
+    @classmethod
+    def _starts(cls, base: Any, X: np.ndarray, y: np.ndarray, row_sets: list) -> Any:
+        """Where training starts: the base itself, for every row set."""
+        return base
 
     def _set(self, model: Any, X: np.ndarray) -> None:
         self.model_ = model
@@ -357,7 +381,7 @@ class ExperimentalMLP(_Strategy):
         return self.model_.predict(self._check_rows(X))
 
 
-class ScaleOffset(_Strategy):
+class ScaleOffset(_Corrected):
     """The base frozen and corrected linearly: ``θ = a·θ_base + c`` (least squares).
 
     Two numbers learned from the measurements: robust with one measured
@@ -382,17 +406,8 @@ class ScaleOffset(_Strategy):
         self.model_ = AffineCorrected(self.base, self.scale_, self.offset_, self.residual_std_)
         return self
 
-    def predict(self, X: ArrayLike) -> np.ndarray:
-        """Corrected angle, degrees."""
-        return self.model_.predict(self._check_rows(X))
 
-    def predict_interval(self, X: ArrayLike, level: float = 0.9) -> tuple[np.ndarray, np.ndarray]:
-        """Central interval of probability ``level`` (Gaussian residuals), degrees."""
-        level = _check_level(level, type(self).__name__)
-        return self.model_.predict_interval(self._check_rows(X), level)
-
-
-class PressureScale(_Strategy):
+class PressureScale(_Corrected):
     """The base frozen and asked at a scaled pressure: ``θ = θ_base(design, s·p)``.
 
     One number learned from the measurements, with a physical meaning: the
@@ -421,15 +436,6 @@ class PressureScale(_Strategy):
         self.residual_std_ = float(np.sqrt(np.sum(residual**2) / max(y.size - 1, 1)))
         self.model_ = PressureScaled(self.base, self.scale_, self.residual_std_)
         return self
-
-    def predict(self, X: ArrayLike) -> np.ndarray:
-        """The base's angle at the scaled pressure, degrees."""
-        return self.model_.predict(self._check_rows(X))
-
-    def predict_interval(self, X: ArrayLike, level: float = 0.9) -> tuple[np.ndarray, np.ndarray]:
-        """Central interval of probability ``level`` (Gaussian residuals), degrees."""
-        level = _check_level(level, type(self).__name__)
-        return self.model_.predict_interval(self._check_rows(X), level)
 
 
 class ScaledRefinedMLP(RefinedMLP):
@@ -460,32 +466,20 @@ class ScaledRefinedMLP(RefinedMLP):
     """
 
     @classmethod
-    def fit_batch(
-        cls, estimators: list[RefinedMLP], X: np.ndarray, y: np.ndarray, row_sets: list
-    ) -> list[RefinedMLP]:
-        """Fit each estimator on its rows: its own scale, then all refined at once."""
-        first = estimators[0]
-        check_mlp(first.base, cls.__name__)
-        _check_same(estimators, ("base", "epochs", "learning_rate"), cls.__name__)
-        scales = [
-            fit_pressure_scale(first.base, X[rows], y[rows], owner=cls.__name__)
+    def _starts(cls, base: Any, X: np.ndarray, y: np.ndarray, row_sets: list) -> list[Any]:
+        """The base mapped with the pressure scale fitted on each row set."""
+        return [
+            scale_mlp_pressure(base, fit_pressure_scale(base, X[rows], y[rows], owner=cls.__name__))
             for rows in row_sets
         ]
-        models = fine_tune_many(
-            [scale_mlp_pressure(first.base, s) for s in scales],
-            X,
-            y,
-            row_weights(row_sets, len(y)),
-            epochs=first.epochs,
-            learning_rate=first.learning_rate,
-        )
-        for estimator, model, scale in zip(estimators, models, scales, strict=True):
-            estimator._set(model, X)
-            estimator.pressure_scale_ = scale
-        return estimators
+
+    def _set(self, model: Any, X: np.ndarray) -> None:
+        super()._set(model, X)
+        # Refinement keeps the start's input standardization, which holds s.
+        self.pressure_scale_ = float(self.base.x_scale_[-1] / model.x_scale_[-1])
 
 
-class ResidualGP(_Strategy):
+class ResidualGP(_Corrected):
     """The base frozen, a Gaussian process on its error (scikit-learn, with a noise term).
 
     The GP sees the standardized features and the base's angle (so an error that
@@ -541,13 +535,8 @@ class ResidualGP(_Strategy):
         """Corrected angle, degrees (and the predictive standard deviation)."""
         return self.model_.predict(self._check_rows(X), return_std=return_std)
 
-    def predict_interval(self, X: ArrayLike, level: float = 0.9) -> tuple[np.ndarray, np.ndarray]:
-        """Central interval of probability ``level`` for a new reading, degrees."""
-        level = _check_level(level, type(self).__name__)
-        return self.model_.predict_interval(self._check_rows(X), level)
 
-
-class RefinedEnsemble(_Strategy):
+class RefinedEnsemble(_Corrected):
     """Refined MLPs on bootstrap draws of the measured actuators.
 
     Each member is :class:`RefinedMLP` on a draw (with replacement) of the
@@ -627,15 +616,6 @@ class RefinedEnsemble(_Strategy):
             estimator.residual_std_ = float(np.sqrt(np.mean((mean - y[rows]) ** 2)))
             estimator.model_ = MeanEnsemble(members, estimator.residual_std_)
         return estimators
-
-    def predict(self, X: ArrayLike) -> np.ndarray:
-        """Members' mean angle, degrees."""
-        return self.model_.predict(self._check_rows(X))
-
-    def predict_interval(self, X: ArrayLike, level: float = 0.9) -> tuple[np.ndarray, np.ndarray]:
-        """Central interval of probability ``level`` (spread and noise, Gaussian), degrees."""
-        level = _check_level(level, type(self).__name__)
-        return self.model_.predict_interval(self._check_rows(X), level)
 
 
 def make_strategy(name: str, base: Any = None, *, seed: int = 0, **options: Any) -> _Strategy:
