@@ -74,6 +74,40 @@ def test_a_scale_on_its_bound_is_one_clear_error(small_base, quick_measurements)
     assert SCALE_BOUNDS == (0.25, 4.0)
 
 
+class _Trap:
+    """A base whose squared error in s has a local minimum at s = 0.7 and the global at 2.5.
+
+    Asked at p = 0.1 MPa only: ``q = 0.1·s``, the error ``(q − 0.25)²·1e4`` with
+    a dip at q = 0.072. Brent's method alone on the whole range starts at
+    s = 0.72 and stays in the dip (it returns 0.726).
+    """
+
+    n_features_in_ = 7
+
+    def predict(self, X):
+        q = np.asarray(X)[:, -1]
+        return (q - 0.25) ** 2 * 1e4 - 300.0 * np.exp(-(((q - 0.072) / 0.01) ** 2))
+
+
+def test_the_scan_finds_the_global_minimum_not_the_nearest(quick_measurements):
+    X = quick_measurements.features.copy()
+    X[:, -1] = 0.1
+    scale = fit_pressure_scale(_Trap(), X, np.zeros(len(X)), owner="test")
+    assert scale == pytest.approx(2.5, rel=1e-4)
+
+
+def test_a_base_that_never_answers_is_one_clear_error(quick_measurements):
+    class Silent:
+        n_features_in_ = 7
+
+        def predict(self, X):
+            return np.full(len(X), np.nan)
+
+    X = quick_measurements.features
+    with pytest.raises(ValueError, match="predicts no finite angle"):
+        fit_pressure_scale(Silent(), X, np.ones(len(X)), owner="test")
+
+
 def test_a_scaled_mlp_answers_the_base_at_the_scaled_pressure(small_base, quick_measurements):
     X = quick_measurements.features
     scaled = scale_mlp_pressure(small_base, 0.87)

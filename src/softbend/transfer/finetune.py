@@ -3,9 +3,9 @@
 Transfer learning trains the same network again and again on small row sets:
 one refit per held-out actuator, per learning-curve point, per ensemble
 member. Each is a full-batch problem of ~100 rows, where PyTorch's per-call
-overhead, not arithmetic, sets the time (about 1 ms per Adam step). So the K
-variants are stacked along a leading axis and trained together: one batched
-matrix product per layer, one Adam step for all. Each variant's loss is the
+overhead, not arithmetic, would set the time (about 1 ms per Adam step). So the
+K variants are stacked along a leading axis and trained together: one batched
+matrix product per layer, one (fused) Adam step for all. Each variant's loss is the
 weighted mean over its own rows, and Adam acts element by element, so variant
 k ends exactly where training it alone would (up to rounding).
 """
@@ -20,7 +20,15 @@ from numpy.typing import ArrayLike
 from softbend._validation import check_int, check_range
 from softbend.errors import ConvergenceError
 
-__all__ = ["check_mlp", "fine_tune_many", "fine_tune_mlp", "row_weights"]
+__all__ = ["FINE_TUNE_THREADS", "check_mlp", "fine_tune_many", "fine_tune_mlp", "row_weights"]
+
+#: Threads of the batched training (at most; fewer if PyTorch has fewer). The
+#: stacked variants of a fold set make every step a batch of matrix products
+#: large enough to be compute-bound, so two threads pay (``softbend transfer
+#: loco`` on the shipped lab: see the README for the time with one and two).
+#: A fixed number, not the machine's core count, so the rounding (and the
+#: figures) do not depend on the machine.
+FINE_TUNE_THREADS = 2
 
 
 def check_mlp(base: Any, owner: str) -> Any:
@@ -121,7 +129,7 @@ def fine_tune_many(
 
     torch = require_torch("refining the MLP surrogate")
     threads = torch.get_num_threads()
-    torch.set_num_threads(1)
+    torch.set_num_threads(min(threads, FINE_TUNE_THREADS))
     try:
         f64 = torch.float64
         z = torch.as_tensor((X[None, :, :] - x_mean) / x_scale, dtype=f64)  # (K, n, d)
@@ -134,7 +142,8 @@ def fine_tune_many(
 
         weights_ = [stacked([m.coefs_[i] for m in starts], False) for i in range(3)]
         biases = [stacked([m.intercepts_[i] for m in starts], True) for i in range(3)]
-        optimizer = torch.optim.Adam([*weights_, *biases], lr=learning_rate)
+        # Fused Adam: one kernel for the update of all six tensors.
+        optimizer = torch.optim.Adam([*weights_, *biases], lr=learning_rate, fused=True)
         curve = np.empty((k, epochs))
         for epoch in range(epochs):
             a = torch.tanh(z @ weights_[0] + biases[0])

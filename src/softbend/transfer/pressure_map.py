@@ -74,24 +74,36 @@ def fit_pressure_scale(base: Any, X: ArrayLike, y: ArrayLike, *, owner: str) -> 
     low, high = SCALE_BOUNDS
 
     def loss(scale: float) -> float:
-        return float(np.sum((np.asarray(base.predict(scaled_rows(rows, scale))) - angles) ** 2))
+        # A base that cannot answer at some scaled pressure (NaN: beyond where
+        # its sweep stops) rules that scale out.
+        value = float(np.sum((np.asarray(base.predict(scaled_rows(rows, scale))) - angles) ** 2))
+        return value if np.isfinite(value) else np.inf
 
-    # Brent's method on log(s): the loss is smooth and has one minimum near 1.
+    # A scan of log(s) finds the basin (an MLP asked far outside its training
+    # pressures can have spurious minima), then Brent's method refines it.
+    grid = np.linspace(np.log(low), np.log(high), 41)
+    losses = np.array([loss(float(np.exp(g))) for g in grid])
+    if not np.isfinite(losses).any():
+        raise ValueError(
+            f"The base of {owner} predicts no finite angle at the measured pressures for any "
+            f"pressure scale in {low:g}–{high:g}."
+        )
+    best = int(np.argmin(losses))
+    if best in (0, grid.size - 1):
+        raise ValueError(
+            f"The pressure scale of {owner} lies on its bound "
+            f"({float(np.exp(grid[best])):.3g}, allowed {low:g}–{high:g}): the measured "
+            "actuators do not behave like the base's actuator with a softer or stiffer "
+            "elastomer. Check the units of the pressure column (MPa) and that the base is a "
+            "surrogate of the same actuator family."
+        )
     found = minimize_scalar(
         lambda log_s: loss(float(np.exp(log_s))),
-        bounds=(np.log(low), np.log(high)),
+        bounds=(grid[best - 1], grid[best + 1]),
         method="bounded",
         options={"xatol": 1e-7},
     )
-    scale = float(np.exp(found.x))
-    if not low * 1.001 < scale < high / 1.001:
-        raise ValueError(
-            f"The pressure scale of {owner} lies on its bound ({scale:.3g}, allowed "
-            f"{low:g}–{high:g}): the measured actuators do not behave like the base's "
-            "actuator with a softer or stiffer elastomer. Check the units of the pressure "
-            "column (MPa) and that the base is a surrogate of the same actuator family."
-        )
-    return scale
+    return float(np.exp(found.x))
 
 
 def scale_mlp_pressure(model: Any, scale: float) -> Any:
