@@ -10,7 +10,7 @@ from softbend.reports.html import Report
 from .conftest import figures_of, only_section
 
 #: Strategies without a network or a Gaussian process to train.
-FAST = ("fem-only", "analytical", "scale-offset")
+FAST = ("fem-only", "analytical", "scale-offset", "pressure-scale")
 
 
 @pytest.fixture(scope="module")
@@ -43,4 +43,5 @@ def test_the_table_has_every_strategy_and_paper_b_beside(section):
     assert "paper B refined MLP (real rig)" in html
     assert str(transfer_section.PAPER_B_REFINED["rmse_deg"]) in html
     assert f"Best: {summary['best']}" in html
+    assert "pressure-scale and scaled-refined strategies go beyond paper B" in html
     assert set(summary["files"]) >= {"summary", "per_actuator", "json"}

@@ -155,8 +155,8 @@ def add_transfer(report: Report, transfer: Transfer, root: Path) -> dict[str, Pa
         "well but refines differently (benchmarks/bench_transfer_seeds.py measures the spread; "
         "see the README)."
         + (
-            " pressure-scale and scaled-refined go beyond paper B: the FEM-trained MLP is "
-            "asked at s·p, one number fitted to the measurements that makes the simulated "
+            " The pressure-scale and scaled-refined strategies go beyond paper B: the FEM-trained "
+            "MLP is asked at s·p, one number fitted to the measurements that makes the simulated "
             "elastomer as stiff as the measured one (an elastomer k times as stiff bends at "
             "k·p as the simulated one at p, gravity and fibers aside); scaled-refined then "
             "refines from that start as paper B does."
