@@ -81,12 +81,24 @@ def main(argv: list[str] | None = None) -> int:
     samples = table1_fem()
     samples = samples[samples["converged"].astype(bool)]
     fem_X, fem_y = fem_rows(samples), samples["angle_deg"].to_numpy(dtype=float)
+    names = list(STRATEGIES)
     print(
-        "seed  FEM-data RMSE  fem-only RMSE  refined RMSE  scaled-refined RMSE  ratios to fem-only"
+        "seed  FEM-data RMSE  fem-only RMSE  "
+        + "  ".join(f"{n + ' RMSE':>19s}" for n in names)
+        + "  ratios to fem-only"
     )
+
+    def line(label: str, fit: float, fem: float, held_out: list[float], ratios: list[float]) -> str:
+        return (
+            f"{label:4s}  {fit:13.2f}  {fem:13.2f}  "
+            + "  ".join(f"{v:19.2f}" for v in held_out)
+            + "  "
+            + ", ".join(f"{r:.3f}" for r in ratios)
+        )
+
     fit, fem = [], []
-    held = {name: [] for name in STRATEGIES}  # per seed: the mean held-out RMSE
-    members = {name: [] for name in STRATEGIES}  # per seed: the held-out predictions
+    held = {name: [] for name in names}  # per seed: the mean held-out RMSE
+    members = {name: [] for name in names}  # per seed: the held-out predictions
     for seed, base in bases.items():
         fit.append(rmse(fem_y, base.predict(fem_X)))
         fem.append(mean_rmse([base.predict(X[m]) for m in held_out]))
@@ -95,22 +107,15 @@ def main(argv: list[str] | None = None) -> int:
             predictions = [model.predict(X[m]) for model, m in zip(models, held_out, strict=True)]
             members[name].append(predictions)
             held[name].append(mean_rmse(predictions))
-        print(
-            f"{seed:4d}  {fit[-1]:13.2f}  {fem[-1]:13.2f}  {held['refined'][-1]:12.2f}  "
-            f"{held['scaled-refined'][-1]:19.2f}  "
-            f"{held['refined'][-1] / fem[-1]:.3f}, {held['scaled-refined'][-1] / fem[-1]:.3f}"
-        )
+        last = [held[n][-1] for n in names]
+        print(line(str(seed).rjust(4), fit[-1], fem[-1], last, [v / fem[-1] for v in last]))
     if len(fem) > 1:
-        fit_a, fem_a = np.array(fit), np.array(fem)
+        fem_a = np.array(fem)
         for label, reduce in (("mean", np.mean), ("sd", lambda a: np.std(a, ddof=1))):
-            ratios = [reduce(np.array(held[n]) / fem_a) for n in STRATEGIES]
-            print(
-                f"{label:4s}  {reduce(fit_a):13.2f}  {reduce(fem_a):13.2f}  "
-                f"{reduce(np.array(held['refined'])):12.2f}  "
-                f"{reduce(np.array(held['scaled-refined'])):19.2f}  "
-                f"{ratios[0]:.3f}, {ratios[1]:.3f}"
-            )
-        for name in STRATEGIES:
+            values = [reduce(np.array(held[n])) for n in names]
+            ratios = [reduce(np.array(held[n]) / fem_a) for n in names]
+            print(line(label, reduce(np.array(fit)), reduce(fem_a), values, ratios))
+        for name in names:
             mean_of_members = [
                 np.mean([p[k] for p in members[name]], axis=0) for k in range(len(ids))
             ]

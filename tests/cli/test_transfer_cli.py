@@ -218,6 +218,31 @@ def test_transfer_base_and_refine_bad_input_is_one_line(tmp_path, capsys, small_
         ]
     )
     assert code == 2 and "nobase.json" in one_error_line(capsys)
+    # Readings at 0 MPa only: no pressure scale can be fitted.
+    lines = lab_csv.read_text().splitlines()
+    header = next(i for i, line in enumerate(lines) if not line.startswith("#"))
+    column = lines[header].split(",").index("pressure_mpa")
+    unpressurized = tmp_path / "zero.csv"
+    unpressurized.write_text(
+        "\n".join(
+            lines[: header + 1]
+            + [r for r in lines[header + 1 :] if float(r.split(",")[column]) == 0.0]
+        )
+        + "\n"
+    )
+    code = main(
+        [
+            "transfer",
+            "refine",
+            str(small_base_file),
+            str(unpressurized),
+            "--out",
+            str(tmp_path / "r.json"),
+            "--strategy",
+            "pressure-scale",
+        ]
+    )
+    assert code == 2 and "pressure above 0 MPa" in one_error_line(capsys)
 
 
 @pytest.mark.parametrize(

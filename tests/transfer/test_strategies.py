@@ -7,6 +7,7 @@ import pytest
 
 from softbend.transfer.finetune import fine_tune_many, fine_tune_mlp, row_weights
 from softbend.transfer.strategies import (
+    NETWORK_STRATEGIES,
     STRATEGIES,
     AnalyticalBaseline,
     ExperimentalMLP,
@@ -18,13 +19,16 @@ from softbend.transfer.strategies import (
     make_strategy,
 )
 
-MLP_STRATEGIES = ("refined", "experimental", "refined-ensemble", "scaled-refined")
+
+def test_the_network_strategies_are_the_ones_with_epochs(small_base):
+    with_epochs = {n for n in STRATEGIES if "epochs" in make_strategy(n, small_base).get_params()}
+    assert with_epochs == set(NETWORK_STRATEGIES)
 
 
 def test_every_named_strategy_fits_and_predicts(small_base, quick_measurements):
     X, y = quick_measurements.features, quick_measurements.angle_deg
     for name in STRATEGIES:
-        options = {"epochs": 20} if name in MLP_STRATEGIES else {}
+        options = {"epochs": 20} if name in NETWORK_STRATEGIES else {}
         model = make_strategy(name, small_base, **options).fit(X, y)
         pred = model.predict(X)
         assert pred.shape == y.shape and np.isfinite(pred).all(), name

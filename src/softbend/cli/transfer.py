@@ -233,10 +233,6 @@ REFINE_STRATEGIES: tuple[str, ...] = (
 )
 
 
-#: Strategies that train a network (``--epochs`` applies).
-_MLP_STRATEGIES: tuple[str, ...] = ("refined", "experimental", "refined-ensemble", "scaled-refined")
-
-
 @app.command("refine")
 def refine(
     base: Path = typer.Argument(..., help="Saved surrogate to start from (an mlp for 'refined')."),
@@ -258,13 +254,13 @@ def refine(
     from softbend._validation import check_choice
     from softbend.surrogates.persistence import save_surrogate
     from softbend.transfer.measurements import load_measurements
-    from softbend.transfer.strategies import fit_strategy
+    from softbend.transfer.strategies import NETWORK_STRATEGIES, fit_strategy
 
     check_choice(strategy, "strategy", "softbend transfer refine", REFINE_STRATEGIES)
-    if epochs is not None and strategy not in _MLP_STRATEGIES:
+    if epochs is not None and strategy not in NETWORK_STRATEGIES:
         raise ValueError(
             f"The '--epochs' option applies to the MLP strategies "
-            f"({', '.join(_MLP_STRATEGIES)}); {strategy!r} trains no network."
+            f"({', '.join(NETWORK_STRATEGIES)}); {strategy!r} trains no network."
         )
     _common.check_output_file(out, "--out", inputs=(base, measurements), kind="json")
     data = load_measurements(measurements)

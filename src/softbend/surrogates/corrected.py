@@ -41,6 +41,7 @@ __all__ = [
     "MeanEnsemble",
     "PressureScaled",
     "gp_kernel",
+    "scaled_pressure_rows",
 ]
 
 
@@ -50,6 +51,13 @@ def _rows(X: ArrayLike, n_features: int, owner: str) -> np.ndarray:
         raise ValueError(
             f"The 'X' of {owner} must have shape (n, {n_features}). Got {rows.shape} instead."
         )
+    return rows
+
+
+def scaled_pressure_rows(X: ArrayLike, scale: float) -> np.ndarray:
+    """A copy of the rows with the pressure column (the last, MPa) multiplied by ``scale``."""
+    rows = np.array(X, dtype=np.float64, copy=True)
+    rows[:, -1] *= scale
     return rows
 
 
@@ -117,8 +125,7 @@ class PressureScaled:
 
     def predict(self, X: ArrayLike) -> np.ndarray:
         """The base's angle at the scaled pressure, degrees."""
-        rows = np.array(_rows(X, self.n_features_in_, type(self).__name__), copy=True)
-        rows[:, -1] *= self.scale_
+        rows = scaled_pressure_rows(_rows(X, self.n_features_in_, type(self).__name__), self.scale_)
         return np.asarray(self.base.predict(rows), dtype=np.float64)
 
     def predict_interval(self, X: ArrayLike, level: float = 0.9) -> tuple[np.ndarray, np.ndarray]:

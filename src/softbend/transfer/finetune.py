@@ -27,7 +27,7 @@ __all__ = ["FINE_TUNE_THREADS", "check_mlp", "fine_tune_many", "fine_tune_mlp", 
 #: large enough to be compute-bound, so two threads pay (``softbend transfer
 #: loco`` on the shipped lab: see the README for the time with one and two).
 #: A fixed number, not the machine's core count, so the rounding (and the
-#: figures) do not depend on the machine.
+#: figures) are the same on every machine with two cores or more.
 FINE_TUNE_THREADS = 2
 
 

@@ -25,17 +25,12 @@ import numpy as np
 from numpy.typing import ArrayLike
 from scipy.optimize import minimize_scalar
 
+from softbend.surrogates.corrected import scaled_pressure_rows as scaled_rows
+
 __all__ = ["SCALE_BOUNDS", "fit_pressure_scale", "scale_mlp_pressure", "scaled_rows"]
 
 #: The pressure scale is searched in this range (the elastomer 4 times softer or stiffer).
 SCALE_BOUNDS: tuple[float, float] = (0.25, 4.0)
-
-
-def scaled_rows(X: ArrayLike, scale: float) -> np.ndarray:
-    """A copy of the rows with the pressure column (the last) multiplied by ``scale``."""
-    rows = np.array(X, dtype=np.float64, copy=True)
-    rows[:, -1] *= scale
-    return rows
 
 
 def fit_pressure_scale(base: Any, X: ArrayLike, y: ArrayLike, *, owner: str) -> float:

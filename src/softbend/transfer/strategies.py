@@ -48,9 +48,10 @@ from softbend.surrogates.corrected import (
     gp_kernel,
 )
 from softbend.transfer.finetune import check_mlp, fine_tune_many, row_weights
-from softbend.transfer.pressure_map import fit_pressure_scale, scale_mlp_pressure
+from softbend.transfer.pressure_map import fit_pressure_scale, scale_mlp_pressure, scaled_rows
 
 __all__ = [
+    "NETWORK_STRATEGIES",
     "STRATEGIES",
     "AnalyticalBaseline",
     "BaseOnly",
@@ -75,6 +76,14 @@ STRATEGIES: tuple[str, ...] = (
     "scale-offset",
     "pressure-scale",
     "residual-gp",
+    "refined-ensemble",
+    "scaled-refined",
+)
+
+#: The strategies that train a network (they take ``epochs``).
+NETWORK_STRATEGIES: tuple[str, ...] = (
+    "refined",
+    "experimental",
     "refined-ensemble",
     "scaled-refined",
 )
@@ -432,7 +441,7 @@ class PressureScale(_Corrected):
         _check_base(self.base, type(self).__name__)
         X, y = self._check_fit_data(X, y)
         self.scale_ = fit_pressure_scale(self.base, X, y, owner=type(self).__name__)
-        residual = PressureScaled(self.base, self.scale_, 0.0).predict(X) - y
+        residual = np.asarray(self.base.predict(scaled_rows(X, self.scale_))) - y
         self.residual_std_ = float(np.sqrt(np.sum(residual**2) / max(y.size - 1, 1)))
         self.model_ = PressureScaled(self.base, self.scale_, self.residual_std_)
         return self
