@@ -159,7 +159,9 @@ class ActuatorModel:
         self.terms = terms = energy_terms(self.fes, o)
         self._fiber_stiffness = self.fiber_stiffness_n_per_mm()
         self._bind()
-        form = ngs.BilinearForm(self.fes, symmetric=True)
+        # Only the lower triangle of the Hessian is stored: sparse Cholesky needs
+        # no more, and assembly writes half the entries (about a tenth faster).
+        form = ngs.BilinearForm(self.fes, symmetric=True, symmetric_storage=True)
         form += ngs.Variation(terms.solid * dx)
         form += ngs.Variation(terms.layer * ds("bottom"))
         form += ngs.Variation(terms.fiber * ds("outer|bottom"))
