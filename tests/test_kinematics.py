@@ -307,3 +307,30 @@ def test_arc_fit_is_frozen():
     fit = fit_arc(_arc_points(30.0, 5.0))
     with pytest.raises(AttributeError):
         fit.angle_deg = 1.0  # type: ignore[misc]
+
+
+def test_the_arc_refinement_jacobian_matches_central_differences():
+    from softbend.kinematics import (
+        _coefficients,
+        _geometric_residuals,
+        _pratt_fit,
+        _residual_jacobian,
+    )
+
+    rng = np.random.default_rng(3)
+    for angle_deg in (1.0, 90.0, 250.0, 350.0):
+        theta = np.radians(np.linspace(0.0, angle_deg, 41))
+        radius = 1.0 / np.radians(angle_deg)  # unit arc length, as fit_arc scales
+        q = np.column_stack([radius * np.sin(theta), radius * (1 - np.cos(theta))])
+        q = q - q[20] + 1e-3 * rng.normal(size=q.shape)
+        a, b, c, d = _pratt_fit(q)
+        # Near the fit, where the refinement works, and a little off it.
+        params = np.array([a, d, np.arctan2(c, b)]) + 1e-2 * rng.normal(size=3)
+        numeric = np.empty((41, 3))
+        for k in range(3):
+            step = np.zeros(3)
+            step[k] = 1e-6
+            plus = _geometric_residuals(_coefficients(params + step), q)
+            minus = _geometric_residuals(_coefficients(params - step), q)
+            numeric[:, k] = (plus - minus) / 2e-6
+        np.testing.assert_allclose(_residual_jacobian(params, q), numeric, atol=1e-7)

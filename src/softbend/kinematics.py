@@ -329,6 +329,28 @@ def _coefficients(params: np.ndarray) -> np.ndarray:
     return np.array([a, scale * math.cos(phi), scale * math.sin(phi), d])
 
 
+def _residual_jacobian(params: np.ndarray, q: np.ndarray) -> np.ndarray:
+    """Derivatives of :func:`_geometric_residuals` by ``(A, D, phi)``, shape (n, 3).
+
+    With ``P = A|q|² + B x + C y + D``, ``w = √(1 + 4AP)`` and the residual
+    ``r = 2P / (1 + w)``: ``∂r/∂P = 1/w`` and ``∂r/∂A = −4P² / (w (1 + w)²)``
+    at fixed ``P``; ``B, C = s (cos phi, sin phi)`` with ``s = √(1 + 4AD)``.
+    """
+    a, d, phi = params
+    s = math.sqrt(max(1.0 + 4.0 * a * d, 1e-300))
+    cos, sin = math.cos(phi), math.sin(phi)
+    x, y = q[:, 0], q[:, 1]
+    along = x * cos + y * sin
+    p = a * np.einsum("ij,ij->i", q, q) + s * along + d
+    w = np.sqrt(np.maximum(1.0 + 4.0 * a * p, 1e-300))
+    dr_dp = 1.0 / w
+    dp_da = np.einsum("ij,ij->i", q, q) + along * (2.0 * d / s)
+    dr_da = dr_dp * dp_da - 4.0 * p * p / (w * (1.0 + w) ** 2)
+    dr_dd = dr_dp * (1.0 + along * (2.0 * a / s))
+    dr_dphi = dr_dp * s * (y * cos - x * sin)
+    return np.column_stack([dr_da, dr_dd, dr_dphi])
+
+
 def _refine(q: np.ndarray, coef: np.ndarray) -> np.ndarray:
     """Minimise the geometric residuals over (A, D, phi), with B, C on the Pratt constraint."""
     a, b, c, d = coef
@@ -337,7 +359,7 @@ def _refine(q: np.ndarray, coef: np.ndarray) -> np.ndarray:
     result = least_squares(
         lambda p: _geometric_residuals(_coefficients(p), q),
         start,
-        jac="3-point",
+        jac=lambda p: _residual_jacobian(p, q),
         xtol=1e-15,
         ftol=1e-15,
         gtol=1e-15,
