@@ -57,6 +57,7 @@ def _row(result, seconds: float) -> dict:
         "steps": len(steps),
         "rejected_steps": s["rejected_steps"],
         "iterations_total": int(t["iterations"]),
+        "chord_steps": int(t.get("chord_steps", 0)),
         "iterations_per_step": float(np.mean(steps)) if steps else 0.0,
         "gravity_iterations": s["step_iterations"][0],
         "assembly_share": (t["assembly_s"] + t["residual_s"]) / seconds,
@@ -134,6 +135,9 @@ def compare(rows: list[dict], reference: Path) -> None:
         f"  wall per sweep: median {statistics.median(t_old):.1f} -> "
         f"{statistics.median(t_now):.1f} s, worst {max(t_old):.1f} -> {max(t_now):.1f} s"
     )
+    its_now = sum(r["iterations_total"] for r, _ in pairs)
+    its_old = sum(o["iterations_total"] for _, o in pairs)
+    print(f"  Newton iterations, all designs: {its_old} -> {its_now}")
     print(
         f"  largest angle change at a common output: {worst_abs:.4f} deg "
         f"({100 * worst_rel:.4f} %) in {where}; outputs gained or lost: {lost}"

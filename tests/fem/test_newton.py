@@ -92,3 +92,32 @@ def test_too_few_iterations_is_a_convergence_error_with_the_residual():
     with pytest.raises(ConvergenceError) as caught:
         solver.solve(force_scale=float(load.Norm()))
     assert caught.value.residual > 0.0
+
+
+def _solve(chord_above: float, chord_accept: float = 0.5):
+    form, gfu, freedofs, load = _problem(nonlinear=True)
+    solver = EnergySolver(form, gfu, freedofs, load=load, rtol=1e-12)
+    solver.first_contraction = math.inf
+    solver.chord_above, solver.chord_accept = chord_above, chord_accept
+    report = solver.solve(force_scale=float(load.Norm()))
+    return report, solver, gfu.vec.FV().NumPy().copy()
+
+
+def test_chord_steps_reach_the_same_minimum_with_fewer_factorizations():
+    plain_report, plain, plain_u = _solve(chord_above=math.inf)
+    report, solver, u = _solve(chord_above=1e3)
+    assert plain_report.chord_steps == 0 and plain.timings.chord_steps == 0
+    assert report.chord_steps >= 1 and solver.timings.chord_steps == report.chord_steps
+    assert solver.timings.factorizations < plain.timings.factorizations
+    assert report.residual <= 1e-12 * float(solver.load.Norm())
+    np.testing.assert_allclose(u, plain_u, rtol=0, atol=1e-9 * np.abs(plain_u).max())
+
+
+def test_a_rejected_chord_step_is_undone_exactly():
+    # No chord step can cut the residual to zero: every one is tried and undone,
+    # and the solve is Newton's (to round-off: two plain solves differ by 1e-15).
+    _, plain, plain_u = _solve(chord_above=math.inf)
+    report, solver, u = _solve(chord_above=0.0, chord_accept=0.0)
+    assert report.chord_steps == 0 and solver.timings.chord_rejected >= 1
+    assert solver.timings.factorizations == plain.timings.factorizations
+    np.testing.assert_allclose(u, plain_u, rtol=0, atol=1e-12 * np.abs(plain_u).max())
