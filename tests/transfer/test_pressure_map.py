@@ -8,12 +8,8 @@ import pytest
 from softbend.analytical import AnalyticalModel
 from softbend.design import SFRBADesign
 from softbend.materials.models import Yeoh
-from softbend.transfer.pressure_map import (
-    SCALE_BOUNDS,
-    fit_pressure_scale,
-    scale_mlp_pressure,
-    scaled_rows,
-)
+from softbend.surrogates.corrected import scaled_pressure_rows as scaled_rows
+from softbend.transfer.pressure_map import SCALE_BOUNDS, fit_pressure_scale, scale_mlp_pressure
 from softbend.transfer.strategies import (
     AnalyticalBaseline,
     PressureScale,

@@ -25,9 +25,9 @@ import numpy as np
 from numpy.typing import ArrayLike
 from scipy.optimize import minimize_scalar
 
-from softbend.surrogates.corrected import scaled_pressure_rows as scaled_rows
+from softbend.surrogates.corrected import scaled_pressure_rows
 
-__all__ = ["SCALE_BOUNDS", "fit_pressure_scale", "scale_mlp_pressure", "scaled_rows"]
+__all__ = ["SCALE_BOUNDS", "fit_pressure_scale", "scale_mlp_pressure"]
 
 #: The pressure scale is searched in this range (the elastomer 4 times softer or stiffer).
 SCALE_BOUNDS: tuple[float, float] = (0.25, 4.0)
@@ -71,7 +71,8 @@ def fit_pressure_scale(base: Any, X: ArrayLike, y: ArrayLike, *, owner: str) -> 
     def loss(scale: float) -> float:
         # A base that cannot answer at some scaled pressure (NaN: beyond where
         # its sweep stops) rules that scale out.
-        value = float(np.sum((np.asarray(base.predict(scaled_rows(rows, scale))) - angles) ** 2))
+        predicted = np.asarray(base.predict(scaled_pressure_rows(rows, scale)))
+        value = float(np.sum((predicted - angles) ** 2))
         return value if np.isfinite(value) else np.inf
 
     # A scan of log(s) finds the basin (an MLP asked far outside its training

@@ -46,9 +46,10 @@ from softbend.surrogates.corrected import (
     MeanEnsemble,
     PressureScaled,
     gp_kernel,
+    scaled_pressure_rows,
 )
 from softbend.transfer.finetune import check_mlp, fine_tune_many, row_weights
-from softbend.transfer.pressure_map import fit_pressure_scale, scale_mlp_pressure, scaled_rows
+from softbend.transfer.pressure_map import fit_pressure_scale, scale_mlp_pressure
 
 __all__ = [
     "NETWORK_STRATEGIES",
@@ -441,7 +442,7 @@ class PressureScale(_Corrected):
         _check_base(self.base, type(self).__name__)
         X, y = self._check_fit_data(X, y)
         self.scale_ = fit_pressure_scale(self.base, X, y, owner=type(self).__name__)
-        residual = np.asarray(self.base.predict(scaled_rows(X, self.scale_))) - y
+        residual = np.asarray(self.base.predict(scaled_pressure_rows(X, self.scale_))) - y
         self.residual_std_ = float(np.sqrt(np.sum(residual**2) / max(y.size - 1, 1)))
         self.model_ = PressureScaled(self.base, self.scale_, self.residual_std_)
         return self
