@@ -118,6 +118,11 @@ def compare(rows: list[dict], reference: Path) -> None:
             before[row["design"]] = row
     worst_abs, worst_rel, lost, where = 0.0, 0.0, 0, ""
     pairs = [(r, before[r["design"]]) for r in rows if r["design"] in before]
+    if any("angles_deg" not in old for _, old in pairs):
+        raise SystemExit(
+            f"{reference} has no 'angles_deg' (written by an older bench_fem.py): copy them in "
+            "from a run of the same code, e.g. benchmarks/reference/bench_fem_f814805.jsonl."
+        )
     for now, old in pairs:
         a, b = np.array(now["angles_deg"]), np.array(old["angles_deg"])
         n = min(len(a), len(b))
