@@ -71,6 +71,22 @@ def test_batched_grid_equals_each_model_trained_alone(dtype, atol):
             np.testing.assert_allclose(batched.val_pred_deg, alone.val_pred_deg, atol=atol * 1e3)
 
 
+def test_the_largest_configuration_is_bitwise_the_same_beside_a_smaller_one():
+    # the quick grid of reproduce trains (63, 65) alone because of this: a smaller
+    # configuration beside it neither pads it nor shares its random stream
+    X, y = _smooth_data()
+    splits = _uneven_splits(len(y))
+    kwargs = dict(epochs=5, batch_size=32, learning_rate=5e-3, seed=1, device="cpu")
+    both = train_mlp_grid(X, y, splits, [(5, 4), (8, 7)], **kwargs)
+    alone = train_mlp_grid(X, y, splits, [(8, 7)], **kwargs)
+    for s in range(len(splits)):
+        a, b = both.model(1, s), alone.model(0, s)
+        for pa, pb in zip(a.coefs + a.intercepts, b.coefs + b.intercepts, strict=True):
+            np.testing.assert_array_equal(pa, pb)
+        np.testing.assert_array_equal(a.loss_curve, b.loss_curve)
+        np.testing.assert_array_equal(a.val_pred_deg, b.val_pred_deg)
+
+
 def test_models_differ_between_configs_and_splits_and_learn():
     X, y = _smooth_data()
     grid = train_mlp_grid(

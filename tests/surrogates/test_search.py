@@ -18,6 +18,7 @@ def test_grid_sizes_match_paper_b():
     mlp = grid("paper", "mlp")
     assert len(mlp) == 121 and (63, 65) in [c["hidden_sizes"] for c in mlp]
     assert len(grid("quick", "plr")) < 9
+    assert grid("quick", "mlp") == [{"hidden_sizes": (63, 65)}]  # paper B's pick
 
 
 @pytest.mark.parametrize(("name", "model"), [("huge", "plr"), ("quick", "svm")])
