@@ -20,8 +20,8 @@ family    ``quick``                           ``paper``
 ========  ==================================  ====================================
 
 The quick grid is what ``softbend reproduce`` trains within its time budget.
-Its MLP is paper B's configuration alone: a second size, (55, 55), made the
-MLP training of ``reproduce`` about 1.6 times longer and never won; the
+Its MLP is paper B's configuration alone: a second size, (55, 55), was padded
+to (63, 65) in the batched training, cost as much to train and never won; the
 largest configuration of a batched training is not padded and keeps its own
 random streams, so (63, 65) scores bitwise the same alone as beside (55, 55)
 (``tests/surrogates/test_batched.py``). The ``paper`` grid searches the
