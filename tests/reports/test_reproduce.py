@@ -122,7 +122,11 @@ def test_surrogate_section(first_run):
     models = summary["paper_b_surrogates"]["models"]
     assert set(models) == {"plr", "xgb", "mlp"}
     assert all(0.5 < m["r2"] <= 1.0 for m in models.values())
-    assert "Fig. 5" in (out / "index.html").read_text(encoding="utf-8")
+    html = (out / "index.html").read_text(encoding="utf-8")
+    assert "Fig. 5" in html
+    # the reduced grid says so, and where paper B's grids are
+    assert models["mlp"]["params"] == "hidden_sizes=(63, 65)"
+    assert "this report&#x27;s reduced one" in html and "--grid paper" in html
 
 
 def test_second_run_resumes_the_campaign(first_run, fem_dataset):

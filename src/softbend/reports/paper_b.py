@@ -203,7 +203,13 @@ def add_surrogate_section(report: Report, summary: dict[str, Any], *, root: Path
         f"designs; its inference time is measured on this machine (single sample: the NumPy "
         f"fast path where the model has one). MAPE leaves out |θ| < "
         f"{settings['mape_threshold_deg']:g}°. MLP: {settings['mlp_epochs']} epochs; XGBoost: "
-        f"{settings['xgb_trees']} trees. Paper B's figures come from its FEM data.",
+        f"{settings['xgb_trees']} trees. Paper B's figures come from its FEM data."
+        + (
+            " The 'quick' grid is this report's reduced one (its MLP is paper B's (63, 65) "
+            "alone); `softbend train --grid paper` runs paper B's grids."
+            if str(settings["grid"]).startswith("quick")
+            else ""
+        ),
         note=True,
     )
     rows = []
