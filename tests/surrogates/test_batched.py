@@ -241,6 +241,41 @@ def test_inactive_model_is_not_updated_by_adam():
     assert any(not torch.equal(p[0], p0[0]) for p, p0 in zip(net.params, before, strict=True))
 
 
+def test_the_in_place_adam_step_of_all_active_models_is_bitwise_the_selecting_one():
+    nets = [_two_padded_models(seed=3), _two_padded_models(seed=3)]
+    gen = torch.Generator().manual_seed(2)
+    for _ in range(3):
+        Z = torch.randn((2, 9, 4), generator=gen, dtype=torch.float64)
+        target = torch.randn((2, 9), generator=gen, dtype=torch.float64)
+        weight, count = torch.ones((2, 9), dtype=torch.float64), torch.full((2,), 9.0)
+        for net, in_place in zip(nets, (False, True), strict=True):
+            grads, _ = net.gradients(Z, target, weight, count)
+            net.adam_step(grads, torch.tensor([True, True]), 0.05, all_active=in_place)
+    a, b = nets
+    for tensors_a, tensors_b in ((a.params, b.params), (a.exp_avg, b.exp_avg)):
+        for x, y in zip(tensors_a, tensors_b, strict=True):
+            assert torch.equal(x, y)
+    assert not torch.equal(a.params[0], _two_padded_models(seed=3).params[0])  # it moved
+
+
+def test_an_unpadded_batch_skips_the_masks_and_computes_the_same():
+    rng = np.random.default_rng(4)
+    coefs, intercepts = zip(*(init_parameters(rng, 4, 6, 5) for _ in range(2)), strict=True)
+    plain = _BatchedMLP(list(coefs), list(intercepts), 6, 5, device="cpu", dtype=torch.float64)
+    masked = _BatchedMLP(list(coefs), list(intercepts), 6, 5, device="cpu", dtype=torch.float64)
+    assert not plain.padded and _two_padded_models().padded
+    masked.padded = True  # the general path, multiplying by all-ones masks
+    gen = torch.Generator().manual_seed(5)
+    Z = torch.randn((2, 9, 4), generator=gen, dtype=torch.float64)
+    target = torch.randn((2, 9), generator=gen, dtype=torch.float64)
+    weight, count = torch.ones((2, 9), dtype=torch.float64), torch.full((2,), 9.0)
+    grads_plain, sse_plain = plain.gradients(Z, target, weight, count)
+    grads_masked, sse_masked = masked.gradients(Z, target, weight, count)
+    assert torch.equal(sse_plain, sse_masked)
+    for g_plain, g_masked in zip(grads_plain, grads_masked, strict=True):
+        assert torch.equal(g_plain, g_masked)
+
+
 def test_short_training_set_ends_its_epoch_without_extra_updates():
     X, y = _smooth_data()
     rows = np.arange(len(y))

@@ -132,8 +132,12 @@ class MiniBatches:
         """Standardized inputs (M, B, d), target (M, B) and row weights (M, B) of step ``s``."""
         cols = slice(s * self.batch_size, (s + 1) * self.batch_size)
         rows = rows_all[:, cols]
-        Z = ((self.X_dev[rows] - self.x_mean) / self.x_scale).to(self.dtype)
-        target = ((self.y_dev[rows] - self.y_mean) / self.y_scale).to(self.dtype)
+        # index_select gathers the same values as X_dev[rows], about twice as fast
+        flat = rows.reshape(-1)
+        X = self.X_dev.index_select(0, flat).view(*rows.shape, -1)
+        y = self.y_dev.index_select(0, flat).view(rows.shape)
+        Z = ((X - self.x_mean) / self.x_scale).to(self.dtype)
+        target = ((y - self.y_mean) / self.y_scale).to(self.dtype)
         return Z, target, self.valid[:, cols]
 
 
@@ -155,13 +159,14 @@ def run_epochs(
     n_models = len(batches.train_idx)
     device = batches.device
     losses = torch.zeros((epochs, n_models), dtype=torch.float64, device=device)
+    all_active = batches.actives.all(dim=1).tolist()  # per step: no model's epoch is over
     for epoch in range(epochs):
         rows_all = batches.rows(rngs)
         sse_epoch = torch.zeros(n_models, dtype=torch.float64, device=device)
         for s in range(batches.n_steps):
             Z, target, valid = batches.step(rows_all, s)
             grads, sse = net.gradients(Z, target, valid, batches.counts[s])
-            net.adam_step(grads, batches.actives[s], learning_rate)
+            net.adam_step(grads, batches.actives[s], learning_rate, all_active=all_active[s])
             sse_epoch += sse.to(torch.float64)
         losses[epoch] = sse_epoch / batches.n_train
         report(epoch + 1)

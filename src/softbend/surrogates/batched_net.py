@@ -68,6 +68,9 @@ class BatchedMLP:
         self.params = [tensor(W[0]), tensor(b[0]), tensor(W[1]), tensor(b[1])]
         self.params += [tensor(W[2]), tensor(b[2])]
         self.mask1, self.mask2 = tensor(mask1), tensor(mask2)
+        # Without padding (every model as wide as the widest) the masks are all ones
+        # and multiplying by them is exact: those products are skipped.
+        self.padded = not (mask1.all() and mask2.all())
         self.exp_avg = [torch.zeros_like(p) for p in self.params]
         self.exp_avg_sq = [torch.zeros_like(p) for p in self.params]
         self.steps = torch.zeros(n_models, dtype=torch.float64, device=device)
@@ -75,8 +78,12 @@ class BatchedMLP:
     def forward(self, Z: torch.Tensor) -> tuple[torch.Tensor, torch.Tensor, torch.Tensor]:
         """Hidden activations A1 (M, B, H1), A2 (M, B, H2) and output (M, B)."""
         W1, b1, W2, b2, W3, b3 = self.params
-        A1 = torch.baddbmm(b1, Z, W1).tanh_().mul_(self.mask1)
-        A2 = torch.baddbmm(b2, A1, W2).tanh_().mul_(self.mask2)
+        A1 = torch.baddbmm(b1, Z, W1).tanh_()
+        if self.padded:
+            A1.mul_(self.mask1)
+        A2 = torch.baddbmm(b2, A1, W2).tanh_()
+        if self.padded:
+            A2.mul_(self.mask2)
         out = torch.baddbmm(b3, A2, W3).squeeze(-1)
         return A1, A2, out
 
@@ -95,18 +102,32 @@ class BatchedMLP:
         G = residual.mul_((2.0 / count).unsqueeze(1)).unsqueeze(-1)  # (M, B, 1)
         gW3 = torch.bmm(A2.transpose(1, 2), G)
         gb3 = G.sum(dim=1, keepdim=True)
-        dP2 = G * (W3.transpose(1, 2) * self.mask2)  # (M, B, H2); zero on padded units
+        W3t = W3.transpose(1, 2) * self.mask2 if self.padded else W3.transpose(1, 2)
+        dP2 = G * W3t  # (M, B, H2); zero on padded units
         dP2.mul_(torch.square(A2).neg_().add_(1.0))
         gW2 = torch.bmm(A1.transpose(1, 2), dP2)
         gb2 = dP2.sum(dim=1, keepdim=True)
-        dP1 = torch.bmm(dP2, (W2 * self.mask1.transpose(1, 2)).transpose(1, 2))
+        W2m = W2 * self.mask1.transpose(1, 2) if self.padded else W2
+        dP1 = torch.bmm(dP2, W2m.transpose(1, 2))
         dP1.mul_(torch.square(A1).neg_().add_(1.0))
         gW1 = torch.bmm(Z.transpose(1, 2), dP1)
         gb1 = dP1.sum(dim=1, keepdim=True)
         return [gW1, gb1, gW2, gb2, gW3, gb3], sse
 
-    def adam_step(self, grads: list[torch.Tensor], active: torch.Tensor, lr: float) -> None:
-        """One Adam update (torch.optim.Adam's formula) of the active models only."""
+    def adam_step(
+        self,
+        grads: list[torch.Tensor],
+        active: torch.Tensor,
+        lr: float,
+        *,
+        all_active: bool = False,
+    ) -> None:
+        """One Adam update (torch.optim.Adam's formula) of the active models only.
+
+        ``all_active``: the caller knows every model is active, so the update is
+        done in place, without selecting between old and new values (the same
+        arithmetic, bitwise the same result, a third of the tensor operations).
+        """
         self.steps += active.to(torch.float64)
         steps = self.steps.clamp(min=1.0)
         step_size = lr / (1.0 - _BETA1**steps)
@@ -115,6 +136,13 @@ class BatchedMLP:
         keep = active.view(-1, 1, 1)
         step_size = step_size.to(dtype).view(-1, 1, 1)
         bc2_sqrt = bc2_sqrt.to(dtype).view(-1, 1, 1)
+        if all_active:
+            for p, m, v, g in zip(self.params, self.exp_avg, self.exp_avg_sq, grads, strict=True):
+                m.lerp_(g, 1.0 - _BETA1)
+                v.mul_(_BETA2).addcmul_(g, g, value=1.0 - _BETA2)
+                denom = (v.sqrt() / bc2_sqrt).add_(_EPS)
+                p.sub_(step_size * m / denom)
+            return
         for p, m, v, g in zip(self.params, self.exp_avg, self.exp_avg_sq, grads, strict=True):
             m_new = torch.lerp(m, g, 1.0 - _BETA1)
             v_new = (v * _BETA2).addcmul_(g, g, value=1.0 - _BETA2)
