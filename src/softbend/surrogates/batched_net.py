@@ -126,7 +126,7 @@ class BatchedMLP:
 
         ``all_active``: the caller knows every model is active, so the update is
         done in place, without selecting between old and new values (the same
-        arithmetic, bitwise the same result, a third of the tensor operations).
+        arithmetic, bitwise the same result, fewer tensor operations).
         """
         self.steps += active.to(torch.float64)
         steps = self.steps.clamp(min=1.0)
