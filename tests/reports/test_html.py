@@ -10,6 +10,7 @@ def test_report_renders_escaped_text_tables_and_relative_figures(tmp_path):
     report = Report("Run <1>", subtitle="seed 0")
     section = report.section("Results")
     section.text("R² > 0.99 & fast")
+    section.text("run `softbend train --grid paper` for <all>; a lone ` stays")
     section.table(["model", "rmse"], [["svr", 0.123456]])
     section.frame(pd.DataFrame({"a": [1.5], "b": ["x"]}))
     section.figure(fig, "a figure", root=tmp_path)
@@ -17,6 +18,7 @@ def test_report_renders_escaped_text_tables_and_relative_figures(tmp_path):
     page = path.read_text()
     assert "Run &lt;1&gt;" in page
     assert "R² &gt; 0.99 &amp; fast" in page
+    assert "run <code>softbend train --grid paper</code> for &lt;all&gt;; a lone ` stays" in page
     assert "<td>0.1235</td>" in page
     assert 'src="figs/a.png"' in page
     assert page.count("<table>") == 2

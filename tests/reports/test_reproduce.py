@@ -126,7 +126,10 @@ def test_surrogate_section(first_run):
     assert "Fig. 5" in html
     # the reduced grid says so, and where paper B's grids are
     assert models["mlp"]["params"] == "hidden_sizes=(63, 65)"
-    assert "this report&#x27;s reduced one" in html and "--grid paper" in html
+    assert (
+        "this report&#x27;s reduced one (its MLP is paper B&#x27;s (63, 65) alone); "
+        "<code>softbend train --grid paper</code> runs paper B&#x27;s grids"
+    ) in html
 
 
 def test_second_run_resumes_the_campaign(first_run, fem_dataset):

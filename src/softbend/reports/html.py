@@ -45,6 +45,9 @@ dl.provenance dd { margin: 0; font-family: ui-monospace, monospace; font-size: 0
 #: A decimal with more digits than a person reads (7 or more after the point).
 _LONG_DECIMAL = re.compile(r"(?<![\w.])-?\d+\.\d{7,}(?:[eE][-+]?\d+)?(?![\w.])")
 
+#: Inline code in a paragraph: a command or a name between backticks, as in Markdown.
+_INLINE_CODE = re.compile(r"`([^`]+)`")
+
 
 def human_numbers(text: str) -> str:
     """Rewrite long decimals in ``text`` with six significant digits.
@@ -80,9 +83,10 @@ class Section:
     parts: list[str] = field(default_factory=list)
 
     def text(self, paragraph: str, *, note: bool = False) -> Section:
-        """Add a paragraph (escaped). ``note=True`` draws it as a highlighted box."""
+        """Add a paragraph (escaped; `backticks` mark code). ``note=True`` draws it as a box."""
         css = ' class="note"' if note else ""
-        self.parts.append(f"<p{css}>{html.escape(human_numbers(paragraph))}</p>")
+        body = _INLINE_CODE.sub(r"<code>\1</code>", html.escape(human_numbers(paragraph)))
+        self.parts.append(f"<p{css}>{body}</p>")
         return self
 
     def table(self, columns: list[str], rows: list[list[Any]], *, caption: str = "") -> Section:
