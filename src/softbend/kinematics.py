@@ -341,10 +341,11 @@ def _residual_jacobian(params: np.ndarray, q: np.ndarray) -> np.ndarray:
     cos, sin = math.cos(phi), math.sin(phi)
     x, y = q[:, 0], q[:, 1]
     along = x * cos + y * sin
-    p = a * np.einsum("ij,ij->i", q, q) + s * along + d
+    squared = np.einsum("ij,ij->i", q, q)
+    p = a * squared + s * along + d
     w = np.sqrt(np.maximum(1.0 + 4.0 * a * p, 1e-300))
     dr_dp = 1.0 / w
-    dp_da = np.einsum("ij,ij->i", q, q) + along * (2.0 * d / s)
+    dp_da = squared + along * (2.0 * d / s)
     dr_da = dr_dp * dp_da - 4.0 * p * p / (w * (1.0 + w) ** 2)
     dr_dd = dr_dp * (1.0 + along * (2.0 * a / s))
     dr_dphi = dr_dp * s * (y * cos - x * sin)
