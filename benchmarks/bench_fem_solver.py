@@ -1,6 +1,6 @@
 """Where a Newton iteration of the FEM spends its time, and what the step control saves.
 
-Two measurements behind the solver's design choices (one thread):
+Three measurements behind the solver's design choices (one thread):
 
 ``assembly``
     Hessian assembly time of each energy term of one design (default: the
@@ -20,10 +20,18 @@ Two measurements behind the solver's design choices (one thread):
     or more); prints Newton iterations and rejected steps. Iteration counts do
     not depend on the machine's speed, so the two rules may run side by side.
 
+``rtol``
+    Four designs (two slow corners, the reference design (140, 8, 3, 3, 10,
+    10) and (100, 6, 2, 2, 5, 8)) swept with Newton tolerances looser than the
+    default 1e-9: Newton iterations, load steps, rejected steps and the largest
+    change of an output angle against the default. Iteration counts do not
+    depend on the machine's speed.
+
 ::
 
     python benchmarks/bench_fem_solver.py assembly
     python benchmarks/bench_fem_solver.py steps
+    python benchmarks/bench_fem_solver.py rtol
 """
 
 from __future__ import annotations
@@ -154,9 +162,38 @@ def steps(rule: str) -> None:
     print(f"step rule '{rule}': {total_iterations} Newton iterations, {total_rejected} rejected")
 
 
+RTOL_DESIGNS = ("160,6,2,2,5,8", "100,6,2,2,5,8", "140,8,3,3,10,10", "160,10,4,2,15,8")
+
+
+def rtol(values: tuple[float, ...] = (1e-9, 3e-9, 1e-8)) -> None:
+    totals = dict.fromkeys(values, 0)
+    for design in RTOL_DESIGNS:
+        reference = None
+        for value in values:
+            result = simulate(
+                SFRBADesign.parse(design), default_pressures_mpa(), FEMOptions(rtol=value)
+            )
+            iterations = int(result.stats["timings"]["iterations"])
+            totals[value] += iterations
+            line = (
+                f"  {design:<18} rtol {value:.0e}: {iterations:4d} Newton iterations, "
+                f"{len(result.stats['steps_mpa'])} steps, {result.stats['rejected_steps']} "
+                f"rejected, {len(result.angle_deg)} outputs"
+            )
+            if reference is None:
+                reference = result
+            else:
+                n = min(len(reference.angle_deg), len(result.angle_deg))
+                change = np.abs(result.angle_deg[:n] - reference.angle_deg[:n])
+                line += f", largest angle change {np.nanmax(change):.4f} deg"
+            print(line)
+    summary = ", ".join(f"{v:.0e}: {n}" for v, n in totals.items())
+    print(f"Newton iterations, all designs: {summary}")
+
+
 def main(argv: list[str] | None = None) -> int:
     parser = argparse.ArgumentParser(description=__doc__.split("\n")[0])
-    parser.add_argument("what", choices=("assembly", "steps"))
+    parser.add_argument("what", choices=("assembly", "steps", "rtol"))
     parser.add_argument("--design", default="160,10,4,2,5,12", help="For 'assembly'.")
     parser.add_argument("--repeats", type=int, default=6, help="For 'assembly'.")
     parser.add_argument(
@@ -169,6 +206,9 @@ def main(argv: list[str] | None = None) -> int:
     with TaskManager():
         if args.what == "assembly":
             assembly(args.design, args.repeats)
+        elif args.what == "rtol":
+            use_compiled(True, wait=True)
+            rtol()
         else:
             for rule in ("miss", "iterations") if args.rule == "both" else (args.rule,):
                 steps(rule)
