@@ -10,8 +10,10 @@ Three measurements behind the solver's design choices (one thread):
     comparison: gravity as a twice-differentiated ``Variation`` term (softbend
     assembles it once as a dead-load vector instead), and two other ways to
     give NGSolve the elastomer's tangent — the first variation ``P:∇v`` with
-    NGSolve's linearisation, and the tangent ``∂P/∂F`` written out with
-    ``Diff`` as a linear form.
+    NGSolve's linearisation, the tangent ``∂P/∂F`` written out with ``Diff``
+    as a linear form, and a 9×9 tangent as the coefficient of a compiled
+    bilinear form (constant, or read from an element-wise GridFunction), beside
+    ``∫∇u:∇v`` on the same space.
 
 ``steps``
     Six slow corner designs swept to 0.5 MPa / 300° with the pressure step sized
@@ -128,6 +130,26 @@ def assembly(design: str, repeats: int) -> None:
     tangent += ngs.InnerProduct(Pg.Diff(Fg, ngs.Grad(u)), ngs.Grad(v)).Compile() * ngs.dx
     seconds = _mean_time(tangent.Assemble, max(1, repeats // 3))
     print(f"  elastomer tangent dP/dF written with Diff (not used): {seconds:.3f} s")
+
+    # A 9x9 material tangent handed to NGSolve as a coefficient of an ordinary
+    # bilinear form, compiled (not used): a constant one is the ceiling of what
+    # that could save; an element-wise GridFunction is what a tangent computed
+    # outside NGSolve would be read from.
+    grad_u, grad_v = ngs.Grad(u).Reshape((9,)), ngs.Grad(v).Reshape((9,))
+    constant = ngs.CoefficientFunction(tuple((np.eye(9) + 0.1).ravel()), dims=(9, 9))
+    stored = ngs.GridFunction(ngs.L2(model.mesh, order=0, dim=81))
+    stored.vec[:] = 1.0
+    element_wise = ngs.InnerProduct(stored.Reshape((9, 9)) * grad_u, grad_v)
+    laplace = ngs.InnerProduct(ngs.Grad(u), ngs.Grad(v))
+    for name, integrand in (
+        ("constant 9x9 tangent", ngs.InnerProduct(constant * grad_u, grad_v)),
+        ("9x9 tangent from an element-wise GridFunction", element_wise),
+        ("grad u : grad v", laplace),
+    ):
+        form = ngs.BilinearForm(model.fes, symmetric=True)
+        form += integrand.Compile(realcompile=True, wait=True) * ngs.dx
+        seconds = _mean_time(form.Assemble, repeats)
+        print(f"  {name}, compiled bilinear form (not used): {1e3 * seconds:.1f} ms")
 
 
 def _iteration_rule() -> None:
