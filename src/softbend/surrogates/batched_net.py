@@ -133,7 +133,6 @@ class BatchedMLP:
         step_size = lr / (1.0 - _BETA1**steps)
         bc2_sqrt = torch.sqrt(1.0 - _BETA2**steps)
         dtype = self.params[0].dtype
-        keep = active.view(-1, 1, 1)
         step_size = step_size.to(dtype).view(-1, 1, 1)
         bc2_sqrt = bc2_sqrt.to(dtype).view(-1, 1, 1)
         if all_active:
@@ -143,6 +142,7 @@ class BatchedMLP:
                 denom = (v.sqrt() / bc2_sqrt).add_(_EPS)
                 p.sub_(step_size * m / denom)
             return
+        keep = active.view(-1, 1, 1)
         for p, m, v, g in zip(self.params, self.exp_avg, self.exp_avg_sq, grads, strict=True):
             m_new = torch.lerp(m, g, 1.0 - _BETA1)
             v_new = (v * _BETA2).addcmul_(g, g, value=1.0 - _BETA2)
