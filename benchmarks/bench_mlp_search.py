@@ -20,6 +20,24 @@ the speed-up, and the projected time of the full paper grid (121 configurations 
 
     taskset -c 0,1 .venv/bin/python benchmarks/bench_mlp_search.py           # K=8, E=20
     .venv/bin/python benchmarks/bench_mlp_search.py --configs 4 --epochs 5 --json
+
+Training paths side by side (``--variants``, one process, the same data and grid):
+each variant trains the grid twice, for E and 2E epochs; the difference is the
+steady cost of E epochs (set-up, warm-up epoch, graph capture and compilation
+cancel out), from which the full grid is projected. On a CUDA device each run is
+also profiled (``torch.profiler``): the GPU kernel time of the extra E epochs
+over their wall time is the GPU busy fraction of the epoch loop. Variants are
+``+``-joined options of :func:`~softbend.surrogates.batched.train_mlp_grid`:
+``host`` / ``device`` (the shuffle), ``graph`` / ``nograph``, ``tf32``, ``compile``::
+
+    python benchmarks/bench_mlp_search.py --fem --configs 121 --epochs 5 --device cuda \
+        --variants host+nograph,device+nograph,device+graph,device+graph+tf32
+
+The exhaustive search itself (``--search``): :func:`softbend.surrogates.search.search`
+of the paper grid on the shipped FEM data, 1000 epochs, refit included, with the
+chosen configuration and its grouped-CV scores::
+
+    python benchmarks/bench_mlp_search.py --search --device cuda [--tf32]
 """
 
 from __future__ import annotations
@@ -28,6 +46,7 @@ import argparse
 import itertools
 import json
 import os
+import subprocess
 import time
 
 import numpy as np
@@ -67,6 +86,12 @@ def synthetic_data(seed: int = 0) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
 
 
 def load_data(args: argparse.Namespace) -> tuple[np.ndarray, np.ndarray, np.ndarray, str]:
+    if args.fem:
+        from softbend.datasets import table1_fem
+        from softbend.surrogates.features import training_data
+
+        data = training_data(table1_fem())
+        return data.X, data.y, data.groups, "shipped table1_fem"
     if args.db is None:
         X, y, groups = synthetic_data(args.seed)
         return X, y, groups, "synthetic"
@@ -102,9 +127,24 @@ def main(argv: list[str] | None = None) -> int:
         help="time only this many one-at-a-time trainings (default: all K x 5)",
     )
     parser.add_argument("--db", default=None, help="campaign database instead of synthetic data")
+    parser.add_argument("--fem", action="store_true", help="the shipped FEM data (51 965 rows)")
     parser.add_argument("--seed", type=int, default=0)
     parser.add_argument("--json", action="store_true", help="print one JSON object")
+    parser.add_argument(
+        "--variants", default=None, help="compare training paths, e.g. host+nograph,device+graph"
+    )
+    parser.add_argument(
+        "--search", action="store_true", help="time the exhaustive paper-grid search and refit"
+    )
+    parser.add_argument("--tf32", action="store_true", help="--search: allow TF32 products")
+    parser.add_argument(
+        "--search-epochs", type=int, default=PAPER_EPOCHS, help="--search: MLP epochs (1000)"
+    )
     args = parser.parse_args(argv)
+    if args.search:
+        return run_search(args)
+    if args.variants:
+        return run_variants(args)
 
     threads = args.threads or len(os.sched_getaffinity(0))
     X, y, groups, source = load_data(args)
@@ -193,6 +233,183 @@ def main(argv: list[str] | None = None) -> int:
         f"one at a time {report['projected_full_grid_sequential_h']:.2f} h "
         f"(one pass of all {full_models} models needs about {full_pass_gb:.1f} GB)"
     )
+    return 0
+
+
+def device_description(device: str) -> str:
+    """The GPU, driver, CUDA and torch versions (or the CPU threads) a figure was measured on."""
+    if device != "cuda":
+        return f"CPU, {torch.get_num_threads()} torch thread(s), torch {torch.__version__}"
+    try:
+        driver = subprocess.run(
+            ["nvidia-smi", "--query-gpu=driver_version", "--format=csv,noheader"],
+            capture_output=True,
+            text=True,
+            check=True,
+        ).stdout.strip()
+    except (OSError, subprocess.CalledProcessError):
+        driver = "unknown"
+    return (
+        f"{torch.cuda.get_device_name()}, driver {driver}, CUDA {torch.version.cuda}, "
+        f"torch {torch.__version__}"
+    )
+
+
+def parse_variant(spec: str) -> dict[str, object]:
+    """Options of train_mlp_grid for a variant such as ``device+graph+tf32``."""
+    options: dict[str, object] = {"shuffle": "host", "cuda_graph": False}
+    for part in spec.split("+"):
+        if part in ("host", "device"):
+            options["shuffle"] = part
+        elif part in ("graph", "nograph"):
+            options["cuda_graph"] = part == "graph"
+        elif part == "tf32":
+            options["tf32"] = True
+        elif part == "compile":
+            options["compile_step"] = True
+        else:
+            raise SystemExit(
+                f"unknown variant part {part!r}: host, device, graph, nograph, tf32, compile"
+            )
+    return options
+
+
+def timed_run(X, y, splits, configs, epochs, options, profile):
+    """Wall time of one train_mlp_grid call, s, and the GPU kernel time in it, s (or None)."""
+    sync = torch.cuda.synchronize if options["device"] == "cuda" else (lambda: None)
+    sync()
+    if not profile:
+        start = time.perf_counter()
+        train_mlp_grid(X, y, splits, configs, epochs=epochs, **options)
+        sync()
+        return time.perf_counter() - start, None
+    import tempfile
+
+    from torch.profiler import ProfilerActivity
+    from torch.profiler import profile as torch_profile
+
+    with torch_profile(activities=[ProfilerActivity.CPU, ProfilerActivity.CUDA]) as prof:
+        start = time.perf_counter()
+        train_mlp_grid(X, y, splits, configs, epochs=epochs, **options)
+        sync()
+        wall = time.perf_counter() - start
+    with tempfile.TemporaryDirectory() as folder:
+        trace = os.path.join(folder, "trace.json")
+        prof.export_chrome_trace(trace)
+        with open(trace) as handle:
+            events = json.load(handle)
+    events = events.get("traceEvents", events) if isinstance(events, dict) else events
+    return wall, gpu_busy_seconds(events)
+
+
+def gpu_busy_seconds(events: list[dict]) -> float:
+    """Seconds in which the GPU ran a kernel, copy or fill: the union of their intervals."""
+    spans = sorted(
+        (float(e["ts"]), float(e["ts"]) + float(e.get("dur", 0.0)))
+        for e in events
+        if e.get("cat") in ("kernel", "gpu_memcpy", "gpu_memset") and "ts" in e
+    )
+    busy_us, end = 0.0, -float("inf")
+    for a, b in spans:
+        if b <= end:
+            continue
+        busy_us += b - max(a, end)
+        end = b
+    return busy_us / 1e6
+
+
+def run_variants(args: argparse.Namespace) -> int:
+    """Steady seconds per epoch of each training path, projections and GPU busy fraction."""
+    X, y, groups, source = load_data(args)
+    splits = list(GroupKFold(n_splits=PAPER_FOLDS).split(X, y, groups))
+    configs = pick_configs(args.configs)
+    device = "cuda" if args.device == "auto" and torch.cuda.is_available() else args.device
+    device = "cpu" if device == "auto" else device
+    threads = args.threads or len(os.sched_getaffinity(0))
+    torch.set_num_threads(threads)
+    n_models = len(configs) * len(splits)
+    print(
+        f"{source}: {X.shape[0]} rows, {len(configs)} configurations x {len(splits)} folds "
+        f"= {n_models} models, batch {args.batch_size}; {device_description(device)}"
+    )
+    print(f"{'variant':34}{'cold 1 epoch s':>15}{'s/epoch':>10}{'full grid s':>13}{'GPU busy':>10}")
+    rows = []
+    for spec in args.variants.split(","):
+        options = {
+            **parse_variant(spec),
+            "device": device,
+            "batch_size": args.batch_size,
+            "seed": args.seed,
+            "num_threads": threads,
+        }
+        profile = device == "cuda"
+        # a cold call first: CUDA context, library handles, compilation (kept apart)
+        w0, _ = timed_run(X, y, splits, configs, 1, options, False)
+        w1, k1 = timed_run(X, y, splits, configs, args.epochs, options, profile)
+        w2, k2 = timed_run(X, y, splits, configs, 2 * args.epochs, options, profile)
+        per_epoch = (w2 - w1) / args.epochs
+        busy = None if k1 is None else (k2 - k1) / max(w2 - w1, 1e-9)
+        full = per_epoch * PAPER_EPOCHS * (len(PAPER_GRID) * PAPER_FOLDS) / n_models
+        rows.append(
+            {
+                "variant": spec,
+                "s_per_epoch": per_epoch,
+                "projected_full_grid_s": full,
+                "gpu_busy": busy,
+                "wall_E_s": w1,
+                "wall_2E_s": w2,
+            }
+        )
+        busy_text = "-" if busy is None else f"{100 * busy:.0f} %"
+        print(f"{spec:34}{w0:>15.2f}{per_epoch:>10.4f}{full:>13.1f}{busy_text:>10}", flush=True)
+    if args.json:
+        print(json.dumps({"data": source, "device": device_description(device), "rows": rows}))
+    return 0
+
+
+def run_search(args: argparse.Namespace) -> int:
+    """The exhaustive paper-grid MLP search on the shipped FEM data, refit included."""
+    from softbend.datasets import table1_fem
+    from softbend.surrogates.features import training_data
+    from softbend.surrogates.search import search
+
+    data = training_data(table1_fem())
+    device = "cuda" if args.device == "auto" and torch.cuda.is_available() else args.device
+    device = "cpu" if device == "auto" else device
+    print(f"shipped table1_fem: {data.n_samples} rows; {device_description(device)}", flush=True)
+    start = time.perf_counter()
+    result = search(
+        data,
+        models=("mlp",),
+        grid_name="paper",
+        device=device,
+        seed=args.seed,
+        tf32=args.tf32,
+        epochs=args.search_epochs,
+    )
+    total = time.perf_counter() - start
+    family = result.families["mlp"]
+    report = {
+        "device": device_description(device),
+        "tf32": args.tf32,
+        "epochs": result.settings["mlp_epochs"],
+        "configurations": len(result.cv_results),
+        "search_s": family.search_s,
+        "refit_s": family.fit_s,
+        "total_s": total,
+        "chosen": family.params,
+        "cv": family.cv,
+    }
+    print(
+        f"paper grid, {report['configurations']} configurations x 5 grouped folds x "
+        f"{report['epochs']} epochs (tf32 {args.tf32}): search {family.search_s:.1f} s, "
+        f"refit {family.fit_s:.1f} s, total {total:.1f} s"
+    )
+    print(
+        f"chosen {family.params}; grouped CV: "
+        + ", ".join(f"{k} {v:.6g}" for k, v in family.cv.items())
+    )
+    print(json.dumps(report, default=str))
     return 0
 
 

@@ -174,7 +174,7 @@ def test_adam_steps_match_torch_optim_adam_for_a_single_model():
     np.testing.assert_allclose(ours.loss_curve, losses, rtol=1e-12)
 
 
-def _two_padded_models(perturb_padding=False, seed=0):
+def _two_padded_models(seed=0):
     rng = np.random.default_rng(seed)
     sizes = [(3, 5), (6, 2)]
     coefs, intercepts = [], []
@@ -182,48 +182,63 @@ def _two_padded_models(perturb_padding=False, seed=0):
         c, b = init_parameters(rng, 4, h1, h2)
         coefs.append(c)
         intercepts.append(b)
-    net = _BatchedMLP(coefs, intercepts, 6, 5, device="cpu", dtype=torch.float64)
-    if perturb_padding:
-        W1, b1, W2, b2, W3, _ = net.params
-        m1, m2 = net.mask1, net.mask2
-        pads = [
-            (W1, (1 - m1).expand_as(W1)),
-            (b1, 1 - m1),
-            (W2, 1 - (m1.transpose(1, 2) * m2)),
-            (b2, 1 - m2),
-            (W3, (1 - m2.transpose(1, 2)).expand_as(W3)),
-        ]
-        gen = torch.Generator().manual_seed(99)
-        for p, pad in pads:
-            p += pad * torch.randn(p.shape, generator=gen, dtype=p.dtype) * 3.0
-    return net
+    return _BatchedMLP(coefs, intercepts, 6, 5, device="cpu", dtype=torch.float64)
 
 
-def test_masked_hidden_units_are_exactly_inert():
+def _padding(net):
+    """Per parameter, 1 where a model's weight or bias belongs to a padded hidden unit."""
+    sizes = [(3, 5), (6, 2)]
+    pads = [torch.ones_like(p) for p in net.params]
+    for m, (h1, h2) in enumerate(sizes):
+        pads[0][m, :, :h1] = 0
+        pads[1][m, :, :h1] = 0
+        pads[2][m, :h1, :h2] = 0
+        pads[3][m, :, :h2] = 0
+        pads[4][m, :h2, :] = 0
+        pads[5][m] = 0
+    return pads
+
+
+def test_padded_hidden_units_stay_zero_and_change_nothing():
     gen = torch.Generator().manual_seed(0)
-    Z = torch.randn((2, 9, 4), generator=gen, dtype=torch.float64)
-    target = torch.randn((2, 9), generator=gen, dtype=torch.float64)
-    weight = torch.ones((2, 9), dtype=torch.float64)
-    count = torch.full((2,), 9.0, dtype=torch.float64)
-    clean = _two_padded_models()
-    dirty = _two_padded_models(perturb_padding=True)
-    assert not all(torch.equal(a, b) for a, b in zip(clean.params, dirty.params, strict=True))
-    assert torch.equal(clean.forward(Z)[2], dirty.forward(Z)[2])
-    grads_clean, sse_clean = clean.gradients(Z, target, weight, count)
-    grads_dirty, sse_dirty = dirty.gradients(Z, target, weight, count)
-    assert torch.equal(sse_clean, sse_dirty)
-    for g_clean, g_dirty in zip(grads_clean, grads_dirty, strict=True):
-        assert torch.equal(g_clean, g_dirty)
-    # padded entries receive exactly zero gradient, so Adam leaves them where they are
-    gW1, gb1, gW2, gb2, gW3, _ = grads_dirty
-    m1, m2 = dirty.mask1, dirty.mask2
-    assert torch.all(gW1 * (1 - m1) == 0) and torch.all(gb1 * (1 - m1) == 0)
-    assert torch.all(gW2 * (1 - m1.transpose(1, 2) * m2) == 0) and torch.all(gb2 * (1 - m2) == 0)
-    assert torch.all(gW3 * (1 - m2.transpose(1, 2)) == 0)
-    before = [p.clone() for p in dirty.params]
-    dirty.adam_step(grads_dirty, torch.tensor([True, True]), 0.1)
-    for p, p0, g in zip(dirty.params, before, grads_dirty, strict=True):
-        assert torch.equal(p[g == 0], p0[g == 0])
+    net = _two_padded_models()
+    pads = _padding(net)
+    for _ in range(3):
+        Z = torch.randn((2, 9, 4), generator=gen, dtype=torch.float64)
+        target = torch.randn((2, 9), generator=gen, dtype=torch.float64)
+        weight = torch.ones((2, 9), dtype=torch.float64)
+        count = torch.full((2,), 9.0, dtype=torch.float64)
+        grads, _ = net.gradients(Z, target, weight, count)
+        for g, pad in zip(grads, pads, strict=True):
+            assert torch.all(g[pad == 1] == 0)  # padding receives exactly zero gradient
+        net.adam_step(grads, torch.tensor([True, True]), 0.1)
+        for p, pad in zip(net.params, pads, strict=True):
+            assert torch.all(p[pad == 1] == 0)  # ... so Adam leaves it at zero
+    # each padded model computes what the same model alone (unpadded) computes
+    for m, (h1, h2) in enumerate([(3, 5), (6, 2)]):
+        alone = _BatchedMLP(
+            [
+                [
+                    W[m].clone().numpy()
+                    for W in (net.params[0][:, :, :h1], net.params[2][:, :h1, :h2])
+                ]
+                + [net.params[4][m, :h2].numpy()]
+            ],
+            [
+                [
+                    net.params[1][m, 0, :h1].numpy(),
+                    net.params[3][m, 0, :h2].numpy(),
+                    net.params[5][m, 0].numpy(),
+                ]
+            ],
+            h1,
+            h2,
+            device="cpu",
+            dtype=torch.float64,
+        )
+        np.testing.assert_allclose(
+            alone.forward(Z[m : m + 1])[2][0], net.forward(Z)[2][m], rtol=0, atol=1e-14
+        )
 
 
 def test_inactive_model_is_not_updated_by_adam():
@@ -256,24 +271,6 @@ def test_the_in_place_adam_step_of_all_active_models_is_bitwise_the_selecting_on
         for x, y in zip(tensors_a, tensors_b, strict=True):
             assert torch.equal(x, y)
     assert not torch.equal(a.params[0], _two_padded_models(seed=3).params[0])  # it moved
-
-
-def test_an_unpadded_batch_skips_the_masks_and_computes_the_same():
-    rng = np.random.default_rng(4)
-    coefs, intercepts = zip(*(init_parameters(rng, 4, 6, 5) for _ in range(2)), strict=True)
-    plain = _BatchedMLP(list(coefs), list(intercepts), 6, 5, device="cpu", dtype=torch.float64)
-    masked = _BatchedMLP(list(coefs), list(intercepts), 6, 5, device="cpu", dtype=torch.float64)
-    assert not plain.padded and _two_padded_models().padded
-    masked.padded = True  # the general path, multiplying by all-ones masks
-    gen = torch.Generator().manual_seed(5)
-    Z = torch.randn((2, 9, 4), generator=gen, dtype=torch.float64)
-    target = torch.randn((2, 9), generator=gen, dtype=torch.float64)
-    weight, count = torch.ones((2, 9), dtype=torch.float64), torch.full((2,), 9.0)
-    grads_plain, sse_plain = plain.gradients(Z, target, weight, count)
-    grads_masked, sse_masked = masked.gradients(Z, target, weight, count)
-    assert torch.equal(sse_plain, sse_masked)
-    for g_plain, g_masked in zip(grads_plain, grads_masked, strict=True):
-        assert torch.equal(g_plain, g_masked)
 
 
 def test_short_training_set_ends_its_epoch_without_extra_updates():
@@ -434,8 +431,14 @@ def test_cuda_is_refused_clearly_without_a_gpu_and_matches_cpu_with_one():
         with pytest.raises(ValueError, match="'device' of train_mlp_grid is 'cuda'"):
             train_mlp_grid(*args, epochs=1, device="cuda")
         pytest.skip("CUDA not available: GPU equivalence not checked")
-    kwargs = dict(epochs=5, batch_size=16, dtype=torch.float64)
+    # the device shuffle draws the same orders on both; the GPU path graphs its epochs
+    kwargs = dict(epochs=5, batch_size=16, dtype=torch.float64, shuffle="device")
     cpu = train_mlp_grid(*args, device="cpu", **kwargs)
     gpu = train_mlp_grid(*args, device="cuda", **kwargs)
-    assert gpu.device == "cuda"
+    assert gpu.device == "cuda" and gpu.shuffle == "device"
     _assert_same_models(cpu, gpu, atol=1e-9)
+    host_cpu = train_mlp_grid(*args, device="cpu", **{**kwargs, "shuffle": "host"})
+    host_gpu = train_mlp_grid(*args, device="cuda", **{**kwargs, "shuffle": "host"})
+    _assert_same_models(host_cpu, host_gpu, atol=1e-9)
+    compiled = train_mlp_grid(*args, device="cuda", compile_step=True, **kwargs)
+    _assert_same_models(cpu, compiled, atol=1e-9)

@@ -46,7 +46,7 @@ import numpy as np
 from numpy.typing import ArrayLike
 
 from softbend._torch import require_torch
-from softbend._validation import check_int, check_range
+from softbend._validation import check_choice, check_int, check_range
 from softbend.errors import ConvergenceError
 from softbend.surrogates.batched_checks import (
     check_data,
@@ -54,9 +54,15 @@ from softbend.surrogates.batched_checks import (
     check_hidden_sizes,
     check_splits,
 )
-from softbend.surrogates.batched_epochs import MiniBatches, final_train_loss, run_epochs
+from softbend.surrogates.batched_epochs import (
+    MiniBatches,
+    StepFunction,
+    final_train_loss,
+    run_epochs,
+)
 from softbend.surrogates.batched_memory import estimate_pass_bytes, models_per_pass
 from softbend.surrogates.batched_net import BatchedMLP
+from softbend.surrogates.batched_shuffle import DeviceShuffle, model_keys
 from softbend.surrogates.mlp_core import (
     init_parameters,
     mlp_forward,
@@ -73,6 +79,7 @@ __all__ = [
     "GridTrainingResult",
     "TrainedMLP",
     "estimate_pass_bytes",
+    "tf32_matmul",
     "train_mlp_grid",
 ]
 
@@ -169,6 +176,10 @@ class GridTrainingResult:
         Number of batched passes the models were split into.
     elapsed_s : float
         Wall-clock time of the training passes, s.
+    shuffle : str
+        Where the row orders were drawn ("host" or "device").
+    tf32 : bool
+        Whether TF32 matrix products were allowed (CUDA only).
     """
 
     models: tuple[TrainedMLP, ...]
@@ -182,6 +193,8 @@ class GridTrainingResult:
     dtype: str
     n_passes: int
     elapsed_s: float = field(default=0.0, compare=False)
+    shuffle: str = "host"
+    tf32: bool = False
 
     def model(self, config_index: int, split_index: int) -> TrainedMLP:
         """The model of configuration ``config_index`` trained on split ``split_index``."""
@@ -213,6 +226,9 @@ class _PassSettings:
     seed: int
     device: str
     dtype: torch.dtype
+    shuffle: str = "host"
+    cuda_graph: bool = False
+    compile_step: bool = False
 
 
 @contextmanager
@@ -236,6 +252,24 @@ def _cpu_settings(num_threads: int | None) -> Iterator[None]:
         torch.set_num_threads(threads_before)
 
 
+@contextmanager
+def tf32_matmul(device: str, tf32: bool) -> Iterator[None]:
+    """TF32 matrix products on a CUDA device inside the block, if ``tf32`` (restored after).
+
+    TF32 rounds the inputs of float32 matrix products to 10 mantissa bits on the
+    GPU's tensor cores (accumulation stays float32). It has no effect on the CPU.
+    """
+    if not (tf32 and device == "cuda"):
+        yield
+        return
+    before = torch.get_float32_matmul_precision()
+    torch.set_float32_matmul_precision("high")
+    try:
+        yield
+    finally:
+        torch.set_float32_matmul_precision(before)
+
+
 def train_mlp_grid(
     X: ArrayLike,
     y: ArrayLike,
@@ -252,6 +286,10 @@ def train_mlp_grid(
     max_models_per_pass: int | None = None,
     max_memory_mb: float | None = None,
     num_threads: int | None = None,
+    shuffle: str = "auto",
+    tf32: bool = False,
+    cuda_graph: bool | None = None,
+    compile_step: bool = False,
 ) -> GridTrainingResult:
     """Train every (configuration, split) MLP of a grid at once (paper B §4.1).
 
@@ -291,6 +329,25 @@ def train_mlp_grid(
         torch intra-op CPU threads while training (restored afterwards); None keeps
         torch's setting. One thread avoids OpenMP oversubscription for small grids
         or on a loaded machine.
+    shuffle : {"auto", "host", "device"}, default "auto"
+        Where each epoch's row orders are drawn: "host" with each model's NumPy
+        stream (the orders of every earlier version of softbend), "device" from
+        counter-based keys on the training device
+        (:mod:`~softbend.surrogates.batched_shuffle`: no host work or copy inside
+        the epoch loop; the same orders on CPU and GPU, other than the host's).
+        "auto" is "device" on a CUDA device and "host" on the CPU.
+    tf32 : bool, default False
+        Allow TF32 tensor-core matrix products on a CUDA device (float32 only;
+        no effect on the CPU). Faster, with inputs of each product rounded to
+        10 mantissa bits.
+    cuda_graph : bool, optional
+        Capture one epoch as a CUDA graph and replay it (needs the device shuffle).
+        None: on when the device is CUDA and the shuffle is "device".
+    compile_step : bool, default False
+        Compile the mini-batch update (forward, backward, Adam) with
+        ``torch.compile``, which fuses its element-wise work into fewer kernels.
+        Compiling takes tens of seconds once per process and shape; if it fails,
+        training goes on uncompiled (logged).
 
     Returns
     -------
@@ -325,6 +382,18 @@ def train_mlp_grid(
         max_memory_mb = check_range(max_memory_mb, "max_memory_mb", _OWNER, low=0.0)
     if num_threads is not None:
         num_threads = check_int(num_threads, "num_threads", _OWNER, low=1)
+    check_choice(shuffle, "shuffle", _OWNER, ("auto", "host", "device"))
+    if shuffle == "auto":
+        shuffle = "device" if device == "cuda" else "host"
+    for name, flag in (("tf32", tf32), ("compile_step", compile_step)):
+        if not isinstance(flag, bool):
+            raise ValueError(f"The '{name}' of {_OWNER} must be True or False. Got {flag!r}.")
+    if cuda_graph is None:
+        cuda_graph = device == "cuda" and shuffle == "device"
+    elif not isinstance(cuda_graph, bool):
+        raise ValueError(
+            f"The 'cuda_graph' of {_OWNER} must be True, False or None. Got {cuda_graph!r}."
+        )
 
     jobs = [
         _Job(c, s, h1, h2, train, val)
@@ -340,6 +409,9 @@ def train_mlp_grid(
         seed=seed,
         device=device,
         dtype=dtype,
+        shuffle=shuffle,
+        cuda_graph=cuda_graph,
+        compile_step=compile_step,
     )
     per_pass = models_per_pass(
         len(jobs),
@@ -357,7 +429,7 @@ def train_mlp_grid(
     X_dev = torch.tensor(X, dtype=torch.float64, device=device)
     y_dev = torch.tensor(y, dtype=torch.float64, device=device)
     start = time.perf_counter()
-    with _cpu_settings(num_threads):
+    with _cpu_settings(num_threads), tf32_matmul(device, tf32):
         trained = _train_in_passes(jobs, X, y, X_dev, y_dev, per_pass, settings, progress)
     elapsed = time.perf_counter() - start
     return GridTrainingResult(
@@ -372,6 +444,8 @@ def train_mlp_grid(
         dtype=str(dtype).removeprefix("torch."),
         n_passes=math.ceil(len(jobs) / per_pass),
         elapsed_s=elapsed,
+        shuffle=shuffle,
+        tf32=tf32 and device == "cuda",
     )
 
 
@@ -425,6 +499,11 @@ def _train_pass(
         device=settings.device,
         dtype=settings.dtype,
     )
+    shuffle = None
+    if settings.shuffle == "device":
+        keys = model_keys(settings.seed, [(job.h1, job.h2, job.split_index) for job in jobs])
+        train_idx = [job.train_idx for job in jobs]
+        shuffle = DeviceShuffle(train_idx, keys, batches.order.shape[1], settings.device)
     with torch.no_grad():
         losses = run_epochs(
             net,
@@ -433,6 +512,9 @@ def _train_pass(
             epochs=settings.epochs,
             learning_rate=settings.learning_rate,
             report=report,
+            shuffle=shuffle,
+            step=_step_function(net, settings.compile_step),
+            cuda_graph=settings.cuda_graph,
         )
         final_loss = final_train_loss(net, batches)
         _check_finite(net, jobs)
@@ -463,6 +545,26 @@ def _train_pass(
             )
         )
     return results
+
+
+def _step_function(net: BatchedMLP, compile_step: bool) -> StepFunction:
+    """``net.train_step``, compiled with ``torch.compile`` if asked (eager if that fails)."""
+    if not compile_step:
+        return net.train_step
+    compiled = torch.compile(net.train_step, fullgraph=True, dynamic=False)
+    state = {"step": compiled}
+
+    def step(*args: object) -> torch.Tensor:
+        try:
+            return state["step"](*args)
+        except Exception as error:  # any compiler failure: train uncompiled
+            if state["step"] is net.train_step:
+                raise
+            logger.warning("torch.compile of the training step failed (%s); running eagerly", error)
+            state["step"] = net.train_step
+            return net.train_step(*args)
+
+    return step
 
 
 def _init_models(

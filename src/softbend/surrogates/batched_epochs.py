@@ -11,6 +11,7 @@ each model's MSE on all its rows afterwards.
 
 from __future__ import annotations
 
+import logging
 import math
 from collections.abc import Callable
 from dataclasses import dataclass
@@ -19,10 +20,13 @@ import numpy as np
 
 from softbend._torch import require_torch
 from softbend.surrogates.batched_net import BatchedMLP
+from softbend.surrogates.batched_shuffle import DeviceShuffle
 
 torch = require_torch("the MLP surrogate (softbend.surrogates)")
 
-__all__ = ["MiniBatches", "final_train_loss", "run_epochs"]
+logger = logging.getLogger(__name__)
+
+__all__ = ["MiniBatches", "StepFunction", "final_train_loss", "run_epochs"]
 
 
 @dataclass(frozen=True)
@@ -141,6 +145,10 @@ class MiniBatches:
         return Z, target, self.valid[:, cols]
 
 
+#: A step function: (Z, target, weight, count, active, lr, all_active) -> SSE (M,).
+StepFunction = Callable[..., torch.Tensor]
+
+
 def run_epochs(
     net: BatchedMLP,
     batches: MiniBatches,
@@ -149,28 +157,100 @@ def run_epochs(
     epochs: int,
     learning_rate: float,
     report: Callable[[int], None],
+    shuffle: DeviceShuffle | None = None,
+    step: StepFunction | None = None,
+    cuda_graph: bool = False,
 ) -> torch.Tensor:
     """Train ``epochs`` epochs; the training MSE of each, (epochs, M), standardized units.
 
     Every epoch each model visits its own training rows once, in the order its own
     stream draws; the loss of an epoch sums the squared errors of its mini-batches
     (before the update that used them) over the model's training rows.
+
+    Parameters
+    ----------
+    shuffle : DeviceShuffle, optional
+        Draw the row orders on the device (no host work inside the epoch loop);
+        None: each model's NumPy stream in ``rngs`` draws them on the host.
+    step : callable, optional
+        The mini-batch update, ``net.train_step`` or a compiled version of it.
+    cuda_graph : bool, default False
+        With ``shuffle`` on a CUDA device: run the first epoch as usual, capture the
+        second as one CUDA graph and replay it for every further epoch (one launch
+        per epoch instead of thousands). If the capture fails, training goes on
+        without it (logged).
     """
+    step = step if step is not None else net.train_step
     n_models = len(batches.train_idx)
     device = batches.device
     losses = torch.zeros((epochs, n_models), dtype=torch.float64, device=device)
     all_active = batches.actives.all(dim=1).tolist()  # per step: no model's epoch is over
-    for epoch in range(epochs):
-        rows_all = batches.rows(rngs)
+
+    def epoch_sse(rows_all: torch.Tensor) -> torch.Tensor:
         sse_epoch = torch.zeros(n_models, dtype=torch.float64, device=device)
         for s in range(batches.n_steps):
             Z, target, valid = batches.step(rows_all, s)
-            grads, sse = net.gradients(Z, target, valid, batches.counts[s])
-            net.adam_step(grads, batches.actives[s], learning_rate, all_active=all_active[s])
+            count, active = batches.counts[s], batches.actives[s]
+            sse = step(Z, target, valid, count, active, learning_rate, all_active[s])
             sse_epoch += sse.to(torch.float64)
-        losses[epoch] = sse_epoch / batches.n_train
-        report(epoch + 1)
+        return sse_epoch
+
+    if shuffle is None:
+        for epoch in range(epochs):
+            losses[epoch] = epoch_sse(batches.rows(rngs)) / batches.n_train
+            report(epoch + 1)
+        return losses
+
+    # The epoch number lives on the device, so that one captured epoch replays as any.
+    epoch_now = torch.zeros(1, dtype=torch.int64, device=device)
+
+    def one_epoch() -> None:
+        sse_epoch = epoch_sse(shuffle.rows(epoch_now))
+        losses.index_copy_(0, epoch_now, (sse_epoch / batches.n_train)[None, :])
+        epoch_now.add_(1)
+
+    if not (cuda_graph and device == "cuda"):
+        for epoch in range(epochs):
+            one_epoch()
+            report(epoch + 1)
+        return losses
+    _run_graphed(one_epoch, epochs, report)
     return losses
+
+
+def _run_graphed(one_epoch: Callable[[], None], epochs: int, report: Callable[[int], None]) -> None:
+    """Run ``one_epoch`` ``epochs`` times: once eagerly, then as replays of a CUDA graph.
+
+    The eager first epoch (on a side stream, as graph capture wants) creates the
+    library handles, workspaces and compiled kernels the capture needs; capturing
+    records the second epoch without running it. The host waits for every replay
+    so that ``report`` tells the truth (the wait costs microseconds per epoch).
+    """
+    side = torch.cuda.Stream()
+    side.wait_stream(torch.cuda.current_stream())
+    with torch.cuda.stream(side):
+        one_epoch()
+    torch.cuda.current_stream().wait_stream(side)
+    torch.cuda.synchronize()
+    report(1)
+    if epochs == 1:
+        return
+    graph = torch.cuda.CUDAGraph()
+    try:
+        with torch.cuda.graph(graph):
+            one_epoch()
+    except RuntimeError as error:  # capture recorded nothing that ran: go on eagerly
+        logger.warning("CUDA graph capture failed (%s); training on without it", error)
+        torch.cuda.synchronize()
+        for epoch in range(1, epochs):
+            one_epoch()
+            report(epoch + 1)
+        return
+    for epoch in range(1, epochs):
+        graph.replay()
+        graph_done = torch.cuda.current_stream()
+        graph_done.synchronize()
+        report(epoch + 1)
 
 
 def final_train_loss(net: BatchedMLP, batches: MiniBatches) -> torch.Tensor:

@@ -3,10 +3,13 @@
 :class:`BatchedMLP` holds the weights of M small MLPs in padded tensors of shape
 (M, d, H1max), (M, H1max, H2max) and (M, H2max, 1); every forward and backward
 product is one ``torch.baddbmm``/``torch.bmm`` over the model axis. Hidden units
-beyond a model's own size are masked to zero after the tanh, so they neither
-contribute to the output nor receive gradient. Gradients are written by hand
+beyond a model's own size have zero incoming and outgoing weights and bias: their
+activation is tanh(0) = 0, so they contribute nothing to the output, their
+gradients are exactly zero, and Adam (zero gradient, zero moments) leaves them at
+zero. No mask is needed (a mask would cost two passes over every activation
+tensor per product). Gradients are written by hand
 (three layers, closed form), not by autograd: that keeps memory at one set of
-activations and makes the masking explicit. The update is Adam written as batched
+activations. The update is Adam written as batched
 tensor operations (betas 0.9/0.999, eps 1e-8, bias correction; the update of
 :class:`torch.optim.Adam`) with a per-model step count and a per-model *active*
 mask. :func:`softbend.surrogates.batched.train_mlp_grid` drives it.
@@ -33,8 +36,8 @@ class BatchedMLP:
     """M padded two-hidden-layer tanh networks with hand-written backward pass and Adam.
 
     Parameters are tensors ``W[l]`` of shape (M, fan_in, fan_out) and biases
-    ``b[l]`` of shape (M, 1, fan_out); ``mask1`` (M, 1, H1) and ``mask2`` (M, 1, H2)
-    are 1 for a model's real hidden units and 0 for padding.
+    ``b[l]`` of shape (M, 1, fan_out), zero on padding (the rows and columns of
+    hidden units beyond a model's own size), where they stay: see the module notes.
     """
 
     def __init__(
@@ -52,25 +55,17 @@ class BatchedMLP:
         shapes = ((d, h1_max), (h1_max, h2_max), (h2_max, 1))
         W = [np.zeros((n_models, *s)) for s in shapes]
         b = [np.zeros((n_models, 1, s[1])) for s in shapes]
-        mask1 = np.zeros((n_models, 1, h1_max))
-        mask2 = np.zeros((n_models, 1, h2_max))
         for m in range(n_models):
             for layer in range(3):
                 rows, cols = coefs[m][layer].shape
                 W[layer][m, :rows, :cols] = coefs[m][layer]
                 b[layer][m, 0, :cols] = intercepts[m][layer]
-            mask1[m, 0, : coefs[m][0].shape[1]] = 1.0
-            mask2[m, 0, : coefs[m][1].shape[1]] = 1.0
 
         def tensor(a: np.ndarray) -> torch.Tensor:
             return torch.tensor(a, dtype=dtype, device=device)
 
         self.params = [tensor(W[0]), tensor(b[0]), tensor(W[1]), tensor(b[1])]
         self.params += [tensor(W[2]), tensor(b[2])]
-        self.mask1, self.mask2 = tensor(mask1), tensor(mask2)
-        # Without padding (every model as wide as the widest) the masks are all ones
-        # and multiplying by them is exact: those products are skipped.
-        self.padded = not (mask1.all() and mask2.all())
         self.exp_avg = [torch.zeros_like(p) for p in self.params]
         self.exp_avg_sq = [torch.zeros_like(p) for p in self.params]
         self.steps = torch.zeros(n_models, dtype=torch.float64, device=device)
@@ -79,11 +74,7 @@ class BatchedMLP:
         """Hidden activations A1 (M, B, H1), A2 (M, B, H2) and output (M, B)."""
         W1, b1, W2, b2, W3, b3 = self.params
         A1 = torch.baddbmm(b1, Z, W1).tanh_()
-        if self.padded:
-            A1.mul_(self.mask1)
         A2 = torch.baddbmm(b2, A1, W2).tanh_()
-        if self.padded:
-            A2.mul_(self.mask2)
         out = torch.baddbmm(b3, A2, W3).squeeze(-1)
         return A1, A2, out
 
@@ -102,13 +93,11 @@ class BatchedMLP:
         G = residual.mul_((2.0 / count).unsqueeze(1)).unsqueeze(-1)  # (M, B, 1)
         gW3 = torch.bmm(A2.transpose(1, 2), G)
         gb3 = G.sum(dim=1, keepdim=True)
-        W3t = W3.transpose(1, 2) * self.mask2 if self.padded else W3.transpose(1, 2)
-        dP2 = G * W3t  # (M, B, H2); zero on padded units
+        dP2 = G * W3.transpose(1, 2)  # (M, B, H2); zero on padded units (W3 is zero there)
         dP2.mul_(torch.square(A2).neg_().add_(1.0))
         gW2 = torch.bmm(A1.transpose(1, 2), dP2)
         gb2 = dP2.sum(dim=1, keepdim=True)
-        W2m = W2 * self.mask1.transpose(1, 2) if self.padded else W2
-        dP1 = torch.bmm(dP2, W2m.transpose(1, 2))
+        dP1 = torch.bmm(dP2, W2.transpose(1, 2))  # zero on padded units (rows of W2 zero)
         dP1.mul_(torch.square(A1).neg_().add_(1.0))
         gW1 = torch.bmm(Z.transpose(1, 2), dP1)
         gb1 = dP1.sum(dim=1, keepdim=True)
@@ -151,6 +140,25 @@ class BatchedMLP:
             m.copy_(torch.where(keep, m_new, m))
             v.copy_(torch.where(keep, v_new, v))
             p.copy_(torch.where(keep, p_new, p))
+
+    def train_step(
+        self,
+        Z: torch.Tensor,
+        target: torch.Tensor,
+        weight: torch.Tensor,
+        count: torch.Tensor,
+        active: torch.Tensor,
+        lr: float,
+        all_active: bool,
+    ) -> torch.Tensor:
+        """One mini-batch: gradients (:meth:`gradients`), then Adam (:meth:`adam_step`).
+
+        Returns each model's sum of squared errors before the update, (M,). One
+        function, so that it can be compiled (``torch.compile``) as a whole.
+        """
+        grads, sse = self.gradients(Z, target, weight, count)
+        self.adam_step(grads, active, lr, all_active=all_active)
+        return sse
 
     def extract(self, m: int, h1: int, h2: int) -> tuple[list[np.ndarray], list[np.ndarray]]:
         """Model ``m``'s parameters, unpadded, as float64 arrays (contract shapes)."""

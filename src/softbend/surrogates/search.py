@@ -49,6 +49,7 @@ import logging
 import math
 import time
 from collections.abc import Callable
+from contextlib import AbstractContextManager, nullcontext
 from dataclasses import dataclass, field
 from typing import TYPE_CHECKING, Any
 
@@ -260,6 +261,16 @@ class SearchResult:
 
 
 Progress = Callable[[str, int, int], None]
+
+
+def _mlp_precision(model: str, device: str, tf32: bool) -> AbstractContextManager[None]:
+    """TF32 products while the MLP family trains on CUDA, if asked; else nothing."""
+    if model != "mlp" or not tf32:
+        return nullcontext()
+    from softbend.surrogates.batched import tf32_matmul
+    from softbend.surrogates.mlp_core import resolve_device
+
+    return tf32_matmul(resolve_device(device, "surrogate search"), True)
 
 
 def _make(
@@ -600,6 +611,7 @@ def search(
     plr_patience: int | None = None,
     checkpoint: SearchCheckpoint | None = None,
     refit: bool = True,
+    tf32: bool = False,
 ) -> SearchResult:
     """Grouped K-fold grid search of each model family, then a refit of the best.
 
@@ -656,6 +668,10 @@ def search(
         Refit each family's best configuration on all rows (``model``,
         ``timing``, ``fit_s`` of its :class:`FamilyResult`); ``False`` scores
         only (``model`` None, timings NaN), e.g. for a second CV protocol.
+    tf32 : bool, default False
+        Allow TF32 matrix products while the MLPs train on a CUDA device, the
+        refit included (:func:`~softbend.surrogates.batched.tf32_matmul`); no
+        effect on the CPU.
 
     Returns
     -------
@@ -678,6 +694,8 @@ def search(
         else int(check_range(epochs, "epochs", owner, low=1, low_inclusive=True))
     )
     check_choice(cv, "cv", owner, CV_PROTOCOLS)
+    if not isinstance(tf32, bool):
+        raise ValueError(f"The 'tf32' of {owner} must be True or False. Got {tf32!r}.")
     if halving is not None:
         halving = check_int(halving, "halving", owner, low=2)
     n_rungs = (
@@ -718,92 +736,94 @@ def search(
                 n_rungs=n_rungs,
                 device=device,
                 n_jobs=n_jobs,
+                tf32=tf32,
             )  # (no plr_patience: it decides which folds are fitted, not their scores)
         )
     resumed = 0
     for model, configs in plan.items():
-        noun = "configuration" if len(configs) == 1 else "configurations"
-        phase = f"{model}: {len(configs)} {noun} x {len(splits)} folds"
-        started = time.perf_counter()
+        with _mlp_precision(model, device, tf32):
+            noun = "configuration" if len(configs) == 1 else "configurations"
+            phase = f"{model}: {len(configs)} {noun} x {len(splits)} folds"
+            started = time.perf_counter()
 
-        def make(params: dict[str, Any], model: str = model) -> Any:
-            return _make(model, params, seed=seed, n_jobs=n_jobs, device=device, epochs=epochs)
+            def make(params: dict[str, Any], model: str = model) -> Any:
+                return _make(model, params, seed=seed, n_jobs=n_jobs, device=device, epochs=epochs)
 
-        if model == "mlp":
+            if model == "mlp":
 
-            def on_epoch(done: int, total_epochs: int, phase: str = phase) -> None:
+                def on_epoch(done: int, total_epochs: int, phase: str = phase) -> None:
+                    if progress is not None:
+                        progress(phase, done, total_epochs)
+
+                outcomes, loaded = _cv_mlp_batched(
+                    configs,
+                    data,
+                    splits,
+                    epochs=epochs,
+                    seed=seed,
+                    device=device,
+                    progress=on_epoch,
+                    halving=halving,
+                    n_rungs=n_rungs,
+                    checkpoint=checkpoint,
+                )
+            else:
+                total = len(configs) * len(splits)
+                done = 0
+
+                def tick(phase: str = phase, total: int = total) -> None:
+                    nonlocal done
+                    done += 1
+                    if progress is not None:
+                        progress(phase, done, total)
+
                 if progress is not None:
-                    progress(phase, done, total_epochs)
-
-            outcomes, loaded = _cv_mlp_batched(
-                configs,
-                data,
-                splits,
-                epochs=epochs,
-                seed=seed,
-                device=device,
-                progress=on_epoch,
-                halving=halving,
-                n_rungs=n_rungs,
-                checkpoint=checkpoint,
+                    progress(phase, 0, total)
+                stop = (
+                    _patience_stop(splits, data.y, patience)
+                    if model == "plr" and patience is not None
+                    else None
+                )
+                outcomes, loaded = _cv_sequential(
+                    model, configs, data, splits, make, tick, checkpoint, stop
+                )
+            resumed += loaded
+            best: tuple[float, dict[str, Any], np.ndarray, dict[str, float]] | None = None
+            for params, pred, seconds, status in outcomes:
+                row: dict[str, Any] = {
+                    "model": model,
+                    "params": describe(params),
+                    "status": status,
+                    "fit_s_per_config": seconds,
+                }
+                if pred is not None:
+                    scores = _fold_scores(data.y, pred, splits, mape_threshold_deg)
+                    row.update(scores)
+                    # A configuration stopped early by successive halving is no candidate.
+                    if status == "ok" and (best is None or scores["rmse_fold_mean"] < best[0]):
+                        best = (scores["rmse_fold_mean"], params, pred, scores)
+                rows.append(row)
+            search_s = time.perf_counter() - started
+            if best is None:
+                logger.warning("no configuration of %s could be fitted", model)
+                continue
+            _, params, pred, scores = best
+            final, timing, fit_s = None, {"single_us": math.nan, "batch_ms": math.nan}, 0.0
+            if refit:
+                start = time.perf_counter()
+                final = make(params).fit(data.X, data.y)
+                fit_s = time.perf_counter() - start
+                timing = inference_time(final, data.X, seed=seed)
+            families[model] = FamilyResult(
+                name=model,
+                params=params,
+                cv=scores,
+                oof_pred=pred,
+                model=final,
+                timing=timing,
+                fit_s=fit_s,
+                search_s=search_s,
             )
-        else:
-            total = len(configs) * len(splits)
-            done = 0
-
-            def tick(phase: str = phase, total: int = total) -> None:
-                nonlocal done
-                done += 1
-                if progress is not None:
-                    progress(phase, done, total)
-
-            if progress is not None:
-                progress(phase, 0, total)
-            stop = (
-                _patience_stop(splits, data.y, patience)
-                if model == "plr" and patience is not None
-                else None
-            )
-            outcomes, loaded = _cv_sequential(
-                model, configs, data, splits, make, tick, checkpoint, stop
-            )
-        resumed += loaded
-        best: tuple[float, dict[str, Any], np.ndarray, dict[str, float]] | None = None
-        for params, pred, seconds, status in outcomes:
-            row: dict[str, Any] = {
-                "model": model,
-                "params": describe(params),
-                "status": status,
-                "fit_s_per_config": seconds,
-            }
-            if pred is not None:
-                scores = _fold_scores(data.y, pred, splits, mape_threshold_deg)
-                row.update(scores)
-                # A configuration stopped early by successive halving is no candidate.
-                if status == "ok" and (best is None or scores["rmse_fold_mean"] < best[0]):
-                    best = (scores["rmse_fold_mean"], params, pred, scores)
-            rows.append(row)
-        search_s = time.perf_counter() - started
-        if best is None:
-            logger.warning("no configuration of %s could be fitted", model)
-            continue
-        _, params, pred, scores = best
-        final, timing, fit_s = None, {"single_us": math.nan, "batch_ms": math.nan}, 0.0
-        if refit:
-            start = time.perf_counter()
-            final = make(params).fit(data.X, data.y)
-            fit_s = time.perf_counter() - start
-            timing = inference_time(final, data.X, seed=seed)
-        families[model] = FamilyResult(
-            name=model,
-            params=params,
-            cv=scores,
-            oof_pred=pred,
-            model=final,
-            timing=timing,
-            fit_s=fit_s,
-            search_s=search_s,
-        )
     settings = {
         "grid": grid_name
         if not param_grid
@@ -816,6 +836,7 @@ def search(
         "seed": seed,
         "device": device,
         "mlp_epochs": epochs,
+        "mlp_tf32": tf32,
         "xgb_trees": XGB_TREES,
         "mape_threshold_deg": mape_threshold_deg,
         "n_samples": data.n_samples,
@@ -844,6 +865,7 @@ def search_fingerprint(
     device: str,
     n_jobs: int | None,
     n_rungs: int | None = None,
+    tf32: bool = False,
 ) -> dict[str, Any]:
     """Everything that determines the scores of a search, for its checkpoint.
 
@@ -892,4 +914,6 @@ def search_fingerprint(
         }
         if halving and n_rungs is not None:  # (absent: older checkpoints stay valid)
             fingerprint["mlp"]["halving_rungs"] = n_rungs
+        if tf32:  # (absent: older checkpoints stay valid)
+            fingerprint["mlp"]["tf32"] = True
     return fingerprint
