@@ -22,11 +22,13 @@ the speed-up, and the projected time of the full paper grid (121 configurations 
     .venv/bin/python benchmarks/bench_mlp_search.py --configs 4 --epochs 5 --json
 
 Training paths side by side (``--variants``, one process, the same data and grid):
-each variant trains the grid twice, for E and 2E epochs; the difference is the
-steady cost of E epochs (set-up, warm-up epoch, graph capture and compilation
-cancel out), from which the full grid is projected. On a CUDA device each run is
-also profiled (``torch.profiler``): the GPU kernel time of the extra E epochs
-over their wall time is the GPU busy fraction of the epoch loop. Variants are
+each variant trains the grid once for one epoch (cold: CUDA context, handles,
+compilation) and once for E epochs, waiting for the device at the end of every
+epoch; the steady seconds per epoch are those of epochs 2..E (set-up, the first
+epoch, graph capture and compilation left out), from which the full grid is
+projected. On a CUDA device the E-epoch run is profiled (``torch.profiler``): the
+time the GPU ran kernels, copies or fills inside a profiler range over epochs
+2..E, over the range's length, is the GPU busy fraction of the epoch loop. Variants are
 ``+``-joined options of :func:`~softbend.surrogates.batched.train_mlp_grid`:
 ``host`` / ``device`` (the shuffle), ``graph`` / ``nograph``, ``tf32``, ``compile``::
 
@@ -275,40 +277,67 @@ def parse_variant(spec: str) -> dict[str, object]:
 
 
 def timed_run(X, y, splits, configs, epochs, options, profile):
-    """Wall time of one train_mlp_grid call, s, and the GPU kernel time in it, s (or None)."""
-    sync = torch.cuda.synchronize if options["device"] == "cuda" else (lambda: None)
-    sync()
-    if not profile:
-        start = time.perf_counter()
-        train_mlp_grid(X, y, splits, configs, epochs=epochs, **options)
+    """One train_mlp_grid call: (wall s, steady s per epoch, GPU busy fraction or None).
+
+    The steady figures cover epochs 2..E: the host waits for the device at the end
+    of every epoch (the CUDA-graph path does so anyway) and stamps the time; when
+    profiling, a profiler range spans the same epochs, and the GPU busy time inside
+    it (kernels, copies, fills) over its length is the busy fraction.
+    """
+    cuda = options["device"] == "cuda"
+    sync = torch.cuda.synchronize if cuda else (lambda: None)
+    stamps: dict[int, float] = {}
+    steady = torch.profiler.record_function("steady epochs")
+
+    def progress(done: int, _total: int) -> None:
         sync()
-        return time.perf_counter() - start, None
+        stamps[done] = time.perf_counter()
+        if profile and done == 1:
+            steady.__enter__()
+        if profile and done == epochs:
+            steady.__exit__(None, None, None)
+
+    def run() -> float:
+        sync()
+        start = time.perf_counter()
+        train_mlp_grid(X, y, splits, configs, epochs=epochs, progress=progress, **options)
+        sync()
+        return time.perf_counter() - start
+
+    if not profile:
+        wall = run()
+        return wall, (stamps[epochs] - stamps[1]) / max(epochs - 1, 1), None
     import tempfile
 
     from torch.profiler import ProfilerActivity
     from torch.profiler import profile as torch_profile
 
-    with torch_profile(activities=[ProfilerActivity.CPU, ProfilerActivity.CUDA]) as prof:
-        start = time.perf_counter()
-        train_mlp_grid(X, y, splits, configs, epochs=epochs, **options)
-        sync()
-        wall = time.perf_counter() - start
+    activities = [ProfilerActivity.CPU] + ([ProfilerActivity.CUDA] if cuda else [])
+    with torch_profile(activities=activities) as prof:
+        wall = run()
     with tempfile.TemporaryDirectory() as folder:
         trace = os.path.join(folder, "trace.json")
         prof.export_chrome_trace(trace)
         with open(trace) as handle:
             events = json.load(handle)
     events = events.get("traceEvents", events) if isinstance(events, dict) else events
-    return wall, gpu_busy_seconds(events)
+    window = [e for e in events if e.get("name") == "steady epochs" and "dur" in e]
+    if not window:
+        return wall, (stamps[epochs] - stamps[1]) / max(epochs - 1, 1), None
+    begin = float(window[0]["ts"])
+    end = begin + float(window[0]["dur"])
+    busy = gpu_busy_seconds(events, begin, end) / max((end - begin) / 1e6, 1e-12)
+    return wall, (stamps[epochs] - stamps[1]) / max(epochs - 1, 1), busy
 
 
-def gpu_busy_seconds(events: list[dict]) -> float:
-    """Seconds in which the GPU ran a kernel, copy or fill: the union of their intervals."""
+def gpu_busy_seconds(events: list[dict], begin_us: float, end_us: float) -> float:
+    """Seconds of [begin, end] (trace µs) in which the GPU ran a kernel, copy or fill."""
     spans = sorted(
-        (float(e["ts"]), float(e["ts"]) + float(e.get("dur", 0.0)))
+        (max(float(e["ts"]), begin_us), min(float(e["ts"]) + float(e.get("dur", 0.0)), end_us))
         for e in events
         if e.get("cat") in ("kernel", "gpu_memcpy", "gpu_memset") and "ts" in e
     )
+    spans = [(a, b) for a, b in spans if b > a]
     busy_us, end = 0.0, -float("inf")
     for a, b in spans:
         if b <= end:
@@ -344,11 +373,8 @@ def run_variants(args: argparse.Namespace) -> int:
         }
         profile = device == "cuda"
         # a cold call first: CUDA context, library handles, compilation (kept apart)
-        w0, _ = timed_run(X, y, splits, configs, 1, options, False)
-        w1, k1 = timed_run(X, y, splits, configs, args.epochs, options, profile)
-        w2, k2 = timed_run(X, y, splits, configs, 2 * args.epochs, options, profile)
-        per_epoch = (w2 - w1) / args.epochs
-        busy = None if k1 is None else (k2 - k1) / max(w2 - w1, 1e-9)
+        cold, _, _ = timed_run(X, y, splits, configs, 1, options, False)
+        wall, per_epoch, busy = timed_run(X, y, splits, configs, args.epochs, options, profile)
         full = per_epoch * PAPER_EPOCHS * (len(PAPER_GRID) * PAPER_FOLDS) / n_models
         rows.append(
             {
@@ -356,12 +382,12 @@ def run_variants(args: argparse.Namespace) -> int:
                 "s_per_epoch": per_epoch,
                 "projected_full_grid_s": full,
                 "gpu_busy": busy,
-                "wall_E_s": w1,
-                "wall_2E_s": w2,
+                "cold_1_epoch_s": cold,
+                "wall_s": wall,
             }
         )
         busy_text = "-" if busy is None else f"{100 * busy:.0f} %"
-        print(f"{spec:34}{w0:>15.2f}{per_epoch:>10.4f}{full:>13.1f}{busy_text:>10}", flush=True)
+        print(f"{spec:34}{cold:>15.2f}{per_epoch:>10.4f}{full:>13.1f}{busy_text:>10}", flush=True)
     if args.json:
         print(json.dumps({"data": source, "device": device_description(device), "rows": rows}))
     return 0

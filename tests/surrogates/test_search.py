@@ -352,3 +352,13 @@ def test_plr_patience_stops_raising_the_degree_once_the_cv_error_rises(small_dat
 def test_plr_patience_must_be_a_positive_integer(small_data, patience):
     with pytest.raises(ValueError, match="'plr_patience' of surrogate search must be an integer"):
         search(small_data, models=["plr"], param_grid=SMALL_GRID, plr_patience=patience)
+
+
+def test_tf32_is_recorded_checked_and_changes_nothing_on_the_cpu(small_data):
+    kwargs = dict(models=["mlp"], param_grid={"mlp": [{"hidden_sizes": (4, 4)}]}, epochs=3)
+    plain = search(small_data, device="cpu", **kwargs)
+    tf32 = search(small_data, device="cpu", tf32=True, **kwargs)
+    assert plain.settings["mlp_tf32"] is False and tf32.settings["mlp_tf32"] is True
+    np.testing.assert_array_equal(plain.families["mlp"].oof_pred, tf32.families["mlp"].oof_pred)
+    with pytest.raises(ValueError, match="'tf32' of surrogate search must be True or False"):
+        search(small_data, device="cpu", tf32="yes", **kwargs)

@@ -29,6 +29,9 @@ def train(
     folds: int = typer.Option(5, help="Design-grouped cross-validation folds."),
     seed: int = typer.Option(0, help="Seed of the folds, XGBoost and the MLP."),
     device: str = typer.Option("auto", help="MLP device: auto, cpu or cuda."),
+    tf32: bool = typer.Option(
+        False, "--tf32", help="On a CUDA device, TF32 matrix products for the MLP (faster)."
+    ),
     epochs: int | None = typer.Option(
         None, help="MLP epochs (default: 200 quick grid, 1000 paper grid as paper B)."
     ),
@@ -106,6 +109,7 @@ def train(
                 halving_rungs=halving_rungs,
                 plr_patience=plr_patience,
                 checkpoint=checkpoint,
+                tf32=tf32,
             )
             summary["files"].update(training_figures(result, stage))
         checkpoint.remove()  # the new folder is in place

@@ -5,8 +5,9 @@ A hyperparameter grid with cross-validation is M = (number of configurations) x
 the weights of all M models live in padded tensors of shape (M, d, H1max),
 (M, H1max, H2max) and (M, H2max, 1), every forward and backward product is one
 ``torch.baddbmm``/``torch.bmm`` over the model axis, and hidden units beyond a
-model's own size are masked to zero after the tanh, so they neither contribute to
-the output nor receive gradient (they stay exactly at their initial value).
+model's own size have zero weights and biases, so their activation is exactly 0,
+they contribute nothing to the output, receive exactly zero gradient and stay at
+zero.
 
 Each model is exactly what it would be if trained alone (the tests check this):
 
@@ -24,13 +25,19 @@ Each model is exactly what it would be if trained alone (the tests check this):
 * the loss of a partial last mini-batch is the mean over that model's true rows.
 
 Gradients are computed by hand (three layers, closed form), not by autograd:
-that keeps memory at one set of activations and makes the masking explicit. The
+that keeps memory at one set of activations. The
 network, its gradients and Adam are :class:`~softbend.surrogates.batched_net.BatchedMLP`;
 the memory a pass needs is :mod:`~softbend.surrogates.batched_memory`'s, and the
 arguments are checked by :mod:`~softbend.surrogates.batched_checks`. The
 random streams come from NumPy (``numpy.random.SeedSequence``), so results do
 not depend on torch's global RNG state, and CPU runs with the same seed give
 identical weights.
+
+On a CUDA device the epoch loop is kept on the device: the row orders are drawn
+there (``shuffle="device"``, :mod:`~softbend.surrogates.batched_shuffle`: the same
+orders on CPU and GPU, not NumPy's), every epoch after the first replays one
+captured CUDA graph, and TF32 products (``tf32=True``) and a compiled step
+(``compile_step=True``) are options. The CPU keeps NumPy's orders by default.
 """
 
 from __future__ import annotations

@@ -4,9 +4,10 @@
 own rows: model m's rows fill the first ``n_m`` columns of an (M, n_steps * B)
 table, the rest is padding with weight 0. :func:`run_epochs` trains a
 :class:`~softbend.surrogates.batched_net.BatchedMLP` on them; every epoch each
-model visits its rows in the order its own random stream draws, and a model whose
-epoch has run out of mini-batches is not updated. :func:`final_train_loss` is
-each model's MSE on all its rows afterwards.
+model visits its rows in the order its own random stream draws (on the host, or
+on the device from counter-based keys), and a model whose epoch has run out of
+mini-batches is not updated; on a CUDA device the epochs can replay one captured
+CUDA graph. :func:`final_train_loss` is each model's MSE on all its rows afterwards.
 """
 
 from __future__ import annotations
@@ -248,8 +249,7 @@ def _run_graphed(one_epoch: Callable[[], None], epochs: int, report: Callable[[i
         return
     for epoch in range(1, epochs):
         graph.replay()
-        graph_done = torch.cuda.current_stream()
-        graph_done.synchronize()
+        torch.cuda.current_stream().synchronize()
         report(epoch + 1)
 
 

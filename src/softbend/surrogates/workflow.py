@@ -74,6 +74,7 @@ def train_surrogates(
     halving_rungs: int | None = None,
     plr_patience: int | None = None,
     checkpoint: SearchCheckpoint | None = None,
+    tf32: bool = False,
 ) -> tuple[SearchResult, dict[str, Any]]:
     """Search, refit, save and export the surrogates of a campaign.
 
@@ -94,6 +95,9 @@ def train_surrogates(
         Where the search saves its finished configuration-folds and from which
         an interrupted search resumes (see :func:`softbend.surrogates.search.search`);
         left in place: the caller removes it once ``out_dir`` is safe.
+    tf32 : bool
+        TF32 matrix products for the MLP on a CUDA device (see
+        :func:`softbend.surrogates.search.search`).
 
     Returns
     -------
@@ -122,6 +126,7 @@ def train_surrogates(
         halving_rungs=halving_rungs,
         plr_patience=plr_patience,
         checkpoint=checkpoint,
+        tf32=tf32,
     )
     out = Path(out_dir)
     (out / "models").mkdir(parents=True, exist_ok=True)
