@@ -8,6 +8,8 @@ temporary file from :func:`tempfile.mkstemp` alone would be ``0o600``).
 from __future__ import annotations
 
 import glob
+import json
+import math
 import os
 import shutil
 import stat
@@ -16,10 +18,12 @@ import tempfile
 from collections.abc import Iterator
 from contextlib import contextmanager
 from pathlib import Path
-from typing import IO
+from typing import IO, Any
 
 __all__ = [
     "atomic_file",
+    "json_safe",
+    "json_text",
     "new_file_mode",
     "remove_stale_staging",
     "staged_dir",
@@ -169,3 +173,27 @@ def _exchange(a: Path, b: Path) -> bool:
     at_fdcwd, rename_exchange = -100, 2
     result = renameat2(at_fdcwd, os.fsencode(a), at_fdcwd, os.fsencode(b), rename_exchange)
     return result == 0
+
+
+def json_safe(value: Any) -> Any:
+    """``value`` with NumPy arrays and numbers as Python ones and NaN or inf as None.
+
+    Dictionary keys become strings. What strict JSON readers (``jq``, JavaScript,
+    most libraries other than Python's) accept: they refuse a bare ``NaN``.
+    """
+    if isinstance(value, dict):
+        return {str(k): json_safe(v) for k, v in value.items()}
+    if isinstance(value, list | tuple):
+        return [json_safe(v) for v in value]
+    if isinstance(value, float):
+        return float(value) if math.isfinite(value) else None
+    if not isinstance(value, str | bytes) and callable(getattr(value, "tolist", None)):
+        return json_safe(value.tolist())  # NumPy arrays and scalars
+    return value
+
+
+def json_text(payload: Any, *, indent: int | None = 2, sort_keys: bool = False) -> str:
+    """``payload`` as strict JSON text: :func:`json_safe`, other objects as ``str``."""
+    return json.dumps(
+        json_safe(payload), indent=indent, sort_keys=sort_keys, allow_nan=False, default=str
+    )

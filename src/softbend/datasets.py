@@ -28,7 +28,7 @@ from importlib import resources
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
-from softbend._io import write_text_atomic
+from softbend._io import json_text, write_text_atomic
 from softbend.errors import DatasetError
 
 if TYPE_CHECKING:
@@ -311,5 +311,5 @@ def write_dataset(
         "written_by": f"softbend {__version__}",
         "files": files,
     }
-    write_text_atomic(out / PROVENANCE_FILE, json.dumps(provenance, indent=2, default=str) + "\n")
+    write_text_atomic(out / PROVENANCE_FILE, json_text(provenance) + "\n")
     return provenance

@@ -21,6 +21,13 @@ class SchemaError(SoftbendError, ValueError):
     """A stored artefact (database, saved model) has an unknown or newer schema."""
 
 
+class LimitError(SoftbendError, ValueError):
+    """An input is larger than a limit of :mod:`softbend.limits` (rows, cycles, bytes, depth).
+
+    The message names the limit, its value and the environment variable that raises it.
+    """
+
+
 class ConvergenceError(SoftbendError, RuntimeError):
     """A numerical solver failed to converge.
 

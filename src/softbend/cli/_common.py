@@ -2,9 +2,7 @@
 
 from __future__ import annotations
 
-import json
 import logging
-import math
 import os
 import warnings
 from collections.abc import Callable, Iterator
@@ -12,7 +10,6 @@ from contextlib import contextmanager
 from pathlib import Path
 from typing import Any
 
-import numpy as np
 from rich.console import Console
 from rich.logging import RichHandler
 from rich.progress import (
@@ -25,6 +22,7 @@ from rich.progress import (
 )
 from rich.table import Table
 
+from softbend._io import json_text
 from softbend.errors import SoftbendError
 
 __all__ = [
@@ -76,25 +74,6 @@ def error_line(message: str) -> None:
     """Print one error line to stderr (no traceback)."""
     text = " ".join(str(message).split())
     err_console.print(f"softbend: error: {text}", markup=False, highlight=False, soft_wrap=True)
-
-
-def _jsonable(value: Any) -> Any:
-    if isinstance(value, dict):
-        return {str(k): _jsonable(v) for k, v in value.items()}
-    if isinstance(value, list | tuple):
-        return [_jsonable(v) for v in value]
-    if isinstance(value, np.ndarray):
-        return _jsonable(value.tolist())
-    if isinstance(value, np.generic):
-        return _jsonable(value.item())
-    if isinstance(value, float) and not math.isfinite(value):
-        return None
-    return value
-
-
-def json_text(payload: Any) -> str:
-    """``payload`` as indented JSON text (NumPy values converted, NaN and inf as null)."""
-    return json.dumps(_jsonable(payload), indent=2, allow_nan=False)
 
 
 def warning_line(message: str) -> None:

@@ -21,7 +21,6 @@ section, returning its results); this module and the section modules of
 
 from __future__ import annotations
 
-import json
 import logging
 import os
 import platform
@@ -31,7 +30,7 @@ from pathlib import Path
 from typing import Any
 
 from softbend import __version__
-from softbend._io import write_text_atomic
+from softbend._io import json_text, write_text_atomic
 from softbend._validation import check_range
 from softbend.design import DesignSpace
 from softbend.pipeline import Progress
@@ -236,5 +235,5 @@ def run_reproduce(
     }
     path = report.write(out_dir / "index.html")
     summary["report"] = str(path)
-    write_text_atomic(out_dir / "summary.json", json.dumps(summary, indent=2, default=str) + "\n")
+    write_text_atomic(out_dir / "summary.json", json_text(summary) + "\n")
     return summary

@@ -1,0 +1,127 @@
+"""Physical plausibility of values read from files: absurd but finite numbers are errors.
+
+A reader that checks only for NaN lets ``1e300`` through, and a fit on it saves a
+scale of -9e295. Every reader of the project checks its columns against the
+ranges here, which are wide (no real soft actuator lies near their ends) but
+finite, and names the file, line and column of the first value outside.
+
+=====================  ===================  =========================================
+quantity               range                why
+=====================  ===================  =========================================
+``angle_deg``          -3600 to 3600        ten turns; the FEM data end near 300°
+``pressure_mpa``       -0.1013 to 2         gauge; no vacuum below -1 atm, and 2 MPa
+                                            bursts any silicone actuator
+``pressure_kpa``       -101.3 to 2000       the same in kPa
+``length_mm``          0 to 10 000          geometry, tip coordinates' magnitude
+``coordinate_mm``      -10 000 to 10 000    tip positions
+``time_s``             0 to 1e7             about four months of recording
+``stress_mpa``         -1000 to 1000        silicones reach a few MPa
+``strain``             -1 to 100            engineering strain (stretch 0 to 101)
+``modulus_mpa``        -1000 to 1e6         material constants (Kevlar: 3.1e4)
+``kernel_width``       1e-6 to 1e6          kernel length scales and widths,
+                                            standardized inputs
+=====================  ===================  =========================================
+
+A pressure column whose values fit kPa but not MPa gets a hint to that effect.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+from dataclasses import dataclass
+
+import numpy as np
+from numpy.typing import ArrayLike
+
+from softbend.errors import DatasetError
+
+__all__ = ["RANGES", "Range", "check_plausible", "implausible_index"]
+
+
+@dataclass(frozen=True)
+class Range:
+    """The plausible range of one quantity (both ends included)."""
+
+    low: float
+    high: float
+    unit: str
+    label: str
+
+
+RANGES: dict[str, Range] = {
+    "angle_deg": Range(-3600.0, 3600.0, "°", "bending angle"),
+    "pressure_mpa": Range(-0.1013, 2.0, "MPa", "gauge pressure"),
+    "pressure_kpa": Range(-101.3, 2000.0, "kPa", "gauge pressure"),
+    "length_mm": Range(0.0, 10_000.0, "mm", "length"),
+    "coordinate_mm": Range(-10_000.0, 10_000.0, "mm", "position"),
+    "time_s": Range(0.0, 1e7, "s", "time"),
+    "stress_mpa": Range(-1000.0, 1000.0, "MPa", "stress"),
+    "strain": Range(-1.0, 100.0, "", "strain"),
+    "modulus_mpa": Range(-1000.0, 1e6, "MPa", "material constant"),
+    "kernel_width": Range(1e-6, 1e6, "", "kernel width"),
+}
+
+
+def implausible_index(values: ArrayLike, quantity: str) -> int | None:
+    """Index of the first finite value of ``values`` outside ``quantity``'s range, or None.
+
+    NaN and missing values are left to the caller's own check.
+    """
+    bounds = _range(quantity)
+    array = np.asarray(values, dtype=np.float64).ravel()
+    with np.errstate(invalid="ignore"):
+        outside = np.isfinite(array) & ((array < bounds.low) | (array > bounds.high))
+        outside |= np.isinf(array)
+    hits = np.flatnonzero(outside)
+    return int(hits[0]) if hits.size else None
+
+
+def check_plausible(
+    values: ArrayLike,
+    quantity: str,
+    *,
+    source: str,
+    column: str,
+    lines: Sequence[int] | None = None,
+    first_line: int = 2,
+) -> None:
+    """Raise :class:`~softbend.errors.DatasetError` at the first implausible value.
+
+    Parameters
+    ----------
+    values : array_like
+        The column's values, in file order.
+    quantity : str
+        A key of :data:`RANGES`.
+    source : str
+        The file (or object) the values came from, for the message.
+    column : str
+        The column (or field) name.
+    lines : sequence of int, optional
+        The file line of each value; default ``first_line + index`` (a CSV whose
+        header is line 1 and whose rows follow without gaps).
+    first_line : int, default 2
+        The line of the first value when ``lines`` is not given.
+    """
+    index = implausible_index(values, quantity)
+    if index is None:
+        return
+    bounds = _range(quantity)
+    value = float(np.asarray(values, dtype=np.float64).ravel()[index])
+    line = lines[index] if lines is not None else first_line + index
+    unit = f" {bounds.unit}" if bounds.unit else ""
+    hint = ""
+    if quantity == "pressure_mpa" and 2.0 < abs(value) <= 2000.0:
+        hint = " It looks like kPa: divide by 1000 for MPa."
+    raise DatasetError(
+        f"{source}, line {line}, column '{column}': {value:g} is not a plausible "
+        f"{bounds.label} (allowed {bounds.low:g} to {bounds.high:g}{unit}).{hint}"
+    )
+
+
+def _range(quantity: str) -> Range:
+    if quantity not in RANGES:
+        raise ValueError(
+            f"Unknown quantity {quantity!r}; the quantities are {', '.join(sorted(RANGES))}."
+        )
+    return RANGES[quantity]

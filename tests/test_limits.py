@@ -1,0 +1,71 @@
+import numpy as np
+import pytest
+
+from softbend.errors import DatasetError, LimitError
+from softbend.limits import LIMITS, check_file_size, check_limit, limit
+from softbend.plausibility import RANGES, check_plausible, implausible_index
+
+
+def test_a_value_over_a_limit_names_it_and_the_variable(monkeypatch):
+    monkeypatch.delenv("SOFTBEND_MAX_CYCLES", raising=False)
+    check_limit("cycles", 1000, "--cycles")  # at the limit: fine
+    with pytest.raises(
+        LimitError,
+        match=r"--cycles is 1,000,000,000 cycles, more than the limit "
+        r"of 1,000 cycles .*SOFTBEND_MAX_CYCLES",
+    ):
+        check_limit("cycles", 10**9, "--cycles")
+    # a huge integer does not overflow anything
+    with pytest.raises(LimitError, match="designs"):
+        check_limit("designs", 99999999999999999999, "--space lhs:N")
+
+
+def test_the_environment_raises_a_limit_and_a_bad_value_is_named(monkeypatch):
+    monkeypatch.setenv("SOFTBEND_MAX_CYCLES", "2_000")
+    assert limit("cycles") == 2000
+    check_limit("cycles", 1500, "--cycles")
+    monkeypatch.setenv("SOFTBEND_MAX_CYCLES", "-3")
+    with pytest.raises(LimitError, match="SOFTBEND_MAX_CYCLES must be a positive integer"):
+        limit("cycles")
+    with pytest.raises(ValueError, match="the limits are csv_rows, cycles"):
+        limit("rows")
+
+
+def test_file_size_limit(tmp_path, monkeypatch):
+    big = tmp_path / "big.csv"
+    big.write_bytes(b"x" * (2 * 2**20 + 10))
+    check_file_size(big)
+    monkeypatch.setenv("SOFTBEND_MAX_FILE_MIB", "1")
+    with pytest.raises(LimitError, match=r"big.csv is 2.0 MiB, more than the limit of 1 MiB"):
+        check_file_size(big)
+    check_file_size(tmp_path / "missing.csv")  # the reader names a missing file
+
+
+def test_every_limit_is_documented():
+    import softbend.limits as module
+
+    for name, entry in LIMITS.items():
+        assert f"``{name}``" in module.__doc__ and entry.default >= 1
+
+
+def test_implausible_values_are_named_by_file_line_and_column():
+    check_plausible([0.0, 0.1, np.nan, 0.5], "pressure_mpa", source="m.csv", column="p")
+    with pytest.raises(
+        DatasetError,
+        match=r"m.csv, line 4, column 'angle_deg': 1e\+300 is not a "
+        r"plausible bending angle \(allowed -3600 to 3600 °\)",
+    ):
+        check_plausible([1.0, 2.0, 1e300], "angle_deg", source="m.csv", column="angle_deg")
+    with pytest.raises(DatasetError, match=r"line 9.*looks like kPa"):
+        check_plausible([0.0, 120.0], "pressure_mpa", source="m.csv", column="p", lines=[3, 9])
+    assert implausible_index([0.0, -np.inf], "angle_deg") == 1
+    assert implausible_index([-0.1013, 2.0], "pressure_mpa") is None  # both ends included
+    with pytest.raises(ValueError, match="the quantities are angle_deg"):
+        implausible_index([1.0], "speed")
+
+
+def test_every_range_is_documented():
+    import softbend.plausibility as module
+
+    for name, bounds in RANGES.items():
+        assert f"``{name}``" in module.__doc__ and bounds.low < bounds.high
