@@ -82,3 +82,36 @@ def test_staging_folders_of_dead_processes_are_removed_by_the_next_run(tmp_path)
     assert not stale.exists()
     assert mine.exists() and unrelated.exists()
     assert (out / "model.json").exists()
+
+
+def test_json_text_is_strict_json_with_nan_as_null():
+    import json
+
+    import numpy as np
+
+    from softbend._io import json_text
+
+    payload = {
+        "nan": float("nan"),
+        "inf": [np.inf, -np.inf, 1.5],
+        "array": np.array([1.0, np.nan]),
+        "scalar": np.float32(0.25),
+        "count": np.int64(3),
+        3: "key as text",
+        "path": __import__("pathlib").Path("a/b"),
+    }
+    text = json_text(payload)
+
+    def refuse(name):
+        raise AssertionError(name)
+
+    back = json.loads(text, parse_constant=refuse)
+    assert back == {
+        "nan": None,
+        "inf": [None, None, 1.5],
+        "array": [1.0, None],
+        "scalar": 0.25,
+        "count": 3,
+        "3": "key as text",
+        "path": "a/b",
+    }

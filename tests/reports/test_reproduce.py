@@ -87,6 +87,19 @@ def test_report_has_both_papers_and_their_files(first_run):
     assert written["report"] == summary["report"] and written["seed"] == 0
 
 
+def _refuse_constant(name):
+    raise ValueError(f"not strict JSON: bare {name}")
+
+
+def test_every_json_file_of_the_run_is_strict_json(first_run):
+    # jq, JavaScript and most JSON libraries refuse NaN and Infinity: none may be written
+    out = first_run[0]
+    files = sorted(out.rglob("*.json"))
+    assert len(files) >= 3
+    for path in files:
+        json.loads(path.read_text(encoding="utf-8"), parse_constant=_refuse_constant)
+
+
 def test_progress_reaches_every_total(first_run):
     _, _, phases = first_run
     assert phases, "no progress reported"
