@@ -26,3 +26,24 @@ def small_campaign(tmp_path_factory):
 @pytest.fixture(scope="session")
 def small_data(small_campaign):
     return training_data(load_samples(small_campaign))
+
+
+#: Inputs tried by the file-format property tests (tests/test_file_formats.py), per format.
+_FUZZ_COUNTS: dict[str, int] = {}
+
+
+@pytest.fixture(scope="session")
+def fuzz_counter():
+    """A per-format count of the inputs the property tests tried, printed in the summary."""
+    from collections import Counter
+
+    counts = Counter()
+    yield counts
+    _FUZZ_COUNTS.update(counts)
+
+
+def pytest_terminal_summary(terminalreporter):
+    if _FUZZ_COUNTS:
+        total = sum(_FUZZ_COUNTS.values())
+        parts = ", ".join(f"{name} {count}" for name, count in sorted(_FUZZ_COUNTS.items()))
+        terminalreporter.write_line(f"file-format property tests: {total} inputs tried ({parts})")

@@ -31,3 +31,34 @@ def stand_in_fem_dataset(folder: Path) -> Path:
     run_campaign(db, DesignSpace.sample(15, seed=4), backend="analytical", workers=0)
     write_dataset(db, folder / "dataset", command="stand-in for the test")
     return folder / "dataset"
+
+
+def web_server():
+    """A local TCP server answering every connection like a web server; returns (port, close)."""
+    import socket
+    import threading
+
+    server = socket.socket()
+    server.bind(("127.0.0.1", 0))
+    server.listen()
+    server.settimeout(0.1)
+    stop = threading.Event()
+
+    def serve() -> None:
+        while not stop.is_set():
+            try:
+                conn, _ = server.accept()
+            except OSError:
+                continue
+            with conn:
+                conn.sendall(b"HTTP/1.1 400 Bad Request\r\nContent-Length: 0\r\n\r\n")
+
+    thread = threading.Thread(target=serve, daemon=True)
+    thread.start()
+
+    def close() -> None:
+        stop.set()
+        thread.join()
+        server.close()
+
+    return server.getsockname()[1], close

@@ -18,7 +18,8 @@ PACKAGE = Path(softbend.__file__).parent
 #: The pipeline, earliest first; a module's stage is that of its first name
 #: after ``softbend.`` (private helper modules sit at the bottom).
 STAGES: tuple[tuple[str, ...], ...] = (
-    ("__init__", "_extras", "_io", "_torch", "_validation", "errors", "limits", "plausibility"),
+    ("__init__", "_extras", "_io", "_jsontext", "_torch", "_validation", "errors", "limits"),
+    ("plausibility",),
     ("design", "metrics", "kinematics"),
     ("materials",),
     ("models",),

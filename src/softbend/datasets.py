@@ -11,16 +11,21 @@ unknowns, softbend version, hash of the FEM options) and
 options, dates, machines, total CPU time).
 
 A dataset is a folder of Parquet files and a ``provenance.json`` that records
-each file's size and SHA-256. Every load checks them: a missing, truncated or
-altered file is a :class:`~softbend.errors.DatasetError` naming the file, never
-a wrong table. :func:`write_dataset` makes such a folder from a campaign
-database (``softbend campaign dataset DB DIR``).
+each file's size and SHA-256. Every load checks them: a provenance of another
+shape (``files`` not an object of ``{"bytes": int >= 0, "sha256": 64 hex
+digits}``), a missing, truncated or altered file, or a table without the
+columns and dtypes of :data:`SAMPLE_COLUMN_KINDS` or :data:`DESIGN_COLUMN_KINDS`
+or with a physically implausible value is a
+:class:`~softbend.errors.DatasetError` naming the file and the field, never a
+wrong table. :func:`write_dataset` makes such a folder from a campaign database
+(``softbend campaign dataset DB DIR``).
 """
 
 from __future__ import annotations
 
 import hashlib
 import json
+import math
 import os
 import re
 from datetime import UTC, datetime
@@ -29,13 +34,19 @@ from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
 from softbend._io import json_text, write_text_atomic
+from softbend._validation import short_repr
+from softbend.design import PARAMETERS
 from softbend.errors import DatasetError
+from softbend.limits import check_file_size
+from softbend.plausibility import RANGES, implausible_index
 
 if TYPE_CHECKING:
     import pandas as pd
 
 __all__ = [
+    "DESIGN_COLUMN_KINDS",
     "DESIGN_STAT_COLUMNS",
+    "SAMPLE_COLUMN_KINDS",
     "table1_fem",
     "table1_fem_designs",
     "table1_fem_provenance",
@@ -46,6 +57,8 @@ __all__ = [
 SAMPLES_FILE = "samples.parquet"
 DESIGNS_FILE = "designs.parquet"
 PROVENANCE_FILE = "provenance.json"
+#: The files of a dataset folder.
+_DATASET_FILES = (SAMPLES_FILE, DESIGNS_FILE, PROVENANCE_FILE)
 _TABLE1_FEM = "table1_fem"
 
 #: Columns of the designs table besides the design parameters.
@@ -68,6 +81,64 @@ DESIGN_STAT_COLUMNS: tuple[str, ...] = (
     "options_sha256",
     "finished_at",
 )
+
+_PARAMETER_QUANTITIES = {
+    name: "angle_deg" if name == "phi_deg" else "length_mm" for name in PARAMETERS
+}
+
+#: Columns of the samples table (:func:`table1_fem`) and the kind of dtype of each:
+#: "string", "float" (any real dtype: float or integer), "integer", "bool" or "datetime".
+SAMPLE_COLUMN_KINDS: dict[str, str] = {
+    "design_id": "string",
+    **dict.fromkeys(PARAMETERS, "float"),
+    "pressure_mpa": "float",
+    "angle_deg": "float",
+    "tip_x_mm": "float",
+    "tip_z_mm": "float",
+    "converged": "bool",
+}
+
+#: Columns of the designs table (:func:`table1_fem_designs`) and the kind of dtype of each.
+DESIGN_COLUMN_KINDS: dict[str, str] = {
+    "design_id": "string",
+    **dict.fromkeys(PARAMETERS, "float"),
+    "status": "string",
+    "error": "string",
+    "n_samples": "integer",
+    "max_pressure_mpa": "float",
+    "max_angle_deg": "float",
+    "stop_kind": "string",
+    "stop_region": "string",
+    "stop_reason": "string",
+    "wall_time_s": "float",
+    "newton_iterations_total": "integer",
+    "load_steps": "integer",
+    "rejected_steps": "integer",
+    "ndof": "integer",
+    "mesh_size": "integer",
+    "softbend_version": "string",
+    "options_sha256": "string",
+    "finished_at": "datetime",
+}
+
+#: The quantity of :data:`softbend.plausibility.RANGES` of each physical column.
+_COLUMN_QUANTITIES: dict[str, dict[str, str]] = {
+    "samples": {
+        **_PARAMETER_QUANTITIES,
+        "pressure_mpa": "pressure_mpa",
+        "angle_deg": "angle_deg",
+        "tip_x_mm": "coordinate_mm",
+        "tip_z_mm": "coordinate_mm",
+    },
+    "designs": {
+        **_PARAMETER_QUANTITIES,
+        "max_pressure_mpa": "pressure_mpa",
+        "max_angle_deg": "angle_deg",
+        "wall_time_s": "time_s",
+    },
+}
+
+_HEX64 = re.compile(r"[0-9a-fA-F]{64}")
 
 #: Stop reasons of the FEM sweep, by the start of their text.
 _STOP_KINDS = (
@@ -92,26 +163,104 @@ def _sha256(path: Path) -> str:
     return digest.hexdigest()
 
 
+def _provenance_files(provenance: Any, record: Path) -> dict[str, dict[str, Any]]:
+    """The ``files`` of a provenance record, its shape and types checked.
+
+    Raises
+    ------
+    DatasetError
+        Naming ``record`` and the field: the record is not an object, ``files`` is
+        missing or not a non-empty object, a file name is not a plain name in the
+        folder, or an entry lacks ``bytes`` (an integer >= 0) or ``sha256`` (64
+        hex digits), or has another key.
+    """
+    where = f"The dataset file {str(record)!r}"
+    if not isinstance(provenance, dict):
+        raise DatasetError(
+            f"{where} is not a softbend provenance record: expected a JSON object, got "
+            f"{type(provenance).__name__}."
+        )
+    if "files" not in provenance:
+        raise DatasetError(
+            f"{where} is not a softbend provenance record: the field 'files' is missing."
+        )
+    files = provenance["files"]
+    if not isinstance(files, dict) or not files:
+        raise DatasetError(
+            f"{where}: the field 'files' must be a non-empty object of "
+            '{"NAME": {"bytes": ..., "sha256": ...}}; got '
+            f"{type(files).__name__ if files else repr(files)}."
+        )
+    for name, entry in files.items():
+        field = f"files.{name}"
+        if not name or name in (".", "..") or "/" in name or "\\" in name:
+            raise DatasetError(
+                f"{where}: the field 'files' must name files of the dataset folder (no "
+                f"folders); got {name!r}."
+            )
+        if not isinstance(entry, dict):
+            raise DatasetError(
+                f"{where}: the field '{field}' must be an object with 'bytes' and 'sha256'; "
+                f"got {type(entry).__name__}."
+            )
+        unknown = sorted(set(entry) - {"bytes", "sha256"})
+        missing = [key for key in ("bytes", "sha256") if key not in entry]
+        if missing or unknown:
+            found = f"missing {', '.join(missing)}" if missing else f"unknown {unknown[0]!r}"
+            raise DatasetError(
+                f"{where}: the field '{field}' must have the keys 'bytes' and 'sha256'; "
+                f"got {found}."
+            )
+        size = entry["bytes"]
+        if type(size) is not int or size < 0:
+            raise DatasetError(
+                f"{where}: the field '{field}.bytes' must be an integer >= 0 (the file's "
+                f"size); got {short_repr(size)}."
+            )
+        digest = entry["sha256"]
+        if not isinstance(digest, str) or not _HEX64.fullmatch(digest):
+            raise DatasetError(
+                f"{where}: the field '{field}.sha256' must be 64 hexadecimal digits; "
+                f"got {short_repr(digest, 80)}."
+            )
+    cpu = provenance.get("cpu_time_s", 0.0)
+    if type(cpu) not in (int, float) or not 0 <= cpu < math.inf:  # NaN compares False
+        raise DatasetError(
+            f"{where}: the field 'cpu_time_s' must be a finite number of seconds >= 0; "
+            f"got {short_repr(cpu)}."
+        )
+    return files
+
+
 def verify_dataset(folder: str | os.PathLike[str]) -> dict[str, Any]:
     """Check every file of a dataset folder against its provenance; return the provenance.
 
     Raises
     ------
     DatasetError
-        The provenance file is missing or unreadable, or a data file is missing,
-        has another size (truncated) or another SHA-256 (altered).
+        The provenance file is missing, unreadable or of another shape (naming
+        the field), or a data file is missing, has another size (truncated) or
+        another SHA-256 (altered).
+    LimitError
+        The provenance file is larger than the ``file_mib`` limit of :mod:`softbend.limits`.
     """
     folder = Path(folder)
     record = folder / PROVENANCE_FILE
+    check_file_size(record)
     try:
         provenance = json.loads(record.read_text(encoding="utf-8"))
-        files = provenance["files"]
     except FileNotFoundError:
         raise DatasetError(f"The dataset file {str(record)!r} is missing.") from None
-    except (OSError, ValueError, KeyError, TypeError) as exc:
+    except RecursionError:
+        raise DatasetError(
+            f"The dataset file {str(record)!r} is not a softbend provenance record (its JSON "
+            "nests too deeply to be read)."
+        ) from None
+    except (OSError, ValueError) as exc:
         raise DatasetError(
             f"The dataset file {str(record)!r} is not a softbend provenance record ({exc})."
         ) from None
+    files = _provenance_files(provenance, record)
     for name, expected in files.items():
         path = folder / name
         if not path.is_file():
@@ -122,12 +271,67 @@ def verify_dataset(folder: str | os.PathLike[str]) -> dict[str, Any]:
                 f"The dataset file {str(path)!r} has {size} bytes, not the {expected['bytes']} "
                 "its provenance records (truncated or replaced)."
             )
-        if _sha256(path) != expected["sha256"]:
+        if _sha256(path) != expected["sha256"].lower():
             raise DatasetError(
                 f"The dataset file {str(path)!r} does not match the SHA-256 its provenance "
                 "records (altered or corrupt)."
             )
     return provenance
+
+
+def _dtype_kind(series: pd.Series) -> str:
+    """The kind of a column's dtype: "string", "float", "integer", "bool", "datetime" or other."""
+    import pandas as pd
+    from pandas.api import types
+
+    dtype = series.dtype
+    if types.is_bool_dtype(dtype):
+        return "bool"
+    if types.is_integer_dtype(dtype):
+        return "integer"
+    if types.is_float_dtype(dtype):
+        return "float"
+    if types.is_datetime64_any_dtype(dtype):
+        return "datetime"
+    if isinstance(dtype, pd.StringDtype):
+        return "string"
+    if types.is_object_dtype(dtype) and all(  # strings as objects (older pandas), None missing
+        isinstance(v, str) or v is None or (isinstance(v, float) and math.isnan(v))
+        for v in series.array
+    ):
+        return "string"
+    return str(dtype)
+
+
+def _check_table(table: pd.DataFrame, path: Path, kinds: dict[str, str], name: str) -> None:
+    """Raise :class:`DatasetError` naming ``path`` and the columns of another name or dtype."""
+    missing = [column for column in kinds if column not in table.columns]
+    if missing:
+        raise DatasetError(
+            f"The dataset file {str(path)!r} lacks the column(s) {', '.join(missing)}; "
+            f"the {name} table has {', '.join(kinds)}."
+        )
+    wrong = []
+    for column, kind in kinds.items():
+        found = _dtype_kind(table[column])
+        ok = found == kind or (kind == "float" and found == "integer")
+        if not ok:
+            wrong.append(f"{column} ({found}, expected {kind})")
+    if wrong:
+        raise DatasetError(
+            f"The dataset file {str(path)!r} has column(s) of another type: {', '.join(wrong)}."
+        )
+    for column, quantity in _COLUMN_QUANTITIES[name].items():
+        values = table[column].to_numpy(dtype="float64", na_value=math.nan)
+        row = implausible_index(values, quantity)
+        if row is not None:
+            bounds = RANGES[quantity]
+            unit = f" {bounds.unit}" if bounds.unit else ""
+            raise DatasetError(
+                f"The dataset file {str(path)!r}, row {row}, column '{column}': "
+                f"{values[row]:g} is not a plausible {bounds.label} (allowed {bounds.low:g} "
+                f"to {bounds.high:g}{unit})."
+            )
 
 
 def _read(folder: Path, name: str) -> pd.DataFrame:
@@ -136,7 +340,18 @@ def _read(folder: Path, name: str) -> pd.DataFrame:
     provenance = verify_dataset(folder)
     if name not in provenance["files"]:
         raise DatasetError(f"The dataset {str(folder)!r} has no {name!r} in its provenance.")
-    return pd.read_parquet(folder / name)
+    path = folder / name
+    try:
+        table = pd.read_parquet(path)
+    except (OSError, ValueError) as exc:  # pyarrow's errors derive from these
+        raise DatasetError(
+            f"The dataset file {str(path)!r} is not a Parquet table ({exc})."
+        ) from None
+    if name == SAMPLES_FILE:
+        _check_table(table, path, SAMPLE_COLUMN_KINDS, "samples")
+    elif name == DESIGNS_FILE:
+        _check_table(table, path, DESIGN_COLUMN_KINDS, "designs")
+    return table
 
 
 def table1_fem(folder: str | os.PathLike[str] | None = None) -> pd.DataFrame:
@@ -160,7 +375,10 @@ def table1_fem(folder: str | os.PathLike[str] | None = None) -> pd.DataFrame:
     Raises
     ------
     DatasetError
-        A file of the dataset is missing, truncated or altered.
+        A file of the dataset is missing, truncated or altered, its provenance
+        has another shape, or the table lacks a column of
+        :data:`SAMPLE_COLUMN_KINDS`, has one of another dtype or a physically
+        implausible value (naming the file and the column).
     """
     return _read(Path(folder) if folder is not None else _shipped(_TABLE1_FEM), SAMPLES_FILE)
 
@@ -172,6 +390,7 @@ def table1_fem_designs(folder: str | os.PathLike[str] | None = None) -> pd.DataF
     (``stop_kind`` one of "last pressure", "angle limit", "stretch limit",
     "inflation instability", "no convergence"; ``stop_region`` the part of the
     actuator a stretch or instability stop names, else empty; times in s).
+    Checked as :func:`table1_fem` is, the columns against :data:`DESIGN_COLUMN_KINDS`.
     """
     return _read(Path(folder) if folder is not None else _shipped(_TABLE1_FEM), DESIGNS_FILE)
 
@@ -197,8 +416,6 @@ def _stop_region(reason: str, kind: str) -> str:
 
 def _design_table(designs: pd.DataFrame) -> pd.DataFrame:
     """The campaign's designs table with its JSON stats unpacked into columns."""
-    from softbend.design import PARAMETERS
-
     stats = [json.loads(s) if isinstance(s, str) and s else {} for s in designs["stats"]]
     out = designs[["design_id", *PARAMETERS]].copy()
     out["status"] = designs["status"]
@@ -244,8 +461,10 @@ def write_dataset(
     db_path : path
         Campaign database (see :class:`softbend.campaign.CampaignStore`).
     out_dir : path
-        Folder of the dataset (created); its files are replaced atomically, the
-        provenance last, so a reader sees the old dataset or the new one.
+        Folder of the dataset (created). It is written beside its place and
+        swapped in whole when complete (:func:`softbend._io.staged_dir`), so a
+        reader, or a run that fails half-way, sees the old dataset or the new one;
+        an existing folder may hold only a dataset's three files.
     command : str
         The command that produced the campaign, recorded for reproduction.
     description : str
@@ -258,12 +477,26 @@ def write_dataset(
     -------
     dict
         The provenance record written.
+
+    Raises
+    ------
+    DatasetError
+        If the campaign has no run or no design yet, or ``out_dir`` holds other
+        files than a dataset's.
     """
     from softbend import __version__
+    from softbend._io import staged_dir
     from softbend.campaign.store import CampaignStore
 
     out = Path(out_dir)
-    out.mkdir(parents=True, exist_ok=True)
+    if out.is_dir():
+        others = sorted(p.name for p in out.iterdir() if p.name not in _DATASET_FILES)
+        if others:
+            raise DatasetError(
+                f"The dataset folder {out} holds other files than a dataset's "
+                f"({', '.join(others[:3])}{' …' if len(others) > 3 else ''}); it is replaced "
+                "as a whole: choose a new or empty folder."
+            )
     with CampaignStore(db_path, read_only=True) as store:
         samples = store.load_samples()
         designs = store.load_designs()
@@ -271,45 +504,65 @@ def write_dataset(
         runs = store.runs()
         backend = store.backend
         grid = store.pressures_mpa
+    if backend is None or grid is None or len(grid) == 0 or designs.empty:
+        raise DatasetError(
+            f"The campaign database {db_path} holds no finished run (backend, pressure grid "
+            "and designs): run 'softbend campaign run' on it before writing a dataset."
+        )
     table = _design_table(designs)
-    stats = [json.loads(s) for s in designs["stats"] if isinstance(s, str) and s]
+    stats = [_stats_record(s, db_path) for s in designs["stats"] if isinstance(s, str) and s]
     options = {json.dumps(s.get("options"), sort_keys=True) for s in stats if "options" in s}
     files: dict[str, dict[str, Any]] = {}
-    for name, frame in ((SAMPLES_FILE, samples), (DESIGNS_FILE, table)):
-        tmp = out / f".{name}.tmp"
-        frame.to_parquet(tmp, compression="zstd", index=False)
-        os.replace(tmp, out / name)
-        files[name] = {"bytes": (out / name).stat().st_size, "sha256": _sha256(out / name)}
-    done = table[table["status"] == "done"]
-    provenance = {
-        "name": "table1_fem",
-        "description": description,
-        "command": command,
-        "backend": backend,
-        "pressures_mpa": {
-            "first": float(grid[0]),
-            "last": float(grid[-1]),
-            "count": len(grid),
-        },
-        "designs": {
-            "planned": int(planned) if planned is not None else len(table),
-            "recorded": len(table),
-            "done": int(status["done"]),
-            "failed": int(status["failed"]),
-            "by_stop_kind": {str(k): int(v) for k, v in done["stop_kind"].value_counts().items()},
-        },
-        "samples": {"rows": len(samples), "converged": int(samples["converged"].sum())},
-        "cpu_time_s": float(done["wall_time_s"].sum()),
-        "cpu_time_note": "sum of the sweeps' wall times, each sweep on one thread",
-        "softbend_versions": sorted(set(table["softbend_version"])),
-        "options_sha256": sorted(set(table["options_sha256"]) - {""}),
-        "options": [json.loads(o) for o in sorted(options)],
-        "campaign_runs": runs,
-        "first_design_at": str(table["finished_at"].min()),
-        "last_design_at": str(table["finished_at"].max()),
-        "written_at": datetime.now(UTC).isoformat(timespec="seconds"),
-        "written_by": f"softbend {__version__}",
-        "files": files,
-    }
-    write_text_atomic(out / PROVENANCE_FILE, json_text(provenance) + "\n")
+    with staged_dir(out) as stage:
+        for name, frame in ((SAMPLES_FILE, samples), (DESIGNS_FILE, table)):
+            frame.to_parquet(stage / name, compression="zstd", index=False)
+            files[name] = {"bytes": (stage / name).stat().st_size, "sha256": _sha256(stage / name)}
+        done = table[table["status"] == "done"]
+        provenance = {
+            "name": "table1_fem",
+            "description": description,
+            "command": command,
+            "backend": backend,
+            "pressures_mpa": {
+                "first": float(grid[0]),
+                "last": float(grid[-1]),
+                "count": len(grid),
+            },
+            "designs": {
+                "planned": int(planned) if planned is not None else len(table),
+                "recorded": len(table),
+                "done": int(status["done"]),
+                "failed": int(status["failed"]),
+                "by_stop_kind": {
+                    str(k): int(v) for k, v in done["stop_kind"].value_counts().items()
+                },
+            },
+            "samples": {"rows": len(samples), "converged": int(samples["converged"].sum())},
+            "cpu_time_s": float(done["wall_time_s"].sum()),
+            "cpu_time_note": "sum of the sweeps' wall times, each sweep on one thread",
+            "softbend_versions": sorted(set(table["softbend_version"])),
+            "options_sha256": sorted(set(table["options_sha256"]) - {""}),
+            "options": [json.loads(o) for o in sorted(options)],
+            "campaign_runs": runs,
+            "first_design_at": str(table["finished_at"].min()),
+            "last_design_at": str(table["finished_at"].max()),
+            "written_at": datetime.now(UTC).isoformat(timespec="seconds"),
+            "written_by": f"softbend {__version__}",
+            "files": files,
+        }
+        write_text_atomic(stage / PROVENANCE_FILE, json_text(provenance) + "\n")
     return provenance
+
+
+def _stats_record(text: str, db_path: str | os.PathLike[str]) -> dict[str, Any]:
+    """One design's stored solver statistics (JSON object text), checked."""
+    try:
+        record = json.loads(text)
+    except (ValueError, RecursionError):
+        record = None
+    if not isinstance(record, dict):
+        raise DatasetError(
+            f"The campaign database {db_path} holds a design whose solver statistics are "
+            "not a JSON object; the database is damaged."
+        )
+    return record

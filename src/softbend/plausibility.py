@@ -13,6 +13,8 @@ quantity               range                why
                                             bursts any silicone actuator
 ``pressure_kpa``       -101.3 to 2000       the same in kPa
 ``length_mm``          0 to 10 000          geometry, tip coordinates' magnitude
+``fiber_angle_deg``    0 to 90              winding angle from the circumferential
+                                            direction (paper B Table 1: 5 to 15)
 ``coordinate_mm``      -10 000 to 10 000    tip positions
 ``time_s``             0 to 1e7             about four months of recording
 ``stress_mpa``         -1000 to 1000        silicones reach a few MPa
@@ -27,7 +29,7 @@ A pressure column whose values fit kPa but not MPa gets a hint to that effect.
 
 from __future__ import annotations
 
-from collections.abc import Sequence
+from collections.abc import Callable, Sequence
 from dataclasses import dataclass
 
 import numpy as np
@@ -35,7 +37,7 @@ from numpy.typing import ArrayLike
 
 from softbend.errors import DatasetError
 
-__all__ = ["RANGES", "Range", "check_plausible", "implausible_index"]
+__all__ = ["RANGES", "Range", "check_plausible", "implausible_index", "implausible_text"]
 
 
 @dataclass(frozen=True)
@@ -53,6 +55,7 @@ RANGES: dict[str, Range] = {
     "pressure_mpa": Range(-0.1013, 2.0, "MPa", "gauge pressure"),
     "pressure_kpa": Range(-101.3, 2000.0, "kPa", "gauge pressure"),
     "length_mm": Range(0.0, 10_000.0, "mm", "length"),
+    "fiber_angle_deg": Range(0.0, 90.0, "°", "fiber winding angle"),
     "coordinate_mm": Range(-10_000.0, 10_000.0, "mm", "position"),
     "time_s": Range(0.0, 1e7, "s", "time"),
     "stress_mpa": Range(-1000.0, 1000.0, "MPa", "stress"),
@@ -76,6 +79,24 @@ def implausible_index(values: ArrayLike, quantity: str) -> int | None:
     return int(hits[0]) if hits.size else None
 
 
+def implausible_text(value: float, quantity: str) -> str | None:
+    """Why ``value`` is not a plausible ``quantity``, in words, or None if it is.
+
+    For a single field (of a JSON or TOML file) whose caller names it itself.
+    """
+    if implausible_index([value], quantity) is None:
+        return None
+    bounds = _range(quantity)
+    unit = f" {bounds.unit}" if bounds.unit else ""
+    hint = ""
+    if quantity == "pressure_mpa" and 2.0 < abs(value) <= 2000.0:
+        hint = " It looks like kPa: divide by 1000 for MPa."
+    return (
+        f"{value:g} is not a plausible {bounds.label} "
+        f"(allowed {bounds.low:g} to {bounds.high:g}{unit}).{hint}"
+    )
+
+
 def check_plausible(
     values: ArrayLike,
     quantity: str,
@@ -84,6 +105,7 @@ def check_plausible(
     column: str,
     lines: Sequence[int] | None = None,
     first_line: int = 2,
+    where: Callable[[int], str] | None = None,
 ) -> None:
     """Raise :class:`~softbend.errors.DatasetError` at the first implausible value.
 
@@ -102,21 +124,19 @@ def check_plausible(
         header is line 1 and whose rows follow without gaps).
     first_line : int, default 2
         The line of the first value when ``lines`` is not given.
+    where : callable, optional
+        ``where(index)`` places a value in words instead of a line (e.g. ``"row 3"``
+        of a table in memory, or ``"field 'sigma'"`` of a JSON file).
     """
     index = implausible_index(values, quantity)
     if index is None:
         return
-    bounds = _range(quantity)
     value = float(np.asarray(values, dtype=np.float64).ravel()[index])
-    line = lines[index] if lines is not None else first_line + index
-    unit = f" {bounds.unit}" if bounds.unit else ""
-    hint = ""
-    if quantity == "pressure_mpa" and 2.0 < abs(value) <= 2000.0:
-        hint = " It looks like kPa: divide by 1000 for MPa."
-    raise DatasetError(
-        f"{source}, line {line}, column '{column}': {value:g} is not a plausible "
-        f"{bounds.label} (allowed {bounds.low:g} to {bounds.high:g}{unit}).{hint}"
-    )
+    if where is not None:
+        place = where(index)
+    else:
+        place = f"line {lines[index] if lines is not None else first_line + index}"
+    raise DatasetError(f"{source}, {place}, column '{column}': {implausible_text(value, quantity)}")
 
 
 def _range(quantity: str) -> Range:

@@ -22,6 +22,8 @@ from softbend.campaign.runner import parse_scheduler_address
 from softbend.design import DesignSpace, SFRBADesign
 from softbend.errors import SchemaError, SoftbendError
 
+from ..stand_ins import web_server
+
 
 def _rows_per_design(path: Path) -> dict[str, tuple[int, int]]:
     """``{design_id: (rows in designs, rows in samples)}`` straight from the database."""
@@ -502,3 +504,116 @@ def test_a_scheduler_address_that_is_not_dask_ends_in_one_line_within_the_deadli
         thread.join()
         server.close()
     assert "\n" not in str(info.value)
+
+
+def test_a_web_server_at_the_scheduler_address_is_named_and_leaves_no_client(
+    tmp_path, designs, grid, monkeypatch
+):
+    import gc
+
+    distributed = pytest.importorskip("distributed")
+    made = []
+    real_client = distributed.Client
+
+    class CountingClient(real_client):
+        def __init__(self, *args, **kwargs):
+            made.append(args)
+            super().__init__(*args, **kwargs)
+
+    monkeypatch.setattr(distributed, "Client", CountingClient)
+    unraisable = []
+    monkeypatch.setattr(sys, "unraisablehook", unraisable.append)
+    port, close = web_server()
+    address = f"tcp://127.0.0.1:{port}"
+    start = time.monotonic()
+    try:
+        with pytest.raises(SoftbendError) as info:
+            run_campaign(
+                tmp_path / "c.duckdb",
+                designs[:2],
+                pressures_mpa=grid,
+                scheduler=address,
+                connect_timeout_s=1.0,
+            )
+    finally:
+        close()
+    message = str(info.value)
+    assert message.startswith(f"The '--scheduler' {address} did not answer as a Dask scheduler")
+    assert "another protocol, e.g. HTTP" in message and "EiB" not in message
+    assert time.monotonic() - start < 5
+    assert made == []  # refused before any Dask client was made
+    del info
+    gc.collect()
+    assert unraisable == []
+    assert not (tmp_path / "c.duckdb").exists()
+
+
+_START_A_CLIENT = """
+import sys
+from distributed import Client
+from softbend.campaign.executors import _closing_client
+try:
+    _closing_client(Client)(sys.argv[1], timeout=1, set_as_default=False)
+except Exception as exc:  # Dask's own error: a 3 EiB message length
+    print(type(exc).__name__)
+"""
+
+
+def test_a_dask_client_that_fails_to_start_closes_itself():
+    pytest.importorskip("distributed")
+    # In a process of its own: a half-started client fails in its destructor only when
+    # the interpreter exits ("Exception ignored in Client.__del__", a traceback).
+    port, close = web_server()
+    try:
+        done = subprocess.run(
+            [sys.executable, "-c", _START_A_CLIENT, f"tcp://127.0.0.1:{port}"],
+            capture_output=True,
+            text=True,
+            timeout=120,
+        )
+    finally:
+        close()
+    assert done.returncode == 0 and done.stdout.strip(), done.stderr
+    assert "Exception ignored" not in done.stderr and "Traceback" not in done.stderr
+
+
+def test_a_dask_worker_address_is_not_taken_for_the_scheduler(tmp_path, designs, grid):
+    distributed = pytest.importorskip("distributed")
+    with distributed.LocalCluster(
+        n_workers=1,
+        threads_per_worker=1,
+        processes=False,
+        protocol="tcp",
+        host="127.0.0.1",
+        dashboard_address=None,
+    ) as cluster:
+        worker = next(iter(cluster.scheduler_info["workers"]))
+        with pytest.raises(SoftbendError, match=r"did not answer as a Dask scheduler \(it is a"):
+            run_campaign(tmp_path / "c.duckdb", designs[:2], pressures_mpa=grid, scheduler=worker)
+    assert not (tmp_path / "c.duckdb").exists()
+
+
+@pytest.mark.parametrize(
+    ("content", "needle"),
+    [
+        ("[" * 100_000, "(nested too deeply)"),
+        ("null", "Got a JSON value instead"),
+        ('{"address": ["tcp://10.0.0.5:8786"]}', "Got 'address' ['tcp://10.0.0.5:8786']"),
+    ],
+)
+def test_a_damaged_scheduler_file_is_one_value_error(tmp_path, content, needle):
+    scheduler_file = tmp_path / "scheduler.json"
+    scheduler_file.write_text(content)
+    with pytest.raises(ValueError, match=r"The Dask scheduler file .* \(--scheduler\)") as info:
+        parse_scheduler_address(str(scheduler_file))
+    assert needle in str(info.value)
+
+
+def test_a_huge_scheduler_file_is_refused_by_the_file_size_limit(tmp_path, monkeypatch):
+    from softbend.errors import LimitError
+
+    monkeypatch.setenv("SOFTBEND_MAX_FILE_MIB", "1")
+    scheduler_file = tmp_path / "scheduler.json"
+    scheduler_file.write_text('{"address": "tcp://10.0.0.5:8786", "x": "' + "a" * 2**21 + '"}')
+    with pytest.raises(LimitError, match="SOFTBEND_MAX_FILE_MIB"):
+        parse_scheduler_address(str(scheduler_file))

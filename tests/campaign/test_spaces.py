@@ -12,6 +12,7 @@ from softbend.campaign.spaces import (
     check_footprint,
     parse_space,
 )
+from softbend.errors import LimitError
 
 
 @pytest.mark.parametrize(
@@ -24,8 +25,37 @@ def test_the_size_is_known_before_any_design_is_built(text, kind, n):
     assert len(spec.build(seed=1)) == n
 
 
-def test_a_huge_space_is_read_without_being_built():
+def test_a_huge_space_is_read_without_being_built(monkeypatch):
+    monkeypatch.setenv("SOFTBEND_MAX_DESIGNS", str(10**13))
     assert parse_space("sobol:1000000000000").n_designs == 10**12
+
+
+@pytest.mark.parametrize("text", ["lhs:99999999999999999999", "sobol:1000001"])
+def test_a_space_over_the_designs_limit_is_one_limit_error(text):
+    with pytest.raises(LimitError) as err:
+        parse_space(text, option="--space", owner="cmd")
+    message = str(err.value)
+    assert message.startswith(f"The '--space' {text} is ")
+    assert "more than the limit of 1,000,000 designs" in message
+    assert "SOFTBEND_MAX_DESIGNS" in message and "\n" not in message
+
+
+def test_a_number_of_thousands_of_digits_is_the_same_limit_error():
+    text = "lhs:" + "9" * 5000  # more digits than Python reads as an integer
+    with pytest.raises(LimitError, match="a number of 5,000 digits, more than the limit") as err:
+        parse_space(text, option="--space", owner="cmd")
+    assert "SOFTBEND_MAX_DESIGNS" in str(err.value) and len(str(err.value)) < 300
+
+
+def test_the_designs_limit_is_raised_by_its_variable(monkeypatch):
+    monkeypatch.setenv("SOFTBEND_MAX_DESIGNS", "2000000")
+    assert parse_space("lhs:1500000").n_designs == 1_500_000
+    monkeypatch.setenv("SOFTBEND_MAX_DESIGNS", "10")
+    assert parse_space("lhs:0010").n_designs == 10
+    with pytest.raises(LimitError, match="more than the limit of 10 designs"):
+        parse_space("table1")
+    with pytest.raises(LimitError, match="more than the limit of 10 designs"):
+        parse_space("corners")
 
 
 @pytest.mark.parametrize("text", ["LHS:3", "Table1", " lhs:3", "lhs:0", "lhs:", "grid:5", "lhs:-3"])

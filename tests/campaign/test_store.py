@@ -387,3 +387,202 @@ def test_a_damaged_samples_block_is_found_when_opening_not_on_a_later_query(tmp_
     broken.write_bytes(bytes(corrupt))
     with pytest.raises(SchemaError, match=r"not a readable .*\(Corrupt database file: "):
         CampaignStore(broken, read_only=True)
+
+
+# -- merging shards all or nothing, failed writes, damaged metadata -----------------
+
+
+def _shard(path, *designs, grid=GRID, backend="analytical"):
+    with CampaignStore(path) as opened:
+        opened.bind(backend, grid)
+        for design in designs:
+            if backend == "analytical":
+                opened.record_success(_sweep(design, grid))
+            else:
+                opened.record_failure(design, "RuntimeError: lost", 1.0)
+    return path
+
+
+def test_merge_campaigns_takes_every_shard_in_one_replacement(tmp_path):
+    from softbend.campaign.store import merge_campaigns
+
+    shards = [_shard(tmp_path / "a.duckdb", A), _shard(tmp_path / "b.duckdb", B)]
+    empty = tmp_path / "never-ran.duckdb"
+    CampaignStore(empty).close()
+    target = tmp_path / "m.duckdb"
+    counts = merge_campaigns(target, [*shards, empty])
+    assert [c["added"] for c in counts] == [1, 1, 0]
+    assert len(load_samples(target)) == 2 * len(GRID)
+    assert sorted(p.name for p in tmp_path.iterdir()) == [
+        "a.duckdb",
+        "b.duckdb",
+        "m.duckdb",
+        "never-ran.duckdb",
+    ]
+    assert merge_campaigns(target, shards) == [
+        {"added": 0, "replaced_failed": 0, "kept": 1},
+        {"added": 0, "replaced_failed": 0, "kept": 1},
+    ]
+
+
+@pytest.mark.parametrize(
+    ("make_bad", "error", "needle"),
+    [
+        (
+            lambda p: _shard(p, B, grid=default_pressures_mpa(0.5, 0.1)),
+            ValueError,
+            "The 'pressures_mpa' of the campaign in",
+        ),
+        (lambda p: _shard(p, B, backend="fem"), ValueError, "The backend of the campaign in"),
+        (
+            lambda p: p.write_bytes(_shard(p, B).read_bytes()[:600000]),
+            SchemaError,
+            "is not a readable softbend campaign database",
+        ),
+        (lambda p: p.write_text("design_id\nx\n"), SchemaError, "not a DuckDB database file"),
+    ],
+    ids=["another grid", "another backend", "truncated", "not a database"],
+)
+def test_merge_campaigns_checks_every_shard_before_writing(tmp_path, make_bad, error, needle):
+    from softbend.campaign.store import merge_campaigns
+
+    good, bad = _shard(tmp_path / "a.duckdb", A), tmp_path / "bad.duckdb"
+    make_bad(bad)
+    target = tmp_path / "m.duckdb"
+    with pytest.raises(error, match=needle) as info:
+        merge_campaigns(target, [good, bad])
+    assert str(bad) in str(info.value)
+    assert not target.exists()  # not even the first shard was merged
+    merge_campaigns(target, [good])
+    before = target.read_bytes()
+    with pytest.raises(error, match=needle):
+        merge_campaigns(target, [bad])
+    assert target.read_bytes() == before
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["a.duckdb", "bad.duckdb", "m.duckdb"]
+
+
+def test_merge_campaigns_refuses_its_own_target_and_no_shards(tmp_path):
+    from softbend.campaign.store import merge_campaigns
+
+    target = _shard(tmp_path / "m.duckdb", A)
+    before = target.read_bytes()
+    with pytest.raises(ValueError, match="merged into itself"):
+        merge_campaigns(target, [_shard(tmp_path / "b.duckdb", B), tmp_path / "." / "m.duckdb"])
+    with pytest.raises(ValueError, match="at least one"):
+        merge_campaigns(target, [])
+    with pytest.raises(FileNotFoundError, match="No campaign database"):
+        merge_campaigns(target, [tmp_path / "missing.duckdb"])
+    assert target.read_bytes() == before
+
+
+@pytest.mark.parametrize(
+    ("text", "expected"),
+    [
+        (
+            'TransactionContext Error: Failed to commit: Could not write file "/d/c.duckdb.wal": '
+            "No space left on device",
+            (28, "No space left on device"),
+        ),
+        (
+            'IO Error: Async write failed: {"exception_type":"IO","exception_message":"Could not '
+            'write file \\".x.tmp\\": No space left on device","errno":"28"}',
+            (28, "No space left on device"),
+        ),
+        ('IO Error: Could not write file "/d/c.duckdb": File too large', (27, "File too large")),
+        ('IO Error: Could not write file "/d/c.duckdb": Odd failure', (5, "Odd failure")),
+        ('IO Error: Could not read file "/d/c.duckdb": Input/output error', None),
+        ("Binder Error: Referenced column x not found", None),
+    ],
+    ids=["commit", "async json", "file size", "unknown reason", "a read", "no write"],
+)
+def test_a_failed_write_of_duckdb_is_the_os_error_naming_the_output(text, expected):
+    from softbend.campaign.schema import write_error
+
+    found = write_error(duckdb.IOException(text), "/out/x.parquet")
+    if expected is None:
+        assert found is None
+    else:
+        assert isinstance(found, OSError)
+        assert (found.errno, found.strerror, found.filename) == (*expected, "/out/x.parquet")
+
+
+def test_a_merge_that_cannot_be_checkpointed_leaves_the_target(tmp_path, monkeypatch):
+    """A checkpoint that fails on closing is silent in DuckDB: the merge must not be lost."""
+    from softbend.campaign.store import merge_campaigns
+
+    target = _shard(tmp_path / "m.duckdb", A)
+    before = target.read_bytes()
+    shard = _shard(tmp_path / "b.duckdb", B)
+    real_execute = duckdb.DuckDBPyConnection.execute
+
+    def execute(con, query, *args, **kwargs):
+        if query == "FORCE CHECKPOINT":
+            raise duckdb.IOException('IO Error: Could not write file "x": No space left on device')
+        return real_execute(con, query, *args, **kwargs)
+
+    try:
+        monkeypatch.setattr(duckdb.DuckDBPyConnection, "execute", execute)
+    except TypeError:  # pragma: no cover - a DuckDB whose connection class is closed
+        pytest.skip("this DuckDB's connection methods cannot be replaced")
+    with pytest.raises(OSError, match="No space left on device") as info:
+        merge_campaigns(target, [shard])
+    assert info.value.filename == str(target)
+    monkeypatch.undo()
+    assert target.read_bytes() == before
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["b.duckdb", "m.duckdb"]
+
+
+@pytest.mark.parametrize(
+    ("key", "value"),
+    [
+        ("pressures_mpa", "[0.0, 0.1"),
+        ("pressures_mpa", '"0.1"'),
+        ("pressures_mpa", "[0.0, true]"),
+        ("pressures_mpa", "[0.0, -0.1]"),
+        ("pressures_mpa", "[[0.0], [0.1]]"),
+    ],
+)
+def test_a_damaged_stored_grid_is_a_schema_error_on_opening(tmp_path, key, value):
+    path = _shard(tmp_path / "c.duckdb", A)
+    con = duckdb.connect(str(path))
+    con.execute("UPDATE meta SET value = ? WHERE key = ?", [value, key])
+    con.close()
+    for read_only in (True, False):
+        with pytest.raises(SchemaError, match=f"has a damaged {key!r} in its 'meta' table"):
+            CampaignStore(path, read_only=read_only)
+
+
+def test_damaged_runs_and_planned_counts_are_schema_errors(tmp_path):
+    path = _shard(tmp_path / "c.duckdb", A)
+    con = duckdb.connect(str(path))
+    con.execute("INSERT INTO meta VALUES ('runs', '{\"a\": 1}'), ('n_designs_planned', 'x')")
+    con.close()
+    with CampaignStore(path, read_only=True) as opened:
+        with pytest.raises(SchemaError, match="damaged 'runs'"):
+            opened.runs()
+        with pytest.raises(SchemaError, match="damaged 'n_designs_planned'"):
+            opened.status_summary()
+
+
+def _left_with_a_log(path, *designs):
+    """A campaign whose last writes are only in its write-ahead log (as after a kill)."""
+    opened = CampaignStore(path)
+    opened.bind("analytical", GRID)
+    for design in designs:
+        opened.record_success(_sweep(design))
+    opened._con.execute("PRAGMA disable_checkpoint_on_shutdown")
+    opened._con.close()
+    assert (path.parent / f"{path.name}.wal").stat().st_size > 0
+    return path
+
+
+def test_merge_campaigns_keeps_what_only_the_write_ahead_logs_hold(tmp_path):
+    from softbend.campaign.store import merge_campaigns
+
+    target = _left_with_a_log(tmp_path / "m.duckdb", A)
+    shard = _left_with_a_log(tmp_path / "s.duckdb", B)
+    assert merge_campaigns(target, [shard]) == [{"added": 1, "replaced_failed": 0, "kept": 0}]
+    with CampaignStore(target, read_only=True) as merged:
+        assert merged.finished_ids() == {A.design_id, B.design_id}
+    assert len(load_samples(target)) == 2 * len(GRID)
+    assert not (tmp_path / "m.duckdb.wal").exists()

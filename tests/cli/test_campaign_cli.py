@@ -10,9 +10,11 @@ import duckdb
 import pandas as pd
 import pytest
 
-from softbend.campaign import CampaignStore, load_samples
+from softbend.campaign import CampaignStore, default_pressures_mpa, load_samples
 from softbend.cli import main
+from softbend.design import SFRBADesign
 
+from ..stand_ins import web_server
 from .conftest import one_error_line
 
 RUN = ["--space", "lhs:6", "--seed", "3", "--pmax", "0.1", "--pstep", "0.05"]
@@ -360,10 +362,11 @@ def roomy_machine(monkeypatch):
 
 
 def test_a_large_space_needs_allow_large_and_is_refused_before_any_design(
-    tmp_path, capsys, roomy_machine
+    tmp_path, capsys, roomy_machine, monkeypatch
 ):
     import time
 
+    monkeypatch.setenv("SOFTBEND_MAX_DESIGNS", str(10**13))
     db = tmp_path / "c.duckdb"
     start = time.monotonic()
     assert main(["campaign", "run", str(db), "--space", "lhs:10000000"]) == 2
@@ -375,7 +378,8 @@ def test_a_large_space_needs_allow_large_and_is_refused_before_any_design(
     assert not db.exists()
 
 
-def test_a_space_that_does_not_fit_is_refused_even_with_allow_large(tmp_path, capsys):
+def test_a_space_that_does_not_fit_is_refused_even_with_allow_large(tmp_path, capsys, monkeypatch):
+    monkeypatch.setenv("SOFTBEND_MAX_DESIGNS", str(10**13))
     db = tmp_path / "c.duckdb"
     argv = ["campaign", "run", str(db), "--space", "sobol:1000000000000", "--allow-large"]
     assert main(argv) == 2
@@ -385,8 +389,316 @@ def test_a_space_that_does_not_fit_is_refused_even_with_allow_large(tmp_path, ca
     assert not db.exists()
 
 
-def test_dataset_records_a_huge_planned_space_without_building_it(campaign_db, tmp_path, capsys):
+def test_dataset_records_a_huge_planned_space_without_building_it(
+    campaign_db, tmp_path, capsys, monkeypatch
+):
     out = tmp_path / "ds"
     argv = ["campaign", "dataset", str(campaign_db), str(out), "--command", "x"]
+    assert main([*argv, "--space", "sobol:1000000000000", "--json"]) == 2
+    assert "SOFTBEND_MAX_DESIGNS" in one_error_line(capsys)
+    assert not out.exists()
+    monkeypatch.setenv("SOFTBEND_MAX_DESIGNS", str(10**13))
     assert main([*argv, "--space", "sobol:1000000000000", "--json"]) == 0
     assert json.loads(capsys.readouterr().out)["designs"]["planned"] == 10**12
+
+
+# -- bad input and faults: one line, nothing half-written ---------------------------
+
+
+@pytest.mark.parametrize(
+    "space",
+    ["lhs:99999999999999999999", "sobol:99999999999999999999", "lhs:" + "7" * 5000],
+    ids=["lhs", "sobol", "5000 digits"],
+)
+def test_a_space_over_the_designs_limit_is_one_line_before_anything(tmp_path, capsys, space):
+    db = tmp_path / "c.duckdb"
+    for extra in ([], ["--allow-large"], ["--shard", "1/4"]):
+        assert main(["campaign", "run", str(db), "--space", space, *extra]) == 2
+        line = one_error_line(capsys)
+        assert line.startswith(f"softbend: error: The '--space' {space[:30]}")
+        assert "more than the limit of 1,000,000 designs" in line
+        assert "set SOFTBEND_MAX_DESIGNS higher" in line
+    assert not db.exists()
+    out = tmp_path / "ds"
+    argv = ["campaign", "dataset", str(db), str(out), "--command", "x", "--space", space]
+    db.write_bytes(b"")  # the space is refused before the database is read
+    assert main(argv) == 2
+    assert "SOFTBEND_MAX_DESIGNS" in one_error_line(capsys)
+    assert not out.exists()
+
+
+def test_a_negative_seed_names_the_option(tmp_path, capsys):
+    db = tmp_path / "c.duckdb"
+    assert main(["campaign", "run", str(db), "--space", "lhs:3", "--seed", "-1"]) == 2
+    assert "The '--seed' of softbend campaign run must be an integer >= 0. Got -1" in (
+        one_error_line(capsys)
+    )
+    assert not db.exists()
+
+
+def _run_shard(db, *extra):
+    assert main(["campaign", "run", str(db), *RUN, "--workers", "0", "--json", *extra]) == 0
+
+
+@pytest.mark.parametrize(
+    ("second", "needle"),
+    [
+        (["--pmax", "0.2"], "The 'pressures_mpa' of the campaign in"),
+        (["--backend", "fem"], "The backend of the campaign in"),
+        (None, "is not a readable softbend campaign database (truncated"),
+    ],
+    ids=["another grid", "another backend", "truncated"],
+)
+def test_a_merge_with_one_bad_shard_writes_nothing(tmp_path, capsys, monkeypatch, second, needle):
+    first, bad = tmp_path / "s0.duckdb", tmp_path / "s1.duckdb"
+    _run_shard(first, "--shard", "0/2")
+    if second is None:
+        _run_shard(bad, "--shard", "1/2")
+        data = bad.read_bytes()
+        bad.write_bytes(data[: len(data) // 2])
+    elif "fem" in second:
+        from softbend.campaign import CampaignStore
+
+        with CampaignStore(bad) as store:  # a shard of the FEM, without running one
+            store.bind("fem", default_pressures_mpa(0.1, 0.05))
+            store.record_failure(SFRBADesign(100, 6, 2, 2, 5, 8), "RuntimeError: x", 1.0)
+    else:
+        _run_shard(bad, "--shard", "1/2", *second)
+    capsys.readouterr()
+    merged = tmp_path / "merged.duckdb"
+    assert main(["campaign", "merge", str(merged), str(first), str(bad)]) == 2
+    line = one_error_line(capsys)
+    assert needle in line and str(bad) in line
+    assert not merged.exists()
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["s0.duckdb", "s1.duckdb"]
+    # A database merged into before is left exactly as it was.
+    assert main(["campaign", "merge", str(merged), str(first), "--json"]) == 0
+    capsys.readouterr()
+    before = merged.read_bytes()
+    assert main(["campaign", "merge", str(merged), str(first), str(bad)]) == 2
+    assert needle in one_error_line(capsys)
+    assert merged.read_bytes() == before
+    assert sorted(p.name for p in tmp_path.iterdir()) == [
+        "merged.duckdb",
+        "s0.duckdb",
+        "s1.duckdb",
+    ]
+
+
+def test_a_merge_into_a_campaign_of_another_grid_writes_nothing(tmp_path, capsys):
+    target, shard = tmp_path / "t.duckdb", tmp_path / "s.duckdb"
+    _run_shard(target, "--pmax", "0.2")
+    _run_shard(shard)
+    capsys.readouterr()
+    before = target.read_bytes()
+    assert main(["campaign", "merge", str(target), str(shard)]) == 2
+    line = one_error_line(capsys)
+    assert f"The 'pressures_mpa' of the campaign in {str(shard)!r}" in line
+    assert f"those of {str(target)!r} 5 pressures from 0 to 0.2 MPa" in line
+    assert target.read_bytes() == before
+
+
+#: Runs softbend's CLI in a process whose files may not grow beyond a size: a real
+#: write failure of DuckDB's (EFBIG, as a full disk gives ENOSPC), not a mock.
+_SMALL_FILES = """
+import resource, signal, sys
+signal.signal(signal.SIGXFSZ, signal.SIG_IGN)
+from softbend.cli import main
+resource.setrlimit(resource.RLIMIT_FSIZE, (int(sys.argv[1]), resource.RLIM_INFINITY))
+sys.exit(main(sys.argv[2:]))
+"""
+
+
+def _with_small_files(max_bytes, *argv, cwd):
+    import subprocess
+    import sys
+
+    return subprocess.run(
+        [sys.executable, "-c", _SMALL_FILES, str(max_bytes), *argv],
+        capture_output=True,
+        text=True,
+        cwd=cwd,
+        timeout=120,
+    )
+
+
+@pytest.fixture(scope="module")
+def larger_campaign_db(tmp_path_factory):
+    db = tmp_path_factory.mktemp("larger") / "c.duckdb"
+    assert main(["campaign", "run", str(db), "--space", "lhs:60", "--workers", "0", "--json"]) == 0
+    return db
+
+
+def test_a_failed_write_of_an_export_is_one_line_and_leaves_no_file(
+    larger_campaign_db, tmp_path, capsys
+):
+    capsys.readouterr()
+    out_dir = tmp_path / "exports"
+    out_dir.mkdir()
+    (out_dir / "old.csv").write_text("design_id\nkept\n")
+    argv = ["campaign", "export", str(larger_campaign_db)]
+    done = _with_small_files(10_000, *argv, "new.parquet", cwd=out_dir)
+    assert done.returncode == 2, done.stderr
+    assert done.stderr.strip() == (
+        "softbend: error: The 'OUT' new.parquet could not be written: File too large."
+    )
+    done = _with_small_files(10_000, *argv, "old.csv", cwd=out_dir)
+    assert done.returncode == 2, done.stderr
+    assert done.stderr.strip() == (
+        "softbend: error: The 'OUT' old.csv could not be written: File too large."
+    )
+    assert sorted(p.name for p in out_dir.iterdir()) == ["old.csv"]  # no temporary file left
+    assert (out_dir / "old.csv").read_text() == "design_id\nkept\n"
+
+
+def test_a_failed_write_of_a_merge_leaves_the_previous_database(
+    larger_campaign_db, tmp_path, capsys
+):
+    capsys.readouterr()
+    folder = tmp_path / "m"
+    folder.mkdir()
+    assert main(["campaign", "merge", str(folder / "m.duckdb"), str(larger_campaign_db)]) == 0
+    capsys.readouterr()
+    before = (folder / "m.duckdb").read_bytes()
+    other = tmp_path / "other.duckdb"  # more designs on the same grid: the merged file grows
+    argv = ["campaign", "run", str(other), "--space", "lhs:20", "--seed", "9", "--workers", "0"]
+    assert main([*argv, "--json"]) == 0
+    done = _with_small_files(len(before), "campaign", "merge", "m.duckdb", str(other), cwd=folder)
+    assert done.returncode == 2, done.stderr
+    assert done.stderr.strip() == (
+        "softbend: error: The 'DB' m.duckdb could not be written: File too large."
+    )
+    assert (folder / "m.duckdb").read_bytes() == before
+    assert sorted(p.name for p in folder.iterdir()) == ["m.duckdb"]
+    # Into a new database: nothing at all is left.
+    done = _with_small_files(20_000, "campaign", "merge", "new.duckdb", str(other), cwd=folder)
+    assert done.returncode == 2, done.stderr
+    assert "The 'DB' new.duckdb could not be written: File too large." in done.stderr
+    assert sorted(p.name for p in folder.iterdir()) == ["m.duckdb"]
+
+
+def test_a_failed_write_of_a_run_is_one_line_and_the_run_resumes(tmp_path, capsys):
+    argv = ["campaign", "run", "c.duckdb", "--space", "lhs:60", "--workers", "0", "--json"]
+    done = _with_small_files(5_000, *argv, cwd=tmp_path)  # not even the empty database fits
+    assert done.returncode == 2, done.stderr
+    assert done.stderr.strip() == (
+        "softbend: error: The 'DB' c.duckdb could not be written: File too large."
+    )
+    assert list(tmp_path.iterdir()) == []  # no half-made database
+    done = _with_small_files(150_000, *argv, cwd=tmp_path)  # full after some designs
+    assert done.returncode == 2, done.stderr
+    lines = [line for line in done.stderr.splitlines() if line.startswith("softbend:")]
+    assert lines == ["softbend: error: The 'DB' c.duckdb could not be written: File too large."]
+    assert "Traceback" not in done.stderr
+    # What was recorded is kept: the same command, with room, resumes and finishes.
+    assert main(["campaign", "run", str(tmp_path / "c.duckdb"), *argv[3:]]) == 0
+    summary = json.loads(capsys.readouterr().out)
+    assert summary["n_skipped_done"] > 0
+    assert summary["n_skipped_done"] + summary["n_done"] == 60
+
+
+def test_an_http_server_as_scheduler_is_one_line_and_no_destructor_traceback(tmp_path):
+    import subprocess
+    import sys
+
+    # In a process of its own: a half-made Dask client failed in its destructor only
+    # when the interpreter exited, after the error line.
+    port, close = web_server()
+    address = f"tcp://127.0.0.1:{port}"
+    argv = ["campaign", "run", "c.duckdb", *RUN, "--scheduler", address, "--connect-timeout", "1"]
+    try:
+        done = subprocess.run(
+            [
+                sys.executable,
+                "-c",
+                "import sys; from softbend.cli import main; sys.exit(main(sys.argv[1:]))",
+                *argv,
+            ],
+            capture_output=True,
+            text=True,
+            cwd=tmp_path,
+            timeout=120,
+        )
+    finally:
+        close()
+    assert done.returncode == 2
+    lines = done.stderr.strip().splitlines()
+    assert len(lines) == 1, done.stderr
+    assert lines[0].startswith(
+        f"softbend: error: The '--scheduler' {address} did not answer as a Dask scheduler"
+    )
+    assert "EiB" not in lines[0]
+    assert list(tmp_path.iterdir()) == []
+
+
+@pytest.mark.parametrize(
+    ("content", "needle"),
+    [
+        ("[" * 100_000, "not JSON (nested too deeply)"),
+        ('["tcp://127.0.0.1:8786"]', "Got a JSON array instead"),
+        ('{"address": 8786}', "Got 'address' 8786 instead"),
+        ('{"adress": "tcp://127.0.0.1:8786"}', "Got no 'address' instead"),
+        ("\xff\xfe garbage", "not JSON"),
+    ],
+    ids=["deep", "array", "number", "misspelt", "binary"],
+)
+def test_a_bad_scheduler_file_is_one_line_naming_it(tmp_path, capsys, content, needle):
+    scheduler = tmp_path / "scheduler.json"
+    scheduler.write_bytes(content.encode("latin-1"))
+    db = tmp_path / "c.duckdb"
+    assert main(["campaign", "run", str(db), *RUN, "--scheduler", str(scheduler)]) == 2
+    line = one_error_line(capsys)
+    assert f"The Dask scheduler file {str(scheduler)!r} (--scheduler)" in line
+    assert needle in line
+    assert not db.exists()
+
+
+def test_a_dataset_of_a_campaign_that_never_ran_is_one_line_and_writes_nothing(tmp_path, capsys):
+    from softbend.campaign import CampaignStore
+
+    db = tmp_path / "empty.duckdb"
+    CampaignStore(db).close()
+    out = tmp_path / "ds"
+    assert main(["campaign", "dataset", str(db), str(out), "--command", "x"]) == 2
+    assert f"The campaign database {db} holds no finished run" in one_error_line(capsys)
+    assert not out.exists()
+
+
+_EVERY_READER = ("status", "run", "merge", "export", "dataset")
+
+
+@pytest.mark.parametrize(
+    ("key", "value", "readers"),
+    [
+        ("pressures_mpa", "not json", _EVERY_READER),
+        ("pressures_mpa", '{"a": 1}', _EVERY_READER),
+        ("pressures_mpa", "[0.1, 0.0]", _EVERY_READER),
+        ("pressures_mpa", "[" * 100_000, _EVERY_READER),
+        ("runs", '{"a": 1}', ("merge", "dataset")),
+        ("runs", "[1, 2]", ("merge", "dataset")),
+        ("n_designs_planned", "many", ("status", "dataset")),
+    ],
+)
+def test_damaged_campaign_metadata_is_one_line_for_every_reader(
+    campaign_db, tmp_path, capsys, key, value, readers
+):
+    con = duckdb.connect(str(campaign_db))
+    con.execute("UPDATE meta SET value = ? WHERE key = ?", [value, key])
+    con.close()
+    other = tmp_path / "other.duckdb"
+    _run_shard(other)
+    capsys.readouterr()
+    before = other.read_bytes()
+    commands = {
+        "status": ["status", str(campaign_db), "--json"],
+        "run": ["run", str(campaign_db), *RUN, "--workers", "0"],
+        "merge": ["merge", str(other), str(campaign_db)],
+        "export": ["export", str(campaign_db), str(tmp_path / "x.csv")],
+        "dataset": ["dataset", str(campaign_db), str(tmp_path / "ds"), "--command", "x"],
+    }
+    for name in readers:
+        assert main(["campaign", *commands[name]]) == 2, name
+        line = one_error_line(capsys)
+        assert f"The campaign database {str(campaign_db)!r} has a damaged {key!r}" in line, name
+    assert other.read_bytes() == before
+    assert not (tmp_path / "ds").exists() and not (tmp_path / "x.csv").exists()

@@ -194,3 +194,99 @@ def test_onnx_export_refuses_a_composite(composites):
 
     with pytest.raises(ValueError, match="no ONNX export"):
         to_onnx(composites["ensemble"])
+
+
+# --- a correction's parameters are physically plausible, or the file is refused ------------------
+
+
+def _set_item(key, index, value):
+    def change(document):
+        document["state"][key]["__ndarray__"][index] = value
+
+    return change
+
+
+_LOG_1E6 = float(np.log(1e6))
+
+
+@pytest.mark.parametrize(
+    ("change", "message"),
+    [
+        (_set_item("kernel_theta_", 1, 1e6), r"kernel_theta_.*length scale of l_mm inf"),
+        (_set_item("kernel_theta_", 3, _LOG_1E6 + 0.01), r"length scale of t_mm 1\.01005e\+06"),
+        (_set_item("kernel_theta_", 8, -20.0), r"length scale of the base's angle_deg 2\.06"),
+        (_set_item("kernel_theta_", 0, 1e6), r"kernel_theta_.*constant inf .*at index 0"),
+        (_set_item("kernel_theta_", 9, 1e6), r"kernel_theta_.*noise inf .*at index 9"),
+        (_set_item("kernel_theta_", 9, -1e6), r"kernel_theta_.*noise 0 .*at index 9"),
+        (_set_item("z_mean_", 0, 1e300), r"z_mean_.*1e\+300 for l_mm .*0 to 10000 mm"),
+        (_set_item("z_mean_", 6, -5.0), r"z_mean_.*-5 for pressure_mpa .*-0\.1013 to 2 MPa"),
+        (_set_item("z_scale_", 7, 1e9), r"z_scale_.*1e\+09 for the base's angle_deg"),
+        (_set_item("targets_", 2, 1e300), r"targets_.*1e\+300 at index 2"),
+    ],
+    ids=[
+        "length-scale-inf",
+        "length-scale-above",
+        "length-scale-below",
+        "constant-inf",
+        "noise-inf",
+        "noise-zero",
+        "mean-length",
+        "mean-pressure",
+        "scale-angle",
+        "target",
+    ],
+)
+def test_implausible_gp_parameters_are_refused_naming_the_file_and_key(
+    change, message, composites, tmp_path
+):
+    path = save_surrogate(composites["gp-corrected"], tmp_path / "m.json")
+    _edit(path, change)
+    with pytest.raises(SchemaError, match=message) as err:
+        load_surrogate(path)
+    text = str(err.value)
+    assert text.startswith(f"{path}: the gp-corrected surrogate's state key ") and "\n" not in text
+    assert "allowed" in text or "within" in text or "from" in text
+
+
+def test_standardized_inputs_of_absurd_magnitude_are_refused(composites, tmp_path):
+    path = save_surrogate(composites["gp-corrected"], tmp_path / "m.json")
+    _edit(path, lambda d: d["state"]["inputs_"]["__ndarray__"][4].__setitem__(2, -1e7))
+    with pytest.raises(SchemaError, match=r"inputs_.*magnitude at most 1e\+06; got -1e\+07 at"):
+        load_surrogate(path)
+
+
+def test_length_scales_at_the_ends_of_the_range_still_load_and_predict(composites, data, tmp_path):
+    path = save_surrogate(composites["gp-corrected"], tmp_path / "m.json")
+    theta = composites["gp-corrected"].kernel_theta_
+    ends = [theta[0], *([_LOG_1E6] * 4), *([float(np.log(0.1))] * 4), theta[-1]]
+    _edit(path, lambda d: d["state"]["kernel_theta_"].update(__ndarray__=ends))
+    model = load_surrogate(path).model
+    X, _ = data
+    mean, std = model.predict(X, return_std=True)
+    assert np.isfinite(mean).all() and np.isfinite(std).all()
+
+
+@pytest.mark.parametrize(
+    ("kind", "change", "message"),
+    [
+        (
+            "affine-corrected",
+            lambda d: d["state"].update(offset_=1e300),
+            r"offset_' must be an angle offset from -3600 to 3600 degrees.*got 1e\+300",
+        ),
+        (
+            "affine-corrected",
+            lambda d: d["state"].update(residual_std_=1e300),
+            r"residual_std_' must be a residual standard deviation from 0 to 3600",
+        ),
+        ("ensemble", lambda d: d["state"].update(residual_std_=4000.0), "residual_std_.*got 4000"),
+        ("pressure-scaled", lambda d: d["state"].update(residual_std_=1e9), "residual_std_"),
+    ],
+    ids=["affine-offset", "affine-residual", "ensemble-residual", "pressure-scaled-residual"],
+)
+def test_implausible_correction_parameters_are_refused(kind, change, message, composites, tmp_path):
+    path = save_surrogate(composites[kind], tmp_path / "m.json")
+    _edit(path, change)
+    with pytest.raises(SchemaError, match=message) as err:
+        load_surrogate(path)
+    assert str(err.value).startswith(f"{path}: the {kind} surrogate's ")

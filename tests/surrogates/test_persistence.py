@@ -1,5 +1,6 @@
 import json
 import math
+import re
 import subprocess
 import sys
 from datetime import datetime
@@ -11,12 +12,13 @@ from sklearn.exceptions import NotFittedError
 from sklearn.linear_model import LinearRegression
 
 from softbend import __version__
-from softbend.errors import SchemaError
+from softbend.errors import LimitError, SchemaError
 from softbend.surrogates.features import FEATURES, UNITS
 from softbend.surrogates.mlp import NormalizedMLPRegressor
 from softbend.surrogates.persistence import (
     BASE_KINDS,
     FORMAT,
+    KINDS,
     SCHEMA_VERSION,
     kind_of,
     load_surrogate,
@@ -147,7 +149,8 @@ def test_xgboost_booster_is_stored_as_json_text(fitted, tmp_path):
         booster["learner"]["attributes"]
         == json.loads(bytes(model.get_booster().save_raw("json")))["learner"]["attributes"]
     )
-    assert math.isnan(document["params"]["missing"])
+    assert document["params"]["missing"] is None  # XGBoost's NaN default, as strict JSON
+    assert math.isnan(load_surrogate(tmp_path / "m.json").model.get_params()["missing"])
 
 
 def _saved(fitted, tmp_path):
@@ -194,7 +197,12 @@ def test_bad_files_raise_schema_error_naming_the_file(fitted, tmp_path, change, 
 
 @pytest.mark.parametrize(
     ("text", "match"),
-    [("not json at all", "not valid JSON"), ("[1, 2]", "format 'list'"), ("{}", "format None")],
+    [
+        ("not json at all", "not valid JSON"),
+        ("[1, 2]", "format 'list'"),
+        ("{}", "format None"),
+        ('{"format": ' + "1" * 5000 + "}", "not valid JSON.*digits"),
+    ],
 )
 def test_non_surrogate_files_raise_schema_error(tmp_path, text, match):
     path = tmp_path / "m.json"
@@ -492,3 +500,311 @@ def test_a_booster_xgboost_refuses_is_one_line(fitted, tmp_path):
     with pytest.raises(SchemaError, match="cannot rebuild the xgboost surrogate") as info:
         load_surrogate(path)
     assert "\n" not in str(info.value) and "Stack trace" not in str(info.value)
+
+
+# --- strict JSON: no bare NaN or Infinity in any saved file ------------------------------------
+
+
+def _strict(text):
+    """``text`` parsed by a strict JSON reader: NaN and Infinity are refused."""
+
+    def refuse(constant):
+        raise ValueError(f"not strict JSON: {constant}")
+
+    return json.loads(text, parse_constant=refuse)
+
+
+def _composites(fitted):
+    from softbend.surrogates.corrected import (
+        AffineCorrected,
+        GPCorrected,
+        MeanEnsemble,
+        PressureScaled,
+        gp_kernel,
+    )
+
+    base = fitted["polynomial"]
+    X = _inputs(30, 21)
+    theta = base.predict(X)
+    Z = np.column_stack([X, theta])
+    mean, scale = Z.mean(axis=0), Z.std(axis=0)
+    inputs = (Z - mean) / scale
+    errors = _angle(X) - theta
+    return {
+        "affine-corrected": AffineCorrected(base, 1.1, -2.0, 0.5),
+        "gp-corrected": GPCorrected(base, mean, scale, gp_kernel(8).theta, inputs, errors),
+        "ensemble": MeanEnsemble([fitted["polynomial"], fitted["mlp"], fitted["xgboost"]], 0.25),
+        "pressure-scaled": PressureScaled(fitted["xgboost"], 1.2, 0.5),
+    }
+
+
+def test_every_kind_saves_strict_json_and_reloads_bit_for_bit(fitted, tmp_path):
+    models = {**fitted, **_composites(fitted)}
+    assert set(models) == set(KINDS)
+    X = _inputs(200, 22)
+    for kind, model in models.items():
+        path = save_surrogate(model, tmp_path / f"{kind}.json", metadata={"r2": float("nan")})
+        document = _strict(path.read_text())
+        assert document["kind"] == kind
+        assert document["metadata"] == {"r2": None}
+        loaded = load_surrogate(path).model
+        np.testing.assert_array_equal(loaded.predict(X), model.predict(X))
+
+
+def test_non_finite_parameters_and_diagnostics_are_tagged_and_restored(fitted, tmp_path):
+    X = _inputs(80, 23)
+    poly = PolynomialRegressor(degree=2).fit(X, _angle(X)).set_params(max_memory_mb=math.inf)
+    text = save_surrogate(poly, tmp_path / "p.json").read_text()
+    assert _strict(text)["params"]["max_memory_mb"] == {"__float__": "inf"}
+    assert load_surrogate(tmp_path / "p.json").model.max_memory_mb == float("inf")
+
+    mlp = load_surrogate(save_surrogate(fitted["mlp"], tmp_path / "a.json")).model
+    mlp.loss_curve_ = [0.5, float("nan"), float("inf"), -float("inf")]
+    document = _strict(save_surrogate(mlp, tmp_path / "m.json").read_text())
+    assert document["state"]["loss_curve_"][1:] == [
+        {"__float__": "nan"},
+        {"__float__": "inf"},
+        {"__float__": "-inf"},
+    ]
+    curve = load_surrogate(tmp_path / "m.json").model.loss_curve_
+    assert curve[0] == 0.5 and math.isnan(curve[1]) and curve[2:] == [math.inf, -math.inf]
+
+
+def test_xgboost_missing_is_null_and_a_file_with_a_bare_nan_still_loads(fitted, tmp_path):
+    model = fitted["xgboost"]
+    path = save_surrogate(model, tmp_path / "m.json")
+    assert '"missing": null' in path.read_text()
+    X = _inputs(300, 24)
+    # A file written before: Python's JSON dialect, "missing": NaN.
+    old = tmp_path / "old.json"
+    old.write_text(path.read_text().replace('"missing": null', '"missing": NaN'))
+    assert '"missing": NaN' in old.read_text()
+    for file in (path, old):
+        loaded = load_surrogate(file).model
+        assert math.isnan(loaded.get_params()["missing"])
+        np.testing.assert_array_equal(loaded.predict(X), model.predict(X))
+        _same_params(loaded, model)
+
+
+@pytest.mark.parametrize(
+    ("missing", "ok"),
+    [(-999.0, True), (0, True), ({"__float__": "nan"}, True), ("abc", False), (True, False)],
+)
+def test_xgboost_missing_must_be_a_number_or_null(fitted, tmp_path, missing, ok):
+    path = save_surrogate(fitted["xgboost"], tmp_path / "m.json")
+    document = json.loads(path.read_text())
+    document["params"]["missing"] = missing
+    path.write_text(json.dumps(document))
+    if ok:
+        assert np.isfinite(load_surrogate(path).model.predict(_inputs(5, 25))).all()
+        return
+    with pytest.raises(SchemaError, match=r"params key 'missing'.*a number or null") as info:
+        load_surrogate(path)
+    assert str(path) in str(info.value)
+
+
+# --- nesting: bounded before anything recurses -------------------------------------------------
+
+
+def _nested(document, depth):
+    """``document`` wrapped ``depth`` times in affine corrections, as one JSON text."""
+    head = {key: value for key, value in document.items() if key != "state"}
+    head.update(kind="affine-corrected", params={}, metadata={})
+    state = {"scale_": 1.0, "offset_": 0.0, "residual_std_": 0.5, "base": 0}
+    opening = json.dumps({**head, "state": state})
+    before, after = opening.rsplit("0}}", 1)[0], "}}" + opening.rsplit("0}}", 1)[1]
+    inner = json.dumps(document)
+    return before * depth + inner + after * depth
+
+
+@pytest.mark.parametrize("shape", ["corrections", "arrays"])
+def test_a_file_nested_beyond_the_parser_is_one_schema_error(fitted, tmp_path, shape):
+    _, document = _saved(fitted, tmp_path)
+    path = tmp_path / "deep.json"
+    text = _nested(document, 20_000) if shape == "corrections" else "[" * 10**5 + "]" * 10**5
+    path.write_text(text)
+    with pytest.raises(SchemaError, match="nests too deeply to be read") as info:
+        load_surrogate(path)
+    assert str(info.value).startswith(str(path)) and "SOFTBEND_MAX_NESTING" in str(info.value)
+
+
+def test_a_file_nested_beyond_the_limit_is_a_limit_error_naming_it(fitted, tmp_path, monkeypatch):
+    _, document = _saved(fitted, tmp_path)
+    path = tmp_path / "deep.json"
+    path.write_text(_nested(document, 50))
+    with pytest.raises(LimitError, match=r"deep\.json is 10\d levels.*SOFTBEND_MAX_NESTING"):
+        load_surrogate(path)
+    monkeypatch.setenv("SOFTBEND_MAX_NESTING", "1000")
+    with pytest.raises(SchemaError, match="surrogates nest at most 4 deep"):
+        load_surrogate(path)
+    path.write_text(_nested(document, 2))  # within both: loads
+    model = load_surrogate(path).model
+    np.testing.assert_array_equal(
+        model.predict(_inputs(5, 26)), fitted["polynomial"].predict(_inputs(5, 26))
+    )
+
+
+# --- training ranges: checked on load -----------------------------------------------------------
+
+
+def _with_ranges(fitted, tmp_path, change):
+    from softbend.surrogates.features import training_ranges
+
+    ranges = training_ranges(_inputs(300, 0))
+    path = save_surrogate(
+        fitted["polynomial"], tmp_path / "m.json", metadata={"training_ranges": ranges}
+    )
+    document = json.loads(path.read_text())
+    change(document["metadata"]["training_ranges"])
+    path.write_text(json.dumps(document))
+    return path
+
+
+@pytest.mark.parametrize(
+    ("change", "match"),
+    [
+        (lambda r: r["l_mm"].__setitem__(0, float("nan")), r"field 'l_mm'.*got \[NaN, "),
+        (lambda r: r["l_mm"].__setitem__(1, float("inf")), r"field 'l_mm'.*Infinity\]"),
+        (lambda r: r.update(r_mm=[10.0, 6.0]), r"field 'r_mm'.*low <= high.*\[10.0, 6.0\]"),
+        (lambda r: r.update(t_mm=["2", "4"]), r"field 't_mm'.*two finite numbers"),
+        (lambda r: r.update(b_mm=[2.0]), r"field 'b_mm'.*\[low, high\]"),
+        (lambda r: r.update(b_mm=None), r"field 'b_mm'.*got null"),
+        (lambda r: r.update(lc_mm=[True, 12.0]), r"field 'lc_mm'"),
+        (
+            lambda r: r.update(pressure_mpa=[0.0, 500.0]),
+            r"field 'pressure_mpa'.*from -0.1013 to 2 MPa.*\[0.0, 500.0\]",
+        ),
+        (lambda r: r.update(phi_deg=[5.0, 1e9]), r"field 'phi_deg'.*from -3600 to 3600 deg"),
+        (lambda r: r.pop("l_mm"), r"each input l_mm.*got no range for l_mm"),
+        (lambda r: r.update(length=[1, 2]), r"got unknown input\(s\) 'length'"),
+        (lambda r: r.update(l_mm=[100, 10**400]), r"field 'l_mm'.*got \[100, 1000"),
+    ],
+    ids=[
+        "nan-low",
+        "inf-high",
+        "low-above-high",
+        "strings",
+        "one-number",
+        "null",
+        "bool",
+        "implausible-pressure",
+        "implausible-angle",
+        "missing-input",
+        "unknown-input",
+        "huge-integer",
+    ],
+)
+def test_bad_training_ranges_are_refused_naming_the_file_and_field(fitted, tmp_path, change, match):
+    path = _with_ranges(fitted, tmp_path, change)
+    with pytest.raises(SchemaError, match=match) as info:
+        load_surrogate(path)
+    message = str(info.value)
+    assert message.startswith(f"{path}: metadata key 'training_ranges'") and "\n" not in message
+
+
+@pytest.mark.parametrize("ranges", [[1, 2], None, "l_mm"])
+def test_training_ranges_that_are_not_an_object_are_refused(fitted, tmp_path, ranges):
+    path = save_surrogate(
+        fitted["polynomial"], tmp_path / "m.json", metadata={"training_ranges": ranges}
+    )
+    with pytest.raises(SchemaError, match="'training_ranges' must be an object of"):
+        load_surrogate(path)
+
+
+def test_integer_training_ranges_still_load(fitted, tmp_path):
+    path = _with_ranges(fitted, tmp_path, lambda r: r.update(l_mm=[100, 160]))
+    assert load_surrogate(path).metadata["training_ranges"]["l_mm"] == [100, 160]
+
+
+# --- other header and state fields read without validation before ------------------------------
+
+
+@pytest.mark.parametrize(
+    ("change", "match"),
+    [
+        (lambda d: d.update(kind=["polynomial"]), r'unknown surrogate kind \["polynomial"\]'),
+        (lambda d: d.update(kind={"a": 1}), "unknown surrogate kind"),
+        (lambda d: d.update(kind=None), "unknown surrogate kind null"),
+        (lambda d: d["units"].update(pressure_mpa="kPa"), "'units' must be .*got \"kPa\""),
+        (lambda d: d["units"].pop("l_mm"), "'units' must be .*got none for 'l_mm'"),
+        (lambda d: d["units"].update(extra="mm"), "'units' must be .*for 'extra'"),
+        (lambda d: d.update(format=["x"] * 1000), r"format \[\"x\", .*\.\.\., expected"),
+        (lambda d: d.update(schema_version=[1]), r"invalid schema_version \[1\]"),
+        (lambda d: d["params"].update(degree=2), "params key 'degree' must be the highest"),
+        (lambda d: d["state"].update(rank_=10**6), "'rank_' must be at most the number of terms"),
+        (lambda d: d["state"].update(y_scale_=10**400), "'y_scale_'.*within float64; got 1000"),
+    ],
+    ids=[
+        "kind-list",
+        "kind-object",
+        "kind-null",
+        "units-kpa",
+        "units-missing",
+        "units-extra",
+        "format-long-list",
+        "schema-version-list",
+        "degree-vs-powers",
+        "rank-vs-terms",
+        "huge-integer",
+    ],
+)
+def test_more_bad_header_and_state_values_are_schema_errors(fitted, tmp_path, change, match):
+    path, document = _saved(fitted, tmp_path)
+    path.write_text(_edit(document, change))
+    with pytest.raises(SchemaError, match=match) as info:
+        load_surrogate(path)
+    assert str(path) in str(info.value) and "\n" not in str(info.value)
+
+
+def test_mlp_hidden_sizes_must_match_the_weights(fitted, tmp_path):
+    path = save_surrogate(fitted["mlp"], tmp_path / "m.json")
+    document = json.loads(path.read_text())
+    document["params"]["hidden_sizes"] = {"__tuple__": [60, 60]}
+    path.write_text(json.dumps(document))
+    with pytest.raises(SchemaError, match=r"'hidden_sizes' must be the layer sizes .*\[8, 6\]"):
+        load_surrogate(path)
+    document["params"].pop("hidden_sizes")  # the default (60, 60) does not match either
+    path.write_text(json.dumps(document))
+    with pytest.raises(SchemaError, match="'hidden_sizes' must be the layer sizes"):
+        load_surrogate(path)
+
+
+@pytest.mark.parametrize(
+    ("change", "match"),
+    [
+        (
+            lambda d: d["params"].update(n_jobs={"__scalar__": 1, "dtype": "datetime64"}),
+            "params of the xgboost surrogate cannot be read",
+        ),
+        (
+            lambda d: d["params"].update(n_jobs={"__float__": "lots"}),
+            "params of the xgboost surrogate cannot be read",
+        ),
+        (lambda d: d["params"].update(n_jobs="many"), "cannot rebuild the xgboost surrogate"),
+        (
+            lambda d: d["state"].update(
+                booster=d["state"]["booster"].replace(
+                    '"feature_names":[]', '"feature_names":["a","b","c","d","e","f","g"]'
+                )
+            ),
+            "must be fitted on the columns l_mm",
+        ),
+        (
+            lambda d: d["state"].update(
+                booster=re.sub(
+                    r'"base_score":"[^"]*"', '"base_score":"[NaN]"', d["state"]["booster"]
+                )
+            ),
+            "booster predicts nan",
+        ),
+    ],
+    ids=["datetime-dtype", "bad-float-tag", "n-jobs-string", "feature-names", "nan-base-score"],
+)
+def test_xgboost_values_read_only_when_predicting_fail_on_load(fitted, tmp_path, change, match):
+    path = save_surrogate(fitted["xgboost"], tmp_path / "m.json")
+    document = json.loads(path.read_text())
+    change(document)
+    path.write_text(json.dumps(document))
+    with pytest.raises(SchemaError, match=match) as info:
+        load_surrogate(path)
+    assert str(info.value).startswith(f"{path}: ") and "\n" not in str(info.value)

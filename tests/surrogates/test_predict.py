@@ -2,10 +2,15 @@
 
 from __future__ import annotations
 
+import json
+import math
+
 import numpy as np
 import pytest
 
 from softbend.design import SFRBADesign
+from softbend.errors import SchemaError
+from softbend.surrogates.corrected import AffineCorrected, GPCorrected, gp_kernel
 from softbend.surrogates.features import training_ranges
 from softbend.surrogates.persistence import save_surrogate
 from softbend.surrogates.polynomial import PolynomialRegressor
@@ -46,3 +51,66 @@ def test_beyond_the_training_pressures_is_flagged_and_strict_refuses(saved):
 def test_bad_pressures_name_the_field(saved, pressures):
     with pytest.raises(ValueError, match="'pressure'"):
         predict_angles(saved[0], SFRBADesign(130, 8, 3, 3, 10, 10), pressures)
+
+
+def _rewrite(path, change):
+    document = json.loads(path.read_text())
+    change(document)
+    path.write_text(json.dumps(document))
+    return path
+
+
+def test_a_nan_training_range_is_refused_on_load_not_silently_unchecked(saved):
+    path, _ = saved
+    _rewrite(path, lambda d: d["metadata"]["training_ranges"]["l_mm"].__setitem__(0, math.nan))
+    with pytest.raises(SchemaError, match=r"training_ranges', field 'l_mm'.*got \[NaN,") as info:
+        predict_angles(path, SFRBADesign(100, 8, 3, 3, 10, 10), [0.1], strict=True)
+    assert str(info.value).startswith(str(path))
+
+
+def test_a_non_finite_prediction_inside_the_training_ranges_names_the_model_file(tmp_path):
+    X = table1_inputs(200, seed=3)
+    base = PolynomialRegressor(degree=1).fit(X, smooth_angle(X))
+    path = save_surrogate(
+        AffineCorrected(base, 1e308, 0.0, 0.5),
+        tmp_path / "overflow.json",
+        metadata={"training_ranges": training_ranges(X)},
+    )
+    with pytest.raises(SchemaError, match="predicts a non-finite angle") as info:
+        predict_angles(path, SFRBADesign(130, 8, 3, 3, 10, 10), [0.2, 0.3])
+    message = str(info.value)
+    assert str(path) in message and "affine-corrected" in message and "0.2 MPa" in message
+
+
+def test_a_non_finite_extrapolation_is_an_error_naming_file_and_inputs(saved):
+    path, _ = saved
+    with pytest.raises(ValueError, match="predicts a non-finite angle") as info:
+        predict_angles(path, SFRBADesign(130, 8, 3, 3, 10, 10), [0.1, 1e308])
+    message = str(info.value)
+    assert str(path) in message and "pressure_mpa 1e+308 outside" in message
+
+
+def test_the_cli_refuses_a_gp_correction_that_would_predict_null(tmp_path, capsys):
+    from sklearn.gaussian_process import GaussianProcessRegressor
+
+    from softbend.cli import main
+
+    X = table1_inputs(60, seed=4)
+    base = PolynomialRegressor(degree=1).fit(X, smooth_angle(X))
+    theta = base.predict(X)
+    Z = np.column_stack([X, theta])
+    mean, scale = Z.mean(axis=0), Z.std(axis=0)
+    inputs, errors = (Z - mean) / scale, smooth_angle(X) - theta
+    gp = GaussianProcessRegressor(kernel=gp_kernel(8), normalize_y=True, random_state=0)
+    gp.fit(inputs, errors)
+    model = GPCorrected(base, mean, scale, gp.kernel_.theta, inputs, errors)
+    path = save_surrogate(model, tmp_path / "gp.json")
+    args = ["predict", str(path), "--design", "130,8,3,3,10,10", "--pressure", "0.1", "--json"]
+    assert main(args) == 0
+    assert json.loads(capsys.readouterr().out)["angle_deg"][0] is not None
+    _rewrite(path, lambda d: d["state"]["kernel_theta_"]["__ndarray__"].__setitem__(0, 1e6))
+    assert main(args) == 2
+    captured = capsys.readouterr()
+    assert captured.out == ""
+    err = captured.err.strip().splitlines()
+    assert len(err) == 1 and str(path) in err[0] and "kernel_theta_" in err[0]

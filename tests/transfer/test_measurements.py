@@ -44,7 +44,7 @@ def _frame(**overrides):
 # ------------------------------------------------------------------ round trip
 def test_save_then_load_gives_equal_measurements(tmp_path):
     frame = _frame(
-        angle_deg=[0.1 + 0.2, 1 / 3, -1e-17, 123456.789012345678, 2.0**-40],
+        angle_deg=[0.1 + 0.2, 1 / 3, -1e-17, 1234.56789012345678, 2.0**-40],
         pressure_mpa=[0.0, 0.1 + 0.2, 1e-300, 0.1, 7 / 90],
         actuator_id=['A, "two"', 'A, "two"', "  B1  ", "B1", 'A, "two"'],
     )
@@ -94,7 +94,7 @@ def test_input_frame_is_copied_and_arrays_are_fresh():
 def test_source_is_not_compared_but_frame_and_metadata_are():
     a = Measurements.from_frame(_frame(), source="a")
     assert a == Measurements.from_frame(_frame(), source="b")
-    assert a != Measurements.from_frame(_frame(), metadata={"k": "v"})
+    assert a != Measurements.from_frame(_frame(), metadata={"rig": "v"})
     assert a != Measurements.from_frame(_frame(angle_deg=[0, 31.5, -0.25, 80.125, 95.5]))
 
 
@@ -192,11 +192,11 @@ BAD_FILES = [
     ("empty", "", ["no header row"]),
     ("comments-only", "# rig: x\n\n# nothing else\n", ["no header row"]),
     ("missing", "l,r,t,b,phi,lc,pressure_mpa\n1,2,3,4,5,6,7\n", ["line 1", "'angle_deg'"]),
-    ("unknown", f"# k: v\n{HEADER},temp_c\n{ROW_A},21\n", ["line 2", "'temp_c'", "direction"]),
+    ("unknown", f"# rig: v\n{HEADER},temp_c\n{ROW_A},21\n", ["line 2", "'temp_c'", "direction"]),
     ("case", "L,r,t,b,phi,lc,pressure_mpa,angle_deg\n", ["line 1", "'L'", "case-sensitive"]),
     ("duplicate", f"{HEADER},phi\n{ROW_A},5\n", ["line 1", "duplicate", "'phi'"]),
     ("cells", f"{HEADER}\n{ROW_A}\n{ROW_A},9\n", ["line 3", "9 cells", "8 columns"]),
-    ("no-rows", f"# a: b\n{HEADER}\n\n", ["line 2", "no data rows"]),
+    ("no-rows", f"# operator: b\n{HEADER}\n\n", ["line 2", "no data rows"]),
     ("text", f"{HEADER}\n{ROW_A}\n{DESIGN_A},high,1\n", ["line 3", "'pressure_mpa'", "'high'"]),
     ("empty-cell", f"{HEADER}\n{DESIGN_A},,1\n", ["line 2", "'pressure_mpa'", "empty cell"]),
     ("nan", f"{HEADER}\n{ROW_A}\n{DESIGN_A},0.2,nan\n", ["line 3", "'angle_deg'", "'nan'"]),
@@ -204,7 +204,7 @@ BAD_FILES = [
     ("negative", f"{HEADER}\n{DESIGN_A},-0.01,1\n", ["line 2", "'pressure_mpa'", ">= 0"]),
     (
         "design",
-        f"# k: v\n\n{HEADER}\n{ROW_A}\n100,6,2,2,61,8,0.1,1\n",
+        f"# rig: v\n\n{HEADER}\n{ROW_A}\n100,6,2,2,61,8,0.1,1\n",
         ["line 5", "column 'phi'", "'phi_deg' of SFRBADesign"],
     ),
     (

@@ -41,8 +41,10 @@ import numpy as np
 
 from softbend._extras import require
 from softbend.campaign.backends import Backend, SweepResult
+from softbend.campaign.schema import first_line
 from softbend.design import SFRBADesign
 from softbend.errors import SoftbendError
+from softbend.limits import check_file_size
 
 if TYPE_CHECKING:
     from softbend.campaign.store import CampaignStore
@@ -328,24 +330,21 @@ def parse_scheduler_address(scheduler: str) -> str:
     """Check a Dask scheduler address ``tcp://HOST:PORT`` (or ``tls://``) and return it.
 
     A path to an existing JSON scheduler file (written by ``dask scheduler
-    --scheduler-file``) is read and its ``address`` returned.
+    --scheduler-file``) is read and its ``address`` returned; the file is at most
+    the ``file_mib`` limit of :mod:`softbend.limits` and must hold a JSON object.
 
     Raises
     ------
     ValueError
         Naming ``--scheduler``, the expected form and the value received.
+    FileNotFoundError
+        The scheduler file does not exist.
+    LimitError
+        The scheduler file is larger than the ``file_mib`` limit.
     """
     text = str(scheduler).strip()
     if text.endswith(".json") and "://" not in text:
-        path = Path(text)
-        if not path.is_file():
-            raise FileNotFoundError(f"No Dask scheduler file at {text!r} (--scheduler).")
-        try:
-            text = str(json.loads(path.read_text())["address"])
-        except (ValueError, KeyError, TypeError):
-            raise ValueError(
-                f"The Dask scheduler file {str(path)!r} (--scheduler) has no 'address'."
-            ) from None
+        text = _scheduler_file_address(Path(text))
     match = _ADDRESS.match(text)
     if match is None or not 1 <= int(match["port"]) <= 65535:
         raise ValueError(
@@ -353,6 +352,42 @@ def parse_scheduler_address(scheduler: str) -> str:
             f"tcp://HOST:PORT (PORT 1-65535) or a Dask scheduler file. Got {scheduler!r} instead."
         )
     return text
+
+
+_JSON_KINDS = {list: "array", str: "string", int: "number", float: "number", bool: "boolean"}
+
+
+def _scheduler_file_address(path: Path) -> str:
+    """The ``address`` of a Dask scheduler file, checked: a JSON object with a string there."""
+    if not path.is_file():
+        raise FileNotFoundError(f"No Dask scheduler file at {str(path)!r} (--scheduler).")
+    check_file_size(path, f"The Dask scheduler file {path} (--scheduler)")
+    try:
+        payload = json.loads(path.read_bytes())
+    except (ValueError, RecursionError) as exc:  # not JSON, not UTF-8, nested too deeply
+        reason = "nested too deeply" if isinstance(exc, RecursionError) else first_line(exc)
+        raise ValueError(
+            f"The Dask scheduler file {str(path)!r} (--scheduler) must be JSON with an "
+            f"'address'. Got a file that is not JSON ({reason}) instead."
+        ) from None
+    except OSError as exc:
+        raise ValueError(
+            f"The Dask scheduler file {str(path)!r} (--scheduler) cannot be read: "
+            f"{exc.strerror or exc}."
+        ) from None
+    address = payload.get("address") if isinstance(payload, dict) else None
+    if not isinstance(address, str):
+        if not isinstance(payload, dict):
+            found = f"a JSON {_JSON_KINDS.get(type(payload), 'value')}"
+        elif "address" in payload:
+            found = f"'address' {address!r}"
+        else:
+            found = "no 'address'"
+        raise ValueError(
+            f"The Dask scheduler file {str(path)!r} (--scheduler) must be a JSON object with "
+            f"an 'address' string (tcp://HOST:PORT). Got {found[:200]} instead."
+        )
+    return address
 
 
 def _probe(address: str, timeout_s: float) -> None:
@@ -370,41 +405,128 @@ def _probe(address: str, timeout_s: float) -> None:
         ) from None
 
 
+def _in_thread(work: Callable[[], Any], deadline_s: float) -> tuple[bool, Any, Any]:
+    """Run ``work()`` in a daemon thread for at most ``deadline_s``.
+
+    Returns ``(finished, value, error)``: ``finished`` False when the deadline
+    passed (the thread is given up), else the value returned or the exception raised.
+    """
+    box: dict[str, Any] = {}
+
+    def attempt() -> None:
+        try:
+            box["value"] = work()
+        except BaseException as exc:  # reported in the caller's thread
+            box["error"] = exc.with_traceback(None)  # keep no frame (and no object) alive
+
+    thread = threading.Thread(target=attempt, name="softbend-dask-connect", daemon=True)
+    thread.start()
+    thread.join(deadline_s)
+    if thread.is_alive():
+        return False, None, None
+    return True, box.get("value"), box.get("error")
+
+
+def _not_dask(address: str, why: str) -> SoftbendError:
+    return SoftbendError(
+        f"The '--scheduler' {address} did not answer as a Dask scheduler ({why}); give the "
+        "address the scheduler prints as 'Scheduler at: tcp://HOST:PORT' (port 8786 by "
+        "default), not its dashboard or another service."
+    )
+
+
+def _identify(address: str, timeout_s: float) -> None:
+    """Raise one line unless a Dask scheduler answers Dask's ``identity`` at ``address``.
+
+    Dask's own connection code reads the first 8 bytes of the answer as a message
+    length: a web server's ``HTTP/1.1`` becomes a request for 3 EiB
+    (``MemoryError``). Asked here, in a short-lived event loop of its own, such an
+    answer is one error and leaves no half-made client behind.
+    """
+    import asyncio
+
+    from distributed.comm import connect as dask_connect
+    from distributed.security import Security
+
+    args = Security().get_connection_args("client")
+
+    async def ask() -> Any:
+        comm = await dask_connect(address, timeout=timeout_s, **args)
+        try:
+            await comm.write({"op": "identity", "reply": True})
+            return await comm.read()
+        finally:
+            comm.abort()
+
+    def run() -> Any:
+        return asyncio.run(asyncio.wait_for(ask(), timeout_s))
+
+    finished, reply, error = _in_thread(run, timeout_s + 5.0)
+    if not finished or isinstance(error, asyncio.TimeoutError | TimeoutError):
+        raise SoftbendError(
+            f"The '--scheduler' {address} did not answer within {timeout_s:g} s: something "
+            "listens there but does not speak Dask's protocol; check --scheduler."
+        )
+    if error is not None:
+        if isinstance(error, MemoryError):
+            why = "it answered in another protocol, e.g. HTTP"
+        else:
+            why = f"{type(error).__name__}: {first_line(error)}"
+        raise _not_dask(address, why)
+    kind = reply.get("type") if isinstance(reply, dict) else None
+    if not isinstance(kind, str) or "Scheduler" not in kind:
+        why = f"it is a Dask {kind}" if isinstance(kind, str) else "it answered something else"
+        raise _not_dask(address, why)
+
+
+def _closing_client(Client: type) -> type:
+    """A subclass of Dask's ``Client`` that closes itself when its start fails.
+
+    A client whose connection fails in its constructor is otherwise left
+    half-started, and its destructor later fails with a traceback of its own.
+    """
+
+    class ClosingClient(Client):  # type: ignore[misc, valid-type]
+        def start(self, **kwargs: Any) -> None:
+            try:
+                super().start(**kwargs)
+            except BaseException:
+                try:
+                    self.close(timeout=5)
+                except Exception:  # the start's error is the one to report
+                    logger.debug("closing a Dask client that failed to start failed too")
+                raise
+
+    return ClosingClient
+
+
 def connect(address: str, timeout_s: float) -> Any:
     """A Dask client of the scheduler at ``address``, or one line within the deadline.
 
     Every wait has a deadline: something that accepts TCP but is not a Dask
     scheduler (a web server, a silent listener) may never finish Dask's
-    handshake, so the connection runs in a helper thread that is given up after
-    ``timeout_s`` (plus a grace of 5 s).
+    handshake, so the address is first asked who it is (:func:`_identify`) and
+    the client is made in a helper thread that is given up after ``timeout_s``
+    (plus a grace of 5 s).
     """
     Client = require("distributed", "A campaign on a Dask cluster (--scheduler)").Client
 
     _probe(address, timeout_s)
-    box: dict[str, Any] = {}
-
-    def attempt() -> None:
-        try:
-            box["client"] = Client(address, timeout=timeout_s, set_as_default=False)
-        except BaseException as exc:  # reported below, in the caller's thread
-            box["error"] = exc
-
-    thread = threading.Thread(target=attempt, name="softbend-dask-connect", daemon=True)
-    thread.start()
-    thread.join(timeout_s + 5.0)
-    if thread.is_alive():
+    _identify(address, timeout_s)
+    ClosingClient = _closing_client(Client)
+    finished, client, error = _in_thread(
+        lambda: ClosingClient(address, timeout=timeout_s, set_as_default=False), timeout_s + 5.0
+    )
+    if not finished:
         raise SoftbendError(
             f"The Dask scheduler at {address} did not answer within {timeout_s:g} s: something "
             "listens there but does not speak Dask's protocol; check --scheduler."
         )
-    if "error" in box:
-        exc = box["error"]
-        reason = " ".join(str(exc).split()) or type(exc).__name__
+    if error is not None:
         raise SoftbendError(
-            f"Cannot connect to the Dask scheduler at {address}: {type(exc).__name__}: "
-            f"{reason[:200]}"
+            f"Cannot connect to the Dask scheduler at {address}: {type(error).__name__}: "
+            f"{first_line(error)}"
         ) from None
-    client = box["client"]
     try:
         client.wait_for_workers(1, timeout=timeout_s)
     except Exception:

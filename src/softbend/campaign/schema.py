@@ -25,12 +25,15 @@ existing one (a softbend campaign, of a version this softbend reads);
 :func:`check_complete` reads every block of an existing file once, so a
 truncated or damaged file is refused on opening rather than on a later query;
 :func:`open_error` and :func:`unreadable` turn DuckDB's errors into one line
-naming the file. The queries and writes live in :mod:`softbend.campaign.store`.
+naming the file, and :func:`write_error` a failed write (a full disk) into the
+:class:`OSError` it is. The queries and writes live in :mod:`softbend.campaign.store`.
 """
 
 from __future__ import annotations
 
+import errno
 import logging
+import os
 import re
 from collections.abc import Iterator
 from contextlib import contextmanager
@@ -53,6 +56,7 @@ __all__ = [
     "transaction",
     "unreadable",
     "utc_now",
+    "write_error",
 ]
 
 logger = logging.getLogger(__name__)
@@ -163,7 +167,10 @@ def transaction(con: Any) -> Iterator[None]:
     try:
         yield
     except BaseException:
-        con.execute("ROLLBACK")
+        try:
+            con.execute("ROLLBACK")
+        except Exception:  # a failed write may have ended the transaction: report the write
+            logger.debug("ROLLBACK after a failed transaction failed too", exc_info=True)
         raise
     con.execute("COMMIT")
 
@@ -301,3 +308,36 @@ def open_error(path: Path, exc: Exception) -> SoftbendError:
     if "not a valid DuckDB database" in text:
         return unreadable(path, "not a DuckDB database file")
     return unreadable(path, first_line(exc))
+
+
+#: OS errors of a write that failed for lack of room or of permission, by their text.
+_WRITE_ERRNOS = (errno.ENOSPC, errno.EFBIG, errno.EDQUOT, errno.EROFS, errno.EACCES, errno.EPERM)
+_COULD_NOT_WRITE = re.compile(
+    r'Could not write(?: to)? file "(?P<file>[^"]*)": (?P<reason>[^"\n]*)'
+)
+
+
+def write_error(exc: Exception, path: str | os.PathLike[str]) -> OSError | None:
+    """The :class:`OSError` of a DuckDB error raised by a failed write to ``path``, or None.
+
+    DuckDB reports a full disk (or a file-size limit, a read-only folder) as its
+    own ``IOException`` or, on commit, ``TransactionException``, whose text holds
+    the OS error (``Could not write file "…": No space left on device``,
+    sometimes with ``"errno":"28"``). The result names ``path`` (the file the
+    caller writes, not DuckDB's write-ahead log beside it), so a command's
+    :func:`~softbend.cli._common.output_errors` turns it into one line.
+    """
+    text = str(exc)
+    number = None
+    found = re.search(r'"errno"\s*:\s*"?(\d+)', text)
+    if found is not None:
+        number = int(found[1])
+    written = _COULD_NOT_WRITE.search(text.replace('\\"', '"'))
+    if number is None and written is not None:
+        reason = written["reason"].strip().rstrip(".")
+        number = next((n for n in _WRITE_ERRNOS if os.strerror(n) == reason), None)
+        if number is None:
+            return OSError(errno.EIO, reason or "write failed", os.fspath(path))
+    if number is None or (written is None and number not in _WRITE_ERRNOS):
+        return None
+    return OSError(number, os.strerror(number), os.fspath(path))

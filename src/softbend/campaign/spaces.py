@@ -8,7 +8,8 @@ Names are lower case, like every other choice of the command line.
 design is built, so :func:`campaign_footprint` can estimate the memory and the
 disk a campaign needs and :func:`check_footprint` can refuse one that does not
 fit before it starts (``lhs:10000000`` would need about 25 GB of memory and
-90 GB of disk).
+90 GB of disk). Every space is also bounded by the ``designs`` limit of
+:mod:`softbend.limits` (``SOFTBEND_MAX_DESIGNS``), checked on the text alone.
 """
 
 from __future__ import annotations
@@ -21,6 +22,8 @@ from dataclasses import dataclass
 from pathlib import Path
 
 from softbend.design import TABLE1_LEVELS, DesignSpace
+from softbend.errors import LimitError
+from softbend.limits import LIMITS, check_limit, limit
 
 __all__ = [
     "DISK_LIMIT_BYTES",
@@ -78,22 +81,57 @@ class SpaceSpec:
 def parse_space(text: str, *, option: str = "space", owner: str = "parse_space") -> SpaceSpec:
     """Read ``table1``, ``corners``, ``lhs:N`` or ``sobol:N`` (lower case, ``N >= 1``).
 
+    The number of designs is known from the text alone and checked against the
+    ``designs`` limit of :mod:`softbend.limits` before anything is built, so a
+    number of any length is one clear error.
+
     Raises
     ------
     ValueError
         Naming ``option`` of ``owner``, the accepted forms and the text received.
+    LimitError
+        The space has more designs than the ``designs`` limit (``SOFTBEND_MAX_DESIGNS``).
     """
     match = re.fullmatch(r"(table1|corners)|(lhs|sobol):([0-9]+)", str(text))
-    if match is None or (match[3] is not None and int(match[3]) < 1):
+    digits = None if match is None or match[3] is None else match[3].lstrip("0")
+    if match is None or digits == "":
         raise ValueError(
             f"The '{option}' of {owner} must be one of {SPACE_FORMS} (lower case, N >= 1). "
             f"Got {text!r} instead."
         )
+    shown = text if len(text) <= 40 else f"{text[:30]}...({len(text)} characters)"
+    what = f"The '{option}' {shown}"
     if match[1] == "table1":
-        return SpaceSpec(text, "table1", math.prod(len(v) for v in TABLE1_LEVELS.values()))
-    if match[1] == "corners":
-        return SpaceSpec(text, "corners", 2 ** len(TABLE1_LEVELS))
-    return SpaceSpec(text, match[2], int(match[3]))
+        spec = SpaceSpec(text, "table1", math.prod(len(v) for v in TABLE1_LEVELS.values()))
+    elif match[1] == "corners":
+        spec = SpaceSpec(text, "corners", 2 ** len(TABLE1_LEVELS))
+    else:
+        assert digits is not None
+        _check_digits(digits, what)
+        spec = SpaceSpec(text, match[2], int(digits))
+    check_limit("designs", spec.n_designs, what)
+    return spec
+
+
+#: Numbers of designs up to this many digits are shown in full in a message.
+_SHOWN_DIGITS = 40
+
+
+def _check_digits(digits: str, what: str) -> None:
+    """Refuse, by its length alone, a number far above the ``designs`` limit.
+
+    Python refuses to read integers of more than 4300 digits, and a message
+    showing thousands of them would be no help: a number with more digits than
+    the limit in force is over it, whatever the digits are.
+    """
+    bound = limit("designs")
+    if len(digits) <= _SHOWN_DIGITS or len(digits) <= len(str(bound)):
+        return
+    entry = LIMITS["designs"]
+    raise LimitError(
+        f"{what} is a number of {len(digits):,} digits, more than the limit of "
+        f"{bound:,} {entry.unit} ({entry.bounds}); set {entry.variable} higher to allow it."
+    )
 
 
 @dataclass(frozen=True)

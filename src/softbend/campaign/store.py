@@ -1,7 +1,8 @@
 """The campaign database: one DuckDB file per campaign.
 
 :class:`CampaignStore` opens (or creates) the file, binds it to one backend and
-pressure grid, records designs, merges shards and reads the data back. The
+pressure grid, records designs, merges shards and reads the data back;
+:func:`merge_campaigns` merges several shards into one database all or nothing. The
 tables, their schema version and the checks of an existing file live in
 :mod:`softbend.campaign.schema`.
 
@@ -15,16 +16,21 @@ coordinates a campaign writes; workers only compute.
 
 from __future__ import annotations
 
+import errno
 import json
 import logging
 import math
 import os
+import shutil
 import uuid
+from collections.abc import Iterator, Sequence
+from contextlib import contextmanager
 from pathlib import Path
 from typing import TYPE_CHECKING, Any, Literal
 
 import numpy as np
 
+from softbend._io import new_file_mode
 from softbend._validation import check_choice
 from softbend.campaign.schema import (
     DESIGN_COLUMNS,
@@ -37,16 +43,17 @@ from softbend.campaign.schema import (
     transaction,
     unreadable,
     utc_now,
+    write_error,
 )
 from softbend.campaign.schema import SAMPLE_COLUMNS as SAMPLE_COLUMNS
 from softbend.design import PARAMETERS, SFRBADesign
-from softbend.errors import SoftbendError
+from softbend.errors import SchemaError, SoftbendError
 from softbend.models import SweepResult, check_pressures_mpa
 
 if TYPE_CHECKING:
     import pandas as pd
 
-__all__ = ["SCHEMA_VERSION", "CampaignStore", "load_designs", "load_samples"]
+__all__ = ["SCHEMA_VERSION", "CampaignStore", "load_designs", "load_samples", "merge_campaigns"]
 
 logger = logging.getLogger(__name__)
 
@@ -98,6 +105,11 @@ class CampaignStore:
         one line naming the file.
     SoftbendError
         The file is locked by another process (a running campaign).
+    OSError
+        A new file could not be written (a full disk): it names the file, and
+        nothing of it is left. Any later write that fails the same way (recording
+        a design, binding, merging, exporting) is an ``OSError`` naming the file
+        written; every design committed before it stays in the database.
 
     Notes
     -----
@@ -121,9 +133,14 @@ class CampaignStore:
         try:
             self._con = duckdb.connect(str(self.path), read_only=self.read_only)
         except duckdb.Error as exc:
-            raise open_error(self.path, exc) from None
+            failed = None if existed else write_error(exc, self.path)
+            if failed is not None:  # a new file that could not be written: no half-made file
+                _remove_database(self.path)
+            raise (failed or open_error(self.path, exc)) from None
         # Every DuckDB error while reading what opening needs (a truncated or corrupt file
-        # fails here, at connect or on the first reads) is one SchemaError naming the file.
+        # fails here, at connect or on the first reads) is one SchemaError naming the file;
+        # one while creating a new file (a full disk) is the OSError it is, and the
+        # half-made file is removed.
         try:
             # No progress bar of DuckDB's own on a long query: it would write to stdout.
             self._con.execute("SET enable_progress_bar = false")
@@ -135,15 +152,46 @@ class CampaignStore:
                 row[0] for row in self._con.execute("SELECT design_id FROM designs").fetchall()
             }
         except duckdb.Error as exc:
-            self._con.close()
-            raise unreadable(self.path, first_line(exc)) from None
+            _close_quietly(self._con)
+            failed = None if self.read_only else write_error(exc, self.path)
+            if not existed:
+                _remove_database(self.path)
+            raise (failed or unreadable(self.path, first_line(exc))) from None
         except BaseException:
-            self._con.close()
+            _close_quietly(self._con)
+            if not existed:
+                _remove_database(self.path)
             raise
 
     def close(self) -> None:
-        """Close the connection (checkpointing the write-ahead log)."""
-        self._con.close()
+        """Close the connection (checkpointing the write-ahead log).
+
+        Raises
+        ------
+        OSError
+            The checkpoint could not be written (a full disk); what was committed
+            stays in the write-ahead log beside the file and is read on the next
+            opening.
+        """
+        with self._writing():
+            self._con.close()
+
+    @contextmanager
+    def _writing(self, path: str | os.PathLike[str] | None = None) -> Iterator[None]:
+        """Within, a DuckDB error of a failed write is the :class:`OSError` it is.
+
+        The error names ``path`` (default: this database), so a command's
+        ``output_errors`` makes it one line; other DuckDB errors pass unchanged.
+        """
+        import duckdb
+
+        try:
+            yield
+        except duckdb.Error as exc:
+            failed = write_error(exc, self.path if path is None else path)
+            if failed is None:
+                raise
+            raise failed from None
 
     def __enter__(self) -> CampaignStore:
         return self
@@ -170,9 +218,39 @@ class CampaignStore:
         meta = self.meta()
         text = meta.get("pressures_mpa")
         self._backend = meta.get("backend")
-        self._grid = None if text is None else np.asarray(json.loads(text), dtype=float)
+        self._grid = None if text is None else self._stored_grid(text)
         if self._grid is not None:
             self._grid.setflags(write=False)
+
+    def _stored_grid(self, text: str) -> np.ndarray:
+        """The pressure grid kept in the ``meta`` table, checked like a grid of a run."""
+        try:
+            values = json.loads(text)
+            if not isinstance(values, list) or not all(
+                isinstance(v, int | float) and not isinstance(v, bool) for v in values
+            ):
+                raise ValueError("not a JSON list of numbers")
+            return check_pressures_mpa(np.asarray(values, dtype=float), "CampaignStore")
+        except (ValueError, RecursionError) as exc:
+            reason = "nested too deeply" if isinstance(exc, RecursionError) else first_line(exc)
+            raise SchemaError(
+                f"The campaign database {str(self.path)!r} has a damaged 'pressures_mpa' in its "
+                f"'meta' table: it must be a JSON list of increasing pressures >= 0 in MPa. "
+                f"Got {text[:80]!r} ({reason})."
+            ) from None
+
+    def _meta_int(self, key: str) -> int | None:
+        """An integer of the ``meta`` table (None when missing); a damaged one is refused."""
+        text = self.meta().get(key)
+        if text is None:
+            return None
+        try:
+            return int(text)
+        except ValueError:
+            raise SchemaError(
+                f"The campaign database {str(self.path)!r} has a damaged {key!r} in its 'meta' "
+                f"table: it must be an integer. Got {text[:80]!r}."
+            ) from None
 
     @property
     def backend(self) -> str | None:
@@ -224,7 +302,7 @@ class CampaignStore:
                 f"{_describe_grid(stored_grid)}. Got {_describe_grid(grid)} instead; "
                 "use a new database for another pressure grid."
             )
-        with transaction(self._con):
+        with self._writing(), transaction(self._con):
             if stored_backend is None:
                 self._set_meta("backend", backend)
             if stored_grid is None:
@@ -236,13 +314,29 @@ class CampaignStore:
         self._load_binding()
 
     def runs(self) -> list[dict[str, Any]]:
-        """The runs recorded by :meth:`log_run` (oldest first), shards merged in included."""
-        return json.loads(self.meta().get("runs", "[]"))
+        """The runs recorded by :meth:`log_run` (oldest first), shards merged in included.
+
+        Raises
+        ------
+        SchemaError
+            The ``runs`` entry of the ``meta`` table is not a JSON list of objects.
+        """
+        text = self.meta().get("runs", "[]")
+        try:
+            runs = json.loads(text)
+        except (ValueError, RecursionError):
+            runs = None
+        if not isinstance(runs, list) or not all(isinstance(run, dict) for run in runs):
+            raise SchemaError(
+                f"The campaign database {str(self.path)!r} has a damaged 'runs' in its 'meta' "
+                f"table: it must be a JSON list of objects. Got {text[:80]!r}."
+            )
+        return runs
 
     def log_run(self, run: dict[str, Any]) -> None:
         """Append one run's record (executor, cores, counts, times) to the ``runs`` metadata."""
         runs = [*self.runs(), run]
-        with transaction(self._con):
+        with self._writing(), transaction(self._con):
             self._set_meta("runs", json.dumps(runs, default=str))
 
     def merge(self, source: str | os.PathLike[str]) -> dict[str, int]:
@@ -286,6 +380,22 @@ class CampaignStore:
         if backend is None or grid is None:
             return {"added": 0, "replaced_failed": 0, "kept": 0}
         self.bind(backend, grid)
+        with self._writing():
+            take, replaced = self._copy_designs(source_path, theirs)
+        if take:
+            known = self.runs()
+            for run in their_runs:
+                if run not in known:
+                    self.log_run({**run, "merged_from": str(source_path.name)})
+        logger.info("merged %d designs of %s into %s", len(take), source_path, self.path)
+        return {
+            "added": len(take) - replaced,
+            "replaced_failed": replaced,
+            "kept": len(theirs) - len(take),
+        }
+
+    def _copy_designs(self, source_path: Path, theirs: dict[str, str]) -> tuple[list[str], int]:
+        """Copy the designs of ``source_path`` that :meth:`merge` takes, in one transaction."""
         mine = {
             row[0]: row[1]
             for row in self._con.execute("SELECT design_id, status FROM designs").fetchall()
@@ -321,17 +431,7 @@ class CampaignStore:
         finally:
             self._con.execute("DETACH merge_src")
         self._recorded.update(take)
-        if take:
-            known = self.runs()
-            for run in their_runs:
-                if run not in known:
-                    self.log_run({**run, "merged_from": str(source_path.name)})
-        logger.info("merged %d designs of %s into %s", len(take), source_path, self.path)
-        return {
-            "added": len(take) - replaced,
-            "replaced_failed": replaced,
-            "kept": len(theirs) - len(take),
-        }
+        return take, replaced
 
     # -- writing -----------------------------------------------------------------
     def record_success(self, result: SweepResult, *, backend: str | None = None) -> None:
@@ -373,7 +473,7 @@ class CampaignStore:
             utc_now(),
             stats,
         ]
-        with transaction(self._con):
+        with self._writing(), transaction(self._con):
             self._delete(design.design_id)
             self._con.execute(_INSERT_DESIGN, row)
             if len(result.pressure_mpa):
@@ -436,7 +536,7 @@ class CampaignStore:
             utc_now(),
             None,
         ]
-        with transaction(self._con):
+        with self._writing(), transaction(self._con):
             self._delete(design.design_id)
             self._con.execute(_INSERT_DESIGN, row)
         self._recorded.add(design.design_id)
@@ -510,7 +610,7 @@ class CampaignStore:
             "WHERE status = 'failed' ORDER BY finished_at, design_id LIMIT ?",
             [int(max_failures)],
         ).fetchall()
-        planned = meta.get("n_designs_planned")
+        planned = self._meta_int("n_designs_planned")
         return {
             "path": str(self.path),
             "schema_version": int(meta["schema_version"]),
@@ -518,7 +618,7 @@ class CampaignStore:
             "created_at": meta.get("created_at"),
             "backend": meta.get("backend"),
             "space": meta.get("space"),
-            "n_designs_planned": int(planned) if planned is not None else None,
+            "n_designs_planned": planned,
             "n_pressures": None if grid is None else len(grid),
             "pmin_mpa": None if grid is None else float(grid[0]),
             "pmax_mpa": None if grid is None else float(grid[-1]),
@@ -593,6 +693,12 @@ class CampaignStore:
         -------
         pathlib.Path
             The written file.
+
+        Raises
+        ------
+        OSError
+            The file could not be written (a full disk, a read-only folder); it
+            names ``path``, and nothing is left of the export.
         """
         check_choice(format, "format", "CampaignStore.export", ("parquet", "csv"))
         check_choice(table, "table", "CampaignStore.export", ("samples", "designs"))
@@ -608,16 +714,178 @@ class CampaignStore:
         )
         tmp = target.with_name(f".{target.name}.{uuid.uuid4().hex}.tmp")
         try:
-            relation = self._con.sql(query)
-            if format == "parquet":
-                relation.write_parquet(str(tmp))
-            else:
-                relation.write_csv(str(tmp), header=True)
+            with self._writing(target):
+                relation = self._con.sql(query)
+                if format == "parquet":
+                    relation.write_parquet(str(tmp))
+                else:
+                    relation.write_csv(str(tmp), header=True)
+            os.chmod(tmp, new_file_mode(target))
             os.replace(tmp, target)
         finally:
             tmp.unlink(missing_ok=True)
         logger.info("exported %s of %s to %s (%s)", table, self.path, target, format)
         return target
+
+
+def merge_campaigns(
+    target: str | os.PathLike[str], sources: Sequence[str | os.PathLike[str]]
+) -> list[dict[str, Any]]:
+    """Merge campaign databases (shards) into ``target``, all or nothing.
+
+    Every source, and ``target`` if it exists, is checked before anything is
+    written: each must be a readable campaign database (not damaged, of a schema
+    this softbend reads), and all that hold a campaign must share one backend and
+    one pressure grid. The merge is then written into a copy of ``target`` (or a
+    new database) beside it, which replaces ``target`` only when every source is
+    in: a merge that fails (a bad shard, a full disk) leaves ``target`` as it
+    was, or absent. ``target`` is held open read-only meanwhile, so no campaign
+    can write to it between the copy and the replacement.
+
+    Parameters
+    ----------
+    target : str or os.PathLike
+        Campaign database to merge into; created if missing. Its folder must exist.
+    sources : sequence of str or os.PathLike
+        Campaign databases to copy designs from (not modified), at least one.
+
+    Returns
+    -------
+    list of dict
+        Per source, as :meth:`CampaignStore.merge`: ``{"added", "replaced_failed", "kept"}``.
+
+    Raises
+    ------
+    FileNotFoundError
+        A source does not exist, or the folder of ``target`` does not.
+    ValueError
+        No source, a source that is ``target``, or a backend or pressure grid that
+        differs from another database's.
+    SchemaError
+        A source or ``target`` is not a readable campaign database.
+    OSError
+        The merged database could not be written (naming ``target``).
+    """
+    target = Path(target)
+    paths = [Path(source) for source in sources]
+    if not paths:
+        raise ValueError("The 'sources' of merge_campaigns must name at least one database.")
+    if not target.parent.is_dir():
+        raise FileNotFoundError(
+            f"The folder of the campaign database {str(target)!r} does not exist."
+        )
+    for source in paths:
+        if not source.is_file():
+            raise FileNotFoundError(f"No campaign database at {str(source)!r}.")
+        if target.exists() and os.path.samefile(source, target):
+            raise ValueError(f"A campaign cannot be merged into itself: {str(source)!r}.")
+    if _has_log(target):
+        # Fold the target's write-ahead log (left by a process that was killed or ran out
+        # of disk) into it first: the copy merged into would not carry it.
+        with CampaignStore(target) as own, own._writing():
+            own._con.execute("FORCE CHECKPOINT")
+        if _has_log(target):
+            raise OSError(errno.EIO, "its write-ahead log could not be folded in", str(target))
+    held = CampaignStore(target, read_only=True) if target.exists() else None
+    try:
+        reference = None
+        if held is not None and held.backend is not None:
+            reference = (held.backend, held.pressures_mpa, target)
+        for source in paths:
+            with CampaignStore(source, read_only=True) as other:
+                backend, grid = other.backend, other.pressures_mpa
+            if backend is None or grid is None:
+                continue  # a shard that never ran: nothing to merge
+            if reference is None:
+                reference = (backend, grid, source)
+            else:
+                _check_same_campaign(reference, (backend, grid, source))
+        return _merge_staged(target, paths, held)
+    finally:
+        if held is not None:
+            held.close()
+
+
+def _check_same_campaign(
+    first: tuple[str, np.ndarray, Path], other: tuple[str, np.ndarray, Path]
+) -> None:
+    """Refuse ``other`` unless it has the backend and pressure grid of ``first``.
+
+    Each is ``(backend, pressures_mpa, path)``.
+    """
+    (backend, grid, path), (other_backend, other_grid, other_path) = first, other
+    if other_backend != backend:
+        raise ValueError(
+            f"The backend of the campaign in {str(other_path)!r} is {other_backend!r}, that of "
+            f"{str(path)!r} is {backend!r}; only campaigns of one backend and one pressure "
+            "grid merge. Nothing was merged."
+        )
+    if not np.array_equal(other_grid, grid):
+        raise ValueError(
+            f"The 'pressures_mpa' of the campaign in {str(other_path)!r} are "
+            f"{_describe_grid(other_grid)}, those of {str(path)!r} {_describe_grid(grid)}; "
+            "only campaigns of one backend and one pressure grid merge. Nothing was merged."
+        )
+
+
+def _merge_staged(
+    target: Path, sources: list[Path], held: CampaignStore | None
+) -> list[dict[str, Any]]:
+    """Merge ``sources`` into a copy of ``target`` beside it, then move it into place."""
+    staging = target.with_name(f".{target.name}.{uuid.uuid4().hex}.tmp")
+    try:
+        if held is not None:
+            shutil.copyfile(target, staging)
+            os.chmod(staging, new_file_mode(target))
+        store = CampaignStore(staging)
+        try:
+            with store._writing(target):
+                counts = [store.merge(source) for source in sources]
+                # Into the file itself: closing would not report a checkpoint that fails,
+                # and the write-ahead log beside the copy does not move with it.
+                store._con.execute("FORCE CHECKPOINT")
+        finally:
+            with store._writing(target):
+                store.close()
+        if _has_log(staging):
+            raise OSError(
+                errno.EIO, "the merged database could not be written in full", str(target)
+            )
+        os.replace(staging, target)
+    except OSError as exc:
+        names = [n for n in (exc.filename, exc.filename2) if isinstance(n, str)]
+        if str(staging) in names:  # name the file the caller asked for, not the copy
+            raise OSError(exc.errno, exc.strerror, str(target)) from None
+        raise
+    finally:
+        _remove_database(staging)
+    return counts
+
+
+def _has_log(path: Path) -> bool:
+    """Whether DuckDB's write-ahead log beside ``path`` holds anything."""
+    wal = path.with_name(path.name + ".wal")
+    try:
+        return wal.stat().st_size > 0
+    except OSError:
+        return False
+
+
+def _close_quietly(con: Any) -> None:
+    """Close a DuckDB connection that is being given up; its own error is not the news."""
+    try:
+        con.close()
+    except Exception:
+        logger.debug("closing a DuckDB connection that failed failed too", exc_info=True)
+
+
+def _remove_database(path: Path) -> None:
+    """Remove a database file that was made here and is being given up, and its log."""
+    for leftover in (path, path.with_name(path.name + ".wal")):
+        try:
+            leftover.unlink(missing_ok=True)
+        except OSError:
+            logger.warning("could not remove %s", leftover)
 
 
 def _sql_text(path: Path) -> str:

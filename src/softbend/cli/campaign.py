@@ -118,6 +118,10 @@ def run(
 
     _common.check_output_file(db, "DB", inputs=(model,) if model is not None else ())
     spec = _space_spec(space)
+    if seed < 0:
+        raise ValueError(
+            f"The '--seed' of softbend campaign run must be an integer >= 0. Got {seed} instead."
+        )
     shard_of = parse_shard(shard) if shard is not None else None
     pressures = default_pressures_mpa(pmax, pstep)
     if (backend == "surrogate") != (model is not None):
@@ -178,18 +182,26 @@ def run(
             advance(done + failed - shown, done=done, failed=failed, running=running)
             shown = done + failed
 
-        summary = run_campaign(
-            db,
-            designs,
-            backend=backend_obj,
-            pressures_mpa=pressures,
-            workers=workers,
-            scheduler=scheduler,
-            retry_failed=retry_failed,
-            progress=progress,
-            chunk_size=chunk_size,
-            connect_timeout_s=connect_timeout,
-        )
+        try:
+            summary = run_campaign(
+                db,
+                designs,
+                backend=backend_obj,
+                pressures_mpa=pressures,
+                workers=workers,
+                scheduler=scheduler,
+                retry_failed=retry_failed,
+                progress=progress,
+                chunk_size=chunk_size,
+                connect_timeout_s=connect_timeout,
+            )
+        except OSError as exc:
+            # A failed write of the database (a full disk) names it: one line naming DB.
+            # The designs recorded before stay in it; re-running the command resumes.
+            if exc.filename is None:
+                raise
+            with _common.output_errors(db, "DB"):
+                raise
     if json_output:
         _common.print_json({"space": designs.name, **summary.as_dict()})
         return
@@ -225,16 +237,18 @@ def merge(
 ) -> None:
     """Merge the databases of campaign shards (same backend and grid) into DB."""
     from softbend.campaign import CampaignStore
+    from softbend.campaign.store import merge_campaigns
 
     for shard in shards:
         if not shard.is_file():
             raise FileNotFoundError(f"No campaign database at {str(shard)!r}.")
     _common.check_output_file(db, "DB", inputs=tuple(shards))
-    rows = []
-    with CampaignStore(db) as store:
-        for shard in shards:
-            counts = store.merge(shard)
-            rows.append({"shard": str(shard), **counts})
+    # Every shard is checked before anything is written, and DB is replaced only
+    # when the whole merge is done: a failed merge leaves DB as it was (or absent).
+    with _common.output_errors(db, "DB"):
+        counts = merge_campaigns(db, shards)
+    rows = [{"shard": str(shard), **c} for shard, c in zip(shards, counts, strict=True)]
+    with CampaignStore(db, read_only=True) as store:
         total = store.status_summary()
     if json_output:
         _common.print_json(
@@ -348,6 +362,7 @@ def dataset(
     planned = _space_spec(space).n_designs if space is not None else None
     written = (SAMPLES_FILE, DESIGNS_FILE, PROVENANCE_FILE)
     _common.check_output_dir(out, "OUT", inputs=(db,), files=written)
+    # write_dataset reads and checks the whole campaign before it writes anything
     with _common.output_errors(out, "OUT"):
         provenance = write_dataset(
             db, out, command=command, description=description, planned=planned

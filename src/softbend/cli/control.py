@@ -63,6 +63,7 @@ def _setup(
 
     check_choice(controller, "controller", command, CONTROLLERS)
     check_choice(plant, "plant", command, PLANTS)
+    _check_supply(supply, command)
     actuator = SFRBADesign.parse(design)
     params = RigParams.for_design(actuator, supply_gauge_mpa=supply)
     surrogate = load_base(model)
@@ -70,6 +71,19 @@ def _setup(
     sensor = mlp_virtual_sensor(surrogate, actuator) if hasattr(surrogate, "predictor") else table
     actuator_table = plant_table(plant, actuator, table)
     return actuator, params, actuator_table, make_controller(controller, table, sensor, params)
+
+
+def _check_supply(supply: float, command: str) -> None:
+    """Refuse a supply pressure that is not a positive, plausible gauge pressure (MPa)."""
+    from softbend.plausibility import RANGES
+
+    high = RANGES["pressure_mpa"].high
+    if not 0.0 < supply <= high:
+        raise ValueError(
+            f"The '--supply' of {command} must be a gauge pressure in (0, {high:g}] MPa "
+            f"({high:g} MPa bursts any silicone actuator; a value in kPa must be divided by "
+            f"1000). Got {supply!r} instead."
+        )
 
 
 @app.command("simulate")
@@ -110,11 +124,17 @@ def simulate_cmd(
         "metrics": metrics,
     }
     with _common.output_errors(out, "--out"):
+        from softbend._io import atomic_file, write_text_atomic
+
         out.mkdir(parents=True, exist_ok=True)
-        run.frame().to_csv(out / "run.csv", index=False)
-        (out / "metrics.json").write_text(_common.json_text(payload) + "\n", encoding="utf-8")
-        figure = control_figures.run_figure(
-            run, out / "run.png", f"{controller} on {actuator}, {reference} (simulated)"
+        with atomic_file(out / "run.csv") as handle:  # never half a table
+            run.frame().to_csv(handle, index=False)
+        write_text_atomic(out / "metrics.json", _common.json_text(payload) + "\n")
+        figure = _figure_atomic(
+            out / "run.png",
+            lambda path: control_figures.run_figure(
+                run, path, f"{controller} on {actuator}, {reference} (simulated)"
+            ),
         )
     payload["files"] = [str(out / "run.csv"), str(out / "metrics.json")] + (
         [str(figure)] if figure else []
@@ -172,8 +192,9 @@ def run_cmd(
     The same controller object as `control simulate`, called every tick (1 ms) with
     the latest pressure reading (read every 10 ms: paper B's 100 Hz). Over-pressure,
     missed or stale readings vent the actuator and stop the run; so do Ctrl-C and SIGTERM. Exit 0
-    when the run completed, 1 when a fault stopped it (the log keeps every tick up to
-    the fault), 130 on Ctrl-C.
+    when the run completed and the rig was vented, 1 when a fault stopped it or the
+    final vent did not reach the rig (the log keeps every tick up to the fault; the
+    one error line says whether the rig was vented), 130 on Ctrl-C.
     """
     from softbend._validation import check_choice, check_range
     from softbend.control.experiments import parse_reference
@@ -214,7 +235,10 @@ def run_cmd(
 
     previous = _terminate_as_interrupt()
     try:
-        with _common.progress_bar("control loop", ticks, enabled=not as_json) as advance:
+        with (
+            _common.output_errors(out, "--out"),  # the tick log: a full disk is one line
+            _common.progress_bar("control loop", ticks, enabled=not as_json) as advance,
+        ):
             result = run_loop(
                 device,
                 ctrl,
@@ -260,11 +284,14 @@ def run_cmd(
         from softbend._io import write_text_atomic
 
         write_text_atomic(out / "run.json", _common.json_text(payload) + "\n")
-        figure = control_figures.run_figure(
-            result.control_run(),
+        figure = _figure_atomic(
             out / "run.png",
-            f"{controller} on {actuator}, {reference}, rig {rig} "
-            f"(tick {loop_period * 1e3:g} ms, sensor {sensor_every * 1e3:g} ms)",
+            lambda path: control_figures.run_figure(
+                result.control_run(),
+                path,
+                f"{controller} on {actuator}, {reference}, rig {rig} "
+                f"(tick {loop_period * 1e3:g} ms, sensor {sensor_every * 1e3:g} ms)",
+            ),
         )
     payload["files"] = [str(out / log_name), str(out / "run.json")] + (
         [str(figure)] if figure else []
@@ -280,9 +307,27 @@ def run_cmd(
     if result.fault_kind == "interrupted":
         _common.error_line(result.stop_reason)
         raise typer.Exit(130)
-    if not result.completed:
+    if not result.completed or not result.vented:  # a fault, or a rig left unvented
         _common.error_line(result.stop_reason)
         raise typer.Exit(1)
+
+
+def _figure_atomic(path: Path, draw: Any) -> Path | None:
+    """Draw a figure with ``draw(temporary_path)`` and move it to ``path`` once complete.
+
+    A figure cut short (a full disk, an interruption) never replaces ``path``.
+    """
+    import os
+
+    temporary = path.with_name(f".{path.stem}.{os.getpid()}.tmp{path.suffix}")
+    try:
+        written = draw(temporary)
+        if not written:
+            return None
+        os.replace(temporary, path)
+        return path
+    finally:
+        temporary.unlink(missing_ok=True)
 
 
 def _terminate_as_interrupt() -> Any:
@@ -354,6 +399,11 @@ def serve_cmd(
         port if port is not None else (settings.connection.port if config is not None else 5020)
     )
     check_range(duration, "duration", "softbend control serve", low=0.0, low_inclusive=True)
+    if not host.strip():
+        raise ValueError(
+            "The '--host' of softbend control serve must be an address to listen on "
+            "(e.g. 127.0.0.1 or 0.0.0.0). Got an empty string instead."
+        )
     if not 0 <= listen <= 65535:
         raise ValueError(
             f"The '--port' of softbend control serve must be an integer in [0, 65535]. "
@@ -386,16 +436,35 @@ def rig_config_cmd(
     out: Path = typer.Option(..., "--out", help="The TOML file to write."),
     host: str = typer.Option("127.0.0.1", help="Modbus TCP host."),
     port: int = typer.Option(5020, help="Modbus TCP port."),
+    force: bool = typer.Option(
+        False, "--force", help="Replace an existing --out file (a rig TOML may be hand-edited)."
+    ),
 ) -> None:
-    """Write a rig TOML template (the built-in register map of `control serve`) to edit."""
+    """Write a rig TOML template (the built-in register map of `control serve`) to edit.
+
+    An existing file is kept unless --force is given; the file is written atomically
+    (a reader sees the old file or the whole new one).
+    """
     from dataclasses import replace
 
     from softbend._io import write_text_atomic
     from softbend.control.rigconfig import RigConfig
 
+    if not 0 <= port <= 65535:
+        raise ValueError(
+            f"The '--port' of softbend control rig-config must be an integer in [0, 65535]. "
+            f"Got {port} instead."
+        )
+    if not host.strip():
+        raise ValueError("The '--host' of softbend control rig-config must not be empty.")
     settings = RigConfig()
     settings = replace(settings, connection=replace(settings.connection, host=host, port=port))
     _common.check_output_file(out, "--out")
+    if out.exists() and not force:
+        raise ValueError(
+            f"The '--out' {out} already exists (perhaps a hand-edited rig config); "
+            "give --force to replace it, or choose another file."
+        )
     header = (
         "# softbend rig: connection, register map, scaling (value = offset + scale*count),\n"
         "# safety limits and loop period. Units: MPa gauge, degrees, seconds.\n\n"

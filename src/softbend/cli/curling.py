@@ -28,8 +28,9 @@ def simulate(
 ) -> None:
     """Write synthetic curling-actuator experiments (positive and negative pressure) as CSV."""
     from softbend.identification.data import save_experiments
-    from softbend.identification.synthetic import synthetic_dataset
+    from softbend.identification.synthetic import check_synthetic_size, synthetic_dataset
 
+    check_synthetic_size(samples, dt, samples="'--samples'", dt="'--dt'")
     _common.check_output_dir(out, "--out")
     dataset = synthetic_dataset(
         n_experiments=experiments, n_samples=samples, dt_s=dt, seed=seed, excitation=excitation
@@ -93,7 +94,7 @@ def identify(
     as_json: bool = typer.Option(False, "--json", help="Print metrics as JSON."),
 ) -> None:
     """Identify rho and L NARX models per pressure sign; leave-one-experiment-out metrics."""
-    from softbend.identification.data import load_experiments
+    from softbend.identification.data import experiment_files, load_experiments
     from softbend.identification.resources import check_identify_memory
     from softbend.identification.study import IdentificationConfig, n_fits
     from softbend.identification.study import identify as run_identify
@@ -110,6 +111,7 @@ def identify(
     csvs = [p for p in data.iterdir() if p.suffix.lower() == ".csv"] if data.is_dir() else []
     inputs = (data, *csvs)
     _common.check_output_dir(out, "--out", inputs=inputs, files=("metrics.csv", "summary.csv"))
+    experiment_files(data)  # missing data and files over the size limit: refused first
     need = check_identify_memory(data, max_memory_mb=max_memory_mb)
     if not as_json and need.csv_bytes >= 4 * 2**20:  # long enough to be worth a line
         _common.err_console.print(

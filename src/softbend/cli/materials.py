@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import os
 from pathlib import Path
 from typing import TYPE_CHECKING, Annotated, Any
 
@@ -117,7 +118,14 @@ def fit(
     results = fit_models(test, names, max_stretch=max_stretch)
 
     with _common.output_errors(out, "--out"):
-        figure = fit_figure(test, results, out / FIT_PNG)
+        out.mkdir(parents=True, exist_ok=True)
+        temporary = out / f".{FIT_PNG}.{os.getpid()}.tmp.png"  # never half a figure
+        try:
+            fit_figure(test, results, temporary)
+            os.replace(temporary, out / FIT_PNG)
+        finally:
+            temporary.unlink(missing_ok=True)
+        figure = out / FIT_PNG
         payload = _payload(test, results, max_stretch)
         payload["files"] = {"figure": str(figure), "json": str(out / FIT_JSON)}
         write_text_atomic(out / FIT_JSON, _common.json_text(payload) + "\n")

@@ -2,6 +2,10 @@
 
 from __future__ import annotations
 
+import os
+import secrets
+from collections.abc import Iterator
+from contextlib import contextmanager
 from pathlib import Path
 from typing import TYPE_CHECKING
 
@@ -26,6 +30,95 @@ def _names(text: str) -> list[str]:
     return [n.strip() for n in text.split(",") if n.strip()]
 
 
+@contextmanager
+def _as_written(staged: Path, final: Path) -> Iterator[None]:
+    """An OS error about a file under ``staged`` names the file it becomes under ``final``.
+
+    Outputs are written beside their place first (a staging folder, a temporary
+    file) and moved there when complete; an error while writing them is about
+    the output, and :func:`_common.output_errors` says so with the final name.
+    """
+    try:
+        yield
+    except OSError as exc:
+        name = exc.filename
+        if exc.errno is None or not isinstance(name, str | bytes):
+            raise
+        found = Path(os.path.abspath(os.fsdecode(name)))
+        root = Path(os.path.abspath(staged))
+        if found != root and root not in found.parents:
+            raise
+        renamed = Path(final) / found.relative_to(root) if found != root else Path(final)
+        raise OSError(exc.errno, exc.strerror, str(renamed)) from exc
+
+
+@contextmanager
+def _staged_files(*targets: Path) -> Iterator[list[Path]]:
+    """Yield one temporary sibling per target; all are moved onto the targets at the end.
+
+    If the block raises, the temporaries are removed and every target is left
+    as it was: the outputs of one command are all new or all old. A temporary
+    keeps its target's suffix (a figure's format follows it); the moved file
+    gets the permissions the target had, or those of a new file.
+    """
+    from softbend._io import new_file_mode
+
+    token = f"{os.getpid()}-{secrets.token_hex(4)}"
+    temps = [t.parent / f".{t.name}.{token}.tmp{t.suffix}" for t in targets]
+    for target in targets:
+        target.parent.mkdir(parents=True, exist_ok=True)
+    try:
+        yield temps
+        for temp, target in zip(temps, targets, strict=True):
+            os.chmod(temp, new_file_mode(target))
+        for temp, target in zip(temps, targets, strict=True):
+            os.replace(temp, target)
+    finally:
+        for temp in temps:
+            temp.unlink(missing_ok=True)
+
+
+#: The files 'transfer loco' writes into its '--out' folder.
+LOCO_FILES: tuple[str, ...] = (
+    "summary.csv",
+    "per_actuator.csv",
+    "predictions.csv",
+    "learning_curve.csv",
+    "loss_curves_deg2.csv",
+    "loco.json",
+    "fig6_loss_curves.png",
+    "fig7_actuators.png",
+    "learning_curve.png",
+)
+
+
+def _check_replaceable_dir(
+    out: Path, option: str, inputs: tuple[Path, ...], files: tuple[str, ...], command: str
+) -> None:
+    """Refuse an existing output folder that a whole-folder replacement would lose data from.
+
+    The folder is replaced as a whole, so it may hold only the files ``command``
+    writes (an earlier run's results), and none of the command's inputs.
+    """
+    if not out.is_dir():
+        return
+    folder = Path(os.path.abspath(out))
+    for source in inputs:
+        if folder in Path(os.path.abspath(source)).parents:
+            raise ValueError(
+                f"The '{option}' {out} holds the input {source}, and the folder is replaced "
+                "as a whole by the new results; choose another folder."
+            )
+    others = sorted(p.name for p in out.iterdir() if p.name not in files)
+    if others:
+        shown = ", ".join(others[:3]) + (f" and {len(others) - 3} more" if len(others) > 3 else "")
+        raise ValueError(
+            f"The '{option}' {out} is replaced as a whole by the results of '{command}', but "
+            f"it holds other files ({shown}); choose a new or empty folder, or one of its "
+            "earlier results."
+        )
+
+
 @lab_app.command("measure")
 def measure(
     out: Path = typer.Option(..., "--out", help="CSV file to write the measurements to."),
@@ -45,15 +138,31 @@ def measure(
     step: float = typer.Option(0.01, help="Pressure increment, MPa."),
     max_angle: float = typer.Option(270.0, help="Stop raising the pressure past this angle, deg."),
     unloading: bool = typer.Option(False, "--unloading", help="Also read the unloading branch."),
-    cycles: int = typer.Option(1, help="Inflation cycles per actuator."),
+    cycles: int = typer.Option(
+        1, help="Inflation cycles per actuator (at most SOFTBEND_MAX_CYCLES, default 1000)."
+    ),
     as_json: bool = typer.Option(False, "--json", help="Print a JSON summary."),
 ) -> None:
-    """Measure the 7 actuators of paper B Fig. 7 in the virtual lab (synthetic data)."""
+    """Measure the 7 actuators of paper B Fig. 7 in the virtual lab (synthetic data).
+
+    Writes the CSV and its figure (the same name with ``.png``) together: a run
+    that fails leaves both as they were.
+    """
+    from softbend.limits import check_limit
     from softbend.reports.transfer_figures import lab_measurements
     from softbend.transfer.lab import VirtualLab
-    from softbend.transfer.measurements import save_measurements
+    from softbend.transfer.measurements import format_measurements
 
+    check_limit("cycles", cycles, "--cycles")
+    out = Path(out)
+    figure = out.with_suffix(".png")
+    if out.suffix.lower() == ".png":
+        raise ValueError(
+            f"The '--out' must name the CSV file; its figure is written beside it with "
+            f"'.png'. Got {out}, which the figure would replace."
+        )
     _common.check_output_file(out, "--out", kind="csv")
+    _common.check_output_file(figure, "--out", kind="png")
     lab = VirtualLab(
         plant=plant,
         seed=seed,
@@ -70,8 +179,17 @@ def measure(
     total = len(lab.actuators)
     with _common.progress_bar("virtual lab", total, enabled=not as_json) as advance:
         measurements = lab.measure(progress=lambda done, n, name: advance(actuator=name))
-    path = save_measurements(measurements, out)
-    figure = lab_measurements(measurements, path.with_suffix(".png"))
+    text = format_measurements(measurements)
+    with _common.output_errors(out, "--out"), _staged_files(out, figure) as (csv_file, png):
+        with (
+            _common.output_errors(out, "--out"),
+            _as_written(csv_file, out),
+            open(csv_file, "w", encoding="utf-8", newline="") as handle,
+        ):
+            handle.write(text)
+        with _common.output_errors(figure, "--out"), _as_written(png, figure):
+            lab_measurements(measurements, png)
+    path = out
     frame = measurements.frame
     per = frame.groupby("actuator_id", sort=False).agg(
         points=("angle_deg", "size"),
@@ -105,6 +223,7 @@ def base(
     seed: int = typer.Option(0, help="Seed of the weights and the batch order."),
 ) -> None:
     """Train paper B's MLP (63, 65) on the shipped Table 1 FEM dataset and save it."""
+    from softbend._io import json_safe
     from softbend.datasets import table1_fem_provenance
     from softbend.surrogates.features import training_ranges
     from softbend.surrogates.persistence import save_surrogate
@@ -120,23 +239,21 @@ def base(
 
         model = train_base_mlp(epochs=epochs, seed=seed, progress=progress)
     provenance = table1_fem_provenance()
-    path = save_surrogate(
-        model,
-        out,
-        metadata={
-            "purpose": "the FEM-trained MLP that transfer learning starts from",
-            "trained_on": "softbend.datasets.table1_fem(), converged samples",
-            "dataset_samples_sha256": provenance.get("files", {})
-            .get("samples.parquet", {})
-            .get("sha256"),
-            "hidden_sizes": list(BASE_HIDDEN_SIZES),
-            "epochs": epochs,
-            "seed": seed,
-            "command": f"softbend transfer base --out {out.name} --epochs {epochs} --seed {seed}",
-            "final_training_mse_deg2": float(model.loss_curve_[-1]) * model.y_scale_**2,
-            "training_ranges": training_ranges(fem_rows()),
-        },
-    )
+    metadata = {
+        "purpose": "the FEM-trained MLP that transfer learning starts from",
+        "trained_on": "softbend.datasets.table1_fem(), converged samples",
+        "dataset_samples_sha256": provenance.get("files", {})
+        .get("samples.parquet", {})
+        .get("sha256"),
+        "hidden_sizes": list(BASE_HIDDEN_SIZES),
+        "epochs": epochs,
+        "seed": seed,
+        "command": f"softbend transfer base --out {out.name} --epochs {epochs} --seed {seed}",
+        "final_training_mse_deg2": float(model.loss_curve_[-1]) * model.y_scale_**2,
+        "training_ranges": training_ranges(fem_rows()),
+    }
+    with _common.output_errors(out, "--out"):
+        path = save_surrogate(model, out, metadata=json_safe(metadata))
     _common.console.print(
         f"FEM MLP {BASE_HIDDEN_SIZES} written to {path} "
         f"(final training MSE {model.loss_curve_[-1] * model.y_scale_**2:.4g} deg²)"
@@ -160,13 +277,23 @@ def loco(
     seed: int = typer.Option(0, help="Seed of the strategies and the learning curve."),
     as_json: bool = typer.Option(False, "--json", help="Print the results as JSON."),
 ) -> None:
-    """Leave one configuration out: every strategy, every held-out actuator (paper B Fig. 7)."""
+    """Leave one configuration out: every strategy, every held-out actuator (paper B Fig. 7).
+
+    The folder ``--out`` is written as a whole: built beside it and swapped in
+    when every table and figure is complete, so a run that fails leaves the
+    previous results as they were. An existing ``--out`` may hold only what this
+    command writes.
+    """
+    from softbend._io import staged_dir
     from softbend.reports import transfer_figures
     from softbend.transfer.base import load_base
     from softbend.transfer.loco import DEFAULT_STRATEGIES, leave_one_configuration_out
     from softbend.transfer.measurements import load_measurements
 
-    _common.check_output_dir(out, "--out", inputs=(measurements,))
+    out = Path(out)
+    inputs = (measurements,) if base is None else (measurements, base)
+    _common.check_output_dir(out, "--out", inputs=inputs, files=LOCO_FILES)
+    _check_replaceable_dir(out, "--out", inputs, LOCO_FILES, "transfer loco")
     data = load_measurements(measurements)
     names = list(DEFAULT_STRATEGIES) if strategies.strip() == "all" else _names(strategies)
     model = load_base(base)
@@ -180,17 +307,20 @@ def loco(
             seed=seed,
             progress=lambda done, total, name: progress("fitting strategies", done, total),
         )
-    files = result.write(out)
-    out = Path(out)
     synthetic = str(data.metadata.get("synthetic", "")).startswith("true")
-    files["fig6"] = str(transfer_figures.loss_curves(result, out / "fig6_loss_curves.png"))
-    files["fig7"] = str(
-        transfer_figures.actuator_panels(result, out / "fig7_actuators.png", synthetic=synthetic)
-    )
-    if learning_curve:
-        files["learning_curve_figure"] = str(
-            transfer_figures.learning_curve(result, out / "learning_curve.png")
+    with _common.output_errors(out, "--out"), staged_dir(out) as stage, _as_written(stage, out):
+        written = result.write(stage)
+        written["fig6"] = str(transfer_figures.loss_curves(result, stage / "fig6_loss_curves.png"))
+        written["fig7"] = str(
+            transfer_figures.actuator_panels(
+                result, stage / "fig7_actuators.png", synthetic=synthetic
+            )
         )
+        if learning_curve:
+            written["learning_curve_figure"] = str(
+                transfer_figures.learning_curve(result, stage / "learning_curve.png")
+            )
+    files = {key: str(out / Path(value).name) for key, value in written.items()}
     if as_json:
         _common.print_json({**result.to_dict(), "files": files, "synthetic": synthetic})
         return
@@ -251,6 +381,7 @@ def refine(
     """
     import numpy as np
 
+    from softbend._io import json_safe
     from softbend._validation import check_choice
     from softbend.surrogates.persistence import save_surrogate
     from softbend.transfer.measurements import load_measurements
@@ -291,7 +422,8 @@ def refine(
     }
     if hasattr(model, "loss_curve_"):
         metadata["final_training_mse_deg2"] = float(model.loss_curve_[-1])
-    path = save_surrogate(model.model_, out, metadata=metadata)
+    with _common.output_errors(out, "--out"):
+        path = save_surrogate(model.model_, out, metadata=json_safe(metadata))
     _common.console.print(
         f"{strategy} model on {len(data)} readings of {len(data.actuator_ids)} actuators "
         f"written to {path} (training RMSE {metadata['training_rmse_deg']:.3g}°); "

@@ -26,9 +26,10 @@ every ``flush_every`` ticks, so a killed process keeps its ticks in
 written from the finished table.
 
 However the run ends (its duration reached, a fault, an exception, Ctrl-C)
-the loop vents the actuator: inlet closed, outlet open. If the rig cannot be
-reached to do that, the stop reason says so: the rig's own watchdog must vent
-it.
+the loop vents the actuator: inlet closed, outlet open. The stop reason is
+written once that vent has been tried, and says what happened to it: "vented
+and stopped" when the vent command reached the rig, or, when it did not, that
+the rig is not vented and its own watchdog must vent it (never both).
 
 Period jitter is ``|Δt − period_s|`` over consecutive actual tick times;
 lateness is the actual minus the scheduled time of each tick. The garbage
@@ -87,7 +88,11 @@ class LoopRun:
     completed : bool
         True when the run reached its duration.
     stop_reason : str
-        ``"completed"``, or the fault, exception or interruption that ended it.
+        ``"completed"``, or the fault, exception or interruption that ended it,
+        followed by the outcome of the final vent: ``"; vented and stopped."``,
+        or ``"; stopped, but could not vent the rig (...)"`` when the vent
+        command failed (a completed run whose vent failed starts ``"Completed,
+        but could not vent"``).
     fault_kind : str or None
         The :class:`~softbend.errors.RigError` kind, ``"over-pressure"``,
         ``"interrupted"``, ``"error"``, or None when completed.
@@ -247,7 +252,8 @@ def run_loop(
     Raises
     ------
     KeyboardInterrupt
-        Never: Ctrl-C ends the run as ``fault_kind="interrupted"``, vented.
+        Never: Ctrl-C ends the run as ``fault_kind="interrupted"``, vented (if the
+        rig answers the vent command; the stop reason says which).
     """
     ref = parse_reference(reference) if isinstance(reference, str) else reference
     period = check_range(period_s, "period_s", "run_loop", low=0.0, high=1.0, high_inclusive=True)
@@ -315,7 +321,7 @@ def run_loop(
                             if missed >= limits.max_missed_reads
                             else f"no good reading for {quiet:.3f} s"
                         )
-                        reason, kind = f"{exc} ({why}; vented and stopped)", exc.kind
+                        reason, kind = f"{_clause(exc)} ({why})", exc.kind
                         log.add(row(k, now, status))
                         break
                     send((False, True if state is None else state[1]))  # inlet shut at once
@@ -326,7 +332,7 @@ def run_loop(
                     if reading > limits.max_pressure_mpa:
                         reason = (
                             f"Over-pressure: {reading:.4f} MPa read, above max_pressure_mpa "
-                            f"{limits.max_pressure_mpa:g} (vented and stopped)."
+                            f"{limits.max_pressure_mpa:g}"
                         )
                         kind = "over-pressure"
                         log.add(row(k, now, "over-pressure"))
@@ -339,25 +345,24 @@ def run_loop(
             if progress is not None and (k + 1) % report_every == 0:
                 progress(k + 1, n)
     except KeyboardInterrupt:
-        reason, kind = "Interrupted (Ctrl-C or SIGTERM); vented and stopped.", "interrupted"
+        reason, kind = "Interrupted (Ctrl-C or SIGTERM)", "interrupted"
     except RigError as exc:  # a command that did not reach the rig
-        reason, kind = f"{exc} (vented and stopped)", exc.kind
+        reason, kind = _clause(exc), exc.kind
     except Exception as exc:  # a controller or rig bug: still leave the valves safe
-        reason, kind = f"Stopped by an error: {type(exc).__name__}: {exc} (vented).", "error"
+        reason, kind = f"Stopped by an error: {type(exc).__name__}: {_clause(exc)}", "error"
     finally:
         if collecting:
             gc.enable()
-    vented = True
+    # How the run ended is told only once the vent has been tried: its outcome decides
+    # between "vented and stopped" and "not vented".
+    vent_error: BaseException | None = None
     try:
         rig.command(*_VENT)
         if state is not None and state != _VENT:
             switches += (state[0] != _VENT[0]) + (state[1] != _VENT[1])
     except Exception as exc:
-        vented = False
-        reason += (
-            f" Could not vent the rig ({exc}): its own watchdog must vent it; check the "
-            f"valves by hand."
-        )
+        vent_error = exc
+    reason = _ending(reason if kind is not None else None, vent_error)
     frame = log.finish()
     return LoopRun(
         ticks=frame,
@@ -365,10 +370,28 @@ def run_loop(
         completed=kind is None,
         stop_reason=reason,
         fault_kind=kind,
-        vented=vented,
+        vented=vent_error is None,
         switches=switches,
         reference=ref,
     )
+
+
+def _clause(exc: BaseException) -> str:
+    """An exception's message as a clause: one line, without its final full stop."""
+    return " ".join(str(exc).split()).rstrip(".")
+
+
+def _ending(cause: str | None, vent_error: BaseException | None) -> str:
+    """The one stop reason of a run: its ``cause`` (None: completed) and the vent's outcome."""
+    if vent_error is None:
+        return "completed" if cause is None else f"{cause}; vented and stopped."
+    not_vented = (
+        f"could not vent the rig ({_clause(vent_error)}): the vent command did not reach it, "
+        "so its own watchdog must vent it; check the valves by hand."
+    )
+    if cause is None:
+        return f"Completed, but {not_vented}"
+    return f"{cause}; stopped, but {not_vented}"
 
 
 def _row(

@@ -47,21 +47,29 @@ stop the loop. Every value has a unit in its name or its comment::
     period_s = 0.001          # tick of the controller and the valves, s
     sensor_period_s = 0.01    # pressure readings, s (paper B: 100 Hz)
 
-:func:`load_rig_config` reads and checks a file (unknown sections or keys, a
-wrong type, a value out of range: one error naming the field and the allowed
-values); :meth:`RigConfig.to_toml` writes one back.
+:func:`load_rig_config` reads and checks a file before anything uses it: a
+TOML syntax error, an unknown section or key, a missing required key (the
+``address`` and ``scale`` of [pressure] and of [angle]: no default fits every
+sensor), a value of the wrong TOML type, out of range, not finite, or a [safety]
+pressure that is not a plausible gauge pressure (:mod:`softbend.plausibility`)
+is one :class:`~softbend.errors.DatasetError` naming the file, the line and the
+key, and the allowed values. :meth:`RigConfig.to_toml` writes one back.
 """
 
 from __future__ import annotations
 
+import datetime
 import math
+import re
 import tomllib
 from dataclasses import dataclass, field, fields
 from pathlib import Path
 from typing import Any
 
-from softbend._validation import check_choice, check_int, check_range
+from softbend._validation import check_choice, check_int, check_range, short_repr
 from softbend.errors import DatasetError
+from softbend.limits import check_file_size
+from softbend.plausibility import RANGES, implausible_index
 
 __all__ = [
     "ConnectionConfig",
@@ -110,6 +118,11 @@ class ConnectionConfig:
                 f"Got {self.device_id!r} instead."
             )
         check_range(self.timeout_s, "timeout_s", owner, low=0.0, high=10.0, high_inclusive=True)
+        if self.transport == "tcp" and not (isinstance(self.host, str) and self.host.strip()):
+            raise ValueError(
+                f"The 'host' of {owner} must name the rig (e.g. '192.168.0.10') when transport "
+                f"is 'tcp'. Got {self.host!r} instead."
+            )
         if self.transport == "rtu" and not self.serial_port:
             raise ValueError(
                 f"The 'serial_port' of {owner} must name a serial device (e.g. "
@@ -268,34 +281,85 @@ class RigConfig:
             used[key] = name
 
     @classmethod
-    def from_dict(cls, data: dict[str, Any]) -> RigConfig:
-        """Build from parsed TOML; unknown sections or keys are errors that name them."""
-        sections = {"connection", "pressure", "angle", "valves", "safety", "loop"}
-        _check_keys(data, sections, "the rig config", "section")
+    def from_dict(
+        cls, data: dict[str, Any], *, source: str = "the rig config", text: str | None = None
+    ) -> RigConfig:
+        """Build from parsed TOML, every section and key checked.
+
+        Parameters
+        ----------
+        data : dict
+            The parsed file.
+        source : str, default ``"the rig config"``
+            The file, for messages.
+        text : str, optional
+            The file's text, to give the line of a bad key in messages.
+
+        Raises
+        ------
+        DatasetError
+            One line naming ``source`` (and the line, when ``text`` is given), the
+            section and the key: an unknown section or key, a section that is not
+            a table, a missing required key (``address`` and ``scale`` of
+            [pressure] and of [angle]), a value of the wrong type (a string for a
+            number, a float for an integer, a boolean for a number, ...), or a value
+            out of range, not finite or not a plausible gauge pressure (the
+            [safety] pressures, :mod:`softbend.plausibility`).
+        """
+        try:
+            return cls._from_checked(data)
+        except (_FieldError, ValueError) as exc:
+            line = _line_of(text, *_field_of(exc)) if text is not None else None
+            where = f"{source}, line {line}" if line is not None else source
+            message = " ".join(str(exc).split())
+            raise DatasetError(f"{where}: {message}") from None
+
+    @classmethod
+    def _from_checked(cls, data: Any) -> RigConfig:
+        _check_keys(data, set(_SECTIONS) | {"loop"}, "the rig config", "section")
         if "pressure" not in data:
             raise ValueError(
                 "The rig config must have a [pressure] section (table, address, scale, ...)."
             )
+        for name in (*_SECTIONS, "loop"):
+            if name in data:
+                _check_table(name, data[name])
 
-        def build(kind: type, name: str, extra: dict[str, Any] | None = None) -> Any:
-            table = data.get(name, {})
-            if not isinstance(table, dict):
-                raise ValueError(f"The [{name}] of the {_OWNER} must be a table.")
-            allowed = {f.name for f in fields(kind)} - {"section"}
-            _check_keys(table, allowed, f"[{name}] of the {_OWNER}", "key")
-            return kind(**table, **(extra or {}))
+        def build(name: str, extra: dict[str, Any] | None = None) -> Any:
+            return _SECTIONS[name](**data.get(name, {}), **(extra or {}))
 
         loop = data.get("loop", {})
-        _check_keys(loop, {"period_s", "sensor_period_s"}, f"[loop] of the {_OWNER}", "key")
-        return cls(
-            connection=build(ConnectionConfig, "connection"),
-            pressure=build(RegisterConfig, "pressure", {"section": "pressure"}),
-            angle=build(RegisterConfig, "angle", {"section": "angle"}) if "angle" in data else None,
-            valves=build(ValveConfig, "valves"),
-            safety=build(SafetyLimits, "safety"),
+        config = cls(
+            connection=build("connection"),
+            pressure=build("pressure", {"section": "pressure"}),
+            angle=build("angle", {"section": "angle"}) if "angle" in data else None,
+            valves=build("valves"),
+            safety=build("safety"),
             period_s=loop.get("period_s", 0.001),
             sensor_period_s=loop.get("sensor_period_s", 0.01),
         )
+        for name, keys in _REQUIRED.items():
+            missing = [key for key in keys if name in data and key not in data[name]]
+            if missing:
+                given = ", ".join(map(repr, data[name]))
+                raise _FieldError(
+                    f"The [{name}] of the {_OWNER} must give {', '.join(map(repr, missing))} "
+                    f"(no default fits every sensor). Got {f'only {given}' if given else 'none'}.",
+                    name,
+                    None,
+                )
+        for key in _PRESSURE_KEYS:
+            value = data.get("safety", {}).get(key)
+            if value is not None and implausible_index([value], "pressure_mpa") is not None:
+                bounds = RANGES["pressure_mpa"]
+                raise _FieldError(
+                    f"The '{key}' of [safety] of the {_OWNER} must be a plausible "
+                    f"{bounds.label} ({bounds.low:g} to {bounds.high:g} {bounds.unit}). "
+                    f"Got {value!r} instead.",
+                    "safety",
+                    key,
+                )
+        return config
 
     def to_toml(self) -> str:
         """The config as TOML text that :func:`load_rig_config` reads back to an equal config."""
@@ -332,19 +396,182 @@ def load_rig_config(path: str | Path) -> RigConfig:
     ------
     FileNotFoundError
         No such file.
+    LimitError
+        The file is larger than the ``file_mib`` limit of :mod:`softbend.limits`.
     DatasetError
-        The file is not valid TOML.
-    ValueError
-        A section, key or value is not allowed (the message names it).
+        One line naming the file: not UTF-8 text, not valid TOML (with the line
+        and column of the syntax error), or a section, key or value that is not
+        allowed (with the line and the key; see :meth:`RigConfig.from_dict`).
+        A ``ValueError``, as before.
     """
     p = Path(path)
     if not p.is_file():
         raise FileNotFoundError(f"The rig config {str(p)!r} does not exist or is not a file.")
+    check_file_size(p, f"The rig config {p}")
     try:
-        data = tomllib.loads(p.read_text(encoding="utf-8"))
-    except (tomllib.TOMLDecodeError, UnicodeDecodeError) as exc:
-        raise DatasetError(f"The rig config {str(p)!r} is not valid TOML: {exc}.") from None
-    return RigConfig.from_dict(data)
+        text = p.read_text(encoding="utf-8")
+    except UnicodeDecodeError as exc:
+        raise DatasetError(
+            f"{p}: the rig config is not valid TOML: not UTF-8 text (byte {exc.start})."
+        ) from None
+    try:
+        data = tomllib.loads(text)
+    except tomllib.TOMLDecodeError as exc:
+        message = " ".join(str(exc).split())
+        at = _TOML_POSITION.search(message)
+        if at is None:
+            raise DatasetError(f"{p}: the rig config is not valid TOML: {message}.") from None
+        raise DatasetError(
+            f"{p}, line {at['line']}, column {at['column']}: the rig config is not valid "
+            f"TOML: {message[: at.start()]}."
+        ) from None
+    except RecursionError:
+        raise DatasetError(
+            f"{p}: the rig config is not valid TOML for softbend: arrays or inline tables "
+            "nested too deeply to read (a rig config has sections of plain keys)."
+        ) from None
+    return RigConfig.from_dict(data, source=str(p), text=text)
+
+
+#: The sections of a rig TOML (besides [loop]) and the dataclasses they build.
+_SECTIONS: dict[str, type] = {
+    "connection": ConnectionConfig,
+    "pressure": RegisterConfig,
+    "angle": RegisterConfig,
+    "valves": ValveConfig,
+    "safety": SafetyLimits,
+}
+#: The keys without a default: a register and its scaling depend on the sensor.
+_REQUIRED: dict[str, tuple[str, ...]] = {
+    "pressure": ("address", "scale"),
+    "angle": ("address", "scale"),
+}
+#: The [safety] keys that are gauge pressures, MPa.
+_PRESSURE_KEYS: tuple[str, ...] = ("max_pressure_mpa", "valid_min_mpa", "valid_max_mpa")
+#: The TOML type each key must have, from the annotations of the dataclasses.
+_KINDS: dict[str, str] = {"str": "a string", "int": "an integer", "float": "a number"}
+_KINDS.update({"bool": "true or false", "int | None": "an integer"})
+_TOML_POSITION = re.compile(r"\s*\(at line (?P<line>\d+), column (?P<column>\d+)\)$")
+
+
+class _FieldError(ValueError):
+    """A bad section or key of a rig config, with where it is (for the line)."""
+
+    def __init__(self, message: str, section: str | None, key: str | None) -> None:
+        super().__init__(message)
+        self.section = section
+        self.key = key
+
+
+def _section_kinds(name: str) -> dict[str, str]:
+    """Key -> expected kind (a key of :data:`_KINDS`) of the section ``name``."""
+    if name == "loop":
+        return {"period_s": "float", "sensor_period_s": "float"}
+    return {f.name: str(f.type) for f in fields(_SECTIONS[name]) if f.name != "section"}
+
+
+def _toml_type(value: Any) -> str:
+    if isinstance(value, bool):
+        return "a boolean"
+    if isinstance(value, int):
+        return "an integer"
+    if isinstance(value, float):
+        return "a float"
+    if isinstance(value, str):
+        return "a string"
+    if isinstance(value, list):
+        return "an array"
+    if isinstance(value, dict):
+        return "a table"
+    if isinstance(value, datetime.date | datetime.time):
+        return "a date or time"
+    return type(value).__name__
+
+
+def _has_kind(value: Any, kind: str) -> bool:
+    if kind == "str":
+        return isinstance(value, str)
+    if kind == "bool":
+        return isinstance(value, bool)
+    if kind in ("int", "int | None"):
+        return type(value) is int
+    return type(value) in (int, float)  # a number: TOML integers and floats, not booleans
+
+
+def _check_table(name: str, table: Any) -> None:
+    """Unknown keys and wrong TOML types of the section ``name``: one :class:`_FieldError`."""
+    owner = f"[{name}] of the {_OWNER}"
+    if not isinstance(table, dict):
+        raise _FieldError(
+            f"The {owner} must be a table ([{name}] followed by its keys). "
+            f"Got {short_repr(table)} ({_toml_type(table)}) instead.",
+            None,
+            name,
+        )
+    kinds = _section_kinds(name)
+    try:
+        _check_keys(table, set(kinds), owner, "key")
+    except ValueError as exc:
+        unknown = sorted(set(table) - set(kinds))
+        raise _FieldError(str(exc), name, unknown[0]) from None
+    for key, value in table.items():
+        kind = kinds[key]
+        if not _has_kind(value, kind):
+            raise _FieldError(
+                f"The '{key}' of {owner} must be {_KINDS[kind]}. "
+                f"Got {short_repr(value)} ({_toml_type(value)}) instead.",
+                name,
+                key,
+            )
+
+
+_KEY_MESSAGE = re.compile(r"The '(?P<key>\w+)' of \[(?P<section>\w+)\]")
+_SECTION_MESSAGE = re.compile(r"The \[(?P<section>\w+)\] (?P<key>\w+) of")
+_UNKNOWN_SECTION = re.compile(r"The section '(?P<key>[^']+)' of the rig config")
+
+
+def _field_of(exc: Exception) -> tuple[str | None, str | None]:
+    """The (section, key) a rig-config error is about, for its line."""
+    if isinstance(exc, _FieldError):
+        return exc.section, exc.key
+    text = str(exc)
+    for pattern in (_KEY_MESSAGE, _SECTION_MESSAGE):
+        match = pattern.search(text)
+        if match:
+            return match["section"], match["key"]
+    match = _UNKNOWN_SECTION.search(text)
+    return (None, match["key"]) if match else (None, None)
+
+
+_HEADER = re.compile(r"\[\s*([A-Za-z0-9_-]+)\s*\]")
+_ASSIGN = re.compile(r"(?:([A-Za-z0-9_-]+)\s*\.\s*)?\"?([A-Za-z0-9_-]+)\"?\s*=")
+
+
+def _line_of(text: str, section: str | None, key: str | None) -> int | None:
+    """The line of ``key`` in ``section`` of a TOML text (else of the section), or None."""
+    if section is None and key is None:
+        return None
+    current: str | None = None
+    header = None
+    for number, line in enumerate(text.splitlines(), start=1):
+        stripped = line.strip()
+        match = _HEADER.match(stripped)
+        if match:
+            current = match.group(1)
+            if section is not None and current == section and header is None:
+                header = number
+            if section is None and current == key:
+                return number
+            continue
+        match = _ASSIGN.match(stripped)
+        if match is None:
+            continue
+        table = match.group(1) if match.group(1) and current is None else current
+        if table == section and match.group(2) == key:
+            return number
+        if section is None and current is None and match.group(2) == key:
+            return number
+    return header
 
 
 def _check_address(value: Any, name: str, owner: str) -> int:

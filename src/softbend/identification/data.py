@@ -23,6 +23,10 @@ experiment's name. Other columns are ignored. Lines starting with ``#`` are
 comments; ``# key: value`` comments before the header set ``synthetic``,
 ``rest_length_mm`` and ``metadata`` (a JSON object). Errors point at rows as
 an editor shows them: row 1 is the first line of the file, comments included.
+A file is refused before its rows are parsed when it exceeds the ``file_mib``
+or ``csv_rows`` limit of :mod:`softbend.limits`, and a value outside the
+plausible range of its column (:mod:`softbend.plausibility`) is an error naming
+the file, line and column.
 """
 
 from __future__ import annotations
@@ -42,9 +46,12 @@ from typing import TYPE_CHECKING, Any, Literal
 import numpy as np
 
 from softbend._io import new_file_mode
+from softbend._jsontext import check_json_nesting
 from softbend._validation import check_range
 from softbend.errors import DatasetError
 from softbend.kinematics import bending_from_tip
+from softbend.limits import check_file_size, check_limit
+from softbend.plausibility import check_plausible, implausible_index
 
 if TYPE_CHECKING:
     import pandas as pd
@@ -57,6 +64,13 @@ REQUIRED_COLUMNS: tuple[str, ...] = ("time_s", "pressure_kpa", "x_mm", "y_mm")
 EXPERIMENT_COLUMN = "experiment"
 #: Default rest length of paper A's curling actuator, mm.
 DEFAULT_REST_LENGTH_MM = 15.25
+#: The plausible range (:mod:`softbend.plausibility`) of each required column.
+COLUMN_QUANTITIES: dict[str, str] = {
+    "time_s": "time_s",
+    "pressure_kpa": "pressure_kpa",
+    "x_mm": "coordinate_mm",
+    "y_mm": "coordinate_mm",
+}
 
 _FORMAT_LINE = "softbend experiment CSV v1"
 _SAFE_NAME = re.compile(r"[A-Za-z0-9][A-Za-z0-9._-]*")
@@ -243,8 +257,9 @@ class Experiment:
 
 
 # --------------------------------------------------------------------- loading
-def _parse_header_comment(text: str, header: dict[str, Any], where: str) -> None:
-    """Read ``key: value`` from a comment before the column header into ``header``."""
+def _parse_header_comment(text: str, header: dict[str, Any], path: Path, number: int) -> None:
+    """Read ``key: value`` from a comment before the column header (row ``number``)."""
+    where = f"{path}, row {number}"
     key, sep, value = text.partition(":")
     key, value = key.strip().lower(), value.strip()
     if not sep:
@@ -257,22 +272,56 @@ def _parse_header_comment(text: str, header: dict[str, Any], where: str) -> None
         header["synthetic"] = value.lower() == "true"
     elif key == "rest_length_mm":
         try:
-            header["rest_length_mm"] = float(value)
+            length = float(value)
         except ValueError:
+            length = math.nan
+        if not 0.0 < length < math.inf:
             raise DatasetError(
-                f"{where}: 'rest_length_mm' must be a number. Got {value!r} instead."
-            ) from None
+                f"{where}: 'rest_length_mm' must be a positive number (mm). Got {value!r} instead."
+            )
+        check_plausible(
+            [length], "length_mm", source=str(path), column="rest_length_mm", first_line=number
+        )
+        header["rest_length_mm"] = length
     elif key == "metadata":
+        check_json_nesting(value, f"{where}: 'metadata'")
         try:
             metadata = json.loads(value)
         except json.JSONDecodeError as exc:
             raise DatasetError(f"{where}: 'metadata' is not valid JSON ({exc.msg}).") from None
+        except RecursionError:
+            raise DatasetError(f"{where}: 'metadata' is nested too deeply to read.") from None
         if not isinstance(metadata, dict):
             raise DatasetError(f"{where}: 'metadata' must be a JSON object. Got {value!r} instead.")
         header["metadata"] = metadata
 
 
+def _data_rows(lines: list[str]) -> int:
+    """Data rows of a CSV's lines: those neither blank nor comments, less the header."""
+    filled = sum(1 for line in lines if line.strip() and not line.lstrip().startswith("#"))
+    return max(0, filled - 1)
+
+
+def _check_plausible_columns(path: Path, values: dict[str, list[float]], lines: list[int]) -> None:
+    """Raise at the first value (in file order) outside its column's plausible range."""
+    first: tuple[int, str] | None = None
+    for column, quantity in COLUMN_QUANTITIES.items():
+        index = implausible_index(values[column], quantity)
+        if index is not None and (first is None or lines[index] < first[0]):
+            first = (lines[index], column)
+    if first is not None:
+        column = first[1]
+        check_plausible(
+            values[column],
+            COLUMN_QUANTITIES[column],
+            source=str(path),
+            column=column,
+            lines=lines,
+        )
+
+
 def _read_csv(path: Path, rest_length_mm: float | None) -> list[Experiment]:
+    check_file_size(path)
     try:
         text = path.read_text(encoding="utf-8-sig")
     except UnicodeDecodeError:
@@ -281,15 +330,20 @@ def _read_csv(path: Path, rest_length_mm: float | None) -> list[Experiment]:
     columns: list[str] | None = None
     records: list[tuple[int, list[str]]] = []
     lines = text.splitlines()
+    del text
+    check_limit("csv_rows", _data_rows(lines), str(path))
     for number, line in enumerate(lines, start=1):
         stripped = line.strip()
         if not stripped:
             continue
         if stripped.startswith("#"):
             if columns is None:
-                _parse_header_comment(stripped[1:], header_info, f"{path}, row {number}")
+                _parse_header_comment(stripped[1:], header_info, path, number)
             continue
-        fields = next(csv.reader([line]))
+        try:
+            fields = next(csv.reader([line]))
+        except csv.Error as exc:
+            raise DatasetError(f"{path}, row {number}: not a CSV row ({exc}).") from None
         if columns is None:
             columns = [c.strip() for c in fields]
             header_row = number
@@ -316,6 +370,8 @@ def _read_csv(path: Path, rest_length_mm: float | None) -> list[Experiment]:
     index = {c: columns.index(c) for c in REQUIRED_COLUMNS}
     named = EXPERIMENT_COLUMN in columns
     groups: dict[str, dict[str, list]] = {}
+    every: dict[str, list[float]] = {c: [] for c in REQUIRED_COLUMNS}
+    every_line: list[int] = []
     for number, fields in records:
         if len(fields) != len(columns):
             raise DatasetError(
@@ -346,6 +402,10 @@ def _read_csv(path: Path, rest_length_mm: float | None) -> list[Experiment]:
                     f"{path}, row {number}, column '{column}': {cell!r} is not finite."
                 )
             group[column].append(value)
+            every[column].append(value)
+        every_line.append(number)
+    _check_plausible_columns(path, every, every_line)
+    del every, every_line
 
     experiments = []
     for name, group in groups.items():
@@ -396,6 +456,40 @@ def _read_csv(path: Path, rest_length_mm: float | None) -> list[Experiment]:
     return experiments
 
 
+def experiment_files(path: str | os.PathLike[str]) -> list[Path]:
+    """The CSV files :func:`load_experiments` reads from ``path``, their sizes checked.
+
+    Parameters
+    ----------
+    path : str or path-like
+        A CSV file, or a folder whose ``*.csv`` files are taken in sorted name order.
+
+    Returns
+    -------
+    list of pathlib.Path
+        The files, none of them over the ``file_mib`` limit of :mod:`softbend.limits`.
+
+    Raises
+    ------
+    DatasetError
+        The path does not exist, or the folder has no CSV files.
+    LimitError
+        A file is larger than the ``file_mib`` limit (the message names it).
+    """
+    source = Path(path)
+    if not source.exists():
+        raise DatasetError(f"Experiment file or folder not found: {source}.")
+    if source.is_dir():
+        files = sorted(p for p in source.iterdir() if p.is_file() and p.suffix.lower() == ".csv")
+        if not files:
+            raise DatasetError(f"The folder {source} has no CSV files (*.csv).")
+    else:
+        files = [source]
+    for file in files:
+        check_file_size(file)
+    return files
+
+
 def load_experiments(
     path: str | os.PathLike[str], *, rest_length_mm: float | None = None
 ) -> list[Experiment]:
@@ -421,22 +515,21 @@ def load_experiments(
         One line naming the file and, where it applies, the column, the row (as
         an editor numbers the file's lines) and the experiment: path not found,
         folder without CSV files, empty file, missing columns, a non-numeric,
-        empty, NaN or infinite value, time not strictly increasing, fewer than 3
-        samples, or the same experiment name twice.
+        empty, NaN or infinite value, a value outside its column's plausible
+        range (:mod:`softbend.plausibility`: ``time_s`` as time, ``pressure_kpa``
+        as gauge pressure in kPa, ``x_mm`` and ``y_mm`` as positions), time not
+        strictly increasing, fewer than 3 samples, or the same experiment name twice.
+    LimitError
+        A file over the ``file_mib`` limit or with more data rows than the
+        ``csv_rows`` limit of :mod:`softbend.limits` (checked before its rows
+        are parsed), or a ``# metadata`` comment nested deeper than ``nesting``.
     """
     if rest_length_mm is not None:
         rest_length_mm = check_range(
             rest_length_mm, "rest_length_mm", "load_experiments", low=0.0, high=math.inf
         )
     source = Path(path)
-    if not source.exists():
-        raise DatasetError(f"Experiment file or folder not found: {source}.")
-    if source.is_dir():
-        files = sorted(p for p in source.iterdir() if p.is_file() and p.suffix.lower() == ".csv")
-        if not files:
-            raise DatasetError(f"The folder {source} has no CSV files (*.csv).")
-    else:
-        files = [source]
+    files = experiment_files(source)
     experiments: list[Experiment] = []
     seen: dict[str, Path] = {}
     for file in files:

@@ -18,12 +18,15 @@ import numpy as np
 from sklearn.preprocessing import StandardScaler
 
 from softbend import __version__
-from softbend._io import write_text_atomic
+from softbend._io import json_text, write_text_atomic
+from softbend._jsontext import check_nesting
 from softbend._validation import short_repr
 from softbend.errors import SchemaError
 from softbend.identification.kernels import MOMENTS_OF
 from softbend.identification.narx import NARXRegressor, _lag_structure, _regressor_names
 from softbend.identification.svr import DEFAULT_MAX_WORKING_SET, GeneralizedGaussianSVR
+from softbend.limits import check_file_size
+from softbend.plausibility import implausible_text
 
 FORMAT = "softbend.narx-gg-svr"
 #: 2: the estimator parameters gained ``moments_of`` and ``max_working_set``. Version 1
@@ -182,9 +185,19 @@ def _vector(
     return np.asarray(value, dtype=float)
 
 
-def _int_vector(value: Any, where: str) -> np.ndarray:
-    if not isinstance(value, list):
-        raise _RuleError(f"'{where}' must be a list of integers; got {short_repr(value)}")
+def _kernel_width(value: Any, where: str) -> float:
+    """A kernel width σ: a finite number in the plausible range of kernel widths."""
+    width = _real(value, where, low=0.0, strict=True)
+    problem = implausible_text(width, "kernel_width")
+    if problem is not None:
+        raise _RuleError(f"'{where}': {problem.rstrip('.')}")
+    return width
+
+
+def _int_vector(value: Any, where: str, length: int | None = None) -> np.ndarray:
+    if not isinstance(value, list) or (length is not None and len(value) != length):
+        size = f"{length} " if length is not None else ""
+        raise _RuleError(f"'{where}' must be a list of {size}integers; got {short_repr(value)}")
     for i, item in enumerate(value):
         _int(item, f"{where}[{i}]", 0)
     return np.asarray(value, dtype=int)
@@ -251,7 +264,7 @@ def _svr_params(value: Any) -> dict[str, Any]:
         _real(params[key], f"{where}.{key}", low=0.0, strict=True)
     _real(params["epsilon"], f"{where}.epsilon", low=0.0)
     if params["sigma"] is not None:
-        _real(params["sigma"], f"{where}.sigma", low=0.0, strict=True)
+        _kernel_width(params["sigma"], f"{where}.sigma")
     if params["shape"] is not None:
         _real(params["shape"], f"{where}.shape", low=0.0, strict=True, high=2.0)
     _bool(params["normalize"], f"{where}.normalize")
@@ -282,6 +295,9 @@ def _check_document(data: dict[str, Any]) -> None:
     current = _bool(params["include_current_input"], "narx.params.include_current_input")
     scale = _bool(params["scale"], "narx.params.scale")
     n_inputs = _int(narx["n_inputs"], "narx.n_inputs", 1)
+    # The offsets are lists in the file: their lengths bound the lags before any array is made.
+    _int_vector(narx["output_offsets"], "narx.output_offsets", na)
+    _int_vector(narx["input_offsets"], "narx.input_offsets", nb)
     structure = _lag_structure(na, nb, current, "load_narx")
     for key, expected in (
         ("max_lag", structure.max_lag),
@@ -316,7 +332,7 @@ def _check_document(data: dict[str, Any]) -> None:
             f"'estimator.n_features_in' must be {n_features} (output_lags + n_inputs x "
             f"input_lags); got {short_repr(estimator['n_features_in'])}"
         )
-    _real(estimator["sigma"], "estimator.sigma", low=0.0, strict=True)
+    _kernel_width(estimator["sigma"], "estimator.sigma")
     _real(estimator["shape"], "estimator.shape", low=0.0, strict=True, high=2.0)
     _real(estimator["kernel_scale"], "estimator.kernel_scale", low=0.0, strict=True)
     _real(estimator["intercept"], "estimator.intercept")
@@ -393,8 +409,12 @@ def narx_from_dict(data: dict[str, Any], *, source: str = "the saved model") -> 
 def save_narx(
     model: NARXRegressor, path: str | Path, *, metadata: dict[str, Any] | None = None
 ) -> Path:
-    """Write a fitted NARX/GG-SVR model to ``path`` (JSON, atomic) and return the path."""
-    text = json.dumps(narx_to_dict(model, metadata), indent=1)
+    """Write a fitted NARX/GG-SVR model to ``path`` (strict JSON, atomic) and return the path.
+
+    The JSON is strict (:func:`softbend._io.json_text`): a NaN or infinite value
+    in ``metadata`` is written as null. The model's own numbers are finite.
+    """
+    text = json_text(narx_to_dict(model, metadata), indent=1)
     return write_text_atomic(Path(path), text + "\n")
 
 
@@ -406,15 +426,25 @@ def load_narx(path: str | Path) -> tuple[NARXRegressor, dict[str, Any]]:
     FileNotFoundError
         If ``path`` is not a file.
     softbend.errors.SchemaError
-        If the file is not JSON, not a saved NARX model, has a newer schema, an
-        unknown or missing key, or a value of the wrong type or shape, non-finite
-        or out of bounds; the one-line message names the file and the key.
+        If the file is not JSON, is nested deeper than the ``nesting`` limit of
+        :mod:`softbend.limits` (checked before parsing), is not a saved NARX
+        model, has a newer schema, an unknown or missing key, or a value of the
+        wrong type or shape, non-finite or out of bounds (a kernel width outside
+        the plausible range of :mod:`softbend.plausibility` included); the
+        one-line message names the file and the key.
+    softbend.errors.LimitError
+        If the file is larger than the ``file_mib`` limit of :mod:`softbend.limits`.
     """
     path = Path(path)
     if not path.is_file():
         raise FileNotFoundError(f"No saved model at {path}.")
+    check_file_size(path)
     try:
-        data = json.loads(path.read_text(encoding="utf-8"))
+        text = path.read_text(encoding="utf-8")
+        check_nesting(text, str(path), SchemaError)
+        data = json.loads(text)
     except (json.JSONDecodeError, UnicodeDecodeError) as err:
         raise SchemaError(f"{path} is not valid JSON: {err}.") from None
+    except RecursionError:
+        raise SchemaError(f"{path} is nested too deeply to read.") from None
     return narx_from_dict(data, source=str(path)), dict(data["metadata"])

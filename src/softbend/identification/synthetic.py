@@ -64,6 +64,8 @@ import numpy as np
 
 from softbend._validation import check_choice, check_range
 from softbend.identification.data import Experiment
+from softbend.limits import check_limit
+from softbend.plausibility import RANGES
 
 #: Profile kinds of the ``"mixed"`` excitation, in the order :func:`synthetic_dataset`
 #: cycles through them.
@@ -623,6 +625,43 @@ def pressure_profile(
     return time, pressure
 
 
+def check_synthetic_size(
+    n_samples: Any, dt_s: Any, *, samples: str = "n_samples", dt: str = "dt_s"
+) -> None:
+    """Refuse experiments that the experiment CSV reader would refuse to read back.
+
+    Each experiment is written as one CSV file of ``n_samples`` rows, so
+    ``n_samples`` is held to the ``csv_rows`` limit of :mod:`softbend.limits`;
+    and its time axis, ``dt_s·(n_samples − 1)`` s, to the plausible range of
+    time (:mod:`softbend.plausibility`).
+
+    Parameters
+    ----------
+    n_samples : int
+        Samples per experiment.
+    dt_s : float
+        Sample interval, s (> 0 and finite; checked here only against the span).
+    samples, dt : str
+        How messages name the two (e.g. the options ``--samples`` and ``--dt``).
+
+    Raises
+    ------
+    LimitError
+        ``n_samples`` over the ``csv_rows`` limit.
+    ValueError
+        A time axis longer than the plausible range of time.
+    """
+    if isinstance(n_samples, int) and not isinstance(n_samples, bool):
+        check_limit("csv_rows", n_samples, samples)
+        span = RANGES["time_s"].high
+        if isinstance(dt_s, int | float) and math.isfinite(dt_s) and dt_s * (n_samples - 1) > span:
+            raise ValueError(
+                f"The {dt} times the {samples} make an experiment "
+                f"{dt_s * (n_samples - 1):.4g} s long, more than the plausible time of "
+                f"{span:g} s a file may hold. Got {dt} = {dt_s!r} and {n_samples} samples."
+            )
+
+
 def synthetic_dataset(
     *,
     n_experiments: int = 6,
@@ -682,6 +721,7 @@ def synthetic_dataset(
         )
     count = int(count)
     check_choice(excitation, "excitation", "synthetic_dataset", EXCITATIONS)
+    check_synthetic_size(n_samples, dt_s, samples="'n_samples' of synthetic_dataset")
     plant = CurlingActuator() if actuator is None else actuator
     if not isinstance(plant, CurlingActuator):
         raise ValueError(

@@ -26,10 +26,13 @@ the working range of an actuator instead.
 
 from __future__ import annotations
 
+import json
 import logging
 import math
-from collections.abc import Callable, Sequence
-from dataclasses import dataclass
+import os
+from collections.abc import Callable, Mapping, Sequence
+from dataclasses import dataclass, fields
+from pathlib import Path
 from typing import Any
 
 import numpy as np
@@ -37,8 +40,10 @@ from numpy.typing import ArrayLike
 from scipy.optimize import least_squares
 
 from softbend import metrics
-from softbend._validation import check_choice, check_finite_array, check_range
-from softbend.errors import ConvergenceError, DatasetError
+from softbend._jsontext import check_nesting
+from softbend._validation import check_choice, check_finite_array, check_range, short_repr
+from softbend.errors import ConvergenceError, DatasetError, SchemaError
+from softbend.limits import check_file_size
 from softbend.materials.models import (
     _AB_COEFFS,
     MODELS,
@@ -48,14 +53,17 @@ from softbend.materials.models import (
     Yeoh,
 )
 from softbend.materials.tensile import TensileTest
+from softbend.plausibility import RANGES, implausible_index
 
 __all__ = [
     "DEFAULT_MODELS",
+    "FIT_FILE_KEYS",
     "LAMBDA_M_MAX",
     "MIN_FIT_POINTS",
     "FitResult",
     "fit_model",
     "fit_models",
+    "load_fit_json",
 ]
 
 logger = logging.getLogger(__name__)
@@ -144,6 +152,214 @@ class FitResult:
             "stretch_max": self.stretch_range[1],
             "at_bound": list(self.at_bound),
         }
+
+    @classmethod
+    def from_dict(cls, data: Any, *, source: str = "FitResult.from_dict") -> FitResult:
+        """Rebuild a result written by :meth:`to_dict` (an entry of ``fit.json``).
+
+        Every key and value is checked first: the keys of :meth:`to_dict` and no
+        other, a registered model, its constants as
+        :meth:`HyperelasticModel.from_dict` checks them (finite; in MPa, a
+        plausible material constant), ``initial_shear_modulus_mpa`` equal to the
+        model's, ``r2`` a number ≤ 1 or null (JSON's NaN), ``rmse_mpa`` a plausible
+        stress ≥ 0, ``n_points`` an integer ≥ :data:`MIN_FIT_POINTS`, the
+        stretch range finite, positive and ordered, ``at_bound`` among the
+        constants' names.
+
+        Parameters
+        ----------
+        data : mapping
+            One fit, as :meth:`to_dict` writes it.
+        source : str
+            Where ``data`` comes from (the file and the entry), for messages.
+
+        Raises
+        ------
+        SchemaError
+            One line naming ``source`` and the key, what is allowed and the value.
+        """
+        try:
+            return _fit_from_dict(data)
+        except ValueError as exc:  # SchemaError included
+            text = str(exc)
+            raise SchemaError(f"{source}: {text}{'' if text.endswith('.') else '.'}") from None
+
+
+#: Keys of the ``fit.json`` file that ``softbend materials fit`` writes.
+FIT_FILE_KEYS: tuple[str, ...] = ("test", "max_stretch", "fits", "best_model", "files")
+_FIT_KEYS: tuple[str, ...] = (
+    "model",
+    "parameters",
+    "initial_shear_modulus_mpa",
+    "r2",
+    "rmse_mpa",
+    "n_points",
+    "stretch_min",
+    "stretch_max",
+    "at_bound",
+)
+
+
+def _keys(data: Any, allowed: Sequence[str], required: Sequence[str], where: str) -> None:
+    if not isinstance(data, Mapping):
+        raise SchemaError(f"'{where}' must be a JSON object; got {short_repr(data)}")
+    unknown = [str(k) for k in data if k not in allowed]
+    if unknown:
+        raise SchemaError(
+            f"unknown key(s) {', '.join(map(repr, unknown))} in '{where}'; "
+            f"allowed keys: {', '.join(allowed)}"
+        )
+    missing = [k for k in required if k not in data]
+    if missing:
+        raise SchemaError(f"'{where}' lacks the key(s) {', '.join(missing)}")
+
+
+def _number(value: Any, where: str, quantity: str | None = None) -> float:
+    if isinstance(value, bool) or not isinstance(value, int | float) or not math.isfinite(value):
+        raise SchemaError(f"'{where}' must be a finite number; got {short_repr(value)}")
+    if quantity is not None and implausible_index([value], quantity) is not None:
+        bounds = RANGES[quantity]
+        raise SchemaError(
+            f"'{where}' must be a plausible {bounds.label} ({bounds.low:g} to {bounds.high:g} "
+            f"{bounds.unit}); got {value!r}"
+        )
+    return float(value)
+
+
+def _stretch(value: Any, where: str) -> float:
+    """A stretch ``1 + strain``: finite, with a plausible engineering strain."""
+    stretch = _number(value, where)
+    if implausible_index([stretch - 1.0], "strain") is not None:
+        bounds = RANGES["strain"]
+        raise SchemaError(
+            f"'{where}' must be a stretch whose strain (stretch - 1) is plausible "
+            f"({bounds.low:g} to {bounds.high:g}); got {value!r}"
+        )
+    return stretch
+
+
+def _fit_from_dict(data: Any) -> FitResult:
+    _keys(data, _FIT_KEYS, _FIT_KEYS, "fit")
+    name = data["model"]
+    if not isinstance(name, str) or name not in MODELS:
+        raise SchemaError(
+            f"'model' must be one of {', '.join(map(repr, MODELS))}; got {short_repr(name)}"
+        )
+    parameters = data["parameters"]
+    if not isinstance(parameters, Mapping):
+        raise SchemaError(f"'parameters' must be a JSON object; got {short_repr(parameters)}")
+    model = MODELS[name].from_dict({"model": name, **parameters})
+    shear = _number(data["initial_shear_modulus_mpa"], "initial_shear_modulus_mpa", "modulus_mpa")
+    if not math.isclose(shear, model.initial_shear_modulus_mpa, rel_tol=1e-9, abs_tol=1e-15):
+        raise SchemaError(
+            f"'initial_shear_modulus_mpa' must be {model.initial_shear_modulus_mpa!r}, the "
+            f"initial shear modulus of its parameters; got {shear!r}"
+        )
+    r2 = data["r2"]
+    r2 = math.nan if r2 is None else _number(r2, "r2")
+    if r2 > 1.0:
+        raise SchemaError(f"'r2' must be a number <= 1 or null; got {r2!r}")
+    rmse = _number(data["rmse_mpa"], "rmse_mpa", "stress_mpa")
+    if rmse < 0.0:
+        raise SchemaError(f"'rmse_mpa' must be >= 0; got {rmse!r}")
+    n_points = data["n_points"]
+    if type(n_points) is not int or n_points < MIN_FIT_POINTS:
+        raise SchemaError(
+            f"'n_points' must be an integer >= {MIN_FIT_POINTS}; got {short_repr(n_points)}"
+        )
+    low = _stretch(data["stretch_min"], "stretch_min")
+    high = _stretch(data["stretch_max"], "stretch_max")
+    if not 0.0 < low <= high:
+        raise SchemaError(
+            f"'stretch_min' and 'stretch_max' must satisfy 0 < stretch_min <= stretch_max; "
+            f"got {low!r} and {high!r}"
+        )
+    names = [f.name for f in fields(model)]
+    at_bound = data["at_bound"]
+    if not isinstance(at_bound, list) or any(item not in names for item in at_bound):
+        raise SchemaError(
+            f"'at_bound' must be a list of names among {', '.join(names)}; "
+            f"got {short_repr(at_bound)}"
+        )
+    return FitResult(
+        model=model,
+        r2=r2,
+        rmse_mpa=rmse,
+        n_points=n_points,
+        stretch_range=(low, high),
+        at_bound=tuple(at_bound),
+    )
+
+
+def load_fit_json(path: str | os.PathLike[str]) -> dict[str, FitResult]:
+    """Read the ``fit.json`` that ``softbend materials fit`` writes, checked.
+
+    Parameters
+    ----------
+    path : str or path-like
+        The file.
+
+    Returns
+    -------
+    dict of str to FitResult
+        One result per model, in the file's order.
+
+    Raises
+    ------
+    FileNotFoundError
+        If ``path`` is not a file.
+    LimitError
+        If the file is over the ``file_mib`` limit of :mod:`softbend.limits`.
+    SchemaError
+        If the file is not strict JSON (a bare ``NaN`` or ``Infinity`` included),
+        is nested deeper than the ``nesting`` limit of :mod:`softbend.limits`,
+        has a key other than :data:`FIT_FILE_KEYS`, or a fit fails
+        :meth:`FitResult.from_dict`; the one-line message names the file and the key.
+    """
+    file = Path(path)
+    if not file.is_file():
+        raise FileNotFoundError(f"No fit file at {file}.")
+    check_file_size(file)
+
+    def refuse(constant: str) -> None:
+        raise SchemaError(f"{file} is not strict JSON: it holds {constant}, which JSON lacks.")
+
+    try:
+        text = file.read_text(encoding="utf-8")
+        check_nesting(text, str(file), SchemaError)
+        data = json.loads(text, parse_constant=refuse)
+    except (json.JSONDecodeError, UnicodeDecodeError) as exc:
+        raise SchemaError(f"{file} is not valid JSON: {exc}.") from None
+    except RecursionError:
+        raise SchemaError(f"{file} is nested too deeply to read.") from None
+    try:
+        _keys(data, FIT_FILE_KEYS, ("fits",), "(top level)")
+        fits = data["fits"]
+        if not isinstance(fits, list) or not fits:
+            raise SchemaError(f"'fits' must be a non-empty list; got {short_repr(fits)}")
+        for key in ("test", "files"):
+            if data.get(key) is not None and not isinstance(data[key], dict):
+                raise SchemaError(
+                    f"'{key}' must be a JSON object or null; got {short_repr(data[key])}"
+                )
+        max_stretch = data.get("max_stretch")
+        if max_stretch is not None and _stretch(max_stretch, "max_stretch") <= 1.0:
+            raise SchemaError(f"'max_stretch' must be null or > 1; got {max_stretch!r}")
+    except SchemaError as exc:
+        raise SchemaError(f"{file}: {exc}.") from None
+    results: dict[str, FitResult] = {}
+    for i, entry in enumerate(fits):
+        result = FitResult.from_dict(entry, source=f"{file}, fits[{i}]")
+        if result.name in results:
+            raise SchemaError(f"{file}, fits[{i}]: the model {result.name!r} is fitted twice.")
+        results[result.name] = result
+    best = data.get("best_model")
+    if best is not None and (not isinstance(best, str) or best not in results):
+        raise SchemaError(
+            f"{file}: 'best_model' must be null or one of the fitted models "
+            f"({', '.join(map(repr, results))}); got {short_repr(best)}."
+        )
+    return results
 
 
 def _g(lam: np.ndarray) -> np.ndarray:

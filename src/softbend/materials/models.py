@@ -21,14 +21,18 @@ treated as exactly incompressible.
 
 from __future__ import annotations
 
-from collections.abc import Mapping
-from dataclasses import dataclass, fields
+import math
+import numbers
+from collections.abc import Iterable, Mapping
+from dataclasses import MISSING, dataclass, fields
 from typing import Any, ClassVar
 
 import numpy as np
 from numpy.typing import ArrayLike
 
-from softbend._validation import check_choice, check_finite_array, check_range
+from softbend._validation import check_choice, check_finite_array, check_range, short_repr
+from softbend.errors import SchemaError
+from softbend.plausibility import RANGES, implausible_index
 
 __all__ = [
     "MODELS",
@@ -36,9 +40,59 @@ __all__ = [
     "HyperelasticModel",
     "NeoHookean",
     "Yeoh",
+    "check_constants",
     "get_model_class",
     "model_from_dict",
 ]
+
+
+def check_constants(
+    data: Any, owner: str, allowed: Iterable[str], required: Iterable[str]
+) -> dict[str, float]:
+    """The constants of a stored material model, checked before the model is built.
+
+    ``data`` must be a mapping whose keys are among ``allowed`` (``"model"`` is
+    dropped) and include ``required``; every value must be a finite real number
+    (not a bool or a string), and a constant in MPa (a key ending in ``_mpa``)
+    must lie in the plausible range of material constants (``modulus_mpa`` of
+    :mod:`softbend.plausibility`).
+
+    Raises
+    ------
+    SchemaError
+        Naming ``owner``, the key, what is allowed and the value received.
+    """
+    if not isinstance(data, Mapping):
+        raise SchemaError(
+            f"The data of {owner} must be a mapping of constants. Got {short_repr(data)} instead."
+        )
+    params = {k: v for k, v in data.items() if k != "model"}
+    allowed = list(allowed)
+    unknown = sorted(str(k) for k in params if k not in allowed)
+    if unknown:
+        raise SchemaError(
+            f"The keys of {owner} must be among "
+            f"{', '.join(repr(a) for a in ['model', *allowed])}. Got {unknown!r} instead."
+        )
+    missing = [k for k in required if k not in params]
+    if missing:
+        raise SchemaError(
+            f"The keys of {owner} must include {', '.join(repr(k) for k in missing)}. "
+            f"Got only {sorted(map(str, data))!r} instead."
+        )
+    limits = RANGES["modulus_mpa"]
+    for key, value in params.items():
+        real = isinstance(value, numbers.Real) and not isinstance(value, bool | np.bool_)
+        if not real or not math.isfinite(value):
+            raise SchemaError(
+                f"The '{key}' of {owner} must be a finite number. Got {short_repr(value)} instead."
+            )
+        if key.endswith("_mpa") and implausible_index([value], "modulus_mpa") is not None:
+            raise SchemaError(
+                f"The '{key}' of {owner} must be a plausible {limits.label} "
+                f"({limits.low:g} to {limits.high:g} {limits.unit}). Got {value!r} instead."
+            )
+    return {k: float(v) for k, v in params.items()}
 
 
 def _positive_stretch(stretch: ArrayLike, owner: str) -> np.ndarray:
@@ -113,9 +167,22 @@ class HyperelasticModel:
 
         Called on :class:`HyperelasticModel` itself it dispatches on ``data["model"]``;
         called on a concrete class, a ``"model"`` entry, if present, must match it.
+
+        Raises
+        ------
+        ValueError
+            An unknown ``"model"`` (the message lists the allowed names).
+        SchemaError
+            ``data`` is not a mapping, has an unknown or lacks a required key, or
+            a constant is not a finite number or (in MPa) outside the plausible
+            range of material constants; see :func:`check_constants`.
         """
-        params = dict(data)
-        name = params.pop("model", None)
+        if not isinstance(data, Mapping):
+            raise SchemaError(
+                f"The data of {cls.__name__}.from_dict must be a mapping of constants. "
+                f"Got {short_repr(data)} instead."
+            )
+        name = data.get("model")
         if cls is HyperelasticModel:
             if name is None:
                 raise ValueError(
@@ -125,13 +192,12 @@ class HyperelasticModel:
             return get_model_class(name).from_dict(data)
         if name is not None:
             check_choice(name, "model", f"{cls.__name__}.from_dict", (cls.name,))
-        allowed = [f.name for f in fields(cls)]
-        unknown = sorted(set(params) - set(allowed))
-        if unknown:
-            raise ValueError(
-                f"The keys of {cls.__name__}.from_dict must be among "
-                f"{', '.join(repr(a) for a in ['model', *allowed])}. Got {unknown!r} instead."
-            )
+        params = check_constants(
+            data,
+            f"{cls.__name__}.from_dict",
+            [f.name for f in fields(cls)],
+            [f.name for f in fields(cls) if f.default is MISSING],
+        )
         return cls(**params)
 
 

@@ -21,8 +21,9 @@ from collections.abc import Mapping
 from dataclasses import dataclass
 from typing import Any, ClassVar
 
-from softbend._validation import check_choice, check_range
-from softbend.materials.models import HyperelasticModel, Yeoh
+from softbend._validation import check_choice, check_range, short_repr
+from softbend.errors import SchemaError
+from softbend.materials.models import HyperelasticModel, Yeoh, check_constants
 
 __all__ = [
     "DRAGON_SKIN_30",
@@ -84,15 +85,16 @@ class LinearElastic:
 
     @classmethod
     def from_dict(cls, data: Mapping[str, Any]) -> LinearElastic:
-        """Rebuild from :meth:`to_dict` output."""
-        params = dict(data)
-        name = params.pop("model", cls.name)
-        check_choice(name, "model", "LinearElastic.from_dict", (cls.name,))
+        """Rebuild from :meth:`to_dict` output (checked as :func:`check_constants` says)."""
+        owner = "LinearElastic.from_dict"
+        if isinstance(data, Mapping):
+            check_choice(data.get("model", cls.name), "model", owner, (cls.name,))
+        params = check_constants(data, owner, ("e_mpa", "nu"), ("e_mpa", "nu"))
         return cls(**params)
 
 
-def _model_from_dict(data: Mapping[str, Any]) -> HyperelasticModel | LinearElastic:
-    if data.get("model") == LinearElastic.name:
+def _model_from_dict(data: Any) -> HyperelasticModel | LinearElastic:
+    if isinstance(data, Mapping) and data.get("model") == LinearElastic.name:
         return LinearElastic.from_dict(data)
     return HyperelasticModel.from_dict(data)
 
@@ -151,11 +153,41 @@ class Material:
 
     @classmethod
     def from_dict(cls, data: Mapping[str, Any]) -> Material:
-        """Rebuild from :meth:`to_dict` output."""
+        """Rebuild from :meth:`to_dict` output.
+
+        Raises
+        ------
+        SchemaError
+            ``data`` is not a mapping, lacks ``name``, ``model`` or
+            ``density_t_per_mm3``, has another key, or the density is not a number;
+            the model is checked as in :meth:`HyperelasticModel.from_dict`.
+        ValueError
+            A value out of range (as the constructor says).
+        """
+        owner = "Material.from_dict"
+        keys = ("name", "model", "density_t_per_mm3", "source")
+        if not isinstance(data, Mapping):
+            raise SchemaError(
+                f"The data of {owner} must be a mapping. Got {short_repr(data)} instead."
+            )
+        unknown = sorted(str(k) for k in data if k not in keys)
+        missing = [k for k in keys[:3] if k not in data]
+        if unknown or missing:
+            got = f"the unknown key(s) {unknown!r}" if unknown else f"no {missing[0]!r}"
+            raise SchemaError(
+                f"The keys of {owner} must be {', '.join(map(repr, keys[:3]))} and optionally "
+                f"'source'. Got {got} instead."
+            )
+        density = data["density_t_per_mm3"]
+        if isinstance(density, bool) or not isinstance(density, int | float):
+            raise SchemaError(
+                f"The 'density_t_per_mm3' of {owner} must be a number (tonne/mm³). "
+                f"Got {short_repr(density)} instead."
+            )
         return cls(
             name=data["name"],
             model=_model_from_dict(data["model"]),
-            density_t_per_mm3=data["density_t_per_mm3"],
+            density_t_per_mm3=density,
             source=data.get("source", ""),
         )
 

@@ -13,7 +13,10 @@ line, a header row and one row per sample. The header is recognised by its colum
 names, not by its line number; the columns used are ``Engineering Strain``
 (dimensionless) and ``Engineering Stress (MPa)`` (nominal stress: force per
 undeformed cross-section). Other columns (time, true strain and stress) are
-ignored.
+ignored. A file over the ``file_mib`` or ``csv_rows`` limit of
+:mod:`softbend.limits` is refused before its rows are parsed, and a strain or
+stress outside its plausible range (:mod:`softbend.plausibility`) is an error
+naming the file, line and column.
 """
 
 from __future__ import annotations
@@ -32,6 +35,8 @@ import numpy as np
 
 from softbend._validation import check_choice, check_finite_array
 from softbend.errors import DatasetError
+from softbend.limits import check_file_size, check_limit
+from softbend.plausibility import check_plausible, implausible_index
 
 __all__ = [
     "ENGINEERING_STRAIN",
@@ -212,6 +217,24 @@ def _parse_number(text: str, column: str, label: str, row: int, line: int) -> fl
     return value
 
 
+#: The plausible range (:mod:`softbend.plausibility`) and header of each column read.
+_QUANTITIES: dict[str, str] = {"strain": ENGINEERING_STRAIN, "stress_mpa": ENGINEERING_STRESS_MPA}
+
+
+def _check_plausible_columns(label: str, values: dict[str, list[float]], lines: list[int]) -> None:
+    """Raise at the first value (in file order) outside its column's plausible range."""
+    first: tuple[int, str] | None = None
+    for quantity in _QUANTITIES:
+        index = implausible_index(values[quantity], quantity)
+        if index is not None and (first is None or lines[index] < first[0]):
+            first = (lines[index], quantity)
+    if first is not None:
+        quantity = first[1]
+        check_plausible(
+            values[quantity], quantity, source=label, column=_QUANTITIES[quantity], lines=lines
+        )
+
+
 def _parse_tensile_text(
     text: str,
     *,
@@ -240,6 +263,8 @@ def _parse_tensile_text(
             )
     strain_col = header.index(ENGINEERING_STRAIN)
     stress_col = header.index(ENGINEERING_STRESS_MPA)
+    rows = sum(1 for line in lines[header_index + 1 :] if line.replace(";", "").strip())
+    check_limit("csv_rows", rows, label)
 
     metadata: dict[str, str] = {}
     for line in lines[:header_index]:
@@ -253,6 +278,7 @@ def _parse_tensile_text(
 
     strain: list[float] = []
     stress: list[float] = []
+    line_numbers: list[int] = []
     for offset, line in enumerate(lines[header_index + 1 :], start=1):
         cells = _cells(line)
         if not any(cells):
@@ -273,6 +299,8 @@ def _parse_tensile_text(
             )
         strain.append(eps)
         stress.append(sig)
+        line_numbers.append(line_no)
+    _check_plausible_columns(label, {"strain": strain, "stress_mpa": stress}, line_numbers)
     if len(strain) < MIN_TENSILE_POINTS:
         raise DatasetError(
             f"The data rows of {label} must number at least {MIN_TENSILE_POINTS}. "
@@ -333,13 +361,21 @@ def load_tensile_csv(
         If no header row is found, a required column is missing (the message
         names it and lists the columns found), a value is empty, non-numeric,
         NaN or infinite, a strain is negative (the message gives the data row and
-        the line), or there are fewer than :data:`MIN_TENSILE_POINTS` rows.
+        the line), a value is outside the plausible range of its column
+        (:mod:`softbend.plausibility`: ``strain``, ``stress_mpa``; the message
+        names the line and the column), or there are fewer than
+        :data:`MIN_TENSILE_POINTS` rows.
+    LimitError
+        If the file is larger than the ``file_mib`` limit or has more data rows
+        than the ``csv_rows`` limit of :mod:`softbend.limits` (checked before the
+        rows are parsed).
     """
     file = Path(path)
     if not file.exists():
         raise FileNotFoundError(f"Tensile data file {str(file)!r} does not exist.")
     if file.is_dir():
         raise DatasetError(f"Tensile data file {str(file)!r} is a folder, not a file.")
+    check_file_size(file, f"Tensile data file {str(file)!r}")
     try:
         text = file.read_text(encoding="utf-8-sig")
     except UnicodeDecodeError as exc:

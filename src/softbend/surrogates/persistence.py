@@ -14,9 +14,13 @@ and where it came from (``softbend_version``, ``created_utc`` and the caller's
 
 Python writes a float with the shortest decimal that reads back to the same
 float64 (``repr``), so a reloaded polynomial or MLP predicts bit for bit what
-the saved one did; XGBoost restores its own JSON model exactly. Non-finite
-floats are written as ``NaN``/``Infinity`` (Python's JSON dialect), which
-XGBoost's default ``missing=nan`` needs.
+the saved one did; XGBoost restores its own JSON model exactly. The file is
+strict JSON (no bare ``NaN`` or ``Infinity``, which most JSON readers refuse):
+XGBoost's ``missing`` (NaN by default) is written as ``null`` and read back as
+NaN, any other NaN or infinite parameter or fitted value as
+``{"__float__": "nan"}`` (``"inf"``, ``"-inf"``), and NaN or infinite numbers in
+the caller's ``metadata`` as ``null``. Files of earlier versions, with bare
+``NaN``, still load.
 
 Arrays are stored as ``{"__ndarray__": nested list, "dtype": ..., "shape": ...}``,
 NumPy scalars as ``{"__scalar__": value, "dtype": ...}`` and tuples as
@@ -28,10 +32,14 @@ contract is.
 Loading trusts nothing in the file: each kind has a schema (``SCHEMAS``) listing
 its ``params`` and ``state`` keys with a rule for each value (type, dtype,
 dimensions, finiteness, bounds such as scales > 0) and rules across keys (the
-chained layer shapes of an MLP, a complete exponent table of a polynomial). A
-key the schema does not know, or a value breaking its rule, is a
-:class:`~softbend.errors.SchemaError` of one line naming the file, the key and
-the rule; only validated keys are ever set on the model.
+chained layer shapes of an MLP, a complete exponent table of a polynomial, the
+declared sizes against the arrays, plausible parameters of a correction). The
+header's ``units`` must be those of this softbend and the ``training_ranges``
+in ``metadata`` (if any) one plausible ``[low, high]`` per input. A file nested
+deeper than the ``nesting`` limit of :mod:`softbend.limits` is a
+:class:`~softbend.errors.LimitError`; a key the schema does not know, or a value
+breaking its rule, is a :class:`~softbend.errors.SchemaError` of one line naming
+the file, the key and the rule; only validated keys are ever set on the model.
 """
 
 from __future__ import annotations
@@ -39,7 +47,9 @@ from __future__ import annotations
 import importlib
 import json
 import logging
+import math
 import sys
+import warnings
 from dataclasses import dataclass, field
 from datetime import UTC, datetime
 from pathlib import Path
@@ -50,11 +60,20 @@ from sklearn.exceptions import NotFittedError
 
 from softbend import __version__
 from softbend._extras import require
-from softbend._io import write_text_atomic
+from softbend._io import json_safe, write_text_atomic
 from softbend._validation import short_repr
 from softbend.errors import SchemaError
+from softbend.limits import check_limit, limit
+from softbend.plausibility import RANGES, implausible_index
 from softbend.surrogates.features import FEATURES, TARGET, UNITS
-from softbend.surrogates.schema import SCHEMAS, Rule, RuleError
+from softbend.surrogates.schema import (
+    QUANTITIES,
+    SCHEMAS,
+    Rule,
+    RuleError,
+    tag_float,
+    untag_float,
+)
 
 logger = logging.getLogger(__name__)
 
@@ -272,9 +291,21 @@ def check_fitted_surrogate(model: Any, owner: str) -> str:
 # --- JSON codec --------------------------------------------------------------------------------
 
 
+def _tagged(nested: Any) -> Any:
+    """A nested list of an array's elements with its NaN and infinities as tags."""
+    if isinstance(nested, list):
+        return [_tagged(v) for v in nested]
+    return tag_float(nested) if isinstance(nested, float) else nested
+
+
 def _encode(value: Any, where: str) -> Any:
-    """JSON-ready form of ``value`` that :func:`_decode` turns back into an equal object."""
-    if value is None or isinstance(value, bool | int | float | str):
+    """Strict-JSON form of ``value`` that :func:`_decode` turns back into an equal object.
+
+    A NaN or infinite float is written as ``{"__float__": "nan" | "inf" | "-inf"}``.
+    """
+    if isinstance(value, float):  # Python floats and NumPy float64: plain numbers
+        return tag_float(value)
+    if value is None or isinstance(value, bool | int | str):
         return value
     if isinstance(value, np.generic | np.ndarray):
         array = np.asarray(value)
@@ -284,9 +315,12 @@ def _encode(value: Any, where: str) -> Any:
             dtype = "str"
         else:
             raise TypeError(f"{where}: arrays of dtype {array.dtype} cannot be saved")
+        finite = array.dtype.kind != "f" or bool(np.isfinite(array).all())
         if isinstance(value, np.generic):
-            return {"__scalar__": value.item(), "dtype": dtype}
-        return {"__ndarray__": array.tolist(), "dtype": dtype, "shape": list(array.shape)}
+            item = value.item()
+            return {"__scalar__": item if finite else tag_float(item), "dtype": dtype}
+        nested = array.tolist() if finite else _tagged(array.tolist())
+        return {"__ndarray__": nested, "dtype": dtype, "shape": list(array.shape)}
     if isinstance(value, tuple):
         return {"__tuple__": [_encode(v, where) for v in value]}
     if isinstance(value, list):
@@ -296,21 +330,39 @@ def _encode(value: Any, where: str) -> Any:
     raise TypeError(f"{where}: values of type {type(value).__name__} cannot be saved")
 
 
+def _untagged(nested: Any) -> Any:
+    """A nested list of an array's elements with its tags of non-finite floats as floats."""
+    if isinstance(nested, list):
+        return [_untagged(v) for v in nested]
+    return untag_float(nested)
+
+
+def _dtype(name: Any) -> np.dtype:
+    """The NumPy dtype ``name`` of a saved array or scalar: a bool, integer or float one."""
+    dtype = np.dtype(name) if isinstance(name, str) else None
+    if dtype is None or dtype.kind not in "biuf":
+        raise TypeError(f"dtype {short_repr(name)} is none of bool, integer, float or 'str'")
+    return dtype
+
+
 def _decode(value: Any) -> Any:
+    """The object :func:`_encode` wrote (raises KeyError, TypeError, ValueError, RuleError)."""
     if isinstance(value, list):
         return [_decode(v) for v in value]
     if not isinstance(value, dict):
         return value
+    if "__float__" in value:
+        return untag_float(value)
     if "__ndarray__" in value:
         if value["dtype"] == "str":
             array = np.asarray(value["__ndarray__"], dtype=object)
         else:
-            array = np.asarray(value["__ndarray__"], dtype=np.dtype(value["dtype"]))
+            array = np.asarray(_untagged(value["__ndarray__"]), dtype=_dtype(value["dtype"]))
         return np.ascontiguousarray(array.reshape(value["shape"]))
     if "__scalar__" in value:
         if value["dtype"] == "str":
             return np.str_(value["__scalar__"])
-        return np.dtype(value["dtype"]).type(value["__scalar__"])
+        return _dtype(value["dtype"]).type(untag_float(value["__scalar__"]))
     if "__tuple__" in value:
         return tuple(_decode(v) for v in value["__tuple__"])
     return {k: _decode(v) for k, v in value.items()}
@@ -328,7 +380,7 @@ def _plain_json(value: Any) -> Any:
 # --- save --------------------------------------------------------------------------------------
 
 
-def _params(model: Any) -> dict[str, Any]:
+def _params(model: Any, kind: str) -> dict[str, Any]:
     params = {}
     for key, value in model.get_params(deep=False).items():
         try:
@@ -339,6 +391,8 @@ def _params(model: Any) -> dict[str, Any]:
                 f"save the model (None, numbers, strings, arrays, lists, tuples, dicts). "
                 f"Got {type(value).__name__} instead."
             ) from None
+    if kind == "xgboost" and params.get("missing") == tag_float(math.nan):
+        params["missing"] = None  # XGBoost's default NaN, as strict JSON; read back as NaN
     return params
 
 
@@ -353,7 +407,7 @@ def _document(model: Any, kind: str, depth: int = 0) -> dict[str, Any]:
         "target": TARGET,
         "softbend_version": __version__,
         "created_utc": datetime.now(UTC).isoformat(timespec="seconds"),
-        "params": {} if kind in COMPOSITE_KINDS else _params(model),
+        "params": {} if kind in COMPOSITE_KINDS else _params(model, kind),
         "state": _state(model, kind, depth),
     }
 
@@ -411,7 +465,8 @@ def save_surrogate(model: Any, path: str | Path, *, metadata: dict[str, Any] | N
         only once the new one is complete.
     metadata : dict, optional
         JSON-serializable provenance with string keys, e.g. ``data_hash``,
-        ``metrics``, ``cv``; NumPy numbers and arrays are written as Python ones.
+        ``metrics``, ``cv``; NumPy numbers and arrays are written as Python ones,
+        NaN and infinities as ``null`` (the file is strict JSON).
 
     Returns
     -------
@@ -434,15 +489,19 @@ def save_surrogate(model: Any, path: str | Path, *, metadata: dict[str, Any] | N
             "The 'metadata' of save_surrogate must be a dict with string keys. "
             f"Got {type(metadata).__name__} instead."
         )
-    try:
-        metadata_json = json.dumps(metadata, default=_plain_json)
-    except (TypeError, ValueError) as err:
+    try:  # strict JSON: NaN and infinities become null
+        metadata_json = json.dumps(json_safe(metadata), default=_plain_json, allow_nan=False)
+    except (TypeError, ValueError, RecursionError) as err:
         raise ValueError(
             f"The 'metadata' of save_surrogate must be JSON-serializable. Got an error: {err}."
         ) from None
     document = _document(model, kind)
     # One top-level key per line: the header stays readable, big arrays stay on one line.
-    lines = [f"{json.dumps(key)}: {json.dumps(value)}" for key, value in document.items()]
+    # Every non-finite float is tagged by _encode, so the text is strict JSON.
+    lines = [
+        f"{json.dumps(key)}: {json.dumps(value, allow_nan=False)}"
+        for key, value in document.items()
+    ]
     lines.insert(-2, f'"metadata": {metadata_json}')
     return write_text_atomic(Path(path), "{\n " + ",\n ".join(lines) + "\n}\n")
 
@@ -450,13 +509,31 @@ def save_surrogate(model: Any, path: str | Path, *, metadata: dict[str, Any] | N
 # --- load --------------------------------------------------------------------------------------
 
 
+def _depth(value: Any) -> int:
+    """How deep JSON objects and arrays nest in ``value`` (a number 0, ``[]`` 1), iteratively."""
+    deepest, stack = 0, [(value, 1)] if isinstance(value, dict | list) else []
+    while stack:
+        item, level = stack.pop()
+        children = item.values() if isinstance(item, dict) else item
+        deepest = max(deepest, level)
+        stack.extend((child, level + 1) for child in children if isinstance(child, dict | list))
+    return deepest
+
+
 def _read_document(path: Path) -> dict[str, Any]:
     if not path.is_file():
         raise FileNotFoundError(f"No saved surrogate at {path}.")
     try:
         document = json.loads(path.read_text(encoding="utf-8"))
-    except (json.JSONDecodeError, UnicodeDecodeError) as err:
+    except (ValueError, UnicodeDecodeError) as err:  # JSONDecodeError, a 5000-digit number
         raise SchemaError(f"{path} is not a softbend surrogate: not valid JSON ({err}).") from None
+    except RecursionError:  # the parser recurses once per level
+        raise SchemaError(
+            f"{path} is not a softbend surrogate: its JSON nests too deeply to be read (a "
+            f"softbend surrogate nests at most {limit('nesting')} levels, the limit "
+            "SOFTBEND_MAX_NESTING)."
+        ) from None
+    check_limit("nesting", _depth(document), f"The JSON nesting of {path}")
     return _checked_document(document, str(path))
 
 
@@ -464,13 +541,15 @@ def _checked_document(document: Any, path: str) -> dict[str, Any]:
     """``document`` if its header is that of a softbend surrogate (``path`` names it)."""
     if not isinstance(document, dict) or document.get("format") != FORMAT:
         found = document.get("format") if isinstance(document, dict) else type(document).__name__
+        shown = repr(found) if isinstance(found, str | None) else short_repr(found)
         raise SchemaError(
-            f"{path} is not a softbend surrogate: format {found!r}, expected {FORMAT!r}."
+            f"{path} is not a softbend surrogate: format {shown}, expected {FORMAT!r}."
         )
     version = document.get("schema_version")
     if isinstance(version, bool) or not isinstance(version, int) or version < 1:
+        shown = repr(version) if isinstance(version, str | None) else short_repr(version)
         raise SchemaError(
-            f"{path} has an invalid schema_version {version!r}; expected an integer "
+            f"{path} has an invalid schema_version {shown}; expected an integer "
             f"from 1 to {SCHEMA_VERSION}."
         )
     if version > SCHEMA_VERSION:
@@ -489,19 +568,32 @@ def _checked_document(document: Any, path: str) -> dict[str, Any]:
             f"{path}: unknown key(s) {', '.join(map(repr, unknown))} in a softbend surrogate; "
             f"allowed keys: format, schema_version, {', '.join(_HEADER_KEYS)}."
         )
-    if document["kind"] not in _CLASSES:
+    kind = document["kind"]
+    if not isinstance(kind, str) or kind not in _CLASSES:
+        shown = repr(kind) if isinstance(kind, str) else short_repr(kind)
         raise SchemaError(
-            f"{path} holds an unknown surrogate kind {document['kind']!r}; "
+            f"{path} holds an unknown surrogate kind {shown}; "
             f"expected one of {', '.join(map(repr, KINDS))}."
         )
     if document["features"] != list(FEATURES) or document["target"] != TARGET:
         raise SchemaError(
-            f"{path} maps {document['features']} -> {document['target']!r}; this softbend's "
-            f"surrogates map {list(FEATURES)} -> {TARGET!r}."
+            f"{path} maps {short_repr(document['features'])} -> {short_repr(document['target'])}"
+            f"; this softbend's surrogates map {list(FEATURES)} -> {TARGET!r}."
         )
     for key in ("params", "state", "metadata", "units"):
         if not isinstance(document[key], dict):
             raise SchemaError(f"{path}: '{key}' must be a JSON object.")
+    units = {name: UNITS[name] for name in (*FEATURES, TARGET)}
+    if document["units"] != units:
+        wrong = next(
+            (name for name in units if document["units"].get(name) != units[name]),
+            next(iter(set(document["units"]) - set(units)), ""),
+        )
+        got = short_repr(document["units"].get(wrong)) if wrong in document["units"] else "none"
+        raise SchemaError(
+            f"{path}: 'units' must be {json.dumps(units)} (the units every softbend surrogate "
+            f"maps); got {got} for {wrong!r}."
+        )
     for key in ("softbend_version", "created_utc"):
         if not isinstance(document[key], str):
             raise SchemaError(f"{path}: '{key}' must be a string; got {short_repr(document[key])}.")
@@ -552,11 +644,69 @@ def _xgboost_params(params: dict[str, Any], path: Path) -> tuple[dict[str, Any],
         )
     try:
         decoded = {key: _decode(value) for key, value in params.items()}
-    except (KeyError, TypeError, ValueError, AttributeError) as err:
+    except (KeyError, TypeError, ValueError, AttributeError, RuleError) as err:
         raise SchemaError(
             f"{path}: params of the xgboost surrogate cannot be read ({err})."
         ) from None
+    if "missing" in decoded:  # null: XGBoost's default NaN (how save_surrogate writes it)
+        missing = decoded["missing"]
+        if missing is None:
+            decoded["missing"] = math.nan
+        elif isinstance(missing, bool | np.bool_) or not isinstance(
+            missing, int | float | np.integer | np.floating
+        ):
+            raise SchemaError(
+                f"{path}: params key 'missing' of the xgboost surrogate must be a number or "
+                f"null (NaN, XGBoost's default); got {short_repr(params['missing'])}."
+            )
     return decoded, standard
+
+
+def _check_training_ranges(metadata: dict[str, Any], path: Path) -> None:
+    """Refuse ``metadata["training_ranges"]`` unless one plausible ``[low, high]`` per input.
+
+    A range that is not two finite numbers (a NaN low end) would silently stop the
+    extrapolation check of :func:`softbend.surrogates.predict.predict_angles`.
+    """
+    if "training_ranges" not in metadata:
+        return
+    ranges = metadata["training_ranges"]
+    where = f"{path}: metadata key 'training_ranges'"
+    if not isinstance(ranges, dict):
+        raise SchemaError(
+            f"{where} must be an object of [low, high] per input ({', '.join(FEATURES)}); "
+            f"got {short_repr(ranges)}."
+        )
+    unknown = [name for name in ranges if name not in FEATURES]
+    missing = [name for name in FEATURES if name not in ranges]
+    if unknown or missing:
+        found = (
+            f"unknown input(s) {', '.join(map(repr, unknown))}"
+            if unknown
+            else f"no range for {', '.join(missing)}"
+        )
+        raise SchemaError(
+            f"{where} must give [low, high] for each input {', '.join(FEATURES)}; got {found}."
+        )
+    for name, pair in ranges.items():
+        bounds = RANGES[QUANTITIES[name]]
+        values: list[float] = []
+        if isinstance(pair, list) and len(pair) == 2 and all(type(v) in (int, float) for v in pair):
+            try:
+                values = [float(v) for v in pair]
+            except OverflowError:  # an integer beyond float64
+                values = []
+        if (
+            not values
+            or not all(math.isfinite(v) for v in values)
+            or implausible_index(values, QUANTITIES[name]) is not None
+            or values[0] > values[1]
+        ):
+            raise SchemaError(
+                f"{where}, field '{name}' must be [low, high]: two finite numbers with "
+                f"low <= high, from {bounds.low:g} to {bounds.high:g} {UNITS[name]} "
+                f"(a plausible {bounds.label}); got {short_repr(pair)}."
+            )
 
 
 def _restore_inner(value: Any, path: str, key: str, depth: int) -> Any:
@@ -618,6 +768,10 @@ def _restore(document: dict[str, Any], path: Path | str, depth: int = 0) -> Any:
     cls = _class_of(kind)
     if kind != "xgboost":
         model = cls(**_validated(document["params"], schema.params or {}, path, kind, "params"))
+        try:  # the declared sizes (defaults included) against the arrays
+            schema.against(model.get_params(deep=False), state)
+        except RuleError as err:
+            raise SchemaError(f"{path}: the {kind} surrogate's {err}.") from None
         for key, value in state.items():  # keys of the schema only
             setattr(model, key, value)
         return model
@@ -625,13 +779,23 @@ def _restore(document: dict[str, Any], path: Path | str, depth: int = 0) -> Any:
     try:
         model = cls(**params)
         model.load_model(bytearray(state["booster"].encode("utf-8")))
+        # load_model fills base_score, booster, ... from the booster; put back the standard
+        # parameters as they were set, so that get_params (and a refit) is unchanged.
+        for key in standard & params.keys():
+            setattr(model, key, params[key])
+        # A parameter XGBoost only reads when predicting (missing, n_jobs, ...) fails here,
+        # not in the caller's first prediction.
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore")
+            probe = np.asarray(model.predict(np.zeros((1, len(FEATURES)))), dtype=np.float64)
     except Exception as err:  # xgboost.core.XGBoostError, a parameter XGBoost refuses, ...
         reason = (str(err).strip().splitlines() or [type(err).__name__])[0]  # no stack trace
         raise SchemaError(f"{path}: cannot rebuild the {kind} surrogate ({reason}).") from None
-    # load_model fills base_score, booster, ... from the booster; put back the standard
-    # parameters as they were set, so that get_params (and a refit) is unchanged.
-    for key in standard & params.keys():
-        setattr(model, key, params[key])
+    if not np.isfinite(probe).all():
+        raise SchemaError(
+            f"{path}: the {kind} surrogate's booster predicts {probe.ravel()[0]} (its "
+            "base_score or a leaf value is not a finite number)."
+        )
     return model
 
 
@@ -660,13 +824,24 @@ def load_surrogate(path: str | Path) -> SavedSurrogate:
         If ``path`` is not a file.
     softbend.errors.SchemaError
         If the file is not JSON, not a softbend surrogate, has a newer schema
-        version, lacks a key, has a key the schema does not know, or a value that
-        breaks its rule (wrong type, dtype or shape, NaN or inf, a scale <= 0);
-        the one-line message names the file, the key and the rule.
+        version, other units, lacks a key, has a key the schema does not know, or a
+        value that breaks its rule (wrong type, dtype or shape, NaN or inf, a
+        scale <= 0, an implausible parameter of a correction, sizes that disagree
+        with the arrays, training ranges that are not plausible ``[low, high]``
+        pairs); the one-line message names the file, the key and the rule.
+    softbend.errors.LimitError
+        If the JSON nests deeper than the ``nesting`` limit of :mod:`softbend.limits`.
     """
     path = Path(path)
     document = _read_document(path)
-    model = _restore(document, path)
+    _check_training_ranges(document["metadata"], path)
+    try:
+        model = _restore(document, path)
+    except RecursionError:  # only with SOFTBEND_MAX_NESTING raised far above its default
+        raise SchemaError(
+            f"{path}: the surrogate nests too deeply to be rebuilt; lower SOFTBEND_MAX_NESTING "
+            f"(now {limit('nesting')}) to have it refused on reading."
+        ) from None
     return SavedSurrogate(
         model=model,
         kind=document["kind"],

@@ -9,6 +9,7 @@ import numpy as np
 from numpy.typing import ArrayLike
 
 from softbend.design import SFRBADesign
+from softbend.errors import SchemaError
 from softbend.models import check_pressures_mpa
 
 __all__ = ["INTERVAL_LEVEL", "Prediction", "predict_angles"]
@@ -71,9 +72,14 @@ def predict_angles(
     Raises
     ------
     ValueError
-        Bad pressures, or with ``strict`` an extrapolation (naming the inputs).
+        Bad pressures, or with ``strict`` an extrapolation (naming the inputs);
+        without ``strict``, an extrapolation where the model predicts a NaN or
+        infinite angle (naming the file and the inputs).
     FileNotFoundError, softbend.errors.SchemaError
-        As :func:`softbend.surrogates.load_surrogate`.
+        As :func:`softbend.surrogates.load_surrogate`; also a ``SchemaError``
+        naming the file when the model predicts a NaN or infinite angle or
+        interval end inside its training ranges (its parameters overflow). A
+        non-finite number is never returned.
     """
     from softbend.surrogates.features import outside_training_ranges
     from softbend.surrogates.persistence import load_surrogate
@@ -104,9 +110,43 @@ def predict_angles(
             f"The model {path} records no training ranges (saved by an older softbend); "
             "--strict cannot check it."
         )
-    angles = np.asarray(saved.model.predict(rows), dtype=float)
-    interval = None
-    if callable(getattr(saved.model, "predict_interval", None)):
-        low, high = saved.model.predict_interval(rows, INTERVAL_LEVEL)
-        interval = (np.asarray(low, dtype=float), np.asarray(high, dtype=float))
+    with np.errstate(all="ignore"):  # an overflow is reported below, naming the file
+        angles = np.asarray(saved.model.predict(rows), dtype=float)
+        interval = None
+        if callable(getattr(saved.model, "predict_interval", None)):
+            low, high = saved.model.predict_interval(rows, INTERVAL_LEVEL)
+            interval = (np.asarray(low, dtype=float), np.asarray(high, dtype=float))
+    _check_finite(path, saved.kind, pressures, angles, "angle", outside)
+    if interval is not None:
+        _check_finite(path, saved.kind, pressures, interval[0], "interval's low end", outside)
+        _check_finite(path, saved.kind, pressures, interval[1], "interval's high end", outside)
     return Prediction(saved.kind, design, pressures, angles, outside, has_ranges, interval)
+
+
+def _check_finite(
+    path: str | os.PathLike[str],
+    kind: str,
+    pressures: np.ndarray,
+    values: np.ndarray,
+    what: str,
+    outside: list[str],
+) -> None:
+    """Raise naming ``path`` at the first non-finite value of ``values``.
+
+    A ``ValueError`` when the inputs lie outside the training ranges (the model
+    overflows where it was never trained), else a :class:`SchemaError` (the file's
+    parameters overflow inside them).
+    """
+    bad = np.flatnonzero(~np.isfinite(values))
+    if bad.size:
+        i = int(bad[0])
+        error, cause = (
+            (ValueError, f"the inputs lie outside its training data ({'; '.join(outside)})")
+            if outside
+            else (SchemaError, "its parameters are corrupt or overflow")
+        )
+        raise error(
+            f"The model {path} ({kind} surrogate) predicts a non-finite {what} "
+            f"({values[i]}) at {pressures[i]:g} MPa; a prediction must be a finite number "
+            f"of degrees: {cause}."
+        )

@@ -3,7 +3,15 @@
 Loading (:func:`softbend.surrogates.load_surrogate`) validates every value before
 it reaches the estimator: each kind has a fixed set of parameter and state keys,
 each with a rule (type, dtype, dimensions, finiteness, bounds), then rules
-across keys (chained shapes). Only a key of the schema is ever set on a model.
+across keys (chained shapes, physical plausibility of the corrections'
+parameters) and between the parameters and the state (an MLP's
+``hidden_sizes`` and its weights, a polynomial's ``degree`` and its exponents).
+Only a key of the schema is ever set on a model.
+
+A float that is NaN or infinite is stored as ``{"__float__": "nan"}`` (or
+``"inf"``, ``"-inf"``) so that the file is strict JSON; the rules that allow
+such a value (a loss curve, an unbounded memory limit) read that form and,
+from files written before it, a bare ``NaN``/``Infinity``.
 """
 
 from __future__ import annotations
@@ -17,9 +25,27 @@ from typing import Any
 import numpy as np
 
 from softbend._validation import short_repr
-from softbend.surrogates.features import FEATURES
+from softbend.plausibility import RANGES, implausible_index
+from softbend.surrogates.features import FEATURES, TARGET
 
-__all__ = ["SCHEMAS", "Rule", "RuleError"]
+__all__ = ["FLOAT_TAG", "QUANTITIES", "SCHEMAS", "Rule", "RuleError", "tag_float", "untag_float"]
+
+#: Key of the JSON object that stands for a NaN or infinite float.
+FLOAT_TAG = "__float__"
+
+_NON_FINITE = {"nan": math.nan, "inf": math.inf, "-inf": -math.inf}
+
+#: The quantity of :data:`softbend.plausibility.RANGES` of each input and of the target.
+QUANTITIES: dict[str, str] = {
+    "l_mm": "length_mm",
+    "r_mm": "length_mm",
+    "t_mm": "length_mm",
+    "b_mm": "length_mm",
+    "phi_deg": "angle_deg",
+    "lc_mm": "length_mm",
+    "pressure_mpa": "pressure_mpa",
+    TARGET: "angle_deg",
+}
 
 
 class RuleError(Exception):
@@ -27,6 +53,33 @@ class RuleError(Exception):
 
 
 Rule = Callable[[Any], Any]
+
+
+def tag_float(value: float) -> Any:
+    """``value`` if finite, else ``{"__float__": "nan" | "inf" | "-inf"}`` (strict JSON)."""
+    if math.isfinite(value):
+        return value
+    return {FLOAT_TAG: "nan" if math.isnan(value) else ("inf" if value > 0 else "-inf")}
+
+
+def untag_float(value: Any) -> Any:
+    """The float a :func:`tag_float` object stands for; any other value unchanged.
+
+    Raises
+    ------
+    RuleError
+        An object with the key ``"__float__"`` that is not one :func:`tag_float` writes.
+    """
+    if isinstance(value, dict) and FLOAT_TAG in value:
+        text = value[FLOAT_TAG]
+        if set(value) != {FLOAT_TAG} or not isinstance(text, str) or text not in _NON_FINITE:
+            raise RuleError(
+                f'must be {{"{FLOAT_TAG}": "nan" | "inf" | "-inf"}} to stand for a non-finite '
+                f"number; got {short_repr(value)}"
+            )
+        return _NON_FINITE[text]
+    return value
+
 
 _FLOAT = "float64"
 _INT = "int64"
@@ -39,12 +92,20 @@ def _is_real(value: Any) -> bool:
 def _scalar(value: Any, dtype: str, what: str) -> Any:
     """A plain JSON number, or a ``{"__scalar__", "dtype"}`` of ``dtype``, decoded."""
     ok = _is_real if dtype == _FLOAT else (lambda v: type(v) is int)
+    if dtype == _FLOAT:
+        value = untag_float(value)
     if ok(value):
-        return float(value) if dtype == _FLOAT else value
+        if dtype != _FLOAT:
+            return value
+        try:
+            return float(value)
+        except OverflowError:  # an integer beyond float64
+            raise RuleError(f"must be {what} within {dtype}; got {short_repr(value)}") from None
     if isinstance(value, dict) and set(value) == {"__scalar__", "dtype"}:
-        if value["dtype"] == dtype and ok(value["__scalar__"]):
+        inner = untag_float(value["__scalar__"]) if dtype == _FLOAT else value["__scalar__"]
+        if value["dtype"] == dtype and ok(inner):
             try:
-                return np.dtype(dtype).type(value["__scalar__"])
+                return np.dtype(dtype).type(inner)
             except OverflowError:
                 raise RuleError(f"must be {what} within {dtype}; got {short_repr(value)}") from None
         raise RuleError(f"must be {what} of dtype {dtype}; got {short_repr(value)}")
@@ -186,6 +247,8 @@ def _arrays(count: int, ndim: int) -> Rule:
 
 def _numbers(value: Any) -> list[float]:
     """A list of numbers (a diagnostic such as a loss curve: NaN and inf allowed)."""
+    if isinstance(value, list):
+        value = [untag_float(v) for v in value]
     if not isinstance(value, list) or not all(_is_real(v) for v in value):
         raise RuleError(f"must be a list of numbers; got {short_repr(value)}")
     return [float(v) for v in value]
@@ -222,6 +285,12 @@ def _booster(value: Any) -> str:
     if n_features is not None and str(n_features) != str(len(FEATURES)):
         raise RuleError(
             f"must take the {len(FEATURES)} surrogate inputs; got {n_features} features"
+        )
+    names = learner.get("feature_names", [])
+    if names and names != list(FEATURES):  # empty: fitted on an array, no names recorded
+        raise RuleError(
+            f"must be fitted on the columns {', '.join(FEATURES)} in this order (or record no "
+            f"feature names); got feature_names {short_repr(names)}"
         )
     return value
 
@@ -304,8 +373,56 @@ def _documents(value: Any) -> Any:
     return [_document(v) for v in value]
 
 
+def _check_angle(state: dict[str, Any], key: str, what: str, *, spread: bool = False) -> None:
+    """``state[key]`` (degrees) a plausible angle, or with ``spread`` a plausible deviation.
+
+    A deviation (a residual standard deviation, >= 0 by its rule) of angles that lie
+    within ``RANGES["angle_deg"]`` is at most the range's upper end.
+    """
+    bounds = RANGES["angle_deg"]
+    value = float(state[key])
+    low = 0.0 if spread else bounds.low
+    if not low <= value <= bounds.high:
+        raise RuleError(
+            f"state key '{key}' must be {what} from {low:g} to {bounds.high:g} degrees "
+            f"(plausible {bounds.label}s); got {value:g}"
+        )
+
+
+def _check_residual_std(state: dict[str, Any]) -> None:
+    _check_angle(state, "residual_std_", "a residual standard deviation", spread=True)
+
+
+def _check_affine(state: dict[str, Any]) -> None:
+    _check_angle(state, "offset_", "an angle offset")
+    _check_residual_std(state)
+
+
+#: Names of the GP kernel's hyperparameters, in the order of ``kernel_theta_``.
+_GP_INPUTS: tuple[str, ...] = (*FEATURES, f"the base's {TARGET}")
+_GP_HYPERPARAMETERS: tuple[str, ...] = (
+    "constant",
+    *(f"length scale of {name}" for name in _GP_INPUTS),
+    "noise",
+)
+
+
 def _check_gp(state: dict[str, Any]) -> None:
-    d = len(FEATURES) + 1  # the inputs and the base's angle
+    """Shapes, then the plausibility of every number of a GP correction.
+
+    The hyperparameters ``exp(kernel_theta_)`` are dimensionless: length scales of
+    standardized inputs, and a constant and noise that are variances in units of
+    the targets' variance (the GP normalizes its targets). All lie within
+    ``RANGES["kernel_width"]`` (a fit keeps them within the far narrower bounds of
+    :func:`softbend.surrogates.corrected.gp_kernel`); outside, the kernel matrix
+    degenerates and the GP predicts NaN. The standardization ``z_mean_`` holds means
+    of the inputs and of the base's angle, each a plausible value of its quantity;
+    ``z_scale_`` their standard deviations (or 1 for a constant column), at most the
+    width of that quantity's range; the standardized ``inputs_`` lie within the
+    kernel-width range in magnitude and the ``targets_`` (the base's errors,
+    degrees) are plausible angles.
+    """
+    d = len(_GP_INPUTS)  # the inputs and the base's angle
     for key in ("z_mean_", "z_scale_"):
         if state[key].shape != (d,):
             raise RuleError(f"state key '{key}' must have shape ({d},); got {state[key].shape}")
@@ -322,15 +439,94 @@ def _check_gp(state: dict[str, Any]) -> None:
             f"state key 'targets_' must have shape ({inputs.shape[0]},) (one per row of "
             f"'inputs_'); got {targets.shape}"
         )
+    width = RANGES["kernel_width"]
+    with np.errstate(over="ignore", under="ignore"):
+        hyper = np.exp(state["kernel_theta_"])
+    bad = implausible_index(hyper, "kernel_width")
+    if bad is not None:
+        raise RuleError(
+            f"state key 'kernel_theta_' must hold the logarithms of the kernel's constant, "
+            f"length scales and noise, each within {width.low:g} to {width.high:g} "
+            f"(log {math.log(width.low):.4g} to {math.log(width.high):.4g}); got "
+            f"{_GP_HYPERPARAMETERS[bad]} {hyper[bad]:g} (log {state['kernel_theta_'][bad]:g}) "
+            f"at index {bad}"
+        )
+    quantities = [QUANTITIES[name] for name in (*FEATURES, TARGET)]
+    for j, (name, quantity) in enumerate(zip(_GP_INPUTS, quantities, strict=True)):
+        bounds = RANGES[quantity]
+        mean, scale = float(state["z_mean_"][j]), float(state["z_scale_"][j])
+        unit = f" {bounds.unit}" if bounds.unit else ""
+        if not bounds.low <= mean <= bounds.high:
+            raise RuleError(
+                f"state key 'z_mean_' must hold plausible means of the GP's inputs; got "
+                f"{mean:g} for {name} at index {j} (allowed {bounds.low:g} to "
+                f"{bounds.high:g}{unit})"
+            )
+        if scale > bounds.high - bounds.low:
+            raise RuleError(
+                f"state key 'z_scale_' must hold plausible standard deviations of the GP's "
+                f"inputs; got {scale:g} for {name} at index {j} (allowed up to "
+                f"{bounds.high - bounds.low:g}{unit}, the width of its range)"
+            )
+    outside = np.abs(inputs) > width.high
+    if outside.any():
+        row, col = (int(i) for i in np.argwhere(outside)[0])
+        raise RuleError(
+            f"state key 'inputs_' must hold standardized values of magnitude at most "
+            f"{width.high:g}; got {inputs[row, col]:g} at ({row}, {col})"
+        )
+    bad = implausible_index(targets, "angle_deg")
+    if bad is not None:
+        bounds = RANGES["angle_deg"]
+        raise RuleError(
+            f"state key 'targets_' must hold the base's errors, plausible angles from "
+            f"{bounds.low:g} to {bounds.high:g} degrees; got {targets[bad]:g} at index {bad}"
+        )
+
+
+def _check_mlp_sizes(params: dict[str, Any], state: dict[str, Any]) -> None:
+    """The declared ``hidden_sizes`` are the sizes of the weights' layers."""
+    declared = tuple(params["hidden_sizes"])
+    actual = (state["coefs_"][0].shape[1], state["coefs_"][1].shape[1])
+    if tuple(int(h) for h in declared) != actual:
+        raise RuleError(
+            f"params key 'hidden_sizes' must be the layer sizes of 'coefs_', {list(actual)}; "
+            f"got {short_repr(list(declared))}"
+        )
+
+
+def _check_polynomial_degree(params: dict[str, Any], state: dict[str, Any]) -> None:
+    """The declared ``degree`` is the highest total degree of ``powers_``; ``rank_`` fits."""
+    powers = state["powers_"]
+    highest = int(powers.sum(axis=1).max())
+    if int(params["degree"]) != highest:
+        raise RuleError(
+            f"params key 'degree' must be the highest total degree of 'powers_', {highest}; "
+            f"got {params['degree']}"
+        )
+    if "rank_" in state and int(state["rank_"]) > powers.shape[0]:
+        raise RuleError(
+            f"state key 'rank_' must be at most the number of terms, {powers.shape[0]}; "
+            f"got {state['rank_']}"
+        )
+
+
+def _no_params_check(params: dict[str, Any], state: dict[str, Any]) -> None:
+    return None
 
 
 @dataclass(frozen=True)
 class _Schema:
-    """What a saved surrogate of one kind may hold, and the rule of each value."""
+    """What a saved surrogate of one kind may hold, and the rule of each value.
+
+    ``check`` takes the decoded state; ``against`` the parameters of the model
+    built (its ``get_params``, defaults included) and the decoded state.
+    """
 
     params: dict[str, Rule] | None  # None: the constructor's keys, values decoded as saved
     state: dict[str, Rule]
     check: Callable[[dict[str, Any]], None]
+    against: Callable[[dict[str, Any], dict[str, Any]], None] = _no_params_check
 
 
 _INPUT_STATE: dict[str, Rule] = {
@@ -358,6 +554,7 @@ SCHEMAS: dict[str, _Schema] = {
             "rank_": _integer(0),
         },
         check=_check_polynomial,
+        against=_check_polynomial_degree,
     ),
     "mlp": _Schema(
         params={
@@ -376,6 +573,7 @@ SCHEMAS: dict[str, _Schema] = {
             "device_": _string(("cpu", "cuda")),
         },
         check=_check_mlp,
+        against=_check_mlp_sizes,
     ),
     "xgboost": _Schema(params=None, state={"booster": _booster}, check=_no_check),
     "affine-corrected": _Schema(
@@ -386,7 +584,7 @@ SCHEMAS: dict[str, _Schema] = {
             "offset_": _real(),
             "residual_std_": _real(low=0.0),
         },
-        check=_no_check,
+        check=_check_affine,
     ),
     "gp-corrected": _Schema(
         params={},
@@ -403,7 +601,7 @@ SCHEMAS: dict[str, _Schema] = {
     "ensemble": _Schema(
         params={},
         state={"members": _documents, "residual_std_": _real(low=0.0)},
-        check=_no_check,
+        check=_check_residual_std,
     ),
     "pressure-scaled": _Schema(
         params={},
@@ -412,6 +610,6 @@ SCHEMAS: dict[str, _Schema] = {
             "scale_": _real(low=0.0, strict=True),
             "residual_std_": _real(low=0.0),
         },
-        check=_no_check,
+        check=_check_residual_std,
     ),
 }

@@ -37,6 +37,8 @@ import pandas as pd
 
 from softbend._validation import check_choice, check_int, check_range
 from softbend.design import PAPER_B_FIG7_DESIGNS, PARAMETERS, SFRBADesign
+from softbend.errors import ConvergenceError
+from softbend.limits import check_limit
 from softbend.materials.fit import fit_model
 from softbend.materials.presets import DRAGON_SKIN_30, Material
 from softbend.materials.tensile import load_shipped, shipped_tensile_tests
@@ -86,7 +88,8 @@ class VirtualLab:
         ``h``: half the largest relative gap between the loading and unloading
         branches, in [0, 0.25).
     camera_noise_deg : float
-        Standard deviation of the angle reading, degrees, >= 0.
+        Standard deviation of the angle reading, degrees, in [0, 90] (a larger
+        spread would read angles no actuator reaches).
     pressure_step_mpa : float
         Increment of the set pressure, MPa (paper B: 0.01).
     pmax_mpa : float
@@ -97,9 +100,16 @@ class VirtualLab:
     unloading : bool
         Also read the unloading branch, from the top pressure back to 0.
     cycles : int
-        Inflation (and deflation) cycles per actuator, >= 1.
+        Inflation (and deflation) cycles per actuator, >= 1 and at most the
+        ``cycles`` limit of :mod:`softbend.limits` (1000 unless raised).
     seed : int
         Seed of the fabrication errors and the camera noise, >= 0.
+
+    Raises
+    ------
+    ValueError
+        A setting out of its range, naming it; :class:`~softbend.errors.LimitError`
+        for ``cycles`` over its limit.
     """
 
     actuators: tuple[SFRBADesign, ...] = LAB_ACTUATORS
@@ -151,7 +161,13 @@ class VirtualLab:
             )
             object.__setattr__(self, name, value)
         noise = check_range(
-            self.camera_noise_deg, "camera_noise_deg", _OWNER, low=0.0, low_inclusive=True
+            self.camera_noise_deg,
+            "camera_noise_deg",
+            _OWNER,
+            low=0.0,
+            high=90.0,
+            low_inclusive=True,
+            high_inclusive=True,
         )
         object.__setattr__(self, "camera_noise_deg", noise)
         angle = check_range(
@@ -163,7 +179,9 @@ class VirtualLab:
                 f"The 'unloading' of {_OWNER} must be True or False. "
                 f"Got {self.unloading!r} instead."
             )
-        object.__setattr__(self, "cycles", check_int(self.cycles, "cycles", _OWNER, low=1))
+        cycles = check_int(self.cycles, "cycles", _OWNER, low=1)
+        check_limit("cycles", cycles, f"The 'cycles' of {_OWNER}")
+        object.__setattr__(self, "cycles", cycles)
         object.__setattr__(self, "seed", check_int(self.seed, "seed", _OWNER, low=0))
         default_pressures_mpa(self.pmax_mpa, self.pressure_step_mpa)  # whole number of steps
 
@@ -255,6 +273,13 @@ class VirtualLab:
         Measurements
             Rows in the order measured, with ``actuator_id`` (the nominal design),
             ``cycle`` and ``direction``; :meth:`metadata` as the file header.
+
+        Raises
+        ------
+        ConvergenceError
+            The model stopped before an actuator's second pressure step.
+        ValueError
+            ``max_angle_deg`` stops an actuator before its second reading.
         """
         model = self.plant_model() if model is None else model
         grid = default_pressures_mpa(self.pmax_mpa, self.pressure_step_mpa)
@@ -268,10 +293,18 @@ class VirtualLab:
             angle = sweep.angle_deg[sweep.converged]
             keep = np.cumprod(angle <= self.max_angle_deg).astype(bool)
             pressures, elastic = reached[keep], angle[keep]
-            if pressures.size < 2:
-                raise RuntimeError(
+            if reached.size < 2:
+                raise ConvergenceError(
                     f"The virtual lab could not load actuator {actuator_id(nominal)}: its "
-                    f"{model.name} model stopped at {float(reached.max(initial=0.0)):g} MPa."
+                    f"{model.name} model stopped before its second pressure step",
+                    pressure_mpa=float(reached.max(initial=0.0)),
+                )
+            if pressures.size < 2:
+                raise ValueError(
+                    f"The 'max_angle_deg' of {_OWNER} ({self.max_angle_deg:g}°) stops actuator "
+                    f"{actuator_id(nominal)} before its second reading: it bends "
+                    f"{float(angle[1]):.4g}° at {float(reached[1]):g} MPa. Raise max_angle_deg "
+                    "or lower pressure_step_mpa."
                 )
             frames.extend(self._readings(nominal, pressures, elastic, noise_rng))
             if progress is not None:

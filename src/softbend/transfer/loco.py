@@ -9,7 +9,6 @@ A learning curve repeats this with 1, 2, ... of the other actuators measured.
 
 from __future__ import annotations
 
-import json
 import os
 import time
 from collections.abc import Callable, Sequence
@@ -20,7 +19,7 @@ from typing import Any
 import numpy as np
 import pandas as pd
 
-from softbend._io import write_text_atomic
+from softbend._io import json_text, write_text_atomic
 from softbend._validation import check_choice, check_int, check_range
 from softbend.metrics import rmse, thresholded_mape
 from softbend.transfer.measurements import Measurements
@@ -78,7 +77,12 @@ class LocoResult:
         return str(self.summary.sort_values("rmse_deg").iloc[0]["strategy"])
 
     def write(self, out: str | os.PathLike[str]) -> dict[str, str]:
-        """Write the tables (CSV) and ``loco.json`` into the folder ``out``; returns the paths."""
+        """Write the tables (CSV) and ``loco.json`` into the folder ``out``; returns the paths.
+
+        Each file is written whole (temporary file, then rename); ``loco.json`` is
+        strict JSON (NaN as null). The command line writes the folder as a whole
+        (:func:`softbend._io.staged_dir`).
+        """
         folder = Path(out)
         folder.mkdir(parents=True, exist_ok=True)
         files = {}
@@ -90,8 +94,7 @@ class LocoResult:
         curves.index = pd.RangeIndex(1, len(curves) + 1, name="epoch")
         write_text_atomic(folder / "loss_curves_deg2.csv", curves.to_csv())
         files["loss_curves"] = str(folder / "loss_curves_deg2.csv")
-        payload = json.dumps(_plain(self.to_dict()), indent=2, allow_nan=False)
-        write_text_atomic(folder / "loco.json", payload + "\n")
+        write_text_atomic(folder / "loco.json", json_text(self.to_dict()) + "\n")
         files["json"] = str(folder / "loco.json")
         return files
 
@@ -105,21 +108,6 @@ class LocoResult:
             "level": self.level,
             "settings": self.settings,
         }
-
-
-def _plain(value: Any) -> Any:
-    """JSON-ready: NumPy scalars as Python numbers, NaN as null."""
-    if isinstance(value, dict):
-        return {str(k): _plain(v) for k, v in value.items()}
-    if isinstance(value, list | tuple):
-        return [_plain(v) for v in value]
-    if isinstance(value, np.ndarray):
-        return _plain(value.tolist())
-    if isinstance(value, np.generic):
-        value = value.item()
-    if isinstance(value, float) and not np.isfinite(value):
-        return None
-    return value
 
 
 def _score(

@@ -25,22 +25,35 @@ default: the design written ``"l,r,t,b,phi,lc"`` with ``%g`` numbers, e.g.
 their names are case-sensitive and no other column is allowed. Whitespace
 around cells is stripped; an empty cell is an error in every column.
 
+Every number must be physically plausible (:mod:`softbend.plausibility`):
+``angle_deg`` within ±3600°, ``pressure_mpa`` at most 2 MPa, the lengths ``l``,
+``r``, ``t``, ``b`` and ``lc`` at most 10 000 mm and ``phi`` within 0–90°; the
+design must also be one :class:`~softbend.design.SFRBADesign` accepts.
+
 Lines starting with ``#`` are comments; a ``# key: value`` comment before the
 header row becomes an entry of :attr:`Measurements.metadata` (text split at the
-first colon, both sides stripped). Blank lines are skipped. Errors name the file
-and, where there is one, the line (numbered as an editor shows it, from 1,
-comments included) and the column.
+first colon, both sides stripped). The keys are those of :data:`METADATA_KEYS`,
+each with a value of its kind (``synthetic`` is ``true`` or ``false``; the
+virtual lab's ``lab.*`` settings are numbers, flags or names): a header that
+sets another key, or a value of the wrong kind, is an error (write other
+remarks as ``# note: ...`` or as a comment without a colon). Blank lines are
+skipped. Errors name the file and, where there is one, the line (numbered as an
+editor shows it, from 1, comments included) and the column.
+
+A file is read only if it is within the limits of :mod:`softbend.limits`
+(``file_mib`` and ``csv_rows``).
 """
 
 from __future__ import annotations
 
 import csv
+import datetime
 import io
 import logging
 import math
 import numbers
 import os
-from collections.abc import Callable, Iterable, Mapping
+from collections.abc import Callable, Iterable, Mapping, Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
@@ -51,6 +64,8 @@ import pandas as pd
 from softbend._io import write_text_atomic
 from softbend.design import FEATURES, PARAMETERS, SFRBADesign
 from softbend.errors import DatasetError
+from softbend.limits import check_file_size, check_limit, limit
+from softbend.plausibility import check_plausible
 
 logger = logging.getLogger(__name__)
 
@@ -81,6 +96,106 @@ _COLUMN_OF: dict[str, str] = {
 _FEATURE_COLUMNS: tuple[str, ...] = tuple(_COLUMN_OF[name] for name in FEATURES)
 _FORMAT_LINE = "softbend measurements CSV v1"
 _MAX_CYCLE = 2**53  # the largest integer a float64 holds exactly
+
+#: Plausible range of each numeric column: a quantity of
+#: :data:`softbend.plausibility.RANGES`.
+_PLAUSIBLE: dict[str, str] = {
+    "l": "length_mm",
+    "r": "length_mm",
+    "t": "length_mm",
+    "b": "length_mm",
+    "phi": "fiber_angle_deg",
+    "lc": "length_mm",
+    "pressure_mpa": "pressure_mpa",
+    "angle_deg": "angle_deg",
+}
+
+
+# ------------------------------------------------------------------ metadata keys
+def _is_text(text: str) -> bool:
+    return True
+
+
+def _is_flag(text: str) -> bool:
+    return text in ("true", "false")
+
+
+def _is_bool(text: str) -> bool:
+    return text in ("True", "False")
+
+
+def _is_number(text: str) -> bool:
+    try:
+        return math.isfinite(float(text))
+    except ValueError:
+        return False
+
+
+def _is_integer(low: int) -> Callable[[str], bool]:
+    def check(text: str) -> bool:
+        try:
+            return int(text) >= low
+        except ValueError:
+            return False
+
+    return check
+
+
+def _is_plant(text: str) -> bool:
+    return text in ("fem", "analytical")
+
+
+def _is_date(text: str) -> bool:
+    try:
+        datetime.datetime.fromisoformat(text)
+    except ValueError:
+        return False
+    return True
+
+
+_TEXT = ("text on one line", _is_text)
+_NUMBER = ("a finite number", _is_number)
+
+#: The keys a ``# key: value`` header line may set: what each value must be
+#: (for the messages) and its check. ``lab.*`` are the settings of the virtual
+#: lab (:meth:`softbend.transfer.lab.VirtualLab.metadata`) that made a file.
+METADATA_KEYS: dict[str, tuple[str, Callable[[str], bool]]] = {
+    "synthetic": ("'true' or 'false'", _is_flag),
+    "note": _TEXT,
+    "generator": _TEXT,
+    "command": _TEXT,
+    "rig": _TEXT,
+    "operator": _TEXT,
+    "date": ("an ISO 8601 date or time, e.g. 2024-05-17 or 2024-05-17T14:30", _is_date),
+    "lab.plant": ("'fem' or 'analytical'", _is_plant),
+    "lab.elastomer": _TEXT,
+    "lab.elastomer_max_stretch": _NUMBER,
+    "lab.fabrication_error_mm": _NUMBER,
+    "lab.hysteresis": _NUMBER,
+    "lab.camera_noise_deg": _NUMBER,
+    "lab.pressure_step_mpa": _NUMBER,
+    "lab.pmax_mpa": _NUMBER,
+    "lab.max_angle_deg": _NUMBER,
+    "lab.unloading": ("'True' or 'False'", _is_bool),
+    "lab.cycles": ("an integer >= 1", _is_integer(1)),
+    "lab.seed": ("an integer >= 0", _is_integer(0)),
+    "lab.elastomer_model": _TEXT,
+    "lab.as_built": _TEXT,
+}
+
+
+def _metadata_problem(key: str, value: str) -> str | None:
+    """What is wrong with the metadata entry ``key: value`` (both stripped), or None."""
+    if key not in METADATA_KEYS:
+        return (
+            f"unknown metadata key {key!r}; the keys are {', '.join(METADATA_KEYS)}. "
+            "Write other remarks as '# note: ...' or as a comment without ':'"
+        )
+    kind, check = METADATA_KEYS[key]
+    if not check(value):
+        return f"the metadata {key!r} must be {kind}. Got {value!r} instead"
+    return None
+
 
 # (owner, where): owner names the file or frame; where(pos) names a row ("line 7").
 _Where = Callable[[int], str]
@@ -220,8 +335,18 @@ def _design_text(values: Iterable[float]) -> str:
     return ", ".join(f"{c}={float(v)!r}" for c, v in zip(_DESIGN_COLUMNS, values, strict=True))
 
 
+def _check_column_plausible(
+    values: np.ndarray, column: str, owner: str, where: _Where, lines: Sequence[int] | None
+) -> None:
+    """Raise :class:`DatasetError` at the first implausible value of a numeric column."""
+    locate = None if lines is not None else where  # a file: by line; a table: by row
+    check_plausible(
+        values, _PLAUSIBLE[column], source=owner, column=column, lines=lines, where=locate
+    )
+
+
 def _normalize(
-    frame: Any, owner: str, where: _Where
+    frame: Any, owner: str, where: _Where, lines: Sequence[int] | None = None
 ) -> tuple[pd.DataFrame, dict[str, SFRBADesign]]:
     """Check a table of measurements and return it in canonical form with its designs.
 
@@ -233,6 +358,8 @@ def _normalize(
         The file or frame the rows come from, first in every message.
     where : callable
         ``where(pos)`` names the row at position ``pos`` (``"line 7"``, ``"row 3"``).
+    lines : sequence of int, optional
+        The file line of each row, when the rows come from a file.
 
     Returns
     -------
@@ -254,6 +381,7 @@ def _normalize(
     data: dict[str, Any] = {}
     for column in MEASUREMENT_COLUMNS:
         data[column] = _float_column(frame[column], owner, where, column)
+        _check_column_plausible(data[column], column, owner, where, lines)
     negative = np.flatnonzero(data["pressure_mpa"] < 0)
     if negative.size:
         pos = int(negative[0])
@@ -373,6 +501,9 @@ def _check_metadata(metadata: Mapping[str, Any], owner: str) -> dict[str, str]:
             raise ValueError(
                 f"The 'metadata' keys of {owner} must be unique after stripping. Got {key!r} twice."
             )
+        problem = _metadata_problem(name, text)
+        if problem is not None:  # what a file could not read back
+            raise ValueError(f"The 'metadata' of {owner}: {problem}.")
         out[name] = text
     return out
 
@@ -413,13 +544,15 @@ class Measurements:
     DatasetError
         One line naming the ``source`` (or "the Measurements frame"), the row
         (by index label) and the column: a missing, duplicate or unknown
-        column, no rows, a non-numeric or non-finite number, a negative
-        pressure, a cycle that is not an integer >= 1, a direction not in
-        :data:`DIRECTIONS`, an empty actuator id, a design
-        :class:`~softbend.design.SFRBADesign` rejects, or one actuator id with
-        two designs.
+        column, no rows, a non-numeric, non-finite or implausible number
+        (:mod:`softbend.plausibility`), a negative pressure, a cycle that is
+        not an integer >= 1, a direction not in :data:`DIRECTIONS`, an empty
+        actuator id, a design :class:`~softbend.design.SFRBADesign` rejects, or
+        one actuator id with two designs.
     ValueError
-        Metadata that is not a mapping of single-line text (keys without ':').
+        Metadata that is not a mapping of single-line text (keys without ':'),
+        or that a file could not hold: a key not in :data:`METADATA_KEYS` or a
+        value not of its kind.
 
     Notes
     -----
@@ -580,14 +713,21 @@ def load_measurements(path: str | os.PathLike[str]) -> Measurements:
         One line naming the file and, where it applies, the line (as an editor
         numbers them, from 1) and the column: file not found or a folder, not
         UTF-8, no header row, a missing, duplicate or unknown column, a row with
-        the wrong number of cells, no data rows, a metadata key given twice, or
-        any cell check of :class:`Measurements`.
+        the wrong number of cells or a cell CSV cannot read, no data rows, a
+        metadata key given twice, unknown or with a malformed value, an
+        implausible number (:mod:`softbend.plausibility`), or any cell check of
+        :class:`Measurements`.
+    LimitError
+        The file is larger than the ``file_mib`` limit or has more data rows
+        than the ``csv_rows`` limit (:mod:`softbend.limits`); checked before the
+        rows are parsed.
     """
     source = Path(path)
     if not source.exists():
         raise DatasetError(f"Measurement file not found: {source}.")
     if source.is_dir():
         raise DatasetError(f"{source} is a folder; a measurement CSV file is required.")
+    check_file_size(source)
     try:
         text = source.read_text(encoding="utf-8-sig")
     except UnicodeDecodeError as exc:
@@ -602,23 +742,32 @@ def load_measurements(path: str | os.PathLike[str]) -> Measurements:
     rows: list[list[str]] = []
     line_of_row: list[int] = []
     lines = text.replace("\r\n", "\n").replace("\r", "\n").split("\n")
+    if len(lines) > limit("csv_rows"):  # may be over: count the data rows (cheap)
+        n_rows = sum(1 for line in lines if line.strip() and not line.lstrip().startswith("#"))
+        check_limit("csv_rows", max(n_rows - 1, 0), str(source))
     for number, line in enumerate(lines, start=1):
         stripped = line.strip()
         if not stripped:
             continue
         if stripped.startswith("#"):
             key, sep, value = stripped[1:].partition(":")
-            key = key.strip()
+            key, value = key.strip(), value.strip()
             if columns is None and sep and key:
                 if key in metadata:
                     raise DatasetError(
                         f"{source}, line {number}: the metadata key {key!r} was already set "
                         f"on line {metadata_line[key]}; each key may appear once."
                     )
-                metadata[key] = value.strip()
+                problem = _metadata_problem(key, value)
+                if problem is not None:
+                    raise DatasetError(f"{source}, line {number}: {problem}.")
+                metadata[key] = value
                 metadata_line[key] = number
             continue
-        cells = [cell.strip() for cell in next(csv.reader([line]))]
+        try:
+            cells = [cell.strip() for cell in next(csv.reader([line]))]
+        except csv.Error as exc:
+            raise DatasetError(f"{source}, line {number}: not a CSV row ({exc}).") from None
         if columns is None:
             _check_columns(cells, f"{source}, line {number}")
             columns, header_line = cells, number
@@ -641,7 +790,9 @@ def load_measurements(path: str | os.PathLike[str]) -> Measurements:
             f"{source}, line {header_line}: the header row is followed by no data rows."
         )
     raw = pd.DataFrame(rows, columns=columns, dtype=object)
-    frame, _ = _normalize(raw, str(source), lambda pos: f"line {line_of_row[pos]}")
+    frame, _ = _normalize(
+        raw, str(source), lambda pos: f"line {line_of_row[pos]}", lines=line_of_row
+    )
     measurements = Measurements(frame, metadata=metadata, source=str(source))
     logger.debug(
         "Loaded %d measurement(s) of %d actuator(s) from %s.",
@@ -658,29 +809,13 @@ def _format_float(value: float) -> str:
     return repr(float(value))
 
 
-def save_measurements(measurements: Measurements, path: str | os.PathLike[str]) -> Path:
-    """Write measurements to a CSV file that :func:`load_measurements` reads back equal.
+def format_measurements(measurements: Measurements) -> str:
+    """The CSV text :func:`save_measurements` writes (format comment, metadata, rows).
 
-    Parameters
-    ----------
-    measurements : Measurements
-        What to write.
-    path : str or path-like
-        The CSV file; its folder is created if needed, an existing file replaced.
-
-    Returns
-    -------
-    pathlib.Path
-        The file written.
-
-    Notes
-    -----
-    The file starts with a format comment and the metadata as ``# key: value``
-    lines, then the header with every column (``MEASUREMENT_COLUMNS +
-    OPTIONAL_COLUMNS``). Floats are written with :func:`repr`, the shortest text
-    that parses back to the same float, so the round trip is exact. The text is
-    written to a temporary file in the same folder and moved into place, so a
-    reader never sees half a file.
+    Raises
+    ------
+    ValueError
+        ``measurements`` is not a :class:`Measurements`.
     """
     if not isinstance(measurements, Measurements):
         raise ValueError(
@@ -707,6 +842,33 @@ def save_measurements(measurements: Measurements, path: str | os.PathLike[str]) 
                 directions[i],
             ]
         )
-    target = write_text_atomic(path, buffer.getvalue())
+    return buffer.getvalue()
+
+
+def save_measurements(measurements: Measurements, path: str | os.PathLike[str]) -> Path:
+    """Write measurements to a CSV file that :func:`load_measurements` reads back equal.
+
+    Parameters
+    ----------
+    measurements : Measurements
+        What to write.
+    path : str or path-like
+        The CSV file; its folder is created if needed, an existing file replaced.
+
+    Returns
+    -------
+    pathlib.Path
+        The file written.
+
+    Notes
+    -----
+    The file starts with a format comment and the metadata as ``# key: value``
+    lines, then the header with every column (``MEASUREMENT_COLUMNS +
+    OPTIONAL_COLUMNS``). Floats are written with :func:`repr`, the shortest text
+    that parses back to the same float, so the round trip is exact. The text is
+    written to a temporary file in the same folder and moved into place, so a
+    reader never sees half a file.
+    """
+    target = write_text_atomic(path, format_measurements(measurements))
     logger.debug("Saved %d measurement(s) to %s.", len(measurements), target)
     return target

@@ -72,7 +72,8 @@ def fit_pressure_scale(base: Any, X: ArrayLike, y: ArrayLike, *, owner: str) -> 
         # A base that cannot answer at some scaled pressure (NaN: beyond where
         # its sweep stops) rules that scale out.
         predicted = np.asarray(base.predict(scaled_pressure_rows(rows, scale)))
-        value = float(np.sum((predicted - angles) ** 2))
+        with np.errstate(over="ignore", invalid="ignore"):  # an overflow is an infinite loss
+            value = float(np.sum((predicted - angles) ** 2))
         return value if np.isfinite(value) else np.inf
 
     # A scan of log(s) finds the basin (an MLP asked far outside its training

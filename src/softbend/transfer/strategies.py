@@ -40,6 +40,8 @@ from sklearn.utils.validation import check_is_fitted, validate_data
 
 from softbend._validation import check_choice, check_int, check_range
 from softbend.design import FEATURES, SFRBADesign
+from softbend.errors import ConvergenceError, DatasetError
+from softbend.plausibility import RANGES, implausible_index
 from softbend.surrogates.corrected import (
     AffineCorrected,
     GPCorrected,
@@ -116,16 +118,63 @@ def _check_level(level: float, owner: str) -> float:
     return check_range(level, "level", f"{owner}.predict_interval", low=0.0, high=1.0)
 
 
+def _check_plausible_array(values: np.ndarray, quantity: str, name: str, owner: str) -> None:
+    """Raise :class:`DatasetError` at the first value of ``values`` outside ``quantity``."""
+    index = implausible_index(values, quantity)
+    if index is None:
+        return
+    bounds = RANGES[quantity]
+    raise DatasetError(
+        f"The {name} of {owner} must be a plausible {bounds.label} (allowed {bounds.low:g} to "
+        f"{bounds.high:g} {bounds.unit}). Got {float(values[index]):g} at row {index} instead."
+    )
+
+
+def _base_angles(base: Any, X: np.ndarray, strategy: str) -> np.ndarray:
+    """The base's angles at the rows, degrees; one error naming ``strategy`` if not finite."""
+    theta = np.asarray(base.predict(X), dtype=np.float64)
+    bad = np.flatnonzero(~np.isfinite(theta))
+    if bad.size:
+        raise ValueError(
+            f"The base of the '{strategy}' strategy predicts a non-finite angle at "
+            f"{bad.size} of the {theta.size} measured rows (first: row {int(bad[0])}, "
+            f"{', '.join(f'{v:g}' for v in X[bad[0]])}); it cannot be corrected there"
+        )
+    return theta
+
+
+def _check_finite_fit(strategy: str, **parameters: Any) -> None:
+    """Raise :class:`ConvergenceError` naming ``strategy`` if a fitted parameter is not finite.
+
+    A fit that overflowed (absurd angles, a base that answers with huge numbers)
+    must fail here, never be saved or used with an infinite spread.
+    """
+    bad = []
+    for name, value in parameters.items():
+        array = np.asarray(value, dtype=np.float64)
+        if not np.isfinite(array).all():
+            bad.append(f"{name}={float(array):g}" if array.ndim == 0 else f"{name} not all finite")
+    if bad:
+        raise ConvergenceError(
+            f"The '{strategy}' strategy fitted non-finite parameters ({', '.join(bad)}): the "
+            "measured angles or the base's predictions are too large for the fit. Check the "
+            "measurements (degrees, MPa) and the base surrogate"
+        )
+
+
 class _Strategy(RegressorMixin, BaseEstimator):
-    """Validation shared by the strategies: 7 finite features, finite angles."""
+    """Validation shared by the strategies: 7 finite features, plausible angles."""
 
     def _check_fit_data(self, X: ArrayLike, y: ArrayLike) -> tuple[np.ndarray, np.ndarray]:
         X, y = validate_data(self, X, y, dtype=np.float64, y_numeric=True)
+        owner = f"{type(self).__name__}.fit"
         if X.shape[1] != len(FEATURES):
             raise ValueError(
-                f"The 'X' of {type(self).__name__}.fit must have the {len(FEATURES)} columns "
+                f"The 'X' of {owner} must have the {len(FEATURES)} columns "
                 f"{', '.join(FEATURES)}. Got {X.shape[1]} columns instead."
             )
+        _check_plausible_array(X[:, -1], "pressure_mpa", "'X' pressure column", owner)
+        _check_plausible_array(y, "angle_deg", "'y'", owner)
         return X, y
 
     def _check_rows(self, X: ArrayLike) -> np.ndarray:
@@ -406,12 +455,31 @@ class ScaleOffset(_Corrected):
         """Fit ``a`` and ``c`` on the rows."""
         _check_base(self.base, type(self).__name__)
         X, y = self._check_fit_data(X, y)
-        theta = np.asarray(self.base.predict(X), dtype=np.float64)
+        if y.size < 3:
+            raise ValueError(
+                "The 'scale-offset' strategy fits two numbers and the spread of the readings "
+                f"around them: it needs at least 3 readings. Got {y.size}."
+            )
+        theta = _base_angles(self.base, X, "scale-offset")
         A = np.column_stack([theta, np.ones_like(theta)])
-        (self.scale_, self.offset_), *_ = np.linalg.lstsq(A, y, rcond=None)
-        dof = max(y.size - 2, 1)
-        self.residual_std_ = float(
-            np.sqrt(np.sum((A @ [self.scale_, self.offset_] - y) ** 2) / dof)
+        with np.errstate(over="ignore", invalid="ignore"):  # checked below
+            (self.scale_, self.offset_), _, rank, _ = np.linalg.lstsq(A, y, rcond=None)
+        if rank < 2:
+            raise ValueError(
+                "The 'scale-offset' strategy cannot tell its scale from its offset: the base "
+                f"predicts the same angle ({theta[0]:g}°) at every reading. Measure at more "
+                "than one pressure."
+            )
+        with np.errstate(over="ignore", invalid="ignore"):  # checked below
+            dof = max(y.size - 2, 1)
+            self.residual_std_ = float(
+                np.sqrt(np.sum((A @ [self.scale_, self.offset_] - y) ** 2) / dof)
+            )
+        _check_finite_fit(
+            "scale-offset",
+            scale=self.scale_,
+            offset=self.offset_,
+            residual_std=self.residual_std_,
         )
         self.model_ = AffineCorrected(self.base, self.scale_, self.offset_, self.residual_std_)
         return self
@@ -441,9 +509,16 @@ class PressureScale(_Corrected):
         """Fit ``s`` by least squares on the rows."""
         _check_base(self.base, type(self).__name__)
         X, y = self._check_fit_data(X, y)
+        if y.size < 2:
+            raise ValueError(
+                "The 'pressure-scale' strategy fits one number and the spread of the readings "
+                f"around it: it needs at least 2 readings. Got {y.size}."
+            )
         self.scale_ = fit_pressure_scale(self.base, X, y, owner=type(self).__name__)
         residual = np.asarray(self.base.predict(scaled_pressure_rows(X, self.scale_))) - y
-        self.residual_std_ = float(np.sqrt(np.sum(residual**2) / max(y.size - 1, 1)))
+        with np.errstate(over="ignore", invalid="ignore"):  # checked below
+            self.residual_std_ = float(np.sqrt(np.sum(residual**2) / max(y.size - 1, 1)))
+        _check_finite_fit("pressure-scale", scale=self.scale_, residual_std=self.residual_std_)
         self.model_ = PressureScaled(self.base, self.scale_, self.residual_std_)
         return self
 
@@ -518,12 +593,14 @@ class ResidualGP(_Corrected):
         _check_base(self.base, type(self).__name__)
         n_restarts = check_int(self.n_restarts, "n_restarts", type(self).__name__, low=0)
         X, y = self._check_fit_data(X, y)
-        theta = np.asarray(self.base.predict(X), dtype=np.float64)
+        theta = _base_angles(self.base, X, "residual-gp")
         Z = np.column_stack([X, theta])
-        z_mean = Z.mean(axis=0)
-        scale = Z.std(axis=0)
-        z_scale = np.where(scale > 0, scale, 1.0)
-        inputs = (Z - z_mean) / z_scale
+        with np.errstate(over="ignore", invalid="ignore"):  # checked below
+            z_mean = Z.mean(axis=0)
+            scale = Z.std(axis=0)
+            z_scale = np.where(scale > 0, scale, 1.0)
+            inputs = (Z - z_mean) / z_scale
+        _check_finite_fit("residual-gp", z_mean=z_mean, z_scale=z_scale)
         # A length scale at its upper bound means "this input does not matter": a
         # normal outcome with six actuators, so the optimizer's warning is muted.
         with warnings.catch_warnings():
@@ -537,6 +614,17 @@ class ResidualGP(_Corrected):
         # The chosen hyperparameters, fixed: the model saves and reloads as it predicts here.
         self.model_ = GPCorrected(self.base, z_mean, z_scale, gp.kernel_.theta, inputs, y - theta)
         self.z_mean_, self.z_scale_, self.gp_ = z_mean, z_scale, self.model_.gp_
+        with np.errstate(all="ignore"):  # checked below
+            mean, std = self.gp_.predict(inputs, return_std=True)
+        _check_finite_fit(
+            "residual-gp",
+            z_mean=z_mean,
+            z_scale=z_scale,
+            kernel_theta=self.model_.kernel_theta_,
+            dual_coef=self.gp_.alpha_,
+            training_prediction=mean,
+            training_std=std,
+        )
         return self
 
     def predict(
@@ -623,7 +711,9 @@ class RefinedEnsemble(_Corrected):
             estimator.members_ = members
             estimator.n_features_in_ = X.shape[1]
             mean = np.mean([m.predict(X[rows]) for m in members], axis=0)
-            estimator.residual_std_ = float(np.sqrt(np.mean((mean - y[rows]) ** 2)))
+            with np.errstate(over="ignore", invalid="ignore"):  # checked below
+                estimator.residual_std_ = float(np.sqrt(np.mean((mean - y[rows]) ** 2)))
+            _check_finite_fit("refined-ensemble", residual_std=estimator.residual_std_)
             estimator.model_ = MeanEnsemble(members, estimator.residual_std_)
         return estimators
 
