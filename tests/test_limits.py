@@ -69,3 +69,44 @@ def test_every_range_is_documented():
 
     for name, bounds in RANGES.items():
         assert f"``{name}``" in module.__doc__ and bounds.low < bounds.high
+
+
+def test_training_epochs_are_bounded_before_any_work():
+    from softbend.surrogates.batched import train_mlp_grid
+
+    X = np.random.default_rng(0).random((20, 7))
+    rows = np.arange(20)
+    with pytest.raises(LimitError, match=r"'epochs' of train_mlp_grid is 1,000,000 epochs"):
+        train_mlp_grid(X, X[:, 0], [(rows, rows[:0])], [(3, 3)], epochs=1_000_000)
+
+
+def test_a_control_loop_run_is_bounded_by_its_ticks():
+    from softbend.control import loop
+
+    with pytest.raises(
+        LimitError,
+        match=r"A run of 86400 s at a period of 1e-06 s is "
+        r"86,400,000,000 ticks.*SOFTBEND_MAX_LOOP_TICKS",
+    ):
+        loop.run_loop(None, None, "step:90", duration_s=86400, period_s=1e-6, sensor_period_s=0.01)
+    with pytest.raises(LimitError, match="ticks"):  # a period so short the count overflows
+        loop.run_loop(
+            None, None, "step:90", duration_s=86400, period_s=5e-324, sensor_period_s=0.01
+        )
+
+
+@pytest.mark.parametrize(
+    "argv",
+    [
+        ["transfer", "base", "--out", "m.json", "--epochs", "1000000000"],
+        ["transfer", "refine", "b.json", "x.csv", "--out", "m.json", "--epochs", "1000000000"],
+    ],
+)
+def test_the_cli_names_the_epochs_option(argv, tmp_path, monkeypatch, capsys):
+    from softbend.cli import main
+
+    monkeypatch.chdir(tmp_path)
+    assert main(argv) == 2
+    err = capsys.readouterr().err.strip().splitlines()
+    assert len(err) == 1 and "--epochs is 1,000,000,000 epochs" in err[0]
+    assert not (tmp_path / "m.json").exists()

@@ -66,6 +66,7 @@ def train(
     """
     from softbend._io import staged_dir
     from softbend._validation import check_int
+    from softbend.limits import check_limit
     from softbend.reports.surrogate_figures import training_figures
     from softbend.surrogates.checkpoint import SearchCheckpoint, checkpoint_path
     from softbend.surrogates.workflow import train_surrogates
@@ -76,6 +77,8 @@ def train(
         check_int(halving_rungs, "--halving-rungs", "softbend train", low=1)
     if plr_patience is not None:
         check_int(plr_patience, "--plr-patience", "softbend train", low=1)
+    if epochs is not None:
+        check_limit("epochs", epochs, "--epochs")
     _common.check_output_dir(out, "--out", inputs=(db,))
     names = [m.strip() for m in models.split(",") if m.strip()]
 

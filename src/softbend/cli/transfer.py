@@ -225,10 +225,12 @@ def base(
     """Train paper B's MLP (63, 65) on the shipped Table 1 FEM dataset and save it."""
     from softbend._io import json_safe
     from softbend.datasets import table1_fem_provenance
+    from softbend.limits import check_limit
     from softbend.surrogates.features import training_ranges
     from softbend.surrogates.persistence import save_surrogate
     from softbend.transfer.base import BASE_HIDDEN_SIZES, fem_rows, train_base_mlp
 
+    check_limit("epochs", epochs, "--epochs")
     _common.check_output_file(out, "--out", kind="json")
     with _common.progress_bar("training the FEM MLP (epochs)", epochs) as advance:
         state = {"done": 0}
@@ -383,11 +385,14 @@ def refine(
 
     from softbend._io import json_safe
     from softbend._validation import check_choice
+    from softbend.limits import check_limit
     from softbend.surrogates.persistence import save_surrogate
     from softbend.transfer.measurements import load_measurements
     from softbend.transfer.strategies import NETWORK_STRATEGIES, fit_strategy
 
     check_choice(strategy, "strategy", "softbend transfer refine", REFINE_STRATEGIES)
+    if epochs is not None:
+        check_limit("epochs", epochs, "--epochs")
     if epochs is not None and strategy not in NETWORK_STRATEGIES:
         raise ValueError(
             f"The '--epochs' option applies to the MLP strategies "

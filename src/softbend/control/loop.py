@@ -54,6 +54,7 @@ from softbend._validation import check_int, check_range
 from softbend.control.experiments import ControlRun, Reference, parse_reference, run_metrics
 from softbend.control.rigconfig import SafetyLimits
 from softbend.errors import RigError
+from softbend.limits import check_limit
 
 __all__ = ["COLUMNS", "LoopRun", "run_loop"]
 
@@ -271,6 +272,11 @@ def run_loop(
         raise ValueError(
             f"The 'log_path' of run_loop must end in .csv or .parquet. Got {str(path)!r} instead."
         )
+    ticks = duration / period
+    check_limit(
+        "loop_ticks", round(ticks) if math.isfinite(ticks) else ticks,
+        f"A run of {duration:g} s at a period of {period:g} s",
+    )  # fmt: skip
     n = max(1, round(duration / period))
     sensor_every = max(1, round(sensor / period))
     log = _Log(path, flush)

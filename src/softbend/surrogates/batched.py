@@ -55,6 +55,7 @@ from numpy.typing import ArrayLike
 from softbend._torch import require_torch
 from softbend._validation import check_choice, check_int, check_range
 from softbend.errors import ConvergenceError
+from softbend.limits import check_limit
 from softbend.surrogates.batched_checks import (
     check_data,
     check_dtype,
@@ -375,6 +376,7 @@ def train_mlp_grid(
     split_list = check_splits(splits, X.shape[0])
     configs = check_hidden_sizes(hidden_sizes)
     epochs = check_int(epochs, "epochs", _OWNER, low=1)
+    check_limit("epochs", epochs, f"The 'epochs' of {_OWNER}")
     batch_size = check_int(batch_size, "batch_size", _OWNER, low=1)
     learning_rate = check_range(learning_rate, "learning_rate", _OWNER, low=0.0, high=math.inf)
     seed = check_int(seed, "seed", _OWNER, low=0)

@@ -19,6 +19,7 @@ from numpy.typing import ArrayLike
 
 from softbend._validation import check_int, check_range
 from softbend.errors import ConvergenceError
+from softbend.limits import check_limit
 
 __all__ = ["FINE_TUNE_THREADS", "check_mlp", "fine_tune_many", "fine_tune_mlp", "row_weights"]
 
@@ -93,6 +94,7 @@ def fine_tune_many(
     starts = [check_mlp(b, owner) for b in (base if isinstance(base, list) else [base])]
     base = starts[0]
     epochs = check_int(epochs, "epochs", owner, low=1)
+    check_limit("epochs", epochs, f"The 'epochs' of {owner}")
     learning_rate = check_range(learning_rate, "learning_rate", owner, low=0.0)
     X = np.asarray(X, dtype=np.float64)
     y = np.asarray(y, dtype=np.float64).ravel()
