@@ -115,3 +115,24 @@ def test_json_text_is_strict_json_with_nan_as_null():
         "3": "key as text",
         "path": "a/b",
     }
+
+
+def test_atomic_files_replace_all_targets_or_none(tmp_path):
+    import pytest
+
+    from softbend._io import atomic_files
+
+    a, b = tmp_path / "run.csv", tmp_path / "run.png"
+    a.write_text("old a")
+    b.write_text("old b")
+    with pytest.raises(OSError, match="full"), atomic_files(a, b) as (ta, tb):
+        assert ta.suffix == ".csv" and tb.suffix == ".png" and ta.parent == tmp_path
+        ta.write_text("new a")
+        raise OSError(28, "full")
+    assert a.read_text() == "old a" and b.read_text() == "old b"
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["run.csv", "run.png"]
+    with atomic_files(a, b, tmp_path / "skipped.txt") as (ta, tb, _):
+        ta.write_text("new a")
+        tb.write_text("new b")
+    assert a.read_text() == "new a" and b.read_text() == "new b"
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["run.csv", "run.png"]

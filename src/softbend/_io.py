@@ -22,6 +22,7 @@ from typing import IO, Any
 
 __all__ = [
     "atomic_file",
+    "atomic_files",
     "json_safe",
     "json_text",
     "new_file_mode",
@@ -77,6 +78,33 @@ def atomic_file(path: str | os.PathLike[str], mode: str = "w") -> Iterator[IO]:
     except BaseException:
         Path(tmp).unlink(missing_ok=True)
         raise
+
+
+@contextmanager
+def atomic_files(*targets: str | os.PathLike[str]) -> Iterator[list[Path]]:
+    """Yield one temporary sibling per target; all replace their targets when the block ends.
+
+    The outputs of one command are then all new or all old: if the block raises,
+    every temporary is removed and every target is left as it was. A temporary
+    keeps its target's suffix (a figure's format follows it) and the moved file
+    gets the permissions a plain write would give it. A temporary the block did
+    not create (an optional output it skipped) leaves its target alone.
+    """
+    paths = [Path(t) for t in targets]
+    token = f"{os.getpid()}-{os.urandom(4).hex()}"
+    temps = [p.parent / f".{p.name}.{token}.tmp{p.suffix}" for p in paths]
+    for path in paths:
+        path.parent.mkdir(parents=True, exist_ok=True)
+    try:
+        yield temps
+        written = [(t, p) for t, p in zip(temps, paths, strict=True) if t.exists()]
+        for temp, path in written:
+            os.chmod(temp, new_file_mode(path))
+        for temp, path in written:
+            os.replace(temp, path)
+    finally:
+        for temp in temps:
+            temp.unlink(missing_ok=True)
 
 
 def write_text_atomic(path: str | os.PathLike[str], text: str) -> Path:

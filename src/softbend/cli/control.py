@@ -123,22 +123,15 @@ def simulate_cmd(
         "rig": params.as_dict(),
         "metrics": metrics,
     }
-    with _common.output_errors(out, "--out"):
-        from softbend._io import atomic_file, write_text_atomic
+    from softbend._io import atomic_files
 
-        out.mkdir(parents=True, exist_ok=True)
-        with atomic_file(out / "run.csv") as handle:  # never half a table
-            run.frame().to_csv(handle, index=False)
-        write_text_atomic(out / "metrics.json", _common.json_text(payload) + "\n")
-        figure = _figure_atomic(
-            out / "run.png",
-            lambda path: control_figures.run_figure(
-                run, path, f"{controller} on {actuator}, {reference} (simulated)"
-            ),
-        )
-    payload["files"] = [str(out / "run.csv"), str(out / "metrics.json")] + (
-        [str(figure)] if figure else []
-    )
+    targets = (out / "run.csv", out / "metrics.json", out / "run.png")
+    with _common.output_errors(out, "--out"), atomic_files(*targets) as (table, summary, png):
+        run.frame().to_csv(table, index=False)  # all three files new, or all as they were
+        summary.write_text(_common.json_text(payload) + "\n", encoding="utf-8")
+        title = f"{controller} on {actuator}, {reference} (simulated)"
+        control_figures.run_figure(run, png, title)
+    payload["files"] = [str(target) for target in targets]
     if as_json:
         _common.print_json(payload)
         return
@@ -280,22 +273,18 @@ def run_cmd(
     if rig == "modbus":
         trips = device.round_trips_s
         payload["round_trip_ms"] = _percentiles_ms(trips)
-    with _common.output_errors(out, "--out"):
-        from softbend._io import write_text_atomic
+    from softbend._io import atomic_files
 
-        write_text_atomic(out / "run.json", _common.json_text(payload) + "\n")
-        figure = _figure_atomic(
-            out / "run.png",
-            lambda path: control_figures.run_figure(
-                result.control_run(),
-                path,
-                f"{controller} on {actuator}, {reference}, rig {rig} "
-                f"(tick {loop_period * 1e3:g} ms, sensor {sensor_every * 1e3:g} ms)",
-            ),
+    targets = (out / "run.json", out / "run.png")
+    with _common.output_errors(out, "--out"), atomic_files(*targets) as (summary, png):
+        summary.write_text(_common.json_text(payload) + "\n", encoding="utf-8")
+        title = (
+            f"{controller} on {actuator}, {reference}, rig {rig} "
+            f"(tick {loop_period * 1e3:g} ms, sensor {sensor_every * 1e3:g} ms)"
         )
-    payload["files"] = [str(out / log_name), str(out / "run.json")] + (
-        [str(figure)] if figure else []
-    )
+        control_figures.run_figure(result.control_run(), png, title)
+    figure = targets[1]
+    payload["files"] = [str(out / log_name), str(out / "run.json"), str(figure)]
     if as_json:
         _common.print_json(payload)
     else:
@@ -310,24 +299,6 @@ def run_cmd(
     if not result.completed or not result.vented:  # a fault, or a rig left unvented
         _common.error_line(result.stop_reason)
         raise typer.Exit(1)
-
-
-def _figure_atomic(path: Path, draw: Any) -> Path | None:
-    """Draw a figure with ``draw(temporary_path)`` and move it to ``path`` once complete.
-
-    A figure cut short (a full disk, an interruption) never replaces ``path``.
-    """
-    import os
-
-    temporary = path.with_name(f".{path.stem}.{os.getpid()}.tmp{path.suffix}")
-    try:
-        written = draw(temporary)
-        if not written:
-            return None
-        os.replace(temporary, path)
-        return path
-    finally:
-        temporary.unlink(missing_ok=True)
 
 
 def _terminate_as_interrupt() -> Any:

@@ -2,7 +2,6 @@
 
 from __future__ import annotations
 
-import os
 from pathlib import Path
 from typing import TYPE_CHECKING, Annotated, Any
 
@@ -107,7 +106,7 @@ def fit(
     tension against the measured engineering stress (MPa), with R² and RMSE.
     Writes OUT/fit.png (data and fitted curves) and OUT/fit.json.
     """
-    from softbend._io import write_text_atomic
+    from softbend._io import atomic_files
     from softbend.materials.fit import fit_models
     from softbend.reports.material_figures import fit_figure
 
@@ -117,18 +116,15 @@ def fit(
     test = _load(csv)
     results = fit_models(test, names, max_stretch=max_stretch)
 
-    with _common.output_errors(out, "--out"):
-        out.mkdir(parents=True, exist_ok=True)
-        temporary = out / f".{FIT_PNG}.{os.getpid()}.tmp.png"  # never half a figure
-        try:
-            fit_figure(test, results, temporary)
-            os.replace(temporary, out / FIT_PNG)
-        finally:
-            temporary.unlink(missing_ok=True)
-        figure = out / FIT_PNG
-        payload = _payload(test, results, max_stretch)
-        payload["files"] = {"figure": str(figure), "json": str(out / FIT_JSON)}
-        write_text_atomic(out / FIT_JSON, _common.json_text(payload) + "\n")
+    figure = out / FIT_PNG
+    payload = _payload(test, results, max_stretch)
+    payload["files"] = {"figure": str(figure), "json": str(out / FIT_JSON)}
+    with (
+        _common.output_errors(out, "--out"),
+        atomic_files(figure, out / FIT_JSON) as (png, summary),  # both new, or both as they were
+    ):
+        fit_figure(test, results, png)
+        summary.write_text(_common.json_text(payload) + "\n", encoding="utf-8")
 
     if json_output:
         _common.print_json(payload)

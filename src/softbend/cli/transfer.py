@@ -3,7 +3,6 @@
 from __future__ import annotations
 
 import os
-import secrets
 from collections.abc import Iterator
 from contextlib import contextmanager
 from pathlib import Path
@@ -50,32 +49,6 @@ def _as_written(staged: Path, final: Path) -> Iterator[None]:
             raise
         renamed = Path(final) / found.relative_to(root) if found != root else Path(final)
         raise OSError(exc.errno, exc.strerror, str(renamed)) from exc
-
-
-@contextmanager
-def _staged_files(*targets: Path) -> Iterator[list[Path]]:
-    """Yield one temporary sibling per target; all are moved onto the targets at the end.
-
-    If the block raises, the temporaries are removed and every target is left
-    as it was: the outputs of one command are all new or all old. A temporary
-    keeps its target's suffix (a figure's format follows it); the moved file
-    gets the permissions the target had, or those of a new file.
-    """
-    from softbend._io import new_file_mode
-
-    token = f"{os.getpid()}-{secrets.token_hex(4)}"
-    temps = [t.parent / f".{t.name}.{token}.tmp{t.suffix}" for t in targets]
-    for target in targets:
-        target.parent.mkdir(parents=True, exist_ok=True)
-    try:
-        yield temps
-        for temp, target in zip(temps, targets, strict=True):
-            os.chmod(temp, new_file_mode(target))
-        for temp, target in zip(temps, targets, strict=True):
-            os.replace(temp, target)
-    finally:
-        for temp in temps:
-            temp.unlink(missing_ok=True)
 
 
 #: The files 'transfer loco' writes into its '--out' folder.
@@ -148,6 +121,7 @@ def measure(
     Writes the CSV and its figure (the same name with ``.png``) together: a run
     that fails leaves both as they were.
     """
+    from softbend._io import atomic_files
     from softbend.limits import check_limit
     from softbend.reports.transfer_figures import lab_measurements
     from softbend.transfer.lab import VirtualLab
@@ -180,7 +154,7 @@ def measure(
     with _common.progress_bar("virtual lab", total, enabled=not as_json) as advance:
         measurements = lab.measure(progress=lambda done, n, name: advance(actuator=name))
     text = format_measurements(measurements)
-    with _common.output_errors(out, "--out"), _staged_files(out, figure) as (csv_file, png):
+    with _common.output_errors(out, "--out"), atomic_files(out, figure) as (csv_file, png):
         with (
             _common.output_errors(out, "--out"),
             _as_written(csv_file, out),
