@@ -17,25 +17,10 @@ from softbend.control.controllers import BangBang, PressureRelay
 from softbend.control.experiments import run_metrics, simulate
 from softbend.control.loop import run_loop
 from softbend.control.modbus import ModbusRig
-from softbend.control.modbus_server import SimulatedModbusServer
 from softbend.control.rig import RigParams, SimulatedRig
 from softbend.errors import RigError
 
 pytest.importorskip("pymodbus")
-
-
-@pytest.fixture
-def server(table):
-    # The server runs in a thread of this process: a short GIL switch interval keeps
-    # its answers as prompt as those of a separate device (the default 5 ms would
-    # add up to 5 ms to a request whenever the loop holds the GIL).
-    interval = sys.getswitchinterval()
-    sys.setswitchinterval(1e-4)
-    try:
-        with SimulatedModbusServer(SimulatedRig(table, RigParams(), seed=0)) as srv:
-            yield srv
-    finally:
-        sys.setswitchinterval(interval)
 
 
 def wait_for(predicate, timeout=2.0):

@@ -1,7 +1,6 @@
 """How a run ended is told once, and truly: "vented and stopped" only when the vent got through."""
 
 import json
-import sys
 import threading
 import time
 
@@ -89,19 +88,6 @@ def test_a_fault_whose_vent_succeeds_says_vented_once(table):
 
 
 pymodbus = pytest.importorskip("pymodbus")
-
-
-@pytest.fixture
-def server(table):
-    from softbend.control.modbus_server import SimulatedModbusServer
-
-    interval = sys.getswitchinterval()
-    sys.setswitchinterval(1e-4)
-    try:
-        with SimulatedModbusServer(SimulatedRig(table, RigParams(), seed=0)) as srv:
-            yield srv
-    finally:
-        sys.setswitchinterval(interval)
 
 
 class StuckOpen:

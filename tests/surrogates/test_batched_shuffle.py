@@ -8,13 +8,7 @@ from softbend.surrogates import batched, batched_epochs
 from softbend.surrogates.batched import train_mlp_grid
 from softbend.surrogates.batched_shuffle import MAX_ROWS, DeviceShuffle, hash32, model_keys
 
-
-@pytest.fixture(autouse=True, scope="module")
-def _one_torch_thread():
-    before = torch.get_num_threads()
-    torch.set_num_threads(1)
-    yield
-    torch.set_num_threads(before)
+pytestmark = pytest.mark.usefixtures("one_torch_thread")
 
 
 def _lowbias32(x: int) -> int:
