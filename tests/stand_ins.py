@@ -62,3 +62,15 @@ def web_server():
         server.close()
 
     return server.getsockname()[1], close
+
+
+class StuckOpen:
+    """A controller that keeps the inlet open: only a watchdog can vent after the link goes."""
+
+    predicted_deg = float("nan")
+
+    def reset(self):
+        pass
+
+    def step(self, measurement_mpa, reference_deg, t_s):
+        return (True, False)

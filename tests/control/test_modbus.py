@@ -20,6 +20,8 @@ from softbend.control.modbus import ModbusRig
 from softbend.control.rig import RigParams, SimulatedRig
 from softbend.errors import RigError
 
+from ..stand_ins import StuckOpen
+
 pytest.importorskip("pymodbus")
 
 
@@ -83,18 +85,6 @@ def test_the_loop_through_modbus_matches_the_direct_simulation(server, table, co
     assert m["rise_s"] == pytest.approx(sum(r["rise_s"] for r in band) / len(band), abs=0.03)
     assert server.valves == (False, True) or wait_for(lambda: server.valves == (False, True))
     assert run.jitter()["ticks"] == 2500
-
-
-class StuckOpen:
-    """A controller that keeps the inlet open: only a watchdog can vent after the link goes."""
-
-    predicted_deg = float("nan")
-
-    def reset(self):
-        pass
-
-    def step(self, measurement_mpa, reference_deg, t_s):
-        return (True, False)
 
 
 def test_server_gone_mid_run_stops_clearly_and_the_watchdog_vents(server):

@@ -12,6 +12,8 @@ from softbend.control.loop import run_loop
 from softbend.control.rig import RigParams, SimulatedRig
 from softbend.errors import RigError
 
+from ..stand_ins import StuckOpen
+
 
 class Rig:
     """A simulated rig whose valves stop answering from ``t_fail`` on (reads may fail too)."""
@@ -88,16 +90,6 @@ def test_a_fault_whose_vent_succeeds_says_vented_once(table):
 
 
 pymodbus = pytest.importorskip("pymodbus")
-
-
-class StuckOpen:
-    predicted_deg = float("nan")
-
-    def reset(self):
-        pass
-
-    def step(self, measurement_mpa, reference_deg, t_s):
-        return (True, False)
 
 
 @pytest.mark.parametrize("end", ["disconnect", "stop"])
