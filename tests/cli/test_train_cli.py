@@ -5,6 +5,8 @@ import pytest
 
 from softbend.cli import main
 
+from .conftest import one_error_line
+
 
 def _run(args, capsys):
     code = main(args)
@@ -324,3 +326,30 @@ def test_a_second_train_into_the_same_folder_is_refused_while_one_runs(
     lines = err.strip().splitlines()
     assert len(lines) == 1 and "Another search is writing the checkpoint" in lines[0]
     assert not out.exists()
+
+
+def test_train_does_not_swap_away_a_folder_of_other_files_or_its_input(
+    small_campaign, tmp_path, capsys
+):
+    import shutil
+
+    mine = tmp_path / "mine"
+    mine.mkdir()
+    (mine / "notes.txt").write_text("keep me")
+    args = ["train", str(small_campaign), "--models", "plr", "--no-onnx"]
+    assert main([*args, "--out", str(mine)]) == 2
+    line = one_error_line(capsys)
+    assert "'--out'" in line and "notes.txt" in line and "replaced as a whole" in line
+    assert (mine / "notes.txt").read_text() == "keep me"
+    # the database inside its own --out folder would be deleted by the swap: refused
+    inside = tmp_path / "inside"
+    inside.mkdir()
+    db = shutil.copy(small_campaign, inside / "c.duckdb")
+    assert main(["train", str(db), "--models", "plr", "--no-onnx", "--out", str(inside)]) == 2
+    assert "holds the input" in one_error_line(capsys)
+    assert (inside / "c.duckdb").is_file()
+    # an earlier result of softbend train is replaced as before
+    out = tmp_path / "out"
+    assert main([*args, "--out", str(out), "--json"]) == 0
+    capsys.readouterr()
+    assert main([*args, "--out", str(out), "--json"]) == 0

@@ -320,6 +320,46 @@ def check_output_dir(
     _writable_parent(path / "x", option)
 
 
+def check_replaceable_dir(
+    path: Path,
+    option: str,
+    command: str,
+    *,
+    inputs: tuple[Path, ...] = (),
+    files: tuple[str, ...] | None = None,
+    marker: str | None = None,
+) -> None:
+    """Refuse an existing output folder that replacing it as a whole would lose data from.
+
+    A command that builds its folder beside ``path`` and swaps it in (``staged_dir``)
+    deletes whatever the old folder held. Refused, before any work: a folder that
+    holds one of the command's ``inputs``; a folder with entries other than
+    ``files`` (the names the command writes); a non-empty folder without
+    ``marker`` (a file every earlier result of the command has).
+    """
+    path = Path(path)
+    if not path.is_dir():
+        return
+    folder = Path(os.path.abspath(path))
+    for source in inputs:  # (a missing input is reported by its reader)
+        if Path(source).exists() and folder in Path(os.path.abspath(source)).parents:
+            raise ValueError(
+                f"The '{option}' {path} holds the input {source}, and the folder is replaced "
+                "as a whole by the new results; choose another folder."
+            )
+    entries = sorted(p.name for p in path.iterdir())
+    others = [name for name in entries if files is not None and name not in files]
+    if marker is not None and entries and marker not in entries:
+        others = others or entries
+    if others:
+        shown = ", ".join(others[:3]) + (f" and {len(others) - 3} more" if len(others) > 3 else "")
+        raise ValueError(
+            f"The '{option}' {path} is replaced as a whole by the results of '{command}', but "
+            f"it holds other files ({shown}); choose a new or empty folder, or one of its "
+            "earlier results."
+        )
+
+
 def _concerns(exc: OSError, path: Path) -> bool:
     """Whether an OS error names ``path``, a file inside it or a temporary file beside it."""
     names = [n for n in (exc.filename, exc.filename2) if n is not None]

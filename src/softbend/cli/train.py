@@ -80,6 +80,10 @@ def train(
     if epochs is not None:
         check_limit("epochs", epochs, "--epochs")
     _common.check_output_dir(out, "--out", inputs=(db,))
+    # the folder is swapped whole: nothing but an earlier result of this command may be lost
+    _common.check_replaceable_dir(
+        out, "--out", "softbend train", inputs=(db,), marker="cv_results.csv"
+    )
     names = [m.strip() for m in models.split(",") if m.strip()]
 
     def resuming(line: str) -> None:

@@ -65,33 +65,6 @@ LOCO_FILES: tuple[str, ...] = (
 )
 
 
-def _check_replaceable_dir(
-    out: Path, option: str, inputs: tuple[Path, ...], files: tuple[str, ...], command: str
-) -> None:
-    """Refuse an existing output folder that a whole-folder replacement would lose data from.
-
-    The folder is replaced as a whole, so it may hold only the files ``command``
-    writes (an earlier run's results), and none of the command's inputs.
-    """
-    if not out.is_dir():
-        return
-    folder = Path(os.path.abspath(out))
-    for source in inputs:
-        if folder in Path(os.path.abspath(source)).parents:
-            raise ValueError(
-                f"The '{option}' {out} holds the input {source}, and the folder is replaced "
-                "as a whole by the new results; choose another folder."
-            )
-    others = sorted(p.name for p in out.iterdir() if p.name not in files)
-    if others:
-        shown = ", ".join(others[:3]) + (f" and {len(others) - 3} more" if len(others) > 3 else "")
-        raise ValueError(
-            f"The '{option}' {out} is replaced as a whole by the results of '{command}', but "
-            f"it holds other files ({shown}); choose a new or empty folder, or one of its "
-            "earlier results."
-        )
-
-
 @lab_app.command("measure")
 def measure(
     out: Path = typer.Option(..., "--out", help="CSV file to write the measurements to."),
@@ -269,7 +242,7 @@ def loco(
     out = Path(out)
     inputs = (measurements,) if base is None else (measurements, base)
     _common.check_output_dir(out, "--out", inputs=inputs, files=LOCO_FILES)
-    _check_replaceable_dir(out, "--out", inputs, LOCO_FILES, "transfer loco")
+    _common.check_replaceable_dir(out, "--out", "transfer loco", inputs=inputs, files=LOCO_FILES)
     data = load_measurements(measurements)
     names = list(DEFAULT_STRATEGIES) if strategies.strip() == "all" else _names(strategies)
     model = load_base(base)
