@@ -136,3 +136,26 @@ def test_atomic_files_replace_all_targets_or_none(tmp_path):
         tb.write_text("new b")
     assert a.read_text() == "new a" and b.read_text() == "new b"
     assert sorted(p.name for p in tmp_path.iterdir()) == ["run.csv", "run.png"]
+
+
+def test_read_input_text_checks_the_size_limit_and_the_encoding(tmp_path, monkeypatch):
+    import pytest
+
+    from softbend._io import read_input_text
+    from softbend.errors import DatasetError, LimitError, SchemaError
+
+    good = tmp_path / "a.csv"
+    good.write_bytes(b"\xef\xbb\xbfx,y\n1,2\n")
+    assert read_input_text(good, "a.csv", encoding="utf-8-sig") == "x,y\n1,2\n"
+    bad = tmp_path / "b.csv"
+    bad.write_bytes(b"x,y\n1,\xe92\n")
+    with pytest.raises(
+        DatasetError, match=r"^The file b is not UTF-8 text \(undecodable byte at offset 6\)\.$"
+    ):
+        read_input_text(bad, "The file b")
+    with pytest.raises(SchemaError, match="not UTF-8 text"):
+        read_input_text(bad, "The file b", error=SchemaError)
+    monkeypatch.setenv("SOFTBEND_MAX_FILE_MIB", "1")
+    (tmp_path / "big.csv").write_bytes(b"x" * (2 * 2**20))
+    with pytest.raises(LimitError, match=r"^The big file is 2.0 MiB"):
+        read_input_text(tmp_path / "big.csv", "The big file")

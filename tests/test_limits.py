@@ -110,3 +110,13 @@ def test_the_cli_names_the_epochs_option(argv, tmp_path, monkeypatch, capsys):
     err = capsys.readouterr().err.strip().splitlines()
     assert len(err) == 1 and "--epochs is 1,000,000,000 epochs" in err[0]
     assert not (tmp_path / "m.json").exists()
+
+
+def test_the_first_implausible_value_in_file_order_is_named_whatever_its_column():
+    from softbend.plausibility import check_plausible_columns
+
+    columns = {"time_s": ([0.0, 0.1, 0.2, -5.0], "time_s"), "p": ([0, 1, 1e6, 2], "pressure_kpa")}
+    # row 3 (line 12) in 'p' comes before row 4 (line 13) in 'time_s'
+    with pytest.raises(DatasetError, match=r"^e.csv, line 12, column 'p': 1e\+06 is not"):
+        check_plausible_columns(columns, source="e.csv", lines=[10, 11, 12, 13])
+    check_plausible_columns({"p": ([0.0, 1.0], "pressure_kpa")}, source="e.csv", lines=[2, 3])

@@ -55,3 +55,17 @@ def test_check_int_rejects_non_integers_and_values_below_low(value):
 def test_check_int_accepts_numpy_integers():
     assert check_int(np.int64(3), "epochs", "f", low=1) == 3
     assert type(check_int(np.int64(3), "epochs", "f")) is int
+
+
+def test_check_object_keys_names_the_place_and_the_keys():
+    from softbend._validation import check_object_keys
+    from softbend.errors import SchemaError
+
+    ok = {"a": 1, "b": 2}
+    assert check_object_keys(ok, "top", ("a", "b", "c"), ("a",), SchemaError) is ok
+    with pytest.raises(SchemaError, match=r"^'top' must be a JSON object; got \[1\]$"):
+        check_object_keys([1], "top", ("a",), (), SchemaError)
+    with pytest.raises(SchemaError, match=r"unknown key\(s\) 'x' in 'top'; allowed keys: a, b"):
+        check_object_keys({"a": 1, "x": 2}, "top", ("a", "b"), (), SchemaError)
+    with pytest.raises(SchemaError, match=r"'top' lacks the key\(s\) b"):
+        check_object_keys({"a": 1}, "top", ("a", "b"), ("a", "b"), SchemaError)

@@ -26,6 +26,7 @@ __all__ = [
     "json_safe",
     "json_text",
     "new_file_mode",
+    "read_input_text",
     "remove_stale_staging",
     "staged_dir",
     "write_bytes_atomic",
@@ -105,6 +106,39 @@ def atomic_files(*targets: str | os.PathLike[str]) -> Iterator[list[Path]]:
     finally:
         for temp in temps:
             temp.unlink(missing_ok=True)
+
+
+def read_input_text(
+    path: str | os.PathLike[str],
+    what: str,
+    *,
+    encoding: str = "utf-8",
+    error: type[Exception] | None = None,
+) -> str:
+    """The text of an input file, after the ``file_mib`` limit, decoded strictly.
+
+    Parameters
+    ----------
+    path : path
+        The file (its existence is the caller's to check and name).
+    what : str
+        The file as messages name it, e.g. ``"The rig config rig.toml"``.
+    encoding : str, default "utf-8"
+        ``"utf-8-sig"`` for CSV files that may start with a byte-order mark.
+    error : exception type, optional
+        Raised for bytes that are not text; default
+        :class:`~softbend.errors.DatasetError`.
+    """
+    from softbend.errors import DatasetError
+    from softbend.limits import check_file_size
+
+    check_file_size(path, what)
+    try:
+        return Path(path).read_text(encoding=encoding)
+    except UnicodeDecodeError as exc:
+        raise (error or DatasetError)(
+            f"{what} is not UTF-8 text (undecodable byte at offset {exc.start})."
+        ) from None
 
 
 def write_text_atomic(path: str | os.PathLike[str], text: str) -> Path:

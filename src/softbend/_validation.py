@@ -9,7 +9,7 @@ from __future__ import annotations
 
 import math
 import numbers
-from collections.abc import Iterable
+from collections.abc import Iterable, Mapping, Sequence
 from typing import Any
 
 import numpy as np
@@ -123,3 +123,29 @@ def short_repr(value: Any, limit: int = 60) -> str:
     except (TypeError, ValueError):
         text = repr(value)
     return text if len(text) <= limit else text[: limit - 3] + "..."
+
+
+def check_object_keys(
+    value: Any,
+    where: str,
+    allowed: Sequence[str],
+    required: Sequence[str],
+    error: type[Exception],
+) -> Mapping[str, Any]:
+    """``value`` if it is a mapping with only ``allowed`` keys and every ``required`` one.
+
+    For the objects of a structured file (JSON, TOML). Otherwise raises ``error``
+    naming ``where`` (the object's place in the file) and the keys at fault.
+    """
+    if not isinstance(value, Mapping):
+        raise error(f"'{where}' must be a JSON object; got {short_repr(value)}")
+    unknown = [str(k) for k in value if k not in allowed]
+    if unknown:
+        raise error(
+            f"unknown key(s) {', '.join(map(repr, unknown))} in '{where}'; "
+            f"allowed keys: {', '.join(allowed)}"
+        )
+    missing = [k for k in required if k not in value]
+    if missing:
+        raise error(f"'{where}' lacks the key(s) {', '.join(missing)}")
+    return value

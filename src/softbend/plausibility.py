@@ -29,7 +29,7 @@ A pressure column whose values fit kPa but not MPa gets a hint to that effect.
 
 from __future__ import annotations
 
-from collections.abc import Callable, Sequence
+from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass
 
 import numpy as np
@@ -37,7 +37,14 @@ from numpy.typing import ArrayLike
 
 from softbend.errors import DatasetError
 
-__all__ = ["RANGES", "Range", "check_plausible", "implausible_index", "implausible_text"]
+__all__ = [
+    "RANGES",
+    "Range",
+    "check_plausible",
+    "check_plausible_columns",
+    "implausible_index",
+    "implausible_text",
+]
 
 
 @dataclass(frozen=True)
@@ -137,6 +144,25 @@ def check_plausible(
     else:
         place = f"line {lines[index] if lines is not None else first_line + index}"
     raise DatasetError(f"{source}, {place}, column '{column}': {implausible_text(value, quantity)}")
+
+
+def check_plausible_columns(
+    columns: Mapping[str, tuple[ArrayLike, str]], *, source: str, lines: Sequence[int]
+) -> None:
+    """:func:`check_plausible` over several columns of one file, in the file's order.
+
+    ``columns`` maps each column name to its values and quantity; ``lines`` is the
+    file line of each row. The error names the first implausible value as a reader
+    of the file meets it, whichever column it is in.
+    """
+    first: tuple[int, str] | None = None
+    for column, (values, quantity) in columns.items():
+        index = implausible_index(values, quantity)
+        if index is not None and (first is None or lines[index] < first[0]):
+            first = (lines[index], column)
+    if first is not None:
+        values, quantity = columns[first[1]]
+        check_plausible(values, quantity, source=source, column=first[1], lines=lines)
 
 
 def _range(quantity: str) -> Range:

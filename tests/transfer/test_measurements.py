@@ -257,7 +257,7 @@ def test_missing_folder_and_non_utf8_files(tmp_path):
         load_measurements(tmp_path)
     latin = tmp_path / "latin1.csv"
     latin.write_bytes(f"# operator: J\xfcrgen\n{HEADER}\n{ROW_A}\n".encode("latin-1"))
-    with pytest.raises(DatasetError, match=r"latin1\.csv is not a UTF-8"):
+    with pytest.raises(DatasetError, match=r"latin1\.csv is not UTF-8 text"):
         load_measurements(latin)
 
 

@@ -66,9 +66,9 @@ from dataclasses import dataclass, field, fields
 from pathlib import Path
 from typing import Any
 
+from softbend._io import read_input_text
 from softbend._validation import check_choice, check_int, check_range, short_repr
 from softbend.errors import DatasetError
-from softbend.limits import check_file_size
 from softbend.plausibility import RANGES, implausible_index
 
 __all__ = [
@@ -407,13 +407,7 @@ def load_rig_config(path: str | Path) -> RigConfig:
     p = Path(path)
     if not p.is_file():
         raise FileNotFoundError(f"The rig config {str(p)!r} does not exist or is not a file.")
-    check_file_size(p, f"The rig config {p}")
-    try:
-        text = p.read_text(encoding="utf-8")
-    except UnicodeDecodeError as exc:
-        raise DatasetError(
-            f"{p}: the rig config is not valid TOML: not UTF-8 text (byte {exc.start})."
-        ) from None
+    text = read_input_text(p, f"{p}: the rig config")
     try:
         data = tomllib.loads(text)
     except tomllib.TOMLDecodeError as exc:

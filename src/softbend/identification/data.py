@@ -45,13 +45,13 @@ from typing import TYPE_CHECKING, Any, Literal
 
 import numpy as np
 
-from softbend._io import new_file_mode
+from softbend._io import new_file_mode, read_input_text
 from softbend._jsontext import check_json_nesting
 from softbend._validation import check_range
 from softbend.errors import DatasetError
 from softbend.kinematics import bending_from_tip
 from softbend.limits import check_file_size, check_limit
-from softbend.plausibility import check_plausible, implausible_index
+from softbend.plausibility import check_plausible, check_plausible_columns
 
 if TYPE_CHECKING:
     import pandas as pd
@@ -302,30 +302,8 @@ def _data_rows(lines: list[str]) -> int:
     return max(0, filled - 1)
 
 
-def _check_plausible_columns(path: Path, values: dict[str, list[float]], lines: list[int]) -> None:
-    """Raise at the first value (in file order) outside its column's plausible range."""
-    first: tuple[int, str] | None = None
-    for column, quantity in COLUMN_QUANTITIES.items():
-        index = implausible_index(values[column], quantity)
-        if index is not None and (first is None or lines[index] < first[0]):
-            first = (lines[index], column)
-    if first is not None:
-        column = first[1]
-        check_plausible(
-            values[column],
-            COLUMN_QUANTITIES[column],
-            source=str(path),
-            column=column,
-            lines=lines,
-        )
-
-
 def _read_csv(path: Path, rest_length_mm: float | None) -> list[Experiment]:
-    check_file_size(path)
-    try:
-        text = path.read_text(encoding="utf-8-sig")
-    except UnicodeDecodeError:
-        raise DatasetError(f"{path} is not a UTF-8 text file.") from None
+    text = read_input_text(path, str(path), encoding="utf-8-sig")
     header_info: dict[str, Any] = {}
     columns: list[str] | None = None
     records: list[tuple[int, list[str]]] = []
@@ -404,7 +382,11 @@ def _read_csv(path: Path, rest_length_mm: float | None) -> list[Experiment]:
             group[column].append(value)
             every[column].append(value)
         every_line.append(number)
-    _check_plausible_columns(path, every, every_line)
+    check_plausible_columns(
+        {column: (every[column], quantity) for column, quantity in COLUMN_QUANTITIES.items()},
+        source=str(path),
+        lines=every_line,
+    )
     del every, every_line
 
     experiments = []

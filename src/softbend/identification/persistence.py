@@ -11,6 +11,7 @@ from __future__ import annotations
 
 import json
 import math
+from collections.abc import Mapping
 from pathlib import Path
 from typing import Any
 
@@ -20,7 +21,7 @@ from sklearn.preprocessing import StandardScaler
 from softbend import __version__
 from softbend._io import json_text, write_text_atomic
 from softbend._jsontext import check_nesting
-from softbend._validation import short_repr
+from softbend._validation import check_object_keys, short_repr
 from softbend.errors import SchemaError
 from softbend.identification.kernels import MOMENTS_OF
 from softbend.identification.narx import NARXRegressor, _lag_structure, _regressor_names
@@ -119,19 +120,8 @@ def _is_real(value: Any) -> bool:
     return type(value) in (int, float)  # JSON numbers, not bool
 
 
-def _object(value: Any, where: str, keys: tuple[str, ...]) -> dict[str, Any]:
-    if not isinstance(value, dict):
-        raise _RuleError(f"'{where}' must be a JSON object; got {short_repr(value)}")
-    unknown = [key for key in value if key not in keys]
-    if unknown:
-        raise _RuleError(
-            f"unknown key(s) {', '.join(map(repr, unknown))} in '{where}'; "
-            f"allowed keys: {', '.join(keys)}"
-        )
-    missing = [key for key in keys if key not in value]
-    if missing:
-        raise _RuleError(f"'{where}' lacks the key(s) {', '.join(missing)}")
-    return value
+def _object(value: Any, where: str, keys: tuple[str, ...]) -> Mapping[str, Any]:
+    return check_object_keys(value, where, keys, keys, _RuleError)
 
 
 def _int(value: Any, where: str, low: int) -> int:

@@ -41,7 +41,13 @@ from scipy.optimize import least_squares
 
 from softbend import metrics
 from softbend._jsontext import check_nesting
-from softbend._validation import check_choice, check_finite_array, check_range, short_repr
+from softbend._validation import (
+    check_choice,
+    check_finite_array,
+    check_object_keys,
+    check_range,
+    short_repr,
+)
 from softbend.errors import ConvergenceError, DatasetError, SchemaError
 from softbend.limits import check_file_size
 from softbend.materials.models import (
@@ -200,20 +206,6 @@ _FIT_KEYS: tuple[str, ...] = (
 )
 
 
-def _keys(data: Any, allowed: Sequence[str], required: Sequence[str], where: str) -> None:
-    if not isinstance(data, Mapping):
-        raise SchemaError(f"'{where}' must be a JSON object; got {short_repr(data)}")
-    unknown = [str(k) for k in data if k not in allowed]
-    if unknown:
-        raise SchemaError(
-            f"unknown key(s) {', '.join(map(repr, unknown))} in '{where}'; "
-            f"allowed keys: {', '.join(allowed)}"
-        )
-    missing = [k for k in required if k not in data]
-    if missing:
-        raise SchemaError(f"'{where}' lacks the key(s) {', '.join(missing)}")
-
-
 def _number(value: Any, where: str, quantity: str | None = None) -> float:
     if isinstance(value, bool) or not isinstance(value, int | float) or not math.isfinite(value):
         raise SchemaError(f"'{where}' must be a finite number; got {short_repr(value)}")
@@ -239,7 +231,7 @@ def _stretch(value: Any, where: str) -> float:
 
 
 def _fit_from_dict(data: Any) -> FitResult:
-    _keys(data, _FIT_KEYS, _FIT_KEYS, "fit")
+    check_object_keys(data, "fit", _FIT_KEYS, _FIT_KEYS, SchemaError)
     name = data["model"]
     if not isinstance(name, str) or name not in MODELS:
         raise SchemaError(
@@ -333,7 +325,7 @@ def load_fit_json(path: str | os.PathLike[str]) -> dict[str, FitResult]:
     except RecursionError:
         raise SchemaError(f"{file} is nested too deeply to read.") from None
     try:
-        _keys(data, FIT_FILE_KEYS, ("fits",), "(top level)")
+        check_object_keys(data, "(top level)", FIT_FILE_KEYS, ("fits",), SchemaError)
         fits = data["fits"]
         if not isinstance(fits, list) or not fits:
             raise SchemaError(f"'fits' must be a non-empty list; got {short_repr(fits)}")

@@ -33,10 +33,11 @@ from typing import Any
 
 import numpy as np
 
+from softbend._io import read_input_text
 from softbend._validation import check_choice, check_finite_array
 from softbend.errors import DatasetError
-from softbend.limits import check_file_size, check_limit
-from softbend.plausibility import check_plausible, implausible_index
+from softbend.limits import check_limit
+from softbend.plausibility import check_plausible_columns
 
 __all__ = [
     "ENGINEERING_STRAIN",
@@ -218,21 +219,6 @@ def _parse_number(text: str, column: str, label: str, row: int, line: int) -> fl
 
 
 #: The plausible range (:mod:`softbend.plausibility`) and header of each column read.
-_QUANTITIES: dict[str, str] = {"strain": ENGINEERING_STRAIN, "stress_mpa": ENGINEERING_STRESS_MPA}
-
-
-def _check_plausible_columns(label: str, values: dict[str, list[float]], lines: list[int]) -> None:
-    """Raise at the first value (in file order) outside its column's plausible range."""
-    first: tuple[int, str] | None = None
-    for quantity in _QUANTITIES:
-        index = implausible_index(values[quantity], quantity)
-        if index is not None and (first is None or lines[index] < first[0]):
-            first = (lines[index], quantity)
-    if first is not None:
-        quantity = first[1]
-        check_plausible(
-            values[quantity], quantity, source=label, column=_QUANTITIES[quantity], lines=lines
-        )
 
 
 def _parse_tensile_text(
@@ -300,7 +286,11 @@ def _parse_tensile_text(
         strain.append(eps)
         stress.append(sig)
         line_numbers.append(line_no)
-    _check_plausible_columns(label, {"strain": strain, "stress_mpa": stress}, line_numbers)
+    check_plausible_columns(
+        {ENGINEERING_STRAIN: (strain, "strain"), ENGINEERING_STRESS_MPA: (stress, "stress_mpa")},
+        source=label,
+        lines=line_numbers,
+    )
     if len(strain) < MIN_TENSILE_POINTS:
         raise DatasetError(
             f"The data rows of {label} must number at least {MIN_TENSILE_POINTS}. "
@@ -375,14 +365,7 @@ def load_tensile_csv(
         raise FileNotFoundError(f"Tensile data file {str(file)!r} does not exist.")
     if file.is_dir():
         raise DatasetError(f"Tensile data file {str(file)!r} is a folder, not a file.")
-    check_file_size(file, f"Tensile data file {str(file)!r}")
-    try:
-        text = file.read_text(encoding="utf-8-sig")
-    except UnicodeDecodeError as exc:
-        raise DatasetError(
-            f"Tensile data file {str(file)!r} must be UTF-8 text. Got undecodable bytes "
-            f"at byte {exc.start} instead."
-        ) from None
+    text = read_input_text(file, f"Tensile data file {str(file)!r}", encoding="utf-8-sig")
     return _parse_tensile_text(
         text,
         label=repr(str(file)),

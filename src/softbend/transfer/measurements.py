@@ -61,10 +61,10 @@ from typing import Any
 import numpy as np
 import pandas as pd
 
-from softbend._io import write_text_atomic
+from softbend._io import read_input_text, write_text_atomic
 from softbend.design import FEATURES, PARAMETERS, SFRBADesign
 from softbend.errors import DatasetError
-from softbend.limits import check_file_size, check_limit, limit
+from softbend.limits import check_limit, limit
 from softbend.plausibility import check_plausible
 
 logger = logging.getLogger(__name__)
@@ -727,13 +727,7 @@ def load_measurements(path: str | os.PathLike[str]) -> Measurements:
         raise DatasetError(f"Measurement file not found: {source}.")
     if source.is_dir():
         raise DatasetError(f"{source} is a folder; a measurement CSV file is required.")
-    check_file_size(source)
-    try:
-        text = source.read_text(encoding="utf-8-sig")
-    except UnicodeDecodeError as exc:
-        raise DatasetError(
-            f"{source} is not a UTF-8 text file (invalid byte at offset {exc.start})."
-        ) from None
+    text = read_input_text(source, str(source), encoding="utf-8-sig")
 
     metadata: dict[str, str] = {}
     metadata_line: dict[str, int] = {}
