@@ -227,34 +227,22 @@ def test_csv_formats(tmp_path, fuzz_counter, name, data):
 # --- rig TOML ------------------------------------------------------------------------------
 
 
-def _rig_toml() -> str:
-    from softbend.control.rigconfig import RigConfig
-
-    return RigConfig().to_toml()
-
-
-@pytest.fixture(scope="module")
-def rig_toml() -> str:
-    return _rig_toml()
-
-
 @SETTINGS
 @given(data=st.data())
-def test_rig_toml(tmp_path, fuzz_counter, rig_toml, data):
-    from softbend.control.rigconfig import load_rig_config
+def test_rig_toml(tmp_path, fuzz_counter, data):
+    from softbend.control.rigconfig import RigConfig, load_rig_config
 
-    text = data.draw(damaged_text(rig_toml))
+    text = data.draw(damaged_text(RigConfig().to_toml()))
     path = tmp_path / "rig.toml"
     path.write_text(text, encoding="utf-8", errors="surrogatepass")
     _only_own_errors(load_rig_config, path, fuzz_counter, "rig TOML")
 
 
-# --- model JSON ----------------------------------------------------------------------------
+# --- model JSON formats --------------------------------------------------------------------
 
 
-@pytest.fixture(scope="module")
-def model_json(tmp_path_factory) -> object:
-    """A small saved surrogate (a degree-2 polynomial), parsed."""
+def _surrogate_file(folder: Path) -> Path:
+    """A small saved surrogate (a degree-2 polynomial)."""
     import numpy as np
 
     from softbend.surrogates.persistence import save_surrogate
@@ -262,68 +250,68 @@ def model_json(tmp_path_factory) -> object:
 
     rng = np.random.default_rng(0)
     X = rng.uniform([100, 6, 2, 2, 5, 8, 0], [160, 10, 4, 4, 15, 12, 0.3], size=(60, 7))
-    y = 300 * X[:, 6] + 0.1 * X[:, 0]
-    model = PolynomialRegressor(degree=2).fit(X, y)
-    path = tmp_path_factory.mktemp("model") / "plr.json"
-    save_surrogate(model, path)
-    return json.loads(path.read_text(encoding="utf-8"))
+    model = PolynomialRegressor(degree=2).fit(X, 300 * X[:, 6] + 0.1 * X[:, 0])
+    return save_surrogate(model, folder / "plr.json")
 
 
-@SETTINGS
-@given(data=st.data())
-def test_surrogate_model_json(tmp_path, fuzz_counter, model_json, data):
-    from softbend.surrogates.persistence import load_surrogate
-
-    path = tmp_path / "model.json"
-    path.write_text(data.draw(damaged_json(model_json)), encoding="utf-8")
-    _only_own_errors(load_surrogate, path, fuzz_counter, "surrogate model JSON")
-
-
-@pytest.fixture(scope="module")
-def narx_json(tmp_path_factory) -> object:
-    """A small saved NARX model of paper A's identification, parsed."""
+def _narx_file(folder: Path) -> Path:
+    """A small saved NARX model of paper A's identification."""
     import numpy as np
 
     from softbend.identification.narx import NARXRegressor
     from softbend.identification.persistence import save_narx
     from softbend.identification.svr import GeneralizedGaussianSVR
 
-    rng = np.random.default_rng(0)
-    u = np.repeat(rng.uniform(-1, 1, 12), 5)[:, None]
-    y = np.tanh(np.cumsum(u[:, 0]) * 0.1)
-    model = NARXRegressor(estimator=GeneralizedGaussianSVR(epsilon=0.05)).fit(u, y)
-    path = save_narx(model, tmp_path_factory.mktemp("narx") / "narx.json")
-    return json.loads(path.read_text(encoding="utf-8"))
+    u = np.repeat(np.random.default_rng(0).uniform(-1, 1, 12), 5)[:, None]
+    model = NARXRegressor(estimator=GeneralizedGaussianSVR(epsilon=0.05))
+    return save_narx(model.fit(u, np.tanh(np.cumsum(u[:, 0]) * 0.1)), folder / "narx.json")
 
 
-@SETTINGS
-@given(data=st.data())
-def test_narx_model_json(tmp_path, fuzz_counter, narx_json, data):
-    from softbend.identification.persistence import load_narx
+def _fit_file(folder: Path) -> Path:
+    """The fit.json of the shipped Dragon Skin 30 test."""
+    from softbend.cli import main
 
-    path = tmp_path / "narx.json"
-    path.write_text(data.draw(damaged_json(narx_json)), encoding="utf-8")
-    _only_own_errors(load_narx, path, fuzz_counter, "NARX model JSON")
+    assert main(["materials", "fit", "--out", str(folder), "--json"]) == 0
+    return folder / "fit.json"
+
+
+def _json_loader(name: str):
+    if name == "surrogate model JSON":
+        from softbend.surrogates.persistence import load_surrogate
+
+        return load_surrogate
+    if name == "NARX model JSON":
+        from softbend.identification.persistence import load_narx
+
+        return load_narx
+    from softbend.materials.fit import load_fit_json
+
+    return load_fit_json
+
+
+JSON_SEEDS = {
+    "surrogate model JSON": _surrogate_file,
+    "NARX model JSON": _narx_file,
+    "material fit JSON": _fit_file,
+}
 
 
 @pytest.fixture(scope="module")
-def fit_json(tmp_path_factory) -> object:
-    """The fit.json of the shipped Dragon Skin 30 test, parsed."""
-    from softbend.cli import main
+def json_seeds(tmp_path_factory) -> dict[str, object]:
+    """Each model format's seed document, parsed."""
+    return {
+        name: json.loads(write(tmp_path_factory.mktemp("seed")).read_text(encoding="utf-8"))
+        for name, write in JSON_SEEDS.items()
+    }
 
-    out = tmp_path_factory.mktemp("fit")
-    assert main(["materials", "fit", "--out", str(out), "--json"]) == 0
-    return json.loads((out / "fit.json").read_text(encoding="utf-8"))
 
-
+@pytest.mark.parametrize("name", list(JSON_SEEDS))
 @SETTINGS
 @given(data=st.data())
-def test_material_fit_json(tmp_path, fuzz_counter, fit_json, data):
-    from softbend.materials.fit import load_fit_json
-
-    path = tmp_path / "fit.json"
-    path.write_text(data.draw(damaged_json(fit_json)), encoding="utf-8")
-    _only_own_errors(load_fit_json, path, fuzz_counter, "material fit JSON")
+def test_model_json_formats(tmp_path, fuzz_counter, json_seeds, name, data):
+    path = tmp_path / "model.json"
+    path.write_text(data.draw(damaged_json(json_seeds[name])), encoding="utf-8")
+    _only_own_errors(_json_loader(name), path, fuzz_counter, name)
 
 
 # --- shipped-dataset provenance ------------------------------------------------------------
