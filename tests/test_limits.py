@@ -120,3 +120,14 @@ def test_the_first_implausible_value_in_file_order_is_named_whatever_its_column(
     with pytest.raises(DatasetError, match=r"^e.csv, line 12, column 'p': 1e\+06 is not"):
         check_plausible_columns(columns, source="e.csv", lines=[10, 11, 12, 13])
     check_plausible_columns({"p": ([0.0, 1.0], "pressure_kpa")}, source="e.csv", lines=[2, 3])
+
+
+def test_a_count_of_thousands_of_digits_is_refused_by_its_length(monkeypatch):
+    from softbend.limits import check_count_text
+
+    monkeypatch.delenv("SOFTBEND_MAX_DESIGNS", raising=False)
+    assert check_count_text("designs", "000120", "--space lhs:N") == 120
+    with pytest.raises(LimitError, match=r"^--space lhs:N is a number of 5,000 digits, more than"):
+        check_count_text("designs", "9" * 5000, "--space lhs:N")  # beyond int()'s 4300 digits
+    with pytest.raises(LimitError, match=r"is 1,000,001 designs, more than the limit"):
+        check_count_text("designs", "1000001", "--space lhs:N")

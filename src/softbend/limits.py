@@ -33,7 +33,7 @@ from pathlib import Path
 
 from softbend.errors import LimitError
 
-__all__ = ["LIMITS", "Limit", "check_file_size", "check_limit", "limit"]
+__all__ = ["LIMITS", "Limit", "check_count_text", "check_file_size", "check_limit", "limit"]
 
 
 @dataclass(frozen=True)
@@ -115,12 +115,37 @@ def check_limit(name: str, value: int | float, what: str) -> None:
     """
     bound = limit(name)
     if value > bound:
-        entry = LIMITS[name]
         shown = f"{value:,}" if isinstance(value, int) else f"{value:,.1f}"
-        raise LimitError(
-            f"{what} is {shown} {entry.unit}, more than the limit of {bound:,} {entry.unit} "
-            f"({entry.bounds}); set {entry.variable} higher to allow it."
-        )
+        _exceeded(name, bound, f"{what} is {shown} {LIMITS[name].unit}")
+
+
+#: Counts up to this many digits are shown in full in a message.
+_SHOWN_DIGITS = 40
+
+
+def check_count_text(name: str, digits: str, what: str) -> int:
+    """The count written as decimal ``digits``, checked against the limit ``name``.
+
+    A count with more digits than the limit in force is over it whatever the
+    digits are, and is refused by its length alone: Python does not read
+    integers of more than 4300 digits, and a message showing thousands of them
+    would be no help.
+    """
+    bound = limit(name)
+    digits = digits.lstrip("0") or "0"
+    if len(digits) > max(_SHOWN_DIGITS, len(str(bound))):
+        _exceeded(name, bound, f"{what} is a number of {len(digits):,} digits")
+    value = int(digits)
+    check_limit(name, value, what)
+    return value
+
+
+def _exceeded(name: str, bound: int, said: str) -> None:
+    entry = LIMITS[name]
+    raise LimitError(
+        f"{said}, more than the limit of {bound:,} {entry.unit} ({entry.bounds}); "
+        f"set {entry.variable} higher to allow it."
+    )
 
 
 def check_file_size(path: str | os.PathLike[str], what: str | None = None) -> None:

@@ -22,8 +22,7 @@ from dataclasses import dataclass
 from pathlib import Path
 
 from softbend.design import TABLE1_LEVELS, DesignSpace
-from softbend.errors import LimitError
-from softbend.limits import LIMITS, check_limit, limit
+from softbend.limits import check_count_text, check_limit
 
 __all__ = [
     "DISK_LIMIT_BYTES",
@@ -106,32 +105,9 @@ def parse_space(text: str, *, option: str = "space", owner: str = "parse_space")
     elif match[1] == "corners":
         spec = SpaceSpec(text, "corners", 2 ** len(TABLE1_LEVELS))
     else:
-        assert digits is not None
-        _check_digits(digits, what)
-        spec = SpaceSpec(text, match[2], int(digits))
+        spec = SpaceSpec(text, match[2], check_count_text("designs", digits, what))
     check_limit("designs", spec.n_designs, what)
     return spec
-
-
-#: Numbers of designs up to this many digits are shown in full in a message.
-_SHOWN_DIGITS = 40
-
-
-def _check_digits(digits: str, what: str) -> None:
-    """Refuse, by its length alone, a number far above the ``designs`` limit.
-
-    Python refuses to read integers of more than 4300 digits, and a message
-    showing thousands of them would be no help: a number with more digits than
-    the limit in force is over it, whatever the digits are.
-    """
-    bound = limit("designs")
-    if len(digits) <= _SHOWN_DIGITS or len(digits) <= len(str(bound)):
-        return
-    entry = LIMITS["designs"]
-    raise LimitError(
-        f"{what} is a number of {len(digits):,} digits, more than the limit of "
-        f"{bound:,} {entry.unit} ({entry.bounds}); set {entry.variable} higher to allow it."
-    )
 
 
 @dataclass(frozen=True)
