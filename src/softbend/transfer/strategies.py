@@ -40,8 +40,8 @@ from sklearn.utils.validation import check_is_fitted, validate_data
 
 from softbend._validation import check_choice, check_int, check_range
 from softbend.design import FEATURES, SFRBADesign
-from softbend.errors import ConvergenceError, DatasetError
-from softbend.plausibility import RANGES, implausible_index
+from softbend.errors import ConvergenceError
+from softbend.plausibility import check_plausible
 from softbend.surrogates.corrected import (
     AffineCorrected,
     GPCorrected,
@@ -118,16 +118,8 @@ def _check_level(level: float, owner: str) -> float:
     return check_range(level, "level", f"{owner}.predict_interval", low=0.0, high=1.0)
 
 
-def _check_plausible_array(values: np.ndarray, quantity: str, name: str, owner: str) -> None:
-    """Raise :class:`DatasetError` at the first value of ``values`` outside ``quantity``."""
-    index = implausible_index(values, quantity)
-    if index is None:
-        return
-    bounds = RANGES[quantity]
-    raise DatasetError(
-        f"The {name} of {owner} must be a plausible {bounds.label} (allowed {bounds.low:g} to "
-        f"{bounds.high:g} {bounds.unit}). Got {float(values[index]):g} at row {index} instead."
-    )
+def _row(index: int) -> str:
+    return f"row {index}"
 
 
 def _base_angles(base: Any, X: np.ndarray, strategy: str) -> np.ndarray:
@@ -173,8 +165,8 @@ class _Strategy(RegressorMixin, BaseEstimator):
                 f"The 'X' of {owner} must have the {len(FEATURES)} columns "
                 f"{', '.join(FEATURES)}. Got {X.shape[1]} columns instead."
             )
-        _check_plausible_array(X[:, -1], "pressure_mpa", "'X' pressure column", owner)
-        _check_plausible_array(y, "angle_deg", "'y'", owner)
+        check_plausible(X[:, -1], "pressure_mpa", source=owner, column="pressure_mpa", where=_row)
+        check_plausible(y, "angle_deg", source=owner, column="y", where=_row)
         return X, y
 
     def _check_rows(self, X: ArrayLike) -> np.ndarray:
