@@ -35,7 +35,7 @@ from typing import TYPE_CHECKING, Any
 
 from softbend._io import json_text, write_text_atomic
 from softbend._validation import short_repr
-from softbend.design import PARAMETERS
+from softbend.design import FEATURE_QUANTITIES, PARAMETERS
 from softbend.errors import DatasetError
 from softbend.limits import check_file_size
 from softbend.plausibility import RANGES, implausible_index
@@ -82,10 +82,6 @@ DESIGN_STAT_COLUMNS: tuple[str, ...] = (
     "finished_at",
 )
 
-_PARAMETER_QUANTITIES = {
-    name: "angle_deg" if name == "phi_deg" else "length_mm" for name in PARAMETERS
-}
-
 #: Columns of the samples table (:func:`table1_fem`) and the kind of dtype of each:
 #: "string", "float" (any real dtype: float or integer), "integer", "bool" or "datetime".
 SAMPLE_COLUMN_KINDS: dict[str, str] = {
@@ -124,14 +120,13 @@ DESIGN_COLUMN_KINDS: dict[str, str] = {
 #: The quantity of :data:`softbend.plausibility.RANGES` of each physical column.
 _COLUMN_QUANTITIES: dict[str, dict[str, str]] = {
     "samples": {
-        **_PARAMETER_QUANTITIES,
-        "pressure_mpa": "pressure_mpa",
+        **FEATURE_QUANTITIES,
         "angle_deg": "angle_deg",
         "tip_x_mm": "coordinate_mm",
         "tip_z_mm": "coordinate_mm",
     },
     "designs": {
-        **_PARAMETER_QUANTITIES,
+        **{name: FEATURE_QUANTITIES[name] for name in PARAMETERS},
         "max_pressure_mpa": "pressure_mpa",
         "max_angle_deg": "angle_deg",
         "wall_time_s": "time_s",

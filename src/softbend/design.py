@@ -29,6 +29,13 @@ PARAMETERS: tuple[str, ...] = ("l_mm", "r_mm", "t_mm", "b_mm", "phi_deg", "lc_mm
 #: order: the design vector and the gauge pressure (mm, deg, MPa).
 FEATURES: tuple[str, ...] = (*PARAMETERS, "pressure_mpa")
 
+#: The quantity of :data:`softbend.plausibility.RANGES` of each feature: the
+#: range a value read from a file or a model must lie in.
+FEATURE_QUANTITIES: dict[str, str] = {
+    **{name: "fiber_angle_deg" if name == "phi_deg" else "length_mm" for name in PARAMETERS},
+    "pressure_mpa": "pressure_mpa",
+}
+
 #: Fixed quantities of paper B (mm).
 FIBER_DIAMETER_MM = 0.28
 STRAIN_LIMITING_LAYER_MM = 0.1

@@ -674,7 +674,10 @@ def _with_ranges(fitted, tmp_path, change):
             lambda r: r.update(pressure_mpa=[0.0, 500.0]),
             r"field 'pressure_mpa'.*from -0.1013 to 2 MPa.*\[0.0, 500.0\]",
         ),
-        (lambda r: r.update(phi_deg=[5.0, 1e9]), r"field 'phi_deg'.*from -3600 to 3600 deg"),
+        (
+            lambda r: r.update(phi_deg=[5.0, 1e9]),
+            r"field 'phi_deg'.*from 0 to 90 deg \(a plausible fiber winding angle\)",
+        ),
         (lambda r: r.pop("l_mm"), r"each input l_mm.*got no range for l_mm"),
         (lambda r: r.update(length=[1, 2]), r"got unknown input\(s\) 'length'"),
         (lambda r: r.update(l_mm=[100, 10**400]), r"field 'l_mm'.*got \[100, 1000"),

@@ -25,6 +25,7 @@ from typing import Any
 import numpy as np
 
 from softbend._validation import short_repr
+from softbend.design import FEATURE_QUANTITIES
 from softbend.plausibility import RANGES, implausible_index
 from softbend.surrogates.features import FEATURES, TARGET
 
@@ -36,16 +37,7 @@ FLOAT_TAG = "__float__"
 _NON_FINITE = {"nan": math.nan, "inf": math.inf, "-inf": -math.inf}
 
 #: The quantity of :data:`softbend.plausibility.RANGES` of each input and of the target.
-QUANTITIES: dict[str, str] = {
-    "l_mm": "length_mm",
-    "r_mm": "length_mm",
-    "t_mm": "length_mm",
-    "b_mm": "length_mm",
-    "phi_deg": "angle_deg",
-    "lc_mm": "length_mm",
-    "pressure_mpa": "pressure_mpa",
-    TARGET: "angle_deg",
-}
+QUANTITIES: dict[str, str] = {**FEATURE_QUANTITIES, TARGET: "angle_deg"}
 
 
 class RuleError(Exception):

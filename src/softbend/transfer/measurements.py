@@ -62,7 +62,7 @@ import numpy as np
 import pandas as pd
 
 from softbend._io import read_input_text, write_text_atomic
-from softbend.design import FEATURES, PARAMETERS, SFRBADesign
+from softbend.design import FEATURE_QUANTITIES, FEATURES, PARAMETERS, SFRBADesign
 from softbend.errors import DatasetError
 from softbend.limits import check_limit, limit
 from softbend.plausibility import check_plausible
@@ -100,13 +100,7 @@ _MAX_CYCLE = 2**53  # the largest integer a float64 holds exactly
 #: Plausible range of each numeric column: a quantity of
 #: :data:`softbend.plausibility.RANGES`.
 _PLAUSIBLE: dict[str, str] = {
-    "l": "length_mm",
-    "r": "length_mm",
-    "t": "length_mm",
-    "b": "length_mm",
-    "phi": "fiber_angle_deg",
-    "lc": "length_mm",
-    "pressure_mpa": "pressure_mpa",
+    **{_COLUMN_OF[name]: quantity for name, quantity in FEATURE_QUANTITIES.items()},
     "angle_deg": "angle_deg",
 }
 
