@@ -8,6 +8,11 @@ K variants are stacked along a leading axis and trained together: one batched
 matrix product per layer, one (fused) Adam step for all. Each variant's loss is the
 weighted mean over its own rows, and Adam acts element by element, so variant
 k ends exactly where training it alone would (up to rounding).
+
+On a GPU (``device="cuda"``, or ``"auto"`` where one is seen) the same code runs
+with every tensor on the device, in float64 as on the CPU; the loss curve is
+gathered there and copied to the host once, after the last epoch, so the epoch
+loop never waits for the host.
 """
 
 from __future__ import annotations
@@ -60,6 +65,7 @@ def fine_tune_many(
     *,
     epochs: int = 1000,
     learning_rate: float = 6e-4,
+    device: str = "auto",
 ) -> list[Any]:
     """Train K copies of a fitted MLP further, full batch, each on its own weighted rows.
 
@@ -79,6 +85,10 @@ def fine_tune_many(
         Adam steps (full batch: one per epoch), >= 1.
     learning_rate : float, default 6e-4
         Adam step size, > 0.
+    device : {"auto", "cpu", "cuda"}, default "auto"
+        Where to train, as for :class:`~softbend.surrogates.mlp.NormalizedMLPRegressor`:
+        "auto" is "cuda" when torch sees a GPU, else "cpu". Recorded as each
+        model's ``device_``.
 
     Returns
     -------
@@ -91,6 +101,10 @@ def fine_tune_many(
     from softbend.surrogates.mlp import NormalizedMLPRegressor
 
     owner = "fine_tune_many"
+    torch = require_torch("refining the MLP surrogate")
+    from softbend.surrogates.mlp_core import resolve_device
+
+    device = resolve_device(device, owner)
     starts = [check_mlp(b, owner) for b in (base if isinstance(base, list) else [base])]
     base = starts[0]
     epochs = check_int(epochs, "epochs", owner, low=1)
@@ -129,24 +143,23 @@ def fine_tune_many(
     y_mean = np.array([m.y_mean_ for m in starts])[:, None]
     y_scale = np.array([m.y_scale_ for m in starts])[:, None]
 
-    torch = require_torch("refining the MLP surrogate")
     threads = torch.get_num_threads()
     torch.set_num_threads(min(threads, FINE_TUNE_THREADS))
     try:
-        f64 = torch.float64
-        z = torch.as_tensor((X[None, :, :] - x_mean) / x_scale, dtype=f64)  # (K, n, d)
-        t = torch.as_tensor((y[None, :] - y_mean) / y_scale, dtype=f64)  # (K, n)
-        share = torch.as_tensor(w / w.sum(axis=1, keepdims=True), dtype=f64)
+        on = {"dtype": torch.float64, "device": device}
+        z = torch.as_tensor((X[None, :, :] - x_mean) / x_scale, **on)  # (K, n, d)
+        t = torch.as_tensor((y[None, :] - y_mean) / y_scale, **on)  # (K, n)
+        share = torch.as_tensor(w / w.sum(axis=1, keepdims=True), **on)
 
         def stacked(arrays: list[np.ndarray], bias: bool) -> Any:
             tiled = np.stack(arrays)[:, None, :] if bias else np.stack(arrays)
-            return torch.tensor(tiled, dtype=f64, requires_grad=True)
+            return torch.tensor(tiled, **on, requires_grad=True)
 
         weights_ = [stacked([m.coefs_[i] for m in starts], False) for i in range(3)]
         biases = [stacked([m.intercepts_[i] for m in starts], True) for i in range(3)]
         # Fused Adam: one kernel for the update of all six tensors.
         optimizer = torch.optim.Adam([*weights_, *biases], lr=learning_rate, fused=True)
-        curve = np.empty((k, epochs))
+        curve_t = torch.empty((k, epochs), **on)
         for epoch in range(epochs):
             a = torch.tanh(z @ weights_[0] + biases[0])
             a = torch.tanh(a @ weights_[1] + biases[1])
@@ -155,11 +168,12 @@ def fine_tune_many(
             optimizer.zero_grad()
             per_variant.sum().backward()
             optimizer.step()
-            curve[:, epoch] = per_variant.detach().numpy()
+            curve_t[:, epoch] = per_variant.detach()
+        curve = curve_t.cpu().numpy()
     finally:
         torch.set_num_threads(threads)
-    coefs = [p.detach().numpy() for p in weights_]
-    intercepts = [p.detach().numpy()[:, 0, :] for p in biases]
+    coefs = [p.detach().cpu().numpy() for p in weights_]
+    intercepts = [p.detach().cpu().numpy()[:, 0, :] for p in biases]
     if not all(np.isfinite(a).all() for a in (*coefs, *intercepts)):
         raise ConvergenceError(f"{owner} produced non-finite weights; lower the learning_rate")
     return [
@@ -171,7 +185,7 @@ def fine_tune_many(
             coefs=[c[i].copy() for c in coefs],
             intercepts=[b[i].copy() for b in intercepts],
             loss_curve=curve[i].tolist(),
-            fitted_device="cpu",
+            fitted_device=device,
             epochs=epochs,
             batch_size=max(int(np.count_nonzero(w[i])), 1),
             learning_rate=learning_rate,
@@ -188,12 +202,13 @@ def fine_tune_mlp(
     *,
     epochs: int = 1000,
     learning_rate: float = 6e-4,
+    device: str = "auto",
 ) -> Any:
     """Train every layer of a fitted MLP further on new rows (full batch), scaling kept.
 
     :func:`fine_tune_many` with one variant holding every row once. Paper B's
     batches of 1024 rows are larger than any set of measurements, so a batch
-    is the whole set, as here.
+    is the whole set, as here. ``device`` as for :func:`fine_tune_many`.
 
     Returns
     -------
@@ -202,5 +217,11 @@ def fine_tune_mlp(
     """
     y = np.asarray(y, dtype=np.float64).ravel()
     return fine_tune_many(
-        base, X, y, np.ones((1, y.size)), epochs=epochs, learning_rate=learning_rate
+        base,
+        X,
+        y,
+        np.ones((1, y.size)),
+        epochs=epochs,
+        learning_rate=learning_rate,
+        device=device,
     )[0]
