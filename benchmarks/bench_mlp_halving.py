@@ -26,11 +26,14 @@ import argparse
 import json
 import time
 
+from softbend.references import SURROGATE_TRAINING
 from softbend.surrogates.features import training_data
 from softbend.surrogates.search import grid, halving_rungs, search
 
-PAPER_CONFIGS = 121
-PAPER_EPOCHS = 1000
+# Paper B §4.1: 11 x 11 hidden-layer sizes (55-65 each), 1000 epochs.
+_UNITS_LOW, _UNITS_HIGH = SURROGATE_TRAINING["mlp_hidden_units"].value
+PAPER_CONFIGS = (_UNITS_HIGH - _UNITS_LOW + 1) ** 2
+PAPER_EPOCHS: int = SURROGATE_TRAINING["mlp_epochs"].value
 
 
 def _model_epochs(n_configs: int, epochs: int, eta: int | None, rungs: int | None = None) -> int:

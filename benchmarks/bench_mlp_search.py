@@ -55,11 +55,15 @@ import numpy as np
 import torch
 from sklearn.model_selection import GroupKFold
 
+from softbend.references import SURROGATE_TRAINING
 from softbend.surrogates.batched import estimate_pass_bytes, train_mlp_grid
 
-PAPER_GRID = [(h1, h2) for h1 in range(55, 66) for h2 in range(55, 66)]
-PAPER_FOLDS = 5
-PAPER_EPOCHS = 1000
+# Paper B §4.1: hidden units 55-65 in each layer, five folds, 1000 epochs.
+_UNITS_LOW, _UNITS_HIGH = SURROGATE_TRAINING["mlp_hidden_units"].value
+_UNITS = range(_UNITS_LOW, _UNITS_HIGH + 1)
+PAPER_GRID = [(h1, h2) for h1 in _UNITS for h2 in _UNITS]
+PAPER_FOLDS: int = SURROGATE_TRAINING["folds"].value
+PAPER_EPOCHS: int = SURROGATE_TRAINING["mlp_epochs"].value
 
 
 def synthetic_data(seed: int = 0) -> tuple[np.ndarray, np.ndarray, np.ndarray]:

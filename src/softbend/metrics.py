@@ -1,5 +1,5 @@
 r"""Error measures shared by every stage: materials fits, identified dynamic
-models (paper A §4, SPEC §3), the linear model of paper B Fig. 4 and the
+models (paper A §4), the linear model of paper B Fig. 4 and the
 surrogates (paper B §4.1).
 
 Each function compares a measured signal ``y`` with a prediction ``y_hat`` of

@@ -21,9 +21,11 @@ from collections.abc import Mapping
 from dataclasses import dataclass
 from typing import Any, ClassVar
 
-from softbend._validation import check_choice, check_range, short_repr
+from softbend._validation import check_choice, check_object_keys, check_range, short_repr
 from softbend.errors import SchemaError
 from softbend.materials.models import HyperelasticModel, Yeoh, check_constants
+from softbend.references import MATERIALS, values
+from softbend.registry import Registry
 
 __all__ = [
     "DRAGON_SKIN_30",
@@ -41,7 +43,10 @@ __all__ = [
 G_PER_CM3_TO_T_PER_MM3 = 1e-9
 
 #: Radius of the beams that model the Kevlar fibers in paper B, mm (real diameter 0.28 mm).
-KEVLAR_MODELLED_RADIUS_MM = 0.07
+KEVLAR_MODELLED_RADIUS_MM: float = MATERIALS["kevlar"]["modelled_radius_mm"].value
+
+# Paper B §3.1 constants of the presets below (:data:`softbend.references.MATERIALS`).
+_DS30, _GLASS, _KEVLAR = (values(MATERIALS[k]) for k in ("dragon-skin-30", "fiberglass", "kevlar"))
 
 
 @dataclass(frozen=True)
@@ -159,25 +164,16 @@ class Material:
         ------
         SchemaError
             ``data`` is not a mapping, lacks ``name``, ``model`` or
-            ``density_t_per_mm3``, has another key, or the density is not a number;
-            the model is checked as in :meth:`HyperelasticModel.from_dict`.
+            ``density_t_per_mm3``, has another key than those and ``source``
+            (:func:`softbend._validation.check_object_keys`), or the density is
+            not a number; the model is checked as in
+            :meth:`HyperelasticModel.from_dict`.
         ValueError
             A value out of range (as the constructor says).
         """
         owner = "Material.from_dict"
         keys = ("name", "model", "density_t_per_mm3", "source")
-        if not isinstance(data, Mapping):
-            raise SchemaError(
-                f"The data of {owner} must be a mapping. Got {short_repr(data)} instead."
-            )
-        unknown = sorted(str(k) for k in data if k not in keys)
-        missing = [k for k in keys[:3] if k not in data]
-        if unknown or missing:
-            got = f"the unknown key(s) {unknown!r}" if unknown else f"no {missing[0]!r}"
-            raise SchemaError(
-                f"The keys of {owner} must be {', '.join(map(repr, keys[:3]))} and optionally "
-                f"'source'. Got {got} instead."
-            )
+        check_object_keys(data, owner, keys, keys[:3], SchemaError)
         density = data["density_t_per_mm3"]
         if isinstance(density, bool) or not isinstance(density, int | float):
             raise SchemaError(
@@ -197,45 +193,50 @@ _PAPER_B = "Ye et al., Sens. Actuators A 368 (2024) 115095, §3.1"
 #: Dragon Skin 30 silicone, Yeoh C10 = 0.11, C20 = 0.003, C30 = 0 MPa; 1.08 g/cm³.
 DRAGON_SKIN_30 = Material(
     name="Dragon Skin 30",
-    model=Yeoh(c10_mpa=0.11, c20_mpa=0.003, c30_mpa=0.0),
-    density_t_per_mm3=1.08 * G_PER_CM3_TO_T_PER_MM3,
+    model=Yeoh(c10_mpa=_DS30["c10_mpa"], c20_mpa=_DS30["c20_mpa"], c30_mpa=_DS30["c30_mpa"]),
+    density_t_per_mm3=_DS30["density_g_per_cm3"] * G_PER_CM3_TO_T_PER_MM3,
     source=f"{_PAPER_B}: Yeoh fit to uniaxial tension of Dragon Skin 30 (R² 0.9982).",
 )
 
 #: Fiberglass strain-limiting layer (0.1 mm), Yeoh C10 = 7.9 MPa; 2.40 g/cm³.
 FIBERGLASS_LAYER = Material(
     name="Fiberglass strain-limiting layer",
-    model=Yeoh(c10_mpa=7.9, c20_mpa=0.0, c30_mpa=0.0),
-    density_t_per_mm3=2.40 * G_PER_CM3_TO_T_PER_MM3,
+    model=Yeoh(c10_mpa=_GLASS["c10_mpa"], c20_mpa=_GLASS["c20_mpa"], c30_mpa=_GLASS["c30_mpa"]),
+    density_t_per_mm3=_GLASS["density_g_per_cm3"] * G_PER_CM3_TO_T_PER_MM3,
     source=f"{_PAPER_B}, after Polygerinos et al., IEEE Trans. Robot. 31 (2015) 778.",
 )
 
 #: Kevlar fiber, linear elastic E = 31076 MPa, ν = 0.36; 1.67 g/cm³.
 KEVLAR_FIBER = Material(
     name="Kevlar fiber",
-    model=LinearElastic(e_mpa=31076.0, nu=0.36),
-    density_t_per_mm3=1.67 * G_PER_CM3_TO_T_PER_MM3,
+    model=LinearElastic(e_mpa=_KEVLAR["e_mpa"], nu=_KEVLAR["nu"]),
+    density_t_per_mm3=_KEVLAR["density_g_per_cm3"] * G_PER_CM3_TO_T_PER_MM3,
     source=(
         f"{_PAPER_B}: 0.28 mm fiber modelled as beams of radius 0.07 mm "
         "(half the real radius, after Polygerinos et al. 2015)."
     ),
 )
 
-#: Presets by registry name.
-PRESETS: dict[str, Material] = {
-    "dragon-skin-30": DRAGON_SKIN_30,
-    "fiberglass": FIBERGLASS_LAYER,
-    "kevlar": KEVLAR_FIBER,
-}
+#: The presets by name; ``PRESETS.register("my-silicone", Material(...))`` adds one.
+PRESETS: Registry[Material] = Registry("material preset")
+PRESETS.register("dragon-skin-30", DRAGON_SKIN_30)
+PRESETS.register("fiberglass", FIBERGLASS_LAYER)
+PRESETS.register("kevlar", KEVLAR_FIBER)
 
 
-def get_preset(name: str) -> Material:
+def get_preset(name: str, *, field: str | None = None) -> Material:
     """Return the preset registered under ``name`` (``"dragon-skin-30"``, ...).
+
+    Parameters
+    ----------
+    name : str
+        A name of :data:`PRESETS`.
+    field : str, optional
+        The option or file field the name came from, named in the message.
 
     Raises
     ------
-    ValueError
-        Listing the allowed names.
+    UnknownNameError
+        Listing the known names.
     """
-    check_choice(name, "preset", "get_preset", PRESETS)
-    return PRESETS[name]
+    return PRESETS.get(name, field=field)

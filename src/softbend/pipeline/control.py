@@ -22,7 +22,8 @@ if TYPE_CHECKING:  # pragma: no cover
 
 __all__ = ["CONTROL_DESIGN", "Control", "run_control"]
 
-#: The actuator of paper B's control experiments (its Fig. 2 design).
+#: The actuator of the control experiments: the reference design of paper B Fig. 7b
+#: (paper B §5 does not say which actuator it controlled).
 CONTROL_DESIGN = "100,6,2,2,5,8"
 
 

@@ -11,6 +11,7 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 
 from softbend.pipeline import Progress
+from softbend.references import FEM_VALIDATION
 
 if TYPE_CHECKING:  # pragma: no cover
     from softbend.materials import FitResult, TensileTest
@@ -18,9 +19,10 @@ if TYPE_CHECKING:  # pragma: no cover
 
 __all__ = ["FIG2_DESIGN", "FIG2_PMAX_MPA", "FEMSweep", "Fig2", "run_fig2", "sweep_with_shapes"]
 
-#: Design and pressures of paper B Fig. 2b.
-FIG2_DESIGN = "100,6,2,2,5,10"
-FIG2_PMAX_MPA = 0.17
+#: Design and highest pressure (MPa) of paper B Fig. 2b
+#: (:data:`softbend.references.FEM_VALIDATION`).
+FIG2_DESIGN: str = FEM_VALIDATION["design"].value
+FIG2_PMAX_MPA: float = FEM_VALIDATION["pmax_mpa"].value
 
 
 @dataclass(frozen=True)

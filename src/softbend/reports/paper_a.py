@@ -5,6 +5,7 @@ from __future__ import annotations
 from pathlib import Path
 from typing import TYPE_CHECKING
 
+from softbend.references import CURLING_ACTUATOR
 from softbend.reports import curling_figures
 from softbend.reports.html import Report
 
@@ -37,11 +38,15 @@ def add_section(
     section = report.section("Paper A — curling actuator: NARX identification with a GG-SVR")
     synthetic = any(e.synthetic for group in result.experiments.values() for e in group)
     if synthetic:
+        rest, longest, shortest = (
+            CURLING_ACTUATOR[k] for k in ("rest_length_mm", "max_length_mm", "min_length_mm")
+        )
         section.text(
             "All data in this section are SYNTHETIC: paper A's measurements are not public, so "
             "softbend's synthetic curling actuator (pneumatic lag, viscoelastic creep, "
-            "rate-independent hysteresis, camera noise; calibrated to L0 = 15.25 mm, "
-            "L = 18.25 mm at full pressure and 9.25 mm at full vacuum) generated them.",
+            f"rate-independent hysteresis, camera noise; calibrated to L0 = {rest.value} mm, "
+            f"L = {longest.value} mm at full pressure and {shortest.value} mm at full vacuum: "
+            f"paper A {rest.source}, {longest.source}, {shortest.source}) generated them.",
             note=True,
         )
     counts = {sign: len(group) for sign, group in result.experiments.items()}

@@ -5,24 +5,27 @@ from __future__ import annotations
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
+from softbend.references import (
+    DESIGN_SPACE,
+    FEM_DATASET,
+    LINEAR_MODEL,
+    SURROGATE_TRAINING,
+    SURROGATES,
+    values,
+)
+
 if TYPE_CHECKING:  # pragma: no cover
     import pandas as pd
 
     from softbend.analysis import RegressionReport
     from softbend.reports.html import Report
 
-#: Paper B §3.3 (FEM data, 972 designs): standardized loadings, R², F and MAPE.
-PAPER_B_FIG4 = {
-    "pressure_mpa": 0.832,
-    "t_mm": -0.369,
-    "b_mm": -0.005,
-    "r2": 0.8893,
-    "f_value": 33935.8,
-    "mape_pct": 42.3,
-}
+#: Paper B §3.3 (FEM data, 972 designs): standardized loadings, R², F and MAPE
+#: (:data:`softbend.references.LINEAR_MODEL`).
+PAPER_B_FIG4: dict[str, float] = values(LINEAR_MODEL)
 
 #: Samples of paper B's FEM dataset (§3.3).
-PAPER_B_SAMPLES = 29577
+PAPER_B_SAMPLES: int = FEM_DATASET["samples"].value
 
 
 def angle_curves(
@@ -84,8 +87,10 @@ def add_section(
     """Append the campaign summary and the Fig. 4 analysis to ``report``."""
     section = report.section("Paper B — design space, campaign and preliminary analysis (Fig. 4)")
     section.text(
-        f"Campaign over paper B Table 1 ({campaign['n_designs']} designs, pressure 0–0.5 MPa "
-        f"in 0.005 MPa steps) with the '{campaign['backend']}' backend: the quasi-static "
+        f"Campaign over paper B Table 1 ({campaign['n_designs']} designs, pressure "
+        f"0–{DESIGN_SPACE['pressure_max_mpa'].value:g} MPa in "
+        f"{DESIGN_SPACE['pressure_step_mpa'].value:g} MPa steps) with the "
+        f"'{campaign['backend']}' backend: the quasi-static "
         "moment-balance model of Polygerinos et al. (no gravity; the fiber angle φ and cap "
         "length lc do not enter it). Sweeps end at the first pressure the backend cannot solve "
         "or at its physical stop. Angles above 360° mean the tip would pass its own base: "
@@ -142,12 +147,14 @@ def add_regression_tables(section: Any, regression: Any, data: str = "") -> None
     section.table(
         ["feature", "loading", "t", "p", "sig.", "paper B loading"],
         loadings_rows(regression),
-        caption=f"Standardized multiple linear regression of the bending angle{suffix}",
+        caption=f"Standardized multiple linear regression of the bending angle{suffix} "
+        f"(paper B: {LINEAR_MODEL['pressure_mpa'].source})",
     )
     section.table(
         ["metric", f"softbend {data}".rstrip(), "paper B"],
         fit_rows(regression),
-        caption=f"Fit of the linear model{suffix}",
+        caption=f"Fit of the linear model{suffix} (paper B: {LINEAR_MODEL['r2'].source}; "
+        f"samples {FEM_DATASET['samples'].source})",
     )
 
 
@@ -205,8 +212,9 @@ def add_surrogate_section(report: Report, summary: dict[str, Any], *, root: Path
         f"{settings['mape_threshold_deg']:g}°. MLP: {settings['mlp_epochs']} epochs; XGBoost: "
         f"{settings['xgb_trees']} trees. Paper B's figures come from its FEM data."
         + (
-            " The 'quick' grid is this report's reduced one (its MLP is paper B's (63, 65) "
-            "alone); `softbend train --grid paper` runs paper B's grids."
+            " The 'quick' grid is this report's reduced one (its MLP is paper B's "
+            f"{SURROGATE_TRAINING['mlp_hidden'].value} alone); `softbend train --grid paper` "
+            "runs paper B's grids."
             if str(settings["grid"]).startswith("quick")
             else ""
         ),
@@ -242,7 +250,8 @@ def add_surrogate_section(report: Report, summary: dict[str, Any], *, root: Path
             "paper B inference (ms)",
         ],
         rows,
-        caption="Best model of each family, cross-validated on held-out designs",
+        caption="Best model of each family, cross-validated on held-out designs "
+        f"({SURROGATES['mlp']['r2'].cite()})",
     )
     files = summary["files"]
     if "fig5" in files:

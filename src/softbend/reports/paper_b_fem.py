@@ -11,6 +11,7 @@ from pathlib import Path
 from typing import Any
 
 from softbend.pipeline.paper_b_fem import FIG2_DESIGN, FIG2_PMAX_MPA, Fig2
+from softbend.references import MATERIALS
 from softbend.reports.html import Report
 
 __all__ = ["FIG2_DESIGN", "FIG2_PMAX_MPA", "add_fig2", "add_section"]
@@ -30,6 +31,7 @@ def add_fig2(report: Report, fig2: Fig2, root: Path) -> dict[str, Path]:
     folder = root / "paper_b_fem"
     test, fits, design, sweep = fig2.test, fig2.fits, fig2.design, fig2.sweep
     figures = {"fit": fit_figure(test, fits, folder / "dragon_skin_30_fit.png")}
+    paper = MATERIALS["dragon-skin-30"]
     section = report.section("Paper B: material fit and finite-element model (Fig. 2)")
     section.table(
         ["model", "parameters (MPa)", "R²", "RMSE (MPa)"],
@@ -37,8 +39,10 @@ def add_fig2(report: Report, fig2: Fig2, root: Path) -> dict[str, Path]:
         caption=(
             f"Least-squares fits to the uniaxial test of Dragon Skin 30 shipped with softbend "
             f"(Marechal et al., Soft Robotics 2021, ODbL; stretch {test.stretch.min():.2f}–"
-            f"{test.stretch.max():.2f}). Paper B: Yeoh best, R² 0.9982, RMSE 0.0204 MPa; the FEM "
-            "below uses paper B's constants (C10 0.11, C20 0.003 MPa)."
+            f"{test.stretch.max():.2f}). Paper B: Yeoh best, R² {paper['fit_r2'].value}, RMSE "
+            f"{paper['fit_rmse_mpa'].value} MPa ({paper['fit_r2'].source}); the FEM below uses "
+            f"paper B's constants (C10 {paper['c10_mpa'].value}, C20 {paper['c20_mpa'].value} "
+            f"MPa; {paper['c10_mpa'].source})."
         ),
     )
     section.figure(

@@ -14,6 +14,7 @@ from typing import Any
 
 from softbend.pipeline import Progress
 from softbend.pipeline.paper_b_fem_data import TABLE1_DESIGNS, FEMData
+from softbend.references import DESIGN_SPACE, FEM_DATASET, SURROGATE_TRAINING, SURROGATES
 from softbend.reports.html import Report
 
 __all__ = ["TABLE1_DESIGNS", "add_fem_data", "add_section"]
@@ -121,8 +122,10 @@ def add_fem_data(report: Report, fem_data: FEMData, root: Path) -> dict[str, Any
     add_regression_tables(section, regression, "FEM")
     section.text(
         f"Why the numbers differ from paper B: its sweeps stopped where ABAQUS stopped "
-        f"converging ({PAPER_B_SAMPLES} samples over 972 designs, about 30 per design), ours at "
-        f"300°, the stretch limit of the material model, an inflation instability or 0.5 MPa "
+        f"converging ({PAPER_B_SAMPLES} samples over {FEM_DATASET['designs'].value} designs, "
+        f"about 30 per design; {FEM_DATASET['samples'].cite()}), ours at "
+        f"300°, the stretch limit of the material model, an inflation instability or "
+        f"{DESIGN_SPACE['pressure_max_mpa'].value:g} MPa "
         f"({len(converged) / max(len(done), 1):.0f} converged samples per design): the linear "
         f"model is fitted over a wider range of angles, where the angle grows faster than "
         f"linearly with pressure, so its R² and MAPE are not the same quantity. Our FEM also "
@@ -167,7 +170,7 @@ def add_fem_data(report: Report, fem_data: FEMData, root: Path) -> dict[str, Any
         caption=(
             f"Surrogates on FEM data, '{settings['grid']}' grid, {settings['folds']}-fold CV: "
             "grouped by design (primary) and, for the configuration it chose, over shuffled "
-            "samples (paper B's protocol)"
+            f"samples (paper B's protocol; {SURROGATES['mlp']['r2'].cite()})"
         ),
     )
     section.text(
@@ -175,7 +178,8 @@ def add_fem_data(report: Report, fem_data: FEMData, root: Path) -> dict[str, Any
         "pressures between ones it was trained on, which is easier: the gap between the two "
         f"columns is how much paper B's protocol flatters a surrogate. MAPE leaves out |θ| < "
         f"{settings['mape_threshold_deg']:g}°. MLP {settings['mlp_epochs']} epochs (paper B "
-        f"1000): `softbend train` with `--grid paper` runs paper B's grids. Paper B: "
+        f"{SURROGATE_TRAINING['mlp_epochs'].value}): `softbend train` with `--grid paper` runs "
+        "paper B's grids. Paper B: "
         f"R² {PAPER_B_FIG4['r2']} for the linear model, and the surrogate figures in the last "
         "column.",
         note=True,

@@ -34,6 +34,7 @@ from softbend._io import json_text, write_text_atomic
 from softbend._validation import check_range
 from softbend.design import DesignSpace
 from softbend.pipeline import Progress
+from softbend.references import FEM_DATASET
 from softbend.reports.html import Report
 
 logger = logging.getLogger(__name__)
@@ -226,7 +227,8 @@ def run_reproduce(
         "seed": seed,
         "campaign workers": "all cores" if workers is None else workers,
         "FEM dataset": (
-            f"{fem_data['designs_done']} of 972 Table 1 designs, samples.parquet SHA-256 "
+            f"{fem_data['designs_done']} of {FEM_DATASET['designs'].value} Table 1 designs, "
+            f"samples.parquet SHA-256 "
             f"{fem_data['samples_sha256'][:16]}…"
         ),
         "started (UTC)": f"{started:%Y-%m-%d %H:%M:%S}",

@@ -14,19 +14,14 @@ from typing import Any
 
 from softbend.pipeline import Progress
 from softbend.pipeline.transfer import Transfer
+from softbend.references import MATERIALS, SURROGATE_TRAINING, TRANSFER_RESULTS, values
 from softbend.reports.html import Report
 
 __all__ = ["PAPER_B_REFINED", "add_section", "add_transfer"]
 
-#: Paper B §4.3 (Fig. 7): the refined MLP, leave one configuration out.
-PAPER_B_REFINED = {
-    "rmse_deg": 7.935,
-    "mape_pct": 6.45,
-    "worst": "120,6,2,2,5,8",
-    "worst_rmse_deg": 19.58,
-    "worst_mape_pct": 11.24,
-    "n_measurements": 139,
-}
+#: Paper B §4.3 (Fig. 7): the refined MLP, leave one configuration out
+#: (:data:`softbend.references.TRANSFER_RESULTS`).
+PAPER_B_REFINED: dict[str, Any] = values(TRANSFER_RESULTS)
 
 
 def add_section(
@@ -83,18 +78,23 @@ def add_transfer(report: Report, transfer: Transfer, root: Path) -> dict[str, Pa
     }
 
     meta = measurements.metadata
+    p = PAPER_B_REFINED
+    hidden = SURROGATE_TRAINING["mlp_hidden"].value
     section = report.section("Paper B — transfer learning to measurements (Figs. 6 and 7)")
     section.text(
-        f"SYNTHETIC measurements: paper B's 139 readings are not public, so the shipped "
-        f"virtual lab stands in ({len(measurements)} readings of the 7 actuators of Fig. 7, "
+        f"SYNTHETIC measurements: paper B's {p['n_measurements']} readings are not public, so "
+        f"the shipped virtual lab stands in ({len(measurements)} readings of the 7 actuators "
+        f"of Fig. 7, "
         f"made by `{meta.get('command', 'softbend lab measure')}`). Its reality gap: the "
         f"elastomer as the shipped Dragon Skin 30 test says ({meta.get('lab.elastomer_model')}, "
-        f"not paper B's C10 = 0.11 MPa), walls and layer off nominal by up to "
-        f"±{meta.get('lab.fabrication_error_mm')} mm, loading below the elastic curve by up to "
+        f"not paper B's C10 = {MATERIALS['dragon-skin-30']['c10_mpa'].value} MPa), walls and "
+        f"layer off nominal by up to ±{meta.get('lab.fabrication_error_mm')} mm, loading "
+        f"below the elastic curve by up to "
         f"{float(meta.get('lab.hysteresis', 0)) * 100:g} % (hysteresis), camera noise "
         f"{meta.get('lab.camera_noise_deg')}°. Every strategy starts from paper B's MLP "
-        f"(63, 65) trained on the shipped FEM dataset ({shipped_base_path().name}); each "
-        f"held-out actuator is predicted by models fitted on the other six.",
+        f"({hidden[0]}, {hidden[1]}) trained on the shipped FEM dataset "
+        f"({shipped_base_path().name}); each held-out actuator is predicted by models fitted "
+        f"on the other six.",
         note=True,
     )
     section.figure(figures["lab"], "The virtual lab's readings (synthetic)", root=root)
@@ -111,7 +111,6 @@ def add_transfer(report: Report, transfer: Transfer, root: Path) -> dict[str, Pa
                 f"{r['worst_actuator']}: {r['worst_rmse_deg']:.2f}°, {r['worst_mape_pct']:.2f} %",
             ]
         )
-    p = PAPER_B_REFINED
     rows.append(
         [
             "paper B refined MLP (real rig)",
@@ -134,7 +133,8 @@ def add_transfer(report: Report, transfer: Transfer, root: Path) -> dict[str, Pa
         rows,
         caption=(
             f"Leave one configuration out on {len(measurements)} synthetic readings "
-            f"(MAPE with the 0 MPa points, as paper B); paper B on its 139 real ones"
+            f"(MAPE with the 0 MPa points, as paper B); paper B on its {p['n_measurements']} "
+            f"real ones ({TRANSFER_RESULTS['rmse_deg'].cite()})"
         ),
     )
     best = result.best()
