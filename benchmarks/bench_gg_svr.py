@@ -16,7 +16,7 @@ Three measurements, each printed:
    100 Hz), fitted in a fresh subprocess at shapes 2 and 1.5; its peak resident
    memory (``ru_maxrss``) minus that of the same process before the fit, and the
    fit's wall time. A dense Gram matrix would need 8·n² bytes (28.8 GB at 60 000).
-3. **Single-step prediction latency** (``predict_one``, the call of free-run
+3. **Single-step prediction latency** (the ``predictor()`` fast path, the call of free-run
    simulation and control loops), best of 5 x 2 000 calls, on the paper-A model.
 
 Run::
@@ -169,9 +169,10 @@ def large_fit(rows: int, shapes: tuple[float, ...], excitation: str = "mixed") -
 
 def latency_us(model) -> float:
     x = np.zeros(model.n_features_in_)
-    model.predict_one(x)
+    predict_one = model.predictor()
+    predict_one(x)
     return 1e6 * min(
-        _best(lambda: [model.predict_one(x) for _ in range(2000)], 1) / 2000 for _ in range(5)
+        _best(lambda: [predict_one(x) for _ in range(2000)], 1) / 2000 for _ in range(5)
     )
 
 

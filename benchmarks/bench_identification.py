@@ -99,7 +99,8 @@ class _NarxAdapter:
         inner = self.model.estimator_
         x = np.zeros(len(self.model.regressor_names_))
         if self.name == "gg-svr":
-            return lambda: inner.predict_one(x)
+            predict_one = inner.predictor()
+            return lambda: predict_one(x)
         row = x[None, :]
         return lambda: inner.predict(row)
 

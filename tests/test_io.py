@@ -159,3 +159,86 @@ def test_read_input_text_checks_the_size_limit_and_the_encoding(tmp_path, monkey
     (tmp_path / "big.csv").write_bytes(b"x" * (2 * 2**20))
     with pytest.raises(LimitError, match=r"^The big file is 2.0 MiB"):
         read_input_text(tmp_path / "big.csv", "The big file")
+
+
+# ----------------------------------------------------------- the commented CSV reader
+
+
+def _lines(path, **kwargs):
+    from softbend._io import read_header_csv
+
+    return [(c.number, c.kind, c.cells, c.key, c.value) for c in read_header_csv(path, **kwargs)]
+
+
+def test_read_header_csv_yields_metadata_header_and_rows_numbered_as_an_editor_shows(tmp_path):
+    path = tmp_path / "m.csv"
+    text = (
+        "\ufeff# softbend measurements CSV v1\n"  # a comment with no colon: skipped
+        "#  rig :  bench 2: left \n"  # split at the first colon, both sides stripped
+        "#: no key\n"  # an empty key: skipped
+        "\n"
+        "  # operator: AB\r\n"
+        " a , b ,c\r"
+        "1, 2 ,3\n"
+        "# after: the header is a comment, not metadata\n"
+        "\n"
+        '4,"5, five",6\n'
+    )
+    path.write_text(text, encoding="utf-8")
+    assert _lines(path) == [
+        (2, "meta", (), "rig", "bench 2: left"),
+        (5, "meta", (), "operator", "AB"),
+        (6, "header", ("a", "b", "c"), "", ""),
+        (7, "row", ("1", "2", "3"), "", ""),
+        (10, "row", ("4", "5, five", "6"), "", ""),
+    ]
+
+
+def test_read_header_csv_without_rows_or_header(tmp_path):
+    empty = tmp_path / "empty.csv"
+    empty.write_text("# note: only comments\n\n", encoding="utf-8")
+    assert _lines(empty) == [(1, "meta", (), "note", "only comments")]
+    header = tmp_path / "header.csv"
+    header.write_text("x,y", encoding="utf-8")
+    assert _lines(header) == [(1, "header", ("x", "y"), "", "")]
+
+
+def test_read_header_csv_names_the_file_and_line_a_csv_row_fails_on(tmp_path):
+    import pytest
+
+    from softbend._io import read_header_csv
+    from softbend.errors import DatasetError
+
+    path = tmp_path / "long.csv"
+    path.write_text("x,y\n1,2\n3," + "4" * 200_000 + "\n5,6\n", encoding="utf-8")
+    lines = read_header_csv(path)
+    assert next(lines).kind == "header" and next(lines).cells == ("1", "2")
+    with pytest.raises(DatasetError, match=rf"^{path}, line 3: not a CSV row \(field larger"):
+        next(lines)
+    with pytest.raises(DatasetError, match=rf"^{path}, row 3: not a CSV row"):
+        _lines(path, line_word="row")
+
+
+def test_read_header_csv_checks_the_encoding_and_the_limits_before_any_row(tmp_path, monkeypatch):
+    import pytest
+
+    from softbend._io import read_header_csv
+    from softbend.errors import DatasetError, LimitError
+
+    bad = tmp_path / "bad.csv"
+    bad.write_bytes(b"x,y\n1,\xe92\n")
+    with pytest.raises(DatasetError, match="not UTF-8 text"):
+        next(read_header_csv(bad))
+    rows = tmp_path / "rows.csv"
+    rows.write_text("# a: b\nx\n" + "1\n" * 6 + "\n# c\n", encoding="utf-8")
+    monkeypatch.setenv("SOFTBEND_MAX_CSV_ROWS", "6")
+    assert len(_lines(rows)) == 8  # six data rows: at the limit
+    monkeypatch.setenv("SOFTBEND_MAX_CSV_ROWS", "5")
+    lines = read_header_csv(rows)
+    with pytest.raises(LimitError, match="6 rows") as info:
+        next(lines)  # refused before the first line is yielded
+    assert "SOFTBEND_MAX_CSV_ROWS" in str(info.value)
+    monkeypatch.setenv("SOFTBEND_MAX_FILE_MIB", "1")
+    (tmp_path / "big.csv").write_bytes(b"x\n" * 2**20)
+    with pytest.raises(LimitError, match="MiB"):
+        next(read_header_csv(tmp_path / "big.csv"))

@@ -1,8 +1,14 @@
-"""Atomic file writes: a finished file is either the old one or the complete new one.
+"""Atomic file writes, and the one reader of softbend's commented CSV files.
 
-The new file gets the permissions a plain ``open(path, "w")`` would give it: those
-of the file it replaces, or ``0o666`` less the process umask for a new file (a
-temporary file from :func:`tempfile.mkstemp` alone would be ``0o600``).
+Writes: a finished file is either the old one or the complete new one. The new
+file gets the permissions a plain ``open(path, "w")`` would give it: those of the
+file it replaces, or ``0o666`` less the process umask for a new file (a temporary
+file from :func:`tempfile.mkstemp` alone would be ``0o600``).
+
+Reads: :func:`read_header_csv` walks a CSV file whose ``# key: value`` comments
+before the column header carry metadata (the experiment CSV of
+:mod:`softbend.identification.data`, the measurement CSV of
+:mod:`softbend.transfer.measurements`), within the limits of :mod:`softbend.limits`.
 """
 
 from __future__ import annotations
@@ -17,15 +23,18 @@ import sys
 import tempfile
 from collections.abc import Iterator
 from contextlib import contextmanager
+from dataclasses import dataclass
 from pathlib import Path
-from typing import IO, Any
+from typing import IO, Any, Literal
 
 __all__ = [
+    "CSVLine",
     "atomic_file",
     "atomic_files",
     "json_safe",
     "json_text",
     "new_file_mode",
+    "read_header_csv",
     "read_input_text",
     "remove_stale_staging",
     "staged_dir",
@@ -139,6 +148,97 @@ def read_input_text(
         raise (error or DatasetError)(
             f"{what} is not UTF-8 text (undecodable byte at offset {exc.start})."
         ) from None
+
+
+@dataclass(frozen=True)
+class CSVLine:
+    """One line of a commented CSV file that carries something (see :func:`read_header_csv`).
+
+    Attributes
+    ----------
+    number : int
+        The line's number as an editor shows it, from 1 (comments and blank
+        lines counted).
+    kind : {"meta", "header", "row"}
+        A ``# key: value`` comment before the column header, the column header
+        (the first line that is neither blank nor a comment) or a data row.
+    cells : tuple of str
+        The header's or the row's cells, each stripped of surrounding
+        whitespace; empty for ``"meta"``.
+    key, value : str
+        The comment split at its first colon, both sides stripped; empty for
+        ``"header"`` and ``"row"``.
+    """
+
+    number: int
+    kind: Literal["meta", "header", "row"]
+    cells: tuple[str, ...] = ()
+    key: str = ""
+    value: str = ""
+
+
+def read_header_csv(path: str | os.PathLike[str], *, line_word: str = "line") -> Iterator[CSVLine]:
+    """The lines of a CSV file with ``# key: value`` comments before its header, in order.
+
+    The file is read as UTF-8 (a byte-order mark is dropped) after the
+    ``file_mib`` limit, and refused before any row is parsed when it has more
+    data rows than the ``csv_rows`` limit (:mod:`softbend.limits`). Lines end at
+    ``\\n``, ``\\r\\n`` or ``\\r`` (as the :mod:`csv` module reads them) and are
+    numbered from 1. Blank lines are skipped; a line whose first non-blank
+    character is ``#`` is a comment: before the column header, one with a colon
+    and a non-empty key is yielded as ``"meta"``, every other comment is
+    skipped. The first other line is the column header; the rest are rows.
+    The caller checks the columns, the cells and the metadata: the lines come
+    one by one, so the first problem in the file is the one reported.
+
+    Parameters
+    ----------
+    path : path
+        The file (its existence is the caller's to check and name).
+    line_word : str, default "line"
+        How messages name a line (``"row"`` for the experiment CSV).
+
+    Yields
+    ------
+    CSVLine
+        The metadata comments, the header and the rows, in file order.
+
+    Raises
+    ------
+    DatasetError
+        Bytes that are not UTF-8, or a line the :mod:`csv` module cannot read
+        (``"<path>, <line_word> <n>: not a CSV row (<reason>)."``).
+    LimitError
+        A file over the ``file_mib`` or ``csv_rows`` limit.
+    """
+    import csv
+
+    from softbend.errors import DatasetError
+    from softbend.limits import check_limit, limit
+
+    text = read_input_text(path, str(path), encoding="utf-8-sig")
+    lines = text.replace("\r\n", "\n").replace("\r", "\n").split("\n")
+    del text
+    if len(lines) > limit("csv_rows"):  # may be over: count the data rows (cheap)
+        n_rows = sum(1 for line in lines if line.strip() and not line.lstrip().startswith("#"))
+        check_limit("csv_rows", max(n_rows - 1, 0), str(path))
+    in_header = True
+    for number, line in enumerate(lines, start=1):
+        stripped = line.strip()
+        if not stripped:
+            continue
+        if stripped.startswith("#"):
+            key, sep, value = stripped[1:].partition(":")
+            key = key.strip()
+            if in_header and sep and key:
+                yield CSVLine(number, "meta", key=key, value=value.strip())
+            continue
+        try:
+            cells = tuple(cell.strip() for cell in next(csv.reader([line])))
+        except csv.Error as exc:
+            raise DatasetError(f"{path}, {line_word} {number}: not a CSV row ({exc}).") from None
+        yield CSVLine(number, "header" if in_header else "row", cells)
+        in_header = False
 
 
 def write_text_atomic(path: str | os.PathLike[str], text: str) -> Path:

@@ -1,7 +1,7 @@
 """Quasi-static analytical model of the fiber-reinforced bending actuator.
 
 The model of Polygerinos et al. (IEEE Trans. Robot. 31, 2015), which paper B uses
-as its baseline (SPEC §4.3): the internal pressure ``P`` acting on the distal
+as its baseline (paper B §4.3): the internal pressure ``P`` acting on the distal
 cross-section of the chamber (a half disc of radius ``r`` on top of the bottom wall
 of thickness ``b``) produces the moment about the strain-limiting layer
 
@@ -407,7 +407,7 @@ def tip_position_mm(design: SFRBADesign, angle_deg: ArrayLike) -> tuple[np.ndarr
 
 @dataclass(frozen=True)
 class AnalyticalModel:
-    """The quasi-static moment balance of Polygerinos et al. (SPEC §4.3).
+    """The quasi-static moment balance of Polygerinos et al. (paper B §4.3).
 
     Calls :func:`softbend.analytical.bending_angle_deg` on the whole grid and
     :func:`softbend.analytical.tip_position_mm` for the tip; the sweep ends at the

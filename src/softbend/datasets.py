@@ -31,7 +31,7 @@ import re
 from datetime import UTC, datetime
 from importlib import resources
 from pathlib import Path
-from typing import TYPE_CHECKING, Any
+from typing import TYPE_CHECKING, Any, cast
 
 from softbend._io import json_text, write_text_atomic
 from softbend._validation import short_repr
@@ -42,6 +42,8 @@ from softbend.plausibility import RANGES, implausible_index
 
 if TYPE_CHECKING:
     import pandas as pd
+
+    from softbend.fem.stats import FEMStats
 
 __all__ = [
     "DESIGN_COLUMN_KINDS",
@@ -410,8 +412,15 @@ def _stop_region(reason: str, kind: str) -> str:
 
 
 def _design_table(designs: pd.DataFrame) -> pd.DataFrame:
-    """The campaign's designs table with its JSON stats unpacked into columns."""
-    stats = [json.loads(s) if isinstance(s, str) and s else {} for s in designs["stats"]]
+    """The campaign's designs table with its JSON stats unpacked into columns.
+
+    The stats are an FEM sweep's (:class:`~softbend.fem.stats.FEMStats`); a key
+    that another backend does not record reads as empty or zero.
+    """
+    stats = [
+        cast("FEMStats", json.loads(s) if isinstance(s, str) and s else {})
+        for s in designs["stats"]
+    ]
     out = designs[["design_id", *PARAMETERS]].copy()
     out["status"] = designs["status"]
     out["error"] = designs["error"].fillna("")

@@ -14,6 +14,7 @@ from __future__ import annotations
 
 import hashlib
 import itertools
+import math
 from collections.abc import Iterator, Sequence
 from dataclasses import asdict, dataclass
 from typing import Literal
@@ -21,6 +22,7 @@ from typing import Literal
 import numpy as np
 
 from softbend._validation import check_choice, check_range
+from softbend.references import DESIGN_SPACE, MATERIALS, MEASURED_ACTUATORS
 
 #: Order of the design parameters in tables, arrays and CLI strings.
 PARAMETERS: tuple[str, ...] = ("l_mm", "r_mm", "t_mm", "b_mm", "phi_deg", "lc_mm")
@@ -36,9 +38,9 @@ FEATURE_QUANTITIES: dict[str, str] = {
     "pressure_mpa": "pressure_mpa",
 }
 
-#: Fixed quantities of paper B (mm).
-FIBER_DIAMETER_MM = 0.28
-STRAIN_LIMITING_LAYER_MM = 0.1
+#: Fixed quantities of paper B (mm, §2.1; :data:`softbend.references.MATERIALS`).
+FIBER_DIAMETER_MM: float = MATERIALS["kevlar"]["diameter_mm"].value
+STRAIN_LIMITING_LAYER_MM: float = MATERIALS["fiberglass"]["thickness_mm"].value
 
 
 # (low, high, low_inclusive); every upper bound is inclusive.
@@ -141,6 +143,17 @@ class SFRBADesign:
         return cls.from_sequence(values)
 
     @property
+    def cavity_volume_mm3(self) -> float:
+        """Undeformed volume of the chamber, mm³: ``½·π·r²·l``.
+
+        The chamber is a half-disc of radius ``r`` (the semicircular top standing
+        on the flat bottom wall) extruded over the chamber length ``l``. The FEM
+        meshes half of it (the half model ``y ≥ 0``), the rig's air volume starts
+        from all of it.
+        """
+        return 0.5 * math.pi * self.r_mm**2 * self.l_mm
+
+    @property
     def design_id(self) -> str:
         """Stable 16-hex-digit identifier: a SHA-1 of the parameters rounded to 1e-6."""
         canonical = ",".join(f"{getattr(self, n):.6f}" for n in PARAMETERS)
@@ -178,18 +191,10 @@ class SFRBADesign:
 
 
 #: The seven actuators paper B measured (Fig. 7), nominal (l, r, t, b, φ, lc) in mm and
-#: degrees: the reference (100, 6, 2, 2, 5, 8) and one parameter changed at a time.
+#: degrees: the reference (100, 6, 2, 2, 5, 8) and one parameter changed at a time
+#: (:data:`softbend.references.MEASURED_ACTUATORS`).
 PAPER_B_FIG7_DESIGNS: tuple[SFRBADesign, ...] = tuple(
-    SFRBADesign(*values)
-    for values in (
-        (100, 6, 2, 2, 5, 8),
-        (120, 6, 2, 2, 5, 8),
-        (100, 8, 2, 2, 5, 8),
-        (100, 6, 3, 2, 5, 8),
-        (100, 6, 2, 3, 5, 8),
-        (100, 6, 2, 2, 10, 8),
-        (100, 6, 2, 2, 5, 10),
-    )
+    SFRBADesign(*values) for values in MEASURED_ACTUATORS.value
 )
 
 
@@ -318,12 +323,7 @@ class DesignSpace:
         return pd.DataFrame(rows, columns=["design_id", *PARAMETERS])
 
 
-#: Levels of paper B Table 1.
+#: Levels of paper B Table 1 (:data:`softbend.references.DESIGN_SPACE`).
 TABLE1_LEVELS: dict[str, tuple[float, ...]] = {
-    "l_mm": (100.0, 120.0, 140.0, 160.0),
-    "r_mm": (6.0, 8.0, 10.0),
-    "t_mm": (2.0, 3.0, 4.0),
-    "b_mm": (2.0, 3.0, 4.0),
-    "phi_deg": (5.0, 10.0, 15.0),
-    "lc_mm": (8.0, 10.0, 12.0),
+    name: DESIGN_SPACE[name].value for name in PARAMETERS
 }

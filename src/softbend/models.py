@@ -125,7 +125,7 @@ def check_pressures_mpa(
 
 
 def _as_vector(values: ArrayLike, dtype: type, name: str) -> np.ndarray:
-    array = np.array(values, dtype=dtype)
+    array: np.ndarray = np.array(values, dtype=dtype)
     if array.ndim != 1:
         raise ValueError(
             f"The '{name}' of SweepResult must be 1-D. Got shape {array.shape} instead."
@@ -302,14 +302,18 @@ class BendingModel(Protocol):
     ----------
     name : str
         Short name (a campaign stores it with every design: ``"analytical"``,
-        ``"fem"``, ``"surrogate"``).
+        ``"fem"``, ``"surrogate"``); read-only, so a frozen dataclass's field or a
+        class attribute answers it.
 
     Optional attribute ``preferred_chunk_size`` (int): how many designs one worker
     task should sweep. Cheap models leave it out and the runner batches designs to
     keep its overhead low; expensive ones (FEM) set 1 for load balancing.
     """
 
-    name: str
+    @property
+    def name(self) -> str:
+        """Short name of the model, stored with every design of a campaign."""
+        ...
 
     def sweep(self, design: SFRBADesign, pressures_mpa: np.ndarray) -> SweepResult:
         """Sweep ``design`` over the increasing gauge pressures ``pressures_mpa`` (MPa)."""

@@ -76,3 +76,30 @@ def test_options_digest_follows_every_setting():
     assert len(base.digest()) == 64
     assert base.replace(maxh_mm=4.0).digest() != base.digest()
     assert base.replace(rtol=1e-8).digest() != base.digest()
+
+
+@pytest.mark.parametrize(
+    "values", [(100, 6, 2, 2, 5, 8), (160, 10, 4, 4, 15, 12), (37.5, 3.25, 1, 1, 0, 1)]
+)
+def test_one_cavity_volume_serves_the_fem_and_the_rig(values):
+    from softbend.control.rig import RigParams
+    from softbend.fem.geometry import ActuatorGeometry
+
+    design = SFRBADesign(*values)
+    l_mm, r_mm = values[0], values[1]
+    # Closed form: a half-disc of radius r extruded over l.
+    assert design.cavity_volume_mm3 == pytest.approx(math.pi * r_mm**2 / 2.0 * l_mm, rel=1e-15)
+    if values[:2] == (100, 6):
+        assert design.cavity_volume_mm3 == pytest.approx(1800.0 * math.pi, rel=1e-15)
+    # The FEM meshes exactly half of it; the rig's air volume is all of it plus the tubing.
+    assert ActuatorGeometry(design, 3.0).half_cavity_volume_mm3 == design.cavity_volume_mm3 / 2
+    rig = RigParams.for_design(design, tubing_mm3=2000.0)
+    assert rig.volume_mm3 == design.cavity_volume_mm3 + 2000.0
+
+
+def test_the_meshed_cavity_has_the_closed_form_volume():
+    from softbend.fem.actuator import ActuatorModel
+
+    design = SFRBADesign(100, 6, 2, 2, 5, 10)
+    model = ActuatorModel(design, FEMOptions(maxh_mm=6.0))
+    assert model.cavity_volume_mm3() == pytest.approx(design.cavity_volume_mm3, rel=2e-3)

@@ -88,7 +88,7 @@ def test_normalized_kernel_is_the_rbf_svr_with_penalty_times_c(sigma, C):
 
 
 @pytest.mark.parametrize("shape", [2.0, 1.0, 1.3])
-def test_predict_is_the_kernel_expansion_and_predict_one_matches_it(shape):
+def test_predict_is_the_kernel_expansion_and_the_predictor_matches_it(shape):
     X, y = _nonlinear_problem()
     X_test, _ = _nonlinear_problem(n_samples=60, seed=3)
     model = GeneralizedGaussianSVR(shape=shape, sigma=0.9).fit(X, y)
@@ -99,9 +99,10 @@ def test_predict_is_the_kernel_expansion_and_predict_one_matches_it(shape):
     )
     batch = model.predict(X_test)
     np.testing.assert_allclose(batch, expansion, rtol=0, atol=1e-12)
-    one_by_one = np.array([model.predict_one(row) for row in X_test])
+    predict_one = model.predictor()
+    one_by_one = np.array([predict_one(row) for row in X_test])
     np.testing.assert_allclose(one_by_one, batch, rtol=0, atol=1e-12)
-    assert isinstance(model.predict_one(X_test[0].tolist()), float)
+    assert isinstance(predict_one(X_test[0].tolist()), float)
 
 
 def test_smooth_function_is_learned_with_r2_above_0_99():
@@ -226,7 +227,7 @@ def test_too_few_distinct_samples_to_estimate_the_kernel():
 
 
 @pytest.mark.parametrize(("sigma", "fast"), [(0.9, True), (0.05, False)])
-def test_predict_one_rbf_path_agrees_near_and_far_from_the_data(sigma, fast):
+def test_the_predictor_rbf_path_agrees_near_and_far_from_the_data(sigma, fast):
     # The factored RBF path serves points near the support vectors of a model whose
     # support is compact in kernel widths; far points, and a narrow kernel, take
     # the direct sum. Both agree with predict.
@@ -236,23 +237,35 @@ def test_predict_one_rbf_path_agrees_near_and_far_from_the_data(sigma, fast):
     rng = np.random.default_rng(5)
     near = rng.normal(size=(40, 3))
     far = 12.0 * sigma * rng.normal(size=(10, 3)) + 40.0  # rate·|x − m|² in the thousands
+    predict_one = model.predictor()
     for rows in (near, far):
-        one_by_one = np.array([model.predict_one(row) for row in rows])
+        one_by_one = np.array([predict_one(row) for row in rows])
         np.testing.assert_allclose(one_by_one, model.predict(rows), rtol=0, atol=1e-12)
-    np.testing.assert_allclose(model.predict_one(far[0]), model.intercept_, atol=1e-12)
+    np.testing.assert_allclose(predict_one(far[0]), model.intercept_, atol=1e-12)
 
 
-def test_predict_one_checks_shape_finiteness_and_fitting():
-    with pytest.raises(NotFittedError):
-        GeneralizedGaussianSVR().predict_one(np.zeros(3))
+def test_the_predictor_checks_shape_finiteness_and_fitting():
+    with pytest.raises(NotFittedError, match="before 'predictor'"):
+        GeneralizedGaussianSVR().predictor()
     X, y = _nonlinear_problem(n_samples=30)
     model = GeneralizedGaussianSVR(shape=2.0).fit(X, y)
-    with pytest.raises(ValueError, match=r"'x' of GeneralizedGaussianSVR.predict_one .*\(3,\)"):
-        model.predict_one(np.zeros(4))
+    predict_one = model.predictor()
+    with pytest.raises(ValueError, match=r"'x' of GeneralizedGaussianSVR.predictor\(\) .*\(3,\)"):
+        predict_one(np.zeros(4))
     with pytest.raises(ValueError, match="must be finite"):
-        model.predict_one(np.array([0.0, np.inf, 0.0]))
+        predict_one(np.array([0.0, np.inf, 0.0]))
     with pytest.raises(ValueError, match="must be finite"):
-        model.predict_one(np.array([0.0, np.nan, 0.0]))
+        predict_one(np.array([0.0, np.nan, 0.0]))
+
+
+def test_the_predictor_keeps_the_fit_it_was_made_from():
+    X, y = _nonlinear_problem(n_samples=60)
+    model = GeneralizedGaussianSVR(shape=1.3, sigma=0.9).fit(X, y)
+    predict_one = model.predictor()
+    before = [predict_one(row) for row in X[:5]]
+    model.fit(X, -y)
+    np.testing.assert_array_equal([predict_one(row) for row in X[:5]], before)
+    assert not hasattr(model, "predict_one")
 
 
 def test_prediction_uses_the_same_kernel_as_a_direct_distance_computation():

@@ -45,21 +45,40 @@ Modelling choices, stated once:
 Modules: :mod:`~softbend.analysis.samples` (default columns, cleaning),
 :mod:`~softbend.analysis.correlation`, :mod:`~softbend.analysis.ols` (z-scored
 least squares and its tests), :mod:`~softbend.analysis.regression` (the report)
-and :mod:`~softbend.analysis.campaign_analysis`.
+and :mod:`~softbend.analysis.campaign_analysis`. Names are imported lazily, so
+``import softbend.analysis`` stays light (pandas is loaded by the first name used).
 """
 
 from __future__ import annotations
 
-from softbend.analysis.campaign_analysis import CampaignAnalysis, analyze_samples
-from softbend.analysis.correlation import correlation_matrix
-from softbend.analysis.ols import significance_stars
-from softbend.analysis.regression import (
-    ConstantFeatureWarning,
-    RegressionReport,
-    standardized_regression,
-)
-from softbend.analysis.samples import DEFAULT_FEATURES, DEFAULT_TARGET
-from softbend.metrics import thresholded_mape
+import importlib
+from typing import TYPE_CHECKING, Any
+
+if TYPE_CHECKING:
+    from softbend.analysis.campaign_analysis import CampaignAnalysis, analyze_samples
+    from softbend.analysis.correlation import correlation_matrix
+    from softbend.analysis.ols import significance_stars
+    from softbend.analysis.regression import (
+        ConstantFeatureWarning,
+        RegressionReport,
+        standardized_regression,
+    )
+    from softbend.analysis.samples import DEFAULT_FEATURES, DEFAULT_TARGET
+    from softbend.metrics import thresholded_mape
+
+#: Public name → module that defines it.
+_EXPORTS = {
+    "DEFAULT_FEATURES": "softbend.analysis.samples",
+    "DEFAULT_TARGET": "softbend.analysis.samples",
+    "CampaignAnalysis": "softbend.analysis.campaign_analysis",
+    "ConstantFeatureWarning": "softbend.analysis.regression",
+    "RegressionReport": "softbend.analysis.regression",
+    "analyze_samples": "softbend.analysis.campaign_analysis",
+    "correlation_matrix": "softbend.analysis.correlation",
+    "significance_stars": "softbend.analysis.ols",
+    "standardized_regression": "softbend.analysis.regression",
+    "thresholded_mape": "softbend.metrics",
+}
 
 __all__ = [
     "DEFAULT_FEATURES",
@@ -73,3 +92,13 @@ __all__ = [
     "standardized_regression",
     "thresholded_mape",
 ]
+
+
+def __getattr__(name: str) -> Any:
+    if name in _EXPORTS:
+        return getattr(importlib.import_module(_EXPORTS[name]), name)
+    raise AttributeError(f"module 'softbend.analysis' has no attribute {name!r}")
+
+
+def __dir__() -> list[str]:
+    return __all__

@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 from pathlib import Path
+from typing import Any
 
 import typer
 
@@ -32,8 +33,9 @@ def simulate(
 
     check_synthetic_size(samples, dt, samples="'--samples'", dt="'--dt'")
     _common.check_output_dir(out, "--out")
+    choice: Any = excitation  # one of EXCITATIONS: synthetic_dataset checks it
     dataset = synthetic_dataset(
-        n_experiments=experiments, n_samples=samples, dt_s=dt, seed=seed, excitation=excitation
+        n_experiments=experiments, n_samples=samples, dt_s=dt, seed=seed, excitation=choice
     )
     all_experiments = [e for group in dataset.values() for e in group]
     with _common.output_errors(out, "--out"):
@@ -100,13 +102,9 @@ def identify(
     from softbend.identification.study import identify as run_identify
     from softbend.reports.paper_a import write_identification_outputs
 
+    choices: dict[str, Any] = {"kernel": kernel, "moments_of": moments_of}  # checked there
     config = IdentificationConfig(
-        C=c,
-        epsilon=epsilon,
-        output_lags=output_lags,
-        input_lags=input_lags,
-        kernel=kernel,
-        moments_of=moments_of,
+        C=c, epsilon=epsilon, output_lags=output_lags, input_lags=input_lags, **choices
     )
     csvs = [p for p in data.iterdir() if p.suffix.lower() == ".csv"] if data.is_dir() else []
     inputs = (data, *csvs)

@@ -58,6 +58,7 @@ def run(
     """
     from softbend._io import write_text_atomic
     from softbend.design import SFRBADesign
+    from softbend.fem.stats import fem_stats
     from softbend.models import default_pressures_mpa
     from softbend.reports.fem_figures import sweep_with_files
 
@@ -92,9 +93,10 @@ def run(
             progress=on_step,
         )
     result = sweep.result
+    stats = fem_stats(result)
     summary = {
         "design": str(actuator),
-        "stop_reason": result.stats["stop_reason"],
+        "stop_reason": stats["stop_reason"],
         "max_pressure_mpa": result.max_pressure_mpa,
         "max_angle_deg": result.max_angle_deg,
         "wall_time_s": result.wall_time_s,
@@ -125,10 +127,10 @@ def run(
         ["pressure MPa", "angle °", "tip x mm", "tip z mm", "Newton its"],
         rows,
     )
-    t = result.stats["timings"]
+    t = stats["timings"]
     _common.console.print(
-        f"stop: {result.stats['stop_reason']}; {result.mesh_size} elements, "
-        f"{result.stats['ndof']} dofs; {result.wall_time_s:.1f} s "
+        f"stop: {stats['stop_reason']}; {result.mesh_size} elements, "
+        f"{stats['ndof']} dofs; {result.wall_time_s:.1f} s "
         f"(assembly {t['assembly_s'] + t['residual_s']:.1f} s, "
         f"factorisation {t['factorization_s']:.1f} s); files in {out}"
     )

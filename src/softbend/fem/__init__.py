@@ -1,30 +1,68 @@
-"""Nonlinear 3D finite-element model of the fiber-reinforced bending actuator (SPEC §4.2).
+"""Nonlinear 3D finite-element model of the fiber-reinforced bending actuator (paper B §3.1).
 
-NGSolve and netgen are imported only inside this subpackage. The pipeline:
-``geometry`` (netgen.occ solid and mesh) → ``mechanics`` (energy densities) →
-``energy`` (the energy terms, optionally compiled once per process) →
+The pipeline: ``geometry`` (netgen.occ solid and mesh) → ``mechanics`` (energy
+densities) → ``energy`` (the energy terms, optionally compiled once per process) →
 ``actuator`` (the model's energy, state and measurements) → ``newton`` (energy
-minimisation) → ``sweep`` (load stepping, :func:`simulate`) → ``model`` (:class:`FEMModel`,
-the FEM as a :class:`~softbend.models.BendingModel`); ``verification``
-holds the closed-form cases solved with the same core.
+minimisation) → ``sweep`` (load stepping, :func:`simulate`) → ``model``
+(:class:`FEMModel`, the FEM as a :class:`~softbend.models.BendingModel`);
+``verification`` holds the closed-form cases solved with the same core.
+
+Names are imported lazily, so ``import softbend.fem`` is light and the
+pure-Python parts work without NGSolve: :class:`FEMOptions`, the typed solver
+statistics :class:`FEMStats` (:func:`fem_stats`) and the dimensions of
+:class:`ActuatorGeometry`. The names that solve (:class:`FEMModel`,
+:func:`simulate`, :func:`use_compiled`) import NGSolve (after PyTorch, see
+:mod:`softbend._torch`) and raise one
+:class:`~softbend.errors.MissingExtraError` naming ``softbend[fem]`` without it.
 """
 
-# PyTorch (if installed) before NGSolve: see softbend._torch.
-import softbend._torch  # noqa: F401  (import order)
-from softbend._extras import require
+from __future__ import annotations
 
-require("ngsolve", "The FEM (softbend.fem)")  # one line naming softbend[fem] if missing
+import importlib
+from typing import TYPE_CHECKING, Any
 
-from softbend.fem.energy import use_compiled  # noqa: E402
-from softbend.fem.model import FEMModel  # noqa: E402
-from softbend.fem.options import GRAVITY_DIRECTIONS, OUTPUT_MODES, FEMOptions  # noqa: E402
-from softbend.fem.sweep import simulate  # noqa: E402
+if TYPE_CHECKING:
+    from softbend.fem.energy import use_compiled
+    from softbend.fem.geometry import ActuatorGeometry
+    from softbend.fem.model import FEMModel
+    from softbend.fem.options import GRAVITY_DIRECTIONS, OUTPUT_MODES, FEMOptions
+    from softbend.fem.stats import FEMStats, FEMTimings, fem_stats
+    from softbend.fem.sweep import simulate
+
+#: Public name → submodule that defines it.
+_EXPORTS = {
+    "ActuatorGeometry": "geometry",
+    "FEMModel": "model",
+    "FEMOptions": "options",
+    "FEMStats": "stats",
+    "FEMTimings": "stats",
+    "GRAVITY_DIRECTIONS": "options",
+    "OUTPUT_MODES": "options",
+    "fem_stats": "stats",
+    "simulate": "sweep",
+    "use_compiled": "energy",
+}
 
 __all__ = [
     "GRAVITY_DIRECTIONS",
     "OUTPUT_MODES",
+    "ActuatorGeometry",
     "FEMModel",
     "FEMOptions",
+    "FEMStats",
+    "FEMTimings",
+    "fem_stats",
     "simulate",
     "use_compiled",
 ]
+
+
+def __getattr__(name: str) -> Any:
+    if name in _EXPORTS:
+        module = importlib.import_module(f"softbend.fem.{_EXPORTS[name]}")
+        return getattr(module, name)
+    raise AttributeError(f"module 'softbend.fem' has no attribute {name!r}")
+
+
+def __dir__() -> list[str]:
+    return __all__

@@ -29,12 +29,15 @@ from typing import Any
 import numpy as np
 
 from softbend.design import FIBER_DIAMETER_MM, SFRBADesign
+from softbend.fem._ngsolve import require_ngsolve
 from softbend.fem.energy import energy_terms
 from softbend.fem.geometry import mesh_actuator
 from softbend.fem.mechanics import helix_stiffness_n_per_mm
 from softbend.fem.newton import EnergySolver
 from softbend.fem.options import FEMOptions
 from softbend.kinematics import fit_arc
+
+require_ngsolve()  # NGSolve after PyTorch, or one line naming softbend[fem]
 
 __all__ = ["ActuatorModel", "Measurement"]
 
@@ -119,7 +122,7 @@ class ActuatorModel:
     def fiber_stiffness_n_per_mm(self) -> float:
         """Smeared stiffness ``E A / s`` of one fiber family, N/mm."""
         return helix_stiffness_n_per_mm(
-            self.options.fiber.model.e_mpa, self.options.fiber_radius_mm, self.fiber_spacing_mm()
+            self.options.fiber_model.e_mpa, self.options.fiber_radius_mm, self.fiber_spacing_mm()
         )
 
     def _gravity_vector(self) -> tuple[float, float, float]:

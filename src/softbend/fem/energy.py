@@ -34,8 +34,11 @@ import threading
 from dataclasses import dataclass
 from typing import Any
 
+from softbend.fem._ngsolve import require_ngsolve
 from softbend.fem.mechanics import fiber_energy, membrane_energy, solid_energy, volume_flux
 from softbend.fem.options import FEMOptions
+
+require_ngsolve()  # NGSolve after PyTorch, or one line naming softbend[fem]
 
 __all__ = ["EnergyTerms", "compiler_available", "energy_terms", "use_compiled"]
 
@@ -153,13 +156,13 @@ def _build(fes: Any, options: FEMOptions, *, compile_code: bool) -> EnergyTerms:
     F = Id(3) + Grad(u)
     Fs = Id(3) + Grad(u).Trace()
     normal = specialcf.normal(3)
-    mu0 = o.elastomer.model.initial_shear_modulus_mpa
+    mu0 = o.elastomer_model.initial_shear_modulus_mpa
     pressure, cos_phi, sin_phi = ngs.Parameter(0.0), ngs.Parameter(1.0), ngs.Parameter(0.0)
     stiffness = ngs.Parameter(0.0)
 
-    solid = solid_energy(F, o.elastomer.model, o.bulk_ratio * mu0)
+    solid = solid_energy(F, o.elastomer_model, o.bulk_ratio * mu0)
     ex, ey = CF((1.0, 0.0, 0.0)), CF((0.0, 1.0, 0.0))
-    layer = membrane_energy(Fs, (ex, ey), o.layer.model, o.layer_thickness_mm)
+    layer = membrane_energy(Fs, (ex, ey), o.layer_model, o.layer_thickness_mm)
     circumferential = Cross(normal, ex)
     circumferential = circumferential / Norm(circumferential)
     fiber = 0.0
@@ -187,4 +190,16 @@ def _build(fes: Any, options: FEMOptions, *, compile_code: bool) -> EnergyTerms:
         )
     else:
         terms = [term.Compile() for term in terms]
-    return EnergyTerms(*terms, pressure, cos_phi, sin_phi, stiffness, compiled=compile_code)
+    solid, layer, fiber, pressure_work, flux = terms
+    return EnergyTerms(
+        solid,
+        layer,
+        fiber,
+        pressure_work,
+        flux,
+        pressure,
+        cos_phi,
+        sin_phi,
+        stiffness,
+        compiled=compile_code,
+    )

@@ -8,8 +8,11 @@ from pathlib import Path
 import numpy as np
 
 from softbend._io import write_text_atomic
+from softbend.fem._ngsolve import require_ngsolve
 from softbend.fem.actuator import ActuatorModel
 from softbend.models import SweepResult
+
+require_ngsolve()  # NGSolve after PyTorch, or one line naming softbend[fem]
 
 __all__ = ["silhouette_mm", "sweep_csv", "write_sweep_csv", "write_vtk"]
 

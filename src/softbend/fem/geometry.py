@@ -1,6 +1,6 @@
 """Solid geometry and mesh of the fiber-reinforced actuator (netgen.occ).
 
-The half actuator ``y ≥ 0`` (SPEC §4.2, paper B Fig. 1a): a body whose section is
+The half actuator ``y ≥ 0`` (paper B §2.1, Fig. 1a): a body whose section is
 a rectangle ``2(r+t) × b`` under a half-disc of radius ``r + t``, from ``x = 0``
 to ``x = cap + l + lc``, minus the cavity: a half-disc of radius ``r`` standing
 on the bottom wall (centre at height ``b``) from ``x = cap`` to ``x = cap + l``.
@@ -17,6 +17,7 @@ from typing import Any
 
 from softbend.design import SFRBADesign
 from softbend.errors import SoftbendError
+from softbend.fem._ngsolve import require_ngsolve
 
 __all__ = ["ActuatorGeometry", "actuator_geometry", "mesh_actuator"]
 
@@ -69,12 +70,16 @@ class ActuatorGeometry:
         d = self.design
         ro = self.outer_radius_mm
         section = ro * d.b_mm + math.pi * ro**2 / 4.0
-        return section * self.length_mm - math.pi * d.r_mm**2 / 4.0 * d.l_mm
+        return section * self.length_mm - self.half_cavity_volume_mm3
 
     @property
     def half_cavity_volume_mm3(self) -> float:
-        """Undeformed volume of the half cavity, mm³."""
-        return math.pi * self.design.r_mm**2 / 4.0 * self.design.l_mm
+        """Undeformed volume of the half cavity, mm³: ``π·r²·l/4``.
+
+        Exactly half of :attr:`softbend.design.SFRBADesign.cavity_volume_mm3` (the
+        mesh is the half model ``y ≥ 0``).
+        """
+        return self.design.cavity_volume_mm3 / 2.0
 
 
 def actuator_geometry(design: SFRBADesign, base_cap_mm: float) -> tuple[Any, ActuatorGeometry]:
@@ -84,6 +89,7 @@ def actuator_geometry(design: SFRBADesign, base_cap_mm: float) -> tuple[Any, Act
     -------
     (netgen.occ.TopoDS_Shape, ActuatorGeometry)
     """
+    require_ngsolve()
     from netgen.occ import Box, Cylinder, Pnt, X
 
     info = ActuatorGeometry(design, base_cap_mm)
@@ -147,7 +153,7 @@ def mesh_actuator(
     SoftbendError
         If netgen fails to mesh the geometry.
     """
-    import ngsolve
+    ngsolve = require_ngsolve()
     from netgen.occ import OCCGeometry
 
     shape, info = actuator_geometry(design, base_cap_mm)

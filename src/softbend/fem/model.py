@@ -17,7 +17,7 @@ __all__ = ["FEMModel"]
 
 @dataclass(frozen=True)
 class FEMModel:
-    """The 3D nonlinear finite-element model (SPEC §4.2): :func:`simulate` with fixed options.
+    """The 3D nonlinear finite-element model (paper B §3.1): :func:`simulate` with fixed options.
 
     Parameters
     ----------

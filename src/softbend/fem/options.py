@@ -3,7 +3,7 @@
 from __future__ import annotations
 
 from dataclasses import asdict, dataclass, field, fields
-from typing import Any
+from typing import Any, cast
 
 from softbend._validation import check_choice, check_int, check_range
 from softbend.fem.mechanics import FIBER_LAWS
@@ -206,6 +206,21 @@ class FEMOptions:
         check_choice(self.output, "output", owner, OUTPUT_MODES)
         check_int(self.backbone_points, "backbone_points", owner, low=5)
         check_int(self.threads, "threads", owner, low=1)
+
+    @property
+    def elastomer_model(self) -> HyperelasticModel:
+        """The elastomer's constitutive model (checked hyperelastic on construction)."""
+        return cast(HyperelasticModel, self.elastomer.model)
+
+    @property
+    def layer_model(self) -> HyperelasticModel:
+        """The strain-limiting layer's constitutive model (checked hyperelastic)."""
+        return cast(HyperelasticModel, self.layer.model)
+
+    @property
+    def fiber_model(self) -> LinearElastic:
+        """The fibers' constitutive model (checked linear elastic on construction)."""
+        return cast(LinearElastic, self.fiber.model)
 
     def replace(self, **changes: Any) -> FEMOptions:
         """A copy with ``changes`` applied (validated again)."""

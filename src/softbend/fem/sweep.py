@@ -25,7 +25,7 @@ That last stop is told apart: where the cavity's stiffness ``dp/dV`` is falling
 to zero just ahead (a ballooning part, the inflation instability of rubber: no
 equilibrium nearby above a pressure maximum) the reason says so and names the
 region; otherwise it is a plain "no convergence". The reason is always in
-``stats["stop_reason"]``. A model
+``stats["stop_reason"]`` (the keys: :class:`~softbend.fem.stats.FEMStats`). A model
 that does not even hold its own weight raises
 :class:`~softbend.errors.ConvergenceError`.
 """
@@ -37,16 +37,20 @@ import math
 import time
 from collections.abc import Callable
 from dataclasses import dataclass, field
-from typing import Any
+from typing import cast
 
 import numpy as np
 from numpy.typing import ArrayLike
 
 from softbend.design import SFRBADesign
 from softbend.errors import ConvergenceError
+from softbend.fem._ngsolve import require_ngsolve
 from softbend.fem.actuator import ActuatorModel
 from softbend.fem.options import FEMOptions
+from softbend.fem.stats import FEMStats, FEMTimings
 from softbend.models import SweepResult, check_pressures_mpa
+
+require_ngsolve()  # NGSolve after PyTorch, or one line naming softbend[fem]
 
 __all__ = ["Step", "StepHistory", "run_sweep", "simulate"]
 
@@ -119,7 +123,10 @@ class StepHistory:
         return out
 
 
-def _record(model: ActuatorModel, pressure: float, iterations: int, keep_state: bool) -> Step:
+def _record(
+    model: ActuatorModel, pressure: float, iterations: int, keep_state: bool
+) -> tuple[Step, np.ndarray]:
+    """The converged state at ``pressure`` as a :class:`Step`, and its tangent ``du/dp``."""
     values = model.measure().as_array()
     tangent = model.pressure_tangent(refactorize=iterations == 0)
     slopes = model.measure_derivative(tangent)
@@ -390,7 +397,9 @@ def simulate(
         :func:`softbend.analytical.tip_position_mm` (mm), Newton iterations of
         the step that reached each pressure, ``mesh_size`` = tetrahedra of the
         half model. ``stats`` holds the steps, the stop reason, the degrees of
-        freedom and the time spent in assembly and factorisation.
+        freedom and the time spent in assembly and factorisation: the keys of
+        :class:`~softbend.fem.stats.FEMStats` (read it with
+        :func:`~softbend.fem.stats.fem_stats`).
 
     Raises
     ------
@@ -472,9 +481,9 @@ def _to_result(
             tip_z.append(np.nan)
             its.append(options.max_iterations)
             converged.append(False)
-    timings = model.solver.timings.as_dict()
+    timings = cast(FEMTimings, model.solver.timings.as_dict())
     wall = time.perf_counter() - started
-    stats: dict[str, Any] = {
+    stats: FEMStats = {
         "model": "3D FEM, NGSolve, half model, quadratic tetrahedra",
         "stop_reason": history.stop_reason,
         "steps_mpa": [float(s.pressure_mpa) for s in history.steps],
@@ -502,5 +511,5 @@ def _to_result(
         newton_iterations=np.array(its, dtype=np.int64),
         wall_time_s=wall,
         mesh_size=model.n_elements,
-        stats=stats,
+        stats=dict(stats),
     )

@@ -6,7 +6,7 @@ Each case meshes a simple solid and solves it with the same energy densities
 
 * :func:`tube_inflation` — a thick-walled incompressible neo-Hookean tube under
   internal (follower) pressure in plane strain, against
-  ``P = μ[ln(λa/λb) + ½(λb⁻² − λa⁻²)]`` with ``a² − A² = b² − B²`` (SPEC §4.2);
+  ``P = μ[ln(λa/λb) + ½(λb⁻² − λa⁻²)]`` with ``a² − A² = b² − B²``;
 * :func:`cantilever_sag` — a slender clamped beam bending under its own weight,
   against the large-deflection elastica ``EI θ'' = −w (L − s) cos θ``,
   ``θ(0) = 0``, ``θ'(L) = 0``, solved with :func:`scipy.integrate.solve_bvp`;
@@ -25,9 +25,12 @@ import numpy as np
 
 from softbend.design import SFRBADesign
 from softbend.errors import ConvergenceError
+from softbend.fem._ngsolve import require_ngsolve
 from softbend.fem.mechanics import solid_energy, volume_flux
 from softbend.fem.newton import EnergySolver
 from softbend.materials.models import NeoHookean
+
+require_ngsolve()  # NGSolve after PyTorch, or one line naming softbend[fem]
 
 __all__ = [
     "CaseResult",
@@ -306,6 +309,7 @@ def mesh_study(
     measure.
     """
     from softbend.fem.options import FEMOptions
+    from softbend.fem.stats import fem_stats
     from softbend.fem.sweep import simulate
 
     options = options or FEMOptions()
@@ -317,14 +321,15 @@ def mesh_study(
         result = simulate(design, pressures_mpa, options.replace(maxh_mm=h, output="solve"))
         angles = [float(a) for a in result.angle_deg]
         angles += [math.nan] * (len(pressures_mpa) - len(angles))
+        stats = fem_stats(result)
         rows.append(
             MeshStudyRow(
                 h,
                 int(result.mesh_size or 0),
-                int(result.stats["ndof"]),
+                int(stats["ndof"]),
                 tuple(angles),
                 result.wall_time_s,
-                result.stats["stop_reason"],
+                stats["stop_reason"],
             )
         )
         if progress is not None:

@@ -8,8 +8,21 @@ imported lazily so that ``import softbend.identification`` stays light.
 from __future__ import annotations
 
 import importlib
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
+if TYPE_CHECKING:
+    from softbend.identification.data import Experiment, load_experiments, save_experiments
+    from softbend.identification.kernels import (
+        estimate_gg_shape,
+        estimate_kernel_shape,
+        generalized_gaussian_kernel,
+    )
+    from softbend.identification.narx import NARXRegressor
+    from softbend.identification.resources import check_identify_memory
+    from softbend.identification.svr import GeneralizedGaussianSVR
+    from softbend.identification.synthetic import CurlingActuator, synthetic_dataset
+
+#: Public name → submodule that defines it.
 _EXPORTS = {
     "estimate_gg_shape": "kernels",
     "estimate_kernel_shape": "kernels",
@@ -24,7 +37,19 @@ _EXPORTS = {
     "check_identify_memory": "resources",
 }
 
-__all__ = sorted(_EXPORTS)
+__all__ = [
+    "CurlingActuator",
+    "Experiment",
+    "GeneralizedGaussianSVR",
+    "NARXRegressor",
+    "check_identify_memory",
+    "estimate_gg_shape",
+    "estimate_kernel_shape",
+    "generalized_gaussian_kernel",
+    "load_experiments",
+    "save_experiments",
+    "synthetic_dataset",
+]
 
 
 def __getattr__(name: str) -> Any:

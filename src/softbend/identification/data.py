@@ -3,7 +3,7 @@
 An experiment is what paper A records (§4.1): the commanded pressure and the tip
 position ``(x, y)`` measured by a camera, sampled in time. Bending grade ``rho``
 and arc length ``L`` follow from the tip by constant-curvature kinematics
-(SPEC §2, :func:`softbend.kinematics.bending_from_tip`).
+(paper A eqs. 16–17, :func:`softbend.kinematics.bending_from_tip`).
 
 CSV format
 ----------
@@ -45,12 +45,12 @@ from typing import TYPE_CHECKING, Any, Literal
 
 import numpy as np
 
-from softbend._io import new_file_mode, read_input_text
+from softbend._io import new_file_mode, read_header_csv
 from softbend._jsontext import check_json_nesting
 from softbend._validation import check_range
 from softbend.errors import DatasetError
 from softbend.kinematics import bending_from_tip
-from softbend.limits import check_file_size, check_limit
+from softbend.limits import check_file_size
 from softbend.plausibility import check_plausible, check_plausible_columns
 
 if TYPE_CHECKING:
@@ -133,6 +133,9 @@ class Experiment:
     rest_length_mm: float = DEFAULT_REST_LENGTH_MM
     synthetic: bool = False
     metadata: dict[str, Any] = field(default_factory=dict)
+    #: Computed in __post_init__ (read them as ``rho`` and ``length_mm``).
+    _rho: np.ndarray = field(init=False, repr=False, compare=False)
+    _length_mm: np.ndarray = field(init=False, repr=False, compare=False)
 
     def __post_init__(self) -> None:
         if not isinstance(self.name, str) or not self.name.strip():
@@ -257,13 +260,16 @@ class Experiment:
 
 
 # --------------------------------------------------------------------- loading
-def _parse_header_comment(text: str, header: dict[str, Any], path: Path, number: int) -> None:
-    """Read ``key: value`` from a comment before the column header (row ``number``)."""
+def _parse_header_comment(
+    key: str, value: str, header: dict[str, Any], path: Path, number: int
+) -> None:
+    """Read one ``# key: value`` comment before the column header (row ``number``).
+
+    The keys ``synthetic``, ``rest_length_mm`` and ``metadata`` are read (in any
+    case); other keys are remarks and are ignored.
+    """
     where = f"{path}, row {number}"
-    key, sep, value = text.partition(":")
-    key, value = key.strip().lower(), value.strip()
-    if not sep:
-        return
+    key = key.lower()
     if key == "synthetic":
         if value.lower() not in {"true", "false"}:
             raise DatasetError(
@@ -296,37 +302,18 @@ def _parse_header_comment(text: str, header: dict[str, Any], path: Path, number:
         header["metadata"] = metadata
 
 
-def _data_rows(lines: list[str]) -> int:
-    """Data rows of a CSV's lines: those neither blank nor comments, less the header."""
-    filled = sum(1 for line in lines if line.strip() and not line.lstrip().startswith("#"))
-    return max(0, filled - 1)
-
-
 def _read_csv(path: Path, rest_length_mm: float | None) -> list[Experiment]:
-    text = read_input_text(path, str(path), encoding="utf-8-sig")
     header_info: dict[str, Any] = {}
     columns: list[str] | None = None
-    records: list[tuple[int, list[str]]] = []
-    lines = text.splitlines()
-    del text
-    check_limit("csv_rows", _data_rows(lines), str(path))
-    for number, line in enumerate(lines, start=1):
-        stripped = line.strip()
-        if not stripped:
-            continue
-        if stripped.startswith("#"):
-            if columns is None:
-                _parse_header_comment(stripped[1:], header_info, path, number)
-            continue
-        try:
-            fields = next(csv.reader([line]))
-        except csv.Error as exc:
-            raise DatasetError(f"{path}, row {number}: not a CSV row ({exc}).") from None
-        if columns is None:
-            columns = [c.strip() for c in fields]
-            header_row = number
-            continue
-        records.append((number, fields))
+    header_row = 0
+    records: list[tuple[int, tuple[str, ...]]] = []
+    for line in read_header_csv(path, line_word="row"):
+        if line.kind == "meta":
+            _parse_header_comment(line.key, line.value, header_info, path, line.number)
+        elif line.kind == "header":
+            columns, header_row = list(line.cells), line.number
+        else:
+            records.append((line.number, line.cells))
 
     required = ", ".join(REQUIRED_COLUMNS)
     if columns is None:
@@ -355,7 +342,7 @@ def _read_csv(path: Path, rest_length_mm: float | None) -> list[Experiment]:
             raise DatasetError(
                 f"{path}, row {number}: {len(fields)} fields, but the header has {len(columns)}."
             )
-        name = fields[columns.index(EXPERIMENT_COLUMN)].strip() if named else path.stem
+        name = fields[columns.index(EXPERIMENT_COLUMN)] if named else path.stem
         if not name:
             raise DatasetError(
                 f"{path}, row {number}, column '{EXPERIMENT_COLUMN}': name is empty."
@@ -363,7 +350,7 @@ def _read_csv(path: Path, rest_length_mm: float | None) -> list[Experiment]:
         group = groups.setdefault(name, {"rows": [], **{c: [] for c in REQUIRED_COLUMNS}})
         group["rows"].append(number)
         for column, position in index.items():
-            cell = fields[position].strip()
+            cell = fields[position]
             try:
                 value = float(cell) if cell else math.nan
             except ValueError:

@@ -41,7 +41,7 @@ of scale enters the shape. :func:`estimate_kernel_shape` offers three readings:
   the kernel argument x − z over all ordered pairs of training rows (computed
   exactly from the moments of the rows, in O(n·d²), not by forming the n² pairs);
 * ``"regressors"``: the centred regressor vectors themselves, radially (x̃ = x − x̄);
-* ``"components"``: the project's first reading (SPEC §3 before this change): the
+* ``"components"``: the project's first reading of paper A §4.3 (eqs. 23–26): the
   centred, per-feature standardized components pooled as 1-D samples, eq. 24 as
   written. It ignores the dimension of the kernel, so it is biased for the very
   density the kernel is (a 4-D elliptical Laplacian-type sample gives γ ≈ 1.3,
@@ -62,7 +62,7 @@ shape carries information where the data are heavier-tailed than Gaussian, e.g.
 the ``"impulsive"`` excitation of
 :func:`softbend.identification.synthetic.synthetic_dataset`.
 
-SPEC correction implied (§3 "Shape estimation"): *x̃ are the kernel's arguments,
+How softbend reads paper A's shape estimation (§4.3, eqs. 23–26): *x̃ are the kernel's arguments,
 the pairwise differences x − z of the (standardized) regressor vectors; the
 fourth-moment ratio of ‖x̃‖, divided by its Gaussian value 1 + 2/d_eff, is matched
 to Γ((d+4)/γ)Γ(d/γ)/Γ((d+2)/γ)² · d/(d+2) (eq. 24 is d = 1); σ stays the pooled

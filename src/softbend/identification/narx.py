@@ -479,6 +479,11 @@ class NARXRegressor(RegressorMixin, BaseEstimator):
     ) -> np.ndarray:
         """One-step-ahead prediction from measured past outputs.
 
+        "One step" is the system-identification notion: every sample is
+        predicted from the *measured* outputs before it, as opposed to the free
+        run of :meth:`simulate`. It is not a one-sample fast path; that is the
+        estimator's ``predictor()``.
+
         Parameters
         ----------
         X : array-like, shape (n_samples,) or (n_samples, n_inputs)
@@ -514,8 +519,9 @@ class NARXRegressor(RegressorMixin, BaseEstimator):
         All experiments are simulated together, time step by time step, with
         one batched prediction per step over the experiments still running
         (they may differ in length). When a single experiment is running and
-        the estimator offers ``predict_one(x)``, that faster path is used. The
-        estimator is called on already scaled float64 rows.
+        the estimator offers a one-sample fast path ``predictor()`` (as
+        :class:`~softbend.identification.svr.GeneralizedGaussianSVR` does), that
+        path is used. The estimator is called on already scaled float64 rows.
 
         Parameters
         ----------
@@ -554,7 +560,8 @@ class NARXRegressor(RegressorMixin, BaseEstimator):
             state[start : start + m] = (initial[k] - y_mean) / y_std
 
         predict = self.estimator_.predict
-        predict_one = getattr(self.estimator_, "predict_one", None)
+        predictor = getattr(self.estimator_, "predictor", None)
+        predict_one = predictor() if callable(predictor) else None
         starts, lengths = segments.starts, segments.lengths
         running = np.ones(starts.size, dtype=bool)
         rows = np.empty((starts.size, n_features))

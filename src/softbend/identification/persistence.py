@@ -207,7 +207,7 @@ def _matrix(value: Any, where: str, rows: int, columns: int) -> np.ndarray:
 _SCALER_KEYS = ("mean", "scale", "var", "n_samples_seen")
 
 
-def _scaler(value: Any, where: str, scale: bool, size: int) -> dict[str, Any] | None:
+def _scaler(value: Any, where: str, scale: bool, size: int) -> Mapping[str, Any] | None:
     if not scale:
         if value is not None:
             raise _RuleError(f"'{where}' must be null when 'narx.params.scale' is false")
@@ -247,7 +247,7 @@ _ESTIMATOR_KEYS = (
 )
 
 
-def _svr_params(value: Any) -> dict[str, Any]:
+def _svr_params(value: Any) -> Mapping[str, Any]:
     where = "estimator.params"
     params = _object(value, where, tuple(GeneralizedGaussianSVR._get_param_names()))
     for key in ("C", "tol", "cache_size"):

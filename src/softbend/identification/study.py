@@ -254,6 +254,8 @@ def identify(
     kernel_params: dict[tuple[str, str], dict[str, Any]] = {}
     for sign, group in by_sign.items():
         for output in OUTPUTS:
+            sigma: float | None
+            shape: float | None
             if config.kernel == "cv":
                 chosen = select_kernel_by_cv(group, output, config)
                 sigma, shape = chosen["sigma"], chosen["shape"]

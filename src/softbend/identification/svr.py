@@ -27,8 +27,9 @@ and ``get_params`` see them. How the ε-SVR dual is solved depends on the shape:
   more slowly.
 
 Prediction is a NumPy kernel expansion over the stored support vectors, in
-row blocks of bounded size, and :meth:`GeneralizedGaussianSVR.predict_one` is a
-low-overhead path for control loops and free-run simulation.
+row blocks of bounded size, and :meth:`GeneralizedGaussianSVR.predictor` returns a
+low-overhead one-sample evaluator for control loops and free-run simulation (the
+fast path of every softbend regressor has that name).
 """
 
 from __future__ import annotations
@@ -36,10 +37,12 @@ from __future__ import annotations
 import logging
 import math
 import warnings
+from collections.abc import Callable
 from numbers import Integral
 from typing import NamedTuple
 
 import numpy as np
+from numpy.typing import ArrayLike
 from scipy.spatial.distance import cdist
 from sklearn import config_context
 from sklearn.base import BaseEstimator, RegressorMixin
@@ -78,7 +81,7 @@ _MAX_ROUNDS = 200
 _ROUNDS_PER_CHUNK = 50
 #: Bytes of one block of kernel values (rows × support vectors) in fit and predict.
 _BLOCK_BYTES = 32 * 2**20
-#: predict_one's factored RBF path is used while rate·|s − m|² and rate·|x − m|² stay
+#: predictor()'s factored RBF path is used while rate·|s − m|² and rate·|x − m|² stay
 #: below this (so no exponent exceeds 2·50 and rounding stays ~1e-14 relative).
 _FAST_EXPONENT = 50.0
 
@@ -638,7 +641,7 @@ class GeneralizedGaussianSVR(RegressorMixin, BaseEstimator):
         self._half_shape = 0.5 * self.shape_
         self._coef = self.dual_coef_ * self.kernel_scale_
         self._x_shape = (self.n_features_in_,)
-        # predict_one's RBF path (γ = 2) about the support vectors' centre m:
+        # predictor()'s RBF path (γ = 2) about the support vectors' centre m:
         # −rate·|s − x|² = 2·rate·(s − m)·x − 2·rate·(s − m)·m − rate·|s − m|² − rate·|x − m|²,
         # so one kernel row is a matrix-vector product, an add and an exp, the
         # |s − m|² factor folded into the coefficients and the |x − m|² one a scalar.
@@ -682,52 +685,67 @@ class GeneralizedGaussianSVR(RegressorMixin, BaseEstimator):
         X = validate_data(self, X, reset=False, dtype=np.float64)
         return self._expansion(X)
 
-    def predict_one(self, x: np.ndarray) -> float:
-        """Predict the target of one sample with minimal overhead.
+    def predictor(self) -> Callable[[ArrayLike], float]:
+        """A fast one-sample evaluator, for control loops and free-run NARX simulation.
 
-        Meant for control loops and free-run (simulation) of NARX models, where
-        one regressor vector is evaluated at a time: no DataFrame handling or
-        scikit-learn validation, only a shape and a finiteness check. The result
-        equals ``predict(x[None, :])[0]`` up to rounding.
-
-        Parameters
-        ----------
-        x : ndarray of shape (n_features,)
-            One input vector (float64 avoids a conversion).
+        The fast path of every softbend regressor has this name (the surrogates'
+        ``predictor()`` too): one regressor vector at a time, without DataFrame
+        handling or scikit-learn validation, only a shape and a finiteness check.
+        The callable holds the fitted arrays of this call: refitting the
+        estimator later does not change it.
 
         Returns
         -------
-        float
-            Predicted target.
+        callable
+            ``f(x) -> float`` for ``x`` array-like of shape (n_features,) (float64
+            avoids a conversion), in the training units; equals
+            ``predict(x[None, :])[0]`` up to rounding. It raises ``ValueError`` for
+            a wrong shape or a non-finite ``x``.
+
+        Raises
+        ------
+        NotFittedError
+            If the estimator is not fitted.
         """
         try:
             support_vectors = self.support_vectors_
         except AttributeError:
             raise NotFittedError(
-                f"This {_OWNER} instance is not fitted yet. Call 'fit' before 'predict_one'."
+                f"This {_OWNER} instance is not fitted yet. Call 'fit' before 'predictor'."
             ) from None
-        x = np.asarray(x, dtype=np.float64)
-        if x.shape != self._x_shape:
-            raise ValueError(
-                f"The 'x' of {_OWNER}.predict_one must have shape {self._x_shape}. "
-                f"Got shape {x.shape} instead."
-            )
-        # |x − m|: NaN or inf for a non-finite x (math.dist is one C call).
-        far = self._rate * math.dist(x.tolist(), self._center) ** 2
-        if not math.isfinite(far):
-            raise ValueError(f"The 'x' of {_OWNER}.predict_one must be finite. Got {x!r} instead.")
-        if self._fast and far <= _FAST_EXPONENT:
-            row = self._fast_matrix @ x
-            row += self._fast_bias
-            np.exp(row, out=row)
-            return float(row @ self._fast_coef) * math.exp(-far) + self.intercept_
-        diff = support_vectors - x
-        arg = np.einsum("ij,ij->i", diff, diff)
-        arg *= self._rate
-        if self._half_shape == 0.5:
-            np.sqrt(arg, out=arg)
-        elif self._half_shape != 1.0:
-            np.power(arg, self._half_shape, out=arg)
-        np.negative(arg, out=arg)
-        np.exp(arg, out=arg)
-        return float(arg @ self._coef) + self.intercept_
+        x_shape, rate, center = self._x_shape, self._rate, self._center
+        half_shape, coef, intercept = self._half_shape, self._coef, self.intercept_
+        fast = self._fast
+        if fast:
+            fast_matrix, fast_bias, fast_coef = self._fast_matrix, self._fast_bias, self._fast_coef
+
+        def predict_one(x: ArrayLike) -> float:
+            x = np.asarray(x, dtype=np.float64)
+            if x.shape != x_shape:
+                raise ValueError(
+                    f"The 'x' of {_OWNER}.predictor() must have shape {x_shape}. "
+                    f"Got shape {x.shape} instead."
+                )
+            # |x − m|: NaN or inf for a non-finite x (math.dist is one C call).
+            far = rate * math.dist(x.tolist(), center) ** 2
+            if not math.isfinite(far):
+                raise ValueError(
+                    f"The 'x' of {_OWNER}.predictor() must be finite. Got {x!r} instead."
+                )
+            if fast and far <= _FAST_EXPONENT:
+                row = fast_matrix @ x
+                row += fast_bias
+                np.exp(row, out=row)
+                return float(row @ fast_coef) * math.exp(-far) + intercept
+            diff = support_vectors - x
+            arg = np.einsum("ij,ij->i", diff, diff)
+            arg *= rate
+            if half_shape == 0.5:
+                np.sqrt(arg, out=arg)
+            elif half_shape != 1.0:
+                np.power(arg, half_shape, out=arg)
+            np.negative(arg, out=arg)
+            np.exp(arg, out=arg)
+            return float(arg @ coef) + intercept
+
+        return predict_one

@@ -36,7 +36,7 @@ The model, from the valve to the camera:
    (:func:`softbend.kinematics.tip_position`), plus Gaussian noise of
    ``noise_std_mm`` on each coordinate and quantization to ``pixel_mm``.
 
-Calibration (SPEC §3, paper A eqs. 18–19): ``L = 18.25 mm`` (+19.67 %) at the
+Calibration (paper A §4.2, eqs. 18–19): ``L = 18.25 mm`` (+19.67 %) at the
 largest positive pressure and ``L = 9.25 mm`` (−39.34 %) at the strongest vacuum,
 in steady state on the static (anhysteretic) maps. **Assumptions not stated in
 paper A**: the pressure range (+100 kPa maximum, −80 kPa strongest vacuum), the
@@ -56,11 +56,11 @@ the slow or hysteretic states.
 from __future__ import annotations
 
 import math
-from collections.abc import Sequence
 from dataclasses import asdict, dataclass
 from typing import Any, Literal
 
 import numpy as np
+from numpy.typing import ArrayLike
 
 from softbend._validation import check_choice, check_range
 from softbend.identification.data import Experiment
@@ -69,7 +69,14 @@ from softbend.plausibility import RANGES
 
 #: Profile kinds of the ``"mixed"`` excitation, in the order :func:`synthetic_dataset`
 #: cycles through them.
-PROFILE_KINDS: tuple[str, ...] = ("random_hold", "staircase", "triangle", "step", "sine", "ramp")
+PROFILE_KINDS: tuple[ProfileKind, ...] = (
+    "random_hold",
+    "staircase",
+    "triangle",
+    "step",
+    "sine",
+    "ramp",
+)
 #: Every kind :func:`pressure_profile` understands: the mixed ones and ``"impulsive"``.
 ALL_PROFILE_KINDS: tuple[str, ...] = (*PROFILE_KINDS, "impulsive")
 #: Excitations of :func:`synthetic_dataset`: ``"mixed"`` cycles through
@@ -127,7 +134,7 @@ class CurlingActuator:
     """Parameters of the synthetic miniature pneumatic curling actuator.
 
     The model is described in the module docstring. Defaults reproduce the
-    calibration of paper A (SPEC §3) under the stated assumptions.
+    calibration of paper A (§4.2) under the stated assumptions.
 
     Parameters
     ----------
@@ -200,7 +207,7 @@ class CurlingActuator:
 
     def __post_init__(self) -> None:
         positive = {"low": 0.0, "high": math.inf}
-        checks: dict[str, dict[str, float | bool]] = {
+        checks: dict[str, dict[str, Any]] = {
             "rest_length_mm": positive,
             "max_pressure_kpa": positive,
             "min_pressure_kpa": {"low": -math.inf, "high": 0.0},
@@ -294,7 +301,7 @@ class CurlingActuator:
         return rho, length
 
     # ----------------------------------------------------------------- dynamic
-    def response(self, time_s: Sequence[float], pressure_kpa: Sequence[float]) -> ActuatorResponse:
+    def response(self, time_s: ArrayLike, pressure_kpa: ArrayLike) -> ActuatorResponse:
         """Integrate the noise-free model over a commanded pressure sequence.
 
         Parameters
@@ -402,8 +409,8 @@ class CurlingActuator:
 
     def simulate(
         self,
-        time_s: Sequence[float],
-        pressure_kpa: Sequence[float],
+        time_s: ArrayLike,
+        pressure_kpa: ArrayLike,
         *,
         seed: int = 0,
         name: str = "synthetic",

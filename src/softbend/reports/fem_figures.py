@@ -9,6 +9,7 @@ from typing import Any
 
 import numpy as np
 
+from softbend.fem.stats import fem_stats
 from softbend.models import SweepResult
 from softbend.reports.analysis_figures import _figure, _save
 
@@ -25,11 +26,12 @@ def angle_pressure_curve(
     fig, ax = _figure((6.0, 4.2))
     ok = result.converged
     ax.plot(result.pressure_mpa[ok], result.angle_deg[ok], color="C0", label="FEM (outputs)")
-    steps = result.stats.get("steps_mpa")
+    stats = fem_stats(result)
+    steps = stats.get("steps_mpa")
     if steps:
         ax.plot(
             steps,
-            result.stats["step_angles_deg"],
+            stats["step_angles_deg"],
             "o",
             ms=3,
             color="C0",
