@@ -82,7 +82,7 @@ def test_the_core_works_without_extras(tmp_path):
 @pytest.mark.parametrize(
     ("code", "extra"),
     [
-        ("import softbend.fem", "softbend[fem]"),
+        ("from softbend.fem import FEMModel", "softbend[fem]"),
         ("from softbend.surrogates import NormalizedMLPRegressor", "softbend[ml]"),
         (XGB, "softbend[ml]"),
     ],
@@ -122,3 +122,33 @@ def test_require_names_the_package_and_the_extra(monkeypatch):
     monkeypatch.setattr(importlib, "import_module", refuse)
     with pytest.raises(MissingExtraError, match=r"Dask distributed.*softbend\[dask\]"):
         require("distributed", "A campaign on a Dask cluster")
+
+
+def test_require_refuses_a_module_no_extra_provides():
+    with pytest.raises(ValueError, match=r"Unknown optional module 'sklearn'.*known: ngsolve"):
+        require("sklearn", "Anything")
+
+
+def test_a_saved_xgboost_surrogate_without_the_extra_is_one_error_naming_it(tmp_path):
+    import numpy as np
+
+    xgb = pytest.importorskip("xgboost")
+    from softbend.surrogates.persistence import save_surrogate
+
+    X = np.random.default_rng(0).uniform(
+        [100, 6, 2, 2, 5, 8, 0], [160, 10, 4, 4, 15, 12, 0.3], (60, 7)
+    )
+    model = xgb.XGBRegressor(n_estimators=3, max_depth=2, n_jobs=1).fit(X, 300 * X[:, 6])
+    path = save_surrogate(model, tmp_path / "xgb.json")
+    done = _run(
+        f"""
+        from softbend.errors import MissingExtraError
+        from softbend.surrogates.persistence import load_surrogate
+        try:
+            load_surrogate({str(path)!r})
+        except MissingExtraError as exc:
+            print(exc)
+        """
+    )
+    assert done.returncode == 0, done.stderr
+    assert "XGBoost" in done.stdout and "softbend[ml]" in done.stdout

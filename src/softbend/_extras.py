@@ -14,6 +14,10 @@ extra      packages                                      needed by
 ``rig``    pymodbus                                      the Modbus rig (``softbend control run``)
 ``all``    all of the above
 =========  ============================================  ===============================
+
+A surrogate family that needs an extra names it in its storage
+(:class:`softbend.surrogates.families.Storage`, ``extra``), so that loading its
+saved model without the extra is the same one-line error.
 """
 
 from __future__ import annotations
@@ -53,7 +57,13 @@ def require(module: str, purpose: str) -> ModuleType:
     ------
     MissingExtraError
         If the module cannot be imported.
+    ValueError
+        For a module that no extra provides (naming the known ones).
     """
+    if module not in EXTRAS:
+        raise ValueError(
+            f"Unknown optional module {module!r} (in require); known: {', '.join(EXTRAS)}."
+        )
     package, extra = EXTRAS[module]
     try:
         return importlib.import_module(module)

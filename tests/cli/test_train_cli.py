@@ -54,7 +54,8 @@ def test_train_writes_models_tables_figures_and_predicts(small_campaign, tmp_pat
 @pytest.mark.parametrize(
     ("extra", "needle"),
     [
-        (["--models", "plr,svm"], "'models'"),
+        (["--models", "plr,svm"], "surrogate family 'svm' (in models); known: plr, xgb, mlp."),
+        (["--models", " , "], "'models' must name at least one surrogate family"),
         (["--grid", "huge"], "'grid'"),
         (["--device", "tpu"], "'device'"),
         (["--folds", "1"], "folds"),
@@ -81,7 +82,8 @@ def test_train_missing_database(tmp_path, capsys):
 @pytest.mark.parametrize(
     ("design", "pressure", "needle"),
     [
-        ("100,6,2,2,5", "0.1", "6 numbers"),
+        ("100,6,2,2,5", "0.1", "6 values"),
+        ("100,6,2,2,5,x", "0.1", "'design' must be six comma-separated numbers"),
         ("100,6,-2,2,5,8", "0.1", "t_mm"),
         ("100,6,2,2,5,8", "0.1,abc", "'pressure'"),
         ("100,6,2,2,5,8", "-0.1", "'pressure'"),

@@ -8,10 +8,11 @@ from onnx import TensorProto
 from sklearn.exceptions import NotFittedError
 from sklearn.linear_model import LinearRegression
 
+from softbend.surrogates.families import MODEL_NAMES as BASE_KINDS
 from softbend.surrogates.features import FEATURES
 from softbend.surrogates.mlp import NormalizedMLPRegressor
 from softbend.surrogates.onnx_export import DEFAULT_OPSET, onnx_predict, save_onnx, to_onnx
-from softbend.surrogates.persistence import BASE_KINDS, load_surrogate, save_surrogate
+from softbend.surrogates.persistence import load_surrogate, save_surrogate
 from softbend.surrogates.polynomial import PolynomialRegressor, monomial_powers
 
 from .conftest import HIGH, LOW
@@ -24,11 +25,11 @@ def fitted():
     X = _inputs(300, 0)
     y = _angle(X)
     return {
-        "polynomial": PolynomialRegressor(degree=4).fit(X, y),
+        "plr": PolynomialRegressor(degree=4).fit(X, y),
         "mlp": NormalizedMLPRegressor(
             hidden_sizes=(8, 6), epochs=3, batch_size=64, seed=1, device="cpu"
         ).fit(X, y),
-        "xgboost": xgb.XGBRegressor(
+        "xgb": xgb.XGBRegressor(
             n_estimators=40, max_depth=6, tree_method="hist", random_state=0, n_jobs=1
         ).fit(X, y),
     }
@@ -59,7 +60,7 @@ def test_graph_signature_and_metadata(fitted, kind):
     in_shape = [d.dim_value or d.dim_param for d in source.type.tensor_type.shape.dim]
     out_shape = [d.dim_value or d.dim_param for d in target.type.tensor_type.shape.dim]
     assert in_shape[1:] == [7] and len(out_shape) == 1
-    dtype = TensorProto.FLOAT if kind == "xgboost" else TensorProto.DOUBLE
+    dtype = TensorProto.FLOAT if kind == "xgb" else TensorProto.DOUBLE
     assert source.type.tensor_type.elem_type == target.type.tensor_type.elem_type == dtype
     props = {p.key: p.value for p in proto.metadata_props}
     assert props["kind"] == kind
@@ -70,7 +71,7 @@ def test_graph_signature_and_metadata(fitted, kind):
 
 @pytest.mark.parametrize("opset", [13, DEFAULT_OPSET, 18, 21])
 def test_polynomial_graph_for_old_and_new_reduce_prod(fitted, opset):
-    model = fitted["polynomial"]
+    model = fitted["plr"]
     proto = to_onnx(model, opset=opset)
     assert [op.version for op in proto.opset_import if op.domain == ""] == [opset]
     X = _inputs(300, 6)
@@ -113,7 +114,7 @@ def test_polynomial_graph_matches_a_closed_form():
 
 def test_polynomial_graph_handles_zero_inputs_exactly(fitted):
     # At x = x_mean_ every z is 0: only the constant monomial (0**0 = 1) survives.
-    model = fitted["polynomial"]
+    model = fitted["plr"]
     at_mean = model.x_mean_[None, :]
     expected = model.y_mean_ + model.y_scale_ * model.coef_[0]
     assert onnx_predict(to_onnx(model), at_mean)[0] == expected
@@ -135,7 +136,7 @@ def test_mlp_graph_matches_the_numpy_formula(fitted):
 
 
 def test_loaded_model_exports_the_same_graph(fitted, tmp_path):
-    model = fitted["polynomial"]
+    model = fitted["plr"]
     loaded = load_surrogate(save_surrogate(model, tmp_path / "m.json")).model
     a, b = to_onnx(model), to_onnx(loaded)
     assert [t.raw_data for t in a.graph.initializer] == [t.raw_data for t in b.graph.initializer]
@@ -154,7 +155,7 @@ def test_save_onnx_writes_a_loadable_file(fitted, tmp_path, kind):
 
 
 def test_bad_inputs_are_refused(fitted, tmp_path):
-    model = fitted["polynomial"]
+    model = fitted["plr"]
     proto = to_onnx(model)
     with pytest.raises(ValueError, match="must have 7 columns"):
         onnx_predict(proto, np.ones((4, 6)))
@@ -168,7 +169,7 @@ def test_bad_inputs_are_refused(fitted, tmp_path):
         with pytest.raises(ValueError, match="'opset' of to_onnx"):
             to_onnx(model, opset=opset)
     with pytest.raises(ValueError, match=r"'opset' of to_onnx.*\[13, "):
-        to_onnx(fitted["xgboost"], opset=99)
+        to_onnx(fitted["xgb"], opset=99)
     with pytest.raises(ValueError, match="'model' of to_onnx must be one of"):
         to_onnx(LinearRegression().fit(np.ones((3, 7)), np.ones(3)))
     with pytest.raises(NotFittedError):

@@ -13,16 +13,16 @@ from sklearn.linear_model import LinearRegression
 
 from softbend import __version__
 from softbend.errors import LimitError, SchemaError
+from softbend.surrogates.families import MODEL_NAMES as BASE_KINDS
 from softbend.surrogates.features import FEATURES, UNITS
 from softbend.surrogates.mlp import NormalizedMLPRegressor
 from softbend.surrogates.persistence import (
-    BASE_KINDS,
     FORMAT,
-    KINDS,
     SCHEMA_VERSION,
     kind_of,
     load_surrogate,
     save_surrogate,
+    saved_kinds,
 )
 from softbend.surrogates.polynomial import PolynomialRegressor
 
@@ -32,11 +32,11 @@ from .conftest import table1_inputs as _inputs
 
 def _new(kind):
     return {
-        "polynomial": lambda: PolynomialRegressor(degree=3),
+        "plr": lambda: PolynomialRegressor(degree=3),
         "mlp": lambda: NormalizedMLPRegressor(
             hidden_sizes=(8, 6), epochs=3, batch_size=64, seed=1, device="cpu"
         ),
-        "xgboost": lambda: xgb.XGBRegressor(
+        "xgb": lambda: xgb.XGBRegressor(
             n_estimators=15, max_depth=4, tree_method="hist", random_state=0, n_jobs=1
         ),
     }[kind]()
@@ -72,12 +72,12 @@ def test_save_load_predicts_bit_for_bit(fitted, tmp_path, kind):
     assert saved.model.n_features_in_ == 7
 
 
-@pytest.mark.parametrize("kind", ["polynomial", "mlp"])
+@pytest.mark.parametrize("kind", ["plr", "mlp"])
 def test_fitted_arrays_keep_values_and_dtypes(fitted, tmp_path, kind):
     model = fitted[kind]
     loaded = load_surrogate(save_surrogate(model, tmp_path / "m.json")).model
     names = ["x_mean_", "x_scale_", "y_mean_", "y_scale_"]
-    names += ["powers_", "coef_"] if kind == "polynomial" else ["coefs_", "intercepts_"]
+    names += ["powers_", "coef_"] if kind == "plr" else ["coefs_", "intercepts_"]
     for name in names:
         ours, theirs = getattr(model, name), getattr(loaded, name)
         if isinstance(ours, list):
@@ -119,11 +119,11 @@ def test_file_is_one_json_with_header_and_metadata(fitted, tmp_path):
         "metrics": {"r2": np.float64(0.995), "mape_pct": 1.8, "n": np.int64(300)},
         "cv": {"folds": 5, "scores": np.array([0.99, 0.98])},
     }
-    path = save_surrogate(fitted["polynomial"], tmp_path / "m.json", metadata=metadata)
+    path = save_surrogate(fitted["plr"], tmp_path / "m.json", metadata=metadata)
     document = json.loads(path.read_text(encoding="utf-8"))
     assert document["format"] == FORMAT
     assert document["schema_version"] == SCHEMA_VERSION
-    assert document["kind"] == "polynomial"
+    assert document["kind"] == "plr"
     assert document["features"] == list(FEATURES)
     assert document["units"]["pressure_mpa"] == UNITS["pressure_mpa"] == "MPa"
     assert document["target"] == "angle_deg"
@@ -142,7 +142,7 @@ def test_file_is_one_json_with_header_and_metadata(fitted, tmp_path):
 
 
 def test_xgboost_booster_is_stored_as_json_text(fitted, tmp_path):
-    model = fitted["xgboost"]
+    model = fitted["xgb"]
     document = json.loads(save_surrogate(model, tmp_path / "m.json").read_text())
     booster = json.loads(document["state"]["booster"])
     assert (
@@ -154,7 +154,7 @@ def test_xgboost_booster_is_stored_as_json_text(fitted, tmp_path):
 
 
 def _saved(fitted, tmp_path):
-    path = save_surrogate(fitted["polynomial"], tmp_path / "m.json")
+    path = save_surrogate(fitted["plr"], tmp_path / "m.json")
     return path, json.loads(path.read_text())
 
 
@@ -212,11 +212,11 @@ def test_non_surrogate_files_raise_schema_error(tmp_path, text, match):
 
 
 def test_broken_xgboost_booster_raises_schema_error(fitted, tmp_path):
-    path = save_surrogate(fitted["xgboost"], tmp_path / "m.json")
+    path = save_surrogate(fitted["xgb"], tmp_path / "m.json")
     document = json.loads(path.read_text())
     document["state"]["booster"] = "{not a booster"
     path.write_text(json.dumps(document))
-    with pytest.raises(SchemaError, match=r"'booster' of the xgboost surrogate .* not valid JSON"):
+    with pytest.raises(SchemaError, match=r"'booster' of the xgb surrogate .* not valid JSON"):
         load_surrogate(path)
 
 
@@ -229,11 +229,9 @@ class _Subclass(PolynomialRegressor):
     pass
 
 
-@pytest.mark.parametrize(
-    "model", [LinearRegression(), _Subclass(), xgb.XGBClassifier(), "polynomial"]
-)
+@pytest.mark.parametrize("model", [LinearRegression(), _Subclass(), xgb.XGBClassifier(), "plr"])
 def test_unknown_model_types_are_refused(tmp_path, model):
-    with pytest.raises(ValueError, match=r"PolynomialRegressor \('polynomial'\).*'xgboost'"):
+    with pytest.raises(ValueError, match=r"PolynomialRegressor \('plr'\).*'xgb'"):
         save_surrogate(model, tmp_path / "m.json")
     with pytest.raises(ValueError, match="must be one of"):
         kind_of(model)
@@ -254,14 +252,14 @@ def test_models_on_other_features_are_refused(tmp_path):
 
 
 def test_bad_metadata_and_params_are_refused_and_old_file_kept(fitted, tmp_path):
-    path = save_surrogate(fitted["polynomial"], tmp_path / "m.json", metadata={"v": 1})
+    path = save_surrogate(fitted["plr"], tmp_path / "m.json", metadata={"v": 1})
     before = path.read_bytes()
     with pytest.raises(ValueError, match="'metadata' of save_surrogate must be JSON"):
-        save_surrogate(fitted["polynomial"], path, metadata={"f": object()})
+        save_surrogate(fitted["plr"], path, metadata={"f": object()})
     with pytest.raises(ValueError, match="string keys"):
-        save_surrogate(fitted["polynomial"], path, metadata={1: "a"})
+        save_surrogate(fitted["plr"], path, metadata={1: "a"})
     with pytest.raises(ValueError, match="string keys"):
-        save_surrogate(fitted["polynomial"], path, metadata=[("a", 1)])
+        save_surrogate(fitted["plr"], path, metadata=[("a", 1)])
     model = PolynomialRegressor(degree=2).fit(_inputs(60, 4), _angle(_inputs(60, 4)))
     model.alpha = lambda: 0.0
     with pytest.raises(ValueError, match="parameter 'alpha' of PolynomialRegressor"):
@@ -355,7 +353,7 @@ _CORRUPTIONS = {
         ("bool feature count", lambda s: s.update(n_features_in_=True), "n_features_in_"),
         ("device", lambda s: s.update(device_="tpu"), "device_.*one of 'cpu', 'cuda'"),
     ],
-    "polynomial": [
+    "plr": [
         ("nan coefficient", _set_first("coef_", float("nan")), "coef_.*finite"),
         ("zero x scale", _set_first("x_scale_", 0.0), "x_scale_.*values > 0"),
         ("zero y scale", lambda s: s.update(y_scale_=0), "y_scale_.*> 0"),
@@ -423,13 +421,13 @@ def test_unknown_state_key_names_the_allowed_keys_and_is_never_set(fitted, tmp_p
 @pytest.mark.parametrize(
     ("kind", "params", "match"),
     [
-        ("polynomial", {"chunk_rows": "many"}, "params key 'chunk_rows'.*integer >= 1"),
-        ("polynomial", {"degree": 0}, "params key 'degree'.*integer >= 1"),
-        ("polynomial", {"alpha": float("nan")}, "params key 'alpha'"),
+        ("plr", {"chunk_rows": "many"}, "params key 'chunk_rows'.*integer >= 1"),
+        ("plr", {"degree": 0}, "params key 'degree'.*integer >= 1"),
+        ("plr", {"alpha": float("nan")}, "params key 'alpha'"),
         ("mlp", {"hidden_sizes": [8]}, "params key 'hidden_sizes'.*two integers"),
         ("mlp", {"predict": 1}, "unknown params key.*'predict'"),
-        ("xgboost", {"predict": 1}, "unknown params key.*'predict'"),
-        ("xgboost", {"_Booster": 1}, "unknown params key.*'_Booster'"),
+        ("xgb", {"predict": 1}, "unknown params key.*'predict'"),
+        ("xgb", {"_Booster": 1}, "unknown params key.*'_Booster'"),
     ],
 )
 def test_hand_edited_params_are_refused(fitted, tmp_path, kind, params, match):
@@ -462,7 +460,7 @@ def test_hand_edited_params_are_refused(fitted, tmp_path, kind, params, match):
     ],
 )
 def test_hand_edited_xgboost_state_is_refused(fitted, tmp_path, change, match):
-    path = save_surrogate(fitted["xgboost"], tmp_path / "m.json")
+    path = save_surrogate(fitted["xgb"], tmp_path / "m.json")
     document = json.loads(path.read_text())
     change(document["state"])
     path.write_text(json.dumps(document))
@@ -471,7 +469,7 @@ def test_hand_edited_xgboost_state_is_refused(fitted, tmp_path, change, match):
 
 
 def test_numpy_scalars_and_xgboost_extra_parameters_still_load(fitted, tmp_path):
-    path = save_surrogate(fitted["polynomial"], tmp_path / "m.json")
+    path = save_surrogate(fitted["plr"], tmp_path / "m.json")
     document = json.loads(path.read_text())
     document["state"]["y_scale_"] = {"__scalar__": 2.0, "dtype": "float64"}
     document["state"]["rank_"] = {"__scalar__": 120, "dtype": "int64"}
@@ -491,13 +489,13 @@ def test_numpy_scalars_and_xgboost_extra_parameters_still_load(fitted, tmp_path)
 
 
 def test_a_booster_xgboost_refuses_is_one_line(fitted, tmp_path):
-    path = save_surrogate(fitted["xgboost"], tmp_path / "m.json")
+    path = save_surrogate(fitted["xgb"], tmp_path / "m.json")
     document = json.loads(path.read_text())
     booster = json.loads(document["state"]["booster"])
     booster["learner"]["gradient_booster"]["model"]["trees"][0]["base_weights"].append(1.0)
     document["state"]["booster"] = json.dumps(booster)
     path.write_text(json.dumps(document))
-    with pytest.raises(SchemaError, match="cannot rebuild the xgboost surrogate") as info:
+    with pytest.raises(SchemaError, match="cannot rebuild the xgb surrogate") as info:
         load_surrogate(path)
     assert "\n" not in str(info.value) and "Stack trace" not in str(info.value)
 
@@ -523,7 +521,7 @@ def _composites(fitted):
         gp_kernel,
     )
 
-    base = fitted["polynomial"]
+    base = fitted["plr"]
     X = _inputs(30, 21)
     theta = base.predict(X)
     Z = np.column_stack([X, theta])
@@ -533,14 +531,14 @@ def _composites(fitted):
     return {
         "affine-corrected": AffineCorrected(base, 1.1, -2.0, 0.5),
         "gp-corrected": GPCorrected(base, mean, scale, gp_kernel(8).theta, inputs, errors),
-        "ensemble": MeanEnsemble([fitted["polynomial"], fitted["mlp"], fitted["xgboost"]], 0.25),
-        "pressure-scaled": PressureScaled(fitted["xgboost"], 1.2, 0.5),
+        "ensemble": MeanEnsemble([fitted["plr"], fitted["mlp"], fitted["xgb"]], 0.25),
+        "pressure-scaled": PressureScaled(fitted["xgb"], 1.2, 0.5),
     }
 
 
 def test_every_kind_saves_strict_json_and_reloads_bit_for_bit(fitted, tmp_path):
     models = {**fitted, **_composites(fitted)}
-    assert set(models) == set(KINDS)
+    assert set(models) == set(saved_kinds())
     X = _inputs(200, 22)
     for kind, model in models.items():
         path = save_surrogate(model, tmp_path / f"{kind}.json", metadata={"r2": float("nan")})
@@ -571,7 +569,7 @@ def test_non_finite_parameters_and_diagnostics_are_tagged_and_restored(fitted, t
 
 
 def test_xgboost_missing_is_null_and_a_file_with_a_bare_nan_still_loads(fitted, tmp_path):
-    model = fitted["xgboost"]
+    model = fitted["xgb"]
     path = save_surrogate(model, tmp_path / "m.json")
     assert '"missing": null' in path.read_text()
     X = _inputs(300, 24)
@@ -591,7 +589,7 @@ def test_xgboost_missing_is_null_and_a_file_with_a_bare_nan_still_loads(fitted, 
     [(-999.0, True), (0, True), ({"__float__": "nan"}, True), ("abc", False), (True, False)],
 )
 def test_xgboost_missing_must_be_a_number_or_null(fitted, tmp_path, missing, ok):
-    path = save_surrogate(fitted["xgboost"], tmp_path / "m.json")
+    path = save_surrogate(fitted["xgb"], tmp_path / "m.json")
     document = json.loads(path.read_text())
     document["params"]["missing"] = missing
     path.write_text(json.dumps(document))
@@ -640,7 +638,7 @@ def test_a_file_nested_beyond_the_limit_is_a_limit_error_naming_it(fitted, tmp_p
     path.write_text(_nested(document, 2))  # within both: loads
     model = load_surrogate(path).model
     np.testing.assert_array_equal(
-        model.predict(_inputs(5, 26)), fitted["polynomial"].predict(_inputs(5, 26))
+        model.predict(_inputs(5, 26)), fitted["plr"].predict(_inputs(5, 26))
     )
 
 
@@ -651,9 +649,7 @@ def _with_ranges(fitted, tmp_path, change):
     from softbend.surrogates.features import training_ranges
 
     ranges = training_ranges(_inputs(300, 0))
-    path = save_surrogate(
-        fitted["polynomial"], tmp_path / "m.json", metadata={"training_ranges": ranges}
-    )
+    path = save_surrogate(fitted["plr"], tmp_path / "m.json", metadata={"training_ranges": ranges})
     document = json.loads(path.read_text())
     change(document["metadata"]["training_ranges"])
     path.write_text(json.dumps(document))
@@ -707,9 +703,7 @@ def test_bad_training_ranges_are_refused_naming_the_file_and_field(fitted, tmp_p
 
 @pytest.mark.parametrize("ranges", [[1, 2], None, "l_mm"])
 def test_training_ranges_that_are_not_an_object_are_refused(fitted, tmp_path, ranges):
-    path = save_surrogate(
-        fitted["polynomial"], tmp_path / "m.json", metadata={"training_ranges": ranges}
-    )
+    path = save_surrogate(fitted["plr"], tmp_path / "m.json", metadata={"training_ranges": ranges})
     with pytest.raises(SchemaError, match="'training_ranges' must be an object of"):
         load_surrogate(path)
 
@@ -725,7 +719,7 @@ def test_integer_training_ranges_still_load(fitted, tmp_path):
 @pytest.mark.parametrize(
     ("change", "match"),
     [
-        (lambda d: d.update(kind=["polynomial"]), r'unknown surrogate kind \["polynomial"\]'),
+        (lambda d: d.update(kind=["plr"]), r'unknown surrogate kind \["plr"\]'),
         (lambda d: d.update(kind={"a": 1}), "unknown surrogate kind"),
         (lambda d: d.update(kind=None), "unknown surrogate kind null"),
         (lambda d: d["units"].update(pressure_mpa="kPa"), "'units' must be .*got \"kPa\""),
@@ -777,13 +771,13 @@ def test_mlp_hidden_sizes_must_match_the_weights(fitted, tmp_path):
     [
         (
             lambda d: d["params"].update(n_jobs={"__scalar__": 1, "dtype": "datetime64"}),
-            "params of the xgboost surrogate cannot be read",
+            "params of the xgb surrogate cannot be read",
         ),
         (
             lambda d: d["params"].update(n_jobs={"__float__": "lots"}),
-            "params of the xgboost surrogate cannot be read",
+            "params of the xgb surrogate cannot be read",
         ),
-        (lambda d: d["params"].update(n_jobs="many"), "cannot rebuild the xgboost surrogate"),
+        (lambda d: d["params"].update(n_jobs="many"), "cannot rebuild the xgb surrogate"),
         (
             lambda d: d["state"].update(
                 booster=d["state"]["booster"].replace(
@@ -804,10 +798,79 @@ def test_mlp_hidden_sizes_must_match_the_weights(fitted, tmp_path):
     ids=["datetime-dtype", "bad-float-tag", "n-jobs-string", "feature-names", "nan-base-score"],
 )
 def test_xgboost_values_read_only_when_predicting_fail_on_load(fitted, tmp_path, change, match):
-    path = save_surrogate(fitted["xgboost"], tmp_path / "m.json")
+    path = save_surrogate(fitted["xgb"], tmp_path / "m.json")
     document = json.loads(path.read_text())
     change(document)
     path.write_text(json.dumps(document))
     with pytest.raises(SchemaError, match=match) as info:
         load_surrogate(path)
     assert str(info.value).startswith(f"{path}: ") and "\n" not in str(info.value)
+
+
+# --- schema version 1: the kinds named otherwise are read as their families ------------------
+
+
+def _as_version_1(document, kind):
+    """``document`` as softbend wrote it with schema version 1: ``kind`` named the old way."""
+    return {**document, "schema_version": 1, "kind": kind}
+
+
+@pytest.mark.parametrize(("family", "old"), [("plr", "polynomial"), ("xgb", "xgboost")])
+def test_a_version_1_file_loads_as_its_family(fitted, tmp_path, family, old):
+    path = save_surrogate(fitted[family], tmp_path / "new.json")
+    document = json.loads(path.read_text())
+    assert (document["kind"], document["schema_version"]) == (family, SCHEMA_VERSION) == (family, 2)
+    old_path = tmp_path / "old.json"
+    old_path.write_text(json.dumps(_as_version_1(document, old)))
+    saved = load_surrogate(old_path)
+    assert saved.kind == family == kind_of(saved.model)
+    X = _inputs(50, 31)
+    np.testing.assert_array_equal(saved.model.predict(X), fitted[family].predict(X))
+    # the old name is a migration, not a second name: a version 2 file must use the family's
+    old_path.write_text(json.dumps({**document, "kind": old}))
+    with pytest.raises(
+        SchemaError, match=rf"unknown surrogate kind '{old}'; expected one of 'plr'"
+    ):
+        load_surrogate(old_path)
+
+
+def test_a_version_1_composite_migrates_its_inner_surrogates(fitted, tmp_path):
+    from softbend.surrogates.corrected import AffineCorrected, MeanEnsemble
+
+    model = AffineCorrected(MeanEnsemble([fitted["plr"], fitted["xgb"]], 0.2), 1.1, -2.0, 0.5)
+    document = json.loads(save_surrogate(model, tmp_path / "m.json").read_text())
+    members = document["state"]["base"]["state"]["members"]
+    members[0] = _as_version_1(members[0], "polynomial")
+    members[1] = _as_version_1(members[1], "xgboost")
+    path = tmp_path / "old.json"
+    path.write_text(json.dumps({**document, "schema_version": 1}))
+    loaded = load_surrogate(path).model
+    assert [kind_of(m) for m in loaded.base.members_] == ["plr", "xgb"]
+    X = _inputs(50, 32)
+    np.testing.assert_array_equal(loaded.predict(X), model.predict(X))
+
+
+def test_the_shipped_version_1_mlp_still_loads():
+    from importlib.resources import files
+
+    path = files("softbend") / "data" / "transfer" / "table1_fem_mlp.json"
+    assert json.loads(path.read_text())["schema_version"] == 1
+    saved = load_surrogate(path)
+    assert saved.kind == "mlp" and type(saved.model).__name__ == "NormalizedMLPRegressor"
+    assert np.isfinite(saved.model.predict(_inputs(5, 33))).all()
+
+
+def test_a_family_without_storage_is_not_saved_and_its_kind_not_read(fitted, tmp_path):
+    from softbend.surrogates.families import FAMILIES, Family
+
+    toy = Family("no-storage", "toy", {"quick": ({},), "paper": ({},)}, lambda p, s: None)
+    path = save_surrogate(fitted["plr"], tmp_path / "m.json")
+    document = json.loads(path.read_text())
+    path.write_text(json.dumps({**document, "kind": "no-storage"}))
+    FAMILIES.register("no-storage", toy)
+    try:
+        assert "no-storage" not in saved_kinds()
+        with pytest.raises(SchemaError, match="unknown surrogate kind 'no-storage'"):
+            load_surrogate(path)
+    finally:
+        FAMILIES.unregister("no-storage")

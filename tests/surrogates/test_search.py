@@ -21,9 +21,15 @@ def test_grid_sizes_match_paper_b():
     assert grid("quick", "mlp") == [{"hidden_sizes": (63, 65)}]  # paper B's pick
 
 
-@pytest.mark.parametrize(("name", "model"), [("huge", "plr"), ("quick", "svm")])
-def test_unknown_grid_or_model(name, model):
-    with pytest.raises(ValueError, match="must be one of"):
+@pytest.mark.parametrize(
+    ("name", "model", "match"),
+    [
+        ("huge", "plr", "'grid' of surrogate search must be one of"),
+        ("quick", "svm", r"Unknown surrogate family 'svm' \(in model\); known: plr, xgb, mlp\."),
+    ],
+)
+def test_unknown_grid_or_model(name, model, match):
+    with pytest.raises(ValueError, match=match):
         grid(name, model)
 
 
@@ -46,7 +52,7 @@ def test_too_few_designs_for_the_folds():
 
 
 def test_unknown_model_in_search(small_data):
-    with pytest.raises(ValueError, match=r"'models'.*'plr', 'xgb', 'mlp'"):
+    with pytest.raises(ValueError, match=r"'gpr' \(in models\); known: plr, xgb, mlp\."):
         search(small_data, models=["plr", "gpr"])
 
 

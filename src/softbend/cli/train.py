@@ -9,22 +9,13 @@ import typer
 from softbend.cli import _common
 
 
-def _floats(text: str, name: str) -> list[float]:
-    try:
-        values = [float(v) for v in text.split(",") if v.strip()]
-    except ValueError:
-        raise ValueError(
-            f"The '{name}' must be comma-separated numbers, e.g. 0.05,0.1. Got {text!r} instead."
-        ) from None
-    if not values:
-        raise ValueError(f"The '{name}' must hold at least one number. Got {text!r} instead.")
-    return values
-
-
 def train(
     db: Path = typer.Argument(..., help="Campaign database (DuckDB) to learn from."),
     out: Path = typer.Option(..., "--out", help="Folder for models, tables and figures."),
-    models: str = typer.Option("plr,xgb,mlp", help="Comma-separated families: plr, xgb, mlp."),
+    models: str = typer.Option(
+        "plr,xgb,mlp",
+        help="Comma-separated surrogate families: plr, xgb, mlp (paper B's) or any registered.",
+    ),
     grid: str = typer.Option("quick", help="Hyperparameter grid: quick or paper."),
     folds: int = typer.Option(5, help="Design-grouped cross-validation folds."),
     seed: int = typer.Option(0, help="Seed of the folds, XGBoost and the MLP."),
@@ -64,12 +55,10 @@ def train(
     from it (a checkpoint of other settings is discarded with a warning). It is
     removed when the new ``--out`` is in place.
     """
-    from softbend._io import staged_dir
     from softbend._validation import check_int
     from softbend.limits import check_limit
     from softbend.reports.surrogate_figures import training_figures
-    from softbend.surrogates.checkpoint import SearchCheckpoint, checkpoint_path
-    from softbend.surrogates.workflow import train_surrogates
+    from softbend.surrogates.workflow import train_into
 
     if jobs is not None:
         check_int(jobs, "--jobs", "softbend train", low=1)
@@ -84,48 +73,35 @@ def train(
     _common.check_replaceable_dir(
         out, "--out", "softbend train", inputs=(db,), marker="cv_results.csv"
     )
-    names = [m.strip() for m in models.split(",") if m.strip()]
 
     def resuming(line: str) -> None:
         _common.err_console.print(line, highlight=False, soft_wrap=True)
 
-    checkpoint = SearchCheckpoint(
-        checkpoint_path(out),
-        on_resume=None if as_json else resuming,
-        on_discard=_common.warning_line,
-    )
-    # Built beside --out and swapped in at the end: an interrupted search leaves the
-    # previous folder as it was, never old models beside new ones, and its finished
-    # configuration-folds in the checkpoint for the next run.
-    with _common.output_errors(out, "--out"), checkpoint:
-        with staged_dir(out) as stage, _common.phase_progress(enabled=not as_json) as progress:
-            result, summary = train_surrogates(
-                db,
-                stage,
-                models=names,
-                grid_name=grid,
-                folds=folds,
-                seed=seed,
-                device=device,
-                n_jobs=jobs,
-                epochs=epochs,
-                export_onnx=not no_onnx,
-                progress=progress,
-                cv=cv,
-                halving=halving,
-                halving_rungs=halving_rungs,
-                plr_patience=plr_patience,
-                checkpoint=checkpoint,
-                tf32=tf32,
-            )
-            summary["files"].update(training_figures(result, stage))
-        checkpoint.remove()  # the new folder is in place
-    summary["files"] = {
-        key: str(Path(out) / Path(value).relative_to(stage))
-        if str(value).startswith(str(stage))
-        else value
-        for key, value in summary["files"].items()
-    }
+    with (
+        _common.output_errors(out, "--out"),
+        _common.phase_progress(enabled=not as_json) as progress,
+    ):
+        _, summary = train_into(
+            db,
+            out,
+            models=models,
+            figures=training_figures,
+            on_resume=None if as_json else resuming,
+            on_discard=_common.warning_line,
+            grid_name=grid,
+            folds=folds,
+            seed=seed,
+            device=device,
+            n_jobs=jobs,
+            epochs=epochs,
+            export_onnx=not no_onnx,
+            progress=progress,
+            cv=cv,
+            halving=halving,
+            halving_rungs=halving_rungs,
+            plr_patience=plr_patience,
+            tf32=tf32,
+        )
     if as_json:
         _common.print_json(summary)
         return
@@ -134,10 +110,13 @@ def train(
 
 
 def print_summary(summary: dict) -> None:
-    """The per-family table beside paper B's figures (used by reproduce too)."""
+    """The per-family table beside paper B's figures (a dash for a family it lacks)."""
     rows = []
     for name, m in summary["models"].items():
         paper = m["paper_b"]
+        theirs = (
+            f"{paper['r2']} / {paper['mape_pct']} % / {paper['inference_ms']} ms" if paper else "—"
+        )
         rows.append(
             [
                 name,
@@ -148,7 +127,7 @@ def print_summary(summary: dict) -> None:
                 f"{m['max_abs_error_deg']:.2f}",
                 f"{m['inference_single_us']:.1f}",
                 f"{m['inference_batch_ms']:.2f}",
-                f"{paper['r2']} / {paper['mape_pct']} % / {paper['inference_ms']} ms",
+                theirs,
             ]
         )
     _common.print_table(
@@ -183,47 +162,24 @@ def predict(
     the model file) is a warning on stderr, or with ``--strict`` an error: a
     surrogate extrapolates without knowing it.
     """
-    from softbend.design import SFRBADesign
-    from softbend.surrogates.predict import INTERVAL_LEVEL, predict_angles
+    from softbend.surrogates.predict import INTERVAL_LEVEL, predict_text
 
-    values = _floats(design, "design")
-    if len(values) != 6:
-        raise ValueError(
-            "The 'design' must be 6 numbers l,r,t,b,phi,lc (mm, mm, mm, mm, deg, mm). "
-            f"Got {len(values)}: {design!r}."
-        )
-    checked = SFRBADesign(*values)  # validates the ranges, names the parameter
-    result = predict_angles(model, checked, _floats(pressure, "pressure"), strict=strict)
-    pressures, angles, outside = (
-        result.pressure_mpa,
-        result.angle_deg,
-        result.outside_training_ranges,
-    )
-    if outside:
+    result = predict_text(model, design, pressure, strict=strict)
+    if result.outside_training_ranges:
         _common.warning_line(
-            f"{model} was not trained there: {'; '.join(outside)}; the prediction is an "
-            "extrapolation (--strict refuses)."
+            f"{model} was not trained there: {'; '.join(result.outside_training_ranges)}; the "
+            "prediction is an extrapolation (--strict refuses)."
         )
-    interval = result.interval_deg
     if as_json:
-        payload = {
-            "model": str(model),
-            "kind": result.kind,
-            "design": checked.as_dict(),
-            "pressure_mpa": pressures.tolist(),
-            "angle_deg": angles.tolist(),
-            "outside_training_ranges": outside,
-        }
-        if interval is not None:
-            payload["interval_level"] = INTERVAL_LEVEL
-            payload["interval_low_deg"] = interval[0].tolist()
-            payload["interval_high_deg"] = interval[1].tolist()
-        _common.print_json(payload)
+        _common.print_json(result.to_dict())
         return
+    interval = result.interval_deg
     columns = ["pressure (MPa)", "angle (°)"]
-    rows = [[f"{p:g}", f"{a:.2f}"] for p, a in zip(pressures, angles, strict=True)]
+    rows = [
+        [f"{p:g}", f"{a:.2f}"] for p, a in zip(result.pressure_mpa, result.angle_deg, strict=True)
+    ]
     if interval is not None:
         columns.append(f"{INTERVAL_LEVEL:.0%} interval (°)")
         for row, low, high in zip(rows, *interval, strict=True):
             row.append(f"{low:.2f} to {high:.2f}")
-    _common.print_table(f"{result.kind} surrogate, design {checked.design_id}", columns, rows)
+    _common.print_table(f"{result.kind} surrogate, design {result.design.design_id}", columns, rows)

@@ -2,7 +2,10 @@
 
 * :func:`parity_and_errors` — per model family, the cross-validated (out-of-fold)
   prediction against the true angle, and the distribution of the error;
-* :func:`mlp_loss_curve` — training loss of the refitted MLP per epoch.
+* :func:`mlp_loss_curve` — training loss per epoch of a refitted network (the
+  MLP, or any family whose model records a ``loss_curve_``).
+
+Families are titled by :data:`softbend.surrogates.families.FAMILIES`.
 
 Matplotlib is imported inside the functions (Agg canvas, no pyplot state).
 """
@@ -28,7 +31,8 @@ def parity_and_errors(result: SearchResult, path: Path) -> Path:
     """
     from matplotlib.figure import Figure
 
-    from softbend.surrogates.search import MODEL_TITLES, describe
+    from softbend.surrogates.families import FAMILIES
+    from softbend.surrogates.search import describe
 
     names = list(result.families)
     fig = Figure(figsize=(10, 3.6 * max(1, len(names))))
@@ -43,7 +47,7 @@ def parity_and_errors(result: SearchResult, path: Path) -> Path:
         ax_parity.set_xlabel("true bending angle (°)")
         ax_parity.set_ylabel("predicted (°), held-out designs")
         ax_parity.set_title(
-            f"{MODEL_TITLES[name]} ({describe(fam.params)})\n"
+            f"{FAMILIES.get(name).title} ({describe(fam.params)})\n"
             f"R² {fam.cv['r2']:.6f}, RMSE {fam.cv['rmse_deg']:.2f}°, "
             f"MAPE {fam.cv['mape_pct']:.2f} %",
             fontsize=9,
@@ -71,8 +75,13 @@ def parity_and_errors(result: SearchResult, path: Path) -> Path:
     return path
 
 
-def mlp_loss_curve(loss_curve: list[float] | np.ndarray, path: Path) -> Path:
-    """Training loss (standardized MSE) of the refitted MLP against the epoch."""
+def mlp_loss_curve(
+    loss_curve: list[float] | np.ndarray, path: Path, title: str = "normalized MLP"
+) -> Path:
+    """Training loss (standardized MSE) of a refitted network against the epoch.
+
+    ``title`` is the family's (:attr:`~softbend.surrogates.families.Family.title`).
+    """
     from matplotlib.figure import Figure
 
     fig = Figure(figsize=(6, 4))
@@ -81,7 +90,7 @@ def mlp_loss_curve(loss_curve: list[float] | np.ndarray, path: Path) -> Path:
     ax.semilogy(epochs, loss_curve, color="navy")
     ax.set_xlabel("epoch")
     ax.set_ylabel("training MSE (standardized angle)")
-    ax.set_title("Normalized MLP, refit on all designs")
+    ax.set_title(f"{title[:1].upper()}{title[1:]}, refit on all designs")
     ax.grid(alpha=0.3, which="both")
     fig.tight_layout()
     path.parent.mkdir(parents=True, exist_ok=True)
@@ -90,7 +99,7 @@ def mlp_loss_curve(loss_curve: list[float] | np.ndarray, path: Path) -> Path:
 
 
 def training_figures(result: SearchResult, out_dir: str | Path) -> dict[str, str]:
-    """Paper B Fig. 5 and the refitted MLP's loss curve of a surrogate search.
+    """Paper B Fig. 5 and the loss curves of the refitted networks of a surrogate search.
 
     Parameters
     ----------
@@ -98,21 +107,26 @@ def training_figures(result: SearchResult, out_dir: str | Path) -> dict[str, str
         What :func:`softbend.surrogates.workflow.train_surrogates` (or
         :func:`~softbend.surrogates.search.search`) returned.
     out_dir : path
-        Folder of ``fig5_parity_errors.png`` and ``mlp_loss.png`` (created).
+        Folder of ``fig5_parity_errors.png`` and ``<family>_loss.png`` (created).
 
     Returns
     -------
     dict
-        ``{"fig5": path, "mlp_loss": path}``, the figures drawn (none without
-        families; no loss curve without an MLP).
+        ``{"fig5": path, "mlp_loss": path, ...}``, the figures drawn: Fig. 5 if
+        any family was searched, and ``<family>_loss`` for each family whose
+        refitted model records a ``loss_curve_`` (the MLP).
     """
+    from softbend.surrogates.families import FAMILIES
+
     out = Path(out_dir)
     out.mkdir(parents=True, exist_ok=True)
     files: dict[str, str] = {}
     if result.families:
         files["fig5"] = str(parity_and_errors(result, out / "fig5_parity_errors.png"))
-    if "mlp" in result.families:
-        curve = getattr(result.families["mlp"].model, "loss_curve_", None)
-        if curve:
-            files["mlp_loss"] = str(mlp_loss_curve(curve, out / "mlp_loss.png"))
+    for name, fam in result.families.items():
+        curve = getattr(fam.model, "loss_curve_", None)
+        if curve is not None and len(curve):
+            title = FAMILIES.get(name).title
+            path = out / f"{name}_loss.png"
+            files[f"{name}_loss"] = str(mlp_loss_curve(curve, path, title))
     return files

@@ -1,10 +1,14 @@
 """Surrogate models of the bending angle: (l, r, t, b, φ, lc, P) → θ (paper B §4.1).
 
 Polynomial regression, XGBoost and the normalized MLP as scikit-learn
-estimators; a design-grouped cross-validated grid search; metrics and
+estimators, each a family of :data:`FAMILIES` (``plr``, ``xgb``, ``mlp``; more
+can be registered); a design-grouped cross-validated grid search; metrics and
 inference timing; persistence with metadata; ONNX export; single-sample fast
-paths for control loops. Names are imported lazily so that
-``import softbend.surrogates`` does not import PyTorch or XGBoost.
+paths for control loops; the :class:`Surrogate` protocol every fitted one
+answers. Names are imported lazily so that ``import softbend.surrogates`` does
+not import PyTorch or XGBoost. The search itself is
+:func:`softbend.surrogates.search.search` (not exported here: the name is its
+module's).
 """
 
 from __future__ import annotations
@@ -12,27 +16,42 @@ from __future__ import annotations
 import importlib
 from typing import Any
 
+#: Every public name, and the module that defines it.
 _EXPORTS = {
+    "FAMILIES": "families",
+    "GRID_NAMES": "families",
+    "MODEL_NAMES": "families",
+    "Family": "families",
+    "FitSettings": "families",
+    "Storage": "families",
+    "Surrogate": "protocol",
+    "FastSurrogate": "protocol",
     "FEATURES": "features",
     "UNITS": "features",
     "TrainingData": "features",
     "training_data": "features",
     "PolynomialRegressor": "polynomial",
     "NormalizedMLPRegressor": "mlp",
+    "AffineCorrected": "corrected",
+    "GPCorrected": "corrected",
+    "MeanEnsemble": "corrected",
+    "PressureScaled": "corrected",
     "train_mlp_grid": "batched",
     "accuracy": "metrics",
     "inference_time": "metrics",
-    "search": "search",
     "grid": "search",
     "grouped_splits": "search",
     "SearchResult": "search",
     "train_surrogates": "workflow",
+    "train_into": "workflow",
     "SurrogateModel": "model",
     "predict_angles": "predict",
     "Prediction": "predict",
     "save_surrogate": "persistence",
     "load_surrogate": "persistence",
+    "SavedSurrogate": "persistence",
     "to_onnx": "onnx_export",
+    "save_onnx": "onnx_export",
     "onnx_predict": "onnx_export",
 }
 

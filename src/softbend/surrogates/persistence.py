@@ -7,10 +7,20 @@ arrays as nested lists, or the XGBoost booster as JSON text), what it maps
 and where it came from (``softbend_version``, ``created_utc`` and the caller's
 ``metadata``, e.g. the training data hash and cross-validated metrics)::
 
-    {"format": "softbend-surrogate", "schema_version": 1, "kind": "polynomial",
+    {"format": "softbend-surrogate", "schema_version": 2, "kind": "plr",
      "features": [...], "units": {...}, "target": "angle_deg",
      "softbend_version": "0.1.0", "created_utc": "2025-01-01T00:00:00+00:00",
      "metadata": {...}, "params": {...}, "state": {...}}
+
+The ``kind`` is the name of the surrogate's family
+(:data:`softbend.surrogates.families.FAMILIES`: ``plr``, ``xgb``, ``mlp`` or any
+family registered with a :class:`~softbend.surrogates.families.Storage`), or that
+of a composite of :mod:`softbend.surrogates.corrected` (:data:`COMPOSITE_KINDS`).
+
+Schema versions: version 2 names the kind by its family. Version 1 files named
+the polynomial ``"polynomial"`` and XGBoost ``"xgboost"`` (a family's
+``legacy_kinds``); they load as ``plr`` and ``xgb``, inner surrogates of a
+composite included, and everything else in them reads as before.
 
 Python writes a float with the shortest decimal that reads back to the same
 float64 (``repr``), so a reloaded polynomial or MLP predicts bit for bit what
@@ -29,7 +39,8 @@ Fitted attributes that are none of these (a framework object such as a torch
 module) are not written; everything ``predict`` needs under the surrogate
 contract is.
 
-Loading trusts nothing in the file: each kind has a schema (``SCHEMAS``) listing
+Loading trusts nothing in the file: each kind has a schema (a family's
+``storage.schema``, a composite's in ``COMPOSITE_SCHEMAS``) listing
 its ``params`` and ``state`` keys with a rule for each value (type, dtype,
 dimensions, finiteness, bounds such as scales > 0) and rules across keys (the
 chained layer shapes of an MLP, a complete exponent table of a polynomial, the
@@ -49,7 +60,6 @@ import json
 import logging
 import math
 import sys
-import warnings
 from dataclasses import dataclass, field
 from datetime import UTC, datetime
 from pathlib import Path
@@ -59,98 +69,68 @@ import numpy as np
 from sklearn.exceptions import NotFittedError
 
 from softbend import __version__
-from softbend._extras import require
 from softbend._io import json_safe, write_text_atomic
 from softbend._validation import short_repr
 from softbend.errors import SchemaError
 from softbend.limits import check_limit, limit
 from softbend.plausibility import RANGES, implausible_index
+from softbend.surrogates.families import FAMILIES, Family, legacy_kinds
 from softbend.surrogates.features import FEATURES, TARGET, UNITS
-from softbend.surrogates.schema import (
-    QUANTITIES,
-    SCHEMAS,
-    Rule,
-    RuleError,
-    tag_float,
-    untag_float,
-)
+from softbend.surrogates.jsonvalues import encode as _encode
+from softbend.surrogates.jsonvalues import encode_params
+from softbend.surrogates.jsonvalues import plain_json as _plain_json
+from softbend.surrogates.schema import COMPOSITE_SCHEMAS, QUANTITIES, Rule, RuleError
 
 logger = logging.getLogger(__name__)
 
 __all__ = [
-    "BASE_KINDS",
     "COMPOSITE_KINDS",
     "FORMAT",
-    "KINDS",
     "SCHEMA_VERSION",
     "SavedSurrogate",
     "check_fitted_surrogate",
     "kind_of",
     "load_surrogate",
     "save_surrogate",
+    "saved_kinds",
 ]
 
 #: Format tag of a saved surrogate file.
 FORMAT = "softbend-surrogate"
 
-#: Newest schema version this softbend writes and reads.
-SCHEMA_VERSION = 1
+#: Newest schema version this softbend writes and reads (2: the kind is the family's name).
+SCHEMA_VERSION = 2
 
-#: Surrogate kinds and the (module, class) each is restored into.
-_CLASSES: dict[str, tuple[str, str]] = {
-    "polynomial": ("softbend.surrogates.polynomial", "PolynomialRegressor"),
-    "mlp": ("softbend.surrogates.mlp", "NormalizedMLPRegressor"),
-    "xgboost": ("xgboost", "XGBRegressor"),
+#: Surrogates built on other surrogates (:mod:`softbend.surrogates.corrected`), by
+#: kind, and the class each is restored into: their ``state`` holds the inner
+#: surrogates as whole documents (``base``, ``members``).
+_COMPOSITES: dict[str, tuple[str, str]] = {
     "affine-corrected": ("softbend.surrogates.corrected", "AffineCorrected"),
     "gp-corrected": ("softbend.surrogates.corrected", "GPCorrected"),
     "ensemble": ("softbend.surrogates.corrected", "MeanEnsemble"),
     "pressure-scaled": ("softbend.surrogates.corrected", "PressureScaled"),
 }
 
-#: Kinds built on other surrogates (:mod:`softbend.surrogates.corrected`): their
-#: ``state`` holds the inner surrogates as whole documents (``base``, ``members``).
-COMPOSITE_KINDS: tuple[str, ...] = (
-    "affine-corrected",
-    "gp-corrected",
-    "ensemble",
-    "pressure-scaled",
-)
+#: Kinds of the composites (not families: they wrap fitted surrogates).
+COMPOSITE_KINDS: tuple[str, ...] = tuple(_COMPOSITES)
 
 #: Inner surrogates nest at most this deep (a corrected ensemble of corrected MLPs).
 _MAX_DEPTH = 4
 
-#: Kinds of surrogate that can be saved.
-KINDS: tuple[str, ...] = tuple(_CLASSES)
-
-#: Kinds trained on data directly (the three families of paper B).
-BASE_KINDS: tuple[str, ...] = tuple(k for k in KINDS if k not in COMPOSITE_KINDS)
-
-#: Fitted attributes that prediction needs (the surrogate contract), per kind.
-_REQUIRED_STATE: dict[str, tuple[str, ...]] = {
-    "polynomial": (
-        "n_features_in_",
-        "x_mean_",
-        "x_scale_",
-        "y_mean_",
-        "y_scale_",
-        "powers_",
-        "coef_",
-    ),
-    "mlp": (
-        "n_features_in_",
-        "x_mean_",
-        "x_scale_",
-        "y_mean_",
-        "y_scale_",
-        "coefs_",
-        "intercepts_",
-    ),
-    "xgboost": ("booster",),
+#: Fitted attributes that prediction needs, per composite kind.
+_COMPOSITE_STATE: dict[str, tuple[str, ...]] = {
     "affine-corrected": ("base", "scale_", "offset_", "residual_std_"),
     "gp-corrected": ("base", "z_mean_", "z_scale_", "kernel_theta_", "inputs_", "targets_"),
     "ensemble": ("members", "residual_std_"),
     "pressure-scaled": ("base", "scale_", "residual_std_"),
 }
+
+
+def saved_kinds() -> tuple[str, ...]:
+    """Kinds this softbend saves and loads: every family with a storage, then the composites."""
+    stored = tuple(name for name, family in FAMILIES.items() if family.storage is not None)
+    return (*stored, *COMPOSITE_KINDS)
+
 
 _HEADER_KEYS = (
     "kind",
@@ -172,11 +152,12 @@ class SavedSurrogate:
     Attributes
     ----------
     model : estimator
-        The fitted surrogate (``PolynomialRegressor``, ``NormalizedMLPRegressor``
-        or ``xgboost.XGBRegressor``); it maps inputs :data:`FEATURES` (mm, deg, MPa)
-        to the bending angle in degrees.
+        The fitted surrogate (``PolynomialRegressor``, ``NormalizedMLPRegressor``,
+        ``xgboost.XGBRegressor``, a composite or a registered family's estimator);
+        it maps inputs :data:`FEATURES` (mm, deg, MPa) to the bending angle in degrees.
     kind : str
-        One of :data:`KINDS`.
+        Its family's name or composite kind (one of :func:`saved_kinds`); a file of
+        schema version 1 gives the family's name too (``plr``, not ``polynomial``).
     metadata : dict
         The caller's metadata as given to :func:`save_surrogate` (after a JSON
         round trip: tuples become lists, NumPy numbers Python numbers).
@@ -193,19 +174,36 @@ class SavedSurrogate:
     created_utc: str = ""
 
 
+def _stored(kind: str) -> Family:
+    """The family ``kind`` if it can be saved (a family with a storage)."""
+    family = FAMILIES.get(kind, field="kind")
+    if family.storage is None:
+        raise ValueError(
+            f"The surrogate family {kind!r} declares no storage: it cannot be saved or loaded."
+        )
+    return family
+
+
 def _class_of(kind: str) -> type:
-    module, name = _CLASSES[kind]
-    if module == "xgboost":
-        return getattr(require("xgboost", "An XGBoost surrogate"), name)
-    return getattr(importlib.import_module(module), name)
+    if kind in _COMPOSITES:
+        module, name = _COMPOSITES[kind]
+        return getattr(importlib.import_module(module), name)
+    family = _stored(kind)
+    return family.storage.estimator_class(f"The {family.title} surrogate ({kind!r})")
 
 
 def _allowed() -> str:
-    return ", ".join(f"{name} ({kind!r})" for kind, (_, name) in _CLASSES.items())
+    classes = [
+        (family.storage.class_name, name)
+        for name, family in FAMILIES.items()
+        if family.storage is not None
+    ]
+    classes += [(cls, kind) for kind, (_, cls) in _COMPOSITES.items()]
+    return ", ".join(f"{cls} ({kind!r})" for cls, kind in classes)
 
 
 def kind_of(model: Any) -> str:
-    """The kind of a surrogate: ``"polynomial"``, ``"mlp"`` or ``"xgboost"``.
+    """The kind of a surrogate: its family's name (``"plr"``, ...) or its composite kind.
 
     Only the exact classes count (a subclass could change what ``params`` and
     ``state`` mean). No heavy module is imported: a model's class is loaded
@@ -214,19 +212,23 @@ def kind_of(model: Any) -> str:
     Parameters
     ----------
     model : estimator
-        A ``PolynomialRegressor``, ``NormalizedMLPRegressor`` or ``xgboost.XGBRegressor``.
+        A fitted surrogate of a family with a storage (``PolynomialRegressor``,
+        ``NormalizedMLPRegressor``, ``xgboost.XGBRegressor``, ...) or a composite.
 
     Returns
     -------
     str
-        One of :data:`KINDS`.
+        One of :func:`saved_kinds`.
 
     Raises
     ------
     ValueError
         For any other type, naming the allowed ones.
     """
-    for kind, (module, name) in _CLASSES.items():
+    for name, family in FAMILIES.items():
+        if family.storage is not None and family.storage.holds(model):
+            return name
+    for kind, (module, name) in _COMPOSITES.items():
         cls = getattr(sys.modules.get(module), name, None)
         if cls is not None and type(model) is cls:
             return kind
@@ -265,12 +267,15 @@ def check_fitted_surrogate(model: Any, owner: str) -> str:
             f"Got {type(model).__name__} instead."
         ) from None
     name = type(model).__name__
-    if kind == "xgboost":
-        fitted = model.__sklearn_is_fitted__()
-    elif kind in COMPOSITE_KINDS:
+    if kind in COMPOSITE_KINDS:
         fitted = True  # built from fitted surrogates, each checked when saved
     else:
-        fitted = all(hasattr(model, key) for key in _REQUIRED_STATE[kind])
+        storage = FAMILIES.get(kind).storage
+        fitted = (
+            storage.codec.is_fitted(model)
+            if storage.codec is not None
+            else all(hasattr(model, key) for key in storage.required_state)
+        )
     if not fitted:
         raise NotFittedError(f"This {name} instance is not fitted yet. Call 'fit' before {owner}.")
     n_features = int(model.n_features_in_)
@@ -288,112 +293,12 @@ def check_fitted_surrogate(model: Any, owner: str) -> str:
     return kind
 
 
-# --- JSON codec --------------------------------------------------------------------------------
-
-
-def _tagged(nested: Any) -> Any:
-    """A nested list of an array's elements with its NaN and infinities as tags."""
-    if isinstance(nested, list):
-        return [_tagged(v) for v in nested]
-    return tag_float(nested) if isinstance(nested, float) else nested
-
-
-def _encode(value: Any, where: str) -> Any:
-    """Strict-JSON form of ``value`` that :func:`_decode` turns back into an equal object.
-
-    A NaN or infinite float is written as ``{"__float__": "nan" | "inf" | "-inf"}``.
-    """
-    if isinstance(value, float):  # Python floats and NumPy float64: plain numbers
-        return tag_float(value)
-    if value is None or isinstance(value, bool | int | str):
-        return value
-    if isinstance(value, np.generic | np.ndarray):
-        array = np.asarray(value)
-        if array.dtype.kind in "biuf":
-            dtype = array.dtype.name
-        elif array.dtype.kind in "OU" and all(isinstance(v, str) for v in array.ravel()):
-            dtype = "str"
-        else:
-            raise TypeError(f"{where}: arrays of dtype {array.dtype} cannot be saved")
-        finite = array.dtype.kind != "f" or bool(np.isfinite(array).all())
-        if isinstance(value, np.generic):
-            item = value.item()
-            return {"__scalar__": item if finite else tag_float(item), "dtype": dtype}
-        nested = array.tolist() if finite else _tagged(array.tolist())
-        return {"__ndarray__": nested, "dtype": dtype, "shape": list(array.shape)}
-    if isinstance(value, tuple):
-        return {"__tuple__": [_encode(v, where) for v in value]}
-    if isinstance(value, list):
-        return [_encode(v, where) for v in value]
-    if isinstance(value, dict) and all(isinstance(k, str) for k in value):
-        return {k: _encode(v, where) for k, v in value.items()}
-    raise TypeError(f"{where}: values of type {type(value).__name__} cannot be saved")
-
-
-def _untagged(nested: Any) -> Any:
-    """A nested list of an array's elements with its tags of non-finite floats as floats."""
-    if isinstance(nested, list):
-        return [_untagged(v) for v in nested]
-    return untag_float(nested)
-
-
-def _dtype(name: Any) -> np.dtype:
-    """The NumPy dtype ``name`` of a saved array or scalar: a bool, integer or float one."""
-    dtype = np.dtype(name) if isinstance(name, str) else None
-    if dtype is None or dtype.kind not in "biuf":
-        raise TypeError(f"dtype {short_repr(name)} is none of bool, integer, float or 'str'")
-    return dtype
-
-
-def _decode(value: Any) -> Any:
-    """The object :func:`_encode` wrote (raises KeyError, TypeError, ValueError, RuleError)."""
-    if isinstance(value, list):
-        return [_decode(v) for v in value]
-    if not isinstance(value, dict):
-        return value
-    if "__float__" in value:
-        return untag_float(value)
-    if "__ndarray__" in value:
-        if value["dtype"] == "str":
-            array = np.asarray(value["__ndarray__"], dtype=object)
-        else:
-            array = np.asarray(_untagged(value["__ndarray__"]), dtype=_dtype(value["dtype"]))
-        return np.ascontiguousarray(array.reshape(value["shape"]))
-    if "__scalar__" in value:
-        if value["dtype"] == "str":
-            return np.str_(value["__scalar__"])
-        return _dtype(value["dtype"]).type(untag_float(value["__scalar__"]))
-    if "__tuple__" in value:
-        return tuple(_decode(v) for v in value["__tuple__"])
-    return {k: _decode(v) for k, v in value.items()}
-
-
-def _plain_json(value: Any) -> Any:
-    """``json.dumps`` fallback for caller metadata: NumPy numbers and arrays as Python ones."""
-    if isinstance(value, np.generic | np.ndarray):
-        return value.tolist()
-    if isinstance(value, Path):
-        return str(value)
-    raise TypeError(f"values of type {type(value).__name__} are not JSON-serializable")
-
-
 # --- save --------------------------------------------------------------------------------------
 
 
 def _params(model: Any, kind: str) -> dict[str, Any]:
-    params = {}
-    for key, value in model.get_params(deep=False).items():
-        try:
-            params[key] = _encode(value, key)
-        except TypeError:
-            raise ValueError(
-                f"The parameter '{key}' of {type(model).__name__} must be JSON-serializable to "
-                f"save the model (None, numbers, strings, arrays, lists, tuples, dicts). "
-                f"Got {type(value).__name__} instead."
-            ) from None
-    if kind == "xgboost" and params.get("missing") == tag_float(math.nan):
-        params["missing"] = None  # XGBoost's default NaN, as strict JSON; read back as NaN
-    return params
+    codec = FAMILIES.get(kind).storage.codec
+    return codec.params(model) if codec is not None else encode_params(model)
 
 
 def _document(model: Any, kind: str, depth: int = 0) -> dict[str, Any]:
@@ -427,22 +332,23 @@ def _composite_state(model: Any, kind: str, depth: int) -> dict[str, Any]:
         state = {"members": [_inner(m, depth) for m in model.members_]}
     else:
         state = {"base": _inner(model.base, depth)}
-    names = [key for key in _REQUIRED_STATE[kind] if key not in ("base", "members")]
+    names = [key for key in _COMPOSITE_STATE[kind] if key not in ("base", "members")]
     return state | {key: _encode(getattr(model, key), key) for key in names}
 
 
 def _state(model: Any, kind: str, depth: int = 0) -> dict[str, Any]:
     if kind in COMPOSITE_KINDS:
         return _composite_state(model, kind, depth)
-    if kind == "xgboost":
-        return {"booster": bytes(model.get_booster().save_raw("json")).decode("utf-8")}
+    storage = FAMILIES.get(kind).storage
+    if storage.codec is not None:
+        return storage.codec.state(model)
     state = {}
     fitted = [k for k in vars(model) if k.endswith("_") and not k.startswith("_")]
     for key in fitted:
         try:
             state[key] = _encode(getattr(model, key), key)
         except TypeError as err:
-            if key in _REQUIRED_STATE[kind]:
+            if key in storage.required_state:
                 raise ValueError(
                     f"The fitted attribute '{key}' of {type(model).__name__} cannot be saved: "
                     f"{err}."
@@ -457,9 +363,11 @@ def save_surrogate(model: Any, path: str | Path, *, metadata: dict[str, Any] | N
     Parameters
     ----------
     model : estimator
-        A fitted ``PolynomialRegressor``, ``NormalizedMLPRegressor`` or
-        ``xgboost.XGBRegressor`` on the 7 inputs :data:`FEATURES` (mm, deg, MPa),
-        predicting the bending angle in degrees.
+        A fitted surrogate on the 7 inputs :data:`FEATURES` (mm, deg, MPa),
+        predicting the bending angle in degrees: of a family with a storage
+        (``PolynomialRegressor``, ``NormalizedMLPRegressor``,
+        ``xgboost.XGBRegressor``, ...) or a composite; its ``kind`` is the family's
+        name.
     path : str or Path
         File to write; parent folders are created. An existing file is replaced
         only once the new one is complete.
@@ -569,11 +477,13 @@ def _checked_document(document: Any, path: str) -> dict[str, Any]:
             f"allowed keys: format, schema_version, {', '.join(_HEADER_KEYS)}."
         )
     kind = document["kind"]
-    if not isinstance(kind, str) or kind not in _CLASSES:
+    if version == 1 and isinstance(kind, str):  # migration: version 1 named two kinds otherwise
+        kind = document["kind"] = legacy_kinds().get(kind, kind)
+    if not isinstance(kind, str) or kind not in saved_kinds():
         shown = repr(kind) if isinstance(kind, str) else short_repr(kind)
         raise SchemaError(
             f"{path} holds an unknown surrogate kind {shown}; "
-            f"expected one of {', '.join(map(repr, KINDS))}."
+            f"expected one of {', '.join(map(repr, saved_kinds()))}."
         )
     if document["features"] != list(FEATURES) or document["target"] != TARGET:
         raise SchemaError(
@@ -619,47 +529,6 @@ def _validated(
                 f"{path}: {section} key '{key}' of the {kind} surrogate {err}."
             ) from None
     return decoded
-
-
-def _xgboost_params(params: dict[str, Any], path: Path) -> tuple[dict[str, Any], set[str]]:
-    """Decoded XGBoost parameters and the names of the standard ones.
-
-    XGBoost takes extra keyword parameters (passed on to the booster, kept in
-    ``kwargs``); such a key is accepted unless it could name an attribute of the
-    estimator (a method such as ``predict``, a private name).
-    """
-    cls = _class_of("xgboost")
-    standard = set(cls().get_params(deep=False))
-    unknown = [
-        key
-        for key in params
-        if key not in standard
-        and (not key.isidentifier() or key.startswith("_") or hasattr(cls, key))
-    ]
-    if unknown:
-        raise SchemaError(
-            f"{path}: unknown params key(s) {', '.join(map(repr, unknown))} for the xgboost "
-            f"surrogate; allowed keys: {', '.join(sorted(standard))} and XGBoost's extra "
-            "booster parameters."
-        )
-    try:
-        decoded = {key: _decode(value) for key, value in params.items()}
-    except (KeyError, TypeError, ValueError, AttributeError, RuleError) as err:
-        raise SchemaError(
-            f"{path}: params of the xgboost surrogate cannot be read ({err})."
-        ) from None
-    if "missing" in decoded:  # null: XGBoost's default NaN (how save_surrogate writes it)
-        missing = decoded["missing"]
-        if missing is None:
-            decoded["missing"] = math.nan
-        elif isinstance(missing, bool | np.bool_) or not isinstance(
-            missing, int | float | np.integer | np.floating
-        ):
-            raise SchemaError(
-                f"{path}: params key 'missing' of the xgboost surrogate must be a number or "
-                f"null (NaN, XGBoost's default); got {short_repr(params['missing'])}."
-            )
-    return decoded, standard
 
 
 def _check_training_ranges(metadata: dict[str, Any], path: Path) -> None:
@@ -722,9 +591,9 @@ def _restore_composite(document: dict[str, Any], path: str, depth: int) -> Any:
     if document["params"]:
         got = short_repr(document["params"])
         raise SchemaError(f"{path}: the {kind} surrogate takes no params; got {got}.")
-    state = _validated(document["state"], SCHEMAS[kind].state, path, kind, "state")
+    state = _validated(document["state"], COMPOSITE_SCHEMAS[kind].state, path, kind, "state")
     try:
-        SCHEMAS[kind].check(state)
+        COMPOSITE_SCHEMAS[kind].check(state)
     except RuleError as err:
         raise SchemaError(f"{path}: the {kind} surrogate's {err}.") from None
     cls = _class_of(kind)
@@ -750,51 +619,38 @@ def _restore_composite(document: dict[str, Any], path: str, depth: int) -> Any:
 def _restore(document: dict[str, Any], path: Path | str, depth: int = 0) -> Any:
     """The model of a document, every params and state value validated by its kind's schema."""
     kind = document["kind"]
-    schema = SCHEMAS[kind]
+    storage = None if kind in COMPOSITE_KINDS else _stored(kind).storage
+    required = _COMPOSITE_STATE[kind] if storage is None else storage.required_state
     state = document["state"]
-    missing = [key for key in _REQUIRED_STATE[kind] if key not in state]
+    missing = [key for key in required if key not in state]
     if missing:
         raise SchemaError(
             f"{path} is an incomplete softbend surrogate: state key(s) "
             f"{', '.join(missing)} missing for kind {kind!r}."
         )
-    if kind in COMPOSITE_KINDS:
+    if storage is None:
         return _restore_composite(document, str(path), depth)
+    schema = storage.schema
     state = _validated(state, schema.state, path, kind, "state")
     try:
         schema.check(state)
     except RuleError as err:
         raise SchemaError(f"{path}: the {kind} surrogate's {err}.") from None
     cls = _class_of(kind)
-    if kind != "xgboost":
-        model = cls(**_validated(document["params"], schema.params or {}, path, kind, "params"))
-        try:  # the declared sizes (defaults included) against the arrays
-            schema.against(model.get_params(deep=False), state)
-        except RuleError as err:
-            raise SchemaError(f"{path}: the {kind} surrogate's {err}.") from None
-        for key, value in state.items():  # keys of the schema only
-            setattr(model, key, value)
-        return model
-    params, standard = _xgboost_params(document["params"], path)
-    try:
-        model = cls(**params)
-        model.load_model(bytearray(state["booster"].encode("utf-8")))
-        # load_model fills base_score, booster, ... from the booster; put back the standard
-        # parameters as they were set, so that get_params (and a refit) is unchanged.
-        for key in standard & params.keys():
-            setattr(model, key, params[key])
-        # A parameter XGBoost only reads when predicting (missing, n_jobs, ...) fails here,
-        # not in the caller's first prediction.
-        with warnings.catch_warnings():
-            warnings.simplefilter("ignore")
-            probe = np.asarray(model.predict(np.zeros((1, len(FEATURES)))), dtype=np.float64)
-    except Exception as err:  # xgboost.core.XGBoostError, a parameter XGBoost refuses, ...
-        reason = (str(err).strip().splitlines() or [type(err).__name__])[0]  # no stack trace
-        raise SchemaError(f"{path}: cannot rebuild the {kind} surrogate ({reason}).") from None
-    if not np.isfinite(probe).all():
+    if storage.codec is not None:
+        return storage.codec.restore(cls, document["params"], state, str(path))
+    model = cls(**_validated(document["params"], schema.params or {}, path, kind, "params"))
+    try:  # the declared sizes (defaults included) against the arrays
+        schema.against(model.get_params(deep=False), state)
+    except RuleError as err:
+        raise SchemaError(f"{path}: the {kind} surrogate's {err}.") from None
+    for key, value in state.items():  # keys of the schema only
+        setattr(model, key, value)
+    n_features = getattr(model, "n_features_in_", None)
+    if isinstance(n_features, bool) or n_features != len(FEATURES):
         raise SchemaError(
-            f"{path}: the {kind} surrogate's booster predicts {probe.ravel()[0]} (its "
-            "base_score or a leaf value is not a finite number)."
+            f"{path}: the {kind} surrogate must take the {len(FEATURES)} inputs "
+            f"{', '.join(FEATURES)}; its state gives n_features_in_ {short_repr(n_features)}."
         )
     return model
 

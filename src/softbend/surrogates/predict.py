@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import os
 from dataclasses import dataclass, field
+from typing import Any
 
 import numpy as np
 from numpy.typing import ArrayLike
@@ -12,7 +13,7 @@ from softbend.design import SFRBADesign
 from softbend.errors import SchemaError
 from softbend.models import check_pressures_mpa
 
-__all__ = ["INTERVAL_LEVEL", "Prediction", "predict_angles"]
+__all__ = ["INTERVAL_LEVEL", "Prediction", "parse_pressures", "predict_angles", "predict_text"]
 
 #: Probability of the prediction intervals reported by :func:`predict_angles`.
 INTERVAL_LEVEL = 0.9
@@ -25,7 +26,8 @@ class Prediction:
     Attributes
     ----------
     kind : str
-        The surrogate's kind (``"mlp"``, ``"polynomial"``, ``"xgboost"``).
+        The surrogate's kind: its family's name (``"plr"``, ``"xgb"``, ``"mlp"``, ...)
+        or a composite kind (``"affine-corrected"``, ...).
     design : SFRBADesign
     pressure_mpa, angle_deg : ndarray
         The pressures asked for (MPa) and the predicted angles (degrees).
@@ -38,6 +40,8 @@ class Prediction:
         ``(low, high)``: the central 90 % interval for a new reading, degrees,
         from models that give one (the transfer-learning corrections); None
         otherwise.
+    source : str
+        The model file.
     """
 
     kind: str
@@ -47,6 +51,64 @@ class Prediction:
     outside_training_ranges: list[str] = field(default_factory=list)
     has_training_ranges: bool = False
     interval_deg: tuple[np.ndarray, np.ndarray] | None = None
+    source: str = ""
+
+    def to_dict(self) -> dict[str, Any]:
+        """JSON-friendly form: model, kind, design (mm, deg), pressures (MPa), angles (deg),
+        the inputs outside the training ranges, and the interval's level and ends if any."""
+        payload: dict[str, Any] = {
+            "model": self.source,
+            "kind": self.kind,
+            "design": self.design.as_dict(),
+            "pressure_mpa": self.pressure_mpa.tolist(),
+            "angle_deg": self.angle_deg.tolist(),
+            "outside_training_ranges": list(self.outside_training_ranges),
+        }
+        if self.interval_deg is not None:
+            payload["interval_level"] = INTERVAL_LEVEL
+            payload["interval_low_deg"] = self.interval_deg[0].tolist()
+            payload["interval_high_deg"] = self.interval_deg[1].tolist()
+        return payload
+
+
+def parse_pressures(text: str, name: str = "pressure") -> list[float]:
+    """Pressures (MPa) from comma-separated text such as ``"0.05,0.1"``.
+
+    Raises
+    ------
+    ValueError
+        Text that is not comma-separated numbers, or holds none, naming ``name``.
+    """
+    try:
+        values = [float(v) for v in text.split(",") if v.strip()]
+    except ValueError:
+        raise ValueError(
+            f"The '{name}' must be comma-separated numbers, e.g. 0.05,0.1. Got {text!r} instead."
+        ) from None
+    if not values:
+        raise ValueError(f"The '{name}' must hold at least one number. Got {text!r} instead.")
+    return values
+
+
+def predict_text(
+    path: str | os.PathLike[str], design: str, pressures: str, *, strict: bool = False
+) -> Prediction:
+    """:func:`predict_angles` of a design and pressures given as text (as on a command line).
+
+    Parameters
+    ----------
+    path : path
+        A file written by :func:`softbend.surrogates.save_surrogate`.
+    design : str
+        ``"l,r,t,b,phi,lc"`` in mm and degrees (:meth:`SFRBADesign.parse`).
+    pressures : str
+        Comma-separated gauge pressures, MPa (:func:`parse_pressures`).
+    strict : bool
+        As :func:`predict_angles`.
+    """
+    return predict_angles(
+        path, SFRBADesign.parse(design), parse_pressures(pressures), strict=strict
+    )
 
 
 def predict_angles(
@@ -120,7 +182,9 @@ def predict_angles(
     if interval is not None:
         _check_finite(path, saved.kind, pressures, interval[0], "interval's low end", outside)
         _check_finite(path, saved.kind, pressures, interval[1], "interval's high end", outside)
-    return Prediction(saved.kind, design, pressures, angles, outside, has_ranges, interval)
+    return Prediction(
+        saved.kind, design, pressures, angles, outside, has_ranges, interval, str(path)
+    )
 
 
 def _check_finite(

@@ -8,6 +8,13 @@ parameters) and between the parameters and the state (an MLP's
 ``hidden_sizes`` and its weights, a polynomial's ``degree`` and its exponents).
 Only a key of the schema is ever set on a model.
 
+Each surrogate family names its :class:`Schema` in its
+:class:`~softbend.surrogates.families.Storage` (:data:`POLYNOMIAL_SCHEMA`,
+:data:`MLP_SCHEMA`, :data:`XGBOOST_SCHEMA`); the composites' are
+:data:`COMPOSITE_SCHEMAS`. A family added outside softbend builds its own from
+the public rules :func:`real`, :func:`integer`, :func:`string`, :func:`array`,
+:func:`boolean` and :func:`optional`.
+
 A float that is NaN or infinite is stored as ``{"__float__": "nan"}`` (or
 ``"inf"``, ``"-inf"``) so that the file is strict JSON; the rules that allow
 such a value (a loss curve, an unbounded memory limit) read that form and,
@@ -29,7 +36,26 @@ from softbend.design import FEATURE_QUANTITIES
 from softbend.plausibility import RANGES, implausible_index
 from softbend.surrogates.features import FEATURES, TARGET
 
-__all__ = ["FLOAT_TAG", "QUANTITIES", "SCHEMAS", "Rule", "RuleError", "tag_float", "untag_float"]
+__all__ = [
+    "COMPOSITE_SCHEMAS",
+    "FLOAT_TAG",
+    "MLP_SCHEMA",
+    "POLYNOMIAL_SCHEMA",
+    "QUANTITIES",
+    "XGBOOST_SCHEMA",
+    "Rule",
+    "RuleError",
+    "Schema",
+    "array",
+    "boolean",
+    "integer",
+    "no_check",
+    "optional",
+    "real",
+    "string",
+    "tag_float",
+    "untag_float",
+]
 
 #: Key of the JSON object that stands for a NaN or infinite float.
 FLOAT_TAG = "__float__"
@@ -108,7 +134,18 @@ def _bounds(low: float | None, strict: bool) -> str:
     return "" if low is None else f" {'>' if strict else '>='} {low:g}"
 
 
-def _real(*, low: float | None = None, strict: bool = False, finite: bool = True) -> Rule:
+def real(*, low: float | None = None, strict: bool = False, finite: bool = True) -> Rule:
+    """A number (a plain JSON one or a float64 ``__scalar__``), finite unless ``finite=False``.
+
+    Parameters
+    ----------
+    low : float, optional
+        Lower bound, in the value's unit.
+    strict : bool
+        The bound is exclusive (``> low``) rather than inclusive.
+    finite : bool
+        Refuse infinities (NaN is always refused).
+    """
     what = ("a finite number" if finite else "a number") + _bounds(low, strict)
 
     def rule(value: Any) -> Any:
@@ -123,7 +160,8 @@ def _real(*, low: float | None = None, strict: bool = False, finite: bool = True
     return rule
 
 
-def _integer(low: int) -> Rule:
+def integer(low: int = 0) -> Rule:
+    """An integer (a plain JSON one, not a bool, or an int64 ``__scalar__``) >= ``low``."""
     what = f"an integer >= {low}"
 
     def rule(value: Any) -> Any:
@@ -135,7 +173,8 @@ def _integer(low: int) -> Rule:
     return rule
 
 
-def _string(choices: tuple[str, ...] | None = None) -> Rule:
+def string(choices: tuple[str, ...] | None = None) -> Rule:
+    """A string, one of ``choices`` if given."""
     what = "a string" if choices is None else f"one of {', '.join(map(repr, choices))}"
 
     def rule(value: Any) -> Any:
@@ -154,6 +193,27 @@ def _string(choices: tuple[str, ...] | None = None) -> Rule:
     return rule
 
 
+def boolean(value: Any) -> bool:
+    """The rule of a ``true`` or ``false`` (not a number)."""
+    if not isinstance(value, bool):
+        raise RuleError(f"must be true or false; got {short_repr(value)}")
+    return value
+
+
+def optional(rule: Rule) -> Rule:
+    """``null`` (None), or a value of ``rule``."""
+
+    def either(value: Any) -> Any:
+        if value is None:
+            return None
+        try:
+            return rule(value)
+        except RuleError as err:
+            raise RuleError(f"{err} (or null)") from None
+
+    return either
+
+
 def _leaves(nested: Any, shape: list[int]) -> list[Any]:
     """The elements of a nested list of ``shape``, in order; raise if it has another shape."""
     items = [nested]
@@ -170,8 +230,18 @@ def _leaves(nested: Any, shape: list[int]) -> list[Any]:
     return items
 
 
-def _array(dtype: str, ndim: int, *, low: float | None = None, strict: bool = False) -> Rule:
-    """A ``{"__ndarray__", "dtype", "shape"}`` of ``dtype`` and ``ndim``; floats finite."""
+def array(dtype: str, ndim: int, *, low: float | None = None, strict: bool = False) -> Rule:
+    """A ``{"__ndarray__", "dtype", "shape"}`` of ``dtype`` and ``ndim``; floats finite.
+
+    Parameters
+    ----------
+    dtype : {"float64", "int64", "str"}
+        The array's dtype.
+    ndim : int
+        Its number of dimensions.
+    low : float, optional
+        Lower bound of every element (``strict``: exclusive).
+    """
     element = {_FLOAT: "finite numbers", _INT: "integers", "str": "strings"}[dtype]
     what = f"a {ndim}-D {dtype} array"
 
@@ -220,7 +290,7 @@ def _array(dtype: str, ndim: int, *, low: float | None = None, strict: bool = Fa
 
 def _arrays(count: int, ndim: int) -> Rule:
     """A list of ``count`` float64 arrays of ``ndim`` dimensions."""
-    item = _array(_FLOAT, ndim)
+    item = array(_FLOAT, ndim)
 
     def rule(value: Any) -> list[np.ndarray]:
         if not isinstance(value, list) or len(value) != count:
@@ -253,7 +323,7 @@ def _int_pair(value: Any) -> Any:
     )
     if not isinstance(items, list) or len(items) != 2:
         raise RuleError(f"must be two integers >= 1; got {short_repr(value)}")
-    pair = [_integer(1)(v) for v in items]
+    pair = [integer(1)(v) for v in items]
     return tuple(pair) if items is not value else pair
 
 
@@ -347,7 +417,8 @@ def _check_mlp(state: dict[str, Any]) -> None:
         )
 
 
-def _no_check(state: dict[str, Any]) -> None:
+def no_check(state: dict[str, Any]) -> None:
+    """A :attr:`Schema.check` that checks nothing across keys."""
     return None
 
 
@@ -508,99 +579,116 @@ def _no_params_check(params: dict[str, Any], state: dict[str, Any]) -> None:
 
 
 @dataclass(frozen=True)
-class _Schema:
+class Schema:
     """What a saved surrogate of one kind may hold, and the rule of each value.
 
-    ``check`` takes the decoded state; ``against`` the parameters of the model
-    built (its ``get_params``, defaults included) and the decoded state.
+    Attributes
+    ----------
+    params : dict or None
+        A rule per constructor parameter (a key without one is refused); None for a
+        family whose codec reads its parameters itself (XGBoost's).
+    state : dict
+        A rule per fitted attribute.
+    check : callable
+        Rules across keys: takes the decoded state, raises :class:`RuleError`.
+    against : callable
+        Rules between the parameters of the model built (its ``get_params``,
+        defaults included) and the decoded state.
     """
 
-    params: dict[str, Rule] | None  # None: the constructor's keys, values decoded as saved
+    params: dict[str, Rule] | None
     state: dict[str, Rule]
-    check: Callable[[dict[str, Any]], None]
+    check: Callable[[dict[str, Any]], None] = no_check
     against: Callable[[dict[str, Any], dict[str, Any]], None] = _no_params_check
 
 
 _INPUT_STATE: dict[str, Rule] = {
-    "n_features_in_": _integer(1),
-    "feature_names_in_": _array("str", 1),
-    "x_mean_": _array(_FLOAT, 1),
-    "x_scale_": _array(_FLOAT, 1, low=0.0, strict=True),
-    "y_mean_": _real(),
-    "y_scale_": _real(low=0.0, strict=True),
+    "n_features_in_": integer(1),
+    "feature_names_in_": array("str", 1),
+    "x_mean_": array(_FLOAT, 1),
+    "x_scale_": array(_FLOAT, 1, low=0.0, strict=True),
+    "y_mean_": real(),
+    "y_scale_": real(low=0.0, strict=True),
 }
 
-SCHEMAS: dict[str, _Schema] = {
-    "polynomial": _Schema(
-        params={
-            "degree": _integer(1),
-            "alpha": _real(low=0.0),
-            "chunk_rows": _integer(1),
-            "max_memory_mb": _real(low=0.0, strict=True, finite=False),
-        },
-        state={
-            **_INPUT_STATE,
-            "powers_": _array(_INT, 2, low=0),
-            "coef_": _array(_FLOAT, 1),
-            "solver_": _string(),
-            "rank_": _integer(0),
-        },
-        check=_check_polynomial,
-        against=_check_polynomial_degree,
-    ),
-    "mlp": _Schema(
-        params={
-            "hidden_sizes": _int_pair,
-            "epochs": _integer(1),
-            "batch_size": _integer(1),
-            "learning_rate": _real(low=0.0, strict=True),
-            "seed": _integer(0),
-            "device": _string(("auto", "cpu", "cuda")),
-        },
-        state={
-            **_INPUT_STATE,
-            "coefs_": _arrays(3, 2),
-            "intercepts_": _arrays(3, 1),
-            "loss_curve_": _numbers,
-            "device_": _string(("cpu", "cuda")),
-        },
-        check=_check_mlp,
-        against=_check_mlp_sizes,
-    ),
-    "xgboost": _Schema(params=None, state={"booster": _booster}, check=_no_check),
-    "affine-corrected": _Schema(
+#: The schema of the polynomial family (``plr``).
+POLYNOMIAL_SCHEMA = Schema(
+    params={
+        "degree": integer(1),
+        "alpha": real(low=0.0),
+        "chunk_rows": integer(1),
+        "max_memory_mb": real(low=0.0, strict=True, finite=False),
+    },
+    state={
+        **_INPUT_STATE,
+        "powers_": array(_INT, 2, low=0),
+        "coef_": array(_FLOAT, 1),
+        "solver_": string(),
+        "rank_": integer(0),
+    },
+    check=_check_polynomial,
+    against=_check_polynomial_degree,
+)
+
+#: The schema of the MLP family (``mlp``).
+MLP_SCHEMA = Schema(
+    params={
+        "hidden_sizes": _int_pair,
+        "epochs": integer(1),
+        "batch_size": integer(1),
+        "learning_rate": real(low=0.0, strict=True),
+        "seed": integer(0),
+        "device": string(("auto", "cpu", "cuda")),
+    },
+    state={
+        **_INPUT_STATE,
+        "coefs_": _arrays(3, 2),
+        "intercepts_": _arrays(3, 1),
+        "loss_curve_": _numbers,
+        "device_": string(("cpu", "cuda")),
+    },
+    check=_check_mlp,
+    against=_check_mlp_sizes,
+)
+
+#: The schema of the XGBoost family (``xgb``): its codec reads the parameters.
+XGBOOST_SCHEMA = Schema(params=None, state={"booster": _booster})
+
+#: The schemas of the surrogates built on other surrogates, by kind.
+COMPOSITE_SCHEMAS: dict[str, Schema] = {
+    "affine-corrected": Schema(
         params={},
         state={
             "base": _document,
-            "scale_": _real(),
-            "offset_": _real(),
-            "residual_std_": _real(low=0.0),
+            "scale_": real(),
+            "offset_": real(),
+            "residual_std_": real(low=0.0),
         },
         check=_check_affine,
     ),
-    "gp-corrected": _Schema(
+    "gp-corrected": Schema(
         params={},
         state={
             "base": _document,
-            "z_mean_": _array(_FLOAT, 1),
-            "z_scale_": _array(_FLOAT, 1, low=0.0, strict=True),
-            "kernel_theta_": _array(_FLOAT, 1),
-            "inputs_": _array(_FLOAT, 2),
-            "targets_": _array(_FLOAT, 1),
+            "z_mean_": array(_FLOAT, 1),
+            "z_scale_": array(_FLOAT, 1, low=0.0, strict=True),
+            "kernel_theta_": array(_FLOAT, 1),
+            "inputs_": array(_FLOAT, 2),
+            "targets_": array(_FLOAT, 1),
         },
         check=_check_gp,
     ),
-    "ensemble": _Schema(
+    "ensemble": Schema(
         params={},
-        state={"members": _documents, "residual_std_": _real(low=0.0)},
+        state={"members": _documents, "residual_std_": real(low=0.0)},
         check=_check_residual_std,
     ),
-    "pressure-scaled": _Schema(
+    "pressure-scaled": Schema(
         params={},
         state={
             "base": _document,
-            "scale_": _real(low=0.0, strict=True),
-            "residual_std_": _real(low=0.0),
+            "scale_": real(low=0.0, strict=True),
+            "residual_std_": real(low=0.0),
         },
         check=_check_residual_std,
     ),

@@ -1,6 +1,7 @@
 """Grid search with design-grouped K-fold cross-validation (paper B §4.1).
 
-Every configuration of every model family is fitted on K−1 folds and scored
+Every configuration of every model family (a :class:`~softbend.surrogates.families.Family`
+of :data:`~softbend.surrogates.families.FAMILIES`, by name) is fitted on K−1 folds and scored
 on the held-out fold, where the folds are groups of whole designs: a pressure
 sweep is never split between training and validation, so the score is that of
 an unseen actuator, not of an unseen pressure of a seen one. The best
@@ -8,7 +9,7 @@ configuration of each family (lowest mean validation RMSE) is refitted on all
 the data. The MLP configurations are trained together in one batched tensor
 program (:func:`softbend.surrogates.batched.train_mlp_grid`).
 
-Grids (``grid="paper"`` is paper B's):
+Grids (``grid="paper"`` is paper B's; each family holds its own):
 
 ========  ==================================  ====================================
 family    ``quick``                           ``paper``
@@ -56,8 +57,16 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 import pandas as pd
 
-from softbend._extras import require
 from softbend._validation import check_choice, check_int, check_range
+from softbend.surrogates.families import (
+    FAMILIES,
+    GRID_NAMES,
+    MODEL_NAMES,
+    MODEL_TITLES,
+    XGB_TREES,
+    FitSettings,
+    family_names,
+)
 from softbend.surrogates.features import TrainingData
 from softbend.surrogates.metrics import MAPE_THRESHOLD_DEG, accuracy, inference_time
 
@@ -66,43 +75,39 @@ if TYPE_CHECKING:
 
 logger = logging.getLogger(__name__)
 
-#: Model families, by their command-line names.
-MODEL_NAMES: tuple[str, ...] = ("plr", "xgb", "mlp")
-
-#: Long names of the families.
-MODEL_TITLES: dict[str, str] = {
-    "plr": "polynomial regression",
-    "xgb": "XGBoost",
-    "mlp": "normalized MLP",
-}
-
-#: Grid names.
-GRID_NAMES: tuple[str, ...] = ("quick", "paper")
-
-#: Trees per XGBoost model.
-XGB_TREES = 300
+__all__ = [
+    "CV_PROTOCOLS",
+    "GRID_NAMES",
+    "MLP_EPOCHS",
+    "MODEL_NAMES",
+    "MODEL_TITLES",
+    "XGB_TREES",
+    "FamilyResult",
+    "Progress",
+    "SearchResult",
+    "describe",
+    "grid",
+    "grouped_splits",
+    "halving_rungs",
+    "random_splits",
+    "search",
+    "search_fingerprint",
+]
 
 #: MLP epochs per grid (paper B: 1000).
 MLP_EPOCHS: dict[str, int] = {"quick": 200, "paper": 1000}
 
 
 def grid(name: str, model: str) -> list[dict[str, Any]]:
-    """The configurations of ``model`` in the grid ``name`` (see the module docstring)."""
+    """The configurations of the family ``model`` in the grid ``name`` (module docstring).
+
+    Raises
+    ------
+    ValueError
+        An unknown grid; :class:`~softbend.registry.UnknownNameError` an unknown family.
+    """
     check_choice(name, "grid", "surrogate search", GRID_NAMES)
-    check_choice(model, "model", "surrogate search", MODEL_NAMES)
-    if model == "plr":
-        degrees = (2, 4, 6) if name == "quick" else range(2, 11)
-        return [{"degree": int(d)} for d in degrees]
-    if model == "xgb":
-        if name == "quick":
-            depths, rates = (6, 9), (0.2, 0.4)
-        else:
-            depths, rates = range(1, 21), [round(0.1 * k, 1) for k in range(1, 11)]
-        return [{"max_depth": int(d), "learning_rate": float(r)} for d in depths for r in rates]
-    sizes = (
-        ((63, 65),) if name == "quick" else [(a, b) for a in range(55, 66) for b in range(55, 66)]
-    )
-    return [{"hidden_sizes": (int(a), int(b))} for a, b in sizes]
+    return FAMILIES.get(model, field="model").configs(name)
 
 
 def describe(params: dict[str, Any]) -> str:
@@ -182,7 +187,7 @@ class FamilyResult:
     Attributes
     ----------
     name : str
-        ``"plr"``, ``"xgb"`` or ``"mlp"``.
+        The family's name (``"plr"``, ``"xgb"``, ``"mlp"``, ...).
     params : dict
         Best configuration.
     cv : dict
@@ -276,24 +281,9 @@ def _mlp_precision(model: str, device: str, tf32: bool) -> AbstractContextManage
 def _make(
     model: str, params: dict[str, Any], *, seed: int, n_jobs: int | None, device: str, epochs: int
 ) -> Any:
-    if model == "plr":
-        from softbend.surrogates.polynomial import PolynomialRegressor
-
-        return PolynomialRegressor(**params)
-    if model == "xgb":
-        XGBRegressor = require("xgboost", "The XGBoost surrogate").XGBRegressor
-
-        return XGBRegressor(
-            n_estimators=XGB_TREES,
-            objective="reg:squarederror",
-            tree_method="hist",
-            random_state=seed,
-            n_jobs=n_jobs,
-            **params,
-        )
-    from softbend.surrogates.mlp import NormalizedMLPRegressor
-
-    return NormalizedMLPRegressor(**params, epochs=epochs, seed=seed, device=device)
+    """A new, unfitted estimator of the family ``model`` in the configuration ``params``."""
+    settings = FitSettings(seed=seed, n_jobs=n_jobs, device=device, epochs=epochs)
+    return FAMILIES.get(model, field="models").make(dict(params), settings)
 
 
 def _fold_scores(
@@ -619,8 +609,9 @@ def search(
     ----------
     data : TrainingData
         From :func:`softbend.surrogates.features.training_data`.
-    models : sequence of str
-        Families among ``"plr"``, ``"xgb"``, ``"mlp"``.
+    models : sequence of str or str
+        Names of registered families (:data:`~softbend.surrogates.families.FAMILIES`:
+        ``"plr"``, ``"xgb"``, ``"mlp"``, ...), or one comma-separated text of them.
     grid_name : {"quick", "paper"}
         Hyperparameter grid (module docstring).
     folds : int
@@ -679,13 +670,7 @@ def search(
         With ``resumed``, the configuration-folds loaded from ``checkpoint``.
     """
     owner = "surrogate search"
-    models = list(dict.fromkeys(models))
-    if not models:
-        raise ValueError(
-            f"The 'models' of {owner} must name at least one of {', '.join(MODEL_NAMES)}."
-        )
-    for model in models:
-        check_choice(model, "models", owner, MODEL_NAMES)
+    models = list(family_names(models, field="models"))
     check_choice(grid_name, "grid", owner, GRID_NAMES)
     check_choice(device, "device", owner, ("auto", "cpu", "cuda"))
     epochs = (
@@ -718,7 +703,7 @@ def search(
     families: dict[str, FamilyResult] = {}
     param_grid = dict(param_grid or {})
     for name in param_grid:
-        check_choice(name, "param_grid", owner, MODEL_NAMES)
+        FAMILIES.check(name, field="param_grid")
     plan = {model: list(param_grid.get(model) or grid(grid_name, model)) for model in models}
     if halving is not None and "mlp" in plan:
         _halving_rungs(len(plan["mlp"]), epochs, halving, n_rungs)  # bad rungs: before any fit

@@ -5,18 +5,24 @@
 into ``out_dir``:
 
 - ``models/<model>.json`` — the refitted best model of each family with its
-  metadata (feature order and units, data hash, CV metrics, softbend version);
-- ``models/<model>.onnx`` — its ONNX export, checked against ``predict``;
+  metadata (feature order and units, data hash, CV metrics, softbend version),
+  for a family with a storage (:class:`~softbend.surrogates.families.Storage`);
+- ``models/<model>.onnx`` — its ONNX export, checked against ``predict``, for a
+  family with one;
 - ``cv_results.csv`` — every configuration's cross-validated scores;
-- ``summary.csv`` — the best of each family beside paper B's figures.
+- ``summary.csv`` — the best of each family beside paper B's figures (empty for
+  a family paper B does not have).
 
 It draws nothing: :func:`softbend.reports.surrogate_figures.training_figures`
 draws paper B Fig. 5 and the MLP's loss from what it returns.
+:func:`train_into` is what ``softbend train`` runs: the same, into a folder that
+is replaced as a whole, resuming an interrupted search from its checkpoint.
 """
 
 from __future__ import annotations
 
 import os
+from collections.abc import Callable, Sequence
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
@@ -24,23 +30,22 @@ import numpy as np
 import pandas as pd
 
 from softbend._io import write_text_atomic
+from softbend.references import SURROGATES, values
+from softbend.surrogates.families import FAMILIES, family_names
 from softbend.surrogates.features import TrainingData, training_data
 from softbend.surrogates.search import MODEL_NAMES, Progress, SearchResult, describe, search
 
 if TYPE_CHECKING:
     from softbend.surrogates.checkpoint import SearchCheckpoint
 
-#: Paper B §4.1 (Fig. 5): best configuration of each family, 5-fold CV on its FEM data.
-PAPER_B_FIG5: dict[str, dict[str, Any]] = {
-    "plr": {"params": "degree 4", "r2": 0.9986, "mape_pct": 1.8, "inference_ms": 22.39},
-    "xgb": {
-        "params": "max depth 9, learning rate 0.2",
-        "r2": 0.9995,
-        "mape_pct": 0.8,
-        "inference_ms": 53.77,
-    },
-    "mlp": {"params": "hidden (63, 65)", "r2": 0.9991, "mape_pct": 0.89, "inference_ms": 12.99},
-}
+#: Paper B §4.1 (Fig. 5): best configuration of each family, 5-fold CV on its FEM data
+#: (:data:`softbend.references.SURROGATES`).
+PAPER_B_FIG5: dict[str, dict[str, Any]] = values(SURROGATES)
+
+
+def _paper_b(name: str) -> dict[str, Any]:
+    """Paper B's figures of the family ``name`` (empty for a family it does not have)."""
+    return dict(PAPER_B_FIG5.get(name) or {})
 
 
 def _load_data(source: Any) -> TrainingData:
@@ -60,7 +65,7 @@ def train_surrogates(
     source: Any,
     out_dir: str | os.PathLike[str],
     *,
-    models: tuple[str, ...] | list[str] = MODEL_NAMES,
+    models: str | Sequence[str] = MODEL_NAMES,
     grid_name: str = "quick",
     folds: int = 5,
     seed: int = 0,
@@ -85,9 +90,11 @@ def train_surrogates(
     out_dir : path
         Output folder (created).
     models, grid_name, folds, seed, device, n_jobs, epochs, progress
-        As :func:`softbend.surrogates.search.search`.
+        As :func:`softbend.surrogates.search.search` (``models``: registered family
+        names, or one comma-separated text of them).
     export_onnx : bool
-        Also write and check ``models/<model>.onnx`` (default True).
+        Also write and check ``models/<model>.onnx`` (default True) for the families
+        that have an ONNX export.
     cv : {"grouped", "random"}, halving : int, optional, halving_rungs : int, plr_patience : int
         Cross-validation protocol, successive halving of the MLP grid and early
         stop of the polynomial's degrees (see :func:`softbend.surrogates.search.search`).
@@ -103,9 +110,9 @@ def train_surrogates(
     -------
     result : SearchResult
     summary : dict
-        JSON-friendly headline figures, per family and paper B's beside them,
-        the files written, and ``resumed_config_folds`` (folds loaded from
-        ``checkpoint``).
+        JSON-friendly headline figures, per family and paper B's beside them
+        (``paper_b``, empty for a family paper B does not have), the files
+        written, and ``resumed_config_folds`` (folds loaded from ``checkpoint``).
     """
     from softbend.surrogates.features import training_ranges
     from softbend.surrogates.persistence import save_surrogate
@@ -141,18 +148,20 @@ def train_surrogates(
             "search": {**result.settings, "params": describe(fam.params)},
             "training_ranges": training_ranges(data.X),
         }
-        files[f"{name}_model"] = str(
-            save_surrogate(fam.model, out / "models" / f"{name}.json", metadata=metadata)
-        )
+        family = FAMILIES.get(name)
+        if family.storage is not None:
+            files[f"{name}_model"] = str(
+                save_surrogate(fam.model, out / "models" / f"{name}.json", metadata=metadata)
+            )
         entry: dict[str, Any] = {
             "params": describe(fam.params),
             **{k: float(v) for k, v in fam.cv.items()},
             **{f"inference_{k}": v for k, v in fam.timing.items()},
             "fit_s": fam.fit_s,
             "search_s": fam.search_s,
-            "paper_b": PAPER_B_FIG5[name],
+            "paper_b": _paper_b(name),
         }
-        if export_onnx:
+        if export_onnx and family.onnx is not None:
             from softbend.surrogates.onnx_export import onnx_predict, save_onnx
 
             onnx_path = save_onnx(fam.model, out / "models" / f"{name}.onnx")
@@ -166,14 +175,8 @@ def train_surrogates(
     cv_path = out / "cv_results.csv"
     write_text_atomic(cv_path, result.cv_results.to_csv(index=False))
     summary_table = result.summary()
-    summary_table["paper_b_params"] = [PAPER_B_FIG5[m]["params"] for m in summary_table["model"]]
-    summary_table["paper_b_r2"] = [PAPER_B_FIG5[m]["r2"] for m in summary_table["model"]]
-    summary_table["paper_b_mape_pct"] = [
-        PAPER_B_FIG5[m]["mape_pct"] for m in summary_table["model"]
-    ]
-    summary_table["paper_b_inference_ms"] = [
-        PAPER_B_FIG5[m]["inference_ms"] for m in summary_table["model"]
-    ]
+    for key in ("params", "r2", "mape_pct", "inference_ms"):
+        summary_table[f"paper_b_{key}"] = [_paper_b(m).get(key) for m in summary_table["model"]]
     write_text_atomic(out / "summary.csv", summary_table.to_csv(index=False))
     files["cv_results"] = str(cv_path)
     files["summary"] = str(out / "summary.csv")
@@ -184,5 +187,75 @@ def train_surrogates(
         "best_by_mape": best,
         "resumed_config_folds": result.resumed,
         "files": files,
+    }
+    return result, summary
+
+
+def train_into(
+    source: Any,
+    out_dir: str | os.PathLike[str],
+    *,
+    models: str | Sequence[str] = MODEL_NAMES,
+    figures: Callable[[SearchResult, Path], dict[str, str]] | None = None,
+    on_resume: Callable[[str], None] | None = None,
+    on_discard: Callable[[str], None] | None = None,
+    **options: Any,
+) -> tuple[SearchResult, dict[str, Any]]:
+    """:func:`train_surrogates` into a folder replaced as a whole, resumable.
+
+    The families are checked first. Everything is written into a staging folder
+    beside ``out_dir`` (with ``figures(result, stage)``'s files, if given) that
+    replaces ``out_dir`` only when complete: an interrupted run leaves the
+    previous folder as it was, never old models beside new ones. Every finished
+    configuration-fold is kept in the checkpoint beside ``out_dir``
+    (:func:`~softbend.surrogates.checkpoint.checkpoint_path`); the same call run
+    again after an interruption resumes from it, and it is removed once the new
+    folder is in place.
+
+    Parameters
+    ----------
+    source, out_dir, models
+        As :func:`train_surrogates`.
+    figures : callable, optional
+        ``figures(result, folder) -> {name: path}``: more files drawn into the
+        staging folder (e.g. :func:`softbend.reports.surrogate_figures.training_figures`).
+    on_resume, on_discard : callable, optional
+        Told one line when a checkpoint is resumed, or discarded as that of other
+        settings (:class:`~softbend.surrogates.checkpoint.SearchCheckpoint`).
+    **options
+        The other keyword arguments of :func:`train_surrogates` (``grid_name``,
+        ``folds``, ``seed``, ``device``, ...), not ``checkpoint``.
+
+    Returns
+    -------
+    result : SearchResult
+    summary : dict
+        As :func:`train_surrogates`, with ``files`` named where they are now, in
+        ``out_dir``.
+
+    Raises
+    ------
+    softbend.registry.UnknownNameError
+        An unknown family, before anything is written.
+    """
+    from softbend._io import staged_dir
+    from softbend.surrogates.checkpoint import SearchCheckpoint, checkpoint_path
+
+    names = family_names(models, field="models")
+    out = Path(out_dir)
+    checkpoint = SearchCheckpoint(checkpoint_path(out), on_resume=on_resume, on_discard=on_discard)
+    with checkpoint:
+        with staged_dir(out) as stage:
+            result, summary = train_surrogates(
+                source, stage, models=names, checkpoint=checkpoint, **options
+            )
+            if figures is not None:
+                summary["files"].update(figures(result, stage))
+        checkpoint.remove()  # the new folder is in place
+    summary["files"] = {
+        key: str(out / Path(value).relative_to(stage))
+        if str(value).startswith(str(stage))
+        else value
+        for key, value in summary["files"].items()
     }
     return result, summary

@@ -1,0 +1,110 @@
+"""How an XGBoost surrogate is written to and rebuilt from a saved surrogate file.
+
+Its ``state`` is XGBoost's own JSON model (the ``booster``, restored exactly);
+its ``params`` are the estimator's, with XGBoost's default ``missing`` (NaN)
+written as ``null`` so that the file is strict JSON. XGBoost also takes extra
+keyword parameters that it passes on to the booster; such a key is accepted
+unless it could name an attribute of the estimator. XGBoost itself is imported
+only when a model is rebuilt.
+"""
+
+from __future__ import annotations
+
+import math
+import warnings
+from typing import Any
+
+import numpy as np
+
+from softbend._validation import short_repr
+from softbend.errors import SchemaError
+from softbend.surrogates.features import FEATURES
+from softbend.surrogates.jsonvalues import decode, encode_params
+from softbend.surrogates.schema import RuleError, tag_float
+
+__all__ = ["XGBoostCodec"]
+
+
+def _params(params: dict[str, Any], cls: type, path: str) -> tuple[dict[str, Any], set[str]]:
+    """Decoded XGBoost parameters and the names of the standard ones."""
+    standard = set(cls().get_params(deep=False))
+    unknown = [
+        key
+        for key in params
+        if key not in standard
+        and (not key.isidentifier() or key.startswith("_") or hasattr(cls, key))
+    ]
+    if unknown:
+        raise SchemaError(
+            f"{path}: unknown params key(s) {', '.join(map(repr, unknown))} for the xgb "
+            f"surrogate; allowed keys: {', '.join(sorted(standard))} and XGBoost's extra "
+            "booster parameters."
+        )
+    try:
+        decoded = {key: decode(value) for key, value in params.items()}
+    except (KeyError, TypeError, ValueError, AttributeError, RuleError) as err:
+        raise SchemaError(f"{path}: params of the xgb surrogate cannot be read ({err}).") from None
+    if "missing" in decoded:  # null: XGBoost's default NaN (how the codec writes it)
+        missing = decoded["missing"]
+        if missing is None:
+            decoded["missing"] = math.nan
+        elif isinstance(missing, bool | np.bool_) or not isinstance(
+            missing, int | float | np.integer | np.floating
+        ):
+            raise SchemaError(
+                f"{path}: params key 'missing' of the xgb surrogate must be a number or "
+                f"null (NaN, XGBoost's default); got {short_repr(params['missing'])}."
+            )
+    return decoded, standard
+
+
+class XGBoostCodec:
+    """The :class:`~softbend.surrogates.families.Codec` of ``xgboost.XGBRegressor``."""
+
+    def is_fitted(self, model: Any) -> bool:
+        """Whether the regressor holds a trained booster."""
+        return bool(model.__sklearn_is_fitted__())
+
+    def params(self, model: Any) -> dict[str, Any]:
+        """The estimator's parameters, XGBoost's default ``missing`` (NaN) as ``null``."""
+        params = encode_params(model)
+        if params.get("missing") == tag_float(math.nan):
+            params["missing"] = None  # read back as NaN
+        return params
+
+    def state(self, model: Any) -> dict[str, Any]:
+        """``{"booster": XGBoost's JSON model as text}``."""
+        return {"booster": bytes(model.get_booster().save_raw("json")).decode("utf-8")}
+
+    def restore(self, cls: type, params: dict[str, Any], state: dict[str, Any], path: str) -> Any:
+        """The regressor of ``params`` (as saved) with the checked ``booster`` loaded.
+
+        Raises
+        ------
+        softbend.errors.SchemaError
+            A parameter XGBoost does not know or refuses, a booster it cannot load or
+            one that predicts a non-finite angle, naming ``path``.
+        """
+        decoded, standard = _params(params, cls, path)
+        try:
+            model = cls(**decoded)
+            model.load_model(bytearray(state["booster"].encode("utf-8")))
+            # load_model fills base_score, booster, ... from the booster; put back the
+            # standard parameters as they were set, so that get_params (and a refit) is
+            # unchanged.
+            for key in standard & decoded.keys():
+                setattr(model, key, decoded[key])
+            # A parameter XGBoost only reads when predicting (missing, n_jobs, ...) fails
+            # here, not in the caller's first prediction.
+            with warnings.catch_warnings():
+                warnings.simplefilter("ignore")
+                probe = np.asarray(model.predict(np.zeros((1, len(FEATURES)))), dtype=np.float64)
+        except Exception as err:  # xgboost.core.XGBoostError, a parameter XGBoost refuses, ...
+            reason = (str(err).strip().splitlines() or [type(err).__name__])[0]  # no stack trace
+            raise SchemaError(f"{path}: cannot rebuild the xgb surrogate ({reason}).") from None
+        if not np.isfinite(probe).all():
+            raise SchemaError(
+                f"{path}: the xgb surrogate's booster predicts {probe.ravel()[0]} (its "
+                "base_score or a leaf value is not a finite number)."
+            )
+        return model
