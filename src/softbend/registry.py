@@ -5,10 +5,10 @@ transfer strategies, controllers, plants, rigs, campaign backends and material
 models. Each keeps a :class:`Registry`; adding an implementation is one module
 plus one ``register`` call, from inside the package or outside it::
 
-    from softbend.control import CONTROLLERS          # a Registry
+    from softbend.control import CONTROLLERS, make_controller
 
     CONTROLLERS.register("my-pid", make_my_pid)       # once, at import time
-    controller = CONTROLLERS.get("my-pid")(table)     # what the library does
+    controller = make_controller("my-pid", table, gain=2.0)  # what the library does
 
 An unknown name is one :class:`UnknownNameError` line listing the known names,
 never a silent default; registering a name twice is refused unless asked for.

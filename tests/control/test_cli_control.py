@@ -11,7 +11,8 @@ def test_bad_controller_is_one_line(capsys):
     code = main(["control", "simulate", "--out", "x", "--controller", "pid"])
     assert code == 2
     err = capsys.readouterr().err.strip().splitlines()
-    assert len(err) == 1 and "'controller'" in err[0] and "'bang-bang'" in err[0]
+    assert len(err) == 1 and "Unknown controller 'pid' (in --controller)" in err[0]
+    assert "known: bang-bang, bang-bang-closed, pressure-pi, pressure-relay, predictive" in err[0]
 
 
 def test_bad_reference_is_one_line(capsys):
@@ -45,7 +46,10 @@ def test_simulate_writes_run(tmp_path, capsys, controller):
 @pytest.mark.parametrize(
     ("args", "needles"),
     [
-        (["run", "--rig", "usb"], ["'rig' of softbend control run", "'modbus'"]),
+        (
+            ["run", "--rig", "usb"],
+            ["Unknown rig 'usb' (in --rig); known: sim, sim-realtime, modbus"],
+        ),
         (["run", "--rig", "modbus"], ["'--config' of softbend control run"]),
         (["run", "--log-format", "xml"], ["'log_format'", "'parquet'"]),
         (["run", "--period", "0.02", "--sensor-period", "0.01"], ["'sensor_period'"]),

@@ -48,5 +48,7 @@ def test_a_plant_that_bends_more_shows_as_steady_state_error():
 
 
 def test_unknown_controller_is_one_error():
-    with pytest.raises(ValueError, match="'controller' of make_controller must be one of"):
+    with pytest.raises(
+        ValueError, match=r"Unknown controller 'pid' \(in control_study\); known: b"
+    ):
         control_study(Linear(), DESIGN, controllers=("pid",), duration_s=1.0)

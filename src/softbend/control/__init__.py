@@ -5,4 +5,69 @@
 - :mod:`softbend.control.controllers`: paper B's deadzone bang-bang and pressure-based
   alternatives behind one ``step(measurement, reference, t) -> ValveCommand`` interface;
 - :mod:`softbend.control.experiments`: references, the loop and its metrics.
+
+Named extension points (:class:`softbend.registry.Registry`): :data:`CONTROLLERS`
+(controller factories, :mod:`softbend.control.factory`), :data:`PLANTS` (θ(p)
+of the actuator, :mod:`softbend.control.plants`) and :data:`RIGS` (what the loop
+runs on, :mod:`softbend.control.rigs`). The names below are imported on first
+use, so ``import softbend.control`` stays light.
 """
+
+from __future__ import annotations
+
+import importlib
+from typing import Any
+
+#: Public name -> the module that defines it.
+_EXPORTS: dict[str, str] = {
+    "CONTROLLERS": "factory",
+    "DEFAULT_CONTROLLER": "factory",
+    "ControllerModel": "factory",
+    "build_controller": "factory",
+    "controller_parameters": "factory",
+    "make_controller": "factory",
+    "BangBang": "controllers",
+    "Controller": "controllers",
+    "PressurePI": "controllers",
+    "PressureRelay": "controllers",
+    "ValveCommand": "controllers",
+    "mlp_virtual_sensor": "controllers",
+    "PredictivePulse": "predictive",
+    "PLANTS": "plants",
+    "plant_table": "plants",
+    "RIGS": "rigs",
+    "RigSetup": "rigs",
+    "make_rig": "rigs",
+    "AngleTable": "rig",
+    "Rig": "rig",
+    "RigParams": "rig",
+    "SimulatedRig": "rig",
+    "ControllerConfig": "rigconfig",
+    "RigConfig": "rigconfig",
+    "load_rig_config": "rigconfig",
+    "ControlRun": "experiments",
+    "parse_reference": "experiments",
+    "run_metrics": "experiments",
+    "simulate": "experiments",
+    "run_loop": "loop",
+    "ControlSetup": "setup",
+    "prepare_control": "setup",
+    "plan_loop": "runs",
+    "simulate_control": "runs",
+    "control_study": "study",
+}
+
+__all__ = sorted(_EXPORTS)
+
+
+def __getattr__(name: str) -> Any:
+    module = _EXPORTS.get(name)
+    if module is None:
+        raise AttributeError(f"module 'softbend.control' has no attribute {name!r}")
+    value = getattr(importlib.import_module(f"softbend.control.{module}"), name)
+    globals()[name] = value
+    return value
+
+
+def __dir__() -> list[str]:
+    return sorted(set(globals()) | set(__all__))

@@ -29,7 +29,6 @@ from softbend._validation import check_choice, check_range
 from softbend.design import SFRBADesign
 
 __all__ = [
-    "CONTROLLERS",
     "BangBang",
     "Controller",
     "PressurePI",
@@ -326,13 +325,3 @@ class PressureRelay(_PressureTarget):
                 self._opened_s = t_s
         self._command = command
         return command
-
-
-#: Names used on the CLI.
-CONTROLLERS: tuple[str, ...] = (
-    "bang-bang",
-    "bang-bang-closed",
-    "pressure-pi",
-    "pressure-relay",
-    "predictive",
-)

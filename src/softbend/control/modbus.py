@@ -78,6 +78,8 @@ class ModbusRig:
     duration of every reading request (for the loop's report).
     """
 
+    synthetic = False
+
     def __init__(self, config: RigConfig, *, client: Any | None = None) -> None:
         self.config = config
         self._client = _client(config) if client is None else client
@@ -90,6 +92,11 @@ class ModbusRig:
         self.requests = 0
         self.round_trips_s: list[float] = []
         self._plan = self._read_plan()
+
+    @property
+    def where(self) -> str:
+        """The rig's address: ``tcp://host:port`` or ``rtu:///dev/ttyUSB0``."""
+        return self._where
 
     # -- the register map -------------------------------------------------
 

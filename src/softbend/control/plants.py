@@ -3,7 +3,10 @@
 The controllers always use their own model (a surrogate); the rig's angle map
 can be that same model (no mismatch), the design's FEM sweep in the shipped
 Table 1 dataset, or the design's virtual-lab readings (the reality gap a
-controller meets on a real actuator). :func:`plant_table` picks one by name.
+controller meets on a real actuator). :data:`PLANTS` names them;
+:func:`plant_table` picks one by name. A plant factory is
+``factory(design, model_table) -> AngleTable``; adding one is one
+``PLANTS.register(name, factory)`` call.
 """
 
 from __future__ import annotations
@@ -13,29 +16,56 @@ from typing import Any
 
 import numpy as np
 
-from softbend._validation import check_choice
 from softbend.control.rig import AngleTable
 from softbend.design import SFRBADesign
+from softbend.registry import Registry
 
 __all__ = [
     "PLANTS",
     "fem_angle_table",
+    "fem_plant",
     "lab_angle_table",
+    "lab_plant",
     "plant_table",
     "shipped_angle_table",
+    "surrogate_plant",
 ]
 
-#: Names of the plants: the controllers' own model, the FEM sweep, the lab readings.
-PLANTS: tuple[str, ...] = ("surrogate", "fem", "lab")
+#: Plant factories by name: ``factory(design, model_table) -> AngleTable``.
+PLANTS: Registry[Callable[[SFRBADesign, AngleTable], AngleTable]] = Registry("plant")
 
 
-def plant_table(name: str, design: SFRBADesign, model_table: AngleTable) -> AngleTable:
-    """The plant ``name`` (one of :data:`PLANTS`) of ``design``; ``model_table`` for "surrogate"."""
-    check_choice(name, "plant", "plant_table", PLANTS)
-    if name == "surrogate":
-        return model_table
-    if name == "fem":
-        return fem_angle_table(design)
+def plant_table(
+    name: str, design: SFRBADesign, model_table: AngleTable, *, field: str = "plant_table"
+) -> AngleTable:
+    """The plant ``name`` (one of :data:`PLANTS`) of ``design``; ``model_table`` for "surrogate".
+
+    Parameters
+    ----------
+    name : str
+        A name of :data:`PLANTS`; an unknown one raises
+        :class:`~softbend.registry.UnknownNameError` listing the known names.
+    design : SFRBADesign
+    model_table : AngleTable
+        θ(p) of the controllers' own model.
+    field : str
+        Where ``name`` came from, for the message (``"--plant"``).
+    """
+    return PLANTS.get(name, field=field)(design, model_table)
+
+
+def surrogate_plant(design: SFRBADesign, model_table: AngleTable) -> AngleTable:
+    """The controllers' own model as the plant: no model mismatch."""
+    return model_table
+
+
+def fem_plant(design: SFRBADesign, model_table: AngleTable) -> AngleTable:
+    """The design's FEM sweep in the shipped Table 1 dataset (:func:`fem_angle_table`)."""
+    return fem_angle_table(design)
+
+
+def lab_plant(design: SFRBADesign, model_table: AngleTable) -> AngleTable:
+    """The design's virtual-lab loading readings, smoothed (:func:`lab_angle_table`)."""
     return lab_angle_table(design)
 
 
@@ -141,3 +171,8 @@ def lab_angle_table(
     grid = np.linspace(0.0, float(p.max()), 64)
     smooth = np.polynomial.polynomial.polyval(grid, coef)
     return AngleTable.from_callable(_extrapolated(grid, smooth), pmax_mpa=pmax_mpa, points=points)
+
+
+PLANTS.register("surrogate", surrogate_plant)
+PLANTS.register("fem", fem_plant)
+PLANTS.register("lab", lab_plant)

@@ -42,6 +42,9 @@ class WallClockRig:
         Seconds, monotonic.
     """
 
+    synthetic = True
+    where = "simulated"
+
     def __init__(
         self,
         rig: SimulatedRig,

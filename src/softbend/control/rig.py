@@ -282,7 +282,7 @@ class RigParams:
         tubing = check_range(
             tubing_mm3, "tubing_mm3", "RigParams.for_design", low=0.0, low_inclusive=True
         )
-        volume = 0.5 * math.pi * design.r_mm**2 * design.l_mm + tubing
+        volume = design.cavity_volume_mm3 + tubing
         return cls(volume_mm3=volume, **kwargs)
 
     def replace(self, **changes: Any) -> RigParams:
@@ -416,7 +416,9 @@ class Rig(Protocol):
     :class:`softbend.errors.RigError`); ``read_angle_deg()`` is the latest angle
     of an evaluation sensor (camera), NaN where the rig has none;
     ``command(inlet, outlet)`` sets the valves (``True`` = open); ``close()``
-    releases the rig (the loop vents it first).
+    releases the rig (the loop vents it first). Optional, for the record of a
+    run: ``synthetic`` (``True`` for a simulation) and ``where`` (its address,
+    e.g. ``"tcp://10.0.0.5:502"``, or ``"simulated"``).
     """
 
     def clock_s(self) -> float: ...
@@ -448,6 +450,9 @@ class SimulatedRig:
     (true), ``inlet_open``, ``outlet_open`` (actual valve states), ``air_used_kg``
     (mass drawn from the supply), ``switches`` (valve state changes).
     """
+
+    synthetic = True
+    where = "simulated"
 
     def __init__(
         self, angle_map: Callable[[float], float], params: RigParams | None = None, *, seed: int = 0

@@ -47,13 +47,19 @@ stop the loop. Every value has a unit in its name or its comment::
     period_s = 0.001          # tick of the controller and the valves, s
     sensor_period_s = 0.01    # pressure readings, s (paper B: 100 Hz)
 
+    [controller]              # optional: the controller of `control run`
+    name = "bang-bang"        # a name of softbend.control.CONTROLLERS
+    deadzone = 0.05           # its parameters (see its factory), as --set NAME=VALUE
+
 :func:`load_rig_config` reads and checks a file before anything uses it: a
 TOML syntax error, an unknown section or key, a missing required key (the
 ``address`` and ``scale`` of [pressure] and of [angle]: no default fits every
 sensor), a value of the wrong TOML type, out of range, not finite, or a [safety]
 pressure that is not a plausible gauge pressure (:mod:`softbend.plausibility`)
 is one :class:`~softbend.errors.DatasetError` naming the file, the line and the
-key, and the allowed values. :meth:`RigConfig.to_toml` writes one back.
+key, and the allowed values; so is an unknown controller name or parameter of
+[controller], or a parameter value of the wrong kind (the message lists the
+known names). :meth:`RigConfig.to_toml` writes one back.
 """
 
 from __future__ import annotations
@@ -73,11 +79,13 @@ from softbend.plausibility import RANGES, implausible_index
 
 __all__ = [
     "ConnectionConfig",
+    "ControllerConfig",
     "RegisterConfig",
     "RigConfig",
     "SafetyLimits",
     "ValveConfig",
     "load_rig_config",
+    "rig_config_template",
 ]
 
 _OWNER = "rig config"
@@ -242,6 +250,36 @@ class SafetyLimits:
 
 
 @dataclass(frozen=True)
+class ControllerConfig:
+    """The [controller] table: a controller's name and the parameters given for it.
+
+    Attributes
+    ----------
+    name : str
+        A name of :data:`softbend.control.factory.CONTROLLERS`.
+    params : tuple of (str, value)
+        The parameters given, checked against the controller's factory (a mapping
+        is accepted and stored as pairs); the others keep their defaults.
+    """
+
+    name: str
+    params: tuple[tuple[str, Any], ...] = ()
+
+    def __post_init__(self) -> None:
+        from softbend.control.factory import CONTROLLERS, controller_parameters
+
+        where = f"[controller] of the {_OWNER}"
+        CONTROLLERS.check(self.name, field=f"the 'name' of {where}")
+        given = dict(self.params)
+        checked = controller_parameters(self.name, given, field=where)
+        object.__setattr__(self, "params", tuple((k, checked[k]) for k in given))
+
+    def as_dict(self) -> dict[str, Any]:
+        """The parameters given, ``{name: value}``."""
+        return dict(self.params)
+
+
+@dataclass(frozen=True)
 class RigConfig:
     """A whole rig: connection, registers, valves, safety, loop tick and sensor period (s)."""
 
@@ -256,6 +294,7 @@ class RigConfig:
     safety: SafetyLimits = field(default_factory=SafetyLimits)
     period_s: float = 0.001
     sensor_period_s: float = 0.01
+    controller: ControllerConfig | None = None
 
     def __post_init__(self) -> None:
         loop = f"[loop] of the {_OWNER}"
@@ -316,7 +355,7 @@ class RigConfig:
 
     @classmethod
     def _from_checked(cls, data: Any) -> RigConfig:
-        _check_keys(data, set(_SECTIONS) | {"loop"}, "the rig config", "section")
+        _check_keys(data, set(_SECTIONS) | {"loop", "controller"}, "the rig config", "section")
         if "pressure" not in data:
             raise ValueError(
                 "The rig config must have a [pressure] section (table, address, scale, ...)."
@@ -337,6 +376,7 @@ class RigConfig:
             safety=build("safety"),
             period_s=loop.get("period_s", 0.001),
             sensor_period_s=loop.get("sensor_period_s", 0.01),
+            controller=_controller(data["controller"]) if "controller" in data else None,
         )
         for name, keys in _REQUIRED.items():
             missing = [key for key in keys if name in data and key not in data[name]]
@@ -386,7 +426,34 @@ class RigConfig:
             f"sensor_period_s = {_toml_value(self.sensor_period_s)}",
             "",
         ]
+        if self.controller is not None:
+            lines.append("[controller]")
+            lines.append(f"name = {_toml_value(self.controller.name)}")
+            lines += [f"{k} = {_toml_value(v)}" for k, v in self.controller.params]
+            lines.append("")
         return "\n".join(lines)
+
+
+def rig_config_template(host: str = "127.0.0.1", port: int = 5020) -> str:
+    """A rig TOML to edit: the built-in register map, reached at ``host:port`` (Modbus TCP).
+
+    The defaults of :class:`RigConfig`, with a header naming the units and a
+    commented-out [controller] table.
+    """
+    from dataclasses import replace
+
+    settings = RigConfig()
+    settings = replace(settings, connection=replace(settings.connection, host=host, port=port))
+    header = (
+        "# softbend rig: connection, register map, scaling (value = offset + scale*count),\n"
+        "# safety limits and loop period. Units: MPa gauge, degrees, seconds.\n\n"
+    )
+    footer = (
+        "# [controller]            # optional: the controller of `softbend control run`\n"
+        '# name = "bang-bang"      # bang-bang, bang-bang-closed, pressure-pi, ...\n'
+        "# deadzone = 0.05         # its parameters, as --set NAME=VALUE (which overrides)\n"
+    )
+    return header + settings.to_toml() + footer
 
 
 def load_rig_config(path: str | Path) -> RigConfig:
@@ -446,6 +513,43 @@ _PRESSURE_KEYS: tuple[str, ...] = ("max_pressure_mpa", "valid_min_mpa", "valid_m
 _KINDS: dict[str, str] = {"str": "a string", "int": "an integer", "float": "a number"}
 _KINDS.update({"bool": "true or false", "int | None": "an integer"})
 _TOML_POSITION = re.compile(r"\s*\(at line (?P<line>\d+), column (?P<column>\d+)\)$")
+
+
+def _controller(table: Any) -> ControllerConfig:
+    """The [controller] table: a string ``name`` and scalar parameters (one _FieldError)."""
+    from softbend.control.params import ParameterValueError, UnknownParameterError
+
+    owner = f"[controller] of the {_OWNER}"
+    if not isinstance(table, dict):
+        raise _FieldError(
+            f"The {owner} must be a table ([controller] followed by its keys). "
+            f"Got {short_repr(table)} ({_toml_type(table)}) instead.",
+            None,
+            "controller",
+        )
+    if "name" not in table:
+        given = ", ".join(map(repr, table))
+        raise _FieldError(
+            f"The {owner} must give 'name' (a controller, e.g. \"bang-bang\"). "
+            f"Got {f'only {given}' if given else 'none'}.",
+            "controller",
+            None,
+        )
+    name = table["name"]
+    if not isinstance(name, str):
+        raise _FieldError(
+            f"The 'name' of {owner} must be a string. "
+            f"Got {short_repr(name)} ({_toml_type(name)}) instead.",
+            "controller",
+            "name",
+        )
+    params = {k: v for k, v in table.items() if k != "name"}
+    try:
+        return ControllerConfig(name, tuple(params.items()))
+    except (UnknownParameterError, ParameterValueError) as exc:
+        raise _FieldError(str(exc), "controller", exc.key) from None
+    except ValueError as exc:
+        raise _FieldError(str(exc), "controller", "name") from None
 
 
 class _FieldError(ValueError):

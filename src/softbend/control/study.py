@@ -12,17 +12,17 @@ benchmark are thin layers over it.
 
 from __future__ import annotations
 
-from collections.abc import Callable, Sequence
+from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass, field
 from typing import Any
 
 import pandas as pd
 
-from softbend.control.controllers import mlp_virtual_sensor
 from softbend.control.experiments import ControlRun, run_metrics, simulate
-from softbend.control.factory import make_controller
+from softbend.control.factory import ControllerModel, build_controller, controller_parameters
 from softbend.control.rig import AngleTable, RigParams, SimulatedRig
 from softbend.design import SFRBADesign
+from softbend.references import CONTROL_RESULTS, values
 
 __all__ = [
     "PAPER_B_CONTROL",
@@ -32,11 +32,9 @@ __all__ = [
     "control_study",
 ]
 
-#: Paper B §5 (Fig. 9), its deadzone bang-bang on its rig.
-PAPER_B_CONTROL: dict[str, dict[str, float]] = {
-    "square": {"mape_pct": 5.5, "settling_s": 0.7, "rise_s": 0.104},
-    "triangle": {"mape_pct": 5.3, "delay_s": 0.0875},
-}
+#: Paper B §5 (Fig. 9), its deadzone bang-bang on its rig
+#: (:data:`softbend.references.CONTROL_RESULTS`).
+PAPER_B_CONTROL: dict[str, dict[str, float]] = values(CONTROL_RESULTS)
 
 #: The references of the study: a step, paper B's square wave and 0.2 Hz triangle.
 STUDY_REFERENCES: tuple[str, ...] = ("step:90", "square:90:4", "triangle:0.2:90:20")
@@ -57,7 +55,8 @@ class ControlStudy:
     runs : dict
         ``{(controller, reference): ControlRun}``.
     settings : dict
-        Design, duration, seed, plant, rig parameters.
+        Design, duration, seed, plant, rig parameters, and ``controllers``: every
+        controller's parameters as used (``{name: {parameter: value}}``).
     """
 
     metrics: pd.DataFrame
@@ -83,6 +82,7 @@ def control_study(
     seed: int = 0,
     params: RigParams | None = None,
     progress: Callable[[int, int], None] | None = None,
+    controller_params: Mapping[str, Mapping[str, Any]] | None = None,
 ) -> ControlStudy:
     """Run every controller on every reference on the simulated rig of ``design``.
 
@@ -97,7 +97,7 @@ def control_study(
     plant : str
         Name of the plant, for the settings (e.g. ``"lab"``).
     controllers, references : sequences of str
-        Names in :data:`~softbend.control.controllers.CONTROLLERS`; reference specs.
+        Names in :data:`~softbend.control.factory.CONTROLLERS`; reference specs.
     duration_s : float, default 10
     seed : int, default 0
         Seed of the sensor and camera noise (the same for every run).
@@ -105,16 +105,37 @@ def control_study(
         Default: :meth:`RigParams.for_design` of ``design``.
     progress : callable, optional
         ``progress(done_runs, total_runs)``.
+    controller_params : mapping, optional
+        ``{controller: {parameter: value}}``: public parameters of some of the
+        ``controllers`` (see their factories, e.g. ``{"bang-bang": {"deadzone": 0.02}}``);
+        the others keep their defaults.
+
+    Raises
+    ------
+    UnknownNameError
+        An unknown controller or parameter; the message lists the known names.
     """
+    given = dict(controller_params or {})
+    for name in given:
+        if name not in controllers:
+            raise ValueError(
+                f"The 'controller_params' of control_study name {name!r}, which is not one "
+                f"of its controllers ({', '.join(controllers)})."
+            )
+    used = {
+        name: controller_parameters(name, given.get(name), field="control_study")
+        for name in controllers
+    }
     params = RigParams.for_design(design) if params is None else params
-    table = AngleTable.from_surrogate(model, design)
-    sensor = mlp_virtual_sensor(model, design) if hasattr(model, "predictor") else table
-    actuator = table if plant_table is None else plant_table
+    controller_model = ControllerModel.from_surrogate(model, design, params)
+    actuator = controller_model.angle_table if plant_table is None else plant_table
     rows, runs = [], {}
     total = len(controllers) * len(references)
     for name in controllers:
         for spec in references:
-            controller = make_controller(name, table, sensor, params)
+            controller = build_controller(
+                name, controller_model, given.get(name), field="control_study"
+            )
             run = simulate(SimulatedRig(actuator, params, seed=seed), controller, spec, duration_s)
             runs[(name, spec)] = run
             rows.append({"controller": name, "reference": spec, **run_metrics(run)})
@@ -126,5 +147,6 @@ def control_study(
         "seed": seed,
         "plant": plant if plant_table is not None else "surrogate",
         "rig": params.as_dict(),
+        "controllers": used,
     }
     return ControlStudy(metrics=pd.DataFrame(rows), runs=runs, settings=settings)

@@ -1,0 +1,32 @@
+"""Options shared by ``softbend control simulate``, ``run`` and ``serve``."""
+
+from __future__ import annotations
+
+import typer
+
+REFERENCE = typer.Option(
+    "step:90",
+    help="step:AMP[:T0_S], square:AMP:PERIOD_S[:LOW] or triangle:FREQ_HZ:AMP[:LOW] (degrees).",
+)
+CONTROLLER = typer.Option(
+    None,
+    help="A registered controller: bang-bang (default; paper B), bang-bang-closed, "
+    "pressure-pi, pressure-relay, predictive or another ('softbend control controllers' "
+    "lists them).",
+)
+SET = typer.Option(
+    None,
+    "--set",
+    metavar="NAME=VALUE",
+    help="A controller parameter NAME=VALUE, repeatable (e.g. --set deadzone=0.02 for "
+    "bang-bang; 'softbend control controllers' lists them).",
+)
+DESIGN = typer.Option("100,6,2,2,5,8", help="Actuator l,r,t,b,phi,lc (mm, deg).")
+MODEL = typer.Option(
+    None, "--model", help="Saved surrogate for θ(p) (default: the shipped FEM-trained MLP)."
+)
+PLANT = typer.Option(
+    "surrogate",
+    help="θ(p) of the actuator: surrogate (the controller's own model), fem (the design's "
+    "FEM sweep) or lab (its virtual-lab readings: model mismatch).",
+)

@@ -1,0 +1,291 @@
+"""Control runs as the command line asks for them: simulated, in the loop on a rig, or served.
+
+- :func:`simulate_control`: a controller on the simulated rig in simulated time,
+  scored as paper B's Fig. 9 (``softbend control simulate``);
+- :func:`plan_loop` then :meth:`LoopPlan.run`: the controller in the
+  fixed-period, safety-checked loop on a rig of :data:`~softbend.control.rigs.RIGS`,
+  with its tick log (``softbend control run``);
+- :func:`simulated_server`: the simulated rig behind a Modbus TCP server
+  (``softbend control serve``).
+
+Each returns, with its results, the summary that the command writes as JSON:
+the effective controller name and parameters (``controller_params``) included.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable, Sequence
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any
+
+from softbend._validation import check_range
+from softbend.control.experiments import ControlRun, Reference, parse_reference
+from softbend.control.rigconfig import RigConfig, load_rig_config
+from softbend.control.rigs import DEFAULT_RIG, RIGS, RigSetup, make_rig
+from softbend.control.setup import DEFAULT_DESIGN, ControlSetup, prepare_control
+
+__all__ = [
+    "LoopPlan",
+    "LoopResult",
+    "Simulation",
+    "plan_loop",
+    "simulate_control",
+    "simulated_server",
+]
+
+
+@dataclass(frozen=True)
+class Simulation:
+    """A run of :func:`simulate_control`: the run and its summary (``metrics.json``)."""
+
+    setup: ControlSetup = field(repr=False)
+    run: ControlRun = field(repr=False)
+    summary: dict[str, Any]
+
+
+def simulate_control(
+    *,
+    reference: str = "step:90",
+    controller: str | None = None,
+    assignments: Sequence[str] = (),
+    design: str = DEFAULT_DESIGN,
+    model: str | Path | None = None,
+    plant: str = "surrogate",
+    duration_s: float = 10.0,
+    supply_mpa: float = 0.2,
+    seed: int = 0,
+    command: str = "simulate_control",
+) -> Simulation:
+    """Run a controller on the simulated rig of ``design`` and score it (synthetic).
+
+    Parameters are those of :func:`~softbend.control.setup.prepare_control`, plus the
+    ``reference`` spec (:func:`~softbend.control.experiments.parse_reference`,
+    degrees), ``duration_s`` (s) and ``seed`` (sensor and camera noise).
+    """
+    from softbend.control.experiments import run_metrics, simulate
+    from softbend.control.rig import SimulatedRig
+
+    ref = parse_reference(reference)
+    setup = prepare_control(
+        controller=controller, assignments=assignments, design=design, model=model,
+        plant=plant, supply_mpa=supply_mpa, command=command,
+    )  # fmt: skip
+    rig = SimulatedRig(setup.plant_table, setup.rig_params, seed=seed)
+    run = simulate(rig, setup.controller, ref, duration_s, seed=seed)
+    summary = {
+        "synthetic": True,
+        "reference": reference,
+        **setup.record(),
+        "duration_s": duration_s,
+        "seed": seed,
+        "rig": setup.rig_params.as_dict(),
+        "metrics": run_metrics(run),
+    }
+    return Simulation(setup=setup, run=run, summary=summary)
+
+
+@dataclass(frozen=True)
+class LoopResult:
+    """A loop run: the :class:`~softbend.control.loop.LoopRun` and its summary (``run.json``)."""
+
+    loop: Any = field(repr=False)
+    summary: dict[str, Any]
+
+    def control_run(self) -> ControlRun:
+        """The run as a :class:`~softbend.control.experiments.ControlRun` (for its figure)."""
+        return self.loop.control_run()
+
+
+@dataclass(frozen=True)
+class LoopPlan:
+    """A checked loop run, ready to start: :func:`plan_loop` builds it.
+
+    Attributes
+    ----------
+    setup : ControlSetup
+    rig : str
+        Name of the rig (:data:`~softbend.control.rigs.RIGS`).
+    rig_setup : RigSetup
+    reference_spec : str
+    reference : Reference
+    duration_s, period_s, sensor_period_s : float
+        Run time, loop tick and sensor period, s.
+    seed : int
+    """
+
+    setup: ControlSetup = field(repr=False)
+    rig: str
+    rig_setup: RigSetup = field(repr=False)
+    reference_spec: str
+    reference: Reference
+    duration_s: float
+    period_s: float
+    sensor_period_s: float
+    seed: int
+
+    @property
+    def ticks(self) -> int:
+        """Ticks of the loop."""
+        return max(1, round(self.duration_s / self.period_s))
+
+    def make_rig(self) -> Any:
+        """The rig of the run, built (a hardware rig connected) by its factory."""
+        return make_rig(self.rig, self.rig_setup, field="--rig")
+
+    def run(
+        self,
+        log_path: Path | None = None,
+        progress: Callable[[int, int], None] | None = None,
+        *,
+        device: Any = None,
+    ) -> LoopResult:
+        """Run the loop on ``device`` (default: :meth:`make_rig`), logging every tick to
+        ``log_path``; the rig is closed at the end, whatever happens."""
+        from softbend.control.loop import run_loop
+
+        device = self.make_rig() if device is None else device
+        try:
+            if log_path is not None:
+                Path(log_path).parent.mkdir(parents=True, exist_ok=True)
+            result = run_loop(
+                device, self.setup.controller, self.reference, self.duration_s,
+                period_s=self.period_s, sensor_period_s=self.sensor_period_s,
+                limits=self.rig_setup.config.safety, log_path=log_path, progress=progress,
+            )  # fmt: skip
+        finally:
+            device.close()
+        return LoopResult(loop=result, summary=self._summary(device, result))
+
+    def _summary(self, device: Any, result: Any) -> dict[str, Any]:
+        synthetic = bool(getattr(device, "synthetic", False))
+        record = self.setup.record()
+        summary = {
+            "synthetic": synthetic,
+            "rig": self.rig,
+            "where": getattr(device, "where", self.rig),
+            "reference": self.reference_spec,
+            **record,
+            "plant": record["plant"] if synthetic else "the rig",
+            "duration_s": self.duration_s,
+            "period_s": self.period_s,
+            "sensor_period_s": self.sensor_period_s,
+            "seed": self.seed,
+            "completed": result.completed,
+            "stop_reason": result.stop_reason,
+            "fault_kind": result.fault_kind,
+            "vented": result.vented,
+            "jitter": result.jitter(),
+            "metrics": result.metrics(),
+            "rig_config": self.rig_setup.config.to_toml(),
+            "rig_params": self.setup.rig_params.as_dict() if synthetic else None,
+        }
+        trips = getattr(device, "round_trips_s", None)
+        if trips is not None:
+            summary["round_trip_ms"] = _percentiles_ms(trips)
+        return summary
+
+
+def plan_loop(
+    *,
+    rig: str = DEFAULT_RIG,
+    config: str | Path | None = None,
+    reference: str = "step:90",
+    controller: str | None = None,
+    assignments: Sequence[str] = (),
+    design: str = DEFAULT_DESIGN,
+    model: str | Path | None = None,
+    plant: str = "surrogate",
+    duration_s: float = 10.0,
+    period_s: float | None = None,
+    sensor_period_s: float | None = None,
+    supply_mpa: float = 0.2,
+    seed: int = 0,
+    command: str = "plan_loop",
+) -> LoopPlan:
+    """Check a loop run and build its controller; the rig is built by :meth:`LoopPlan.run`.
+
+    Parameters
+    ----------
+    rig : str
+        A name of :data:`~softbend.control.rigs.RIGS` (``sim``, ``sim-realtime``, ``modbus``).
+    config : path, optional
+        A rig TOML: its [safety] and [loop] apply to every rig, its connection and
+        register map to ``modbus``, its [controller] when ``controller`` is not given
+        or the same.
+    period_s, sensor_period_s : float, optional
+        Loop tick and sensor period, s (default: the config's).
+    others
+        As :func:`simulate_control`.
+    """
+    RIGS.check(rig, field="--rig")
+    ref = parse_reference(reference)
+    settings = load_rig_config(config) if config is not None else RigConfig()
+    tick = settings.period_s if period_s is None else period_s
+    sensor = settings.sensor_period_s if sensor_period_s is None else sensor_period_s
+    setup = prepare_control(
+        controller=controller, assignments=assignments, config=settings.controller,
+        design=design, model=model, plant=plant, supply_mpa=supply_mpa, command=command,
+    )  # fmt: skip
+    check_range(duration_s, "duration", command, low=0.0, high=86400.0, high_inclusive=True)
+    check_range(tick, "period", command, low=0.0, high=1.0, high_inclusive=True)
+    check_range(
+        sensor, "sensor_period", command, low=tick, high=10.0,
+        low_inclusive=True, high_inclusive=True,
+    )  # fmt: skip
+    rig_setup = RigSetup(
+        config=settings, config_path=None if config is None else Path(config),
+        plant_table=setup.plant_table, params=setup.rig_params, seed=seed, command=command,
+    )  # fmt: skip
+    return LoopPlan(
+        setup=setup, rig=rig, rig_setup=rig_setup, reference_spec=reference, reference=ref,
+        duration_s=duration_s, period_s=tick, sensor_period_s=sensor, seed=seed,
+    )  # fmt: skip
+
+
+def simulated_server(
+    *,
+    config: str | Path | None = None,
+    host: str = "127.0.0.1",
+    port: int | None = None,
+    design: str = DEFAULT_DESIGN,
+    model: str | Path | None = None,
+    plant: str = "surrogate",
+    supply_mpa: float = 0.2,
+    seed: int = 0,
+    command: str = "simulated_server",
+) -> Any:
+    """The simulated rig of ``design`` behind a Modbus TCP server (not started).
+
+    The register map is the ``config``'s (default: the built-in map); ``port``
+    defaults to the config's, else 5020.
+    """
+    from softbend.control.modbus_server import SimulatedModbusServer
+    from softbend.control.rig import SimulatedRig
+
+    settings = load_rig_config(config) if config is not None else RigConfig()
+    listen = port if port is not None else (settings.connection.port if config else 5020)
+    if not host.strip():
+        raise ValueError(
+            f"The '--host' of {command} must be an address to listen on "
+            "(e.g. 127.0.0.1 or 0.0.0.0). Got an empty string instead."
+        )
+    if not 0 <= listen <= 65535:
+        raise ValueError(
+            f"The '--port' of {command} must be an integer in [0, 65535]. Got {listen} instead."
+        )
+    setup = prepare_control(
+        design=design, model=model, plant=plant, supply_mpa=supply_mpa, command=command
+    )
+    rig = SimulatedRig(setup.plant_table, setup.rig_params, seed=seed)
+    return SimulatedModbusServer(rig, settings, host=host, port=listen)
+
+
+def _percentiles_ms(values: list[float]) -> dict[str, float]:
+    """The median and 99th percentile of durations in s, as ms (empty for none)."""
+    import numpy as np
+
+    if not values:
+        return {}
+    ms = np.asarray(values) * 1e3
+    return {"p50": float(np.percentile(ms, 50)), "p99": float(np.percentile(ms, 99))}
