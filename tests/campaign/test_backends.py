@@ -27,23 +27,49 @@ DESIGN = SFRBADesign(100, 6, 2, 2, 5, 8)
 
 def test_registry_names_the_allowed_backends():
     assert {"analytical", "fem", "fault-injection"} <= set(available_backends())
+    assert backends.BACKENDS.names()[:3] == ("analytical", "fem", "fault-injection")
     with pytest.raises(
-        ValueError, match="'backend' of get_backend must be one of 'analytical', 'fem'"
+        ValueError,
+        match=r"Unknown campaign backend 'abaqus' \(in backend\); known: analytical, fem, ",
     ):
         get_backend("abaqus")
     with pytest.raises(ValueError, match="options of backend 'analytical' are invalid"):
         get_backend("analytical", mesh_size=3)
 
 
-def test_register_backend_plugs_in_a_model_and_refuses_silent_replacement(monkeypatch):
-    monkeypatch.setattr(backends, "_REGISTRY", dict(backends._REGISTRY))
+def test_register_backend_plugs_in_a_model_and_refuses_silent_replacement():
     register_backend("analytical-stiff", lambda: AnalyticalModel(material="fiberglass"))
-    assert get_backend("analytical-stiff").material.name.startswith("Fiberglass")
+    try:
+        assert get_backend("analytical-stiff").material.name.startswith("Fiberglass")
+        assert "analytical-stiff" in available_backends()
+        assert "analytical-stiff" in backends.public_backends()
+    finally:
+        backends.BACKENDS.unregister("analytical-stiff")
+    assert "analytical-stiff" not in available_backends()
     with pytest.raises(ValueError, match="already registered"):
         register_backend("analytical", AnalyticalModel)
     assert AnalyticalBackend is AnalyticalModel  # the earlier name still works
     with pytest.raises(ValueError, match="'factory'"):
         register_backend("x", 3)
+    with pytest.raises(ValueError, match="lower-case"):
+        register_backend("My Model", AnalyticalModel)
+
+
+def test_backend_for_run_builds_public_backends_with_what_the_command_line_gives():
+    assert backends.public_backends()[:2] == ("analytical", "fem")
+    assert isinstance(backends.backend_for_run("analytical", compiled=True), AnalyticalModel)
+    with pytest.raises(ValueError, match=r"'fault-injection' \(in --backend\); known: analytical"):
+        backends.backend_for_run("fault-injection", field="--backend")
+    with pytest.raises(ValueError, match="'model' of backend_for_run must be given with"):
+        backends.backend_for_run("analytical", model="m.json")
+    register_backend("from-file", lambda path: AnalyticalModel())
+    try:
+        assert isinstance(backends.backend_for_run("from-file", model="m.json"), AnalyticalModel)
+        only = r"saved file \(backend (surrogate or )?from-file\), and only then"
+        with pytest.raises(ValueError, match=only):
+            backends.backend_for_run("from-file")
+    finally:
+        backends.BACKENDS.unregister("from-file")
 
 
 # ----------------------------------------------------------------------------- analytical
@@ -85,7 +111,7 @@ def test_analytical_sweep_ends_where_the_model_stops_converging(soft_design):
 
 def test_analytical_backend_options():
     assert get_backend("analytical", material="dragon-skin-30").material.name == "Dragon Skin 30"
-    with pytest.raises(ValueError, match="'preset'"):
+    with pytest.raises(ValueError, match="Unknown material preset 'rubber'; known: dragon-skin"):
         get_backend("analytical", material="rubber")
     with pytest.raises(ValueError, match="'material' of AnalyticalModel"):
         AnalyticalModel(material=3.0)

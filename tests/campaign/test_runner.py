@@ -241,7 +241,7 @@ def test_a_campaign_killed_with_sigkill_resumes_without_losing_or_duplicating(
 @pytest.mark.parametrize(
     ("kwargs", "error", "match"),
     [
-        ({"backend": "abaqus"}, ValueError, "must be one of 'analytical', 'fem'"),
+        ({"backend": "abaqus"}, ValueError, "backend 'abaqus'.*known: analytical, fem"),
         ({"backend": "analytical", "backend_options": {"mesh": 2}}, ValueError, "options"),
         ({"workers": -1}, ValueError, r"'workers' of run_campaign must be a number in \[0, "),
         ({"chunk_size": 0}, ValueError, "'chunk_size'"),

@@ -106,3 +106,12 @@ def test_a_campaign_that_does_not_fit_is_refused_even_when_allowed(tmp_path, mon
         check_footprint(
             campaign_footprint(10_000, 100_001), tmp_path / "c.duckdb", allow_large=True
         )
+
+
+def test_a_shard_is_k_of_n():
+    from softbend.campaign.spaces import parse_shard
+
+    assert parse_shard("0/8") == (0, 8) and parse_shard(" 2 / 3 ") == (2, 3)
+    for text in ("3/3", "1of2", "0/0", "-1/2"):
+        with pytest.raises(ValueError, match=r"'--shard' of c must be K/N"):
+            parse_shard(text, option="--shard", owner="c")

@@ -144,9 +144,9 @@ def _closed_port() -> int:
     [
         (
             ["--backend", "abaqus"],
-            "'--backend' of softbend campaign run must be one of 'analytical', 'fem', 'surrogate'",
+            "Unknown campaign backend 'abaqus' (in --backend); known: analytical, fem, surrogate.",
         ),
-        (["--backend", "fault-injection"], "must be one of 'analytical', 'fem', 'surrogate'"),
+        (["--backend", "fault-injection"], "(in --backend); known: analytical, fem, surrogate."),
         (["--space", "grid:5"], "'--space' of softbend campaign run must be one of table1"),
         (["--space", "lhs:0"], "'--space'"),
         (["--pmax", "0.1", "--pstep", "0.03"], "whole number of steps"),

@@ -137,3 +137,33 @@ def test_an_os_error_reads_as_reason_and_path_without_an_errno():
     assert _common.os_error_message(FileNotFoundError("No campaign database at 'c'.")) == (
         "No campaign database at 'c'."
     )
+
+
+def test_parse_assignments_reads_name_value_pairs_once_each():
+    import pytest
+
+    assert _common.parse_assignments(["epochs=500", " share = 0.5 "]) == {
+        "epochs": "500",
+        "share": "0.5",
+    }
+    assert _common.parse_assignments([]) == {}
+    for bad, needle in ((["epochs"], "NAME=VALUE"), (["=3"], "NAME=VALUE")):
+        with pytest.raises(ValueError, match=needle):
+            _common.parse_assignments(bad)
+    with pytest.raises(ValueError, match="names 'epochs' twice"):
+        _common.parse_assignments(["epochs=1", "epochs=2"])
+
+
+def test_as_written_names_the_final_file_of_a_staged_one(tmp_path):
+    import errno
+
+    import pytest
+
+    stage, final = tmp_path / ".stage", tmp_path / "out"
+    with pytest.raises(OSError) as caught, _common.as_written(stage, final):
+        raise OSError(errno.ENOSPC, "No space left on device", str(stage / "a.csv"))
+    assert caught.value.filename == str(final / "a.csv")
+    elsewhere = str(tmp_path / "input.csv")
+    with pytest.raises(OSError) as caught, _common.as_written(stage, final):
+        raise OSError(errno.ENOENT, "No such file or directory", elsewhere)
+    assert caught.value.filename == elsewhere

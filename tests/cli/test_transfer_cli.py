@@ -154,7 +154,9 @@ def test_unknown_strategy_and_bad_out_are_refused_before_work(
             "magic",
         ]
     )
-    assert code == 2 and "'strategy'" in one_error_line(capsys)
+    line = one_error_line(capsys)
+    assert code == 2 and "Unknown transfer strategy 'magic' (in strategies)" in line
+    assert "known: fem-only, analytical" in line
     a_file = tmp_path / "file.txt"
     a_file.write_text("x")
     code = main(
@@ -162,7 +164,7 @@ def test_unknown_strategy_and_bad_out_are_refused_before_work(
     )
     assert code == 2 and "--out" in one_error_line(capsys)
     code = main(["lab", "measure", "--plant", "abaqus", "--out", str(tmp_path / "x.csv")])
-    assert code == 2 and "'plant'" in one_error_line(capsys)
+    assert code == 2 and "Unknown lab plant 'abaqus'" in one_error_line(capsys)
     code = main(
         [
             "transfer",
@@ -175,7 +177,8 @@ def test_unknown_strategy_and_bad_out_are_refused_before_work(
             "analytical",
         ]
     )
-    assert code == 2 and "'strategy'" in one_error_line(capsys)
+    line = one_error_line(capsys)
+    assert code == 2 and "'analytical' learns nothing" in line and "refined, " in line
     code = main(
         [
             "transfer",
@@ -190,7 +193,8 @@ def test_unknown_strategy_and_bad_out_are_refused_before_work(
             "5",
         ]
     )
-    assert code == 2 and "--epochs" in one_error_line(capsys)
+    line = one_error_line(capsys)
+    assert code == 2 and "Unknown parameter 'epochs'" in line and "known: n_restarts" in line
 
 
 def test_transfer_base_and_refine_bad_input_is_one_line(tmp_path, capsys, small_base_file, lab_csv):
@@ -279,3 +283,55 @@ def test_every_refine_strategy_saves_a_model_that_predicts(
         # The table shows the interval too.
         assert main(["predict", str(model), "--design", "100,6,2,2,5,8", "--pressure", "0.05"]) == 0
         assert "90% interval" in capsys.readouterr().out
+
+
+def test_refine_parameters_by_set_are_recorded_and_match_the_epochs_option(
+    lab_csv, tmp_path, capsys, small_base_file
+):
+    argv = ["transfer", "refine", str(small_base_file), str(lab_csv)]
+    by_option, by_set = tmp_path / "a.json", tmp_path / "b.json"
+    assert main([*argv, "--out", str(by_option), "--epochs", "20"]) == 0
+    assert (
+        main([*argv, "--out", str(by_set), "--set", "epochs=20", "--set", "learning_rate=6e-4"])
+        == 0
+    )
+    capsys.readouterr()
+    a, b = (json.loads(p.read_text()) for p in (by_option, by_set))
+    assert a["metadata"]["parameters"] == {"epochs": 20, "learning_rate": 6e-4, "seed": 0}
+    assert b["metadata"]["parameters"] == a["metadata"]["parameters"]
+    assert a["state"] == b["state"]
+    bad = [*argv, "--out", str(tmp_path / "c.json")]
+    assert main([*bad, "--epochs", "20", "--set", "epochs=30"]) == 2
+    assert "given twice" in one_error_line(capsys)
+    assert main([*bad, "--set", "epochs=many"]) == 2
+    assert "'epochs' of transfer strategy 'refined' (in --set) must be an integer" in (
+        one_error_line(capsys)
+    )
+    assert main([*bad, "--set", "epochs"]) == 2
+    assert "NAME=VALUE" in one_error_line(capsys)
+    assert not (tmp_path / "c.json").exists()
+
+
+def test_loco_set_reaches_the_strategies_of_the_run(lab_csv, tmp_path, capsys, small_base_file):
+    argv = ["transfer", "loco", str(lab_csv), "--base", str(small_base_file)]
+    argv += ["--out", str(tmp_path / "o"), "--strategies", "fem-only,scale-offset"]
+    assert main([*argv, "--set", "epochs=5"]) == 2
+    line = one_error_line(capsys)
+    assert "Unknown parameter 'epochs' (in --set)" in line and "fem-only, scale-offset" in line
+    assert main([*argv, "--set", "refined.epoch=5"]) == 2
+    assert "Unknown parameter 'epoch' of transfer strategy 'refined'" in one_error_line(capsys)
+    assert not (tmp_path / "o").exists()
+
+
+def test_strategies_lists_every_strategy_with_its_parameters(capsys):
+    assert main(["transfer", "strategies", "--json"]) == 0
+    rows = json.loads(capsys.readouterr().out)
+    by_name = {r["name"]: r for r in rows}
+    assert list(by_name)[:2] == ["fem-only", "analytical"]
+    assert by_name["refined"]["parameters"] == {"epochs": 1000, "learning_rate": 6e-4}
+    assert by_name["experimental"]["parameters"]["hidden_sizes"] == [63, 65]
+    assert not by_name["fem-only"]["learns"] and by_name["residual-gp"]["interval"]
+    assert main(["transfer", "strategies"]) == 0
+    assert "n_restarts=3" in capsys.readouterr().out
+    assert main(["transfer", "loco", "--help"]) == 0
+    assert "softbend transfer strategies" in " ".join(capsys.readouterr().out.split())

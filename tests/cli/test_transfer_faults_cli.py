@@ -109,7 +109,7 @@ def test_lab_measure_failing_on_the_figure_keeps_the_previous_csv(tmp_path, monk
 
 
 def test_lab_measure_failing_on_the_csv_names_it_and_writes_nothing(tmp_path, monkeypatch, capsys):
-    import softbend.cli.transfer as command
+    import softbend.cli.transfer_lab as command
 
     out, figure = _old_lab_outputs(tmp_path)
 
@@ -276,16 +276,16 @@ def test_refine_writes_strict_json(lab_csv, tmp_path, capsys, small_base_file, s
 
 
 def test_refine_metadata_nan_is_written_as_null(lab_csv, tmp_path, monkeypatch, small_base_file):
-    import softbend.transfer.strategies as strategies
+    import softbend.transfer.refine as refine
 
-    fit = strategies.fit_strategy
+    fit = refine.fit_strategy
 
     def with_nan_loss(*args, **kwargs):
         model = fit(*args, **kwargs)
         model.loss_curve_ = [float("nan")]
         return model
 
-    monkeypatch.setattr(strategies, "fit_strategy", with_nan_loss)
+    monkeypatch.setattr(refine, "fit_strategy", with_nan_loss)
     out = tmp_path / "model.json"
     argv = ["transfer", "refine", str(small_base_file), str(lab_csv), "--out", str(out)]
     assert main([*argv, "--strategy", "scale-offset"]) == 0

@@ -163,11 +163,10 @@ def test_max_stretch_restricts_the_fit():
 
 
 def test_unknown_model_lists_allowed_names():
-    with pytest.raises(ValueError, match="'model' of fit_model") as info:
+    with pytest.raises(ValueError, match="Unknown material model 'mooney-rivlin'") as info:
         fit_model("mooney-rivlin", STRETCH, STRETCH - 1.0)
-    for name in DEFAULT_MODELS:
-        assert repr(name) in str(info.value)
-    with pytest.raises(ValueError, match="Got 'mooney' instead"):
+    assert f"known: {', '.join(DEFAULT_MODELS)}." in str(info.value)
+    with pytest.raises(ValueError, match=r"'mooney' \(in models\)"):
         fit_models((STRETCH, STRETCH - 1.0), ["yeoh", "mooney"])
 
 

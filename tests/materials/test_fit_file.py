@@ -67,7 +67,7 @@ _CORRUPTIONS = [
     (
         "missing constant",
         lambda d: _yeoh(d)["parameters"].pop("c10_mpa"),
-        r"must include 'c10_mpa'",
+        r"'Yeoh.from_dict' lacks the key\(s\) c10_mpa",
     ),
     (
         "negative modulus",
@@ -159,11 +159,11 @@ def test_a_fit_json_over_the_size_limit_is_refused(tmp_path, monkeypatch):
 @pytest.mark.parametrize(
     ("data", "match"),
     [
-        ({"model": "yeoh"}, r"The keys of Yeoh.from_dict must include 'c10_mpa'"),
+        ({"model": "yeoh"}, r"'Yeoh.from_dict' lacks the key\(s\) c10_mpa"),
         ({"model": "neo-hookean", "c10_mpa": 1e300}, r"'c10_mpa'.*plausible material constant"),
         ({"model": "neo-hookean", "c10_mpa": "0.1"}, r"'c10_mpa'.*finite number"),
         ({"model": "neo-hookean", "c10_mpa": True}, r"'c10_mpa'.*finite number"),
-        ({"model": "arruda-boyce", "mu_mpa": 0.2}, r"must include 'lambda_m'"),
+        ({"model": "arruda-boyce", "mu_mpa": 0.2}, r"lacks the key\(s\) lambda_m"),
         ([("model", "yeoh")], r"must be a mapping of constants"),
     ],
 )
@@ -176,11 +176,11 @@ def test_material_dicts_are_checked_before_use():
     good = DRAGON_SKIN_30.to_dict()
     for key in ("name", "model", "density_t_per_mm3"):
         broken = {k: v for k, v in good.items() if k != key}
-        with pytest.raises(SchemaError, match=f"no '{key}'"):
+        with pytest.raises(SchemaError, match=rf"'Material.from_dict' lacks the key\(s\) {key}"):
             Material.from_dict(broken)
     with pytest.raises(SchemaError, match=r"'density_t_per_mm3' of Material\.from_dict"):
         Material.from_dict({**good, "density_t_per_mm3": "1e-9"})
-    with pytest.raises(SchemaError, match=r"must include 'nu'"):
+    with pytest.raises(SchemaError, match=r"lacks the key\(s\) nu"):
         LinearElastic.from_dict({"model": "linear-elastic", "e_mpa": 31076.0})
     with pytest.raises(SchemaError, match=r"'e_mpa'.*plausible material constant"):
         LinearElastic.from_dict({"model": "linear-elastic", "e_mpa": 1e9, "nu": 0.3})

@@ -114,10 +114,11 @@ def test_written_files_are_tables_and_strict_json(result, tmp_path):
     [
         ({"strategies": []}, "at least one"),
         ({"strategies": ["refined", "refined"]}, "distinct"),
-        ({"strategies": ["magic"]}, "'strategy'"),
+        ({"strategies": ["magic"]}, r"Unknown transfer strategy 'magic' \(in strategies\)"),
         ({"level": 1.0}, "'level'"),
         ({"seed": -1}, "'seed'"),
-        ({"options": {"magic": {}}}, "'options'"),
+        ({"options": {"magic": {}}}, r"'magic' \(in options\); known: fem-only"),
+        ({"options": {"refined": {"epoch": 5}}}, "Unknown parameter 'epoch'.*known: epochs"),
     ],
 )
 def test_bad_arguments_name_the_field(small_base, quick_measurements, kwargs, match):

@@ -38,8 +38,10 @@ def test_every_named_strategy_fits_and_predicts(small_base, quick_measurements):
 
 
 def test_unknown_strategy_lists_the_allowed_ones():
-    with pytest.raises(ValueError, match=r"'strategy'.*'refined'.*'residual-gp'"):
+    with pytest.raises(ValueError, match=r"Unknown transfer strategy 'transfer-magic'.*refined"):
         make_strategy("transfer-magic")
+    with pytest.raises(ValueError, match=r"parameter 'epoch' .*'refined'.*epochs, learning_rate"):
+        make_strategy("refined", epoch=5)
 
 
 def test_refining_needs_an_mlp_base(quick_measurements):

@@ -1,10 +1,12 @@
-"""Design campaigns: sweep many actuator designs and keep the results (SPEC §4.4).
+"""Design campaigns: sweep many actuator designs and keep the results (paper B §3.3, Table 1).
 
 * :mod:`~softbend.campaign.backends` — what computes one sweep (analytical model,
-  FEM) behind one protocol and a registry;
+  FEM, a saved surrogate) behind one protocol and a registry (:data:`BACKENDS`);
 * :mod:`~softbend.campaign.schema` — the tables of a campaign database, their
   version and the checks of an existing file;
 * :mod:`~softbend.campaign.store` — the DuckDB database, one transaction per design;
+* :mod:`~softbend.campaign.spaces` — design spaces and shards named by text, and
+  the memory and disk a campaign over one needs;
 * :mod:`~softbend.campaign.runner` — :func:`run_campaign`: plans a run
   (:mod:`~softbend.campaign.planning`: resume, the designs left, the executor) and
   runs it (:mod:`~softbend.campaign.executors`: serial, local processes or a Dask
@@ -17,28 +19,51 @@ Example::
 
     summary = run_campaign("table1.duckdb", DesignSpace.table1(), backend="analytical")
 
-DuckDB and Dask are imported only when a database is opened or a cluster used.
+DuckDB and Dask are imported only when a database is opened or a cluster used;
+names are imported on first use.
 """
 
-from softbend.campaign.backends import (
-    SweepResult,
-    available_backends,
-    default_pressures_mpa,
-    get_backend,
-    register_backend,
-)
-from softbend.campaign.runner import CampaignSummary, run_campaign
-from softbend.campaign.store import SCHEMA_VERSION, CampaignStore, load_samples
+from __future__ import annotations
 
-__all__ = [
-    "SCHEMA_VERSION",
-    "CampaignStore",
-    "CampaignSummary",
-    "SweepResult",
-    "available_backends",
-    "default_pressures_mpa",
-    "get_backend",
-    "load_samples",
-    "register_backend",
-    "run_campaign",
-]
+import importlib
+from typing import Any
+
+_EXPORTS = {
+    "BACKENDS": "backends",
+    "INTERNAL_BACKENDS": "backends",
+    "SweepResult": "backends",
+    "available_backends": "backends",
+    "backend_for_run": "backends",
+    "default_pressures_mpa": "backends",
+    "get_backend": "backends",
+    "public_backends": "backends",
+    "register_backend": "backends",
+    "CampaignSummary": "runner",
+    "count_designs_to_run": "runner",
+    "parse_scheduler_address": "runner",
+    "run_campaign": "runner",
+    "SPACE_FORMS": "spaces",
+    "SpaceSpec": "spaces",
+    "campaign_footprint": "spaces",
+    "check_footprint": "spaces",
+    "parse_shard": "spaces",
+    "parse_space": "spaces",
+    "SCHEMA_VERSION": "store",
+    "CampaignStore": "store",
+    "load_designs": "store",
+    "load_samples": "store",
+    "merge_campaigns": "store",
+}
+
+__all__ = sorted(_EXPORTS)
+
+
+def __getattr__(name: str) -> Any:
+    if name in _EXPORTS:
+        module = importlib.import_module(f"softbend.campaign.{_EXPORTS[name]}")
+        return getattr(module, name)
+    raise AttributeError(f"module 'softbend.campaign' has no attribute {name!r}")
+
+
+def __dir__() -> list[str]:
+    return __all__

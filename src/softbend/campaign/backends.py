@@ -1,16 +1,21 @@
 """The campaign's registry of bending models, by name.
 
 The campaign runner sweeps any :class:`~softbend.models.BendingModel`; this
-module maps the names a command line or a database uses to them::
+module maps the names a command line or a database uses to them
+(:data:`BACKENDS`, a :class:`~softbend.registry.Registry` of factories)::
 
     backend = get_backend("analytical")      # softbend.analytical.AnalyticalModel
     backend = get_backend("fem", maxh_mm=4)  # softbend.fem.FEMModel
     result = backend.sweep(design, default_pressures_mpa())
 
-A trained surrogate is not in the registry (surrogates sit above the campaign in
-the pipeline): pass a :class:`softbend.surrogates.SurrogateModel` to
-:func:`~softbend.campaign.run_campaign` as its backend, or use
-``softbend campaign run --backend surrogate --model FILE``.
+One call adds a backend: ``register_backend("my-model", factory)``, where
+``factory(**options)`` returns the model. A backend read from a saved file takes
+its path as the option ``path``; :func:`backend_for_run` gives it the file of a
+command line (``softbend campaign run --backend NAME --model FILE``). A trained
+surrogate is such a backend, ``"surrogate"``; it is registered from above the
+campaign in the pipeline (surrogates sit above it), so that a campaign can also
+run on a :class:`softbend.surrogates.SurrogateModel` passed as an object to
+:func:`~softbend.campaign.run_campaign`.
 
 The sweep result, the pressure grid and the protocol live in
 :mod:`softbend.models` and are re-exported here.
@@ -32,7 +37,7 @@ from typing import Any
 
 import numpy as np
 
-from softbend._validation import check_choice, check_range
+from softbend._validation import check_range
 from softbend.analytical import AnalyticalModel
 from softbend.design import SFRBADesign
 from softbend.errors import ConvergenceError, SoftbendError
@@ -44,8 +49,10 @@ from softbend.models import (
     check_pressures_mpa,
     default_pressures_mpa,
 )
+from softbend.registry import Registry
 
 __all__ = [
+    "BACKENDS",
     "DEFAULT_PMAX_MPA",
     "DEFAULT_PSTEP_MPA",
     "INTERNAL_BACKENDS",
@@ -55,9 +62,11 @@ __all__ = [
     "FaultInjectionBackend",
     "SweepResult",
     "available_backends",
+    "backend_for_run",
     "check_pressures_mpa",
     "default_pressures_mpa",
     "get_backend",
+    "public_backends",
     "register_backend",
 ]
 
@@ -197,11 +206,11 @@ def _id_set(ids: Any) -> frozenset[str]:
 #: Registered for tests and the library, not offered on the command line.
 INTERNAL_BACKENDS: tuple[str, ...] = ("fault-injection",)
 
-_REGISTRY: dict[str, Callable[..., Backend]] = {
-    "analytical": AnalyticalModel,
-    "fem": _make_fem,
-    "fault-injection": _make_fault_injection,
-}
+#: The backends by name: ``factory(**options) -> Backend``, in registration order.
+BACKENDS: Registry[Callable[..., Backend]] = Registry("campaign backend")
+BACKENDS.register("analytical", AnalyticalModel)
+BACKENDS.register("fem", _make_fem)
+BACKENDS.register("fault-injection", _make_fault_injection)
 
 
 def register_backend(name: str, factory: Callable[..., Backend], *, replace: bool = False) -> None:
@@ -210,30 +219,33 @@ def register_backend(name: str, factory: Callable[..., Backend], *, replace: boo
     Parameters
     ----------
     name : str
-        Registry name (non-empty).
+        Registry name: lower case, no spaces (``"my-model"``).
     factory : callable
         Returns an object satisfying :class:`Backend`. It runs in the coordinating
-        process; the backend it returns is pickled to the workers.
+        process; the backend it returns is pickled to the workers. A backend read
+        from a saved file takes the file as the keyword ``path``.
     replace : bool
         Allow replacing an existing registration.
+
+    Raises
+    ------
+    ValueError
+        A factory that is not callable, a name that is not lower case without
+        spaces, or a name already registered (without ``replace``).
     """
-    if not isinstance(name, str) or not name.strip():
-        raise ValueError(
-            f"The 'name' of register_backend must be a non-empty string. Got {name!r}."
-        )
     if not callable(factory):
         raise ValueError(f"The 'factory' of register_backend must be callable. Got {factory!r}.")
-    if name in _REGISTRY and not replace:
-        raise ValueError(
-            f"The 'name' of register_backend must be new (or pass replace=True). "
-            f"Got {name!r}, already registered."
-        )
-    _REGISTRY[name] = factory
+    BACKENDS.register(name, factory, replace=replace)
 
 
 def available_backends() -> tuple[str, ...]:
     """Names accepted by :func:`get_backend`."""
-    return tuple(_REGISTRY)
+    return BACKENDS.names()
+
+
+def public_backends() -> tuple[str, ...]:
+    """Names a command line offers: every backend but the :data:`INTERNAL_BACKENDS`."""
+    return tuple(name for name in BACKENDS if name not in INTERNAL_BACKENDS)
 
 
 def get_backend(name: str, **options: Any) -> Backend:
@@ -241,15 +253,15 @@ def get_backend(name: str, **options: Any) -> Backend:
 
     Raises
     ------
+    UnknownNameError
+        For an unknown name (listing the registered ones).
     ValueError
-        For an unknown name (listing the registered ones) or an option the backend
-        does not take.
+        For an option the backend does not take.
     SoftbendError
         If the backend's implementation is not installed (``"fem"`` without
         ``softbend.fem``).
     """
-    check_choice(name, "backend", "get_backend", available_backends())
-    factory = _REGISTRY[name]
+    factory = BACKENDS.get(name, field="backend")
     try:
         inspect.signature(factory).bind(**options)
     except TypeError as exc:
@@ -261,3 +273,51 @@ def get_backend(name: str, **options: Any) -> Backend:
             "which has no 'name' and 'sweep'."
         )
     return backend
+
+
+def backend_for_run(
+    name: str,
+    *,
+    model: str | os.PathLike[str] | None = None,
+    compiled: bool = False,
+    field: str = "backend",
+    model_field: str = "model",
+    owner: str = "backend_for_run",
+) -> Backend:
+    """The backend a command line names, built with what the command line gives it.
+
+    Parameters
+    ----------
+    name : str
+        One of :func:`public_backends`.
+    model : path, optional
+        The saved file of a backend read from one (its factory takes ``path``,
+        e.g. ``"surrogate"``); required for such a backend, refused for others.
+    compiled : bool, default False
+        Passed to a backend whose factory takes it (``"fem"``: compile the energy).
+    field, model_field, owner : str
+        The options and the command named in messages (``"--backend"``,
+        ``"--model"``, ``"softbend campaign run"``).
+
+    Raises
+    ------
+    UnknownNameError
+        A name that is not a public backend (the public ones listed).
+    ValueError
+        A file given to a backend that reads none, or none to one that does.
+    """
+    public = Registry[Callable[..., Backend]](BACKENDS.kind)
+    for known in public_backends():
+        public.register(known, BACKENDS.get(known))
+    takes = inspect.signature(public.get(name, field=field)).parameters
+    if ("path" in takes) != (model is not None):
+        from_file = [n for n in public if "path" in inspect.signature(public.get(n)).parameters]
+        shown = f"{field} {' or '.join(from_file)}" if from_file else "none is registered"
+        raise ValueError(
+            f"The '{model_field}' of {owner} must be given with a backend read from a saved "
+            f"file ({shown}), and only then. Got {field} {name} and {model_field} {model} instead."
+        )
+    options: dict[str, Any] = {"path": model} if model is not None else {}
+    if "compiled" in takes:
+        options["compiled"] = compiled
+    return get_backend(name, **options)

@@ -76,7 +76,7 @@ from softbend.campaign.planning import (
 from softbend.campaign.store import CampaignStore
 from softbend.design import SFRBADesign
 
-__all__ = ["CampaignSummary", "parse_scheduler_address", "run_campaign"]
+__all__ = ["CampaignSummary", "count_designs_to_run", "parse_scheduler_address", "run_campaign"]
 
 logger = logging.getLogger(__name__)
 
@@ -271,6 +271,23 @@ def run_campaign(
         summary.wall_time_s,
     )
     return summary
+
+
+def count_designs_to_run(
+    db: str | os.PathLike[str], designs: Iterable[SFRBADesign], retry_failed: bool = True
+) -> int:
+    """How many of ``designs`` a run on ``db`` will sweep (all of them for a new database).
+
+    The designs already done are left out, and those recorded as failed unless
+    ``retry_failed``: the total of a progress bar, and what a resumed run says
+    it skips.
+    """
+    designs = list(designs)
+    if not Path(db).exists():
+        return len(designs)
+    with CampaignStore(db, read_only=True) as store:
+        skip = store.finished_ids(include_failed=not retry_failed)
+    return sum(d.design_id not in skip for d in designs)
 
 
 def _execute(

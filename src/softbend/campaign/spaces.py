@@ -32,6 +32,7 @@ __all__ = [
     "SpaceSpec",
     "campaign_footprint",
     "check_footprint",
+    "parse_shard",
     "parse_space",
 ]
 
@@ -108,6 +109,23 @@ def parse_space(text: str, *, option: str = "space", owner: str = "parse_space")
         spec = SpaceSpec(text, match[2], check_count_text("designs", digits, what))
     check_limit("designs", spec.n_designs, what)
     return spec
+
+
+def parse_shard(text: str, *, option: str = "shard", owner: str = "parse_shard") -> tuple[int, int]:
+    """``(K, N)`` from ``K/N``: shard K (0-based) of N, every N-th design from the K-th.
+
+    Raises
+    ------
+    ValueError
+        Naming ``option`` of ``owner``, unless ``N >= 1`` and ``K`` in ``0..N-1``.
+    """
+    match = re.fullmatch(r"\s*(\d+)\s*/\s*(\d+)\s*", str(text))
+    if match is None or int(match[2]) < 1 or int(match[1]) >= int(match[2]):
+        raise ValueError(
+            f"The '{option}' of {owner} must be K/N with N >= 1 and K in 0..N-1 "
+            f"(e.g. 0/8). Got {text!r} instead."
+        )
+    return int(match[1]), int(match[2])
 
 
 @dataclass(frozen=True)

@@ -3,7 +3,7 @@
 from __future__ import annotations
 
 from pathlib import Path
-from typing import TYPE_CHECKING, Annotated, Any
+from typing import TYPE_CHECKING, Annotated
 
 import typer
 
@@ -11,7 +11,6 @@ from softbend.cli import _common
 
 if TYPE_CHECKING:
     from softbend.materials.fit import FitResult
-    from softbend.materials.tensile import TensileTest
 
 app = typer.Typer(
     help="Materials (paper B §3.1): shipped tensile tests and hyperelastic model fits.",
@@ -21,9 +20,6 @@ app = typer.Typer(
 #: Files written into ``--out`` by ``fit``.
 FIT_PNG = "fit.png"
 FIT_JSON = "fit.json"
-#: Shipped test fitted when no CSV is given.
-DEFAULT_TEST = "dragon-skin-30"
-
 _SYMBOLS = {
     "c10_mpa": "C10",
     "c20_mpa": "C20",
@@ -33,38 +29,8 @@ _SYMBOLS = {
 }
 
 
-def _load(csv: str | None) -> TensileTest:
-    """A CSV file, else a shipped test by name; the shipped Dragon Skin 30 by default."""
-    from softbend.materials.tensile import load_shipped, load_tensile_csv, shipped_tensile_tests
-
-    if csv is None:
-        return load_shipped(DEFAULT_TEST)
-    if Path(csv).exists():
-        return load_tensile_csv(csv)
-    shipped = shipped_tensile_tests()
-    if csv in shipped:
-        return load_shipped(csv)
-    raise FileNotFoundError(
-        f"Tensile data file {csv!r} does not exist and is not a shipped test "
-        f"({', '.join(shipped)})."
-    )
-
-
 def _describe(result: FitResult) -> str:
     return ", ".join(f"{_SYMBOLS.get(k, k)} {v:.4g}" for k, v in result.parameters.items())
-
-
-def _payload(
-    test: TensileTest, results: dict[str, FitResult], max_stretch: float | None
-) -> dict[str, Any]:
-    ranked = [r for r in results.values() if r.r2 == r.r2]  # NaN R² never ranks
-    best = max(ranked, key=lambda r: r.r2).name if ranked else None
-    return {
-        "test": test.summary(),
-        "max_stretch": max_stretch,
-        "fits": [r.to_dict() for r in results.values()],
-        "best_model": best,
-    }
 
 
 @app.command("fit")
@@ -100,24 +66,29 @@ def fit(
     ] = None,
     json_output: Annotated[bool, typer.Option("--json", help="Print the results as JSON.")] = False,
 ) -> None:
-    """Fit hyperelastic models to a uniaxial tensile test (paper B Fig. 2a).
+    """Fit hyperelastic models to a uniaxial tensile test (as paper B, Figure 2a).
 
     Least squares of each model's nominal stress in incompressible uniaxial
     tension against the measured engineering stress (MPa), with R² and RMSE.
     Writes OUT/fit.png (data and fitted curves) and OUT/fit.json.
+
+    Example:
+
+        softbend materials fit dragon-skin-30 --models yeoh --out results/materials
     """
     from softbend._io import atomic_files
-    from softbend.materials.fit import fit_models
+    from softbend.materials.fit import fit_file_payload, fit_models
+    from softbend.materials.tensile import load_tensile
     from softbend.reports.material_figures import fit_figure
 
     names = [m.strip() for m in models.split(",") if m.strip()]
     inputs = (Path(csv),) if csv is not None and Path(csv).exists() else ()
     _common.check_output_dir(out, "--out", inputs=inputs, files=(FIT_PNG, FIT_JSON))
-    test = _load(csv)
+    test = load_tensile(csv)
     results = fit_models(test, names, max_stretch=max_stretch)
 
     figure = out / FIT_PNG
-    payload = _payload(test, results, max_stretch)
+    payload = fit_file_payload(test, results, max_stretch)
     payload["files"] = {"figure": str(figure), "json": str(out / FIT_JSON)}
     with (
         _common.output_errors(out, "--out"),
@@ -149,7 +120,14 @@ def fit(
 def list_tests(
     json_output: Annotated[bool, typer.Option("--json", help="Print the list as JSON.")] = False,
 ) -> None:
-    """List the tensile tests shipped with softbend (Marechal et al. 2021, ODbL 1.0)."""
+    """List the tensile tests shipped with softbend; data under ODbL 1.0.
+
+    The tests are those of Marechal et al. 2021 (pull to failure).
+
+    Example:
+
+        softbend materials list --json
+    """
     from softbend.materials.tensile import SHIPPED_ATTRIBUTION, load_shipped, shipped_tensile_tests
 
     tests = [load_shipped(name) for name in shipped_tensile_tests()]

@@ -1,62 +1,56 @@
 """Hyperelastic and linear elastic material models and the presets of paper B.
 
 ``models`` holds the incompressible ``W(I1)`` laws (neo-Hookean, Yeoh,
-Arruda–Boyce) and their registry; ``presets`` the materials of paper B §3.1 with
-their sources; ``tensile`` reads uniaxial tensile tests (five real ones ship with
-softbend, Marechal et al. 2021, ODbL 1.0); ``fit`` fits the models to them.
+Arruda–Boyce) and their registry (:data:`MODELS`); ``presets`` the materials of
+paper B §3.1 with their sources (:data:`PRESETS`); ``tensile`` reads uniaxial
+tensile tests (five real ones ship with softbend, Marechal et al. 2021, ODbL
+1.0); ``fit`` fits the models to them.
+
+Names are imported on first use: ``import softbend.materials`` imports no
+submodule (the fits need SciPy).
 """
 
-from softbend.materials.fit import DEFAULT_MODELS, FitResult, fit_model, fit_models
-from softbend.materials.models import (
-    MODELS,
-    ArrudaBoyce,
-    HyperelasticModel,
-    NeoHookean,
-    Yeoh,
-    get_model_class,
-    model_from_dict,
-)
-from softbend.materials.presets import (
-    DRAGON_SKIN_30,
-    FIBERGLASS_LAYER,
-    KEVLAR_FIBER,
-    KEVLAR_MODELLED_RADIUS_MM,
-    PRESETS,
-    LinearElastic,
-    Material,
-    get_preset,
-)
-from softbend.materials.tensile import (
-    SHIPPED_ATTRIBUTION,
-    TensileTest,
-    load_shipped,
-    load_tensile_csv,
-    shipped_tensile_tests,
-)
+from __future__ import annotations
 
-__all__ = [
-    "DEFAULT_MODELS",
-    "DRAGON_SKIN_30",
-    "FIBERGLASS_LAYER",
-    "KEVLAR_FIBER",
-    "KEVLAR_MODELLED_RADIUS_MM",
-    "MODELS",
-    "PRESETS",
-    "SHIPPED_ATTRIBUTION",
-    "ArrudaBoyce",
-    "FitResult",
-    "HyperelasticModel",
-    "LinearElastic",
-    "Material",
-    "NeoHookean",
-    "TensileTest",
-    "Yeoh",
-    "fit_model",
-    "fit_models",
-    "get_model_class",
-    "get_preset",
-    "load_shipped",
-    "load_tensile_csv",
-    "model_from_dict",
-    "shipped_tensile_tests",
-]
+import importlib
+from typing import Any
+
+_EXPORTS = {
+    "DEFAULT_MODELS": "fit",
+    "FitResult": "fit",
+    "fit_model": "fit",
+    "fit_models": "fit",
+    "MODELS": "models",
+    "ArrudaBoyce": "models",
+    "HyperelasticModel": "models",
+    "NeoHookean": "models",
+    "Yeoh": "models",
+    "get_model_class": "models",
+    "model_from_dict": "models",
+    "DRAGON_SKIN_30": "presets",
+    "FIBERGLASS_LAYER": "presets",
+    "KEVLAR_FIBER": "presets",
+    "KEVLAR_MODELLED_RADIUS_MM": "presets",
+    "PRESETS": "presets",
+    "LinearElastic": "presets",
+    "Material": "presets",
+    "get_preset": "presets",
+    "SHIPPED_ATTRIBUTION": "tensile",
+    "TensileTest": "tensile",
+    "load_shipped": "tensile",
+    "load_tensile_csv": "tensile",
+    "shipped_tensile_tests": "tensile",
+}
+
+__all__ = sorted(_EXPORTS)
+
+
+def __getattr__(name: str) -> Any:
+    if name in _EXPORTS:
+        module = importlib.import_module(f"softbend.materials.{_EXPORTS[name]}")
+        return getattr(module, name)
+    raise AttributeError(f"module 'softbend.materials' has no attribute {name!r}")
+
+
+def __dir__() -> list[str]:
+    return __all__

@@ -42,7 +42,6 @@ from scipy.optimize import least_squares
 from softbend import metrics
 from softbend._jsontext import check_nesting
 from softbend._validation import (
-    check_choice,
     check_finite_array,
     check_object_keys,
     check_range,
@@ -60,6 +59,7 @@ from softbend.materials.models import (
 )
 from softbend.materials.tensile import TensileTest
 from softbend.plausibility import RANGES, implausible_index
+from softbend.registry import Registry
 
 __all__ = [
     "DEFAULT_MODELS",
@@ -67,6 +67,7 @@ __all__ = [
     "LAMBDA_M_MAX",
     "MIN_FIT_POINTS",
     "FitResult",
+    "fit_file_payload",
     "fit_model",
     "fit_models",
     "load_fit_json",
@@ -240,7 +241,7 @@ def _fit_from_dict(data: Any) -> FitResult:
     parameters = data["parameters"]
     if not isinstance(parameters, Mapping):
         raise SchemaError(f"'parameters' must be a JSON object; got {short_repr(parameters)}")
-    model = MODELS[name].from_dict({"model": name, **parameters})
+    model = MODELS.get(name).from_dict({"model": name, **parameters})
     shear = _number(data["initial_shear_modulus_mpa"], "initial_shear_modulus_mpa", "modulus_mpa")
     if not math.isclose(shear, model.initial_shear_modulus_mpa, rel_tol=1e-9, abs_tol=1e-15):
         raise SchemaError(
@@ -281,6 +282,35 @@ def _fit_from_dict(data: Any) -> FitResult:
         stretch_range=(low, high),
         at_bound=tuple(at_bound),
     )
+
+
+def fit_file_payload(
+    test: TensileTest, results: Mapping[str, FitResult], max_stretch: float | None = None
+) -> dict[str, Any]:
+    """The content of ``fit.json`` (:data:`FIT_FILE_KEYS` but ``files``) for fits of one test.
+
+    Parameters
+    ----------
+    test : TensileTest
+        The test fitted (its summary is kept).
+    results : mapping of str to FitResult
+        The fits, by model name (:func:`fit_models`).
+    max_stretch : float, optional
+        The largest stretch fitted, as given (None: all points).
+
+    Returns
+    -------
+    dict
+        ``test``, ``max_stretch``, ``fits`` and ``best_model``: the model with
+        the highest R² (a fit whose R² is NaN never ranks; None if none ranks).
+    """
+    ranked = [r for r in results.values() if r.r2 == r.r2]
+    return {
+        "test": test.summary(),
+        "max_stretch": max_stretch,
+        "fits": [r.to_dict() for r in results.values()],
+        "best_model": max(ranked, key=lambda r: r.r2).name if ranked else None,
+    }
 
 
 def load_fit_json(path: str | os.PathLike[str]) -> dict[str, FitResult]:
@@ -419,19 +449,23 @@ class _Problem:
     upper: np.ndarray
 
 
-def _problem(model_name: str, lam: np.ndarray, y: np.ndarray) -> _Problem:
-    if model_name in (NeoHookean.name, Yeoh.name):
-        A = _linear_design(model_name, lam)
-        n = A.shape[1]
-        names = ("c10_mpa", "c20_mpa", "c30_mpa")[:n]
-        return _Problem(
-            names=names,
-            build=(lambda p: NeoHookean(p[0])) if n == 1 else (lambda p: Yeoh(*p)),
-            jac=lambda p: A,
-            x0=_scaled_lstsq(A, y),
-            lower=np.array([_MODULUS_FLOOR_MPA] + [-np.inf] * (n - 1)),
-            upper=np.full(n, np.inf),
-        )
+def _linear_problem(model_name: str, lam: np.ndarray, y: np.ndarray) -> _Problem:
+    """Neo-Hookean and Yeoh: linear in their constants, started from least squares."""
+    A = _linear_design(model_name, lam)
+    n = A.shape[1]
+    names = ("c10_mpa", "c20_mpa", "c30_mpa")[:n]
+    return _Problem(
+        names=names,
+        build=(lambda p: NeoHookean(p[0])) if n == 1 else (lambda p: Yeoh(*p)),
+        jac=lambda p: A,
+        x0=_scaled_lstsq(A, y),
+        lower=np.array([_MODULUS_FLOOR_MPA] + [-np.inf] * (n - 1)),
+        upper=np.full(n, np.inf),
+    )
+
+
+def _arruda_boyce_problem(model_name: str, lam: np.ndarray, y: np.ndarray) -> _Problem:
+    """Arruda–Boyce: nonlinear in the locking stretch, started from a grid (see the module)."""
     g = _g(lam)
 
     def jac(p: np.ndarray) -> np.ndarray:
@@ -446,6 +480,17 @@ def _problem(model_name: str, lam: np.ndarray, y: np.ndarray) -> _Problem:
         lower=np.array([_MODULUS_FLOOR_MPA, _LAMBDA_M_FLOOR]),
         upper=np.array([np.inf, LAMBDA_M_MAX]),
     )
+
+
+#: How each model of :data:`~softbend.materials.models.MODELS` is fitted, by name.
+_PROBLEMS: Registry[Callable[[str, np.ndarray, np.ndarray], _Problem]] = Registry("material model")
+_PROBLEMS.register(NeoHookean.name, _linear_problem)
+_PROBLEMS.register(Yeoh.name, _linear_problem)
+_PROBLEMS.register(ArrudaBoyce.name, _arruda_boyce_problem)
+
+
+def _problem(model_name: str, lam: np.ndarray, y: np.ndarray) -> _Problem:
+    return _PROBLEMS.get(model_name, field="model")(model_name, lam, y)
 
 
 def _check_data(stretch: ArrayLike, stress: ArrayLike, owner: str) -> tuple[np.ndarray, np.ndarray]:
@@ -530,7 +575,7 @@ def fit_model(
     (Arruda–Boyce); ``C20`` and ``C30`` are free. See the module docstring for the
     starting points.
     """
-    check_choice(model_name, "model", "fit_model", MODELS)
+    _PROBLEMS.check(model_name, field="model")
     lam, y = _check_data(stretch, nominal_stress_mpa, "fit_model")
     lam, y = _select(lam, y, max_stretch, "fit_model")
     problem = _problem(model_name, lam, y)
@@ -648,10 +693,10 @@ def fit_models(
     if not names:
         raise ValueError(
             "The 'models' of fit_models must name at least one of "
-            f"{', '.join(repr(m) for m in MODELS)}. Got {models!r} instead."
+            f"{', '.join(repr(m) for m in _PROBLEMS)}. Got {models!r} instead."
         )
     for name in names:
-        check_choice(name, "model", "fit_models", MODELS)
+        _PROBLEMS.check(name, field="models")
     if len(set(names)) != len(names):
         raise ValueError(
             f"The 'models' of fit_models must be distinct. Got {list(names)!r} instead."

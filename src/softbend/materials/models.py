@@ -30,9 +30,16 @@ from typing import Any, ClassVar
 import numpy as np
 from numpy.typing import ArrayLike
 
-from softbend._validation import check_choice, check_finite_array, check_range, short_repr
+from softbend._validation import (
+    check_choice,
+    check_finite_array,
+    check_object_keys,
+    check_range,
+    short_repr,
+)
 from softbend.errors import SchemaError
 from softbend.plausibility import RANGES, implausible_index
+from softbend.registry import Registry
 
 __all__ = [
     "MODELS",
@@ -51,35 +58,20 @@ def check_constants(
 ) -> dict[str, float]:
     """The constants of a stored material model, checked before the model is built.
 
-    ``data`` must be a mapping whose keys are among ``allowed`` (``"model"`` is
-    dropped) and include ``required``; every value must be a finite real number
-    (not a bool or a string), and a constant in MPa (a key ending in ``_mpa``)
-    must lie in the plausible range of material constants (``modulus_mpa`` of
-    :mod:`softbend.plausibility`).
+    ``data`` must be a mapping whose keys are among ``allowed`` (and ``"model"``,
+    which is dropped) and include ``required``
+    (:func:`softbend._validation.check_object_keys`); every value must be a
+    finite real number (not a bool or a string), and a constant in MPa (a key
+    ending in ``_mpa``) must lie in the plausible range of material constants
+    (``modulus_mpa`` of :mod:`softbend.plausibility`).
 
     Raises
     ------
     SchemaError
         Naming ``owner``, the key, what is allowed and the value received.
     """
-    if not isinstance(data, Mapping):
-        raise SchemaError(
-            f"The data of {owner} must be a mapping of constants. Got {short_repr(data)} instead."
-        )
+    check_object_keys(data, owner, ["model", *allowed], list(required), SchemaError)
     params = {k: v for k, v in data.items() if k != "model"}
-    allowed = list(allowed)
-    unknown = sorted(str(k) for k in params if k not in allowed)
-    if unknown:
-        raise SchemaError(
-            f"The keys of {owner} must be among "
-            f"{', '.join(repr(a) for a in ['model', *allowed])}. Got {unknown!r} instead."
-        )
-    missing = [k for k in required if k not in params]
-    if missing:
-        raise SchemaError(
-            f"The keys of {owner} must include {', '.join(repr(k) for k in missing)}. "
-            f"Got only {sorted(map(str, data))!r} instead."
-        )
     limits = RANGES["modulus_mpa"]
     for key, value in params.items():
         real = isinstance(value, numbers.Real) and not isinstance(value, bool | np.bool_)
@@ -165,13 +157,14 @@ class HyperelasticModel:
     def from_dict(cls, data: Mapping[str, Any]) -> HyperelasticModel:
         """Rebuild a model written by :meth:`to_dict`.
 
-        Called on :class:`HyperelasticModel` itself it dispatches on ``data["model"]``;
-        called on a concrete class, a ``"model"`` entry, if present, must match it.
+        Called on :class:`HyperelasticModel` itself it dispatches on ``data["model"]``
+        (a name of :data:`MODELS`); called on a concrete class, a ``"model"``
+        entry, if present, must match it.
 
         Raises
         ------
-        ValueError
-            An unknown ``"model"`` (the message lists the allowed names).
+        UnknownNameError
+            An unknown or missing ``"model"`` (the message lists the known names).
         SchemaError
             ``data`` is not a mapping, has an unknown or lacks a required key, or
             a constant is not a finite number or (in MPa) outside the plausible
@@ -184,11 +177,6 @@ class HyperelasticModel:
             )
         name = data.get("model")
         if cls is HyperelasticModel:
-            if name is None:
-                raise ValueError(
-                    "The 'model' of HyperelasticModel.from_dict must be one of "
-                    f"{', '.join(repr(n) for n in MODELS)}. Got None instead."
-                )
             return get_model_class(name).from_dict(data)
         if name is not None:
             check_choice(name, "model", f"{cls.__name__}.from_dict", (cls.name,))
@@ -328,24 +316,23 @@ class ArrudaBoyce(HyperelasticModel):
         return self.mu_mpa * total
 
 
-#: Registry of the hyperelastic models by name.
-MODELS: dict[str, type[HyperelasticModel]] = {
-    NeoHookean.name: NeoHookean,
-    Yeoh.name: Yeoh,
-    ArrudaBoyce.name: ArrudaBoyce,
-}
+#: The hyperelastic models by name (each class's ``name``); ``MODELS.register(cls.name, cls)``
+#: adds one (:mod:`softbend.materials.fit` fits the models it has a problem for).
+MODELS: Registry[type[HyperelasticModel]] = Registry("material model")
+for _model in (NeoHookean, Yeoh, ArrudaBoyce):
+    MODELS.register(_model.name, _model)
+del _model
 
 
 def get_model_class(name: str) -> type[HyperelasticModel]:
-    """Return the model class registered under ``name``.
+    """Return the model class registered under ``name`` (``"neo-hookean"``, ``"yeoh"``, ...).
 
     Raises
     ------
-    ValueError
-        If ``name`` is not one of ``"neo-hookean"``, ``"yeoh"``, ``"arruda-boyce"``.
+    UnknownNameError
+        If ``name`` is not a name of :data:`MODELS` (the message lists them).
     """
-    check_choice(name, "model", "get_model_class", MODELS)
-    return MODELS[name]
+    return MODELS.get(name, field="model")
 
 
 def model_from_dict(data: Mapping[str, Any]) -> HyperelasticModel:

@@ -46,6 +46,7 @@ __all__ = [
     "SHIPPED_ATTRIBUTION",
     "TensileTest",
     "load_shipped",
+    "load_tensile",
     "load_tensile_csv",
     "shipped_tensile_tests",
 ]
@@ -433,4 +434,31 @@ def load_shipped(name: str) -> TensileTest:
         name=name,
         material=_SHIPPED_MATERIALS.get(name),
         attribution=SHIPPED_ATTRIBUTION,
+    )
+
+
+def load_tensile(source: str | os.PathLike[str] | None = None) -> TensileTest:
+    """A tensile test by file or by shipped name; the shipped ``"dragon-skin-30"`` by default.
+
+    Parameters
+    ----------
+    source : str or path-like, optional
+        A tensile data file (:func:`load_tensile_csv`) if one exists there, else
+        the name of a shipped test (:func:`shipped_tensile_tests`).
+
+    Raises
+    ------
+    FileNotFoundError
+        Neither a file nor a shipped test; the message lists the shipped ones.
+    """
+    if source is None:
+        return load_shipped("dragon-skin-30")
+    if Path(source).exists():
+        return load_tensile_csv(source)
+    shipped = shipped_tensile_tests()
+    if source in shipped:
+        return load_shipped(str(source))
+    raise FileNotFoundError(
+        f"Tensile data file {str(source)!r} does not exist and is not a shipped test "
+        f"({', '.join(shipped)})."
     )

@@ -3,6 +3,64 @@
 Paper B §4.2–4.3: measurements as data (:mod:`~softbend.transfer.measurements`),
 a virtual lab with a reality gap (:mod:`~softbend.transfer.lab`), the surrogate
 the refinement starts from (:mod:`~softbend.transfer.base`), the refinement
-strategies (:mod:`~softbend.transfer.strategies`) and their
+strategies (:mod:`~softbend.transfer.strategies`, registered by name in
+:data:`STRATEGIES`, their parameters in :mod:`~softbend.transfer.parameters`),
+one strategy fitted and saved (:mod:`~softbend.transfer.refine`) and their
 leave-one-configuration-out evaluation (:mod:`~softbend.transfer.loco`).
+
+Names are imported lazily, so that ``import softbend.transfer`` imports neither
+scikit-learn nor PyTorch.
 """
+
+from __future__ import annotations
+
+import importlib
+from typing import Any
+
+_EXPORTS = {
+    "BASE_HIDDEN_SIZES": "base",
+    "load_base": "base",
+    "shipped_base_path": "base",
+    "train_base_mlp": "base",
+    "LAB_ACTUATORS": "lab",
+    "PLANTS": "lab",
+    "VirtualLab": "lab",
+    "actuator_id": "lab",
+    "shipped_measurements": "lab",
+    "DEFAULT_STRATEGIES": "loco",
+    "LocoResult": "loco",
+    "leave_one_configuration_out": "loco",
+    "strategy_options": "loco",
+    "Measurements": "measurements",
+    "format_measurements": "measurements",
+    "load_measurements": "measurements",
+    "save_measurements": "measurements",
+    "check_parameters": "parameters",
+    "parameter_defaults": "parameters",
+    "fit_pressure_scale": "pressure_map",
+    "scale_mlp_pressure": "pressure_map",
+    "Refinement": "refine",
+    "refinable_strategies": "refine",
+    "refine_surrogate": "refine",
+    "BUILTIN_STRATEGIES": "strategies",
+    "NETWORK_STRATEGIES": "strategies",
+    "STRATEGIES": "strategies",
+    "describe_strategies": "strategies",
+    "fit_strategy": "strategies",
+    "has_interval": "strategies",
+    "make_strategy": "strategies",
+    "strategy_parameters": "strategies",
+}
+
+__all__ = sorted(_EXPORTS)
+
+
+def __getattr__(name: str) -> Any:
+    if name in _EXPORTS:
+        module = importlib.import_module(f"softbend.transfer.{_EXPORTS[name]}")
+        return getattr(module, name)
+    raise AttributeError(f"module 'softbend.transfer' has no attribute {name!r}")
+
+
+def __dir__() -> list[str]:
+    return __all__

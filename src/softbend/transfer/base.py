@@ -21,7 +21,14 @@ import numpy as np
 from softbend.design import FEATURES
 from softbend.errors import DatasetError
 
-__all__ = ["BASE_HIDDEN_SIZES", "fem_rows", "load_base", "shipped_base_path", "train_base_mlp"]
+__all__ = [
+    "BASE_HIDDEN_SIZES",
+    "base_metadata",
+    "fem_rows",
+    "load_base",
+    "shipped_base_path",
+    "train_base_mlp",
+]
 
 #: Paper B's MLP (§4.1, Fig. 5): hidden layers of 63 and 65 units.
 BASE_HIDDEN_SIZES: tuple[int, int] = (63, 65)
@@ -97,6 +104,44 @@ def train_base_mlp(
         num_threads=1,
     )
     return NormalizedMLPRegressor.from_grid(grid, 0, 0)
+
+
+def base_metadata(model: Any, *, epochs: int, seed: int, command: str) -> dict[str, Any]:
+    """The record saved with a base MLP that :func:`train_base_mlp` trained on the shipped data.
+
+    Parameters
+    ----------
+    model : NormalizedMLPRegressor
+        The trained MLP.
+    epochs, seed : int
+        As given to :func:`train_base_mlp`.
+    command : str
+        The command that made it, as a user would type it again.
+
+    Returns
+    -------
+    dict
+        Purpose, dataset (and the SHA-256 of its samples), hidden sizes, epochs,
+        seed, command, final training MSE (deg²) and the training ranges (mm,
+        deg, MPa).
+    """
+    from softbend.datasets import table1_fem_provenance
+    from softbend.surrogates.features import training_ranges
+
+    provenance = table1_fem_provenance()
+    return {
+        "purpose": "the FEM-trained MLP that transfer learning starts from",
+        "trained_on": "softbend.datasets.table1_fem(), converged samples",
+        "dataset_samples_sha256": provenance.get("files", {})
+        .get("samples.parquet", {})
+        .get("sha256"),
+        "hidden_sizes": list(BASE_HIDDEN_SIZES),
+        "epochs": epochs,
+        "seed": seed,
+        "command": command,
+        "final_training_mse_deg2": float(model.loss_curve_[-1]) * model.y_scale_**2,
+        "training_ranges": training_ranges(fem_rows()),
+    }
 
 
 def load_base(path: str | os.PathLike[str] | None = None) -> Any:

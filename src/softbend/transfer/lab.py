@@ -1,4 +1,4 @@
-"""A virtual lab: labelled-synthetic measurements of real-looking actuators (SPEC §4.7).
+"""A virtual lab: labelled-synthetic measurements of real-looking actuators (paper B §4.2–4.3).
 
 Paper B's measurements are not public. The virtual lab produces measurements
 of the seven actuators of paper B Fig. 7 the way their rig did (pressure set
@@ -43,6 +43,8 @@ from softbend.materials.fit import fit_model
 from softbend.materials.presets import DRAGON_SKIN_30, Material
 from softbend.materials.tensile import load_shipped, shipped_tensile_tests
 from softbend.models import BendingModel, default_pressures_mpa
+from softbend.references import FEM_VALIDATION
+from softbend.registry import Registry
 from softbend.transfer.measurements import Measurements
 
 __all__ = ["LAB_ACTUATORS", "PLANTS", "VirtualLab", "actuator_id", "shipped_measurements"]
@@ -52,8 +54,23 @@ _OWNER = "VirtualLab"
 #: The seven actuators of paper B Fig. 7 (:data:`softbend.design.PAPER_B_FIG7_DESIGNS`).
 LAB_ACTUATORS: tuple[SFRBADesign, ...] = PAPER_B_FIG7_DESIGNS
 
-#: Models that can play the lab's actuators.
-PLANTS: tuple[str, ...] = ("fem", "analytical")
+
+def _fem_plant(elastomer: Material) -> BendingModel:
+    from softbend.fem import FEMModel, FEMOptions
+
+    return FEMModel(FEMOptions(elastomer=elastomer))
+
+
+def _analytical_plant(elastomer: Material) -> BendingModel:
+    from softbend.analytical import AnalyticalModel
+
+    return AnalyticalModel(material=elastomer)
+
+
+#: Models that can play the lab's actuators: ``factory(elastomer) -> BendingModel``.
+PLANTS: Registry[Callable[[Material], BendingModel]] = Registry("lab plant")
+PLANTS.register("fem", _fem_plant)
+PLANTS.register("analytical", _analytical_plant)
 
 
 def actuator_id(design: SFRBADesign) -> str:
@@ -73,9 +90,10 @@ class VirtualLab:
     ----------
     actuators : tuple of SFRBADesign
         Nominal designs measured, default :data:`LAB_ACTUATORS` (paper B Fig. 7).
-    plant : {"fem", "analytical"}
-        Model of the actuators as built: the 3D FEM (default) or the analytical
-        model (seconds instead of minutes, for checks).
+    plant : str
+        Model of the actuators as built, a name of :data:`PLANTS`: the 3D FEM
+        (``"fem"``, default) or the analytical model (``"analytical"``: seconds
+        instead of minutes, for checks).
     elastomer : str
         Shipped tensile test the lab's silicone is fitted to (Yeoh), default
         ``"dragon-skin-30"``.
@@ -119,7 +137,7 @@ class VirtualLab:
     fabrication_error_mm: float = 0.2
     hysteresis: float = 0.02
     camera_noise_deg: float = 1.0
-    pressure_step_mpa: float = 0.01
+    pressure_step_mpa: float = FEM_VALIDATION["pressure_step_mpa"].value
     pmax_mpa: float = 0.25
     max_angle_deg: float = 270.0
     unloading: bool = False
@@ -140,7 +158,7 @@ class VirtualLab:
                 f"The 'actuators' of {_OWNER} must be distinct designs. Got {ids} instead."
             )
         object.__setattr__(self, "actuators", actuators)
-        check_choice(self.plant, "plant", _OWNER, PLANTS)
+        PLANTS.check(self.plant, field="plant")
         check_choice(self.elastomer, "elastomer", _OWNER, shipped_tensile_tests())
         for name, low, high in (
             ("elastomer_max_stretch", 1.0, 50.0),
@@ -223,13 +241,7 @@ class VirtualLab:
 
     def plant_model(self) -> BendingModel:
         """The bending model of the actuators as built, with the lab's elastomer."""
-        if self.plant == "analytical":
-            from softbend.analytical import AnalyticalModel
-
-            return AnalyticalModel(material=self.elastomer_material())
-        from softbend.fem import FEMModel, FEMOptions
-
-        return FEMModel(FEMOptions(elastomer=self.elastomer_material()))
+        return PLANTS.get(self.plant, field="plant")(self.elastomer_material())
 
     def metadata(self) -> dict[str, str]:
         """Header lines of the lab's files: synthetic, the gap's parameters, the material."""

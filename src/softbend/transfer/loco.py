@@ -11,7 +11,7 @@ from __future__ import annotations
 
 import os
 import time
-from collections.abc import Callable, Sequence
+from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
@@ -20,15 +20,28 @@ import numpy as np
 import pandas as pd
 
 from softbend._io import json_text, write_text_atomic
-from softbend._validation import check_choice, check_int, check_range
+from softbend._validation import check_int, check_range
 from softbend.metrics import rmse, thresholded_mape
+from softbend.registry import UnknownNameError
 from softbend.transfer.measurements import Measurements
-from softbend.transfer.strategies import STRATEGIES, has_interval, make_strategy
+from softbend.transfer.parameters import check_parameters, recorded_parameters
+from softbend.transfer.strategies import (
+    BUILTIN_STRATEGIES,
+    STRATEGIES,
+    has_interval,
+    make_strategy,
+    strategy_parameters,
+)
 
-__all__ = ["DEFAULT_STRATEGIES", "LocoResult", "leave_one_configuration_out"]
+__all__ = [
+    "DEFAULT_STRATEGIES",
+    "LocoResult",
+    "leave_one_configuration_out",
+    "strategy_options",
+]
 
-#: The strategies of a default evaluation: all of them.
-DEFAULT_STRATEGIES: tuple[str, ...] = STRATEGIES
+#: The strategies of a default evaluation: softbend's own, in the order of the tables.
+DEFAULT_STRATEGIES: tuple[str, ...] = BUILTIN_STRATEGIES
 
 #: Strategies left out of the learning curve (the longest training).
 _SLOW = ("experimental", "refined-ensemble")
@@ -177,7 +190,8 @@ def leave_one_configuration_out(
         The simulation-trained surrogate the strategies start from (an ``mlp``
         surrogate for ``refined``, ``refined-ensemble``).
     strategies : sequence of str
-        Names among :data:`~softbend.transfer.strategies.STRATEGIES`.
+        Names among :data:`~softbend.transfer.strategies.STRATEGIES` (any
+        registered strategy).
     level : float, default 0.9
         Probability of the prediction intervals, in (0, 1).
     learning_curve : bool, default True
@@ -187,7 +201,8 @@ def leave_one_configuration_out(
     seed : int, default 0
         Seed of the strategies and of the learning curve's actuator order.
     options : dict, optional
-        Constructor options per strategy name, e.g. ``{"refined": {"epochs": 500}}``.
+        Parameters per strategy name, e.g. ``{"refined": {"epochs": 500}}``
+        (see :func:`strategy_options` for text such as ``epochs=500``).
     progress : callable, optional
         ``progress(done, total, strategy)`` after each strategy's fits.
 
@@ -202,16 +217,19 @@ def leave_one_configuration_out(
         )
     names = tuple(strategies)
     if not names:
-        raise ValueError(f"The 'strategies' of {_OWNER} must name at least one of {STRATEGIES}.")
+        raise ValueError(
+            f"The 'strategies' of {_OWNER} must name at least one of {', '.join(STRATEGIES)}."
+        )
     for name in names:
-        check_choice(name, "strategy", _OWNER, STRATEGIES)
+        STRATEGIES.check(name, field="strategies")
     if len(set(names)) != len(names):
         raise ValueError(f"The 'strategies' of {_OWNER} must be distinct. Got {list(names)}.")
     level = check_range(level, "level", _OWNER, low=0.0, high=1.0)
     seed = check_int(seed, "seed", _OWNER, low=0)
-    options = dict(options or {})
-    for name in options:
-        check_choice(name, "options", _OWNER, STRATEGIES)
+    options = {
+        name: check_parameters(name, STRATEGIES.get(name, field="options"), values)
+        for name, values in dict(options or {}).items()
+    }
     ids = measurements.actuator_ids
     if len(ids) < 2:
         raise ValueError(
@@ -305,6 +323,12 @@ def leave_one_configuration_out(
             "actuators": list(ids),
             "n_measurements": len(measurements),
             "options": options,
+            "parameters": {
+                name: recorded_parameters(
+                    make_strategy(name, base, seed=seed, **options.get(name, {}))
+                )
+                for name in names
+            },
             "fits": len(tasks),
             "wall_time_s": time.perf_counter() - start,
         },
@@ -334,3 +358,54 @@ def _summarize(per_actuator: pd.DataFrame, names: Sequence[str]) -> pd.DataFrame
             }
         )
     return pd.DataFrame(rows)
+
+
+def strategy_options(
+    strategies: Sequence[str], settings: Mapping[str, str], *, field: str = "--set"
+) -> dict[str, dict[str, Any]]:
+    """Text settings of a run of several strategies as the ``options`` of the run.
+
+    Parameters
+    ----------
+    strategies : sequence of str
+        The strategies of the run.
+    settings : mapping of str to str
+        ``{"refined.epochs": "500"}`` sets a parameter of one strategy;
+        ``{"epochs": "500"}`` sets it on every strategy of the run that takes it.
+    field : str, default "--set"
+        Where the settings came from, named in messages.
+
+    Returns
+    -------
+    dict
+        ``{strategy: {parameter: value}}``, typed by each parameter's default.
+
+    Raises
+    ------
+    UnknownNameError
+        A strategy that is not registered, a parameter it does not take, or a
+        parameter no strategy of the run takes (the known ones listed).
+    ValueError
+        A value that is not of the parameter's kind.
+    """
+    names = [STRATEGIES.check(name, field="strategies") for name in strategies]
+    options: dict[str, dict[str, Any]] = {}
+    for key, text in settings.items():
+        target, dot, parameter = key.rpartition(".")
+        if dot:
+            STRATEGIES.check(target, field=field)
+            targets = [target]
+        else:
+            targets = [n for n in names if parameter in strategy_parameters(n)]
+            if not targets:
+                known = sorted({p for n in names for p in strategy_parameters(n)})
+                raise UnknownNameError(
+                    f"Unknown parameter {parameter!r} (in {field}): no strategy of the run "
+                    f"({', '.join(names)}) takes it; known: {', '.join(known) or 'none'}."
+                )
+        for name in targets:
+            value = check_parameters(
+                name, STRATEGIES.get(name), {parameter: text}, field=field, from_text=True
+            )
+            options.setdefault(name, {}).update(value)
+    return options

@@ -61,10 +61,9 @@ from typing import Any
 import numpy as np
 import pandas as pd
 
-from softbend._io import read_input_text, write_text_atomic
+from softbend._io import read_header_csv, write_text_atomic
 from softbend.design import FEATURE_QUANTITIES, FEATURES, PARAMETERS, SFRBADesign
 from softbend.errors import DatasetError
-from softbend.limits import check_limit, limit
 from softbend.plausibility import check_plausible
 
 logger = logging.getLogger(__name__)
@@ -655,6 +654,18 @@ class Measurements:
         """Actuator id of each row, shape (n,), for ``LeaveOneGroupOut``."""
         return self.frame["actuator_id"].to_numpy(dtype=object, copy=True)
 
+    def per_actuator(self) -> pd.DataFrame:
+        """One row per actuator, in measured order: ``points``, ``pmax`` (MPa), ``angle_max`` (deg).
+
+        Indexed by ``actuator_id``: the readings, the highest pressure set and
+        the largest angle read.
+        """
+        return self.frame.groupby("actuator_id", sort=False).agg(
+            points=("angle_deg", "size"),
+            pmax=("pressure_mpa", "max"),
+            angle_max=("angle_deg", "max"),
+        )
+
     def subset(self, actuator_ids: Iterable[str]) -> Measurements:
         """The rows of some actuators, in their original order.
 
@@ -721,41 +732,28 @@ def load_measurements(path: str | os.PathLike[str]) -> Measurements:
         raise DatasetError(f"Measurement file not found: {source}.")
     if source.is_dir():
         raise DatasetError(f"{source} is a folder; a measurement CSV file is required.")
-    text = read_input_text(source, str(source), encoding="utf-8-sig")
-
     metadata: dict[str, str] = {}
     metadata_line: dict[str, int] = {}
     columns: list[str] | None = None
     header_line = 0
     rows: list[list[str]] = []
     line_of_row: list[int] = []
-    lines = text.replace("\r\n", "\n").replace("\r", "\n").split("\n")
-    if len(lines) > limit("csv_rows"):  # may be over: count the data rows (cheap)
-        n_rows = sum(1 for line in lines if line.strip() and not line.lstrip().startswith("#"))
-        check_limit("csv_rows", max(n_rows - 1, 0), str(source))
-    for number, line in enumerate(lines, start=1):
-        stripped = line.strip()
-        if not stripped:
+    for line in read_header_csv(source):
+        number = line.number
+        if line.kind == "meta":
+            key, value = line.key, line.value
+            if key in metadata:
+                raise DatasetError(
+                    f"{source}, line {number}: the metadata key {key!r} was already set "
+                    f"on line {metadata_line[key]}; each key may appear once."
+                )
+            problem = _metadata_problem(key, value)
+            if problem is not None:
+                raise DatasetError(f"{source}, line {number}: {problem}.")
+            metadata[key] = value
+            metadata_line[key] = number
             continue
-        if stripped.startswith("#"):
-            key, sep, value = stripped[1:].partition(":")
-            key, value = key.strip(), value.strip()
-            if columns is None and sep and key:
-                if key in metadata:
-                    raise DatasetError(
-                        f"{source}, line {number}: the metadata key {key!r} was already set "
-                        f"on line {metadata_line[key]}; each key may appear once."
-                    )
-                problem = _metadata_problem(key, value)
-                if problem is not None:
-                    raise DatasetError(f"{source}, line {number}: {problem}.")
-                metadata[key] = value
-                metadata_line[key] = number
-            continue
-        try:
-            cells = [cell.strip() for cell in next(csv.reader([line]))]
-        except csv.Error as exc:
-            raise DatasetError(f"{source}, line {number}: not a CSV row ({exc}).") from None
+        cells = list(line.cells)
         if columns is None:
             _check_columns(cells, f"{source}, line {number}")
             columns, header_line = cells, number

@@ -24,12 +24,25 @@ trained on the FEM dataset by default):
 =================  ============================================================
 
 Strategies with intervals have ``predict_interval(X, level)``.
+
+:data:`STRATEGIES` maps each name to its class; one call adds a strategy, from
+inside softbend or outside it, and every command and report then knows it::
+
+    STRATEGIES.register("my-strategy", MyStrategy)
+    # softbend transfer refine BASE.json lab.csv --out m.json --strategy my-strategy
+
+A strategy class is a scikit-learn regressor on the rows above. Its
+constructor's ``base`` and ``seed``, if it takes them, are filled by the library;
+its other parameters, with defaults, are the ones a user sets
+(:mod:`softbend.transfer.parameters`: ``--set NAME=VALUE``). ``fit(X, y)`` sets
+``model_``, the surrogate that ``softbend transfer refine`` saves; a class whose
+``learns`` is False (a baseline) has nothing to save.
 """
 
 from __future__ import annotations
 
 import warnings
-from typing import Any
+from typing import Any, ClassVar
 
 import numpy as np
 from numpy.typing import ArrayLike
@@ -38,10 +51,11 @@ from sklearn.exceptions import ConvergenceWarning
 from sklearn.gaussian_process import GaussianProcessRegressor
 from sklearn.utils.validation import check_is_fitted, validate_data
 
-from softbend._validation import check_choice, check_int, check_range
+from softbend._validation import check_int, check_range
 from softbend.design import FEATURES, SFRBADesign
 from softbend.errors import ConvergenceError
 from softbend.plausibility import check_plausible
+from softbend.registry import Registry
 from softbend.surrogates.corrected import (
     AffineCorrected,
     GPCorrected,
@@ -51,9 +65,11 @@ from softbend.surrogates.corrected import (
     scaled_pressure_rows,
 )
 from softbend.transfer.finetune import check_mlp, fine_tune_many, row_weights
+from softbend.transfer.parameters import check_parameters, parameter_defaults, takes
 from softbend.transfer.pressure_map import fit_pressure_scale, scale_mlp_pressure
 
 __all__ = [
+    "BUILTIN_STRATEGIES",
     "NETWORK_STRATEGIES",
     "STRATEGIES",
     "AnalyticalBaseline",
@@ -65,23 +81,16 @@ __all__ = [
     "ResidualGP",
     "ScaleOffset",
     "ScaledRefinedMLP",
+    "describe_strategies",
     "fit_strategy",
     "has_interval",
+    "learns",
     "make_strategy",
+    "strategy_parameters",
 ]
 
-#: Names of the strategies, in the order of the tables.
-STRATEGIES: tuple[str, ...] = (
-    "fem-only",
-    "analytical",
-    "experimental",
-    "refined",
-    "scale-offset",
-    "pressure-scale",
-    "residual-gp",
-    "refined-ensemble",
-    "scaled-refined",
-)
+#: The strategies by name, in the order of the tables (filled at the end of this module).
+STRATEGIES: Registry[type] = Registry("transfer strategy")
 
 #: The strategies that train a network (they take ``epochs``).
 NETWORK_STRATEGIES: tuple[str, ...] = (
@@ -157,6 +166,9 @@ def _check_finite_fit(strategy: str, **parameters: Any) -> None:
 class _Strategy(RegressorMixin, BaseEstimator):
     """Validation shared by the strategies: 7 finite features, plausible angles."""
 
+    #: Whether fitting learns a model from the measurements (``model_``, saved by refine).
+    learns: ClassVar[bool] = True
+
     def _check_fit_data(self, X: ArrayLike, y: ArrayLike) -> tuple[np.ndarray, np.ndarray]:
         X, y = validate_data(self, X, y, dtype=np.float64, y_numeric=True)
         owner = f"{type(self).__name__}.fit"
@@ -196,6 +208,8 @@ class _Corrected(_Strategy):
 class BaseOnly(_Strategy):
     """The base surrogate as it is ("fem-only"); ``fit`` only records the features."""
 
+    learns: ClassVar[bool] = False
+
     def __init__(self, base: Any = None) -> None:
         self.base = base
 
@@ -223,6 +237,8 @@ class AnalyticalBaseline(_Strategy):
         Default :class:`softbend.analytical.AnalyticalModel` (Dragon Skin 30 of
         paper B, no gravity).
     """
+
+    learns: ClassVar[bool] = False
 
     def __init__(self, model: Any = None) -> None:
         self.model = model
@@ -710,7 +726,69 @@ class RefinedEnsemble(_Corrected):
         return estimators
 
 
-def make_strategy(name: str, base: Any = None, *, seed: int = 0, **options: Any) -> _Strategy:
+for _name, _cls in (
+    ("fem-only", BaseOnly),
+    ("analytical", AnalyticalBaseline),
+    ("experimental", ExperimentalMLP),
+    ("refined", RefinedMLP),
+    ("scale-offset", ScaleOffset),
+    ("pressure-scale", PressureScale),
+    ("residual-gp", ResidualGP),
+    ("refined-ensemble", RefinedEnsemble),
+    ("scaled-refined", ScaledRefinedMLP),
+):
+    STRATEGIES.register(_name, _cls)
+del _name, _cls
+
+#: softbend's own strategies, in the order of the tables (those registered later are not).
+BUILTIN_STRATEGIES: tuple[str, ...] = STRATEGIES.names()
+
+
+def strategy_parameters(name: str) -> dict[str, Any]:
+    """The parameters a user may set on strategy ``name``, with their defaults.
+
+    Raises
+    ------
+    UnknownNameError
+        An unknown name (listing :data:`STRATEGIES`).
+    """
+    return parameter_defaults(STRATEGIES.get(name, field="strategy"))
+
+
+def learns(name: str) -> bool:
+    """Whether strategy ``name`` learns a model from the measurements (a baseline does not)."""
+    return bool(getattr(STRATEGIES.get(name, field="strategy"), "learns", True))
+
+
+def describe_strategies() -> list[dict[str, Any]]:
+    """Every registered strategy, in order: what it is and what a user may set.
+
+    Returns
+    -------
+    list of dict
+        ``name``; ``summary`` (the first line of its class's docstring, as text);
+        ``parameters`` (``{name: default}``, see :func:`strategy_parameters`);
+        ``uses_base`` (starts from the base surrogate); ``learns`` (fits a model
+        that ``softbend transfer refine`` saves); ``interval`` (gives prediction
+        intervals).
+    """
+    rows = []
+    for name, cls in STRATEGIES.items():
+        doc = (cls.__doc__ or "").strip()
+        rows.append(
+            {
+                "name": name,
+                "summary": doc.splitlines()[0].replace("``", "") if doc else cls.__name__,
+                "parameters": parameter_defaults(cls),
+                "uses_base": takes(cls, "base"),
+                "learns": learns(name),
+                "interval": callable(getattr(cls, "predict_interval", None)),
+            }
+        )
+    return rows
+
+
+def make_strategy(name: str, base: Any = None, *, seed: int = 0, **options: Any) -> Any:
     """A fresh, unfitted strategy by name.
 
     Parameters
@@ -723,31 +801,18 @@ def make_strategy(name: str, base: Any = None, *, seed: int = 0, **options: Any)
     seed : int, default 0
         Seed of the strategy's random choices.
     **options
-        Constructor parameters of the strategy (e.g. ``epochs``).
+        Parameters of the strategy (e.g. ``epochs``; see :func:`strategy_parameters`).
 
     Raises
     ------
-    ValueError
-        An unknown name (listing :data:`STRATEGIES`).
+    UnknownNameError
+        An unknown name (listing :data:`STRATEGIES`), or a parameter the strategy
+        does not take (listing those it takes).
     """
-    check_choice(name, "strategy", "make_strategy", STRATEGIES)
-    if name == "fem-only":
-        return BaseOnly(base, **options)
-    if name == "analytical":
-        return AnalyticalBaseline(**options)
-    if name == "experimental":
-        return ExperimentalMLP(seed=seed, **options)
-    if name == "refined":
-        return RefinedMLP(base, seed=seed, **options)
-    if name == "scale-offset":
-        return ScaleOffset(base, **options)
-    if name == "pressure-scale":
-        return PressureScale(base, **options)
-    if name == "residual-gp":
-        return ResidualGP(base, seed=seed, **options)
-    if name == "scaled-refined":
-        return ScaledRefinedMLP(base, seed=seed, **options)
-    return RefinedEnsemble(base, seed=seed, **options)
+    cls = STRATEGIES.get(name, field="strategy")
+    options = check_parameters(name, cls, options)
+    filled = {"base": base, "seed": seed}
+    return cls(**{k: v for k, v in filled.items() if takes(cls, k)}, **options)
 
 
 def fit_strategy(

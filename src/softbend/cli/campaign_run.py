@@ -1,0 +1,202 @@
+"""``softbend campaign run``: sweep a design space (or one shard of it) into a database."""
+
+from __future__ import annotations
+
+from contextlib import ExitStack
+from pathlib import Path
+
+import typer
+
+from softbend.cli import _common
+
+_OWNER = "softbend campaign run"
+#: The design spaces of --space (softbend.campaign.spaces.SPACE_FORMS, not imported at start).
+SPACE_FORMS = "table1, corners, lhs:N or sobol:N"
+
+
+def one_line(text: str) -> str:
+    """``text`` with its whitespace runs (newlines too) as single spaces."""
+    return " ".join(str(text).split())
+
+
+def _saved_surrogate(path: str) -> object:
+    from softbend.surrogates.model import SurrogateModel
+
+    return SurrogateModel.load(path)
+
+
+def with_surrogates() -> None:
+    """Register the ``"surrogate"`` campaign backend (a saved surrogate, read from its path).
+
+    softbend.surrogates sits above the campaign in the pipeline, so the campaign
+    cannot register it itself; nothing happens if it is registered already.
+    """
+    from softbend.campaign.backends import BACKENDS, register_backend
+
+    if "surrogate" not in BACKENDS:
+        register_backend("surrogate", _saved_surrogate)
+
+
+def run(
+    db: Path = typer.Argument(..., help="Campaign database (DuckDB); created or resumed."),
+    backend: str = typer.Option(
+        "analytical",
+        help="Sweep model, a campaign backend: analytical, fem or surrogate (with --model).",
+    ),
+    model: Path | None = typer.Option(
+        None, help="A surrogate saved by 'softbend train' (models/*.json), for --backend surrogate."
+    ),
+    space: str = typer.Option("table1", help=f"Designs: {SPACE_FORMS}."),
+    seed: int = typer.Option(0, help="Seed of the lhs/sobol sampler."),
+    shard: str | None = typer.Option(
+        None,
+        help="Only shard K/N of the space (every N-th design from the K-th, K in 0..N-1); "
+        "merge the shards' databases with 'softbend campaign merge'.",
+    ),
+    pmax: float = typer.Option(0.5, help="Largest pressure of the sweep, MPa."),
+    pstep: float = typer.Option(0.005, help="Pressure step of the sweep, MPa."),
+    workers: int | None = typer.Option(
+        None, help="Local worker processes (default: all cores; 0 or 1: serial)."
+    ),
+    scheduler: str | None = typer.Option(
+        None, help="Dask scheduler tcp://HOST:PORT (or scheduler file) to run on a cluster."
+    ),
+    retry_failed: bool = typer.Option(
+        True, "--retry-failed/--no-retry-failed", help="Re-run designs recorded as failed."
+    ),
+    chunk_size: int | None = typer.Option(None, help="Designs per worker task (default: auto)."),
+    connect_timeout: float = typer.Option(
+        5.0, help="Seconds allowed to reach the Dask scheduler and find a worker."
+    ),
+    allow_large: bool = typer.Option(
+        False,
+        "--allow-large",
+        help="Run a campaign estimated above 2 GiB of memory or 20 GiB of disk "
+        "(one that does not fit the machine is refused anyway).",
+    ),
+    compile_energy: bool = typer.Option(
+        True,
+        "--compile/--no-compile",
+        help="--backend fem: compile the energy to machine code once per worker "
+        "(about 30 CPU s in the background; then faster assembly, the same results; "
+        "see benchmarks/bench_fem.py).",
+    ),
+    json_output: bool = typer.Option(False, "--json", help="Print the summary as JSON."),
+) -> None:
+    """Sweep every design of a space not yet in DB; re-run the same command to resume.
+
+    Example:
+
+        softbend campaign run table1.duckdb --backend analytical --space table1
+    """
+    from softbend.campaign.backends import backend_for_run, default_pressures_mpa
+    from softbend.campaign.runner import (
+        count_designs_to_run,
+        parse_scheduler_address,
+        run_campaign,
+    )
+    from softbend.campaign.spaces import (
+        campaign_footprint,
+        check_footprint,
+        parse_shard,
+        parse_space,
+    )
+
+    _common.check_output_file(db, "DB", inputs=(model,) if model is not None else ())
+    spec = parse_space(space, option="--space", owner=_OWNER)
+    if seed < 0:
+        raise ValueError(f"The '--seed' of {_OWNER} must be an integer >= 0. Got {seed} instead.")
+    shard_of = parse_shard(shard, option="--shard", owner=_OWNER) if shard is not None else None
+    pressures = default_pressures_mpa(pmax, pstep)
+    with_surrogates()
+    backend_obj = backend_for_run(
+        backend,
+        model=model,
+        compiled=compile_energy,
+        field="--backend",
+        model_field="--model",
+        owner=_OWNER,
+    )
+    if scheduler is not None:
+        parse_scheduler_address(scheduler)
+    k, count = shard_of or (0, 1)
+    n_stored = len(range(k, spec.n_designs, count))  # designs of the shard
+    check_footprint(
+        campaign_footprint(spec.n_designs, len(pressures), n_stored=n_stored),
+        db,
+        allow_large=allow_large,
+        option="--space",
+        owner=_OWNER,
+        allow_flag="--allow-large",
+    )
+    designs = spec.build(seed)
+    if shard_of is not None:
+        designs = designs.shard(*shard_of)
+    n_todo = count_designs_to_run(db, designs, retry_failed)
+    if n_todo < len(designs) and not json_output:
+        _common.err_console.print(
+            f"resuming {db}: {len(designs) - n_todo} of {len(designs)} designs already recorded",
+            highlight=False,
+            soft_wrap=True,  # one line whatever the path's length (logs, tests)
+        )
+    with ExitStack() as stack:
+        # The bar opens with the first report, so errors before any work print no bar.
+        advance = None
+        shown = 0
+
+        def progress(done: int, failed: int, running: int, total: int) -> None:
+            nonlocal advance, shown
+            if advance is None:
+                advance = stack.enter_context(
+                    _common.progress_bar(
+                        f"campaign {db.name}", total=total, enabled=not json_output
+                    )
+                )
+            advance(done + failed - shown, done=done, failed=failed, running=running)
+            shown = done + failed
+
+        try:
+            summary = run_campaign(
+                db,
+                designs,
+                backend=backend_obj,
+                pressures_mpa=pressures,
+                workers=workers,
+                scheduler=scheduler,
+                retry_failed=retry_failed,
+                progress=progress,
+                chunk_size=chunk_size,
+                connect_timeout_s=connect_timeout,
+            )
+        except OSError as exc:
+            # A failed write of the database (a full disk) names it: one line naming DB.
+            # The designs recorded before stay in it; re-running the command resumes.
+            if exc.filename is None:
+                raise
+            with _common.output_errors(db, "DB"):
+                raise
+    if json_output:
+        _common.print_json({"space": designs.name, **summary.as_dict()})
+        return
+    _common.print_table(
+        f"campaign {summary.db_path}",
+        ["quantity", "value"],
+        [
+            ["backend", summary.backend],
+            ["space", f"{designs.name} ({summary.n_designs} designs)"],
+            ["executor", summary.executor],
+            ["already done (skipped)", summary.n_skipped_done],
+            ["failed before, not retried", summary.n_skipped_failed],
+            ["done in this run", summary.n_done],
+            ["failed in this run", summary.n_failed],
+            ["wall time (s)", summary.wall_time_s],
+            ["designs per second", summary.designs_per_s],
+            ["sweep time, sum (s)", summary.sweep_time_s],
+        ],
+    )
+    if summary.failures:
+        _common.print_table(
+            "failed designs",
+            ["design_id", "error"],
+            [[i, one_line(e)] for i, e in summary.failures[:20]],
+        )

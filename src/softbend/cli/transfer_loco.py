@@ -1,0 +1,154 @@
+"""``softbend transfer loco``: every strategy scored on every held-out actuator."""
+
+from __future__ import annotations
+
+from pathlib import Path
+from typing import TYPE_CHECKING
+
+import typer
+
+from softbend.cli import _common
+
+if TYPE_CHECKING:
+    from softbend.transfer.loco import LocoResult
+
+#: The files 'transfer loco' writes into its '--out' folder.
+LOCO_FILES: tuple[str, ...] = (
+    "summary.csv",
+    "per_actuator.csv",
+    "predictions.csv",
+    "learning_curve.csv",
+    "loss_curves_deg2.csv",
+    "loco.json",
+    "fig6_loss_curves.png",
+    "fig7_actuators.png",
+    "learning_curve.png",
+)
+
+
+def loco(
+    measurements: Path = typer.Argument(..., help="Measurements CSV (see 'softbend lab measure')."),
+    out: Path = typer.Option(..., "--out", help="Folder for tables and figures."),
+    base: Path | None = typer.Option(
+        None, help="Saved surrogate to start from (default: the shipped FEM-trained MLP)."
+    ),
+    strategies: str = typer.Option(
+        "all",
+        help="Comma-separated strategies, or 'all': softbend's own "
+        "(see 'softbend transfer strategies').",
+    ),
+    settings: list[str] | None = typer.Option(
+        None,
+        "--set",
+        help="A strategy parameter, STRATEGY.NAME=VALUE, or NAME=VALUE for every strategy "
+        "that takes it (repeatable; recorded in loco.json).",
+    ),
+    level: float = typer.Option(0.9, help="Probability of the prediction intervals."),
+    learning_curve: bool = typer.Option(
+        True, "--learning-curve/--no-learning-curve", help="Also fit on 1..n-2 actuators."
+    ),
+    seed: int = typer.Option(0, help="Seed of the strategies and the learning curve."),
+    as_json: bool = typer.Option(False, "--json", help="Print the results as JSON."),
+) -> None:
+    """Leave one configuration out: every strategy, every held-out actuator (paper B Fig. 7).
+
+    The folder --out is written as a whole: built beside it and swapped in
+    when every table and figure is complete, so a run that fails leaves the
+    previous results as they were. An existing --out may hold only what this
+    command writes. loco.json records every parameter of every strategy as used.
+
+    Example:
+
+        softbend transfer loco lab.csv --out loco --strategies refined,scale-offset --set epochs=500
+    """
+    from softbend._io import staged_dir
+    from softbend.reports import transfer_figures
+    from softbend.transfer.base import load_base
+    from softbend.transfer.loco import (
+        DEFAULT_STRATEGIES,
+        leave_one_configuration_out,
+        strategy_options,
+    )
+    from softbend.transfer.measurements import load_measurements
+
+    out = Path(out)
+    inputs = (measurements,) if base is None else (measurements, base)
+    _common.check_output_dir(out, "--out", inputs=inputs, files=LOCO_FILES)
+    _common.check_replaceable_dir(out, "--out", "transfer loco", inputs=inputs, files=LOCO_FILES)
+    names = (
+        list(DEFAULT_STRATEGIES)
+        if strategies.strip() == "all"
+        else [n.strip() for n in strategies.split(",") if n.strip()]
+    )
+    options = strategy_options(names, _common.parse_assignments(settings or ()))
+    data = load_measurements(measurements)
+    model = load_base(base)
+    with _common.phase_progress(enabled=not as_json) as progress:
+        result = leave_one_configuration_out(
+            data,
+            model,
+            names,
+            level=level,
+            learning_curve=learning_curve,
+            seed=seed,
+            options=options,
+            progress=lambda done, total, name: progress("fitting strategies", done, total),
+        )
+    synthetic = str(data.metadata.get("synthetic", "")).startswith("true")
+    with (
+        _common.output_errors(out, "--out"),
+        staged_dir(out) as stage,
+        _common.as_written(stage, out),
+    ):
+        written = result.write(stage)
+        written["fig6"] = str(transfer_figures.loss_curves(result, stage / "fig6_loss_curves.png"))
+        written["fig7"] = str(
+            transfer_figures.actuator_panels(
+                result, stage / "fig7_actuators.png", synthetic=synthetic
+            )
+        )
+        if learning_curve:
+            written["learning_curve_figure"] = str(
+                transfer_figures.learning_curve(result, stage / "learning_curve.png")
+            )
+    files = {key: str(out / Path(value).name) for key, value in written.items()}
+    if as_json:
+        _common.print_json({**result.to_dict(), "files": files, "synthetic": synthetic})
+        return
+    print_loco_summary(result)
+    _common.console.print(f"tables and figures written to {out}")
+
+
+def print_loco_summary(result: LocoResult) -> None:
+    """The per-strategy table beside paper B's refined MLP (paper B §4.3, Fig. 7)."""
+    from softbend.references import TRANSFER_RESULTS, values
+
+    paper = values(TRANSFER_RESULTS)
+    rows = []
+    for _, r in result.summary.iterrows():
+        rows.append(
+            [
+                r["strategy"],
+                float(r["rmse_deg"]),
+                float(r["mape_pct"]),
+                float(r["max_error_deg"]),
+                "—" if r["coverage"] != r["coverage"] else f"{100 * r['coverage']:.1f} %",
+                f"{r['worst_actuator']} ({r['worst_rmse_deg']:.1f}°)",
+            ]
+        )
+    rows.append(
+        [
+            "paper B refined MLP",
+            paper["rmse_deg"],
+            paper["mape_pct"],
+            "—",
+            "—",
+            f"{paper['worst']} ({paper['worst_rmse_deg']:.2f}°)",
+        ]
+    )
+    _common.print_table(
+        f"Leave one configuration out ({len(result.settings['actuators'])} actuators, "
+        f"{result.settings['n_measurements']} readings; intervals {result.level:.0%})",
+        ["strategy", "mean RMSE °", "mean MAPE %", "max |e| °", "coverage", "worst actuator"],
+        rows,
+    )
