@@ -19,7 +19,7 @@ PACKAGE = Path(softbend.__file__).parent
 #: after ``softbend.`` (private helper modules sit at the bottom).
 STAGES: tuple[tuple[str, ...], ...] = (
     ("__init__", "_extras", "_io", "_jsontext", "_torch", "_validation", "errors", "limits"),
-    ("registry", "references"),
+    ("registry", "references", "parameters"),
     ("plausibility",),
     ("design", "metrics", "kinematics"),
     ("materials",),

@@ -8,11 +8,11 @@ from softbend.cli import main
 from softbend.control import CONTROLLERS, PLANTS, RIGS
 from softbend.control.experiments import run_metrics, simulate
 from softbend.control.factory import controller_parameters, make_controller
-from softbend.control.params import parse_assignments
 from softbend.control.rig import RigParams, SimulatedRig
 from softbend.control.rigconfig import ControllerConfig, RigConfig, load_rig_config
 from softbend.control.study import control_study
 from softbend.design import SFRBADesign
+from softbend.parameters import parse_assignments
 from softbend.registry import Registry, UnknownNameError
 
 BANG_BANG = "known: deadzone, period."

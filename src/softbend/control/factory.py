@@ -4,7 +4,7 @@ A controller factory takes the controller's model (:class:`ControllerModel`:
 the θ(p) table it inverts, its virtual angle sensor, the rig model) and its
 public parameters as keyword-only arguments with defaults; those names are the
 ones of ``--set NAME=VALUE`` and of a rig TOML's ``[controller]`` table
-(:mod:`softbend.control.params`). Adding a controller is one factory and one
+(:mod:`softbend.parameters`). Adding a controller is one factory and one
 ``CONTROLLERS.register(name, factory)`` call, from inside the package or out::
 
     def make_toy(model, *, gain: float = 1.0):
@@ -27,10 +27,10 @@ from softbend.control.controllers import (
     PressureRelay,
     mlp_virtual_sensor,
 )
-from softbend.control.params import check_parameters, effective_parameters
 from softbend.control.predictive import PredictivePulse
 from softbend.control.rig import AngleTable, RigParams
 from softbend.design import SFRBADesign
+from softbend.parameters import check_parameters, effective_parameters
 from softbend.registry import Registry
 
 __all__ = [
@@ -240,7 +240,7 @@ def controller_parameters(
     name : str
         A name of :data:`CONTROLLERS`.
     values : mapping, optional
-        ``{parameter: value}`` (see :func:`~softbend.control.params.check_parameters`).
+        ``{parameter: value}`` (see :func:`~softbend.parameters.check_parameters`).
     field : str
         Where the name and values came from, for messages (``"--set"``).
     from_text : bool, default False

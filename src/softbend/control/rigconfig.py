@@ -517,7 +517,7 @@ _TOML_POSITION = re.compile(r"\s*\(at line (?P<line>\d+), column (?P<column>\d+)
 
 def _controller(table: Any) -> ControllerConfig:
     """The [controller] table: a string ``name`` and scalar parameters (one _FieldError)."""
-    from softbend.control.params import ParameterValueError, UnknownParameterError
+    from softbend.parameters import ParameterValueError, UnknownParameterError
 
     owner = f"[controller] of the {_OWNER}"
     if not isinstance(table, dict):

@@ -26,11 +26,11 @@ from softbend.control.factory import (
     build_controller,
     controller_parameters,
 )
-from softbend.control.params import parse_assignments
 from softbend.control.plants import PLANTS, plant_table
 from softbend.control.rig import AngleTable, RigParams
 from softbend.control.rigconfig import ControllerConfig
 from softbend.design import SFRBADesign
+from softbend.parameters import parse_assignments
 
 __all__ = [
     "DEFAULT_DESIGN",

@@ -1,0 +1,296 @@
+"""Public parameters of a registered implementation: ``NAME=VALUE`` text and data values.
+
+A registry entry (a controller factory, a transfer strategy class) declares its
+public parameters in its signature, with defaults::
+
+    def bang_bang(model, *, deadzone: float = 0.05, period: float = 0.01): ...
+    class RefinedMLP:
+        def __init__(self, base, *, epochs: int = 1000, learning_rate: float = 6e-4): ...
+
+:func:`check_parameters` checks given values against them: an unknown name is
+one :class:`UnknownParameterError` line listing the known ones; a value of the
+wrong kind is one :class:`ParameterValueError` line naming the parameter and
+the kind it must have. Text typed on a command line (``--set deadzone=0.02``,
+parsed by :func:`parse_assignments`) is read by the parameter's kind: the type
+of its default, else its annotation: ``true``/``false`` for booleans, an
+integer, a number, a string, or integers separated by commas for a tuple of
+integers (``hidden_sizes=63,65``). An ``epochs`` parameter is held to the
+``epochs`` limit of :mod:`softbend.limits`. :func:`effective_parameters` fills
+in the defaults, for the record of a run.
+"""
+
+from __future__ import annotations
+
+import inspect
+import math
+import numbers
+from collections.abc import Callable, Collection, Mapping, Sequence
+from typing import Any
+
+from softbend.errors import SoftbendError
+from softbend.limits import check_limit
+from softbend.registry import UnknownNameError
+
+__all__ = [
+    "ParameterValueError",
+    "UnknownParameterError",
+    "check_parameters",
+    "effective_parameters",
+    "parameter_defaults",
+    "parse_assignments",
+    "public_parameters",
+]
+
+_KINDS = {bool: "bool", int: "int", float: "float", str: "str"}
+_WORDS = {
+    "bool": "true or false",
+    "int": "an integer",
+    "float": "a number",
+    "str": "a string",
+    "ints": "integers separated by commas",
+    "any": "a number, true/false or a string",
+}
+_TRUE = ("true", "yes", "on", "1")
+_FALSE = ("false", "no", "off", "0")
+
+
+class UnknownParameterError(UnknownNameError):
+    """A parameter name that an implementation does not take; ``key`` is the name."""
+
+    def __init__(self, message: str, key: str) -> None:
+        super().__init__(message)
+        self.key = key
+
+
+class ParameterValueError(SoftbendError, ValueError):
+    """A parameter value of the wrong kind; ``key`` is the parameter's name."""
+
+    def __init__(self, message: str, key: str) -> None:
+        super().__init__(message)
+        self.key = key
+
+
+def public_parameters(
+    entry: Callable[..., Any], *, skip: Collection[str] = (), keyword_only: bool = True
+) -> tuple[dict[str, inspect.Parameter], bool]:
+    """The public parameters of ``entry`` and whether it takes ``**kwargs``.
+
+    Parameters
+    ----------
+    entry : callable
+        A factory function or a class (its constructor's parameters).
+    skip : collection of str
+        Names the library fills itself (a strategy's ``base`` and ``seed``).
+    keyword_only : bool, default True
+        Only keyword-only parameters are public (a factory's model comes first,
+        positionally); False: positional-or-keyword ones too.
+    """
+    kinds = {inspect.Parameter.KEYWORD_ONLY}
+    if not keyword_only:
+        kinds.add(inspect.Parameter.POSITIONAL_OR_KEYWORD)
+    found: dict[str, inspect.Parameter] = {}
+    open_ended = False
+    for parameter in inspect.signature(entry).parameters.values():
+        if parameter.kind is inspect.Parameter.VAR_KEYWORD:
+            open_ended = True
+        elif parameter.kind in kinds and parameter.name not in skip:
+            found[parameter.name] = parameter
+    return found, open_ended
+
+
+def parameter_defaults(
+    entry: Callable[..., Any], *, skip: Collection[str] = (), keyword_only: bool = True
+) -> dict[str, Any]:
+    """The public parameters of ``entry`` and their defaults (``None`` when one has none)."""
+    found, _ = public_parameters(entry, skip=skip, keyword_only=keyword_only)
+    return {
+        name: (None if p.default is inspect.Parameter.empty else p.default)
+        for name, p in found.items()
+    }
+
+
+def effective_parameters(
+    entry: Callable[..., Any],
+    checked: Mapping[str, Any] | None = None,
+    *,
+    skip: Collection[str] = (),
+    keyword_only: bool = True,
+) -> dict[str, Any]:
+    """Every public parameter of ``entry``: its default, or the checked value given."""
+    return {**parameter_defaults(entry, skip=skip, keyword_only=keyword_only), **(checked or {})}
+
+
+def parse_assignments(items: Sequence[str] | None, field: str = "--set") -> dict[str, str]:
+    """``["NAME=VALUE", ...]`` as ``{name: text}`` (the values are read later, by kind).
+
+    Parameters
+    ----------
+    items : sequence of str, optional
+        The assignments, e.g. the repeated values of ``--set``.
+    field : str, default "--set"
+        Where they came from, for messages.
+
+    Raises
+    ------
+    ValueError
+        An item without ``=``, with an empty name, or a name given twice.
+    """
+    values: dict[str, str] = {}
+    for item in items or ():
+        name, sep, text = str(item).partition("=")
+        name = name.strip()
+        if not sep or not name:
+            raise ValueError(
+                f"The '{field}' values must be NAME=VALUE (e.g. epochs=500). "
+                f"Got {item!r} instead."
+            )
+        if name in values:
+            raise ValueError(
+                f"The '{field}' parameter {name!r} is given twice ({values[name]!r} and "
+                f"{text.strip()!r}); give it once."
+            )
+        values[name] = text.strip()
+    return values
+
+
+def _is_ints(value: Any) -> bool:
+    return isinstance(value, tuple | list) and all(
+        isinstance(v, numbers.Integral) and not isinstance(v, bool) for v in value
+    )
+
+
+def _kind(parameter: inspect.Parameter) -> str:
+    """The kind of one parameter: from its default's type, else from its annotation."""
+    default = parameter.default
+    if type(default) in _KINDS:
+        return _KINDS[type(default)]
+    if isinstance(default, tuple) and default and _is_ints(default):
+        return "ints"
+    note = parameter.annotation
+    text = note if isinstance(note, str) else getattr(note, "__name__", str(note))
+    words = [w for w in text.replace(" ", "").split("|") if w not in ("None", "NoneType")]
+    if len(words) == 1 and words[0].startswith("tuple[int"):
+        return "ints"
+    return words[0] if len(words) == 1 and words[0] in _KINDS.values() else "any"
+
+
+def _from_text(text: str, kind: str) -> Any:
+    """A value typed on a command line, as ``kind``; ``ValueError`` when it is not one."""
+    word = text.strip().lower()
+    if kind == "str":
+        return text.strip()
+    if kind == "ints":
+        return tuple(int(part) for part in word.split(","))
+    if kind == "bool" or (kind == "any" and word in _TRUE[:1] + _FALSE[:1]):
+        if word in _TRUE:
+            return True
+        if word in _FALSE:
+            return False
+        raise ValueError(text)
+    try:
+        return int(word) if kind in ("int", "any") else float(word)
+    except ValueError:
+        if kind == "int":
+            raise
+    try:
+        return float(word)
+    except ValueError:
+        if kind == "float":
+            raise
+    return text.strip()
+
+
+def _typed(value: Any, kind: str) -> Any:
+    """A value given as data (TOML, Python), checked to be ``kind``; ``ValueError`` if not."""
+    real = isinstance(value, numbers.Real) and not isinstance(value, bool)
+    if kind == "bool" and isinstance(value, bool):
+        return value
+    if kind == "int" and isinstance(value, numbers.Integral) and not isinstance(value, bool):
+        return int(value)
+    if kind == "float" and real:
+        return float(value)
+    if kind == "str" and isinstance(value, str):
+        return value
+    if kind == "ints" and _is_ints(value):
+        return tuple(int(v) for v in value)
+    if kind == "any" and (real or isinstance(value, bool | str)):
+        return value
+    raise ValueError(value)
+
+
+def check_parameters(
+    entry: Callable[..., Any],
+    values: Mapping[str, Any] | None,
+    *,
+    owner: str,
+    field: str,
+    from_text: bool = False,
+    skip: Collection[str] = (),
+    keyword_only: bool = True,
+    hints: Mapping[str, str] | None = None,
+) -> dict[str, Any]:
+    """The given ``values`` checked against the public parameters of ``entry``.
+
+    Parameters
+    ----------
+    entry : callable
+        A factory or a class; see :func:`public_parameters`. One that takes
+        ``**kwargs`` also accepts any other name.
+    values : mapping, optional
+        ``{name: value}``: text from a command line (``from_text``) or data (TOML, Python).
+    owner : str
+        What the parameters belong to, for messages (``"controller 'bang-bang'"``).
+    field : str
+        Where the values came from, for messages (``"--set"``).
+    from_text : bool, default False
+        Read text values by each parameter's kind.
+    skip, keyword_only
+        As for :func:`public_parameters`.
+    hints : mapping, optional
+        ``{name: text}`` added to the message when a skipped name is given
+        (``{"seed": "the seed is set once per run: --seed"}``).
+
+    Returns
+    -------
+    dict
+        The given names with their checked values (an integer given for a number
+        becomes a float, a list of integers a tuple).
+
+    Raises
+    ------
+    UnknownParameterError
+        A name ``entry`` does not take; the message lists the known names.
+    ParameterValueError
+        A value that is not of the parameter's kind, or a number that is not finite.
+    LimitError
+        ``epochs`` over the ``epochs`` limit of :mod:`softbend.limits`.
+    """
+    known, open_ended = public_parameters(entry, skip=skip, keyword_only=keyword_only)
+    checked: dict[str, Any] = {}
+    for key, value in (values or {}).items():
+        if key not in known and not open_ended:
+            hint = f" ({hints[key]})" if hints and key in hints else ""
+            raise UnknownParameterError(
+                f"Unknown parameter {key!r} of {owner} (in {field}){hint}; known: "
+                f"{', '.join(known) or 'none'}.",
+                key,
+            )
+        kind = _kind(known[key]) if key in known else "any"
+        try:
+            result = _from_text(str(value), kind) if from_text else _typed(value, kind)
+        except ValueError:
+            raise ParameterValueError(
+                f"The parameter {key!r} of {owner} (in {field}) must be {_WORDS[kind]}. "
+                f"Got {value!r} instead.",
+                key,
+            ) from None
+        if isinstance(result, float) and not math.isfinite(result):
+            raise ParameterValueError(
+                f"The parameter {key!r} of {owner} (in {field}) must be a finite number. "
+                f"Got {value!r} instead.",
+                key,
+            )
+        if key == "epochs" and kind == "int":
+            check_limit("epochs", result, f"The 'epochs' of {owner} (in {field})")
+        checked[key] = result
+    return checked

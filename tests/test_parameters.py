@@ -1,0 +1,120 @@
+"""Public parameters by name: one set of rules for controllers and transfer strategies."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from softbend.errors import LimitError
+from softbend.parameters import (
+    ParameterValueError,
+    UnknownParameterError,
+    check_parameters,
+    effective_parameters,
+    parameter_defaults,
+    parse_assignments,
+)
+
+
+def factory(
+    model,
+    *,
+    gain: float = 1.0,
+    steps: int = 3,
+    on: bool = True,
+    tag: str = "a",
+    preview: float | None = None,
+    sizes: tuple[int, int] = (8, 8),
+    epochs: int = 10,
+):
+    return model
+
+
+class Strategy:
+    def __init__(self, base=None, epochs: int = 1000, seed: int = 0) -> None:
+        self.base, self.epochs, self.seed = base, epochs, seed
+
+
+def test_text_is_read_by_each_parameters_kind():
+    given = {
+        "gain": "2",
+        "steps": "5",
+        "on": "off",
+        "tag": " b ",
+        "preview": "0.5",
+        "sizes": "63,65",
+    }
+    checked = check_parameters(factory, given, owner="toy", field="--set", from_text=True)
+    assert checked == {
+        "gain": 2.0,
+        "steps": 5,
+        "on": False,
+        "tag": "b",
+        "preview": 0.5,
+        "sizes": (63, 65),
+    }
+    assert isinstance(checked["gain"], float) and isinstance(checked["steps"], int)
+
+
+def test_data_values_are_checked_and_normalised():
+    checked = check_parameters(
+        factory, {"gain": 2, "steps": np.int64(4), "sizes": [3, 4]}, owner="toy", field="TOML"
+    )
+    assert checked == {"gain": 2.0, "steps": 4, "sizes": (3, 4)}
+    assert type(checked["steps"]) is int
+    with pytest.raises(
+        ParameterValueError, match="'steps' of toy \\(in TOML\\) must be an integer"
+    ):
+        check_parameters(factory, {"steps": 2.5}, owner="toy", field="TOML")
+    with pytest.raises(ParameterValueError, match="must be true or false"):
+        check_parameters(factory, {"on": 1}, owner="toy", field="TOML")
+
+
+@pytest.mark.parametrize(
+    ("key", "text"),
+    [("gain", "fast"), ("gain", "nan"), ("steps", "1.5"), ("on", "maybe"), ("sizes", "63;65")],
+)
+def test_bad_text_is_one_line_naming_the_parameter(key, text):
+    with pytest.raises(ParameterValueError, match=f"'{key}' of toy \\(in --set\\)") as info:
+        check_parameters(factory, {key: text}, owner="toy", field="--set", from_text=True)
+    assert info.value.key == key and "\n" not in str(info.value)
+
+
+def test_unknown_name_lists_the_known_ones_and_hints_at_filled_ones():
+    with pytest.raises(
+        UnknownParameterError, match="known: gain, steps, on, tag, preview, sizes, epochs"
+    ):
+        check_parameters(factory, {"gian": "1"}, owner="toy", field="--set", from_text=True)
+    with pytest.raises(UnknownParameterError, match="\\(set once per run\\); known: epochs\\."):
+        check_parameters(
+            Strategy,
+            {"seed": 1},
+            owner="s",
+            field="--set",
+            skip=("base", "seed"),
+            keyword_only=False,
+            hints={"seed": "set once per run"},
+        )
+
+
+def test_epochs_are_held_to_the_limit():
+    with pytest.raises(LimitError, match="epochs"):
+        check_parameters(
+            factory, {"epochs": "1000000000"}, owner="toy", field="--set", from_text=True
+        )
+
+
+def test_defaults_and_the_record_of_a_run():
+    assert parameter_defaults(Strategy, skip=("base", "seed"), keyword_only=False) == {
+        "epochs": 1000
+    }
+    assert effective_parameters(factory, {"gain": 3.0})["gain"] == 3.0
+    assert effective_parameters(factory)["preview"] is None
+
+
+def test_assignments():
+    assert parse_assignments(["a=1", " b = x "]) == {"a": "1", "b": "x"}
+    with pytest.raises(ValueError, match="NAME=VALUE"):
+        parse_assignments(["a"])
+    with pytest.raises(ValueError, match="given twice"):
+        parse_assignments(["a=1", "a=2"])
