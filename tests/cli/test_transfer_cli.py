@@ -297,7 +297,12 @@ def test_refine_parameters_by_set_are_recorded_and_match_the_epochs_option(
     )
     capsys.readouterr()
     a, b = (json.loads(p.read_text()) for p in (by_option, by_set))
-    assert a["metadata"]["parameters"] == {"epochs": 20, "learning_rate": 6e-4, "seed": 0}
+    assert a["metadata"]["parameters"] == {
+        "epochs": 20,
+        "learning_rate": 6e-4,
+        "device": "auto",
+        "seed": 0,
+    }
     assert b["metadata"]["parameters"] == a["metadata"]["parameters"]
     assert a["state"] == b["state"]
     bad = [*argv, "--out", str(tmp_path / "c.json")]
@@ -328,7 +333,11 @@ def test_strategies_lists_every_strategy_with_its_parameters(capsys):
     rows = json.loads(capsys.readouterr().out)
     by_name = {r["name"]: r for r in rows}
     assert list(by_name)[:2] == ["fem-only", "analytical"]
-    assert by_name["refined"]["parameters"] == {"epochs": 1000, "learning_rate": 6e-4}
+    assert by_name["refined"]["parameters"] == {
+        "epochs": 1000,
+        "learning_rate": 6e-4,
+        "device": "auto",
+    }
     assert by_name["experimental"]["parameters"]["hidden_sizes"] == [63, 65]
     assert not by_name["fem-only"]["learns"] and by_name["residual-gp"]["interval"]
     assert main(["transfer", "strategies"]) == 0

@@ -285,6 +285,9 @@ class RefinedMLP(_Strategy):
         Adam steps over the measurements (paper B Fig. 6: 1000 epochs).
     learning_rate : float, default 6e-4
         Adam step size (paper B's).
+    device : {"auto", "cpu", "cuda"}, default "auto"
+        Where the refits train (:func:`~softbend.transfer.finetune.fine_tune_many`):
+        "auto" is the GPU when torch sees one.
     seed : int, default 0
         Unused (full-batch training draws nothing); kept for a uniform interface.
 
@@ -302,11 +305,13 @@ class RefinedMLP(_Strategy):
         *,
         epochs: int = 1000,
         learning_rate: float = 6e-4,
+        device: str = "auto",
         seed: int = 0,
     ) -> None:
         self.base = base
         self.epochs = epochs
         self.learning_rate = learning_rate
+        self.device = device
         self.seed = seed
 
     def fit(self, X: ArrayLike, y: ArrayLike) -> RefinedMLP:
@@ -326,7 +331,7 @@ class RefinedMLP(_Strategy):
         """
         first = estimators[0]
         check_mlp(first.base, cls.__name__)
-        _check_same(estimators, ("base", "epochs", "learning_rate"), cls.__name__)
+        _check_same(estimators, ("base", "epochs", "learning_rate", "device"), cls.__name__)
         models = fine_tune_many(
             cls._starts(first.base, X, y, row_sets),
             X,
@@ -334,6 +339,7 @@ class RefinedMLP(_Strategy):
             row_weights(row_sets, len(y)),
             epochs=first.epochs,
             learning_rate=first.learning_rate,
+            device=first.device,
         )
         for estimator, model in zip(estimators, models, strict=True):
             estimator._set(model, X)
@@ -365,6 +371,9 @@ class ExperimentalMLP(_Strategy):
         Paper B Fig. 6.
     learning_rate : float, default 6e-4
         Adam step size (paper B's).
+    device : {"auto", "cpu", "cuda"}, default "auto"
+        Where the refits train (:func:`~softbend.transfer.finetune.fine_tune_many`):
+        "auto" is the GPU when torch sees one.
     seed : int, default 0
         Seed of the initial weights.
 
@@ -381,11 +390,13 @@ class ExperimentalMLP(_Strategy):
         hidden_sizes: tuple[int, int] = (63, 65),
         epochs: int = 15000,
         learning_rate: float = 6e-4,
+        device: str = "auto",
         seed: int = 0,
     ) -> None:
         self.hidden_sizes = hidden_sizes
         self.epochs = epochs
         self.learning_rate = learning_rate
+        self.device = device
         self.seed = seed
 
     def fit(self, X: ArrayLike, y: ArrayLike) -> ExperimentalMLP:
@@ -410,7 +421,9 @@ class ExperimentalMLP(_Strategy):
         from softbend.surrogates.mlp_core import init_parameters, model_rng, standardization
 
         first = estimators[0]
-        _check_same(estimators, ("hidden_sizes", "epochs", "learning_rate", "seed"), cls.__name__)
+        _check_same(
+            estimators, ("hidden_sizes", "epochs", "learning_rate", "device", "seed"), cls.__name__
+        )
         h1, h2 = (int(h) for h in first.hidden_sizes)
         starts = []
         for k, rows in enumerate(row_sets):
@@ -436,6 +449,7 @@ class ExperimentalMLP(_Strategy):
             row_weights(row_sets, len(y)),
             epochs=first.epochs,
             learning_rate=first.learning_rate,
+            device=first.device,
         )
         for estimator, model in zip(estimators, models, strict=True):
             estimator.model_ = model
@@ -655,7 +669,7 @@ class RefinedEnsemble(_Corrected):
     base : NormalizedMLPRegressor
     n_members : int, default 5
         Refined networks, >= 2.
-    epochs, learning_rate
+    epochs, learning_rate, device
         As :class:`RefinedMLP`.
     seed : int, default 0
         Seed of the draws.
@@ -668,12 +682,14 @@ class RefinedEnsemble(_Corrected):
         n_members: int = 5,
         epochs: int = 1000,
         learning_rate: float = 6e-4,
+        device: str = "auto",
         seed: int = 0,
     ) -> None:
         self.base = base
         self.n_members = n_members
         self.epochs = epochs
         self.learning_rate = learning_rate
+        self.device = device
         self.seed = seed
 
     def fit(self, X: ArrayLike, y: ArrayLike) -> RefinedEnsemble:
@@ -701,7 +717,9 @@ class RefinedEnsemble(_Corrected):
         """Fit each ensemble on its rows; every member of every ensemble trained at once."""
         first = estimators[0]
         check_mlp(first.base, cls.__name__)
-        _check_same(estimators, ("base", "epochs", "learning_rate", "n_members"), cls.__name__)
+        _check_same(
+            estimators, ("base", "epochs", "learning_rate", "device", "n_members"), cls.__name__
+        )
         draws = [
             est._draws(X, np.asarray(rows)) for est, rows in zip(estimators, row_sets, strict=True)
         ]
@@ -713,6 +731,7 @@ class RefinedEnsemble(_Corrected):
             row_weights(flat, len(y)),
             epochs=first.epochs,
             learning_rate=first.learning_rate,
+            device=first.device,
         )
         for i, (estimator, rows) in enumerate(zip(estimators, row_sets, strict=True)):
             members = models[i * first.n_members : (i + 1) * first.n_members]
