@@ -131,11 +131,12 @@ def add_section(
 
 def surrogate_cells(name: str, model: dict[str, Any]) -> list[Any]:
     """Model, configuration, R², RMSE, MAPE, max error and inference times of a family."""
-    from softbend.surrogates.search import MODEL_TITLES
+    from softbend.surrogates.families import FAMILIES
 
     keys = ("params", "r2", "rmse_deg", "mape_pct", "max_abs_error_deg")
     timing = ("inference_single_us", "inference_batch_ms")
-    return [MODEL_TITLES[name], *(model[k] for k in keys), *(model[k] for k in timing)]
+    title = FAMILIES.get(name).title if name in FAMILIES else name
+    return [title, *(model[k] for k in keys), *(model[k] for k in timing)]
 
 
 def add_regression_tables(section: Any, regression: Any, data: str = "") -> None:

@@ -142,13 +142,15 @@ def add_fem_data(report: Report, fem_data: FEMData, root: Path) -> dict[str, Any
     rows = []
     for name, m in grouped["models"].items():
         other = shuffled["models"].get(name, {})
-        paper = PAPER_B_FIG5[name]
+        paper = PAPER_B_FIG5.get(name)  # a family of one's own has no paper figure
         rows.append(
             [
                 *surrogate_cells(name, m),
                 other.get("r2", ""),
                 other.get("mape_pct", ""),
-                f"{paper['params']}: R² {paper['r2']}, MAPE {paper['mape_pct']} %",
+                f"{paper['params']}: R² {paper['r2']}, MAPE {paper['mape_pct']} %"
+                if paper
+                else "—",
             ]
         )
     settings = grouped["settings"]
