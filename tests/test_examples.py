@@ -34,3 +34,19 @@ def test_design_campaign_example_resumes(tmp_path, capsys):
     again = example.main(db, seed=0)
     assert again == pytest.approx(loadings)
     assert "0 designs run, 40 already" in capsys.readouterr().out
+
+
+def test_custom_controller_example_registers_and_runs(capsys):
+    from softbend.control import CONTROLLERS
+
+    try:
+        results = _load("custom_controller").main(duration_s=6.0)
+        assert "lead-bang-bang" in CONTROLLERS
+        paper, lead = results["bang-bang"], results["lead-bang-bang"]
+        assert 0 < paper["mape_pct"] < 20 and 0 < lead["mape_pct"] < 20
+        # The unfiltered lead chatters: more valve switches than paper B's controller.
+        assert lead["switches"] > paper["switches"]
+        assert "'lead': 0.05" in capsys.readouterr().out
+    finally:
+        if "lead-bang-bang" in CONTROLLERS:
+            CONTROLLERS.unregister("lead-bang-bang")
