@@ -17,6 +17,7 @@ from softbend._extras import require
 
 __all__ = ["require_torch", "torch_loaded"]
 
+_torch: ModuleType | None
 try:
     import torch as _torch
 except ImportError:  # the 'ml' extra is not installed: nothing to load first

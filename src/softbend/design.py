@@ -15,7 +15,7 @@ from __future__ import annotations
 import hashlib
 import itertools
 import math
-from collections.abc import Iterator, Sequence
+from collections.abc import Iterator, Mapping, Sequence
 from dataclasses import asdict, dataclass
 from typing import Literal
 
@@ -255,7 +255,7 @@ class DesignSpace:
         return DesignSpace(self.designs[index::count], name=f"{self.name}[{index}/{count}]")
 
     @classmethod
-    def grid(cls, levels: dict[str, Sequence[float]], name: str = "grid") -> DesignSpace:
+    def grid(cls, levels: Mapping[str, Sequence[float]], name: str = "grid") -> DesignSpace:
         """Full factorial grid over ``levels``, one sequence per name in :data:`PARAMETERS`."""
         missing = [p for p in PARAMETERS if p not in levels]
         extra = [p for p in levels if p not in PARAMETERS]

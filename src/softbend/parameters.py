@@ -85,7 +85,7 @@ def public_parameters(
         Only keyword-only parameters are public (a factory's model comes first,
         positionally); False: positional-or-keyword ones too.
     """
-    kinds = {inspect.Parameter.KEYWORD_ONLY}
+    kinds: set[inspect._ParameterKind] = {inspect.Parameter.KEYWORD_ONLY}
     if not keyword_only:
         kinds.add(inspect.Parameter.POSITIONAL_OR_KEYWORD)
     found: dict[str, inspect.Parameter] = {}
@@ -141,8 +141,7 @@ def parse_assignments(items: Sequence[str] | None, field: str = "--set") -> dict
         name = name.strip()
         if not sep or not name:
             raise ValueError(
-                f"The '{field}' values must be NAME=VALUE (e.g. epochs=500). "
-                f"Got {item!r} instead."
+                f"The '{field}' values must be NAME=VALUE (e.g. epochs=500). Got {item!r} instead."
             )
         if name in values:
             raise ValueError(

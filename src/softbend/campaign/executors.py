@@ -393,6 +393,7 @@ def _scheduler_file_address(path: Path) -> str:
 def _probe(address: str, timeout_s: float) -> None:
     """Fail fast, with one clear line, when nothing listens at the scheduler address."""
     match = _ADDRESS.match(parse_scheduler_address(address))
+    assert match is not None  # parse_scheduler_address returns only matching addresses
     host = match["host"].strip("[]")
     try:
         with socket.create_connection((host, int(match["port"])), timeout=timeout_s):

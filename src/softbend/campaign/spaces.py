@@ -20,6 +20,7 @@ import re
 import shutil
 from dataclasses import dataclass
 from pathlib import Path
+from typing import Literal, cast
 
 from softbend.design import TABLE1_LEVELS, DesignSpace
 from softbend.limits import check_count_text, check_limit
@@ -75,7 +76,8 @@ class SpaceSpec:
             return DesignSpace.table1()
         if self.kind == "corners":
             return DesignSpace.corners()
-        return DesignSpace.sample(self.n_designs, method=self.kind, seed=seed)
+        method = cast(Literal["lhs", "sobol"], self.kind)
+        return DesignSpace.sample(self.n_designs, method=method, seed=seed)
 
 
 def parse_space(text: str, *, option: str = "space", owner: str = "parse_space") -> SpaceSpec:
@@ -106,6 +108,7 @@ def parse_space(text: str, *, option: str = "space", owner: str = "parse_space")
     elif match[1] == "corners":
         spec = SpaceSpec(text, "corners", 2 ** len(TABLE1_LEVELS))
     else:
+        assert digits is not None  # the lhs:N / sobol:N branch always has digits
         spec = SpaceSpec(text, match[2], check_count_text("designs", digits, what))
     check_limit("designs", spec.n_designs, what)
     return spec

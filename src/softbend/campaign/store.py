@@ -26,7 +26,7 @@ import uuid
 from collections.abc import Iterator, Sequence
 from contextlib import contextmanager
 from pathlib import Path
-from typing import TYPE_CHECKING, Any, Literal
+from typing import TYPE_CHECKING, Any, Literal, cast
 
 import numpy as np
 
@@ -595,16 +595,20 @@ class CampaignStore:
         """
         meta = self.meta()
         grid = self.pressures_mpa
-        done, failed, wall_total, wall_mean, max_angle, last = self._con.execute(
+        counts = self._con.execute(
             "SELECT count(*) FILTER (WHERE status = 'done'), "
             "count(*) FILTER (WHERE status = 'failed'), "
             "sum(wall_time_s) FILTER (WHERE status = 'done'), "
             "avg(wall_time_s) FILTER (WHERE status = 'done'), "
             "max(max_angle_deg), max(finished_at) FROM designs"
         ).fetchone()
-        n_samples, n_converged = self._con.execute(
+        sample_counts = self._con.execute(
             "SELECT count(*), count(*) FILTER (WHERE converged) FROM samples"
         ).fetchone()
+        # Aggregate queries without GROUP BY always return one row.
+        assert counts is not None and sample_counts is not None
+        done, failed, wall_total, wall_mean, max_angle, last = counts
+        n_samples, n_converged = sample_counts
         failures = self._con.execute(
             f"SELECT design_id, {', '.join(PARAMETERS)}, error FROM designs "
             "WHERE status = 'failed' ORDER BY finished_at, design_id LIMIT ?",
@@ -790,7 +794,8 @@ def merge_campaigns(
     try:
         reference = None
         if held is not None and held.backend is not None:
-            reference = (held.backend, held.pressures_mpa, target)
+            # bind() writes the backend and the pressure grid together.
+            reference = (held.backend, cast(np.ndarray, held.pressures_mpa), target)
         for source in paths:
             with CampaignStore(source, read_only=True) as other:
                 backend, grid = other.backend, other.pressures_mpa
@@ -893,7 +898,9 @@ def _sql_text(path: Path) -> str:
     return str(path).replace("'", "''")
 
 
-def _describe_grid(grid: np.ndarray) -> str:
+def _describe_grid(grid: np.ndarray | None) -> str:
+    if grid is None:
+        return "no recorded pressure grid"
     if len(grid) == 0:
         return "an empty grid"
     return f"{len(grid)} pressures from {grid[0]:g} to {grid[-1]:g} MPa"

@@ -120,7 +120,7 @@ class LoopRun:
         """Period jitter and lateness percentiles, ms."""
         t = self.ticks["t_s"].to_numpy(dtype=float)
         late = self.ticks["lateness_s"].to_numpy(dtype=float)
-        out = {"ticks": int(t.size)}
+        out: dict[str, float] = {"ticks": int(t.size)}
         if t.size >= 2:
             dev = np.round(np.abs(np.diff(t) - self.period_s) * 1e3, 6)  # ns resolution
             out["period_jitter_p50_ms"] = float(np.percentile(dev, 50))

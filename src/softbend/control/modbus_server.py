@@ -27,6 +27,7 @@ import contextlib
 import socket
 import threading
 import time
+from collections.abc import Sequence
 from dataclasses import replace
 from typing import Any
 
@@ -270,7 +271,7 @@ class SimulatedModbusServer:
             registers[a.address - start_address] = a.encode(angle)
         return None
 
-    def _write_coils(self, address: int, values: list[bool]) -> None:
+    def _write_coils(self, address: int, values: Sequence[int]) -> None:
         v = self.config.valves
         with self.plant.lock:
             self.plant.catch_up()

@@ -24,8 +24,8 @@ from __future__ import annotations
 import math
 import numbers
 from collections.abc import Iterable, Mapping
-from dataclasses import MISSING, dataclass, fields
-from typing import Any, ClassVar
+from dataclasses import MISSING, Field, dataclass, fields
+from typing import TYPE_CHECKING, Any, ClassVar
 
 import numpy as np
 from numpy.typing import ArrayLike
@@ -109,6 +109,10 @@ class HyperelasticModel:
 
     #: Registry name of the model ("neo-hookean", "yeoh", "arruda-boyce").
     name: ClassVar[str] = ""
+
+    if TYPE_CHECKING:
+        # Every concrete model is a dataclass, so dataclasses.fields accepts it.
+        __dataclass_fields__: ClassVar[dict[str, Field[Any]]]
 
     def energy(self, I1: Any) -> Any:  # pragma: no cover - abstract
         """``W(I1)`` in MPa for any number-like ``I1``: a float, an array or a
@@ -324,7 +328,7 @@ for _model in (NeoHookean, Yeoh, ArrudaBoyce):
 del _model
 
 
-def get_model_class(name: str) -> type[HyperelasticModel]:
+def get_model_class(name: str | None) -> type[HyperelasticModel]:
     """Return the model class registered under ``name`` (``"neo-hookean"``, ``"yeoh"``, ...).
 
     Raises

@@ -99,10 +99,14 @@ def sweep_with_shapes(
     )
     files: dict[str, Any] = {"csv": write_sweep_csv(result, out / f"{prefix}sweep.csv")}
     analytical = AnalyticalModel().sweep(design, pressures_mpa)
-    if isinstance(shape_pressures_mpa, int):
-        shape_pressures_mpa = np.linspace(0.0, history.pressures[-1], shape_pressures_mpa)
+    shapes = (
+        np.linspace(0.0, history.pressures[-1], shape_pressures_mpa)
+        if isinstance(shape_pressures_mpa, int)
+        else shape_pressures_mpa
+    )
     outlines, vtk_files = [], []
-    for chosen in history.nearest_steps(shape_pressures_mpa):
+    for chosen in history.nearest_steps(shapes):
+        assert chosen.state is not None  # run_sweep kept the state of every step
         model.set_state(chosen.state)
         outlines.append((float(chosen.pressure_mpa), silhouette_mm(model)))
         if vtk:

@@ -48,6 +48,7 @@ import time
 from collections.abc import Callable, Iterator, Sequence
 from contextlib import contextmanager
 from dataclasses import dataclass, field
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 from numpy.typing import ArrayLike
@@ -79,7 +80,10 @@ from softbend.surrogates.mlp_core import (
     standardization,
 )
 
-torch = require_torch("the MLP surrogate (softbend.surrogates)")
+if TYPE_CHECKING:
+    import torch
+else:
+    torch = require_torch("the MLP surrogate (softbend.surrogates)")
 
 logger = logging.getLogger(__name__)
 
@@ -564,7 +568,7 @@ def _step_function(net: BatchedMLP, compile_step: bool) -> StepFunction:
     compiled = torch.compile(net.train_step, fullgraph=True, dynamic=False)
     state = {"step": compiled}
 
-    def step(*args: object) -> torch.Tensor:
+    def step(*args: Any) -> torch.Tensor:
         try:
             return state["step"](*args)
         except Exception as error:  # any compiler failure: train uncompiled

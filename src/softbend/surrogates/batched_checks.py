@@ -7,6 +7,7 @@ allowed, what came in.
 from __future__ import annotations
 
 from collections.abc import Sequence
+from typing import TYPE_CHECKING
 
 import numpy as np
 from numpy.typing import ArrayLike
@@ -14,7 +15,10 @@ from numpy.typing import ArrayLike
 from softbend._torch import require_torch
 from softbend.surrogates.mlp_core import check_hidden_pair
 
-torch = require_torch("the MLP surrogate (softbend.surrogates)")
+if TYPE_CHECKING:
+    import torch
+else:
+    torch = require_torch("the MLP surrogate (softbend.surrogates)")
 
 __all__ = ["check_data", "check_dtype", "check_hidden_sizes", "check_splits"]
 

@@ -16,6 +16,7 @@ import logging
 import math
 from collections.abc import Callable
 from dataclasses import dataclass
+from typing import TYPE_CHECKING
 
 import numpy as np
 
@@ -23,7 +24,10 @@ from softbend._torch import require_torch
 from softbend.surrogates.batched_net import BatchedMLP
 from softbend.surrogates.batched_shuffle import DeviceShuffle
 
-torch = require_torch("the MLP surrogate (softbend.surrogates)")
+if TYPE_CHECKING:
+    import torch
+else:
+    torch = require_torch("the MLP surrogate (softbend.surrogates)")
 
 logger = logging.getLogger(__name__)
 

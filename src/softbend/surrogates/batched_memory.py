@@ -9,10 +9,14 @@ from __future__ import annotations
 
 import math
 import os
+from typing import TYPE_CHECKING
 
 from softbend._torch import require_torch
 
-torch = require_torch("the MLP surrogate (softbend.surrogates)")
+if TYPE_CHECKING:
+    import torch
+else:
+    torch = require_torch("the MLP surrogate (softbend.surrogates)")
 
 __all__ = ["available_bytes", "estimate_pass_bytes", "models_per_pass"]
 

@@ -18,12 +18,16 @@ mask. :func:`softbend.surrogates.batched.train_mlp_grid` drives it.
 from __future__ import annotations
 
 from collections.abc import Sequence
+from typing import TYPE_CHECKING
 
 import numpy as np
 
 from softbend._torch import require_torch
 
-torch = require_torch("the MLP surrogate (softbend.surrogates)")
+if TYPE_CHECKING:
+    import torch
+else:
+    torch = require_torch("the MLP surrogate (softbend.surrogates)")
 
 __all__ = ["BatchedMLP"]
 

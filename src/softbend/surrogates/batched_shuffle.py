@@ -25,11 +25,16 @@ rounds with constants found by search for low bias). Products are split into
 
 from __future__ import annotations
 
+from typing import TYPE_CHECKING
+
 import numpy as np
 
 from softbend._torch import require_torch
 
-torch = require_torch("the MLP surrogate (softbend.surrogates)")
+if TYPE_CHECKING:
+    import torch
+else:
+    torch = require_torch("the MLP surrogate (softbend.surrogates)")
 
 __all__ = ["DeviceShuffle", "hash32", "model_keys"]
 

@@ -157,12 +157,14 @@ class NormalizedMLPRegressor(RegressorMixin, BaseEstimator):
         device = resolve_device(self.device, _OWNER)
 
         _check_finite_y(y)
-        X, y = validate_data(self, X, y, dtype=np.float64, y_numeric=True, ensure_all_finite=False)
-        _check_finite_x(X, "fit")
-        rows = np.arange(X.shape[0])
+        X_arr, y_arr = validate_data(
+            self, X, y, dtype=np.float64, y_numeric=True, ensure_all_finite=False
+        )
+        _check_finite_x(X_arr, "fit")
+        rows = np.arange(X_arr.shape[0])
         result = train_mlp_grid(
-            X,
-            y,
+            X_arr,
+            y_arr,
             [(rows, rows[:0])],
             [hidden],
             epochs=epochs,
@@ -276,16 +278,16 @@ class NormalizedMLPRegressor(RegressorMixin, BaseEstimator):
         ValueError
             If the shapes are inconsistent or a value is not finite.
         """
-        coefs = [np.asarray(c, dtype=np.float64) for c in coefs]
-        intercepts = [np.asarray(b, dtype=np.float64) for b in intercepts]
-        x_mean = np.asarray(x_mean, dtype=np.float64)
-        x_scale = np.asarray(x_scale, dtype=np.float64)
-        d = x_mean.shape[0] if x_mean.ndim == 1 else -1
-        ok = len(coefs) == 3 and len(intercepts) == 3 and d > 0 and x_scale.shape == (d,)
+        weights = [np.asarray(c, dtype=np.float64) for c in coefs]
+        biases = [np.asarray(b, dtype=np.float64) for b in intercepts]
+        mean = np.asarray(x_mean, dtype=np.float64)
+        scale = np.asarray(x_scale, dtype=np.float64)
+        d = mean.shape[0] if mean.ndim == 1 else -1
+        ok = len(weights) == 3 and len(biases) == 3 and d > 0 and scale.shape == (d,)
         if ok:
-            h1, h2 = coefs[0].shape[-1], coefs[1].shape[-1]
+            h1, h2 = weights[0].shape[-1], weights[1].shape[-1]
             expected = [(d, h1), (h1, h2), (h2, 1)]
-            ok = [c.shape for c in coefs] == expected and [b.shape for b in intercepts] == [
+            ok = [c.shape for c in weights] == expected and [b.shape for b in biases] == [
                 (h1,),
                 (h2,),
                 (1,),
@@ -294,20 +296,20 @@ class NormalizedMLPRegressor(RegressorMixin, BaseEstimator):
             raise ValueError(
                 f"The arrays of {_OWNER}.from_arrays must have shapes x_mean (d,), "
                 f"x_scale (d,), coefs (d, h1), (h1, h2), (h2, 1), intercepts (h1,), (h2,), "
-                f"(1,). Got x_mean {x_mean.shape}, x_scale {x_scale.shape}, coefs "
-                f"{[c.shape for c in coefs]}, intercepts {[b.shape for b in intercepts]}."
+                f"(1,). Got x_mean {mean.shape}, x_scale {scale.shape}, coefs "
+                f"{[c.shape for c in weights]}, intercepts {[b.shape for b in biases]}."
             )
-        values = [x_mean, x_scale, np.array([y_mean, y_scale], dtype=np.float64)]
-        if not all(np.all(np.isfinite(v)) for v in [*values, *coefs, *intercepts]):
+        values = [mean, scale, np.array([y_mean, y_scale], dtype=np.float64)]
+        if not all(np.all(np.isfinite(v)) for v in [*values, *weights, *biases]):
             raise ValueError(f"The arrays of {_OWNER}.from_arrays must be finite.")
-        if np.any(x_scale <= 0) or not y_scale > 0:
+        if np.any(scale <= 0) or not y_scale > 0:
             raise ValueError(
                 f"The 'x_scale' and 'y_scale' of {_OWNER}.from_arrays must be > 0. "
-                f"Got x_scale {x_scale.tolist()}, y_scale {y_scale!r} instead."
+                f"Got x_scale {scale.tolist()}, y_scale {y_scale!r} instead."
             )
         estimator = cls(hidden_sizes=(int(h1), int(h2)), **params)
         estimator._set_fitted(
-            x_mean, x_scale, y_mean, y_scale, coefs, intercepts, loss_curve, fitted_device
+            mean, scale, y_mean, y_scale, weights, biases, loss_curve, fitted_device
         )
         return estimator
 
@@ -325,10 +327,10 @@ class NormalizedMLPRegressor(RegressorMixin, BaseEstimator):
             Predictions, float64.
         """
         check_is_fitted(self)
-        X = validate_data(self, X, reset=False, dtype=np.float64, ensure_all_finite=False)
-        _check_finite_x(X, "predict")
+        X_arr = validate_data(self, X, reset=False, dtype=np.float64, ensure_all_finite=False)
+        _check_finite_x(X_arr, "predict")
         return mlp_forward(
-            X,
+            X_arr,
             self.x_mean_,
             self.x_scale_,
             self.y_mean_,

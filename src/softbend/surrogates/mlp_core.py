@@ -13,13 +13,17 @@ from __future__ import annotations
 import math
 from collections.abc import Sequence
 from numbers import Integral
+from typing import TYPE_CHECKING, Any, cast
 
 import numpy as np
 
 from softbend._torch import require_torch
 from softbend._validation import check_choice
 
-torch = require_torch("the MLP surrogate (softbend.surrogates)")
+if TYPE_CHECKING:
+    import torch
+else:
+    torch = require_torch("the MLP surrogate (softbend.surrogates)")
 
 __all__ = [
     "check_hidden_pair",
@@ -72,11 +76,11 @@ def check_hidden_pair(value: object, name: str, owner: str) -> tuple[int, int]:
         f"Got {value!r} instead."
     )
     try:
-        pair = tuple(value)  # type: ignore[arg-type]
+        pair: tuple[Any, ...] = tuple(value)  # type: ignore[arg-type]
     except TypeError:
         raise ValueError(message) from None
     if len(pair) != 2 or not all(
-        isinstance(h, Integral) and not isinstance(h, bool) and h >= 1 for h in pair
+        isinstance(h, Integral) and not isinstance(h, bool) and cast(int, h) >= 1 for h in pair
     ):
         raise ValueError(message)
     return int(pair[0]), int(pair[1])

@@ -15,7 +15,7 @@ adds the metadata and checks the model. The families of
 from __future__ import annotations
 
 import copy
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 from numpy.typing import ArrayLike
@@ -23,7 +23,10 @@ from numpy.typing import ArrayLike
 from softbend._extras import require
 from softbend.surrogates.features import TARGET
 
-onnx = require("onnx", "ONNX export (softbend.surrogates.onnx_export)")
+if TYPE_CHECKING:
+    import onnx
+else:
+    onnx = require("onnx", "ONNX export (softbend.surrogates.onnx_export)")
 TensorProto, helper, numpy_helper = onnx.TensorProto, onnx.helper, onnx.numpy_helper
 
 __all__ = ["DEFAULT_OPSET", "check_opset", "mlp_graph", "polynomial_graph", "xgboost_graph"]

@@ -59,6 +59,7 @@ import importlib
 import json
 import logging
 import math
+import os
 import sys
 from dataclasses import dataclass, field
 from datetime import UTC, datetime
@@ -189,6 +190,7 @@ def _class_of(kind: str) -> type:
         module, name = _COMPOSITES[kind]
         return getattr(importlib.import_module(module), name)
     family = _stored(kind)
+    assert family.storage is not None  # _stored refuses a family without a storage
     return family.storage.estimator_class(f"The {family.title} surrogate ({kind!r})")
 
 
@@ -271,6 +273,7 @@ def check_fitted_surrogate(model: Any, owner: str) -> str:
         fitted = True  # built from fitted surrogates, each checked when saved
     else:
         storage = FAMILIES.get(kind).storage
+        assert storage is not None  # kind_of names only families with a storage
         fitted = (
             storage.codec.is_fitted(model)
             if storage.codec is not None
@@ -297,7 +300,9 @@ def check_fitted_surrogate(model: Any, owner: str) -> str:
 
 
 def _params(model: Any, kind: str) -> dict[str, Any]:
-    codec = FAMILIES.get(kind).storage.codec
+    storage = FAMILIES.get(kind).storage
+    assert storage is not None  # kind_of names only families with a storage
+    codec = storage.codec
     return codec.params(model) if codec is not None else encode_params(model)
 
 
@@ -328,6 +333,7 @@ def _inner(model: Any, depth: int) -> dict[str, Any]:
 
 
 def _composite_state(model: Any, kind: str, depth: int) -> dict[str, Any]:
+    state: dict[str, Any]
     if kind == "ensemble":
         state = {"members": [_inner(m, depth) for m in model.members_]}
     else:
@@ -340,6 +346,7 @@ def _state(model: Any, kind: str, depth: int = 0) -> dict[str, Any]:
     if kind in COMPOSITE_KINDS:
         return _composite_state(model, kind, depth)
     storage = FAMILIES.get(kind).storage
+    assert storage is not None  # kind_of names only families with a storage
     if storage.codec is not None:
         return storage.codec.state(model)
     state = {}
@@ -357,7 +364,9 @@ def _state(model: Any, kind: str, depth: int = 0) -> dict[str, Any]:
     return state
 
 
-def save_surrogate(model: Any, path: str | Path, *, metadata: dict[str, Any] | None = None) -> Path:
+def save_surrogate(
+    model: Any, path: str | os.PathLike[str], *, metadata: dict[str, Any] | None = None
+) -> Path:
     """Write a fitted surrogate to one JSON file (atomically) and return its path.
 
     Parameters
@@ -368,7 +377,7 @@ def save_surrogate(model: Any, path: str | Path, *, metadata: dict[str, Any] | N
         (``PolynomialRegressor``, ``NormalizedMLPRegressor``,
         ``xgboost.XGBRegressor``, ...) or a composite; its ``kind`` is the family's
         name.
-    path : str or Path
+    path : str or os.PathLike
         File to write; parent folders are created. An existing file is replaced
         only once the new one is complete.
     metadata : dict, optional
@@ -511,7 +520,7 @@ def _checked_document(document: Any, path: str) -> dict[str, Any]:
 
 
 def _validated(
-    values: dict[str, Any], rules: dict[str, Rule], path: Path, kind: str, section: str
+    values: dict[str, Any], rules: dict[str, Rule], path: Path | str, kind: str, section: str
 ) -> dict[str, Any]:
     """``values`` decoded by their rules; a key without a rule or a broken rule raises."""
     unknown = [key for key in values if key not in rules]
@@ -655,7 +664,7 @@ def _restore(document: dict[str, Any], path: Path | str, depth: int = 0) -> Any:
     return model
 
 
-def load_surrogate(path: str | Path) -> SavedSurrogate:
+def load_surrogate(path: str | os.PathLike[str]) -> SavedSurrogate:
     """Read a surrogate written by :func:`save_surrogate`.
 
     Every value is checked against the schema of the surrogate's kind before the
@@ -665,7 +674,7 @@ def load_surrogate(path: str | Path) -> SavedSurrogate:
 
     Parameters
     ----------
-    path : str or Path
+    path : str or os.PathLike
         The JSON file.
 
     Returns

@@ -173,9 +173,10 @@ def _plan(powers: np.ndarray) -> _Plan:
     for total in range(1, int(totals.max(initial=0)) + 1):
         rows = np.flatnonzero(totals == total)
         parents_k, features_k = parent_of[rows], feature_of[rows]
+        where: np.ndarray | slice = rows
         if rows.size and rows[-1] - rows[0] + 1 == rows.size:
-            rows = slice(int(rows[0]), int(rows[-1]) + 1)  # graded order: write in place
-        levels.append((rows, parents_k, features_k))
+            where = slice(int(rows[0]), int(rows[-1]) + 1)  # graded order: write in place
+        levels.append((where, parents_k, features_k))
     return _Plan(powers=powers, levels=tuple(levels))
 
 
@@ -334,16 +335,18 @@ class PolynomialRegressor(RegressorMixin, BaseEstimator):
         y_values = np.asarray(y)
         if y_values.dtype.kind == "f" and y_values.ndim in (1, 2):
             _check_finite(y_values, "y")  # anything else: validate_data's message
-        X, y = validate_data(self, X, y, dtype=np.float64, y_numeric=True, ensure_all_finite=False)
-        _check_finite(X, "X")
-        n_samples, n_features = X.shape
+        X_arr, y_arr = validate_data(
+            self, X, y, dtype=np.float64, y_numeric=True, ensure_all_finite=False
+        )
+        _check_finite(X_arr, "X")
+        n_samples, n_features = X_arr.shape
         chunk_rows = min(chunk_rows, n_samples)
         self._check_memory(n_features, degree, chunk_rows, limit)
 
-        x_mean = X.mean(axis=0)
-        x_scale = X.std(axis=0)
-        y_mean = float(y.mean())
-        y_scale = float(y.std())
+        x_mean = X_arr.mean(axis=0)
+        x_scale = X_arr.std(axis=0)
+        y_mean = float(y_arr.mean())
+        y_scale = float(y_arr.std())
         x_scale = np.where(x_scale > 1e-12 * np.maximum(1.0, np.abs(x_mean)), x_scale, 1.0)
         if not y_scale > 1e-12 * max(1.0, abs(y_mean)):
             y_scale = 1.0
@@ -357,10 +360,10 @@ class PolynomialRegressor(RegressorMixin, BaseEstimator):
         buffer = np.empty(terms * chunk_rows)
         for start in range(0, n_samples, chunk_rows):
             stop = min(start + chunk_rows, n_samples)
-            Zt = np.ascontiguousarray(((X[start:stop] - x_mean) / x_scale).T)
+            Zt = np.ascontiguousarray(((X_arr[start:stop] - x_mean) / x_scale).T)
             rows = buffer[: terms * (stop - start)].reshape(terms, stop - start)
             Phi_t = _design_t(plan, Zt, 0, rows)
-            target = (y[start:stop] - y_mean) / y_scale
+            target = (y_arr[start:stop] - y_mean) / y_scale
             # Lower triangle of G += Φᵀ Φ (Phi_t.T is Fortran-ordered: no copy).
             G = dsyrk(1.0, Phi_t.T, beta=1.0, c=G, trans=1, lower=1, overwrite_c=1)
             rhs += Phi_t @ target
@@ -409,17 +412,17 @@ class PolynomialRegressor(RegressorMixin, BaseEstimator):
             Predictions in target units (degrees for the bending angle).
         """
         check_is_fitted(self)
-        X = validate_data(self, X, reset=False, dtype=np.float64, ensure_all_finite=False)
-        _check_finite(X, "X")
+        X_arr = validate_data(self, X, reset=False, dtype=np.float64, ensure_all_finite=False)
+        _check_finite(X_arr, "X")
         plan = self._current_plan()
         coef = np.asarray(self.coef_, dtype=np.float64)
         constant_row = int(np.flatnonzero(plan.powers.sum(axis=1) == 0)[0])
-        chunk_rows = max(1, min(int(self.chunk_rows), X.shape[0]))
+        chunk_rows = max(1, min(int(self.chunk_rows), X_arr.shape[0]))
         buffer = np.empty(coef.size * chunk_rows)
-        out = np.empty(X.shape[0])
-        for start in range(0, X.shape[0], chunk_rows):
-            stop = min(start + chunk_rows, X.shape[0])
-            Zt = np.ascontiguousarray(((X[start:stop] - self.x_mean_) / self.x_scale_).T)
+        out = np.empty(X_arr.shape[0])
+        for start in range(0, X_arr.shape[0], chunk_rows):
+            stop = min(start + chunk_rows, X_arr.shape[0])
+            Zt = np.ascontiguousarray(((X_arr[start:stop] - self.x_mean_) / self.x_scale_).T)
             rows = buffer[: coef.size * (stop - start)].reshape(coef.size, stop - start)
             Phi_t = _design_t(plan, Zt, constant_row, rows)
             out[start:stop] = coef @ Phi_t

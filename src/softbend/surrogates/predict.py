@@ -161,7 +161,7 @@ def predict_angles(
     rows = design.feature_rows(pressures)
     ranges = saved.metadata.get("training_ranges")
     has_ranges = isinstance(ranges, dict)
-    outside = outside_training_ranges(ranges, rows) if has_ranges else []
+    outside = outside_training_ranges(ranges, rows) if isinstance(ranges, dict) else []
     if strict and outside:
         raise ValueError(
             f"The 'design' and 'pressure' must lie in the training data of {path}: "

@@ -49,7 +49,7 @@ import hashlib
 import logging
 import math
 import time
-from collections.abc import Callable
+from collections.abc import Callable, Sequence
 from contextlib import AbstractContextManager, nullcontext
 from dataclasses import dataclass, field
 from typing import TYPE_CHECKING, Any
@@ -585,7 +585,7 @@ def _cv_mlp_batched(
 def search(
     data: TrainingData,
     *,
-    models: tuple[str, ...] | list[str] = MODEL_NAMES,
+    models: str | Sequence[str] = MODEL_NAMES,
     grid_name: str = "quick",
     folds: int = 5,
     seed: int = 0,

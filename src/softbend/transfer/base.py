@@ -14,7 +14,7 @@ import os
 from collections.abc import Callable
 from importlib import resources
 from pathlib import Path
-from typing import Any
+from typing import Any, cast
 
 import numpy as np
 
@@ -96,7 +96,7 @@ def train_base_mlp(
         X,
         y,
         [(rows, rows[:0])],
-        [tuple(hidden_sizes)],
+        [cast(tuple[int, int], tuple(hidden_sizes))],
         epochs=epochs,
         seed=seed,
         device="cpu",

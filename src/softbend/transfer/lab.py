@@ -40,6 +40,7 @@ from softbend.design import PAPER_B_FIG7_DESIGNS, PARAMETERS, SFRBADesign
 from softbend.errors import ConvergenceError
 from softbend.limits import check_limit
 from softbend.materials.fit import fit_model
+from softbend.materials.models import Yeoh
 from softbend.materials.presets import DRAGON_SKIN_30, Material
 from softbend.materials.tensile import load_shipped, shipped_tensile_tests
 from softbend.models import BendingModel, default_pressures_mpa
@@ -253,9 +254,10 @@ class VirtualLab:
             "generator": "softbend.transfer.VirtualLab",
         }
         meta.update({f"lab.{k}": str(v) for k, v in values.items()})
+        yeoh = material.model
+        assert isinstance(yeoh, Yeoh)  # elastomer_material is a Yeoh fit
         meta["lab.elastomer_model"] = (
-            f"Yeoh c10={material.model.c10_mpa:.5g} c20={material.model.c20_mpa:.5g} "
-            f"c30={material.model.c30_mpa:.5g} MPa"
+            f"Yeoh c10={yeoh.c10_mpa:.5g} c20={yeoh.c20_mpa:.5g} c30={yeoh.c30_mpa:.5g} MPa"
         )
         meta["lab.as_built"] = "; ".join(
             f"{actuator_id(n)} -> t={b.t_mm:g} b={b.b_mm:g} mm"

@@ -392,7 +392,7 @@ def _normalize(
         try:
             design_of_code.append(SFRBADesign(*design_values[pos].tolist()))
         except ValueError as exc:
-            column = next(
+            bad_column = next(
                 (
                     c
                     for p, c in zip(PARAMETERS, _DESIGN_COLUMNS, strict=True)
@@ -400,7 +400,7 @@ def _normalize(
                 ),
                 None,
             )
-            at = f", column '{column}'" if column else ""
+            at = f", column '{bad_column}'" if bad_column else ""
             raise DatasetError(f"{owner}, {where(int(pos))}{at}: {exc}") from None
 
     if "actuator_id" in frame.columns:

@@ -42,7 +42,7 @@ its other parameters, with defaults, are the ones a user sets
 from __future__ import annotations
 
 import warnings
-from typing import Any, ClassVar
+from typing import Any, ClassVar, Literal, overload
 
 import numpy as np
 from numpy.typing import ArrayLike
@@ -170,16 +170,18 @@ class _Strategy(RegressorMixin, BaseEstimator):
     learns: ClassVar[bool] = True
 
     def _check_fit_data(self, X: ArrayLike, y: ArrayLike) -> tuple[np.ndarray, np.ndarray]:
-        X, y = validate_data(self, X, y, dtype=np.float64, y_numeric=True)
+        X_arr, y_arr = validate_data(self, X, y, dtype=np.float64, y_numeric=True)
         owner = f"{type(self).__name__}.fit"
-        if X.shape[1] != len(FEATURES):
+        if X_arr.shape[1] != len(FEATURES):
             raise ValueError(
                 f"The 'X' of {owner} must have the {len(FEATURES)} columns "
-                f"{', '.join(FEATURES)}. Got {X.shape[1]} columns instead."
+                f"{', '.join(FEATURES)}. Got {X_arr.shape[1]} columns instead."
             )
-        check_plausible(X[:, -1], "pressure_mpa", source=owner, column="pressure_mpa", where=_row)
-        check_plausible(y, "angle_deg", source=owner, column="y", where=_row)
-        return X, y
+        check_plausible(
+            X_arr[:, -1], "pressure_mpa", source=owner, column="pressure_mpa", where=_row
+        )
+        check_plausible(y_arr, "angle_deg", source=owner, column="y", where=_row)
+        return X_arr, y_arr
 
     def _check_rows(self, X: ArrayLike) -> np.ndarray:
         check_is_fitted(self)
@@ -648,6 +650,17 @@ class ResidualGP(_Corrected):
             training_std=std,
         )
         return self
+
+    @overload
+    def predict(self, X: ArrayLike, return_std: Literal[False] = ...) -> np.ndarray: ...
+
+    @overload
+    def predict(self, X: ArrayLike, return_std: Literal[True]) -> tuple[np.ndarray, np.ndarray]: ...
+
+    @overload
+    def predict(
+        self, X: ArrayLike, return_std: bool
+    ) -> np.ndarray | tuple[np.ndarray, np.ndarray]: ...
 
     def predict(
         self, X: ArrayLike, return_std: bool = False
