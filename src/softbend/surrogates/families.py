@@ -46,6 +46,7 @@ from typing import Any, Protocol
 
 from softbend._extras import require
 from softbend._validation import check_choice
+from softbend.references import SURROGATE_TRAINING
 from softbend.registry import Registry
 from softbend.surrogates.schema import MLP_SCHEMA, POLYNOMIAL_SCHEMA, XGBOOST_SCHEMA, Schema
 from softbend.surrogates.xgboost_codec import XGBoostCodec
@@ -353,6 +354,15 @@ def _mlp_onnx(model: Any, opset: int | None) -> Any:
 
 _INPUT_STATE = ("n_features_in_", "x_mean_", "x_scale_", "y_mean_", "y_scale_")
 
+
+def _paper_range(name: str) -> range:
+    """The integers of paper B's grid ``name`` (Sec. 4.1), both ends included."""
+    low, high = SURROGATE_TRAINING[name].value
+    return range(int(low), int(high) + 1)
+
+
+_MLP_PICK = tuple(SURROGATE_TRAINING["mlp_hidden"].value)
+
 FAMILIES.register(
     "plr",
     Family(
@@ -360,7 +370,7 @@ FAMILIES.register(
         title="polynomial regression",
         grids={
             "quick": tuple({"degree": d} for d in (2, 4, 6)),
-            "paper": tuple({"degree": d} for d in range(2, 11)),
+            "paper": tuple({"degree": d} for d in _paper_range("plr_degrees")),
         },
         make=_make_plr,
         storage=Storage(
@@ -384,8 +394,8 @@ FAMILIES.register(
             ),
             "paper": tuple(
                 {"max_depth": d, "learning_rate": round(0.1 * k, 1)}
-                for d in range(1, 21)
-                for k in range(1, 11)
+                for d in _paper_range("xgb_max_depths")
+                for k in range(1, 11)  # 0.1 to 1 by 0.1
             ),
         },
         make=_make_xgb,
@@ -407,8 +417,12 @@ FAMILIES.register(
         name="mlp",
         title="normalized MLP",
         grids={
-            "quick": ({"hidden_sizes": (63, 65)},),  # paper B's pick
-            "paper": tuple({"hidden_sizes": (a, b)} for a in range(55, 66) for b in range(55, 66)),
+            "quick": ({"hidden_sizes": _MLP_PICK},),  # paper B's pick
+            "paper": tuple(
+                {"hidden_sizes": (a, b)}
+                for a in _paper_range("mlp_hidden_units")
+                for b in _paper_range("mlp_hidden_units")
+            ),
         },
         make=_make_mlp,
         storage=Storage(

@@ -58,6 +58,7 @@ import numpy as np
 import pandas as pd
 
 from softbend._validation import check_choice, check_int, check_range
+from softbend.references import SURROGATE_TRAINING
 from softbend.surrogates.families import (
     FAMILIES,
     GRID_NAMES,
@@ -95,7 +96,7 @@ __all__ = [
 ]
 
 #: MLP epochs per grid (paper B: 1000).
-MLP_EPOCHS: dict[str, int] = {"quick": 200, "paper": 1000}
+MLP_EPOCHS: dict[str, int] = {"quick": 200, "paper": int(SURROGATE_TRAINING["mlp_epochs"].value)}
 
 
 def grid(name: str, model: str) -> list[dict[str, Any]]:

@@ -20,6 +20,7 @@ import numpy as np
 
 from softbend.design import FEATURES
 from softbend.errors import DatasetError
+from softbend.references import SURROGATE_TRAINING
 
 __all__ = [
     "BASE_HIDDEN_SIZES",
@@ -31,7 +32,9 @@ __all__ = [
 ]
 
 #: Paper B's MLP (§4.1, Fig. 5): hidden layers of 63 and 65 units.
-BASE_HIDDEN_SIZES: tuple[int, int] = (63, 65)
+BASE_HIDDEN_SIZES: tuple[int, int] = cast(
+    tuple[int, int], tuple(SURROGATE_TRAINING["mlp_hidden"].value)
+)
 
 _SHIPPED = "table1_fem_mlp.json"
 
