@@ -19,22 +19,9 @@ def one_line(text: str) -> str:
     return " ".join(str(text).split())
 
 
-def _saved_surrogate(path: str) -> object:
-    from softbend.surrogates.model import SurrogateModel
-
-    return SurrogateModel.load(path)
-
-
 def with_surrogates() -> None:
-    """Register the ``"surrogate"`` campaign backend (a saved surrogate, read from its path).
-
-    softbend.surrogates sits above the campaign in the pipeline, so the campaign
-    cannot register it itself; nothing happens if it is registered already.
-    """
-    from softbend.campaign.backends import BACKENDS, register_backend
-
-    if "surrogate" not in BACKENDS:
-        register_backend("surrogate", _saved_surrogate)
+    """Make the ``"surrogate"`` campaign backend available (registered on import)."""
+    import softbend.surrogates.model  # noqa: F401  (registers the backend on import)
 
 
 def run(
@@ -53,8 +40,8 @@ def run(
         help="Only shard K/N of the space (every N-th design from the K-th, K in 0..N-1); "
         "merge the shards' databases with 'softbend campaign merge'.",
     ),
-    pmax: float = typer.Option(0.5, help="Largest pressure of the sweep, MPa."),
-    pstep: float = typer.Option(0.005, help="Pressure step of the sweep, MPa."),
+    pmax: float = typer.Option(0.5, help="Largest pressure of the sweep's grid, MPa."),
+    pstep: float = typer.Option(0.005, help="Pressure step of the sweep's grid, MPa."),
     workers: int | None = typer.Option(
         None, help="Local worker processes (default: all cores; 0 or 1: serial)."
     ),
@@ -83,10 +70,15 @@ def run(
     ),
     json_output: bool = typer.Option(False, "--json", help="Print the summary as JSON."),
 ) -> None:
-    """Sweep every design of a space not yet in DB; re-run the same command to resume.
+    """Sweep a design space into a campaign database.
+
+    Sweeps every design of --space not yet recorded in DB (a DuckDB file,
+    created if missing) from 0 to --pmax MPa in steps of --pstep MPa, one
+    transaction per design; re-run the same command to resume.
 
     Example:
 
+    \b
         softbend campaign run table1.duckdb --backend analytical --space table1
     """
     from softbend.campaign.backends import backend_for_run, default_pressures_mpa
@@ -195,8 +187,9 @@ def run(
         ],
     )
     if summary.failures:
+        by_id = {design.design_id: str(design) for design in designs}
         _common.print_table(
             "failed designs",
-            ["design_id", "error"],
-            [[i, one_line(e)] for i, e in summary.failures[:20]],
+            ["design (l,r,t,b,phi,lc)", "error"],
+            [[by_id.get(i, i), one_line(e)] for i, e in summary.failures[:20]],
         )

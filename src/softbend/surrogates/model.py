@@ -18,6 +18,7 @@ from typing import Any
 from numpy.typing import ArrayLike
 
 from softbend.analytical import tip_position_mm
+from softbend.campaign.backends import BACKENDS, register_backend
 from softbend.design import SFRBADesign
 from softbend.models import SweepResult, check_pressures_mpa
 
@@ -92,3 +93,15 @@ class SurrogateModel:
                 "source": self.source or type(self.estimator).__name__,
             },
         )
+
+
+def _saved_surrogate(path: str | os.PathLike[str]) -> SurrogateModel:
+    """The ``"surrogate"`` campaign backend: the surrogate saved at ``path``."""
+    return SurrogateModel.load(path)
+
+
+# A saved surrogate sweeps like any backend (``softbend campaign run --backend
+# surrogate --model FILE``); the campaign sits below the surrogates in the
+# pipeline, so the surrogates register it here, once.
+if "surrogate" not in BACKENDS:
+    register_backend("surrogate", _saved_surrogate)
