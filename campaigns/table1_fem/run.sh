@@ -15,7 +15,7 @@ cd "$(dirname "$0")/../.."
 here=campaigns/table1_fem
 softbend=${SOFTBEND:-.venv/bin/softbend}
 shards=8
-command="softbend campaign run $here/shard-K-of-$shards.duckdb --space table1 --backend fem --shard K/$shards (K = 0..$((shards - 1))); softbend campaign merge $here/table1_fem.duckdb $here/shard-*-of-$shards.duckdb; softbend campaign dataset $here/table1_fem.duckdb src/softbend/data/table1_fem --space table1"
+command="softbend campaign run $here/shard-K-of-$shards.duckdb --space table1 --backend fem --shard K/$shards (K = 0..$((shards - 1))); softbend campaign merge $here/table1_fem.duckdb $here/shard-*-of-$shards.duckdb; softbend campaign dataset $here/table1_fem.duckdb --out src/softbend/data/table1_fem --space table1"
 
 run_shard() {
   local k=$1 workers=${2:-2}
@@ -48,7 +48,7 @@ case "${1:-}" in
     [ ${#done_shards[@]} -gt 0 ] || { echo "no complete shard to ship" >&2; exit 2; }
     rm -f "$here/table1_fem.duckdb"
     "$softbend" campaign merge "$here/table1_fem.duckdb" "${done_shards[@]}"
-    "$softbend" campaign dataset "$here/table1_fem.duckdb" src/softbend/data/table1_fem \
+    "$softbend" campaign dataset "$here/table1_fem.duckdb" --out src/softbend/data/table1_fem \
       --space table1 --command "$command" \
       --description "Paper B Table 1 (972 designs) swept by softbend's 3D FEM with its default options, 0 to 0.5 MPa in 0.005 MPa outputs, each sweep ending at the last pressure, 300 degrees, the stretch limit of the material model or an inflation instability." ;;
   *) sed -n 2,13p "$0"; exit 2 ;;

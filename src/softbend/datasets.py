@@ -18,7 +18,7 @@ columns and dtypes of :data:`SAMPLE_COLUMN_KINDS` or :data:`DESIGN_COLUMN_KINDS`
 or with a physically implausible value is a
 :class:`~softbend.errors.DatasetError` naming the file and the field, never a
 wrong table. :func:`write_dataset` makes such a folder from a campaign database
-(``softbend campaign dataset DB DIR``).
+(``softbend campaign dataset DB --out DIR``).
 """
 
 from __future__ import annotations

@@ -1,4 +1,4 @@
-"""``softbend campaign run|status|export``: in-process CLI runs and one-line errors."""
+"""``softbend campaign run|status|export|dataset``: in-process CLI runs and one-line errors."""
 
 from __future__ import annotations
 
@@ -43,7 +43,7 @@ def test_run_status_export_and_resume(tmp_path, capsys):
     samples = load_samples(db)
     for suffix, reader in ((".parquet", pd.read_parquet), (".csv", pd.read_csv)):
         out = tmp_path / f"samples{suffix}"
-        assert main(["campaign", "export", str(db), str(out)]) == 0
+        assert main(["campaign", "export", str(db), "--out", str(out)]) == 0
         assert f"wrote 18 samples rows to {out}" in " ".join(capsys.readouterr().out.split())
         back = reader(out)
         pd.testing.assert_frame_equal(
@@ -53,7 +53,19 @@ def test_run_status_export_and_resume(tmp_path, capsys):
         )
     forced = tmp_path / "designs.out"
     assert (
-        main(["campaign", "export", str(db), str(forced), "--format", "csv", "--table", "designs"])
+        main(
+            [
+                "campaign",
+                "export",
+                str(db),
+                "--out",
+                str(forced),
+                "--format",
+                "csv",
+                "--table",
+                "designs",
+            ]
+        )
         == 0
     )
     assert len(pd.read_csv(forced)) == 6
@@ -121,14 +133,37 @@ def test_a_dataset_from_some_shards_says_how_many_designs_it_lacks(tmp_path, cap
     assert main(["campaign", "merge", str(part), *map(str, shards), "--json"]) == 0
     capsys.readouterr()
     out = tmp_path / "ds"
-    args = ["campaign", "dataset", str(part), str(out), "--command", "run it", "--space", "lhs:6"]
+    args = [
+        "campaign",
+        "dataset",
+        str(part),
+        "--out",
+        str(out),
+        "--command",
+        "run it",
+        "--space",
+        "lhs:6",
+    ]
     assert main(args) == 0
     assert "4 / 0 (of 6)" in capsys.readouterr().out
     provenance = table1_fem_provenance(out)
     assert (provenance["designs"]["planned"], provenance["designs"]["done"]) == (6, 4)
     pd.testing.assert_frame_equal(table1_fem(out), load_samples(part))
     assert (
-        main(["campaign", "dataset", str(part), str(out), "--command", "x", "--space", "grid"]) == 2
+        main(
+            [
+                "campaign",
+                "dataset",
+                str(part),
+                "--out",
+                str(out),
+                "--command",
+                "x",
+                "--space",
+                "grid",
+            ]
+        )
+        == 2
     )
     assert "'--space'" in one_error_line(capsys)
 
@@ -194,7 +229,7 @@ def test_newer_schema_is_exit_2_for_every_subcommand(tmp_path, capsys):
     for argv in (
         ["campaign", "run", str(db), *RUN],
         ["campaign", "status", str(db)],
-        ["campaign", "export", str(db), str(tmp_path / "x.parquet")],
+        ["campaign", "export", str(db), "--out", str(tmp_path / "x.parquet")],
     ):
         assert main(argv) == 2
         assert "schema version 2, newer than this softbend supports (1)" in one_error_line(capsys)
@@ -207,11 +242,14 @@ def test_status_and_export_bad_input(tmp_path, capsys):
     db = tmp_path / "c.duckdb"
     assert main(["campaign", "run", str(db), *RUN, "--workers", "0", "--json"]) == 0
     capsys.readouterr()
-    assert main(["campaign", "export", str(db), str(tmp_path / "x.xlsx"), "--format", "xlsx"]) == 2
+    assert (
+        main(["campaign", "export", str(db), "--out", str(tmp_path / "x.xlsx"), "--format", "xlsx"])
+        == 2
+    )
     assert "'--format' of softbend campaign export must be one of 'parquet', 'csv'" in (
         one_error_line(capsys)
     )
-    assert main(["campaign", "export", str(db), str(tmp_path / "no" / "x.csv")]) == 2
+    assert main(["campaign", "export", str(db), "--out", str(tmp_path / "no" / "x.csv")]) == 2
     assert "does not exist" in one_error_line(capsys)
 
 
@@ -238,8 +276,8 @@ def test_a_truncated_database_is_one_line_and_exit_2_for_every_subcommand(tmp_pa
     for argv in (
         ["campaign", "status", str(db)],
         ["campaign", "status", str(db), "--json"],
-        ["campaign", "export", str(db), str(tmp_path / "x.parquet")],
-        ["campaign", "export", str(db), str(tmp_path / "x.csv"), "--table", "designs"],
+        ["campaign", "export", str(db), "--out", str(tmp_path / "x.parquet")],
+        ["campaign", "export", str(db), "--out", str(tmp_path / "x.csv"), "--table", "designs"],
         ["campaign", "run", str(db), *RUN, "--workers", "0"],
     ):
         assert main(argv) == 2, argv
@@ -264,7 +302,7 @@ def test_a_file_that_is_no_database_is_one_line_for_status_and_export(
     db.write_bytes(content)
     for argv in (
         ["campaign", "status", str(db)],
-        ["campaign", "export", str(db), str(tmp_path / "x.csv")],
+        ["campaign", "export", str(db), "--out", str(tmp_path / "x.csv")],
     ):
         assert main(argv) == 2
         line = one_error_line(capsys)
@@ -282,8 +320,8 @@ def campaign_db(tmp_path, capsys):
 @pytest.mark.parametrize("extra", [[], ["--format", "csv"], ["--format", "parquet"]])
 def test_export_onto_its_own_database_is_refused_and_keeps_it(campaign_db, capsys, extra):
     before = campaign_db.read_bytes()
-    assert main(["campaign", "export", str(campaign_db), str(campaign_db), *extra]) == 2
-    assert f"The 'OUT' {campaign_db} is also an input" in one_error_line(capsys)
+    assert main(["campaign", "export", str(campaign_db), "--out", str(campaign_db), *extra]) == 2
+    assert f"The '--out' {campaign_db} is also an input" in one_error_line(capsys)
     assert campaign_db.read_bytes() == before
     assert main(["campaign", "status", str(campaign_db), "--json"]) == 0
     assert json.loads(capsys.readouterr().out)["done"] == 6
@@ -293,32 +331,36 @@ def test_export_never_replaces_a_file_of_another_kind(campaign_db, tmp_path, cap
     other = tmp_path / "other.duckdb"
     other.write_bytes(campaign_db.read_bytes())
     parquet = tmp_path / "s.parquet"
-    assert main(["campaign", "export", str(campaign_db), str(parquet)]) == 0
+    assert main(["campaign", "export", str(campaign_db), "--out", str(parquet)]) == 0
     capsys.readouterr()
     for out, kind, found in ((other, "parquet", "DuckDB database"), (parquet, "csv", "Parquet")):
         before = out.read_bytes()
-        assert main(["campaign", "export", str(campaign_db), str(out), "--format", kind]) == 2
         assert (
-            f"The 'OUT' must be a new file or a {kind} file to replace. "
+            main(["campaign", "export", str(campaign_db), "--out", str(out), "--format", kind]) == 2
+        )
+        assert (
+            f"The '--out' must be a new file or a {kind} file to replace. "
             f"Got {out}, an existing {found} file, instead."
         ) in one_error_line(capsys)
         assert out.read_bytes() == before
     # The same kind is replaced, as before.
-    assert main(["campaign", "export", str(campaign_db), str(parquet)]) == 0
+    assert main(["campaign", "export", str(campaign_db), "--out", str(parquet)]) == 0
 
 
 def test_export_onto_a_folder_or_into_a_read_only_one_is_one_line(
     campaign_db, tmp_path, monkeypatch, capsys
 ):
-    assert main(["campaign", "export", str(campaign_db), str(tmp_path)]) == 2
-    assert f"The 'OUT' must name a file; {tmp_path} is a folder." in one_error_line(capsys)
+    assert main(["campaign", "export", str(campaign_db), "--out", str(tmp_path)]) == 2
+    assert f"The '--out' must name a file; {tmp_path} is a folder." in one_error_line(capsys)
     import os
 
     # As root every folder is writable: make the check see a read-only one.
     monkeypatch.setattr(os, "access", lambda path, mode: not mode & os.W_OK)
     out = tmp_path / "x.csv"
-    assert main(["campaign", "export", str(campaign_db), str(out)]) == 2
-    assert f"The 'OUT' {out} cannot be written: {tmp_path} is read-only." in one_error_line(capsys)
+    assert main(["campaign", "export", str(campaign_db), "--out", str(out)]) == 2
+    assert f"The '--out' {out} cannot be written: {tmp_path} is read-only." in one_error_line(
+        capsys
+    )
 
 
 def test_a_full_disk_during_the_export_is_one_line_naming_out(campaign_db, tmp_path, capsys):
@@ -327,9 +369,9 @@ def test_a_full_disk_during_the_export_is_one_line_naming_out(campaign_db, tmp_p
     out = tmp_path / "x.parquet"
     full = OSError(errno.ENOSPC, "No space left on device")
     with mock.patch.object(CampaignStore, "export", side_effect=full):
-        assert main(["campaign", "export", str(campaign_db), str(out)]) == 2
+        assert main(["campaign", "export", str(campaign_db), "--out", str(out)]) == 2
     assert one_error_line(capsys) == (
-        f"softbend: error: The 'OUT' {out} could not be written: No space left on device."
+        f"softbend: error: The '--out' {out} could not be written: No space left on device."
     )
 
 
@@ -349,7 +391,10 @@ def test_space_names_are_lower_case_like_every_other_choice(tmp_path, capsys, sp
     assert main(["campaign", "run", str(db), "--space", space]) == 2
     assert f"(lower case, N >= 1). Got {space!r} instead." in one_error_line(capsys)
     assert not db.exists()
-    assert main(["campaign", "export", str(db), str(tmp_path / "x.csv"), "--format", "CSV"]) == 2
+    assert (
+        main(["campaign", "export", str(db), "--out", str(tmp_path / "x.csv"), "--format", "CSV"])
+        == 2
+    )
     assert "'--format' of softbend campaign export must be one of" in one_error_line(capsys)
 
 
@@ -393,7 +438,7 @@ def test_dataset_records_a_huge_planned_space_without_building_it(
     campaign_db, tmp_path, capsys, monkeypatch
 ):
     out = tmp_path / "ds"
-    argv = ["campaign", "dataset", str(campaign_db), str(out), "--command", "x"]
+    argv = ["campaign", "dataset", str(campaign_db), "--out", str(out), "--command", "x"]
     assert main([*argv, "--space", "sobol:1000000000000", "--json"]) == 2
     assert "SOFTBEND_MAX_DESIGNS" in one_error_line(capsys)
     assert not out.exists()
@@ -420,7 +465,7 @@ def test_a_space_over_the_designs_limit_is_one_line_before_anything(tmp_path, ca
         assert "set SOFTBEND_MAX_DESIGNS higher" in line
     assert not db.exists()
     out = tmp_path / "ds"
-    argv = ["campaign", "dataset", str(db), str(out), "--command", "x", "--space", space]
+    argv = ["campaign", "dataset", str(db), "--out", str(out), "--command", "x", "--space", space]
     db.write_bytes(b"")  # the space is refused before the database is read
     assert main(argv) == 2
     assert "SOFTBEND_MAX_DESIGNS" in one_error_line(capsys)
@@ -536,16 +581,16 @@ def test_a_failed_write_of_an_export_is_one_line_and_leaves_no_file(
     out_dir = tmp_path / "exports"
     out_dir.mkdir()
     (out_dir / "old.csv").write_text("design_id\nkept\n")
-    argv = ["campaign", "export", str(larger_campaign_db)]
+    argv = ["campaign", "export", str(larger_campaign_db), "--out"]
     done = _with_small_files(10_000, *argv, "new.parquet", cwd=out_dir)
     assert done.returncode == 2, done.stderr
     assert done.stderr.strip() == (
-        "softbend: error: The 'OUT' new.parquet could not be written: File too large."
+        "softbend: error: The '--out' new.parquet could not be written: File too large."
     )
     done = _with_small_files(10_000, *argv, "old.csv", cwd=out_dir)
     assert done.returncode == 2, done.stderr
     assert done.stderr.strip() == (
-        "softbend: error: The 'OUT' old.csv could not be written: File too large."
+        "softbend: error: The '--out' old.csv could not be written: File too large."
     )
     assert sorted(p.name for p in out_dir.iterdir()) == ["old.csv"]  # no temporary file left
     assert (out_dir / "old.csv").read_text() == "design_id\nkept\n"
@@ -659,7 +704,7 @@ def test_a_dataset_of_a_campaign_that_never_ran_is_one_line_and_writes_nothing(t
     db = tmp_path / "empty.duckdb"
     CampaignStore(db).close()
     out = tmp_path / "ds"
-    assert main(["campaign", "dataset", str(db), str(out), "--command", "x"]) == 2
+    assert main(["campaign", "dataset", str(db), "--out", str(out), "--command", "x"]) == 2
     assert f"The campaign database {db} holds no finished run" in one_error_line(capsys)
     assert not out.exists()
 
@@ -693,8 +738,8 @@ def test_damaged_campaign_metadata_is_one_line_for_every_reader(
         "status": ["status", str(campaign_db), "--json"],
         "run": ["run", str(campaign_db), *RUN, "--workers", "0"],
         "merge": ["merge", str(other), str(campaign_db)],
-        "export": ["export", str(campaign_db), str(tmp_path / "x.csv")],
-        "dataset": ["dataset", str(campaign_db), str(tmp_path / "ds"), "--command", "x"],
+        "export": ["export", str(campaign_db), "--out", str(tmp_path / "x.csv")],
+        "dataset": ["dataset", str(campaign_db), "--out", str(tmp_path / "ds"), "--command", "x"],
     }
     for name in readers:
         assert main(["campaign", *commands[name]]) == 2, name

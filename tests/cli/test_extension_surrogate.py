@@ -90,7 +90,7 @@ def test_a_family_registered_outside_softbend_trains_saves_and_predicts(
     assert saved.kind == "toy-linear" and type(saved.model) is LinearRegression
     X = np.array([[100, 6, 2, 2, 5, 8, p] for p in (0.0, 0.05, 0.1)], dtype=float)
     refit = saved.model.predict(X)
-    predict = ["predict", str(path), "--design", "100,6,2,2,5,8", "--pressure", "0,0.05,0.1"]
+    predict = ["predict", str(path), "--design", "100,6,2,2,5,8", "--pressures", "0,0.05,0.1"]
     assert main(predict) == 0
     assert "toy-linear surrogate" in capsys.readouterr().out
     assert main([*predict, "--json"]) == 0
@@ -101,7 +101,7 @@ def test_a_family_registered_outside_softbend_trains_saves_and_predicts(
     # a hand-edited value is refused by the family's own schema
     document["state"]["coef_"]["__ndarray__"][0] = "x"
     path.write_text(json.dumps(document))
-    assert main(["predict", str(path), "--design", "100,6,2,2,5,8", "--pressure", "0.1"]) == 2
+    assert main(["predict", str(path), "--design", "100,6,2,2,5,8", "--pressures", "0.1"]) == 2
     assert "state key 'coef_' of the toy-linear surrogate" in one_error_line(capsys)
 
 

@@ -14,7 +14,7 @@ from softbend.surrogates.polynomial import PolynomialRegressor
 
 from .conftest import one_error_line
 
-ARGS = ["--design", "100,6,2,2,5,8", "--pressure", "0.05,0.1"]
+ARGS = ["--design", "100,6,2,2,5,8", "--pressures", "0.05,0.1"]
 
 
 @pytest.fixture(scope="module")

@@ -31,7 +31,7 @@ def _commands(tmp_path, out):
         "curling simulate": ["curling", "simulate", "--out", str(out), "--samples", "16"],
         "fem run": ["fem", "run", "--out", str(out), "--pmax", "0.01"],
         "train": ["train", str(db), "--out", str(out), "--models", "plr"],
-        "campaign dataset": ["campaign", "dataset", str(db), str(out), "--command", "x"],
+        "campaign dataset": ["campaign", "dataset", str(db), "--out", str(out), "--command", "x"],
     }
 
 
@@ -51,8 +51,7 @@ def test_an_out_folder_that_is_a_file_is_one_line_before_any_work(tmp_path, afil
     argv = _commands(tmp_path, afile)[command]
     assert main(argv) == 2
     line = one_error_line(capsys)
-    option = "OUT" if command == "campaign dataset" else "--out"
-    assert f"The '{option}' must name a folder; {afile} is a file." in line
+    assert f"The '--out' must name a folder; {afile} is a file." in line
     assert afile.read_text() == "keep me\n"
 
 

@@ -38,7 +38,7 @@ def test_train_writes_models_tables_figures_and_predicts(small_campaign, tmp_pat
             str(tmp_path / "models" / "plr.json"),
             "--design",
             "100,6,2,2,5,8",
-            "--pressure",
+            "--pressures",
             "0,0.05,0.1",
             "--json",
         ],
@@ -59,8 +59,11 @@ def test_train_writes_models_tables_figures_and_predicts(small_campaign, tmp_pat
         (["--grid", "huge"], "'grid'"),
         (["--device", "tpu"], "'device'"),
         (["--folds", "1"], "folds"),
-        (["--jobs", "0"], "The '--jobs' of softbend train must be an integer in [1, inf). Got 0"),
-        (["--jobs", "-1"], "'--jobs' of softbend train must be an integer in [1, inf)"),
+        (
+            ["--workers", "0"],
+            "The '--workers' of softbend train must be an integer in [1, inf). Got 0",
+        ),
+        (["--workers", "-1"], "'--workers' of softbend train must be an integer in [1, inf)"),
         (["--halving-rungs", "0"], "'--halving-rungs' of softbend train must be an integer"),
         (["--plr-patience", "0"], "'--plr-patience' of softbend train must be an integer"),
         (["--halving-rungs", "3"], "needs 'halving'"),
@@ -85,14 +88,14 @@ def test_train_missing_database(tmp_path, capsys):
         ("100,6,2,2,5", "0.1", "6 values"),
         ("100,6,2,2,5,x", "0.1", "'design' must be six comma-separated numbers"),
         ("100,6,-2,2,5,8", "0.1", "t_mm"),
-        ("100,6,2,2,5,8", "0.1,abc", "'pressure'"),
-        ("100,6,2,2,5,8", "-0.1", "'pressure'"),
+        ("100,6,2,2,5,8", "0.1,abc", "'--pressures'"),
+        ("100,6,2,2,5,8", "-0.1", "'--pressures'"),
     ],
 )
 def test_predict_bad_input(tmp_path, capsys, design, pressure, needle):
     fake = tmp_path / "m.json"
     fake.write_text("{}")
-    code, _, err = _run(["predict", str(fake), "--design", design, "--pressure", pressure], capsys)
+    code, _, err = _run(["predict", str(fake), "--design", design, "--pressures", pressure], capsys)
     assert code == 2
     assert needle in err and len(err.strip().splitlines()) == 1
 
@@ -101,7 +104,7 @@ def test_predict_not_a_model(tmp_path, capsys):
     fake = tmp_path / "m.json"
     fake.write_text('{"hello": 1}')
     code, _, err = _run(
-        ["predict", str(fake), "--design", "100,6,2,2,5,8", "--pressure", "0.1"], capsys
+        ["predict", str(fake), "--design", "100,6,2,2,5,8", "--pressures", "0.1"], capsys
     )
     assert code == 2 and len(err.strip().splitlines()) == 1
 
@@ -122,15 +125,15 @@ def test_predict_warns_outside_the_training_ranges_and_strict_refuses(tmp_path, 
         model, tmp_path / "m.json", metadata={"training_ranges": training_ranges(X)}
     )
     args = ["predict", str(path), "--design", "130,8,3,3,10,10"]
-    assert main([*args, "--pressure", "0.1"]) == 0
+    assert main([*args, "--pressures", "0.1"]) == 0
     assert "warning" not in capsys.readouterr().err
-    assert main([*args, "--pressure", "0.5", "--json"]) == 0
+    assert main([*args, "--pressures", "0.5", "--json"]) == 0
     captured = capsys.readouterr()
     assert "softbend: warning:" in captured.err and "pressure_mpa 0.5 outside" in captured.err
-    assert main([*args, "--pressure", "0.5", "--strict"]) == 2
+    assert main([*args, "--pressures", "0.5", "--strict"]) == 2
     assert "pressure_mpa" in capsys.readouterr().err
     # an absurd pressure whose prediction overflows is one error line, never a null angle
-    assert main([*args, "--pressure", "1e308", "--json"]) == 2
+    assert main([*args, "--pressures", "1e308", "--json"]) == 2
     assert "pressure_mpa" in capsys.readouterr().err
 
 
@@ -234,7 +237,7 @@ def test_a_killed_train_resumes_from_its_finished_folds(small_campaign, tmp_path
 
     out = tmp_path / "surrogates"
     checkpoint = checkpoint_path(out)
-    options = ["--models", "xgb", "--folds", "3", "--jobs", "1", "--no-onnx"]
+    options = ["--models", "xgb", "--folds", "3", "--workers", "1", "--no-onnx"]
     cli = [sys.executable, "-c", "import sys; from softbend.cli import main; sys.exit(main())"]
     child = subprocess.Popen(
         [*cli, "train", str(small_campaign), "--out", str(out), *options],

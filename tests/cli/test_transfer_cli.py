@@ -98,7 +98,7 @@ def test_loco_then_refine_then_predict(lab_csv, tmp_path, capsys, small_base_fil
     )
     capsys.readouterr()
     assert (
-        main(["predict", str(model), "--design", "100,6,2,2,5,8", "--pressure", "0.05", "--json"])
+        main(["predict", str(model), "--design", "100,6,2,2,5,8", "--pressures", "0.05", "--json"])
         == 0
     )
     angle = json.loads(capsys.readouterr().out)["angle_deg"][0]
@@ -270,7 +270,7 @@ def test_every_refine_strategy_saves_a_model_that_predicts(
     saved = json.loads(model.read_text())
     assert saved["metadata"]["strategy"] == strategy
     assert saved["metadata"]["training_rmse_deg"] >= 0.0
-    argv = ["predict", str(model), "--design", "100,6,2,2,5,8", "--pressure", "0,0.05", "--json"]
+    argv = ["predict", str(model), "--design", "100,6,2,2,5,8", "--pressures", "0,0.05", "--json"]
     assert main(argv) == 0
     result = json.loads(capsys.readouterr().out)
     assert ("interval_low_deg" in result) is interval
@@ -281,7 +281,9 @@ def test_every_refine_strategy_saves_a_model_that_predicts(
         assert all(lo < a < hi for lo, a, hi in zip(low, angle, high, strict=True))
         assert result["interval_level"] == 0.9
         # The table shows the interval too.
-        assert main(["predict", str(model), "--design", "100,6,2,2,5,8", "--pressure", "0.05"]) == 0
+        assert (
+            main(["predict", str(model), "--design", "100,6,2,2,5,8", "--pressures", "0.05"]) == 0
+        )
         assert "90% interval" in capsys.readouterr().out
 
 

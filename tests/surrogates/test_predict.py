@@ -105,7 +105,7 @@ def test_the_cli_refuses_a_gp_correction_that_would_predict_null(tmp_path, capsy
     gp.fit(inputs, errors)
     model = GPCorrected(base, mean, scale, gp.kernel_.theta, inputs, errors)
     path = save_surrogate(model, tmp_path / "gp.json")
-    args = ["predict", str(path), "--design", "130,8,3,3,10,10", "--pressure", "0.1", "--json"]
+    args = ["predict", str(path), "--design", "130,8,3,3,10,10", "--pressures", "0.1", "--json"]
     assert main(args) == 0
     assert json.loads(capsys.readouterr().out)["angle_deg"][0] is not None
     _rewrite(path, lambda d: d["state"]["kernel_theta_"]["__ndarray__"].__setitem__(0, 1e6))

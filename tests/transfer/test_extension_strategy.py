@@ -79,7 +79,7 @@ def test_a_registered_strategy_is_refined_saved_and_predicts_through_the_cli(
 
     data = load_measurements(lab)
     offset = 0.5 * float(np.mean(data.angle_deg - small_base.predict(data.features)))
-    argv = ["predict", str(out), "--design", DESIGN, "--pressure", "0.05", "--json"]
+    argv = ["predict", str(out), "--design", DESIGN, "--pressures", "0.05", "--json"]
     assert main(argv) == 0
     angle = json.loads(capsys.readouterr().out)["angle_deg"][0]
     row = np.array([[100, 6, 2, 2, 5, 8, 0.05]], dtype=float)

@@ -4,7 +4,8 @@ Gathered here for the command modules (``from softbend.cli import _common``);
 each part lives in its own module: :mod:`~softbend.cli._console` (consoles,
 one-line errors, JSON, tables), :mod:`~softbend.cli._progress` (progress on
 stderr) and :mod:`~softbend.cli._outputs` (outputs checked before any work, OS
-errors as one line). :func:`parse_assignments` reads repeated ``--set NAME=VALUE``.
+errors as one line). :func:`parse_assignments` reads repeated ``--set NAME=VALUE``;
+:data:`DESIGN_HELP` is the help of every ``--design`` option.
 """
 
 from __future__ import annotations
@@ -36,6 +37,7 @@ from softbend.cli._progress import phase_progress, progress_bar
 from softbend.errors import SoftbendError
 
 __all__ = [
+    "DESIGN_HELP",
     "OutputError",
     "SoftbendError",
     "as_written",
@@ -59,25 +61,15 @@ __all__ = [
     "warnings_as_lines",
 ]
 
+#: The help of every ``--design`` option: one actuator's parameters and their units.
+DESIGN_HELP = "Actuator l,r,t,b,phi,lc (mm, mm, mm, mm, deg, mm)."
+
 
 def parse_assignments(texts: Sequence[str], option: str = "--set") -> dict[str, str]:
-    """``NAME=VALUE`` texts (a repeated option) as a mapping of names to value texts.
+    """``NAME=VALUE`` texts (a repeated option) as names and value texts.
 
-    Raises
-    ------
-    ValueError
-        For a text without ``=`` or with an empty name, or a name given twice.
+    :func:`softbend.parameters.parse_assignments`; ``option`` names the option in messages.
     """
-    values: dict[str, str] = {}
-    for text in texts:
-        name, sep, value = str(text).partition("=")
-        name = name.strip()
-        if not sep or not name:
-            raise ValueError(
-                f"The '{option}' must be NAME=VALUE (e.g. {option} epochs=500). "
-                f"Got {text!r} instead."
-            )
-        if name in values:
-            raise ValueError(f"The '{option}' names {name!r} twice; give each parameter once.")
-        values[name] = value.strip()
-    return values
+    from softbend.parameters import parse_assignments as parse
+
+    return parse(texts, option)

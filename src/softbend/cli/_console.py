@@ -69,11 +69,40 @@ def print_json(payload: Any) -> None:
     print(json_text(payload))
 
 
+#: Cells that stand for a missing value; they do not make a column textual.
+_PLACEHOLDERS = frozenset({"", "-", "—", "n.s."})
+
+
+def _is_number(text: str) -> bool:
+    """True for a number as a table shows it (a unit sign such as % or ° may follow)."""
+    try:
+        float(text.rstrip("%°").strip())
+    except ValueError:
+        return False
+    return True
+
+
+def _numeric_column(cells: list[str]) -> bool:
+    """True when every cell is a number or a placeholder, and one at least a number."""
+    shown = [cell for cell in cells if cell.strip() not in _PLACEHOLDERS]
+    return bool(shown) and all(_is_number(cell) for cell in shown)
+
+
 def print_table(title: str, columns: list[str], rows: list[list[Any]]) -> None:
-    """Print a rich table; floats are shown with four significant digits."""
+    """Print a rich table; floats are shown with four significant digits.
+
+    Numeric columns are right-aligned, text columns left-aligned. Cells wrap (a
+    word longer than its column folds onto the next line), so that nothing is
+    cut short with an ellipsis on a narrow terminal (80 columns).
+    """
+    shown = [[f"{v:.4g}" if isinstance(v, float) else str(v) for v in row] for row in rows]
     table = Table(title=title)
-    for column in columns:
-        table.add_column(column, justify="right" if column != columns[0] else "left")
-    for row in rows:
-        table.add_row(*(f"{v:.4g}" if isinstance(v, float) else str(v) for v in row))
+    for index, column in enumerate(columns):
+        cells = [row[index] for row in shown if index < len(row)]
+        numeric = index > 0 and _numeric_column(cells)
+        table.add_column(
+            column, justify="right" if numeric else "left", overflow="fold", no_wrap=False
+        )
+    for row in shown:
+        table.add_row(*row)
     console.print(table)

@@ -32,13 +32,19 @@ def analyze(
     ] = 1.0,
     json_output: Annotated[bool, typer.Option("--json", help="Print the results as JSON.")] = False,
 ) -> None:
-    """Correlations and standardized regression of a campaign database.
+    """Correlations and standardized regression of a campaign.
 
-    Uses the converged samples of the campaign: Pearson correlations of the
-    design parameters, pressure and bending angle, and a multiple linear
-    regression of the z-scored angle on the z-scored inputs (loadings,
-    t-tests, R², F, MAPE). Writes correlation.png, loadings.png, parity.png,
-    coefficients.csv and correlation.csv into OUT.
+    Uses the converged samples of the campaign database DB: Pearson
+    correlations of the design parameters, pressure and bending angle, and a
+    multiple linear regression of the z-scored angle on the z-scored inputs
+    (loadings, t-tests, R², F, MAPE), as paper B, Figure 4. Writes
+    correlation.png, loadings.png, parity.png, coefficients.csv and
+    correlation.csv into the folder --out.
+
+    Example:
+
+    \b
+        softbend analyze table1.duckdb --out analysis
     """
     from softbend._io import write_text_atomic
     from softbend.analysis import analyze_samples

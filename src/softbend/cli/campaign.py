@@ -2,7 +2,8 @@
 
 ``run`` sweeps a design space (or one shard of it) into a DuckDB file (resuming
 if it exists), ``merge`` joins the databases of shards, ``status`` summarises a
-database, ``export`` writes its samples (or designs) to Parquet or CSV.
+database, ``export`` writes its samples (or designs) to Parquet or CSV and
+``dataset`` writes it as a verified dataset.
 """
 
 from __future__ import annotations
@@ -18,7 +19,12 @@ from softbend.cli.campaign_run import SPACE_FORMS, one_line, run
 if TYPE_CHECKING:
     from softbend.design import DesignSpace
 
-app = typer.Typer(help="Run FEM or analytical sweeps over a design space.", no_args_is_help=True)
+app = typer.Typer(
+    help="Run FEM or analytical sweeps over a design space.\n\n"
+    "A campaign is a DuckDB file of designs and their pressure sweeps; run it, "
+    "merge its shards, inspect it and export it.",
+    no_args_is_help=True,
+)
 app.command("run")(run)
 
 
@@ -37,10 +43,15 @@ def merge(
     ),
     json_output: bool = typer.Option(False, "--json", help="Print the counts as JSON."),
 ) -> None:
-    """Merge the databases of campaign shards (same backend and grid) into DB.
+    """Merge the databases of campaign shards into DB.
+
+    The shards must share the backend and the pressure grid. Every shard is
+    checked before anything is written; DB is replaced only when the whole
+    merge is done.
 
     Example:
 
+    \b
         softbend campaign merge all.duckdb shard0.duckdb shard1.duckdb
     """
     from softbend.campaign import CampaignStore
@@ -77,10 +88,14 @@ def status(
     db: Path = typer.Argument(..., help="Campaign database (DuckDB)."),
     json_output: bool = typer.Option(False, "--json", help="Print the status as JSON."),
 ) -> None:
-    """Summarise a campaign database: designs done and failed, samples, metadata.
+    """Summarise a campaign database.
+
+    Designs done and failed, samples, the pressure grid and the metadata of the
+    database DB.
 
     Example:
 
+    \b
         softbend campaign status table1.duckdb --json
     """
     from softbend.campaign import CampaignStore
@@ -124,25 +139,29 @@ def status(
     if summary["failures"]:
         _common.print_table(
             "failed designs",
-            ["design_id", "design", "error"],
-            [[f["design_id"], f["design"], one_line(f["error"])] for f in summary["failures"]],
+            ["design (l,r,t,b,phi,lc)", "error"],
+            [[f["design"], one_line(f["error"])] for f in summary["failures"]],
         )
 
 
 @app.command("export")
 def export(
     db: Path = typer.Argument(..., help="Campaign database (DuckDB)."),
-    out: Path = typer.Argument(..., help="Output file (.parquet or .csv)."),
+    out: Path = typer.Option(..., "--out", "-o", help="Output file (.parquet or .csv)."),
     format: str | None = typer.Option(
-        None, "--format", help="parquet or csv (default: from the suffix of OUT, else parquet)."
+        None, "--format", help="parquet or csv (default: from the suffix of --out, else parquet)."
     ),
     table: str = typer.Option("samples", help="samples (joined with the designs) or designs."),
 ) -> None:
-    """Write the samples (or the designs table) of a campaign to Parquet or CSV.
+    """Write a campaign's samples or designs to Parquet or CSV.
+
+    The samples are joined with their designs' parameters; --table designs
+    writes the designs table alone.
 
     Example:
 
-        softbend campaign export table1.duckdb samples.parquet
+    \b
+        softbend campaign export table1.duckdb --out samples.parquet
     """
     from softbend._validation import check_choice
     from softbend.campaign import CampaignStore
@@ -151,8 +170,8 @@ def export(
         format = "csv" if out.suffix.lower() == ".csv" else "parquet"
     check_choice(format, "--format", "softbend campaign export", ("parquet", "csv"))
     check_choice(table, "--table", "softbend campaign export", ("samples", "designs"))
-    _common.check_output_file(out, "OUT", inputs=(db,), kind=format)
-    with CampaignStore(db, read_only=True) as store, _common.output_errors(out, "OUT"):
+    _common.check_output_file(out, "--out", inputs=(db,), kind=format)
+    with CampaignStore(db, read_only=True) as store, _common.output_errors(out, "--out"):
         path = store.export(out, format=format, table=table)
         n_rows = len(store.load_samples() if table == "samples" else store.load_designs())
     _common.console.print(f"wrote {n_rows} {table} rows to {path} ({format})", highlight=False)
@@ -161,7 +180,9 @@ def export(
 @app.command("dataset")
 def dataset(
     db: Path = typer.Argument(..., help="Campaign database (DuckDB)."),
-    out: Path = typer.Argument(..., help="Dataset folder (created; its files are replaced)."),
+    out: Path = typer.Option(
+        ..., "--out", "-o", help="Dataset folder (created; its files are replaced)."
+    ),
     command: str = typer.Option(
         ..., help="The command that produced the campaign (recorded in the provenance)."
     ),
@@ -171,11 +192,16 @@ def dataset(
     ),
     json_output: bool = typer.Option(False, "--json", help="Print the provenance as JSON."),
 ) -> None:
-    """Write a campaign as a verified dataset: Parquet samples and designs, provenance.
+    """Write a campaign as a verified dataset with its provenance.
+
+    Writes the samples and the designs as Parquet and a provenance file (the
+    command, the counts and each file's SHA-256) into the folder --out.
 
     Example:
 
-        softbend campaign dataset table1.duckdb data/ --command "softbend campaign run ..."
+    \b
+        softbend campaign dataset table1.duckdb --out data \\
+            --command "softbend campaign run table1.duckdb --space table1"
     """
     from softbend.campaign.spaces import parse_space
     from softbend.datasets import DESIGNS_FILE, PROVENANCE_FILE, SAMPLES_FILE, write_dataset
@@ -188,9 +214,9 @@ def dataset(
         else None
     )
     written = (SAMPLES_FILE, DESIGNS_FILE, PROVENANCE_FILE)
-    _common.check_output_dir(out, "OUT", inputs=(db,), files=written)
+    _common.check_output_dir(out, "--out", inputs=(db,), files=written)
     # write_dataset reads and checks the whole campaign before it writes anything
-    with _common.output_errors(out, "OUT"):
+    with _common.output_errors(out, "--out"):
         provenance = write_dataset(
             db, out, command=command, description=description, planned=planned
         )

@@ -15,7 +15,9 @@ from softbend.cli import _common, control_run
 from softbend.cli import control_options as opt
 
 app = typer.Typer(
-    help="Closed-loop control (paper B §5): valves, pressure sensor, virtual angle sensor.",
+    help="Closed-loop control of an actuator (paper B §5).\n\n"
+    "Valves, a pressure sensor and a virtual angle sensor, on a simulated rig or a "
+    "Modbus TCP one.",
     no_args_is_help=True,
 )
 
@@ -24,7 +26,9 @@ _FILES = ("run.csv", "metrics.json", "run.png")
 
 @app.command("simulate")
 def simulate_cmd(
-    out: Path = typer.Option(..., "--out", help="Folder for run.csv, metrics.json and run.png."),
+    out: Path = typer.Option(
+        ..., "--out", "-o", help="Folder for run.csv, metrics.json and run.png."
+    ),
     reference: str = opt.REFERENCE,
     controller: str = opt.CONTROLLER,
     settings: list[str] = opt.SET,
@@ -36,12 +40,14 @@ def simulate_cmd(
     seed: int = typer.Option(0, help="Seed of the sensor and camera noise."),
     as_json: bool = typer.Option(False, "--json", help="Print the metrics as JSON."),
 ) -> None:
-    """Run a controller on the simulated rig and score it as paper B's Fig. 9 (synthetic).
+    """Run a controller on the simulated rig and score it.
 
-    metrics.json records the controller and every one of its parameters as used.
+    Scores the run as paper B, Figure 9 (synthetic data). metrics.json records
+    the controller and every one of its parameters as used.
 
     Example:
 
+    \b
         softbend control simulate --out bb --set deadzone=0.02
     """
     from softbend._io import atomic_files
@@ -81,10 +87,14 @@ app.command("run")(control_run.run_cmd)
 def controllers_cmd(
     as_json: bool = typer.Option(False, "--json", help="Print the list as JSON."),
 ) -> None:
-    """List the registered controllers and their parameters (for --set NAME=VALUE).
+    """List the controllers and their parameters.
+
+    Each parameter is given to a run by --set NAME=VALUE (or a [controller]
+    table of the rig TOML).
 
     Example:
 
+    \b
         softbend control controllers --json
     """
     from softbend.control.factory import controller_catalog
@@ -117,12 +127,14 @@ def serve_cmd(
     seed: int = typer.Option(0, help="Seed of the sensor and camera noise."),
     duration: float = typer.Option(0.0, help="Serve for this long, s (0: until Ctrl-C)."),
 ) -> None:
-    """Serve the simulated rig as a Modbus TCP device, to rehearse 'control run --rig modbus'.
+    """Serve the simulated rig as a Modbus TCP device.
 
-    Registers as in the config; the actuator is vented when no request came for 0.25 s.
+    A rehearsal of 'softbend control run --rig modbus': registers as in the
+    config; the actuator is vented when no request came for 0.25 s.
 
     Example:
 
+    \b
         softbend control serve --config rig.toml --port 5020
     """
     import time
@@ -154,20 +166,22 @@ def serve_cmd(
 
 @app.command("rig-config")
 def rig_config_cmd(
-    out: Path = typer.Option(..., "--out", help="The TOML file to write."),
+    out: Path = typer.Option(..., "--out", "-o", help="The TOML file to write."),
     host: str = typer.Option("127.0.0.1", help="Modbus TCP host."),
     port: int = typer.Option(5020, help="Modbus TCP port."),
     force: bool = typer.Option(
         False, "--force", help="Replace an existing --out file (a rig TOML may be hand-edited)."
     ),
 ) -> None:
-    """Write a rig TOML template (the built-in register map of 'control serve') to edit.
+    """Write a rig TOML template to edit.
 
-    An existing file is kept unless --force is given; the file is written atomically
-    (a reader sees the old file or the whole new one).
+    The template holds the built-in register map of 'softbend control serve'.
+    An existing file is kept unless --force is given; the file is written
+    atomically (a reader sees the old file or the whole new one).
 
     Example:
 
+    \b
         softbend control rig-config --out rig.toml --port 502
     """
     from softbend._io import write_text_atomic

@@ -4,6 +4,8 @@ from __future__ import annotations
 
 import typer
 
+from softbend.cli._common import DESIGN_HELP
+
 REFERENCE = typer.Option(
     "step:90",
     help="step:AMP[:T0_S], square:AMP:PERIOD_S[:LOW] or triangle:FREQ_HZ:AMP[:LOW] (degrees).",
@@ -21,7 +23,7 @@ SET = typer.Option(
     help="A controller parameter NAME=VALUE, repeatable (e.g. --set deadzone=0.02 for "
     "bang-bang; 'softbend control controllers' lists them).",
 )
-DESIGN = typer.Option("100,6,2,2,5,8", help="Actuator l,r,t,b,phi,lc (mm, deg).")
+DESIGN = typer.Option("100,6,2,2,5,8", help=DESIGN_HELP)
 MODEL = typer.Option(
     None, "--model", help="Saved surrogate for θ(p) (default: the shipped FEM-trained MLP)."
 )

@@ -17,7 +17,7 @@ _LOG_FORMATS = ("csv", "parquet")
 
 def run_cmd(
     out: Path = typer.Option(
-        ..., "--out", help="Folder for ticks.csv|parquet, run.json and run.png."
+        ..., "--out", "-o", help="Folder for ticks.csv|parquet, run.json and run.png."
     ),
     rig: str = typer.Option(
         "sim",
@@ -49,19 +49,21 @@ def run_cmd(
     log_format: str = typer.Option("csv", help="Tick log format: csv (streamed) or parquet."),
     as_json: bool = typer.Option(False, "--json", help="Print the summary as JSON."),
 ) -> None:
-    """Run a controller in the fixed-period loop on a rig, with its safety limits and tick log.
+    """Run a controller in the fixed-period loop on a rig.
 
-    The same controller object as 'control simulate', called every tick (1 ms) with
-    the latest pressure reading (read every 10 ms: paper B's 100 Hz). The controller
-    and its parameters come from --controller and --set, else the config's
-    [controller] table (--set overrides its values); run.json records them. Over-pressure,
-    missed or stale readings vent the actuator and stop the run; so do Ctrl-C and SIGTERM. Exit 0
-    when the run completed and the rig was vented, 1 when a fault stopped it or the
-    final vent did not reach the rig (the log keeps every tick up to the fault; the
-    one error line says whether the rig was vented), 130 on Ctrl-C.
+    The loop keeps the rig's safety limits and a log of every tick. It calls the same
+    controller object as 'softbend control simulate' every tick (1 ms) with the latest
+    pressure reading (read every 10 ms: paper B's 100 Hz). The controller and its
+    parameters come from --controller and --set, else the config's [controller] table
+    (--set overrides its values); run.json records them. Over-pressure, missed or stale
+    readings vent the actuator and stop the run; so do Ctrl-C and SIGTERM. Exit 0 when
+    the run completed and the rig was vented, 1 when a fault stopped it or the final
+    vent did not reach the rig (the log keeps every tick up to the fault; the one error
+    line says whether the rig was vented), 130 on Ctrl-C.
 
     Example:
 
+    \b
         softbend control run --out loop --config rig.toml --set deadzone=0.02
     """
     from softbend._io import atomic_files

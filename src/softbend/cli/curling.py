@@ -10,24 +10,34 @@ import typer
 from softbend.cli import _common
 
 app = typer.Typer(
-    help="Curling actuator (paper A): synthetic experiments and NARX/SVR identification.",
+    help="The curling actuator of paper A.\n\n"
+    "Synthetic experiments and NARX/SVR identification of its bending.",
     no_args_is_help=True,
 )
 
 
 @app.command("simulate")
 def simulate(
-    out: Path = typer.Option(..., "--out", help="Folder for the experiment CSV files."),
+    out: Path = typer.Option(..., "--out", "-o", help="Folder for the experiment CSV files."),
     experiments: int = typer.Option(6, help="Experiments per pressure sign."),
     samples: int = typer.Option(512, help="Samples per experiment."),
-    dt: float = typer.Option(0.02, "--dt", help="Sample period in s."),
+    dt: float = typer.Option(0.02, "--dt", help="Sample period, s."),
     seed: int = typer.Option(0, help="Seed of the experiment design and the camera noise."),
     excitation: str = typer.Option(
         "mixed", help="Pressure profiles: mixed (paper A-like) or impulsive (rare short pulses)."
     ),
     as_json: bool = typer.Option(False, "--json", help="Print a JSON summary instead of a table."),
 ) -> None:
-    """Write synthetic curling-actuator experiments (positive and negative pressure) as CSV."""
+    """Write synthetic curling-actuator experiments as CSV.
+
+    Experiments at positive and at negative pressure, one CSV file each, in
+    the folder --out; the data are synthetic and say so.
+
+    Example:
+
+    \b
+        softbend curling simulate --out experiments --experiments 6
+    """
     from softbend.identification.data import save_experiments
     from softbend.identification.synthetic import check_synthetic_size, synthetic_dataset
 
@@ -74,7 +84,7 @@ def simulate(
 @app.command("identify")
 def identify(
     data: Path = typer.Argument(..., help="A CSV file or a folder of CSV files."),
-    out: Path = typer.Option(..., "--out", help="Folder for metrics, models and figures."),
+    out: Path = typer.Option(..., "--out", "-o", help="Folder for metrics, models and figures."),
     c: float = typer.Option(100.0, "--C", help="SVR penalty C (paper A calls it gamma)."),
     epsilon: float = typer.Option(0.1, help="SVR epsilon, in units of the standardized output."),
     output_lags: int = typer.Option(2, help="Past outputs in the regressor."),
@@ -95,7 +105,17 @@ def identify(
     ),
     as_json: bool = typer.Option(False, "--json", help="Print metrics as JSON."),
 ) -> None:
-    """Identify rho and L NARX models per pressure sign; leave-one-experiment-out metrics."""
+    """Identify NARX models of rho and L per pressure sign.
+
+    Fits SVR-based NARX models of the bending grade rho and the arc length L
+    to the experiments in DATA, one per output and pressure sign, and scores
+    each held-out experiment (leave one experiment out), as paper A.
+
+    Example:
+
+    \b
+        softbend curling identify experiments --out identification
+    """
     from softbend.identification.data import experiment_files, load_experiments
     from softbend.identification.resources import check_identify_memory
     from softbend.identification.study import IdentificationConfig, n_fits

@@ -10,7 +10,9 @@ import typer
 from softbend.cli import _common
 
 app = typer.Typer(
-    help="Nonlinear 3D finite-element model of the fiber-reinforced actuator.",
+    help="Nonlinear 3D finite-element model of the actuator.\n\n"
+    "The fiber-reinforced bending actuator of paper B: pressure sweeps of one "
+    "design and the mesh-convergence study.",
     no_args_is_help=True,
 )
 
@@ -20,11 +22,16 @@ SWEEP_JSON = "sweep.json"
 
 DesignOption = Annotated[
     str,
-    typer.Option("--design", help="Design l,r,t,b,phi,lc (mm, mm, mm, mm, deg, mm)."),
+    typer.Option("--design", help=_common.DESIGN_HELP),
 ]
 MaxhOption = Annotated[float, typer.Option("--maxh", help="Largest element size, mm.")]
 GravityOption = Annotated[
-    str, typer.Option("--gravity", help="bending, against, axial or none (see FEMOptions).")
+    str,
+    typer.Option(
+        "--gravity",
+        help="Direction of gravity: bending (towards the strain-limiting layer, as paper B's "
+        "experiments), against (the opposite), axial (base to tip) or none.",
+    ),
 ]
 
 
@@ -37,9 +44,15 @@ def _options(maxh: float, gravity: str, **extra):
 @app.command("run")
 def run(
     design: DesignOption = "100,6,2,2,5,10",
-    pmax: Annotated[float, typer.Option("--pmax", help="Largest pressure, MPa.")] = 0.2,
-    step: Annotated[float, typer.Option("--step", help="Output pressure step, MPa.")] = 0.005,
-    out: Annotated[Path, typer.Option("--out", "-o", help="Output folder.")] = Path("results/fem"),
+    pmax: Annotated[
+        float, typer.Option("--pmax", help="Largest pressure of the sweep's grid, MPa.")
+    ] = 0.2,
+    pstep: Annotated[
+        float, typer.Option("--pstep", help="Pressure step of the sweep's grid (outputs), MPa.")
+    ] = 0.005,
+    out: Annotated[
+        Path, typer.Option("--out", "-o", help="Folder for the CSV, JSON, figures and VTK files.")
+    ] = Path("results/fem"),
     maxh: MaxhOption = 5.0,
     gravity: GravityOption = "bending",
     shapes: Annotated[int, typer.Option("--shapes", help="Deformed shapes drawn and saved.")] = 5,
@@ -49,12 +62,18 @@ def run(
     ] = False,
     json_output: Annotated[bool, typer.Option("--json", help="Print the sweep as JSON.")] = False,
 ) -> None:
-    """Sweep one design from 0 MPa to PMAX; write CSV, figures and VTK into OUT.
+    """Sweep one design from 0 MPa to --pmax with the FEM.
 
-    Writes sweep.csv (pressure, angle, tip, converged, Newton iterations),
-    sweep.json (solver statistics and options), angle_pressure.png (with the
-    analytical model), shapes.png (deformed shapes, paper B Fig. 2b) and
-    vtk/shape_<kPa>kPa.vtu (e.g. shape_050p00kPa.vtu) for ParaView (apply Warp By Vector).
+    Writes into the folder --out: sweep.csv (pressure, angle, tip, converged,
+    Newton iterations), sweep.json (solver statistics and options),
+    angle_pressure.png (with the analytical model), shapes.png (deformed
+    shapes, paper B, Figure 2b) and vtk/shape_<kPa>kPa.vtu (such as
+    shape_050p00kPa.vtu) for ParaView (apply Warp By Vector).
+
+    Example:
+
+    \b
+        softbend fem run --design 100,6,2,2,5,10 --pmax 0.2 --out fem
     """
     from softbend._io import write_text_atomic
     from softbend.design import SFRBADesign
@@ -63,7 +82,7 @@ def run(
     from softbend.reports.fem_figures import sweep_with_files
 
     actuator = SFRBADesign.parse(design)
-    pressures = default_pressures_mpa(pmax, step)
+    pressures = default_pressures_mpa(pmax, pstep)
     options = _options(maxh, gravity, output="solve" if solve_every else "interpolate")
     if shapes < 1:
         raise ValueError(f"The '--shapes' must be an integer in [1, inf). Got {shapes} instead.")
@@ -120,7 +139,7 @@ def run(
             result.newton_iterations,
             strict=True,
         )
-        if round(p / step) % max(1, round(0.02 / step)) == 0
+        if round(p / pstep) % max(1, round(0.02 / pstep)) == 0
     ]
     _common.print_table(
         f"FEM sweep of ({actuator})",
@@ -148,7 +167,16 @@ def mesh_study(
     gravity: GravityOption = "bending",
     json_output: Annotated[bool, typer.Option("--json", help="Print the table as JSON.")] = False,
 ) -> None:
-    """Bending angle at PRESSURES for each element size; change relative to the previous size."""
+    """Bending angle at --pressures for each element size.
+
+    One row per element size of --maxh, coarse to fine, with the change of
+    each angle relative to the previous size, in %.
+
+    Example:
+
+    \b
+        softbend fem mesh-study --maxh 6,5,4,3 --pressures 0,0.05,0.1
+    """
     from softbend.design import SFRBADesign
     from softbend.fem.verification import mesh_study as study
 

@@ -13,7 +13,9 @@ if TYPE_CHECKING:
     from softbend.materials.fit import FitResult
 
 app = typer.Typer(
-    help="Materials (paper B §3.1): shipped tensile tests and hyperelastic model fits.",
+    help="Tensile tests and hyperelastic fits (paper B §3.1).\n\n"
+    "The uniaxial tensile tests shipped with softbend, and fits of hyperelastic "
+    "models to them or to your own.",
     no_args_is_help=True,
 )
 
@@ -66,14 +68,16 @@ def fit(
     ] = None,
     json_output: Annotated[bool, typer.Option("--json", help="Print the results as JSON.")] = False,
 ) -> None:
-    """Fit hyperelastic models to a uniaxial tensile test (as paper B, Figure 2a).
+    """Fit hyperelastic models to a uniaxial tensile test.
 
-    Least squares of each model's nominal stress in incompressible uniaxial
-    tension against the measured engineering stress (MPa), with R² and RMSE.
-    Writes OUT/fit.png (data and fitted curves) and OUT/fit.json.
+    As paper B, Figure 2a: least squares of each model's nominal stress in
+    incompressible uniaxial tension against the measured engineering stress
+    (MPa), with R² and RMSE. Writes fit.png (data and fitted curves) and
+    fit.json into the folder --out.
 
     Example:
 
+    \b
         softbend materials fit dragon-skin-30 --models yeoh --out results/materials
     """
     from softbend._io import atomic_files
@@ -120,12 +124,14 @@ def fit(
 def list_tests(
     json_output: Annotated[bool, typer.Option("--json", help="Print the list as JSON.")] = False,
 ) -> None:
-    """List the tensile tests shipped with softbend; data under ODbL 1.0.
+    """List the tensile tests shipped with softbend.
 
-    The tests are those of Marechal et al. 2021 (pull to failure).
+    The tests are those of Marechal et al. (Soft Robotics, 2021), pulled to
+    failure; the data are under the ODbL 1.0.
 
     Example:
 
+    \b
         softbend materials list --json
     """
     from softbend.materials.tensile import SHIPPED_ATTRIBUTION, load_shipped, shipped_tensile_tests

@@ -11,14 +11,26 @@ from softbend.cli import _common
 
 
 def reproduce(
-    out: Path = typer.Option(Path("results/reproduce"), "--out", help="Output folder."),
+    out: Path = typer.Option(
+        Path("results/reproduce"), "--out", "-o", help="Folder for the report and its files."
+    ),
     seed: int = typer.Option(0, help="Seed of every random process."),
     workers: int | None = typer.Option(
         None, help="Local worker processes for the campaign (default: all cores)."
     ),
     as_json: bool = typer.Option(False, "--json", help="Print the headline figures as JSON."),
 ) -> None:
-    """Run the papers' pipelines end to end on built-in defaults; write OUT/index.html."""
+    """Run the papers' pipelines end to end into one report.
+
+    Paper A's identification and paper B's campaign, analysis, surrogates,
+    FEM, transfer learning and control, on built-in defaults; the report is
+    index.html in the folder --out, with the data, models and figures beside it.
+
+    Example:
+
+    \b
+        softbend reproduce --out results/reproduce --workers 2
+    """
     from softbend.reports.reproduce import run_reproduce
 
     with _common.phase_progress(enabled=not as_json) as progress:

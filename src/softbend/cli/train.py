@@ -11,7 +11,7 @@ from softbend.cli import _common
 
 def train(
     db: Path = typer.Argument(..., help="Campaign database (DuckDB) to learn from."),
-    out: Path = typer.Option(..., "--out", help="Folder for models, tables and figures."),
+    out: Path = typer.Option(..., "--out", "-o", help="Folder for models, tables and figures."),
     models: str = typer.Option(
         "plr,xgb,mlp",
         help="Comma-separated surrogate families: plr, xgb, mlp (paper B's) or any registered.",
@@ -26,7 +26,9 @@ def train(
     epochs: int | None = typer.Option(
         None, help="MLP epochs (default: 200 quick grid, 1000 paper grid as paper B)."
     ),
-    jobs: int | None = typer.Option(None, "--jobs", help="XGBoost threads, >= 1 (default: all)."),
+    workers: int | None = typer.Option(
+        None, "--workers", help="XGBoost threads, >= 1 (default: all cores)."
+    ),
     halving: int | None = typer.Option(
         None,
         help="Race the MLP configurations by successive halving with this factor (e.g. 3): "
@@ -48,20 +50,30 @@ def train(
     no_onnx: bool = typer.Option(False, "--no-onnx", help="Skip the ONNX export."),
     as_json: bool = typer.Option(False, "--json", help="Print the results as JSON."),
 ) -> None:
-    """Grid-search the surrogates with grouped K-fold CV, refit the best, save and plot.
+    """Train surrogates of a campaign by cross-validated search.
 
-    Every finished configuration-fold is saved in ``.OUT.train-checkpoint.jsonl``
-    beside ``--out``; the same command run again after an interruption resumes
-    from it (a checkpoint of other settings is discarded with a warning). It is
-    removed when the new ``--out`` is in place.
+    Grid-searches each surrogate family with design-grouped K-fold
+    cross-validation, refits the best configuration on all designs, then saves
+    the models and draws the figures (paper B, Figure 5) into the folder --out.
+
+    Every finished configuration-fold is saved in a checkpoint file beside
+    --out (.NAME.train-checkpoint.jsonl for an --out named NAME); the same
+    command run again after an interruption resumes from it (a checkpoint of
+    other settings is discarded with a warning). It is removed when the new
+    --out is in place.
+
+    Example:
+
+    \b
+        softbend train table1.duckdb --out surrogates --models plr,xgb,mlp
     """
     from softbend._validation import check_int
     from softbend.limits import check_limit
     from softbend.reports.surrogate_figures import training_figures
     from softbend.surrogates.workflow import train_into
 
-    if jobs is not None:
-        check_int(jobs, "--jobs", "softbend train", low=1)
+    if workers is not None:
+        check_int(workers, "--workers", "softbend train", low=1)
     if halving_rungs is not None:
         check_int(halving_rungs, "--halving-rungs", "softbend train", low=1)
     if plr_patience is not None:
@@ -92,7 +104,7 @@ def train(
             folds=folds,
             seed=seed,
             device=device,
-            n_jobs=jobs,
+            n_jobs=workers,
             epochs=epochs,
             export_onnx=not no_onnx,
             progress=progress,
@@ -149,8 +161,8 @@ def print_summary(summary: dict) -> None:
 
 def predict(
     model: Path = typer.Argument(..., help="A model saved by 'softbend train' (models/*.json)."),
-    design: str = typer.Option(..., help="l,r,t,b,phi,lc in mm and degrees, e.g. 100,6,2,2,5,8."),
-    pressure: str = typer.Option(..., help="Pressures in MPa, comma-separated, e.g. 0.05,0.1."),
+    design: str = typer.Option(..., help=_common.DESIGN_HELP),
+    pressures: str = typer.Option(..., help="Comma-separated pressures, MPa (such as 0.05,0.1)."),
     strict: bool = typer.Option(
         False, "--strict", help="Refuse a design or pressure outside the model's training data."
     ),
@@ -159,12 +171,18 @@ def predict(
     """Predict the bending angle of a design at the given pressures.
 
     A design or pressure outside the ranges the model was trained on (recorded in
-    the model file) is a warning on stderr, or with ``--strict`` an error: a
+    the model file) is a warning on stderr, or with --strict an error: a
     surrogate extrapolates without knowing it.
+
+    Example:
+
+    \b
+        softbend predict surrogates/models/mlp.json --design 100,6,2,2,5,8 \\
+            --pressures 0.05,0.1,0.17
     """
     from softbend.surrogates.predict import INTERVAL_LEVEL, predict_text
 
-    result = predict_text(model, design, pressure, strict=strict)
+    result = predict_text(model, design, pressures, strict=strict)
     if result.outside_training_ranges:
         _common.warning_line(
             f"{model} was not trained there: {'; '.join(result.outside_training_ranges)}; the "
@@ -182,4 +200,4 @@ def predict(
         columns.append(f"{INTERVAL_LEVEL:.0%} interval (°)")
         for row, low, high in zip(rows, *interval, strict=True):
             row.append(f"{low:.2f} to {high:.2f}")
-    _common.print_table(f"{result.kind} surrogate, design {result.design.design_id}", columns, rows)
+    _common.print_table(f"{result.kind} surrogate, design ({result.design})", columns, rows)

@@ -19,7 +19,9 @@ from softbend.cli.transfer_loco import LOCO_FILES, loco, print_loco_summary
 __all__ = ["LOCO_FILES", "app", "lab_app", "print_loco_summary"]
 
 app = typer.Typer(
-    help="Transfer learning (paper B §4.2–4.3): refine a surrogate on measurements.",
+    help="Refine a surrogate on measurements (paper B §4.2-4.3).\n\n"
+    "Transfer learning: train the base surrogate, refine it on an actuator's "
+    "measurements with a strategy, and score the strategies on held-out actuators.",
     no_args_is_help=True,
 )
 app.command("loco")(loco)
@@ -27,14 +29,19 @@ app.command("loco")(loco)
 
 @app.command("base")
 def base(
-    out: Path = typer.Option(..., "--out", help="File for the saved MLP (JSON)."),
+    out: Path = typer.Option(..., "--out", "-o", help="File for the saved MLP (JSON)."),
     epochs: int = typer.Option(1000, help="Training epochs (paper B: 1000)."),
     seed: int = typer.Option(0, help="Seed of the weights and the batch order."),
 ) -> None:
-    """Train paper B's MLP (63, 65) on the shipped Table 1 FEM dataset and save it.
+    """Train paper B's base MLP on the shipped FEM dataset.
+
+    The MLP of paper B (hidden layers 63 and 65), trained on the shipped
+    Table 1 FEM dataset and saved as a surrogate: the model the strategies
+    refine.
 
     Example:
 
+    \b
         softbend transfer base --out base.json --epochs 1000
     """
     from softbend._io import json_safe
@@ -66,7 +73,7 @@ def base(
 def refine(
     base: Path = typer.Argument(..., help="Saved surrogate to start from (an mlp for 'refined')."),
     measurements: Path = typer.Argument(..., help="Measurements CSV."),
-    out: Path = typer.Option(..., "--out", help="File for the refined model (JSON)."),
+    out: Path = typer.Option(..., "--out", "-o", help="File for the refined model (JSON)."),
     strategy: str = typer.Option(
         "refined",
         help="A strategy that learns from the measurements (see 'softbend transfer strategies').",
@@ -81,14 +88,16 @@ def refine(
     ),
     seed: int = typer.Option(0, help="Seed of the training."),
 ) -> None:
-    """Fit a strategy on all measurements and save it like the other surrogates.
+    """Fit a strategy on measurements and save it.
 
-    The saved model plugs into 'softbend predict'; the strategies with intervals
+    The strategy learns from all the MEASUREMENTS; the model is saved like the other
+    surrogates and plugs into 'softbend predict'; the strategies with intervals
     (scale-offset, pressure-scale, residual-gp, refined-ensemble) save them too. The
     model file records the strategy and every one of its parameters as used.
 
     Example:
 
+    \b
         softbend transfer refine base.json lab.csv --out refined.json --set epochs=500
     """
     from softbend.limits import check_limit
@@ -118,10 +127,14 @@ def refine(
 def strategies(
     as_json: bool = typer.Option(False, "--json", help="Print the list as JSON."),
 ) -> None:
-    """List the transfer strategies, what they do and the parameters --set may give them.
+    """List the transfer strategies and their parameters.
+
+    What each strategy does, whether it learns (refine) and gives intervals,
+    and the parameters --set NAME=VALUE may give it.
 
     Example:
 
+    \b
         softbend transfer strategies --json
     """
     from softbend.transfer.strategies import describe_strategies
@@ -141,7 +154,7 @@ def strategies(
             [
                 r["name"],
                 r["summary"],
-                " ".join(f"{k}={shown(v)}" for k, v in r["parameters"].items()) or "—",
+                ", ".join(f"{k}={shown(v)}" for k, v in r["parameters"].items()) or "—",
                 "yes" if r["learns"] else "no (baseline)",
                 "yes" if r["interval"] else "no",
             ]

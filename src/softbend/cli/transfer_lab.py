@@ -9,14 +9,16 @@ import typer
 from softbend.cli import _common
 
 lab_app = typer.Typer(
-    help="The virtual lab: labelled-synthetic measurements of paper B's Fig. 7 actuators.",
+    help="Virtual lab: synthetic measurements of paper B's actuators.\n\n"
+    "Labelled-synthetic readings of the actuators of paper B, Figure 7, as built "
+    "(fabrication errors, hysteresis, camera noise).",
     no_args_is_help=True,
 )
 
 
 @lab_app.command("measure")
 def measure(
-    out: Path = typer.Option(..., "--out", help="CSV file to write the measurements to."),
+    out: Path = typer.Option(..., "--out", "-o", help="CSV file to write the measurements to."),
     plant: str = typer.Option(
         "fem", help="Model of the actuators as built: a lab plant (fem or analytical)."
     ),
@@ -31,8 +33,8 @@ def measure(
     elastomer_max_stretch: float = typer.Option(
         3.0, help="Largest stretch of the shipped Dragon Skin 30 test used by the lab's fit."
     ),
-    pmax: float = typer.Option(0.25, help="Highest pressure set, MPa."),
-    step: float = typer.Option(0.01, help="Pressure increment, MPa."),
+    pmax: float = typer.Option(0.25, help="Largest pressure set, MPa."),
+    pstep: float = typer.Option(0.01, help="Pressure step between readings, MPa."),
     max_angle: float = typer.Option(270.0, help="Stop raising the pressure past this angle, deg."),
     unloading: bool = typer.Option(False, "--unloading", help="Also read the unloading branch."),
     cycles: int = typer.Option(
@@ -40,13 +42,15 @@ def measure(
     ),
     as_json: bool = typer.Option(False, "--json", help="Print a JSON summary."),
 ) -> None:
-    """Measure the 7 actuators of paper B, Figure 7, in the virtual lab (synthetic data).
+    """Measure paper B's 7 actuators in the virtual lab.
 
+    The actuators of paper B, Figure 7, measured as built (synthetic data).
     Writes the CSV and its figure (the same name with .png) together: a run
     that fails leaves both as they were.
 
     Example:
 
+    \b
         softbend lab measure --out lab.csv --plant analytical
     """
     from softbend._io import atomic_files
@@ -73,7 +77,7 @@ def measure(
         camera_noise_deg=camera_noise,
         elastomer_max_stretch=elastomer_max_stretch,
         pmax_mpa=pmax,
-        pressure_step_mpa=step,
+        pressure_step_mpa=pstep,
         max_angle_deg=max_angle,
         unloading=unloading,
         cycles=cycles,

@@ -28,7 +28,7 @@ LOCO_FILES: tuple[str, ...] = (
 
 def loco(
     measurements: Path = typer.Argument(..., help="Measurements CSV (see 'softbend lab measure')."),
-    out: Path = typer.Option(..., "--out", help="Folder for tables and figures."),
+    out: Path = typer.Option(..., "--out", "-o", help="Folder for tables and figures."),
     base: Path | None = typer.Option(
         None, help="Saved surrogate to start from (default: the shipped FEM-trained MLP)."
     ),
@@ -50,16 +50,20 @@ def loco(
     seed: int = typer.Option(0, help="Seed of the strategies and the learning curve."),
     as_json: bool = typer.Option(False, "--json", help="Print the results as JSON."),
 ) -> None:
-    """Leave one configuration out: every strategy, every held-out actuator (paper B Fig. 7).
+    """Score every strategy on held-out actuators.
 
-    The folder --out is written as a whole: built beside it and swapped in
-    when every table and figure is complete, so a run that fails leaves the
-    previous results as they were. An existing --out may hold only what this
-    command writes. loco.json records every parameter of every strategy as used.
+    Leave one configuration out: each strategy is fitted on all actuators but one and
+    scored on the one held out, in turn (paper B, Figure 7). The folder --out is written
+    as a whole: built beside it and swapped in when every table and figure is complete,
+    so a run that fails leaves the previous results as they were. An existing --out may
+    hold only what this command writes. loco.json records every parameter of every
+    strategy as used.
 
     Example:
 
-        softbend transfer loco lab.csv --out loco --strategies refined,scale-offset --set epochs=500
+    \b
+        softbend transfer loco lab.csv --out loco \\
+            --strategies refined,scale-offset --set epochs=500
     """
     from softbend._io import staged_dir
     from softbend.reports import transfer_figures

@@ -91,7 +91,12 @@ def parse_pressures(text: str, name: str = "pressure") -> list[float]:
 
 
 def predict_text(
-    path: str | os.PathLike[str], design: str, pressures: str, *, strict: bool = False
+    path: str | os.PathLike[str],
+    design: str,
+    pressures: str,
+    *,
+    strict: bool = False,
+    field: str = "--pressures",
 ) -> Prediction:
     """:func:`predict_angles` of a design and pressures given as text (as on a command line).
 
@@ -105,9 +110,15 @@ def predict_text(
         Comma-separated gauge pressures, MPa (:func:`parse_pressures`).
     strict : bool
         As :func:`predict_angles`.
+    field : str, default "--pressures"
+        The option the pressures came from, named in messages.
     """
     return predict_angles(
-        path, SFRBADesign.parse(design), parse_pressures(pressures), strict=strict
+        path,
+        SFRBADesign.parse(design),
+        parse_pressures(pressures, field),
+        strict=strict,
+        field=field,
     )
 
 
@@ -117,6 +128,7 @@ def predict_angles(
     pressures_mpa: ArrayLike,
     *,
     strict: bool = False,
+    field: str = "pressure",
 ) -> Prediction:
     """Load a saved surrogate and predict ``design``'s angle at each pressure.
 
@@ -130,6 +142,8 @@ def predict_angles(
     strict : bool, default False
         Refuse inputs outside the model's training ranges (and models that
         record none) instead of flagging them.
+    field : str, default "pressure"
+        The name of the pressures in messages (``"--pressures"`` from the command line).
 
     Raises
     ------
@@ -153,10 +167,10 @@ def predict_angles(
     pressures = np.asarray(pressures_mpa, dtype=float).ravel()
     if pressures.size == 0 or not np.all(np.isfinite(pressures)) or np.any(pressures < 0):
         raise ValueError(
-            "The 'pressure' must be finite and >= 0 MPa. "
+            f"The '{field}' must be finite and >= 0 MPa. "
             f"Got {np.asarray(pressures_mpa).tolist()!r} instead."
         )
-    check_pressures_mpa(np.unique(pressures), "predict_angles", "pressure")
+    check_pressures_mpa(np.unique(pressures), "predict_angles", field)
     saved = load_surrogate(path)
     rows = design.feature_rows(pressures)
     ranges = saved.metadata.get("training_ranges")
