@@ -168,9 +168,12 @@ def test_a_controller_table_is_applied_and_set_overrides_it(tmp_path, capsys):
     assert '[controller]\nname = "pressure-relay"' in payload["rig_config"]
     # another controller on the command line: the table's parameters are not its own
     assert main([*base, "--out", str(tmp_path / "b"), "--controller", "bang-bang"]) == 0
-    assert json.loads(capsys.readouterr().out)["controller_params"] == {
+    captured = capsys.readouterr()
+    assert json.loads(captured.out)["controller_params"] == {
         "deadzone": 0.05, "period": 0.01,
     }  # fmt: skip
+    # ... and saying so, not silently
+    assert "sets parameters of 'pressure-relay', but --controller is 'bang-bang'" in captured.err
 
 
 def _write(tmp_path, text):

@@ -13,6 +13,7 @@ else :data:`~softbend.control.factory.DEFAULT_CONTROLLER` with its defaults;
 
 from __future__ import annotations
 
+import warnings
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -117,7 +118,8 @@ def resolve_controller(
         the ``config``'s values.
     config : ControllerConfig, optional
         A rig TOML's [controller] table; its parameters apply when it names the same
-        controller as ``name`` (or ``name`` is not given).
+        controller as ``name`` (or ``name`` is not given); for another controller
+        they are left out, with a warning.
 
     Returns
     -------
@@ -140,6 +142,12 @@ def resolve_controller(
     typed = controller_parameters(chosen, texts, field="--set", from_text=True)
     from_set = {k: typed[k] for k in texts}
     from_toml = config.as_dict() if config is not None and config.name == chosen else {}
+    if config is not None and config.name != chosen and config.as_dict():
+        warnings.warn(
+            f"The {_TOML} sets parameters of {config.name!r}, but --controller is {chosen!r}: "
+            f"they are not used ({chosen!r} runs with its defaults and --set).",
+            stacklevel=2,
+        )
     given = {origin: v for origin, v in (("--set", from_set), (_TOML, from_toml)) if v}
     params = controller_parameters(chosen, {**from_toml, **from_set})
     return chosen, params, given
