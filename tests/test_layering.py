@@ -18,7 +18,17 @@ PACKAGE = Path(softbend.__file__).parent
 #: The pipeline, earliest first; a module's stage is that of its first name
 #: after ``softbend.`` (private helper modules sit at the bottom).
 STAGES: tuple[tuple[str, ...], ...] = (
-    ("__init__", "_extras", "_io", "_jsontext", "_torch", "_validation", "errors", "limits"),
+    (
+        "__init__",
+        "_extras",
+        "_io",
+        "_jsontext",
+        "_lazy",
+        "_torch",
+        "_validation",
+        "errors",
+        "limits",
+    ),
     ("registry", "references", "parameters"),
     ("plausibility",),
     ("design", "metrics", "kinematics"),

@@ -51,8 +51,9 @@ and :mod:`~softbend.analysis.campaign_analysis`. Names are imported lazily, so
 
 from __future__ import annotations
 
-import importlib
 from typing import TYPE_CHECKING, Any
+
+from softbend._lazy import export
 
 if TYPE_CHECKING:
     from softbend.analysis.campaign_analysis import CampaignAnalysis, analyze_samples
@@ -95,10 +96,8 @@ __all__ = [
 
 
 def __getattr__(name: str) -> Any:
-    if name in _EXPORTS:
-        return getattr(importlib.import_module(_EXPORTS[name]), name)
-    raise AttributeError(f"module 'softbend.analysis' has no attribute {name!r}")
+    return export(__name__, _EXPORTS, name)
 
 
 def __dir__() -> list[str]:
-    return __all__
+    return list(__all__)

@@ -25,8 +25,9 @@ names are imported on first use.
 
 from __future__ import annotations
 
-import importlib
 from typing import Any
+
+from softbend._lazy import export
 
 _EXPORTS = {
     "BACKENDS": "backends",
@@ -59,11 +60,8 @@ __all__ = sorted(_EXPORTS)
 
 
 def __getattr__(name: str) -> Any:
-    if name in _EXPORTS:
-        module = importlib.import_module(f"softbend.campaign.{_EXPORTS[name]}")
-        return getattr(module, name)
-    raise AttributeError(f"module 'softbend.campaign' has no attribute {name!r}")
+    return export(__name__, _EXPORTS, name)
 
 
 def __dir__() -> list[str]:
-    return __all__
+    return list(__all__)

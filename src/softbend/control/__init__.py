@@ -15,8 +15,9 @@ use, so ``import softbend.control`` stays light.
 
 from __future__ import annotations
 
-import importlib
 from typing import Any
+
+from softbend._lazy import export
 
 #: Public name -> the module that defines it.
 _EXPORTS: dict[str, str] = {
@@ -61,13 +62,8 @@ __all__ = sorted(_EXPORTS)
 
 
 def __getattr__(name: str) -> Any:
-    module = _EXPORTS.get(name)
-    if module is None:
-        raise AttributeError(f"module 'softbend.control' has no attribute {name!r}")
-    value = getattr(importlib.import_module(f"softbend.control.{module}"), name)
-    globals()[name] = value
-    return value
+    return export(__name__, _EXPORTS, name)
 
 
 def __dir__() -> list[str]:
-    return sorted(set(globals()) | set(__all__))
+    return list(__all__)

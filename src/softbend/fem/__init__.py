@@ -18,8 +18,9 @@ statistics :class:`FEMStats` (:func:`fem_stats`) and the dimensions of
 
 from __future__ import annotations
 
-import importlib
 from typing import TYPE_CHECKING, Any
+
+from softbend._lazy import export
 
 if TYPE_CHECKING:
     from softbend.fem.energy import use_compiled
@@ -58,11 +59,8 @@ __all__ = [
 
 
 def __getattr__(name: str) -> Any:
-    if name in _EXPORTS:
-        module = importlib.import_module(f"softbend.fem.{_EXPORTS[name]}")
-        return getattr(module, name)
-    raise AttributeError(f"module 'softbend.fem' has no attribute {name!r}")
+    return export(__name__, _EXPORTS, name)
 
 
 def __dir__() -> list[str]:
-    return __all__
+    return list(__all__)

@@ -7,8 +7,9 @@ imported lazily so that ``import softbend.identification`` stays light.
 
 from __future__ import annotations
 
-import importlib
 from typing import TYPE_CHECKING, Any
+
+from softbend._lazy import export
 
 if TYPE_CHECKING:
     from softbend.identification.data import Experiment, load_experiments, save_experiments
@@ -53,11 +54,8 @@ __all__ = [
 
 
 def __getattr__(name: str) -> Any:
-    if name in _EXPORTS:
-        module = importlib.import_module(f"softbend.identification.{_EXPORTS[name]}")
-        return getattr(module, name)
-    raise AttributeError(f"module 'softbend.identification' has no attribute {name!r}")
+    return export(__name__, _EXPORTS, name)
 
 
 def __dir__() -> list[str]:
-    return __all__
+    return list(__all__)

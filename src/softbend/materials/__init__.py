@@ -12,8 +12,9 @@ submodule (the fits need SciPy).
 
 from __future__ import annotations
 
-import importlib
 from typing import Any
+
+from softbend._lazy import export
 
 _EXPORTS = {
     "DEFAULT_MODELS": "fit",
@@ -46,11 +47,8 @@ __all__ = sorted(_EXPORTS)
 
 
 def __getattr__(name: str) -> Any:
-    if name in _EXPORTS:
-        module = importlib.import_module(f"softbend.materials.{_EXPORTS[name]}")
-        return getattr(module, name)
-    raise AttributeError(f"module 'softbend.materials' has no attribute {name!r}")
+    return export(__name__, _EXPORTS, name)
 
 
 def __dir__() -> list[str]:
-    return __all__
+    return list(__all__)

@@ -14,8 +14,9 @@ scikit-learn nor PyTorch.
 
 from __future__ import annotations
 
-import importlib
 from typing import Any
+
+from softbend._lazy import export
 
 _EXPORTS = {
     "BASE_HIDDEN_SIZES": "base",
@@ -56,11 +57,8 @@ __all__ = sorted(_EXPORTS)
 
 
 def __getattr__(name: str) -> Any:
-    if name in _EXPORTS:
-        module = importlib.import_module(f"softbend.transfer.{_EXPORTS[name]}")
-        return getattr(module, name)
-    raise AttributeError(f"module 'softbend.transfer' has no attribute {name!r}")
+    return export(__name__, _EXPORTS, name)
 
 
 def __dir__() -> list[str]:
-    return __all__
+    return list(__all__)
