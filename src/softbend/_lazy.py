@@ -4,11 +4,13 @@ A subpackage's ``__init__`` maps each exported name to the module defining it
 and delegates its module-level ``__getattr__`` here, so ``import softbend.x``
 stays light (no SciPy, PyTorch or NGSolve until a name that needs them is used)::
 
+    from softbend._lazy import export as _export  # private: a submodule may be "export"
+
     _EXPORTS = {"run_campaign": "runner", "CampaignStore": "store"}
     __all__ = sorted(_EXPORTS)
 
     def __getattr__(name: str) -> Any:
-        return export(__name__, _EXPORTS, name)
+        return _export(__name__, _EXPORTS, name)
 """
 
 from __future__ import annotations

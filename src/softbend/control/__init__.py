@@ -17,7 +17,7 @@ from __future__ import annotations
 
 from typing import Any
 
-from softbend._lazy import export
+from softbend._lazy import export as _export
 
 #: Public name -> the module that defines it.
 _EXPORTS: dict[str, str] = {
@@ -62,7 +62,7 @@ __all__ = sorted(_EXPORTS)
 
 
 def __getattr__(name: str) -> Any:
-    return export(__name__, _EXPORTS, name)
+    return _export(__name__, _EXPORTS, name)
 
 
 def __dir__() -> list[str]:

@@ -9,7 +9,7 @@ from __future__ import annotations
 
 from typing import TYPE_CHECKING, Any
 
-from softbend._lazy import export
+from softbend._lazy import export as _export
 
 if TYPE_CHECKING:
     from softbend.identification.data import Experiment, load_experiments, save_experiments
@@ -54,7 +54,7 @@ __all__ = [
 
 
 def __getattr__(name: str) -> Any:
-    return export(__name__, _EXPORTS, name)
+    return _export(__name__, _EXPORTS, name)
 
 
 def __dir__() -> list[str]:
