@@ -35,10 +35,22 @@ GravityOption = Annotated[
 ]
 
 
-def _options(maxh: float, gravity: str, **extra):
-    from softbend.fem import FEMOptions
+MaterialOption = Annotated[
+    str,
+    typer.Option(
+        "--material",
+        help="Elastomer: a preset (dragon-skin-30) or the fit.json of 'softbend materials fit', "
+        "optionally with its model after # (fit.json#yeoh; default the best fit).",
+    ),
+]
 
-    return FEMOptions(maxh_mm=maxh, gravity=gravity, **extra)
+
+def _options(maxh: float, gravity: str, material: str = "dragon-skin-30", **extra):
+    from softbend.fem import FEMOptions
+    from softbend.materials.choice import material_from_spec
+
+    elastomer = material_from_spec(material)
+    return FEMOptions(maxh_mm=maxh, gravity=gravity, elastomer=elastomer, **extra)
 
 
 @app.command("run")
@@ -55,6 +67,7 @@ def run(
     ] = Path("results/fem"),
     maxh: MaxhOption = 5.0,
     gravity: GravityOption = "bending",
+    material: MaterialOption = "dragon-skin-30",
     shapes: Annotated[int, typer.Option("--shapes", help="Deformed shapes drawn and saved.")] = 5,
     solve_every: Annotated[
         bool,
@@ -83,7 +96,7 @@ def run(
 
     actuator = SFRBADesign.parse(design)
     pressures = default_pressures_mpa(pmax, pstep)
-    options = _options(maxh, gravity, output="solve" if solve_every else "interpolate")
+    options = _options(maxh, gravity, material, output="solve" if solve_every else "interpolate")
     if shapes < 1:
         raise ValueError(f"The '--shapes' must be an integer in [1, inf). Got {shapes} instead.")
     written = ("sweep.csv", SWEEP_JSON, "angle_pressure.png", "shapes.png")
@@ -165,6 +178,7 @@ def mesh_study(
         str, typer.Option("--pressures", help="Comma-separated pressures, MPa.")
     ] = "0,0.05,0.1",
     gravity: GravityOption = "bending",
+    material: MaterialOption = "dragon-skin-30",
     json_output: Annotated[bool, typer.Option("--json", help="Print the table as JSON.")] = False,
 ) -> None:
     """Bending angle at --pressures for each element size.
@@ -184,7 +198,9 @@ def mesh_study(
     sizes = _floats(maxh, "--maxh")
     grid = _floats(pressures, "--pressures")
     with _common.progress_bar("mesh sizes", len(sizes), enabled=not json_output) as advance:
-        rows = study(actuator, sizes, grid, _options(4.0, gravity), progress=lambda d, n: advance())
+        rows = study(
+            actuator, sizes, grid, _options(4.0, gravity, material), progress=lambda d, n: advance()
+        )
     table = []
     for i, row in enumerate(rows):
         change = (

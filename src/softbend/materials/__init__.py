@@ -36,6 +36,7 @@ _EXPORTS = {
     "LinearElastic": "presets",
     "Material": "presets",
     "get_preset": "presets",
+    "material_from_spec": "choice",
     "SHIPPED_ATTRIBUTION": "tensile",
     "TensileTest": "tensile",
     "load_shipped": "tensile",
