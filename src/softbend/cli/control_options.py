@@ -30,5 +30,7 @@ MODEL = typer.Option(
 PLANT = typer.Option(
     "surrogate",
     help="θ(p) of the actuator: surrogate (the controller's own model), fem (the design's "
-    "FEM sweep) or lab (its virtual-lab readings: model mismatch).",
+    "FEM sweep), lab (its virtual-lab readings: model mismatch), or a file of your own "
+    "actuator: a saved surrogate .json (e.g. from 'softbend transfer refine') or a "
+    "measurements .csv (its loading readings, smoothed).",
 )

@@ -7,25 +7,33 @@ controller meets on a real actuator). :data:`PLANTS` names them;
 :func:`plant_table` picks one by name. A plant factory is
 ``factory(design, model_table) -> AngleTable``; adding one is one
 ``PLANTS.register(name, factory)`` call.
+
+A lab's own actuator plays the plant from a file instead of a name: a saved
+surrogate (``model.json``, e.g. the one ``softbend transfer refine`` wrote for
+it) or a measurements CSV (``readings.csv``: its loading readings of the
+design, smoothed), as ``--plant model.json`` or ``--plant readings.csv``.
 """
 
 from __future__ import annotations
 
 from collections.abc import Callable
+from pathlib import Path
 from typing import Any
 
 import numpy as np
 
 from softbend.control.rig import AngleTable
 from softbend.design import SFRBADesign
-from softbend.registry import Registry
+from softbend.registry import Registry, UnknownNameError
 
 __all__ = [
     "PLANTS",
+    "check_plant",
     "fem_angle_table",
     "fem_plant",
     "lab_angle_table",
     "lab_plant",
+    "plant_file",
     "plant_table",
     "shipped_angle_table",
     "surrogate_plant",
@@ -35,15 +43,43 @@ __all__ = [
 PLANTS: Registry[Callable[[SFRBADesign, AngleTable], AngleTable]] = Registry("plant")
 
 
+def plant_file(name: str) -> Path | None:
+    """``name`` as a plant file (an existing ``.json`` or ``.csv``), else None."""
+    path = Path(name)
+    return path if path.suffix.lower() in (".json", ".csv") and path.is_file() else None
+
+
+def check_plant(name: str, *, field: str = "plant") -> str:
+    """``name`` if it names a plant: a name of :data:`PLANTS` or a plant file.
+
+    Raises
+    ------
+    UnknownNameError
+        Neither (the message lists the names and says a file may be given).
+    """
+    if plant_file(name) is None:
+        try:
+            PLANTS.check(name, field=field)
+        except UnknownNameError as exc:
+            raise UnknownNameError(
+                f"{exc} A plant may also be the path of a saved surrogate (.json) or of "
+                "measurements (.csv)."
+            ) from None
+    return name
+
+
 def plant_table(
     name: str, design: SFRBADesign, model_table: AngleTable, *, field: str = "plant_table"
 ) -> AngleTable:
-    """The plant ``name`` (one of :data:`PLANTS`) of ``design``; ``model_table`` for "surrogate".
+    """The plant ``name`` of ``design``: a name of :data:`PLANTS`, or a plant file.
 
     Parameters
     ----------
     name : str
-        A name of :data:`PLANTS`; an unknown one raises
+        A name of :data:`PLANTS` (``model_table`` for "surrogate"), the path of a
+        saved surrogate (``.json``: its θ(p) for ``design``) or of a measurements
+        CSV (``.csv``: the design's loading readings, smoothed as
+        :func:`lab_angle_table` does). Anything else raises
         :class:`~softbend.registry.UnknownNameError` listing the known names.
     design : SFRBADesign
     model_table : AngleTable
@@ -51,7 +87,16 @@ def plant_table(
     field : str
         Where ``name`` came from, for the message (``"--plant"``).
     """
-    return PLANTS.get(name, field=field)(design, model_table)
+    path = plant_file(name)
+    if path is None:
+        return PLANTS.get(check_plant(name, field=field), field=field)(design, model_table)
+    if path.suffix.lower() == ".json":
+        from softbend.surrogates.persistence import load_surrogate
+
+        return AngleTable.from_surrogate(load_surrogate(path).model, design)
+    from softbend.transfer.measurements import load_measurements
+
+    return lab_angle_table(design, measurements=load_measurements(path), source=str(path))
 
 
 def surrogate_plant(design: SFRBADesign, model_table: AngleTable) -> AngleTable:
@@ -136,6 +181,7 @@ def lab_angle_table(
     points: int = 501,
     measurements: Any = None,
     degree: int = 3,
+    source: str = "the virtual lab",
 ) -> AngleTable:
     """θ(p) of ``design`` as measured: the virtual lab's loading readings, smoothed.
 
@@ -152,19 +198,28 @@ def lab_angle_table(
         One of the measured actuators (paper B Fig. 7).
     measurements : Measurements, optional
         Default: the shipped virtual-lab readings
-        (:func:`softbend.transfer.lab.shipped_measurements`).
+        (:func:`softbend.transfer.lab.shipped_measurements`). The rows of
+        ``design`` are found by its six design columns.
     degree : int, default 3
+    source : str
+        What the readings are, for the message when ``design`` has too few.
     """
-    from softbend.transfer.lab import actuator_id, shipped_measurements
+    from softbend.transfer.lab import shipped_measurements
+    from softbend.transfer.measurements import MEASUREMENT_COLUMNS
 
     data = (shipped_measurements() if measurements is None else measurements).frame
-    key = actuator_id(design)
-    rows = data[(data["actuator_id"] == key) & (data["direction"] == "loading")]
+    columns = list(MEASUREMENT_COLUMNS[:6])  # l, r, t, b, phi, lc
+    mask = (data["direction"] == "loading").to_numpy(dtype=bool, copy=True)
+    for column, value in zip(columns, design.as_array(), strict=True):
+        mask &= np.isclose(data[column].to_numpy(dtype=float), value)
+    rows = data[mask]
     if len(rows) <= degree:
-        known = ", ".join(sorted(str(v) for v in data["actuator_id"].unique()))
+        designs = data[columns].drop_duplicates().to_numpy()
+        known = ", ".join(",".join(f"{v:g}" for v in row) for row in designs)
         raise ValueError(
-            f"The design {key} has no measured loading curve (measured: {known}); use the "
-            "'surrogate' or 'fem' plant for it."
+            f"The design {design} has no measured loading curve in {source} (fewer than "
+            f"{degree + 1} readings; measured designs: {known}); use the 'surrogate' or 'fem' "
+            "plant for it."
         )
     p = rows["pressure_mpa"].to_numpy(dtype=float)
     coef = np.polynomial.polynomial.polyfit(p, rows["angle_deg"].to_numpy(dtype=float), degree)

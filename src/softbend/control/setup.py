@@ -27,7 +27,7 @@ from softbend.control.factory import (
     build_controller,
     controller_parameters,
 )
-from softbend.control.plants import PLANTS, plant_table
+from softbend.control.plants import check_plant, plant_table
 from softbend.control.rig import AngleTable, RigParams
 from softbend.control.rigconfig import ControllerConfig
 from softbend.design import SFRBADesign
@@ -175,7 +175,9 @@ def prepare_control(
     model : path, optional
         A saved surrogate for the controller's θ(p) (default: the shipped FEM-trained MLP).
     plant : str
-        A name of :data:`~softbend.control.plants.PLANTS`: the actuator's θ(p).
+        The actuator's θ(p): a name of :data:`~softbend.control.plants.PLANTS`, or a
+        saved surrogate ``.json`` / measurements ``.csv`` of the lab's own actuator
+        (:func:`~softbend.control.plants.plant_table`).
     supply_mpa : float, default 0.2
         Supply pressure of the simulated rig, MPa gauge.
     command : str
@@ -191,7 +193,7 @@ def prepare_control(
     from softbend.transfer.base import load_base
 
     name, params, given = resolve_controller(controller, assignments, config)
-    PLANTS.check(plant, field="--plant")
+    check_plant(plant, field="--plant")
     check_supply(supply_mpa, command)
     actuator = design if isinstance(design, SFRBADesign) else SFRBADesign.parse(design)
     rig = RigParams.for_design(actuator, supply_gauge_mpa=supply_mpa)
