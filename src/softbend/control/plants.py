@@ -31,6 +31,7 @@ __all__ = [
     "check_plant",
     "fem_angle_table",
     "fem_plant",
+    "in_table1",
     "lab_angle_table",
     "lab_plant",
     "plant_file",
@@ -104,9 +105,27 @@ def surrogate_plant(design: SFRBADesign, model_table: AngleTable) -> AngleTable:
     return model_table
 
 
+def in_table1(design: SFRBADesign) -> bool:
+    """Whether ``design`` is one of the 972 of Table 1 (its FEM sweep is shipped)."""
+    from softbend.design import TABLE1_LEVELS
+
+    return all(
+        any(np.isclose(value, level) for level in TABLE1_LEVELS[name])
+        for name, value in design.as_dict().items()
+    )
+
+
 def fem_plant(design: SFRBADesign, model_table: AngleTable) -> AngleTable:
-    """The design's FEM sweep in the shipped Table 1 dataset (:func:`fem_angle_table`)."""
-    return fem_angle_table(design)
+    """The design's FEM sweep: shipped for Table 1 (:func:`fem_angle_table`), else solved once.
+
+    A design outside Table 1 is swept by the FEM on demand and kept in a cache
+    folder (:func:`softbend.control.fem_plant.fem_curve`).
+    """
+    if in_table1(design):
+        return fem_angle_table(design)
+    from softbend.control.fem_plant import fem_curve
+
+    return fem_curve(design).table()
 
 
 def lab_plant(design: SFRBADesign, model_table: AngleTable) -> AngleTable:

@@ -27,7 +27,7 @@ from softbend.control.factory import (
     build_controller,
     controller_parameters,
 )
-from softbend.control.plants import check_plant, plant_table
+from softbend.control.plants import check_plant, in_table1, plant_table
 from softbend.control.rig import AngleTable, RigParams
 from softbend.control.rigconfig import ControllerConfig
 from softbend.design import SFRBADesign
@@ -197,6 +197,14 @@ def prepare_control(
     check_supply(supply_mpa, command)
     actuator = design if isinstance(design, SFRBADesign) else SFRBADesign.parse(design)
     rig = RigParams.for_design(actuator, supply_gauge_mpa=supply_mpa)
+    if plant == "fem" and not in_table1(actuator):
+        # The design's own FEM sweep (solved once, cached) gives its chamber's compliance.
+        from softbend.control.fem_plant import fem_curve
+
+        compliance = fem_curve(actuator).compliance_mm3_per_mpa(supply_mpa)
+        rig = RigParams.for_design(
+            actuator, supply_gauge_mpa=supply_mpa, compliance_mm3_per_mpa=compliance
+        )
     surrogate = load_base(model)
     controller_model = ControllerModel.from_surrogate(surrogate, actuator, rig)
     actuator_table = plant_table(plant, actuator, controller_model.angle_table, field="--plant")
