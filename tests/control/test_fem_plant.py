@@ -56,3 +56,24 @@ def test_a_damaged_cache_entry_is_solved_again(coarse, tmp_path):
     again = fp.fem_curve(OWN, coarse)
     np.testing.assert_allclose(again.angle_deg, curve.angle_deg)
     assert json.loads(entry.read_text())["angle_deg"] == curve.angle_deg.tolist()
+
+
+def test_control_simulate_uses_the_designs_own_sweep_and_compliance(monkeypatch, tmp_path, capsys):
+    """A synthetic sweep stands in for the FEM: 600 deg/MPa, dV/dp 90 000 mm³/MPa."""
+    from softbend.cli import main
+
+    p = np.linspace(0.0, 0.3, 31)
+    curve = fp.FEMCurve(OWN, p, 600.0 * p, p, np.full(p.size, 90_000.0), "reached 300°")
+    calls = []
+
+    def fake(design, *args, **kwargs):
+        calls.append(design)
+        return curve
+
+    monkeypatch.setattr(fp, "fem_curve", fake)
+    args = ["control", "simulate", "--plant", "fem", "--design", "130,7,2.5,3,10,9",
+            "--duration", "2", "--json", "-o", str(tmp_path / "run")]  # fmt: skip
+    assert main(args) == 0, capsys.readouterr().err
+    payload = json.loads(capsys.readouterr().out)
+    assert calls and all(d == OWN for d in calls)
+    assert payload["rig"]["compliance_mm3_per_mpa"] == pytest.approx(90_000.0)
