@@ -55,7 +55,7 @@ def test_fem_run_writes_the_sweep_figures_and_vtk(tmp_path, capsys):
     for name in ("angle_pressure.png", "shapes.png", "sweep.json"):
         assert (out / name).stat().st_size > 1000
     vtks = sorted(p.name for p in (out / "vtk").glob("*.vtu"))
-    assert vtks[0] == "shape_000p00kPa.vtu" and len(vtks) == 2
+    assert vtks[0] == "shape_p0.000MPa.vtu" and len(vtks) == 2
     assert b"displacement" in (out / "vtk" / vtks[0]).read_bytes()
 
 

@@ -80,8 +80,10 @@ def run(
     Writes into the folder --out: sweep.csv (pressure, angle, tip, converged,
     Newton iterations), sweep.json (solver statistics and options),
     angle_pressure.png (with the analytical model), shapes.png (deformed
-    shapes, paper B, Figure 2b) and vtk/shape_<kPa>kPa.vtu (such as
-    shape_050p00kPa.vtu) for ParaView (apply Warp By Vector).
+    shapes, paper B, Figure 2b) and vtk/shape_p<MPa>MPa.vtu (such as
+    shape_p0.050MPa.vtu: the whole actuator with the displacement, mm, the
+    largest principal stretch and the strain-energy density, MPa) for
+    ParaView (apply Warp By Vector).
 
     Example:
 

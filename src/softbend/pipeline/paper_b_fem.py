@@ -68,7 +68,7 @@ def sweep_with_shapes(
     """Sweep one design with the FEM; keep the analytical curve and the deformed outlines.
 
     Writes ``<prefix>sweep.csv`` (pressure, angle, tip, converged, Newton
-    iterations) and with ``vtk`` the shapes as ``vtk/shape_<kPa>kPa.vtu``.
+    iterations) and with ``vtk`` the shapes as ``vtk/shape_p<MPa>MPa.vtu``.
 
     Parameters
     ----------
@@ -89,7 +89,7 @@ def sweep_with_shapes(
         ``progress(pressure_mpa, angle_deg, target_mpa)`` after each load step.
     """
     from softbend.analytical import AnalyticalModel
-    from softbend.fem.export import silhouette_mm, write_sweep_csv, write_vtk
+    from softbend.fem.export import silhouette_mm, vtk_file_name, write_sweep_csv, write_vtk
     from softbend.fem.sweep import run_sweep
 
     out = Path(out_dir)
@@ -110,8 +110,8 @@ def sweep_with_shapes(
         model.set_state(chosen.state)
         outlines.append((float(chosen.pressure_mpa), silhouette_mm(model)))
         if vtk:
-            kpa = f"{1000 * chosen.pressure_mpa:06.2f}".replace(".", "p")
-            vtk_files.append(write_vtk(model, out / "vtk" / f"shape_{kpa}kPa.vtu"))
+            p = float(chosen.pressure_mpa)
+            vtk_files.append(write_vtk(model, out / "vtk" / vtk_file_name(p), pressure_mpa=p))
     if vtk:
         files["vtk"] = vtk_files
     return FEMSweep(result, analytical, outlines, len(history.steps) - 1, files)

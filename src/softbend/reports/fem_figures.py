@@ -124,7 +124,7 @@ def sweep_with_files(
     iterations), ``<prefix>angle_pressure.png`` (with the analytical model) and
     ``<prefix>shapes.png`` (the deformed actuator at the converged steps nearest
     to ``shape_pressures_mpa``, paper B Fig. 2b), and with ``vtk`` the same
-    shapes as ``vtk/shape_<kPa>kPa.vtu`` for ParaView.
+    shapes as ``vtk/shape_p<MPa>MPa.vtu`` for ParaView.
 
     Parameters
     ----------
