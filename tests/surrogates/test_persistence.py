@@ -19,7 +19,10 @@ from softbend.surrogates.mlp import NormalizedMLPRegressor
 from softbend.surrogates.persistence import (
     FORMAT,
     SCHEMA_VERSION,
+    SavedState,
+    SavedSurrogate,
     kind_of,
+    load_state,
     load_surrogate,
     save_surrogate,
     saved_kinds,
@@ -874,3 +877,76 @@ def test_a_family_without_storage_is_not_saved_and_its_kind_not_read(fitted, tmp
             load_surrogate(path)
     finally:
         FAMILIES.unregister("no-storage")
+
+
+# --- load_state: a saved MLP's validated arrays, its estimator not built ---------------------
+
+
+def test_load_state_gives_the_arrays_load_surrogate_sets(fitted, tmp_path):
+    path = save_surrogate(fitted["mlp"], tmp_path / "m.json", metadata={"note": "x"})
+    state = load_state(path, ("mlp",))
+    model = load_surrogate(path).model
+    assert isinstance(state, SavedState) and state.kind == "mlp"
+    assert state.metadata == {"note": "x"} and state.params == model.get_params(deep=False)
+    for key, value in state.state.items():
+        if isinstance(value, list) and value and isinstance(value[0], np.ndarray):
+            for a, b in zip(value, getattr(model, key), strict=True):
+                assert a.dtype == b.dtype and a.tobytes() == b.tobytes()
+        elif isinstance(value, np.ndarray):
+            assert value.dtype == getattr(model, key).dtype
+            assert value.tobytes() == getattr(model, key).tobytes()
+        else:
+            assert value == getattr(model, key), key
+
+
+def test_load_state_builds_other_kinds_and_files_it_cannot_check_alone(fitted, tmp_path):
+    path = save_surrogate(fitted["plr"], tmp_path / "plr.json")
+    assert isinstance(load_state(path, ("mlp",)), SavedSurrogate)
+    path = save_surrogate(fitted["mlp"], tmp_path / "mlp.json")
+    assert isinstance(load_state(path, ()), SavedSurrogate)
+    document = json.loads(path.read_text())
+    document["params"].pop("epochs")  # the estimator's default fills it in
+    path.write_text(json.dumps(document))
+    saved = load_state(path, ("mlp",))
+    assert isinstance(saved, SavedSurrogate) and saved.model.epochs == 1000
+
+
+@pytest.mark.parametrize(
+    ("change", "match"),
+    [pytest.param(change, match, id=name) for name, change, match in _CORRUPTIONS["mlp"]]
+    + [
+        pytest.param(lambda s: s.pop("coefs_"), r"state key\(s\) coefs_ missing", id="missing-key"),
+    ],
+)
+def test_load_state_refuses_a_bad_mlp_as_load_surrogate_does(fitted, tmp_path, change, match):
+    path = save_surrogate(fitted["mlp"], tmp_path / "m.json")
+    document = json.loads(path.read_text())
+    change(document["state"])
+    path.write_text(json.dumps(document))
+    with pytest.raises(SchemaError, match=match) as info:
+        load_state(path, ("mlp",))
+    with pytest.raises(SchemaError) as reference:
+        load_surrogate(path)
+    assert str(info.value) == str(reference.value)
+
+
+@pytest.mark.parametrize(
+    "change",
+    [
+        lambda d: d["params"].update(hidden_sizes={"__tuple__": [60, 60]}),
+        lambda d: d["params"].update(epochs=0),
+        lambda d: d["params"].update(device="tpu"),
+        lambda d: d["metadata"].update(training_ranges={"l_mm": [1, 2]}),
+    ],
+    ids=["hidden-sizes", "epochs", "device", "training-ranges"],
+)
+def test_load_state_refuses_bad_mlp_params_as_load_surrogate_does(fitted, tmp_path, change):
+    path = save_surrogate(fitted["mlp"], tmp_path / "m.json")
+    document = json.loads(path.read_text())
+    change(document)
+    path.write_text(json.dumps(document))
+    with pytest.raises(SchemaError) as info:
+        load_state(path, ("mlp",))
+    with pytest.raises(SchemaError) as reference:
+        load_surrogate(path)
+    assert str(info.value) == str(reference.value)

@@ -114,3 +114,19 @@ def test_the_cli_refuses_a_gp_correction_that_would_predict_null(tmp_path, capsy
     assert captured.out == ""
     err = captured.err.strip().splitlines()
     assert len(err) == 1 and str(path) in err[0] and "kernel_theta_" in err[0]
+
+
+def test_the_shipped_mlp_predicts_bit_for_bit_as_its_estimator():
+    from importlib.resources import files
+
+    from softbend.surrogates.persistence import load_surrogate
+
+    path = files("softbend") / "data" / "transfer" / "table1_fem_mlp.json"
+    model = load_surrogate(path).model
+    rng = np.random.default_rng(5)
+    for design in (SFRBADesign(100, 6, 2, 2, 5, 8), SFRBADesign(130, 7, 2.5, 3, 10, 9)):
+        pressures = np.concatenate([[0.05], rng.uniform(0.0, 0.2, 20)])
+        result = predict_angles(path, design, pressures)
+        expected = model.predict(design.feature_rows(pressures))
+        assert result.angle_deg.tobytes() == expected.tobytes()
+    assert result.kind == "mlp" and result.interval_deg is None

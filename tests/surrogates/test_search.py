@@ -284,7 +284,7 @@ def test_an_interrupted_search_resumes_from_its_finished_folds(small_data, tmp_p
     with SearchCheckpoint(path) as checkpoint:
         resumed = search(small_data, **RESUME, checkpoint=checkpoint)
         assert checkpoint.n_records == 6 + 6 + 4 * 3 + 2 * 3
-    assert made == ["plr", "xgb", "mlp"] and trainings == [8]
+    assert made == ["plr", "xgb", "mlp"] and trainings == [8, 8]  # the second rung, then the MLP refit
     assert resumed.resumed == 6 + 6 + 4 * 3
     assert reference.resumed == 0
     _assert_same_search(resumed, reference)
@@ -295,7 +295,7 @@ def test_an_interrupted_search_resumes_from_its_finished_folds(small_data, tmp_p
     trainings.clear()
     with SearchCheckpoint(path) as checkpoint:
         again = search(small_data, **RESUME, checkpoint=checkpoint)
-    assert made == ["plr", "xgb", "mlp"] and trainings == []
+    assert made == ["plr", "xgb", "mlp"] and trainings == [8]  # the MLP refit
     assert again.resumed == 6 + 6 + 4 * 3 + 2 * 3
     _assert_same_search(again, reference)
 

@@ -11,13 +11,16 @@ from __future__ import annotations
 
 import hashlib
 from dataclasses import dataclass
+from typing import TYPE_CHECKING
 
 import numpy as np
-import pandas as pd
 from numpy.typing import ArrayLike
 
 from softbend.design import FEATURES as DESIGN_FEATURES
 from softbend.errors import DatasetError
+
+if TYPE_CHECKING:  # a table only for training: predicting needs no pandas
+    import pandas as pd
 
 #: Input columns, in the order every surrogate expects them (those of every model).
 FEATURES: tuple[str, ...] = DESIGN_FEATURES

@@ -16,7 +16,7 @@ from __future__ import annotations
 
 import math
 from collections.abc import Callable, Sequence
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 from numpy.typing import ArrayLike
@@ -24,9 +24,11 @@ from sklearn.base import BaseEstimator, RegressorMixin
 from sklearn.utils.validation import check_is_fitted, validate_data
 
 from softbend._validation import check_int, check_range
-from softbend.surrogates.batched import GridTrainingResult, train_mlp_grid
 from softbend.surrogates.features import FEATURES
 from softbend.surrogates.mlp_core import check_hidden_pair, mlp_forward, resolve_device
+
+if TYPE_CHECKING:
+    from softbend.surrogates.batched import GridTrainingResult
 
 __all__ = ["NormalizedMLPRegressor", "mlp_forward"]
 
@@ -155,6 +157,8 @@ class NormalizedMLPRegressor(RegressorMixin, BaseEstimator):
         )
         seed = check_int(self.seed, "seed", _OWNER, low=0)
         device = resolve_device(self.device, _OWNER)
+        # PyTorch only for training: loading and predicting stay NumPy
+        from softbend.surrogates.batched import train_mlp_grid
 
         _check_finite_y(y)
         X_arr, y_arr = validate_data(

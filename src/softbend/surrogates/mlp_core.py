@@ -13,17 +13,11 @@ from __future__ import annotations
 import math
 from collections.abc import Sequence
 from numbers import Integral
-from typing import TYPE_CHECKING, Any, cast
+from typing import Any, cast
 
 import numpy as np
 
-from softbend._torch import require_torch
 from softbend._validation import check_choice
-
-if TYPE_CHECKING:
-    import torch
-else:
-    torch = require_torch("the MLP surrogate (softbend.surrogates)")
 
 __all__ = [
     "check_hidden_pair",
@@ -107,6 +101,10 @@ def resolve_device(device: object, owner: str = "train_mlp_grid") -> str:
         For another value, or ``"cuda"`` without a usable GPU.
     """
     check_choice(device, "device", owner, ("auto", "cpu", "cuda"))
+    # PyTorch only here (training): a fitted model predicts with NumPy alone
+    from softbend._torch import require_torch
+
+    torch = require_torch("the MLP surrogate (softbend.surrogates)")
     if device == "auto":
         return "cuda" if torch.cuda.is_available() else "cpu"
     if device == "cuda" and not torch.cuda.is_available():

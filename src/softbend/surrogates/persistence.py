@@ -51,6 +51,11 @@ deeper than the ``nesting`` limit of :mod:`softbend.limits` is a
 :class:`~softbend.errors.LimitError`; a key the schema does not know, or a value
 breaking its rule, is a :class:`~softbend.errors.SchemaError` of one line naming
 the file, the key and the rule; only validated keys are ever set on the model.
+
+:func:`load_state` checks a file by the same rules but, for the families asked
+for, returns the validated arrays without building the estimator (nor importing
+its class and scikit-learn): ``softbend predict`` computes a saved MLP's angles
+from them with NumPy alone, bit for bit those of the estimator.
 """
 
 from __future__ import annotations
@@ -67,7 +72,6 @@ from pathlib import Path
 from typing import Any
 
 import numpy as np
-from sklearn.exceptions import NotFittedError
 
 from softbend import __version__
 from softbend._io import json_safe, write_text_atomic
@@ -88,9 +92,11 @@ __all__ = [
     "COMPOSITE_KINDS",
     "FORMAT",
     "SCHEMA_VERSION",
+    "SavedState",
     "SavedSurrogate",
     "check_fitted_surrogate",
     "kind_of",
+    "load_state",
     "load_surrogate",
     "save_surrogate",
     "saved_kinds",
@@ -280,6 +286,8 @@ def check_fitted_surrogate(model: Any, owner: str) -> str:
             else all(hasattr(model, key) for key in storage.required_state)
         )
     if not fitted:
+        from sklearn.exceptions import NotFittedError  # only here: loading needs no sklearn
+
         raise NotFittedError(f"This {name} instance is not fitted yet. Call 'fit' before {owner}.")
     n_features = int(model.n_features_in_)
     if n_features != len(FEATURES):
@@ -625,42 +633,69 @@ def _restore_composite(document: dict[str, Any], path: str, depth: int) -> Any:
         raise SchemaError(f"{path}: cannot rebuild the {kind} surrogate ({err}).") from None
 
 
-def _restore(document: dict[str, Any], path: Path | str, depth: int = 0) -> Any:
-    """The model of a document, every params and state value validated by its kind's schema."""
-    kind = document["kind"]
-    storage = None if kind in COMPOSITE_KINDS else _stored(kind).storage
-    required = _COMPOSITE_STATE[kind] if storage is None else storage.required_state
-    state = document["state"]
-    missing = [key for key in required if key not in state]
+def _check_required(document: dict[str, Any], path: Path | str, required: tuple[str, ...]) -> None:
+    missing = [key for key in required if key not in document["state"]]
     if missing:
         raise SchemaError(
             f"{path} is an incomplete softbend surrogate: state key(s) "
-            f"{', '.join(missing)} missing for kind {kind!r}."
+            f"{', '.join(missing)} missing for kind {document['kind']!r}."
         )
-    if storage is None:
-        return _restore_composite(document, str(path), depth)
+
+
+def _family_state(document: dict[str, Any], path: Path | str) -> dict[str, Any]:
+    """A family's state, every value validated by its schema (rules across keys included)."""
+    kind = document["kind"]
+    storage = _stored(kind).storage
+    assert storage is not None  # _stored refuses a family without a storage
+    _check_required(document, path, storage.required_state)
     schema = storage.schema
-    state = _validated(state, schema.state, path, kind, "state")
+    state = _validated(document["state"], schema.state, path, kind, "state")
     try:
         schema.check(state)
     except RuleError as err:
         raise SchemaError(f"{path}: the {kind} surrogate's {err}.") from None
-    cls = _class_of(kind)
-    if storage.codec is not None:
-        return storage.codec.restore(cls, document["params"], state, str(path))
-    model = cls(**_validated(document["params"], schema.params or {}, path, kind, "params"))
-    try:  # the declared sizes (defaults included) against the arrays
-        schema.against(model.get_params(deep=False), state)
+    return state
+
+
+def _check_against(
+    kind: str, params: dict[str, Any], state: dict[str, Any], path: Path | str
+) -> None:
+    """The declared sizes (defaults included) against the arrays, and the 7 inputs."""
+    storage = _stored(kind).storage
+    assert storage is not None  # _stored refuses a family without a storage
+    try:
+        storage.schema.against(params, state)
     except RuleError as err:
         raise SchemaError(f"{path}: the {kind} surrogate's {err}.") from None
-    for key, value in state.items():  # keys of the schema only
-        setattr(model, key, value)
-    n_features = getattr(model, "n_features_in_", None)
+    n_features = state.get("n_features_in_")
     if isinstance(n_features, bool) or n_features != len(FEATURES):
         raise SchemaError(
             f"{path}: the {kind} surrogate must take the {len(FEATURES)} inputs "
             f"{', '.join(FEATURES)}; its state gives n_features_in_ {short_repr(n_features)}."
         )
+
+
+def _restore(document: dict[str, Any], path: Path | str, depth: int = 0) -> Any:
+    """The model of a document, every params and state value validated by its kind's schema."""
+    kind = document["kind"]
+    if kind in COMPOSITE_KINDS:
+        _check_required(document, path, _COMPOSITE_STATE[kind])
+        return _restore_composite(document, str(path), depth)
+    storage = _stored(kind).storage
+    assert storage is not None  # _stored refuses a family without a storage
+    state = _family_state(document, path)
+    cls = _class_of(kind)
+    if storage.codec is not None:
+        return storage.codec.restore(cls, document["params"], state, str(path))
+    model = cls(**_validated(document["params"], storage.schema.params or {}, path, kind, "params"))
+    for key, value in state.items():  # keys of the schema only
+        setattr(model, key, value)
+    _check_against(
+        kind,
+        model.get_params(deep=False),
+        {**state, "n_features_in_": getattr(model, "n_features_in_", None)},
+        path,
+    )
     return model
 
 
@@ -700,6 +735,11 @@ def load_surrogate(path: str | os.PathLike[str]) -> SavedSurrogate:
     path = Path(path)
     document = _read_document(path)
     _check_training_ranges(document["metadata"], path)
+    return _saved_surrogate(document, path)
+
+
+def _saved_surrogate(document: dict[str, Any], path: Path) -> SavedSurrogate:
+    """The surrogate of a checked document, built."""
     try:
         model = _restore(document, path)
     except RecursionError:  # only with SOFTBEND_MAX_NESTING raised far above its default
@@ -714,3 +754,73 @@ def load_surrogate(path: str | os.PathLike[str]) -> SavedSurrogate:
         softbend_version=document["softbend_version"],
         created_utc=document["created_utc"],
     )
+
+
+@dataclass(frozen=True)
+class SavedState:
+    """A saved family surrogate read by :func:`load_state`: validated, its estimator not built.
+
+    Attributes
+    ----------
+    kind : str
+        Its family's name (one of the ``kinds`` asked for).
+    params : dict
+        Every constructor parameter of the estimator, validated by the family's schema.
+    state : dict
+        The fitted attributes (arrays in the units of :data:`FEATURES`, degrees),
+        validated by the family's schema exactly as :func:`load_surrogate` does.
+    metadata : dict
+        The caller's metadata, as :attr:`SavedSurrogate.metadata`.
+    """
+
+    kind: str
+    params: dict[str, Any]
+    state: dict[str, Any]
+    metadata: dict[str, Any] = field(default_factory=dict)
+
+
+def load_state(path: str | os.PathLike[str], kinds: tuple[str, ...]) -> SavedState | SavedSurrogate:
+    """Read a surrogate as its validated arrays where its kind is in ``kinds``, else built.
+
+    For a family in ``kinds`` whose file gives every constructor parameter and no
+    ``feature_names_in_`` (which the estimator checks on each prediction), the
+    file is checked by the same rules as :func:`load_surrogate` but the estimator
+    is not built, so its class and what it imports (scikit-learn) stay unloaded:
+    a caller that computes the prediction from the arrays (the MLP's
+    :func:`softbend.surrogates.mlp_core.mlp_forward`) gets the same numbers,
+    bit for bit. Any other file is :func:`load_surrogate`'s result.
+
+    Parameters
+    ----------
+    path : str or os.PathLike
+        The JSON file.
+    kinds : tuple of str
+        Family names (see :func:`saved_kinds`) to return as :class:`SavedState`.
+
+    Returns
+    -------
+    SavedState or SavedSurrogate
+
+    Raises
+    ------
+    FileNotFoundError, softbend.errors.SchemaError, softbend.errors.LimitError
+        As :func:`load_surrogate`.
+    """
+    path = Path(path)
+    document = _read_document(path)
+    _check_training_ranges(document["metadata"], path)
+    kind = document["kind"]
+    storage = None if kind in COMPOSITE_KINDS else _stored(kind).storage
+    if (
+        kind in kinds
+        and storage is not None
+        and storage.codec is None
+        and storage.schema.params is not None
+        and set(storage.schema.params) <= set(document["params"])
+        and "feature_names_in_" not in document["state"]
+    ):
+        state = _family_state(document, path)
+        params = _validated(document["params"], storage.schema.params, path, kind, "params")
+        _check_against(kind, params, state, path)
+        return SavedState(kind=kind, params=params, state=state, metadata=document["metadata"])
+    return _saved_surrogate(document, path)

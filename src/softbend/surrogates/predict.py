@@ -158,7 +158,7 @@ def predict_angles(
         non-finite number is never returned.
     """
     from softbend.surrogates.features import outside_training_ranges
-    from softbend.surrogates.persistence import load_surrogate
+    from softbend.surrogates.persistence import SavedState, load_state
 
     if not isinstance(design, SFRBADesign):
         raise ValueError(
@@ -171,7 +171,9 @@ def predict_angles(
             f"Got {np.asarray(pressures_mpa).tolist()!r} instead."
         )
     check_pressures_mpa(np.unique(pressures), "predict_angles", field)
-    saved = load_surrogate(path)
+    # an MLP predicts from its arrays (NumPy only); any other kind through its estimator
+    saved = load_state(path, ("mlp",))
+    model: Any = _MLPArrays(saved.state) if isinstance(saved, SavedState) else saved.model
     rows = design.feature_rows(pressures)
     ranges = saved.metadata.get("training_ranges")
     has_ranges = isinstance(ranges, dict)
@@ -187,10 +189,10 @@ def predict_angles(
             "--strict cannot check it."
         )
     with np.errstate(all="ignore"):  # an overflow is reported below, naming the file
-        angles = np.asarray(saved.model.predict(rows), dtype=float)
+        angles = np.asarray(model.predict(rows), dtype=float)
         interval = None
-        if callable(getattr(saved.model, "predict_interval", None)):
-            low, high = saved.model.predict_interval(rows, INTERVAL_LEVEL)
+        if callable(getattr(model, "predict_interval", None)):
+            low, high = model.predict_interval(rows, INTERVAL_LEVEL)
             interval = (np.asarray(low, dtype=float), np.asarray(high, dtype=float))
     _check_finite(path, saved.kind, pressures, angles, "angle", outside)
     if interval is not None:
@@ -199,6 +201,32 @@ def predict_angles(
     return Prediction(
         saved.kind, design, pressures, angles, outside, has_ranges, interval, str(path)
     )
+
+
+class _MLPArrays:
+    """The prediction of a saved MLP from its validated arrays (no estimator, no sklearn).
+
+    The same forward pass as :meth:`NormalizedMLPRegressor.predict
+    <softbend.surrogates.mlp.NormalizedMLPRegressor.predict>`, so the same angles bit for bit.
+    """
+
+    def __init__(self, state: dict[str, Any]) -> None:
+        self.state = state
+
+    def predict(self, rows: np.ndarray) -> np.ndarray:
+        """Angles (deg) of finite float rows of the 7 inputs (mm, deg, MPa)."""
+        from softbend.surrogates.mlp_core import mlp_forward
+
+        s = self.state
+        return mlp_forward(
+            np.asarray(rows, dtype=np.float64),
+            s["x_mean_"],
+            s["x_scale_"],
+            s["y_mean_"],
+            s["y_scale_"],
+            s["coefs_"],
+            s["intercepts_"],
+        )
 
 
 def _check_finite(
