@@ -284,7 +284,7 @@ def test_an_interrupted_search_resumes_from_its_finished_folds(small_data, tmp_p
     with SearchCheckpoint(path) as checkpoint:
         resumed = search(small_data, **RESUME, checkpoint=checkpoint)
         assert checkpoint.n_records == 6 + 6 + 4 * 3 + 2 * 3
-    assert made == ["plr", "xgb", "mlp"] and trainings == [8, 8]  # the second rung, then the MLP refit
+    assert made == ["plr", "xgb", "mlp"] and trainings == [8, 8]  # 2nd rung, MLP refit
     assert resumed.resumed == 6 + 6 + 4 * 3
     assert reference.resumed == 0
     _assert_same_search(resumed, reference)
