@@ -40,9 +40,18 @@ def measure(
     cycles: int = typer.Option(
         1, help="Inflation cycles per actuator (at most SOFTBEND_MAX_CYCLES, default 1000)."
     ),
+    designs: list[str] | None = typer.Option(
+        None,
+        "--design",
+        help="Measure this design instead of paper B's seven (l,r,t,b,phi,lc in mm and deg); "
+        "repeat for several.",
+    ),
+    elastomer: str = typer.Option(
+        "dragon-skin-30", help="Shipped tensile test the lab's silicone is fitted to (Yeoh)."
+    ),
     as_json: bool = typer.Option(False, "--json", help="Print a JSON summary."),
 ) -> None:
-    """Measure paper B's 7 actuators in the virtual lab.
+    """Measure actuators in the virtual lab (paper B's seven, or --design).
 
     The actuators of paper B, Figure 7, measured as built (synthetic data).
     Writes the CSV and its figure (the same name with .png) together: a run
@@ -52,6 +61,7 @@ def measure(
 
     \b
         softbend lab measure --out lab.csv --plant analytical
+        softbend lab measure --out own.csv --design 130,7,2.5,3,10,9 --plant analytical
     """
     from softbend._io import atomic_files
     from softbend.limits import check_limit
@@ -69,7 +79,13 @@ def measure(
         )
     _common.check_output_file(out, "--out", kind="csv")
     _common.check_output_file(figure, "--out", kind="png")
+    from softbend.design import SFRBADesign
+    from softbend.transfer.lab import LAB_ACTUATORS
+
+    actuators = tuple(SFRBADesign.parse(d) for d in designs) if designs else LAB_ACTUATORS
     lab = VirtualLab(
+        actuators=actuators,
+        elastomer=elastomer,
         plant=plant,
         seed=seed,
         fabrication_error_mm=fabrication_error,
