@@ -51,9 +51,10 @@ def measure(
     ),
     as_json: bool = typer.Option(False, "--json", help="Print a JSON summary."),
 ) -> None:
-    """Measure actuators in the virtual lab (paper B's seven, or --design).
+    """Measure actuators in the virtual lab.
 
-    The actuators of paper B, Figure 7, measured as built (synthetic data).
+    The actuators of paper B, Figure 7 (or those of --design), measured as built
+    (synthetic data).
     Writes the CSV and its figure (the same name with .png) together: a run
     that fails leaves both as they were.
 
