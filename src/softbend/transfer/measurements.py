@@ -42,17 +42,41 @@ editor shows it, from 1, comments included) and the column.
 
 A file is read only if it is within the limits of :mod:`softbend.limits`
 (``file_mib`` and ``csv_rows``).
+
+Units
+-----
+Two slips of a hand-written file are caught as errors naming the file, the line
+and the column. A ``pressure_mpa`` column written in kPa has a value above
+2 MPa, the plausible limit: the error says it looks like kPa (divide by 1000).
+This one is not overridable: no strategy or surrogate accepts a pressure above
+2 MPa. An ``angle_deg`` column written in radians: when the file's pressures
+reach above :data:`RADIAN_PRESSURE_MPA` (0.05 MPa, where the actuators of
+paper B already bend tens of degrees, paper B Fig. 7) and yet no |angle|
+exceeds :data:`RADIAN_ANGLE_MAX` (2π·1.05 ≈ 6.6, a full turn in radians with
+5 % margin), the angles are taken for radians. A very stiff actuator may truly
+bend so little: ``force=True`` (``--force`` on the command line) then reads
+the angles as degrees, as given, with a warning.
+
+Several files
+-------------
+:func:`load_measurements_files` reads one or more files and joins their
+readings. Each file fills its own missing optional columns, and each reading
+keeps its file's provenance in :attr:`Measurements.provenance` (``source``,
+``synthetic``, ``date`` and the file's other ``# key: value`` entries); the
+joined :attr:`Measurements.metadata` holds the entries every file gives alike.
 """
 
 from __future__ import annotations
 
 import csv
 import datetime
+import hashlib
 import io
 import logging
 import math
 import numbers
 import os
+import warnings
 from collections.abc import Callable, Iterable, Mapping, Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -94,6 +118,15 @@ _COLUMN_OF: dict[str, str] = {
 #: Columns of :attr:`Measurements.features`, in :data:`softbend.design.FEATURES` order.
 _FEATURE_COLUMNS: tuple[str, ...] = tuple(_COLUMN_OF[name] for name in FEATURES)
 _FORMAT_LINE = "softbend measurements CSV v1"
+#: Columns of :attr:`Measurements.provenance` every table has, before the other
+#: metadata keys of the files: the file, its ``synthetic`` flag and its ``date``.
+PROVENANCE_COLUMNS: tuple[str, ...] = ("source", "synthetic", "date")
+#: Pressure (MPa) above which the angles of a file must exceed
+#: :data:`RADIAN_ANGLE_MAX` somewhere, or they look like radians.
+RADIAN_PRESSURE_MPA = 0.05
+#: The largest |angle| of a file in radians that the radian rule suspects: a
+#: full turn with 5 % margin (2π·1.05).
+RADIAN_ANGLE_MAX = 2.0 * math.pi * 1.05
 _MAX_CYCLE = 2**53  # the largest integer a float64 holds exactly
 
 #: Plausible range of each numeric column: a quantity of
@@ -501,6 +534,42 @@ def _check_metadata(metadata: Mapping[str, Any], owner: str) -> dict[str, str]:
     return out
 
 
+def _provenance_of(n: int, source: str, metadata: Mapping[str, str]) -> pd.DataFrame:
+    """``n`` readings all from ``source`` with ``metadata``: the default provenance."""
+    columns: dict[str, Any] = {
+        "source": [source] * n,
+        "synthetic": np.full(n, metadata.get("synthetic", "") == "true", dtype=bool),
+        "date": [metadata.get("date", "")] * n,
+    }
+    for key, value in metadata.items():
+        if key not in columns:
+            columns[key] = [value] * n
+    return pd.DataFrame(columns)
+
+
+def _check_provenance(
+    provenance: Any, n: int, source: str, metadata: Mapping[str, str]
+) -> pd.DataFrame:
+    """The provenance table of ``n`` readings, checked and copied (default: one source)."""
+    if provenance is None:
+        return _provenance_of(n, source, metadata)
+    if not isinstance(provenance, pd.DataFrame):
+        raise ValueError(
+            "The 'provenance' of Measurements must be a pandas DataFrame or None. "
+            f"Got {type(provenance).__name__} instead."
+        )
+    missing = [c for c in PROVENANCE_COLUMNS if c not in provenance.columns]
+    if missing or len(provenance) != n:
+        raise ValueError(
+            f"The 'provenance' of Measurements must have one row per reading ({n}) and the "
+            f"columns {', '.join(PROVENANCE_COLUMNS)}. Got {len(provenance)} rows with "
+            f"columns {', '.join(map(str, provenance.columns))} instead."
+        )
+    out = provenance.reset_index(drop=True).copy()
+    out["synthetic"] = out["synthetic"].astype(bool)
+    return out
+
+
 def _row_label(index: pd.Index) -> _Where:
     def where(pos: int) -> str:
         label = index[pos]
@@ -531,6 +600,12 @@ class Measurements:
     source : str
         The file the measurements came from, or a description; path-likes are
         converted to text.
+    provenance : pandas.DataFrame, optional
+        Where each reading comes from, one row per row of ``frame``: the columns
+        :data:`PROVENANCE_COLUMNS` (``source`` text, ``synthetic`` bool,
+        ``date`` text, empty if none) and any other metadata keys (text, empty
+        where a file does not set them). Default: every reading from ``source``
+        with ``metadata``. Stored as a copy with index 0..n-1.
 
     Raises
     ------
@@ -545,18 +620,20 @@ class Measurements:
     ValueError
         Metadata that is not a mapping of single-line text (keys without ':'),
         or that a file could not hold: a key not in :data:`METADATA_KEYS` or a
-        value not of its kind.
+        value not of its kind; a ``provenance`` that is not a table of one row
+        per reading with the :data:`PROVENANCE_COLUMNS`.
 
     Notes
     -----
     Two instances compare equal when their frames are equal
-    (:meth:`pandas.DataFrame.equals`) and their metadata are; ``source`` is
-    provenance and is not compared, so ``load_measurements(save_measurements(m, p)) == m``.
+    (:meth:`pandas.DataFrame.equals`) and their metadata are; ``source`` and
+    ``provenance`` are not compared, so ``load_measurements(save_measurements(m, p)) == m``.
     """
 
     frame: pd.DataFrame
     metadata: Mapping[str, str] = field(default_factory=dict)
     source: str = ""
+    provenance: pd.DataFrame | None = None
     _designs: dict[str, SFRBADesign] = field(init=False, repr=False, compare=False)
 
     def __post_init__(self) -> None:
@@ -568,9 +645,13 @@ class Measurements:
         owner = source or "the Measurements frame"
         where = _row_label(self.frame.index) if isinstance(self.frame, pd.DataFrame) else str
         frame, designs = _normalize(self.frame, owner, where)
+        metadata = _check_metadata(self.metadata, "Measurements")
         object.__setattr__(self, "source", source)
         object.__setattr__(self, "frame", frame)
-        object.__setattr__(self, "metadata", _check_metadata(self.metadata, "Measurements"))
+        object.__setattr__(self, "metadata", metadata)
+        object.__setattr__(
+            self, "provenance", _check_provenance(self.provenance, len(frame), source, metadata)
+        )
         object.__setattr__(self, "_designs", designs)
 
     @classmethod
@@ -694,17 +775,57 @@ class Measurements:
             )
         mask = self.frame["actuator_id"].isin(wanted).to_numpy()
         frame = self.frame.loc[mask].reset_index(drop=True)
-        return Measurements(frame, metadata=dict(self.metadata), source=self.source)
+        provenance = None
+        if self.provenance is not None:
+            provenance = self.provenance.loc[mask].reset_index(drop=True)
+        return Measurements(
+            frame,
+            metadata=dict(self.metadata),
+            source=self.source,
+            provenance=provenance,
+        )
+
+    @property
+    def synthetic(self) -> np.ndarray:
+        """Whether each reading comes from a ``# synthetic: true`` file, shape (n,), bool."""
+        assert self.provenance is not None  # set by __post_init__
+        return self.provenance["synthetic"].to_numpy(dtype=bool, copy=True)
 
 
 # --------------------------------------------------------------------- loading
-def load_measurements(path: str | os.PathLike[str]) -> Measurements:
+def _check_angle_unit(frame: pd.DataFrame, source: Path, lines: Sequence[int], force: bool) -> None:
+    """Raise (or, with ``force``, warn) when the file's angles look like radians.
+
+    The rule of the module docstring (Units): the pressures reach above
+    :data:`RADIAN_PRESSURE_MPA` and no |angle| exceeds :data:`RADIAN_ANGLE_MAX`.
+    The line named is that of the reading at the highest pressure.
+    """
+    pressure = frame["pressure_mpa"].to_numpy(dtype=np.float64)
+    angle = np.abs(frame["angle_deg"].to_numpy(dtype=np.float64))
+    if pressure.max() <= RADIAN_PRESSURE_MPA or angle.max() > RADIAN_ANGLE_MAX:
+        return
+    pos = int(np.argmax(pressure))
+    text = (
+        f"{source}, line {lines[pos]}, column 'angle_deg': the angles reach only "
+        f"{angle.max():.4g} while the pressure reaches {pressure[pos]:g} MPa; they look like "
+        "radians: multiply by 180/π (57.2958) for degrees"
+    )
+    if not force:
+        raise DatasetError(f"{text}, or pass force=True (--force) to read them as degrees.")
+    warnings.warn(f"{text}; read as degrees as given (force).", UserWarning, stacklevel=3)
+
+
+def load_measurements(path: str | os.PathLike[str], *, force: bool = False) -> Measurements:
     """Read measurements from a CSV file in the format of this module.
 
     Parameters
     ----------
     path : str or path-like
         The CSV file.
+    force : bool, default False
+        Read an ``angle_deg`` column that looks like radians as degrees, as
+        given, with a warning (:class:`UserWarning`), instead of raising
+        (module docstring, Units).
 
     Returns
     -------
@@ -720,8 +841,9 @@ def load_measurements(path: str | os.PathLike[str]) -> Measurements:
         UTF-8, no header row, a missing, duplicate or unknown column, a row with
         the wrong number of cells or a cell CSV cannot read, no data rows, a
         metadata key given twice, unknown or with a malformed value, an
-        implausible number (:mod:`softbend.plausibility`), or any cell check of
-        :class:`Measurements`.
+        implausible number (:mod:`softbend.plausibility`; a pressure above
+        2 MPa is said to look like kPa), angles that look like radians (unless
+        ``force``), or any cell check of :class:`Measurements`.
     LimitError
         The file is larger than the ``file_mib`` limit or has more data rows
         than the ``csv_rows`` limit (:mod:`softbend.limits`); checked before the
@@ -779,6 +901,7 @@ def load_measurements(path: str | os.PathLike[str]) -> Measurements:
     frame, _ = _normalize(
         raw, str(source), lambda pos: f"line {line_of_row[pos]}", lines=line_of_row
     )
+    _check_angle_unit(frame, source, line_of_row, force)
     measurements = Measurements(frame, metadata=metadata, source=str(source))
     logger.debug(
         "Loaded %d measurement(s) of %d actuator(s) from %s.",
@@ -787,6 +910,134 @@ def load_measurements(path: str | os.PathLike[str]) -> Measurements:
         source,
     )
     return measurements
+
+
+def load_measurements_files(
+    paths: str | os.PathLike[str] | Sequence[str | os.PathLike[str]], *, force: bool = False
+) -> Measurements:
+    """Read measurements from one or more CSV files and join their readings, in file order.
+
+    Parameters
+    ----------
+    paths : path or sequence of paths
+        The CSV files (:func:`load_measurements`); one path reads as
+        :func:`load_measurements` does.
+    force : bool, default False
+        As for :func:`load_measurements`, for every file.
+
+    Returns
+    -------
+    Measurements
+        Every file's readings, each file's missing optional columns filled as
+        that file alone fills them. :attr:`Measurements.provenance` holds each
+        reading's file (``source``), its file's ``synthetic`` flag, ``date`` and
+        other metadata; :attr:`Measurements.metadata` the entries every file
+        gives with the same value; ``source`` the files joined by ``", "``.
+
+    Raises
+    ------
+    DatasetError
+        Any error of :func:`load_measurements`, naming its file; no file; the
+        same file twice; or one actuator_id with two designs in two files
+        (both files named).
+    LimitError
+        As for :func:`load_measurements`.
+    """
+    items = [paths] if isinstance(paths, str | os.PathLike) else list(paths)
+    if not items:
+        raise DatasetError("No measurement file given; at least one CSV file is required.")
+    if len(items) == 1:
+        return load_measurements(items[0], force=force)
+    seen: dict[Path, str] = {}
+    for item in items:
+        key = Path(item).resolve()
+        if key in seen:
+            raise DatasetError(
+                f"The measurement file {item} is given twice (also as {seen[key]}); "
+                "give each file once."
+            )
+        seen[key] = str(item)
+    parts = [load_measurements(item, force=force) for item in items]
+    owner: dict[str, tuple[SFRBADesign, str]] = {}
+    for part in parts:
+        for actuator in part.actuator_ids:
+            design = part.design_of(actuator)
+            if actuator in owner and owner[actuator][0] != design:
+                first, where = owner[actuator]
+                raise DatasetError(
+                    f"{part.source}: the actuator {actuator!r} has the design "
+                    f"({_design_text(design.as_array())}) here but "
+                    f"({_design_text(first.as_array())}) in {where}; one actuator_id must keep "
+                    "one design across files (rename one of them)."
+                )
+            owner.setdefault(actuator, (design, part.source))
+    common = {
+        key: value
+        for key, value in parts[0].metadata.items()
+        if all(p.metadata.get(key) == value for p in parts[1:])
+    }
+    provenance = pd.concat([p.provenance for p in parts], ignore_index=True).fillna("")
+    provenance["synthetic"] = provenance["synthetic"].astype(bool)
+    frame = pd.concat([p.frame for p in parts], ignore_index=True)
+    return Measurements(
+        frame,
+        metadata=common,
+        source=", ".join(p.source for p in parts),
+        provenance=provenance,
+    )
+
+
+def files_record(
+    paths: Sequence[str | os.PathLike[str]], measurements: Measurements
+) -> list[dict[str, Any]]:
+    """What a run records of its measurement files: path, SHA-256, readings, synthetic.
+
+    Parameters
+    ----------
+    paths : sequence of path
+        The files ``measurements`` were read from (:func:`load_measurements_files`).
+    measurements : Measurements
+        Their readings.
+
+    Returns
+    -------
+    list of dict
+        One ``{"path", "sha256", "readings", "synthetic"}`` per file, in order:
+        the path as given, the hex SHA-256 of its bytes, its number of readings
+        and whether its header says ``# synthetic: true``.
+    """
+    provenance = measurements.provenance
+    assert provenance is not None  # set by Measurements.__post_init__
+    out = []
+    for item in paths:
+        digest = hashlib.sha256()
+        with open(item, "rb") as handle:
+            for block in iter(lambda: handle.read(1 << 20), b""):
+                digest.update(block)
+        rows = provenance["source"].to_numpy(dtype=object) == str(Path(item))
+        out.append(
+            {
+                "path": str(item),
+                "sha256": digest.hexdigest(),
+                "readings": int(rows.sum()),
+                "synthetic": bool(provenance["synthetic"].to_numpy(dtype=bool)[rows].all()),
+            }
+        )
+    return out
+
+
+def synthetic_label(measurements: Measurements) -> str:
+    """``"true"`` if every reading is synthetic, ``"false"`` if none, else ``"mixed"``.
+
+    Readings of one file keep the text of its ``# synthetic:`` header
+    (``"false"`` when it has none).
+    """
+    if "synthetic" in measurements.metadata:
+        return str(measurements.metadata["synthetic"])
+    flags = measurements.synthetic
+    if flags.all() and len(flags):
+        return "true"
+    return "mixed" if flags.any() else "false"
 
 
 # ---------------------------------------------------------------------- saving
