@@ -260,9 +260,10 @@ def test_refine_on_a_full_disk_names_the_option_and_keeps_the_old_model(
     monkeypatch.setattr(io.os, "replace", full)
     argv = ["transfer", "refine", str(small_base_file), str(lab_csv), "--out", str(out)]
     assert main([*argv, "--strategy", "scale-offset"]) == 2
-    assert one_error_line(capsys) == (
-        f"softbend: error: The '--out' {out} could not be written: {FULL}."
-    )
+    lines = capsys.readouterr().err.strip().splitlines()
+    # The lab file's few actuators earn a warning about the calibration first.
+    assert all(line.startswith("softbend: warning: ") for line in lines[:-1])
+    assert lines[-1] == f"softbend: error: The '--out' {out} could not be written: {FULL}."
     assert out.read_text() == '{"old": true}\n' and _listing(tmp_path) == ["model.json"]
 
 

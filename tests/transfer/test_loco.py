@@ -24,6 +24,7 @@ def result(small_base, quick_measurements):
         small_base,
         ["fem-only", "refined", "scale-offset", "residual-gp", "refined-ensemble"],
         options=FAST,
+        calibrated=True,
     )
 
 
@@ -130,3 +131,28 @@ def test_one_actuator_is_not_enough(small_base, quick_measurements):
     one = quick_measurements.subset([quick_measurements.actuator_ids[0]])
     with pytest.raises(ValueError, match="at least 2 actuators"):
         leave_one_configuration_out(one, small_base, ["fem-only"])
+
+
+def test_calibrated_intervals_are_scored_nested_and_written(result, tmp_path):
+    summary = result.summary.set_index("strategy")
+    for name in ("fem-only", "refined", "scale-offset", "residual-gp"):
+        assert 0.0 <= summary.loc[name, "calibrated_coverage"] <= 1.0
+        assert summary.loc[name, "calibrated_width_deg"] > 0.0
+    # The slowest strategy is not calibrated (as it has no learning curve).
+    assert np.isnan(summary.loc["refined-ensemble", "calibrated_coverage"])
+    assert "refined-ensemble" not in result.calibrations
+    result.write(tmp_path / "out")
+    payload = json.loads((tmp_path / "out" / "loco.json").read_text())
+    assert payload["calibration"]["refined"]["n_actuators"] == 4
+    assert payload["calibration"]["refined"]["guaranteed"] is False
+
+
+def test_calibration_can_be_left_out_and_leaves_the_scores_alone(
+    small_base, quick_measurements, result
+):
+    plain = leave_one_configuration_out(
+        quick_measurements, small_base, ["scale-offset"], calibrated=False, learning_curve=False
+    )
+    assert plain.summary["calibrated_coverage"].isna().all() and plain.calibrations == {}
+    mine = result.per_actuator.query("strategy == 'scale-offset'")["rmse_deg"].to_numpy()
+    np.testing.assert_array_equal(plain.per_actuator["rmse_deg"].to_numpy(), mine)

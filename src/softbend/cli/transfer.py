@@ -72,7 +72,11 @@ def base(
 @app.command("refine")
 def refine(
     base: Path = typer.Argument(..., help="Saved surrogate to start from (an mlp for 'refined')."),
-    measurements: Path = typer.Argument(..., help="Measurements CSV."),
+    measurements: list[Path] = typer.Argument(
+        ...,
+        metavar="MEASUREMENTS",
+        help="Measurements CSV file(s); several are joined, each keeping its provenance.",
+    ),
     out: Path = typer.Option(..., "--out", "-o", help="File for the refined model (JSON)."),
     strategy: str = typer.Option(
         "refined",
@@ -87,10 +91,16 @@ def refine(
         None, help="Epochs of the MLP strategies (default: the strategy's); as --set epochs=N."
     ),
     seed: int = typer.Option(0, help="Seed of the training."),
+    force: bool = typer.Option(
+        False,
+        "--force",
+        help="Read angles that look like radians as degrees, as given (with a warning).",
+    ),
 ) -> None:
     """Fit a strategy on measurements and save it.
 
-    The strategy learns from all the MEASUREMENTS; the model is saved like the other
+    The strategy learns from all the MEASUREMENTS (one or more CSV files, joined; the
+    model file records each file with its SHA-256); the model is saved like the other
     surrogates and plugs into 'softbend predict'; the strategies with intervals
     (scale-offset, pressure-scale, residual-gp, refined-ensemble) save them too. The
     model file records the strategy and every one of its parameters as used.
@@ -99,6 +109,7 @@ def refine(
 
     \b
         softbend transfer refine base.json lab.csv --out refined.json --set epochs=500
+        softbend transfer refine base.json lab.csv bench.csv --out refined.json
     """
     from softbend.limits import check_limit
     from softbend.transfer.refine import refine_surrogate
@@ -111,15 +122,22 @@ def refine(
             )
         check_limit("epochs", epochs, "--epochs")
         values["epochs"] = str(epochs)
-    _common.check_output_file(out, "--out", inputs=(base, measurements), kind="json")
-    result = refine_surrogate(base, measurements, strategy, seed=seed, settings=values)
+    _common.check_output_file(out, "--out", inputs=(base, *measurements), kind="json")
+    result = refine_surrogate(base, measurements, strategy, seed=seed, settings=values, force=force)
     with _common.output_errors(out, "--out"):
         path = result.save(out)
     meta = result.metadata
+    interval = meta.get("interval")
+    calibration = (
+        f"; calibrated {interval['level']:.0%} interval ±{interval['half_width_deg']:.3g}° "
+        f"over {interval['n_actuators']} actuators"
+        if isinstance(interval, dict)
+        else ""
+    )
     _common.console.print(
         f"{strategy} model on {meta['n_measurements']} readings of {len(meta['actuators'])} "
-        f"actuators written to {path} (training RMSE {meta['training_rmse_deg']:.3g}°); "
-        f"use it with 'softbend predict {path}'"
+        f"actuators written to {path} (training RMSE {meta['training_rmse_deg']:.3g}°"
+        f"{calibration}); use it with 'softbend predict {path}'"
     )
 
 

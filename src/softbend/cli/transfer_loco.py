@@ -27,7 +27,12 @@ LOCO_FILES: tuple[str, ...] = (
 
 
 def loco(
-    measurements: Path = typer.Argument(..., help="Measurements CSV (see 'softbend lab measure')."),
+    measurements: list[Path] = typer.Argument(
+        ...,
+        metavar="MEASUREMENTS",
+        help="Measurements CSV file(s) (see 'softbend lab measure'); several are joined, "
+        "each keeping its provenance.",
+    ),
     out: Path = typer.Option(..., "--out", "-o", help="Folder for tables and figures."),
     base: Path | None = typer.Option(
         None, help="Saved surrogate to start from (default: the shipped FEM-trained MLP)."
@@ -47,8 +52,19 @@ def loco(
     learning_curve: bool = typer.Option(
         True, "--learning-curve/--no-learning-curve", help="Also fit on 1..n-2 actuators."
     ),
+    calibrate: bool = typer.Option(
+        False,
+        "--calibrate",
+        help="Also score the calibrated 90 % interval on each held-out actuator, calibrated "
+        "without it (n-1 more fits per actuator: several times the run time).",
+    ),
     seed: int = typer.Option(0, help="Seed of the strategies and the learning curve."),
     as_json: bool = typer.Option(False, "--json", help="Print the results as JSON."),
+    force: bool = typer.Option(
+        False,
+        "--force",
+        help="Read angles that look like radians as degrees, as given (with a warning).",
+    ),
 ) -> None:
     """Score every strategy on held-out actuators.
 
@@ -57,13 +73,14 @@ def loco(
     as a whole: built beside it and swapped in when every table and figure is complete,
     so a run that fails leaves the previous results as they were. An existing --out may
     hold only what this command writes. loco.json records every parameter of every
-    strategy as used.
+    strategy as used, and each MEASUREMENTS file (one or more, joined) with its SHA-256.
 
     Example:
 
     \b
         softbend transfer loco lab.csv --out loco \\
             --strategies refined,scale-offset --set epochs=500
+        softbend transfer loco lab.csv bench.csv --out loco
     """
     from softbend._io import staged_dir
     from softbend.reports import transfer_figures
@@ -73,10 +90,10 @@ def loco(
         leave_one_configuration_out,
         strategy_options,
     )
-    from softbend.transfer.measurements import load_measurements
+    from softbend.transfer.measurements import files_record, load_measurements_files
 
     out = Path(out)
-    inputs = (measurements,) if base is None else (measurements, base)
+    inputs = tuple(measurements) if base is None else (*measurements, base)
     _common.check_output_dir(out, "--out", inputs=inputs, files=LOCO_FILES)
     _common.check_replaceable_dir(out, "--out", "transfer loco", inputs=inputs, files=LOCO_FILES)
     names = (
@@ -85,7 +102,7 @@ def loco(
         else [n.strip() for n in strategies.split(",") if n.strip()]
     )
     options = strategy_options(names, _common.parse_assignments(settings or ()))
-    data = load_measurements(measurements)
+    data = load_measurements_files(measurements, force=force)
     model = load_base(base)
     with _common.phase_progress(enabled=not as_json) as progress:
         result = leave_one_configuration_out(
@@ -94,11 +111,13 @@ def loco(
             names,
             level=level,
             learning_curve=learning_curve,
+            calibrated=calibrate,
             seed=seed,
             options=options,
             progress=lambda done, total, name: progress("fitting strategies", done, total),
         )
-    synthetic = str(data.metadata.get("synthetic", "")).startswith("true")
+    result.settings["measurement_files"] = files_record(measurements, data)
+    synthetic = bool(data.synthetic.any())  # the figure flags any synthetic reading
     with (
         _common.output_errors(out, "--out"),
         staged_dir(out) as stage,
@@ -125,9 +144,19 @@ def loco(
 
 def print_loco_summary(result: LocoResult) -> None:
     """The per-strategy table beside paper B's refined MLP (paper B §4.3, Fig. 7)."""
+    import pandas as pd
+
     from softbend.references import TRANSFER_RESULTS, values
 
     paper = values(TRANSFER_RESULTS)
+
+    def _calibrated_cell(r: pd.Series) -> str:
+        """Coverage of the calibrated interval and its mean width, or a dash."""
+        coverage = float(r.get("calibrated_coverage", float("nan")))
+        if coverage != coverage:
+            return "—"
+        return f"{100 * coverage:.1f} % ({float(r['calibrated_width_deg']):.1f})"
+
     rows = []
     for _, r in result.summary.iterrows():
         rows.append(
@@ -137,6 +166,7 @@ def print_loco_summary(result: LocoResult) -> None:
                 float(r["mape_pct"]),
                 float(r["max_error_deg"]),
                 "—" if r["coverage"] != r["coverage"] else f"{100 * r['coverage']:.1f} %",
+                _calibrated_cell(r),
                 f"{r['worst_actuator']} ({r['worst_rmse_deg']:.1f}°)",
             ]
         )
@@ -147,12 +177,28 @@ def print_loco_summary(result: LocoResult) -> None:
             paper["mape_pct"],
             "—",
             "—",
+            "—",
             f"{paper['worst']} ({paper['worst_rmse_deg']:.2f}°)",
         ]
     )
     _common.print_table(
         f"Leave one configuration out ({len(result.settings['actuators'])} actuators, "
         f"{result.settings['n_measurements']} readings; intervals {result.level:.0%})",
-        ["strategy", "mean RMSE °", "mean MAPE %", "max |e| °", "coverage", "worst actuator"],
+        [
+            "strategy",
+            "mean RMSE °",
+            "mean MAPE %",
+            "max |e| °",
+            "coverage",
+            "calibrated coverage (mean width °)",
+            "worst actuator",
+        ],
         rows,
     )
+    for name, cal in result.calibrations.items():
+        if not cal.get("guaranteed", True):
+            _common.warning_line(
+                f"{name}: {cal['n_actuators']} actuators are too few for a guaranteed "
+                f"{result.level:.0%} interval (the rule needs {cal['min_actuators']}); "
+                "its calibrated half-width is the largest leave-one-actuator-out error."
+            )

@@ -37,9 +37,10 @@ class Prediction:
     has_training_ranges : bool
         Whether the file records its training ranges.
     interval_deg : tuple of ndarray or None
-        ``(low, high)``: the central 90 % interval for a new reading, degrees,
-        from models that give one (the transfer-learning corrections); None
-        otherwise.
+        ``(low, high)``: the 90 % interval for a new reading, degrees: the
+        calibrated one a refined model records (``softbend transfer refine``:
+        conformal over its actuators), else the model's own (the Gaussian
+        interval of the corrections); None otherwise.
     source : str
         The model file.
     """
@@ -69,6 +70,22 @@ class Prediction:
             payload["interval_low_deg"] = self.interval_deg[0].tolist()
             payload["interval_high_deg"] = self.interval_deg[1].tolist()
         return payload
+
+
+def _calibrated_interval(record: Any, angles: np.ndarray) -> tuple[np.ndarray, np.ndarray] | None:
+    """The calibrated 90 % interval a refined model records (``transfer refine``), if any.
+
+    The record is the ``interval`` metadata of :mod:`softbend.transfer.conformal`:
+    ``angle ± half_width_deg``, the low end raised to ``floor_deg`` but never above
+    the angle. It replaces a model's own interval, which is not calibrated.
+    """
+    if not isinstance(record, dict) or record.get("method") != "conformal":
+        return None
+    if record.get("level") != INTERVAL_LEVEL:
+        return None
+    half = float(record["half_width_deg"])
+    floor = float(record.get("floor_deg", -np.inf))
+    return np.minimum(np.maximum(angles - half, floor), angles), angles + half
 
 
 def parse_pressures(text: str, name: str = "pressure") -> list[float]:
@@ -195,6 +212,8 @@ def predict_angles(
             low, high = model.predict_interval(rows, INTERVAL_LEVEL)
             interval = (np.asarray(low, dtype=float), np.asarray(high, dtype=float))
     _check_finite(path, saved.kind, pressures, angles, "angle", outside)
+    calibrated = _calibrated_interval(saved.metadata.get("interval"), angles)
+    interval = calibrated if calibrated is not None else interval
     if interval is not None:
         _check_finite(path, saved.kind, pressures, interval[0], "interval's low end", outside)
         _check_finite(path, saved.kind, pressures, interval[1], "interval's high end", outside)

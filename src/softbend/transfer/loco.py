@@ -4,7 +4,12 @@ For every measured actuator, every strategy is fitted on the measurements of the
 other actuators and scored on the held-out one: RMSE, MAPE (the 0 MPa points
 included, as paper B; only exact zeros are left out), largest error, and for
 strategies with intervals the share of held-out readings inside the interval.
-A learning curve repeats this with 1, 2, ... of the other actuators measured.
+Every strategy (but the two slowest) also gets a calibrated interval
+(:mod:`softbend.transfer.conformal`), nested: the held-out actuator's interval
+is calibrated on the leave-one-out errors of the other actuators, each from a
+model fitted without it and without the held-out one, as a lab with those
+actuators alone would have calibrated it. A learning curve repeats this with
+1, 2, ... of the other actuators measured.
 """
 
 from __future__ import annotations
@@ -23,6 +28,7 @@ from softbend._io import json_text, write_text_atomic
 from softbend._validation import check_int, check_range
 from softbend.metrics import rmse, thresholded_mape
 from softbend.registry import UnknownNameError
+from softbend.transfer.conformal import Calibration, angle_floor, calibrate
 from softbend.transfer.measurements import Measurements
 from softbend.transfer.parameters import check_parameters, recorded_parameters
 from softbend.transfer.strategies import (
@@ -36,6 +42,7 @@ from softbend.transfer.strategies import (
 __all__ = [
     "DEFAULT_STRATEGIES",
     "LocoResult",
+    "held_out_residuals",
     "leave_one_configuration_out",
     "strategy_options",
 ]
@@ -43,7 +50,7 @@ __all__ = [
 #: The strategies of a default evaluation: softbend's own, in the order of the tables.
 DEFAULT_STRATEGIES: tuple[str, ...] = BUILTIN_STRATEGIES
 
-#: Strategies left out of the learning curve (the longest training).
+#: Strategies left out of the learning curve and the nested calibration (the longest training).
 _SLOW = ("experimental", "refined-ensemble")
 
 _OWNER = "leave_one_configuration_out"
@@ -58,13 +65,17 @@ class LocoResult:
     per_actuator : DataFrame
         One row per (strategy, held-out actuator): ``n_points``, ``rmse_deg``,
         ``mape_pct``, ``max_error_deg``, ``coverage`` (share inside the interval,
-        NaN without one), ``fit_s``.
+        NaN without one), ``calibrated_coverage`` and ``calibrated_width_deg``
+        (share inside, and mean width in degrees, of the calibrated interval,
+        calibrated without the held-out actuator; NaN when not calibrated),
+        ``calibration_half_width_deg``, ``calibration_guaranteed``, ``fit_s``.
     summary : DataFrame
-        One row per strategy: the means over actuators, the worst actuator and
-        its RMSE and MAPE.
+        One row per strategy: the means over actuators (coverages weighted by
+        readings), the worst actuator and its RMSE and MAPE.
     predictions : DataFrame
         Every held-out reading with each strategy's prediction (``lo``/``hi`` for
-        interval strategies).
+        interval strategies, ``cal_lo_deg``/``cal_hi_deg`` for the calibrated
+        interval).
     learning_curve : DataFrame
         ``strategy, n_actuators, held_out, rmse_deg, mape_pct``: fitted on the
         first ``n`` of the other actuators in a seeded order.
@@ -75,6 +86,9 @@ class LocoResult:
         Probability of the intervals.
     settings : dict
         Strategies, seed, interval level, time taken.
+    calibrations : dict of str to dict
+        Per calibrated strategy, the calibration on all the actuators (what
+        ``softbend transfer refine`` would record; :meth:`Calibration.to_dict`).
     """
 
     per_actuator: pd.DataFrame
@@ -84,6 +98,7 @@ class LocoResult:
     loss_curves: dict[str, np.ndarray] = field(default_factory=dict)
     level: float = 0.9
     settings: dict[str, Any] = field(default_factory=dict)
+    calibrations: dict[str, dict[str, Any]] = field(default_factory=dict)
 
     def best(self) -> str:
         """The strategy with the lowest mean RMSE."""
@@ -119,6 +134,7 @@ class LocoResult:
             "learning_curve": self.learning_curve.to_dict(orient="records"),
             "final_loss_deg2": {k: float(v[-1]) for k, v in self.loss_curves.items()},
             "level": self.level,
+            "calibration": self.calibrations,
             "settings": self.settings,
         }
 
@@ -176,6 +192,7 @@ def leave_one_configuration_out(
     *,
     level: float = 0.9,
     learning_curve: bool = True,
+    calibrated: bool = False,
     seed: int = 0,
     options: dict[str, dict[str, Any]] | None = None,
     progress: Callable[[int, int, str], None] | None = None,
@@ -198,6 +215,11 @@ def leave_one_configuration_out(
         Also fit on 1, 2, ..., n−2 of the other actuators (n−1 is the main
         evaluation); not ``experimental`` and ``refined-ensemble``, whose
         training would dominate the time.
+    calibrated : bool, default False
+        Also score the calibrated interval of :mod:`softbend.transfer.conformal`
+        on each held-out actuator, nested (n − 1 more fits per held-out
+        actuator, each without it and one other; at least 3 actuators); not
+        ``experimental`` and ``refined-ensemble``.
     seed : int, default 0
         Seed of the strategies and of the learning curve's actuator order.
     options : dict, optional
@@ -239,6 +261,7 @@ def leave_one_configuration_out(
     X, y, groups = measurements.features, measurements.angle_deg, measurements.groups
     rng = np.random.default_rng([seed, 3])
     curve_names = [n for n in names if n not in _SLOW] if learning_curve else []
+    nested_names = [n for n in names if n not in _SLOW] if calibrated and len(ids) >= 3 else []
     start = time.perf_counter()
 
     # Every fit is a task: (kind, held-out actuator, n actuators, strategy, train, test rows).
@@ -252,44 +275,76 @@ def leave_one_configuration_out(
         for size in range(1, len(ids) - 1):
             rows = np.flatnonzero(np.isin(groups, order[:size]))
             tasks += [("curve", held_out, size, n, rows, test) for n in curve_names]
+        # Nested calibration: each other actuator predicted without it and without held_out.
+        for inner in others:
+            rows = np.flatnonzero(~np.isin(groups, [held_out, inner]))
+            inner_test = np.flatnonzero(groups == inner)
+            tasks += [
+                ("nested", f"{held_out}\x00{inner}", len(ids) - 2, n, rows, inner_test)
+                for n in nested_names
+            ]
     everything = np.arange(len(y))
     tasks += [("all", "", len(ids), n, everything, everything[:0]) for n in names]
     results: list[dict[str, Any]] = [{} for _ in tasks]
     done = 0
     for name in names:
         mine = [i for i, task in enumerate(tasks) if task[3] == name]
-        models, fit_s = _fit_all(
-            name, base, options.get(name, {}), seed, X, y, [tasks[i][4] for i in mine]
-        )
-        for i, model in zip(mine, models, strict=True):
-            test = tasks[i][5]
-            out: dict[str, Any] = {"fit_s": fit_s}
-            if test.size:
-                out["pred"] = np.asarray(model.predict(X[test]), dtype=np.float64)
-                out["interval"] = (
-                    model.predict_interval(X[test], level) if has_interval(model) else None
-                )
-            if hasattr(model, "loss_curve_"):
-                out["loss_curve"] = np.asarray(model.loss_curve_)
-            results[i] = out
+        # The nested calibration's fits in a batch of their own: the others' as without it.
+        for batch in (
+            [i for i in mine if tasks[i][0] != "nested"],
+            [i for i in mine if tasks[i][0] == "nested"],
+        ):
+            if not batch:
+                continue
+            models, fit_s = _fit_all(
+                name, base, options.get(name, {}), seed, X, y, [tasks[i][4] for i in batch]
+            )
+            for i, model in zip(batch, models, strict=True):
+                test = tasks[i][5]
+                out: dict[str, Any] = {"fit_s": fit_s}
+                if test.size:
+                    out["pred"] = np.asarray(model.predict(X[test]), dtype=np.float64)
+                    out["interval"] = (
+                        model.predict_interval(X[test], level) if has_interval(model) else None
+                    )
+                if hasattr(model, "loss_curve_"):
+                    out["loss_curve"] = np.asarray(model.loss_curve_)
+                results[i] = out
         done += len(mine)
         if progress is not None:
             progress(done, len(tasks), name)
 
+    # Leave-one-out errors: nested[(name, held_out)][inner], loco_errors[name][held_out].
+    nested: dict[tuple[str, str], dict[str, np.ndarray]] = {}
+    loco_errors: dict[str, dict[str, np.ndarray]] = {}
+    for (kind, held_out, _, name, _, test), out in zip(tasks, results, strict=True):
+        if kind == "nested":
+            outer, inner = held_out.split("\x00")
+            nested.setdefault((name, outer), {})[inner] = np.abs(out["pred"] - y[test])
+        elif kind == "loco" and name in nested_names:
+            loco_errors.setdefault(name, {})[held_out] = np.abs(out["pred"] - y[test])
+
     scores, predictions, curve = [], [], []
     loss_curves: dict[str, np.ndarray] = {}
-    for (kind, held_out, size, name, _, test), out in zip(tasks, results, strict=True):
+    for (kind, held_out, size, name, train, test), out in zip(tasks, results, strict=True):
         if kind == "all":
             if "loss_curve" in out:
                 loss_curves[name] = out["loss_curve"]
             continue
+        if kind == "nested":
+            continue
         row = _score(name, held_out, y[test], out["pred"], out["interval"])
         if kind == "loco":
             row["fit_s"] = out["fit_s"]
+            cal = _calibration(nested.get((name, held_out)), level, y[train])
+            row.update(_score_calibrated(cal, y[test], out["pred"]))
             scores.append(row)
             part = measurements.frame.iloc[test].assign(strategy=name, predicted_deg=out["pred"])
             if out["interval"] is not None:
                 part = part.assign(lo_deg=out["interval"][0], hi_deg=out["interval"][1])
+            if cal is not None:
+                lo, hi = cal.interval(out["pred"])
+                part = part.assign(cal_lo_deg=lo, cal_hi_deg=hi)
             predictions.append(part)
         if kind == "curve" or (kind == "loco" and name in curve_names):
             curve.append(
@@ -316,6 +371,11 @@ def leave_one_configuration_out(
         .reset_index(drop=True),
         loss_curves=loss_curves,
         level=level,
+        calibrations={
+            name: cal.to_dict()
+            for name in nested_names
+            if (cal := _calibration(loco_errors.get(name), level, y)) is not None
+        },
         settings={
             "strategies": list(names),
             "seed": seed,
@@ -329,10 +389,96 @@ def leave_one_configuration_out(
                 )
                 for name in names
             },
+            "calibrated": list(nested_names),
             "fits": len(tasks),
             "wall_time_s": time.perf_counter() - start,
         },
     )
+
+
+def held_out_residuals(
+    measurements: Measurements,
+    base: Any,
+    strategy: str,
+    *,
+    seed: int = 0,
+    options: dict[str, Any] | None = None,
+) -> dict[str, np.ndarray]:
+    """Each actuator's absolute errors from ``strategy`` fitted on the other actuators.
+
+    The leave-one-out errors that :func:`softbend.transfer.conformal.calibrate`
+    turns into a calibrated interval (one fit per actuator, batched where the
+    strategy can).
+
+    Parameters
+    ----------
+    measurements : Measurements
+        At least two actuators.
+    base : estimator
+        The simulation-trained surrogate the strategy starts from.
+    strategy : str
+        A registered strategy.
+    seed : int, default 0
+        Seed of the strategy.
+    options : dict, optional
+        Parameters of the strategy.
+
+    Returns
+    -------
+    dict of str to ndarray
+        Actuator id → ``|prediction − reading|`` on its readings, degrees.
+    """
+    owner = "held_out_residuals"
+    STRATEGIES.check(strategy, field="strategy")
+    ids = measurements.actuator_ids
+    if len(ids) < 2:
+        raise ValueError(
+            f"The 'measurements' of {owner} must cover at least 2 actuators. "
+            f"Got {len(ids)} ({', '.join(ids)}) instead."
+        )
+    values = check_parameters(strategy, STRATEGIES.get(strategy), dict(options or {}))
+    X, y, groups = measurements.features, measurements.angle_deg, measurements.groups
+    tests = [np.flatnonzero(groups == a) for a in ids]
+    trains = [np.flatnonzero(groups != a) for a in ids]
+    models, _ = _fit_all(strategy, base, values, seed, X, y, trains)
+    return {
+        a: np.abs(np.asarray(m.predict(X[t]), dtype=np.float64) - y[t])
+        for a, m, t in zip(ids, models, tests, strict=True)
+    }
+
+
+def _calibration(
+    errors: dict[str, np.ndarray] | None, level: float, seen: np.ndarray
+) -> Calibration | None:
+    """The calibration from leave-one-out errors; None without any, or with an actuator
+    whose errors are all non-finite."""
+    if not errors or not all(np.isfinite(e).any() for e in errors.values()):
+        return None
+    return calibrate(errors, level, floor_deg=angle_floor(seen))
+
+
+def _score_calibrated(cal: Calibration | None, y: np.ndarray, pred: np.ndarray) -> dict[str, Any]:
+    if cal is None:
+        return {
+            "calibrated_coverage": np.nan,
+            "calibrated_width_deg": np.nan,
+            "calibration_half_width_deg": np.nan,
+            "calibration_guaranteed": None,
+        }
+    lo, hi = cal.interval(pred)
+    return {
+        "calibrated_coverage": float(np.mean((y >= lo) & (y <= hi))),
+        "calibrated_width_deg": float(np.mean(hi - lo)),
+        "calibration_half_width_deg": cal.half_width_deg,
+        "calibration_guaranteed": cal.guaranteed,
+    }
+
+
+def _weighted(part: pd.DataFrame, column: str) -> float:
+    """The mean of ``column`` weighted by readings; NaN unless every actuator has one."""
+    if not part[column].notna().all():
+        return np.nan
+    return float((part[column] * part["n_points"]).sum() / part["n_points"].sum())
 
 
 def _summarize(per_actuator: pd.DataFrame, names: Sequence[str]) -> pd.DataFrame:
@@ -351,6 +497,8 @@ def _summarize(per_actuator: pd.DataFrame, names: Sequence[str]) -> pd.DataFrame
                 )
                 if part["coverage"].notna().all()
                 else np.nan,
+                "calibrated_coverage": _weighted(part, "calibrated_coverage"),
+                "calibrated_width_deg": _weighted(part, "calibrated_width_deg"),
                 "worst_actuator": None if worst is None else worst["actuator_id"],
                 "worst_rmse_deg": np.nan if worst is None else float(worst["rmse_deg"]),
                 "worst_mape_pct": np.nan if worst is None else float(worst["mape_pct"]),

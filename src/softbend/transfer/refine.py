@@ -6,18 +6,27 @@ and a measurements file, fits a strategy of
 returns a :class:`Refinement`, whose :meth:`~Refinement.save` writes the fitted
 model with its record (strategy, parameters, inputs, training error, the
 ranges it was trained on). The saved model plugs into ``softbend predict``.
+
+Every refinement is also calibrated (:mod:`softbend.transfer.conformal`): the
+strategy is refitted once per measured actuator without it, and the
+leave-one-actuator-out errors give the half-width of a 90 % interval for a new
+actuator, recorded as the ``interval`` of the record. With too few actuators
+for the rule's guarantee the half-width is the largest such error, and a
+warning says so.
 """
 
 from __future__ import annotations
 
 import os
-from collections.abc import Mapping
+import warnings
+from collections.abc import Mapping, Sequence
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
 import numpy as np
 
+from softbend.transfer.conformal import Calibration, angle_floor, calibrate
 from softbend.transfer.parameters import check_parameters, recorded_parameters, takes
 from softbend.transfer.strategies import STRATEGIES, fit_strategy, learns
 
@@ -39,14 +48,39 @@ class Refinement:
         The fitted strategy; ``strategy.model_`` is the surrogate saved.
     metadata : dict
         The record saved with it: ``strategy``, ``parameters`` (every parameter
-        as it ran, seed included), ``base``, ``measurements``,
-        ``n_measurements``, ``actuators``, ``synthetic_measurements``,
+        as it ran, seed included), ``base``, ``measurements`` (the file, or
+        the list of files), ``measurement_files`` (path, SHA-256, readings and
+        synthetic flag of each), ``n_measurements``, ``actuators``,
+        ``synthetic_measurements`` (``true``, ``false`` or ``mixed``),
         ``training_rmse_deg`` (degrees), ``training_ranges`` (mm, deg, MPa) and,
-        for the strategies that train a network, ``final_training_mse_deg2``.
+        for the strategies that train a network, ``final_training_mse_deg2``;
+        ``interval``: the calibration (:meth:`Calibration.to_dict`, with a
+        ``warning`` when too few actuators) or None when not calibrated.
+    calibration : Calibration or None
+        The calibrated 90 % interval for a new actuator; None when not
+        calibrated (one actuator, or ``calibrated=False``).
     """
 
     strategy: Any
     metadata: dict[str, Any]
+    calibration: Calibration | None = None
+
+    def predict_interval(self, X: Any, level: float = 0.9) -> tuple[np.ndarray, np.ndarray]:
+        """The calibrated interval at the rows ``X``, degrees (``level``: the calibration's).
+
+        Raises
+        ------
+        ValueError
+            Not calibrated, or another ``level``.
+        """
+        from softbend.transfer.conformal import Calibrated
+
+        if self.calibration is None:
+            raise ValueError(
+                "The refinement has no calibrated interval: it needs measurements of at "
+                "least 2 actuators and calibrated=True."
+            )
+        return Calibrated(self.strategy, self.calibration).predict_interval(X, level)
 
     def save(self, path: str | os.PathLike[str]) -> Path:
         """Write the fitted model and its record to ``path`` (JSON, atomically); returns it."""
@@ -65,13 +99,15 @@ def _merged_ranges(own: dict[str, list[float]], base: Any) -> dict[str, list[flo
 
 def refine_surrogate(
     base: str | os.PathLike[str],
-    measurements: str | os.PathLike[str],
+    measurements: str | os.PathLike[str] | Sequence[str | os.PathLike[str]],
     strategy: str = "refined",
     *,
     seed: int = 0,
     settings: Mapping[str, str] | None = None,
     options: Mapping[str, Any] | None = None,
     field: str = "--set",
+    calibrated: bool = True,
+    force: bool = False,
 ) -> Refinement:
     """Fit ``strategy`` on every reading of a measurements file, starting from a saved surrogate.
 
@@ -80,8 +116,9 @@ def refine_surrogate(
     base : path
         A surrogate saved by :func:`softbend.surrogates.save_surrogate` (an
         ``mlp`` for the strategies that refine a network).
-    measurements : path
-        A measurements CSV (:func:`softbend.transfer.measurements.load_measurements`).
+    measurements : path or sequence of paths
+        One or more measurements CSV files, joined
+        (:func:`softbend.transfer.measurements.load_measurements_files`).
     strategy : str, default "refined"
         A registered strategy that learns from the measurements
         (:func:`refinable_strategies`).
@@ -94,6 +131,14 @@ def refine_surrogate(
         Parameters of the strategy as values (``{"epochs": 500}``).
     field : str, default "--set"
         Where ``settings`` came from, named in messages.
+    calibrated : bool, default True
+        Also calibrate the 90 % interval over actuators (one more fit per
+        actuator; at least 2 actuators). A ``UserWarning`` when there are too
+        few for the rule's guarantee (:func:`softbend.transfer.conformal.min_actuators`)
+        or too few to calibrate at all.
+    force : bool, default False
+        Read angles that look like radians as degrees, as given, with a
+        warning (:mod:`softbend.transfer.measurements`, Units).
 
     Returns
     -------
@@ -111,7 +156,11 @@ def refine_surrogate(
     """
     from softbend.surrogates.features import training_ranges
     from softbend.surrogates.persistence import load_surrogate
-    from softbend.transfer.measurements import load_measurements
+    from softbend.transfer.measurements import (
+        files_record,
+        load_measurements_files,
+        synthetic_label,
+    )
 
     cls = STRATEGIES.get(strategy, field="strategy")
     if not learns(strategy):
@@ -123,7 +172,8 @@ def refine_surrogate(
         **check_parameters(strategy, cls, settings, field=field, from_text=True),
         **check_parameters(strategy, cls, options),
     }
-    data = load_measurements(measurements)
+    files = [measurements] if isinstance(measurements, str | os.PathLike) else list(measurements)
+    data = load_measurements_files(files, force=force)
     start = load_surrogate(base)
     model = fit_strategy(strategy, start.model, data, seed=seed, **values)
     ranges = training_ranges(data.features)
@@ -134,13 +184,42 @@ def refine_surrogate(
         "strategy": strategy,
         "parameters": recorded_parameters(model),
         "base": str(base),
-        "measurements": str(measurements),
+        "measurements": str(files[0]) if len(files) == 1 else [str(f) for f in files],
+        "measurement_files": files_record(files, data),
         "n_measurements": len(data),
         "actuators": list(data.actuator_ids),
-        "synthetic_measurements": str(data.metadata.get("synthetic", "false")),
+        "synthetic_measurements": synthetic_label(data),
         "training_rmse_deg": float(np.sqrt(np.mean(residual**2))),
         "training_ranges": ranges,
     }
     if hasattr(model, "loss_curve_"):
         metadata["final_training_mse_deg2"] = float(model.loss_curve_[-1])
-    return Refinement(model, metadata)
+    calibration = _calibrate(data, start.model, strategy, seed, values) if calibrated else None
+    metadata["interval"] = None if calibration is None else calibration.to_dict()
+    if calibration is not None and calibration.warning() is not None:
+        metadata["interval"]["warning"] = calibration.warning()
+    return Refinement(model, metadata, calibration)
+
+
+def _calibrate(
+    data: Any, base: Any, strategy: str, seed: int, values: dict[str, Any]
+) -> Calibration | None:
+    """The 90 % calibration over the actuators of ``data``; warns when they are too few."""
+    from softbend.surrogates.predict import INTERVAL_LEVEL
+    from softbend.transfer.loco import held_out_residuals
+
+    n = len(data.actuator_ids)
+    if n < 2:
+        warnings.warn(
+            f"{n} actuator measured: no calibrated interval (calibrating over actuators "
+            "needs at least 2, and 9 for a guaranteed 90 % interval).",
+            UserWarning,
+            stacklevel=3,
+        )
+        return None
+    residuals = held_out_residuals(data, base, strategy, seed=seed, options=values)
+    calibration = calibrate(residuals, INTERVAL_LEVEL, floor_deg=angle_floor(data.angle_deg))
+    message = calibration.warning()
+    if message is not None:
+        warnings.warn(message, UserWarning, stacklevel=3)
+    return calibration
