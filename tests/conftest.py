@@ -1,10 +1,18 @@
 """Shared fixtures: a small analytical campaign for the surrogate and CLI tests."""
 
+import os
+import tempfile
+
 import pytest
 
 from softbend.campaign import load_samples, run_campaign
 from softbend.design import DesignSpace
 from softbend.surrogates.features import training_data
+
+
+def pytest_configure(config):
+    """Caches the tests fill (swept FEM plants) go to a temporary folder, not the user's."""
+    os.environ["SOFTBEND_CACHE_DIR"] = tempfile.mkdtemp(prefix="softbend-test-cache-")
 
 
 @pytest.fixture(scope="session")

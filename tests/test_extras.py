@@ -83,7 +83,12 @@ def test_the_core_works_without_extras(tmp_path):
     ("code", "extra"),
     [
         ("from softbend.fem import FEMModel", "softbend[fem]"),
-        ("from softbend.surrogates import NormalizedMLPRegressor", "softbend[ml]"),
+        # A saved MLP predicts on NumPy alone; training it needs PyTorch.
+        (
+            "from softbend.surrogates import NormalizedMLPRegressor; "
+            "NormalizedMLPRegressor(epochs=1).fit([[1.0] * 7, [2.0] * 7], [0.0, 1.0])",
+            "softbend[ml]",
+        ),
         (XGB, "softbend[ml]"),
     ],
 )

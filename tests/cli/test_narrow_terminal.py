@@ -94,6 +94,7 @@ def test_loco_summary_wraps_on_80_columns(narrow, capsys):
         summary=summary,
         settings={"actuators": ["a"] * 7, "n_measurements": 139},
         level=0.9,
+        calibrations={},
     )
     print_loco_summary(result)
     _check_whole(capsys.readouterr().out)

@@ -59,7 +59,7 @@ def test_simulate_writes_run(tmp_path, capsys, controller):
         (["serve", "--duration", "-2"], ["'duration'"]),
         (["serve", "--port", "70000"], ["'--port' of softbend control serve"]),
         (["simulate", "--plant", "lab", "--design", "160,10,4,4,15,12"], ["no measured"]),
-        (["simulate", "--plant", "fem", "--design", "105,6,2,2,5,8"], ["not in the FEM dataset"]),
+        (["simulate", "--plant", "fem", "--design", "0,6,2,2,5,8"], ["l_mm"]),
     ],
 )
 def test_bad_input_of_every_control_command_is_one_line(tmp_path, capsys, args, needles):
