@@ -5,6 +5,8 @@
 * :mod:`~softbend.campaign.schema` — the tables of a campaign database, their
   version and the checks of an existing file;
 * :mod:`~softbend.campaign.store` — the DuckDB database, one transaction per design;
+* :mod:`~softbend.campaign.settings` — the backend's settings a database records
+  (mesh, FEM options, material) and checks on resume;
 * :mod:`~softbend.campaign.spaces` — design spaces and shards named by text, and
   the memory and disk a campaign over one needs;
 * :mod:`~softbend.campaign.runner` — :func:`run_campaign`: plans a run
@@ -49,6 +51,9 @@ _EXPORTS = {
     "check_footprint": "spaces",
     "parse_shard": "spaces",
     "parse_space": "spaces",
+    "SettingsMismatchError": "settings",
+    "UncheckedSettingsWarning": "settings",
+    "backend_settings": "settings",
     "SCHEMA_VERSION": "store",
     "CampaignStore": "store",
     "load_designs": "store",

@@ -11,7 +11,9 @@ module maps the names a command line or a database uses to them
 One call adds a backend: ``register_backend("my-model", factory)``, where
 ``factory(**options)`` returns the model. A backend read from a saved file takes
 its path as the option ``path``; :func:`backend_for_run` gives it the file of a
-command line (``softbend campaign run --backend NAME --model FILE``). A trained
+command line (``softbend campaign run --backend NAME --model FILE``), and a backend
+that takes an elastomer (:func:`takes_material`: ``"fem"``, ``"analytical"``) its
+``--material`` (:func:`resolve_material`, :func:`with_material`). A trained
 surrogate is such a backend, ``"surrogate"``; it is registered from above the
 campaign in the pipeline (surrogates sit above it), so that a campaign can also
 run on a :class:`softbend.surrogates.SurrogateModel` passed as an object to
@@ -27,13 +29,14 @@ process, which validates their options before any work starts.
 
 from __future__ import annotations
 
+import dataclasses
 import inspect
 import logging
 import os
 import time
 from collections.abc import Callable, Mapping
 from dataclasses import dataclass, field
-from typing import Any
+from typing import Any, cast
 
 import numpy as np
 
@@ -41,6 +44,7 @@ from softbend._validation import check_range
 from softbend.analytical import AnalyticalModel
 from softbend.design import SFRBADesign
 from softbend.errors import ConvergenceError, SoftbendError
+from softbend.materials.presets import Material
 from softbend.models import (
     DEFAULT_PMAX_MPA,
     DEFAULT_PSTEP_MPA,
@@ -68,6 +72,9 @@ __all__ = [
     "get_backend",
     "public_backends",
     "register_backend",
+    "resolve_material",
+    "takes_material",
+    "with_material",
 ]
 
 logger = logging.getLogger(__name__)
@@ -89,8 +96,20 @@ def _import_fem() -> Any:
     return fem
 
 
-def _make_fem(options: Any = None, *, compiled: bool = False, **fem_options: Any) -> BendingModel:
+def _make_fem(
+    options: Any = None, *, compiled: bool = False, material: Any = None, **fem_options: Any
+) -> BendingModel:
     fem = _import_fem()
+    if material is not None:
+        if "elastomer" in fem_options:
+            raise ValueError(
+                "The elastomer of the 'fem' backend must be given either as 'material' or as "
+                f"'elastomer', not both. Got material={material!r}."
+            )
+        if options is None:
+            fem_options["elastomer"] = resolve_material(material)[0]
+        else:
+            options = options.replace(elastomer=resolve_material(material)[0])
     if fem_options:
         if options is not None:
             raise ValueError(
@@ -280,8 +299,10 @@ def backend_for_run(
     *,
     model: str | os.PathLike[str] | None = None,
     compiled: bool = False,
+    material: str | os.PathLike[str] | Material | None = None,
     field: str = "backend",
     model_field: str = "model",
+    material_field: str = "material",
     owner: str = "backend_for_run",
 ) -> Backend:
     """The backend a command line names, built with what the command line gives it.
@@ -295,21 +316,31 @@ def backend_for_run(
         e.g. ``"surrogate"``); required for such a backend, refused for others.
     compiled : bool, default False
         Passed to a backend whose factory takes it (``"fem"``: compile the energy).
-    field, model_field, owner : str
+    material : str, path or Material, optional
+        The elastomer of a backend that takes one (:func:`takes_material`): a
+        preset name or ``fit.json[#model]``, as
+        :func:`~softbend.materials.choice.material_from_spec`; refused for others.
+        Default: the backend's own (Dragon Skin 30).
+    field, model_field, material_field, owner : str
         The options and the command named in messages (``"--backend"``,
-        ``"--model"``, ``"softbend campaign run"``).
+        ``"--model"``, ``"--material"``, ``"softbend campaign run"``).
 
     Raises
     ------
     UnknownNameError
         A name that is not a public backend (the public ones listed).
     ValueError
-        A file given to a backend that reads none, or none to one that does.
+        A file given to a backend that reads none, or none to one that does; a
+        material given to a backend that takes none.
+    UnknownNameError, SchemaError
+        A material that is neither a preset nor a readable ``fit.json``.
     """
     public = Registry[Callable[..., Backend]](BACKENDS.kind)
     for known in public_backends():
         public.register(known, BACKENDS.get(known))
     takes = inspect.signature(public.get(name, field=field)).parameters
+    if material is not None and "material" not in takes:
+        raise ValueError(_no_material(material_field, owner, f"{field} {name}"))
     if ("path" in takes) != (model is not None):
         from_file = [n for n in public if "path" in inspect.signature(public.get(n)).parameters]
         shown = f"{field} {' or '.join(from_file)}" if from_file else "none is registered"
@@ -318,6 +349,87 @@ def backend_for_run(
             f"file ({shown}), and only then. Got {field} {name} and {model_field} {model} instead."
         )
     options: dict[str, Any] = {"path": model} if model is not None else {}
+    if material is not None:
+        options["material"] = resolve_material(material, field=material_field)[0]
     if "compiled" in takes:
         options["compiled"] = compiled
     return get_backend(name, **options)
+
+
+def takes_material(name: str) -> bool:
+    """Whether the backend registered as ``name`` takes an elastomer (a ``material`` option)."""
+    return "material" in inspect.signature(BACKENDS.get(name, field="backend")).parameters
+
+
+def _no_material(field: str, owner: str, given: str) -> str:
+    takers = [n for n in public_backends() if takes_material(n)]
+    return (
+        f"The '{field}' of {owner} applies to a backend that takes a material "
+        f"({', '.join(takers)}). Got {given} instead."
+    )
+
+
+def resolve_material(
+    material: str | os.PathLike[str] | Material, *, field: str = "material"
+) -> tuple[Material, dict[str, str] | None]:
+    """The material ``material`` names, and what named it (None for a Material object).
+
+    Parameters
+    ----------
+    material : str, path or Material
+        A preset name, ``fit.json[#model]`` (as
+        :func:`~softbend.materials.choice.material_from_spec`) or a material.
+    field : str
+        Where it came from, named in messages.
+
+    Returns
+    -------
+    (Material, dict or None)
+        The material, and :func:`~softbend.materials.choice.material_spec_record`
+        of a spec (the spec, and a fit's file and SHA-256).
+    """
+    if isinstance(material, Material):
+        return material, None
+    from softbend.materials.choice import material_from_spec, material_spec_record
+
+    if not isinstance(material, str | os.PathLike):
+        raise ValueError(
+            f"The '{field}' must be a preset name, the path of a fit.json or a Material. "
+            f"Got {material!r} instead."
+        )
+    return material_from_spec(material, field=field), material_spec_record(material)
+
+
+def with_material(
+    backend: Backend, material: Material, *, field: str = "material", owner: str = "with_material"
+) -> Backend:
+    """``backend`` with ``material`` as its elastomer.
+
+    The FEM's :class:`~softbend.fem.FEMOptions` get it as their ``elastomer``;
+    a backend with a ``material`` field (the analytical model) as that; a
+    wrapper (``"fault-injection"``) passes it to its inner backend. The result
+    is a new object, picklable as the backend was.
+
+    Raises
+    ------
+    ValueError
+        A backend that takes no material.
+    """
+    from softbend.campaign.settings import fem_options_of
+
+    options = fem_options_of(backend)
+    target: Any = backend  # a dataclass, checked below
+    names: set[str] = set()
+    if dataclasses.is_dataclass(target) and not isinstance(target, type):
+        names = {f.name for f in dataclasses.fields(target)}
+    if options is not None and "options" in names:
+        return cast(
+            Backend, dataclasses.replace(target, options=options.replace(elastomer=material))
+        )
+    if "material" in names:
+        return cast(Backend, dataclasses.replace(target, material=material))
+    inner = getattr(backend, "inner", None)
+    if "inner" in names and isinstance(inner, Backend):
+        inner = with_material(inner, material, field=field, owner=owner)
+        return cast(Backend, dataclasses.replace(target, inner=inner))
+    raise ValueError(_no_material(field, owner, f"backend {backend.name!r}"))

@@ -2,10 +2,10 @@
 
 :func:`check_designs`, :func:`resolve_backend` and :func:`check_run_options`
 check the arguments of :func:`~softbend.campaign.runner.run_campaign`;
-:func:`plan_run` binds the database to the backend and pressure grid (or checks
-them on resume), leaves out the designs already done (and those that failed
-before, unless they are retried) and names the executor; :func:`auto_chunk_size`
-and :func:`chunks` cut the designs left into worker tasks.
+:func:`plan_run` binds the database to the backend, its settings and the
+pressure grid (or checks them on resume), leaves out the designs already done
+(and those that failed before, unless they are retried) and names the executor;
+:func:`auto_chunk_size` and :func:`chunks` cut the designs left into worker tasks.
 """
 
 from __future__ import annotations
@@ -178,6 +178,8 @@ def plan_run(
     retry_failed: bool,
     workers: int,
     address: str | None,
+    settings: dict[str, Any] | None = None,
+    accept_new_settings: bool = False,
 ) -> RunPlan:
     """Bind the campaign, find the designs left and name the executor.
 
@@ -199,6 +201,11 @@ def plan_run(
         Local worker processes asked for (checked).
     address : str, optional
         Dask scheduler address (checked); None for this machine.
+    settings : dict, optional
+        The backend's settings (:func:`~softbend.campaign.settings.backend_settings`),
+        recorded by the first run and checked by later ones.
+    accept_new_settings : bool
+        Run even if ``settings`` differ from the recorded ones.
 
     Returns
     -------
@@ -209,8 +216,17 @@ def plan_run(
     ------
     ValueError
         The database holds a campaign with another backend or grid.
+    SettingsMismatchError
+        Other recorded settings, not accepted.
     """
-    store.bind(backend, pressures_mpa, space=space, n_designs_planned=len(designs))
+    store.bind(
+        backend,
+        pressures_mpa,
+        space=space,
+        n_designs_planned=len(designs),
+        settings=settings,
+        accept_new_settings=accept_new_settings,
+    )
     done_ids = store.finished_ids()
     failed_ids = store.failed_ids()
     todo = [

@@ -54,7 +54,13 @@ import numpy as np
 from numpy.typing import ArrayLike
 
 from softbend import __version__
-from softbend.campaign.backends import Backend, check_pressures_mpa, default_pressures_mpa
+from softbend.campaign.backends import (
+    Backend,
+    check_pressures_mpa,
+    default_pressures_mpa,
+    resolve_material,
+    with_material,
+)
 from softbend.campaign.executors import (
     ProgressCallback,
     Recorder,
@@ -73,8 +79,10 @@ from softbend.campaign.planning import (
     plan_run,
     resolve_backend,
 )
+from softbend.campaign.settings import backend_settings
 from softbend.campaign.store import CampaignStore
 from softbend.design import SFRBADesign
+from softbend.materials.presets import Material
 
 __all__ = ["CampaignSummary", "count_designs_to_run", "parse_scheduler_address", "run_campaign"]
 
@@ -160,6 +168,8 @@ def run_campaign(
     progress: ProgressCallback | None = None,
     chunk_size: int | None = None,
     connect_timeout_s: float = 5.0,
+    material: str | os.PathLike[str] | Material | None = None,
+    accept_new_settings: bool = False,
 ) -> CampaignSummary:
     """Sweep every design not yet done and record each in the campaign database.
 
@@ -196,6 +206,15 @@ def run_campaign(
         most 16.
     connect_timeout_s : float
         Time allowed to reach the Dask scheduler and find a worker, s, in (0, 600].
+    material : str, path or Material, optional
+        Elastomer of a backend that takes one (``"fem"``, ``"analytical"``): a
+        preset name, ``fit.json[#model]`` (as
+        :func:`~softbend.materials.choice.material_from_spec`) or a material; it
+        reaches every sweep, in every worker. Default: the backend's own.
+    accept_new_settings : bool
+        Resume even if the backend's settings (mesh size and other FEM options,
+        material, see :mod:`~softbend.campaign.settings`) differ from those the
+        database recorded at its first run; each run's settings stay in its record.
 
     Returns
     -------
@@ -207,7 +226,11 @@ def run_campaign(
     ValueError
         Bad input: unknown backend or option, empty or duplicate designs, a
         negative or non-increasing pressure grid, ``workers < 0``, a malformed
-        scheduler address, or a database holding another backend or grid.
+        scheduler address, a material given to a backend that takes none, or a
+        database holding another backend or grid.
+    SettingsMismatchError
+        The database recorded other backend settings (not accepted); the message
+        names each differing setting with both values.
     SchemaError
         The database has a newer schema or is not a campaign database.
     SoftbendError
@@ -216,10 +239,15 @@ def run_campaign(
     """
     start = time.perf_counter()
     backend_obj = resolve_backend(backend, backend_options)
+    given = None
+    if material is not None:
+        elastomer, given = resolve_material(material)
+        backend_obj = with_material(backend_obj, elastomer, owner=_OWNER)
     design_list = check_designs(designs)
     grid = check_pressures_mpa(
         default_pressures_mpa() if pressures_mpa is None else pressures_mpa, _OWNER
     )
+    settings = backend_settings(backend_obj, grid, material_given=given)
     workers, chunk_size, timeout_s = check_run_options(workers, chunk_size, connect_timeout_s)
     address = parse_scheduler_address(scheduler) if scheduler is not None else None
     if progress is not None and not callable(progress):
@@ -239,12 +267,14 @@ def run_campaign(
                 retry_failed=retry_failed,
                 workers=workers,
                 address=address,
+                settings=settings,
+                accept_new_settings=accept_new_settings,
             )
             recorder = Recorder(store, backend_obj.name, len(plan.todo), progress)
             recorder.report()
             chunk_size = _execute(plan, backend_obj, grid, client, chunk_size, recorder)
             if recorder.done or recorder.failed:
-                store.log_run(_run_record(space, plan.executor, recorder, start))
+                store.log_run(_run_record(space, plan.executor, recorder, start, settings))
     finally:
         if client is not None:
             client.close()
@@ -321,9 +351,13 @@ def _execute(
 
 
 def _run_record(
-    space: str | None, executor: str, recorder: Recorder, start: float
+    space: str | None,
+    executor: str,
+    recorder: Recorder,
+    start: float,
+    settings: dict[str, Any],
 ) -> dict[str, Any]:
-    """The record of this run kept in the campaign's ``runs`` metadata."""
+    """The record of this run kept in the campaign's ``runs`` metadata (and a dataset's)."""
     return {
         "space": space,
         "executor": executor,
@@ -335,4 +369,6 @@ def _run_record(
         "sweep_time_s": recorder.sweep_time_s,
         "wall_time_s": time.perf_counter() - start,
         "finished_at": time.strftime("%Y-%m-%dT%H:%M:%SZ", time.gmtime()),
+        "material": settings.get("material"),
+        "settings": settings,
     }

@@ -6,7 +6,11 @@ Tables (schema version :data:`SCHEMA_VERSION`):
     ``schema_version``, ``softbend_version`` and ``created_at`` (set on creation),
     ``backend`` and ``pressures_mpa`` (JSON list; set by the first run and checked
     by every later one, so a resumed campaign cannot mix models or grids),
-    ``space`` and ``n_designs_planned`` (of the latest run).
+    ``settings`` (JSON object: the backend's settings that change the numbers,
+    mesh size, FEM options and material among them, see
+    :mod:`softbend.campaign.settings`; set by the first run, checked by later
+    ones, absent in databases of older softbend versions), ``runs`` (JSON list
+    of each run's record), ``space`` and ``n_designs_planned`` (of the latest run).
 ``designs``
     One row per attempted design: its parameters (``l_mm`` ... ``lc_mm``),
     ``status`` ``'done'`` or ``'failed'``, ``error`` (``"ExceptionType: message"``

@@ -1,7 +1,8 @@
 """The campaign database: one DuckDB file per campaign.
 
-:class:`CampaignStore` opens (or creates) the file, binds it to one backend and
-pressure grid, records designs, merges shards and reads the data back;
+:class:`CampaignStore` opens (or creates) the file, binds it to one backend, its
+settings (:mod:`softbend.campaign.settings`) and one pressure grid, records
+designs, merges shards and reads the data back;
 :func:`merge_campaigns` merges several shards into one database all or nothing. The
 tables, their schema version and the checks of an existing file live in
 :mod:`softbend.campaign.schema`.
@@ -23,6 +24,7 @@ import math
 import os
 import shutil
 import uuid
+import warnings
 from collections.abc import Iterator, Sequence
 from contextlib import contextmanager
 from pathlib import Path
@@ -46,6 +48,12 @@ from softbend.campaign.schema import (
     write_error,
 )
 from softbend.campaign.schema import SAMPLE_COLUMNS as SAMPLE_COLUMNS
+from softbend.campaign.settings import (
+    SettingsMismatchError,
+    UncheckedSettingsWarning,
+    describe_differences,
+    settings_differences,
+)
 from softbend.design import PARAMETERS, SFRBADesign
 from softbend.errors import SchemaError, SoftbendError
 from softbend.models import SweepResult, check_pressures_mpa
@@ -221,6 +229,21 @@ class CampaignStore:
         self._grid = None if text is None else self._stored_grid(text)
         if self._grid is not None:
             self._grid.setflags(write=False)
+        settings = meta.get("settings")
+        self._settings = None if settings is None else self._stored_settings(settings)
+
+    def _stored_settings(self, text: str) -> dict[str, Any]:
+        """The backend settings kept in the ``meta`` table; a damaged entry is refused."""
+        try:
+            settings = json.loads(text)
+        except (ValueError, RecursionError):
+            settings = None
+        if not isinstance(settings, dict):
+            raise SchemaError(
+                f"The campaign database {str(self.path)!r} has a damaged 'settings' in its "
+                f"'meta' table: it must be a JSON object. Got {text[:80]!r}."
+            )
+        return settings
 
     def _stored_grid(self, text: str) -> np.ndarray:
         """The pressure grid kept in the ``meta`` table, checked like a grid of a run."""
@@ -262,6 +285,16 @@ class CampaignStore:
         """Pressure grid of the campaign in MPa (None before the first run)."""
         return self._grid
 
+    @property
+    def settings(self) -> dict[str, Any] | None:
+        """Backend settings the campaign was started with (None if not recorded).
+
+        See :func:`~softbend.campaign.settings.backend_settings`: the backend, the
+        pressure grid, the FEM options and the material. None before the first
+        run and in a database of a softbend that did not record them.
+        """
+        return None if self._settings is None else json.loads(json.dumps(self._settings))
+
     def bind(
         self,
         backend: str,
@@ -269,8 +302,10 @@ class CampaignStore:
         *,
         space: str | None = None,
         n_designs_planned: int | None = None,
+        settings: dict[str, Any] | None = None,
+        accept_new_settings: bool = False,
     ) -> None:
-        """Fix the backend and pressure grid of the campaign, or check them on resume.
+        """Fix the backend, its settings and the pressure grid, or check them on resume.
 
         Parameters
         ----------
@@ -282,12 +317,24 @@ class CampaignStore:
             Label of the design space (stored for reports).
         n_designs_planned : int, optional
             Number of designs this run asked for.
+        settings : dict, optional
+            The backend's settings (:func:`~softbend.campaign.settings.backend_settings`).
+            Recorded by the first bind; checked by later ones. A database
+            bound before without settings (of an older softbend) takes them,
+            with an :class:`~softbend.campaign.settings.UncheckedSettingsWarning`
+            when it holds designs already.
+        accept_new_settings : bool
+            Go on even if ``settings`` differ from the recorded ones (the recorded
+            ones stay: they are those of the campaign's first run).
 
         Raises
         ------
         ValueError
             If the database already holds a campaign with another backend or grid:
             mixing them would make the data inconsistent; use a new database.
+        SettingsMismatchError
+            Other settings than the recorded ones, not accepted; it names each
+            differing setting with both values.
         """
         grid = check_pressures_mpa(pressures_mpa, "CampaignStore.bind")
         stored_backend, stored_grid = self.backend, self.pressures_mpa
@@ -302,11 +349,33 @@ class CampaignStore:
                 f"{_describe_grid(stored_grid)}. Got {_describe_grid(grid)} instead; "
                 "use a new database for another pressure grid."
             )
+        recorded = self._settings
+        if settings is not None and recorded is not None:
+            differences = settings_differences(recorded, settings)
+            if differences and not accept_new_settings:
+                raise SettingsMismatchError(self.path, differences)
+            if differences:
+                logger.warning(
+                    "campaign %s resumed with other settings (accepted): %s",
+                    self.path,
+                    ", ".join(name for name, _, _ in differences),
+                )
+        elif settings is not None and stored_backend is not None and self._recorded:
+            warnings.warn(
+                f"The campaign database {str(self.path)!r} records no backend settings (an "
+                f"older softbend's, or bound without them): its {len(self._recorded)} designs "
+                "recorded before could not be checked against the settings of this run "
+                "(mesh, material, options); these are recorded now and checked from now on.",
+                UncheckedSettingsWarning,
+                stacklevel=2,
+            )
         with self._writing(), transaction(self._con):
             if stored_backend is None:
                 self._set_meta("backend", backend)
             if stored_grid is None:
                 self._set_meta("pressures_mpa", json.dumps(grid.tolist()))
+            if settings is not None and recorded is None:
+                self._set_meta("settings", json.dumps(settings, default=str, sort_keys=True))
             if space is not None:
                 self._set_meta("space", str(space))
             if n_designs_planned is not None:
@@ -342,12 +411,12 @@ class CampaignStore:
     def merge(self, source: str | os.PathLike[str]) -> dict[str, int]:
         """Copy the designs of another campaign database (a shard) into this one.
 
-        The source must hold the same backend and pressure grid (this database
-        takes them if it has none yet). Each design is copied with its samples in
-        one transaction per source: a design done here is kept; a design done in
-        the source replaces a failed row here; a design failed in the source is
-        copied only where this database has no row for it. Merging the same shard
-        twice changes nothing.
+        The source must hold the same backend, settings and pressure grid (this database takes them
+        if it has none yet; settings missing on either side, in a database of an older
+        softbend, cannot be checked and are warned of). Each design is copied with its
+        samples in one transaction per source: a design done here is kept; a design done in
+        the source replaces a failed row here; a design failed in the source is copied only
+        where this database has no row for it. Merging the same shard twice changes nothing.
 
         Parameters
         ----------
@@ -364,6 +433,8 @@ class CampaignStore:
         ------
         ValueError
             The source holds another backend or pressure grid, or is this database.
+        SettingsMismatchError
+            The source holds other settings.
         """
         if self.read_only:
             raise SoftbendError(f"{str(self.path)!r} is open read-only; it cannot be merged into.")
@@ -371,7 +442,7 @@ class CampaignStore:
         if source_path.resolve() == self.path.resolve():
             raise ValueError(f"A campaign cannot be merged into itself: {str(source_path)!r}.")
         with CampaignStore(source_path, read_only=True) as other:
-            backend, grid = other.backend, other.pressures_mpa
+            backend, grid, settings = other.backend, other.pressures_mpa, other.settings
             their_runs = other.runs()
             theirs = {
                 row[0]: row[1]
@@ -379,7 +450,15 @@ class CampaignStore:
             }
         if backend is None or grid is None:
             return {"added": 0, "replaced_failed": 0, "kept": 0}
-        self.bind(backend, grid)
+        if settings is None and self._settings is not None and theirs:
+            warnings.warn(
+                f"The campaign database {str(source_path)!r} records no backend settings (an "
+                f"older softbend's, or bound without them): its {len(theirs)} designs could not be "
+                f"checked against the settings of {str(self.path)!r}.",
+                UncheckedSettingsWarning,
+                stacklevel=2,
+            )
+        self.bind(backend, grid, settings=settings)
         with self._writing():
             take, replaced = self._copy_designs(source_path, theirs)
         if take:
@@ -586,7 +665,8 @@ class CampaignStore:
         """Counts and metadata of the campaign, JSON-serialisable.
 
         Keys: ``path``, ``schema_version``, ``softbend_version``, ``created_at``,
-        ``backend``, ``space``, ``n_designs_planned`` (None if never run),
+        ``backend``, ``settings`` (as :attr:`settings`), ``space``,
+        ``n_designs_planned`` (None if never run),
         ``n_pressures``, ``pmin_mpa``, ``pmax_mpa``, ``designs_recorded``,
         ``done``, ``failed``, ``samples``, ``converged_samples``,
         ``sweep_time_s_total``, ``sweep_time_s_mean`` (over done designs),
@@ -621,6 +701,7 @@ class CampaignStore:
             "softbend_version": meta.get("softbend_version"),
             "created_at": meta.get("created_at"),
             "backend": meta.get("backend"),
+            "settings": self.settings,
             "space": meta.get("space"),
             "n_designs_planned": planned,
             "n_pressures": None if grid is None else len(grid),
@@ -737,14 +818,14 @@ def merge_campaigns(
 ) -> list[dict[str, Any]]:
     """Merge campaign databases (shards) into ``target``, all or nothing.
 
-    Every source, and ``target`` if it exists, is checked before anything is
-    written: each must be a readable campaign database (not damaged, of a schema
-    this softbend reads), and all that hold a campaign must share one backend and
-    one pressure grid. The merge is then written into a copy of ``target`` (or a
-    new database) beside it, which replaces ``target`` only when every source is
-    in: a merge that fails (a bad shard, a full disk) leaves ``target`` as it
-    was, or absent. ``target`` is held open read-only meanwhile, so no campaign
-    can write to it between the copy and the replacement.
+    Every source, and ``target`` if it exists, is checked before anything is written: each must
+    be a readable campaign database (not damaged, of a schema this softbend reads), and all
+    that hold a campaign must share one backend, one pressure grid and the same settings
+    (where recorded). The merge is then written into a copy of ``target`` (or a new
+    database) beside it, which replaces ``target`` only when every source is in: a merge
+    that fails (a bad shard, a full disk) leaves ``target`` as it was, or absent. ``target``
+    is held open read-only meanwhile, so no campaign can write to it between the copy and
+    the replacement.
 
     Parameters
     ----------
@@ -763,8 +844,8 @@ def merge_campaigns(
     FileNotFoundError
         A source does not exist, or the folder of ``target`` does not.
     ValueError
-        No source, a source that is ``target``, or a backend or pressure grid that
-        differs from another database's.
+        No source, a source that is ``target``, or a backend, pressure grid or
+        settings that differ from another database's.
     SchemaError
         A source or ``target`` is not a readable campaign database.
     OSError
@@ -793,19 +874,40 @@ def merge_campaigns(
     held = CampaignStore(target, read_only=True) if target.exists() else None
     try:
         reference = None
+        recorded: tuple[dict[str, Any], Path] | None = None
+        unchecked: list[Path] = []  # databases of an older softbend, without settings
         if held is not None and held.backend is not None:
             # bind() writes the backend and the pressure grid together.
             reference = (held.backend, cast(np.ndarray, held.pressures_mpa), target)
+            recorded = None if held.settings is None else (held.settings, target)
+            if held.settings is None:
+                unchecked.append(target)
         for source in paths:
             with CampaignStore(source, read_only=True) as other:
-                backend, grid = other.backend, other.pressures_mpa
+                backend, grid, settings = other.backend, other.pressures_mpa, other.settings
             if backend is None or grid is None:
                 continue  # a shard that never ran: nothing to merge
             if reference is None:
                 reference = (backend, grid, source)
             else:
                 _check_same_campaign(reference, (backend, grid, source))
-        return _merge_staged(target, paths, held)
+            if settings is None:
+                unchecked.append(source)
+            elif recorded is None:
+                recorded = (settings, source)
+            else:
+                _check_same_settings(recorded, (settings, source))
+        if recorded is not None and unchecked:
+            warnings.warn(
+                f"The campaign database(s) {', '.join(repr(str(p)) for p in unchecked)} record "
+                "no backend settings (an older softbend's, or bound without them): their "
+                f"designs could not be checked against the settings of {str(recorded[1])!r}.",
+                UncheckedSettingsWarning,
+                stacklevel=2,
+            )
+        with warnings.catch_warnings():  # said above, naming the databases given
+            warnings.simplefilter("ignore", UncheckedSettingsWarning)
+            return _merge_staged(target, paths, held)
     finally:
         if held is not None:
             held.close()
@@ -830,6 +932,23 @@ def _check_same_campaign(
             f"The 'pressures_mpa' of the campaign in {str(other_path)!r} are "
             f"{_describe_grid(other_grid)}, those of {str(path)!r} {_describe_grid(grid)}; "
             "only campaigns of one backend and one pressure grid merge. Nothing was merged."
+        )
+
+
+def _check_same_settings(
+    first: tuple[dict[str, Any], Path], other: tuple[dict[str, Any], Path]
+) -> None:
+    """Refuse ``other`` unless it has the settings of ``first``; each is ``(settings, path)``."""
+    (settings, path), (other_settings, other_path) = first, other
+    differences = settings_differences(settings, other_settings)
+    if differences:
+        shown = describe_differences(
+            differences, recorded=f"in {str(path)!r}", given=f"in {str(other_path)!r}"
+        )
+        raise ValueError(
+            f"The settings of the campaign in {str(other_path)!r} differ from those of "
+            f"{str(path)!r}: {shown}; only shards run with the same settings merge: re-run "
+            "that shard with them into a new database. Nothing was merged."
         )
 
 

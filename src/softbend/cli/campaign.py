@@ -90,8 +90,9 @@ def status(
 ) -> None:
     """Summarise a campaign database.
 
-    Designs done and failed, samples, the pressure grid and the metadata of the
-    database DB.
+    Designs done and failed, samples, the pressure grid, the backend's
+    material and mesh size and the metadata of the database DB (--json: all
+    recorded settings).
 
     Example:
 
@@ -106,6 +107,8 @@ def status(
         _common.print_json(summary)
         return
     planned = summary["n_designs_planned"]
+    settings = summary["settings"] or {}  # None in a database of an older softbend
+    maxh = (settings.get("options") or {}).get("maxh_mm")
     grid = (
         "-"
         if summary["n_pressures"] is None
@@ -119,6 +122,8 @@ def status(
         ["quantity", "value"],
         [
             ["backend", summary["backend"] or "-"],
+            ["material", (settings.get("material") or {}).get("name", "-")],
+            ["mesh size maxh (mm)", "-" if maxh is None else maxh],
             ["space of the latest run", f"{summary['space'] or '-'} ({planned or 0} designs)"],
             ["designs done", summary["done"]],
             ["designs failed", summary["failed"]],

@@ -68,13 +68,27 @@ def run(
         "(about 30 CPU s in the background; then faster assembly, the same results; "
         "see benchmarks/bench_fem.py).",
     ),
+    material: str | None = typer.Option(
+        None,
+        help="Elastomer of --backend fem or analytical: a preset (dragon-skin-30, the default) "
+        "or the fit.json of 'softbend materials fit', optionally with its model after # "
+        "(fit.json#yeoh; default the best fit).",
+    ),
+    accept_new_settings: bool = typer.Option(
+        False,
+        "--accept-new-settings",
+        help="Resume DB even if its recorded settings (mesh, FEM options, material) differ "
+        "from this run's; its designs then mix both.",
+    ),
     json_output: bool = typer.Option(False, "--json", help="Print the summary as JSON."),
 ) -> None:
     """Sweep a design space into a campaign database.
 
     Sweeps every design of --space not yet recorded in DB (a DuckDB file,
     created if missing) from 0 to --pmax MPa in steps of --pstep MPa, one
-    transaction per design; re-run the same command to resume.
+    transaction per design; re-run the same command to resume. DB records the
+    backend's settings (mesh, FEM options, material) and refuses a resume with
+    other ones.
 
     Example:
 
@@ -87,6 +101,7 @@ def run(
         parse_scheduler_address,
         run_campaign,
     )
+    from softbend.campaign.settings import SettingsMismatchError
     from softbend.campaign.spaces import (
         campaign_footprint,
         check_footprint,
@@ -105,8 +120,10 @@ def run(
         backend,
         model=model,
         compiled=compile_energy,
+        material=material,
         field="--backend",
         model_field="--model",
+        material_field="--material",
         owner=_OWNER,
     )
     if scheduler is not None:
@@ -125,12 +142,6 @@ def run(
     if shard_of is not None:
         designs = designs.shard(*shard_of)
     n_todo = count_designs_to_run(db, designs, retry_failed)
-    if n_todo < len(designs) and not json_output:
-        _common.err_console.print(
-            f"resuming {db}: {len(designs) - n_todo} of {len(designs)} designs already recorded",
-            highlight=False,
-            soft_wrap=True,  # one line whatever the path's length (logs, tests)
-        )
     with ExitStack() as stack:
         # The bar opens with the first report, so errors before any work print no bar.
         advance = None
@@ -138,6 +149,14 @@ def run(
 
         def progress(done: int, failed: int, running: int, total: int) -> None:
             nonlocal advance, shown
+            if advance is None and n_todo < len(designs) and not json_output:
+                # Said once the settings are checked: a refused resume is one error line.
+                _common.err_console.print(
+                    f"resuming {db}: {len(designs) - n_todo} of {len(designs)} designs "
+                    "already recorded",
+                    highlight=False,
+                    soft_wrap=True,  # one line whatever the path's length (logs, tests)
+                )
             if advance is None:
                 advance = stack.enter_context(
                     _common.progress_bar(
@@ -159,7 +178,11 @@ def run(
                 progress=progress,
                 chunk_size=chunk_size,
                 connect_timeout_s=connect_timeout,
+                material=material,
+                accept_new_settings=accept_new_settings,
             )
+        except SettingsMismatchError as exc:
+            raise exc.with_names(new="a new DB", accept="--accept-new-settings") from None
         except OSError as exc:
             # A failed write of the database (a full disk) names it: one line naming DB.
             # The designs recorded before stay in it; re-running the command resumes.

@@ -16,6 +16,7 @@ given, and the material's ``source`` says which.
 
 from __future__ import annotations
 
+import hashlib
 import os
 from pathlib import Path
 
@@ -27,7 +28,7 @@ from softbend.materials.presets import (
     Material,
 )
 
-__all__ = ["material_from_spec"]
+__all__ = ["material_from_spec", "material_spec_record"]
 
 
 def material_from_spec(
@@ -96,3 +97,33 @@ def material_from_spec(
             f"stretch {chosen.stretch_range[0]:g}-{chosen.stretch_range[1]:g}; {density_note}."
         ),
     )
+
+
+def material_spec_record(spec: str | os.PathLike[str]) -> dict[str, str]:
+    """What ``spec`` names, to record beside the material it gives.
+
+    Parameters
+    ----------
+    spec : str or path-like
+        As :func:`material_from_spec`: a preset name, or ``PATH`` / ``PATH#MODEL``
+        of a ``fit.json``.
+
+    Returns
+    -------
+    dict
+        ``{"spec": text}`` for a preset; for a file also ``"file"`` (its path),
+        ``"model"`` (the model after ``#``, empty for the best fit) and ``"sha256"``
+        (of the file's bytes), so that data made from one fit can be told from
+        data made from a refit.
+    """
+    text = os.fspath(spec)
+    path_text, _, model_name = text.partition("#")
+    path = Path(path_text)
+    if not path.is_file():
+        return {"spec": text}
+    return {
+        "spec": text,
+        "file": str(path),
+        "model": model_name,
+        "sha256": hashlib.sha256(path.read_bytes()).hexdigest(),
+    }
