@@ -115,18 +115,29 @@ def test_predict_warns_outside_the_training_ranges_and_strict_refuses(tmp_path, 
     from softbend.surrogates.features import training_ranges
     from softbend.surrogates.persistence import save_surrogate
     from softbend.surrogates.polynomial import PolynomialRegressor
+    from softbend.surrogates.support import support_from_rows
 
     rng = np.random.default_rng(0)
     low = np.array([100.0, 6.0, 2.0, 2.0, 5.0, 8.0, 0.0])
     high = np.array([160.0, 10.0, 4.0, 4.0, 15.0, 12.0, 0.3])
     X = low + (high - low) * rng.random((200, 7))
+    X[:, 6] = np.tile(np.linspace(0.0, 0.3, 5), 40)  # 40 designs, each swept to 0.3 MPa
+    X[:, :6] = np.repeat(X[::5, :6], 5, axis=0)
     model = PolynomialRegressor(degree=2).fit(X, 300 * X[:, 6])
-    path = save_surrogate(
-        model, tmp_path / "m.json", metadata={"training_ranges": training_ranges(X)}
-    )
+    metadata = {
+        "training_ranges": training_ranges(X),
+        "support": support_from_rows(X, 300 * X[:, 6]).to_dict(),
+    }
+    path = save_surrogate(model, tmp_path / "m.json", metadata=metadata)
     args = ["predict", str(path), "--design", "130,8,3,3,10,10"]
     assert main([*args, "--pressures", "0.1"]) == 0
     assert "warning" not in capsys.readouterr().err
+    # an older file without support: a note that only the ranges were checked
+    old = save_surrogate(
+        model, tmp_path / "old.json", metadata={"training_ranges": training_ranges(X)}
+    )
+    assert main(["predict", str(old), "--design", "130,8,3,3,10,10", "--pressures", "0.1"]) == 0
+    assert "records no training support" in capsys.readouterr().err
     assert main([*args, "--pressures", "0.5", "--json"]) == 0
     captured = capsys.readouterr()
     assert "softbend: warning:" in captured.err and "pressure_mpa 0.5 outside" in captured.err

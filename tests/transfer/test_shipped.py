@@ -48,3 +48,19 @@ def test_the_shipped_lab_is_what_the_lab_measures_today():
     assert again.actuator_ids == shipped.actuator_ids
     np.testing.assert_array_equal(again.frame["pressure_mpa"], shipped.frame["pressure_mpa"])
     np.testing.assert_allclose(again.angle_deg, shipped.angle_deg, atol=0.05)
+
+
+def test_the_base_records_the_support_of_the_shipped_dataset():
+    # Each design's largest converged pressure and the largest angle, as the dataset has them.
+    from softbend.datasets import table1_fem
+    from softbend.design import FEATURES
+    from softbend.surrogates.support import Support, support_from_rows
+
+    samples = table1_fem()
+    samples = samples[samples["converged"]]
+    expected = support_from_rows(samples[list(FEATURES)].to_numpy(), samples["angle_deg"])
+    recorded = Support.from_dict(load_surrogate(shipped_base_path()).metadata["support"])
+    assert recorded.designs.shape == (972, 6)
+    np.testing.assert_array_equal(recorded.designs, expected.designs)
+    np.testing.assert_array_equal(recorded.max_pressure_mpa, expected.max_pressure_mpa)
+    assert recorded.max_angle_deg == expected.max_angle_deg <= 300.0

@@ -170,8 +170,10 @@ def predict(
 ) -> None:
     """Predict the bending angle of a design at the given pressures.
 
-    A design or pressure outside the ranges the model was trained on (recorded in
-    the model file) is a warning on stderr, or with --strict an error: a
+    A design or pressure outside the ranges the model was trained on, a pressure
+    past what the training designs nearest to this one were swept to, or an angle
+    past the largest trained on (all recorded in the model file) is a warning on
+    stderr and a "no" in the table's last column, or with --strict an error: a
     surrogate extrapolates without knowing it.
 
     Example:
@@ -183,10 +185,15 @@ def predict(
     from softbend.surrogates.predict import INTERVAL_LEVEL, predict_text
 
     result = predict_text(model, design, pressures, strict=strict)
-    if result.outside_training_ranges:
+    if result.extrapolated:
         _common.warning_line(
-            f"{model} was not trained there: {'; '.join(result.outside_training_ranges)}; the "
+            f"{model} was not trained there: {'; '.join(result.extrapolated)}; the "
             "prediction is an extrapolation (--strict refuses)."
+        )
+    elif result.supported is None:
+        _common.warning_line(
+            f"{model} records no training support (saved by an older softbend): only its "
+            "training ranges were checked."
         )
     if as_json:
         _common.print_json(result.to_dict())
@@ -200,4 +207,8 @@ def predict(
         columns.append(f"{INTERVAL_LEVEL:.0%} interval (°)")
         for row, low, high in zip(rows, *interval, strict=True):
             row.append(f"{low:.2f} to {high:.2f}")
+    if result.supported is not None:
+        columns.append("trained there")
+        for row, ok in zip(rows, result.supported, strict=True):
+            row.append("yes" if ok else "no")
     _common.print_table(f"{result.kind} surrogate, design ({result.design})", columns, rows)

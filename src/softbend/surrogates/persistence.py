@@ -595,6 +595,26 @@ def _check_training_ranges(metadata: dict[str, Any], path: Path) -> None:
             )
 
 
+def _check_support(metadata: dict[str, Any], path: Path) -> None:
+    """Refuse ``metadata["support"]`` unless a :class:`~softbend.surrogates.support.Support` record.
+
+    A broken support would silently stop the check of
+    :func:`softbend.surrogates.predict.predict_angles` that a prediction lies
+    where the training data were.
+    """
+    if "support" not in metadata:
+        return
+    from softbend.surrogates.support import Support
+
+    try:
+        Support.from_dict(metadata["support"])
+    except ValueError as err:
+        raise SchemaError(
+            f"{path}: metadata key 'support' (each training design's largest pressure and the "
+            f"largest angle) {err}."
+        ) from None
+
+
 def _restore_inner(value: Any, path: str, key: str, depth: int) -> Any:
     where = f"{path}, state key '{key}'"
     if depth >= _MAX_DEPTH:
@@ -735,6 +755,7 @@ def load_surrogate(path: str | os.PathLike[str]) -> SavedSurrogate:
     path = Path(path)
     document = _read_document(path)
     _check_training_ranges(document["metadata"], path)
+    _check_support(document["metadata"], path)
     return _saved_surrogate(document, path)
 
 
@@ -809,6 +830,7 @@ def load_state(path: str | os.PathLike[str], kinds: tuple[str, ...]) -> SavedSta
     path = Path(path)
     document = _read_document(path)
     _check_training_ranges(document["metadata"], path)
+    _check_support(document["metadata"], path)
     kind = document["kind"]
     storage = None if kind in COMPOSITE_KINDS else _stored(kind).storage
     if (

@@ -36,6 +36,14 @@ class Prediction:
         (empty inside them, or when the file records none).
     has_training_ranges : bool
         Whether the file records its training ranges.
+    beyond_support : list of str
+        One phrase per way the predictions leave the training data's support
+        (:mod:`softbend.surrogates.support`: a pressure past what the training
+        designs nearest to ``design`` were swept to, an angle past the largest
+        trained on); empty inside it, or when the file records none.
+    supported : ndarray of bool or None
+        Per pressure, whether the prediction lies in the support; None when the
+        file records none.
     interval_deg : tuple of ndarray or None
         ``(low, high)``: the 90 % interval for a new reading, degrees: the
         calibrated one a refined model records (``softbend transfer refine``:
@@ -53,10 +61,19 @@ class Prediction:
     has_training_ranges: bool = False
     interval_deg: tuple[np.ndarray, np.ndarray] | None = None
     source: str = ""
+    beyond_support: list[str] = field(default_factory=list)
+    supported: np.ndarray | None = None
+
+    @property
+    def extrapolated(self) -> list[str]:
+        """Every phrase saying where the prediction leaves the training data."""
+        return [*self.outside_training_ranges, *self.beyond_support]
 
     def to_dict(self) -> dict[str, Any]:
         """JSON-friendly form: model, kind, design (mm, deg), pressures (MPa), angles (deg),
-        the inputs outside the training ranges, and the interval's level and ends if any."""
+        the inputs outside the training ranges, the ways the predictions leave the
+        training data's support and, per pressure, whether each lies in it (null
+        when the model records no support), and the interval's level and ends if any."""
         payload: dict[str, Any] = {
             "model": self.source,
             "kind": self.kind,
@@ -64,6 +81,8 @@ class Prediction:
             "pressure_mpa": self.pressure_mpa.tolist(),
             "angle_deg": self.angle_deg.tolist(),
             "outside_training_ranges": list(self.outside_training_ranges),
+            "beyond_training_support": list(self.beyond_support),
+            "supported": None if self.supported is None else self.supported.tolist(),
         }
         if self.interval_deg is not None:
             payload["interval_level"] = INTERVAL_LEVEL
@@ -157,15 +176,17 @@ def predict_angles(
     pressures_mpa : array_like
         Gauge pressures, MPa, finite and >= 0 (any order).
     strict : bool, default False
-        Refuse inputs outside the model's training ranges (and models that
-        record none) instead of flagging them.
+        Refuse inputs outside the model's training ranges, and predictions
+        beyond its training data's support (:mod:`softbend.surrogates.support`),
+        instead of flagging them; refuse models that record neither.
     field : str, default "pressure"
         The name of the pressures in messages (``"--pressures"`` from the command line).
 
     Raises
     ------
     ValueError
-        Bad pressures, or with ``strict`` an extrapolation (naming the inputs);
+        Bad pressures, or with ``strict`` an extrapolation (naming the inputs
+        or the support left);
         without ``strict``, an extrapolation where the model predicts a NaN or
         infinite angle (naming the file and the inputs).
     FileNotFoundError, softbend.errors.SchemaError
@@ -212,14 +233,47 @@ def predict_angles(
             low, high = model.predict_interval(rows, INTERVAL_LEVEL)
             interval = (np.asarray(low, dtype=float), np.asarray(high, dtype=float))
     _check_finite(path, saved.kind, pressures, angles, "angle", outside)
+    beyond, supported = _support_check(saved.metadata.get("support"), rows, angles)
+    if strict and beyond:
+        raise ValueError(
+            f"The 'design' and 'pressure' must lie in the training data of {path}: "
+            f"{'; '.join(beyond)}."
+        )
+    if strict and supported is None:
+        raise ValueError(
+            f"The model {path} records no training support (each training design's largest "
+            "pressure; saved by an older softbend); --strict cannot check it."
+        )
     calibrated = _calibrated_interval(saved.metadata.get("interval"), angles)
     interval = calibrated if calibrated is not None else interval
     if interval is not None:
         _check_finite(path, saved.kind, pressures, interval[0], "interval's low end", outside)
         _check_finite(path, saved.kind, pressures, interval[1], "interval's high end", outside)
     return Prediction(
-        saved.kind, design, pressures, angles, outside, has_ranges, interval, str(path)
+        saved.kind,
+        design,
+        pressures,
+        angles,
+        outside,
+        has_ranges,
+        interval,
+        str(path),
+        beyond,
+        supported,
     )
+
+
+def _support_check(
+    record: Any, rows: np.ndarray, angles: np.ndarray
+) -> tuple[list[str], np.ndarray | None]:
+    """The phrases and per-row mask of :class:`~softbend.surrogates.support.Support`;
+    ``([], None)`` when the model records no support (checked on load)."""
+    if not isinstance(record, dict):
+        return [], None
+    from softbend.surrogates.support import Support
+
+    support = Support.from_dict(record)
+    return support.beyond(rows, angles), support.supported(rows, angles)
 
 
 class _MLPArrays:

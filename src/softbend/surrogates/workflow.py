@@ -116,6 +116,7 @@ def train_surrogates(
     """
     from softbend.surrogates.features import training_ranges
     from softbend.surrogates.persistence import save_surrogate
+    from softbend.surrogates.support import support_from_rows
 
     data = _load_data(source)
     result = search(
@@ -147,6 +148,7 @@ def train_surrogates(
             "cv": {k: float(v) for k, v in fam.cv.items()},
             "search": {**result.settings, "params": describe(fam.params)},
             "training_ranges": training_ranges(data.X),
+            "support": support_from_rows(data.X, data.y).to_dict(),
         }
         family = FAMILIES.get(name)
         if family.storage is not None:

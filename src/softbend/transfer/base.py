@@ -125,13 +125,17 @@ def base_metadata(model: Any, *, epochs: int, seed: int, command: str) -> dict[s
     -------
     dict
         Purpose, dataset (and the SHA-256 of its samples), hidden sizes, epochs,
-        seed, command, final training MSE (deg²) and the training ranges (mm,
-        deg, MPa).
+        seed, command, final training MSE (deg²), the training ranges (mm,
+        deg, MPa) and the support (each design's largest converged pressure and
+        the largest angle: :class:`softbend.surrogates.support.Support`).
     """
-    from softbend.datasets import table1_fem_provenance
+    from softbend.datasets import table1_fem, table1_fem_provenance
     from softbend.surrogates.features import training_ranges
+    from softbend.surrogates.support import support_from_rows
 
     provenance = table1_fem_provenance()
+    samples = table1_fem()
+    samples = samples[samples["converged"].astype(bool)]
     return {
         "purpose": "the FEM-trained MLP that transfer learning starts from",
         "trained_on": "softbend.datasets.table1_fem(), converged samples",
@@ -144,6 +148,10 @@ def base_metadata(model: Any, *, epochs: int, seed: int, command: str) -> dict[s
         "command": command,
         "final_training_mse_deg2": float(model.loss_curve_[-1]) * model.y_scale_**2,
         "training_ranges": training_ranges(fem_rows()),
+        "support": support_from_rows(
+            samples[list(FEATURES)].to_numpy(dtype=np.float64),
+            samples["angle_deg"].to_numpy(dtype=np.float64),
+        ).to_dict(),
     }
 
 
@@ -157,6 +165,17 @@ def load_base(path: str | os.PathLike[str] | None = None) -> Any:
     FileNotFoundError, softbend.errors.SchemaError
         As :func:`softbend.surrogates.load_surrogate` for a given path.
     """
+    return load_base_saved(path).model
+
+
+def load_base_saved(path: str | os.PathLike[str] | None = None) -> Any:
+    """:func:`load_base`, with the file's record: a :class:`~softbend.surrogates.SavedSurrogate`.
+
+    Raises
+    ------
+    DatasetError, FileNotFoundError, softbend.errors.SchemaError
+        As :func:`load_base`.
+    """
     from softbend.surrogates.persistence import load_surrogate
 
     if path is None:
@@ -166,5 +185,5 @@ def load_base(path: str | os.PathLike[str] | None = None) -> Any:
                 f"The shipped FEM-trained MLP {target} is missing; "
                 "'softbend transfer base --out PATH' trains it again."
             )
-        return load_surrogate(target).model
-    return load_surrogate(path).model
+        return load_surrogate(target)
+    return load_surrogate(path)

@@ -52,7 +52,10 @@ class Refinement:
         the list of files), ``measurement_files`` (path, SHA-256, readings and
         synthetic flag of each), ``n_measurements``, ``actuators``,
         ``synthetic_measurements`` (``true``, ``false`` or ``mixed``),
-        ``training_rmse_deg`` (degrees), ``training_ranges`` (mm, deg, MPa) and,
+        ``training_rmse_deg`` (degrees), ``training_ranges`` (mm, deg, MPa),
+        ``support`` (each design's largest pressure and the largest angle, the
+        measured ones and, for a strategy that keeps the base's simulations,
+        the base's: :class:`softbend.surrogates.support.Support`) and,
         for the strategies that train a network, ``final_training_mse_deg2``;
         ``interval``: the calibration (:meth:`Calibration.to_dict`, with a
         ``warning`` when too few actuators) or None when not calibrated.
@@ -156,6 +159,7 @@ def refine_surrogate(
     """
     from softbend.surrogates.features import training_ranges
     from softbend.surrogates.persistence import load_surrogate
+    from softbend.surrogates.support import Support, support_from_rows
     from softbend.transfer.measurements import (
         files_record,
         load_measurements_files,
@@ -177,8 +181,11 @@ def refine_surrogate(
     start = load_surrogate(base)
     model = fit_strategy(strategy, start.model, data, seed=seed, **values)
     ranges = training_ranges(data.features)
+    support = support_from_rows(data.features, data.angle_deg)
     if takes(cls, "base"):  # the base's simulations and the measurements
         ranges = _merged_ranges(ranges, start.metadata.get("training_ranges"))
+        if isinstance(start.metadata.get("support"), dict):
+            support = support.merged(Support.from_dict(start.metadata["support"]))
     residual = data.angle_deg - model.predict(data.features)
     metadata: dict[str, Any] = {
         "strategy": strategy,
@@ -191,6 +198,7 @@ def refine_surrogate(
         "synthetic_measurements": synthetic_label(data),
         "training_rmse_deg": float(np.sqrt(np.mean(residual**2))),
         "training_ranges": ranges,
+        "support": support.to_dict(),
     }
     if hasattr(model, "loss_curve_"):
         metadata["final_training_mse_deg2"] = float(model.loss_curve_[-1])

@@ -1,0 +1,219 @@
+"""Where a surrogate's training data hold: the pressure each design was swept to, and the angles.
+
+A box around each input (:func:`softbend.surrogates.features.training_ranges`)
+is not where a bending-angle surrogate holds. The FEM sweeps of Table 1 stop
+where the actuator passes 300° (or the solver stops), which is 0.115 MPa for a
+long, thin-walled design and 0.5 MPa for a short, thick one: a pressure inside
+the box is often far past what any design near the one asked for was swept
+to, and there a network's curve bends back or runs on to 500°.
+
+:class:`Support` keeps, with a saved model, each training design's largest
+pressure (MPa) and the largest angle seen (degrees). A prediction is *beyond
+the support* when
+
+- its pressure exceeds the largest pressure the training designs nearest to
+  its design were swept to: the designs' own value for a training design,
+  else the inverse-distance-weighted mean (power 2) over the
+  :data:`NEIGHBOURS` nearest training designs, distances measured in units of
+  each parameter's span over the training designs; or
+- its angle exceeds the largest angle in the training data by more than
+  :data:`ANGLE_TOLERANCE` of it (the FEM's 300° stop, a network's small
+  overshoot at the last swept pressure allowed).
+
+``softbend predict`` flags such a prediction and with ``--strict`` refuses it;
+the control plant built from a surrogate tabulates θ(p) only up to the
+supported pressure.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+from typing import Any
+
+import numpy as np
+from numpy.typing import ArrayLike
+
+from softbend.design import PARAMETERS
+
+__all__ = ["ANGLE_TOLERANCE", "NEIGHBOURS", "RULE", "Support", "support_from_rows"]
+
+#: Training designs whose swept pressure is interpolated to a new design.
+NEIGHBOURS = 12
+
+#: A predicted angle may exceed the largest training angle by this share of it.
+ANGLE_TOLERANCE = 0.02
+
+#: The rule, recorded with the support.
+RULE = (
+    f"pressure <= the largest swept at the design (inverse-distance mean over the "
+    f"{NEIGHBOURS} nearest training designs, distances in parameter spans); angle <= "
+    f"{1 + ANGLE_TOLERANCE:g} x the largest training angle"
+)
+
+_DESIGN = slice(0, len(PARAMETERS))
+
+
+@dataclass(frozen=True)
+class Support:
+    """The training data's support: each design's largest pressure, and the largest angle.
+
+    Attributes
+    ----------
+    designs : ndarray, shape (n, 6)
+        The training designs (mm, deg; columns :data:`softbend.design.PARAMETERS`).
+    max_pressure_mpa : ndarray, shape (n,)
+        The largest pressure each design was trained at, MPa gauge.
+    max_angle_deg : float
+        The largest angle in the training data, degrees.
+    """
+
+    designs: np.ndarray
+    max_pressure_mpa: np.ndarray
+    max_angle_deg: float
+
+    def __post_init__(self) -> None:
+        designs = np.asarray(self.designs, dtype=np.float64)
+        pmax = np.asarray(self.max_pressure_mpa, dtype=np.float64).ravel()
+        if designs.ndim != 2 or designs.shape[1] != len(PARAMETERS) or designs.shape[0] == 0:
+            raise ValueError(
+                f"The 'designs' of Support must have shape (n, {len(PARAMETERS)}) with n >= 1. "
+                f"Got shape {designs.shape} instead."
+            )
+        if pmax.shape != (designs.shape[0],):
+            raise ValueError(
+                f"The 'max_pressure_mpa' of Support must hold one pressure per design "
+                f"({designs.shape[0]}). Got {pmax.size} instead."
+            )
+        if not (np.isfinite(designs).all() and np.isfinite(pmax).all() and (pmax >= 0).all()):
+            raise ValueError(
+                "The 'designs' and 'max_pressure_mpa' of Support must be finite, the "
+                "pressures >= 0 MPa."
+            )
+        if not (math.isfinite(self.max_angle_deg) and self.max_angle_deg > 0):
+            raise ValueError(
+                f"The 'max_angle_deg' of Support must be a finite angle > 0 degrees. "
+                f"Got {self.max_angle_deg!r} instead."
+            )
+        object.__setattr__(self, "designs", designs)
+        object.__setattr__(self, "max_pressure_mpa", pmax)
+        object.__setattr__(self, "max_angle_deg", float(self.max_angle_deg))
+
+    @property
+    def angle_limit_deg(self) -> float:
+        """The largest angle a supported prediction may have, degrees."""
+        return self.max_angle_deg * (1.0 + ANGLE_TOLERANCE)
+
+    def max_pressure(self, designs: ArrayLike) -> np.ndarray:
+        """The largest supported pressure at each of ``designs`` (rows of 6), MPa."""
+        query = np.atleast_2d(np.asarray(designs, dtype=np.float64))[:, _DESIGN]
+        span = np.ptp(self.designs, axis=0)
+        span = np.where(span > 0, span, 1.0)
+        out = np.empty(query.shape[0])
+        unique, inverse = np.unique(query, axis=0, return_inverse=True)
+        for i, row in enumerate(unique):
+            d = np.sqrt((((self.designs - row) / span) ** 2).sum(axis=1))
+            nearest = np.argsort(d, kind="stable")[:NEIGHBOURS]
+            if d[nearest[0]] < 1e-9:
+                value = float(self.max_pressure_mpa[d < 1e-9].max())
+            else:
+                w = 1.0 / d[nearest] ** 2
+                value = float(w @ self.max_pressure_mpa[nearest] / w.sum())
+            out[inverse.ravel() == i] = value
+        return out
+
+    def supported(self, X: ArrayLike, angles: ArrayLike | None = None) -> np.ndarray:
+        """Whether each row of ``X`` (7 inputs) and its predicted angle lie in the support."""
+        rows = np.atleast_2d(np.asarray(X, dtype=np.float64))
+        ok = rows[:, -1] <= self.max_pressure(rows) * (1 + 1e-9) + 1e-12
+        if angles is not None:
+            a = np.asarray(angles, dtype=np.float64).ravel()
+            ok &= ~(a > self.angle_limit_deg)
+        return ok
+
+    def beyond(self, X: ArrayLike, angles: ArrayLike | None = None) -> list[str]:
+        """One phrase per way the rows leave the support; empty when all are inside."""
+        rows = np.atleast_2d(np.asarray(X, dtype=np.float64))
+        limit = self.max_pressure(rows)
+        phrases = []
+        over = rows[:, -1] > limit * (1 + 1e-9) + 1e-12
+        if over.any():
+            i = int(np.flatnonzero(over)[np.argmax(rows[over, -1] - limit[over])])
+            phrases.append(
+                f"pressure {rows[i, -1]:g} MPa beyond the {limit[i]:.3g} MPa the training "
+                f"designs nearest to ({','.join(f'{v:g}' for v in rows[i, _DESIGN])}) "
+                "were swept to"
+            )
+        if angles is not None:
+            a = np.asarray(angles, dtype=np.float64).ravel()
+            high = a > self.angle_limit_deg
+            if high.any():
+                phrases.append(
+                    f"angle {a[high].max():.4g}° beyond the largest in the training data "
+                    f"({self.max_angle_deg:.4g}°)"
+                )
+        return phrases
+
+    def merged(self, other: Support) -> Support:
+        """The union of two supports (a design in both keeps its larger pressure)."""
+        designs = np.vstack([self.designs, other.designs])
+        pmax = np.concatenate([self.max_pressure_mpa, other.max_pressure_mpa])
+        unique, inverse = np.unique(designs, axis=0, return_inverse=True)
+        best = np.zeros(unique.shape[0])
+        np.maximum.at(best, inverse.ravel(), pmax)
+        return Support(unique, best, max(self.max_angle_deg, other.max_angle_deg))
+
+    def to_dict(self) -> dict[str, Any]:
+        """JSON-friendly record (the ``support`` metadata of a saved surrogate)."""
+        return {
+            "rule": RULE,
+            "parameters": list(PARAMETERS),
+            "designs": [[float(v) for v in row] for row in self.designs],
+            "max_pressure_mpa": [float(v) for v in self.max_pressure_mpa],
+            "max_angle_deg": self.max_angle_deg,
+        }
+
+    @classmethod
+    def from_dict(cls, data: Any) -> Support:
+        """The support a :meth:`to_dict` record describes.
+
+        Raises
+        ------
+        ValueError
+            A record that is not one (missing keys, other parameters, wrong shapes,
+            non-finite numbers), naming what is wrong.
+        """
+        if not isinstance(data, dict):
+            raise ValueError(f"must be an object; got {type(data).__name__}")
+        missing = [k for k in ("designs", "max_pressure_mpa", "max_angle_deg") if k not in data]
+        if missing:
+            raise ValueError(f"lacks {', '.join(missing)}")
+        if data.get("parameters", list(PARAMETERS)) != list(PARAMETERS):
+            raise ValueError(f"must list the parameters {', '.join(PARAMETERS)}")
+        try:
+            designs = np.asarray(data["designs"], dtype=np.float64)
+            pmax = np.asarray(data["max_pressure_mpa"], dtype=np.float64)
+            angle = float(data["max_angle_deg"])
+        except (TypeError, ValueError):
+            raise ValueError("must hold numbers only") from None
+        return cls(designs, pmax, angle)
+
+
+def support_from_rows(X: ArrayLike, y: ArrayLike) -> Support:
+    """The support of training rows ``X`` (7 inputs, mm, deg, MPa) and angles ``y`` (deg).
+
+    Each distinct design (first six columns) keeps its largest pressure; the
+    largest finite angle is the angle limit's base.
+    """
+    rows = np.asarray(X, dtype=np.float64)
+    angles = np.asarray(y, dtype=np.float64).ravel()
+    if rows.ndim != 2 or rows.shape[1] != len(PARAMETERS) + 1 or rows.shape[0] != angles.size:
+        raise ValueError(
+            f"The 'X' and 'y' of support_from_rows must be rows of {len(PARAMETERS) + 1} inputs "
+            f"and one angle per row. Got shapes {rows.shape} and {angles.shape} instead."
+        )
+    unique, inverse = np.unique(rows[:, _DESIGN], axis=0, return_inverse=True)
+    pmax = np.zeros(unique.shape[0])
+    np.maximum.at(pmax, inverse.ravel(), rows[:, -1])
+    finite = angles[np.isfinite(angles)]
+    return Support(unique, pmax, float(finite.max()) if finite.size else math.nan)
