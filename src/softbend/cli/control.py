@@ -36,19 +36,21 @@ def simulate_cmd(
     model: Path = opt.MODEL,
     plant: str = opt.PLANT,
     duration: float = typer.Option(10.0, help="Simulated time, s."),
-    supply: float = typer.Option(0.2, help="Supply pressure, MPa gauge."),
+    supply: float = opt.SUPPLY,
+    rig_params: list[str] = opt.RIG_PARAM,
     seed: int = typer.Option(0, help="Seed of the sensor and camera noise."),
+    strict: bool = opt.STRICT,
     as_json: bool = typer.Option(False, "--json", help="Print the metrics as JSON."),
 ) -> None:
     """Run a controller on the simulated rig and score it.
 
     Scores the run as paper B, Figure 9 (synthetic data). metrics.json records
-    the controller and every one of its parameters as used.
+    the controller and the rig, with every one of their parameters as used.
 
     Example:
 
     \b
-        softbend control simulate --out bb --set deadzone=0.02
+        softbend control simulate --out bb --set deadzone=0.02 --rig-param valve_delay_s=0.02
     """
     from softbend._io import atomic_files
     from softbend.control.runs import simulate_control
@@ -57,8 +59,9 @@ def simulate_cmd(
     _common.check_output_dir(out, "--out", files=_FILES)
     result = simulate_control(
         reference=reference, controller=controller, assignments=settings or (), design=design,
-        model=model, plant=plant, duration_s=duration, supply_mpa=supply, seed=seed,
-        command="softbend control simulate",
+        model=model, plant=plant, duration_s=duration, supply_mpa=supply,
+        rig_assignments=rig_params or (), seed=seed, command="softbend control simulate",
+        strict=strict,
     )  # fmt: skip
     payload = dict(result.summary)
     name, actuator = payload["controller"], payload["design"]
@@ -113,6 +116,32 @@ def controllers_cmd(
     )
 
 
+@app.command("rig-parameters")
+def rig_parameters_cmd(
+    as_json: bool = typer.Option(False, "--json", help="Print the list as JSON."),
+) -> None:
+    """List the simulated rig's parameters.
+
+    Each is given to simulate, run and serve by --rig-param NAME=VALUE (or a
+    [simulation] table of the rig TOML); the unit is in the name.
+
+    Example:
+
+    \b
+        softbend control rig-parameters --json
+    """
+    from softbend.control.rigs import rig_parameter_catalog
+
+    rows = rig_parameter_catalog()
+    if as_json:
+        _common.print_json(rows)
+        return
+    table = [[r["name"], f"{r['default']:g}", r["what"]] for r in rows]
+    _common.print_table(
+        "simulated rig (--rig-param NAME=VALUE)", ["name", "default", "what"], table
+    )
+
+
 @app.command("serve")
 def serve_cmd(
     config: Path = typer.Option(
@@ -123,7 +152,8 @@ def serve_cmd(
     design: str = opt.DESIGN,
     model: Path = opt.MODEL,
     plant: str = opt.PLANT,
-    supply: float = typer.Option(0.2, help="Supply pressure, MPa gauge."),
+    supply: float = opt.SUPPLY,
+    rig_params: list[str] = opt.RIG_PARAM,
     seed: int = typer.Option(0, help="Seed of the sensor and camera noise."),
     duration: float = typer.Option(0.0, help="Serve for this long, s (0: until Ctrl-C)."),
 ) -> None:
@@ -146,7 +176,7 @@ def serve_cmd(
     check_range(duration, "duration", command, low=0.0, low_inclusive=True)
     server = simulated_server(
         config=config, host=host, port=port, design=design, model=model, plant=plant,
-        supply_mpa=supply, seed=seed, command=command,
+        supply_mpa=supply, rig_assignments=rig_params or (), seed=seed, command=command,
     )  # fmt: skip
     server.start()
     _common.console.print(

@@ -34,3 +34,24 @@ PLANT = typer.Option(
     "actuator: a saved surrogate .json (e.g. from 'softbend transfer refine') or a "
     "measurements .csv (its loading readings, smoothed).",
 )
+RIG_PARAM = typer.Option(
+    None,
+    "--rig-param",
+    metavar="NAME=VALUE",
+    help="A parameter of the simulated rig NAME=VALUE, repeatable: valves "
+    "(inlet_conductance_m3_s_pa, outlet_conductance_m3_s_pa, critical_ratio, valve_delay_s), "
+    "tubing_mm3, supply_gauge_mpa, sensor (sensor_noise_mpa, sensor_bits, sensor_range_mpa), "
+    "camera_noise_deg and more (the command 'control rig-parameters' lists them all).",
+)
+SUPPLY = typer.Option(
+    None,
+    help="Supply pressure of the simulated rig, MPa gauge (default 0.2; the same as "
+    "--rig-param supply_gauge_mpa).",
+)
+STRICT = typer.Option(
+    False,
+    "--strict",
+    help="Refuse a controller model or plant surrogate whose θ(p) of the design, up to the "
+    "supply, leaves its training data (a pressure past what the designs nearest to it were "
+    "swept to, an angle past the largest trained on).",
+)

@@ -27,8 +27,8 @@ def run_cmd(
     config: Path = typer.Option(
         None,
         "--config",
-        help="Rig TOML: connection, register map, scaling, safety, period, [controller] "
-        "(required for --rig modbus; its [safety] and [loop] apply to every rig).",
+        help="Rig TOML: connection, register map, scaling, safety, period, [controller], "
+        "[simulation] (required for --rig modbus; its [safety] and [loop] apply to every rig).",
     ),
     reference: str = opt.REFERENCE,
     controller: str = opt.CONTROLLER,
@@ -44,7 +44,8 @@ def run_cmd(
         None,
         help="Pressure reading period, s (default: the config's sensor_period_s, 0.01: 100 Hz).",
     ),
-    supply: float = typer.Option(0.2, help="Supply pressure of a simulated rig, MPa gauge."),
+    supply: float = opt.SUPPLY,
+    rig_params: list[str] = opt.RIG_PARAM,
     seed: int = typer.Option(0, help="Seed of a simulated rig's sensor and camera noise."),
     log_format: str = typer.Option("csv", help="Tick log format: csv (streamed) or parquet."),
     as_json: bool = typer.Option(False, "--json", help="Print the summary as JSON."),
@@ -55,7 +56,8 @@ def run_cmd(
     controller object as 'softbend control simulate' every tick (1 ms) with the latest
     pressure reading (read every 10 ms: paper B's 100 Hz). The controller and its
     parameters come from --controller and --set, else the config's [controller] table
-    (--set overrides its values); run.json records them. Over-pressure, missed or stale
+    (--set overrides its values); run.json records them. A simulated rig takes the
+    config's [simulation] table and --rig-param (which overrides it). Over-pressure, missed or stale
     readings vent the actuator and stop the run; so do Ctrl-C and SIGTERM. Exit 0 when
     the run completed and the rig was vented, 1 when a fault stopped it or the final
     vent did not reach the rig (the log keeps every tick up to the fault; the one error
@@ -77,7 +79,7 @@ def run_cmd(
         rig=rig, config=config, reference=reference, controller=controller,
         assignments=settings or (), design=design, model=model, plant=plant,
         duration_s=duration, period_s=period, sensor_period_s=sensor_period,
-        supply_mpa=supply, seed=seed, command=command,
+        supply_mpa=supply, rig_assignments=rig_params or (), seed=seed, command=command,
     )  # fmt: skip
     log_name = f"ticks.{log_format}"
     _common.check_output_dir(out, "--out", files=(log_name, "run.json", "run.png"))

@@ -37,6 +37,7 @@ __all__ = [
     "plant_file",
     "plant_table",
     "shipped_angle_table",
+    "support_warnings",
     "surrogate_plant",
 ]
 
@@ -126,6 +127,65 @@ def fem_plant(design: SFRBADesign, model_table: AngleTable) -> AngleTable:
     from softbend.control.fem_plant import fem_curve
 
     return fem_curve(design).table()
+
+
+def support_warnings(
+    saved: Any,
+    design: SFRBADesign,
+    up_to_mpa: float,
+    *,
+    role: str = "the controller's model",
+) -> tuple[float | None, str | None, str | None]:
+    """How far a saved surrogate's θ(p) of ``design`` holds, and where up to ``up_to_mpa`` not.
+
+    A rig reaches any pressure up to its supply; a surrogate's θ(p) past the
+    pressure its nearest training designs were swept to, or past the largest
+    angle it was trained on, is an extrapolation
+    (:mod:`softbend.surrogates.support`).
+
+    Parameters
+    ----------
+    saved : SavedSurrogate
+        A loaded surrogate file (``.model`` and ``.metadata``).
+    design : SFRBADesign
+    up_to_mpa : float
+        The largest pressure the rig reaches (its supply), MPa gauge.
+    role : str
+        What the model plays and its file, for the message.
+
+    Returns
+    -------
+    supported_mpa : float or None
+        The largest supported pressure at ``design``, MPa; None when the file
+        records no support.
+    pressure_note : str or None
+        A phrase when ``up_to_mpa`` lies past ``supported_mpa``.
+    angle_note : str or None
+        A phrase when θ(p) up to the supported pressure passes the largest
+        angle trained on.
+    """
+    from softbend.surrogates.support import Support
+
+    record = saved.metadata.get("support")
+    if not isinstance(record, dict):
+        return None, None, None
+    support = Support.from_dict(record)
+    limit = float(support.max_pressure(design.as_array()[None, :])[0])
+    pressure_note = angle_note = None
+    if up_to_mpa > limit * (1 + 1e-9):
+        pressure_note = (
+            f"{role} was trained near the design {design} up to {limit:.3g} MPa only: its "
+            f"θ(p) from there to the supply ({up_to_mpa:g} MPa) is an extrapolation"
+        )
+    reach = min(up_to_mpa, limit)
+    angles = np.asarray(saved.model.predict(design.feature_rows(np.linspace(0.0, reach, 101))))
+    if np.max(angles) > support.angle_limit_deg:
+        angle_note = (
+            f"{role} predicts {np.max(angles):.4g}° for the design {design} below "
+            f"{reach:.3g} MPa, beyond the largest angle it was trained on "
+            f"({support.max_angle_deg:.4g}°)"
+        )
+    return limit, pressure_note, angle_note
 
 
 def lab_plant(design: SFRBADesign, model_table: AngleTable) -> AngleTable:

@@ -51,6 +51,10 @@ stop the loop. Every value has a unit in its name or its comment::
     name = "bang-bang"        # a name of softbend.control.CONTROLLERS
     deadzone = 0.05           # its parameters (see its factory), as --set NAME=VALUE
 
+    [simulation]              # optional: the simulated rig of `control run` and `serve`
+    valve_delay_s = 0.005     # names of softbend.control.rigs.RIG_SETTINGS, as --rig-param
+    tubing_mm3 = 2000.0       # NAME=VALUE (which overrides); a hardware rig ignores it
+
 :func:`load_rig_config` reads and checks a file before anything uses it: a
 TOML syntax error, an unknown section or key, a missing required key (the
 ``address`` and ``scale`` of [pressure] and of [angle]: no default fits every
@@ -59,15 +63,19 @@ pressure that is not a plausible gauge pressure (:mod:`softbend.plausibility`)
 is one :class:`~softbend.errors.DatasetError` naming the file, the line and the
 key, and the allowed values; so is an unknown controller name or parameter of
 [controller], or a parameter value of the wrong kind (the message lists the
-known names). :meth:`RigConfig.to_toml` writes one back.
+known names); and so is an unknown name of [simulation], a value of the wrong
+kind or out of the range of :class:`~softbend.control.rig.RigParams`.
+:meth:`RigConfig.to_toml` writes one back.
 """
 
 from __future__ import annotations
 
 import datetime
+import inspect
 import math
 import re
 import tomllib
+from collections.abc import Mapping
 from dataclasses import dataclass, field, fields
 from pathlib import Path
 from typing import Any
@@ -78,17 +86,23 @@ from softbend.errors import DatasetError
 from softbend.plausibility import RANGES, implausible_index
 
 __all__ = [
+    "DEFAULT_TUBING_MM3",
     "ConnectionConfig",
     "ControllerConfig",
     "RegisterConfig",
     "RigConfig",
     "SafetyLimits",
     "ValveConfig",
+    "check_simulation_settings",
     "load_rig_config",
     "rig_config_template",
+    "simulation_settings_entry",
 ]
 
 _OWNER = "rig config"
+
+#: The tubing volume between the inlet valve and the actuator, mm³ (:meth:`RigParams.for_design`).
+DEFAULT_TUBING_MM3 = 2000.0
 
 
 @dataclass(frozen=True)
@@ -281,7 +295,11 @@ class ControllerConfig:
 
 @dataclass(frozen=True)
 class RigConfig:
-    """A whole rig: connection, registers, valves, safety, loop tick and sensor period (s)."""
+    """A whole rig: connection, registers, valves, safety, loop tick and sensor period (s).
+
+    ``simulation`` holds the [simulation] table: ``(name, value)`` pairs of the
+    simulated rig's settings (:func:`softbend.control.rigs.rig_settings`), checked.
+    """
 
     connection: ConnectionConfig = field(default_factory=ConnectionConfig)
     pressure: RegisterConfig = field(
@@ -295,8 +313,12 @@ class RigConfig:
     period_s: float = 0.001
     sensor_period_s: float = 0.01
     controller: ControllerConfig | None = None
+    simulation: tuple[tuple[str, Any], ...] = ()
 
     def __post_init__(self) -> None:
+        given = dict(self.simulation)
+        checked = check_simulation_settings(given, f"[simulation] of the {_OWNER}")
+        object.__setattr__(self, "simulation", tuple((k, checked[k]) for k in given))
         loop = f"[loop] of the {_OWNER}"
         check_range(self.period_s, "period_s", loop, low=0.0, high=1.0, high_inclusive=True)
         check_range(
@@ -355,7 +377,8 @@ class RigConfig:
 
     @classmethod
     def _from_checked(cls, data: Any) -> RigConfig:
-        _check_keys(data, set(_SECTIONS) | {"loop", "controller"}, "the rig config", "section")
+        sections = set(_SECTIONS) | {"loop", "controller", "simulation"}
+        _check_keys(data, sections, "the rig config", "section")
         if "pressure" not in data:
             raise ValueError(
                 "The rig config must have a [pressure] section (table, address, scale, ...)."
@@ -377,6 +400,7 @@ class RigConfig:
             period_s=loop.get("period_s", 0.001),
             sensor_period_s=loop.get("sensor_period_s", 0.01),
             controller=_controller(data["controller"]) if "controller" in data else None,
+            simulation=_simulation(data["simulation"]) if "simulation" in data else (),
         )
         for name, keys in _REQUIRED.items():
             missing = [key for key in keys if name in data and key not in data[name]]
@@ -431,6 +455,10 @@ class RigConfig:
             lines.append(f"name = {_toml_value(self.controller.name)}")
             lines += [f"{k} = {_toml_value(v)}" for k, v in self.controller.params]
             lines.append("")
+        if self.simulation:
+            lines.append("[simulation]")
+            lines += [f"{k} = {_toml_value(v)}" for k, v in self.simulation]
+            lines.append("")
         return "\n".join(lines)
 
 
@@ -438,7 +466,7 @@ def rig_config_template(host: str = "127.0.0.1", port: int = 5020) -> str:
     """A rig TOML to edit: the built-in register map, reached at ``host:port`` (Modbus TCP).
 
     The defaults of :class:`RigConfig`, with a header naming the units and a
-    commented-out [controller] table.
+    commented-out [controller] and [simulation] table.
     """
     from dataclasses import replace
 
@@ -452,6 +480,9 @@ def rig_config_template(host: str = "127.0.0.1", port: int = 5020) -> str:
         "# [controller]            # optional: the controller of `softbend control run`\n"
         '# name = "bang-bang"      # bang-bang, bang-bang-closed, pressure-pi, ...\n'
         "# deadzone = 0.05         # its parameters, as --set NAME=VALUE (which overrides)\n"
+        "\n# [simulation]            # optional: the simulated rig (control run --rig sim, serve)\n"
+        "# valve_delay_s = 0.005   # as --rig-param NAME=VALUE (which overrides); names:\n"
+        "# tubing_mm3 = 2000.0     # 'softbend control rig-parameters'\n"
     )
     return header + settings.to_toml() + footer
 
@@ -550,6 +581,81 @@ def _controller(table: Any) -> ControllerConfig:
         raise _FieldError(str(exc), "controller", exc.key) from None
     except ValueError as exc:
         raise _FieldError(str(exc), "controller", "name") from None
+
+
+def _settings_signature() -> inspect.Signature:
+    """The names a simulated rig takes, with their defaults: RigParams's fields and tubing_mm3."""
+    from softbend.control.rig import RigParams
+
+    defaults = {f.name: f.default for f in fields(RigParams)}
+    defaults["tubing_mm3"] = DEFAULT_TUBING_MM3
+    keyword = inspect.Parameter.KEYWORD_ONLY
+    return inspect.Signature(
+        [inspect.Parameter(name, keyword, default=value) for name, value in defaults.items()]
+    )
+
+
+def simulation_settings_entry(**settings: Any) -> None:
+    """The settings of a simulated rig, as a signature that ``check_parameters`` reads."""
+
+
+simulation_settings_entry.__signature__ = _settings_signature()  # type: ignore[attr-defined]
+
+
+def check_simulation_settings(
+    values: Mapping[str, Any], field: str, *, from_text: bool = False
+) -> dict[str, Any]:
+    """Settings of a simulated rig (the [simulation] table, ``--rig-param``), checked.
+
+    Names and kinds by :func:`softbend.parameters.check_parameters` against the
+    fields of :class:`~softbend.control.rig.RigParams` and ``tubing_mm3``, then
+    the ranges of RigParams itself, name by name.
+
+    Raises
+    ------
+    UnknownParameterError
+        An unknown name; the message lists the known ones.
+    ParameterValueError
+        A value of the wrong kind or out of range (``key`` names it).
+    """
+    from softbend.control.rig import RigParams
+    from softbend.design import SFRBADesign
+    from softbend.parameters import ParameterValueError, check_parameters
+
+    owner = "the simulated rig"
+    checked = check_parameters(
+        simulation_settings_entry, values, owner=owner, field=field, from_text=from_text
+    )
+    for key, value in checked.items():
+        try:
+            if key == "tubing_mm3":
+                RigParams.for_design(SFRBADesign(100, 6, 2, 2, 5, 8), tubing_mm3=value)
+            else:
+                RigParams(**{key: value})
+        except ValueError as exc:
+            message = str(exc).replace(" of RigParams.for_design", " of RigParams", 1)
+            message = message.replace(" of RigParams", f" of {owner} (in {field})", 1)
+            raise ParameterValueError(message, key) from None
+    return checked
+
+
+def _simulation(table: Any) -> tuple[tuple[str, Any], ...]:
+    """The [simulation] table: settings of the simulated rig, checked (one _FieldError)."""
+    from softbend.parameters import ParameterValueError, UnknownParameterError
+
+    owner = f"[simulation] of the {_OWNER}"
+    if not isinstance(table, dict):
+        raise _FieldError(
+            f"The {owner} must be a table ([simulation] followed by its keys). "
+            f"Got {short_repr(table)} ({_toml_type(table)}) instead.",
+            None,
+            "simulation",
+        )
+    try:
+        checked = check_simulation_settings(table, owner)
+    except (UnknownParameterError, ParameterValueError) as exc:
+        raise _FieldError(str(exc), "simulation", exc.key) from None
+    return tuple((k, checked[k]) for k in table)
 
 
 class _FieldError(ValueError):

@@ -7,25 +7,45 @@ its parameters, the noise seed) and returns a connected
 in simulated time), ``sim-realtime`` (the same, kept in step with the wall
 clock) and ``modbus`` (hardware over Modbus, from the TOML's connection and
 register map). Adding one is one ``RIGS.register(name, factory)`` call.
+
+A simulated rig is described by :class:`~softbend.control.rig.RigParams`:
+:func:`rig_settings` checks ``NAME=VALUE`` text (``--rig-param``) and a rig
+TOML's [simulation] table against its fields (plus ``tubing_mm3``, the tubing
+volume added to the design's cavity) and :func:`rig_params_for` builds the
+parameters of a design from them; :data:`RIG_SETTINGS` says what each name means.
 """
 
 from __future__ import annotations
 
-from collections.abc import Callable
+import inspect
+from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
 from softbend.control.rig import AngleTable, Rig, RigParams, SimulatedRig
-from softbend.control.rigconfig import RigConfig
+from softbend.control.rigconfig import (
+    DEFAULT_TUBING_MM3,
+    RigConfig,
+    check_simulation_settings,
+    simulation_settings_entry,
+)
+from softbend.design import SFRBADesign
+from softbend.parameters import parse_assignments
 from softbend.registry import Registry
 
 __all__ = [
     "DEFAULT_RIG",
+    "DEFAULT_TUBING_MM3",
+    "HARDWARE_RIGS",
     "RIGS",
+    "RIG_SETTINGS",
     "RigSetup",
     "make_rig",
     "modbus_rig",
+    "rig_parameter_catalog",
+    "rig_params_for",
+    "rig_settings",
     "sim_realtime_rig",
     "sim_rig",
 ]
@@ -106,3 +126,129 @@ def make_rig(name: str, setup: RigSetup, *, field: str = "make_rig") -> Rig:
     known ones (``field`` names where it came from, e.g. ``"--rig"``).
     """
     return RIGS.get(name, field=field)(setup)
+
+
+#: Rigs that are hardware: the parameters of a simulated rig mean nothing to them.
+HARDWARE_RIGS: frozenset[str] = frozenset({"modbus"})
+
+#: What each setting of a simulated rig is (its unit is in its name; :mod:`softbend.control.rig`).
+RIG_SETTINGS: dict[str, str] = {
+    "supply_gauge_mpa": "supply pressure behind the inlet valve (same as --supply)",
+    "atmosphere_mpa": "absolute pressure of the atmosphere the outlet vents to",
+    "temperature_k": "temperature of the air",
+    "inlet_conductance_m3_s_pa": "ISO 6358 sonic conductance C of the inlet valve + throttle",
+    "outlet_conductance_m3_s_pa": "ISO 6358 sonic conductance C of the outlet valve + throttle",
+    "critical_ratio": "ISO 6358 critical pressure ratio b of both valves, in [0, 1)",
+    "valve_delay_s": "delay from a valve command to the valve switching",
+    "volume_mm3": "whole chamber volume at 0 MPa gauge (default: the design's cavity + tubing)",
+    "tubing_mm3": "tubing volume added to the design's cavity (or give volume_mm3)",
+    "compliance_mm3_per_mpa": "growth of the chamber volume with gauge pressure, dV/dp",
+    "polytropic_exponent": "of the gas in the chamber: 1 isothermal to 1.4 adiabatic",
+    "angle_time_constant_s": "first-order lag of the angle behind its quasi-static θ(p)",
+    "sensor_noise_mpa": "standard deviation of the pressure sensor's Gaussian noise",
+    "sensor_bits": "resolution of the pressure sensor over its range (0: no quantisation)",
+    "sensor_range_mpa": "full scale of the pressure sensor, gauge",
+    "camera_fps": "frame rate of the camera that records the true angle",
+    "camera_latency_s": "delay of the camera's angle",
+    "camera_noise_deg": "standard deviation of the camera's Gaussian angle noise",
+    "step_s": "integration step of the rig model, at most 0.01",
+}
+
+
+def rig_parameter_catalog() -> list[dict[str, Any]]:
+    """Every setting of a simulated rig: ``{"name", "default", "what"}`` (RigParams, tubing_mm3).
+
+    ``default`` is the default of :class:`~softbend.control.rig.RigParams`
+    (``volume_mm3``: that of paper B's (100,6,2,2,5,8) actuator; a run computes
+    it for its design from ``tubing_mm3``).
+    """
+    return [
+        {"name": p.name, "default": p.default, "what": RIG_SETTINGS.get(p.name, "")}
+        for p in inspect.signature(simulation_settings_entry).parameters.values()
+    ]
+
+
+def rig_settings(
+    assignments: Sequence[str] | None = (),
+    values: Mapping[str, Any] | None = None,
+    *,
+    supply_mpa: float | None = None,
+    field: str = "--rig-param",
+    table_field: str = "[simulation] of the rig config",
+    supply_field: str = "--supply",
+) -> dict[str, Any]:
+    """The settings of a simulated rig that differ from the defaults, checked.
+
+    Parameters
+    ----------
+    assignments : sequence of str, optional
+        ``NAME=VALUE`` text (``--rig-param``), read by the kind of each name:
+        a field of :class:`~softbend.control.rig.RigParams` or ``tubing_mm3``
+        (:data:`RIG_SETTINGS`).
+    values : mapping, optional
+        Data values of the same names (a rig TOML's [simulation] table);
+        ``assignments`` override them.
+    supply_mpa : float, optional
+        The supply pressure given on its own (``--supply``), MPa gauge: the same as
+        ``supply_gauge_mpa``; it overrides ``values`` too.
+    field, table_field, supply_field : str
+        Where the assignments, the values and the supply came from, for messages.
+
+    Returns
+    -------
+    dict
+        ``{name: value}`` of the names given, typed (``float``, ``int`` for
+        ``sensor_bits``); :func:`rig_params_for` builds the parameters from it.
+
+    Raises
+    ------
+    UnknownParameterError
+        An unknown name; the message lists the known names.
+    ParameterValueError
+        A value of the wrong kind, or out of the range that RigParams allows.
+    ValueError
+        An assignment that is not ``NAME=VALUE`` or gives a name twice, a
+        ``supply_mpa`` that differs from ``supply_gauge_mpa`` of the assignments,
+        or both ``volume_mm3`` and ``tubing_mm3``.
+        (Whether the supply is a plausible gauge pressure is for
+        :func:`~softbend.control.setup.check_supply`.)
+    """
+    table = check_simulation_settings(values or {}, table_field, from_text=False)
+    given = check_simulation_settings(parse_assignments(assignments, field), field, from_text=True)
+    if supply_mpa is not None:
+        supply = check_simulation_settings(
+            {"supply_gauge_mpa": supply_mpa}, supply_field, from_text=False
+        )
+        other = given.get("supply_gauge_mpa", supply["supply_gauge_mpa"])
+        if other != supply["supply_gauge_mpa"]:
+            raise ValueError(
+                f"The '{supply_field}' and '{field} supply_gauge_mpa' are the same setting, "
+                f"the supply pressure (MPa gauge): give one, or the same value. Got "
+                f"{supply_mpa!r} and {other!r} instead."
+            )
+        given.update(supply)
+    merged = {**table, **given}
+    if "volume_mm3" in merged and "tubing_mm3" in merged:
+        raise ValueError(
+            f"The 'volume_mm3' (the whole chamber) and 'tubing_mm3' (added to the design's "
+            f"cavity) of the simulated rig (in {field} or the {table_field}) both set the "
+            "chamber volume: give one. Got both instead."
+        )
+    return merged
+
+
+def rig_params_for(
+    design: SFRBADesign, settings: Mapping[str, Any] | None = None, **defaults: Any
+) -> RigParams:
+    """The simulated rig of ``design`` with ``settings`` (:func:`rig_settings`) applied.
+
+    The chamber volume is the design's cavity plus ``tubing_mm3``
+    (:meth:`RigParams.for_design`) unless ``volume_mm3`` is given; ``defaults``
+    are RigParams fields the library derives (an FEM compliance), which
+    ``settings`` override.
+    """
+    chosen = {**defaults, **(settings or {})}
+    tubing = chosen.pop("tubing_mm3", DEFAULT_TUBING_MM3)
+    if "volume_mm3" in chosen:
+        return RigParams(**chosen)
+    return RigParams.for_design(design, tubing_mm3=tubing, **chosen)

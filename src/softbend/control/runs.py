@@ -14,16 +14,32 @@ the effective controller name and parameters (``controller_params``) included.
 
 from __future__ import annotations
 
+import warnings
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
+import numpy as np
+
 from softbend._validation import check_range
 from softbend.control.experiments import ControlRun, Reference, parse_reference
 from softbend.control.rigconfig import RigConfig, load_rig_config
-from softbend.control.rigs import DEFAULT_RIG, RIGS, RigSetup, make_rig
-from softbend.control.setup import DEFAULT_DESIGN, ControlSetup, prepare_control
+from softbend.control.rigs import (
+    DEFAULT_RIG,
+    HARDWARE_RIGS,
+    RIGS,
+    RigSetup,
+    make_rig,
+    rig_settings,
+)
+from softbend.control.setup import (
+    DEFAULT_DESIGN,
+    ControlSetup,
+    beyond_support,
+    check_supply,
+    prepare_control,
+)
 
 __all__ = [
     "LoopPlan",
@@ -53,26 +69,40 @@ def simulate_control(
     model: str | Path | None = None,
     plant: str = "surrogate",
     duration_s: float = 10.0,
-    supply_mpa: float = 0.2,
+    supply_mpa: float | None = None,
+    rig_assignments: Sequence[str] = (),
     seed: int = 0,
     command: str = "simulate_control",
+    strict: bool = False,
 ) -> Simulation:
     """Run a controller on the simulated rig of ``design`` and score it (synthetic).
 
     Parameters are those of :func:`~softbend.control.setup.prepare_control`, plus the
     ``reference`` spec (:func:`~softbend.control.experiments.parse_reference`,
-    degrees), ``duration_s`` (s) and ``seed`` (sensor and camera noise).
+    degrees), ``duration_s`` (s), ``seed`` (sensor and camera noise) and
+    ``rig_assignments``: ``NAME=VALUE`` settings of the simulated rig
+    (``--rig-param``, :func:`~softbend.control.rigs.rig_settings`; ``supply_mpa``,
+    default 0.2 MPa, is its ``supply_gauge_mpa``). A run
+    that reaches a pressure past what the models were trained to near the
+    design warns (:func:`~softbend.control.setup.beyond_support`) and says so in
+    the summary's ``support``; with ``strict`` the run is refused before it starts
+    when the supply lies past it.
     """
     from softbend.control.experiments import run_metrics, simulate
     from softbend.control.rig import SimulatedRig
 
     ref = parse_reference(reference)
+    simulated = _rig_settings(rig_assignments, {}, supply_mpa, command)
     setup = prepare_control(
         controller=controller, assignments=assignments, design=design, model=model,
-        plant=plant, supply_mpa=supply_mpa, command=command,
+        plant=plant, rig_settings=simulated, command=command, strict=strict,
     )  # fmt: skip
     rig = SimulatedRig(setup.plant_table, setup.rig_params, seed=seed)
     run = simulate(rig, setup.controller, ref, duration_s, seed=seed)
+    reached = float(np.max(run.pressure_mpa))
+    beyond = beyond_support(setup, reached)
+    if beyond is not None:
+        warnings.warn(beyond, UserWarning, stacklevel=2)
     summary = {
         "synthetic": True,
         "reference": reference,
@@ -80,7 +110,14 @@ def simulate_control(
         "duration_s": duration_s,
         "seed": seed,
         "rig": setup.rig_params.as_dict(),
+        "rig_settings": dict(setup.rig_settings),
         "metrics": run_metrics(run),
+        "support": {
+            "supported_mpa": setup.supported_mpa,
+            "max_pressure_mpa": reached,
+            "beyond": beyond is not None,
+            "notes": list(setup.support_notes),
+        },
     }
     return Simulation(setup=setup, run=run, summary=summary)
 
@@ -179,6 +216,7 @@ class LoopPlan:
             "metrics": result.metrics(),
             "rig_config": self.rig_setup.config.to_toml(),
             "rig_params": self.setup.rig_params.as_dict() if synthetic else None,
+            "rig_settings": dict(self.setup.rig_settings) if synthetic else None,
         }
         trips = getattr(device, "round_trips_s", None)
         if trips is not None:
@@ -199,7 +237,8 @@ def plan_loop(
     duration_s: float = 10.0,
     period_s: float | None = None,
     sensor_period_s: float | None = None,
-    supply_mpa: float = 0.2,
+    supply_mpa: float | None = None,
+    rig_assignments: Sequence[str] = (),
     seed: int = 0,
     command: str = "plan_loop",
 ) -> LoopPlan:
@@ -212,20 +251,32 @@ def plan_loop(
     config : path, optional
         A rig TOML: its [safety] and [loop] apply to every rig, its connection and
         register map to ``modbus``, its [controller] when ``controller`` is not given
-        or the same.
+        or the same, its [simulation] to a simulated rig (``rig_assignments``
+        override it).
+    rig_assignments : sequence of str
+        ``NAME=VALUE`` settings of a simulated rig (``--rig-param``); refused with a
+        hardware rig (:data:`~softbend.control.rigs.HARDWARE_RIGS`).
     period_s, sensor_period_s : float, optional
         Loop tick and sensor period, s (default: the config's).
     others
         As :func:`simulate_control`.
     """
     RIGS.check(rig, field="--rig")
+    if rig in HARDWARE_RIGS and rig_assignments:
+        raise ValueError(
+            f"The '--rig-param' of {command} sets the simulated rig; --rig {rig} is hardware "
+            "(its pneumatics are what they are): drop --rig-param, or use --rig sim or "
+            f"sim-realtime. Got {list(rig_assignments)!r} instead."
+        )
     ref = parse_reference(reference)
     settings = load_rig_config(config) if config is not None else RigConfig()
     tick = settings.period_s if period_s is None else period_s
     sensor = settings.sensor_period_s if sensor_period_s is None else sensor_period_s
+    table = dict(settings.simulation) if rig not in HARDWARE_RIGS else {}
+    simulated = _rig_settings(rig_assignments, table, supply_mpa, command)
     setup = prepare_control(
         controller=controller, assignments=assignments, config=settings.controller,
-        design=design, model=model, plant=plant, supply_mpa=supply_mpa, command=command,
+        design=design, model=model, plant=plant, rig_settings=simulated, command=command,
     )  # fmt: skip
     check_range(duration_s, "duration", command, low=0.0, high=86400.0, high_inclusive=True)
     check_range(tick, "period", command, low=0.0, high=1.0, high_inclusive=True)
@@ -251,14 +302,17 @@ def simulated_server(
     design: str = DEFAULT_DESIGN,
     model: str | Path | None = None,
     plant: str = "surrogate",
-    supply_mpa: float = 0.2,
+    supply_mpa: float | None = None,
+    rig_assignments: Sequence[str] = (),
     seed: int = 0,
     command: str = "simulated_server",
 ) -> Any:
     """The simulated rig of ``design`` behind a Modbus TCP server (not started).
 
     The register map is the ``config``'s (default: the built-in map); ``port``
-    defaults to the config's, else 5020.
+    defaults to the config's, else 5020. The rig's parameters are the config's
+    [simulation] table with ``rig_assignments`` (``--rig-param NAME=VALUE``) and
+    ``supply_mpa`` over it (:func:`~softbend.control.rigs.rig_settings`).
     """
     from softbend.control.modbus_server import SimulatedModbusServer
     from softbend.control.rig import SimulatedRig
@@ -274,11 +328,22 @@ def simulated_server(
         raise ValueError(
             f"The '--port' of {command} must be an integer in [0, 65535]. Got {listen} instead."
         )
+    table = dict(settings.simulation)
+    simulated = _rig_settings(rig_assignments, table, supply_mpa, command)
     setup = prepare_control(
-        design=design, model=model, plant=plant, supply_mpa=supply_mpa, command=command
+        design=design, model=model, plant=plant, rig_settings=simulated, command=command
     )
     rig = SimulatedRig(setup.plant_table, setup.rig_params, seed=seed)
     return SimulatedModbusServer(rig, settings, host=host, port=listen)
+
+
+def _rig_settings(
+    assignments: Sequence[str], table: dict[str, Any], supply_mpa: float | None, command: str
+) -> dict[str, Any]:
+    """The simulated rig's settings: ``--supply`` checked as a gauge pressure first."""
+    if supply_mpa is not None:
+        check_supply(supply_mpa, command)
+    return rig_settings(assignments, table, supply_mpa=supply_mpa)
 
 
 def _percentiles_ms(values: list[float]) -> dict[str, float]:
