@@ -49,6 +49,11 @@ def measure(
     elastomer: str = typer.Option(
         "dragon-skin-30", help="Shipped tensile test the lab's silicone is fitted to (Yeoh)."
     ),
+    material: str | None = typer.Option(
+        None,
+        help="The lab's silicone whole, instead of --elastomer: a preset or the fit.json of "
+        "'softbend materials fit' (fit.json#yeoh for one of its models).",
+    ),
     as_json: bool = typer.Option(False, "--json", help="Print a JSON summary."),
 ) -> None:
     """Measure actuators in the virtual lab.
@@ -63,6 +68,7 @@ def measure(
     \b
         softbend lab measure --out lab.csv --plant analytical
         softbend lab measure --out own.csv --design 130,7,2.5,3,10,9 --plant analytical
+        softbend lab measure --out own.csv --design 130,7,2.5,3,10,9 --material fit.json
     """
     from softbend._io import atomic_files
     from softbend.limits import check_limit
@@ -84,9 +90,14 @@ def measure(
     from softbend.transfer.lab import LAB_ACTUATORS
 
     actuators = tuple(SFRBADesign.parse(d) for d in designs) if designs else LAB_ACTUATORS
+    if material is not None:
+        from softbend.materials.choice import material_from_spec
+
+        material_from_spec(material, field="--material")
     lab = VirtualLab(
         actuators=actuators,
         elastomer=elastomer,
+        material=material,
         plant=plant,
         seed=seed,
         fabrication_error_mm=fabrication_error,

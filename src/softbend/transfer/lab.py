@@ -101,6 +101,11 @@ class VirtualLab:
     elastomer_max_stretch : float
         Largest stretch of the tensile test used by the fit, > 1 (default 3: the
         working range of the walls).
+    material : str, optional
+        The lab's silicone given whole instead: a preset name or the ``fit.json``
+        of ``softbend materials fit`` (``PATH#MODEL`` for one of its models;
+        :func:`softbend.materials.material_from_spec`). ``elastomer`` and
+        ``elastomer_max_stretch`` are then not used.
     fabrication_error_mm : float
         Half-width of the uniform error of ``t`` and ``b``, mm, in [0, 1).
     hysteresis : float
@@ -135,6 +140,7 @@ class VirtualLab:
     plant: str = "fem"
     elastomer: str = "dragon-skin-30"
     elastomer_max_stretch: float = 3.0
+    material: str | None = None
     fabrication_error_mm: float = 0.2
     hysteresis: float = 0.02
     camera_noise_deg: float = 1.0
@@ -202,12 +208,20 @@ class VirtualLab:
         check_limit("cycles", cycles, f"The 'cycles' of {_OWNER}")
         object.__setattr__(self, "cycles", cycles)
         object.__setattr__(self, "seed", check_int(self.seed, "seed", _OWNER, low=0))
+        if self.material is not None:
+            self.elastomer_material()  # a bad spec is refused here, naming 'material'
         default_pressures_mpa(self.pmax_mpa, self.pressure_step_mpa)  # whole number of steps
 
     # -- the gap -----------------------------------------------------------------
 
     def elastomer_material(self) -> Material:
-        """The lab's silicone: a Yeoh fit of the shipped tensile test (density of DS30)."""
+        """The lab's silicone: ``material`` if given, else a Yeoh fit of the shipped tensile
+        test (density of DS30)."""
+        if self._material is None and self.material is not None:
+            from softbend.materials.choice import material_from_spec
+
+            chosen = material_from_spec(str(self.material), field="material")
+            object.__setattr__(self, "_material", chosen)
         if self._material is None:
             test = load_shipped(self.elastomer)
             fit = fit_model(
@@ -247,18 +261,27 @@ class VirtualLab:
     def metadata(self) -> dict[str, str]:
         """Header lines of the lab's files: synthetic, the gap's parameters, the material."""
         material = self.elastomer_material()
-        values = {k: v for k, v in asdict(self).items() if k not in ("actuators", "_material")}
+        values = {
+            k: v
+            for k, v in asdict(self).items()
+            if k not in ("actuators", "_material")
+            # the material given whole replaces the shipped test's fit
+            and not (k == "material" and v is None)
+            and not (k.startswith("elastomer") and self.material is not None)
+        }
         meta = {
             "synthetic": "true",
             "note": "virtual-lab measurements (labelled-synthetic), not of a real actuator",
             "generator": "softbend.transfer.VirtualLab",
         }
         meta.update({f"lab.{k}": str(v) for k, v in values.items()})
-        yeoh = material.model
-        assert isinstance(yeoh, Yeoh)  # elastomer_material is a Yeoh fit
+        model = material.model
         meta["lab.elastomer_model"] = (
-            f"Yeoh c10={yeoh.c10_mpa:.5g} c20={yeoh.c20_mpa:.5g} c30={yeoh.c30_mpa:.5g} MPa"
+            f"Yeoh c10={model.c10_mpa:.5g} c20={model.c20_mpa:.5g} c30={model.c30_mpa:.5g} MPa"
+            if isinstance(model, Yeoh)
+            else " ".join(f"{k}={v}" for k, v in model.to_dict().items())
         )
+        meta["lab.material_source"] = material.source
         meta["lab.as_built"] = "; ".join(
             f"{actuator_id(n)} -> t={b.t_mm:g} b={b.b_mm:g} mm"
             for n, b in zip(self.actuators, self.as_built(), strict=True)

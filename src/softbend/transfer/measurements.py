@@ -206,6 +206,8 @@ METADATA_KEYS: dict[str, tuple[str, Callable[[str], bool]]] = {
     "lab.cycles": ("an integer >= 1", _is_integer(1)),
     "lab.seed": ("an integer >= 0", _is_integer(0)),
     "lab.elastomer_model": _TEXT,
+    "lab.material": _TEXT,
+    "lab.material_source": _TEXT,
     "lab.as_built": _TEXT,
 }
 
