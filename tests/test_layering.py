@@ -24,6 +24,7 @@ STAGES: tuple[tuple[str, ...], ...] = (
         "_io",
         "_jsontext",
         "_lazy",
+        "_progress",
         "_torch",
         "_validation",
         "errors",

@@ -74,3 +74,14 @@ def test_gpu_refits_match_the_cpu(base):
         for a, b in zip(c.coefs_, g.coefs_, strict=True):
             np.testing.assert_allclose(b, a, rtol=0, atol=1e-9 * np.abs(a).max())
         np.testing.assert_allclose(g.loss_curve_, c.loss_curve_, rtol=1e-9)
+
+
+def test_a_refit_reports_its_epochs_to_the_listener(base):
+    from softbend._progress import listening
+
+    X, y = _rows(base)
+    heard = []
+    with listening(lambda phase, done, total: heard.append((phase, done, total))):
+        fine_tune_many(base, X, y, np.ones((2, y.size)), epochs=120, device="cpu")
+    assert heard[-1] == ("training 2 networks (epochs)", 120, 120)
+    assert [d for _, d, _ in heard] == sorted(d for _, d, _ in heard) and len(heard) <= 61

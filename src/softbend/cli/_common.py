@@ -33,7 +33,7 @@ from softbend.cli._outputs import (
     os_error_message,
     output_errors,
 )
-from softbend.cli._progress import phase_progress, progress_bar
+from softbend.cli._progress import library_progress, phase_progress, progress_bar
 from softbend.errors import SoftbendError
 
 __all__ = [
@@ -50,6 +50,7 @@ __all__ = [
     "error_line",
     "file_kind",
     "json_text",
+    "library_progress",
     "os_error_message",
     "output_errors",
     "parse_assignments",

@@ -17,7 +17,7 @@ from rich.progress import (
 
 from softbend.cli._console import err_console
 
-__all__ = ["phase_progress", "progress_bar"]
+__all__ = ["library_progress", "phase_progress", "progress_bar"]
 
 
 @contextmanager
@@ -119,3 +119,16 @@ def phase_progress(*, enabled: bool = True) -> Iterator[Callable[[str, int, int]
         err_console.print(f"{phase}: {done}/{total} ({elapsed:.0f} s)", highlight=False)
 
     yield write
+
+
+@contextmanager
+def library_progress(*, enabled: bool = True) -> Iterator[Callable[[str, int, int], None]]:
+    """:func:`phase_progress` that also hears the library's own reports.
+
+    The epochs of a network's refit and the pressures of an FEM sweep report to
+    :mod:`softbend._progress`; inside this block they are drawn as phases.
+    """
+    from softbend._progress import listening
+
+    with phase_progress(enabled=enabled) as progress, listening(progress):
+        yield progress

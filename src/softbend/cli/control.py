@@ -57,12 +57,13 @@ def simulate_cmd(
     from softbend.reports import control_figures
 
     _common.check_output_dir(out, "--out", files=_FILES)
-    result = simulate_control(
-        reference=reference, controller=controller, assignments=settings or (), design=design,
-        model=model, plant=plant, duration_s=duration, supply_mpa=supply,
-        rig_assignments=rig_params or (), seed=seed, command="softbend control simulate",
-        strict=strict,
-    )  # fmt: skip
+    with _common.library_progress(enabled=not as_json):  # an FEM plant's sweep, if any
+        result = simulate_control(
+            reference=reference, controller=controller, assignments=settings or (),
+            design=design, model=model, plant=plant, duration_s=duration, supply_mpa=supply,
+            rig_assignments=rig_params or (), seed=seed, command="softbend control simulate",
+            strict=strict,
+        )  # fmt: skip
     payload = dict(result.summary)
     name, actuator = payload["controller"], payload["design"]
     targets = tuple(out / name for name in _FILES)
@@ -174,10 +175,11 @@ def serve_cmd(
 
     command = "softbend control serve"
     check_range(duration, "duration", command, low=0.0, low_inclusive=True)
-    server = simulated_server(
-        config=config, host=host, port=port, design=design, model=model, plant=plant,
-        supply_mpa=supply, rig_assignments=rig_params or (), seed=seed, command=command,
-    )  # fmt: skip
+    with _common.library_progress():  # an FEM plant's sweep, if any
+        server = simulated_server(
+            config=config, host=host, port=port, design=design, model=model, plant=plant,
+            supply_mpa=supply, rig_assignments=rig_params or (), seed=seed, command=command,
+        )  # fmt: skip
     server.start()
     _common.console.print(
         f"simulated rig {design} serving on {server.config.connection.where} "

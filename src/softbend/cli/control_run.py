@@ -75,12 +75,13 @@ def run_cmd(
 
     command = "softbend control run"
     check_choice(log_format, "log_format", command, _LOG_FORMATS)
-    plan = plan_loop(
-        rig=rig, config=config, reference=reference, controller=controller,
-        assignments=settings or (), design=design, model=model, plant=plant,
-        duration_s=duration, period_s=period, sensor_period_s=sensor_period,
-        supply_mpa=supply, rig_assignments=rig_params or (), seed=seed, command=command,
-    )  # fmt: skip
+    with _common.library_progress():  # an FEM plant's sweep, if any
+        plan = plan_loop(
+            rig=rig, config=config, reference=reference, controller=controller,
+            assignments=settings or (), design=design, model=model, plant=plant,
+            duration_s=duration, period_s=period, sensor_period_s=sensor_period,
+            supply_mpa=supply, rig_assignments=rig_params or (), seed=seed, command=command,
+        )  # fmt: skip
     log_name = f"ticks.{log_format}"
     _common.check_output_dir(out, "--out", files=(log_name, "run.json", "run.png"))
     done = [0]

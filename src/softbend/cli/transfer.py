@@ -123,7 +123,10 @@ def refine(
         check_limit("epochs", epochs, "--epochs")
         values["epochs"] = str(epochs)
     _common.check_output_file(out, "--out", inputs=(base, *measurements), kind="json")
-    result = refine_surrogate(base, measurements, strategy, seed=seed, settings=values, force=force)
+    with _common.library_progress():  # the refit's epochs, then the calibration's
+        result = refine_surrogate(
+            base, measurements, strategy, seed=seed, settings=values, force=force
+        )
     with _common.output_errors(out, "--out"):
         path = result.save(out)
     meta = result.metadata

@@ -104,7 +104,7 @@ def loco(
     options = strategy_options(names, _common.parse_assignments(settings or ()))
     data = load_measurements_files(measurements, force=force)
     model = load_base(base)
-    with _common.phase_progress(enabled=not as_json) as progress:
+    with _common.library_progress(enabled=not as_json) as progress:
         result = leave_one_configuration_out(
             data,
             model,

@@ -26,6 +26,7 @@ from typing import Any
 import numpy as np
 
 from softbend._io import json_text, write_text_atomic
+from softbend._progress import report
 from softbend.control.rig import AngleTable, cavity_compliance_mm3_per_mpa
 from softbend.design import SFRBADesign
 
@@ -127,7 +128,8 @@ def fem_curve(
     options : FEMOptions, optional
         The FEM's settings (default :class:`~softbend.fem.FEMOptions`); part of the key.
     progress : callable, optional
-        Passed to :func:`softbend.fem.simulate` (``progress(p, angle, pmax)``).
+        Passed to :func:`softbend.fem.simulate` (``progress(p, angle, pmax)``);
+        default: reported to the listener of :mod:`softbend._progress`.
     cache : bool, default True
         Read and write the cache folder (:func:`cache_dir`).
 
@@ -146,6 +148,12 @@ def fem_curve(
             return FEMCurve.from_dict(json.loads(path.read_text(encoding="utf-8")))
         except (ValueError, KeyError, TypeError):
             pass  # damaged: solve again and overwrite
+    if progress is None:  # whoever listens hears the sweep, in kPa of the 0.5 MPa
+        phase = f"FEM sweep of {design} (kPa)"
+
+        def progress(p: float, angle: float, pmax: float) -> None:
+            report(phase, round(1000 * p), round(1000 * pmax))
+
     result = simulate(design, default_pressures_mpa(PMAX_MPA), options, progress=progress)
     ok = np.asarray(result.converged, dtype=bool)
     if ok.sum() < 2:

@@ -22,6 +22,7 @@ from typing import Any
 import numpy as np
 from numpy.typing import ArrayLike
 
+from softbend._progress import every, report
 from softbend._validation import check_int, check_range
 from softbend.errors import ConvergenceError
 from softbend.limits import check_limit
@@ -160,6 +161,7 @@ def fine_tune_many(
         # Fused Adam: one kernel for the update of all six tensors.
         optimizer = torch.optim.Adam([*weights_, *biases], lr=learning_rate, fused=True)
         curve_t = torch.empty((k, epochs), **on)
+        phase, stride = f"training {k} network{'s' * (k > 1)} (epochs)", every(epochs)
         for epoch in range(epochs):
             a = torch.tanh(z @ weights_[0] + biases[0])
             a = torch.tanh(a @ weights_[1] + biases[1])
@@ -169,6 +171,8 @@ def fine_tune_many(
             per_variant.sum().backward()
             optimizer.step()
             curve_t[:, epoch] = per_variant.detach()
+            if (epoch + 1) % stride == 0 or epoch + 1 == epochs:
+                report(phase, epoch + 1, epochs)
         curve = curve_t.cpu().numpy()
     finally:
         torch.set_num_threads(threads)
