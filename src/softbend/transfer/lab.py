@@ -48,7 +48,14 @@ from softbend.references import FEM_VALIDATION
 from softbend.registry import Registry
 from softbend.transfer.measurements import Measurements
 
-__all__ = ["LAB_ACTUATORS", "PLANTS", "VirtualLab", "actuator_id", "shipped_measurements"]
+__all__ = [
+    "LAB_ACTUATORS",
+    "PLANTS",
+    "VirtualLab",
+    "actuator_id",
+    "shipped_measurements",
+    "shipped_measurements_path",
+]
 
 _OWNER = "VirtualLab"
 
@@ -388,17 +395,20 @@ class VirtualLab:
         return out
 
 
+def shipped_measurements_path() -> Path:
+    """Path of the shipped virtual-lab readings (``softbend/data/transfer/virtual_lab.csv``)."""
+    from importlib import resources
+
+    return Path(str(resources.files("softbend") / "data" / "transfer" / "virtual_lab.csv"))
+
+
 def shipped_measurements() -> Measurements:
     """The default virtual lab's measurements as shipped (``softbend lab measure``, seed 0, FEM).
 
     120 labelled-synthetic readings of the seven actuators of paper B Fig. 7;
     ``softbend lab measure --out virtual_lab.csv`` makes them again (about two
-    CPU minutes).
+    CPU minutes). The file: :func:`shipped_measurements_path`.
     """
-    from importlib import resources
-
     from softbend.transfer.measurements import load_measurements
 
-    return load_measurements(
-        Path(str(resources.files("softbend") / "data" / "transfer" / "virtual_lab.csv"))
-    )
+    return load_measurements(shipped_measurements_path())
