@@ -31,15 +31,22 @@ def test_the_rule_on_a_hand_made_case():
     assert conformal_half_width({"a": [-3.0], "b": [2.0]}, 0.5)[0] == 3.0  # ⌈1.5⌉ = 2nd
 
 
-def test_too_few_actuators_take_the_largest_error_and_warn():
+def test_too_few_actuators_take_the_plug_in_quantile_or_the_largest_error_and_warn():
     assert min_actuators(0.9) == 9 and min_actuators(0.95) == 19
     seven = {str(i): [float(i), 0.5] for i in range(1, 8)}
-    half, guaranteed = conformal_half_width(seven, 0.9)
-    assert (half, guaranteed) == (7.0, False)
-    cal = calibrate(seven, 0.9)
-    message = cal.warning()
-    assert message is not None and "7 actuators are too few" in message and "87.5%" in message
-    assert calibrate({str(i): [1.0] for i in range(9)}, 0.9).warning() is None
+    # Σ F_i(t) = 3.5 + t/2 at t = 1..7: the plug-in quantile reaches 0.9·7 = 6.3 at t = 6.
+    assert conformal_half_width(seven, 0.9) == (6.0, False)
+    assert conformal_half_width(seven, 0.9, fallback="largest") == (7.0, False)
+    quantile = calibrate(seven, 0.9)
+    message = quantile.warning()
+    assert message is not None and "7 actuators are too few" in message
+    assert "without a guarantee" in message and quantile.to_dict()["fallback"] == "quantile"
+    largest = calibrate(seven, 0.9, fallback="largest")
+    assert "87.5%" in largest.warning() and largest.half_width_deg == 7.0
+    enough = calibrate({str(i): [1.0] for i in range(9)}, 0.9)
+    assert enough.warning() is None and enough.to_dict()["fallback"] is None
+    with pytest.raises(ValueError, match="fallback"):
+        conformal_half_width(seven, 0.9, fallback="max")
 
 
 def test_the_low_end_stops_at_the_smallest_angle_seen():
@@ -121,15 +128,20 @@ def test_loco_scores_the_nested_calibrated_interval(small_base, quick_measuremen
         assert summary.loc[name, "calibrated_width_deg"] > 0.0
         assert result.calibrations[name]["n_actuators"] == len(quick_measurements.actuator_ids)
     # fem-only does not learn: its nested errors are the base's, so calibrating without
-    # the held-out actuator is the largest base error of the 3 others.
+    # the held-out actuator is the plug-in quantile of the base errors of the 3 others.
     held = quick_measurements.actuator_ids[0]
     y, X, groups = (
         quick_measurements.angle_deg,
         quick_measurements.features,
         quick_measurements.groups,
     )
-    others = groups != held
-    expected = float(np.max(np.abs(small_base.predict(X[others]) - y[others])))
+    errors = {
+        a: np.abs(small_base.predict(X[groups == a]) - y[groups == a])
+        for a in quick_measurements.actuator_ids
+        if a != held
+    }
+    expected, guaranteed = conformal_half_width(errors, 0.9)
+    assert not guaranteed
     row = result.per_actuator.query("strategy == 'fem-only' and actuator_id == @held").iloc[0]
     assert row["calibration_half_width_deg"] == pytest.approx(expected)
     assert {"cal_lo_deg", "cal_hi_deg"} <= set(result.predictions.columns)

@@ -200,5 +200,6 @@ def print_loco_summary(result: LocoResult) -> None:
             _common.warning_line(
                 f"{name}: {cal['n_actuators']} actuators are too few for a guaranteed "
                 f"{result.level:.0%} interval (the rule needs {cal['min_actuators']}); "
-                "its calibrated half-width is the largest leave-one-actuator-out error."
+                f"its calibrated half-width is the {result.level:.0%} quantile of the "
+                "leave-one-actuator-out errors, without a guarantee."
             )

@@ -193,6 +193,7 @@ def leave_one_configuration_out(
     level: float = 0.9,
     learning_curve: bool = True,
     calibrated: bool = False,
+    fallback: str = "quantile",
     seed: int = 0,
     options: dict[str, dict[str, Any]] | None = None,
     progress: Callable[[int, int, str], None] | None = None,
@@ -220,6 +221,9 @@ def leave_one_configuration_out(
         on each held-out actuator, nested (n − 1 more fits per held-out
         actuator, each without it and one other; at least 3 actuators); not
         ``experimental`` and ``refined-ensemble``.
+    fallback : {"quantile", "largest"}, default "quantile"
+        The calibrated half-width with too few actuators for the conformal
+        guarantee (:func:`softbend.transfer.conformal.calibrate`).
     seed : int, default 0
         Seed of the strategies and of the learning curve's actuator order.
     options : dict, optional
@@ -336,7 +340,7 @@ def leave_one_configuration_out(
         row = _score(name, held_out, y[test], out["pred"], out["interval"])
         if kind == "loco":
             row["fit_s"] = out["fit_s"]
-            cal = _calibration(nested.get((name, held_out)), level, y[train])
+            cal = _calibration(nested.get((name, held_out)), level, y[train], fallback)
             row.update(_score_calibrated(cal, y[test], out["pred"]))
             scores.append(row)
             part = measurements.frame.iloc[test].assign(strategy=name, predicted_deg=out["pred"])
@@ -374,7 +378,7 @@ def leave_one_configuration_out(
         calibrations={
             name: cal.to_dict()
             for name in nested_names
-            if (cal := _calibration(loco_errors.get(name), level, y)) is not None
+            if (cal := _calibration(loco_errors.get(name), level, y, fallback)) is not None
         },
         settings={
             "strategies": list(names),
@@ -448,13 +452,13 @@ def held_out_residuals(
 
 
 def _calibration(
-    errors: dict[str, np.ndarray] | None, level: float, seen: np.ndarray
+    errors: dict[str, np.ndarray] | None, level: float, seen: np.ndarray, fallback: str
 ) -> Calibration | None:
     """The calibration from leave-one-out errors; None without any, or with an actuator
     whose errors are all non-finite."""
     if not errors or not all(np.isfinite(e).any() for e in errors.values()):
         return None
-    return calibrate(errors, level, floor_deg=angle_floor(seen))
+    return calibrate(errors, level, floor_deg=angle_floor(seen), fallback=fallback)
 
 
 def _score_calibrated(cal: Calibration | None, y: np.ndarray, pred: np.ndarray) -> dict[str, Any]:

@@ -11,8 +11,8 @@ Every refinement is also calibrated (:mod:`softbend.transfer.conformal`): the
 strategy is refitted once per measured actuator without it, and the
 leave-one-actuator-out errors give the half-width of a 90 % interval for a new
 actuator, recorded as the ``interval`` of the record. With too few actuators
-for the rule's guarantee the half-width is the largest such error, and a
-warning says so.
+for the rule's guarantee the half-width is the plug-in quantile of those
+errors (:mod:`softbend.transfer.conformal`), and a warning says so.
 """
 
 from __future__ import annotations
