@@ -40,7 +40,7 @@ STAGES: tuple[tuple[str, ...], ...] = (
     ("datasets", "analysis"),
     ("surrogates",),
     ("identification",),
-    ("transfer", "control"),
+    ("transfer", "control", "design_search"),
     ("pipeline",),
     ("reports",),
     ("cli",),

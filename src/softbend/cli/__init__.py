@@ -35,6 +35,7 @@ def _register() -> None:
         campaign,
         control,
         curling,
+        design,
         fem,
         materials,
         reproduce,
@@ -49,6 +50,7 @@ def _register() -> None:
     app.add_typer(transfer.lab_app, name="lab")
     app.add_typer(transfer.app, name="transfer")
     app.add_typer(control.app, name="control")
+    app.add_typer(design.app, name="design")
     app.command("analyze")(analyze.analyze)
     app.command("train")(train.train)
     app.command("predict")(train.predict)

@@ -13,7 +13,14 @@ from softbend.design import SFRBADesign
 from softbend.errors import SchemaError
 from softbend.models import check_pressures_mpa
 
-__all__ = ["INTERVAL_LEVEL", "Prediction", "parse_pressures", "predict_angles", "predict_text"]
+__all__ = [
+    "INTERVAL_LEVEL",
+    "Prediction",
+    "load_predictor",
+    "parse_pressures",
+    "predict_angles",
+    "predict_text",
+]
 
 #: Probability of the prediction intervals reported by :func:`predict_angles`.
 INTERVAL_LEVEL = 0.9
@@ -276,6 +283,31 @@ def _support_check(
     return support.beyond(rows, angles), support.supported(rows, angles)
 
 
+def load_predictor(path: str | os.PathLike[str]) -> tuple[Any, Any]:
+    """A saved surrogate's fastest predictor and its file record.
+
+    Returns
+    -------
+    predictor : object
+        ``.predict(rows)`` of float rows of the 7 inputs (mm, deg, MPa) in degrees:
+        for an MLP its NumPy forward pass (no estimator, no scikit-learn; also
+        ``.predict32`` in float32, for screening millions of rows), else the
+        estimator itself.
+    saved : SavedState or SavedSurrogate
+        ``.kind`` and ``.metadata`` of the file.
+
+    Raises
+    ------
+    FileNotFoundError, softbend.errors.SchemaError
+        As :func:`softbend.surrogates.load_surrogate`.
+    """
+    from softbend.surrogates.persistence import SavedState, load_state
+
+    saved = load_state(path, ("mlp",))
+    model: Any = _MLPArrays(saved.state) if isinstance(saved, SavedState) else saved.model
+    return model, saved
+
+
 class _MLPArrays:
     """The prediction of a saved MLP from its validated arrays (no estimator, no sklearn).
 
@@ -300,6 +332,21 @@ class _MLPArrays:
             s["coefs_"],
             s["intercepts_"],
         )
+
+    def predict32(self, rows: np.ndarray) -> np.ndarray:
+        """:meth:`predict` in float32 (about three times faster; some 1e-4° apart), degrees."""
+        s = self.state
+        if "_f32" not in s:
+            s["_f32"] = (
+                [np.asarray(c, dtype=np.float32) for c in s["coefs_"]],
+                [np.asarray(b, dtype=np.float32) for b in s["intercepts_"]],
+            )
+        coefs, biases = s["_f32"]
+        z = ((np.asarray(rows, dtype=np.float64) - s["x_mean_"]) / s["x_scale_"]).astype(np.float32)
+        a = np.tanh(z @ coefs[0] + biases[0])
+        a = np.tanh(a @ coefs[1] + biases[1])
+        out = (a @ coefs[2] + biases[2])[:, 0]
+        return out.astype(np.float64) * float(s["y_scale_"]) + float(s["y_mean_"])
 
 
 def _check_finite(

@@ -1,0 +1,38 @@
+"""Design to a specification: search the design space on a surrogate, verify with the FEM.
+
+:class:`Specification` says what the actuator must do (bend θ* at p*, reach θ*
+below a pressure, bend as far as possible, follow a curve), the parameters'
+ranges and the mould's step, and what to minimise; :func:`find_designs` scores
+every design of the grid on a saved surrogate and ranks those that meet it;
+:func:`verify_candidates` sweeps the best with the FEM (the campaign machinery)
+and sets the FEM's angle beside the surrogate's.
+"""
+
+from __future__ import annotations
+
+from typing import Any
+
+from softbend._lazy import export as _export
+
+#: Public name -> the module that defines it.
+_EXPORTS: dict[str, str] = {
+    "Candidate": "search",
+    "SearchResult": "search",
+    "find_designs": "search",
+    "Objective": "spec",
+    "ParameterRange": "spec",
+    "Specification": "spec",
+    "Target": "spec",
+    "load_specifications": "spec",
+    "verify_candidates": "verify",
+}
+
+__all__ = sorted(_EXPORTS)
+
+
+def __getattr__(name: str) -> Any:
+    return _export(__name__, _EXPORTS, name)
+
+
+def __dir__() -> list[str]:
+    return list(__all__)

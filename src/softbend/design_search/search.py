@@ -1,0 +1,618 @@
+"""Find the designs that meet a specification, on a surrogate: exhaustive on the mould's grid.
+
+A saved surrogate answers in microseconds, so every design of the grid of
+manufacturable values (the step of each parameter, 0.5 mm by default: some
+2.7 million designs over Table 1's box) is scored, which is exact on that grid
+and faster than any sampler would converge: an MLP is screened in float32
+(:meth:`load_predictor <softbend.surrogates.predict.load_predictor>`), and the
+designs that rank are scored again in float64. A parameter searched
+continuously (step 0) is screened on a grid of :data:`CONTINUOUS_POINTS` values
+and the best designs are then polished by SciPy's bounded Powell method.
+
+Among the designs that meet the target (within its tolerance), the
+objectives rank them: one objective sorts them (the miss of the target breaks
+ties), several give the Pareto front (best first by the first objective,
+then the next front). Every answer lies in the model's training ranges and
+its support (:mod:`softbend.surrogates.support`: a pressure the training
+designs nearest to it were swept to, an angle no larger than the largest
+trained on); designs outside are passed over, or with
+``allow_extrapolation`` kept and flagged. When no design meets the target,
+the closest designs are returned with how far they miss.
+"""
+
+from __future__ import annotations
+
+import math
+import os
+import time
+from collections.abc import Callable, Mapping
+from dataclasses import dataclass, field
+from typing import Any
+
+import numpy as np
+
+from softbend.design import SFRBADesign
+from softbend.design_search.spec import (
+    NAMES,
+    ParameterRange,
+    Specification,
+)
+
+__all__ = [
+    "CONTINUOUS_POINTS",
+    "MAX_DESIGNS",
+    "Candidate",
+    "SearchResult",
+    "elastomer_volume_mm3",
+    "find_designs",
+    "pareto_front",
+]
+
+#: Values a continuous parameter is screened at before the best designs are polished.
+CONTINUOUS_POINTS = 17
+
+#: The most designs one search scores (a larger grid: a larger step, or narrower ranges).
+MAX_DESIGNS = 20_000_000
+
+#: Rows per evaluation chunk (memory: about 70 MB of activations for an MLP).
+CHUNK = 1 << 17
+
+#: Pressure step of the finite difference of the sensitivity dθ/dp, MPa.
+_DP = 0.0025
+
+
+@dataclass
+class Candidate:
+    """A design scored against a specification.
+
+    Attributes
+    ----------
+    design : SFRBADesign
+    angle_deg : float
+        The surrogate's angle at the target's pressure (degrees); for a curve,
+        at its last point.
+    pressure_mpa : float
+        The target's pressure, or for ``pressure_for`` the pressure that reaches
+        the angle (MPa; NaN if it is not reached).
+    error_deg : float
+        How far the surrogate misses the target (degrees; a curve's largest miss;
+        0 for ``max_angle``).
+    meets : bool
+        Whether the error is within the tolerance (less the specification's margin).
+    objectives : dict of str to float
+        Each objective's value, in the units of :data:`~softbend.design_search.spec.OBJECTIVES`.
+    interval_deg : (float, float) or None
+        The model's 90 % interval of ``angle_deg`` where it has one.
+    flags : list of str
+        Why the answer is outside the model's training data (empty inside).
+    fem_angle_deg, fem_error_deg : float or None
+        The FEM's angle at the target's pressure and its miss, once verified.
+    fem_meets : bool or None
+        Whether the FEM confirms the target within its tolerance.
+    fem_curve : (ndarray, ndarray) or None
+        The FEM's converged sweep, pressures (MPa) and angles (degrees).
+    """
+
+    design: SFRBADesign
+    angle_deg: float
+    pressure_mpa: float
+    error_deg: float
+    meets: bool
+    objectives: dict[str, float]
+    interval_deg: tuple[float, float] | None = None
+    flags: list[str] = field(default_factory=list)
+    fem_angle_deg: float | None = None
+    fem_error_deg: float | None = None
+    fem_meets: bool | None = None
+    fem_curve: tuple[np.ndarray, np.ndarray] | None = field(default=None, repr=False)
+
+    def to_dict(self) -> dict[str, Any]:
+        """JSON-friendly: the design by named parameters (mm, deg) and every figure."""
+        out: dict[str, Any] = {
+            "design": dict(zip(NAMES, (float(v) for v in self.design.as_array()), strict=True)),
+            "angle_deg": self.angle_deg,
+            "pressure_mpa": self.pressure_mpa,
+            "error_deg": self.error_deg,
+            "meets": self.meets,
+            "objectives": dict(self.objectives),
+            "flags": list(self.flags),
+        }
+        if self.interval_deg is not None:
+            out["interval_deg"] = list(self.interval_deg)
+        if self.fem_angle_deg is not None or self.fem_meets is not None:
+            out["fem_angle_deg"] = self.fem_angle_deg
+            out["fem_error_deg"] = self.fem_error_deg
+            out["fem_meets"] = self.fem_meets
+        return out
+
+
+@dataclass
+class SearchResult:
+    """The answer to a specification.
+
+    Attributes
+    ----------
+    spec : Specification
+    candidates : list of Candidate
+        Best first: the designs that meet the target, or the closest when none does.
+    feasible : bool
+        Whether any design meets the target.
+    ranges : dict of str to ParameterRange
+        The ranges searched (the given ones and the model's training ranges).
+    n_designs, n_meeting : int
+        Designs scored, and those meeting the target.
+    n_passed_over : int
+        Designs that would have ranked but lie outside the training data's support.
+    front : ndarray
+        The objective values of the meeting designs' Pareto front (rows; in the
+        objectives' units), for a plot.
+    model : str
+        The model file.
+    seconds : float
+        Time of the search (not of any verification), s.
+    """
+
+    spec: Specification
+    candidates: list[Candidate]
+    feasible: bool
+    ranges: dict[str, ParameterRange]
+    n_designs: int
+    n_meeting: int
+    n_passed_over: int
+    front: np.ndarray
+    model: str
+    seconds: float
+
+    def message(self) -> str | None:
+        """One line when no design meets the target: the closest, and by how much it misses."""
+        if self.feasible:
+            return None
+        if not self.candidates:
+            return f"No design in the ranges searched meets {self.spec.target.describe()}."
+        best = self.candidates[0]
+        allowed = self.spec.target.tolerance_deg - self.spec.margin_deg
+        return (
+            f"No design in the ranges searched meets {self.spec.target.describe()}: the "
+            f"closest, {best.design}, misses by {best.error_deg:.3g}° "
+            f"({best.error_deg - allowed:.3g}° beyond the {allowed:g}° allowed)."
+        )
+
+    def to_dict(self) -> dict[str, Any]:
+        """JSON-friendly: the specification, the search's figures and ``candidates``, best first."""
+        return {
+            "spec": {
+                "name": self.spec.name,
+                "target": self.spec.target.describe(),
+                "kind": self.spec.target.kind,
+                "angle_deg": _finite_or_none(self.spec.target.angle_deg),
+                "pressure_mpa": _finite_or_none(self.spec.target.pressure_mpa),
+                "tolerance_deg": self.spec.target.tolerance_deg,
+                "objectives": [str(o) for o in self.spec.objectives],
+                "ranges": {
+                    n: {"low": r.low, "high": r.high, "step": r.step}
+                    for n, r in self.ranges.items()
+                },
+            },
+            "model": self.model,
+            "feasible": self.feasible,
+            "message": self.message(),
+            "n_designs": self.n_designs,
+            "n_meeting": self.n_meeting,
+            "n_passed_over": self.n_passed_over,
+            "search_s": self.seconds,
+            "candidates": [c.to_dict() for c in self.candidates],
+        }
+
+
+def _finite_or_none(value: float) -> float | None:
+    return float(value) if math.isfinite(value) else None
+
+
+def elastomer_volume_mm3(designs: np.ndarray) -> np.ndarray:
+    """Elastomer of each design (rows of 6: l, r, t, b, φ, lc), mm³.
+
+    The half-cylindrical wall ``½·π·((r+t)² − r²)·l``, the strain-limiting layer
+    ``2·(r+t)·b·l`` under it, and the two end caps ``π·(r+t)²/2·lc`` (the
+    geometry of :class:`~softbend.design.SFRBADesign`, fibres neglected).
+    """
+    d = np.atleast_2d(np.asarray(designs, dtype=np.float64))
+    length, r, t, b, lc = d[:, 0], d[:, 1], d[:, 2], d[:, 3], d[:, 5]
+    outer = r + t
+    wall = 0.5 * np.pi * (outer**2 - r**2) * length
+    layer = 2.0 * outer * b * length
+    caps = 0.5 * np.pi * outer**2 * lc
+    return wall + layer + caps
+
+
+def pareto_front(values: np.ndarray) -> np.ndarray:
+    """Indices of the rows of ``values`` (n × k, all minimised) that no other row dominates.
+
+    Sorted by the first column (then the others); ties keep the first.
+    """
+    v = np.asarray(values, dtype=np.float64)
+    if v.shape[0] == 0:
+        return np.zeros(0, dtype=np.intp)
+    order = np.lexsort(v.T[::-1])
+    kept: list[int] = []
+    front = np.empty((0, v.shape[1]))
+    for i in order:
+        row = v[i]
+        if front.shape[0] and np.any(np.all(front <= row, axis=1)):
+            continue
+        kept.append(int(i))
+        front = np.vstack([front, row])
+    return np.asarray(kept, dtype=np.intp)
+
+
+class _Scorer:
+    """The target's angle, miss and pressure of rows of designs, from a predictor."""
+
+    def __init__(self, predict: Callable[[np.ndarray], np.ndarray], spec: Specification):
+        self.predict = predict
+        self.target = spec.target
+        self.need_sensitivity = any(o.name == "sensitivity" for o in spec.objectives)
+
+    def _angles(self, designs: np.ndarray, pressure: float | np.ndarray) -> np.ndarray:
+        rows = np.empty((designs.shape[0], 7))
+        rows[:, :6] = designs
+        rows[:, 6] = pressure
+        return np.asarray(self.predict(rows), dtype=np.float64)
+
+    def score(self, designs: np.ndarray) -> dict[str, np.ndarray]:
+        """``angle``, ``error``, ``pressure`` (and ``sensitivity``) per design row."""
+        target = self.target
+        if target.kind == "curve":
+            misses = [np.abs(self._angles(designs, p) - a) for p, a in target.points]
+            angle = self._angles(designs, target.points[-1][0])
+            error = np.max(misses, axis=0)
+            pressure = np.full(designs.shape[0], target.points[-1][0])
+        elif target.kind == "pressure_for":
+            pressure, angle = self._pressure_for(designs)
+            error = np.abs(angle - target.angle_deg)
+        else:
+            pressure = np.full(designs.shape[0], target.pressure_mpa)
+            angle = self._angles(designs, target.pressure_mpa)
+            error = (
+                np.zeros_like(angle)
+                if target.kind == "max_angle"
+                else np.abs(angle - target.angle_deg)
+            )
+        out = {"angle": angle, "error": error, "pressure": pressure}
+        if self.need_sensitivity:
+            p = pressure if target.kind == "pressure_for" else target.pressure_mpa
+            lo = self._angles(designs, np.maximum(p - _DP, 0.0))
+            hi = self._angles(designs, p + _DP)
+            out["sensitivity"] = (hi - lo) / (np.minimum(p, _DP) + _DP)
+        return out
+
+    def _pressure_for(self, designs: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """The lowest pressure up to the limit that reaches the angle (bisection on a
+        rising θ(p)); NaN and the angle at the limit where it is not reached."""
+        limit = self.target.pressure_mpa
+        goal = self.target.angle_deg
+        at_limit = self._angles(designs, limit)
+        reached = at_limit >= goal
+        low = np.zeros(designs.shape[0])
+        high = np.full(designs.shape[0], limit)
+        for _ in range(24):  # 0.5 MPa / 2**24: far below any pressure regulator
+            mid = 0.5 * (low + high)
+            above = self._angles(designs, mid) >= goal
+            high = np.where(above, mid, high)
+            low = np.where(above, low, mid)
+            if np.all(high - low < 1e-6):
+                break
+        pressure = np.where(reached, high, np.nan)
+        angle = np.where(reached, self._angles(designs, high), at_limit)
+        return pressure, angle
+
+
+def _objective_matrix(
+    spec: Specification, designs: np.ndarray, scores: Mapping[str, np.ndarray]
+) -> np.ndarray:
+    """Each objective per design, signed so that smaller is better."""
+    columns = []
+    for objective in spec.objectives:
+        if objective.name in NAMES:
+            value = designs[:, NAMES.index(objective.name)]
+        elif objective.name == "volume":
+            value = elastomer_volume_mm3(designs)
+        else:
+            value = scores[objective.name]
+        columns.append(value if objective.sense == "min" else -value)
+    return np.column_stack(columns)
+
+
+def _objective_values(
+    spec: Specification, design: np.ndarray, scores: Mapping[str, float]
+) -> dict[str, float]:
+    out = {}
+    for objective in spec.objectives:
+        if objective.name in NAMES:
+            out[objective.name] = float(design[NAMES.index(objective.name)])
+        elif objective.name == "volume":
+            out["volume"] = float(elastomer_volume_mm3(design)[0])
+        else:
+            out[objective.name] = float(scores[objective.name])
+    return out
+
+
+def _grid(ranges: Mapping[str, ParameterRange]) -> list[np.ndarray]:
+    axes = []
+    for name in NAMES:
+        r = ranges[name]
+        if r.fixed:
+            axes.append(np.array([r.low]))
+        elif r.step == 0:
+            axes.append(np.linspace(r.low, r.high, CONTINUOUS_POINTS))
+        else:
+            axes.append(np.asarray(r.values()))
+    return axes
+
+
+def _designs_at(axes: list[np.ndarray], flat: np.ndarray) -> np.ndarray:
+    index = np.unravel_index(flat, tuple(a.size for a in axes))
+    return np.column_stack([a[i] for a, i in zip(axes, index, strict=True)])
+
+
+def find_designs(
+    model: str | os.PathLike[str],
+    spec: Specification,
+    *,
+    top: int = 10,
+    allow_extrapolation: bool = False,
+    progress: Callable[[int, int], None] | None = None,
+) -> SearchResult:
+    """The designs that best meet ``spec`` on the saved surrogate ``model``.
+
+    Parameters
+    ----------
+    model : path
+        A saved surrogate (:func:`softbend.surrogates.save_surrogate`, a refined
+        one of ``softbend transfer refine`` included).
+    spec : Specification
+    top : int, default 10
+        Candidates returned, >= 1.
+    allow_extrapolation : bool, default False
+        Let ranges leave the model's training ranges and keep designs outside
+        its training data's support, flagged, instead of passing them over.
+    progress : callable, optional
+        ``progress(done, total)`` in designs scored.
+
+    Returns
+    -------
+    SearchResult
+
+    Raises
+    ------
+    ValueError
+        A range outside the training ranges (without ``allow_extrapolation``),
+        a grid over :data:`MAX_DESIGNS`, a bad ``top``.
+    """
+    from softbend._progress import report
+    from softbend.surrogates.features import outside_training_ranges
+    from softbend.surrogates.predict import load_predictor
+    from softbend.surrogates.support import Support
+
+    if isinstance(top, bool) or not isinstance(top, int) or top < 1:
+        raise ValueError(f"The 'top' of find_designs must be an integer >= 1. Got {top!r}.")
+    start = time.perf_counter()
+    predictor, saved = load_predictor(model)
+    metadata = saved.metadata
+    training = metadata.get("training_ranges")
+    ranges = spec.resolved(
+        training if isinstance(training, dict) else None, allow_extrapolation=allow_extrapolation
+    )
+    axes = _grid(ranges)
+    total = int(np.prod([a.size for a in axes], dtype=np.int64))
+    if total > MAX_DESIGNS:
+        raise ValueError(
+            f"The ranges and steps hold {total:,} designs, more than the {MAX_DESIGNS:,} one "
+            "search scores; coarsen --resolution or narrow the ranges."
+        )
+    exact = predictor.predict
+    screen = getattr(predictor, "predict32", exact)
+    scorer = _Scorer(screen, spec)
+    tolerance = spec.target.tolerance_deg - spec.margin_deg
+    error = np.empty(total)
+    objectives = np.empty((total, len(spec.objectives)))
+    for first in range(0, total, CHUNK):
+        flat = np.arange(first, min(first + CHUNK, total))
+        designs = _designs_at(axes, flat)
+        with np.errstate(all="ignore"):
+            scores = scorer.score(designs)
+            error[flat] = scores["error"]
+            objectives[flat] = _objective_matrix(spec, designs, scores)
+        done = int(flat[-1]) + 1
+        report("scoring designs", done, total)
+        if progress is not None:
+            progress(done, total)
+    error = np.where(np.isfinite(error), error, np.inf)
+    meeting = np.flatnonzero(error <= tolerance + 1e-3)  # the float64 pass decides the edge
+    feasible_screen = meeting.size > 0
+    if feasible_screen:
+        order = _ranked(objectives[meeting], error[meeting])
+        ranked = meeting[order]
+    else:
+        ranked = np.argsort(error, kind="stable")
+    support = (
+        Support.from_dict(metadata["support"])
+        if isinstance(metadata.get("support"), dict)
+        else None
+    )
+    exact_scorer = _Scorer(exact, spec)
+    interval = _interval_of(predictor, metadata)
+    candidates: list[Candidate] = []
+    passed_over = 0
+    continuous = [n for n in NAMES if not ranges[n].fixed and ranges[n].step == 0]
+    for first in range(0, ranked.size, 4 * top):
+        batch = ranked[first : first + 4 * top]
+        designs = _designs_at(axes, batch)
+        if continuous and feasible_screen:
+            designs = _polish(designs, exact_scorer, spec, ranges, continuous)
+        with np.errstate(all="ignore"):
+            scores = exact_scorer.score(designs)
+        for row, design in enumerate(designs):
+            one = {k: float(v[row]) for k, v in scores.items()}
+            meets = bool(np.isfinite(one["error"]) and one["error"] <= tolerance)
+            if feasible_screen and not meets:
+                continue
+            flags = _flags(design, one, spec, training, support, outside_training_ranges)
+            if flags and not allow_extrapolation:
+                passed_over += 1
+                continue
+            candidates.append(
+                Candidate(
+                    design=SFRBADesign.from_sequence(design.tolist()),
+                    angle_deg=one["angle"],
+                    pressure_mpa=one["pressure"],
+                    error_deg=one["error"],
+                    meets=meets,
+                    objectives=_objective_values(spec, design, one),
+                    interval_deg=interval(design, one),
+                    flags=flags,
+                )
+            )
+        if len(candidates) >= 2 * top:
+            break
+    feasible = any(c.meets for c in candidates)
+    candidates = _final_order(candidates, spec, feasible)[:top]
+    front = np.zeros((0, len(spec.objectives)))
+    if feasible_screen:
+        signs = np.array([1.0 if o.sense == "min" else -1.0 for o in spec.objectives])
+        front_idx = pareto_front(objectives[meeting])
+        front = objectives[meeting][front_idx] * signs
+    return SearchResult(
+        spec=spec,
+        candidates=candidates,
+        feasible=feasible,
+        ranges=ranges,
+        n_designs=total,
+        n_meeting=int(meeting.size),
+        n_passed_over=passed_over,
+        front=front,
+        model=str(model),
+        seconds=time.perf_counter() - start,
+    )
+
+
+def _ranked(objectives: np.ndarray, error: np.ndarray) -> np.ndarray:
+    """Order of the meeting designs: by the one objective (the miss breaks ties), or
+    Pareto fronts one after another, each by its first objective."""
+    if objectives.shape[1] == 1:
+        return np.lexsort((error, objectives[:, 0]))
+    remaining = np.arange(objectives.shape[0])
+    order: list[np.ndarray] = []
+    collected = 0
+    while remaining.size and collected < 2000:
+        front = remaining[pareto_front(objectives[remaining])]
+        order.append(front)
+        collected += front.size
+        remaining = np.setdiff1d(remaining, front, assume_unique=True)
+    rest = remaining[np.lexsort((error[remaining], objectives[remaining, 0]))]
+    return np.concatenate([*order, rest])
+
+
+def _final_order(
+    candidates: list[Candidate], spec: Specification, feasible: bool
+) -> list[Candidate]:
+    """The candidates re-ranked on their float64 figures."""
+    if not feasible:
+        return sorted((c for c in candidates), key=lambda c: c.error_deg)
+    meeting = [c for c in candidates if c.meets]
+    signs = [1.0 if o.sense == "min" else -1.0 for o in spec.objectives]
+    values = np.array(
+        [
+            [s * c.objectives[o.name] for s, o in zip(signs, spec.objectives, strict=True)]
+            for c in meeting
+        ]
+    ).reshape(len(meeting), len(signs))
+    errors = np.array([c.error_deg for c in meeting])
+    return [meeting[i] for i in _ranked(values, errors)]
+
+
+def _flags(
+    design: np.ndarray,
+    scores: Mapping[str, float],
+    spec: Specification,
+    training: Any,
+    support: Any,
+    outside: Callable[[dict[str, list[float]], np.ndarray], list[str]],
+) -> list[str]:
+    """Why a design's answer lies outside the model's training data (empty inside)."""
+    pressures = [p for p in spec.target.pressures_mpa]
+    if spec.target.kind == "pressure_for" and math.isfinite(scores["pressure"]):
+        pressures = [scores["pressure"]]
+    rows = np.column_stack([np.tile(design, (len(pressures), 1)), pressures])
+    flags = outside(training, rows) if isinstance(training, dict) else []
+    if support is not None:
+        angles = np.full(len(pressures), scores["angle"])
+        flags += support.beyond(rows, angles)
+    return flags
+
+
+def _interval_of(
+    predictor: Any, metadata: Mapping[str, Any]
+) -> Callable[[np.ndarray, Mapping[str, float]], tuple[float, float] | None]:
+    """The 90 % interval of a candidate's angle: the calibrated one a refined model
+    records, else the model's own, else None."""
+    from softbend.surrogates.predict import INTERVAL_LEVEL, _calibrated_interval
+
+    record = metadata.get("interval")
+    own = getattr(predictor, "predict_interval", None)
+
+    def interval(design: np.ndarray, scores: Mapping[str, float]) -> tuple[float, float] | None:
+        angle = np.array([scores["angle"]])
+        calibrated = _calibrated_interval(record, angle)
+        if calibrated is not None:
+            return float(calibrated[0][0]), float(calibrated[1][0])
+        if callable(own) and math.isfinite(scores["pressure"]):
+            row = np.append(design, scores["pressure"])[None, :]
+            low, high = own(row, INTERVAL_LEVEL)
+            return float(np.asarray(low)[0]), float(np.asarray(high)[0])
+        return None
+
+    return interval
+
+
+def _polish(
+    designs: np.ndarray,
+    scorer: _Scorer,
+    spec: Specification,
+    ranges: Mapping[str, ParameterRange],
+    continuous: list[str],
+) -> np.ndarray:
+    """Each design moved, in its continuous parameters, to the best of its first objective
+    that still meets the target (SciPy's bounded Powell from the grid point)."""
+    from scipy.optimize import minimize
+
+    which = [NAMES.index(n) for n in continuous]
+    bounds = [(ranges[n].low, ranges[n].high) for n in continuous]
+    tolerance = spec.target.tolerance_deg - spec.margin_deg
+    first = spec.objectives[0]
+    scale = {n: max(ranges[n].high - ranges[n].low, 1e-9) for n in continuous}
+    out = designs.copy()
+    for k, design in enumerate(designs):
+
+        def cost(x: np.ndarray, design: np.ndarray = design) -> float:
+            trial = design.copy()
+            trial[which] = x
+            with np.errstate(all="ignore"):
+                scores = scorer.score(trial[None, :])
+            miss = float(scores["error"][0])
+            if not math.isfinite(miss):
+                return 1e12
+            value = _objective_matrix(spec, trial[None, :], scores)[0, 0]
+            if first.name == "error":
+                return float(value)
+            return float(value) + 1e3 * max(0.0, miss - 0.999 * tolerance)
+
+        result = minimize(
+            cost,
+            design[which],
+            method="Powell",
+            bounds=bounds,
+            options={"xtol": 1e-4 * min(scale.values()), "maxfev": 400},
+        )
+        if cost(result.x) <= cost(design[which]):
+            out[k, which] = result.x
+    return out

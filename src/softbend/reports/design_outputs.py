@@ -1,0 +1,65 @@
+"""A design search's files: the ranked table, the record, and the figures."""
+
+from __future__ import annotations
+
+import csv
+import math
+from pathlib import Path
+from typing import Any
+
+from softbend.design_search.search import SearchResult
+from softbend.design_search.spec import NAMES, UNITS
+
+__all__ = ["FILES", "candidate_rows", "write_search"]
+
+#: The files of one specification's folder.
+FILES: tuple[str, ...] = ("candidates.csv", "search.json", "front.png", "curves.png")
+
+
+def candidate_rows(result: SearchResult) -> list[dict[str, Any]]:
+    """One flat row per candidate, best first: rank, design (mm, deg), angles, miss, objectives."""
+    rows = []
+    for rank, c in enumerate(result.candidates, start=1):
+        row: dict[str, Any] = {"rank": rank}
+        row.update(
+            {f"{n}_{UNITS[n]}": float(v) for n, v in zip(NAMES, c.design.as_array(), strict=True)}
+        )
+        row["pressure_mpa"] = c.pressure_mpa
+        row["angle_deg"] = c.angle_deg
+        row["error_deg"] = c.error_deg
+        row["meets"] = c.meets
+        if c.interval_deg is not None:
+            row["interval_low_deg"], row["interval_high_deg"] = c.interval_deg
+        for name, value in c.objectives.items():
+            row[f"objective_{name}"] = value
+        if c.fem_meets is not None:
+            row["fem_angle_deg"] = c.fem_angle_deg
+            row["fem_error_deg"] = c.fem_error_deg
+            row["fem_meets"] = c.fem_meets
+        row["flags"] = "; ".join(c.flags)
+        rows.append(row)
+    return rows
+
+
+def write_search(result: SearchResult, predictor: Any, folder: str | Path) -> dict[str, str]:
+    """Write :data:`FILES` into ``folder`` (created); returns name → path."""
+    from softbend._io import json_text
+    from softbend.reports import design_figures
+
+    out = Path(folder)
+    out.mkdir(parents=True, exist_ok=True)
+    rows = candidate_rows(result)
+    columns: list[str] = []
+    for row in rows:
+        columns += [k for k in row if k not in columns]
+    with open(out / "candidates.csv", "w", encoding="utf-8", newline="") as handle:
+        writer = csv.DictWriter(handle, fieldnames=columns or ["rank"])
+        writer.writeheader()
+        for row in rows:
+            writer.writerow(
+                {k: ("" if isinstance(v, float) and math.isnan(v) else v) for k, v in row.items()}
+            )
+    (out / "search.json").write_text(json_text(result.to_dict()) + "\n", encoding="utf-8")
+    design_figures.front_figure(result, out / "front.png")
+    design_figures.curves_figure(result, predictor, out / "curves.png")
+    return {name: str(out / name) for name in FILES}

@@ -1,0 +1,170 @@
+"""find_designs: exhaustive on the mould's grid, exact against closed-form answers."""
+
+from __future__ import annotations
+
+import json
+
+import numpy as np
+import pytest
+
+from softbend.design_search.search import elastomer_volume_mm3, find_designs, pareto_front
+from softbend.design_search.spec import Objective, ParameterRange, Specification, Target
+
+AT_90 = Target("angle_at", angle_deg=90.0, pressure_mpa=0.08)
+# Everything but l fixed: 121 designs, l = 100, 100.5, ..., 160 mm.
+ONLY_L = {
+    "r": ParameterRange(8, 8),
+    "t": ParameterRange(3, 3),
+    "b": ParameterRange(3, 3),
+    "phi": ParameterRange(10, 10),
+    "lc": ParameterRange(10, 10),
+}
+
+
+def _l(candidate) -> float:
+    return candidate.design.l_mm
+
+
+def test_the_smallest_miss_is_the_exact_answer(linear_model):
+    result = find_designs(linear_model, Specification(AT_90, ONLY_L))
+    assert result.n_designs == 121 and result.feasible
+    assert _l(result.candidates[0]) == 112.5
+    assert result.candidates[0].angle_deg == pytest.approx(90.0, abs=1e-4)
+    # l in [108.75, 116.25] on the 0.5 mm grid: 109 ... 116, 15 designs meet it.
+    assert result.n_meeting == 15
+    assert all(c.meets and c.error_deg <= 3.0 for c in result.candidates)
+
+
+def test_minimising_and_maximising_the_length_go_to_the_ends_of_the_tolerance(linear_model):
+    shortest = find_designs(linear_model, Specification(AT_90, ONLY_L, (Objective("l"),)))
+    longest = find_designs(linear_model, Specification(AT_90, ONLY_L, (Objective("l", "max"),)))
+    assert [_l(c) for c in shortest.candidates[:3]] == [109.0, 109.5, 110.0]
+    assert [_l(c) for c in longest.candidates[:3]] == [116.0, 115.5, 115.0]
+    assert shortest.candidates[0].objectives == {"l": 109.0}
+
+
+def test_a_margin_keeps_the_answers_off_the_edge(linear_model):
+    spec = Specification(AT_90, ONLY_L, (Objective("l"),), margin_deg=1.0)
+    result = find_designs(linear_model, spec)
+    assert _l(result.candidates[0]) == 110.0  # 0.8·l >= 88 → l >= 110
+    assert result.candidates[0].error_deg <= 2.0
+
+
+def test_every_parameter_stays_in_its_range_and_on_its_step(linear_model):
+    ranges = {"t": ParameterRange(3.0, 4.0, 0.5), "phi": ParameterRange(10, 10)}
+    result = find_designs(linear_model, Specification(AT_90, ranges), top=50)
+    for c in result.candidates:
+        assert c.design.t_mm in (3.0, 3.5, 4.0) and c.design.phi_deg == 10.0
+        assert c.design.r_mm * 2 == round(c.design.r_mm * 2)
+        assert 100.0 <= c.design.l_mm <= 160.0
+
+
+def test_the_pressure_that_reaches_the_angle(linear_model):
+    target = Target("pressure_for", angle_deg=90.0, pressure_mpa=0.1)
+    spec = Specification(target, ONLY_L, (Objective("pressure"),))
+    result = find_designs(linear_model, spec)
+    best = result.candidates[0]
+    assert _l(best) == 160.0  # the longest reaches 90° first: p = 90 / (10·160)
+    assert best.pressure_mpa == pytest.approx(90.0 / 1600.0, abs=1e-5)
+    assert best.objectives["pressure"] == pytest.approx(best.pressure_mpa)
+    # Too short to reach 90° below 0.1 MPa: l < 90 mm does not exist, but 0.05 MPa cuts at 180.
+    tight = Specification(Target("pressure_for", angle_deg=90.0, pressure_mpa=0.05), ONLY_L)
+    assert not find_designs(linear_model, tight).feasible
+
+
+def test_the_largest_angle_at_a_pressure(linear_model):
+    spec = Specification(Target("max_angle", pressure_mpa=0.08), ONLY_L)
+    result = find_designs(linear_model, spec)
+    assert _l(result.candidates[0]) == 160.0
+    assert result.candidates[0].angle_deg == pytest.approx(128.0, abs=1e-4)
+
+
+def test_a_curve_to_follow(linear_model):
+    target = Target("curve", tolerance_deg=2.0, points=((0.05, 62.5), (0.1, 125.0)))
+    result = find_designs(linear_model, Specification(target, ONLY_L))
+    assert _l(result.candidates[0]) == 125.0 and result.candidates[0].error_deg < 1e-4
+
+
+def test_a_continuous_parameter_is_polished_to_the_edge(linear_model):
+    spec = Specification(AT_90, {**ONLY_L, "l": ParameterRange(100, 160, 0.0)}, (Objective("l"),))
+    result = find_designs(linear_model, spec)
+    assert _l(result.candidates[0]) == pytest.approx(108.75, abs=0.02)
+    assert result.candidates[0].meets
+
+
+def test_two_objectives_give_the_pareto_front(linear_model):
+    # Shorter costs less elastomer but bends less per MPa: the front is the 15 lengths.
+    spec = Specification(
+        AT_90, ONLY_L, (Objective("volume"), Objective("sensitivity", "max")), name="trade"
+    )
+    result = find_designs(linear_model, spec, top=15)
+    assert result.front.shape == (15, 2)
+    order = np.argsort(result.front[:, 0])
+    assert np.all(np.diff(result.front[order, 1]) > 0)  # more volume, more dθ/dp
+    sensitivities = [c.objectives["sensitivity"] for c in result.candidates]
+    assert sensitivities == pytest.approx([10.0 * _l(c) for c in result.candidates], rel=1e-3)
+
+
+def test_no_design_meets_it_says_so_with_the_closest(linear_model):
+    spec = Specification(Target("angle_at", angle_deg=200.0, pressure_mpa=0.08), ONLY_L)
+    result = find_designs(linear_model, spec)
+    assert not result.feasible
+    assert _l(result.candidates[0]) == 160.0  # 128°, the closest
+    assert result.candidates[0].error_deg == pytest.approx(72.0, abs=1e-4)
+    message = result.message()
+    assert "160,8,3,3,10,10" in message and "72" in message and "69" in message  # 72 − 3
+
+
+def test_outside_the_training_ranges_is_refused_unless_allowed(linear_model):
+    ranges = {**ONLY_L, "l": ParameterRange(150.0, 180.0, 10.0)}
+    with pytest.raises(ValueError, match=r"'l'.*training range.*--allow-extrapolation"):
+        find_designs(linear_model, Specification(AT_90, ranges))
+    far = Specification(Target("angle_at", angle_deg=144.0, pressure_mpa=0.08), ranges)
+    result = find_designs(linear_model, far, allow_extrapolation=True)
+    assert _l(result.candidates[0]) == 180.0
+    assert any("l_mm 180 outside" in f for f in result.candidates[0].flags)
+
+
+def test_designs_past_their_sweep_are_passed_over(short_sweeps_model):
+    # The 160 mm designs were swept to 0.05 MPa only: at 0.08 MPa they are not answers.
+    spec = Specification(Target("max_angle", pressure_mpa=0.08), ONLY_L)
+    result = find_designs(short_sweeps_model, spec)
+    assert result.n_passed_over > 0
+    assert all(c.flags == [] for c in result.candidates)
+    assert _l(result.candidates[0]) < 160.0
+    flagged = find_designs(short_sweeps_model, spec, allow_extrapolation=True)
+    assert _l(flagged.candidates[0]) == 160.0 and flagged.candidates[0].flags
+
+
+def test_the_json_names_every_parameter(linear_model):
+    result = find_designs(linear_model, Specification(AT_90, ONLY_L))
+    payload = json.loads(json.dumps(result.to_dict()))
+    first = payload["candidates"][0]
+    assert set(first["design"]) == {"l", "r", "t", "b", "phi", "lc"}
+    assert first["design"]["l"] == 112.5 and first["angle_deg"] == pytest.approx(90.0)
+    assert payload["feasible"] is True and payload["message"] is None
+
+
+def test_the_shipped_mlp_answers_90_degrees_at_0_08_mpa():
+    from softbend.transfer.base import shipped_base_path
+
+    spec = Specification(AT_90, {"phi": ParameterRange(10, 10), "lc": ParameterRange(10, 10)})
+    result = find_designs(shipped_base_path(), spec, top=5)
+    assert result.feasible and result.n_designs == 121 * 9 * 5 * 5
+    best = result.candidates[0]
+    assert best.angle_deg == pytest.approx(90.0, abs=0.05) and not best.flags
+
+
+def test_pareto_front_of_a_small_set():
+    values = np.array([[1.0, 5.0], [2.0, 3.0], [3.0, 4.0], [4.0, 1.0], [2.0, 3.0]])
+    assert pareto_front(values).tolist() == [0, 1, 3]
+
+
+def test_elastomer_volume_grows_with_every_size():
+    base = np.array([[100.0, 6.0, 2.0, 2.0, 5.0, 8.0]])
+    v0 = elastomer_volume_mm3(base)[0]
+    for j in (0, 1, 2, 3, 5):
+        bigger = base.copy()
+        bigger[0, j] += 1.0
+        assert elastomer_volume_mm3(bigger)[0] > v0
+    assert elastomer_volume_mm3(np.array([[100.0, 6.0, 2.0, 2.0, 15.0, 8.0]]))[0] == v0
