@@ -7,10 +7,24 @@ import math
 
 import pytest
 
+from softbend.design_search.spec import Objective, ParameterRange, Specification, Target
 from softbend.fem import FEMOptions
 from softbend.reports.reproduce import run_reproduce
 
 from ..stand_ins import small_space, stand_in_fem_dataset
+
+#: Design search in a second: one small specification, checked by the analytical model.
+QUICK_DESIGN = {
+    "backend": "analytical",
+    "specifications": (
+        Specification(
+            Target("angle_at", angle_deg=90.0, pressure_mpa=0.08),
+            {n: ParameterRange(v, v) for n, v in (("r", 8.0), ("b", 3.0), ("phi", 10.0))},
+            (Objective("l"),),
+            name="quick",
+        ),
+    ),
+}
 
 #: Transfer learning in seconds: few epochs, one ensemble pair, no GP restarts.
 QUICK_TRANSFER = {
@@ -46,6 +60,7 @@ def first_run(tmp_path_factory, fem_dataset):
         fem_dataset_epochs=5,
         transfer_options=QUICK_TRANSFER,
         control_options={"duration_s": 1.5, "refine_epochs": 20},
+        design_options=QUICK_DESIGN,
     )
     return out, summary, phases
 
@@ -156,6 +171,7 @@ def test_second_run_resumes_the_campaign(first_run, fem_dataset):
         fem_dataset_epochs=5,
         transfer_options=QUICK_TRANSFER,
         control_options={"duration_s": 1.5, "refine_epochs": 20},
+        design_options=QUICK_DESIGN,
     )
     b = again["paper_b"]
     assert b["run_now"] == 0 and b["resumed_done"] == 8
@@ -229,3 +245,15 @@ def test_the_report_as_a_user_sees_it_in_chromium(first_run, tmp_path):
     assert seen["section_ids"][-1] == "provenance"
     assert seen["tables"] == html.count("<table>") >= 10
     assert "0.23094937748277466" not in html  # no 17-digit reprs
+
+
+def test_design_section(first_run):
+    out, summary, _ = first_run
+    (quick,) = summary["design"]["specifications"]
+    assert quick["name"] == "quick" and quick["meeting"] > 0 and quick["verified"] == 1
+    best = quick["best"]
+    assert abs(best["angle_deg"] - 90.0) <= 3.0 and "fem_angle_deg" in best
+    html = (out / "index.html").read_text(encoding="utf-8")
+    assert "Design to a specification" in html and "design/quick/curves.png" in html
+    for name in ("candidates.csv", "search.json", "front.png", "curves.png"):
+        assert (out / "design" / "quick" / name).is_file(), name

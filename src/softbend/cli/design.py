@@ -54,6 +54,9 @@ def find(
         "0 searches continuously. Default 0.5 mm and 1° of phi.",
     ),
     top: int = typer.Option(10, help="Candidates listed."),
+    neighbours: bool = typer.Option(
+        False, "--neighbours", help="Also list designs one step from a better one."
+    ),
     verify: int = typer.Option(0, help="Sweep the best N with --backend and compare."),
     backend: str = typer.Option("fem", help="Backend of the verification: fem or analytical."),
     workers: int = typer.Option(None, help="Processes of the verification (default: all cores)."),
@@ -68,7 +71,8 @@ def find(
     Every design of the grid of manufacturable values (--resolution) within the
     model's training ranges (or --range, --fix) is scored on the surrogate;
     those that meet the target within --tolerance are ranked by the
-    objectives (several: the Pareto front). Answers outside the model's
+    objectives (several: the Pareto front), each listed design more than one
+    step from a better one (--neighbours lists them all). Answers outside the model's
     training data are passed over unless --allow-extrapolation. With --verify N
     the best N are swept by the FEM and set beside the surrogate.
 
@@ -124,7 +128,13 @@ def find(
     results = []
     with _common.library_progress(enabled=not as_json):
         for one in chosen:
-            result = find_designs(model_path, one, top=top, allow_extrapolation=allow_extrapolation)
+            result = find_designs(
+                model_path,
+                one,
+                top=top,
+                allow_extrapolation=allow_extrapolation,
+                distinct=not neighbours,
+            )
             if verify and result.candidates:
                 verify_candidates(
                     result, verify, backend=backend, workers=workers, material=material

@@ -287,22 +287,25 @@ class _Scorer:
 
     def _pressure_for(self, designs: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         """The lowest pressure up to the limit that reaches the angle (bisection on a
-        rising θ(p)); NaN and the angle at the limit where it is not reached."""
+        rising θ(p), to 1e-5 of the limit); NaN and the angle at the limit where it is
+        not reached."""
         limit = self.target.pressure_mpa
         goal = self.target.angle_deg
         at_limit = self._angles(designs, limit)
-        reached = at_limit >= goal
-        low = np.zeros(designs.shape[0])
-        high = np.full(designs.shape[0], limit)
-        for _ in range(24):  # 0.5 MPa / 2**24: far below any pressure regulator
-            mid = 0.5 * (low + high)
-            above = self._angles(designs, mid) >= goal
-            high = np.where(above, mid, high)
-            low = np.where(above, low, mid)
-            if np.all(high - low < 1e-6):
-                break
-        pressure = np.where(reached, high, np.nan)
-        angle = np.where(reached, self._angles(designs, high), at_limit)
+        reached = np.flatnonzero(at_limit >= goal)
+        pressure = np.full(designs.shape[0], np.nan)
+        angle = at_limit.copy()
+        if reached.size:
+            rows = designs[reached]
+            low = np.zeros(reached.size)
+            high = np.full(reached.size, limit)
+            for _ in range(17):  # 2**-17 of the limit: below a regulator's resolution
+                mid = 0.5 * (low + high)
+                above = self._angles(rows, mid) >= goal
+                high = np.where(above, mid, high)
+                low = np.where(above, low, mid)
+            pressure[reached] = high
+            angle[reached] = self._angles(rows, high)
         return pressure, angle
 
 
@@ -360,6 +363,7 @@ def find_designs(
     *,
     top: int = 10,
     allow_extrapolation: bool = False,
+    distinct: bool = True,
     progress: Callable[[int, int], None] | None = None,
 ) -> SearchResult:
     """The designs that best meet ``spec`` on the saved surrogate ``model``.
@@ -375,6 +379,10 @@ def find_designs(
     allow_extrapolation : bool, default False
         Let ranges leave the model's training ranges and keep designs outside
         its training data's support, flagged, instead of passing them over.
+    distinct : bool, default True
+        List only designs that differ from every better-ranked one by more than
+        one step in some parameter (a neighbour on the grid is nearly the same
+        actuator); False lists every design in rank order.
     progress : callable, optional
         ``progress(done, total)`` in designs scored.
 
@@ -444,6 +452,8 @@ def find_designs(
     candidates: list[Candidate] = []
     passed_over = 0
     continuous = [n for n in NAMES if not ranges[n].fixed and ranges[n].step == 0]
+    steps = np.array([ranges[n].step for n in NAMES]) + 1e-9
+    kept: list[np.ndarray] = []
     for first in range(0, ranked.size, 4 * top):
         batch = ranked[first : first + 4 * top]
         designs = _designs_at(axes, batch)
@@ -460,6 +470,9 @@ def find_designs(
             if flags and not allow_extrapolation:
                 passed_over += 1
                 continue
+            if distinct and any(np.all(np.abs(k - design) <= steps) for k in kept):
+                continue
+            kept.append(design)
             candidates.append(
                 Candidate(
                     design=SFRBADesign.from_sequence(design.tolist()),

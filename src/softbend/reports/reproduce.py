@@ -13,6 +13,8 @@ softbend can reproduce, and the data, models and figures beside it:
 - ``transfer/``: transfer learning on the shipped virtual lab (Figs. 6 and 7).
 - ``control/``: closed-loop control on the simulated rig, with the lab actuator as a
   mismatched plant (Figs. 8 and 9).
+- ``design/``: three design specifications answered on the shipped FEM surrogate,
+  the best design of each swept by the FEM.
 
 Each section's computation is in :mod:`softbend.pipeline` (one module per
 section, returning its results); this module and the section modules of
@@ -126,6 +128,7 @@ def run_reproduce(
     fem_dataset_epochs: int | None = None,
     transfer_options: dict[str, dict[str, Any]] | None = None,
     control_options: dict[str, Any] | None = None,
+    design_options: dict[str, Any] | None = None,
     command: str | None = None,
 ) -> dict[str, Any]:
     """Run every reproducible section and write ``out_dir/index.html``.
@@ -156,6 +159,11 @@ def run_reproduce(
     control_options : dict, optional
         Options of the control section (:func:`softbend.reports.control_section.add_section`,
         e.g. ``{"duration_s": 2, "refine_epochs": 20}`` for a quick run).
+    design_options : dict, optional
+        Options of the design-search section
+        (:func:`softbend.reports.design_section.add_section`, e.g.
+        ``{"backend": "analytical"}`` for a quick run); default: the best design of
+        each specification verified by the FEM.
     command : str, optional
         The command line that started the run, shown in the report's provenance.
 
@@ -215,6 +223,11 @@ def run_reproduce(
 
     summary["control"] = control_section.add_section(
         report, out_dir, seed, progress, **(control_options or {})
+    )
+    from softbend.reports import design_section
+
+    summary["design"] = design_section.add_section(
+        report, out_dir, progress, **(design_options or {})
     )
     finished = datetime.now(UTC)
     summary["seconds"] = (finished - started).total_seconds()
