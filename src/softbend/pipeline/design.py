@@ -11,7 +11,6 @@ from __future__ import annotations
 
 import time
 from dataclasses import dataclass
-from pathlib import Path
 from typing import Any
 
 from softbend.design_search.search import SearchResult
@@ -53,15 +52,13 @@ SPECIFICATIONS: tuple[Specification, ...] = (
 @dataclass(frozen=True)
 class Design:
     """What :func:`run_design` found: per specification its search result (the verified
-    candidates carry the FEM's figures), the files written, and headline figures."""
+    candidates carry the FEM's figures), and headline figures."""
 
     results: list[SearchResult]
-    files: dict[str, dict[str, str]]
     summary: dict[str, Any]
 
 
 def run_design(
-    out_dir: Path,
     progress: Progress | None = None,
     *,
     verify: int = 1,
@@ -72,8 +69,6 @@ def run_design(
 
     Parameters
     ----------
-    out_dir : path
-        The report's folder; each specification's files go to ``out_dir/design/NAME``.
     progress : callable, optional
         ``progress(phase, done, total)``.
     verify : int, default 1
@@ -85,13 +80,10 @@ def run_design(
     from softbend._progress import listening
     from softbend.design_search.search import find_designs
     from softbend.design_search.verify import verify_candidates
-    from softbend.reports.design_outputs import write_search
-    from softbend.surrogates.predict import load_predictor
     from softbend.transfer.base import shipped_base_path
 
     model = shipped_base_path()
-    predictor, _ = load_predictor(model)
-    results, files, rows = [], {}, []
+    results, rows = [], []
     for spec in specifications:
         start = time.perf_counter()
         with listening(progress):
@@ -99,7 +91,6 @@ def run_design(
             if verify and result.candidates:
                 verify_candidates(result, verify, backend=backend, workers=1)
         results.append(result)
-        files[spec.name] = write_search(result, predictor, Path(out_dir) / "design" / spec.name)
         best = result.candidates[0] if result.candidates else None
         rows.append(
             {
@@ -115,4 +106,4 @@ def run_design(
             }
         )
     summary = {"backend": backend, "verify": verify, "specifications": rows}
-    return Design(results, files, summary)
+    return Design(results, summary)

@@ -46,12 +46,20 @@ def add_section(
 
     start = time.perf_counter()
     design = run_design(
-        out_dir,
         progress,
         verify=verify,
         backend=backend,
         specifications=SPECIFICATIONS if specifications is None else tuple(specifications),
     )
+    from softbend.reports.design_outputs import write_search
+    from softbend.surrogates.predict import load_predictor
+    from softbend.transfer.base import shipped_base_path
+
+    predictor, _ = load_predictor(shipped_base_path())
+    files = {
+        r.spec.name: write_search(r, predictor, Path(out_dir) / "design" / r.spec.name)
+        for r in design.results
+    }
     section = report.section("Design to a specification (softbend design find)")
     section.text(
         "Three questions a designer asks of paper B's actuator, answered on the shipped "
@@ -104,7 +112,7 @@ def add_section(
     )
     for result in design.results:
         name = result.spec.name
-        folder = Path(design.files[name]["curves.png"]).parent
+        folder = Path(files[name]["curves.png"]).parent
         section.figure(
             folder / "curves.png",
             f"{name}: θ(p) of the best designs, surrogate (lines) and {backend.upper()} (circles)",
