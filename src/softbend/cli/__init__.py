@@ -37,6 +37,7 @@ def _register() -> None:
         curling,
         design,
         fem,
+        identify,
         materials,
         reproduce,
         train,
@@ -55,6 +56,7 @@ def _register() -> None:
     app.command("train")(train.train)
     app.command("predict")(train.predict)
     app.command("reproduce")(reproduce.reproduce)
+    app.command("identify")(identify.identify)
 
 
 _register()

@@ -103,6 +103,12 @@ def identify(
         help="Memory the run may use, MiB; data estimated to need more are refused before "
         "reading. Default: the memory available.",
     ),
+    select: bool = typer.Option(
+        False,
+        "--select",
+        help="Also choose a model per pressure sign by held-out free-run error among linear, "
+        "polynomial and kernel NARX models of rho and L together (out/selection_<sign>/).",
+    ),
     as_json: bool = typer.Option(False, "--json", help="Print metrics as JSON."),
 ) -> None:
     """Identify NARX models of rho and L per pressure sign.
@@ -143,6 +149,7 @@ def identify(
         result = run_identify(experiments, config, progress=lambda label: bar(last=label))
     with _common.output_errors(out, "--out"):
         outputs = write_identification_outputs(result, out)
+    verdicts = _select(experiments, out, as_json) if select else {}
     if as_json:
         _common.print_json(
             {
@@ -150,11 +157,34 @@ def identify(
                 "summary": result.summary().to_dict(orient="records"),
                 "kernel": {f"{s}/{o}": v for (s, o), v in result.kernel_params.items()},
                 "files": {k: str(v) for k, v in outputs.items()},
+                "selection": verdicts,
             }
         )
         return
     print_metrics(result)
+    for sign, verdict in verdicts.items():
+        _common.console.print(f"{sign} pressure: {verdict}")
     _common.console.print(f"models, metrics and figures written to {out}")
+
+
+def _select(experiments: list[Any], out: Path, quiet: bool) -> dict[str, str]:
+    """The free-run selection per pressure sign, written to out/selection_<sign>/."""
+    from softbend.identification.selection import select_model
+    from softbend.identification.study import split_by_sign
+    from softbend.identification.timeseries import from_experiments
+    from softbend.reports.identify_outputs import write_identification
+
+    verdicts = {}
+    with _common.library_progress(enabled=not quiet):
+        for sign, group in split_by_sign(experiments).items():
+            if len(group) < 2:
+                continue  # nothing to hold out: paper A's leave-one-out says so above
+            data = from_experiments(group)
+            selection = select_model(data)
+            with _common.output_errors(out, "--out"):
+                write_identification(selection, data, out / f"selection_{sign}")
+            verdicts[sign] = selection.verdict()
+    return verdicts
 
 
 def print_metrics(result) -> None:

@@ -1,0 +1,115 @@
+"""``softbend identify``: a NARX model of any time series, chosen by its held-out free run."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import typer
+
+from softbend.cli import _common
+
+
+def _names(text: str | None, option: str) -> list[str]:
+    names = [n.strip() for n in (text or "").split(",") if n.strip()]
+    if text is not None and not names:
+        raise ValueError(f"The '{option}' must name at least one column. Got {text!r} instead.")
+    return names
+
+
+def identify(
+    data: Path = typer.Argument(
+        ..., help="A CSV file, or a folder of CSV files (one experiment each)."
+    ),
+    inputs: str = typer.Option(..., help="Comma-separated input columns (e.g. p1,p2,p3)."),
+    outputs: str = typer.Option(..., help="Comma-separated output columns (e.g. x,y)."),
+    experiment: str = typer.Option(
+        None, help="Column that splits a file into experiments (contiguous runs)."
+    ),
+    time: str = typer.Option(None, help="Time column (default: the sample index)."),
+    validate_on: str = typer.Option(
+        None, help="Experiments kept out of the selection and scored at the end (comma-separated)."
+    ),
+    folds: int = typer.Option(4, help="Cross-validation folds of whole experiments."),
+    seed: int = typer.Option(0, help="Seed of the kernel models' random search."),
+    max_memory_mb: float = typer.Option(
+        None, help="Refuse data whose identification would need more memory than this, MiB."
+    ),
+    out: Path = typer.Option(..., "--out", "-o", help="Folder for the model, tables, figures."),
+    as_json: bool = typer.Option(False, "--json", help="Print the selection as JSON."),
+) -> None:
+    """A NARX model of any time series, chosen by its free run.
+
+    Linear ARX and degree-2 polynomial NARX models (several lags), paper A's
+    GG-SVR setting and a seeded search of kernel models are cross-validated on
+    whole held-out experiments, each run free from its first samples; the lowest
+    free-run error wins, whatever the family, and the output says when a linear
+    model is the best. Every output's regressor holds the lags of every output.
+    Writes the selection table, the model, the held-out free runs
+    (holdout_freerun.csv) and their figures into --out.
+
+    Example:
+
+    \b
+        softbend identify arm/ --inputs p1_kpa,p2_kpa,p3_kpa --outputs x_mm,y_mm \\
+            --time time_s --validate-on val01,val02 --out arm-model
+    """
+    from softbend._io import staged_dir
+    from softbend.identification.data import experiment_files
+    from softbend.identification.resources import check_identify_memory
+    from softbend.identification.selection import select_model
+    from softbend.identification.timeseries_io import check_holdout, load_timeseries
+    from softbend.reports.identify_outputs import FILES, write_identification
+
+    out = Path(out)
+    _common.check_output_dir(out, "--out", inputs=(data,))
+    _common.check_replaceable_dir(
+        out, "--out", "identify", inputs=(data,), files=FILES, marker="selection.json"
+    )
+    experiment_files(data)  # a missing path or a folder without CSV: refused first
+    check_identify_memory(data, max_memory_mb=max_memory_mb)
+    series = load_timeseries(
+        data,
+        _names(inputs, "--inputs"),
+        _names(outputs, "--outputs"),
+        experiment=experiment,
+        time=time,
+    )
+    held = _names(validate_on, "--validate-on") if validate_on is not None else None
+    check_holdout(series, held)
+    with _common.library_progress(enabled=not as_json):
+        selection = select_model(series, validate_on=held, folds=folds, seed=seed)
+    with _common.output_errors(out, "--out"), staged_dir(out) as stage:
+        write_identification(selection, series, stage)
+    if as_json:
+        _common.print_json(
+            {**selection.to_dict(), "files": {name: str(out / name) for name in FILES}}
+        )
+        return
+    _print_selection(selection)
+    _common.console.print(selection.verdict())
+    _common.console.print(f"{', '.join(FILES)} written to {out}")
+
+
+def _print_selection(selection: object) -> None:
+    from softbend.identification.selection import Selection
+
+    assert isinstance(selection, Selection)
+    validated = bool(selection.validation)
+    columns = ["candidate", "free run (CV)", "one step (CV)"]
+    columns += ["free run (validation)"] if validated else []
+    columns += ["fit (s)"]
+    rows = []
+    for _, r in selection.table.iterrows():
+        mark = " ◀" if r["candidate"] == selection.best else ""
+        row = [f"{r['candidate']}{mark}", f"{r['cv_freerun_nrmse']:.4f}"]
+        row.append(f"{r['cv_onestep_nrmse']:.4f}")
+        if validated:
+            value = r["validation_freerun_nrmse"]
+            row.append("" if value != value else f"{value:.4f}")
+        row.append(f"{r['fit_s']:.2f}")
+        rows.append(row)
+    title = (
+        f"NRMSE (RMSE / output range) of {len(rows)} candidates, "
+        f"{len(selection.train)} training experiments"
+    )
+    _common.print_table(title, columns, rows)

@@ -1,0 +1,446 @@
+"""Multi-output NARX: every output's regressor holds the lags of every output, run free jointly.
+
+For m outputs and k inputs the regressor at time t is
+
+    φ(t) = [y(t−1), …, y(t−na), u(t), …, u(t−nb+1)]      (y: all m outputs, u: all k inputs)
+
+of length na·m + nb·k, and one static map per output gives y_j(t) = f_j(φ(t)).
+The x and y of an arm's tip, or paper A's ρ and L, are coupled through the
+body that carries both; a model that sees only its own output's past cannot
+say so. Free-run simulation feeds every output's prediction back into every
+regressor, all experiments stepped together.
+
+The static maps are one of :data:`FAMILIES`:
+
+- ``arx``: linear (least squares with a tiny ridge), the baseline every model
+  must beat;
+- ``poly2``: every product of two regressors (degree-2 polynomial), least squares;
+- ``gg-svr``: paper A's generalized-Gaussian kernel SVR
+  (:class:`~softbend.identification.svr.GeneralizedGaussianSVR`; ``shape=2``
+  is the Gaussian RBF kernel), fitted on at most ``max_rows`` evenly spaced
+  regressor rows (a kernel fit grows with the square of the rows).
+
+Signals are standardized per signal (each output's mean and standard
+deviation from the training data, shared by its lags), so ``epsilon`` of an
+SVR is in output standard deviations. A free run is kept within the training
+outputs' range widened by :data:`FREE_RUN_MARGIN` ranges on each side: a model
+that diverges saturates there instead of overflowing, and its error shows it.
+"""
+
+from __future__ import annotations
+
+import json
+import os
+from collections.abc import Mapping, Sequence
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from softbend.errors import SchemaError
+
+__all__ = [
+    "FAMILIES",
+    "FREE_RUN_MARGIN",
+    "MultiNARX",
+    "load_multi_narx",
+    "save_multi_narx",
+]
+
+#: The static maps a :class:`MultiNARX` may use.
+FAMILIES: tuple[str, ...] = ("arx", "poly2", "gg-svr")
+
+#: A free run stays within the training range widened by this many ranges per side.
+FREE_RUN_MARGIN = 1.0
+
+_FORMAT = "softbend-multi-narx"
+_SCHEMA = 1
+_RIDGE = 1e-8
+
+
+def _segments(groups: Any, n: int) -> list[tuple[int, int]]:
+    """``[(start, stop), ...]`` of contiguous runs of equal labels (one run without groups)."""
+    if groups is None:
+        return [(0, n)]
+    labels = np.asarray(groups)
+    if labels.shape != (n,):
+        raise ValueError(f"The 'groups' must hold one label per sample ({n}).")
+    change = np.flatnonzero(labels[1:] != labels[:-1]) + 1
+    starts = np.concatenate([[0], change])
+    stops = np.concatenate([change, [n]])
+    return list(zip(starts.tolist(), stops.tolist(), strict=True))
+
+
+class _Ridge:
+    """Least squares with a tiny ridge on standardized regressors (closed form, exact reload)."""
+
+    def __init__(self, degree: int = 1) -> None:
+        self.degree = degree
+
+    def _features(self, X: np.ndarray) -> np.ndarray:
+        if self.degree == 1:
+            return X
+        i, j = np.triu_indices(X.shape[1])
+        return np.hstack([X, X[:, i] * X[:, j]])
+
+    def fit(self, X: np.ndarray, y: np.ndarray) -> _Ridge:
+        F = self._features(X)
+        A = np.hstack([F, np.ones((F.shape[0], 1))])
+        gram = A.T @ A
+        gram[np.diag_indices_from(gram)] += _RIDGE * max(1.0, float(np.trace(gram)) / len(gram))
+        solution = np.linalg.solve(gram, A.T @ y)
+        self.coef_, self.intercept_ = solution[:-1], float(solution[-1])
+        return self
+
+    def predict(self, X: np.ndarray) -> np.ndarray:
+        return self._features(X) @ self.coef_ + self.intercept_
+
+    def state(self) -> dict[str, Any]:
+        return {"degree": self.degree, "coef": self.coef_.tolist(), "intercept": self.intercept_}
+
+    @classmethod
+    def from_state(cls, state: Mapping[str, Any]) -> _Ridge:
+        model = cls(int(state["degree"]))
+        model.coef_ = np.asarray(state["coef"], dtype=np.float64)
+        model.intercept_ = float(state["intercept"])
+        return model
+
+
+def _svr_state(svr: Any) -> dict[str, Any]:
+    return {
+        "params": dict(svr.get_params()),
+        "n_features_in": int(svr.n_features_in_),
+        "sigma": float(svr.sigma_),
+        "shape": float(svr.shape_),
+        "kernel_scale": float(svr.kernel_scale_),
+        "intercept": float(svr.intercept_),
+        "n_iter": int(svr.n_iter_),
+        "dual_coef": svr.dual_coef_.tolist(),
+        "support_vectors": svr.support_vectors_.tolist(),
+    }
+
+
+def _svr_from_state(state: Mapping[str, Any]) -> Any:
+    from softbend.identification.svr import GeneralizedGaussianSVR
+
+    svr = GeneralizedGaussianSVR(**state["params"])
+    svr.n_features_in_ = int(state["n_features_in"])
+    svr.sigma_ = float(state["sigma"])
+    svr.shape_ = float(state["shape"])
+    svr.kernel_scale_ = float(state["kernel_scale"])
+    svr.intercept_ = float(state["intercept"])
+    svr.n_iter_ = int(state["n_iter"])
+    svr.dual_coef_ = np.asarray(state["dual_coef"], dtype=np.float64)
+    svr.support_vectors_ = np.ascontiguousarray(
+        np.asarray(state["support_vectors"], dtype=np.float64).reshape(-1, svr.n_features_in_)
+    )
+    svr.n_support_ = int(svr.dual_coef_.size)
+    svr.shape_estimate_ = None
+    svr._precompute()
+    return svr
+
+
+class MultiNARX:
+    """NARX with several outputs whose regressors share every output's lags.
+
+    Parameters
+    ----------
+    family : {"arx", "poly2", "gg-svr"}, default "arx"
+        The static map of each output (module docstring).
+    output_lags : int, default 2
+        na ≥ 1: past samples of every output in the regressor.
+    input_lags : int, default 2
+        nb ≥ 1: samples of every input, u(t) … u(t−nb+1).
+    params : dict, optional
+        Parameters of the static map: for ``gg-svr`` those of
+        :class:`~softbend.identification.svr.GeneralizedGaussianSVR` (``C``,
+        ``epsilon``, ``shape``, ...; default paper A's C = 100, ε = 0.1).
+    max_rows : int, default 4000
+        Regressor rows a ``gg-svr`` map is fitted on (evenly spaced; all when fewer).
+
+    Attributes
+    ----------
+    estimators_ : list
+        One fitted static map per output (in standardized units).
+    y_mean_, y_std_, u_mean_, u_std_ : ndarray
+        Standardization of the outputs and inputs.
+    y_low_, y_high_ : ndarray
+        The bounds of a free run (training range widened by :data:`FREE_RUN_MARGIN`).
+    n_outputs_, n_inputs_, max_lag_ : int
+    """
+
+    def __init__(
+        self,
+        family: str = "arx",
+        *,
+        output_lags: int = 2,
+        input_lags: int = 2,
+        params: Mapping[str, Any] | None = None,
+        max_rows: int = 4000,
+    ) -> None:
+        if family not in FAMILIES:
+            raise ValueError(
+                f"The 'family' of MultiNARX must be one of {', '.join(FAMILIES)}. "
+                f"Got {family!r} instead."
+            )
+        for name, value in (("output_lags", output_lags), ("input_lags", input_lags)):
+            if isinstance(value, bool) or not isinstance(value, int) or value < 1:
+                raise ValueError(
+                    f"The '{name}' of MultiNARX must be an integer >= 1. Got {value!r}."
+                )
+        if isinstance(max_rows, bool) or not isinstance(max_rows, int) or max_rows < 10:
+            raise ValueError(
+                f"The 'max_rows' of MultiNARX must be an integer >= 10. Got {max_rows!r}."
+            )
+        self.family = family
+        self.output_lags = output_lags
+        self.input_lags = input_lags
+        self.params = dict(params or {})
+        self.max_rows = max_rows
+
+    @property
+    def max_lag(self) -> int:
+        """Samples of initial conditions per experiment: max(na, nb − 1)."""
+        return max(self.output_lags, self.input_lags - 1)
+
+    def describe(self) -> str:
+        """The model in one line: family, lags and the map's settings."""
+        settings = ", ".join(f"{k}={v:g}" if isinstance(v, float) else f"{k}={v}"
+                             for k, v in sorted(self.params.items()))  # fmt: skip
+        text = f"{self.family} na={self.output_lags} nb={self.input_lags}"
+        return f"{text} ({settings})" if settings else text
+
+    def _map(self) -> Any:
+        if self.family == "arx":
+            return _Ridge(1)
+        if self.family == "poly2":
+            return _Ridge(2)
+        from softbend.identification.svr import GeneralizedGaussianSVR
+
+        return GeneralizedGaussianSVR(**{"C": 100.0, "epsilon": 0.1, **self.params})
+
+    def _regressors(self, U: np.ndarray, Y: np.ndarray, t: np.ndarray) -> np.ndarray:
+        """Rows φ(t) for the time indices ``t`` of standardized U and Y."""
+        na, nb = self.output_lags, self.input_lags
+        blocks = [Y[t - k] for k in range(1, na + 1)] + [U[t - k] for k in range(nb)]
+        return np.hstack(blocks)
+
+    def fit(self, U: Any, Y: Any, groups: Any = None) -> MultiNARX:
+        """Fit every output's map on the one-step regressors of every experiment.
+
+        Parameters
+        ----------
+        U : array_like, shape (n, k)
+            Inputs.
+        Y : array_like, shape (n, m)
+            Outputs.
+        groups : array_like, shape (n,), optional
+            Experiment label per sample (contiguous runs); default one experiment.
+        """
+        U, Y = self._arrays(U, Y)
+        segments = _segments(groups, U.shape[0])
+        lag = self.max_lag
+        short = [stop - start for start, stop in segments if stop - start <= lag]
+        if short:
+            raise ValueError(
+                f"Every experiment needs more than {lag} samples (the lags); "
+                f"{len(short)} have {min(short)} or fewer."
+            )
+        self.u_mean_, self.u_std_ = U.mean(axis=0), U.std(axis=0)
+        self.y_mean_, self.y_std_ = Y.mean(axis=0), Y.std(axis=0)
+        self.u_std_[self.u_std_ == 0] = 1.0
+        self.y_std_[self.y_std_ == 0] = 1.0
+        low, high = Y.min(axis=0), Y.max(axis=0)
+        span = np.maximum(high - low, 1e-12)
+        self.y_low_ = low - FREE_RUN_MARGIN * span
+        self.y_high_ = high + FREE_RUN_MARGIN * span
+        Us, Ys = (U - self.u_mean_) / self.u_std_, (Y - self.y_mean_) / self.y_std_
+        index = np.concatenate([np.arange(start + lag, stop) for start, stop in segments])
+        Phi = self._regressors(Us, Ys, index)
+        target = Ys[index]
+        if self.family == "gg-svr" and index.size > self.max_rows:
+            keep = np.unique(np.linspace(0, index.size - 1, self.max_rows).round().astype(int))
+            Phi, target = Phi[keep], target[keep]
+        self.estimators_ = [self._map().fit(Phi, target[:, j]) for j in range(Y.shape[1])]
+        self.n_inputs_, self.n_outputs_ = U.shape[1], Y.shape[1]
+        self.n_train_rows_ = int(Phi.shape[0])
+        return self
+
+    def _arrays(self, U: Any, Y: Any) -> tuple[np.ndarray, np.ndarray]:
+        U = np.asarray(U, dtype=np.float64)
+        Y = np.asarray(Y, dtype=np.float64)
+        U = U[:, None] if U.ndim == 1 else U
+        Y = Y[:, None] if Y.ndim == 1 else Y
+        if U.ndim != 2 or Y.ndim != 2 or U.shape[0] != Y.shape[0]:
+            raise ValueError(
+                f"The inputs and outputs must be (n, k) and (n, m) with the same n. "
+                f"Got {U.shape} and {Y.shape}."
+            )
+        if not (np.isfinite(U).all() and np.isfinite(Y).all()):
+            raise ValueError("The inputs and outputs must be finite (no NaN or inf).")
+        return U, Y
+
+    def _check_fitted(self, U: np.ndarray) -> None:
+        if not hasattr(self, "estimators_"):
+            raise ValueError("This MultiNARX is not fitted yet: call fit first.")
+        if U.shape[1] != self.n_inputs_:
+            raise ValueError(f"The model has {self.n_inputs_} inputs. Got {U.shape[1]}.")
+
+    def predict_one_step(self, U: Any, Y: Any, groups: Any = None) -> np.ndarray:
+        """Each output at t from the measured past (NaN for the initial conditions)."""
+        U, Y = self._arrays(U, Y)
+        self._check_fitted(U)
+        Us, Ys = (U - self.u_mean_) / self.u_std_, (Y - self.y_mean_) / self.y_std_
+        out = np.full(Y.shape, np.nan)
+        lag = self.max_lag
+        for start, stop in _segments(groups, U.shape[0]):
+            index = np.arange(start + lag, stop)
+            if index.size:
+                Phi = self._regressors(Us, Ys, index)
+                out[index] = np.column_stack([e.predict(Phi) for e in self.estimators_])
+        return out * self.y_std_ + self.y_mean_
+
+    def simulate(self, U: Any, Y_init: Any, groups: Any = None) -> np.ndarray:
+        """Free run: every output fed back, every experiment stepped together.
+
+        Parameters
+        ----------
+        U : array_like, shape (n, k)
+            Inputs of all experiments, concatenated.
+        Y_init : array_like, shape (n, m)
+            Outputs whose first ``max_lag`` samples of each experiment are the
+            initial conditions (the rest is not read).
+        groups : array_like, optional
+            Experiment label per sample.
+
+        Returns
+        -------
+        ndarray, shape (n, m)
+            The simulated outputs (the initial conditions copied).
+        """
+        U, Y0 = self._arrays(U, Y_init)
+        self._check_fitted(U)
+        segments = _segments(groups, U.shape[0])
+        lag = self.max_lag
+        Us = (U - self.u_mean_) / self.u_std_
+        Ys = (Y0 - self.y_mean_) / self.y_std_
+        low = (self.y_low_ - self.y_mean_) / self.y_std_
+        high = (self.y_high_ - self.y_mean_) / self.y_std_
+        # the maps' own evaluation, without scikit-learn's per-call validation
+        maps = [getattr(e, "_expansion", e.predict) for e in self.estimators_]
+        lengths = np.array([stop - start for start, stop in segments])
+        starts = np.array([start for start, _ in segments])
+        for step in range(lag, int(lengths.max(initial=0))):
+            running = lengths > step
+            t = starts[running] + step
+            Phi = self._regressors(Us, Ys, t)
+            with np.errstate(all="ignore"):
+                new = np.column_stack([f(Phi) for f in maps])
+            Ys[t] = np.clip(np.nan_to_num(new, nan=0.0), low, high)
+        return Ys * self.y_std_ + self.y_mean_
+
+    # -- persistence ------------------------------------------------------------------
+
+    def to_dict(self, metadata: Mapping[str, Any] | None = None) -> dict[str, Any]:
+        """The fitted model as JSON-ready data (:func:`save_multi_narx`)."""
+        if not hasattr(self, "estimators_"):
+            raise ValueError("This MultiNARX is not fitted yet: call fit first.")
+        maps = [_svr_state(e) if self.family == "gg-svr" else e.state() for e in self.estimators_]
+        return {
+            "format": _FORMAT,
+            "schema_version": _SCHEMA,
+            "metadata": dict(metadata or {}),
+            "family": self.family,
+            "output_lags": self.output_lags,
+            "input_lags": self.input_lags,
+            "params": self.params,
+            "max_rows": self.max_rows,
+            "n_inputs": self.n_inputs_,
+            "n_outputs": self.n_outputs_,
+            "n_train_rows": self.n_train_rows_,
+            **{
+                name: getattr(self, f"{name}_").tolist()
+                for name in ("u_mean", "u_std", "y_mean", "y_std", "y_low", "y_high")
+            },
+            "maps": maps,
+        }
+
+    @classmethod
+    def from_dict(cls, data: Mapping[str, Any], *, source: str = "the saved model") -> MultiNARX:
+        """Rebuild a fitted model from :meth:`to_dict` data (a SchemaError names ``source``)."""
+        if not isinstance(data, Mapping) or data.get("format") != _FORMAT:
+            raise SchemaError(f"{source} is not a saved softbend multi-output NARX model.")
+        if data.get("schema_version") != _SCHEMA:
+            raise SchemaError(
+                f"{source} has schema version {data.get('schema_version')!r}; this softbend "
+                f"reads version {_SCHEMA}."
+            )
+        try:
+            model = cls(
+                data["family"],
+                output_lags=int(data["output_lags"]),
+                input_lags=int(data["input_lags"]),
+                params=data["params"],
+                max_rows=int(data["max_rows"]),
+            )
+            model.n_inputs_, model.n_outputs_ = int(data["n_inputs"]), int(data["n_outputs"])
+            model.n_train_rows_ = int(data["n_train_rows"])
+            sizes = {"u_mean": model.n_inputs_, "u_std": model.n_inputs_}
+            sizes |= dict.fromkeys(("y_mean", "y_std", "y_low", "y_high"), model.n_outputs_)
+            for name, size in sizes.items():
+                values = np.asarray(data[name], dtype=np.float64)
+                if values.shape != (size,) or not np.isfinite(values).all():
+                    raise ValueError(f"'{name}' must hold {size} finite numbers")
+                setattr(model, f"{name}_", values)
+            maps = data["maps"]
+            if not isinstance(maps, list) or len(maps) != model.n_outputs_:
+                raise ValueError(f"'maps' must hold one map per output ({model.n_outputs_})")
+            model.estimators_ = [
+                _svr_from_state(m) if model.family == "gg-svr" else _Ridge.from_state(m)
+                for m in maps
+            ]
+        except (KeyError, TypeError, ValueError) as err:
+            raise SchemaError(f"{source}: {err}.") from None
+        return model
+
+
+def save_multi_narx(
+    model: MultiNARX, path: str | os.PathLike[str], metadata: Mapping[str, Any] | None = None
+) -> Path:
+    """Write a fitted :class:`MultiNARX` to ``path`` (strict JSON, atomic); returns the path.
+
+    Floats are written with their shortest round-trip text, so a reloaded model
+    simulates bit for bit as the saved one.
+    """
+    from softbend._io import json_text, write_text_atomic
+
+    target = Path(path)
+    write_text_atomic(target, json_text(model.to_dict(metadata)) + "\n")
+    return target
+
+
+def load_multi_narx(path: str | os.PathLike[str]) -> tuple[MultiNARX, dict[str, Any]]:
+    """A model written by :func:`save_multi_narx` and its metadata.
+
+    Raises
+    ------
+    FileNotFoundError
+        No such file.
+    SchemaError
+        Not a saved model, or a broken one (naming the file).
+    """
+    file = Path(path)
+    try:
+        data = json.loads(file.read_text(encoding="utf-8"))
+    except json.JSONDecodeError as err:
+        raise SchemaError(f"{file} is not JSON: {err}.") from None
+    model = MultiNARX.from_dict(data, source=str(file))
+    return model, dict(data.get("metadata", {}))
+
+
+def nrmse(
+    measured: np.ndarray, simulated: np.ndarray, ranges: Sequence[float] | np.ndarray
+) -> np.ndarray:
+    """RMSE of each output over its range (the ranges given), dimensionless."""
+    error = np.sqrt(np.nanmean((np.asarray(simulated) - np.asarray(measured)) ** 2, axis=0))
+    return error / np.maximum(np.asarray(ranges, dtype=np.float64), 1e-12)

@@ -1,0 +1,512 @@
+"""Reading and writing time series of any actuator as CSV (:class:`TimeSeriesSet`).
+
+A recording is a CSV file, or a folder of them, with one header line and one
+line per sample; the caller names the columns that are inputs and outputs::
+
+    # rig: bench 2
+    run,t_s,p1_kpa,p2_kpa,x_mm,y_mm
+    a,0.0,0.0,0.0,0.0,0.0
+    a,0.01,4.5,0.0,0.12,0.01
+
+Other columns are ignored. Lines whose first non-blank character is ``#`` are
+comments, and blank lines are skipped. A folder holds one experiment per
+``*.csv`` file, named by its stem and read in sorted name order; an
+``experiment`` column (any name, given by the caller) instead splits a file
+into contiguous runs of the same value. Without a time column the sample index
+(0, 1, 2, ...) is the time. Errors are one line naming the file, the line as an
+editor numbers it (from 1, comments and blank lines counted) and the column.
+Files are read with :func:`softbend._io.read_header_csv`, within the
+``file_mib`` and ``csv_rows`` limits of :mod:`softbend.limits`.
+
+:func:`save_timeseries` writes a set as one such file with an ``experiment``
+column, floats as the shortest text that parses back to the same double, so
+reading it again gives the same numbers bit for bit.
+"""
+
+from __future__ import annotations
+
+import csv
+import io
+import logging
+import math
+import os
+from collections.abc import Sequence
+from pathlib import Path
+
+import numpy as np
+
+from softbend._io import atomic_file, read_header_csv
+from softbend._validation import check_int
+from softbend.errors import DatasetError
+from softbend.identification.data import experiment_files
+from softbend.identification.timeseries import Series, TimeSeriesSet
+
+logger = logging.getLogger(__name__)
+
+__all__ = [
+    "SAMPLE_TIME_NAME",
+    "check_experiments_for_lags",
+    "check_holdout",
+    "load_timeseries",
+    "save_timeseries",
+]
+
+#: ``time_name`` of a set read without a time column (the time is the sample index).
+SAMPLE_TIME_NAME = "sample"
+#: Name of the experiment column :func:`save_timeseries` writes.
+EXPERIMENT_COLUMN = "experiment"
+
+_FORMAT_LINE = "softbend time series v1"
+
+
+# --------------------------------------------------------------------- loading
+def _names(value: str | Sequence[str], field: str) -> tuple[str, ...]:
+    """Column names given as one name or a sequence of names, checked."""
+    names = (value,) if isinstance(value, str) else tuple(value)
+    if not names or not all(isinstance(n, str) and n.strip() for n in names):
+        raise ValueError(
+            f"The '{field}' of load_timeseries must be one or more non-empty column names. "
+            f"Got {value!r} instead."
+        )
+    names = tuple(n.strip() for n in names)
+    duplicates = sorted({n for n in names if names.count(n) > 1})
+    if duplicates:
+        raise ValueError(
+            f"The '{field}' of load_timeseries must name distinct columns. "
+            f"Got {', '.join(duplicates)} more than once."
+        )
+    return names
+
+
+def _column(value: str | None, field: str) -> str | None:
+    if value is None:
+        return None
+    if not isinstance(value, str) or not value.strip():
+        raise ValueError(
+            f"The '{field}' of load_timeseries must be a non-empty column name or None. "
+            f"Got {value!r} instead."
+        )
+    return value.strip()
+
+
+def _check_roles(
+    inputs: tuple[str, ...], outputs: tuple[str, ...], time: str | None, experiment: str | None
+) -> None:
+    """No column may play two roles (input, output, time, experiment)."""
+    roles: dict[str, str] = {}
+    for role, names in (
+        ("inputs", inputs),
+        ("outputs", outputs),
+        ("time", (time,) if time else ()),
+        ("experiment", (experiment,) if experiment else ()),
+    ):
+        for name in names:
+            if name in roles:
+                raise ValueError(
+                    f"The '{role}' of load_timeseries must not name a column that is already "
+                    f"in '{roles[name]}'. Got {name!r} in both."
+                )
+            roles[name] = role
+
+
+def _first_bad_cell(cells: list[str]) -> tuple[int, str]:
+    """Index of the first cell that is not a finite number, and why."""
+    for index, cell in enumerate(cells):
+        if not cell:
+            return index, "missing value (empty cell)"
+        try:
+            value = float(cell)
+        except ValueError:
+            return index, f"{cell!r} is not a number"
+        if not math.isfinite(value):
+            return index, f"{cell!r} is not finite (NaN and infinite values are not allowed)"
+    raise AssertionError("no bad cell")  # pragma: no cover - only called after a failure
+
+
+def _numbers(columns: dict[str, list[str]], lines: list[int], path: Path) -> dict[str, np.ndarray]:
+    """The cells of each column as floats; the first bad cell of the file is an error."""
+    values: dict[str, np.ndarray] = {}
+    bad: list[tuple[int, int, str, str]] = []  # (row, column order, column, reason)
+    for order, (name, cells) in enumerate(columns.items()):
+        try:
+            array = np.fromiter(map(float, cells), dtype=np.float64, count=len(cells))
+        except ValueError:
+            row, reason = _first_bad_cell(cells)
+            bad.append((row, order, name, reason))
+            continue
+        infinite = np.flatnonzero(~np.isfinite(array))
+        if infinite.size:
+            row, reason = _first_bad_cell(cells[: int(infinite[0]) + 1])
+            bad.append((row, order, name, reason))
+            continue
+        values[name] = array
+    if bad:
+        row, _, name, reason = min(bad)
+        raise DatasetError(f"{path}, line {lines[row]}, column '{name}': {reason}.")
+    return values
+
+
+def _runs(
+    names: list[str], lines: list[int], path: Path, column: str
+) -> list[tuple[str, int, int]]:
+    """Contiguous runs ``(name, start, stop)`` of the experiment column, checked."""
+    runs: list[tuple[str, int, int]] = []
+    seen: dict[str, int] = {}
+    start = 0
+    for i in range(1, len(names) + 1):
+        if i < len(names) and names[i] == names[start]:
+            continue
+        name = names[start]
+        if not name:
+            raise DatasetError(
+                f"{path}, line {lines[start]}, column '{column}': the experiment name is empty."
+            )
+        if name in seen:
+            raise DatasetError(
+                f"{path}, line {lines[start]}, column '{column}': experiment {name!r} appears "
+                f"again after {runs[-1][0]!r} (its rows ended at line {lines[seen[name]]}); "
+                "the rows of an experiment must be contiguous."
+            )
+        seen[name] = i - 1
+        runs.append((name, start, i))
+        start = i
+    return runs
+
+
+def _read_file(
+    path: Path,
+    inputs: tuple[str, ...],
+    outputs: tuple[str, ...],
+    experiment: str | None,
+    time: str | None,
+    first: tuple[Path, tuple[str, ...]] | None,
+) -> tuple[list[Series], tuple[str, ...]]:
+    """The experiments of one CSV file, and its columns."""
+    named = [*([experiment] if experiment else []), *([time] if time else []), *inputs, *outputs]
+    header: tuple[str, ...] | None = None
+    header_line = 0
+    rows: list[tuple[str, ...]] = []
+    lines: list[int] = []
+    for line in read_header_csv(path):
+        if line.kind == "header":
+            header, header_line = line.cells, line.number
+        elif line.kind == "row":
+            rows.append(line.cells)
+            lines.append(line.number)
+    if header is None:
+        raise DatasetError(
+            f"{path} is empty: expected a header line with the columns {', '.join(named)}."
+        )
+    missing = [c for c in named if c not in header]
+    if missing:
+        unlike = ""
+        if first is not None:
+            unlike = f" (unlike the first file {first[0]}, which has {', '.join(first[1])})"
+        raise DatasetError(
+            f"{path}, line {header_line}: missing column(s) {', '.join(missing)}; the file's "
+            f"columns are {', '.join(header)}{unlike}."
+        )
+    duplicates = [c for c in named if header.count(c) > 1]
+    if duplicates:
+        raise DatasetError(
+            f"{path}, line {header_line}, column '{duplicates[0]}': the column appears "
+            f"{header.count(duplicates[0])} times in the header."
+        )
+    if not rows:
+        raise DatasetError(f"{path} has a header line (line {header_line}) but no data lines.")
+    width = len(header)
+    for cells, number in zip(rows, lines, strict=True):
+        if len(cells) != width:
+            raise DatasetError(
+                f"{path}, line {number}: {len(cells)} fields, but the header has {width}."
+            )
+    position = {c: header.index(c) for c in named}
+    numeric = [c for c in named if c != experiment]
+    values = _numbers({c: [r[position[c]] for r in rows] for c in numeric}, lines, path)
+    if experiment:
+        runs = _runs([r[position[experiment]] for r in rows], lines, path, experiment)
+    else:
+        runs = [(path.stem, 0, len(rows))]
+    inputs_array = np.column_stack([values[c] for c in inputs])
+    outputs_array = np.column_stack([values[c] for c in outputs])
+    series = []
+    for name, start, stop in runs:
+        if time:
+            times = values[time][start:stop]
+            steps = np.flatnonzero(np.diff(times) <= 0)
+            if steps.size:
+                k = start + int(steps[0]) + 1
+                raise DatasetError(
+                    f"{path}, line {lines[k]}, column '{time}': {float(values[time][k])!r} does "
+                    f"not increase after {float(values[time][k - 1])!r} (line {lines[k - 1]}) "
+                    f"in experiment {name!r}; time must increase strictly."
+                )
+        else:
+            times = np.arange(stop - start, dtype=np.float64)
+        series.append(
+            Series(
+                name,
+                times,
+                inputs_array[start:stop],
+                outputs_array[start:stop],
+                source=str(path),
+            )
+        )
+    return series, header
+
+
+def load_timeseries(
+    path: str | os.PathLike[str],
+    inputs: str | Sequence[str],
+    outputs: str | Sequence[str],
+    *,
+    experiment: str | None = None,
+    time: str | None = None,
+) -> TimeSeriesSet:
+    """Read the time series of any actuator from a CSV file or a folder of CSV files.
+
+    Parameters
+    ----------
+    path : str or path-like
+        A CSV file, or a folder whose ``*.csv`` files are read in sorted name
+        order, each file one experiment named by its stem (unless
+        ``experiment`` is given). See the module docstring for the format.
+    inputs, outputs : str or sequence of str
+        The columns of the inputs and of the outputs, in the order the set keeps
+        them; at least one each, no column in both. Values in the columns' units.
+    experiment : str, optional
+        Column naming the experiment of each line: a file is split into
+        contiguous runs of the same value. Default: one experiment per file.
+    time : str, optional
+        Column of the sample times (its unit is the set's time unit). Default:
+        the sample index 0, 1, 2, ... of each experiment, with ``time_name``
+        ``"sample"``.
+
+    Returns
+    -------
+    TimeSeriesSet
+        The experiments in file order, and within a file in line order; each
+        :class:`Series` has ``source`` set to its file.
+
+    Raises
+    ------
+    DatasetError
+        One line naming the file and, where it applies, the line (as an editor
+        numbers it, comments counted) and the column: path not found, folder
+        without CSV files, empty file or no data lines, a named column missing
+        (listing the file's columns, and for a later file of a folder those of
+        the first) or repeated, a line with the wrong number of fields, a
+        non-numeric, empty, NaN or infinite value, time not strictly increasing
+        within an experiment, an experiment whose lines are not contiguous or
+        whose name is empty, or the same experiment name in two files.
+    LimitError
+        A file over the ``file_mib`` limit or with more data lines than the
+        ``csv_rows`` limit of :mod:`softbend.limits`.
+    ValueError
+        ``inputs`` or ``outputs`` empty or repeating a name, or a column named
+        for two roles.
+    """
+    input_names = _names(inputs, "inputs")
+    output_names = _names(outputs, "outputs")
+    experiment = _column(experiment, "experiment")
+    time = _column(time, "time")
+    _check_roles(input_names, output_names, time, experiment)
+    files = experiment_files(path)
+    experiments: list[Series] = []
+    seen: dict[str, str] = {}
+    first: tuple[Path, tuple[str, ...]] | None = None
+    for file in files:
+        series, header = _read_file(file, input_names, output_names, experiment, time, first)
+        if first is None:
+            first = (file, header)
+        for item in series:
+            if item.name in seen:
+                raise DatasetError(
+                    f"{file}: experiment {item.name!r} was already read from "
+                    f"{seen[item.name]}; experiment names must be unique."
+                )
+            seen[item.name] = item.source
+            experiments.append(item)
+    logger.debug("Loaded %d experiment(s) from %s.", len(experiments), path)
+    return TimeSeriesSet(input_names, output_names, tuple(experiments), time or SAMPLE_TIME_NAME)
+
+
+# ---------------------------------------------------------------------- saving
+def _csv_text(cells: Sequence[str]) -> str:
+    """One CSV line (no line end), quoted where needed."""
+    buffer = io.StringIO()
+    csv.writer(buffer, lineterminator="").writerow(cells)
+    return buffer.getvalue()
+
+
+def _check_writable(name: object, what: str) -> str:
+    """A column or experiment name that reads back unchanged, else ValueError."""
+    if (
+        not isinstance(name, str)
+        or not name
+        or name != name.strip()
+        or "\n" in name
+        or "\r" in name
+    ):
+        raise ValueError(
+            f"The {what} of save_timeseries must be non-empty text without line breaks or "
+            f"surrounding spaces (it could not be read back unchanged). Got {name!r} instead."
+        )
+    return name
+
+
+def save_timeseries(data: TimeSeriesSet, path: str | os.PathLike[str]) -> Path:
+    """Write a time-series set to one CSV file, atomically.
+
+    Parameters
+    ----------
+    data : TimeSeriesSet
+        What to write.
+    path : str or path-like
+        The CSV file (its folder is created if missing; an existing file is replaced).
+
+    Returns
+    -------
+    pathlib.Path
+        The file written.
+
+    Raises
+    ------
+    ValueError
+        ``data`` not a set, ``path`` a folder, a column or experiment name that
+        would not read back unchanged (empty, line breaks, surrounding spaces),
+        or the same column name twice (``experiment``, the time column, the
+        inputs and the outputs must all differ).
+
+    Notes
+    -----
+    The columns are ``experiment``, the set's time column, the inputs and the
+    outputs, after the comment lines ``# softbend time series v1``,
+    ``# time: <name>``, ``# inputs: a,b`` and ``# outputs: x,y``. Floats are
+    written with :func:`repr`, the shortest text that parses back to the same
+    double, so ``load_timeseries(path, data.input_names, data.output_names,
+    experiment="experiment", time=data.time_name)`` gives the same numbers bit
+    for bit (``source`` becomes the file). The file is written to a temporary
+    file beside it and moved into place, so a reader never sees half of it.
+    """
+    if not isinstance(data, TimeSeriesSet):
+        raise ValueError(
+            "The 'data' of save_timeseries must be a TimeSeriesSet. "
+            f"Got {type(data).__name__} instead."
+        )
+    target = Path(path)
+    if target.is_dir():
+        raise ValueError(
+            f"The 'path' of save_timeseries must be a file. Got the folder {target} instead."
+        )
+    columns = [EXPERIMENT_COLUMN, data.time_name, *data.input_names, *data.output_names]
+    for name in columns:
+        _check_writable(name, "column name")
+    duplicates = sorted({c for c in columns if columns.count(c) > 1})
+    if duplicates:
+        raise ValueError(
+            "The columns of save_timeseries (experiment, time, inputs, outputs) must have "
+            f"distinct names. Got {', '.join(map(repr, duplicates))} more than once."
+        )
+    labels = {}
+    for item in data.experiments:
+        _check_writable(item.name, "experiment name")
+        label = _csv_text([item.name])
+        labels[item.name] = f'"{label}"' if label.startswith("#") else label
+    with atomic_file(target, "w") as handle:
+        handle.write(f"# {_FORMAT_LINE}\n")
+        handle.write(f"# time: {_csv_text([data.time_name])}\n")
+        handle.write(f"# inputs: {_csv_text(data.input_names)}\n")
+        handle.write(f"# outputs: {_csv_text(data.output_names)}\n")
+        handle.write(_csv_text(columns) + "\n")
+        for item in data.experiments:
+            label = labels[item.name]
+            table = np.column_stack([item.time, item.inputs, item.outputs]).tolist()
+            handle.writelines(f"{label},{','.join(map(repr, row))}\n" for row in table)
+        handle.flush()
+        os.fsync(handle.fileno())
+    logger.debug("Saved %d experiment(s) to %s.", len(data.experiments), target)
+    return target
+
+
+# ---------------------------------------------------------------------- checks
+def check_experiments_for_lags(data: TimeSeriesSet, max_lag: int) -> None:
+    """Refuse experiments too short for NARX regressors of ``max_lag`` lags.
+
+    The first ``max_lag`` samples of an experiment are initial conditions, so a
+    regressor row needs ``max_lag + 1`` samples.
+
+    Parameters
+    ----------
+    data : TimeSeriesSet
+        The experiments.
+    max_lag : int
+        The largest lag, in samples (>= 0).
+
+    Raises
+    ------
+    DatasetError
+        An experiment with fewer than ``max_lag + 1`` samples: the first one is
+        named with its file, its sample count and the count needed.
+    ValueError
+        ``max_lag`` not an integer >= 0.
+    """
+    max_lag = check_int(max_lag, "max_lag", "check_experiments_for_lags")
+    need = max_lag + 1
+    short = [e for e in data.experiments if e.n_samples < need]
+    if short:
+        e = short[0]
+        source = f" ({e.source})" if e.source else ""
+        others = (
+            f"; {len(short) - 1} other experiment(s) are too short too" if len(short) > 1 else ""
+        )
+        raise DatasetError(
+            f"Experiment {e.name!r}{source} has {e.n_samples} sample(s), but lags up to "
+            f"{max_lag} need at least {need} (the first {max_lag} are initial "
+            f"conditions){others}."
+        )
+
+
+def check_holdout(data: TimeSeriesSet, validate_on: str | Sequence[str] | None) -> None:
+    """Check that experiments can be held out for validation.
+
+    Parameters
+    ----------
+    data : TimeSeriesSet
+        The experiments.
+    validate_on : str or sequence of str, optional
+        The experiments held out (one name or several). None: one experiment is
+        to be held out at a time, which needs at least two.
+
+    Raises
+    ------
+    ValueError
+        A name that is not an experiment of ``data`` (the message lists them),
+        ``validate_on`` empty or naming every experiment (none left to train
+        on), or ``validate_on`` None with a single experiment (nothing to hold out).
+    """
+    known = data.names
+    if validate_on is None:
+        if len(known) < 2:
+            raise ValueError(
+                f"There is nothing to hold out: the data has one experiment ({known[0]!r}); "
+                "validation needs at least two (one to train on, one to hold out)."
+            )
+        return
+    names = (validate_on,) if isinstance(validate_on, str) else tuple(validate_on)
+    if not names:
+        raise ValueError(
+            "The 'validate_on' of check_holdout must name at least one experiment, or be None. "
+            "Got none."
+        )
+    unknown = [n for n in names if n not in known]
+    if unknown:
+        raise ValueError(
+            f"The 'validate_on' of check_holdout must name experiments of the data "
+            f"({', '.join(known)}). Got {', '.join(map(repr, unknown))} instead."
+        )
+    if set(names) >= set(known):
+        raise ValueError(
+            f"The 'validate_on' of check_holdout must leave at least one experiment to train "
+            f"on. Got all {len(known)} experiment(s) ({', '.join(known)})."
+        )
