@@ -73,3 +73,16 @@ def test_one_experiment_only_has_nothing_to_hold_out(recording, tmp_path, capsys
     assert main(["identify", str(one), *ARGS, "--out", str(tmp_path / "x")]) == 2
     err = capsys.readouterr().err.strip().splitlines()
     assert len(err) == 1 and "hold" in err[0]
+
+
+def test_an_experiment_shorter_than_the_lags_is_one_line(recording, tmp_path, capsys):
+    from softbend.identification.timeseries import Series, TimeSeriesSet
+
+    _, data = recording
+    first = data.experiments[0]
+    stub = Series("stub", first.time[:3], first.inputs[:3], first.outputs[:3])
+    short = TimeSeriesSet(data.input_names, data.output_names, (*data.experiments, stub), "time_s")
+    path = save_timeseries(short, tmp_path / "short.csv")
+    assert main(["identify", str(path), *ARGS, "--out", str(tmp_path / "x")]) == 2
+    err = capsys.readouterr().err.strip().splitlines()
+    assert len(err) == 1 and "stub" in err[0], err

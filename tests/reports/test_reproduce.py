@@ -257,3 +257,15 @@ def test_design_section(first_run):
     assert "Design to a specification" in html and "design/quick/curves.png" in html
     for name in ("candidates.csv", "search.json", "front.png", "curves.png"):
         assert (out / "design" / "quick" / name).is_file(), name
+
+
+def test_paper_a_selection_beside_paper_a_s_setting(first_run):
+    out, summary, _ = first_run
+    selection = summary["paper_a"]["selection"]
+    assert set(selection) == {"positive", "negative"}
+    for chosen in selection.values():
+        # chosen by cross-validated free run: never worse than the best linear ARX there
+        assert chosen["cv_freerun_nrmse"] <= chosen["best_arx_cv_freerun_nrmse"]
+        assert chosen["cv_freerun_nrmse"] <= chosen["paper_a_cv_freerun_nrmse"]
+    html = (out / "index.html").read_text(encoding="utf-8")
+    assert "paper_a/selection_positive/freerun.png" in html and "(selected)" in html

@@ -56,8 +56,12 @@ def identify(
     from softbend._io import staged_dir
     from softbend.identification.data import experiment_files
     from softbend.identification.resources import check_identify_memory
-    from softbend.identification.selection import select_model
-    from softbend.identification.timeseries_io import check_holdout, load_timeseries
+    from softbend.identification.selection import default_candidates, select_model
+    from softbend.identification.timeseries_io import (
+        check_experiments_for_lags,
+        check_holdout,
+        load_timeseries,
+    )
     from softbend.reports.identify_outputs import FILES, write_identification
 
     out = Path(out)
@@ -76,6 +80,8 @@ def identify(
     )
     held = _names(validate_on, "--validate-on") if validate_on is not None else None
     check_holdout(series, held)
+    # every candidate's regressor must fit in every experiment (the longest lags: 3)
+    check_experiments_for_lags(series, max(c.build(10).max_lag for c in default_candidates(seed)))
     with _common.library_progress(enabled=not as_json):
         selection = select_model(series, validate_on=held, folds=folds, seed=seed)
     with _common.output_errors(out, "--out"), staged_dir(out) as stage:

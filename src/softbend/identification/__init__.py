@@ -12,16 +12,21 @@ from typing import TYPE_CHECKING, Any
 from softbend._lazy import export as _export
 
 if TYPE_CHECKING:
+    from softbend.identification.arm import SoftArm, arm_experiments
     from softbend.identification.data import Experiment, load_experiments, save_experiments
     from softbend.identification.kernels import (
         estimate_gg_shape,
         estimate_kernel_shape,
         generalized_gaussian_kernel,
     )
+    from softbend.identification.multi import MultiNARX, load_multi_narx, save_multi_narx
     from softbend.identification.narx import NARXRegressor
     from softbend.identification.resources import check_identify_memory
+    from softbend.identification.selection import Selection, select_model
     from softbend.identification.svr import GeneralizedGaussianSVR
     from softbend.identification.synthetic import CurlingActuator, synthetic_dataset
+    from softbend.identification.timeseries import Series, TimeSeriesSet, from_experiments
+    from softbend.identification.timeseries_io import load_timeseries, save_timeseries
 
 #: Public name → submodule that defines it.
 _EXPORTS = {
@@ -36,19 +41,43 @@ _EXPORTS = {
     "CurlingActuator": "synthetic",
     "synthetic_dataset": "synthetic",
     "check_identify_memory": "resources",
+    "SoftArm": "arm",
+    "arm_experiments": "arm",
+    "MultiNARX": "multi",
+    "load_multi_narx": "multi",
+    "save_multi_narx": "multi",
+    "Selection": "selection",
+    "select_model": "selection",
+    "Series": "timeseries",
+    "TimeSeriesSet": "timeseries",
+    "from_experiments": "timeseries",
+    "load_timeseries": "timeseries_io",
+    "save_timeseries": "timeseries_io",
 }
 
 __all__ = [
     "CurlingActuator",
     "Experiment",
     "GeneralizedGaussianSVR",
+    "MultiNARX",
     "NARXRegressor",
+    "Selection",
+    "Series",
+    "SoftArm",
+    "TimeSeriesSet",
+    "arm_experiments",
     "check_identify_memory",
     "estimate_gg_shape",
     "estimate_kernel_shape",
+    "from_experiments",
     "generalized_gaussian_kernel",
     "load_experiments",
+    "load_multi_narx",
+    "load_timeseries",
     "save_experiments",
+    "save_multi_narx",
+    "save_timeseries",
+    "select_model",
     "synthetic_dataset",
 ]
 

@@ -3,7 +3,7 @@
 from __future__ import annotations
 
 import time
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
@@ -28,12 +28,18 @@ class PaperA:
         ``{artefact name: path}`` of the files written (metrics, models).
     summary : dict
         Headline figures: wall time, free-run NRMSE mean and worst per
-        ``"sign/output"``.
+        ``"sign/output"``, and per sign the model chosen by free-run error.
+    selections : dict of str to Selection
+        Per pressure sign, the selection by held-out free-run error among linear,
+        polynomial and kernel NARX models of ρ and L together
+        (:func:`softbend.identification.selection.select_model`), beside paper A's
+        setting, which the identification above keeps.
     """
 
     result: IdentificationResult
     paths: dict[str, Path]
     summary: dict[str, Any]
+    selections: dict[str, Any] = field(default_factory=dict)
 
 
 def write_identification_data(result: IdentificationResult, out_dir: Path) -> dict[str, Path]:
@@ -110,6 +116,7 @@ def run_paper_a(out_dir: Path, *, seed: int = 0, progress: Progress | None = Non
         progress(phase, 0, total)
     result = identify(experiments, IdentificationConfig(), progress=step)
     paths = write_identification_data(result, folder)
+    selections = _selections(dataset, seed, progress)
     table = result.summary()
     free_run = table[table["mode"] == "free-run"]
     summary = {
@@ -121,4 +128,39 @@ def run_paper_a(out_dir: Path, *, seed: int = 0, progress: Progress | None = Non
             f"{r.sign}/{r.output}": float(r.nrmse_max) for r in free_run.itertuples()
         },
     }
-    return PaperA(result=result, paths=paths, summary=summary)
+    summary["selection"] = {
+        sign: {
+            "best": chosen.best,
+            "cv_freerun_nrmse": float(chosen.row(chosen.best)["cv_freerun_nrmse"]),
+            "best_arx": (chosen.best_of("arx") or {}).get("candidate"),
+            "best_arx_cv_freerun_nrmse": float(
+                (chosen.best_of("arx") or {}).get("cv_freerun_nrmse", float("nan"))
+            ),
+            "paper_a_cv_freerun_nrmse": float(chosen.row("paper-a")["cv_freerun_nrmse"]),
+        }
+        for sign, chosen in selections.items()
+    }
+    return PaperA(result=result, paths=paths, summary=summary, selections=selections)
+
+
+def _selections(
+    dataset: dict[str, list[Any]], seed: int, progress: Progress | None
+) -> dict[str, Any]:
+    """Per pressure sign, the model chosen by held-out free-run error (ρ and L together)."""
+    from softbend._progress import listening
+    from softbend.identification.selection import select_model
+    from softbend.identification.timeseries import from_experiments
+
+    out = {}
+    for sign, group in dataset.items():
+        if len(group) < 2:
+            continue
+        phase = f"paper A: model selection ({sign})"
+
+        def tick(done: int, total: int, phase: str = phase) -> None:
+            if progress is not None:
+                progress(phase, done, total)
+
+        with listening(None):  # the selection's own fits are this phase
+            out[sign] = select_model(from_experiments(group), seed=seed, progress=tick)
+    return out

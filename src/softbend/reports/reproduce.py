@@ -54,7 +54,9 @@ def _paper_a(report: Report, out_dir: Path, seed: int, progress: Progress | None
         **identified.paths,
         **curling_figures.all_figures(identified.result, out_dir / "paper_a"),
     }
-    paper_a.add_section(report, identified.result, paths, root=out_dir)
+    paper_a.add_section(
+        report, identified.result, paths, root=out_dir, selections=identified.selections
+    )
     return {**identified.summary, "seconds": time.perf_counter() - start}
 
 
