@@ -55,3 +55,14 @@ def pytest_terminal_summary(terminalreporter):
         total = sum(_FUZZ_COUNTS.values())
         parts = ", ".join(f"{name} {count}" for name, count in sorted(_FUZZ_COUNTS.items()))
         terminalreporter.write_line(f"file-format property tests: {total} inputs tried ({parts})")
+
+
+@pytest.fixture(scope="session")
+def fit_file(tmp_path_factory):
+    """A fit.json of the shipped Dragon Skin 30 tensile test (neo-Hookean and Yeoh), as
+    ``softbend materials fit`` writes it: the lab's own material for ``--material``."""
+    from softbend.cli import main
+
+    out = tmp_path_factory.mktemp("fit")
+    assert main(["materials", "fit", "--models", "neo-hookean,yeoh", "-o", str(out)]) == 0
+    return out / "fit.json"

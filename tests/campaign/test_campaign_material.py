@@ -29,14 +29,6 @@ SOFT = Material(
 CLI_RUN = ["--space", "lhs:2", "--seed", "1", "--pmax", "0.1", "--pstep", "0.05", "--workers", "0"]
 
 
-@pytest.fixture(scope="module")
-def fit_file(tmp_path_factory):
-    """A fit.json of the shipped Dragon Skin 30 tensile test (neo-Hookean and Yeoh)."""
-    out = tmp_path_factory.mktemp("fit")
-    assert main(["materials", "fit", "--models", "neo-hookean,yeoh", "-o", str(out)]) == 0
-    return out / "fit.json"
-
-
 @pytest.fixture
 def solves(monkeypatch):
     """Replace the FEM solve by a stand-in that records the elastomer of each call."""

@@ -27,14 +27,6 @@ DESIGNS = [SFRBADesign(100, 6, 2, 2, 5, 8), SFRBADesign(120, 8, 2, 2, 5, 10)]
 CLI_RUN = ["--space", "lhs:3", "--seed", "2", "--pmax", "0.1", "--pstep", "0.05", "--workers", "0"]
 
 
-@pytest.fixture(scope="module")
-def fit_file(tmp_path_factory):
-    """A fit.json of the shipped Dragon Skin 30 tensile test (neo-Hookean and Yeoh)."""
-    out = tmp_path_factory.mktemp("fit")
-    assert main(["materials", "fit", "--models", "neo-hookean,yeoh", "-o", str(out)]) == 0
-    return out / "fit.json"
-
-
 @pytest.fixture
 def fast_fem(monkeypatch):
     """The FEM backend with its solve replaced by a linear stand-in (no mesh, no Newton)."""

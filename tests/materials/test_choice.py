@@ -12,13 +12,6 @@ from softbend.materials import DRAGON_SKIN_30, material_from_spec
 from softbend.registry import UnknownNameError
 
 
-@pytest.fixture(scope="module")
-def fit_file(tmp_path_factory):
-    out = tmp_path_factory.mktemp("fit")
-    assert main(["materials", "fit", "--models", "neo-hookean,yeoh", "-o", str(out)]) == 0
-    return out / "fit.json"
-
-
 def test_a_preset_by_name():
     assert material_from_spec("dragon-skin-30") is DRAGON_SKIN_30
 

@@ -38,6 +38,7 @@ from typing import Any
 import numpy as np
 
 from softbend.errors import SchemaError
+from softbend.identification.persistence import svr_from_state, svr_state
 
 __all__ = [
     "FAMILIES",
@@ -104,40 +105,6 @@ class _Ridge:
         model.coef_ = np.asarray(state["coef"], dtype=np.float64)
         model.intercept_ = float(state["intercept"])
         return model
-
-
-def _svr_state(svr: Any) -> dict[str, Any]:
-    return {
-        "params": dict(svr.get_params()),
-        "n_features_in": int(svr.n_features_in_),
-        "sigma": float(svr.sigma_),
-        "shape": float(svr.shape_),
-        "kernel_scale": float(svr.kernel_scale_),
-        "intercept": float(svr.intercept_),
-        "n_iter": int(svr.n_iter_),
-        "dual_coef": svr.dual_coef_.tolist(),
-        "support_vectors": svr.support_vectors_.tolist(),
-    }
-
-
-def _svr_from_state(state: Mapping[str, Any]) -> Any:
-    from softbend.identification.svr import GeneralizedGaussianSVR
-
-    svr = GeneralizedGaussianSVR(**state["params"])
-    svr.n_features_in_ = int(state["n_features_in"])
-    svr.sigma_ = float(state["sigma"])
-    svr.shape_ = float(state["shape"])
-    svr.kernel_scale_ = float(state["kernel_scale"])
-    svr.intercept_ = float(state["intercept"])
-    svr.n_iter_ = int(state["n_iter"])
-    svr.dual_coef_ = np.asarray(state["dual_coef"], dtype=np.float64)
-    svr.support_vectors_ = np.ascontiguousarray(
-        np.asarray(state["support_vectors"], dtype=np.float64).reshape(-1, svr.n_features_in_)
-    )
-    svr.n_support_ = int(svr.dual_coef_.size)
-    svr.shape_estimate_ = None
-    svr._precompute()
-    return svr
 
 
 class MultiNARX:
@@ -345,7 +312,7 @@ class MultiNARX:
         """The fitted model as JSON-ready data (:func:`save_multi_narx`)."""
         if not hasattr(self, "estimators_"):
             raise ValueError("This MultiNARX is not fitted yet: call fit first.")
-        maps = [_svr_state(e) if self.family == "gg-svr" else e.state() for e in self.estimators_]
+        maps = [svr_state(e) if self.family == "gg-svr" else e.state() for e in self.estimators_]
         return {
             "format": _FORMAT,
             "schema_version": _SCHEMA,
@@ -396,7 +363,7 @@ class MultiNARX:
             if not isinstance(maps, list) or len(maps) != model.n_outputs_:
                 raise ValueError(f"'maps' must hold one map per output ({model.n_outputs_})")
             model.estimators_ = [
-                _svr_from_state(m) if model.family == "gg-svr" else _Ridge.from_state(m)
+                svr_from_state(m) if model.family == "gg-svr" else _Ridge.from_state(m)
                 for m in maps
             ]
         except (KeyError, TypeError, ValueError) as err:

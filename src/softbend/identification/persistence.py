@@ -89,18 +89,7 @@ def narx_to_dict(model: NARXRegressor, metadata: dict[str, Any] | None = None) -
             "y_scaler": _scaler_state(model.y_scaler_),
             "u_scaler": _scaler_state(model.u_scaler_),
         },
-        "estimator": {
-            "class": "GeneralizedGaussianSVR",
-            "params": {k: v for k, v in svr.get_params().items()},
-            "n_features_in": int(svr.n_features_in_),
-            "sigma": svr.sigma_,
-            "shape": svr.shape_,
-            "kernel_scale": svr.kernel_scale_,
-            "intercept": svr.intercept_,
-            "n_iter": int(svr.n_iter_),
-            "dual_coef": svr.dual_coef_.tolist(),
-            "support_vectors": svr.support_vectors_.tolist(),
-        },
+        "estimator": svr_state(svr),
     }
 
 
@@ -331,6 +320,42 @@ def _check_document(data: dict[str, Any]) -> None:
     _matrix(estimator["support_vectors"], "estimator.support_vectors", dual_coef.size, n_features)
 
 
+def svr_state(svr: GeneralizedGaussianSVR) -> dict[str, Any]:
+    """A fitted GG-SVR's parameters and solution as JSON-ready data (:func:`svr_from_state`)."""
+    return {
+        "class": "GeneralizedGaussianSVR",
+        "params": dict(svr.get_params()),
+        "n_features_in": int(svr.n_features_in_),
+        "sigma": svr.sigma_,
+        "shape": svr.shape_,
+        "kernel_scale": svr.kernel_scale_,
+        "intercept": svr.intercept_,
+        "n_iter": int(svr.n_iter_),
+        "dual_coef": svr.dual_coef_.tolist(),
+        "support_vectors": svr.support_vectors_.tolist(),
+    }
+
+
+def svr_from_state(state: Mapping[str, Any]) -> GeneralizedGaussianSVR:
+    """The fitted GG-SVR of :func:`svr_state` data (checked by the caller), predicting bit for
+    bit as the one saved."""
+    svr = GeneralizedGaussianSVR(**state["params"])
+    svr.n_features_in_ = int(state["n_features_in"])
+    svr.sigma_ = float(state["sigma"])
+    svr.shape_ = float(state["shape"])
+    svr.kernel_scale_ = float(state["kernel_scale"])
+    svr.intercept_ = float(state["intercept"])
+    svr.n_iter_ = int(state["n_iter"])
+    svr.dual_coef_ = np.asarray(state["dual_coef"], dtype=float)
+    svr.support_vectors_ = np.ascontiguousarray(
+        np.asarray(state["support_vectors"], dtype=float).reshape(-1, svr.n_features_in_)
+    )
+    svr.n_support_ = int(svr.dual_coef_.size)
+    svr.shape_estimate_ = None  # the moment diagnostics are not stored
+    svr._precompute()
+    return svr
+
+
 def narx_from_dict(data: dict[str, Any], *, source: str = "the saved model") -> NARXRegressor:
     """Rebuild a fitted NARX model from :func:`narx_to_dict` data.
 
@@ -363,20 +388,7 @@ def narx_from_dict(data: dict[str, Any], *, source: str = "the saved model") -> 
         raise SchemaError(f"{source}: {err}.") from None
 
     state = data["estimator"]
-    svr = GeneralizedGaussianSVR(**state["params"])
-    svr.n_features_in_ = int(state["n_features_in"])
-    svr.sigma_ = float(state["sigma"])
-    svr.shape_ = float(state["shape"])
-    svr.kernel_scale_ = float(state["kernel_scale"])
-    svr.intercept_ = float(state["intercept"])
-    svr.n_iter_ = int(state["n_iter"])
-    svr.dual_coef_ = np.asarray(state["dual_coef"], dtype=float)
-    svr.support_vectors_ = np.ascontiguousarray(
-        np.asarray(state["support_vectors"], dtype=float).reshape(-1, svr.n_features_in_)
-    )
-    svr.n_support_ = int(svr.dual_coef_.size)
-    svr.shape_estimate_ = None  # the moment diagnostics are not stored
-    svr._precompute()
+    svr = svr_from_state(state)
 
     narx_state = data["narx"]
     model = NARXRegressor(
