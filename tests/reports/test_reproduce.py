@@ -269,3 +269,20 @@ def test_paper_a_selection_beside_paper_a_s_setting(first_run):
         assert chosen["cv_freerun_nrmse"] <= chosen["paper_a_cv_freerun_nrmse"]
     html = (out / "index.html").read_text(encoding="utf-8")
     assert "paper_a/selection_positive/freerun.png" in html and "(selected)" in html
+
+
+def test_the_report_opens_on_the_summary_table_and_says_it_is_reduced(first_run):
+    import re
+
+    out, summary, _ = first_run
+    html = (out / "index.html").read_text(encoding="utf-8")
+    first = html.index("<section")
+    assert html.startswith('<section id="summary-softbend-beside-the-papers">', first)
+    assert "REDUCED SETTINGS" in html[first : html.index("</section>", first)]
+    assert summary["reduced_settings"]  # the tests' run is a reduced one
+    cells = re.findall(r"<td>(.*?)</td>", html)
+    assert cells and not any(re.search(r"\bnan\b", c, re.IGNORECASE) for c in cells)
+    # every summary row links to its section, and every link lands on an anchor
+    summary_html = html[first : html.index("</section>", first)]
+    for anchor in re.findall(r'href="#([^"]+)"', summary_html):
+        assert f'id="{anchor}"' in html, anchor

@@ -19,7 +19,7 @@ from typing import Any
 
 from softbend._io import write_text_atomic
 
-__all__ = ["Report", "Section", "human_numbers", "slug", "write_text_atomic"]
+__all__ = ["Link", "Report", "Section", "human_numbers", "slug", "write_text_atomic"]
 
 _CSS = """
 body { font-family: system-ui, sans-serif; max-width: 1100px; margin: 2em auto; padding: 0 1em;
@@ -65,7 +65,17 @@ def slug(title: str) -> str:
     return "-".join(words) or "section"
 
 
+@dataclass(frozen=True)
+class Link:
+    """A table cell that links to an anchor or a file of the report."""
+
+    text: str
+    href: str
+
+
 def _format_cell(value: Any) -> str:
+    if isinstance(value, Link):
+        return f'<a href="{html.escape(value.href)}">{html.escape(value.text)}</a>'
     if isinstance(value, bool):
         return html.escape(str(value))
     if isinstance(value, float):

@@ -231,6 +231,24 @@ def run_reproduce(
     summary["design"] = design_section.add_section(
         report, out_dir, progress, **(design_options or {})
     )
+    from softbend.reports.summary_section import add_summary
+
+    reduced = [
+        name
+        for name, value in (
+            ("another design space", design_space),
+            ("other FEM options", fem_options),
+            ("another Fig. 2 pressure", fem_pmax_mpa),
+            ("another FEM dataset", fem_dataset),
+            ("fewer MLP epochs on the FEM data", fem_dataset_epochs),
+            ("other transfer settings", transfer_options),
+            ("other control settings", control_options),
+            ("other design settings", design_options),
+        )
+        if value is not None
+    ]
+    summary["reduced_settings"] = reduced
+    add_summary(report, summary, reduced=", ".join(reduced) or None)
     finished = datetime.now(UTC)
     summary["seconds"] = (finished - started).total_seconds()
     fem_data = summary["paper_b_fem_data"]

@@ -163,7 +163,7 @@ def add_transfer(report: Report, transfer: Transfer, root: Path) -> dict[str, Pa
         "they agree in kind, not to the digit. Each figure is also one draw of the base "
         "MLP's training seed: a base trained with another seed fits the FEM data about as "
         "well but refines differently (benchmarks/bench_transfer_seeds.py measures the spread; "
-        "see the README)."
+        "see docs/results.md)."
         + (
             " The pressure-scale and scaled-refined strategies go beyond paper B: the FEM-trained "
             "MLP is asked at s·p, one number fitted to the measurements that makes the simulated "

@@ -27,7 +27,7 @@ largest configuration of a batched training is not padded and keeps its own
 random streams, so (63, 65) scores bitwise the same alone as beside (55, 55)
 (``tests/surrogates/test_batched.py``). The ``paper`` grid searches the
 sizes; with successive halving (``halving=3`` and five rungs) the whole paper
-MLP grid on the FEM data took 34 min on 2 cores (the README has the command).
+MLP grid on the FEM data took 34 min on 2 cores (docs/results.md has the command).
 
 XGBoost uses 300 trees (paper B does not give the number), histogram tree
 method. The MLP trains with batch 1024 and Adam lr 6e-4 (paper B) for 1000

@@ -32,7 +32,7 @@ __all__ = ["FINE_TUNE_THREADS", "check_mlp", "fine_tune_many", "fine_tune_mlp", 
 #: Threads of the batched training (at most; fewer if PyTorch has fewer). The
 #: stacked variants of a fold set make every step a batch of matrix products
 #: large enough to be compute-bound, so two threads pay (``softbend transfer
-#: loco`` on the shipped lab: see the README for the time with one and two).
+#: loco`` on the shipped lab: docs/results.md gives the time with one and two).
 #: A fixed number, not the machine's core count, so the rounding (and the
 #: figures) are the same on every machine with two cores or more.
 FINE_TUNE_THREADS = 2
