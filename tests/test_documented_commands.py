@@ -1,0 +1,85 @@
+"""Every softbend command shown in the README and the docs names a real command and options.
+
+The commands are read from the ```bash blocks (continuation lines joined, comments dropped);
+each is resolved in the command tree of ``softbend`` and each ``--option`` must be one of that
+command's. A renamed command or option breaks this test, not a reader's first try.
+"""
+
+from __future__ import annotations
+
+import re
+import shlex
+from pathlib import Path
+
+import pytest
+import typer
+
+from softbend.cli import app
+
+ROOT = Path(__file__).resolve().parents[1]
+PAGES = [ROOT / "README.md", *sorted((ROOT / "docs").glob("*.md"))]
+
+
+def _commands(page: Path) -> list[tuple[str, int, str]]:
+    """``(page name, line, command)`` of every ``softbend …`` line in its bash blocks."""
+    out = []
+    inside = False
+    pending = ""
+    start = 0
+    for number, line in enumerate(page.read_text(encoding="utf-8").splitlines(), start=1):
+        if line.startswith("```"):
+            inside = line.strip() == "```bash" if not inside else False
+            continue
+        if not inside:
+            continue
+        text = line.split(" #", 1)[0].rstrip() if not line.lstrip().startswith("#") else ""
+        if pending:
+            pending += " " + text.strip().rstrip("\\").strip()
+        elif text.strip().startswith("softbend "):
+            pending, start = text.strip().rstrip("\\").strip(), number
+        if pending and not text.rstrip().endswith("\\"):
+            out.append((page.name, start, pending))
+            pending = ""
+    return out
+
+
+COMMANDS = [c for page in PAGES for c in _commands(page)]
+
+
+def test_the_pages_show_commands():
+    assert len([c for c in COMMANDS if c[0] == "README.md"]) >= 10
+    assert len(COMMANDS) >= 40
+
+
+def _problem(command: str) -> str | None:
+    """Why ``command`` is not a real softbend command with real options, or None."""
+    words = shlex.split(command.replace("…", "x"))
+    if words[0] != "softbend":
+        return f"not a softbend command: {command}"
+    group = typer.main.get_command(app)
+    path = ["softbend"]
+    rest = words[1:]
+    while hasattr(group, "commands") and rest and not rest[0].startswith("-"):
+        sub = group.commands.get(rest[0])
+        if sub is None:
+            return f"no command '{' '.join([*path, rest[0]])}'"
+        group, path, rest = sub, [*path, rest[0]], rest[1:]
+    known = {name for p in group.params for name in (*p.opts, *p.secondary_opts)}
+    for word in rest:
+        if word.startswith("--") or re.fullmatch(r"-[a-zA-Z]", word):
+            option = word.split("=", 1)[0]
+            if option not in known:
+                return f"'{' '.join(path)}' has no option {option}"
+    return None
+
+
+def test_a_renamed_command_or_option_is_caught():
+    assert _problem("softbend fem run --design 100,6,2,2,5,8 -o x") is None
+    assert "no option --no-such" in _problem("softbend fem run --no-such 1")
+    assert "no command 'softbend fem walk'" in _problem("softbend fem walk")
+
+
+@pytest.mark.parametrize(("page", "line", "command"), COMMANDS, ids=lambda v: str(v)[:40])
+def test_a_documented_command_exists_with_its_options(page, line, command):
+    problem = _problem(command)
+    assert problem is None, f"{page}:{line}: {problem}"
