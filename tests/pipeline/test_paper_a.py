@@ -62,7 +62,12 @@ def test_held_out_free_run_error_is_small_and_the_worst_bounds_the_mean(paper_a)
 
 def test_progress_counts_every_fit_and_the_result_is_frozen(paper_a):
     _, result, phases = paper_a
-    assert phases.all_finished() and list(phases.last) == ["paper A: identification"]
+    assert phases.all_finished()
+    assert list(phases.last) == [
+        "paper A: identification",
+        "paper A: model selection (positive)",
+        "paper A: model selection (negative)",
+    ]
     assert isinstance(result, PaperA)
     with pytest.raises(dataclasses.FrozenInstanceError):
         result.summary = {}  # type: ignore[misc]
