@@ -234,3 +234,21 @@ def test_labels_are_recorded_but_not_compared():
         ("pressures_mpa.count", 3, 41),
         ("pressures_mpa.last", 0.1, 0.2),
     ]
+
+
+def test_the_cli_mesh_size_reaches_the_fem_and_a_resume_with_another_is_refused(
+    tmp_path, capsys, fast_fem
+):
+    db = tmp_path / "fem.duckdb"
+    fem = ["campaign", "run", str(db), *CLI_RUN, "--backend", "fem", "--no-compile"]
+    assert main([*fem, "--maxh", "4", "--json"]) == 0
+    capsys.readouterr()
+    with CampaignStore(db, read_only=True) as store:
+        assert store.settings["options"]["maxh_mm"] == 4.0
+    assert main([*fem, "--maxh", "3"]) == 2
+    err = capsys.readouterr().err.strip().splitlines()
+    assert len(err) == 1 and "options.maxh_mm is 4 there, 3 here" in err[0]
+    analytical = ["campaign", "run", str(tmp_path / "a.duckdb"), *CLI_RUN, "--maxh", "4"]
+    assert main(analytical) == 2
+    err = capsys.readouterr().err.strip().splitlines()
+    assert len(err) == 1 and "--maxh" in err[0] and "no mesh" in err[0]

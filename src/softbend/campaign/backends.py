@@ -300,9 +300,11 @@ def backend_for_run(
     model: str | os.PathLike[str] | None = None,
     compiled: bool = False,
     material: str | os.PathLike[str] | Material | None = None,
+    maxh_mm: float | None = None,
     field: str = "backend",
     model_field: str = "model",
     material_field: str = "material",
+    maxh_field: str = "maxh_mm",
     owner: str = "backend_for_run",
 ) -> Backend:
     """The backend a command line names, built with what the command line gives it.
@@ -321,7 +323,10 @@ def backend_for_run(
         preset name or ``fit.json[#model]``, as
         :func:`~softbend.materials.choice.material_from_spec`; refused for others.
         Default: the backend's own (Dragon Skin 30).
-    field, model_field, material_field, owner : str
+    maxh_mm : float, optional
+        Largest element size of the ``"fem"`` backend, mm (> 0); refused for others.
+        Default: the FEM's own (:class:`~softbend.fem.FEMOptions`).
+    field, model_field, material_field, maxh_field, owner : str
         The options and the command named in messages (``"--backend"``,
         ``"--model"``, ``"--material"``, ``"softbend campaign run"``).
 
@@ -353,6 +358,17 @@ def backend_for_run(
         options["material"] = resolve_material(material, field=material_field)[0]
     if "compiled" in takes:
         options["compiled"] = compiled
+    if maxh_mm is not None:
+        if name != "fem":
+            raise ValueError(
+                f"The '{maxh_field}' of {owner} is the mesh size of the 'fem' backend. Got "
+                f"{field} {name}, which has no mesh."
+            )
+        if isinstance(maxh_mm, bool) or not (isinstance(maxh_mm, int | float) and maxh_mm > 0):
+            raise ValueError(
+                f"The '{maxh_field}' of {owner} must be a size > 0 mm. Got {maxh_mm!r} instead."
+            )
+        options["maxh_mm"] = float(maxh_mm)
     return get_backend(name, **options)
 
 

@@ -68,6 +68,9 @@ def run(
         "(about 30 CPU s in the background; then faster assembly, the same results; "
         "see benchmarks/bench_fem.py).",
     ),
+    maxh: float | None = typer.Option(
+        None, help="Largest element size of --backend fem, mm (default: the FEM's, 5)."
+    ),
     material: str | None = typer.Option(
         None,
         help="Elastomer of --backend fem or analytical: a preset (dragon-skin-30, the default) "
@@ -121,9 +124,11 @@ def run(
         model=model,
         compiled=compile_energy,
         material=material,
+        maxh_mm=maxh,
         field="--backend",
         model_field="--model",
         material_field="--material",
+        maxh_field="--maxh",
         owner=_OWNER,
     )
     if scheduler is not None:
