@@ -59,9 +59,11 @@ def _number(value: Any, fmt: Callable[[float], str]) -> str:
 
 
 def _paper(ref: Reference | None, fmt: Callable[[float], str]) -> str:
+    """The paper's value as the paper gives it (every digit), its unit and its source."""
     if ref is None:
         return "—"
-    return f"{fmt(float(ref.value))} ({ref.source})"
+    unit = {"deg": "°", "%": " %"}.get(ref.unit, f" {ref.unit}" if ref.unit else "")
+    return f"{float(ref.value):g}{unit} ({ref.source})"
 
 
 def _pct(v: float) -> str:
@@ -72,8 +74,8 @@ def _deg(v: float) -> str:
     return f"{v:.2f}°"
 
 
-def _plain(v: float) -> str:
-    return f"{v:.4g}"
+def _f_value(v: float) -> str:
+    return f"{v:.1f}"
 
 
 def _r2(v: float) -> str:
@@ -116,7 +118,7 @@ def headline_rows(summary: Mapping[str, Any]) -> list[tuple[str, str, str, str]]
     ):
         for name, fmt, shown in (
             ("r2", _r2, "R²"),
-            ("f_value", _plain, "F"),
+            ("f_value", _f_value, "F"),
             ("mape_pct", _pct, "MAPE"),
         ):
             rows.append(

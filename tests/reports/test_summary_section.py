@@ -1,0 +1,53 @@
+"""The report's summary table: softbend's figures beside the papers', never a bare nan."""
+
+from __future__ import annotations
+
+import math
+
+from softbend.reports.html import Report
+from softbend.reports.summary_section import add_summary, headline_rows
+
+SUMMARY = {
+    "paper_b": {"r2": 0.84181, "f_value": 68146.33, "mape_pct": 133.5},
+    "paper_b_fem_data": {
+        "r2": math.nan,
+        "surrogates_random": {"mlp": {"r2": 0.99994, "mape_pct": 1.31}},
+    },
+    "transfer": {"best": "refined", "summary": {"refined": {"rmse_deg": 7.6, "mape_pct": 7.05}}},
+    "control": {"rig": [{"controller": "bang-bang", "reference": "square:90:4", "mape_pct": 7.2}]},
+}
+
+
+def test_each_figure_sits_beside_the_paper_s_with_its_source():
+    rows = {figure: (ours, paper) for figure, ours, paper, _ in headline_rows(SUMMARY)}
+    ours, paper = rows["Paper B Fig. 7, refined MLP, leave one actuator out: mean RMSE "
+                       "(synthetic virtual lab)"]  # fmt: skip
+    assert ours == "7.60°" and paper == "7.935° (Sec. 4.3, Fig. 7)"
+    ours, paper = rows["Paper B Fig. 4c, linear model on the analytical model, Table 1: F"]
+    assert ours == "68146.3" and paper == "33935.8 (Sec. 3.3, Fig. 4c)"
+    ours, _ = rows["Paper B Fig. 9, bang-bang on the simulated rig, square:90:4: MAPE"]
+    assert ours == "7.20 %"
+
+
+def test_a_figure_the_run_lacks_says_why_and_never_nan():
+    rows = {figure: ours for figure, ours, _, _ in headline_rows(SUMMARY)}
+    assert rows["Paper B Fig. 4c, linear model on the FEM dataset, Table 1: R²"].startswith(
+        "undefined"
+    )
+    assert rows["Paper B Fig. 4c, linear model on the FEM dataset, Table 1: MAPE"] == (
+        "not computed in this run"
+    )
+    assert not any("nan" in ours.lower() for ours in rows.values())
+
+
+def test_the_summary_goes_first_and_links_to_the_sections():
+    report = Report("r")
+    report.section("Paper B — closed-loop control (Figs. 8 and 9)").text("...")
+    add_summary(report, SUMMARY, reduced="fewer designs")
+    html = report.render()
+    assert report.sections[0].title.startswith("Summary")
+    assert "REDUCED SETTINGS: this report was made with fewer designs" in html
+    assert 'href="#paper-b-closed-loop-control-figs-8-and-9"' in html
+    plain = Report("r")
+    add_summary(plain, SUMMARY, reduced=None)
+    assert "REDUCED" not in plain.render()
