@@ -6,7 +6,7 @@ VENV ?= .venv
 BIN := $(VENV)/bin
 OUT ?= results/reproduce
 
-.PHONY: setup run test test-all lint typecheck bench clean
+.PHONY: setup run test test-all lint typecheck docs bench clean
 
 $(BIN)/.softbend-installed: pyproject.toml
 	$(PYTHON) -m venv $(VENV)
@@ -32,6 +32,10 @@ lint: setup
 # mypy on the whole package with [tool.mypy] of pyproject.toml (about 20 s cold, 1 s cached).
 typecheck: setup
 	$(BIN)/mypy
+
+# The generated pages of docs/ (the command-line reference); a test checks they are current.
+docs: setup
+	$(BIN)/python docs/gen_cli_reference.py
 
 bench: setup
 	$(BIN)/python benchmarks/bench_identification.py
