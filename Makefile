@@ -36,6 +36,8 @@ typecheck: setup
 # The generated pages of docs/ (the command-line reference); a test checks they are current.
 docs: setup
 	$(BIN)/python docs/gen_cli_reference.py
+	@if [ -f $(OUT)/summary.json ]; then $(BIN)/python docs/gen_validation.py $(OUT)/summary.json; \
+	else echo "docs/validation.md kept: make run writes $(OUT)/summary.json"; fi
 
 bench: setup
 	$(BIN)/python benchmarks/bench_identification.py

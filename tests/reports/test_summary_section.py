@@ -51,3 +51,17 @@ def test_the_summary_goes_first_and_links_to_the_sections():
     plain = Report("r")
     add_summary(plain, SUMMARY, reduced=None)
     assert "REDUCED" not in plain.render()
+
+
+def test_the_validation_page_carries_the_run_s_provenance_and_every_row():
+    from softbend.reports.summary_section import validation_markdown
+
+    page = validation_markdown(
+        {**SUMMARY, "provenance": {"machine": "Linux x86_64, 2 logical CPUs", "seed": 0}}
+    )
+    assert page.startswith("# Validation: softbend beside the papers")
+    assert "| machine | Linux x86_64, 2 logical CPUs |" in page
+    assert "| 7.60° | 7.935° (Sec. 4.3, Fig. 7) |" in page
+    assert len([line for line in page.splitlines() if line.startswith("| Paper")]) == len(
+        headline_rows(SUMMARY)
+    ) - sum(figure.startswith("  ") for figure, *_ in headline_rows(SUMMARY))

@@ -268,6 +268,7 @@ def run_reproduce(
         "finished (UTC)": f"{finished:%Y-%m-%d %H:%M:%S}",
         "wall time": f"{summary['seconds']:.0f} s",
     }
+    summary["provenance"] = dict(report.provenance)
     path = report.write(out_dir / "index.html")
     summary["report"] = str(path)
     write_text_atomic(out_dir / "summary.json", json_text(summary) + "\n")
