@@ -26,8 +26,9 @@ OUT=${1:-results/lab_own_actuator}
 QUICK=${2:-}
 DESIGN=130,7,2.5,3,10,9
 SOFTBEND=${SOFTBEND:-softbend}
-LAB=$(python -c "from softbend.transfer.lab import shipped_measurements_path as p; print(p())")
-BASE=$(python -c "from softbend.transfer.base import shipped_base_path as p; print(p())")
+PYTHON=${PYTHON:-python3}
+LAB=$("$PYTHON" -c "from softbend.transfer.lab import shipped_measurements_path as p; print(p())")
+BASE=$("$PYTHON" -c "from softbend.transfer.base import shipped_base_path as p; print(p())")
 mkdir -p "$OUT"
 
 if [[ "$QUICK" == "--quick" ]]; then
@@ -48,7 +49,7 @@ fi
 # 3. Two days of readings of the built actuator (two inflation cycles, one per file).
 "$SOFTBEND" lab measure --design "$DESIGN" --material "$MATERIAL" --plant "$PLANT" \
     --cycles 2 --seed 8 -o "$OUT/own_both.csv"
-python - "$OUT" <<'PY'
+"$PYTHON" - "$OUT" <<'PY'
 import csv
 import sys
 from pathlib import Path

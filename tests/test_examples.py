@@ -70,6 +70,7 @@ def test_the_lab_s_own_actuator_end_to_end(tmp_path):
         **os.environ,
         "PATH": f"{bin_dir}{os.pathsep}{os.environ.get('PATH', '')}",
         "SOFTBEND": str(bin_dir / "softbend"),
+        "PYTHON": sys.executable,
     }
     out = tmp_path / "lab"
     done = subprocess.run(
