@@ -64,7 +64,7 @@ def _problem(command: str) -> str | None:
         if sub is None:
             return f"no command '{' '.join([*path, rest[0]])}'"
         group, path, rest = sub, [*path, rest[0]], rest[1:]
-    known = {name for p in group.params for name in (*p.opts, *p.secondary_opts)}
+    known = {"--help"} | {name for p in group.params for name in (*p.opts, *p.secondary_opts)}
     for word in rest:
         if word.startswith("--") or re.fullmatch(r"-[a-zA-Z]", word):
             option = word.split("=", 1)[0]

@@ -1,0 +1,50 @@
+"""The tutorials in docs/ run as written: every bash block, in order, in a fresh folder.
+
+Set-up lines (``make …``, ``export PATH=…``) are left out: the test runs with this
+environment's softbend first on PATH. The folder holds a link to the repository's ``src`` so
+that the tutorials' paths to the shipped data work as they do from the repository's folder.
+"""
+
+from __future__ import annotations
+
+import os
+import re
+import shutil
+import subprocess
+import sys
+from pathlib import Path
+
+import pytest
+
+ROOT = Path(__file__).resolve().parents[1]
+TUTORIALS = sorted((ROOT / "docs").glob("tutorial-*.md"))
+_SETUP = re.compile(r"^\s*(make |export PATH=)")
+
+
+def _script(page: Path) -> str:
+    blocks = re.findall(r"```bash\n(.*?)```", page.read_text(encoding="utf-8"), flags=re.S)
+    lines = [line for block in blocks for line in block.splitlines() if not _SETUP.match(line)]
+    return "set -euo pipefail\n" + "\n".join(lines) + "\n"
+
+
+def test_there_is_a_tutorial_for_one_s_own_measurements():
+    assert ROOT / "docs" / "tutorial-own-measurements.md" in TUTORIALS
+
+
+@pytest.mark.parametrize("page", TUTORIALS, ids=lambda p: p.stem)
+def test_a_tutorial_runs_as_written(page, tmp_path):
+    bash = shutil.which("bash")
+    if bash is None:
+        pytest.skip("bash is needed to run the tutorials")
+    (tmp_path / "src").symlink_to(ROOT / "src", target_is_directory=True)
+    env = {**os.environ, "PATH": f"{Path(sys.executable).parent}{os.pathsep}{os.environ['PATH']}"}
+    done = subprocess.run(
+        [bash, "-c", _script(page)],
+        cwd=tmp_path,
+        env=env,
+        capture_output=True,
+        text=True,
+        timeout=900,
+        check=False,
+    )
+    assert done.returncode == 0, f"{page.name}:\n{done.stderr[-3000:]}"
