@@ -69,6 +69,7 @@ def test_no_design_meets_it_is_a_warning_with_the_closest(model, tmp_path, capsy
         (["--angle", "90", "--at", "0.08", "--fix", "wall=3"], "--fix"),
         (["--angle", "90", "--at", "0.08", "--resolution", "fine"], "--resolution"),
         (["--angle", "90", "--at", "0.08", "--top", "0"], "--top"),
+        (["--angle", "90", "--at", "0.08", "--verify", "1", "--backend", "nope"], "--backend"),
     ],
 )
 def test_bad_input_is_one_line_exit_2(model, tmp_path, capsys, extra, needle):

@@ -51,6 +51,7 @@ def test_identify_writes_the_selection_the_model_and_the_held_out_runs(recording
         (["--outputs", "x_mm,z_mm"], None, "z_mm"),
         ([], lambda text: text.replace("val02-ramps", "train01-steps"), "contiguous"),
         (["--validate-on", "val09"], None, "val09"),
+        (["--folds", "1"], None, "--folds"),
         ([], lambda text: text.replace(",0.25,", ",nan,", 1), "line"),
     ],
 )

@@ -101,6 +101,14 @@ def find(
         raise ValueError(f"The '--top' must be an integer >= 1. Got {top} instead.")
     if verify < 0:
         raise ValueError(f"The '--verify' must be an integer >= 0. Got {verify} instead.")
+    if verify:
+        from softbend.campaign.backends import public_backends
+
+        if backend not in public_backends():
+            raise ValueError(
+                f"The '--backend' must be one of {', '.join(public_backends())}. "
+                f"Got {backend!r} instead."
+            )
     if spec is not None:
         chosen = specs.load_specifications(spec)
     else:

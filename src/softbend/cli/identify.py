@@ -65,6 +65,8 @@ def identify(
     from softbend.reports.identify_outputs import FILES, write_identification
 
     out = Path(out)
+    if folds < 2:
+        raise ValueError(f"The '--folds' must be an integer >= 2. Got {folds} instead.")
     _common.check_output_dir(out, "--out", inputs=(data,))
     _common.check_replaceable_dir(
         out, "--out", "identify", inputs=(data,), files=FILES, marker="selection.json"

@@ -568,14 +568,14 @@ def _interval_of(
 ) -> Callable[[np.ndarray, Mapping[str, float]], tuple[float, float] | None]:
     """The 90 % interval of a candidate's angle: the calibrated one a refined model
     records, else the model's own, else None."""
-    from softbend.surrogates.predict import INTERVAL_LEVEL, _calibrated_interval
+    from softbend.surrogates.predict import INTERVAL_LEVEL, calibrated_interval
 
     record = metadata.get("interval")
     own = getattr(predictor, "predict_interval", None)
 
     def interval(design: np.ndarray, scores: Mapping[str, float]) -> tuple[float, float] | None:
         angle = np.array([scores["angle"]])
-        calibrated = _calibrated_interval(record, angle)
+        calibrated = calibrated_interval(record, angle)
         if calibrated is not None:
             return float(calibrated[0][0]), float(calibrated[1][0])
         if callable(own) and math.isfinite(scores["pressure"]):

@@ -38,6 +38,7 @@ from typing import Any
 import numpy as np
 
 from softbend.errors import SchemaError
+from softbend.identification.narx import _row_index, _segments
 from softbend.identification.persistence import svr_from_state, svr_state
 
 __all__ = [
@@ -57,19 +58,7 @@ FREE_RUN_MARGIN = 1.0
 _FORMAT = "softbend-multi-narx"
 _SCHEMA = 1
 _RIDGE = 1e-8
-
-
-def _segments(groups: Any, n: int) -> list[tuple[int, int]]:
-    """``[(start, stop), ...]`` of contiguous runs of equal labels (one run without groups)."""
-    if groups is None:
-        return [(0, n)]
-    labels = np.asarray(groups)
-    if labels.shape != (n,):
-        raise ValueError(f"The 'groups' must hold one label per sample ({n}).")
-    change = np.flatnonzero(labels[1:] != labels[:-1]) + 1
-    starts = np.concatenate([[0], change])
-    stops = np.concatenate([change, [n]])
-    return list(zip(starts.tolist(), stops.tolist(), strict=True))
+_OWNER = "MultiNARX"
 
 
 class _Ridge:
@@ -205,14 +194,8 @@ class MultiNARX:
             Experiment label per sample (contiguous runs); default one experiment.
         """
         U, Y = self._arrays(U, Y)
-        segments = _segments(groups, U.shape[0])
         lag = self.max_lag
-        short = [stop - start for start, stop in segments if stop - start <= lag]
-        if short:
-            raise ValueError(
-                f"Every experiment needs more than {lag} samples (the lags); "
-                f"{len(short)} have {min(short)} or fewer."
-            )
+        segments = _segments(groups, U.shape[0], lag, _OWNER)
         self.u_mean_, self.u_std_ = U.mean(axis=0), U.std(axis=0)
         self.y_mean_, self.y_std_ = Y.mean(axis=0), Y.std(axis=0)
         self.u_std_[self.u_std_ == 0] = 1.0
@@ -222,7 +205,7 @@ class MultiNARX:
         self.y_low_ = low - FREE_RUN_MARGIN * span
         self.y_high_ = high + FREE_RUN_MARGIN * span
         Us, Ys = (U - self.u_mean_) / self.u_std_, (Y - self.y_mean_) / self.y_std_
-        index = np.concatenate([np.arange(start + lag, stop) for start, stop in segments])
+        index = _row_index(segments, lag)
         Phi = self._regressors(Us, Ys, index)
         target = Ys[index]
         if self.family == "gg-svr" and index.size > self.max_rows:
@@ -259,12 +242,9 @@ class MultiNARX:
         self._check_fitted(U)
         Us, Ys = (U - self.u_mean_) / self.u_std_, (Y - self.y_mean_) / self.y_std_
         out = np.full(Y.shape, np.nan)
-        lag = self.max_lag
-        for start, stop in _segments(groups, U.shape[0]):
-            index = np.arange(start + lag, stop)
-            if index.size:
-                Phi = self._regressors(Us, Ys, index)
-                out[index] = np.column_stack([e.predict(Phi) for e in self.estimators_])
+        index = _row_index(_segments(groups, U.shape[0], self.max_lag, _OWNER), self.max_lag)
+        Phi = self._regressors(Us, Ys, index)
+        out[index] = np.column_stack([e.predict(Phi) for e in self.estimators_])
         return out * self.y_std_ + self.y_mean_
 
     def simulate(self, U: Any, Y_init: Any, groups: Any = None) -> np.ndarray:
@@ -287,16 +267,15 @@ class MultiNARX:
         """
         U, Y0 = self._arrays(U, Y_init)
         self._check_fitted(U)
-        segments = _segments(groups, U.shape[0])
         lag = self.max_lag
+        segments = _segments(groups, U.shape[0], lag, _OWNER)
         Us = (U - self.u_mean_) / self.u_std_
         Ys = (Y0 - self.y_mean_) / self.y_std_
         low = (self.y_low_ - self.y_mean_) / self.y_std_
         high = (self.y_high_ - self.y_mean_) / self.y_std_
         # the maps' own evaluation, without scikit-learn's per-call validation
         maps = [getattr(e, "_expansion", e.predict) for e in self.estimators_]
-        lengths = np.array([stop - start for start, stop in segments])
-        starts = np.array([start for start, _ in segments])
+        lengths, starts = segments.lengths, segments.starts
         for step in range(lag, int(lengths.max(initial=0))):
             running = lengths > step
             t = starts[running] + step

@@ -16,6 +16,7 @@ from softbend.models import check_pressures_mpa
 __all__ = [
     "INTERVAL_LEVEL",
     "Prediction",
+    "calibrated_interval",
     "load_predictor",
     "parse_pressures",
     "predict_angles",
@@ -98,7 +99,7 @@ class Prediction:
         return payload
 
 
-def _calibrated_interval(record: Any, angles: np.ndarray) -> tuple[np.ndarray, np.ndarray] | None:
+def calibrated_interval(record: Any, angles: np.ndarray) -> tuple[np.ndarray, np.ndarray] | None:
     """The calibrated 90 % interval a refined model records (``transfer refine``), if any.
 
     The record is the ``interval`` metadata of :mod:`softbend.transfer.conformal`:
@@ -251,7 +252,7 @@ def predict_angles(
             f"The model {path} records no training support (each training design's largest "
             "pressure; saved by an older softbend); --strict cannot check it."
         )
-    calibrated = _calibrated_interval(saved.metadata.get("interval"), angles)
+    calibrated = calibrated_interval(saved.metadata.get("interval"), angles)
     interval = calibrated if calibrated is not None else interval
     if interval is not None:
         _check_finite(path, saved.kind, pressures, interval[0], "interval's low end", outside)
