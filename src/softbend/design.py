@@ -52,6 +52,10 @@ _BOUNDS: dict[str, tuple[float, float, bool]] = {
     "phi_deg": (0.0, 60.0, True),
     "lc_mm": (0.0, 200.0, False),
 }
+#: ``{parameter: (low, high, low_inclusive)}`` a design accepts, by short name (``l``, ``phi``).
+DESIGN_LIMITS: dict[str, tuple[float, float, bool]] = {
+    name.rsplit("_", 1)[0]: limits for name, limits in _BOUNDS.items()
+}
 
 
 @dataclass(frozen=True)

@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import numpy as np
 import pytest
 
 from softbend.campaign import spaces
@@ -115,3 +116,46 @@ def test_a_shard_is_k_of_n():
     for text in ("3/3", "1of2", "0/0", "-1/2"):
         with pytest.raises(ValueError, match=r"'--shard' of c must be K/N"):
             parse_shard(text, option="--shard", owner="c")
+
+
+def test_ranges_of_one_s_own_are_read_by_short_name():
+    assert spaces.parse_ranges(["l=60:90", " phi = 0:20"]) == {
+        "l": (60.0, 90.0),
+        "phi": (0.0, 20.0),
+    }
+
+
+@pytest.mark.parametrize(
+    ("texts", "needle"),
+    [
+        (["l60:90"], "must be NAME=LOW:HIGH"),
+        (["l=a:b"], "must be NAME=LOW:HIGH"),
+        (["l=nan:9"], "must be NAME=LOW:HIGH"),
+        (["l=90:60"], "a range LOW < HIGH within (0, 1000] mm"),
+        (["l=0:60"], "(0, 1000] mm"),
+        (["phi=-1:20"], "[0, 60] deg"),
+        (["l=60:90", "l=70:80"], "gives l twice"),
+        (["r=2:4"], "t's high must be below r's low. Got t up to 4 mm and r from 2 mm"),
+    ],
+)
+def test_a_bad_range_is_one_error_naming_the_option(texts, needle):
+    with pytest.raises(ValueError, match="'--range' of me") as caught:
+        spaces.parse_ranges(texts, option="--range", owner="me")
+    assert needle in str(caught.value)
+
+
+def test_a_sampled_space_over_own_ranges_stays_inside_them_and_is_seeded():
+    spec = parse_space("lhs:50").with_ranges({"l": (60.0, 90.0), "t": (1.0, 1.5)})
+    space = spec.build(seed=3)
+    frame = space.to_frame()
+    assert frame["l_mm"].between(60, 90).all() and frame["t_mm"].between(1, 1.5).all()
+    assert frame["r_mm"].between(6, 10).all() and frame["phi_deg"].between(5, 15).all()
+    # Latin hypercube: every tenth of the own range of l holds five designs.
+    assert (np.histogram(frame["l_mm"], bins=10, range=(60, 90))[0] == 5).all()
+    assert space.name == "lhs-50-seed3 l=60:90 t=1:1.5"
+    assert spec.build(seed=3).to_frame().equals(frame)
+
+
+def test_the_levels_of_table_1_take_no_range():
+    with pytest.raises(ValueError, match="applies to the sampled spaces lhs:N and sobol:N"):
+        parse_space("corners").with_ranges({"l": (60.0, 90.0)})

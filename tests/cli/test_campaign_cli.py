@@ -71,6 +71,21 @@ def test_run_status_export_and_resume(tmp_path, capsys):
     assert len(pd.read_csv(forced)) == 6
 
 
+def test_a_sampled_space_over_ranges_of_one_s_own(tmp_path, capsys):
+    db = tmp_path / "own.duckdb"
+    args = ["campaign", "run", str(db), "--space", "sobol:8", "--range", "l=60:90"]
+    args += ["--range", "t=1:1.5", "--pmax", "0.02", "--pstep", "0.01", "--workers", "1"]
+    assert main(args) == 0
+    assert "sobol-8-seed0 l=60:90 t=1:1.5 (8 designs)" in capsys.readouterr().out
+    designs = load_samples(db).drop_duplicates("design_id")
+    assert len(designs) == 8
+    assert designs["l_mm"].between(60, 90).all() and designs["t_mm"].between(1, 1.5).all()
+    assert designs["r_mm"].between(6, 10).all()  # the others keep Table 1's ranges
+    assert main(args) == 0  # nothing left: no rate is made up
+    out = capsys.readouterr().out
+    assert "- (none run)" in out and "nan" not in out
+
+
 def test_a_space_of_the_table_and_the_summary_table(tmp_path, capsys):
     db = tmp_path / "c.duckdb"
     assert (
@@ -189,6 +204,10 @@ def _closed_port() -> int:
         (["--workers", "-2"], "'workers' of run_campaign"),
         (["--shard", "3/3"], "'--shard' of softbend campaign run must be K/N"),
         (["--shard", "1of2"], "'--shard'"),
+        (["--space", "table1", "--range", "l=60:90"], "applies to the sampled spaces"),
+        (["--space", "lhs:4", "--range", "x=1:2"], "NAME one of l, r, t, b, phi, lc"),
+        (["--space", "lhs:4", "--range", "phi=50:70"], "within [0, 60] deg"),
+        (["--space", "lhs:4", "--range", "t=3:7"], "t's high must be below r's low"),
         (
             ["--scheduler", "127.0.0.1:8786"],
             "(--scheduler) of run_campaign must be an address of the form tcp://HOST:PORT",

@@ -1,7 +1,8 @@
 """Design spaces named by a short text, and what a campaign over one will need.
 
 ``table1`` (paper B Table 1, 972 designs), ``corners`` (its 64 corners),
-``lhs:N`` and ``sobol:N`` (``N`` space-filling designs over the Table 1 ranges).
+``lhs:N`` and ``sobol:N`` (``N`` space-filling designs over the Table 1 ranges, or over
+ranges of one's own: :func:`parse_ranges` and :meth:`SpaceSpec.with_ranges`).
 Names are lower case, like every other choice of the command line.
 
 :func:`parse_space` reads the text and knows the number of designs before any
@@ -18,11 +19,12 @@ import math
 import os
 import re
 import shutil
-from dataclasses import dataclass
+from collections.abc import Sequence
+from dataclasses import dataclass, replace
 from pathlib import Path
 from typing import Literal, cast
 
-from softbend.design import TABLE1_LEVELS, DesignSpace
+from softbend.design import DESIGN_LIMITS, PARAMETERS, TABLE1_LEVELS, DesignSpace
 from softbend.limits import check_count_text, check_limit
 
 __all__ = [
@@ -33,9 +35,13 @@ __all__ = [
     "SpaceSpec",
     "campaign_footprint",
     "check_footprint",
+    "parse_ranges",
     "parse_shard",
     "parse_space",
 ]
+
+#: Short names of the parameters (``l``, ``phi``, ...), as the command line writes them.
+_SHORT = {name.rsplit("_", 1)[0]: name for name in PARAMETERS}
 
 #: The forms :func:`parse_space` accepts, for messages and help texts.
 SPACE_FORMS = "table1, corners, lhs:N or sobol:N"
@@ -64,11 +70,31 @@ class SpaceSpec:
     kind : {"table1", "corners", "lhs", "sobol"}
     n_designs : int
         Number of designs of the whole space.
+    ranges : tuple of (str, float, float)
+        ``(parameter, low, high)`` of the parameters sampled over a range of their own
+        (mm, or degrees for ``phi``); the others span paper B's Table 1 ranges.
     """
 
     text: str
     kind: str
     n_designs: int
+    ranges: tuple[tuple[str, float, float], ...] = ()
+
+    def with_ranges(self, ranges: dict[str, tuple[float, float]]) -> SpaceSpec:
+        """The same space sampled over ``ranges`` (from :func:`parse_ranges`).
+
+        Raises
+        ------
+        ValueError
+            Naming ``--range``: only the sampled spaces (``lhs:N``, ``sobol:N``) take ranges.
+        """
+        if self.kind not in ("lhs", "sobol"):
+            raise ValueError(
+                f"The '--range' of a campaign applies to the sampled spaces lhs:N and sobol:N, "
+                f"not to {self.text!r}, whose designs are paper B's Table 1 levels."
+            )
+        ordered = tuple((p, *ranges[p]) for p in _SHORT if p in ranges)
+        return replace(self, ranges=ordered)
 
     def build(self, seed: int = 0) -> DesignSpace:
         """The designs; ``seed`` seeds the ``lhs`` and ``sobol`` samplers."""
@@ -77,7 +103,64 @@ class SpaceSpec:
         if self.kind == "corners":
             return DesignSpace.corners()
         method = cast(Literal["lhs", "sobol"], self.kind)
-        return DesignSpace.sample(self.n_designs, method=method, seed=seed)
+        if not self.ranges:
+            return DesignSpace.sample(self.n_designs, method=method, seed=seed)
+        bounds = {p: (min(v), max(v)) for p, v in TABLE1_LEVELS.items()}
+        bounds.update({_SHORT[p]: (low, high) for p, low, high in self.ranges})
+        space = DesignSpace.sample(self.n_designs, method=method, seed=seed, bounds=bounds)
+        own = " ".join(f"{p}={low:g}:{high:g}" for p, low, high in self.ranges)
+        return DesignSpace(space.designs, name=f"{space.name} {own}")
+
+
+def parse_ranges(
+    texts: Sequence[str], *, option: str = "ranges", owner: str = "parse_ranges"
+) -> dict[str, tuple[float, float]]:
+    """``{parameter: (low, high)}`` from ``NAME=LOW:HIGH`` texts (``l=60:90``).
+
+    ``NAME`` is one of ``l, r, t, b, phi, lc``; ``LOW < HIGH`` in mm (degrees for
+    ``phi``), within what a design accepts: lengths above 0, ``phi`` in [0, 60],
+    and the wall thinner than the radius everywhere (``t``'s high below ``r``'s low).
+
+    Raises
+    ------
+    ValueError
+        Naming ``option`` of ``owner``, the allowed form and values, and the text received.
+    """
+    out: dict[str, tuple[float, float]] = {}
+    for text in texts:
+        match = re.fullmatch(r"\s*([a-z]+)\s*=\s*([^:]+):(.+)", str(text))
+        name = match[1] if match else None
+        try:
+            low, high = (float(match[2]), float(match[3])) if match else (math.nan, math.nan)
+        except ValueError:
+            low, high = math.nan, math.nan
+        if name not in DESIGN_LIMITS or not (math.isfinite(low) and math.isfinite(high)):
+            raise ValueError(
+                f"The '{option}' of {owner} must be NAME=LOW:HIGH with NAME one of "
+                f"{', '.join(_SHORT)} and LOW, HIGH numbers (mm; degrees for phi). "
+                f"Got {text!r} instead."
+            )
+        least, most, closed = DESIGN_LIMITS[name]
+        if not (least <= low if closed else least < low) or not low < high <= most:
+            opening = "[" if closed else "("
+            unit = "deg" if name == "phi" else "mm"
+            bound = f"{opening}{least:g}, {most:g}] {unit}"
+            raise ValueError(
+                f"The '{option}' of {owner} must give {name} a range LOW < HIGH within {bound}. "
+                f"Got {text!r} instead."
+            )
+        if name in out:
+            raise ValueError(f"The '{option}' of {owner} gives {name} twice. Got {text!r} again.")
+        out[name] = (low, high)
+    t_high = out.get("t", (0.0, max(TABLE1_LEVELS["t_mm"])))[1]
+    r_low = out.get("r", (min(TABLE1_LEVELS["r_mm"]), 0.0))[0]
+    if t_high >= r_low:
+        raise ValueError(
+            f"The '{option}' of {owner} must keep the wall thinner than the radius in every "
+            f"design: t's high must be below r's low. Got t up to {t_high:g} mm and r from "
+            f"{r_low:g} mm instead."
+        )
+    return out
 
 
 def parse_space(text: str, *, option: str = "space", owner: str = "parse_space") -> SpaceSpec:

@@ -34,6 +34,12 @@ def run(
         None, help="A surrogate saved by 'softbend train' (models/*.json), for --backend surrogate."
     ),
     space: str = typer.Option("table1", help=f"Designs: {SPACE_FORMS}."),
+    ranges: list[str] = typer.Option(
+        None,
+        "--range",
+        help="Range of one parameter of an lhs/sobol space, NAME=LOW:HIGH in mm or deg "
+        "(repeatable; the others keep paper B's Table 1 ranges).",
+    ),
     seed: int = typer.Option(0, help="Seed of the lhs/sobol sampler."),
     shard: str | None = typer.Option(
         None,
@@ -97,6 +103,7 @@ def run(
 
     \b
         softbend campaign run table1.duckdb --backend analytical --space table1
+        softbend campaign run own.duckdb --space sobol:256 --range l=60:90 --range t=1:2
     """
     from softbend.campaign.backends import backend_for_run, default_pressures_mpa
     from softbend.campaign.runner import (
@@ -108,12 +115,15 @@ def run(
     from softbend.campaign.spaces import (
         campaign_footprint,
         check_footprint,
+        parse_ranges,
         parse_shard,
         parse_space,
     )
 
     _common.check_output_file(db, "DB", inputs=(model,) if model is not None else ())
     spec = parse_space(space, option="--space", owner=_OWNER)
+    if ranges:
+        spec = spec.with_ranges(parse_ranges(ranges, option="--range", owner=_OWNER))
     if seed < 0:
         raise ValueError(f"The '--seed' of {_OWNER} must be an integer >= 0. Got {seed} instead.")
     shard_of = parse_shard(shard, option="--shard", owner=_OWNER) if shard is not None else None
@@ -210,7 +220,7 @@ def run(
             ["done in this run", summary.n_done],
             ["failed in this run", summary.n_failed],
             ["wall time (s)", summary.wall_time_s],
-            ["designs per second", summary.designs_per_s],
+            ["designs per second", summary.designs_per_s if summary.n_run else "- (none run)"],
             ["sweep time, sum (s)", summary.sweep_time_s],
         ],
     )
