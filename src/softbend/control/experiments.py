@@ -329,7 +329,7 @@ def run_metrics(
 ) -> dict[str, float]:
     """Scores of a run on its camera angle (what paper B measured).
 
-    - ``mape_pct``: mean |θe − θr|/θr·100 over the samples with θr >= ``mape_min_deg``;
+    - ``mape_pct``: mean ``|θe − θr|/θr``·100 over the samples with θr >= ``mape_min_deg``;
     - ``predicted_mape_pct``: the same for the virtual angle θp;
     - for steps and squares, over the rising edges (reference jumping up) and
       the segment until the next edge: ``rise_s`` (10–90 % of the jump, from the

@@ -100,7 +100,7 @@ def bang_bang(
     ----------
     model : ControllerModel
     deadzone : float, default 0.05
-        Half-width of the deadzone as a fraction of |θr| (paper B: 5 %).
+        Half-width of the deadzone as a fraction of ``|θr|`` (paper B: 5 %).
     period : float, default 0.01
         Sample period of the controller, s (paper B: 100 Hz).
     """
@@ -119,7 +119,7 @@ def bang_bang_closed(
     ----------
     model : ControllerModel
     deadzone : float, default 0.05
-        Half-width of the deadzone as a fraction of |θr|.
+        Half-width of the deadzone as a fraction of ``|θr|``.
     period : float, default 0.01
         Sample period of the controller, s.
     """

@@ -73,6 +73,8 @@ class ModbusRig:
     client : object, optional
         A pymodbus client (default: built from ``config.connection``).
 
+    Notes
+    -----
     Use as a context manager, or call :meth:`connect` and :meth:`close`.
     ``requests`` counts the requests sent; ``round_trips_s`` keeps the
     duration of every reading request (for the loop's report).

@@ -527,7 +527,7 @@ class NARXRegressor(RegressorMixin, BaseEstimator):
         ----------
         X : array-like, shape (n_samples,) or (n_samples, n_inputs)
             Input(s) of all experiments, concatenated.
-        y_init : array-like, shape (n_samples,) or (n_experiments, max_lag_)
+        y_init : array-like, shape (n_samples,) or (n_experiments, ``max_lag_``)
             Initial outputs: either the measured output of full length, of which
             only the first ``max_lag_`` samples of each experiment are read
             (the rest may be anything, even NaN), or the initial conditions of

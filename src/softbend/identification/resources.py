@@ -19,7 +19,7 @@ The model of the peak (bytes), measured on softbend's synthetic CSV files
   merged copies, LIBSVM's per-row arrays and the held-out predictions, about
   :data:`FIT_BYTES_PER_ROW` = 600 bytes per sample, plus LIBSVM's kernel cache
   and, when the shape is not 2, the active-set solver's Gram block (two copies of
-  ``max_working_set``² doubles), its column cache and its kernel blocks;
+  ``max_working_set²`` doubles), its column cache and its kernel blocks;
 * :data:`BASE_BYTES` = 300 MiB for the interpreter, NumPy, scikit-learn,
   pandas and matplotlib.
 """

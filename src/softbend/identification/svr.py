@@ -19,7 +19,7 @@ and ``get_params`` see them. How the ε-SVR dual is solved depends on the shape:
   and cached (up to ``cache_size`` MB). The SVR dual is sparse (paper A's data:
   about 40 support vectors of 3 060 rows), so W stays small and the fit is
   exact to solver tolerance, as the dense formulation is; memory is at most
-  about 16·|W|² bytes (256 MiB at 4 096 rows) plus the two caches. When the
+  about 16·``|W|``² bytes (256 MiB at 4 096 rows) plus the two caches. When the
   support vectors and the violators do not fit in ``max_working_set`` rows, W
   is the set of most violating rows (Joachims' SVMlight selection), the other
   rows keep their coefficients, and the equality constraint of the dual is kept

@@ -17,7 +17,7 @@ from numpy.typing import ArrayLike
 
 from softbend.metrics import r2, rmse, thresholded_mape
 
-#: Default smallest |θ| (degrees) included in the MAPE.
+#: Default smallest ``|θ|`` (degrees) included in the MAPE.
 MAPE_THRESHOLD_DEG = 1.0
 
 

@@ -204,11 +204,14 @@ def _symmetrize_from_lower(G: np.ndarray) -> None:
 class PolynomialRegressor(RegressorMixin, BaseEstimator):
     """Full polynomial of total degree ≤ ``degree`` in the standardized inputs.
 
-    y = y_mean_ + y_scale_ · Σₖ coef_[k] · Πⱼ zⱼ^powers_[k, j],
-    z = (x − x_mean_)/x_scale_, fitted by ridge least squares on the
-    standardized target: (ΦᵀΦ + α·n·I′) c = Φᵀ y_std, where I′ is the
-    identity without the constant term (the intercept is not penalized) and n
-    the number of samples.
+    ::
+
+        y = y_mean_ + y_scale_ · Σₖ coef_[k] · Πⱼ zⱼ^powers_[k, j],
+        z = (x − x_mean_)/x_scale_,
+
+    fitted by ridge least squares on the standardized target:
+    (ΦᵀΦ + α·n·I′) c = Φᵀ y_std, where I′ is the identity without the constant
+    term (the intercept is not penalized) and n the number of samples.
 
     Parameters
     ----------

@@ -626,7 +626,7 @@ def search(
     epochs : int, optional
         MLP epochs (default :data:`MLP_EPOCHS` of the grid: 200 quick, 1000 paper).
     mape_threshold_deg : float
-        Smallest |θ| in the MAPE, degrees.
+        Smallest ``|θ|`` in the MAPE, degrees.
     param_grid : dict, optional
         Own configurations for some families, replacing the named grid for
         them, e.g. ``{"plr": [{"degree": 3}, {"degree": 5}]}``.

@@ -51,7 +51,7 @@ and the column. A ``pressure_mpa`` column written in kPa has a value above
 This one is not overridable: no strategy or surrogate accepts a pressure above
 2 MPa. An ``angle_deg`` column written in radians: when the file's pressures
 reach above :data:`RADIAN_PRESSURE_MPA` (0.05 MPa, where the actuators of
-paper B already bend tens of degrees, paper B Fig. 7) and yet no |angle|
+paper B already bend tens of degrees, paper B Fig. 7) and yet no ``|angle|``
 exceeds :data:`RADIAN_ANGLE_MAX` (2π·1.05 ≈ 6.6, a full turn in radians with
 5 % margin), the angles are taken for radians. A very stiff actuator may truly
 bend so little: ``force=True`` (``--force`` on the command line) then reads
@@ -124,7 +124,7 @@ PROVENANCE_COLUMNS: tuple[str, ...] = ("source", "synthetic", "date")
 #: Pressure (MPa) above which the angles of a file must exceed
 #: :data:`RADIAN_ANGLE_MAX` somewhere, or they look like radians.
 RADIAN_PRESSURE_MPA = 0.05
-#: The largest |angle| of a file in radians that the radian rule suspects: a
+#: The largest ``|angle|`` of a file in radians that the radian rule suspects: a
 #: full turn with 5 % margin (2π·1.05).
 RADIAN_ANGLE_MAX = 2.0 * math.pi * 1.05
 _MAX_CYCLE = 2**53  # the largest integer a float64 holds exactly
@@ -799,7 +799,7 @@ def _check_angle_unit(frame: pd.DataFrame, source: Path, lines: Sequence[int], f
     """Raise (or, with ``force``, warn) when the file's angles look like radians.
 
     The rule of the module docstring (Units): the pressures reach above
-    :data:`RADIAN_PRESSURE_MPA` and no |angle| exceeds :data:`RADIAN_ANGLE_MAX`.
+    :data:`RADIAN_PRESSURE_MPA` and no ``|angle|`` exceeds :data:`RADIAN_ANGLE_MAX`.
     The line named is that of the reading at the highest pressure.
     """
     pressure = frame["pressure_mpa"].to_numpy(dtype=np.float64)

@@ -5,23 +5,23 @@ Every strategy is a scikit-learn regressor on the rows of
 starts from a fitted *base* surrogate (any estimator with ``predict``; the MLP
 trained on the FEM dataset by default):
 
-=================  ============================================================
-``fem-only``       the base, unchanged (paper B's "NMLPR"), a baseline
-``analytical``     the analytical model of the actuator, a baseline (no base)
-``refined``        paper B's refined MLP: every layer trained further from the
-                   base's weights on the measurements, input scaling kept
-``experimental``   paper B's experimental MLP: from scratch, measurements only
-``residual-gp``    the base frozen, a Gaussian process on its error with a
-                   noise term; gives prediction intervals
-``scale-offset``   the base frozen, ``θ = a·θ_base + c`` by least squares
-``pressure-scale``  the base frozen and asked at ``s·p``: one number for an
-                   elastomer softer or stiffer than the simulated one
-                   (:mod:`softbend.transfer.pressure_map`); gives intervals
+====================  ============================================================
+``fem-only``          the base, unchanged (paper B's "NMLPR"), a baseline
+``analytical``        the analytical model of the actuator, a baseline (no base)
+``refined``           paper B's refined MLP: every layer trained further from the
+                      base's weights on the measurements, input scaling kept
+``experimental``      paper B's experimental MLP: from scratch, measurements only
+``residual-gp``       the base frozen, a Gaussian process on its error with a
+                      noise term; gives prediction intervals
+``scale-offset``      the base frozen, ``θ = a·θ_base + c`` by least squares
+``pressure-scale``    the base frozen and asked at ``s·p``: one number for an
+                      elastomer softer or stiffer than the simulated one
+                      (:mod:`softbend.transfer.pressure_map`); gives intervals
 ``refined-ensemble``  refined MLPs on bootstrap draws of the measured
-                   actuators; mean, and an interval from their spread
-``scaled-refined``  the pressure scale fitted first and folded into the MLP,
-                   then paper B's refinement from that start
-=================  ============================================================
+                      actuators; mean, and an interval from their spread
+``scaled-refined``    the pressure scale fitted first and folded into the MLP,
+                      then paper B's refinement from that start
+====================  ============================================================
 
 Strategies with intervals have ``predict_interval(X, level)``.
 
