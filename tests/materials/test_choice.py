@@ -24,6 +24,8 @@ def test_a_fit_file_gives_its_best_or_named_model(fit_file):
     assert neo.model.name == "neo-hookean"
     assert neo.model.to_dict()["c10_mpa"] == pytest.approx(fits["fits"][0]["parameters"]["c10_mpa"])
     assert "assumed (Dragon Skin 30's)" in best.source and str(fit_file) in best.source
+    tested = fits["test"]["material"]
+    assert tested and best.name == f"{tested} (yeoh)"  # named as the tensile test names it
     assert best.density_g_per_cm3 == pytest.approx(DRAGON_SKIN_30.density_g_per_cm3)
     assert material_from_spec(fit_file, density_g_per_cm3=1.07).density_g_per_cm3 == (
         pytest.approx(1.07)
@@ -52,3 +54,11 @@ def test_fem_run_uses_and_records_the_material(fit_file, tmp_path, capsys):
     assert 0 < angles["own"] < angles["paper"]
     code = main([*base, "-o", str(tmp_path / "bad"), "--material", "ecoflex"])
     assert code == 2 and "Unknown material preset 'ecoflex'" in capsys.readouterr().err
+
+
+def test_a_fit_whose_test_names_no_material_is_named_after_its_file(fit_file, tmp_path):
+    fits = json.loads(fit_file.read_text())
+    fits["test"]["material"] = ""
+    unnamed = tmp_path / "bench-3.json"
+    unnamed.write_text(json.dumps(fits))
+    assert material_from_spec(unnamed).name == "bench-3 (yeoh)"

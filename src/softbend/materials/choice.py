@@ -89,7 +89,7 @@ def material_from_spec(
         density = float(density_g_per_cm3)
         density_note = f"density {density:g} g/cm³ given"
     return Material(
-        name=f"{path.stem} ({chosen.name})",
+        name=f"{_tested_material(path) or path.stem} ({chosen.name})",
         model=chosen.model,
         density_t_per_mm3=density * G_PER_CM3_TO_T_PER_MM3,
         source=(
@@ -127,3 +127,15 @@ def material_spec_record(spec: str | os.PathLike[str]) -> dict[str, str]:
         "model": model_name,
         "sha256": hashlib.sha256(path.read_bytes()).hexdigest(),
     }
+
+
+def _tested_material(path: Path) -> str | None:
+    """The material the tensile test of a ``fit.json`` names (its ``Material``), if any."""
+    import json
+
+    try:
+        test = json.loads(path.read_text(encoding="utf-8")).get("test", {})
+    except (OSError, ValueError, AttributeError):
+        return None
+    name = test.get("material") if isinstance(test, dict) else None
+    return name.strip() if isinstance(name, str) and name.strip() else None
