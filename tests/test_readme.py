@@ -1,0 +1,99 @@
+"""The README's tour runs: every ``softbend …`` command of its bash blocks, in order, in a quick
+variant, in a fresh folder.
+
+The quick variant appends options to a command (a later option wins in the command line) so
+that the tour runs in about a minute: a coarser mesh, fewer designs, epochs and folds, an
+analytical check instead of the FEM's. :data:`QUICK` holds them by command. A command of the
+README that :data:`QUICK` does not know fails the test, so each new command gets a decision.
+``make run`` and ``make test``, the README's two commands, are what CI and the pipeline tests
+run; they are not run again here.
+"""
+
+from __future__ import annotations
+
+import os
+import shlex
+import subprocess
+import sys
+from pathlib import Path
+
+ROOT = Path(__file__).resolve().parents[1]
+
+#: Options appended to each README command (by its command path) in the quick variant.
+QUICK: dict[str, tuple[str, ...]] = {
+    "materials fit": (),
+    "fem run": ("--maxh", "12", "--pmax", "0.04", "--pstep", "0.02", "--shapes", "2"),
+    "campaign run": ("--space", "corners", "--pmax", "0.1", "--pstep", "0.01"),
+    "analyze": (),
+    "train": ("--models", "plr,mlp", "--folds", "2", "--epochs", "3", "--no-onnx"),
+    "predict": (),
+    "design find": ("--verify", "1", "--backend", "analytical"),
+    "lab measure": ("--plant", "analytical"),
+    "transfer loco": ("--strategies", "scale-offset,pressure-scale", "--no-learning-curve"),
+    "transfer refine": ("--epochs", "20"),
+    "control simulate": ("--duration", "4"),
+    "curling simulate": ("--experiments", "3", "--samples", "160"),
+    "curling identify": (),
+}
+
+
+def _commands() -> list[list[str]]:
+    """The README's ``softbend`` commands, continuation lines joined, comments dropped."""
+    out: list[list[str]] = []
+    inside, pending = False, ""
+    for line in (ROOT / "README.md").read_text(encoding="utf-8").splitlines():
+        if line.startswith("```"):
+            inside = line.strip() == "```bash" if not inside else False
+            continue
+        text = line.split(" #", 1)[0].rstrip() if inside else ""
+        if text.lstrip().startswith("#"):
+            text = ""
+        if pending:
+            pending += " " + text.strip().rstrip("\\").strip()
+        elif text.strip().startswith("softbend "):
+            pending = text.strip().rstrip("\\").strip()
+        if pending and not text.rstrip().endswith("\\"):
+            out.append(shlex.split(pending))
+            pending = ""
+    return out
+
+
+def _path(words: list[str]) -> str:
+    """``fem run`` of ``softbend fem run --design …``."""
+    head = [w for w in words[1:3] if not w.startswith("-")]
+    two = " ".join(head[:2])
+    return two if two in QUICK else head[0]
+
+
+COMMANDS = _commands()
+
+
+def test_the_tour_shows_the_lab_s_path():
+    paths = [_path(c) for c in COMMANDS]
+    assert len(paths) >= 12
+    for stage in ("materials fit", "fem run", "campaign run", "train", "design find"):
+        assert stage in paths
+    assert {"transfer refine", "control simulate", "curling identify"} <= set(paths)
+
+
+def test_every_readme_command_has_a_quick_variant():
+    unknown = sorted({_path(c) for c in COMMANDS} - set(QUICK))
+    assert not unknown, f"add the README's {unknown} to QUICK (with the options that make it quick)"
+
+
+def test_the_tour_runs_in_its_quick_variant(tmp_path):
+    (tmp_path / "src").symlink_to(ROOT / "src", target_is_directory=True)
+    bin_dir = Path(sys.executable).parent
+    env = {**os.environ, "PATH": f"{bin_dir}{os.pathsep}{os.environ['PATH']}"}
+    softbend = str(bin_dir / "softbend") if (bin_dir / "softbend").exists() else "softbend"
+    for words in COMMANDS:
+        argv = [softbend, *words[1:], *QUICK[_path(words)]]
+        done = subprocess.run(
+            argv, cwd=tmp_path, env=env, capture_output=True, text=True, timeout=600, check=False
+        )
+        shown = " ".join(words)
+        assert done.returncode == 0, f"{shown}\n{done.stderr[-3000:]}"
+    # The tour's files are where the README says they are.
+    for name in ("mat/fit.json", "table1.duckdb", "surrogates/models/mlp.json", "refined.json"):
+        assert (tmp_path / name).exists(), name
+    assert (tmp_path / "ctl").is_dir() and (tmp_path / "ident").is_dir()
