@@ -37,3 +37,20 @@ def test_a_run_that_reaches_past_the_support_warns_and_says_so(tmp_path):
         low = simulate_control(reference="step:60", duration_s=3.0)
     assert low.summary["support"]["beyond"] is False
     assert low.summary["support"]["max_pressure_mpa"] < 0.17
+
+
+def test_a_loop_run_keeps_the_same_watch_on_where_its_model_holds():
+    from softbend.control.runs import plan_loop
+
+    with pytest.raises(ValueError, match=r"--strict.*0\.17 MPa"):
+        plan_loop(supply_mpa=0.2, strict=True, command="softbend control run")
+    plan = plan_loop(reference="step:295", duration_s=1.5, supply_mpa=0.2)
+    with pytest.warns(UserWarning, match="past the 0.17 MPa"):
+        high = plan.run()
+    support = high.summary["support"]
+    assert support["beyond"] is True and support["supported_mpa"] == pytest.approx(0.17)
+    assert support["max_pressure_mpa"] > 0.17
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        low = plan_loop(reference="step:60", duration_s=1.5, supply_mpa=0.2).run()
+    assert low.summary["support"]["beyond"] is False

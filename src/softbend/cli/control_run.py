@@ -48,6 +48,7 @@ def run_cmd(
     rig_params: list[str] = opt.RIG_PARAM,
     seed: int = typer.Option(0, help="Seed of a simulated rig's sensor and camera noise."),
     log_format: str = typer.Option("csv", help="Tick log format: csv (streamed) or parquet."),
+    strict: bool = opt.STRICT,
     as_json: bool = typer.Option(False, "--json", help="Print the summary as JSON."),
 ) -> None:
     """Run a controller in the fixed-period loop on a rig.
@@ -81,6 +82,7 @@ def run_cmd(
             assignments=settings or (), design=design, model=model, plant=plant,
             duration_s=duration, period_s=period, sensor_period_s=sensor_period,
             supply_mpa=supply, rig_assignments=rig_params or (), seed=seed, command=command,
+            strict=strict,
         )  # fmt: skip
     log_name = f"ticks.{log_format}"
     _common.check_output_dir(out, "--out", files=(log_name, "run.json", "run.png"))

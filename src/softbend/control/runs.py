@@ -192,7 +192,18 @@ class LoopPlan:
             )  # fmt: skip
         finally:
             device.close()
-        return LoopResult(loop=result, summary=self._summary(device, result))
+        summary = self._summary(device, result)
+        beyond = beyond_support(self.setup, self._reached(result))
+        if beyond is not None:
+            warnings.warn(beyond, UserWarning, stacklevel=2)
+        return LoopResult(loop=result, summary=summary)
+
+    @staticmethod
+    def _reached(result: Any) -> float:
+        """The largest pressure read in the run, MPa (0 when no reading was logged)."""
+        measured = result.control_run().measured_mpa
+        finite = measured[np.isfinite(measured)]
+        return float(finite.max()) if finite.size else 0.0
 
     def _summary(self, device: Any, result: Any) -> dict[str, Any]:
         synthetic = bool(getattr(device, "synthetic", False))
@@ -217,6 +228,12 @@ class LoopPlan:
             "rig_config": self.rig_setup.config.to_toml(),
             "rig_params": self.setup.rig_params.as_dict() if synthetic else None,
             "rig_settings": dict(self.setup.rig_settings) if synthetic else None,
+            "support": {
+                "supported_mpa": self.setup.supported_mpa,
+                "max_pressure_mpa": self._reached(result),
+                "beyond": beyond_support(self.setup, self._reached(result)) is not None,
+                "notes": list(self.setup.support_notes),
+            },
         }
         trips = getattr(device, "round_trips_s", None)
         if trips is not None:
@@ -241,6 +258,7 @@ def plan_loop(
     rig_assignments: Sequence[str] = (),
     seed: int = 0,
     command: str = "plan_loop",
+    strict: bool = False,
 ) -> LoopPlan:
     """Check a loop run and build its controller; the rig is built by :meth:`LoopPlan.run`.
 
@@ -258,6 +276,10 @@ def plan_loop(
         hardware rig (:data:`~softbend.control.rigs.HARDWARE_RIGS`).
     period_s, sensor_period_s : float, optional
         Loop tick and sensor period, s (default: the config's).
+    strict : bool, default False
+        Refuse, before any valve moves, a controller model or plant surrogate whose θ(p)
+        of the design up to the supply leaves its training data (else a run that reached
+        past it warns, and its summary's ``support`` says so).
     others
         As :func:`simulate_control`.
     """
@@ -277,6 +299,7 @@ def plan_loop(
     setup = prepare_control(
         controller=controller, assignments=assignments, config=settings.controller,
         design=design, model=model, plant=plant, rig_settings=simulated, command=command,
+        strict=strict,
     )  # fmt: skip
     check_range(duration_s, "duration", command, low=0.0, high=86400.0, high_inclusive=True)
     check_range(tick, "period", command, low=0.0, high=1.0, high_inclusive=True)
