@@ -30,6 +30,7 @@ from dataclasses import dataclass
 from pathlib import Path
 
 import numpy as np
+from _record import record, variant_name
 
 from softbend.campaign import SweepResult, default_pressures_mpa, get_backend, run_campaign
 from softbend.cli.campaign import parse_space
@@ -115,6 +116,22 @@ def main(argv: list[str] | None = None) -> int:
         "cpu_count": os.cpu_count(),
         "target_overhead_ms_per_design": TARGET_OVERHEAD_MS,
     }
+    figures: dict = {}
+    units: dict = {}
+    for row in rows:
+        for key, figure, unit in (
+            ("designs_per_s", "throughput", "designs/s"),
+            ("overhead_ms_per_design", "overhead", "ms/design"),
+        ):
+            figures[f"{row['run']}: {figure}"] = round(row[key], 2)
+            units[f"{row['run']}: {figure}"] = unit
+    record(
+        variant_name("campaign", None if args.space == "table1" else args.space),
+        figures,
+        units=units,
+        notes=f"{len(designs)} designs x {len(grid)} pressures, {args.workers} workers; "
+        f"target overhead < {TARGET_OVERHEAD_MS:g} ms/design",
+    )
     if args.json:
         print(json.dumps({**header, "runs": rows}, indent=2))
         return 0

@@ -21,6 +21,7 @@ import json
 import time
 
 import numpy as np
+from _record import record, variant_name
 
 from softbend.control import CONTROLLERS
 from softbend.control.controllers import mlp_virtual_sensor
@@ -79,6 +80,21 @@ def main() -> None:
             results.append(
                 {"controller": name, "reference": spec, **m, "step_p50_us": p50, "step_p99_us": p99}
             )
+    figures: dict = {}
+    units: dict = {}
+    for r in results:
+        key = f"{r['controller']}, {r['reference']}"
+        figures[f"{key}: MAPE"], units[f"{key}: MAPE"] = round(r["mape_pct"], 2), "%"
+        figures[f"{key}: real-time factor"] = round(r["realtime_factor"], 1)
+        figures[f"{r['controller']}: decision p99"] = round(r["step_p99_us"], 1)
+        units[f"{r['controller']}: decision p99"] = "µs"
+    record(
+        variant_name("control", None if args.plant == "surrogate" else args.plant),
+        figures,
+        units=units,
+        notes=f"{args.duration:g} s runs on (100,6,2,2,5,8), plant {args.plant}, "
+        f"model {args.model or 'shipped FEM-trained MLP'}",
+    )
     if args.json:
         print(json.dumps(results, indent=2))
         return

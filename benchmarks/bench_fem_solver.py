@@ -42,6 +42,8 @@ import argparse
 import time
 
 import numpy as np
+from _record import record as record_figures
+from _record import variant_name
 
 import softbend.fem  # noqa: F401  (loads PyTorch before NGSolve)
 from softbend.campaign.backends import default_pressures_mpa
@@ -68,7 +70,7 @@ def _mean_time(action, repeats: int) -> float:
     return (time.perf_counter() - start) / repeats
 
 
-def assembly(design: str, repeats: int) -> None:
+def assembly(design: str, repeats: int) -> dict:
     import ngsolve as ngs
 
     model = ActuatorModel(SFRBADesign.parse(design), FEMOptions())
@@ -86,7 +88,9 @@ def assembly(design: str, repeats: int) -> None:
 
     names = ("elastomer (volume)", "layer membrane", "fibers", "pressure")
     terms = list(model.form.integrators)
-    print(f"  all terms together: {linearization_time(*terms):.3f} s")
+    together = linearization_time(*terms)
+    print(f"  all terms together: {together:.3f} s")
+    figures = {"Hessian assembly, all terms, interpreted": round(1e3 * together, 1)}
     for name, term in zip(names, terms, strict=True):
         print(f"  {name}: {linearization_time(term):.3f} s")
 
@@ -100,14 +104,16 @@ def assembly(design: str, repeats: int) -> None:
     fast.set_load(0.05, 1.0)
     print("  compiled (use_compiled), Hessian assembly interpreted -> compiled:")
     for name, slow_term, fast_term in zip(names, terms, fast.form.integrators, strict=True):
-        print(
-            f"    {name}: {1e3 * linearization_time(slow_term):.1f} -> "
-            f"{1e3 * linearization_time(fast_term):.1f} ms"
-        )
+        slow, quick = linearization_time(slow_term), linearization_time(fast_term)
+        print(f"    {name}: {1e3 * slow:.1f} -> {1e3 * quick:.1f} ms")
+        figures[f"{name}, interpreted"] = round(1e3 * slow, 1)
+        figures[f"{name}, compiled"] = round(1e3 * quick, 1)
     residual = vec.CreateVector()
     slow_s = _mean_time(lambda: model.form.Apply(vec, residual), repeats)
     fast_s = _mean_time(lambda: fast.form.Apply(vec, residual), repeats)
     print(f"    residual, all terms: {1e3 * slow_s:.1f} -> {1e3 * fast_s:.1f} ms")
+    figures["residual, all terms, interpreted"] = round(1e3 * slow_s, 1)
+    figures["residual, all terms, compiled"] = round(1e3 * fast_s, 1)
 
     u, v = model.fes.TnT()
     g = ngs.CoefficientFunction(model._gravity_vector())
@@ -150,6 +156,7 @@ def assembly(design: str, repeats: int) -> None:
         form += integrand.Compile(realcompile=True, wait=True) * ngs.dx
         seconds = _mean_time(form.Assemble, repeats)
         print(f"  {name}, compiled bilinear form (not used): {1e3 * seconds:.1f} ms")
+    return figures
 
 
 def _iteration_rule() -> None:
@@ -170,7 +177,7 @@ def _iteration_rule() -> None:
     sweep._record, sweep._next_step = recording, by_iterations
 
 
-def steps(rule: str) -> None:
+def steps(rule: str) -> dict:
     if rule == "iterations":
         _iteration_rule()
     total_iterations = total_rejected = 0
@@ -182,12 +189,16 @@ def steps(rule: str) -> None:
         total_rejected += rejected
         print(f"  {design:<18} {iterations:4d} Newton iterations, {rejected} rejected steps")
     print(f"step rule '{rule}': {total_iterations} Newton iterations, {total_rejected} rejected")
+    return {
+        f"step rule '{rule}': Newton iterations": total_iterations,
+        f"step rule '{rule}': rejected steps": total_rejected,
+    }
 
 
 RTOL_DESIGNS = ("160,6,2,2,5,8", "100,6,2,2,5,8", "140,8,3,3,10,10", "160,10,4,2,15,8")
 
 
-def rtol(values: tuple[float, ...] = (1e-9, 3e-9, 1e-8)) -> None:
+def rtol(values: tuple[float, ...] = (1e-9, 3e-9, 1e-8)) -> dict:
     totals = dict.fromkeys(values, 0)
     for design in RTOL_DESIGNS:
         reference = None
@@ -211,6 +222,7 @@ def rtol(values: tuple[float, ...] = (1e-9, 3e-9, 1e-8)) -> None:
             print(line)
     summary = ", ".join(f"{v:.0e}: {n}" for v, n in totals.items())
     print(f"Newton iterations, all designs: {summary}")
+    return {f"rtol {v:.0e}: Newton iterations, all designs": n for v, n in totals.items()}
 
 
 def main(argv: list[str] | None = None) -> int:
@@ -225,15 +237,20 @@ def main(argv: list[str] | None = None) -> int:
     from ngsolve import SetNumThreads, TaskManager
 
     SetNumThreads(1)
+    figures: dict = {}
     with TaskManager():
         if args.what == "assembly":
-            assembly(args.design, args.repeats)
+            figures = assembly(args.design, args.repeats)
         elif args.what == "rtol":
             use_compiled(True, wait=True)
-            rtol()
+            figures = rtol()
         else:
             for rule in ("miss", "iterations") if args.rule == "both" else (args.rule,):
-                steps(rule)
+                figures.update(steps(rule))
+    note = f"design {args.design}, mean of {args.repeats}" if args.what == "assembly" else ""
+    units = dict.fromkeys(figures, "ms") if args.what == "assembly" else {}
+    name = variant_name("fem_solver", args.what)
+    record_figures(name, figures, units=units, notes=f"one thread; {note}".rstrip("; "))
     return 0
 
 

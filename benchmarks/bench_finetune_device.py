@@ -17,6 +17,7 @@ import json
 import time
 
 import numpy as np
+from _record import record
 
 from softbend.transfer.base import load_base
 from softbend.transfer.finetune import fine_tune_many
@@ -47,6 +48,8 @@ def main() -> None:
     if torch.cuda.is_available():
         print(f"GPU {torch.cuda.get_device_name(0)}, CUDA {torch.version.cuda}", flush=True)
     rows = []
+    figures: dict = {}
+    units: dict = {}
     for k in (int(v) for v in args.variants.split(",")):
         X, y, w = _workload(k)
         models = {}
@@ -76,6 +79,13 @@ def main() -> None:
                     100 * row["gpu_busy_s_per_epoch"] * args.epochs / seconds, 1
                 )
             rows.append(row)
+            figures[f"{device}, K={k}: wall time"], units[f"{device}, K={k}: wall time"] = (
+                row["seconds"],
+                "s",
+            )
+            if "gpu_busy_pct" in row:
+                figures[f"{device}, K={k}: GPU busy"] = row["gpu_busy_pct"]
+                units[f"{device}, K={k}: GPU busy"] = "%"
             print(json.dumps(row), flush=True)
         if len(models) == 2:
             diff = max(
@@ -84,6 +94,13 @@ def main() -> None:
                 for a, b in zip(mc.coefs_, mg.coefs_, strict=True)
             )
             print(json.dumps({"variants": k, "max_weight_diff_cpu_vs_cuda": diff}), flush=True)
+            figures[f"K={k}: largest weight difference, CPU vs GPU"] = diff
+    record(
+        "finetune_device",
+        figures,
+        units=units,
+        notes=f"{args.epochs} epochs, float64; CPU threads {torch.get_num_threads()}",
+    )
 
 
 if __name__ == "__main__":

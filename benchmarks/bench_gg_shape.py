@@ -51,6 +51,7 @@ import time
 import warnings
 
 import numpy as np
+from _record import record, table_figures
 from sklearn.svm import SVR
 
 from softbend.identification.kernels import ShapeClippedWarning
@@ -195,6 +196,18 @@ def main() -> None:
         scenario: run(scenario, args.folds, args.seed, tuple(args.signs))
         for scenario in args.scenarios
     }
+    columns = {
+        "free_run_nrmse_pct": ("free-run NRMSE", "%"),
+        "free_run_nrmse_worst_pct": ("worst free-run NRMSE", "%"),
+        "one_step_nrmse_pct": ("one-step NRMSE", "%"),
+        "diverged": ("diverged", ""),
+    }
+    figures, units = table_figures(
+        {f"{sc}, {m}": r for sc, summary in results.items() for m, r in summary.items()}, columns
+    )
+    record(
+        "gg_shape", figures, units=units, notes=f"{args.folds} folds, signs {', '.join(args.signs)}"
+    )
     if args.json:
         print(json.dumps(results, indent=2))
         return

@@ -35,6 +35,7 @@ import time
 import warnings
 
 import numpy as np
+from _record import record, table_figures
 
 from softbend.identification.kernels import ShapeClippedWarning, gg_normalization
 from softbend.identification.narx import lagged_matrix
@@ -197,6 +198,28 @@ def main() -> None:
     report = {"fit_paper_a": fits, "predict_one_us": latency_us(model)}
     if not args.skip_large:
         report["large_fit"] = large_fit(args.rows, tuple(args.shapes), args.excitation)
+    figures = {
+        f"paper A fit, {label}": round(1e3 * fits[key], 1)
+        for label, key in (
+            ("scikit-learn SVR rbf", "sklearn_rbf_s"),
+            ("GG-SVR shape 2", "gg2_s"),
+            ("GG-SVR shape 1.5", "gg15_s"),
+        )
+    }
+    units = dict.fromkeys(figures, "ms")
+    figures["single-step prediction"], units["single-step prediction"] = (
+        round(report["predict_one_us"], 2),
+        "µs",
+    )
+    large = {f"large fit, shape {k}": v for k, v in report.get("large_fit", {}).items()}
+    columns = {
+        "rows": ("rows", ""),
+        "seconds": ("wall time", "s"),
+        "rss_peak_mib": ("process peak RSS", "MiB"),
+        "fit_adds_at_most_mib": ("fit adds at most", "MiB"),
+    }
+    more, more_units = table_figures(large, columns, digits=1)
+    record("gg_svr", {**figures, **more}, units={**units, **more_units}, notes=args.excitation)
     if args.json:
         print(json.dumps(report, indent=2))
         return

@@ -33,6 +33,7 @@ import time
 import warnings
 
 import numpy as np
+from _record import record, table_figures
 from sklearn.linear_model import LinearRegression
 from sklearn.model_selection import GridSearchCV, KFold
 from sklearn.svm import SVR
@@ -197,6 +198,22 @@ def main() -> None:
     parser.add_argument("--json", action="store_true")
     args = parser.parse_args()
     summary = run(args.folds, args.seed)
+    columns = {
+        "one_step_nrmse_pct": ("one-step NRMSE", "%"),
+        "free_run_nrmse_pct": ("free-run NRMSE", "%"),
+        "free_run_nrmse_worst_pct": ("worst free-run NRMSE", "%"),
+        "diverged_runs": ("diverged runs", ""),
+        "fit_s": ("fit", "s"),
+        "single_step_us": ("single step", "µs"),
+    }
+    figures, units = table_figures(summary, columns)
+    record(
+        "identification",
+        figures,
+        units=units,
+        notes=f"{args.folds} folds, seed {args.seed}; "
+        f"mean over {summary['gg-svr']['n_heldout']} held-out runs",
+    )
     if args.json:
         print(json.dumps(summary, indent=2))
         return

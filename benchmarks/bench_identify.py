@@ -10,7 +10,7 @@
 
 Prints, per dataset, every candidate's cross-validated free-run NRMSE, one-step
 NRMSE and validation free-run NRMSE, and the verdict against the best linear
-ARX. Writes nothing. About two minutes on two cores.
+ARX, and records the figures in benchmarks/results/. About two minutes on two cores.
 
 Usage: python benchmarks/bench_identify.py
 """
@@ -20,34 +20,54 @@ from __future__ import annotations
 import resource
 import time
 
+from _record import record
+
 from softbend.identification.arm import ARM_VALIDATION, arm_experiments
 from softbend.identification.selection import select_model
 from softbend.identification.synthetic import synthetic_dataset
 from softbend.identification.timeseries import from_experiments
 
 
-def show(label: str, selection, seconds: float) -> None:
+def show(label: str, selection, seconds: float, figures: dict, units: dict) -> None:
     print(f"\n{label}: {seconds:.1f} s")
     table = selection.table[
         ["candidate", "cv_freerun_nrmse", "cv_onestep_nrmse", "validation_freerun_nrmse"]
     ]
     print(table.to_string(index=False, float_format=lambda v: f"{v:.4f}"))
     print(selection.verdict())
+    best, linear = selection.row(selection.best), selection.best_of("arx")
+    column = "validation_freerun_nrmse"
+    for key, value, unit in (
+        ("wall time", round(seconds, 1), "s"),
+        ("selected", selection.best, ""),
+        ("selected: validation free-run NRMSE", round(float(best[column]), 4), ""),
+        ("best linear ARX: validation free-run NRMSE", round(float(linear[column]), 4), "")
+        if linear
+        else ("best linear ARX", "none", ""),
+    ):
+        figures[f"{label}: {key}"], units[f"{label}: {key}"] = value, unit
 
 
 def main() -> None:
     arm = arm_experiments()
     rows = sum(e.n_samples for e in arm.experiments)
+    figures: dict = {}
+    units: dict = {}
     start = time.perf_counter()
     selection = select_model(arm, validate_on=list(ARM_VALIDATION))
-    show(f"soft arm, {rows:,} rows x 3 inputs x 2 outputs", selection, time.perf_counter() - start)
+    seconds = time.perf_counter() - start
+    show(f"soft arm, {rows:,} rows x 3 inputs x 2 outputs", selection, seconds, figures, units)
     peak = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024
     print(f"peak memory of the process: {peak:.0f} MiB")
+    figures["soft arm: peak memory of the process"] = round(peak)
+    units["soft arm: peak memory of the process"] = "MiB"
     for sign, experiments in synthetic_dataset(seed=0).items():
         data = from_experiments(experiments)
         start = time.perf_counter()
         selection = select_model(data, validate_on=[data.names[-1]])
-        show(f"paper A curling actuator, {sign} pressure", selection, time.perf_counter() - start)
+        seconds = time.perf_counter() - start
+        show(f"paper A curling actuator, {sign} pressure", selection, seconds, figures, units)
+    record("identify", figures, units=units, notes="held-out free-run NRMSE; selection by CV")
 
 
 if __name__ == "__main__":

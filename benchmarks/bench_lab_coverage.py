@@ -25,6 +25,8 @@ import tempfile
 import time
 from pathlib import Path
 
+from _record import record
+
 from softbend.design import SFRBADesign
 from softbend.transfer.base import load_base
 from softbend.transfer.lab import VirtualLab, shipped_measurements, shipped_measurements_path
@@ -52,6 +54,8 @@ def main() -> None:
         own = save_measurements(eighth_actuator(), Path(scratch) / "own.csv")
         eight = load_measurements_files([shipped_measurements_path(), own])
     print(f"eighth actuator measured in {time.perf_counter() - start:.0f} s")
+    figures = {"eighth actuator measured in": round(time.perf_counter() - start, 1)}
+    units = {"eighth actuator measured in": "s"}
     for label, data in (("shipped lab (7)", seven), ("lab + (130,7,2.5,3,10,9) (8)", eight)):
         for fallback in ("quantile", "largest"):
             start = time.perf_counter()
@@ -72,6 +76,16 @@ def main() -> None:
                 f"{cal['half_width_deg']:.1f}°, held-out RMSE {row['rmse_deg']:.2f}° "
                 f"({time.perf_counter() - start:.0f} s)"
             )
+            for figure, value, unit in (
+                ("calibrated coverage", 100 * row["calibrated_coverage"], "%"),
+                ("mean width", row["calibrated_width_deg"], "°"),
+                ("half-width on all", cal["half_width_deg"], "°"),
+                ("held-out RMSE", row["rmse_deg"], "°"),
+                ("wall time", time.perf_counter() - start, "s"),
+            ):
+                key = f"{label}, {fallback}: {figure}"
+                figures[key], units[key] = round(float(value), 3), unit
+    record("lab_coverage", figures, units=units, notes="refined strategy, 90 % interval")
 
 
 if __name__ == "__main__":

@@ -26,6 +26,8 @@ import argparse
 import json
 import time
 
+from _record import record
+
 from softbend.references import SURROGATE_TRAINING
 from softbend.surrogates.features import training_data
 from softbend.surrogates.search import grid, halving_rungs, search
@@ -114,6 +116,27 @@ def main(argv: list[str] | None = None) -> int:
         "halving_pick_rank_in_exhaustive": rank,
         "paper_grid_projected_hours": projection,
     }
+    figures: dict = {}
+    units: dict = {}
+    for label, run in runs.items():
+        for key, value, unit in (
+            ("wall time", round(run["seconds"], 1), "s"),
+            ("pick", run["pick"], ""),
+            ("CV RMSE", round(run["rmse_deg"], 3), "°"),
+            ("CV MAPE", round(run["mape_pct"], 3), "%"),
+        ):
+            figures[f"{label}: {key}"], units[f"{label}: {key}"] = value, unit
+    figures["halving's pick: rank in the exhaustive search"] = f"{rank} of {len(subset)}"
+    for label, hours in projection.items():
+        figures[f"paper grid projected: {label}"] = round(hours, 2)
+        units[f"paper grid projected: {label}"] = "h"
+    record(
+        "mlp_halving",
+        figures,
+        units=units,
+        notes=f"{len(subset)} configurations, {args.epochs} epochs, 5 grouped folds, "
+        f"{data.n_samples} samples of {data.n_groups} designs",
+    )
     if args.json:
         print(json.dumps(out, indent=2))
         return 0

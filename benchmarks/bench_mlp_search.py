@@ -53,6 +53,7 @@ import time
 
 import numpy as np
 import torch
+from _record import record, variant_name
 from sklearn.model_selection import GroupKFold
 
 from softbend.references import SURROGATE_TRAINING
@@ -217,6 +218,28 @@ def main(argv: list[str] | None = None) -> int:
         "full_grid_one_pass_memory_gb": full_pass_gb,
         "median_val_mape_pct_after_E_epochs": 100 * float(np.median(val_mape)),
     }
+    record(
+        variant_name("mlp_search", None if batched.device == "cpu" else "gpu"),
+        {
+            "batched, per (configuration, fold)": round(report["batched_s_per_config_fold"], 3),
+            "one at a time, per (configuration, fold)": round(
+                report["sequential_s_per_config_fold"], 3
+            ),
+            "speed-up batched vs one at a time": round(report["speedup"], 2),
+            "full paper grid projected, batched": round(report["projected_full_grid_batched_h"], 2),
+            "full paper grid projected, one at a time": round(
+                report["projected_full_grid_sequential_h"], 2
+            ),
+        },
+        units={
+            "batched, per (configuration, fold)": "s",
+            "one at a time, per (configuration, fold)": "s",
+            "full paper grid projected, batched": "h",
+            "full paper grid projected, one at a time": "h",
+        },
+        notes=f"{source}, {len(configs)} configurations x {len(splits)} folds, "
+        f"{args.epochs} epochs, device {batched.device}, {threads} thread(s)",
+    )
     if args.json:
         print(json.dumps(report))
         return 0
@@ -392,6 +415,23 @@ def run_variants(args: argparse.Namespace) -> int:
         )
         busy_text = "-" if busy is None else f"{100 * busy:.0f} %"
         print(f"{spec:34}{cold:>15.2f}{per_epoch:>10.4f}{full:>13.1f}{busy_text:>10}", flush=True)
+    figures: dict = {}
+    units: dict = {}
+    for r in rows:
+        for key, label, unit, scale in (
+            ("s_per_epoch", "steady epoch", "s", 1),
+            ("projected_full_grid_s", "full grid projected", "s", 1),
+            ("gpu_busy", "GPU busy", "%", 100),
+        ):
+            value = r[key]
+            figures[f"{r['variant']}: {label}"] = None if value is None else round(scale * value, 4)
+            units[f"{r['variant']}: {label}"] = unit
+    record(
+        variant_name("mlp_search-paths", None if device == "cpu" else "gpu"),
+        figures,
+        units=units,
+        notes=f"{source}, {n_models} models, {args.epochs} epochs; {device_description(device)}",
+    )
     if args.json:
         print(json.dumps({"data": source, "device": device_description(device), "rows": rows}))
     return 0
@@ -440,6 +480,20 @@ def run_search(args: argparse.Namespace) -> int:
         + ", ".join(f"{k} {v:.6g}" for k, v in family.cv.items())
     )
     print(json.dumps(report, default=str))
+    figures = {
+        "search": round(family.search_s, 1),
+        "refit": round(family.fit_s, 1),
+        "total": round(total, 1),
+        "chosen": str(family.params),
+        **{f"grouped CV {k}": round(float(v), 4) for k, v in family.cv.items()},
+    }
+    record(
+        variant_name("mlp_search-paper-grid", None if device == "cpu" else "gpu"),
+        figures,
+        units=dict.fromkeys(("search", "refit", "total"), "s"),
+        notes=f"{report['configurations']} configurations x 5 grouped folds x "
+        f"{report['epochs']} epochs, tf32 {args.tf32}; {report['device']}",
+    )
     return 0
 
 

@@ -22,6 +22,8 @@ import sys
 import time
 from pathlib import Path
 
+from _record import record
+
 ROOT = Path(__file__).resolve().parents[1]
 
 #: The MLP shipped with softbend (paper B, Table 1 campaign).
@@ -79,6 +81,16 @@ def main() -> None:
         "median_s": round(statistics.median(walls), 3),
         "heavy_modules": heavy,
     }
+    record(
+        "predict",
+        {
+            "best": result["best_s"],
+            "median": result["median_s"],
+            "heavy modules imported": ", ".join(heavy) or "none",
+        },
+        units={"best": "s", "median": "s"},
+        notes=f"design {args.design}, {args.pressures} MPa, {args.runs} fresh processes (warm)",
+    )
     if args.json:
         print(json.dumps(result, indent=2))
         return

@@ -22,6 +22,7 @@ import json
 import time
 
 import numpy as np
+from _record import record, variant_name
 
 
 def _median_us(call, number: int, repeats: int = 7) -> float:
@@ -106,6 +107,20 @@ def main() -> None:
         row["onnx_10k_ms"] = _median_us(lambda s=session, f=feed_batch: s.run(None, f), 5) / 1e3
         results[name] = row
 
+    figures: dict = {}
+    units: dict = {}
+    for m, r in results.items():
+        for k, v in r.items():
+            label, unit = k.rsplit("_", 1)
+            key = f"{m}: {label.replace('_', ' ').replace('onnx', 'ONNX')}"
+            figures[key] = None if v is None else round(v, 2)
+            units[key] = "µs" if unit == "us" else unit
+    record(
+        variant_name("surrogates", "db" if args.db else None),
+        figures,
+        units=units,
+        notes=f"median of repeated runs; {data.n_samples} samples ({data.n_groups} designs)",
+    )
     if args.json:
         print(json.dumps({"n_samples": data.n_samples, "results": results}, indent=2))
         return

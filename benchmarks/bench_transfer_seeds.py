@@ -28,6 +28,7 @@ from concurrent.futures import ProcessPoolExecutor
 from pathlib import Path
 
 import numpy as np
+from _record import record
 
 from softbend.datasets import table1_fem
 from softbend.metrics import rmse
@@ -96,6 +97,7 @@ def main(argv: list[str] | None = None) -> int:
             + ", ".join(f"{r:.3f}" for r in ratios)
         )
 
+    figures: dict = {}
     fit, fem = [], []
     held = {name: [] for name in names}  # per seed: the mean held-out RMSE
     members = {name: [] for name in names}  # per seed: the held-out predictions
@@ -109,6 +111,10 @@ def main(argv: list[str] | None = None) -> int:
             held[name].append(mean_rmse(predictions))
         last = [held[n][-1] for n in names]
         print(line(str(seed).rjust(4), fit[-1], fem[-1], last, [v / fem[-1] for v in last]))
+        figures[f"seed {seed}: base RMSE on the FEM data"] = round(fit[-1], 3)
+        figures[f"seed {seed}: fem-only held-out RMSE"] = round(fem[-1], 3)
+        for n in names:
+            figures[f"seed {seed}: {n} held-out RMSE"] = round(held[n][-1], 3)
     if len(fem) > 1:
         fem_a = np.array(fem)
         for label, reduce in (("mean", np.mean), ("sd", lambda a: np.std(a, ddof=1))):
@@ -123,6 +129,15 @@ def main(argv: list[str] | None = None) -> int:
                 f"{name} MLPs of all {len(fem)} seeds averaged: mean RMSE "
                 f"{mean_rmse(mean_of_members):.2f}"
             )
+            figures[f"{name}, MLPs of all seeds averaged: held-out RMSE"] = round(
+                mean_rmse(mean_of_members), 3
+            )
+    record(
+        "transfer_seeds",
+        figures,
+        units=dict.fromkeys(figures, "°"),
+        notes=f"{len(ids)} actuators, {y.size} readings ({args.lab.name}); refined: 1000 epochs",
+    )
     return 0
 
 
