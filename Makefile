@@ -11,13 +11,14 @@ OUT ?= results/reproduce
 $(BIN)/.softbend-installed: pyproject.toml
 	$(PYTHON) -m venv $(VENV)
 	$(BIN)/python -m pip install --quiet --upgrade pip
-	$(BIN)/python -m pip install --quiet -e ".[all,dev]"
+	$(BIN)/python -m pip install --quiet -e ".[all,dev,docs]"
 	touch $@
 
 setup: $(BIN)/.softbend-installed
 
 run: setup
 	$(BIN)/softbend reproduce --out $(OUT)
+	@echo "report: $(OUT)/index.html; documentation: docs/index.md (make docs builds docs/_build/html)"
 
 test: setup
 	$(BIN)/python -m pytest -q -m "not slow"
@@ -33,14 +34,19 @@ lint: setup
 typecheck: setup
 	$(BIN)/mypy
 
-# The generated pages of docs/ (the command-line reference); a test checks they are current.
+# The documentation site (Sphinx + MyST) into docs/_build/html, warnings as errors. The generated
+# pages are written first: the command-line reference, the performance page (from the benchmarks'
+# JSON in benchmarks/results/) and, after a `make run`, the validation page from its summary.json.
 docs: setup
 	$(BIN)/python docs/gen_cli_reference.py
+	$(BIN)/python docs/gen_performance.py
 	@if [ -f $(OUT)/summary.json ]; then $(BIN)/python docs/gen_validation.py $(OUT)/summary.json; \
 	else echo "docs/validation.md kept: make run writes $(OUT)/summary.json"; fi
+	$(BIN)/sphinx-build -j auto -W --keep-going -q -b html docs docs/_build/html
+	@echo "docs/_build/html/index.html"
 
 bench: setup
 	$(BIN)/python benchmarks/bench_identification.py
 
 clean:
-	rm -rf $(VENV) results .pytest_cache .ruff_cache .mypy_cache
+	rm -rf $(VENV) results .pytest_cache .ruff_cache .mypy_cache docs/_build docs/api/_generated
