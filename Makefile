@@ -27,8 +27,8 @@ test-all: setup
 	$(BIN)/python -m pytest -q
 
 lint: setup
-	$(BIN)/ruff check src tests benchmarks examples
-	$(BIN)/ruff format --check src tests benchmarks examples
+	$(BIN)/ruff check src tests benchmarks examples docs
+	$(BIN)/ruff format --check src tests benchmarks examples docs
 
 # mypy on the whole package with [tool.mypy] of pyproject.toml (about 20 s cold, 1 s cached).
 typecheck: setup
