@@ -1,4 +1,5 @@
-"""The tutorials in docs/ run as written: every bash block, in order, in a fresh folder.
+"""The tutorials in docs/ (and Getting started) run as written: every bash block, in order, in a
+fresh folder.
 
 Set-up lines (``make …``, ``export PATH=…``) are left out: the test runs with this
 environment's softbend first on PATH. The folder holds a link to the repository's ``src`` so
@@ -17,7 +18,8 @@ from pathlib import Path
 import pytest
 
 ROOT = Path(__file__).resolve().parents[1]
-TUTORIALS = sorted((ROOT / "docs").glob("tutorial-*.md"))
+#: The pages a newcomer follows step by step: the tutorials and Getting started.
+TUTORIALS = [*sorted((ROOT / "docs").glob("tutorial-*.md")), ROOT / "docs" / "getting-started.md"]
 _SETUP = re.compile(r"^\s*(make |export PATH=)")
 
 
