@@ -34,6 +34,8 @@ def test_custom_grid_and_bad_grids():
         default_pressures_mpa(-0.1)
     with pytest.raises(ValueError, match="'step_mpa'"):
         default_pressures_mpa(0.1, 0.0)
+    with pytest.raises(ValueError, match=r"'--pmax' of me must be .* \(the '--pstep'\)"):
+        default_pressures_mpa(0.1, 0.03, names=("--pmax", "--pstep"), owner="me")
 
 
 @pytest.mark.parametrize(

@@ -47,7 +47,11 @@ DEFAULT_PSTEP_MPA = 0.005
 
 
 def default_pressures_mpa(
-    pmax_mpa: float = DEFAULT_PMAX_MPA, step_mpa: float = DEFAULT_PSTEP_MPA
+    pmax_mpa: float = DEFAULT_PMAX_MPA,
+    step_mpa: float = DEFAULT_PSTEP_MPA,
+    *,
+    names: tuple[str, str] = ("pmax_mpa", "step_mpa"),
+    owner: str = "default_pressures_mpa",
 ) -> np.ndarray:
     """Uniform gauge-pressure grid ``0, step, 2·step, ..., pmax`` in MPa.
 
@@ -63,19 +67,24 @@ def default_pressures_mpa(
         (to 1e-9 relative).
     step_mpa : float
         Step, MPa, in (0, pmax_mpa].
+    names : (str, str)
+        What the caller calls the two, for messages (a command line: ``("--pmax", "--pstep")``).
+    owner : str
+        Who asks, for messages.
 
     Returns
     -------
     numpy.ndarray
         ``round(pmax/step) + 1`` increasing pressures starting at 0.
     """
-    owner = "default_pressures_mpa"
-    pmax = check_range(pmax_mpa, "pmax_mpa", owner, low=0.0, high=100.0, high_inclusive=True)
-    step = check_range(step_mpa, "step_mpa", owner, low=0.0, high=pmax, high_inclusive=True)
+    pmax_name, step_name = names
+    pmax = check_range(pmax_mpa, pmax_name, owner, low=0.0, high=100.0, high_inclusive=True)
+    step = check_range(step_mpa, step_name, owner, low=0.0, high=pmax, high_inclusive=True)
     n_steps = round(pmax / step)
     if abs(n_steps * step - pmax) > 1e-9 * pmax:
         raise ValueError(
-            f"The 'pmax_mpa' of {owner} must be a whole number of steps of {step:g} MPa. "
+            f"The '{pmax_name}' of {owner} must be a whole number of steps of {step:g} MPa "
+            f"(the '{step_name}'). "
             f"Got {pmax:g} MPa ({pmax / step:.6g} steps) instead."
         )
     if n_steps > 100_000:

@@ -14,7 +14,8 @@ from .conftest import one_error_line
         (["--design", "100,6,2"], "A design needs 6 values"),
         (["--maxh", "0"], "'maxh_mm' of FEMOptions"),
         (["--gravity", "up"], "'gravity' of FEMOptions must be one of"),
-        (["--pmax", "nan"], "'pmax_mpa' of default_pressures_mpa"),
+        (["--pmax", "nan"], "'--pmax' of softbend fem run"),
+        (["--pmax", "0.1", "--pstep", "0.03"], "'--pmax' of softbend fem run must be a whole"),
         (["--shapes", "0"], "'--shapes' must be an integer in [1, inf)"),
     ],
 )

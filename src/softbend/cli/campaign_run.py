@@ -127,7 +127,7 @@ def run(
     if seed < 0:
         raise ValueError(f"The '--seed' of {_OWNER} must be an integer >= 0. Got {seed} instead.")
     shard_of = parse_shard(shard, option="--shard", owner=_OWNER) if shard is not None else None
-    pressures = default_pressures_mpa(pmax, pstep)
+    pressures = default_pressures_mpa(pmax, pstep, names=("--pmax", "--pstep"), owner=_OWNER)
     with_surrogates()
     backend_obj = backend_for_run(
         backend,

@@ -97,7 +97,9 @@ def run(
     from softbend.reports.fem_figures import sweep_with_files
 
     actuator = SFRBADesign.parse(design)
-    pressures = default_pressures_mpa(pmax, pstep)
+    pressures = default_pressures_mpa(
+        pmax, pstep, names=("--pmax", "--pstep"), owner="softbend fem run"
+    )
     options = _options(maxh, gravity, material, output="solve" if solve_every else "interpolate")
     if shapes < 1:
         raise ValueError(f"The '--shapes' must be an integer in [1, inf). Got {shapes} instead.")

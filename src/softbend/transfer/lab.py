@@ -217,7 +217,10 @@ class VirtualLab:
         object.__setattr__(self, "seed", check_int(self.seed, "seed", _OWNER, low=0))
         if self.material is not None:
             self.elastomer_material()  # a bad spec is refused here, naming 'material'
-        default_pressures_mpa(self.pmax_mpa, self.pressure_step_mpa)  # whole number of steps
+        default_pressures_mpa(  # a whole number of steps
+            self.pmax_mpa, self.pressure_step_mpa, names=("pmax_mpa", "pressure_step_mpa"),
+            owner=_OWNER,
+        )  # fmt: skip
 
     # -- the gap -----------------------------------------------------------------
 
