@@ -112,3 +112,16 @@ def test_list_shipped_tests(capsys):
         "ecoflex-0050",
     ]
     assert "ODbL" in payload["attribution"]
+
+
+def test_a_test_in_kpa_is_one_line_exit_2_and_force_reads_it(tmp_path, capsys):
+    csv = tmp_path / "kpa.csv"
+    rows = "\n".join(f"{0.1 * i:.2f};{400.0 * 0.1 * i:.2f}" for i in range(1, 12))  # E = 400
+    csv.write_text("Engineering Strain;Engineering Stress (MPa)\n" + rows + "\n")
+    out = tmp_path / "o"
+    assert main(["materials", "fit", str(csv), "--out", str(out)]) == 2
+    line = one_error_line(capsys)
+    assert "looks like kPa" in line and "400 MPa" in line and "--force" in line
+    assert not out.exists()
+    assert main(["materials", "fit", str(csv), "--force", "--out", str(out)]) == 0
+    assert (out / "fit.json").exists()

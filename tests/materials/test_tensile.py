@@ -252,3 +252,38 @@ def test_summary_describes_the_shipped_dragon_skin_30():
     assert summary["source"].endswith("Dragon_Skin_30.csv")
     assert "Marechal" in summary["attribution"]
     json.dumps(summary)  # JSON-friendly as it is
+
+
+def _in_kpa(tmp_path, name, *, below_mpa=1.0):
+    """The shipped test ``name`` up to ``below_mpa`` of stress, written in kPa under (MPa)."""
+    test = load_shipped(name)
+    keep = test.engineering_stress_mpa < below_mpa
+    rows = [
+        f"{e:.6f};{1000.0 * s:.4f}"
+        for e, s in zip(
+            test.engineering_strain[keep], test.engineering_stress_mpa[keep], strict=True
+        )
+    ]
+    header = "Engineering Strain;Engineering Stress (MPa)"
+    return _write(tmp_path, rows, header=header, metadata=[], name=f"{name}_kpa.csv")
+
+
+@pytest.mark.parametrize("name", ["ecoflex-0030", "dragon-skin-10-medium", "dragon-skin-30"])
+def test_a_stress_column_in_kpa_is_caught_by_its_stiffness(tmp_path, name):
+    # Below 1 MPa (1000 kPa) every value is inside the plausible stress range: only the
+    # stiffness tells. The shipped tests themselves are far below the threshold.
+    path = _in_kpa(tmp_path, name)
+    with pytest.raises(DatasetError, match="looks like kPa: its median secant modulus") as caught:
+        load_tensile_csv(path)
+    assert "Divide the column by 1000" in str(caught.value) and path.name in str(caught.value)
+    with pytest.warns(UserWarning, match="read as given"):
+        stiff = load_tensile_csv(path, force=True)
+    assert stiff.engineering_stress_mpa.max() > 100.0  # read as given, nothing rescaled
+
+
+def test_every_shipped_test_is_well_below_the_kpa_stiffness():
+    for name in shipped_tensile_tests():
+        test = load_shipped(name)
+        small = (test.engineering_strain > 0) & (test.engineering_strain <= 0.5)
+        ratio = test.engineering_stress_mpa[small] / test.engineering_strain[small]
+        assert np.median(ratio) < 0.5  # MPa: 40 times below the threshold

@@ -66,6 +66,13 @@ def fit(
             show_default=False,
         ),
     ] = None,
+    force: Annotated[
+        bool,
+        typer.Option(
+            "--force",
+            help="Read a stress column that looks like kPa (stiffer than 20 MPa) as given.",
+        ),
+    ] = False,
     json_output: Annotated[bool, typer.Option("--json", help="Print the results as JSON.")] = False,
 ) -> None:
     """Fit hyperelastic models to a uniaxial tensile test.
@@ -88,7 +95,7 @@ def fit(
     names = [m.strip() for m in models.split(",") if m.strip()]
     inputs = (Path(csv),) if csv is not None and Path(csv).exists() else ()
     _common.check_output_dir(out, "--out", inputs=inputs, files=(FIT_PNG, FIT_JSON))
-    test = load_tensile(csv)
+    test = load_tensile(csv, force=force)
     results = fit_models(test, names, max_stretch=max_stretch)
 
     figure = out / FIT_PNG

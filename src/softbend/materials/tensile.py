@@ -17,6 +17,13 @@ ignored. A file over the ``file_mib`` or ``csv_rows`` limit of
 :mod:`softbend.limits` is refused before its rows are parsed, and a strain or
 stress outside its plausible range (:mod:`softbend.plausibility`) is an error
 naming the file, line and column.
+
+A stress column written in kPa under the ``(MPa)`` header is caught by the test's
+stiffness: the median secant modulus (stress over strain) up to 50 % strain above
+:data:`KPA_SECANT_MODULUS_MPA` (20 MPa) is refused as "looks like kPa". Silicones
+lie far below it (the shipped tests: 0.03 to 0.44 MPa; Sylgard 184 about 2 MPa),
+while the same tests written in kPa read 34 to 438. An elastomer that truly is this
+stiff is read with ``force=True`` (``--force``), with a warning.
 """
 
 from __future__ import annotations
@@ -24,6 +31,7 @@ from __future__ import annotations
 import logging
 import math
 import os
+import warnings
 from collections.abc import Mapping
 from dataclasses import dataclass, field
 from importlib import resources
@@ -222,6 +230,34 @@ def _parse_number(text: str, column: str, label: str, row: int, line: int) -> fl
 #: The plausible range (:mod:`softbend.plausibility`) and header of each column read.
 
 
+#: The median secant modulus up to 50 % strain, MPa, above which a stress column is taken for kPa.
+KPA_SECANT_MODULUS_MPA = 20.0
+
+
+def _check_not_kpa(strain: list[float], stress: list[float], label: str, force: bool) -> None:
+    """Refuse a stress column whose small-strain stiffness says it was written in kPa."""
+    eps, sig = np.asarray(strain), np.asarray(stress)
+    small = (eps > 0.0) & (eps <= 0.5)
+    if not small.any():
+        small = eps > 0.0
+    if not small.any():
+        return
+    secant = float(np.median(sig[small] / eps[small]))
+    if secant <= KPA_SECANT_MODULUS_MPA:
+        return
+    what = (
+        f"The '{ENGINEERING_STRESS_MPA}' of {label} looks like kPa: its median secant modulus "
+        f"up to 50 % strain is {secant:.4g} MPa, where silicones lie far below "
+        f"{KPA_SECANT_MODULUS_MPA:g} MPa (Dragon Skin 30: 0.44 MPa)"
+    )
+    if not force:
+        raise DatasetError(
+            f"{what}. Divide the column by 1000, or read it as given with force=True "
+            "(--force) for an elastomer this stiff."
+        )
+    warnings.warn(f"{what}; read as given (force).", UserWarning, stacklevel=4)
+
+
 def _parse_tensile_text(
     text: str,
     *,
@@ -231,6 +267,7 @@ def _parse_tensile_text(
     name: str | None,
     material: str | None,
     attribution: str,
+    force: bool = False,
 ) -> TensileTest:
     """Parse the text of a tensile data file; ``label`` names the file in messages."""
     lines = text.splitlines()
@@ -297,6 +334,7 @@ def _parse_tensile_text(
             f"The data rows of {label} must number at least {MIN_TENSILE_POINTS}. "
             f"Got {len(strain)} instead."
         )
+    _check_not_kpa(strain, stress, label, force)
     test = TensileTest(
         name=name or stem.lower().replace("_", "-").replace(" ", "-"),
         material=material or metadata.get("Material") or stem.replace("_", " "),
@@ -322,6 +360,7 @@ def load_tensile_csv(
     name: str | None = None,
     material: str | None = None,
     attribution: str = "",
+    force: bool = False,
 ) -> TensileTest:
     """Read a uniaxial tensile test from a semicolon-separated data file.
 
@@ -338,6 +377,9 @@ def load_tensile_csv(
         Readable material name; default: the file's ``Material`` entry, else the stem.
     attribution : str, optional
         Provenance and licence of the data, kept with the test.
+    force : bool, default False
+        Read a stress column that looks like kPa (:data:`KPA_SECANT_MODULUS_MPA`) as
+        given, with a warning, instead of refusing it.
 
     Returns
     -------
@@ -354,8 +396,8 @@ def load_tensile_csv(
         NaN or infinite, a strain is negative (the message gives the data row and
         the line), a value is outside the plausible range of its column
         (:mod:`softbend.plausibility`: ``strain``, ``stress_mpa``; the message
-        names the line and the column), or there are fewer than
-        :data:`MIN_TENSILE_POINTS` rows.
+        names the line and the column), there are fewer than
+        :data:`MIN_TENSILE_POINTS` rows, or the stress looks like kPa (without ``force``).
     LimitError
         If the file is larger than the ``file_mib`` limit or has more data rows
         than the ``csv_rows`` limit of :mod:`softbend.limits` (checked before the
@@ -375,6 +417,7 @@ def load_tensile_csv(
         name=name,
         material=material,
         attribution=attribution,
+        force=force,
     )
 
 
@@ -437,7 +480,9 @@ def load_shipped(name: str) -> TensileTest:
     )
 
 
-def load_tensile(source: str | os.PathLike[str] | None = None) -> TensileTest:
+def load_tensile(
+    source: str | os.PathLike[str] | None = None, *, force: bool = False
+) -> TensileTest:
     """A tensile test by file or by shipped name; the shipped ``"dragon-skin-30"`` by default.
 
     Parameters
@@ -445,6 +490,8 @@ def load_tensile(source: str | os.PathLike[str] | None = None) -> TensileTest:
     source : str or path-like, optional
         A tensile data file (:func:`load_tensile_csv`) if one exists there, else
         the name of a shipped test (:func:`shipped_tensile_tests`).
+    force : bool, default False
+        As :func:`load_tensile_csv`: read a stress column that looks like kPa as given.
 
     Raises
     ------
@@ -454,7 +501,7 @@ def load_tensile(source: str | os.PathLike[str] | None = None) -> TensileTest:
     if source is None:
         return load_shipped("dragon-skin-30")
     if Path(source).exists():
-        return load_tensile_csv(source)
+        return load_tensile_csv(source, force=force)
     shipped = shipped_tensile_tests()
     if source in shipped:
         return load_shipped(str(source))
