@@ -167,6 +167,11 @@ def _gpu_name() -> str | None:
     return None
 
 
+#: The 1-minute load average when the benchmark imported this module, before it ran: other
+#: work on the machine (None where the platform has no load average).
+_LOAD_AT_START = round(os.getloadavg()[0], 2) if hasattr(os, "getloadavg") else None
+
+
 def machine() -> dict[str, Any]:
     """Platform, CPU model, logical cores, memory (GiB) and the GPU used (or None)."""
     return {
@@ -174,8 +179,8 @@ def machine() -> dict[str, Any]:
         "gpu": _gpu_name(),
         "logical_cores": os.cpu_count(),
         "memory_gib": _memory_gib(),
-        # How busy the machine was as the figures were written (1-minute load average, Unix).
-        "load_average_1min": round(os.getloadavg()[0], 2) if hasattr(os, "getloadavg") else None,
+        # How busy the machine was before the benchmark started (1-minute load average, Unix).
+        "load_average_1min": _LOAD_AT_START,
         "platform": platform.platform(),
     }
 

@@ -141,7 +141,7 @@ def _machine(machine: Mapping[str, Any]) -> str:
         parts.append(f"{machine['memory_gib']} GiB memory")
     parts.append(f"GPU {machine['gpu']}" if machine.get("gpu") else "no GPU used")
     if machine.get("load_average_1min") is not None:
-        parts.append(f"load average {machine['load_average_1min']} as it finished")
+        parts.append(f"load average {machine['load_average_1min']} before it started")
     if machine.get("platform"):
         parts.append(str(machine["platform"]))
     return ", ".join(parts)
