@@ -3,6 +3,7 @@
 import json
 import os
 import signal
+import socket
 import subprocess
 import sys
 import threading
@@ -209,3 +210,31 @@ def test_serve_on_a_port_in_use_is_one_line(server, capsys):
     assert code == 2
     err = capsys.readouterr().err.strip().splitlines()
     assert len(err) == 1 and f"cannot listen on tcp://127.0.0.1:{server.port}" in err[0]
+
+
+@pytest.mark.skipif(sys.platform == "win32", reason="POSIX signals to a child")
+def test_kill_stops_the_served_rig_as_ctrl_c_does(tmp_path):
+    port = _free_port()
+    softbend = Path(sys.executable).with_name("softbend")  # the console script
+    cmd = [str(softbend), "control", "serve", "--port", str(port)]
+    child = subprocess.Popen(cmd, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+    try:
+        assert wait_for(lambda: _listening(port), timeout=60.0), "the rig never listened"
+        child.send_signal(signal.SIGTERM)
+        out, err = child.communicate(timeout=30)
+    finally:
+        child.kill()
+    assert child.returncode == 0, err
+    assert "valves left vented" in out.strip().splitlines()[-1]
+
+
+def _free_port() -> int:
+    with socket.socket() as probe:
+        probe.bind(("127.0.0.1", 0))
+        return probe.getsockname()[1]
+
+
+def _listening(port: int) -> bool:
+    with socket.socket() as probe:
+        probe.settimeout(0.2)
+        return probe.connect_ex(("127.0.0.1", port)) == 0

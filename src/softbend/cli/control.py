@@ -161,13 +161,15 @@ def serve_cmd(
     """Serve the simulated rig as a Modbus TCP device.
 
     A rehearsal of 'softbend control run --rig modbus': registers as in the
-    config; the actuator is vented when no request came for 0.25 s.
+    config; the actuator is vented when no request came for 0.25 s. Ctrl-C or
+    SIGTERM stops it with the valves vented (exit 0).
 
     Example:
 
     \b
         softbend control serve --config rig.toml --port 5020
     """
+    import signal
     import time
 
     from softbend._validation import check_range
@@ -180,12 +182,13 @@ def serve_cmd(
             config=config, host=host, port=port, design=design, model=model, plant=plant,
             supply_mpa=supply, rig_assignments=rig_params or (), seed=seed, command=command,
         )  # fmt: skip
-    server.start()
-    _common.console.print(
-        f"simulated rig {design} serving on {server.config.connection.where} "
-        f"({'Ctrl-C to stop' if duration == 0 else f'for {duration:g} s'})"
-    )
+    previous = control_run.terminate_as_interrupt()  # `kill` stops it as Ctrl-C does
     try:
+        server.start()
+        _common.console.print(
+            f"simulated rig {design} serving on {server.config.connection.where} "
+            f"({'Ctrl-C to stop' if duration == 0 else f'for {duration:g} s'})"
+        )
         end = time.monotonic() + (duration if duration > 0 else float("inf"))
         while time.monotonic() < end:
             time.sleep(min(0.2, max(0.0, end - time.monotonic())))
@@ -193,6 +196,8 @@ def serve_cmd(
         pass
     finally:
         server.stop()
+        if previous is not None:
+            signal.signal(signal.SIGTERM, previous)
     _common.console.print(f"served {server.requests} requests; valves left vented")
 
 

@@ -93,7 +93,7 @@ def run_cmd(
         done[0] = n
 
     device = plan.make_rig()
-    previous = _terminate_as_interrupt()
+    previous = terminate_as_interrupt()
     try:
         with (
             _common.output_errors(out, "--out"),  # the tick log: a full disk is one line
@@ -130,8 +130,8 @@ def run_cmd(
         raise typer.Exit(1)
 
 
-def _terminate_as_interrupt() -> Any:
-    """Make SIGTERM (``kill``, a service stop) end the loop as Ctrl-C does: vented.
+def terminate_as_interrupt() -> Any:
+    """Make SIGTERM (``kill``, a service stop) end a loop or a server as Ctrl-C does: vented.
 
     Returns the previous handler (None off the main thread, where signals
     cannot be set).
