@@ -80,17 +80,24 @@ class SpaceSpec:
     n_designs: int
     ranges: tuple[tuple[str, float, float], ...] = ()
 
-    def with_ranges(self, ranges: dict[str, tuple[float, float]]) -> SpaceSpec:
+    def with_ranges(
+        self,
+        ranges: dict[str, tuple[float, float]],
+        *,
+        option: str = "ranges",
+        owner: str = "SpaceSpec.with_ranges",
+    ) -> SpaceSpec:
         """The same space sampled over ``ranges`` (from :func:`parse_ranges`).
 
         Raises
         ------
         ValueError
-            Naming ``--range``: only the sampled spaces (``lhs:N``, ``sobol:N``) take ranges.
+            Naming ``option`` of ``owner``: only the sampled spaces (``lhs:N``, ``sobol:N``)
+            take ranges.
         """
         if self.kind not in ("lhs", "sobol"):
             raise ValueError(
-                f"The '--range' of a campaign applies to the sampled spaces lhs:N and sobol:N, "
+                f"The '{option}' of {owner} applies to the sampled spaces lhs:N and sobol:N, "
                 f"not to {self.text!r}, whose designs are paper B's Table 1 levels."
             )
         ordered = tuple((p, *ranges[p]) for p in _SHORT if p in ranges)

@@ -123,7 +123,8 @@ def run(
     _common.check_output_file(db, "DB", inputs=(model,) if model is not None else ())
     spec = parse_space(space, option="--space", owner=_OWNER)
     if ranges:
-        spec = spec.with_ranges(parse_ranges(ranges, option="--range", owner=_OWNER))
+        given = parse_ranges(ranges, option="--range", owner=_OWNER)
+        spec = spec.with_ranges(given, option="--range", owner=_OWNER)
     if seed < 0:
         raise ValueError(f"The '--seed' of {_OWNER} must be an integer >= 0. Got {seed} instead.")
     shard_of = parse_shard(shard, option="--shard", owner=_OWNER) if shard is not None else None
