@@ -17,7 +17,8 @@ once per run (once per variant, under the variant's name), which writes
     }
 
 Figures keep the order the benchmark gives them; every other key is sorted, so
-two runs that measure the same numbers write the same file up to the date. The
+two runs that measure the same numbers write the same file up to the date and the
+machine's load average before the run. The
 file is written to a temporary file in the same folder and renamed over the old
 one, so a reader never sees half of it. ``docs/gen_performance.py`` renders the
 files as the documentation's Performance page.

@@ -16,31 +16,15 @@ import typer
 
 from softbend.cli import app
 
+from .doc_commands import softbend_commands
+
 ROOT = Path(__file__).resolve().parents[1]
 PAGES = [ROOT / "README.md", *sorted((ROOT / "docs").glob("*.md"))]
 
 
 def _commands(page: Path) -> list[tuple[str, int, str]]:
     """``(page name, line, command)`` of every ``softbend …`` line in its bash blocks."""
-    out = []
-    inside = False
-    pending = ""
-    start = 0
-    for number, line in enumerate(page.read_text(encoding="utf-8").splitlines(), start=1):
-        if line.startswith("```"):
-            inside = line.strip() == "```bash" if not inside else False
-            continue
-        if not inside:
-            continue
-        text = line.split(" #", 1)[0].rstrip() if not line.lstrip().startswith("#") else ""
-        if pending:
-            pending += " " + text.strip().rstrip("\\").strip()
-        elif text.strip().startswith("softbend "):
-            pending, start = text.strip().rstrip("\\").strip(), number
-        if pending and not text.rstrip().endswith("\\"):
-            out.append((page.name, start, pending))
-            pending = ""
-    return out
+    return [(page.name, line, command) for line, command in softbend_commands(page)]
 
 
 COMMANDS = [c for page in PAGES for c in _commands(page)]

@@ -17,6 +17,8 @@ import subprocess
 import sys
 from pathlib import Path
 
+from .doc_commands import softbend_commands
+
 ROOT = Path(__file__).resolve().parents[1]
 
 #: Options appended to each README command (by its command path) in the quick variant.
@@ -38,24 +40,8 @@ QUICK: dict[str, tuple[str, ...]] = {
 
 
 def _commands() -> list[list[str]]:
-    """The README's ``softbend`` commands, continuation lines joined, comments dropped."""
-    out: list[list[str]] = []
-    inside, pending = False, ""
-    for line in (ROOT / "README.md").read_text(encoding="utf-8").splitlines():
-        if line.startswith("```"):
-            inside = line.strip() == "```bash" if not inside else False
-            continue
-        text = line.split(" #", 1)[0].rstrip() if inside else ""
-        if text.lstrip().startswith("#"):
-            text = ""
-        if pending:
-            pending += " " + text.strip().rstrip("\\").strip()
-        elif text.strip().startswith("softbend "):
-            pending = text.strip().rstrip("\\").strip()
-        if pending and not text.rstrip().endswith("\\"):
-            out.append(shlex.split(pending))
-            pending = ""
-    return out
+    """The README's ``softbend`` commands as words, continuation lines joined."""
+    return [shlex.split(command) for _, command in softbend_commands(ROOT / "README.md")]
 
 
 def _path(words: list[str]) -> str:

@@ -192,11 +192,11 @@ class LoopPlan:
             )  # fmt: skip
         finally:
             device.close()
-        summary = self._summary(device, result)
-        beyond = beyond_support(self.setup, self._reached(result))
+        reached = self._reached(result)
+        beyond = beyond_support(self.setup, reached)
         if beyond is not None:
             warnings.warn(beyond, UserWarning, stacklevel=2)
-        return LoopResult(loop=result, summary=summary)
+        return LoopResult(loop=result, summary=self._summary(device, result, reached, beyond))
 
     @staticmethod
     def _reached(result: Any) -> float:
@@ -205,7 +205,9 @@ class LoopPlan:
         finite = measured[np.isfinite(measured)]
         return float(finite.max()) if finite.size else 0.0
 
-    def _summary(self, device: Any, result: Any) -> dict[str, Any]:
+    def _summary(
+        self, device: Any, result: Any, reached: float, beyond: str | None
+    ) -> dict[str, Any]:
         synthetic = bool(getattr(device, "synthetic", False))
         record = self.setup.record()
         summary = {
@@ -230,8 +232,8 @@ class LoopPlan:
             "rig_settings": dict(self.setup.rig_settings) if synthetic else None,
             "support": {
                 "supported_mpa": self.setup.supported_mpa,
-                "max_pressure_mpa": self._reached(result),
-                "beyond": beyond_support(self.setup, self._reached(result)) is not None,
+                "max_pressure_mpa": reached,
+                "beyond": beyond is not None,
                 "notes": list(self.setup.support_notes),
             },
         }
