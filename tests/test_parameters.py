@@ -118,3 +118,84 @@ def test_assignments():
         parse_assignments(["a"])
     with pytest.raises(ValueError, match="given twice"):
         parse_assignments(["a=1", "a=2"])
+
+
+# --- declared ranges -----------------------------------------------------------------------
+
+
+def _ranged():
+    from softbend.parameters import Range, declare_ranges
+
+    @declare_ranges(
+        period=Range(1e-4, 10.0, "s", "a tick"),
+        gain=Range(0.0, 1.0, low_inclusive=False),
+        hidden_sizes=Range(1, 1024, "units", max_items=8),
+    )
+    def factory(
+        model, *, period: float = 0.01, gain: float = 0.5, hidden_sizes=(8, 8), name: str = "a"
+    ):
+        return None
+
+    return factory
+
+
+@pytest.mark.parametrize(
+    ("text", "shown"),
+    [
+        ({"period": "1e-12"}, "must be [0.0001, 10] s. Got '1e-12'"),
+        ({"period": "11"}, "[0.0001, 10] s"),
+        ({"gain": "0"}, "must be (0, 1]. Got '0'"),
+        ({"hidden_sizes": "0,0"}, "1 to 8 values, each in [1, 1024] units. Got 0,0"),
+        ({"hidden_sizes": "100000,100000"}, "Got 100000,100000"),
+        ({"hidden_sizes": "-3,4"}, "Got -3,4"),
+        ({"hidden_sizes": ",".join(["4"] * 9)}, "1 to 8 values"),
+    ],
+)
+def test_a_value_outside_its_declared_range_is_refused(text, shown):
+    with pytest.raises(ParameterValueError) as info:
+        check_parameters(_ranged(), text, owner="controller 'x'", field="--set", from_text=True)
+    message = str(info.value)
+    assert shown in message
+    assert message.startswith(f"The parameter {next(iter(text))!r} of controller 'x' (in --set)")
+    assert info.value.key == next(iter(text))
+
+
+def test_values_inside_their_ranges_pass_and_undeclared_ones_are_not_bounded():
+    checked = check_parameters(
+        _ranged(),
+        {"period": "10", "gain": "1", "hidden_sizes": "1024,1", "name": "b"},
+        owner="x",
+        field="--set",
+        from_text=True,
+    )
+    assert checked == {"period": 10.0, "gain": 1.0, "hidden_sizes": (1024, 1), "name": "b"}
+    data = check_parameters(_ranged(), {"period": 1e-4}, owner="x", field="[controller]")
+    assert data == {"period": 1e-4}
+
+
+def test_ranges_are_declared_only_for_parameters_that_exist():
+    from softbend.parameters import Range, declare_ranges
+
+    with pytest.raises(TypeError, match="no parameter"):
+
+        @declare_ranges(nope=Range(0, 1))
+        def factory(model, *, period: float = 0.01):
+            return None
+
+
+def test_a_subclass_inherits_and_overrides_the_declarations():
+    from softbend.parameters import Range, declare_ranges, declared_ranges
+
+    @declare_ranges(a=Range(0, 1), b=Range(0, 2))
+    class Base:
+        def __init__(self, *, a: float = 0.5, b: float = 1.0):
+            pass
+
+    @declare_ranges(b=Range(0, 3))
+    class Child(Base):
+        pass
+
+    assert declared_ranges(Child) == {"a": Range(0, 1), "b": Range(0, 3)}
+    assert declared_ranges(Base)["b"] == Range(0, 2)
+    assert Range(0, 1).describe() == "[0, 1]"
+    assert Range(0.0, unit="s", low_inclusive=False).describe() == "(0, inf) s"

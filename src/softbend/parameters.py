@@ -17,6 +17,17 @@ integer, a number, a string, or integers separated by commas for a tuple of
 integers (``hidden_sizes=63,65``). An ``epochs`` parameter is held to the
 ``epochs`` limit of :mod:`softbend.limits`. :func:`effective_parameters` fills
 in the defaults, for the record of a run.
+
+Every numeric parameter also declares the physical or computational range it
+accepts, beside its definition::
+
+    @declare_ranges(deadzone=Range(0, 0.5, "fraction of the target"),
+                    period=Range(1e-4, 10, "s"))
+    def bang_bang(model, *, deadzone: float = 0.05, period: float = 0.01): ...
+
+:func:`check_parameters` holds each given value to its range before any work
+(a tuple of integers element by element, and to ``max_items``), and the
+guarantees page lists the declarations (:func:`declared_ranges`).
 """
 
 from __future__ import annotations
@@ -25,7 +36,8 @@ import inspect
 import math
 import numbers
 from collections.abc import Callable, Collection, Mapping, Sequence
-from typing import Any
+from dataclasses import dataclass
+from typing import Any, TypeVar
 
 from softbend.errors import SoftbendError
 from softbend.limits import check_limit
@@ -33,8 +45,11 @@ from softbend.registry import UnknownNameError
 
 __all__ = [
     "ParameterValueError",
+    "Range",
     "UnknownParameterError",
     "check_parameters",
+    "declare_ranges",
+    "declared_ranges",
     "effective_parameters",
     "parameter_defaults",
     "parse_assignments",
@@ -68,6 +83,96 @@ class ParameterValueError(SoftbendError, ValueError):
     def __init__(self, message: str, key: str) -> None:
         super().__init__(message)
         self.key = key
+
+
+def _bound(value: float) -> str:
+    if math.isinf(value):
+        return "inf" if value > 0 else "-inf"
+    return f"{value:g}"
+
+
+@dataclass(frozen=True)
+class Range:
+    """The values a numeric parameter accepts: an interval, and what it means.
+
+    Parameters
+    ----------
+    low, high : float
+        The bounds (``-inf``/``inf`` for none).
+    unit : str, default ""
+        The unit of the values, for messages and the guarantees page (``"s"``).
+    why : str, default ""
+        Why the bounds are where they are, for the guarantees page.
+    low_inclusive, high_inclusive : bool, default True
+        Whether the bounds belong to the interval.
+    max_items : int, optional
+        For a tuple of integers (``hidden_sizes``): the most items; each item
+        is held to the interval.
+    """
+
+    low: float = -math.inf
+    high: float = math.inf
+    unit: str = ""
+    why: str = ""
+    low_inclusive: bool = True
+    high_inclusive: bool = True
+    max_items: int | None = None
+
+    def interval(self) -> str:
+        """The interval as text, e.g. ``[1e-05, 0.01]`` or ``(0, inf)``."""
+        left = "[" if self.low_inclusive and math.isfinite(self.low) else "("
+        right = "]" if self.high_inclusive and math.isfinite(self.high) else ")"
+        return f"{left}{_bound(self.low)}, {_bound(self.high)}{right}"
+
+    def describe(self) -> str:
+        """The interval with its unit and item count, e.g. ``[1e-05, 0.01] s``."""
+        text = self.interval() + (f" {self.unit}" if self.unit else "")
+        if self.max_items is not None:
+            text = f"1 to {self.max_items} values, each in {text}"
+        return text
+
+    def contains(self, value: Any) -> bool:
+        """Whether ``value`` (a number, or a tuple of them with ``max_items``) is accepted."""
+        if isinstance(value, tuple | list):
+            if self.max_items is not None and not 1 <= len(value) <= self.max_items:
+                return False
+            return all(self.contains(v) for v in value)
+        if isinstance(value, bool) or not isinstance(value, numbers.Real):
+            return True  # not a number: the kind check speaks for it
+        number = float(value)
+        if math.isnan(number):
+            return False
+        below = number < self.low or (number == self.low and not self.low_inclusive)
+        above = number > self.high or (number == self.high and not self.high_inclusive)
+        return not (below or above)
+
+
+Entry = TypeVar("Entry", bound=Callable[..., Any])
+
+
+def declare_ranges(**ranges: Range) -> Callable[[Entry], Entry]:
+    """Declare the :class:`Range` of public parameters of a factory or class.
+
+    Used as a decorator; the ranges are read by :func:`check_parameters` and
+    listed by :func:`declared_ranges`. A class inherits its parents'
+    declarations, and its own override them.
+    """
+
+    def attach(entry: Entry) -> Entry:
+        known, open_ended = public_parameters(entry, keyword_only=False)
+        unknown = [name for name in ranges if name not in known and not open_ended]
+        if unknown:
+            raise TypeError(f"{entry!r} has no parameter(s) {', '.join(unknown)} to declare")
+        inherited = dict(getattr(entry, "__parameter_ranges__", {}))
+        entry.__parameter_ranges__ = {**inherited, **ranges}  # type: ignore[attr-defined]
+        return entry
+
+    return attach
+
+
+def declared_ranges(entry: Callable[..., Any]) -> dict[str, Range]:
+    """The declared :class:`Range` of each parameter of ``entry`` (empty if none)."""
+    return dict(getattr(entry, "__parameter_ranges__", {}))
 
 
 def public_parameters(
@@ -260,11 +365,13 @@ def check_parameters(
     UnknownParameterError
         A name ``entry`` does not take; the message lists the known names.
     ParameterValueError
-        A value that is not of the parameter's kind, or a number that is not finite.
+        A value that is not of the parameter's kind, a number that is not finite,
+        or a value outside its declared :class:`Range`.
     LimitError
         ``epochs`` over the ``epochs`` limit of :mod:`softbend.limits`.
     """
     known, open_ended = public_parameters(entry, skip=skip, keyword_only=keyword_only)
+    ranges = declared_ranges(entry)
     checked: dict[str, Any] = {}
     for key, value in (values or {}).items():
         if key not in known and not open_ended:
@@ -291,5 +398,13 @@ def check_parameters(
             )
         if key == "epochs" and kind == "int":
             check_limit("epochs", result, f"The 'epochs' of {owner} (in {field})")
+        declared = ranges.get(key)
+        if declared is not None and not declared.contains(result):
+            shown = ",".join(map(str, result)) if isinstance(result, tuple) else repr(value)
+            raise ParameterValueError(
+                f"The parameter {key!r} of {owner} (in {field}) must be "
+                f"{declared.describe()}. Got {shown} instead.",
+                key,
+            )
         checked[key] = result
     return checked
