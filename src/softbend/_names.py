@@ -35,7 +35,7 @@ MAX_NAME_CHARS = 64
 #: The rule in words, for messages and the guarantees page.
 NAME_RULE = (
     f"1 to {MAX_NAME_CHARS} letters, digits, '-', '_', '.' or inner spaces, not starting "
-    "with '.', with no '/' or '\\\\'"
+    "with '.', with no '/' or '\\'"
 )
 
 _ALLOWED = re.compile(r"[\w\-. ]+")
