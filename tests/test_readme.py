@@ -67,18 +67,57 @@ def test_every_readme_command_has_a_quick_variant():
     assert not unknown, f"add the README's {unknown} to QUICK (with the options that make it quick)"
 
 
+def _tree(root: Path) -> dict[str, tuple[int, int]]:
+    """Every file and folder under ``root`` (links not followed): size and modification time."""
+    found = {}
+    for path in root.rglob("*"):
+        if path.is_symlink():
+            continue
+        info = path.stat()
+        found[path.relative_to(root).as_posix()] = (info.st_size, info.st_mtime_ns)
+    return found
+
+
+def _outputs(words: list[str]) -> set[str]:
+    """The first path component of every output a command names: --out, -o, a campaign's DB."""
+    named = {words[i + 1] for i, w in enumerate(words[:-1]) if w in ("--out", "-o")}
+    if _path(words) == "campaign run":
+        named.add(words[3])
+    return {Path(n).parts[0] for n in named}
+
+
+def _outside(changed: set[str], outputs: set[str]) -> list[str]:
+    """The changed paths outside a command's outputs.
+
+    Beside an output file, its companions count as the output: a DuckDB write-ahead
+    log (``table1.duckdb.wal``) and the figure of a measurement file (``lab.png``
+    beside ``lab.csv``).
+    """
+
+    def own(top: str, output: str) -> bool:
+        stem = Path(output).stem
+        return top in (output, f"{output}.wal") or (stem != output and top == f"{stem}.png")
+
+    return sorted(p for p in changed if not any(own(Path(p).parts[0], o) for o in outputs))
+
+
 def test_the_tour_runs_in_its_quick_variant(tmp_path):
+    """Each command succeeds and writes nothing outside its own outputs."""
     (tmp_path / "src").symlink_to(ROOT / "src", target_is_directory=True)
     bin_dir = Path(sys.executable).parent
     env = {**os.environ, "PATH": f"{bin_dir}{os.pathsep}{os.environ['PATH']}"}
     softbend = str(bin_dir / "softbend") if (bin_dir / "softbend").exists() else "softbend"
     for words in COMMANDS:
         argv = [softbend, *words[1:], *QUICK[_path(words)]]
+        before = _tree(tmp_path)
         done = subprocess.run(
             argv, cwd=tmp_path, env=env, capture_output=True, text=True, timeout=600, check=False
         )
         shown = " ".join(words)
         assert done.returncode == 0, f"{shown}\n{done.stderr[-3000:]}"
+        after = _tree(tmp_path)
+        changed = {p for p, v in after.items() if before.get(p) != v} | (set(before) - set(after))
+        assert not _outside(changed, _outputs(words)), f"{shown} wrote outside its outputs"
     # The tour's files are where the README says they are.
     for name in ("mat/fit.json", "table1.duckdb", "surrogates/models/mlp.json", "refined.json"):
         assert (tmp_path / name).exists(), name
