@@ -224,7 +224,55 @@ def test_csv_formats(tmp_path, fuzz_counter, name, data):
     _only_own_errors(_reader(name), path, fuzz_counter, name)
 
 
-# --- rig TOML ------------------------------------------------------------------------------
+# --- TOML formats: rig files and design specifications ------------------------------------
+
+
+@st.composite
+def damaged_toml(draw: st.DrawFn, seed: str) -> str:
+    """``seed`` damaged as text, now and then with a key nested thousands deep."""
+    text = draw(damaged_text(seed))
+    deep = draw(st.integers(0, 9))
+    if deep == 0:  # an array 20 000 deep
+        text += "\ndeep = " + "[" * 20_000 + "]" * 20_000 + "\n"
+    elif deep == 1:  # an inline table 3 000 deep
+        text += "\ndeep = " + "{a = " * 3_000 + "1" + "}" * 3_000 + "\n"
+    elif deep == 2:  # tables nested by a dotted header
+        text += "\n[" + ".".join(["t"] * draw(st.integers(60, 400))) + "]\nx = 1\n"
+    return text
+
+
+SPECS = """\
+[[spec]]
+name = "gripper finger"
+angle = 90.0
+at = 0.08
+tolerance = 3.0
+minimize = ["l"]
+fix = {phi = 10.0}
+range = {t = [3.0, 4.0]}
+resolution = 0.5
+
+[[spec]]
+name = "stiff"
+max_angle_at = 0.1
+maximize = ["angle"]
+resolution = {l = 1.0}
+
+[[spec]]
+name = "curve"
+curve = [[0.05, 40.0], [0.1, 95.0]]
+"""
+
+
+@SETTINGS
+@given(data=st.data())
+def test_design_spec_toml(tmp_path, fuzz_counter, data):
+    from softbend.design_search.spec import load_specifications
+
+    text = data.draw(damaged_toml(SPECS))
+    path = tmp_path / "specs.toml"
+    path.write_text(text, encoding="utf-8", errors="surrogatepass")
+    _only_own_errors(load_specifications, path, fuzz_counter, "design spec TOML")
 
 
 @SETTINGS
@@ -232,7 +280,7 @@ def test_csv_formats(tmp_path, fuzz_counter, name, data):
 def test_rig_toml(tmp_path, fuzz_counter, data):
     from softbend.control.rigconfig import RigConfig, load_rig_config
 
-    text = data.draw(damaged_text(RigConfig().to_toml()))
+    text = data.draw(damaged_toml(RigConfig().to_toml()))
     path = tmp_path / "rig.toml"
     path.write_text(text, encoding="utf-8", errors="surrogatepass")
     _only_own_errors(load_rig_config, path, fuzz_counter, "rig TOML")
