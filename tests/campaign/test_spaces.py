@@ -136,6 +136,8 @@ def test_ranges_of_one_s_own_are_read_by_short_name():
         (["phi=-1:20"], "[0, 60] deg"),
         (["l=60:90", "l=70:80"], "gives l twice"),
         (["r=2:4"], "t's high must be below r's low. Got t up to 4 mm and r from 2 mm"),
+        (["t=1e-9:1e-8"], "at least 1e-06 mm wide from at least 1e-06 mm"),
+        (["phi=0:1e-9"], "at least 1e-06 deg wide (designs are sampled to 1e-06 deg)"),
     ],
 )
 def test_a_bad_range_is_one_error_naming_the_option(texts, needle):

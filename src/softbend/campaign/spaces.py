@@ -119,6 +119,10 @@ class SpaceSpec:
         return DesignSpace(space.designs, name=f"{space.name} {own}")
 
 
+#: The step to which sampled design values are rounded (DesignSpace.sample), mm or degrees.
+_RECORDED = 1e-6
+
+
 def parse_ranges(
     texts: Sequence[str], *, option: str = "ranges", owner: str = "parse_ranges"
 ) -> dict[str, tuple[float, float]]:
@@ -154,6 +158,18 @@ def parse_ranges(
             bound = f"{opening}{least:g}, {most:g}] {unit}"
             raise ValueError(
                 f"The '{option}' of {owner} must give {name} a range LOW < HIGH within {bound}. "
+                f"Got {text!r} instead."
+            )
+        unit = "deg" if name == "phi" else "mm"
+        if (
+            high - low < _RECORDED
+            or round(low, 6) == round(high, 6)
+            or (not closed and round(low, 6) <= least)
+        ):
+            start = "" if closed else f" from at least {_RECORDED:g} {unit}"
+            raise ValueError(
+                f"The '{option}' of {owner} must give {name} a range at least {_RECORDED:g} "
+                f"{unit} wide{start} (designs are sampled to {_RECORDED:g} {unit}). "
                 f"Got {text!r} instead."
             )
         if name in out:
