@@ -87,3 +87,99 @@ def test_the_default_candidates_hold_every_baseline_and_a_seeded_search():
         paper.output_lags,
         paper.input_lags,
     ) == (2, 2)
+
+
+def _no_fit(monkeypatch):
+    """Make any model fit fail the test: a check must come before the first one."""
+    from softbend.identification.multi import MultiNARX
+
+    def fit(self, *args, **kwargs):
+        raise AssertionError("a model was fitted before the input was checked")
+
+    monkeypatch.setattr(MultiNARX, "fit", fit)
+
+
+@pytest.mark.parametrize(
+    ("kwargs", "match"),
+    [
+        ({"seed": -1}, r"^The 'seed' of select_model must be an integer in \[0, 4294967295\]\. "
+                       r"Got -1 instead\.$"),
+        ({"folds": 1}, r"'folds' of select_model must be an integer in \[2, 1000\]\. Got 1 "),
+        ({"folds": 10**20}, r"'folds' of select_model must be an integer in \[2, 1000\]"),
+        ({"validate_on": ["e0", "e0"]}, r"must name each experiment once\. Got 'e0' more than"),
+    ],
+)  # fmt: skip
+def test_bad_settings_are_refused_before_any_fit(monkeypatch, kwargs, match):
+    data = _linear_set(n_experiments=4, n=40)
+    _no_fit(monkeypatch)
+    with pytest.raises(ValueError, match=match):
+        select_model(data, candidates=FEW[:1], **kwargs)
+
+
+def test_default_candidates_refuses_a_negative_seed():
+    with pytest.raises(ValueError, match=r"'seed' of default_candidates must be an integer in"):
+        default_candidates(-1)
+
+
+def _with_output(values_of) -> TimeSeriesSet:
+    rng = np.random.default_rng(0)
+    experiments = [
+        Series(f"e{i}", np.arange(30.0), rng.normal(size=30), values_of(i, rng)) for i in range(3)
+    ]
+    return TimeSeriesSet(("u",), ("y",), tuple(experiments))
+
+
+@pytest.mark.parametrize(
+    ("values_of", "match"),
+    [
+        (lambda i, rng: np.full(30, 3.0), r"output column 'y' is constant .*every sample 3\.0"),
+        (lambda i, rng: 1e301 * rng.normal(size=30), r"output column 'y' of experiment 'e0'"),
+    ],
+    ids=["constant", "1e301"],
+)
+def test_a_constant_or_overflowing_output_is_refused_before_any_fit(monkeypatch, values_of, match):
+    from softbend.errors import DatasetError
+
+    _no_fit(monkeypatch)
+    with pytest.raises(DatasetError, match=match):
+        select_model(_with_output(values_of), candidates=FEW, folds=2)
+
+
+def test_folds_too_short_for_the_kernel_candidates_are_refused_before_any_fit(monkeypatch):
+    from softbend.errors import DatasetError
+
+    data = _with_output(lambda i, rng: rng.normal(size=30))
+    short = TimeSeriesSet(("u",), ("y",), tuple(e.__class__(e.name, e.time[:4], e.inputs[:4],
+                          e.outputs[:4]) for e in data.experiments))  # fmt: skip
+    _no_fit(monkeypatch)
+    with pytest.raises(DatasetError, match=r"need at least 4 regressor rows.*give 2 \(lags up"):
+        select_model(short, candidates=FEW, folds=2)
+
+
+def test_figures_that_are_not_finite_fail_the_selection(monkeypatch):
+    from softbend.errors import ConvergenceError
+    from softbend.identification import selection as module
+
+    real = module.free_run_error
+
+    def broken(model, data, ranges):
+        free, step, simulated = real(model, data, ranges)
+        return (np.nan if model.family == "poly2" else free), step, simulated
+
+    monkeypatch.setattr(module, "free_run_error", broken)
+    with pytest.raises(ConvergenceError, match=r"cv_freerun_nrmse of candidate poly2-1-1 is nan"):
+        select_model(_linear_set(n_experiments=3, n=60), candidates=FEW[:3], folds=2)
+
+
+def test_the_verdict_has_no_nan_when_the_linear_model_is_exact():
+    from softbend.identification.selection import Selection
+
+    selection = select_model(_linear_set(n_experiments=3, n=60), candidates=FEW[:3], folds=2)
+    table = selection.table.copy()
+    table["validation_freerun_nrmse"] = [0.0 if f == "arx" else 0.5 for f in table["family"]]
+    table.loc[table["family"] == "poly2", "cv_freerun_nrmse"] = 0.0
+    best = table.loc[table["family"] == "poly2", "candidate"].iloc[0]
+    table = table.sort_values("cv_freerun_nrmse").reset_index(drop=True)
+    fake = Selection(**{**selection.__dict__, "table": table, "best": best, "validation": ("x",)})
+    verdict = fake.verdict()
+    assert "nan" not in verdict and "against 0 for the best linear ARX" in verdict

@@ -1,3 +1,5 @@
+import warnings
+
 import numpy as np
 import pytest
 
@@ -118,3 +120,58 @@ def test_split_by_sign_keeps_order(small_dataset):
 def test_bad_configuration_names_the_field(field, value):
     with pytest.raises(ValueError, match=f"'{field}' of IdentificationConfig"):
         IdentificationConfig(**{field: value})
+
+
+@pytest.mark.parametrize(
+    ("field", "value", "shown"),
+    [
+        ("C", 1e300, r"a number in \(0, 10000\]\. Got 1e\+300"),
+        ("epsilon", float("nan"), r"a number in \[0, 10\]\. Got nan"),
+        ("input_lags", 1_000_000_000, r"an integer in \[1, 50\]\. Got 1000000000"),
+        ("output_lags", 99999999999999999999, r"an integer in \[1, 50\]\. Got 9{20}"),
+    ],
+)
+def test_settings_beyond_their_declared_range_are_refused(field, value, shown):
+    with pytest.raises(
+        ValueError, match=rf"^The '{field}' of IdentificationConfig must be {shown}"
+    ):
+        IdentificationConfig(**{field: value})
+
+
+def test_lags_the_shortest_experiment_cannot_hold_are_refused_before_any_fit(small_dataset):
+    short = synthetic_dataset(n_experiments=2, n_samples=16, seed=1)["positive"]
+    calls = []
+    with pytest.raises(ValueError, match=r"'output_lags' of IdentificationConfig must be an "
+                       r"integer in \[1, 12\] for these experiments.*16 sample"):  # fmt: skip
+        identify(short, IdentificationConfig(output_lags=13), progress=calls.append)
+    assert calls == []
+
+
+def test_a_constant_output_is_refused_before_any_fit(small_dataset):
+    from softbend.identification.data import Experiment
+
+    rest = small_dataset[0]
+    still = Experiment(
+        "still", rest.time_s, np.full(rest.n_samples, 5.0), np.zeros(rest.n_samples),
+        np.zeros(rest.n_samples),
+    )  # fmt: skip
+    calls = []
+    with pytest.raises(DatasetError, match=r"'still' has a constant rho \(every sample 0\)"):
+        identify([*small_dataset, still], progress=calls.append)
+    assert calls == []
+
+
+def test_a_diverged_free_run_is_an_error_not_nan_figures(small_dataset, monkeypatch):
+    from softbend.errors import ConvergenceError
+    from softbend.identification.narx import NARXRegressor
+
+    def diverged(self, X, y_init, *, groups=None):
+        warnings.warn("diverged", RuntimeWarning, stacklevel=2)
+        return np.full(np.shape(X)[0], np.nan)
+
+    monkeypatch.setattr(NARXRegressor, "simulate", diverged)
+    pair = [e for e in small_dataset if e.sign == "negative"][:2]
+    with warnings.catch_warnings():
+        warnings.simplefilter("error", RuntimeWarning)  # the error only, no warning besides
+        with pytest.raises(ConvergenceError, match=r"free-run prediction of rho.*not finite"):
+            identify(pair)

@@ -387,3 +387,23 @@ def test_bad_solver_and_estimation_settings_raise_naming_the_field(params, match
     X, y = _nonlinear_problem(n_samples=30)
     with pytest.raises(ValueError, match=match):
         GeneralizedGaussianSVR(**params).fit(X, y)
+
+
+def test_no_support_vector_is_the_intercept_everywhere(tmp_path):
+    """ε wider than the data (every sample in the tube): a constant model, no NaN centre."""
+    from softbend.identification.narx import NARXRegressor
+    from softbend.identification.persistence import load_narx, save_narx
+
+    X, y = _nonlinear_problem(n_samples=40)
+    with warnings.catch_warnings():
+        warnings.simplefilter("error", RuntimeWarning)  # the mean of no support vector
+        model = GeneralizedGaussianSVR(epsilon=10.0).fit(X, y)
+        assert model.n_support_ == 0
+        predict_one = model.predictor()
+        for row in (X[0], 100.0 * X[1]):
+            assert predict_one(row) == pytest.approx(model.intercept_)
+        np.testing.assert_allclose(model.predict(X[:3]), model.intercept_)
+        narx = NARXRegressor(estimator=GeneralizedGaussianSVR(epsilon=10.0)).fit(X[:, :1], y)
+        loaded, _ = load_narx(save_narx(narx, tmp_path / "m.json"))
+        simulated = loaded.simulate(X[:, :1], y)
+    assert np.isfinite(simulated).all()

@@ -6,6 +6,7 @@ from softbend.identification.timeseries import Series, TimeSeriesSet
 from softbend.identification.timeseries_io import (
     check_experiments_for_lags,
     check_holdout,
+    check_signals,
     load_timeseries,
     save_timeseries,
 )
@@ -333,11 +334,51 @@ def test_check_holdout():
     check_holdout(data, "c")
     with pytest.raises(ValueError, match=r"'zz'.*\(a, b, c\)|\(a, b, c\).*'zz'"):
         check_holdout(data, ["a", "zz"])
-    with pytest.raises(ValueError, match="at least one experiment to train"):
+    with pytest.raises(ValueError, match="at least 2 of the 3 experiments to train on"):
         check_holdout(data, ["a", "b", "c"])
     with pytest.raises(ValueError, match="at least one experiment, or be None"):
         check_holdout(data, [])
     with pytest.raises(ValueError, match="nothing to hold out"):
         check_holdout(data.subset(["a"]), None)
-    with pytest.raises(ValueError, match="at least one experiment to train"):
+    with pytest.raises(ValueError, match="at least 2 of the 1 experiments to train"):
         check_holdout(data.subset(["a"]), ["a"])
+
+
+def test_check_holdout_refuses_a_repeated_name_and_a_single_training_experiment():
+    data = _set("a", "b", "c", n=5)
+    with pytest.raises(ValueError, match=r"^The '--validate-on' must name each experiment once\. "
+                       r"Got 'a' more than once\.$"):  # fmt: skip
+        check_holdout(data, ["a", "a"], label="'--validate-on'")
+    # selecting holds one training experiment out at a time: one left is too few
+    with pytest.raises(ValueError, match=r"'--validate-on' must leave at least 2 .*leaves 'c'"):
+        check_holdout(data, ["a", "b"], label="'--validate-on'")
+
+
+def _one_output(*columns, inputs=None):
+    """A set of one output column per experiment (``columns``), inputs random by default."""
+    experiments = []
+    for k, column in enumerate(columns):
+        values = np.asarray(column, dtype=float)
+        u = np.arange(values.size, dtype=float) if inputs is None else inputs
+        experiments.append(Series(f"e{k}", np.arange(values.size), u, values, source=f"f{k}.csv"))
+    return TimeSeriesSet(("u",), ("y",), tuple(experiments))
+
+
+def test_check_signals_refuses_a_constant_output_naming_the_column():
+    check_signals(_one_output([1, 2, 3], [1, 1, 1]))  # constant in one experiment only: fine
+    with pytest.raises(DatasetError, match=r"output column 'y' is constant .*every sample 3\.0"):
+        check_signals(_one_output([3, 3, 3], [3, 3, 3]))
+    # constant over the training experiments: the validation one does not count
+    with pytest.raises(DatasetError, match="'y' is constant over the training experiments"):
+        check_signals(_one_output([3, 3, 3], [3, 3, 3], [1, 2, 3]), ["e2"])
+    with pytest.raises(DatasetError, match=r"'y' varies by only 1e-200"):
+        check_signals(_one_output([0, 1e-200, 0], [0, 0, 0]))
+
+
+def test_check_signals_refuses_values_whose_squares_overflow():
+    with pytest.raises(DatasetError, match=r"output column 'y' of experiment 'e1' \(f1\.csv\) "
+                       r"holds 1e\+301 at sample 2.*within ±1e\+100"):  # fmt: skip
+        check_signals(_one_output([1, 2, 3], [1, 2, 1e301]))
+    with pytest.raises(DatasetError, match=r"input column 'u' of experiment 'e0'.*-1e\+200"):
+        check_signals(_one_output([1, 2, 3], [1, 2, 3], inputs=np.array([0.0, -1e200, 1.0])))
+    check_signals(_one_output([1, 2, 1e100], [-1e100, 0, 1]))  # the bound itself is accepted

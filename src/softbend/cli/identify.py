@@ -55,18 +55,29 @@ def identify(
     """
     from softbend._io import staged_dir
     from softbend.identification.data import experiment_files
+    from softbend.identification.ranges import (
+        FOLDS_RANGE,
+        MAX_MEMORY_MB_RANGE,
+        SEED_RANGE,
+        check_integer,
+        check_number,
+    )
     from softbend.identification.resources import check_identify_memory
     from softbend.identification.selection import default_candidates, select_model
     from softbend.identification.timeseries_io import (
         check_experiments_for_lags,
         check_holdout,
+        check_signals,
         load_timeseries,
     )
     from softbend.reports.identify_outputs import FILES, write_identification
 
     out = Path(out)
-    if folds < 2:
-        raise ValueError(f"The '--folds' must be an integer >= 2. Got {folds} instead.")
+    # every numeric option within its declared range (softbend.identification.ranges)
+    check_integer(folds, FOLDS_RANGE, "'--folds'")
+    check_integer(seed, SEED_RANGE, "'--seed'")
+    if max_memory_mb is not None:
+        check_number(max_memory_mb, MAX_MEMORY_MB_RANGE, "'--max-memory-mb'")
     _common.check_output_dir(out, "--out", inputs=(data,))
     _common.check_replaceable_dir(
         out, "--out", "identify", inputs=(data,), files=FILES, marker="selection.json"
@@ -81,7 +92,8 @@ def identify(
         time=time,
     )
     held = _names(validate_on, "--validate-on") if validate_on is not None else None
-    check_holdout(series, held)
+    check_holdout(series, held, label="'--validate-on'")
+    check_signals(series, held)  # a constant or huge output: refused before any fit
     # every candidate's regressor must fit in every experiment (the longest lags: 3)
     check_experiments_for_lags(series, max(c.build(10).max_lag for c in default_candidates(seed)))
     with _common.library_progress(enabled=not as_json):

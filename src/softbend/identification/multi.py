@@ -201,7 +201,7 @@ class MultiNARX:
         self.u_std_[self.u_std_ == 0] = 1.0
         self.y_std_[self.y_std_ == 0] = 1.0
         low, high = Y.min(axis=0), Y.max(axis=0)
-        span = np.maximum(high - low, 1e-12)
+        span = np.maximum(high - low, np.finfo(np.float64).tiny)
         self.y_low_ = low - FREE_RUN_MARGIN * span
         self.y_high_ = high + FREE_RUN_MARGIN * span
         Us, Ys = (U - self.u_mean_) / self.u_std_, (Y - self.y_mean_) / self.y_std_
@@ -387,6 +387,11 @@ def load_multi_narx(path: str | os.PathLike[str]) -> tuple[MultiNARX, dict[str, 
 def nrmse(
     measured: np.ndarray, simulated: np.ndarray, ranges: Sequence[float] | np.ndarray
 ) -> np.ndarray:
-    """RMSE of each output over its range (the ranges given), dimensionless."""
+    """RMSE of each output over its range (the ranges given), dimensionless.
+
+    A range of zero counts as the smallest positive double, so that a tiny but
+    non-zero range (an output in small units) is used as it is.
+    """
     error = np.sqrt(np.nanmean((np.asarray(simulated) - np.asarray(measured)) ** 2, axis=0))
-    return error / np.maximum(np.asarray(ranges, dtype=np.float64), 1e-12)
+    floor = np.finfo(np.float64).tiny
+    return error / np.maximum(np.asarray(ranges, dtype=np.float64), floor)

@@ -31,8 +31,8 @@ import os
 from dataclasses import dataclass
 from pathlib import Path
 
-from softbend._validation import check_range
 from softbend.errors import DatasetError
+from softbend.identification.ranges import MAX_MEMORY_MB_RANGE, check_number
 
 logger = logging.getLogger(__name__)
 
@@ -183,7 +183,7 @@ def check_identify_memory(
     path : str or path-like
         A CSV file or a folder of CSV files.
     max_memory_mb : float, optional
-        Memory the identification may use, MiB (> 0); default: what
+        Memory the identification may use, MiB, in (0, 1e9]; default: what
         :func:`available_memory_bytes` reports (no check when it cannot tell).
     cache_size_mb, max_working_set
         Solver settings, as in :func:`estimate_identify_memory`.
@@ -199,15 +199,16 @@ def check_identify_memory(
         One line with the data size, the estimated need and the limit, when the
         estimate exceeds the limit.
     ValueError
-        If ``max_memory_mb`` is not a positive number.
+        If ``max_memory_mb`` is not a number in (0, 1e9].
     """
     if max_memory_mb is None:
         limit = available_memory_bytes()
         source = "the memory available"
     else:
-        limit = int(
-            check_range(max_memory_mb, "max_memory_mb", "check_identify_memory", low=0.0) * MIB
+        checked = check_number(
+            max_memory_mb, MAX_MEMORY_MB_RANGE, "'max_memory_mb' of check_identify_memory"
         )
+        limit = int(checked * MIB)
         source = "--max-memory-mb"
     estimate = estimate_identify_memory(
         path, cache_size_mb=cache_size_mb, max_working_set=max_working_set

@@ -34,9 +34,13 @@ from typing import Any
 
 import numpy as np
 
+from softbend.errors import ConvergenceError, DatasetError
 from softbend.identification.kernels import ShapeClippedWarning
 from softbend.identification.multi import MultiNARX, nrmse
+from softbend.identification.ranges import FOLDS_RANGE, SEED_RANGE, check_integer
 from softbend.identification.timeseries import TimeSeriesSet
+from softbend.identification.timeseries_io import check_signals
+from softbend.parameters import Range
 
 __all__ = [
     "FIRST_RUNG_ROWS",
@@ -49,6 +53,12 @@ __all__ = [
 
 #: Regressor rows of a kernel candidate's first rung (then the best third get ``max_rows``).
 FIRST_RUNG_ROWS = 500
+
+#: Regressor rows a kernel map needs at least: its width and shape are estimated from them.
+MIN_KERNEL_ROWS = 4
+
+#: Kernel candidates of :func:`default_candidates`: each costs a cross-validation.
+_N_KERNEL_RANGE = Range(0, 1000, "candidates", why="each costs a cross-validation")
 
 
 @dataclass(frozen=True)
@@ -78,7 +88,17 @@ class Candidate:
 
 
 def default_candidates(seed: int = 0, n_kernel: int = 6) -> list[Candidate]:
-    """The baselines and ``n_kernel`` seeded kernel candidates (module docstring)."""
+    """The baselines and ``n_kernel`` seeded kernel candidates (module docstring).
+
+    Parameters
+    ----------
+    seed : int, default 0
+        Seed of the kernel candidates, in [0, 2**32 - 1].
+    n_kernel : int, default 6
+        Kernel candidates, in [0, 1000].
+    """
+    seed = check_integer(seed, SEED_RANGE, "'seed' of default_candidates")
+    n_kernel = check_integer(n_kernel, _N_KERNEL_RANGE, "'n_kernel' of default_candidates")
     lags = [(na, nb) for na in (1, 2, 3) for nb in (1, 2, 3)]
     out = [Candidate(f"arx-{na}-{nb}", "arx", na, nb) for na, nb in lags]
     out += [Candidate(f"poly2-{na}-{nb}", "poly2", na, nb) for na, nb in lags if na + nb <= 4]
@@ -191,7 +211,13 @@ class Selection:
                 f"A linear ARX model is the best: {self.best} (free-run NRMSE "
                 f"{best[column]:.4g} {where}); no nonlinear candidate ran free better."
             )
-        gain = 1.0 - best[column] / linear[column] if linear[column] > 0 else math.nan
+        if not linear[column] > 0:  # the linear ARX ran free without error: no ratio
+            return (
+                f"Selected {self.best} ({best['family']}): free-run NRMSE {best[column]:.4g} "
+                f"{where}, against {linear[column]:.4g} for the best linear ARX "
+                f"({linear['candidate']})."
+            )
+        gain = 1.0 - best[column] / linear[column]
         return (
             f"Selected {self.best} ({best['family']}): free-run NRMSE {best[column]:.4g} "
             f"{where}, {100 * gain:.0f} % below the best linear ARX ({linear['candidate']}, "
@@ -233,10 +259,12 @@ def select_model(
     validate_on : sequence of str, optional
         Experiments kept out of the selection and scored at the end.
     folds : int, default 4
-        Folds of whole training experiments (at most one per experiment), >= 2.
+        Folds of whole training experiments (at most one per experiment), in
+        [2, 1000].
     candidates : sequence of Candidate, optional
         Default :func:`default_candidates` of ``seed``.
     seed : int, default 0
+        In [0, 2**32 - 1].
     max_rows : int, default 2000
         Regressor rows of a kernel map in the last rung (evenly spaced over the
         training rows; a kernel fit's cost grows with their square).
@@ -246,8 +274,15 @@ def select_model(
     Raises
     ------
     ValueError
-        Fewer than 2 training experiments, an unknown validation experiment, a
-        bad ``folds``.
+        Fewer than 2 training experiments, an unknown or repeated validation
+        experiment, ``folds`` or ``seed`` out of range (all before any fit).
+    DatasetError
+        Signals :func:`~softbend.identification.timeseries_io.check_signals`
+        refuses (a value beyond ±1e100, a constant output), or training folds
+        with fewer than :data:`MIN_KERNEL_ROWS` regressor rows for a kernel
+        candidate (all before any fit).
+    ConvergenceError
+        A figure of the selection that is not finite (the reason named).
     """
     import pandas as pd
 
@@ -261,6 +296,12 @@ def select_model(
             f"Unknown validation experiment(s) {', '.join(map(repr, unknown))}; the "
             f"experiments are {', '.join(data.names)}."
         )
+    repeated = sorted({n for n in held if held.count(n) > 1})
+    if repeated:
+        raise ValueError(
+            f"The 'validate_on' of select_model must name each experiment once. "
+            f"Got {', '.join(map(repr, repeated))} more than once."
+        )
     train_names = tuple(n for n in data.names if n not in held)
     if len(train_names) < 2:
         raise ValueError(
@@ -268,9 +309,9 @@ def select_model(
             f"{len(train_names)} remain{'s' if len(train_names) == 1 else ''} "
             f"({', '.join(train_names) or 'none'})."
         )
-    if isinstance(folds, bool) or not isinstance(folds, int) or folds < 2:
-        raise ValueError(f"The 'folds' of select_model must be an integer >= 2. Got {folds!r}.")
-    folds = min(folds, len(train_names))
+    folds = min(check_integer(folds, FOLDS_RANGE, "'folds' of select_model"), len(train_names))
+    seed = check_integer(seed, SEED_RANGE, "'seed' of select_model")
+    check_signals(data, held)
     train = data.subset(train_names)
     ranges = np.ptp(np.vstack([e.outputs for e in train.experiments]), axis=0)
     fold_of = _fold_of(train_names, folds)
@@ -282,6 +323,7 @@ def select_model(
         for k in range(folds)
     ]
     chosen = list(default_candidates(seed) if candidates is None else candidates)
+    _check_kernel_rows(chosen, parts)
     cheap = [c for c in chosen if c.family != "gg-svr" or c.baseline]
     raced = [c for c in chosen if c.family == "gg-svr" and not c.baseline]
     survivors = max(1, math.ceil(len(raced) / 3)) if raced else 0
@@ -364,6 +406,7 @@ def select_model(
     )
     columns = ["candidate", "family", "na", "nb", "settings", "rows", "rung", "cv_freerun_nrmse"]
     columns += ["cv_onestep_nrmse", "validation_freerun_nrmse", "fit_s"]
+    _check_finite(table, validated=bool(held))
     return Selection(
         table=table[columns],
         best=best.name,
@@ -377,6 +420,46 @@ def select_model(
         seconds=time.perf_counter() - start,
         cv_outputs=cv_runs[best.name],
     )
+
+
+def _check_kernel_rows(
+    candidates: Sequence[Candidate], parts: Sequence[tuple[TimeSeriesSet, TimeSeriesSet]]
+) -> None:
+    """Refuse, before any fit, folds too short for the kernel candidates' maps."""
+    lags = [c.build(10).max_lag for c in candidates if c.family == "gg-svr"]
+    if not lags:
+        return
+    lag = max(lags)
+    for fit_on, held_out in parts:
+        rows = sum(max(e.n_samples - lag, 0) for e in fit_on.experiments)
+        if rows < MIN_KERNEL_ROWS:
+            raise DatasetError(
+                f"The kernel candidates need at least {MIN_KERNEL_ROWS} regressor rows to fit "
+                f"on, but the training experiments without {', '.join(held_out.names)} give "
+                f"{rows} (lags up to {lag}; experiments of "
+                f"{', '.join(str(e.n_samples) for e in fit_on.experiments)} samples): record "
+                "longer experiments."
+            )
+
+
+def _check_finite(table: Any, *, validated: bool) -> None:
+    """Raise :class:`ConvergenceError` naming the first figure of ``table`` that is not finite.
+
+    The validation error is NaN by design without validation experiments and for
+    a candidate dropped in the first rung; every other figure must be a number.
+    """
+    figures = ["cv_freerun_nrmse", "cv_onestep_nrmse", "fit_s"]
+    for _, row in table.iterrows():
+        checked = figures + (
+            ["validation_freerun_nrmse"] if validated and row["rung"] != "first" else []
+        )
+        for column in checked:
+            if not math.isfinite(float(row[column])):
+                raise ConvergenceError(
+                    f"The {column} of candidate {row['candidate']} is {float(row[column])!r}: "
+                    "the selection's figures are not all finite, so none is reported. The "
+                    "data's scale or a degenerate signal is the likely cause."
+                )
 
 
 def _split(data: TimeSeriesSet, stacked: np.ndarray) -> dict[str, np.ndarray]:

@@ -16,18 +16,26 @@ from __future__ import annotations
 
 import logging
 import warnings
-from collections.abc import Callable, Sequence
+from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass, field
 from typing import Any, Literal
 
 import numpy as np
 import pandas as pd
 
-from softbend._validation import check_choice, check_int, check_range
-from softbend.errors import DatasetError
+from softbend._validation import check_choice
+from softbend.errors import ConvergenceError, DatasetError
 from softbend.identification.data import Experiment
 from softbend.identification.kernels import MOMENTS_OF, ShapeClippedWarning
 from softbend.identification.narx import NARXRegressor
+from softbend.identification.ranges import (
+    C_RANGE,
+    EPSILON_RANGE,
+    LAGS_RANGE,
+    check_integer,
+    check_lags_fit,
+    check_number,
+)
 from softbend.metrics import regression_metrics
 
 logger = logging.getLogger(__name__)
@@ -36,6 +44,9 @@ logger = logging.getLogger(__name__)
 OUTPUTS: tuple[str, ...] = ("rho", "length_mm")
 SIGNS: tuple[str, ...] = ("positive", "negative")
 MODES: tuple[str, ...] = ("one-step", "free-run")
+#: Samples each experiment must hold after its initial conditions: the kernel's width
+#: and shape are estimated from at least 4 regressor rows.
+MIN_PREDICTED = 4
 
 
 @dataclass(frozen=True)
@@ -45,13 +56,14 @@ class IdentificationConfig:
     Parameters
     ----------
     C : float
-        SVR penalty (paper A calls it γ), > 0. Default 100.
+        SVR penalty (paper A calls it γ), in (0, 1e4]. Default 100.
     epsilon : float
-        Width of the ε-insensitive tube in units of the standardized target, ≥ 0.
-        Default 0.1.
+        Width of the ε-insensitive tube in units of the standardized target, in
+        [0, 10]. Default 0.1.
     output_lags, input_lags : int
-        Number of past outputs and of inputs in the regressor; the defaults give
-        φ(t) = [y(t−1), y(t−2), u(t), u(t−1)] (paper A eq. 27).
+        Number of past outputs and of inputs in the regressor, each in [1, 50];
+        the defaults give φ(t) = [y(t−1), y(t−2), u(t), u(t−1)] (paper A eq. 27).
+        The ranges are those of :mod:`softbend.identification.ranges`.
     kernel : {"moments", "cv"}
         How σ and the shape γ of the kernel are chosen: ``"moments"`` estimates
         them from the standardized regressors by the fourth-moment method (paper
@@ -72,12 +84,47 @@ class IdentificationConfig:
     moments_of: Literal["differences", "regressors", "components"] = "differences"
 
     def __post_init__(self) -> None:
-        check_range(self.C, "C", "IdentificationConfig", low=0.0)
-        check_range(self.epsilon, "epsilon", "IdentificationConfig", low=0.0, low_inclusive=True)
-        for name in ("output_lags", "input_lags"):
-            check_int(getattr(self, name), name, "IdentificationConfig", low=1)
+        check_settings(
+            C=self.C, epsilon=self.epsilon, output_lags=self.output_lags, input_lags=self.input_lags
+        )
         check_choice(self.kernel, "kernel", "IdentificationConfig", ("moments", "cv"))
         check_choice(self.moments_of, "moments_of", "IdentificationConfig", MOMENTS_OF)
+
+
+def _label(name: str, names: Mapping[str, str] | None) -> str:
+    """How a message names the setting ``name``: its option, else its field."""
+    if names is not None and name in names:
+        return f"'{names[name]}'"
+    return f"'{name}' of IdentificationConfig"
+
+
+def check_settings(
+    *,
+    C: Any,
+    epsilon: Any,
+    output_lags: Any,
+    input_lags: Any,
+    names: Mapping[str, str] | None = None,
+) -> None:
+    """Hold the numeric settings of :class:`IdentificationConfig` to their declared ranges.
+
+    Parameters
+    ----------
+    C, epsilon, output_lags, input_lags
+        The values given (see :class:`IdentificationConfig`).
+    names : mapping of str to str, optional
+        The option that set each field (``{"input_lags": "--input-lags"}``), for
+        the message; default the field of ``IdentificationConfig``.
+
+    Raises
+    ------
+    ValueError
+        One line naming the first setting out of its range, the range and the value.
+    """
+    check_number(C, C_RANGE, _label("C", names))
+    check_number(epsilon, EPSILON_RANGE, _label("epsilon", names))
+    check_integer(output_lags, LAGS_RANGE, _label("output_lags", names))
+    check_integer(input_lags, LAGS_RANGE, _label("input_lags", names))
 
 
 @dataclass
@@ -217,6 +264,64 @@ def _kernel_report(svr: Any, config: IdentificationConfig) -> dict[str, Any]:
     }
 
 
+def check_experiments(
+    experiments: Sequence[Experiment],
+    config: IdentificationConfig,
+    *,
+    names: Mapping[str, str] | None = None,
+) -> None:
+    """Refuse, before any fit, experiments :func:`identify` cannot score.
+
+    Parameters
+    ----------
+    experiments : sequence of Experiment
+        The experiments.
+    config : IdentificationConfig
+        The settings.
+    names : mapping of str to str, optional
+        The option that set each field of ``config``, for the message (as in
+        :func:`check_settings`).
+
+    Raises
+    ------
+    DatasetError
+        No experiments, a pressure sign with a single experiment (nothing to
+        hold out), or an experiment whose ρ or L is constant: each experiment is
+        held out and scored by its error over its range (NRMSE) and by R², which
+        a constant output leaves undefined.
+    ValueError
+        Lags that leave the shortest experiment fewer than :data:`MIN_PREDICTED`
+        samples to predict (naming the setting, its range for these experiments
+        and the experiment).
+    """
+    by_sign = split_by_sign(experiments)
+    if not by_sign:
+        raise DatasetError("No experiments to identify from.")
+    for sign, group in by_sign.items():
+        if len(group) < 2:
+            raise DatasetError(
+                f"Leave-one-experiment-out needs at least 2 {sign}-pressure experiments. "
+                f"Got {len(group)}."
+            )
+    shortest = min(experiments, key=lambda e: e.n_samples)
+    check_lags_fit(
+        config.output_lags,
+        config.input_lags,
+        (shortest.name, shortest.n_samples),
+        (_label("output_lags", names), _label("input_lags", names)),
+        predicted=MIN_PREDICTED,
+    )
+    for experiment in experiments:
+        for output in OUTPUTS:
+            values = output_values(experiment, output)
+            if np.ptp(values) == 0:
+                raise DatasetError(
+                    f"Experiment {experiment.name!r} has a constant {output} (every "
+                    f"sample {float(values[0]):g}): held out, its error over its range (NRMSE) "
+                    "and its R² are undefined; leave it out or record it moving."
+                )
+
+
 def identify(
     experiments: Sequence[Experiment],
     config: IdentificationConfig | None = None,
@@ -237,17 +342,18 @@ def identify(
     Returns
     -------
     IdentificationResult
+        Every figure of its metrics finite.
+
+    Raises
+    ------
+    DatasetError, ValueError
+        Experiments :func:`check_experiments` refuses (before any fit).
+    ConvergenceError
+        A held-out free run that diverged (its figures would not be finite).
     """
     config = config or IdentificationConfig()
+    check_experiments(experiments, config)
     by_sign = split_by_sign(experiments)
-    if not by_sign:
-        raise DatasetError("No experiments to identify from.")
-    for sign, group in by_sign.items():
-        if len(group) < 2:
-            raise DatasetError(
-                f"Leave-one-experiment-out needs at least 2 {sign}-pressure experiments. "
-                f"Got {len(group)}."
-            )
     rows: list[dict[str, object]] = []
     predictions: dict[tuple[str, str, str], dict[str, np.ndarray]] = {}
     models: dict[tuple[str, str], NARXRegressor] = {}
@@ -270,7 +376,10 @@ def identify(
                     model = _make_model(config, sigma, shape).fit(u_train, y_train, groups=g_train)
                 u, y, groups = _stack([held_out], output)
                 one_step = model.predict_one_step(u, y, groups=groups)
-                free_run = model.simulate(u, y, groups=groups)
+                with warnings.catch_warnings():
+                    # A diverged run is the error below, not a warning besides.
+                    warnings.simplefilter("ignore", RuntimeWarning)
+                    free_run = model.simulate(u, y, groups=groups)
                 predictions[(sign, output, held_out.name)] = {
                     "one-step": one_step,
                     "free-run": free_run,
@@ -278,6 +387,13 @@ def identify(
                 start = model.max_lag_
                 for mode, y_hat in (("one-step", one_step), ("free-run", free_run)):
                     scores = regression_metrics(y[start:], y_hat[start:])
+                    if not all(np.isfinite(v) for v in scores.values()):
+                        raise ConvergenceError(
+                            f"The {mode} prediction of {output} of the {sign}-pressure "
+                            f"experiment {held_out.name!r} (held out) is not finite: the "
+                            "model diverged and its figures would be NaN. A smaller C or "
+                            "fewer lags may keep it stable."
+                        )
                     rows.append(
                         {
                             "sign": sign,

@@ -647,7 +647,9 @@ class GeneralizedGaussianSVR(RegressorMixin, BaseEstimator):
         # |s − m|² factor folded into the coefficients and the |x − m|² one a scalar.
         # Used where every exponent stays small (error ~ exponent × 1e-16).
         support = self.support_vectors_
-        center = support.mean(axis=0)
+        # No support vector (every sample inside the ε-tube): the model is its intercept,
+        # and any centre will do (the mean of none is NaN).
+        center = support.mean(axis=0) if len(support) else np.zeros(support.shape[1])
         centred = support - center
         spread = self._rate * np.einsum("ij,ij->i", centred, centred)
         self._center = center.tolist()

@@ -39,6 +39,7 @@ from softbend._io import atomic_file, read_header_csv
 from softbend._validation import check_int
 from softbend.errors import DatasetError
 from softbend.identification.data import experiment_files
+from softbend.identification.ranges import MAX_ABS_VALUE, MIN_OUTPUT_RANGE
 from softbend.identification.timeseries import Series, TimeSeriesSet
 
 logger = logging.getLogger(__name__)
@@ -47,6 +48,7 @@ __all__ = [
     "SAMPLE_TIME_NAME",
     "check_experiments_for_lags",
     "check_holdout",
+    "check_signals",
     "load_timeseries",
     "save_timeseries",
 ]
@@ -467,8 +469,13 @@ def check_experiments_for_lags(data: TimeSeriesSet, max_lag: int) -> None:
         )
 
 
-def check_holdout(data: TimeSeriesSet, validate_on: str | Sequence[str] | None) -> None:
-    """Check that experiments can be held out for validation.
+def check_holdout(
+    data: TimeSeriesSet,
+    validate_on: str | Sequence[str] | None,
+    *,
+    label: str = "'validate_on' of check_holdout",
+) -> None:
+    """Check that experiments can be held out for validation and the rest selected on.
 
     Parameters
     ----------
@@ -477,13 +484,16 @@ def check_holdout(data: TimeSeriesSet, validate_on: str | Sequence[str] | None) 
     validate_on : str or sequence of str, optional
         The experiments held out (one name or several). None: one experiment is
         to be held out at a time, which needs at least two.
+    label : str, default "'validate_on' of check_holdout"
+        How the message names ``validate_on``, quoted (``"'--validate-on'"``).
 
     Raises
     ------
     ValueError
         A name that is not an experiment of ``data`` (the message lists them),
-        ``validate_on`` empty or naming every experiment (none left to train
-        on), or ``validate_on`` None with a single experiment (nothing to hold out).
+        a name given twice, ``validate_on`` empty or leaving fewer than two
+        experiments to train on (the selection holds one out at a time), or
+        ``validate_on`` None with a single experiment (nothing to hold out).
     """
     known = data.names
     if validate_on is None:
@@ -495,18 +505,82 @@ def check_holdout(data: TimeSeriesSet, validate_on: str | Sequence[str] | None) 
         return
     names = (validate_on,) if isinstance(validate_on, str) else tuple(validate_on)
     if not names:
-        raise ValueError(
-            "The 'validate_on' of check_holdout must name at least one experiment, or be None. "
-            "Got none."
-        )
+        raise ValueError(f"The {label} must name at least one experiment, or be None. Got none.")
     unknown = [n for n in names if n not in known]
     if unknown:
         raise ValueError(
-            f"The 'validate_on' of check_holdout must name experiments of the data "
-            f"({', '.join(known)}). Got {', '.join(map(repr, unknown))} instead."
+            f"The {label} must name experiments of the data ({', '.join(known)}). "
+            f"Got {', '.join(map(repr, unknown))} instead."
         )
-    if set(names) >= set(known):
+    repeated = sorted({n for n in names if names.count(n) > 1})
+    if repeated:
         raise ValueError(
-            f"The 'validate_on' of check_holdout must leave at least one experiment to train "
-            f"on. Got all {len(known)} experiment(s) ({', '.join(known)})."
+            f"The {label} must name each experiment once. "
+            f"Got {', '.join(map(repr, repeated))} more than once."
         )
+    left = [n for n in known if n not in names]
+    if len(left) < 2:
+        raise ValueError(
+            f"The {label} must leave at least 2 of the {len(known)} experiments to train on "
+            f"(the selection holds one out at a time). Got {', '.join(map(repr, names))}, "
+            f"which leaves {', '.join(map(repr, left)) or 'none'}."
+        )
+
+
+def check_signals(data: TimeSeriesSet, validate_on: str | Sequence[str] | None = None) -> None:
+    """Refuse, before any fit, signals whose identification figures could not be finite.
+
+    Every input and output value must lie within ±:data:`~softbend.identification.ranges.
+    MAX_ABS_VALUE` (1e100: the squares of larger values overflow the standardization),
+    and every output must vary over the training experiments (those not in
+    ``validate_on``) by at least :data:`~softbend.identification.ranges.MIN_OUTPUT_RANGE`:
+    the error of a model is over its output's range (NRMSE), undefined for a
+    constant output.
+
+    Parameters
+    ----------
+    data : TimeSeriesSet
+        The experiments (finite, as every :class:`Series` is).
+    validate_on : str or sequence of str, optional
+        The validation experiments, left out of the outputs' ranges.
+
+    Raises
+    ------
+    DatasetError
+        One line naming the column and, for a value too large, the experiment,
+        its file and the value.
+    """
+    held = {validate_on} if isinstance(validate_on, str) else set(validate_on or ())
+    for kind, names, attribute in (
+        ("input", data.input_names, "inputs"),
+        ("output", data.output_names, "outputs"),
+    ):
+        for e in data.experiments:
+            values = getattr(e, attribute)
+            too_large = np.abs(values) > MAX_ABS_VALUE
+            if too_large.any():
+                row, column = (int(i[0]) for i in np.nonzero(too_large))
+                source = f" ({e.source})" if e.source else ""
+                raise DatasetError(
+                    f"The {kind} column '{names[column]}' of experiment {e.name!r}{source} "
+                    f"holds {float(values[row, column])!r} at sample {row}: values must lie "
+                    f"within ±{MAX_ABS_VALUE:g} (the squares of larger ones overflow); "
+                    "rescale the column (e.g. a larger unit)."
+                )
+    train = [e for e in data.experiments if e.name not in held] or list(data.experiments)
+    outputs = np.vstack([e.outputs for e in train])
+    spans = np.ptp(outputs, axis=0)
+    for column, name in enumerate(data.output_names):
+        if spans[column] == 0:
+            raise DatasetError(
+                f"The output column '{name}' is constant over the training experiments "
+                f"(every sample {float(outputs[0, column])!r}): a model of it has nothing to "
+                "learn and its error over its range (NRMSE) is undefined; leave it out of "
+                "the outputs."
+            )
+        if spans[column] < MIN_OUTPUT_RANGE:
+            raise DatasetError(
+                f"The output column '{name}' varies by only {float(spans[column])!r} over the "
+                f"training experiments, less than {MIN_OUTPUT_RANGE:g}: too little to "
+                "standardize in double precision; rescale it (e.g. a smaller unit)."
+            )
