@@ -9,6 +9,9 @@ scripts with no file yet are listed at the end with the command to run.
 Usage: python docs/gen_performance.py [--check] [--results DIR] [--benchmarks DIR] [--out FILE]
 
 ``--check`` writes nothing and exits 1 if the page differs from what it would write.
+A results file that is not a benchmark record (not JSON, a key missing or of the
+wrong type) is one line naming the file and what is wrong, exit code 2, and the
+page is left as it was.
 """
 
 from __future__ import annotations
@@ -48,27 +51,116 @@ class RecordError(ValueError):
     """A file of the results folder is not a benchmark record."""
 
 
+#: The type each key of :data:`REQUIRED` must have, as JSON names it.
+_TYPES: dict[str, tuple[type, ...]] = {
+    "benchmark": (str,),
+    "command": (str,),
+    "date": (str,),
+    "figures": (list,),
+    "machine": (dict,),
+    "notes": (str,),
+    "software": (dict,),
+}
+
+#: The schema of ``benchmarks/_record.py`` this page reads.
+SCHEMA = 1
+
+
+def json_kind(value: Any) -> str:
+    """What a parsed JSON value is, as JSON names it (``"an object"``, ``"null"``…).
+
+    >>> json_kind({}), json_kind([1]), json_kind("x"), json_kind(2.5), json_kind(None)
+    ('an object', 'a list', 'a string', 'a number', 'null')
+    """
+    if value is None:
+        return "null"
+    if isinstance(value, bool):
+        return "true or false"
+    if isinstance(value, int | float):
+        return "a number"
+    if isinstance(value, str):
+        return "a string"
+    return "a list" if isinstance(value, list) else "an object"
+
+
+def read_json(path: Path, error: type[Exception]) -> Any:
+    """The parsed JSON of ``path``; ``error`` naming the file for one that cannot be.
+
+    Unreadable, not UTF-8, not JSON (with the line and column) or nested too
+    deeply to parse: one line each.
+    """
+    try:
+        text = path.read_text(encoding="utf-8")
+    except UnicodeDecodeError as exc:
+        raise error(f"{path}: not UTF-8 text (undecodable byte at offset {exc.start}).") from None
+    except OSError as exc:
+        raise error(f"{path}: cannot be read ({exc.strerror or type(exc).__name__}).") from None
+    try:
+        return json.loads(text)
+    except json.JSONDecodeError as exc:
+        raise error(f"{path}: not valid JSON (line {exc.lineno}, column {exc.colno}).") from None
+    except RecursionError:
+        raise error(f"{path}: JSON nested too deeply to read.") from None
+
+
+def check_record(data: Any, path: Path) -> dict[str, Any]:
+    """``data`` if it is a benchmark record of :data:`SCHEMA`, else :class:`RecordError`.
+
+    Every key of :data:`REQUIRED` with its type (:data:`_TYPES`); ``figures`` a
+    list of objects, each with a text ``name``, a text ``unit`` (or none) and a
+    ``value`` that is a number, a text, true/false or null.
+    """
+    missing = [k for k in REQUIRED if not isinstance(data, dict) or k not in data]
+    if missing:
+        raise RecordError(
+            f"The file {path} must be a benchmark record with keys {list(REQUIRED)}. "
+            f"Got one without {missing} instead."
+        )
+    for key, types in _TYPES.items():
+        if not isinstance(data[key], types):
+            wanted = json_kind(types[0]())
+            raise RecordError(
+                f"The file {path} must be a benchmark record whose '{key}' is {wanted}. "
+                f"Got {json_kind(data[key])} instead."
+            )
+    schema = data.get("schema", SCHEMA)
+    if schema != SCHEMA or isinstance(schema, bool):
+        raise RecordError(
+            f"The file {path} must be a benchmark record of schema {SCHEMA}. "
+            f"Got schema {schema!r} instead."
+        )
+    for i, figure in enumerate(data["figures"]):
+        where = f"The file {path} must be a benchmark record whose figure {i + 1}"
+        if not isinstance(figure, dict) or not isinstance(figure.get("name"), str):
+            raise RecordError(
+                f"{where} is an object with a text 'name'. Got {json_kind(figure)}"
+                f"{'' if not isinstance(figure, dict) else ' without one'} instead."
+            )
+        if not isinstance(figure.get("unit", ""), str | None):
+            raise RecordError(
+                f"{where} ({figure['name']!r}) has a text 'unit'. "
+                f"Got {json_kind(figure['unit'])} instead."
+            )
+        if not isinstance(figure.get("value"), int | float | str | None):
+            raise RecordError(
+                f"{where} ({figure['name']!r}) has a 'value' that is a number, a text, "
+                f"true/false or null. Got {json_kind(figure['value'])} instead."
+            )
+    return data
+
+
 def load_records(folder: Path) -> list[dict[str, Any]]:
     """The records of ``folder/*.json``, sorted by benchmark name.
 
     Raises
     ------
     RecordError
-        If a file is not JSON or lacks one of :data:`REQUIRED`.
+        If ``folder`` is not a folder, or a file is not JSON or not a benchmark
+        record (:func:`check_record`), naming the file and what is wrong.
     """
-    records = []
-    for path in sorted(folder.glob("*.json")):
-        try:
-            data = json.loads(path.read_text(encoding="utf-8"))
-        except (OSError, ValueError) as exc:
-            raise RecordError(f"{path}: not readable as JSON ({exc}).") from None
-        missing = [k for k in REQUIRED if not isinstance(data, dict) or k not in data]
-        if missing:
-            raise RecordError(
-                f"The file {path} must be a benchmark record with keys {list(REQUIRED)}. "
-                f"Got one without {missing} instead."
-            )
-        records.append(data)
+    if not folder.is_dir():
+        raise RecordError(f"The results folder {folder} does not exist or is not a folder.")
+    records = [check_record(read_json(p, RecordError), p) for p in sorted(folder.glob("*.json"))]
     return sorted(records, key=lambda r: str(r["benchmark"]))
 
 
@@ -232,6 +324,10 @@ def main(argv: Sequence[str] | None = None) -> int:
     args = parser.parse_args(argv)
     try:
         records = load_records(args.results)
+        if not args.benchmarks.is_dir():
+            raise RecordError(
+                f"The benchmarks folder {args.benchmarks} does not exist or is not a folder."
+            )
     except RecordError as exc:
         print(exc, file=sys.stderr)
         return 2
@@ -247,7 +343,11 @@ def main(argv: Sequence[str] | None = None) -> int:
         return 0
     from softbend._io import write_text_atomic
 
-    write_text_atomic(args.out, text)
+    try:
+        write_text_atomic(args.out, text)  # the page whole or as it was, never half of it
+    except OSError as exc:
+        print(f"{args.out}: cannot be written ({exc.strerror or exc}).", file=sys.stderr)
+        return 1
     print(f"wrote {args.out} from {len(records)} benchmark records")
     return 0
 

@@ -309,8 +309,8 @@ def test_a_truncated_database_is_one_line_and_exit_2_for_every_subcommand(tmp_pa
 @pytest.mark.parametrize(
     ("content", "reason"),
     [
-        (b"design_id,angle_deg\nd1,12.5\n", "not a DuckDB database file"),
-        (b"", "not a DuckDB database file"),
+        (b"design_id,angle_deg\nd1,12.5\n", "not a DuckDB database file; "),
+        (b"", "an empty file; "),
     ],
     ids=["a csv renamed", "empty"],
 )
@@ -325,7 +325,10 @@ def test_a_file_that_is_no_database_is_one_line_for_status_and_export(
     ):
         assert main(argv) == 2
         line = one_error_line(capsys)
-        assert f"{str(db)!r} is not a readable softbend campaign database ({reason})" in line
+        assert f"{str(db)!r} is not a readable softbend campaign database ({reason}" in line
+        assert line.endswith(
+            "the DuckDB file that 'softbend campaign run' or 'softbend campaign merge' writes)."
+        )
 
 
 @pytest.fixture

@@ -79,7 +79,7 @@ from softbend.campaign.planning import (
     plan_run,
     resolve_backend,
 )
-from softbend.campaign.settings import backend_settings
+from softbend.campaign.settings import backend_settings, fem_options_of
 from softbend.campaign.store import CampaignStore
 from softbend.design import SFRBADesign
 from softbend.materials.presets import Material
@@ -224,7 +224,9 @@ def run_campaign(
     Raises
     ------
     ValueError
-        Bad input: unknown backend or option, empty or duplicate designs, a
+        Bad input: unknown backend or option, empty or duplicate designs, an
+        FEM mesh size that would mesh one of the designs with more elements than
+        the FEM allows (:func:`softbend.fem.options.check_mesh_size`), a
         negative or non-increasing pressure grid, ``workers < 0``, a malformed
         scheduler address, a material given to a backend that takes none, or a
         database holding another backend or grid.
@@ -244,6 +246,11 @@ def run_campaign(
         elastomer, given = resolve_material(material)
         backend_obj = with_material(backend_obj, elastomer, owner=_OWNER)
     design_list = check_designs(designs)
+    fem_options = fem_options_of(backend_obj)
+    if fem_options is not None:
+        # The FEM's own rule on the mesh size, for every design before any is swept:
+        # a mesh size too fine for them would otherwise fail each design in turn.
+        fem_options.check_mesh(design_list)
     grid = check_pressures_mpa(
         default_pressures_mpa() if pressures_mpa is None else pressures_mpa, _OWNER
     )

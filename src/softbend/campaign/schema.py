@@ -26,11 +26,14 @@ Tables (schema version :data:`SCHEMA_VERSION`):
 
 :func:`ensure_schema` creates these tables in a new file and checks those of an
 existing one (a softbend campaign, of a version this softbend reads);
-:func:`check_complete` reads every block of an existing file once, so a
-truncated or damaged file is refused on opening rather than on a later query;
-:func:`open_error` and :func:`unreadable` turn DuckDB's errors into one line
-naming the file, and :func:`write_error` a failed write (a full disk) into the
-:class:`OSError` it is. The queries and writes live in :mod:`softbend.campaign.store`.
+:func:`check_duckdb_file` refuses an existing file that is no DuckDB database
+(empty, a CSV) before DuckDB opens it; :func:`check_complete` reads every block
+of an existing file once, so a truncated or damaged file is refused on opening
+rather than on a later query; :func:`open_error`, :func:`missing_database`,
+:func:`not_a_database` and :func:`unreadable` turn DuckDB's errors (and a file
+that is not there) into one line naming the file, and :func:`write_error` a
+failed write (a full disk) into the :class:`OSError` it is. The queries and
+writes live in :mod:`softbend.campaign.store`.
 """
 
 from __future__ import annotations
@@ -53,8 +56,11 @@ __all__ = [
     "SAMPLE_COLUMNS",
     "SCHEMA_VERSION",
     "check_complete",
+    "check_duckdb_file",
     "ensure_schema",
     "first_line",
+    "missing_database",
+    "not_a_database",
     "open_error",
     "softbend_version",
     "transaction",
@@ -147,6 +153,15 @@ _DDL = (
 #: Bytes before the first block of a DuckDB file: its main header and two database headers.
 _DUCKDB_HEADER_BYTES = 3 * 4096
 
+#: Where a DuckDB file's main header holds its magic bytes (after an 8-byte checksum).
+_DUCKDB_MAGIC_OFFSET, _DUCKDB_MAGIC = 8, b"DUCK"
+
+#: What a campaign database is, said after a file that is none.
+_WHAT_A_CAMPAIGN_IS = (
+    "a campaign database is the DuckDB file that 'softbend campaign run' or "
+    "'softbend campaign merge' writes"
+)
+
 
 def softbend_version() -> str:
     """The version of softbend stamped on the database and on every design row."""
@@ -213,7 +228,7 @@ def ensure_schema(con: Any, path: Path, *, read_only: bool) -> None:
             found = ", ".join(sorted(tables)) or "no tables"
             raise SchemaError(
                 f"{str(path)!r} is not a softbend campaign database "
-                f"(no 'meta' table; found {found})."
+                f"(no 'meta' table; found {found}; {_WHAT_A_CAMPAIGN_IS})."
             )
         _create(con, path)
         return
@@ -279,6 +294,28 @@ def check_complete(con: Any, path: Path) -> None:
         con.execute(f"SELECT max(hash(COLUMNS(*))) FROM {name}").fetchall()
 
 
+def check_duckdb_file(path: Path) -> None:
+    """Raise unless the existing file ``path`` begins as a DuckDB database file does.
+
+    Checked before DuckDB opens it: DuckDB would open a file that is not one of
+    its databases, but has a suffix it reads (``.csv``, ``.parquet``, ``.json``),
+    as an empty in-memory database, and then fail with an error about that
+    database rather than the file.
+
+    Raises
+    ------
+    SchemaError
+        The file is empty or not a DuckDB database file; one line naming the
+        file and what a campaign database is.
+    """
+    with open(path, "rb") as handle:
+        head = handle.read(_DUCKDB_MAGIC_OFFSET + len(_DUCKDB_MAGIC))
+    if not head:
+        raise not_a_database(path, "an empty file")
+    if head[_DUCKDB_MAGIC_OFFSET:] != _DUCKDB_MAGIC:
+        raise not_a_database(path)
+
+
 # -- one line per error of opening -------------------------------------------------
 
 
@@ -296,6 +333,20 @@ def unreadable(path: Path, reason: str) -> SchemaError:
     )
 
 
+def not_a_database(path: Path, what: str = "not a DuckDB database file") -> SchemaError:
+    """The error of a file that is no DuckDB database at all (``what`` it is), and what to give."""
+    return unreadable(path, f"{what}; {_WHAT_A_CAMPAIGN_IS}")
+
+
+def missing_database(path: Path) -> SchemaError | FileNotFoundError:
+    """The error of a campaign database that is not there: a folder in its place, or nothing."""
+    if path.is_dir():
+        return SchemaError(
+            f"{str(path)!r} is a folder, not a softbend campaign database ({_WHAT_A_CAMPAIGN_IS})."
+        )
+    return FileNotFoundError(f"No campaign database at {str(path)!r}.")
+
+
 def open_error(path: Path, exc: Exception) -> SoftbendError:
     """The one-line error for a DuckDB error raised while connecting to ``path``."""
     text = str(exc)
@@ -309,8 +360,9 @@ def open_error(path: Path, exc: Exception) -> SoftbendError:
             f"The campaign database {str(path)!r} is already open in this process in another "
             "mode; close that CampaignStore first."
         )
-    if "not a valid DuckDB database" in text:
-        return unreadable(path, "not a DuckDB database file")
+    if "not a valid DuckDB database" in text or "in-memory database" in text:
+        # The second: a file DuckDB took for data to read into a database of its own.
+        return not_a_database(path)
     return unreadable(path, first_line(exc))
 
 

@@ -38,8 +38,10 @@ from softbend.campaign.schema import (
     DESIGN_COLUMNS,
     SCHEMA_VERSION,
     check_complete,
+    check_duckdb_file,
     ensure_schema,
     first_line,
+    missing_database,
     open_error,
     softbend_version,
     transaction,
@@ -107,10 +109,10 @@ class CampaignStore:
     FileNotFoundError
         ``read_only`` and no file at ``path``.
     SchemaError
-        The file is not a readable DuckDB database (not DuckDB, truncated, a
-        damaged block: every block is read once on opening), not a softbend
-        campaign, or has a schema version newer than :data:`SCHEMA_VERSION`;
-        one line naming the file.
+        The file is not a readable DuckDB database (empty, not DuckDB such as a
+        CSV, truncated, a damaged block: every block is read once on opening), not
+        a softbend campaign, or has a schema version newer than
+        :data:`SCHEMA_VERSION`, or ``path`` is a folder; one line naming the file.
     SoftbendError
         The file is locked by another process (a running campaign).
     OSError
@@ -131,13 +133,15 @@ class CampaignStore:
 
         self.path = Path(path)
         self.read_only = bool(read_only)
-        if self.read_only and not self.path.is_file():
-            raise FileNotFoundError(f"No campaign database at {str(self.path)!r}.")
+        if self.path.is_dir() or (self.read_only and not self.path.is_file()):
+            raise missing_database(self.path)
         if not self.read_only and not self.path.parent.is_dir():
             raise FileNotFoundError(
                 f"The folder of the campaign database {str(self.path)!r} does not exist."
             )
         existed = self.path.is_file()
+        if existed:
+            check_duckdb_file(self.path)  # a CSV or an empty file, before DuckDB reads it
         try:
             self._con = duckdb.connect(str(self.path), read_only=self.read_only)
         except duckdb.Error as exc:
@@ -847,7 +851,7 @@ def merge_campaigns(
         No source, a source that is ``target``, or a backend, pressure grid or
         settings that differ from another database's.
     SchemaError
-        A source or ``target`` is not a readable campaign database.
+        A source or ``target`` is not a readable campaign database (or a folder).
     OSError
         The merged database could not be written (naming ``target``).
     """
@@ -861,7 +865,7 @@ def merge_campaigns(
         )
     for source in paths:
         if not source.is_file():
-            raise FileNotFoundError(f"No campaign database at {str(source)!r}.")
+            raise missing_database(source)
         if target.exists() and os.path.samefile(source, target):
             raise ValueError(f"A campaign cannot be merged into itself: {str(source)!r}.")
     if _has_log(target):

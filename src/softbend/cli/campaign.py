@@ -55,11 +55,12 @@ def merge(
         softbend campaign merge all.duckdb shard0.duckdb shard1.duckdb
     """
     from softbend.campaign import CampaignStore
+    from softbend.campaign.schema import missing_database
     from softbend.campaign.store import merge_campaigns
 
     for shard in shards:
-        if not shard.is_file():
-            raise FileNotFoundError(f"No campaign database at {str(shard)!r}.")
+        if not shard.is_file():  # a folder or nothing: one line naming it, before DB is checked
+            raise missing_database(shard)
     _common.check_output_file(db, "DB", inputs=tuple(shards))
     # Every shard is checked before anything is written, and DB is replaced only
     # when the whole merge is done: a failed merge leaves DB as it was (or absent).
@@ -208,11 +209,12 @@ def dataset(
         softbend campaign dataset table1.duckdb --out data \\
             --command "softbend campaign run table1.duckdb --space table1"
     """
+    from softbend.campaign.schema import missing_database
     from softbend.campaign.spaces import parse_space
     from softbend.datasets import DESIGNS_FILE, PROVENANCE_FILE, SAMPLES_FILE, write_dataset
 
     if not db.is_file():
-        raise FileNotFoundError(f"No campaign database at {str(db)!r}.")
+        raise missing_database(db)
     planned = (
         parse_space(space, option="--space", owner="softbend campaign dataset").n_designs
         if space is not None

@@ -4,10 +4,14 @@ from __future__ import annotations
 
 from contextlib import ExitStack
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 import typer
 
 from softbend.cli import _common
+
+if TYPE_CHECKING:
+    from softbend.campaign.runner import CampaignSummary
 
 _OWNER = "softbend campaign run"
 #: The design spaces of --space (softbend.campaign.spaces.SPACE_FORMS, not imported at start).
@@ -97,7 +101,10 @@ def run(
     created if missing) from 0 to --pmax MPa in steps of --pstep MPa, one
     transaction per design; re-run the same command to resume. DB records the
     backend's settings (mesh, FEM options, material) and refuses a resume with
-    other ones.
+    other ones. A design that fails is recorded with the reason and the others
+    go on; if every design of the run fails, the command exits with code 1
+    and the first reason. A --maxh too fine for a design of --space is
+    refused before any work (the FEM's limit on the elements of a mesh).
 
     Example:
 
@@ -208,6 +215,7 @@ def run(
                 raise
     if json_output:
         _common.print_json({"space": designs.name, **summary.as_dict()})
+        _exit_if_all_failed(summary, db)
         return
     _common.print_table(
         f"campaign {summary.db_path}",
@@ -232,3 +240,32 @@ def run(
             ["design (l,r,t,b,phi,lc)", "error"],
             [[by_id.get(i, i), one_line(e)] for i, e in summary.failures[:20]],
         )
+    _exit_if_all_failed(summary, db)
+
+
+def _exit_if_all_failed(summary: CampaignSummary, db: Path) -> None:
+    """End with exit code 1 and the first failure if every design this run swept failed.
+
+    A run that swept no design (all done before) or finished any is a success;
+    the failed designs stay recorded either way, and a re-run retries them.
+    """
+    if summary.n_run == 0 or summary.n_done > 0:
+        return
+    reason = _without_type(summary.failures[0][1]) if summary.failures else "no reason recorded."
+    _common.error_line(
+        f"every design of this run failed ({summary.n_failed} of {summary.n_failed}); "
+        f"the first: {reason} They are recorded in {db} as failed "
+        f"('softbend campaign status {db}' lists them); run the command again to retry them."
+    )
+    raise typer.Exit(1)
+
+
+def _without_type(error: str, limit: int = 300) -> str:
+    """A recorded failure (``"ExceptionType: message"``) as its message: one line, a sentence."""
+    text = one_line(error)
+    head, sep, rest = text.partition(": ")
+    if sep and head.isidentifier() and head[:1].isupper() and rest:
+        text = rest
+    if len(text) > limit:
+        text = text[: limit - 1].rstrip() + "…"
+    return text if text.endswith((".", "!", "?", "…")) else text + "."

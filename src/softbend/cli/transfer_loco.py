@@ -56,7 +56,8 @@ def loco(
         False,
         "--calibrate",
         help="Also score the calibrated 90 % interval on each held-out actuator, calibrated "
-        "without it (n-1 more fits per actuator: several times the run time).",
+        "without it (n-1 more fits per actuator: several times the run time; at least 3 "
+        "actuators).",
     ),
     seed: int = typer.Option(0, help="Seed of the strategies and the learning curve."),
     as_json: bool = typer.Option(False, "--json", help="Print the results as JSON."),
@@ -87,6 +88,7 @@ def loco(
     from softbend.transfer.base import load_base
     from softbend.transfer.loco import (
         DEFAULT_STRATEGIES,
+        check_calibration,
         leave_one_configuration_out,
         strategy_options,
     )
@@ -103,6 +105,14 @@ def loco(
     )
     options = strategy_options(names, _common.parse_assignments(settings or ()))
     data = load_measurements_files(measurements, force=force)
+    if calibrate:  # before the base is read and any strategy fitted
+        check_calibration(
+            data.actuator_ids,
+            names,
+            field="--calibrate",
+            data_field="MEASUREMENTS",
+            owner="softbend transfer loco",
+        )
     model = load_base(base)
     with _common.library_progress(enabled=not as_json) as progress:
         result = leave_one_configuration_out(

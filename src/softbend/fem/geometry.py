@@ -156,13 +156,10 @@ def mesh_actuator(
     ngsolve = require_ngsolve()
     from netgen.occ import OCCGeometry
 
+    from softbend.fem.options import check_mesh_size  # here: options imports geometry
+
+    check_mesh_size(design, maxh_mm, base_cap_mm)
     shape, info = actuator_geometry(design, base_cap_mm)
-    estimate = 6.0 * info.half_volume_mm3 / (maxh_mm**3 / (6.0 * math.sqrt(2.0)))
-    if estimate > MAX_ELEMENTS:
-        raise ValueError(
-            f"The 'maxh_mm' of the FEM mesh must give at most {MAX_ELEMENTS} elements for "
-            f"design {design}. Got {maxh_mm:g} mm (about {estimate:.0f} elements) instead."
-        )
     try:
         mesh = ngsolve.Mesh(OCCGeometry(shape).GenerateMesh(maxh=maxh_mm))
     except Exception as exc:  # netgen raises its own exception types

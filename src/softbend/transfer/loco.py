@@ -41,7 +41,9 @@ from softbend.transfer.strategies import (
 
 __all__ = [
     "DEFAULT_STRATEGIES",
+    "MIN_CALIBRATION_ACTUATORS",
     "LocoResult",
+    "check_calibration",
     "held_out_residuals",
     "leave_one_configuration_out",
     "strategy_options",
@@ -54,6 +56,10 @@ DEFAULT_STRATEGIES: tuple[str, ...] = BUILTIN_STRATEGIES
 _SLOW = ("experimental", "refined-ensemble")
 
 _OWNER = "leave_one_configuration_out"
+
+#: Actuators the nested calibration needs: the held-out one, and at least two others,
+#: each predicted by a model fitted without it and without the held-out one.
+MIN_CALIBRATION_ACTUATORS = 3
 
 
 @dataclass(frozen=True)
@@ -219,8 +225,10 @@ def leave_one_configuration_out(
     calibrated : bool, default False
         Also score the calibrated interval of :mod:`softbend.transfer.conformal`
         on each held-out actuator, nested (n − 1 more fits per held-out
-        actuator, each without it and one other; at least 3 actuators); not
-        ``experimental`` and ``refined-ensemble``.
+        actuator, each without it and one other); not ``experimental`` and
+        ``refined-ensemble``. Refused (:func:`check_calibration`) with fewer
+        than :data:`MIN_CALIBRATION_ACTUATORS` actuators or with no strategy
+        but those two.
     fallback : {"quantile", "largest"}, default "quantile"
         The calibrated half-width with too few actuators for the conformal
         guarantee (:func:`softbend.transfer.conformal.calibrate`).
@@ -235,6 +243,12 @@ def leave_one_configuration_out(
     Returns
     -------
     LocoResult
+
+    Raises
+    ------
+    ValueError
+        Bad input; among them ``calibrated`` with too few actuators or only
+        the slowest strategies (:func:`check_calibration`).
     """
     if not isinstance(measurements, Measurements):
         raise ValueError(
@@ -262,10 +276,12 @@ def leave_one_configuration_out(
             f"The 'measurements' of {_OWNER} must cover at least 2 actuators. "
             f"Got {len(ids)} ({', '.join(ids)}) instead."
         )
+    if calibrated:
+        check_calibration(ids, names)
     X, y, groups = measurements.features, measurements.angle_deg, measurements.groups
     rng = np.random.default_rng([seed, 3])
     curve_names = [n for n in names if n not in _SLOW] if learning_curve else []
-    nested_names = [n for n in names if n not in _SLOW] if calibrated and len(ids) >= 3 else []
+    nested_names = [n for n in names if n not in _SLOW] if calibrated else []
     start = time.perf_counter()
 
     # Every fit is a task: (kind, held-out actuator, n actuators, strategy, train, test rows).
@@ -398,6 +414,53 @@ def leave_one_configuration_out(
             "wall_time_s": time.perf_counter() - start,
         },
     )
+
+
+def check_calibration(
+    actuators: Sequence[str],
+    strategies: Sequence[str],
+    *,
+    field: str = "calibrated",
+    data_field: str = "measurements",
+    owner: str = _OWNER,
+) -> None:
+    """Refuse a nested calibration that :func:`leave_one_configuration_out` cannot make.
+
+    The calibrated interval of a held-out actuator comes from the leave-one-out
+    errors of the other actuators, each predicted by a model fitted without it
+    and without the held-out one: with two actuators that model would have no
+    data at all, so the interval would be missing. The two slowest strategies
+    (``experimental``, ``refined-ensemble``) are never calibrated.
+
+    Parameters
+    ----------
+    actuators : sequence of str
+        The measured actuators.
+    strategies : sequence of str
+        The strategies to score.
+    field, data_field, owner : str
+        The option, the measurements and the caller named in messages
+        (``"--calibrate"``, ``"MEASUREMENTS"``, ``"softbend transfer loco"``).
+
+    Raises
+    ------
+    ValueError
+        Fewer than :data:`MIN_CALIBRATION_ACTUATORS` actuators, or no strategy
+        that is calibrated.
+    """
+    if len(actuators) < MIN_CALIBRATION_ACTUATORS:
+        raise ValueError(
+            f"The '{field}' of {owner} needs the {data_field} of at least "
+            f"{MIN_CALIBRATION_ACTUATORS} actuators (the held-out one and two others, each "
+            "predicted by a model fitted without it, to calibrate its interval on). "
+            f"Got {len(actuators)} ({'; '.join(actuators)}) instead."
+        )
+    if all(name in _SLOW for name in strategies):
+        raise ValueError(
+            f"The '{field}' of {owner} calibrates strategies other than "
+            f"{' and '.join(_SLOW)} (their training would dominate the time). "
+            f"Got only {', '.join(strategies)} instead."
+        )
 
 
 def held_out_residuals(
