@@ -63,3 +63,11 @@ def test_a_second_result_of_the_same_name_is_refused():
     with pytest.raises(ValueError, match=r"\[\[spec\]\] 2 .*only in case"):
         check_output_names(["Stiff", "stiff"], "[[spec]] {index} 'name'")
     assert check_output_names(["a", "b"], "x") == ["a", "b"]
+
+
+def test_a_field_with_braces_and_repeated_reserved_names():
+    with pytest.raises(ValueError, match=r"\{odd\}.toml, \[\[spec\]\] 2"):
+        check_output_names(["a", ""], "{odd}.toml, [[spec]] {index}")
+    with pytest.raises(ValueError) as info:
+        output_name("x.csv", "'name'", reserved=("x.csv", "x.csv"))
+    assert "(x.csv)" in str(info.value)

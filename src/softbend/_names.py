@@ -82,7 +82,7 @@ def output_name(
     if clash is not None:
         raise ValueError(
             f"The {field} {shown} is a name the command writes itself "
-            f"({', '.join(sorted(reserved))}); choose another."
+            f"({', '.join(sorted(set(reserved)))}); choose another."
         )
     other = next((t for t in taken if t.casefold() == folded), None)
     if other is not None:
@@ -127,6 +127,8 @@ def check_output_names(
     checked: list[str] = []
     for index, name in enumerate(names, start=1):
         checked.append(
-            output_name(name, field.format(index=index), reserved=reserved, taken=checked)
+            output_name(
+                name, field.replace("{index}", str(index)), reserved=reserved, taken=checked
+            )
         )
     return checked
