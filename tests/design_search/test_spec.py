@@ -144,8 +144,8 @@ tolerance = 5.0
     assert reach.target.kind == "max_angle" and reach.steps["l"] == 2.0
     assert third.name == "spec3" and third.target.tolerance_deg == 5.0
     path.write_text("[[spec]]\nangle = 90\nat = 0.08\ncolour = 'red'\n")
-    with pytest.raises(DatasetError, match=r"number 1: unknown key\(s\) colour"):
+    with pytest.raises(DatasetError, match=r"\[\[spec\]\] 1: unknown key\(s\) 'colour'"):
         load_specifications(path)
     path.write_text("[[spec]\n")
-    with pytest.raises(DatasetError, match="not TOML"):
+    with pytest.raises(DatasetError, match="line 1, column 7: not valid TOML"):
         load_specifications(path)

@@ -1,12 +1,113 @@
-"""``softbend design find``: the designs that meet a specification, verified by the FEM."""
+"""``softbend design find``: the designs that meet a specification, verified by the FEM.
+
+Everything is checked before a design is scored: the output folder, every
+number against its declared range (:data:`VERIFY`, :data:`WORKERS`,
+:data:`softbend.design_search.search.TOP` and the target's), options that
+contradict each other (a target, range or objective beside ``--spec``; a
+verification option without ``--verify``), the material of the verification,
+every spec of the file and the size of every search's grid. The verification's
+temporary campaign lives in the staging folder of ``--out``, which the next run
+removes if this one is killed.
+"""
 
 from __future__ import annotations
 
 from pathlib import Path
+from typing import Any
 
 import typer
 
 from softbend.cli import _common
+from softbend.parameters import Range
+
+#: How many of the best candidates ``--verify`` sweeps.
+VERIFY = Range(0, 100, "designs", "each is a sweep of the FEM, minutes long")
+
+#: The processes of the verification (``--workers``).
+WORKERS = Range(1, 4096, "processes", "the bound of a campaign's local workers")
+
+#: Options a spec file gives itself, and what of each spec they set.
+_SPEC_GIVES: dict[str, tuple[str, str]] = {
+    "angle": ("--angle", "target"),
+    "at": ("--at", "target"),
+    "max_pressure": ("--max-pressure", "target"),
+    "max_angle_at": ("--max-angle-at", "target"),
+    "curve": ("--curve", "target"),
+    "tolerance": ("--tolerance", "tolerance"),
+    "margin": ("--margin", "margin"),
+    "minimize": ("--minimize", "objectives"),
+    "maximize": ("--maximize", "objectives"),
+    "fix": ("--fix", "ranges (fix, range)"),
+    "ranges": ("--range", "ranges (fix, range)"),
+    "resolution": ("--resolution", "resolution"),
+}
+
+#: Options of the verification alone.
+_VERIFY_OPTIONS: dict[str, str] = {
+    "backend": "--backend",
+    "workers": "--workers",
+    "material": "--material",
+}
+
+
+def _typed(ctx: typer.Context, parameter: str) -> bool:
+    """Whether the option of ``parameter`` was given (typed or from the environment)."""
+    source = ctx.get_parameter_source(parameter)
+    return getattr(source, "name", None) in ("COMMANDLINE", "ENVIRONMENT")
+
+
+def _check_count(value: int, option: str, allowed: Range) -> None:
+    """Refuse an integer option outside ``allowed``, naming it, the range and why."""
+    if not allowed.contains(value):
+        raise ValueError(
+            f"The '{option}' must be an integer in {allowed.describe()} ({allowed.why}). "
+            f"Got {value} instead."
+        )
+
+
+def _verification(
+    ctx: typer.Context, verify: int, backend: str, workers: int | None, material: str | None
+) -> Any:
+    """Check the options of ``--verify`` and resolve ``--material`` once; the material
+    (None: the backend's own).
+
+    Raises
+    ------
+    ValueError
+        A verification option without ``--verify``, a backend that is not public
+        or takes no material, ``--workers`` outside :data:`WORKERS`.
+    SoftbendError
+        A material that is not a preset nor a valid ``fit.json`` (as ``fem run``).
+    """
+    _check_count(verify, "--verify", VERIFY)
+    if not verify:
+        given = [flag for name, flag in _VERIFY_OPTIONS.items() if _typed(ctx, name)]
+        if given:
+            raise ValueError(
+                f"The '{given[0]}' applies to the verification; give --verify N "
+                "(the best N candidates swept), or leave it out."
+            )
+        return None
+    from softbend.campaign.backends import public_backends, resolve_material, takes_material
+
+    if backend not in public_backends():
+        raise ValueError(
+            f"The '--backend' must be one of {', '.join(public_backends())}. "
+            f"Got {backend!r} instead."
+        )
+    if workers is not None:
+        _check_count(workers, "--workers", WORKERS)
+    if material is None:
+        return None
+    if not takes_material(backend):
+        takers = [n for n in public_backends() if takes_material(n)]
+        raise ValueError(
+            f"The '--material' applies to a backend that takes a material "
+            f"({', '.join(takers)}). Got --backend {backend}."
+        )
+    elastomer, _ = resolve_material(material, field="--material")
+    return elastomer
+
 
 app = typer.Typer(
     help="Design to a specification.\n\n"
@@ -18,6 +119,7 @@ app = typer.Typer(
 
 @app.command("find")
 def find(
+    ctx: typer.Context,
     out: Path = typer.Option(..., "--out", "-o", help="Folder for the tables and figures."),
     model: Path = typer.Option(
         None, help="Saved surrogate to search (default: the shipped FEM-trained MLP)."
@@ -34,7 +136,7 @@ def find(
     curve: str = typer.Option(
         None, help="Follow the points P:ANGLE, comma-separated (MPa:deg), e.g. 0.05:40,0.1:95."
     ),
-    tolerance: float = typer.Option(3.0, help="How far the angle may miss, deg."),
+    tolerance: float = typer.Option(3.0, help="How far the angle may miss, deg, in (0, 90]."),
     margin: float = typer.Option(
         0.0, help="Degrees of the tolerance kept back on the surrogate (its own error)."
     ),
@@ -53,13 +155,19 @@ def find(
         help="Mould resolution: a number for every parameter or NAME=STEP (repeatable); "
         "0 searches continuously. Default 0.5 mm and 1° of phi.",
     ),
-    top: int = typer.Option(10, help="Candidates listed."),
+    top: int = typer.Option(
+        10, help="Candidates listed, 1 to 1000 (to 25 with a continuous parameter)."
+    ),
     neighbours: bool = typer.Option(
         False, "--neighbours", help="Also list designs one step from a better one."
     ),
-    verify: int = typer.Option(0, help="Sweep the best N with --backend and compare."),
+    verify: int = typer.Option(
+        0, help="Sweep the best N (at most 100) with --backend and compare."
+    ),
     backend: str = typer.Option("fem", help="Backend of the verification: fem or analytical."),
-    workers: int = typer.Option(None, help="Processes of the verification (default: all cores)."),
+    workers: int = typer.Option(
+        None, help="Processes of the verification, 1 to 4096 (default: all cores)."
+    ),
     material: str = typer.Option(None, help="Elastomer of the verification (as fem run)."),
     allow_extrapolation: bool = typer.Option(
         False, "--allow-extrapolation", help="Search outside the training data, answers flagged."
@@ -76,6 +184,14 @@ def find(
     training data are passed over unless --allow-extrapolation. With --verify N
     the best N are swept by the FEM and set beside the surrogate.
 
+    Every input is checked before a design is scored: each number against its
+    range, the size of each grid (at most 20 million designs), the material,
+    and every [[spec]] of --spec (a name is a plain folder name of --out; the
+    target, range and objective options are the file's, not given beside it).
+    The results are built beside --out and swapped in when complete; a run
+    killed during the verification leaves a hidden .OUT.PID-*.new folder that
+    the next run into --out removes.
+
     Example:
 
     \b
@@ -84,7 +200,7 @@ def find(
     """
     from softbend._io import staged_dir
     from softbend.design_search import spec as specs
-    from softbend.design_search.search import find_designs
+    from softbend.design_search.search import TOP, find_designs, searched_ranges
     from softbend.design_search.verify import verify_candidates
     from softbend.reports.design_outputs import FILES, write_search
     from softbend.surrogates.predict import load_predictor
@@ -97,25 +213,28 @@ def find(
     _common.check_replaceable_dir(
         out, "--out", "design find", inputs=inputs, files=None, marker="search.json"
     )
-    if top < 1:
-        raise ValueError(f"The '--top' must be an integer >= 1. Got {top} instead.")
-    if verify < 0:
-        raise ValueError(f"The '--verify' must be an integer >= 0. Got {verify} instead.")
-    if verify:
-        from softbend.campaign.backends import public_backends
-
-        if backend not in public_backends():
-            raise ValueError(
-                f"The '--backend' must be one of {', '.join(public_backends())}. "
-                f"Got {backend!r} instead."
-            )
+    _check_count(top, "--top", TOP)
+    elastomer = _verification(ctx, verify, backend, workers, material)
     if spec is not None:
-        chosen = specs.load_specifications(spec)
+        for name, (flag, what) in _SPEC_GIVES.items():
+            if _typed(ctx, name):
+                raise ValueError(
+                    f"The '{flag}' cannot be used with --spec: the spec file gives each "
+                    f"spec's {what}."
+                )
+        chosen = specs.load_specifications(
+            spec, what=f"--spec {spec}", reserved=sorted({"search.json", *FILES})
+        )
     else:
         target = specs.target_from_options(
             angle=angle, at=at, max_pressure=max_pressure, max_angle_at=max_angle_at,
             curve=curve, tolerance=tolerance,
         )  # fmt: skip
+        if not 0 <= margin < tolerance:
+            raise ValueError(
+                f"The '--margin' must lie in [0, {tolerance:g}) degrees (below --tolerance, "
+                f"the miss the surrogate's own error may take). Got {margin!r} instead."
+            )
         numbers = [s for s in resolution or () if "=" not in s]
         if len(numbers) > 1:
             raise ValueError(
@@ -132,24 +251,48 @@ def find(
         )
         objectives = specs.parse_objectives(minimize or (), maximize or ())
         chosen = [specs.Specification(target, given, objectives, "spec", steps, margin)]
-    predictor, _ = load_predictor(model_path)
-    results = []
+    predictor, saved = load_predictor(model_path)
+    training = saved.metadata.get("training_ranges")
+    hint = (
+        "coarsen --resolution or narrow the ranges (--range, --fix)"
+        if spec is None
+        else "coarsen its 'resolution' or narrow its ranges ('range', 'fix')"
+    )
+    for number, one in enumerate(chosen, start=1):  # every grid counted before any is built
+        try:
+            searched_ranges(
+                one, training, allow_extrapolation=allow_extrapolation, hint=hint, top=top
+            )
+        except ValueError as exc:
+            if spec is None:
+                raise
+            raise ValueError(f"--spec {spec}, [[spec]] {number} ({one.name!r}): {exc}") from None
     with _common.library_progress(enabled=not as_json):
-        for one in chosen:
-            result = find_designs(
+        results = [
+            find_designs(
                 model_path,
                 one,
                 top=top,
                 allow_extrapolation=allow_extrapolation,
                 distinct=not neighbours,
             )
-            if verify and result.candidates:
-                verify_candidates(
-                    result, verify, backend=backend, workers=workers, material=material
-                )
-            results.append(result)
-    payload = [r.to_dict() for r in results]
+            for one in chosen
+        ]
+    payload: list[dict[str, Any]] = []
     with _common.output_errors(out, "--out"), staged_dir(out) as stage:
+        if verify:  # the temporary campaign in the staging folder: a kill leaves it there
+            with _common.library_progress(enabled=not as_json):
+                for result in results:
+                    if result.candidates:
+                        verify_candidates(
+                            result,
+                            verify,
+                            backend=backend,
+                            workers=workers,
+                            material=elastomer,
+                            scratch_dir=stage,
+                        )
+        payload = [r.to_dict() for r in results]
         for result in results:
             folder = stage / result.spec.name if len(results) > 1 else stage
             write_search(result, predictor, folder)

@@ -34,18 +34,24 @@ import numpy as np
 from softbend.design import SFRBADesign
 from softbend.design_search.spec import (
     NAMES,
+    UNITS,
     ParameterRange,
     Specification,
 )
+from softbend.parameters import Range
 
 __all__ = [
     "CONTINUOUS_POINTS",
     "MAX_DESIGNS",
+    "TOP",
+    "TOP_CONTINUOUS",
     "Candidate",
     "SearchResult",
     "elastomer_volume_mm3",
     "find_designs",
+    "grid_size",
     "pareto_front",
+    "searched_ranges",
 ]
 
 #: Values a continuous parameter is screened at before the best designs are polished.
@@ -54,8 +60,29 @@ CONTINUOUS_POINTS = 17
 #: The most designs one search scores (a larger grid: a larger step, or narrower ranges).
 MAX_DESIGNS = 20_000_000
 
+#: The candidates one search lists (``top``).
+TOP = Range(
+    1,
+    1000,
+    "candidates",
+    "a shortlist: each is scored again in float64, checked against the training data, "
+    "written and drawn; every design of the grid is scored whatever the shortlist",
+)
+
+#: The candidates a search with a continuous parameter (step 0) lists.
+TOP_CONTINUOUS = Range(
+    1,
+    25,
+    "candidates",
+    "each of the best 4 × top designs is polished by an optimisation of its own, about a "
+    "second each",
+)
+
 #: Rows per evaluation chunk (memory: about 70 MB of activations for an MLP).
 CHUNK = 1 << 17
+
+#: Designs whose support is checked at once, ahead of listing them.
+_AHEAD = 64
 
 #: Pressure step of the finite difference of the sensitivity dθ/dp, MPa.
 _DP = 0.0025
@@ -227,21 +254,120 @@ def elastomer_volume_mm3(designs: np.ndarray) -> np.ndarray:
 def pareto_front(values: np.ndarray) -> np.ndarray:
     """Indices of the rows of ``values`` (n × k, all minimised) that no other row dominates.
 
-    Sorted by the first column (then the others); ties keep the first.
+    Sorted by the first column (then the others); ties keep the first; NaN counts
+    as the worst value. Vectorised: one pass over the rows left per member of the
+    front (a running minimum for two columns).
     """
     v = np.asarray(values, dtype=np.float64)
     if v.shape[0] == 0:
         return np.zeros(0, dtype=np.intp)
+    v = np.where(np.isnan(v), np.inf, v)
     order = np.lexsort(v.T[::-1])
-    kept: list[int] = []
-    front = np.empty((0, v.shape[1]))
-    for i in order:
-        row = v[i]
-        if front.shape[0] and np.any(np.all(front <= row, axis=1)):
-            continue
-        kept.append(int(i))
-        front = np.vstack([front, row])
-    return np.asarray(kept, dtype=np.intp)
+    ranked = v[order]
+    if v.shape[1] == 1:
+        return order[:1].astype(np.intp)
+    if v.shape[1] == 2:
+        best = np.minimum.accumulate(ranked[:, 1])
+        keep = np.ones(ranked.shape[0], dtype=bool)
+        keep[1:] = ranked[1:, 1] < best[:-1]
+        return order[keep].astype(np.intp)
+    # A row is on the front unless an earlier one (in this order) is no worse anywhere:
+    # the rows before ``i`` left are all on the front, so each pass keeps them.
+    alive = np.arange(ranked.shape[0])
+    i = 0
+    while i < alive.size:
+        rows = ranked[alive]
+        better = np.any(rows < rows[i], axis=1)
+        better[: i + 1] = True
+        alive = alive[better]
+        i += 1
+    return order[alive].astype(np.intp)
+
+
+def grid_size(ranges: Mapping[str, ParameterRange]) -> int:
+    """The designs of the grid of ``ranges`` (every parameter's), counted without building it.
+
+    A fixed parameter counts once, a continuous one :data:`CONTINUOUS_POINTS`
+    times (its screening grid), a stepped one :meth:`ParameterRange.count` times.
+    """
+    return math.prod(_axis_size(ranges[name]) for name in NAMES)
+
+
+def _axis_size(r: ParameterRange) -> int:
+    if r.fixed:
+        return 1
+    return CONTINUOUS_POINTS if r.step == 0 else r.count()
+
+
+def searched_ranges(
+    spec: Specification,
+    training_ranges: Mapping[str, Any] | None,
+    *,
+    allow_extrapolation: bool = False,
+    hint: str = "coarsen --resolution or narrow the ranges (--range, --fix)",
+    top: int | None = None,
+) -> tuple[dict[str, ParameterRange], int]:
+    """Every parameter's range a search of ``spec`` scores, and the designs of its grid.
+
+    Checked before anything is built or scored, so that a command refuses a
+    search it cannot finish at once.
+
+    Parameters
+    ----------
+    spec : Specification
+    training_ranges : dict, optional
+        The model's training ranges (``metadata["training_ranges"]``).
+    allow_extrapolation : bool, default False
+        As :func:`find_designs`.
+    hint : str
+        What to change when the grid is too large, as the caller's input names it.
+    top : int, optional
+        The candidates to list, held to :data:`TOP_CONTINUOUS` when a parameter
+        is searched continuously.
+
+    Returns
+    -------
+    (dict of str to ParameterRange, int)
+
+    Raises
+    ------
+    ValueError
+        As :meth:`Specification.resolved`; a grid over :data:`MAX_DESIGNS`
+        (counted arithmetically, naming each parameter's count and step); ranges
+        in which no design has a wall thinner than its radius (t < r); a ``top``
+        over :data:`TOP_CONTINUOUS` with a continuous parameter.
+    """
+    ranges = spec.resolved(
+        training_ranges if isinstance(training_ranges, dict) else None,
+        allow_extrapolation=allow_extrapolation,
+    )
+    total = grid_size(ranges)
+    if total > MAX_DESIGNS:
+        shown = f"{total:,}" if total < 10**15 else f"{float(total):.3g}"
+        counts = ", ".join(
+            f"{n} {_axis_size(r):,}"
+            + ("" if r.fixed else f" at {r.step:g} {UNITS[n]}" if r.step else " (continuous)")
+            for n, r in ranges.items()
+            if not r.fixed
+        )
+        raise ValueError(
+            f"The ranges and steps hold {shown} designs ({counts}), more than the "
+            f"{MAX_DESIGNS:,} one search scores; {hint}."
+        )
+    t, r = ranges["t"], ranges["r"]
+    if t.low >= r.high:
+        raise ValueError(
+            f"No design of the ranges has a wall thinner than its radius (t < r): t is at "
+            f"least {t.low:g} mm and r at most {r.high:g} mm; widen the ranges of t or r."
+        )
+    continuous = [n for n, one in ranges.items() if not one.fixed and one.step == 0]
+    if continuous and top is not None and not TOP_CONTINUOUS.contains(top):
+        raise ValueError(
+            f"A search with a continuous parameter ({', '.join(continuous)}: step 0) lists "
+            f"at most {TOP_CONTINUOUS.high:g} candidates (--top; {TOP_CONTINUOUS.why}). "
+            f"Got {top}."
+        )
+    return ranges, total
 
 
 class _Scorer:
@@ -394,38 +520,43 @@ def find_designs(
     ------
     ValueError
         A range outside the training ranges (without ``allow_extrapolation``),
-        a grid over :data:`MAX_DESIGNS`, a bad ``top``.
+        a grid over :data:`MAX_DESIGNS` (:func:`searched_ranges`), a ``top``
+        outside :data:`TOP` (:data:`TOP_CONTINUOUS` with a continuous parameter).
+
+    Notes
+    -----
+    Designs of the grid whose wall is not thinner than their radius (t >= r)
+    are not actuators: they are left out of the scores and of ``n_designs``.
     """
     from softbend._progress import report
     from softbend.surrogates.features import outside_training_ranges
     from softbend.surrogates.predict import load_predictor
     from softbend.surrogates.support import Support
 
-    if isinstance(top, bool) or not isinstance(top, int) or top < 1:
-        raise ValueError(f"The 'top' of find_designs must be an integer >= 1. Got {top!r}.")
+    if isinstance(top, bool) or not isinstance(top, int) or not TOP.contains(top):
+        raise ValueError(
+            f"The 'top' of find_designs must be an integer in {TOP.describe()} ({TOP.why}). "
+            f"Got {top!r} instead."
+        )
     start = time.perf_counter()
     predictor, saved = load_predictor(model)
     metadata = saved.metadata
     training = metadata.get("training_ranges")
-    ranges = spec.resolved(
-        training if isinstance(training, dict) else None, allow_extrapolation=allow_extrapolation
+    ranges, total = searched_ranges(
+        spec, training, allow_extrapolation=allow_extrapolation, top=top
     )
     axes = _grid(ranges)
-    total = int(np.prod([a.size for a in axes], dtype=np.int64))
-    if total > MAX_DESIGNS:
-        raise ValueError(
-            f"The ranges and steps hold {total:,} designs, more than the {MAX_DESIGNS:,} one "
-            "search scores; coarsen --resolution or narrow the ranges."
-        )
     exact = predictor.predict
     screen = getattr(predictor, "predict32", exact)
     scorer = _Scorer(screen, spec)
     tolerance = spec.target.tolerance_deg - spec.margin_deg
     error = np.empty(total)
+    valid = np.empty(total, dtype=bool)
     objectives = np.empty((total, len(spec.objectives)))
     for first in range(0, total, CHUNK):
         flat = np.arange(first, min(first + CHUNK, total))
         designs = _designs_at(axes, flat)
+        valid[flat] = _actuators(designs)
         with np.errstate(all="ignore"):
             scores = scorer.score(designs)
             error[flat] = scores["error"]
@@ -435,13 +566,14 @@ def find_designs(
         if progress is not None:
             progress(done, total)
     error = np.where(np.isfinite(error), error, np.inf)
-    meeting = np.flatnonzero(error <= tolerance + 1e-3)  # the float64 pass decides the edge
+    meeting = np.flatnonzero((error <= tolerance + 1e-3) & valid)  # float64 decides the edge
     feasible_screen = meeting.size > 0
     if feasible_screen:
         order = _ranked(objectives[meeting], error[meeting])
         ranked = meeting[order]
     else:
         ranked = np.argsort(error, kind="stable")
+        ranked = ranked[valid[ranked]]
     support = (
         Support.from_dict(metadata["support"])
         if isinstance(metadata.get("support"), dict)
@@ -452,8 +584,7 @@ def find_designs(
     candidates: list[Candidate] = []
     passed_over = 0
     continuous = [n for n in NAMES if not ranges[n].fixed and ranges[n].step == 0]
-    steps = np.array([ranges[n].step for n in NAMES]) + 1e-9
-    kept: list[np.ndarray] = []
+    listed = _Listed(ranges)
     for first in range(0, ranked.size, 4 * top):
         batch = ranked[first : first + 4 * top]
         designs = _designs_at(axes, batch)
@@ -461,25 +592,42 @@ def find_designs(
             designs = _polish(designs, exact_scorer, spec, ranges, continuous)
         with np.errstate(all="ignore"):
             scores = exact_scorer.score(designs)
-        for row, design in enumerate(designs):
+        meets_all = np.isfinite(scores["error"]) & (scores["error"] <= tolerance)
+        rows = np.flatnonzero((meets_all | (not feasible_screen)) & _actuators(designs))
+        cells = listed.cells_of(designs)
+        outside = np.zeros(designs.shape[0], dtype=bool)
+        known = np.zeros(designs.shape[0], dtype=bool)
+        for position, row in enumerate(rows):
+            design = designs[row]
+            if distinct and listed.near(design, cells[row]):
+                continue
+            if not known[row]:  # the support of the next rows that may be listed, at once
+                ahead = np.array(
+                    [
+                        r
+                        for r in rows[position : position + _AHEAD]
+                        if not known[r] and not (distinct and listed.near(designs[r], cells[r]))
+                    ]
+                )
+                picked = {k: np.asarray(v)[ahead] for k, v in scores.items()}
+                outside[ahead] = _outside_mask(designs[ahead], picked, spec, training, support)
+                known[ahead] = True
             one = {k: float(v[row]) for k, v in scores.items()}
-            meets = bool(np.isfinite(one["error"]) and one["error"] <= tolerance)
-            if feasible_screen and not meets:
-                continue
-            flags = _flags(design, one, spec, training, support, outside_training_ranges)
-            if flags and not allow_extrapolation:
-                passed_over += 1
-                continue
-            if distinct and any(np.all(np.abs(k - design) <= steps) for k in kept):
-                continue
-            kept.append(design)
+            flags: list[str] = []
+            if outside[row]:
+                flags = _flags(design, one, spec, training, support, outside_training_ranges)
+                if flags and not allow_extrapolation:
+                    passed_over += 1
+                    continue
+            if distinct:
+                listed.add(design, cells[row])
             candidates.append(
                 Candidate(
                     design=SFRBADesign.from_sequence(design.tolist()),
                     angle_deg=one["angle"],
                     pressure_mpa=one["pressure"],
                     error_deg=one["error"],
-                    meets=meets,
+                    meets=bool(meets_all[row]),
                     objectives=_objective_values(spec, design, one),
                     interval_deg=interval(design, one),
                     flags=flags,
@@ -499,7 +647,7 @@ def find_designs(
         candidates=candidates,
         feasible=feasible,
         ranges=ranges,
-        n_designs=total,
+        n_designs=int(np.count_nonzero(valid)),
         n_meeting=int(meeting.size),
         n_passed_over=passed_over,
         front=front,
@@ -517,10 +665,12 @@ def _ranked(objectives: np.ndarray, error: np.ndarray) -> np.ndarray:
     order: list[np.ndarray] = []
     collected = 0
     while remaining.size and collected < 2000:
-        front = remaining[pareto_front(objectives[remaining])]
-        order.append(front)
-        collected += front.size
-        remaining = np.setdiff1d(remaining, front, assume_unique=True)
+        on_front = pareto_front(objectives[remaining])
+        order.append(remaining[on_front])
+        collected += on_front.size
+        left = np.ones(remaining.size, dtype=bool)
+        left[on_front] = False
+        remaining = remaining[left]
     rest = remaining[np.lexsort((error[remaining], objectives[remaining, 0]))]
     return np.concatenate([*order, rest])
 
@@ -541,6 +691,94 @@ def _final_order(
     ).reshape(len(meeting), len(signs))
     errors = np.array([c.error_deg for c in meeting])
     return [meeting[i] for i in _ranked(values, errors)]
+
+
+class _Listed:
+    """The designs listed so far, filed by grid cell, so that whether a design lies one
+    step from one of them (within a step in every parameter) is a lookup, not a scan.
+
+    A design's cell is its index on the grid of each stepped parameter, one
+    number in mixed radix; a listed design files every cell within one index of
+    its own, so a design one step from it finds its own cell filed. On a grid
+    that is the rule exactly. A continuous parameter (polished values) takes no
+    part in the cell: a filed cell is then checked against the listed designs.
+    """
+
+    def __init__(self, ranges: Mapping[str, ParameterRange]) -> None:
+        chosen = [ranges[n] for n in NAMES]
+        stepped = np.array([not r.fixed and r.step > 0 for r in chosen])
+        self.low = np.array([r.low for r in chosen])
+        self.step = np.where(stepped, [r.step for r in chosen], 1.0)
+        self.stepped = stepped
+        self.exact = not any(not r.fixed and r.step == 0 for r in chosen)
+        self.tolerance = np.array([r.step for r in chosen]) + 1e-9
+        # Indices run from -1 to count: radix count + 2, so no neighbour wraps around.
+        sizes = np.array([r.count() + 2 if s else 1 for r, s in zip(chosen, stepped, strict=True)])
+        self.radix = np.concatenate([[1], np.cumprod(sizes[:-1])]).astype(np.int64)
+        dims = np.flatnonzero(stepped)
+        offsets = np.zeros((3**dims.size, len(NAMES)), dtype=np.int64)
+        grids = np.meshgrid(*([np.array([-1, 0, 1])] * dims.size), indexing="ij")
+        for k, grid in zip(dims, grids, strict=True):
+            offsets[:, k] = grid.ravel()
+        self.neighbours = offsets @ self.radix
+        self.filed: set[int] = set()
+        self.designs: list[np.ndarray] = []
+
+    def cells_of(self, designs: np.ndarray) -> np.ndarray:
+        """The cell of each row of ``designs`` (one integer each)."""
+        index = np.where(self.stepped, np.rint((designs - self.low) / self.step) + 1, 0.0)
+        return index.astype(np.int64) @ self.radix
+
+    def near(self, design: np.ndarray, cell: np.int64) -> bool:
+        """Whether ``design`` (in ``cell``) lies within a step of a listed design."""
+        if int(cell) not in self.filed:
+            return False
+        if self.exact:
+            return True
+        listed = np.asarray(self.designs)
+        return bool(np.any(np.all(np.abs(listed - design) <= self.tolerance, axis=1)))
+
+    def add(self, design: np.ndarray, cell: np.int64) -> None:
+        """List ``design`` (in ``cell``)."""
+        self.filed.update((self.neighbours + cell).tolist())
+        self.designs.append(design)
+
+
+def _actuators(designs: np.ndarray) -> np.ndarray:
+    """Which rows of designs are actuators: a wall thinner than the radius (t < r)."""
+    return designs[:, NAMES.index("t")] < designs[:, NAMES.index("r")]
+
+
+def _outside_mask(
+    designs: np.ndarray,
+    scores: Mapping[str, np.ndarray],
+    spec: Specification,
+    training: Any,
+    support: Any,
+) -> np.ndarray:
+    """Which rows :func:`_flags` would flag, for a batch at once (the same comparisons)."""
+    from softbend.surrogates.features import FEATURES
+
+    n = designs.shape[0]
+    target = spec.target
+    if target.kind == "pressure_for":
+        reached = np.asarray(scores["pressure"], dtype=np.float64)
+        low = high = np.where(np.isfinite(reached), reached, target.pressure_mpa)
+    else:
+        low = np.full(n, min(target.pressures_mpa))
+        high = np.full(n, max(target.pressures_mpa))
+    flagged = np.zeros(n, dtype=bool)
+    if isinstance(training, dict):
+        for j, name in enumerate(FEATURES):
+            if name not in training:
+                continue
+            lo, hi = (float(v) for v in training[name])
+            first, last = (designs[:, j], designs[:, j]) if j < designs.shape[1] else (low, high)
+            flagged |= (first < lo) | (last > hi)
+    if support is not None:
+        flagged |= high > support.max_pressure(designs) * (1 + 1e-9) + 1e-12
+        flagged |= np.asarray(scores["angle"], dtype=np.float64) > support.angle_limit_deg
+    return flagged
 
 
 def _flags(
@@ -609,6 +847,8 @@ def _polish(
         def cost(x: np.ndarray, design: np.ndarray = design) -> float:
             trial = design.copy()
             trial[which] = x
+            if not _actuators(trial[None, :])[0]:
+                return 1e12
             with np.errstate(all="ignore"):
                 scores = scorer.score(trial[None, :])
             miss = float(scores["error"][0])

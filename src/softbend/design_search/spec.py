@@ -21,27 +21,38 @@ A :class:`Specification` says what an actuator must do and what may be chosen:
 
 Specifications come from code, from command-line text (:func:`parse_assignment`,
 :func:`parse_range`) or from a TOML file (:func:`load_specifications`: one
-``[[spec]]`` table per specification).
+``[[spec]]`` table per specification). Every number is held to a declared
+range (:data:`ANGLE`, :data:`PRESSURE`, :data:`TOLERANCE`, the limits of a
+design), and a ``[[spec]]`` name becomes a folder of the output only through
+:func:`softbend._names.output_name`, all before any design is scored.
 """
 
 from __future__ import annotations
 
 import math
 import os
-import tomllib
-from collections.abc import Mapping, Sequence
+import reprlib
+from collections.abc import Collection, Mapping, Sequence
 from dataclasses import dataclass, field
-from pathlib import Path
 from typing import Any
 
-from softbend.design import PARAMETERS
+from softbend._names import output_name
+from softbend._tomltext import read_toml
+from softbend.design import DESIGN_LIMITS, PARAMETERS
 from softbend.errors import DatasetError
+from softbend.parameters import Range
 
 __all__ = [
+    "ANGLE",
+    "CURVE_POINTS",
     "DEFAULT_STEPS",
     "NAMES",
     "OBJECTIVES",
+    "PRESSURE",
+    "SPECS",
+    "STEP",
     "TARGETS",
+    "TOLERANCE",
     "Objective",
     "ParameterRange",
     "Specification",
@@ -78,6 +89,35 @@ OBJECTIVES: dict[str, str] = {
     "angle": "deg",
     "error": "deg",
 }
+
+#: A target's angle.
+ANGLE = Range(0.0, 360.0, "deg", "a bending angle, one turn at most", low_inclusive=False)
+
+#: A target's pressure.
+PRESSURE = Range(
+    0.0,
+    1.0,
+    "MPa",
+    "a gauge pressure; a larger value is likely kPa (0.08 MPa = 80 kPa)",
+    low_inclusive=False,
+)
+
+#: How far a target's angle may miss.
+TOLERANCE = Range(0.0, 90.0, "deg", "a wider miss accepts nearly any design", low_inclusive=False)
+
+#: The points of a ``curve`` target.
+CURVE_POINTS = Range(
+    2, 50, "points", "two make a curve; each is one more pass of the surrogate over every design"
+)
+
+#: The ``[[spec]]`` tables of one file.
+SPECS = Range(1, 100, "tables", "each is a search of up to 20 million designs")
+
+#: A mould's step (``--resolution``): finite, 0 for a continuous search.
+STEP = Range(0.0, math.inf, "", "0 searches continuously", high_inclusive=False)
+
+#: The most values one parameter's grid is built with (:meth:`ParameterRange.values`).
+_MAX_VALUES = 20_000_000
 
 _OWNER = "Specification"
 
@@ -118,12 +158,35 @@ class ParameterRange:
         """Whether the parameter is fixed to one value."""
         return self.low == self.high
 
+    def count(self) -> int:
+        """How many values :meth:`values` holds, counted without building them (0 when
+        continuous; at most 10**30 for a step too fine to count in floats)."""
+        if self.fixed:
+            return 1
+        if self.step == 0:
+            return 0
+        spans = (self.high - self.low) / self.step
+        if not math.isfinite(spans) or spans > 1e30:
+            return 10**30
+        return math.floor(spans + 1e-9) + 1
+
     def values(self) -> list[float]:
-        """The allowed values on the step's grid (``[low]`` when fixed), rounded to 1e-9."""
+        """The allowed values on the step's grid (``[low]`` when fixed), rounded to 1e-9.
+
+        Raises
+        ------
+        ValueError
+            More than 20 million values (a step far finer than any mould's).
+        """
+        count = self.count()
+        if count > _MAX_VALUES:
+            raise ValueError(
+                f"A parameter range of {self.low:g}:{self.high:g} at a step of {self.step:g} "
+                f"holds {count:,} values, more than the {_MAX_VALUES:,} one search builds."
+            )
         if self.fixed or self.step == 0:
             return [self.low] if self.fixed else []
-        count = math.floor((self.high - self.low) / self.step + 1e-9)
-        return [round(self.low + i * self.step, 9) for i in range(count + 1)]
+        return [round(self.low + i * self.step, 9) for i in range(count)]
 
 
 @dataclass(frozen=True)
@@ -157,18 +220,40 @@ class Target:
                 f"The 'kind' of a target must be one of {', '.join(TARGETS)}. "
                 f"Got {self.kind!r} instead."
             )
-        if not (math.isfinite(self.tolerance_deg) and self.tolerance_deg > 0):
+        tolerance = self.tolerance_deg
+        if (
+            isinstance(tolerance, bool)
+            or not isinstance(tolerance, int | float)
+            or not TOLERANCE.contains(tolerance)
+        ):
             raise ValueError(
-                f"The tolerance of a target must be > 0 degrees. Got {self.tolerance_deg!r}."
+                f"The tolerance of a target must lie in {TOLERANCE.describe()} "
+                f"({TOLERANCE.why}). Got {tolerance!r}."
             )
         if self.kind == "curve":
-            if len(self.points) < 2:
-                raise ValueError("A 'curve' target needs at least 2 (pressure, angle) points.")
-            for p, a in self.points:
-                _check_pressure(p, "a point's pressure")
-                _check_angle(a, "a point's angle")
+            points = tuple(self.points)
+            if not CURVE_POINTS.contains(len(points)):
+                raise ValueError(
+                    f"A 'curve' target needs at least {CURVE_POINTS.low:g} and at most "
+                    f"{CURVE_POINTS.high:g} (pressure, angle) points ({CURVE_POINTS.why}). "
+                    f"Got {len(points)}."
+                )
+            for point in points:
+                if not isinstance(point, Sequence) or len(point) != 2:
+                    raise ValueError(
+                        f"A point of a 'curve' target must be (pressure, angle). Got {point!r}."
+                    )
+                _check_pressure(point[0], "a point's pressure")
+                _check_angle(point[1], "a point's angle")
+            pressures = [float(p) for p, _ in points]
+            twice = sorted({p for p in pressures if pressures.count(p) > 1})
+            if twice:
+                raise ValueError(
+                    "A 'curve' target gives each pressure once (one angle at each); "
+                    f"{', '.join(f'{p:g}' for p in twice)} MPa is given more than once."
+                )
             object.__setattr__(
-                self, "points", tuple(sorted((float(p), float(a)) for p, a in self.points))
+                self, "points", tuple(sorted((float(p), float(a)) for p, a in points))
             )
             return
         _check_pressure(self.pressure_mpa, "pressure")
@@ -315,6 +400,13 @@ class Specification:
                         f"--fix {name}=VALUE): the model records no training ranges."
                     )
                 given = ParameterRange(trained[0], trained[1], float(self.steps[name]))
+            for end in (given.low, given.high):
+                problem = _design_value_problem(name, end)
+                if problem is not None:
+                    raise ValueError(
+                        f"The range of {name!r} ({given.low:g}:{given.high:g} {UNITS[name]}) "
+                        f"{problem}."
+                    )
             outside = trained is not None and (
                 given.low < trained[0] - 1e-9 or given.high > trained[1] + 1e-9
             )
@@ -325,7 +417,7 @@ class Specification:
                     f"[{trained[0]:g}, {trained[1]:g}]; narrow it, or pass "
                     "--allow-extrapolation (the answers outside are then flagged)."
                 )
-            if not given.fixed and given.step > 0 and not given.values():
+            if not given.fixed and given.step > 0 and given.count() < 1:
                 raise ValueError(f"The range of {name!r} holds no value on its step.")
             if not given.fixed and given.step > given.high - given.low + 1e-9:
                 raise ValueError(
@@ -343,21 +435,32 @@ class Specification:
         return "; ".join(parts)
 
 
-def _check_pressure(value: Any, what: str) -> None:
+def _design_value_problem(name: str, value: float) -> str | None:
+    """Why ``value`` cannot be the parameter ``name`` of a design (its limits), or None."""
+    low, high, low_inclusive = DESIGN_LIMITS[name]
+    allowed = Range(low, high, UNITS[name], low_inclusive=low_inclusive)
+    if allowed.contains(value):
+        return None
+    return f"leaves the values a design may take, {allowed.describe()}"
+
+
+def _check_pressure(value: Any, what: str, where: str = "The target's ") -> None:
     if isinstance(value, bool) or not isinstance(value, int | float) or not math.isfinite(value):
-        raise ValueError(f"The target's {what} must be a number of MPa. Got {value!r} instead.")
-    if not 0 < value <= 1.0:
+        raise ValueError(f"{where}{what} must be a number of MPa. Got {value!r} instead.")
+    if not PRESSURE.contains(value):
+        hint = "; a value in kPa? (0.08 MPa = 80 kPa)" if value > PRESSURE.high else "."
         raise ValueError(
-            f"The target's {what} must be a gauge pressure in (0, 1] MPa. Got {value:g}; "
-            "a value in kPa? (0.08 MPa = 80 kPa)"
+            f"{where}{what} must be a gauge pressure in {PRESSURE.describe()}. Got {value:g}{hint}"
         )
 
 
-def _check_angle(value: Any, what: str) -> None:
+def _check_angle(value: Any, what: str, where: str = "The target's ") -> None:
     if isinstance(value, bool) or not isinstance(value, int | float) or not math.isfinite(value):
-        raise ValueError(f"The target's {what} must be a number of degrees. Got {value!r}.")
-    if not 0 < value <= 360:
-        raise ValueError(f"The target's {what} must lie in (0, 360] degrees. Got {value:g}.")
+        raise ValueError(f"{where}{what} must be a number of degrees. Got {value!r}.")
+    if not ANGLE.contains(value):
+        raise ValueError(
+            f"{where}{what} must lie in {ANGLE.describe()} ({ANGLE.why}). Got {value:g}."
+        )
 
 
 def parse_assignment(text: str, field_name: str = "--fix") -> tuple[str, float]:
@@ -436,6 +539,11 @@ def build_ranges(
     fixed and ranged, or named twice, is refused. Returns the ranges given and
     the step of every parameter (for those left to their training range).
     """
+    if step is not None and not STEP.contains(step):
+        raise ValueError(
+            f"The '--resolution' must be a finite number >= 0 (mm and deg; {STEP.why}). "
+            f"Got {step!r} instead."
+        )
     per_step = dict(DEFAULT_STEPS) if step is None else dict.fromkeys(NAMES, float(step))
     for text in steps:
         name, value = parse_assignment(text, "--resolution")
@@ -447,9 +555,11 @@ def build_ranges(
     given: list[tuple[str, ParameterRange]] = []
     for text in fixes:
         name, value = parse_assignment(text, "--fix")
+        _check_design_value(name, (value,), f"The '--fix' value of {name!r}", text)
         given.append((name, ParameterRange(value, value, 0.0)))
     for text in ranges:
         name, low, high = parse_range(text)
+        _check_design_value(name, (low, high), f"The '--range' of {name!r}", text)
         given.append((name, ParameterRange(low, high, per_step[name])))
     for name, chosen in given:
         if name in out:
@@ -458,7 +568,16 @@ def build_ranges(
     return out, per_step
 
 
-def load_specifications(path: str | os.PathLike[str]) -> list[Specification]:
+def _check_design_value(name: str, values: Sequence[float], field: str, given: str) -> None:
+    for value in values:
+        problem = _design_value_problem(name, value)
+        if problem is not None:
+            raise ValueError(f"{field} {problem}. Got {given!r} instead.")
+
+
+def load_specifications(
+    path: str | os.PathLike[str], *, what: str | None = None, reserved: Collection[str] = ()
+) -> list[Specification]:
     """The ``[[spec]]`` tables of a TOML file, each a :class:`Specification`.
 
     A table::
@@ -475,33 +594,76 @@ def load_specifications(path: str | os.PathLike[str]) -> list[Specification]:
         margin = 1.0              # degrees kept from the tolerance on the surrogate
 
     ``max_angle_at = P`` asks for the largest angle at P; ``curve = [[p, angle], ...]``
-    for a curve.
+    for a curve (each pressure once). The file is read by
+    :func:`softbend._tomltext.read_toml` (size, UTF-8 and nesting limits), and
+    every key of every table is checked, with its type and range, before any
+    search starts. Each ``name`` (default ``specN``) names the folder of that
+    spec's results, so it must be a plain name of a folder
+    (:func:`softbend._names.output_name`), unlike the other names ignoring case,
+    and not one of ``reserved``.
+
+    Parameters
+    ----------
+    path : path
+        The TOML file.
+    what : str, optional
+        The file as messages name it (default: the path), e.g. ``"--spec specs.toml"``.
+    reserved : collection of str
+        Names the caller writes beside the specs' folders (``search.json``).
+
+    Returns
+    -------
+    list of Specification
+        One per ``[[spec]]``, in the file's order.
 
     Raises
     ------
+    FileNotFoundError
+        No such file.
     DatasetError
-        A file that is not TOML, has no ``[[spec]]``, or a table that is not a
-        specification, naming the file, the table and what is wrong.
+        A file over the size limit, not UTF-8, not TOML, nested too deep, with
+        no ``[[spec]]`` or more than :data:`SPECS`, or a table that is not a
+        specification: one line naming the file, the ``[[spec]]`` number, the
+        key, what was expected and what was found.
     """
-    file = Path(path)
-    try:
-        data = tomllib.loads(file.read_text(encoding="utf-8"))
-    except OSError as exc:
-        raise DatasetError(f"The specification file {file} cannot be read: {exc}.") from None
-    except tomllib.TOMLDecodeError as exc:
-        raise DatasetError(f"The specification file {file} is not TOML: {exc}.") from None
+    source = str(os.fspath(path)) if what is None else what
+    data = read_toml(path, source, DatasetError)
+    others = sorted(k for k in data if k != "spec")
+    if others:
+        raise DatasetError(
+            f"{source}: unknown key(s) {', '.join(map(repr, others))} at the top; a "
+            "specification file holds [[spec]] tables only."
+        )
     tables = data.get("spec")
     if not isinstance(tables, list) or not tables:
-        raise DatasetError(f"The specification file {file} must hold at least one [[spec]].")
-    specs = []
+        raise DatasetError(
+            f"{source}: expected at least one [[spec]] table; found "
+            f"{'none' if tables is None else _found(tables)}."
+        )
+    if not SPECS.contains(len(tables)):
+        raise DatasetError(
+            f"{source}: holds {len(tables):,} [[spec]] tables, more than {SPECS.high:g} "
+            f"({SPECS.why}); split it into several files."
+        )
+    specs: list[Specification] = []
+    names: list[str] = []
     for i, table in enumerate(tables, start=1):
+        where = f"{source}, [[spec]] {i}"
+        if not isinstance(table, dict):
+            raise DatasetError(f"{where}: expected a table; found {_found(table)}.")
+        spec = _SpecTable(table, where).specification(f"spec{i}")
         try:
-            specs.append(_spec_from_table(table, f"spec{i}"))
-        except (ValueError, TypeError) as exc:
-            raise DatasetError(f"{file}, [[spec]] number {i}: {exc}") from None
+            output_name(
+                spec.name, f"[[spec]] {i} 'name' of {source}", reserved=reserved, taken=names
+            )
+        except ValueError as exc:
+            raise DatasetError(str(exc)) from None
+        names.append(spec.name)
+        specs.append(spec)
     return specs
 
 
+#: The keys of a ``[[spec]]`` table.
 _TABLE_KEYS = (
     "name",
     "angle",
@@ -518,47 +680,220 @@ _TABLE_KEYS = (
     "margin",
 )
 
+#: The keys that each give a kind of target; a table gives one.
+_TARGET_KEYS = ("at", "max_pressure", "max_angle_at", "curve")
 
-def _spec_from_table(table: Any, default_name: str) -> Specification:
-    if not isinstance(table, dict):
-        raise ValueError("a [[spec]] must be a table")
-    unknown = sorted(set(table) - set(_TABLE_KEYS))
-    if unknown:
-        raise ValueError(
-            f"unknown key(s) {', '.join(unknown)}; the keys are {', '.join(_TABLE_KEYS)}"
-        )
-    tolerance = float(table.get("tolerance", 3.0))
-    kinds = [k for k in ("at", "max_pressure", "max_angle_at", "curve") if k in table]
-    if len(kinds) != 1:
-        raise ValueError("give exactly one of at, max_pressure, max_angle_at or curve")
-    kind = kinds[0]
-    if kind == "curve":
-        target = Target("curve", tolerance_deg=tolerance, points=tuple(map(tuple, table["curve"])))
-    elif kind == "max_angle_at":
-        target = Target("max_angle", pressure_mpa=float(table["max_angle_at"]))
-    else:
+_SHORT = reprlib.Repr()
+_SHORT.maxstring = 40
+_SHORT.maxother = 40
+_SHORT.maxlist = 4
+_SHORT.maxdict = 4
+_SHORT.maxlevel = 3
+_SHORT.maxlong = 40
+
+
+def _found(value: Any) -> str:
+    """A value of a TOML file, short, with its kind."""
+    if isinstance(value, bool):
+        return f"{'true' if value else 'false'} (a boolean)"
+    if isinstance(value, str):
+        return f"the text {_SHORT.repr(value)}"
+    if isinstance(value, int | float):
+        return _SHORT.repr(value)
+    if isinstance(value, list):
+        return f"an array of {len(value)} {_SHORT.repr(value)}"
+    if isinstance(value, dict):
+        return f"a table {_SHORT.repr(value)}"
+    return f"{type(value).__name__} {_SHORT.repr(value)}"
+
+
+def _is_number(value: Any) -> bool:
+    """Whether ``value`` is a number of a TOML file a float can hold."""
+    if isinstance(value, bool) or not isinstance(value, int | float):
+        return False
+    try:
+        float(value)
+    except OverflowError:  # an integer of hundreds of digits
+        return False
+    return True
+
+
+class _SpecTable:
+    """One ``[[spec]]`` table read key by key; every error names ``where`` and the key."""
+
+    def __init__(self, table: dict[str, Any], where: str) -> None:
+        self.table = table
+        self.where = where
+
+    def fail(self, key: str, expected: str, found: Any) -> DatasetError:
+        """The error of ``key``: what was expected and what was found."""
+        return DatasetError(f"{self.where} '{key}': expected {expected}; found {_found(found)}.")
+
+    def number(self, key: str, allowed: Range, what: str, value: Any = None) -> float:
+        """The number at ``key`` (or ``value``) in ``allowed``."""
+        value = self.table[key] if value is None else value
+        expected = f"{what} in {allowed.describe()}" + (f" ({allowed.why})" if allowed.why else "")
+        if not _is_number(value) or not allowed.contains(value):
+            raise self.fail(key, expected, value)
+        return float(value)
+
+    def per_parameter(self, key: str, what: str) -> dict[str, Any]:
+        """The table at ``key`` whose keys are parameter names."""
+        value = self.table.get(key, {})
+        if not isinstance(value, dict):
+            raise self.fail(key, f"a table of {what} by parameter ({', '.join(NAMES)})", value)
+        unknown = [k for k in value if k not in NAMES]
+        if unknown:
+            raise DatasetError(
+                f"{self.where} '{key}': expected parameters among {', '.join(NAMES)}; found "
+                f"{', '.join(map(repr, unknown))}."
+            )
+        return value
+
+    def design_number(self, key: str, name: str, value: Any) -> float:
+        """``value`` as a value of the parameter ``name`` of a design."""
+        low, high, low_inclusive = DESIGN_LIMITS[name]
+        allowed = Range(low, high, UNITS[name], "the values a design may take", low_inclusive)
+        return self.number(f"{key}.{name}", allowed, "a number", value)
+
+    def target(self) -> Target:
+        """The table's target, from exactly one of :data:`_TARGET_KEYS`."""
+        table = self.table
+        kinds = [k for k in _TARGET_KEYS if k in table]
+        if len(kinds) != 1:
+            found = " and ".join(map(repr, kinds)) if kinds else "none of them"
+            raise DatasetError(
+                f"{self.where}: expected exactly one target key, 'at', 'max_pressure', "
+                f"'max_angle_at' or 'curve'; found {found}."
+            )
+        kind = kinds[0]
+        tolerance = self.number("tolerance", TOLERANCE, "degrees") if "tolerance" in table else 3.0
+        if kind in ("max_angle_at", "curve") and "angle" in table:
+            raise DatasetError(
+                f"{self.where} 'angle': has no meaning with '{kind}' (the "
+                f"{'curve gives its angles' if kind == 'curve' else 'angle is maximised'}); "
+                "leave it out."
+            )
+        if kind == "curve":
+            return Target("curve", tolerance_deg=tolerance, points=self.curve())
+        pressure = self.number(kind, PRESSURE, "a pressure")
+        if kind == "max_angle_at":
+            return Target("max_angle", pressure_mpa=pressure, tolerance_deg=tolerance)
         if "angle" not in table:
-            raise ValueError(f"'{kind}' needs 'angle' (degrees)")
-        target = Target(
+            raise DatasetError(f"{self.where} 'angle': expected with '{kind}'; found none.")
+        angle = self.number("angle", ANGLE, "degrees")
+        return Target(
             "angle_at" if kind == "at" else "pressure_for",
-            angle_deg=float(table["angle"]),
-            pressure_mpa=float(table[kind]),
+            angle_deg=angle,
+            pressure_mpa=pressure,
             tolerance_deg=tolerance,
         )
-    step = table.get("resolution")
-    steps = step if isinstance(step, dict) else {}
-    fixes = [f"{k}={v}" for k, v in dict(table.get("fix", {})).items()]
-    ranges = [f"{k}={v[0]}:{v[1]}" for k, v in dict(table.get("range", {})).items()]
-    built, per_step = build_ranges(
-        fixes,
-        ranges,
-        [f"{k}={v}" for k, v in steps.items()],
-        step=None if isinstance(step, dict) or step is None else float(step),
-    )
-    objectives = parse_objectives(list(table.get("minimize", [])), list(table.get("maximize", [])))
-    margin = float(table.get("margin", 0.0))
-    name = str(table.get("name", default_name))
-    return Specification(target, built, objectives, name, per_step, margin)
+
+    def curve(self) -> tuple[tuple[float, float], ...]:
+        """The points of ``curve``: [[pressure, angle], ...], each pressure once."""
+        value = self.table["curve"]
+        expected = (
+            f"an array of {CURVE_POINTS.low:g} to {CURVE_POINTS.high:g} [pressure MPa, "
+            "angle deg] pairs"
+        )
+        if not isinstance(value, list) or not CURVE_POINTS.contains(len(value)):
+            raise self.fail("curve", expected, value)
+        points: list[tuple[float, float]] = []
+        for k, point in enumerate(value, start=1):
+            key = f"curve[{k}]"
+            if not isinstance(point, list) or len(point) != 2:
+                raise self.fail(key, "a pair [pressure MPa, angle deg]", point)
+            pressure = self.number(key, PRESSURE, "a pressure first", point[0])
+            angle = self.number(key, ANGLE, "an angle second", point[1])
+            if any(pressure == p for p, _ in points):
+                raise DatasetError(
+                    f"{self.where} '{key}': gives {pressure:g} MPa a second time; a curve "
+                    "gives each pressure once (one angle at each)."
+                )
+            points.append((pressure, angle))
+        return tuple(points)
+
+    def objectives(self) -> tuple[Objective, ...]:
+        """``minimize`` and ``maximize``: names of :data:`OBJECTIVES`, an array or one text."""
+        out = []
+        for key, sense in (("minimize", "min"), ("maximize", "max")):
+            value = self.table.get(key, [])
+            items = value.split(",") if isinstance(value, str) else value
+            expected = f"an array of objectives among {', '.join(OBJECTIVES)}"
+            if not isinstance(items, list):
+                raise self.fail(key, expected, value)
+            for item in items:
+                if not isinstance(item, str) or item.strip() not in OBJECTIVES:
+                    raise self.fail(key, expected, item)
+                out.append(Objective(item.strip(), sense))
+        return tuple(out)
+
+    def steps(self) -> dict[str, float]:
+        """``resolution``: one step for every parameter, or a table by parameter."""
+        value = self.table.get("resolution")
+        what = "a step of the mould (mm, deg for phi)"
+        if value is None:
+            return dict(DEFAULT_STEPS)
+        if isinstance(value, dict):
+            steps = dict(DEFAULT_STEPS)
+            for name, step in self.per_parameter("resolution", "steps").items():
+                steps[name] = self.number(f"resolution.{name}", STEP, what, step)
+            return steps
+        if not _is_number(value):
+            raise self.fail("resolution", f"{what}, or a table of steps by parameter", value)
+        return dict.fromkeys(NAMES, self.number("resolution", STEP, what))
+
+    def ranges(self, steps: Mapping[str, float]) -> dict[str, ParameterRange]:
+        """``fix`` (a value by parameter) and ``range`` ([low, high] by parameter)."""
+        out: dict[str, ParameterRange] = {}
+        for name, value in self.per_parameter("fix", "values").items():
+            fixed = self.design_number("fix", name, value)
+            out[name] = ParameterRange(fixed, fixed, 0.0)
+        for name, value in self.per_parameter("range", "[low, high] pairs").items():
+            key = f"range.{name}"
+            if not isinstance(value, list) or len(value) != 2:
+                raise self.fail(key, f"[low, high], two numbers of {UNITS[name]}", value)
+            low, high = (self.design_number("range", name, v) for v in value)
+            if low > high:
+                raise self.fail(key, "[low, high] with low <= high", value)
+            if name in out:
+                raise DatasetError(
+                    f"{self.where} 'range.{name}': {name!r} is also in 'fix'; give it once."
+                )
+            out[name] = ParameterRange(low, high, float(steps[name]))
+        return out
+
+    def specification(self, default_name: str) -> Specification:
+        """The table as a :class:`Specification` (its name not yet checked as a path)."""
+        table = self.table
+        unknown = [k for k in table if k not in _TABLE_KEYS]
+        if unknown:
+            raise DatasetError(
+                f"{self.where}: unknown key(s) {', '.join(map(repr, unknown))}; the keys are "
+                f"{', '.join(_TABLE_KEYS)}."
+            )
+        name = table.get("name", default_name)
+        if not isinstance(name, str):
+            raise self.fail("name", "a text, the name of the spec's folder of results", name)
+        try:
+            target = self.target()
+        except ValueError as exc:
+            if isinstance(exc, DatasetError):
+                raise
+            raise DatasetError(f"{self.where}: {exc}") from None
+        steps = self.steps()
+        ranges = self.ranges(steps)
+        objectives = self.objectives()
+        margin = 0.0
+        if "margin" in table:
+            allowed = Range(0.0, target.tolerance_deg, "deg", "below the tolerance", True, False)
+            margin = self.number("margin", allowed, "degrees kept from the tolerance")
+        try:
+            return Specification(target, ranges, objectives, name, steps, margin)
+        except ValueError as exc:
+            keys = [k for k in ("minimize", "maximize") if k in table]
+            about = f" '{' and '.join(keys)}'" if keys and "objective" in str(exc) else ""
+            raise DatasetError(f"{self.where}{about}: {exc}") from None
 
 
 def target_from_options(
@@ -593,20 +928,27 @@ def target_from_options(
             "The target must be one of --angle A --at P, --angle A --max-pressure P, "
             f"--max-angle-at P or --curve P:A,P:A,... Got {', '.join(given) or 'none'}."
         )
+    if not (_is_number(tolerance) and TOLERANCE.contains(tolerance)):
+        raise ValueError(
+            f"The '--tolerance' must lie in {TOLERANCE.describe()} ({TOLERANCE.why}). "
+            f"Got {tolerance!r} instead."
+        )
+    for option, value in (
+        ("--at", at),
+        ("--max-pressure", max_pressure),
+        ("--max-angle-at", max_angle_at),
+    ):
+        if value is not None:
+            _check_pressure(value, "", f"The '{option}'")
+    if angle is not None:
+        _check_angle(angle, "", "The '--angle'")
     if curve is not None:
-        points = []
-        for item in (x.strip() for x in curve.split(",") if x.strip()):
-            p, colon, a = item.partition(":")
-            try:
-                points.append((float(p), float(a)))
-            except ValueError:
-                raise ValueError(
-                    f"The '--curve' must be PRESSURE:ANGLE pairs (MPa:deg), e.g. 0.05:40,0.1:95. "
-                    f"Got {item!r} instead."
-                ) from None
-            if not colon:
-                raise ValueError(f"The '--curve' point {item!r} lacks ':ANGLE'.")
-        return Target("curve", tolerance_deg=tolerance, points=tuple(points))
+        if angle is not None:
+            raise ValueError(
+                "The '--angle' has no meaning with --curve (the curve gives its angles); "
+                "leave it out."
+            )
+        return Target("curve", tolerance_deg=tolerance, points=_curve_points(curve))
     if max_angle_at is not None:
         if angle is not None:
             raise ValueError("The '--angle' has no meaning with --max-angle-at; leave it out.")
@@ -616,3 +958,36 @@ def target_from_options(
     kind, pressure = ("angle_at", at) if at is not None else ("pressure_for", max_pressure)
     assert pressure is not None  # exactly one of --at and --max-pressure, checked above
     return Target(kind, angle_deg=angle, pressure_mpa=float(pressure), tolerance_deg=tolerance)
+
+
+def _curve_points(text: str) -> tuple[tuple[float, float], ...]:
+    """The points of ``--curve P:ANGLE,...``: each pressure once, each number in its range."""
+    items = [x.strip() for x in text.split(",") if x.strip()]
+    if not CURVE_POINTS.contains(len(items)):
+        raise ValueError(
+            f"The '--curve' must give {CURVE_POINTS.low:g} to {CURVE_POINTS.high:g} points "
+            f"PRESSURE:ANGLE ({CURVE_POINTS.why}). Got {len(items):,}."
+        )
+    points: list[tuple[float, float]] = []
+    seen: dict[float, str] = {}
+    for item in items:
+        p, colon, a = item.partition(":")
+        try:
+            pressure, angle = float(p), float(a)
+        except ValueError:
+            raise ValueError(
+                f"The '--curve' must be PRESSURE:ANGLE pairs (MPa:deg), e.g. 0.05:40,0.1:95. "
+                f"Got {item!r} instead."
+            ) from None
+        if not colon:
+            raise ValueError(f"The '--curve' point {item!r} lacks ':ANGLE'.")
+        _check_pressure(pressure, f" point {item!r}", "The '--curve'")
+        _check_angle(angle, f" point {item!r}", "The '--curve'")
+        if pressure in seen:
+            raise ValueError(
+                f"The '--curve' gives {pressure:g} MPa twice ({seen[pressure]!r} and {item!r}); "
+                "a curve gives each pressure once (one angle at each)."
+            )
+        seen[pressure] = item
+        points.append((pressure, angle))
+    return tuple(points)

@@ -85,6 +85,7 @@ def verify_candidates(
     workers: int | None = None,
     scheduler: str | None = None,
     material: Any = None,
+    scratch_dir: str | os.PathLike[str] | None = None,
 ) -> list[Candidate]:
     """Sweep the best ``k`` candidates of ``result`` and set their FEM figures in place.
 
@@ -106,6 +107,10 @@ def verify_candidates(
         A Dask scheduler address to run the sweeps on.
     material : str or Material, optional
         The elastomer of the backend (``--material``).
+    scratch_dir : path, optional
+        The folder the temporary folder of the sweeps is made in (default: the
+        system's). A command passes the staging folder of its output, so that a
+        run killed before the end leaves it where the next run removes it.
 
     Returns
     -------
@@ -131,7 +136,7 @@ def verify_candidates(
         return []
     pressures = _sweep_pressures(result, chosen)
     designs = list(dict.fromkeys(c.design for c in chosen))
-    with tempfile.TemporaryDirectory(prefix="softbend-verify-") as scratch:
+    with tempfile.TemporaryDirectory(prefix="softbend-verify-", dir=scratch_dir) as scratch:
         db = Path(db_path) if db_path is not None else Path(scratch) / "verify.duckdb"
         total = len(designs)
 

@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import csv
+import dataclasses
 import math
 from pathlib import Path
 from typing import Any
@@ -10,10 +11,13 @@ from typing import Any
 from softbend.design_search.search import SearchResult
 from softbend.design_search.spec import NAMES, UNITS
 
-__all__ = ["FILES", "candidate_rows", "write_search"]
+__all__ = ["FIGURE_CANDIDATES", "FILES", "candidate_rows", "write_search"]
 
 #: The files of one specification's folder.
 FILES: tuple[str, ...] = ("candidates.csv", "search.json", "front.png", "curves.png")
+
+#: The best candidates front.png marks one by one (a rank each); the tables list them all.
+FIGURE_CANDIDATES = 50
 
 
 def candidate_rows(result: SearchResult) -> list[dict[str, Any]]:
@@ -42,7 +46,12 @@ def candidate_rows(result: SearchResult) -> list[dict[str, Any]]:
 
 
 def write_search(result: SearchResult, predictor: Any, folder: str | Path) -> dict[str, str]:
-    """Write :data:`FILES` into ``folder`` (created); returns name → path."""
+    """Write :data:`FILES` into ``folder`` (created); returns name → path.
+
+    ``candidates.csv`` and ``search.json`` hold every candidate; ``front.png``
+    marks the best :data:`FIGURE_CANDIDATES` (a longer list is no longer
+    readable there, and drawing it would take minutes).
+    """
     from softbend._io import json_text
     from softbend.reports import design_figures
 
@@ -60,6 +69,7 @@ def write_search(result: SearchResult, predictor: Any, folder: str | Path) -> di
                 {k: ("" if isinstance(v, float) and math.isnan(v) else v) for k, v in row.items()}
             )
     (out / "search.json").write_text(json_text(result.to_dict()) + "\n", encoding="utf-8")
-    design_figures.front_figure(result, out / "front.png")
+    shown = dataclasses.replace(result, candidates=result.candidates[:FIGURE_CANDIDATES])
+    design_figures.front_figure(shown, out / "front.png")
     design_figures.curves_figure(result, predictor, out / "curves.png")
     return {name: str(out / name) for name in FILES}
