@@ -199,3 +199,13 @@ def test_a_subclass_inherits_and_overrides_the_declarations():
     assert declared_ranges(Base)["b"] == Range(0, 2)
     assert Range(0, 1).describe() == "[0, 1]"
     assert Range(0.0, unit="s", low_inclusive=False).describe() == "(0, inf) s"
+
+
+def test_an_integer_of_any_size_is_compared_without_overflow():
+    from softbend.parameters import Range
+
+    assert not Range(0, 100).contains(10**400)
+    assert not Range(0, 100).contains(-(10**400))
+    assert Range(0, 100).contains(100)
+    with pytest.raises(ParameterValueError, match="characters"):
+        check_parameters(_ranged(), {"period": 10**400}, owner="x", field="[controller]")

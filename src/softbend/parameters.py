@@ -139,12 +139,19 @@ class Range:
             return all(self.contains(v) for v in value)
         if isinstance(value, bool) or not isinstance(value, numbers.Real):
             return True  # not a number: the kind check speaks for it
-        number = float(value)
-        if math.isnan(number):
+        number = value if isinstance(value, numbers.Integral) else float(value)
+        if isinstance(number, float) and math.isnan(number):
             return False
+        # Python compares an integer of any size with a float exactly: no float() overflow.
         below = number < self.low or (number == self.low and not self.low_inclusive)
         above = number > self.high or (number == self.high and not self.high_inclusive)
         return not (below or above)
+
+
+def _shown(value: Any) -> str:
+    """``repr(value)`` for a message, cut short (an integer of 400 digits is not read)."""
+    text = repr(value)
+    return text if len(text) <= 60 else f"{text[:45]}... ({len(text)} characters)"
 
 
 Entry = TypeVar("Entry", bound=Callable[..., Any])
@@ -384,23 +391,24 @@ def check_parameters(
         kind = _kind(known[key]) if key in known else "any"
         try:
             result = _from_text(str(value), kind) if from_text else _typed(value, kind)
-        except ValueError:
+        except (ValueError, OverflowError):  # an integer too large for a float is no number
             raise ParameterValueError(
                 f"The parameter {key!r} of {owner} (in {field}) must be {_WORDS[kind]}. "
-                f"Got {value!r} instead.",
+                f"Got {_shown(value)} instead.",
                 key,
             ) from None
         if isinstance(result, float) and not math.isfinite(result):
             raise ParameterValueError(
                 f"The parameter {key!r} of {owner} (in {field}) must be a finite number. "
-                f"Got {value!r} instead.",
+                f"Got {_shown(value)} instead.",
                 key,
             )
         if key == "epochs" and kind == "int":
             check_limit("epochs", result, f"The 'epochs' of {owner} (in {field})")
         declared = ranges.get(key)
         if declared is not None and not declared.contains(result):
-            shown = ",".join(map(str, result)) if isinstance(result, tuple) else repr(value)
+            shown = ",".join(map(str, result)) if isinstance(result, tuple) else _shown(value)
+            shown = shown if len(shown) <= 60 else f"{shown[:45]}... ({len(shown)} characters)"
             raise ParameterValueError(
                 f"The parameter {key!r} of {owner} (in {field}) must be "
                 f"{declared.describe()}. Got {shown} instead.",
