@@ -82,7 +82,10 @@ def test_lab_measure_a_max_angle_below_the_first_step_is_one_line(tmp_path, caps
     out = tmp_path / "lab.csv"
     argv = ["lab", "measure", "--plant", "analytical", "--max-angle", "0.01", "--out", str(out)]
     assert main(argv) == 2
-    assert "'max_angle_deg'" in one_error_line(capsys)
+    line = one_error_line(capsys)
+    assert "The '--max-angle' of softbend lab measure (0.01°) stops actuator" in line
+    assert "Raise --max-angle or lower --pstep." in line
+    assert "max_angle_deg" not in line and "VirtualLab" not in line
     assert _listing(tmp_path) == []
 
 
@@ -276,7 +279,9 @@ def test_refine_writes_strict_json(lab_csv, tmp_path, capsys, small_base_file, s
     assert saved["metadata"]["strategy"] == strategy
 
 
-def test_refine_metadata_nan_is_written_as_null(lab_csv, tmp_path, monkeypatch, small_base_file):
+def test_refine_a_non_finite_figure_is_one_line_and_no_model(
+    lab_csv, tmp_path, monkeypatch, capsys, small_base_file
+):
     import softbend.transfer.refine as refine
 
     fit = refine.fit_strategy
@@ -289,8 +294,14 @@ def test_refine_metadata_nan_is_written_as_null(lab_csv, tmp_path, monkeypatch, 
     monkeypatch.setattr(refine, "fit_strategy", with_nan_loss)
     out = tmp_path / "model.json"
     argv = ["transfer", "refine", str(small_base_file), str(lab_csv), "--out", str(out)]
-    assert main([*argv, "--strategy", "scale-offset"]) == 0
-    assert _strict_json(out.read_text())["metadata"]["final_training_mse_deg2"] is None
+    assert main([*argv, "--strategy", "scale-offset"]) == 2
+    lines = capsys.readouterr().err.strip().splitlines()
+    assert lines[-1] == (
+        "softbend: error: The 'scale-offset' refit's final training MSE (deg²) is nan, not a "
+        "finite number; it is not saved. Check the strategy's parameters (a smaller "
+        "learning_rate) and the measurements"
+    )
+    assert not out.exists() and _listing(tmp_path) == []
 
 
 # ---------------------------------------------------------------- transfer base

@@ -88,9 +88,11 @@ def refine(
         help="A parameter of the strategy, NAME=VALUE (repeatable; recorded in the model file).",
     ),
     epochs: int | None = typer.Option(
-        None, help="Epochs of the MLP strategies (default: the strategy's); as --set epochs=N."
+        None,
+        min=1,
+        help="Epochs of the MLP strategies (default: the strategy's); as --set epochs=N.",
     ),
-    seed: int = typer.Option(0, help="Seed of the training."),
+    seed: int = typer.Option(0, min=0, help="Seed of the training."),
     force: bool = typer.Option(
         False,
         "--force",
@@ -104,6 +106,10 @@ def refine(
     surrogates and plugs into 'softbend predict'; the strategies with intervals
     (scale-offset, pressure-scale, residual-gp, refined-ensemble) save them too. The
     model file records the strategy and every one of its parameters as used.
+
+    Every --set value is held to the range its parameter declares before any work
+    ('softbend transfer strategies' lists them); a refit whose predictions or
+    figures are not finite is an error, never a saved model.
 
     Example:
 
@@ -151,7 +157,8 @@ def strategies(
     """List the transfer strategies and their parameters.
 
     What each strategy does, whether it learns (refine) and gives intervals,
-    and the parameters --set NAME=VALUE may give it.
+    and the parameters --set NAME=VALUE may give it, with the range of each
+    number (a value outside is refused before any work).
 
     Example:
 
@@ -175,7 +182,11 @@ def strategies(
             [
                 r["name"],
                 r["summary"],
-                ", ".join(f"{k}={shown(v)}" for k, v in r["parameters"].items()) or "—",
+                ", ".join(
+                    f"{k}={shown(v)}" + (f" in {r['ranges'][k]}" if k in r["ranges"] else "")
+                    for k, v in r["parameters"].items()
+                )
+                or "—",
                 "yes" if r["learns"] else "no (baseline)",
                 "yes" if r["interval"] else "no",
             ]

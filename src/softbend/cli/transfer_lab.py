@@ -1,12 +1,84 @@
-"""``softbend lab``: the virtual lab's labelled-synthetic measurements of paper B's actuators."""
+"""``softbend lab``: the virtual lab's labelled-synthetic measurements of paper B's actuators.
+
+Every setting is checked before the lab runs, and a message names the option
+typed (``--pmax``), not the library's field. Options that contradict each other
+(``--material`` gives the silicone whole, so ``--elastomer`` and
+``--elastomer-max-stretch`` would be dropped) are refused, naming both. The CSV
+and its figure are written together through temporary files beside them: a run
+that fails, or is stopped by Ctrl-C or SIGTERM, leaves both as they were and no
+temporary file.
+"""
 
 from __future__ import annotations
 
+import signal
+import threading
+from collections.abc import Iterator
+from contextlib import contextmanager
 from pathlib import Path
+from typing import TYPE_CHECKING, Any
 
 import typer
 
 from softbend.cli import _common
+
+if TYPE_CHECKING:
+    from softbend.design import SFRBADesign
+
+_COMMAND = "softbend lab measure"
+
+#: The option that sets each setting of :class:`~softbend.transfer.lab.VirtualLab`.
+OPTIONS: dict[str, str] = {
+    "actuators": "--design",
+    "plant": "--plant",
+    "elastomer": "--elastomer",
+    "elastomer_max_stretch": "--elastomer-max-stretch",
+    "material": "--material",
+    "fabrication_error_mm": "--fabrication-error",
+    "hysteresis": "--hysteresis",
+    "camera_noise_deg": "--camera-noise",
+    "pmax_mpa": "--pmax",
+    "pressure_step_mpa": "--pstep",
+    "max_angle_deg": "--max-angle",
+    "unloading": "--unloading",
+    "cycles": "--cycles",
+    "seed": "--seed",
+}
+
+#: Options that ``--material`` makes pointless: the silicone is given whole.
+_MATERIAL_REPLACES: dict[str, str] = {
+    "elastomer": "--elastomer",
+    "elastomer_max_stretch": "--elastomer-max-stretch",
+}
+
+
+def _typed(ctx: typer.Context, parameter: str) -> bool:
+    """Whether the option of ``parameter`` was given (typed or from the environment)."""
+    source = ctx.get_parameter_source(parameter)
+    return getattr(source, "name", None) in ("COMMANDLINE", "ENVIRONMENT")
+
+
+@contextmanager
+def _terminate_as_interrupt() -> Iterator[None]:
+    """SIGTERM (``kill``) ends the block as Ctrl-C does, so its clean-up runs.
+
+    Without it the process would die at once and leave the temporary outputs
+    beside the files. Nothing is changed off the main thread (signals cannot be
+    set there).
+    """
+    if threading.current_thread() is not threading.main_thread():
+        yield
+        return
+
+    def interrupt(signum: int, frame: Any) -> None:
+        raise KeyboardInterrupt
+
+    previous = signal.signal(signal.SIGTERM, interrupt)
+    try:
+        yield
+    finally:
+        signal.signal(signal.SIGTERM, previous)
+
 
 lab_app = typer.Typer(
     help="Virtual lab: synthetic measurements of paper B's actuators.\n\n"
@@ -18,6 +90,7 @@ lab_app = typer.Typer(
 
 @lab_app.command("measure")
 def measure(
+    ctx: typer.Context,
     out: Path = typer.Option(..., "--out", "-o", help="CSV file to write the measurements to."),
     plant: str = typer.Option(
         "fem", help="Model of the actuators as built: a lab plant (fem or analytical)."
@@ -51,8 +124,9 @@ def measure(
     ),
     material: str | None = typer.Option(
         None,
-        help="The lab's silicone whole, instead of --elastomer: a preset or the fit.json of "
-        "'softbend materials fit' (fit.json#yeoh for one of its models).",
+        help="The lab's silicone whole, instead of --elastomer and --elastomer-max-stretch "
+        "(not with them): a preset or the fit.json of 'softbend materials fit' (fit.json#yeoh "
+        "for one of its models).",
     ),
     as_json: bool = typer.Option(False, "--json", help="Print a JSON summary."),
 ) -> None:
@@ -61,7 +135,7 @@ def measure(
     The actuators of paper B, Figure 7 (or those of --design), measured as built
     (synthetic data).
     Writes the CSV and its figure (the same name with .png) together: a run
-    that fails leaves both as they were.
+    that fails or is interrupted leaves both as they were.
 
     Example:
 
@@ -73,9 +147,16 @@ def measure(
     from softbend._io import atomic_files
     from softbend.limits import check_limit
     from softbend.reports.transfer_figures import lab_measurements
-    from softbend.transfer.lab import VirtualLab
+    from softbend.transfer.lab import LAB_ACTUATORS, VirtualLab
     from softbend.transfer.measurements import format_measurements
 
+    if material is not None:
+        for parameter, option in _MATERIAL_REPLACES.items():
+            if _typed(ctx, parameter):
+                raise ValueError(
+                    f"The '--material' gives the lab's silicone whole, so the '{option}' "
+                    f"would not be used; give one of '--material' and '{option}'."
+                )
     check_limit("cycles", cycles, "--cycles")
     out = Path(out)
     figure = out.with_suffix(".png")
@@ -86,43 +167,48 @@ def measure(
         )
     _common.check_output_file(out, "--out", kind="csv")
     _common.check_output_file(figure, "--out", kind="png")
-    from softbend.design import SFRBADesign
-    from softbend.transfer.lab import LAB_ACTUATORS
-
-    actuators = tuple(SFRBADesign.parse(d) for d in designs) if designs else LAB_ACTUATORS
-    if material is not None:
-        from softbend.materials.choice import material_from_spec
-
-        material_from_spec(material, field="--material")
-    lab = VirtualLab(
+    actuators = tuple(_design(text) for text in designs) if designs else LAB_ACTUATORS
+    lab = VirtualLab.from_options(
+        OPTIONS,
+        _COMMAND,
         actuators=actuators,
-        elastomer=elastomer,
-        material=material,
         plant=plant,
         seed=seed,
         fabrication_error_mm=fabrication_error,
         hysteresis=hysteresis,
         camera_noise_deg=camera_noise,
-        elastomer_max_stretch=elastomer_max_stretch,
         pmax_mpa=pmax,
         pressure_step_mpa=pstep,
         max_angle_deg=max_angle,
         unloading=unloading,
         cycles=cycles,
+        **(
+            {"material": material}
+            if material is not None
+            else {"elastomer": elastomer, "elastomer_max_stretch": elastomer_max_stretch}
+        ),
     )
     total = len(lab.actuators)
-    with _common.progress_bar("virtual lab", total, enabled=not as_json) as advance:
-        measurements = lab.measure(progress=lambda done, n, name: advance(actuator=name))
-    text = format_measurements(measurements)
-    with _common.output_errors(out, "--out"), atomic_files(out, figure) as (csv_file, png):
-        with (
-            _common.output_errors(out, "--out"),
-            _common.as_written(csv_file, out),
-            open(csv_file, "w", encoding="utf-8", newline="") as handle,
-        ):
-            handle.write(text)
-        with _common.output_errors(figure, "--out"), _common.as_written(png, figure):
-            lab_measurements(measurements, png)
+    try:
+        with _terminate_as_interrupt():
+            with _common.progress_bar("virtual lab", total, enabled=not as_json) as advance:
+                measurements = lab.measure(progress=lambda done, n, name: advance(actuator=name))
+            text = format_measurements(measurements)
+            with (
+                _common.output_errors(out, "--out"),
+                atomic_files(out, figure) as (csv_file, png),
+            ):
+                with (
+                    _common.output_errors(out, "--out"),
+                    _common.as_written(csv_file, out),
+                    open(csv_file, "w", encoding="utf-8", newline="") as handle,
+                ):
+                    handle.write(text)
+                with _common.output_errors(figure, "--out"), _common.as_written(png, figure):
+                    lab_measurements(measurements, png)
+    except KeyboardInterrupt:
+        _common.error_line(f"interrupted: {out} and {figure} are as they were")
+        raise typer.Exit(130) from None
     per = measurements.per_actuator()
     if as_json:
         _common.print_json(
@@ -142,3 +228,13 @@ def measure(
         [[str(k), int(r.points), float(r.pmax), float(r.angle_max)] for k, r in per.iterrows()],
     )
     _common.console.print(f"measurements written to {out}, figure {figure}")
+
+
+def _design(text: str) -> SFRBADesign:
+    """One ``--design`` value as a design; a bad one is one error naming the option."""
+    from softbend.design import SFRBADesign
+
+    try:
+        return SFRBADesign.parse(text)
+    except ValueError as exc:
+        raise ValueError(f"The '--design' {text!r} is not a design: {exc}") from None

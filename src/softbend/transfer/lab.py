@@ -27,7 +27,7 @@ is synthetic and lists the gap's parameters in its header.
 
 from __future__ import annotations
 
-from collections.abc import Callable
+from collections.abc import Callable, Mapping
 from dataclasses import asdict, dataclass, field, replace
 from pathlib import Path
 from typing import Any
@@ -89,6 +89,96 @@ def actuator_id(design: SFRBADesign) -> str:
 #: CSV column of each design parameter (the measurement files' names).
 _COLUMNS = dict(zip(PARAMETERS, ("l", "r", "t", "b", "phi", "lc"), strict=True))
 
+#: The interval of each numeric setting: ``(low, high, low_inclusive, high_inclusive)``.
+_BOUNDS: dict[str, tuple[float, float, bool, bool]] = {
+    "elastomer_max_stretch": (1.0, 50.0, False, False),
+    "fabrication_error_mm": (0.0, 1.0, True, False),
+    "hysteresis": (0.0, 0.25, True, False),
+    "pressure_step_mpa": (0.0, 0.1, False, True),
+    "pmax_mpa": (0.0, 1.0, False, True),
+    "camera_noise_deg": (0.0, 90.0, True, True),
+    "max_angle_deg": (0.0, 300.0, False, True),
+}
+
+
+def _checked_settings(
+    settings: Mapping[str, Any], names: Mapping[str, str], owner: str
+) -> dict[str, Any]:
+    """The settings of a :class:`VirtualLab`, checked; messages name each as ``names`` does.
+
+    ``names`` maps a setting to what the caller calls it (a command line's
+    ``{"pmax_mpa": "--pmax"}``); a setting it leaves out is named as it is.
+    Only the settings given are checked (the lab's own defaults need none).
+    """
+
+    def name(key: str) -> str:
+        return names.get(key, key)
+
+    out = dict(settings)
+    if "actuators" in settings:
+        actuators = settings["actuators"]
+        try:
+            actuators = tuple(actuators)
+        except TypeError:
+            actuators = ()
+        if not actuators or not all(isinstance(a, SFRBADesign) for a in actuators):
+            raise ValueError(
+                f"The '{name('actuators')}' of {owner} must be a non-empty sequence of "
+                f"SFRBADesign. Got {settings['actuators']!r} instead."
+            )
+        ids = [actuator_id(a) for a in actuators]
+        repeated = sorted({i for i in ids if ids.count(i) > 1})
+        if repeated:
+            raise ValueError(
+                f"The '{name('actuators')}' of {owner} must be distinct designs. Got "
+                f"{', '.join(repeated)} more than once."
+            )
+        out["actuators"] = actuators
+    if "plant" in settings:
+        PLANTS.check(settings["plant"], field=name("plant"))
+    if "elastomer" in settings:
+        check_choice(settings["elastomer"], name("elastomer"), owner, shipped_tensile_tests())
+    for key, (low, high, low_inclusive, high_inclusive) in _BOUNDS.items():
+        if key in settings:
+            out[key] = check_range(
+                settings[key],
+                name(key),
+                owner,
+                low=low,
+                high=high,
+                low_inclusive=low_inclusive,
+                high_inclusive=high_inclusive,
+            )
+    if "unloading" in settings and not isinstance(settings["unloading"], bool):
+        raise ValueError(
+            f"The '{name('unloading')}' of {owner} must be True or False. "
+            f"Got {settings['unloading']!r} instead."
+        )
+    if "cycles" in settings:
+        out["cycles"] = check_int(settings["cycles"], name("cycles"), owner, low=1)
+        check_limit("cycles", out["cycles"], f"The '{name('cycles')}' of {owner}")
+    if "seed" in settings:
+        out["seed"] = check_int(settings["seed"], name("seed"), owner, low=0)
+    if settings.get("material") is not None:
+        from softbend.materials.choice import material_from_spec
+
+        for key in ("elastomer", "elastomer_max_stretch"):
+            if key in settings and settings[key] != getattr(VirtualLab, key):
+                raise ValueError(
+                    f"The '{name('material')}' of {owner} gives the lab's silicone whole, so "
+                    f"the '{name(key)}' ({settings[key]!r}) would not be used; give one of "
+                    f"'{name('material')}' and '{name(key)}'."
+                )
+        out["_material"] = material_from_spec(str(settings["material"]), field=name("material"))
+    if "pmax_mpa" in out or "pressure_step_mpa" in out:
+        default_pressures_mpa(  # a whole number of steps
+            out.get("pmax_mpa", VirtualLab.pmax_mpa),
+            out.get("pressure_step_mpa", VirtualLab.pressure_step_mpa),
+            names=(name("pmax_mpa"), name("pressure_step_mpa")),
+            owner=owner,
+        )
+    return out
+
 
 @dataclass(frozen=True)
 class VirtualLab:
@@ -112,7 +202,8 @@ class VirtualLab:
         The lab's silicone given whole instead: a preset name or the ``fit.json``
         of ``softbend materials fit`` (``PATH#MODEL`` for one of its models;
         :func:`softbend.materials.material_from_spec`). ``elastomer`` and
-        ``elastomer_max_stretch`` are then not used.
+        ``elastomer_max_stretch`` are then not used, and must be left at their
+        defaults (another value is refused: it would be dropped).
     fabrication_error_mm : float
         Half-width of the uniform error of ``t`` and ``b``, mm, in [0, 1).
     hysteresis : float
@@ -158,69 +249,60 @@ class VirtualLab:
     cycles: int = 1
     seed: int = 0
     _material: Material | None = field(default=None, init=False, repr=False, compare=False)
+    _names: tuple[dict[str, str], str] | None = field(
+        default=None, init=False, repr=False, compare=False
+    )
 
     def __post_init__(self) -> None:
-        actuators = tuple(self.actuators)
-        if not actuators or not all(isinstance(a, SFRBADesign) for a in actuators):
-            raise ValueError(
-                f"The 'actuators' of {_OWNER} must be a non-empty sequence of SFRBADesign. "
-                f"Got {self.actuators!r} instead."
+        settings = {
+            key: getattr(self, key)
+            for key in (
+                "actuators",
+                "plant",
+                "elastomer",
+                "material",
+                *_BOUNDS,
+                "unloading",
+                "cycles",
+                "seed",
             )
-        ids = [actuator_id(a) for a in actuators]
-        if len(set(ids)) != len(ids):
-            raise ValueError(
-                f"The 'actuators' of {_OWNER} must be distinct designs. Got {ids} instead."
-            )
-        object.__setattr__(self, "actuators", actuators)
-        PLANTS.check(self.plant, field="plant")
-        check_choice(self.elastomer, "elastomer", _OWNER, shipped_tensile_tests())
-        for name, low, high in (
-            ("elastomer_max_stretch", 1.0, 50.0),
-            ("fabrication_error_mm", 0.0, 1.0),
-            ("hysteresis", 0.0, 0.25),
-            ("pressure_step_mpa", 0.0, 0.1),
-            ("pmax_mpa", 0.0, 1.0),
-        ):
-            low_inclusive = name in ("fabrication_error_mm", "hysteresis")
-            value = check_range(
-                getattr(self, name),
-                name,
-                _OWNER,
-                low=low,
-                high=high,
-                low_inclusive=low_inclusive,
-                high_inclusive=name in ("pressure_step_mpa", "pmax_mpa"),
-            )
-            object.__setattr__(self, name, value)
-        noise = check_range(
-            self.camera_noise_deg,
-            "camera_noise_deg",
-            _OWNER,
-            low=0.0,
-            high=90.0,
-            low_inclusive=True,
-            high_inclusive=True,
-        )
-        object.__setattr__(self, "camera_noise_deg", noise)
-        angle = check_range(
-            self.max_angle_deg, "max_angle_deg", _OWNER, low=0.0, high=300.0, high_inclusive=True
-        )
-        object.__setattr__(self, "max_angle_deg", angle)
-        if not isinstance(self.unloading, bool):
-            raise ValueError(
-                f"The 'unloading' of {_OWNER} must be True or False. "
-                f"Got {self.unloading!r} instead."
-            )
-        cycles = check_int(self.cycles, "cycles", _OWNER, low=1)
-        check_limit("cycles", cycles, f"The 'cycles' of {_OWNER}")
-        object.__setattr__(self, "cycles", cycles)
-        object.__setattr__(self, "seed", check_int(self.seed, "seed", _OWNER, low=0))
-        if self.material is not None:
-            self.elastomer_material()  # a bad spec is refused here, naming 'material'
-        default_pressures_mpa(  # a whole number of steps
-            self.pmax_mpa, self.pressure_step_mpa, names=("pmax_mpa", "pressure_step_mpa"),
-            owner=_OWNER,
-        )  # fmt: skip
+        }
+        # A bad material spec is refused here, naming 'material'; a good one is kept.
+        for key, value in _checked_settings(settings, {}, _OWNER).items():
+            object.__setattr__(self, key, value)
+
+    @classmethod
+    def from_options(cls, names: Mapping[str, str], owner: str, **settings: Any) -> VirtualLab:
+        """A lab whose messages name its settings as the caller does (a command line's options).
+
+        Parameters
+        ----------
+        names : mapping of str to str
+            What the caller calls each setting (``{"pmax_mpa": "--pmax"}``); a
+            setting left out is named as it is.
+        owner : str
+            Who asks, for messages (``"softbend lab measure"``).
+        **settings
+            The settings of :class:`VirtualLab`.
+
+        Raises
+        ------
+        ValueError
+            As :class:`VirtualLab`, naming the setting as ``names`` does; so do
+            the errors of :meth:`measure` about a setting (``max_angle_deg``).
+        """
+        _checked_settings(settings, names, owner)
+        lab = cls(**settings)
+        object.__setattr__(lab, "_names", (dict(names), owner))
+        return lab
+
+    def _named(self, key: str) -> str:
+        """A setting as the messages name it (see :meth:`from_options`)."""
+        return (self._names or ({}, _OWNER))[0].get(key, key)
+
+    @property
+    def _owner(self) -> str:
+        return (self._names or ({}, _OWNER))[1]
 
     # -- the gap -----------------------------------------------------------------
 
@@ -274,7 +356,7 @@ class VirtualLab:
         values = {
             k: v
             for k, v in asdict(self).items()
-            if k not in ("actuators", "_material")
+            if k not in ("actuators", "_material", "_names")
             # the material given whole replaces the shipped test's fit
             and not (k == "material" and v is None)
             and not (k.startswith("elastomer") and self.material is not None)
@@ -347,11 +429,12 @@ class VirtualLab:
                     pressure_mpa=float(reached.max(initial=0.0)),
                 )
             if pressures.size < 2:
+                max_angle, step = self._named("max_angle_deg"), self._named("pressure_step_mpa")
                 raise ValueError(
-                    f"The 'max_angle_deg' of {_OWNER} ({self.max_angle_deg:g}°) stops actuator "
-                    f"{actuator_id(nominal)} before its second reading: it bends "
-                    f"{float(angle[1]):.4g}° at {float(reached[1]):g} MPa. Raise max_angle_deg "
-                    "or lower pressure_step_mpa."
+                    f"The '{max_angle}' of {self._owner} ({self.max_angle_deg:g}°) stops "
+                    f"actuator {actuator_id(nominal)} before its second reading: it bends "
+                    f"{float(angle[1]):.4g}° at {float(reached[1]):g} MPa. Raise {max_angle} "
+                    f"or lower {step}."
                 )
             frames.extend(self._readings(nominal, pressures, elastic, noise_rng))
             if progress is not None:

@@ -11,17 +11,36 @@ commas for a tuple such as ``hidden_sizes=63,65``), by the rules of
 :mod:`softbend.parameters` that the controllers' parameters follow too. An
 unknown name is one :class:`~softbend.parameters.UnknownParameterError` line
 listing the known ones.
+
+Every numeric parameter of a strategy declares the range it accepts beside its
+class (:func:`~softbend.parameters.declare_ranges`), and every value, typed on
+a command line or given as data, is held to it before any work: a value outside
+is one :class:`~softbend.parameters.ParameterValueError` line naming the
+parameter and the range. A tuple annotated with a fixed number of items
+(``hidden_sizes: tuple[int, int]``, the sizes of two hidden layers) must have
+that many. :func:`check_estimator` holds a strategy built directly
+(``RefinedMLP(base, learning_rate=...)``) to the same ranges when it is fitted.
 """
 
 from __future__ import annotations
 
 import inspect
+import re
 from collections.abc import Mapping
 from typing import Any
 
 from softbend import parameters as _parameters
 
-__all__ = ["FILLED", "check_parameters", "parameter_defaults", "recorded_parameters", "takes"]
+__all__ = [
+    "FILLED",
+    "check_estimator",
+    "check_parameters",
+    "describe_range",
+    "item_count",
+    "parameter_defaults",
+    "recorded_parameters",
+    "takes",
+]
 
 #: Constructor parameters the library fills itself: never set by name.
 FILLED: tuple[str, ...] = ("base", "seed")
@@ -45,6 +64,107 @@ def parameter_defaults(cls: type) -> dict[str, Any]:
     parameter without a default.
     """
     return _parameters.parameter_defaults(cls, skip=FILLED, keyword_only=False)
+
+
+def item_count(cls: type, name: str) -> int | None:
+    """The number of items the tuple parameter ``name`` of ``cls`` must have, or None.
+
+    Read from its annotation: ``tuple[int, int]`` is 2; ``tuple[int, ...]``, a
+    parameter that is not a tuple, or one without an annotation is None.
+    """
+    parameter = _constructor(cls).get(name)
+    if parameter is None:
+        return None
+    note = parameter.annotation
+    text = note if isinstance(note, str) else str(note)
+    found = re.fullmatch(r"\s*tuple\[([^\[\]]*)\]\s*(\|\s*None\s*)?", text)
+    if found is None or "..." in found.group(1):
+        return None
+    return len([part for part in found.group(1).split(",") if part.strip()])
+
+
+def _owner(name: str) -> str:
+    return f"transfer strategy {name!r}"
+
+
+def _count_words(cls: type, key: str, count: int) -> str:
+    """``"2 integers separated by commas, each in [1, 1024] units"``."""
+    declared = _parameters.declared_ranges(cls).get(key)
+    each = f", each in {declared.interval()}" if declared is not None else ""
+    unit = f" {declared.unit}" if declared is not None and declared.unit else ""
+    return f"{count} integers separated by commas{each}{unit}"
+
+
+def describe_range(cls: type, key: str) -> str | None:
+    """The declared range of parameter ``key`` of ``cls`` as text; None if it declares none.
+
+    ``"(0, 1] standardized units"``; a tuple of a fixed number of items
+    (:func:`item_count`) says so: ``"2 integers separated by commas, each in [1, 1024] ..."``.
+    """
+    declared = _parameters.declared_ranges(cls).get(key)
+    if declared is None:
+        return None
+    count = item_count(cls, key)
+    return _count_words(cls, key, count) if count is not None else declared.describe()
+
+
+def _check_one(
+    name: str, cls: type, key: str, value: Any, *, field: str, from_text: bool
+) -> dict[str, Any]:
+    """One parameter checked by :func:`softbend.parameters.check_parameters`, and its count."""
+    owner = _owner(name)
+    count = item_count(cls, key)
+    try:
+        checked = _parameters.check_parameters(
+            cls,
+            {key: value},
+            owner=owner,
+            field=field,
+            from_text=from_text,
+            skip=FILLED,
+            keyword_only=False,
+            hints=_HINTS,
+        )
+    except OverflowError:  # an integer too large to compare with a float bound
+        if count is not None:
+            must, shown = _count_words(cls, key, count), _items(value)
+        else:
+            declared = _parameters.declared_ranges(cls).get(key)
+            must = declared.describe() if declared is not None else "a smaller number"
+            shown = str(value).strip()
+            shown = shown if len(shown) <= 40 else f"a number of {len(shown)} characters"
+        raise _parameters.ParameterValueError(
+            f"The parameter {key!r} of {owner} (in {field}) must be {must}. Got {shown} instead.",
+            key,
+        ) from None
+    except _parameters.ParameterValueError:
+        if count is None:
+            raise
+        raise _parameters.ParameterValueError(
+            f"The parameter {key!r} of {owner} (in {field}) must be "
+            f"{_count_words(cls, key, count)}. Got {_items(value)} instead.",
+            key,
+        ) from None
+    result = checked.get(key)
+    if count is not None and isinstance(result, tuple) and len(result) != count:
+        raise _parameters.ParameterValueError(
+            f"The parameter {key!r} of {owner} (in {field}) must be "
+            f"{_count_words(cls, key, count)}. Got {_items(value)} instead.",
+            key,
+        )
+    return checked
+
+
+def _items(value: Any) -> str:
+    """A value given for a tuple parameter, with its number of items: ``'0,0' (2 values)``."""
+    if isinstance(value, str):
+        n = len(value.split(","))
+    elif isinstance(value, tuple | list):
+        n = len(value)
+    else:
+        return repr(value)
+    shown = repr(value) if len(repr(value)) <= 60 else repr(value)[:57] + "..."
+    return f"{shown} ({n} value{'s' * (n != 1)})"
 
 
 def check_parameters(
@@ -83,20 +203,46 @@ def check_parameters(
     UnknownParameterError
         A parameter the strategy does not take (the known ones listed).
     ParameterValueError
-        A value that is not of the parameter's kind.
+        A value that is not of the parameter's kind, not finite, outside its
+        declared range, or a tuple of another number of items than its
+        annotation's (:func:`item_count`).
     LimitError
         ``epochs`` over the ``epochs`` limit of :mod:`softbend.limits`.
     """
-    return _parameters.check_parameters(
-        cls,
-        values,
-        owner=f"transfer strategy {name!r}",
-        field=field,
-        from_text=from_text,
-        skip=FILLED,
-        keyword_only=False,
-        hints=_HINTS,
-    )
+    checked: dict[str, Any] = {}
+    for key, value in (values or {}).items():
+        checked.update(_check_one(name, cls, key, value, field=field, from_text=from_text))
+    return checked
+
+
+def check_estimator(name: str, estimator: Any, *, field: str | None = None) -> dict[str, Any]:
+    """The ranged parameters of a strategy object, checked as :func:`check_parameters` does.
+
+    For a strategy built directly (``RefinedMLP(base, learning_rate=...)``) or
+    changed by ``set_params``: its fit calls this before any work.
+
+    Parameters
+    ----------
+    name : str
+        The strategy's registered name (its class name if it has none), for messages.
+    estimator : object
+        The strategy object; every parameter of its class with a declared range is read.
+    field : str, optional
+        Where the values came from, for messages; default ``"<Class> parameters"``.
+
+    Returns
+    -------
+    dict
+        The checked values of those parameters.
+    """
+    cls = type(estimator)
+    known = _constructor(cls)
+    values = {
+        key: getattr(estimator, key)
+        for key in _parameters.declared_ranges(cls)
+        if key in known and key not in FILLED and hasattr(estimator, key)
+    }
+    return check_parameters(name, cls, values, field=field or f"{cls.__name__} parameters")
 
 
 def recorded_parameters(estimator: Any) -> dict[str, Any]:

@@ -13,6 +13,11 @@ leave-one-actuator-out errors give the half-width of a 90 % interval for a new
 actuator, recorded as the ``interval`` of the record. With too few actuators
 for the rule's guarantee the half-width is the plug-in quantile of those
 errors (:mod:`softbend.transfer.conformal`), and a warning says so.
+
+A refinement whose predictions on the measured readings, training error, final
+loss or calibrated half-width is not finite is a
+:class:`~softbend.errors.ConvergenceError` naming what: never a model saved, or
+a figure printed, as NaN.
 """
 
 from __future__ import annotations
@@ -26,6 +31,7 @@ from typing import Any
 
 import numpy as np
 
+from softbend.errors import ConvergenceError
 from softbend.transfer.conformal import Calibration, angle_floor, calibrate
 from softbend.transfer.parameters import check_parameters, recorded_parameters, takes
 from softbend.transfer.strategies import STRATEGIES, fit_strategy, learns
@@ -100,6 +106,29 @@ def _merged_ranges(own: dict[str, list[float]], base: Any) -> dict[str, list[flo
     return {k: [min(v[0], base[k][0]), max(v[1], base[k][1])] for k, v in own.items()}
 
 
+def _check_finite_predictions(strategy: str, predicted: np.ndarray, features: np.ndarray) -> None:
+    """Raise :class:`ConvergenceError` if the refit predicts a non-finite angle at a reading."""
+    bad = np.flatnonzero(~np.isfinite(predicted))
+    if bad.size:
+        first = ", ".join(f"{v:g}" for v in features[bad[0]])
+        raise ConvergenceError(
+            f"The '{strategy}' refit predicts no finite angle at {bad.size} of the "
+            f"{predicted.size} measured readings (first: reading {int(bad[0])}, {first}); "
+            "it is not saved. Check the strategy's parameters and the base surrogate"
+        )
+
+
+def _check_finite_figures(strategy: str, figures: Mapping[str, Any]) -> None:
+    """Raise :class:`ConvergenceError` naming the first figure of the record that is not finite."""
+    for name, value in figures.items():
+        if value is not None and not np.isfinite(float(value)):
+            raise ConvergenceError(
+                f"The '{strategy}' refit's {name} is {float(value):g}, not a finite number; "
+                "it is not saved. Check the strategy's parameters (a smaller learning_rate) "
+                "and the measurements"
+            )
+
+
 def refine_surrogate(
     base: str | os.PathLike[str],
     measurements: str | os.PathLike[str] | Sequence[str | os.PathLike[str]],
@@ -156,6 +185,9 @@ def refine_surrogate(
         wrong kind, bad measurements or a fit that cannot be made.
     FileNotFoundError, SchemaError
         A missing or unreadable input.
+    ConvergenceError
+        A refit that diverged, or whose predictions on the readings, training
+        error, final loss or calibrated half-width is not finite.
     """
     from softbend.surrogates.features import training_ranges
     from softbend.surrogates.persistence import load_surrogate
@@ -186,7 +218,10 @@ def refine_surrogate(
         ranges = _merged_ranges(ranges, start.metadata.get("training_ranges"))
         if isinstance(start.metadata.get("support"), dict):
             support = support.merged(Support.from_dict(start.metadata["support"]))
-    residual = data.angle_deg - model.predict(data.features)
+    predicted = np.asarray(model.predict(data.features), dtype=np.float64)
+    _check_finite_predictions(strategy, predicted, data.features)
+    with np.errstate(over="ignore", invalid="ignore"):  # checked below
+        residual = data.angle_deg - predicted
     metadata: dict[str, Any] = {
         "strategy": strategy,
         "parameters": recorded_parameters(model),
@@ -202,7 +237,18 @@ def refine_surrogate(
     }
     if hasattr(model, "loss_curve_"):
         metadata["final_training_mse_deg2"] = float(model.loss_curve_[-1])
+    _check_finite_figures(
+        strategy,
+        {
+            "training RMSE (deg)": metadata["training_rmse_deg"],
+            "final training MSE (deg²)": metadata.get("final_training_mse_deg2"),
+        },
+    )
     calibration = _calibrate(data, start.model, strategy, seed, values) if calibrated else None
+    if calibration is not None:
+        _check_finite_figures(
+            strategy, {"calibrated interval half-width (deg)": calibration.half_width_deg}
+        )
     metadata["interval"] = None if calibration is None else calibration.to_dict()
     if calibration is not None and calibration.warning() is not None:
         metadata["interval"]["warning"] = calibration.warning()

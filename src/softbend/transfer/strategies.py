@@ -25,6 +25,13 @@ trained on the FEM dataset by default):
 
 Strategies with intervals have ``predict_interval(X, level)``.
 
+Every numeric parameter declares the range it accepts beside its class
+(:func:`~softbend.parameters.declare_ranges`; the table of the guarantees page
+lists them): ``--set``, a Python option or a strategy built directly is held to
+it before any work. A network whose training diverges anyway (non-finite
+losses, or angles no actuator reaches on its own training rows) is a
+:class:`~softbend.errors.ConvergenceError`, never a saved model.
+
 :data:`STRATEGIES` maps each name to its class; one call adds a strategy, from
 inside softbend or outside it, and every command and report then knows it::
 
@@ -41,6 +48,7 @@ its other parameters, with defaults, are the ones a user sets
 
 from __future__ import annotations
 
+import math
 import warnings
 from typing import Any, ClassVar, Literal, overload
 
@@ -54,6 +62,8 @@ from sklearn.utils.validation import check_is_fitted, validate_data
 from softbend._validation import check_int, check_range
 from softbend.design import FEATURES, SFRBADesign
 from softbend.errors import ConvergenceError
+from softbend.parameters import Range, declare_ranges, declared_ranges
+from softbend.plausibility import RANGES as PLAUSIBLE
 from softbend.plausibility import check_plausible
 from softbend.registry import Registry
 from softbend.surrogates.corrected import (
@@ -65,7 +75,13 @@ from softbend.surrogates.corrected import (
     scaled_pressure_rows,
 )
 from softbend.transfer.finetune import check_mlp, fine_tune_many, row_weights
-from softbend.transfer.parameters import check_parameters, parameter_defaults, takes
+from softbend.transfer.parameters import (
+    check_estimator,
+    check_parameters,
+    describe_range,
+    parameter_defaults,
+    takes,
+)
 from softbend.transfer.pressure_map import fit_pressure_scale, scale_mlp_pressure
 
 __all__ = [
@@ -99,6 +115,59 @@ NETWORK_STRATEGIES: tuple[str, ...] = (
     "refined-ensemble",
     "scaled-refined",
 )
+
+
+#: Adam steps of a network strategy; the largest is the ``epochs`` limit of
+#: :mod:`softbend.limits` (``SOFTBEND_MAX_EPOCHS``), checked beside the range.
+_EPOCHS = Range(
+    1,
+    math.inf,
+    "Adam steps",
+    "at least one step to train at all; the most is the 'epochs' limit (100 000 unless "
+    "SOFTBEND_MAX_EPOCHS raises it): each epoch is a full-batch step of every refit",
+)
+#: Adam's step size, in the standardized units of the weights.
+_LEARNING_RATE = Range(
+    0,
+    1,
+    "standardized units",
+    "a step of 0 learns nothing; above 1 Adam's steps overshoot the tanh network's "
+    "standardized weights and the training diverges to huge or NaN angles",
+    low_inclusive=False,
+)
+
+
+def _registered_name(cls: type) -> str:
+    """The name ``cls`` is registered under in :data:`STRATEGIES`, else its class name."""
+    return next((name for name, entry in STRATEGIES.items() if entry is cls), cls.__name__)
+
+
+def _check_trained(strategy: str, model: Any, X: np.ndarray, learning_rate: float) -> None:
+    """Raise :class:`ConvergenceError` if a trained network diverged.
+
+    Diverged: a non-finite training loss, or a non-finite angle or one no
+    actuator reaches (outside the plausible range of
+    :mod:`softbend.plausibility`) at a reading it was trained on.
+    """
+    with np.errstate(all="ignore"):
+        loss = np.asarray(model.loss_curve_, dtype=np.float64) * model.y_scale_**2
+        angles = np.asarray(model.predict(X), dtype=np.float64)
+    bounds = PLAUSIBLE["angle_deg"]
+    bad = ~np.isfinite(angles) | (angles < bounds.low) | (angles > bounds.high)
+    if np.isfinite(loss).all() and not bad.any():
+        return
+    if bad.any():
+        first = float(angles[np.flatnonzero(bad)[0]])
+        found = (
+            f"it predicts {first:.4g}° at {int(bad.sum())} of the {angles.size} readings it "
+            f"was trained on (plausible: {bounds.low:g} to {bounds.high:g}°)"
+        )
+    else:
+        found = "its training loss is not finite"
+    raise ConvergenceError(
+        f"The '{strategy}' strategy's training diverged at learning_rate {learning_rate:g}: "
+        f"{found}. Lower the learning_rate (--set learning_rate=...)"
+    )
 
 
 def _check_base(base: Any, owner: str) -> Any:
@@ -187,6 +256,10 @@ class _Strategy(RegressorMixin, BaseEstimator):
         check_is_fitted(self)
         return validate_data(self, X, reset=False, dtype=np.float64)
 
+    def _check_parameters(self) -> None:
+        """Hold the parameters to their declared ranges (a strategy built directly)."""
+        check_estimator(_registered_name(type(self)), self)
+
 
 class _Corrected(_Strategy):
     """A strategy whose fitted ``model_`` is a surrogate with an interval (``corrected``)."""
@@ -252,8 +325,13 @@ class AnalyticalBaseline(_Strategy):
             from softbend.analytical import AnalyticalModel
 
             self.model_ = AnalyticalModel()
-        else:
+        elif callable(getattr(self.model, "sweep", None)):
             self.model_ = self.model
+        else:
+            raise ValueError(
+                f"The 'model' of the '{_registered_name(type(self))}' strategy must be a bending "
+                f"model with a 'sweep' method (from Python). Got {self.model!r} instead."
+            )
         return self
 
     def predict(self, X: ArrayLike) -> np.ndarray:
@@ -272,6 +350,7 @@ class AnalyticalBaseline(_Strategy):
         return out
 
 
+@declare_ranges(epochs=_EPOCHS, learning_rate=_LEARNING_RATE)
 class RefinedMLP(_Strategy):
     """Paper B's refined MLP: the FEM-trained MLP trained further on the measurements.
 
@@ -284,9 +363,10 @@ class RefinedMLP(_Strategy):
     base : NormalizedMLPRegressor
         The FEM-trained MLP.
     epochs : int, default 1000
-        Adam steps over the measurements (paper B Fig. 6: 1000 epochs).
+        Adam steps over the measurements (paper B Fig. 6: 1000 epochs), >= 1 and
+        at most the ``epochs`` limit of :mod:`softbend.limits`.
     learning_rate : float, default 6e-4
-        Adam step size (paper B's).
+        Adam step size (paper B's), in (0, 1].
     device : {"auto", "cpu", "cuda"}, default "auto"
         Where the refits train (:func:`~softbend.transfer.finetune.fine_tune_many`):
         "auto" is the GPU when torch sees one.
@@ -332,6 +412,8 @@ class RefinedMLP(_Strategy):
         epochs and learning rate.
         """
         first = estimators[0]
+        for estimator in estimators:
+            estimator._check_parameters()
         check_mlp(first.base, cls.__name__)
         _check_same(estimators, ("base", "epochs", "learning_rate", "device"), cls.__name__)
         models = fine_tune_many(
@@ -343,6 +425,9 @@ class RefinedMLP(_Strategy):
             learning_rate=first.learning_rate,
             device=first.device,
         )
+        name = _registered_name(cls)
+        for model, rows in zip(models, row_sets, strict=True):
+            _check_trained(name, model, X[np.asarray(rows)], first.learning_rate)
         for estimator, model in zip(estimators, models, strict=True):
             estimator._set(model, X)
         return estimators
@@ -362,17 +447,30 @@ class RefinedMLP(_Strategy):
         return self.model_.predict(self._check_rows(X))
 
 
+@declare_ranges(
+    hidden_sizes=Range(
+        1,
+        1024,
+        "units per layer",
+        "two hidden layers (paper B's network); a layer of 0 units divides by zero, and "
+        "the weights grow as the product of the sizes: 1024 x 1024 is 8 MB per network "
+        "(and Adam's state), 100000 x 100000 would be 80 GB",
+        max_items=2,
+    ),
+    epochs=_EPOCHS,
+    learning_rate=_LEARNING_RATE,
+)
 class ExperimentalMLP(_Strategy):
     """Paper B's experimental MLP: the same network from scratch on the measurements.
 
     Parameters
     ----------
     hidden_sizes : tuple of int, default (63, 65)
-        Paper B's MLP.
+        The sizes of the two hidden layers, each in [1, 1024] (paper B's MLP: 63, 65).
     epochs : int, default 15000
-        Paper B Fig. 6.
+        Paper B Fig. 6; as for :class:`RefinedMLP`.
     learning_rate : float, default 6e-4
-        Adam step size (paper B's).
+        Adam step size (paper B's), in (0, 1].
     device : {"auto", "cpu", "cuda"}, default "auto"
         Where the refits train (:func:`~softbend.transfer.finetune.fine_tune_many`):
         "auto" is the GPU when torch sees one.
@@ -423,6 +521,8 @@ class ExperimentalMLP(_Strategy):
         from softbend.surrogates.mlp_core import init_parameters, model_rng, standardization
 
         first = estimators[0]
+        for estimator in estimators:
+            estimator._check_parameters()
         _check_same(
             estimators, ("hidden_sizes", "epochs", "learning_rate", "device", "seed"), cls.__name__
         )
@@ -453,6 +553,9 @@ class ExperimentalMLP(_Strategy):
             learning_rate=first.learning_rate,
             device=first.device,
         )
+        name = _registered_name(cls)
+        for model, rows in zip(models, row_sets, strict=True):
+            _check_trained(name, model, X[np.asarray(rows)], first.learning_rate)
         for estimator, model in zip(estimators, models, strict=True):
             estimator.model_ = model
             estimator.loss_curve_ = np.asarray(model.loss_curve_) * model.y_scale_**2
@@ -588,6 +691,15 @@ class ScaledRefinedMLP(RefinedMLP):
         self.pressure_scale_ = float(self.base.x_scale_[-1] / model.x_scale_[-1])
 
 
+@declare_ranges(
+    n_restarts=Range(
+        0,
+        100,
+        "restarts",
+        "each restart is one more full optimization of the GP's marginal likelihood "
+        "(a Cholesky factorization per step); a billion would never end",
+    )
+)
 class ResidualGP(_Corrected):
     """The base frozen, a Gaussian process on its error (scikit-learn, with a noise term).
 
@@ -602,7 +714,7 @@ class ResidualGP(_Corrected):
     base : estimator
         Any fitted surrogate.
     n_restarts : int, default 3
-        Restarts of the hyperparameter optimizer, >= 0.
+        Restarts of the hyperparameter optimizer, in [0, 100].
     seed : int, default 0
         Seed of the restarts.
     """
@@ -614,6 +726,7 @@ class ResidualGP(_Corrected):
 
     def fit(self, X: ArrayLike, y: ArrayLike) -> ResidualGP:
         """Fit the GP to ``y − base(X)``."""
+        self._check_parameters()
         _check_base(self.base, type(self).__name__)
         n_restarts = check_int(self.n_restarts, "n_restarts", type(self).__name__, low=0)
         X, y = self._check_fit_data(X, y)
@@ -669,6 +782,17 @@ class ResidualGP(_Corrected):
         return self.model_.predict(self._check_rows(X), return_std=return_std)
 
 
+@declare_ranges(
+    n_members=Range(
+        2,
+        100,
+        "networks",
+        "a spread needs at least 2 members; every member is a refined network trained "
+        "beside the others (memory and time grow with their number, times the folds of loco)",
+    ),
+    epochs=_EPOCHS,
+    learning_rate=_LEARNING_RATE,
+)
 class RefinedEnsemble(_Corrected):
     """Refined MLPs on bootstrap draws of the measured actuators.
 
@@ -681,7 +805,7 @@ class RefinedEnsemble(_Corrected):
     ----------
     base : NormalizedMLPRegressor
     n_members : int, default 5
-        Refined networks, >= 2.
+        Refined networks, in [2, 100].
     epochs, learning_rate, device
         As :class:`RefinedMLP`.
     seed : int, default 0
@@ -729,6 +853,8 @@ class RefinedEnsemble(_Corrected):
     ) -> list[RefinedEnsemble]:
         """Fit each ensemble on its rows; every member of every ensemble trained at once."""
         first = estimators[0]
+        for estimator in estimators:
+            estimator._check_parameters()
         check_mlp(first.base, cls.__name__)
         _check_same(
             estimators, ("base", "epochs", "learning_rate", "device", "n_members"), cls.__name__
@@ -746,6 +872,9 @@ class RefinedEnsemble(_Corrected):
             learning_rate=first.learning_rate,
             device=first.device,
         )
+        name = _registered_name(cls)
+        for model, rows in zip(models, flat, strict=True):
+            _check_trained(name, model, X[rows], first.learning_rate)
         for i, (estimator, rows) in enumerate(zip(estimators, row_sets, strict=True)):
             members = models[i * first.n_members : (i + 1) * first.n_members]
             estimator.members_ = members
@@ -800,18 +929,23 @@ def describe_strategies() -> list[dict[str, Any]]:
     list of dict
         ``name``; ``summary`` (the first line of its class's docstring, as text);
         ``parameters`` (``{name: default}``, see :func:`strategy_parameters`);
-        ``uses_base`` (starts from the base surrogate); ``learns`` (fits a model
-        that ``softbend transfer refine`` saves); ``interval`` (gives prediction
-        intervals).
+        ``ranges`` (``{name: range}`` of the parameters that declare one, as
+        text, e.g. ``"(0, 1] ..."``); ``uses_base`` (starts from the base
+        surrogate); ``learns`` (fits a model that ``softbend transfer refine``
+        saves); ``interval`` (gives prediction intervals).
     """
     rows = []
     for name, cls in STRATEGIES.items():
         doc = (cls.__doc__ or "").strip()
+        defaults = parameter_defaults(cls)
         rows.append(
             {
                 "name": name,
                 "summary": doc.splitlines()[0].replace("``", "") if doc else cls.__name__,
-                "parameters": parameter_defaults(cls),
+                "parameters": defaults,
+                "ranges": {
+                    key: describe_range(cls, key) for key in declared_ranges(cls) if key in defaults
+                },
                 "uses_base": takes(cls, "base"),
                 "learns": learns(name),
                 "interval": callable(getattr(cls, "predict_interval", None)),
@@ -831,18 +965,24 @@ def make_strategy(name: str, base: Any = None, *, seed: int = 0, **options: Any)
         The simulation-trained surrogate (not used by ``analytical`` and
         ``experimental``).
     seed : int, default 0
-        Seed of the strategy's random choices.
+        Seed of the strategy's random choices, >= 0.
     **options
-        Parameters of the strategy (e.g. ``epochs``; see :func:`strategy_parameters`).
+        Parameters of the strategy (e.g. ``epochs``; see :func:`strategy_parameters`),
+        each held to its declared range.
 
     Raises
     ------
     UnknownNameError
         An unknown name (listing :data:`STRATEGIES`), or a parameter the strategy
         does not take (listing those it takes).
+    ValueError
+        A value of the wrong kind or outside its declared range
+        (:class:`~softbend.parameters.ParameterValueError`), or a negative seed.
     """
     cls = STRATEGIES.get(name, field="strategy")
     options = check_parameters(name, cls, options)
+    if takes(cls, "seed"):
+        seed = check_int(seed, "seed", f"transfer strategy {name!r}", low=0)
     filled = {"base": base, "seed": seed}
     return cls(**{k: v for k, v in filled.items() if takes(cls, k)}, **options)
 
