@@ -38,6 +38,7 @@ __all__ = [
     "read_input_text",
     "remove_stale_staging",
     "staged_dir",
+    "stale_staging",
     "write_bytes_atomic",
     "write_text_atomic",
 ]
@@ -300,15 +301,28 @@ def remove_stale_staging(path: str | os.PathLike[str]) -> list[Path]:
     live process (a run still going, or an unrelated process that reuses the
     PID) is kept. Returns the folders removed.
     """
-    path = Path(path)
     removed = []
-    for folder in path.parent.glob(f".{glob.escape(path.name)}.*-*.new"):
-        pid_text = folder.name[len(path.name) + 2 :].split("-", 1)[0]
-        if not pid_text.isdigit() or not folder.is_dir() or _alive(int(pid_text)):
-            continue
+    for folder in stale_staging(path):
         shutil.rmtree(folder, ignore_errors=True)
         removed.append(folder)
     return removed
+
+
+def stale_staging(path: str | os.PathLike[str]) -> list[Path]:
+    """The staging folders of :func:`staged_dir` beside ``path`` whose process is gone.
+
+    The folders ``.NAME.PID-*.new`` that :func:`remove_stale_staging` removes,
+    left in place: what a run killed before its swap had written, for a caller
+    that resumes from it first.
+    """
+    path = Path(path)
+    found = []
+    for folder in sorted(path.parent.glob(f".{glob.escape(path.name)}.*-*.new")):
+        pid_text = folder.name[len(path.name) + 2 :].split("-", 1)[0]
+        if not pid_text.isdigit() or not folder.is_dir() or _alive(int(pid_text)):
+            continue
+        found.append(folder)
+    return found
 
 
 def _alive(pid: int) -> bool:

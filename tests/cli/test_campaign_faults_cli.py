@@ -19,7 +19,8 @@ from softbend.analytical import AnalyticalModel
 from softbend.cli import main
 from softbend.design import DesignSpace, SFRBADesign
 from softbend.errors import ConvergenceError
-from softbend.fem.options import FEMOptions, check_mesh_size
+from softbend.fem.geometry import check_mesh_size
+from softbend.fem.options import FEMOptions
 
 from .conftest import one_error_line
 

@@ -16,12 +16,26 @@ PARITY_PNG = "parity.png"
 COEFFICIENTS_CSV = "coefficients.csv"
 CORRELATION_CSV = "correlation.csv"
 
+#: Everything ``analyze`` writes into ``--out`` (the folder is replaced as a whole).
+FILES: tuple[str, ...] = (
+    CORRELATION_PNG,
+    LOADINGS_PNG,
+    PARITY_PNG,
+    COEFFICIENTS_CSV,
+    CORRELATION_CSV,
+)
+
 
 def analyze(
     db: Annotated[Path, typer.Argument(help="Campaign database (DuckDB file) to analyze.")],
     out: Annotated[
         Path,
-        typer.Option("--out", "-o", help="Folder for the figures and tables (created if missing)."),
+        typer.Option(
+            "--out",
+            "-o",
+            help="Folder for the figures and tables (replaced as a whole: a new or empty "
+            "folder, or an earlier result of this command).",
+        ),
     ],
     mape_threshold_deg: Annotated[
         float,
@@ -39,14 +53,17 @@ def analyze(
     multiple linear regression of the z-scored angle on the z-scored inputs
     (loadings, t-tests, R², F, MAPE), as paper B, Figure 4. Writes
     correlation.png, loadings.png, parity.png, coefficients.csv and
-    correlation.csv into the folder --out.
+    correlation.csv into the folder --out. The folder is written as a whole:
+    built beside --out and swapped in when every file is complete, so a run
+    that fails leaves the previous results as they were. An existing --out may
+    hold only what this command writes.
 
     Example:
 
     \b
         softbend analyze table1.duckdb --out analysis
     """
-    from softbend._io import write_text_atomic
+    from softbend._io import staged_dir, write_text_atomic
     from softbend.analysis import analyze_samples
     from softbend.errors import DatasetError
     from softbend.reports.analysis_figures import campaign_analysis_figures
@@ -55,8 +72,11 @@ def analyze(
         raise FileNotFoundError(f"Campaign database {str(db)!r} does not exist.")
     if db.is_dir():
         raise DatasetError(f"Campaign database {str(db)!r} is a folder, not a DuckDB file.")
-    written = (CORRELATION_PNG, LOADINGS_PNG, PARITY_PNG, COEFFICIENTS_CSV, CORRELATION_CSV)
-    _common.check_output_dir(out, "--out", inputs=(db,), files=written)
+    out = Path(out)
+    _common.check_output_dir(out, "--out", inputs=(db,), files=FILES)
+    _common.check_replaceable_dir(
+        out, "--out", "analyze", inputs=(db,), files=FILES, marker=COEFFICIENTS_CSV
+    )
 
     from softbend.campaign.store import load_samples
 
@@ -67,18 +87,23 @@ def analyze(
     analysis = analyze_samples(samples, mape_threshold=mape_threshold_deg)
     report, corr = analysis.regression, analysis.correlation
 
-    with _common.output_errors(out, "--out"):
-        out.mkdir(parents=True, exist_ok=True)
-        figures = campaign_analysis_figures(
+    with (
+        _common.output_errors(out, "--out"),
+        staged_dir(out) as stage,
+        _common.as_written(stage, out),
+    ):
+        drawn = campaign_analysis_figures(
             analysis,
-            out,
+            stage,
             correlation_png=CORRELATION_PNG,
             loadings_png=LOADINGS_PNG,
             parity_png=PARITY_PNG,
         )
-        tables = {"coefficients": out / COEFFICIENTS_CSV, "correlation": out / CORRELATION_CSV}
-        write_text_atomic(tables["coefficients"], report.coefficients.to_csv(float_format="%.10g"))
-        write_text_atomic(tables["correlation"], corr.to_csv(float_format="%.10g"))
+        coefficients = report.coefficients.to_csv(float_format="%.10g")
+        write_text_atomic(stage / COEFFICIENTS_CSV, coefficients)
+        write_text_atomic(stage / CORRELATION_CSV, corr.to_csv(float_format="%.10g"))
+    figures = {key: out / Path(path).name for key, path in drawn.items()}
+    tables = {"coefficients": out / COEFFICIENTS_CSV, "correlation": out / CORRELATION_CSV}
 
     if json_output:
         payload = analysis.to_dict()

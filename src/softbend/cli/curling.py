@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import re
 from pathlib import Path
 from typing import Any
 
@@ -18,7 +19,13 @@ app = typer.Typer(
 
 @app.command("simulate")
 def simulate(
-    out: Path = typer.Option(..., "--out", "-o", help="Folder for the experiment CSV files."),
+    out: Path = typer.Option(
+        ...,
+        "--out",
+        "-o",
+        help="Folder for the experiment CSV files (replaced as a whole: a new or empty folder, "
+        "or an earlier result of this command).",
+    ),
     experiments: int = typer.Option(6, help="Experiments per pressure sign."),
     samples: int = typer.Option(512, help="Samples per experiment."),
     dt: float = typer.Option(0.02, "--dt", help="Sample period, s."),
@@ -31,25 +38,38 @@ def simulate(
     """Write synthetic curling-actuator experiments as CSV.
 
     Experiments at positive and at negative pressure, one CSV file each, in
-    the folder --out; the data are synthetic and say so.
+    the folder --out; the data are synthetic and say so. The folder is written
+    as a whole: built beside --out and swapped in when every file is complete,
+    so a run that fails leaves the previous experiments as they were and a
+    rerun never leaves an earlier run's experiments beside the new ones. An
+    existing --out may hold only experiments this command wrote.
 
     Example:
 
     \b
         softbend curling simulate --out experiments --experiments 6
     """
+    from softbend._io import staged_dir
     from softbend.identification.data import save_experiments
     from softbend.identification.synthetic import check_synthetic_size, synthetic_dataset
 
     check_synthetic_size(samples, dt, samples="'--samples'", dt="'--dt'")
+    out = Path(out)
     _common.check_output_dir(out, "--out")
+    _common.check_replaceable_dir(
+        out, "--out", "curling simulate", files=_simulated_files(out), marker=None
+    )
     choice: Any = excitation  # one of EXCITATIONS: synthetic_dataset checks it
     dataset = synthetic_dataset(
         n_experiments=experiments, n_samples=samples, dt_s=dt, seed=seed, excitation=choice
     )
     all_experiments = [e for group in dataset.values() for e in group]
-    with _common.output_errors(out, "--out"):
-        paths = save_experiments(all_experiments, out)
+    with (
+        _common.output_errors(out, "--out"),
+        staged_dir(out) as stage,
+        _common.as_written(stage, out),
+    ):
+        paths = [out / p.name for p in save_experiments(all_experiments, stage)]
     rows = [
         [
             e.name,
@@ -81,10 +101,57 @@ def simulate(
     )
 
 
+#: Everything ``curling identify`` writes into its ``--out`` folder (``--select``: the last two).
+IDENTIFY_FILES: tuple[str, ...] = (
+    "metrics.csv",
+    "summary.csv",
+    "models",
+    "fig5_tip_positions.png",
+    "fig6_bending_grade.png",
+    "fig7_arc_length.png",
+    "fig9_identified_rho.png",
+    "fig10_identified_length.png",
+    "selection_positive",
+    "selection_negative",
+)
+
+#: The name of an experiment file of ``curling simulate``: ``positive-01.csv``, …
+_SIMULATED_NAME = re.compile(r"(positive|negative)-[0-9]{2,}\.csv")
+
+
+def _simulated_files(folder: Path) -> tuple[str, ...]:
+    """The files in ``folder`` that ``curling simulate`` wrote: its names, labelled synthetic.
+
+    A file counts when its name is one the command gives and its header
+    comments, before the column header, say ``# synthetic: true``; the rest of
+    the folder (a measurement of the same name included) is the user's.
+    """
+    if not folder.is_dir():
+        return ()
+    own = []
+    for path in folder.iterdir():
+        if not (_SIMULATED_NAME.fullmatch(path.name) and path.is_file()):
+            continue
+        try:
+            with open(path, encoding="utf-8", errors="replace") as handle:
+                head = [handle.readline().strip() for _ in range(8)]
+        except OSError:
+            continue
+        if "# synthetic: true" in head:
+            own.append(path.name)
+    return tuple(own)
+
+
 @app.command("identify")
 def identify(
     data: Path = typer.Argument(..., help="A CSV file or a folder of CSV files."),
-    out: Path = typer.Option(..., "--out", "-o", help="Folder for metrics, models and figures."),
+    out: Path = typer.Option(
+        ...,
+        "--out",
+        "-o",
+        help="Folder for metrics, models and figures (replaced as a whole: a new or empty "
+        "folder, or an earlier result of this command).",
+    ),
     c: float = typer.Option(100.0, "--C", help="SVR penalty C (paper A calls it gamma)."),
     epsilon: float = typer.Option(0.1, help="SVR epsilon, in units of the standardized output."),
     output_lags: int = typer.Option(2, help="Past outputs in the regressor."),
@@ -115,26 +182,51 @@ def identify(
 
     Fits SVR-based NARX models of the bending grade rho and the arc length L
     to the experiments in DATA, one per output and pressure sign, and scores
-    each held-out experiment (leave one experiment out), as paper A.
+    each held-out experiment (leave one experiment out), as paper A. The
+    folder --out (with --select's subfolders) is written as a whole: built
+    beside it and swapped in when every file is complete, so a run that fails
+    leaves the previous results as they were. An existing --out may hold only
+    what this command writes.
 
     Example:
 
     \b
         softbend curling identify experiments --out identification
     """
+    from softbend._io import staged_dir
     from softbend.identification.data import experiment_files, load_experiments
+    from softbend.identification.ranges import MAX_MEMORY_MB_RANGE, check_number
     from softbend.identification.resources import check_identify_memory
-    from softbend.identification.study import IdentificationConfig, n_fits
+    from softbend.identification.study import (
+        IdentificationConfig,
+        check_experiments,
+        check_settings,
+        n_fits,
+    )
     from softbend.identification.study import identify as run_identify
+    from softbend.reports.identify_outputs import write_identification
     from softbend.reports.paper_a import write_identification_outputs
 
+    # every numeric option within its declared range (softbend.identification.ranges),
+    # before anything is read: lags of 10**9 would allocate GiB before the first fit
+    options = {"C": "--C", "epsilon": "--epsilon"}
+    options |= {"output_lags": "--output-lags", "input_lags": "--input-lags"}
+    check_settings(
+        C=c, epsilon=epsilon, output_lags=output_lags, input_lags=input_lags, names=options
+    )
+    if max_memory_mb is not None:
+        check_number(max_memory_mb, MAX_MEMORY_MB_RANGE, "'--max-memory-mb'")
     choices: dict[str, Any] = {"kernel": kernel, "moments_of": moments_of}  # checked there
     config = IdentificationConfig(
         C=c, epsilon=epsilon, output_lags=output_lags, input_lags=input_lags, **choices
     )
     csvs = [p for p in data.iterdir() if p.suffix.lower() == ".csv"] if data.is_dir() else []
     inputs = (data, *csvs)
+    out = Path(out)
     _common.check_output_dir(out, "--out", inputs=inputs, files=("metrics.csv", "summary.csv"))
+    _common.check_replaceable_dir(
+        out, "--out", "curling identify", inputs=inputs, files=IDENTIFY_FILES, marker="metrics.csv"
+    )
     experiment_files(data)  # missing data and files over the size limit: refused first
     need = check_identify_memory(data, max_memory_mb=max_memory_mb)
     if not as_json and need.csv_bytes >= 4 * 2**20:  # long enough to be worth a line
@@ -143,13 +235,22 @@ def identify(
             highlight=False,
         )
     experiments = load_experiments(data)
+    check_experiments(experiments, config, names=options)  # lags the data can hold, before fits
     with _common.progress_bar(
         "fitting NARX models", n_fits(experiments), enabled=not as_json
     ) as bar:
         result = run_identify(experiments, config, progress=lambda label: bar(last=label))
-    with _common.output_errors(out, "--out"):
-        outputs = write_identification_outputs(result, out)
-    verdicts = _select(experiments, out, as_json) if select else {}
+    selections = _select(experiments, as_json) if select else {}
+    with (
+        _common.output_errors(out, "--out"),
+        staged_dir(out) as stage,
+        _common.as_written(stage, out),
+    ):
+        written = write_identification_outputs(result, stage)
+        for sign, (selection, series) in selections.items():
+            write_identification(selection, series, stage / f"selection_{sign}")
+    outputs = {key: out / Path(path).relative_to(stage) for key, path in written.items()}
+    verdicts = {sign: selection.verdict() for sign, (selection, _) in selections.items()}
     if as_json:
         _common.print_json(
             {
@@ -167,24 +268,24 @@ def identify(
     _common.console.print(f"models, metrics and figures written to {out}")
 
 
-def _select(experiments: list[Any], out: Path, quiet: bool) -> dict[str, str]:
-    """The free-run selection per pressure sign, written to out/selection_<sign>/."""
+def _select(experiments: list[Any], quiet: bool) -> dict[str, tuple[Any, Any]]:
+    """The free-run selection per pressure sign and the data it was made on.
+
+    Returns ``{sign: (selection, series)}``, written to ``out/selection_<sign>/``;
+    a sign with fewer than two experiments has nothing to hold out and no entry.
+    """
     from softbend.identification.selection import select_model
     from softbend.identification.study import split_by_sign
     from softbend.identification.timeseries import from_experiments
-    from softbend.reports.identify_outputs import write_identification
 
-    verdicts = {}
+    chosen = {}
     with _common.library_progress(enabled=not quiet):
         for sign, group in split_by_sign(experiments).items():
             if len(group) < 2:
                 continue  # nothing to hold out: paper A's leave-one-out says so above
             data = from_experiments(group)
-            selection = select_model(data)
-            with _common.output_errors(out, "--out"):
-                write_identification(selection, data, out / f"selection_{sign}")
-            verdicts[sign] = selection.verdict()
-    return verdicts
+            chosen[sign] = (select_model(data), data)
+    return chosen
 
 
 def print_metrics(result) -> None:

@@ -17,8 +17,11 @@ app = typer.Typer(
 )
 
 #: Solver statistics written by ``fem run`` beside the files of
-#: :func:`softbend.reports.fem_figures.sweep_with_files`.
+#: :func:`softbend.reports.fem_figures.sweep_with_files`; the marker of its folder.
 SWEEP_JSON = "sweep.json"
+
+#: Everything ``fem run`` writes into its ``--out`` folder (the last: the folder of VTK files).
+RUN_FILES: tuple[str, ...] = ("sweep.csv", SWEEP_JSON, "angle_pressure.png", "shapes.png", "vtk")
 
 DesignOption = Annotated[
     str,
@@ -63,7 +66,13 @@ def run(
         float, typer.Option("--pstep", help="Pressure step of the sweep's grid (outputs), MPa.")
     ] = 0.005,
     out: Annotated[
-        Path, typer.Option("--out", "-o", help="Folder for the CSV, JSON, figures and VTK files.")
+        Path,
+        typer.Option(
+            "--out",
+            "-o",
+            help="Folder for the CSV, JSON, figures and VTK files (replaced as a whole: a new "
+            "or empty folder, or an earlier result of this command).",
+        ),
     ] = Path("results/fem"),
     maxh: MaxhOption = 5.0,
     gravity: GravityOption = "bending",
@@ -83,14 +92,17 @@ def run(
     shapes, paper B, Figure 2b) and vtk/shape_p<MPa>MPa.vtu (such as
     shape_p0.050MPa.vtu: the whole actuator with the displacement, mm, the
     largest principal stretch and the strain-energy density, MPa) for
-    ParaView (apply Warp By Vector).
+    ParaView (apply Warp By Vector). The folder is written as a whole: built
+    beside --out and swapped in when every file is complete, so a run that
+    fails leaves the previous results as they were and a rerun never mixes two
+    runs. An existing --out may hold only what this command writes.
 
     Example:
 
     \b
         softbend fem run --design 100,6,2,2,5,10 --pmax 0.2 --out fem
     """
-    from softbend._io import write_text_atomic
+    from softbend._io import staged_dir, write_text_atomic
     from softbend.design import SFRBADesign
     from softbend.fem.stats import fem_stats
     from softbend.models import default_pressures_mpa
@@ -101,46 +113,51 @@ def run(
         pmax, pstep, names=("--pmax", "--pstep"), owner="softbend fem run"
     )
     options = _options(maxh, gravity, material, output="solve" if solve_every else "interpolate")
+    options.check_mesh(actuator)  # before NGSolve loads: a too fine --maxh is one line at once
     if shapes < 1:
         raise ValueError(f"The '--shapes' must be an integer in [1, inf). Got {shapes} instead.")
-    written = ("sweep.csv", SWEEP_JSON, "angle_pressure.png", "shapes.png")
-    _common.check_output_dir(out, "--out", files=written)
+    out = Path(out)
+    _common.check_output_dir(out, "--out", files=RUN_FILES[:-1])
+    _common.check_replaceable_dir(out, "--out", "fem run", files=RUN_FILES, marker=SWEEP_JSON)
     scale = 1000
     with (
         _common.output_errors(out, "--out"),
-        _common.progress_bar(
-            "FEM sweep (pressure x 1000 / pmax)", scale, enabled=not json_output
-        ) as advance,
+        staged_dir(out) as stage,
+        _common.as_written(stage, out),
     ):
-        state = {"done": 0}
+        with _common.progress_bar(
+            "FEM sweep (pressure x 1000 / pmax)", scale, enabled=not json_output
+        ) as advance:
+            state = {"done": 0}
 
-        def on_step(pressure: float, angle: float, target: float) -> None:
-            done = round(scale * pressure / target) if target > 0 else scale
-            advance(max(done - state["done"], 0), p=f"{pressure:.4f} MPa", angle=f"{angle:.1f}°")
-            state["done"] = max(done, state["done"])
+            def on_step(pressure: float, angle: float, target: float) -> None:
+                done = round(scale * pressure / target) if target > 0 else scale
+                advance(
+                    max(done - state["done"], 0), p=f"{pressure:.4f} MPa", angle=f"{angle:.1f}°"
+                )
+                state["done"] = max(done, state["done"])
 
-        sweep = sweep_with_files(
-            actuator,
-            pressures,
-            options,
-            out,
-            shape_pressures_mpa=shapes,
-            vtk=True,
-            progress=on_step,
-        )
-    result = sweep.result
-    stats = fem_stats(result)
-    summary = {
-        "design": str(actuator),
-        "stop_reason": stats["stop_reason"],
-        "max_pressure_mpa": result.max_pressure_mpa,
-        "max_angle_deg": result.max_angle_deg,
-        "wall_time_s": result.wall_time_s,
-        "elements": result.mesh_size,
-        "stats": result.stats,
-    }
-    with _common.output_errors(out, "--out"):
-        write_text_atomic(out / SWEEP_JSON, _common.json_text(summary))
+            sweep = sweep_with_files(
+                actuator,
+                pressures,
+                options,
+                stage,
+                shape_pressures_mpa=shapes,
+                vtk=True,
+                progress=on_step,
+            )
+        result = sweep.result
+        stats = fem_stats(result)
+        summary = {
+            "design": str(actuator),
+            "stop_reason": stats["stop_reason"],
+            "max_pressure_mpa": result.max_pressure_mpa,
+            "max_angle_deg": result.max_angle_deg,
+            "wall_time_s": result.wall_time_s,
+            "elements": result.mesh_size,
+            "stats": result.stats,
+        }
+        write_text_atomic(stage / SWEEP_JSON, _common.json_text(summary))
     if json_output:
         _common.print_json(
             {**summary, "pressure_mpa": result.pressure_mpa, "angle_deg": result.angle_deg}

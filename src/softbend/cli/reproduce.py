@@ -12,7 +12,11 @@ from softbend.cli import _common
 
 def reproduce(
     out: Path = typer.Option(
-        Path("results/reproduce"), "--out", "-o", help="Folder for the report and its files."
+        Path("results/reproduce"),
+        "--out",
+        "-o",
+        help="Folder for the report and its files (replaced as a whole: a new or empty folder, "
+        "or an earlier report).",
     ),
     seed: int = typer.Option(0, help="Seed of every random process."),
     workers: int | None = typer.Option(
@@ -25,14 +29,22 @@ def reproduce(
     Paper A's identification and paper B's campaign, analysis, surrogates,
     FEM, transfer learning and control, on built-in defaults; the report is
     index.html in the folder --out, with the data, models and figures beside it.
+    The folder is written as a whole: built beside --out and swapped in when the
+    report is complete, so a run that fails or is stopped leaves the previous
+    report as it was. An existing --out may hold only an earlier report. The
+    campaign database resumes: from the previous report, or from a run that
+    failed or was stopped (kept in a hidden folder beside --out until the next run).
 
     Example:
 
     \b
         softbend reproduce --out results/reproduce --workers 2
     """
-    from softbend.reports.reproduce import run_reproduce
+    from softbend.reports.reproduce import ENTRIES, MARKER, run_reproduce
 
+    out = Path(out)
+    _common.check_output_dir(out, "--out")
+    _common.check_replaceable_dir(out, "--out", "reproduce", files=ENTRIES, marker=MARKER)
     with _common.phase_progress(enabled=not as_json) as progress:
         summary = run_reproduce(
             out,

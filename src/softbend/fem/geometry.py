@@ -12,6 +12,7 @@ Faces are named for the physics: ``base`` (fixed), ``symmetry`` (``y = 0``),
 from __future__ import annotations
 
 import math
+from collections.abc import Iterable
 from dataclasses import dataclass
 from typing import Any
 
@@ -19,7 +20,13 @@ from softbend.design import SFRBADesign
 from softbend.errors import SoftbendError
 from softbend.fem._ngsolve import require_ngsolve
 
-__all__ = ["ActuatorGeometry", "actuator_geometry", "mesh_actuator"]
+__all__ = [
+    "ActuatorGeometry",
+    "actuator_geometry",
+    "check_mesh_size",
+    "estimated_elements",
+    "mesh_actuator",
+]
 
 #: Largest number of tetrahedra a mesh may have (guards against a tiny maxh).
 MAX_ELEMENTS = 400_000
@@ -156,8 +163,6 @@ def mesh_actuator(
     ngsolve = require_ngsolve()
     from netgen.occ import OCCGeometry
 
-    from softbend.fem.options import check_mesh_size  # here: options imports geometry
-
     check_mesh_size(design, maxh_mm, base_cap_mm)
     shape, info = actuator_geometry(design, base_cap_mm)
     try:
@@ -168,3 +173,67 @@ def mesh_actuator(
         ) from exc
     mesh.Curve(order)
     return mesh, info
+
+
+def estimated_elements(design: SFRBADesign, maxh_mm: float, base_cap_mm: float = 3.0) -> float:
+    """About how many tetrahedra the FEM's mesh of ``design`` has with ``maxh_mm``.
+
+    Six times the half actuator's volume over that of a regular tetrahedron of
+    edge ``maxh_mm``: the estimate of :func:`check_mesh_size`, known before
+    meshing and without NGSolve.
+
+    Parameters
+    ----------
+    design : SFRBADesign
+        The actuator.
+    maxh_mm : float
+        Largest element size, mm (> 0).
+    base_cap_mm : float, default 3.0
+        Proximal end wall, mm (:attr:`~softbend.fem.options.FEMOptions.base_cap_mm`).
+
+    Returns
+    -------
+    float
+        The estimated number of elements.
+    """
+    volume = ActuatorGeometry(design, base_cap_mm).half_volume_mm3
+    return 6.0 * volume / (maxh_mm**3 / (6.0 * math.sqrt(2.0)))
+
+
+def check_mesh_size(
+    designs: SFRBADesign | Iterable[SFRBADesign], maxh_mm: float, base_cap_mm: float = 3.0
+) -> None:
+    """Refuse a ``maxh_mm`` that would mesh a design with too many elements.
+
+    The FEM's rule on the mesh size: at most
+    :data:`MAX_ELEMENTS` tetrahedra, as estimated by
+    :func:`estimated_elements` (:func:`mesh_actuator`
+    applies it to the design it meshes). A command checks it on every design
+    it will sweep, before any work.
+
+    Parameters
+    ----------
+    designs : SFRBADesign or iterable of SFRBADesign
+        The actuators to mesh.
+    maxh_mm : float
+        Largest element size, mm (> 0).
+    base_cap_mm : float, default 3.0
+        Proximal end wall, mm.
+
+    Raises
+    ------
+    ValueError
+        A design's estimated mesh exceeds :data:`MAX_ELEMENTS`; the message
+        names the design with the most elements, as the FEM would.
+    """
+    items = [designs] if isinstance(designs, SFRBADesign) else list(designs)
+    if not items:
+        return
+    estimates = [estimated_elements(d, maxh_mm, base_cap_mm) for d in items]
+    largest = max(range(len(items)), key=estimates.__getitem__)
+    if estimates[largest] > MAX_ELEMENTS:
+        raise ValueError(
+            f"The 'maxh_mm' of the FEM mesh must give at most {MAX_ELEMENTS} elements for "
+            f"design {items[largest]}. Got {maxh_mm:g} mm (about {estimates[largest]:.0f} "
+            "elements) instead."
+        )

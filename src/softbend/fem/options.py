@@ -2,14 +2,13 @@
 
 from __future__ import annotations
 
-import math
 from collections.abc import Iterable
 from dataclasses import asdict, dataclass, field, fields
 from typing import Any, cast
 
 from softbend._validation import check_choice, check_int, check_range
 from softbend.design import SFRBADesign
-from softbend.fem.geometry import MAX_ELEMENTS, ActuatorGeometry
+from softbend.fem.geometry import check_mesh_size
 from softbend.fem.mechanics import FIBER_LAWS
 from softbend.materials.models import HyperelasticModel
 from softbend.materials.presets import (
@@ -25,8 +24,6 @@ __all__ = [
     "GRAVITY_DIRECTIONS",
     "OUTPUT_MODES",
     "FEMOptions",
-    "check_mesh_size",
-    "estimated_elements",
 ]
 
 #: Where gravity points, relative to the actuator (see :class:`FEMOptions`).
@@ -235,8 +232,9 @@ class FEMOptions:
     def check_mesh(self, designs: SFRBADesign | Iterable[SFRBADesign]) -> None:
         """Refuse these options' ``maxh_mm`` if it meshes any of ``designs`` too finely.
 
-        :func:`check_mesh_size` with :attr:`maxh_mm` and :attr:`base_cap_mm`: the
-        rule the FEM applies before meshing, checked before any sweep starts.
+        :func:`~softbend.fem.geometry.check_mesh_size` with :attr:`maxh_mm` and
+        :attr:`base_cap_mm`: the rule the FEM applies before meshing, checked before any
+        sweep starts.
 
         Raises
         ------
@@ -277,67 +275,3 @@ class FEMOptions:
             out[name] = getattr(self, name).to_dict()
         out.pop("extra")
         return out
-
-
-def estimated_elements(design: SFRBADesign, maxh_mm: float, base_cap_mm: float = 3.0) -> float:
-    """About how many tetrahedra the FEM's mesh of ``design`` has with ``maxh_mm``.
-
-    Six times the half actuator's volume over that of a regular tetrahedron of
-    edge ``maxh_mm``: the estimate of :func:`check_mesh_size`, known before
-    meshing and without NGSolve.
-
-    Parameters
-    ----------
-    design : SFRBADesign
-        The actuator.
-    maxh_mm : float
-        Largest element size, mm (> 0).
-    base_cap_mm : float, default 3.0
-        Proximal end wall, mm (:attr:`FEMOptions.base_cap_mm`).
-
-    Returns
-    -------
-    float
-        The estimated number of elements.
-    """
-    volume = ActuatorGeometry(design, base_cap_mm).half_volume_mm3
-    return 6.0 * volume / (maxh_mm**3 / (6.0 * math.sqrt(2.0)))
-
-
-def check_mesh_size(
-    designs: SFRBADesign | Iterable[SFRBADesign], maxh_mm: float, base_cap_mm: float = 3.0
-) -> None:
-    """Refuse a ``maxh_mm`` that would mesh a design with too many elements.
-
-    The FEM's rule on the mesh size: at most
-    :data:`~softbend.fem.geometry.MAX_ELEMENTS` tetrahedra, as estimated by
-    :func:`estimated_elements` (:func:`softbend.fem.geometry.mesh_actuator`
-    applies it to the design it meshes). A command checks it on every design
-    it will sweep, before any work.
-
-    Parameters
-    ----------
-    designs : SFRBADesign or iterable of SFRBADesign
-        The actuators to mesh.
-    maxh_mm : float
-        Largest element size, mm (> 0).
-    base_cap_mm : float, default 3.0
-        Proximal end wall, mm.
-
-    Raises
-    ------
-    ValueError
-        A design's estimated mesh exceeds :data:`~softbend.fem.geometry.MAX_ELEMENTS`; the message
-        names the design with the most elements, as the FEM would.
-    """
-    items = [designs] if isinstance(designs, SFRBADesign) else list(designs)
-    if not items:
-        return
-    estimates = [estimated_elements(d, maxh_mm, base_cap_mm) for d in items]
-    largest = max(range(len(items)), key=estimates.__getitem__)
-    if estimates[largest] > MAX_ELEMENTS:
-        raise ValueError(
-            f"The 'maxh_mm' of the FEM mesh must give at most {MAX_ELEMENTS} elements for "
-            f"design {items[largest]}. Got {maxh_mm:g} mm (about {estimates[largest]:.0f} "
-            "elements) instead."
-        )

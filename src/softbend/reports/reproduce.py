@@ -19,20 +19,33 @@ softbend can reproduce, and the data, models and figures beside it:
 Each section's computation is in :mod:`softbend.pipeline` (one module per
 section, returning its results); this module and the section modules of
 :mod:`softbend.reports` draw those results and write the HTML.
+
+The folder is written as a whole: every section writes into a staging folder
+beside ``out_dir`` (:func:`softbend._io.staged_dir`), swapped in once
+``summary.json`` is written, so ``out_dir`` holds one run, never a mix of two,
+and a run that fails or is killed leaves the previous report as it was. The one
+thing carried over is the campaign database, so that the campaign resumes: the
+newest of ``out_dir``'s (copied; the old report keeps its own) and that of a run
+that failed or was killed. A failed run moves its database to the hidden folder
+``.NAME.resume`` beside ``out_dir``, a killed one leaves it in its staging
+folder; the next run takes it from there and removes the folder.
 """
 
 from __future__ import annotations
 
+import contextlib
 import logging
+import math
 import os
 import platform
+import shutil
 import time
 from datetime import UTC, datetime
 from pathlib import Path
 from typing import Any
 
 from softbend import __version__
-from softbend._io import json_text, write_text_atomic
+from softbend._io import json_text, staged_dir, stale_staging, write_text_atomic
 from softbend._validation import check_range
 from softbend.design import DesignSpace
 from softbend.pipeline import Progress
@@ -41,7 +54,26 @@ from softbend.reports.html import Report
 
 logger = logging.getLogger(__name__)
 
-__all__ = ["Progress", "run_reproduce"]
+__all__ = ["ENTRIES", "MARKER", "Progress", "run_reproduce"]
+
+#: Everything :func:`run_reproduce` writes into its folder, which it replaces as a whole.
+ENTRIES: tuple[str, ...] = (
+    "index.html",
+    "summary.json",
+    "paper_a",
+    "paper_b",
+    "paper_b_fem",
+    "transfer",
+    "control",
+    "design",
+)
+
+#: The file every finished report folder has (written last).
+MARKER = "summary.json"
+
+#: The campaign database, relative to the report's folder, and its companion files.
+_CAMPAIGN = Path("paper_b") / "campaign.duckdb"
+_CAMPAIGN_SUFFIXES = ("", ".wal")
 
 
 def _paper_a(report: Report, out_dir: Path, seed: int, progress: Progress | None) -> dict[str, Any]:
@@ -138,7 +170,8 @@ def run_reproduce(
     Parameters
     ----------
     out_dir : path
-        Output folder (created).
+        Output folder, replaced as a whole when the run is complete: a new or
+        empty folder, or an earlier report's (with ``summary.json``).
     seed : int
         Seed of every random process (synthetic data, noise, samplers).
     workers : int, optional
@@ -147,7 +180,8 @@ def run_reproduce(
         ``progress(phase, done, total)``.
     design_space : DesignSpace, optional
         Designs of the paper B campaign (default: Table 1, 972 designs). A
-        different space needs a new ``out_dir``: the campaign database resumes.
+        different space needs a new ``out_dir``: the campaign database of the
+        previous run (or of a killed one) resumes.
     fem_options, fem_pmax_mpa : optional
         Settings of the FEM sweep of the Fig. 2 design (default: the model's
         defaults, 0.17 MPa as in paper B Fig. 2b).
@@ -174,6 +208,12 @@ def run_reproduce(
     dict
         Headline figures per section, the report path and the wall time (also
         written to ``out_dir/summary.json``).
+
+    Raises
+    ------
+    ValueError
+        ``out_dir`` is a file, or a folder with other files than an earlier
+        report's (it would be lost when the folder is replaced).
     """
     if workers is not None:
         # Checked before any work starts, not after paper A.
@@ -189,7 +229,56 @@ def run_reproduce(
             )
         )
     out_dir = Path(out_dir)
-    out_dir.mkdir(parents=True, exist_ok=True)
+    _check_replaceable(out_dir)
+    _rescue_interrupted(out_dir)
+    with staged_dir(out_dir) as stage:
+        _seed_campaign(stage, out_dir)
+        try:
+            summary = _run_into(
+                stage,
+                out_dir,
+                seed=seed,
+                workers=workers,
+                progress=progress,
+                design_space=design_space,
+                fem_options=fem_options,
+                fem_pmax_mpa=fem_pmax_mpa,
+                fem_dataset=fem_dataset,
+                fem_dataset_epochs=fem_dataset_epochs,
+                transfer_options=transfer_options,
+                control_options=control_options,
+                design_options=design_options,
+                command=command,
+            )
+        except BaseException:
+            _keep_campaign(stage, out_dir)
+            raise
+    return summary
+
+
+def _run_into(
+    stage: Path,
+    final: Path,
+    *,
+    seed: int,
+    workers: int | None,
+    progress: Progress | None,
+    design_space: DesignSpace | None,
+    fem_options: Any,
+    fem_pmax_mpa: float | None,
+    fem_dataset: str | Path | None,
+    fem_dataset_epochs: int | None,
+    transfer_options: dict[str, dict[str, Any]] | None,
+    control_options: dict[str, Any] | None,
+    design_options: dict[str, Any] | None,
+    command: str | None,
+) -> dict[str, Any]:
+    """Every section of :func:`run_reproduce` written into ``stage``, paths named under ``final``.
+
+    The summary (returned, and written to ``stage/summary.json``, last) names
+    every file where it will be once ``stage`` has replaced ``final``.
+    """
+    out_dir = stage  # every section writes into the staging folder
     started = datetime.now(UTC)
     report = Report(
         "softbend — reproduction report",
@@ -253,7 +342,7 @@ def run_reproduce(
     summary["seconds"] = (finished - started).total_seconds()
     fem_data = summary["paper_b_fem_data"]
     report.provenance = {
-        "command": command or f"run_reproduce({str(out_dir)!r}, seed={seed})",
+        "command": command or f"run_reproduce({str(final)!r}, seed={seed})",
         "softbend": __version__,
         "Python": f"{platform.python_version()} ({platform.python_implementation()})",
         "machine": f"{platform.system()} {platform.machine()}, {os.cpu_count()} logical CPUs",
@@ -269,7 +358,108 @@ def run_reproduce(
         "wall time": f"{summary['seconds']:.0f} s",
     }
     summary["provenance"] = dict(report.provenance)
-    path = report.write(out_dir / "index.html")
-    summary["report"] = str(path)
-    write_text_atomic(out_dir / "summary.json", json_text(summary) + "\n")
+    report.write(out_dir / "index.html")
+    summary = _renamed(summary, str(stage), str(final))
+    summary["report"] = str(final / "index.html")
+    write_text_atomic(out_dir / MARKER, json_text(summary) + "\n")
     return summary
+
+
+def _renamed(value: Any, staged: str, final: str) -> Any:
+    """``value`` with every path under ``staged`` (text or ``Path``) named under ``final``."""
+    if isinstance(value, dict):
+        return {key: _renamed(item, staged, final) for key, item in value.items()}
+    if isinstance(value, list | tuple):
+        return type(value)(_renamed(item, staged, final) for item in value)
+    if isinstance(value, Path):
+        return Path(_renamed(str(value), staged, final))
+    if isinstance(value, str) and (value == staged or value.startswith(staged + os.sep)):
+        return final + value[len(staged) :]
+    return value
+
+
+def _check_replaceable(out_dir: Path) -> None:
+    """Refuse an ``out_dir`` whose files replacing it as a whole would lose."""
+    if out_dir.exists() and not out_dir.is_dir():
+        raise ValueError(
+            f"The 'out_dir' of run_reproduce must be a folder. Got the file {out_dir}."
+        )
+    if not out_dir.is_dir():
+        return
+    entries = sorted(p.name for p in out_dir.iterdir())
+    others = [name for name in entries if name not in ENTRIES]
+    if others or (entries and MARKER not in entries):
+        shown = ", ".join((others or entries)[:3])
+        raise ValueError(
+            f"The 'out_dir' of run_reproduce must be a new or empty folder or an earlier "
+            f"report's (with {MARKER}); it is replaced as a whole. Got {out_dir}, which holds "
+            f"other files ({shown}), instead."
+        )
+
+
+def _campaign_time(folder: Path) -> float:
+    """When the campaign database under ``folder`` last changed (-inf: there is none)."""
+    if not (folder / _CAMPAIGN).is_file():
+        return -math.inf
+    paths = [folder / f"{_CAMPAIGN}{suffix}" for suffix in _CAMPAIGN_SUFFIXES]
+    return max(path.stat().st_mtime for path in paths if path.is_file())
+
+
+def _resume_dir(out_dir: Path) -> Path:
+    """Where a failed or killed run leaves its campaign database for the next run."""
+    return out_dir.with_name(f".{out_dir.name}.resume")
+
+
+def _move_campaign(source: Path, target: Path, *, copy: bool = False) -> None:
+    """Move (or copy) the campaign database under ``source`` to the same place under ``target``."""
+    (target / _CAMPAIGN).parent.mkdir(parents=True, exist_ok=True)
+    for suffix in _CAMPAIGN_SUFFIXES:
+        origin, into = source / f"{_CAMPAIGN}{suffix}", target / f"{_CAMPAIGN}{suffix}"
+        into.unlink(missing_ok=True)
+        if origin.is_file():
+            (shutil.copy2 if copy else os.replace)(origin, into)
+
+
+def _rescue_interrupted(out_dir: Path) -> None:
+    """Keep the campaign database of a killed run for this one, before its folder is removed.
+
+    A run killed before its swap leaves its staging folder beside ``out_dir``
+    (removed by :func:`~softbend._io.staged_dir`); a database there newer than
+    the one kept aside (and than ``out_dir``'s) moves to :func:`_resume_dir`.
+    """
+    kept = _resume_dir(out_dir)
+    newest = max(_campaign_time(out_dir), _campaign_time(kept))
+    for folder in stale_staging(out_dir):
+        when = _campaign_time(folder)
+        if when > newest:
+            _move_campaign(folder, kept)
+            newest = when
+            logger.info("Resuming the campaign of an interrupted run (%s).", folder.name)
+
+
+def _seed_campaign(stage: Path, out_dir: Path) -> None:
+    """Put the campaign database to resume into ``stage``: the one kept aside, or a copy.
+
+    The newer of :func:`_resume_dir`'s (moved, and the folder removed) and
+    ``out_dir``'s (copied: DuckDB writes in place, and the previous report keeps
+    its own as it was if this run fails).
+    """
+    kept = _resume_dir(out_dir)
+    kept_time, out_time = _campaign_time(kept), _campaign_time(out_dir)
+    if kept_time > -math.inf and kept_time >= out_time:
+        _move_campaign(kept, stage)
+    elif out_time > -math.inf:
+        _move_campaign(out_dir, stage, copy=True)
+    shutil.rmtree(kept, ignore_errors=True)
+
+
+def _keep_campaign(stage: Path, out_dir: Path) -> None:
+    """Keep aside the campaign database of a run that fails, for the next run to resume.
+
+    Only a database that went further than ``out_dir``'s; best effort (a full
+    disk or a read-only folder: the failure itself is what is reported).
+    """
+    if _campaign_time(stage) <= _campaign_time(out_dir):
+        return
+    with contextlib.suppress(OSError):
+        _move_campaign(stage, _resume_dir(out_dir))
