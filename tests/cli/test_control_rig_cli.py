@@ -44,12 +44,15 @@ def test_a_valve_delay_changes_the_simulated_run(tmp_path, capsys):
             ["Unknown parameter 'valve_dealy_s'", "(in --rig-param)", "valve_delay_s, "],
         ),
         (["--rig-param", "sensor_bits=high"], ["'sensor_bits'", "must be an integer"]),
-        (["--rig-param", "critical_ratio=1.5"], ["'critical_ratio'", "[0, 1)"]),
+        (["--rig-param", "critical_ratio=1.5"], ["'critical_ratio'", "[0, 0.95]"]),
         (
             ["--supply", "0.2", "--rig-param", "supply_gauge_mpa=0.3"],
             ["'--supply' and '--rig-param supply_gauge_mpa'", "0.2 and 0.3"],
         ),
-        (["--rig-param", "supply_gauge_mpa=5"], ["'supply_gauge_mpa' of softbend control"]),
+        (
+            ["--rig-param", "supply_gauge_mpa=5"],
+            ["'supply_gauge_mpa' of the simulated rig (in --rig-param) must be (0, 2] MPa"],
+        ),
     ],
 )
 def test_bad_rig_parameters_exit_2_with_one_line(tmp_path, capsys, args, needles):

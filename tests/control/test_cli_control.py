@@ -53,7 +53,7 @@ def test_simulate_writes_run(tmp_path, capsys, controller):
         (["run", "--rig", "modbus"], ["'--config' of softbend control run"]),
         (["run", "--log-format", "xml"], ["'log_format'", "'parquet'"]),
         (["run", "--period", "0.02", "--sensor-period", "0.01"], ["'sensor_period'"]),
-        (["run", "--duration", "-1"], ["'duration'"]),
+        (["run", "--duration", "-1"], ["'--duration' of softbend control run"]),
         (["run", "--rig", "modbus", "--config", "nope.toml"], ["does not exist"]),
         (["serve", "--config", "nope.toml"], ["does not exist"]),
         (["serve", "--duration", "-2"], ["'duration'"]),

@@ -125,7 +125,10 @@ def test_set_deadzone_changes_the_run_and_is_recorded(tmp_path, capsys):
             ["known: kp, ki, deadband, pwm_period, period."],
         ),
         (["--set", "deadzone=wide"], ["'deadzone'", "(in --set) must be a number. Got 'wide'"]),
-        (["--set", "deadzone=2"], ["refuses deadzone=2.0 (in --set)", "of BangBang"]),
+        (
+            ["--set", "deadzone=2"],
+            ["'deadzone' of controller 'bang-bang' (in --set) must be [0, 0.5] fraction of"],
+        ),
         (["--set", "deadzone"], ["'--set' values must be NAME=VALUE"]),
         (["--controller", "pid"], ["Unknown controller 'pid' (in --controller); known: bang"]),
         (["--plant", "camera"], ["Unknown plant 'camera' (in --plant); known: surrogate, fem"]),
@@ -201,10 +204,12 @@ def test_a_bad_controller_table_is_one_line_naming_its_line(tmp_path, capsys, ta
         assert needle in line
 
 
-def test_a_controller_table_out_of_range_is_refused_when_built(tmp_path, capsys):
+def test_a_controller_table_out_of_range_is_refused_with_its_line(tmp_path, capsys):
     config = _toml(tmp_path, 'name = "bang-bang"\ndeadzone = 1.5\n')
     assert main(["control", "run", "--config", str(config), "--out", str(tmp_path / "o")]) == 2
-    assert "refuses deadzone=1.5 (in [controller] of the rig config)" in _line(capsys)
+    line = _line(capsys)
+    assert f"{config}, line 7: The parameter 'deadzone' of controller 'bang-bang'" in line
+    assert "(in [controller] of the rig config) must be [0, 0.5]" in line
 
 
 def test_the_config_dataclass_checks_its_controller():

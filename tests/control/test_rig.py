@@ -110,7 +110,7 @@ def test_sensor_quantised_and_seeded(table):
 
 def test_params_validation_names_field():
     with pytest.raises(
-        ValueError, match="'valve_delay_s' of RigParams must be a number in \\[0, inf\\)"
+        ValueError, match=r"'valve_delay_s' of RigParams must be a number in \[0, 1\] s\. Got -1"
     ):
         RigParams(valve_delay_s=-1)
     with pytest.raises(ValueError, match="'polytropic_exponent' of RigParams"):

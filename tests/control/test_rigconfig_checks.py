@@ -63,14 +63,21 @@ def test_a_toml_syntax_error_names_the_file_line_and_column(tmp_path):
     path = _write(tmp_path, GOOD + "[safety]\nmax_pressure_mpa = = 0.2\n")
     with pytest.raises(DatasetError) as info:
         load_rig_config(path)
-    assert str(info.value) == (
-        f"{path}, line 5, column 20: the rig config is not valid TOML: Invalid value."
-    )
+    assert str(info.value) == f"{path}, line 5, column 20: not valid TOML: Invalid value."
 
 
 def test_deep_nesting_and_bad_bytes_are_one_line(tmp_path):
-    path = _write(tmp_path, "x = " + "[" * 20_000 + "]" * 20_000 + "\n")
-    with pytest.raises(DatasetError, match=f"{path}: .*nested too deeply"):
+    # the nesting limit of JSON files, counted on the text before the parser sees it
+    path = _write(tmp_path, "[pressure]\naddress = 0\nx = " + "[" * 20_000 + "]" * 20_000 + "\n")
+    with pytest.raises(DatasetError) as info:
+        load_rig_config(path)
+    assert str(info.value).startswith(f"{path}, line 3: nested 20,000 levels deep under the key")
+    assert "SOFTBEND_MAX_NESTING" in str(info.value)
+    path.write_text("[pressure]\naddress = 0\n" + "[a" + ".b" * 100 + "]\nc = 1\n")
+    with pytest.raises(DatasetError, match="SOFTBEND_MAX_NESTING"):
+        load_rig_config(path)  # tables nested by dotted headers: the same limit
+    path.write_bytes(b"[pressure]\n# a\x00b\n")
+    with pytest.raises(DatasetError, match=f"{path}: the rig config is not text"):
         load_rig_config(path)
     path.write_bytes(b"\xff\xfe[pressure]\n")
     with pytest.raises(DatasetError, match=f"{path}: .*not UTF-8 text"):

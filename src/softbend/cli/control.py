@@ -27,7 +27,11 @@ _FILES = ("run.csv", "metrics.json", "run.png")
 @app.command("simulate")
 def simulate_cmd(
     out: Path = typer.Option(
-        ..., "--out", "-o", help="Folder for run.csv, metrics.json and run.png."
+        ...,
+        "--out",
+        "-o",
+        help="Folder for run.csv, metrics.json and run.png (replaced as a whole: a new or "
+        "empty folder, or an earlier result of this command).",
     ),
     reference: str = opt.REFERENCE,
     controller: str = opt.CONTROLLER,
@@ -35,7 +39,11 @@ def simulate_cmd(
     design: str = opt.DESIGN,
     model: Path = opt.MODEL,
     plant: str = opt.PLANT,
-    duration: float = typer.Option(10.0, help="Simulated time, s."),
+    duration: float = typer.Option(
+        10.0,
+        help="Simulated time, s: in (0, 86400] and at most SOFTBEND_MAX_LOOP_TICKS rig steps "
+        "(default 10 000 000: 10 000 s at the default step_s of 1 ms), each logged in memory.",
+    ),
     supply: float = opt.SUPPLY,
     rig_params: list[str] = opt.RIG_PARAM,
     seed: int = typer.Option(0, help="Seed of the sensor and camera noise."),
@@ -46,40 +54,60 @@ def simulate_cmd(
 
     Scores the run as paper B, Figure 9 (synthetic data). metrics.json records
     the controller and the rig, with every one of their parameters as used.
+    A score the run does not define (an angle that did not settle within the
+    run, a run without a rising edge) is null in metrics.json and --json, with
+    the reason under undefined_metrics, and 'null (the reason)' in the table;
+    never NaN. Every --set and --rig-param value is held to its declared range
+    and the run to the memory it needs, before it starts. The results are
+    written beside --out and swapped in at the end: an error, Ctrl-C or kill
+    leaves the previous results (or none).
 
     Example:
 
     \b
         softbend control simulate --out bb --set deadzone=0.02 --rig-param valve_delay_s=0.02
     """
-    from softbend._io import atomic_files
+    import signal
+
+    from softbend._io import staged_dir
     from softbend.control.runs import simulate_control
     from softbend.reports import control_figures
 
+    command = "softbend control simulate"
     _common.check_output_dir(out, "--out", files=_FILES)
-    with _common.library_progress(enabled=not as_json):  # an FEM plant's sweep, if any
-        result = simulate_control(
-            reference=reference, controller=controller, assignments=settings or (),
-            design=design, model=model, plant=plant, duration_s=duration, supply_mpa=supply,
-            rig_assignments=rig_params or (), seed=seed, command="softbend control simulate",
-            strict=strict,
-        )  # fmt: skip
-    payload = dict(result.summary)
-    name, actuator = payload["controller"], payload["design"]
-    targets = tuple(out / name for name in _FILES)
-    with _common.output_errors(out, "--out"), atomic_files(*targets) as (table, summary, png):
-        result.run.frame().to_csv(table, index=False)  # all three files new, or all as they were
-        summary.write_text(_common.json_text(payload) + "\n", encoding="utf-8")
-        title = f"{name} on {actuator}, {reference} (simulated)"
-        control_figures.run_figure(result.run, png, title)
-    payload["files"] = [str(target) for target in targets]
+    _common.check_replaceable_dir(out, "--out", "control simulate", files=_FILES, marker=_FILES[1])
+    previous = control_run.terminate_as_interrupt()  # `kill`: staged results removed
+    try:
+        with _common.library_progress(enabled=not as_json):  # an FEM plant's sweep, if any
+            result = simulate_control(
+                reference=reference, controller=controller, assignments=settings or (),
+                design=design, model=model, plant=plant, duration_s=duration,
+                supply_mpa=supply, rig_assignments=rig_params or (), seed=seed,
+                command=command, strict=strict,
+            )  # fmt: skip
+        payload = dict(result.summary)
+        name, actuator = payload["controller"], payload["design"]
+        with (
+            _common.output_errors(out, "--out"),
+            staged_dir(out) as stage,
+            _common.as_written(stage, out),
+        ):
+            result.run.frame().to_csv(stage / _FILES[0], index=False)
+            text = _common.json_text(payload) + "\n"
+            (stage / _FILES[1]).write_text(text, encoding="utf-8")
+            title = f"{name} on {actuator}, {reference} (simulated)"
+            control_figures.run_figure(result.run.decimated(), stage / _FILES[2], title)
+    finally:
+        if previous is not None:
+            signal.signal(signal.SIGTERM, previous)
+    payload["files"] = [str(out / name) for name in _FILES]
     if as_json:
         _common.print_json(payload)
         return
     _common.print_table(
         f"{name} on {actuator}, {reference}: simulated rig (SYNTHETIC)",
         ["metric", "value"],
-        [[k, v] for k, v in payload["metrics"].items()],
+        control_run.metric_rows(payload["metrics"], payload["undefined_metrics"]),
     )
     _common.console.print(f"run written to {out}")
 
@@ -94,7 +122,8 @@ def controllers_cmd(
     """List the controllers and their parameters.
 
     Each parameter is given to a run by --set NAME=VALUE (or a [controller]
-    table of the rig TOML).
+    table of the rig TOML); a value outside its range is refused before the
+    run starts.
 
     Example:
 
@@ -109,9 +138,16 @@ def controllers_cmd(
         return
     _common.print_table(
         "controllers (--controller NAME --set PARAM=VALUE)",
-        ["controller", "parameters (defaults)", "what"],
+        ["controller", "parameters (defaults, ranges)", "what"],
         [
-            [r["name"], ", ".join(f"{k}={v}" for k, v in r["params"].items()), r["summary"]]
+            [
+                r["name"],
+                ", ".join(
+                    f"{k}={v} in {r['ranges'][k]}" if k in r["ranges"] else f"{k}={v}"
+                    for k, v in r["params"].items()
+                ),
+                r["summary"],
+            ]
             for r in rows
         ],
     )
@@ -124,7 +160,8 @@ def rig_parameters_cmd(
     """List the simulated rig's parameters.
 
     Each is given to simulate, run and serve by --rig-param NAME=VALUE (or a
-    [simulation] table of the rig TOML); the unit is in the name.
+    [simulation] table of the rig TOML); the unit is in the name, and a value
+    outside the range listed is refused before the run starts.
 
     Example:
 
@@ -137,9 +174,9 @@ def rig_parameters_cmd(
     if as_json:
         _common.print_json(rows)
         return
-    table = [[r["name"], f"{r['default']:g}", r["what"]] for r in rows]
+    table = [[r["name"], f"{r['default']:g}", r["range"], r["what"]] for r in rows]
     _common.print_table(
-        "simulated rig (--rig-param NAME=VALUE)", ["name", "default", "what"], table
+        "simulated rig (--rig-param NAME=VALUE)", ["name", "default", "range", "what"], table
     )
 
 

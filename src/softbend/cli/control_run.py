@@ -13,11 +13,17 @@ from softbend.cli import _common
 from softbend.cli import control_options as opt
 
 _LOG_FORMATS = ("csv", "parquet")
+#: What an earlier result in --out may hold (it is replaced as a whole).
+_REPLACEABLE = ("ticks.csv", "ticks.parquet", "ticks.csv.partial", "run.json", "run.png")
 
 
 def run_cmd(
     out: Path = typer.Option(
-        ..., "--out", "-o", help="Folder for ticks.csv|parquet, run.json and run.png."
+        ...,
+        "--out",
+        "-o",
+        help="Folder for ticks.csv|parquet, run.json and run.png (replaced as a whole: a new "
+        "or empty folder, or an earlier result of this command).",
     ),
     rig: str = typer.Option(
         "sim",
@@ -36,7 +42,11 @@ def run_cmd(
     design: str = opt.DESIGN,
     model: Path = opt.MODEL,
     plant: str = opt.PLANT,
-    duration: float = typer.Option(10.0, help="Run time, s."),
+    duration: float = typer.Option(
+        10.0,
+        help="Run time, s: in (0, 86400] and at most SOFTBEND_MAX_LOOP_TICKS ticks (default "
+        "10 000 000: 10 000 s at the default 1 ms tick), each logged in memory.",
+    ),
     period: float = typer.Option(
         None, help="Loop tick (controller, valves), s (default: the config's period_s, 0.001)."
     ),
@@ -64,18 +74,32 @@ def run_cmd(
     vent did not reach the rig (the log keeps every tick up to the fault; the one error
     line says whether the rig was vented), 130 on Ctrl-C.
 
+    Every --set and --rig-param value is held to its declared range and the run to
+    the memory it needs, before it starts. A score the run does not define (an angle
+    that did not settle within the run, a rig without an angle sensor) is null in
+    run.json and --json, with the reason under undefined_metrics, and 'null (the
+    reason)' in the table; never NaN. The results are built beside --out and swapped
+    in once written: a kill -9 leaves the previous results whole (the ticks of the
+    killed run stay in the hidden folder .OUT.PID-*.new/ticks.csv.partial beside it
+    until the next run into --out).
+
     Example:
 
     \b
         softbend control run --out loop --config rig.toml --set deadzone=0.02
     """
-    from softbend._io import atomic_files
+    from softbend._io import staged_dir
     from softbend._validation import check_choice
     from softbend.control.runs import plan_loop
     from softbend.reports import control_figures
 
     command = "softbend control run"
     check_choice(log_format, "log_format", command, _LOG_FORMATS)
+    log_name = f"ticks.{log_format}"
+    _common.check_output_dir(out, "--out", files=(log_name, "run.json", "run.png"))
+    _common.check_replaceable_dir(
+        out, "--out", "control run", files=_REPLACEABLE, marker="run.json"
+    )
     with _common.library_progress():  # an FEM plant's sweep, if any
         plan = plan_loop(
             rig=rig, config=config, reference=reference, controller=controller,
@@ -84,8 +108,6 @@ def run_cmd(
             supply_mpa=supply, rig_assignments=rig_params or (), seed=seed, command=command,
             strict=strict,
         )  # fmt: skip
-    log_name = f"ticks.{log_format}"
-    _common.check_output_dir(out, "--out", files=(log_name, "run.json", "run.png"))
     done = [0]
 
     def report(n: int, _total: int) -> None:
@@ -96,28 +118,30 @@ def run_cmd(
     previous = terminate_as_interrupt()
     try:
         with (
-            _common.output_errors(out, "--out"),  # the tick log: a full disk is one line
-            _common.progress_bar("control loop", plan.ticks, enabled=not as_json) as advance,
+            _common.output_errors(out, "--out"),  # a full disk is one line
+            staged_dir(out) as stage,  # built beside --out, swapped in whole at the end
+            _common.as_written(stage, out),
         ):
-            result = plan.run(out / log_name, progress=report, device=device)
+            with _common.progress_bar("control loop", plan.ticks, enabled=not as_json) as advance:
+                result = plan.run(stage / log_name, progress=report, device=device)
+            payload = dict(result.summary)
+            name, actuator = payload["controller"], payload["design"]
+            text = _common.json_text(payload) + "\n"
+            (stage / "run.json").write_text(text, encoding="utf-8")
+            title = (
+                f"{name} on {actuator}, {reference}, rig {rig} "
+                f"(tick {plan.period_s * 1e3:g} ms, sensor {plan.sensor_period_s * 1e3:g} ms)"
+            )
+            control_figures.run_figure(result.control_run().decimated(), stage / "run.png", title)
     finally:
         if previous is not None:
             signal.signal(signal.SIGTERM, previous)
-    payload = dict(result.summary)
-    name, actuator = payload["controller"], payload["design"]
-    targets = (out / "run.json", out / "run.png")
-    with _common.output_errors(out, "--out"), atomic_files(*targets) as (summary, png):
-        summary.write_text(_common.json_text(payload) + "\n", encoding="utf-8")
-        title = (
-            f"{name} on {actuator}, {reference}, rig {rig} "
-            f"(tick {plan.period_s * 1e3:g} ms, sensor {plan.sensor_period_s * 1e3:g} ms)"
-        )
-        control_figures.run_figure(result.control_run(), png, title)
-    payload["files"] = [str(out / log_name), str(targets[0]), str(targets[1])]
+    payload["files"] = [str(out / log_name), str(out / "run.json"), str(out / "run.png")]
     if as_json:
         _common.print_json(payload)
     else:
-        rows = [[k, v] for k, v in {**payload["metrics"], **payload["jitter"]}.items()]
+        rows = metric_rows(payload["metrics"], payload["undefined_metrics"])
+        rows += [[k, v] for k, v in payload["jitter"].items()]
         _common.print_table(
             f"{name} on {actuator}, {reference}, rig {rig}", ["metric", "value"], rows
         )
@@ -128,6 +152,14 @@ def run_cmd(
     if not result.loop.completed or not result.loop.vented:  # a fault, or a rig left unvented
         _common.error_line(result.loop.stop_reason)
         raise typer.Exit(1)
+
+
+def metric_rows(metrics: dict[str, Any], undefined: dict[str, str]) -> list[list[Any]]:
+    """The rows of a run's score table: a score the run does not define as 'null (why)'."""
+    return [
+        [key, f"null ({undefined.get(key, 'not defined by this run')})" if value is None else value]
+        for key, value in metrics.items()
+    ]
 
 
 def terminate_as_interrupt() -> Any:
@@ -145,4 +177,4 @@ def terminate_as_interrupt() -> Any:
     return signal.signal(signal.SIGTERM, interrupt)
 
 
-__all__ = ["run_cmd"]
+__all__ = ["metric_rows", "run_cmd", "terminate_as_interrupt"]

@@ -25,10 +25,14 @@ from typing import Any, NamedTuple, Protocol, runtime_checkable
 
 import numpy as np
 
-from softbend._validation import check_choice, check_range
+from softbend._validation import check_choice
+from softbend.control._ranges import check_declared
 from softbend.design import SFRBADesign
+from softbend.parameters import Range, declare_ranges, declared_ranges
 
 __all__ = [
+    "PERIOD_RANGE",
+    "PRESSURE_BAND_RANGE",
     "BangBang",
     "Controller",
     "PressurePI",
@@ -78,10 +82,33 @@ def mlp_virtual_sensor(model: Any, design: SFRBADesign) -> Callable[[float], flo
     return sensor
 
 
-def _period(value: float, owner: str) -> float:
-    return check_range(value, "period_s", owner, low=0.0, high=1.0, high_inclusive=True)
+#: The sample period of every controller, s.
+PERIOD_RANGE = Range(
+    1e-4, 1.0, "s",
+    "from 10 kHz, finer than any on/off valve switches, to 1 Hz: the actuator rises in about "
+    "0.1 s, so a slower controller leaves it unwatched for whole moves",
+)  # fmt: skip
+#: A pressure error a controller leaves alone (deadband, hysteresis), MPa.
+PRESSURE_BAND_RANGE = Range(
+    0.0, 0.1, "MPa",
+    "0 acts on any error (the sensor's noise included); above 0.1 MPa, half the default "
+    "supply, most targets would never be approached",
+)  # fmt: skip
 
 
+def _check(cls: type, value: Any, name: str) -> float:
+    """``value`` of the constructor argument ``name`` of ``cls``, held to its declared range."""
+    return check_declared(value, name, cls.__name__, declared_ranges(cls)[name])
+
+
+@declare_ranges(
+    deadzone_fraction=Range(
+        0.0, 0.5, "fraction of |θr|",
+        "half-width of the deadzone: 0 switches the valves at every sample; beyond 0.5 any "
+        "angle from half to one and a half times the reference would count as reached",
+    ),
+    period_s=PERIOD_RANGE,
+)  # fmt: skip
 class BangBang:
     """Paper B's deadzone bang-bang controller on the virtual angle (§5, eq. 1).
 
@@ -114,11 +141,9 @@ class BangBang:
                 f"The 'virtual_sensor' of {owner} must be callable. Got {virtual_sensor!r} instead."
             )
         self.virtual_sensor = virtual_sensor
-        self.deadzone_fraction = check_range(
-            deadzone_fraction, "deadzone_fraction", owner, low=0.0, high=1.0, low_inclusive=True
-        )
+        self.deadzone_fraction = _check(BangBang, deadzone_fraction, "deadzone_fraction")
         self.mode = check_choice(mode, "mode", owner, ("hold", "closed"))
-        self.period_s = _period(period_s, owner)
+        self.period_s = _check(BangBang, period_s, "period_s")
         self.reset()
 
     def reset(self) -> None:
@@ -163,6 +188,26 @@ class _PressureTarget:
         return self._target
 
 
+@declare_ranges(
+    kp_per_mpa=Range(
+        0.0, 1e4, "1/MPa",
+        "duty per MPa of pressure error: 0 never opens a valve; at 1e4 full duty comes from "
+        "0.1 kPa, below the sensor's resolution (a relay, not a PI)",
+        low_inclusive=False,
+    ),
+    ki_per_mpa_s=Range(
+        0.0, 1e4, "1/(MPa·s)",
+        "duty per MPa·s of integrated error: 0 is P control; at 1e4 the integral alone "
+        "saturates within one sample of the smallest resolvable error",
+    ),
+    deadband_mpa=PRESSURE_BAND_RANGE,
+    pwm_period_s=Range(
+        1e-4, 1.0, "s",
+        "the valves' PWM period: below 0.1 ms no on/off valve follows; beyond 1 s one pulse "
+        "outlasts a whole move of the actuator",
+    ),
+    period_s=PERIOD_RANGE,
+)  # fmt: skip
 class PressurePI(_PressureTarget):
     """PI control of the pressure toward the surrogate's inverse θr → p*, by PWM of the valves.
 
@@ -201,17 +246,11 @@ class PressurePI(_PressureTarget):
     ) -> None:
         owner = "PressurePI"
         super().__init__(angle_table, owner)
-        self.kp_per_mpa = check_range(kp_per_mpa, "kp_per_mpa", owner, low=0.0)
-        self.ki_per_mpa_s = check_range(
-            ki_per_mpa_s, "ki_per_mpa_s", owner, low=0.0, low_inclusive=True
-        )
-        self.deadband_mpa = check_range(
-            deadband_mpa, "deadband_mpa", owner, low=0.0, low_inclusive=True
-        )
-        self.pwm_period_s = check_range(
-            pwm_period_s, "pwm_period_s", owner, low=0.0, high=1.0, high_inclusive=True
-        )
-        self.period_s = _period(period_s, owner)
+        self.kp_per_mpa = _check(PressurePI, kp_per_mpa, "kp_per_mpa")
+        self.ki_per_mpa_s = _check(PressurePI, ki_per_mpa_s, "ki_per_mpa_s")
+        self.deadband_mpa = _check(PressurePI, deadband_mpa, "deadband_mpa")
+        self.pwm_period_s = _check(PressurePI, pwm_period_s, "pwm_period_s")
+        self.period_s = _check(PressurePI, period_s, "period_s")
         self.reset()
 
     def reset(self) -> None:
@@ -250,6 +289,19 @@ class PressurePI(_PressureTarget):
         return _CLOSED
 
 
+@declare_ranges(
+    hysteresis_mpa=PRESSURE_BAND_RANGE,
+    lead_s=Range(
+        0.0, 1.5, "s",
+        "how long the pressure keeps moving after a close: the valve delay (at most 1 s on "
+        "the simulated rig) plus half a sample (at most 0.5 s)",
+    ),
+    min_on_s=Range(
+        0.0, 1.0, "s",
+        "shortest opening of a valve: beyond 1 s one pulse overfills any move of the actuator",
+    ),
+    period_s=PERIOD_RANGE,
+)  # fmt: skip
 class PressureRelay(_PressureTarget):
     """A three-state relay on the pressure toward the target p*, with lead and hysteresis.
 
@@ -280,14 +332,10 @@ class PressureRelay(_PressureTarget):
     ) -> None:
         owner = "PressureRelay"
         super().__init__(angle_table, owner)
-        self.hysteresis_mpa = check_range(
-            hysteresis_mpa, "hysteresis_mpa", owner, low=0.0, low_inclusive=True
-        )
-        self.lead_s = check_range(lead_s, "lead_s", owner, low=0.0, high=1.0, low_inclusive=True)
-        self.min_on_s = check_range(
-            min_on_s, "min_on_s", owner, low=0.0, high=1.0, low_inclusive=True
-        )
-        self.period_s = _period(period_s, owner)
+        self.hysteresis_mpa = _check(PressureRelay, hysteresis_mpa, "hysteresis_mpa")
+        self.lead_s = _check(PressureRelay, lead_s, "lead_s")
+        self.min_on_s = _check(PressureRelay, min_on_s, "min_on_s")
+        self.period_s = _check(PressureRelay, period_s, "period_s")
         self.reset()
 
     def reset(self) -> None:

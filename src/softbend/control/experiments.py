@@ -20,7 +20,8 @@ from __future__ import annotations
 import itertools
 import math
 import time
-from dataclasses import dataclass, field
+from array import array
+from dataclasses import dataclass, field, replace
 from typing import Any
 
 import numpy as np
@@ -35,6 +36,7 @@ __all__ = [
     "rise_time_s",
     "run_metrics",
     "simulate",
+    "summary_metrics",
 ]
 
 
@@ -159,6 +161,28 @@ class ControlRun:
         duration = float(self.t_s[-1] + (self.t_s[1] - self.t_s[0])) if self.t_s.size > 1 else 0.0
         return duration / self.wall_s if self.wall_s > 0 else math.inf
 
+    def decimated(self, max_points: int = 20_000) -> ControlRun:
+        """The run on at most about ``max_points`` of its rows, for a figure.
+
+        The rows are cut into buckets; each keeps its first row and the rows of
+        the smallest and largest camera angle and pressure, so the envelope of
+        the lines survives (a figure is about a thousand pixels wide). A run of
+        no more rows is returned as it is. Scores are computed on the whole run.
+        """
+        n = int(self.t_s.size)
+        if n <= max_points:
+            return self
+        width = math.ceil(n / max(1, max_points // 5))
+        keep = [np.arange(0, n, width), np.array([n - 1])]
+        for values in (self.camera_deg, self.pressure_mpa):
+            keep += [_bucket_extreme(values, width, True), _bucket_extreme(values, width, False)]
+        rows = np.unique(np.concatenate(keep))
+        arrays = (
+            "t_s", "reference_deg", "angle_deg", "camera_deg", "predicted_deg",
+            "pressure_mpa", "measured_mpa", "inlet", "outlet",
+        )  # fmt: skip
+        return replace(self, **{name: getattr(self, name)[rows] for name in arrays})
+
     def frame(self):  # -> pandas.DataFrame
         """The run as a table (one row per step)."""
         import pandas as pd
@@ -178,6 +202,18 @@ class ControlRun:
         )
 
 
+def _bucket_extreme(values: np.ndarray, width: int, largest: bool) -> np.ndarray:
+    """The index of the largest (smallest) value of each run of ``width`` values (NaN skipped)."""
+    n = values.size
+    buckets = math.ceil(n / width)
+    fill = -math.inf if largest else math.inf
+    padded = np.full(buckets * width, fill)
+    padded[:n] = np.where(np.isnan(values), fill, values)
+    pick = np.argmax if largest else np.argmin
+    found = pick(padded.reshape(buckets, width), axis=1) + np.arange(buckets) * width
+    return np.minimum(found, n - 1)
+
+
 def simulate(
     rig: Any,
     controller: Any,
@@ -192,28 +228,39 @@ def simulate(
     The pressure sensor is read every ``sensor_period_s`` (paper B: 100 Hz) and
     held; the controller is called at every rig step with the held reading. The
     rig and the controller are reset first (``seed`` reseeds the rig's noise).
+
+    Every rig step is logged, so the run is sized first
+    (:func:`~softbend.control.budget.check_run_size`): a ``duration_s`` outside
+    (0, 86400] s, more steps than the ``loop_ticks`` limit, or more memory than
+    the machine has left is refused (``ValueError``, ``LimitError``) before any
+    step.
     """
+    from softbend.control.budget import SIMULATE_BYTES_PER_STEP, check_run_size
+
     ref = parse_reference(reference) if isinstance(reference, str) else reference
-    duration = check_range(
-        duration_s, "duration_s", "simulate", low=0.0, high=86400.0, high_inclusive=True
-    )
     h = rig.step_s
+    n = check_run_size(
+        duration_s, h, SIMULATE_BYTES_PER_STEP, what="A simulated run", owner="simulate",
+        duration_name="duration_s", step_name="the rig's step_s", unit="rig steps",
+        name_options=False,
+    ).ticks  # fmt: skip
     sensor_every = max(
         1, round(check_range(sensor_period_s, "sensor_period_s", "simulate", low=0.0) / h)
     )
-    n = max(1, round(duration / h))
-    t = np.arange(n) * h
-    r = ref.values(t)
-    r_list = r.tolist()
+    # The log is kept in preallocated arrays of machine numbers (8 bytes a value, 1 a
+    # valve state), not lists of Python floats (32): a long run's memory is known in
+    # advance (softbend.control.budget) and four times smaller.
+    r_list = array("d")
+    r_list.frombytes(ref.values(np.arange(n) * h).tobytes())
     rig.reset(seed)
     controller.reset()
-    angle = [0.0] * n
-    camera = [0.0] * n
-    predicted = [0.0] * n
-    pressure = [0.0] * n
-    measured = [0.0] * n
-    inlet = [False] * n
-    outlet = [False] * n
+    angle = array("d", [0.0]) * n
+    camera = array("d", [0.0]) * n
+    predicted = array("d", [0.0]) * n
+    pressure = array("d", [0.0]) * n
+    measured = array("d", [0.0]) * n
+    inlet = array("b", [0]) * n
+    outlet = array("b", [0]) * n
     step = controller.step
     advance = rig.advance
     command = rig.command
@@ -237,17 +284,21 @@ def simulate(
         inlet[i] = rig.inlet_open
         outlet[i] = rig.outlet_open
     wall = time.perf_counter() - start
-    t_after = t + h  # states are recorded at the end of each step
+    del r_list
+    t_after = np.arange(n) * h + h  # states are recorded at the end of each step
+    gauge = np.frombuffer(pressure, dtype=float)
+    gauge -= rig.params.atmosphere_mpa * 1e6
+    gauge *= 1e-6
     return ControlRun(
         t_s=t_after,
         reference_deg=ref.values(t_after),
-        angle_deg=np.array(angle),
-        camera_deg=np.array(camera),
-        predicted_deg=np.array(predicted),
-        pressure_mpa=(np.array(pressure) - rig.params.atmosphere_mpa * 1e6) * 1e-6,
-        measured_mpa=np.array(measured),
-        inlet=np.array(inlet, dtype=bool),
-        outlet=np.array(outlet, dtype=bool),
+        angle_deg=np.frombuffer(angle, dtype=float),
+        camera_deg=np.frombuffer(camera, dtype=float),
+        predicted_deg=np.frombuffer(predicted, dtype=float),
+        pressure_mpa=gauge,
+        measured_mpa=np.frombuffer(measured, dtype=float),
+        inlet=np.frombuffer(inlet, dtype=np.int8).view(bool),
+        outlet=np.frombuffer(outlet, dtype=np.int8).view(bool),
         air_used_kg=float(rig.air_used_kg),
         switches=int(rig.switches),
         wall_s=wall,
@@ -295,11 +346,16 @@ def cross_correlation_delay_s(
 
     For each lag from 0 to ``max_delay_s`` on the uniform grid ``t_s`` the
     Pearson correlation of the overlapping parts is computed; the best lag is
-    refined by a parabola through it and its neighbours.
+    refined by a parabola through it and its neighbours. NaN with fewer than
+    two samples. A long run with many lags (more than 1e9 lags × samples) has
+    its correlations computed at once by FFT (:func:`_pearson_by_lag`), the same
+    to rounding.
     """
     t = np.asarray(t_s, dtype=float)
     x = np.asarray(reference, dtype=float)
     y = np.asarray(response, dtype=float)
+    if t.size < 2:
+        return math.nan
     h = float(t[1] - t[0])
     lags = int(min(round(max_delay_s / h), len(x) // 2))
 
@@ -309,7 +365,10 @@ def cross_correlation_delay_s(
         denom = math.sqrt(float(np.dot(a, a)) * float(np.dot(b, b)))
         return float(np.dot(a, b)) / denom if denom > 0 else 0.0
 
-    scores = np.array([corr(k) for k in range(lags + 1)])
+    if (lags + 1) * x.size > 1e9:
+        scores = _pearson_by_lag(x, y, lags)
+    else:
+        scores = np.array([corr(k) for k in range(lags + 1)])
     k = int(np.argmax(scores))
     shift = 0.0
     if 0 < k < lags:
@@ -320,12 +379,43 @@ def cross_correlation_delay_s(
     return float((k + shift) * h)
 
 
+def _pearson_by_lag(x: np.ndarray, y: np.ndarray, lags: int) -> np.ndarray:
+    """Pearson correlation of ``x[:n-k]`` with ``y[k:]`` for every lag ``k`` in 0..``lags``.
+
+    The sums of products come from one FFT (``O(n log n)`` instead of ``O(n·lags)``),
+    the sums and sums of squares from cumulative sums; 0 where a part is constant.
+    """
+    n = x.size
+    size = 1 << int(n + lags).bit_length()
+    spectrum = np.conj(np.fft.rfft(x, size)) * np.fft.rfft(y, size)
+    products = np.fft.irfft(spectrum, size)[: lags + 1]
+    del spectrum
+    k = np.arange(lags + 1)
+    m = (n - k).astype(float)
+    sx = np.concatenate([[0.0], np.cumsum(x)])
+    sxx = np.concatenate([[0.0], np.cumsum(x * x)])
+    sy = np.concatenate([[0.0], np.cumsum(y)])
+    syy = np.concatenate([[0.0], np.cumsum(y * y)])
+    sum_a, sum_aa = sx[n - k], sxx[n - k]
+    sum_b, sum_bb = sy[n] - sy[k], syy[n] - syy[k]
+    cov = products - sum_a * sum_b / m
+    var = np.maximum(sum_aa - sum_a**2 / m, 0.0) * np.maximum(sum_bb - sum_b**2 / m, 0.0)
+    scores = np.zeros(lags + 1)
+    positive = var > 0
+    scores[positive] = cov[positive] / np.sqrt(var[positive])
+    return scores
+
+
 def _edges(reference: np.ndarray) -> list[int]:
     return [int(i) + 1 for i in np.flatnonzero(np.diff(reference) != 0)]
 
 
 def run_metrics(
-    run: ControlRun, *, mape_min_deg: float = 5.0, band: float = 0.05
+    run: ControlRun,
+    *,
+    mape_min_deg: float = 5.0,
+    band: float = 0.05,
+    reasons: dict[str, str] | None = None,
 ) -> dict[str, float]:
     """Scores of a run on its camera angle (what paper B measured).
 
@@ -341,6 +431,11 @@ def run_metrics(
     - for triangles ``delay_s`` by cross-correlation of θe with θr (and
       ``predicted_delay_s`` for θp);
     - ``switches`` (valve state changes), ``air_used_kg``, ``realtime_factor``.
+
+    A score the run does not define is NaN (``realtime_factor``: inf when the
+    run took no measurable time): an angle that never settled within the run,
+    no rising edge, no angle reading. ``reasons``, when given, receives why, by
+    name (:func:`summary_metrics` puts both in a run's summary).
     """
     t = run.t_s
     r = run.reference_deg
@@ -355,16 +450,32 @@ def run_metrics(
         "air_used_kg": float(run.air_used_kg),
         "realtime_factor": float(run.realtime_factor),
     }
+    why = {} if reasons is None else reasons
+    if not ok.any():
+        for name in ("mape_pct", "predicted_mape_pct"):
+            why[name] = (
+                f"no sample with a reference of at least {mape_min_deg:g}° and an angle reading"
+            )
+    elif math.isnan(out["predicted_mape_pct"]):
+        why["predicted_mape_pct"] = "the controller predicted no angle at some of those samples"
+    if math.isinf(out["realtime_factor"]):
+        why["realtime_factor"] = "the run took no measurable time on the clock"
+    if math.isnan(out["air_used_kg"]):
+        why["air_used_kg"] = "the rig does not measure the air it uses"
     kind = run.reference.kind if run.reference is not None else "step"
     if kind == "triangle":
         finite = np.isfinite(y)
         out["delay_s"] = cross_correlation_delay_s(t[finite], r[finite], y[finite])
         pf = np.isfinite(run.predicted_deg)
         out["predicted_delay_s"] = cross_correlation_delay_s(t[pf], r[pf], run.predicted_deg[pf])
+        for name, count in (("delay_s", finite.sum()), ("predicted_delay_s", pf.sum())):
+            if count < 2:
+                why[name] = "fewer than two angle readings within the run"
         return out
     edges = _edges(r)
     bounds = [*edges, len(r)]
     rises, settles, overs = [], [], []
+    read: list[bool] = []  # whether each edge has angle readings
     for a, b in itertools.pairwise(bounds):
         final, before = float(r[a]), float(r[a - 1])
         if final <= before or b - a < 10:
@@ -379,11 +490,57 @@ def run_metrics(
             settles.append(math.nan)
         else:
             settles.append(float(seg_t[outside[-1] + 1] - t[a - 1]))
-        overs.append(max(0.0, float(np.max(seg_y) - final)) / (final - start) * 100)
+        jump = final - start
+        peak = float(np.max(seg_y))
+        overs.append(max(0.0, peak - final) / jump * 100 if jump != 0 else math.nan)
+        read.append(bool(np.isfinite(seg_y).any()) and start == start)
     out["rising_edges"] = len(rises)
     out["unsettled_edges"] = int(sum(1 for v in settles if math.isnan(v)))
     for name, values in (("rise_s", rises), ("settling_s", settles), ("overshoot_pct", overs)):
         vals = np.array(values, dtype=float)
         vals = vals[np.isfinite(vals)]
         out[name] = float(np.mean(vals)) if vals.size else math.nan
+    if reasons is not None:
+        reasons.update(_edge_reasons(out, read, band))
     return out
+
+
+def _edge_reasons(out: dict[str, float], read: list[bool], band: float) -> dict[str, str]:
+    """Why ``rise_s``, ``settling_s`` or ``overshoot_pct`` of a step or square run is NaN."""
+    found: dict[str, str] = {}
+    if not read:
+        why = "no rising edge of the reference with 10 samples after it within the run"
+        return {name: why for name in ("rise_s", "settling_s", "overshoot_pct")}
+    if not any(read):
+        why = "no angle reading around a rising edge of the reference"
+        return {name: why for name in ("rise_s", "settling_s", "overshoot_pct")}
+    if math.isnan(out["rise_s"]):
+        found["rise_s"] = "the angle did not rise from 10 % to 90 % of a step within the run"
+    if math.isnan(out["settling_s"]):
+        found["settling_s"] = (
+            f"the angle did not settle within ±{band * 100:g} % of the reference before the "
+            "run ended"
+        )
+    if math.isnan(out["overshoot_pct"]):
+        found["overshoot_pct"] = "the angle was already at the new reference at each edge"
+    return found
+
+
+def summary_metrics(
+    metrics: dict[str, float], reasons: dict[str, str]
+) -> tuple[dict[str, float | int | None], dict[str, str]]:
+    """The scores of a run as its summary gives them: every one a finite number or None.
+
+    A score that is not a finite number (NaN, inf) is None, and the second
+    dict says why, by name (from ``reasons`` of :func:`run_metrics`, else
+    "not defined by this run"): a summary never shows NaN or inf.
+    """
+    values: dict[str, float | int | None] = {}
+    why: dict[str, str] = {}
+    for name, value in metrics.items():
+        if isinstance(value, float) and not math.isfinite(value):
+            values[name] = None
+            why[name] = reasons.get(name, "not defined by this run")
+        else:
+            values[name] = value
+    return values, why

@@ -20,6 +20,7 @@ from collections.abc import Callable, Mapping
 from dataclasses import dataclass
 from typing import Any
 
+from softbend.control._ranges import ranges_of
 from softbend.control.controllers import (
     BangBang,
     Controller,
@@ -30,7 +31,12 @@ from softbend.control.controllers import (
 from softbend.control.predictive import PredictivePulse
 from softbend.control.rig import AngleTable, RigParams
 from softbend.design import SFRBADesign
-from softbend.parameters import check_parameters, effective_parameters
+from softbend.parameters import (
+    check_parameters,
+    declare_ranges,
+    declared_ranges,
+    effective_parameters,
+)
 from softbend.registry import Registry
 
 __all__ = [
@@ -88,6 +94,7 @@ def _default(cls: type, name: str) -> Any:
     return inspect.signature(cls).parameters[name].default
 
 
+@declare_ranges(**ranges_of(BangBang, deadzone="deadzone_fraction", period="period_s"))
 def bang_bang(
     model: ControllerModel,
     *,
@@ -107,6 +114,7 @@ def bang_bang(
     return BangBang(model.virtual_sensor, deadzone_fraction=deadzone, mode="hold", period_s=period)
 
 
+@declare_ranges(**ranges_of(BangBang, deadzone="deadzone_fraction", period="period_s"))
 def bang_bang_closed(
     model: ControllerModel,
     *,
@@ -128,6 +136,12 @@ def bang_bang_closed(
     )
 
 
+@declare_ranges(
+    **ranges_of(
+        PressurePI, kp="kp_per_mpa", ki="ki_per_mpa_s", deadband="deadband_mpa",
+        pwm_period="pwm_period_s", period="period_s",
+    )
+)  # fmt: skip
 def pressure_pi(
     model: ControllerModel,
     *,
@@ -159,6 +173,12 @@ def pressure_pi(
     )  # fmt: skip
 
 
+@declare_ranges(
+    **ranges_of(
+        PressureRelay, hysteresis="hysteresis_mpa", lead="lead_s", min_on="min_on_s",
+        period="period_s",
+    )
+)  # fmt: skip
 def pressure_relay(
     model: ControllerModel,
     *,
@@ -187,6 +207,12 @@ def pressure_relay(
     )  # fmt: skip
 
 
+@declare_ranges(
+    **ranges_of(
+        PredictivePulse, deadband="deadband_mpa", observer_gain="observer_gain",
+        preview="preview_s", tick="tick_s",
+    )
+)  # fmt: skip
 def predictive(
     model: ControllerModel,
     *,
@@ -260,9 +286,11 @@ def controller_parameters(
 
 
 def controller_catalog() -> list[dict[str, Any]]:
-    """Every registered controller: ``{"name", "summary", "params"}`` (parameters and defaults).
+    """Every registered controller: ``{"name", "summary", "params", "ranges"}``.
 
-    The summary is the first line of the factory's docstring.
+    ``params`` are the parameters and their defaults, ``ranges`` the declared
+    range of each (with its unit); the summary is the first line of the
+    factory's docstring.
     """
     rows = []
     for name, factory in CONTROLLERS.items():
@@ -272,6 +300,7 @@ def controller_catalog() -> list[dict[str, Any]]:
                 "name": name,
                 "summary": doc.splitlines()[0] if doc else "",
                 "params": effective_parameters(factory),
+                "ranges": {k: r.describe() for k, r in declared_ranges(factory).items()},
             }
         )
     return rows

@@ -43,6 +43,7 @@ from __future__ import annotations
 import gc
 import math
 import os
+from array import array
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
@@ -51,10 +52,10 @@ import numpy as np
 
 from softbend._io import atomic_file
 from softbend._validation import check_int, check_range
+from softbend.control.budget import LOOP_BYTES_PER_TICK, check_run_size
 from softbend.control.experiments import ControlRun, Reference, parse_reference, run_metrics
 from softbend.control.rigconfig import SafetyLimits
 from softbend.errors import RigError
-from softbend.limits import check_limit
 
 __all__ = ["COLUMNS", "LoopRun", "run_loop"]
 
@@ -152,21 +153,40 @@ class LoopRun:
             reference=self.reference,
         )
 
-    def metrics(self) -> dict[str, float]:
-        """:func:`run_metrics` on the angle sensor's readings (NaN without one)."""
-        out = run_metrics(self.control_run())
+    def metrics(self, reasons: dict[str, str] | None = None) -> dict[str, float]:
+        """:func:`run_metrics` on the angle sensor's readings (NaN without one).
+
+        ``reasons``, when given, receives why a score is NaN, by name.
+        """
+        why: dict[str, str] = {}
+        out = run_metrics(self.control_run(), reasons=why)
         for key in ("air_used_kg", "realtime_factor"):
             out.pop(key, None)
+            why.pop(key, None)
+        if reasons is not None:
+            reasons.update(why)
         return out
 
 
+#: How each column of the log is kept in memory (array typecodes; "status" as codes).
+_STORAGE: tuple[str, ...] = ("q", "d", "d", "d", "d", "d", "d", "b", "b", "d", "H")
+
+
 class _Log:
-    """The tick rows, kept in memory and streamed to ``<path>.partial`` as CSV."""
+    """The tick rows, streamed to ``<path>.partial`` as CSV and kept in memory by column.
+
+    Rows are gathered ``flush_every`` at a time and moved into one array of machine
+    numbers per column (8 bytes a number, 1 a valve state, 2 a status code): a long
+    run holds about 70 bytes a tick instead of a tuple of Python objects (about 300).
+    """
 
     def __init__(self, path: Path | None, flush_every: int) -> None:
-        self.rows: list[tuple] = []
         self.path = path
         self.flush_every = flush_every
+        self.count = 0
+        self._batch: list[tuple] = []
+        self._columns = [array(code) for code in _STORAGE]
+        self._statuses: dict[str, int] = {}
         self._file = None
         if path is not None and path.suffix.lower() == ".csv":
             self.partial = path.with_name(path.name + ".partial")
@@ -174,16 +194,47 @@ class _Log:
             self._file.write(",".join(COLUMNS) + "\n")
 
     def add(self, row: tuple) -> None:
-        self.rows.append(row)
+        self._batch.append(row)
+        self.count += 1
         if self._file is not None:
             self._file.write(",".join(_cell(v) for v in row) + "\n")
-            if len(self.rows) % self.flush_every == 0:
+        if len(self._batch) >= self.flush_every:
+            if self._file is not None:
                 self._file.flush()
+            self._store()
 
-    def finish(self):  # -> pandas.DataFrame
+    def _store(self) -> None:
+        """Move the gathered rows into the column arrays."""
+        if not self._batch:
+            return
+        *values, statuses = zip(*self._batch, strict=True)
+        for column, part in zip(self._columns, values, strict=False):
+            column.extend(part)
+        codes = self._statuses
+        self._columns[-1].extend(codes.setdefault(s, len(codes)) for s in statuses)
+        self._batch = []
+
+    def frame(self):  # -> pandas.DataFrame
+        """The ticks so far as a table, columns :data:`COLUMNS`."""
         import pandas as pd
 
-        frame = pd.DataFrame(self.rows, columns=list(COLUMNS))
+        self._store()
+        data = {}
+        for name, code, column in zip(COLUMNS, _STORAGE, self._columns, strict=True):
+            if name == "status":
+                names = np.array(list(self._statuses), dtype=object)
+                data[name] = names[np.frombuffer(column, dtype=np.uint16)] if column else []
+            elif code == "b":
+                data[name] = np.frombuffer(column, dtype=np.int8).view(bool) if column else []
+            else:
+                data[name] = np.frombuffer(column, dtype=np.dtype(code)) if column else []
+        frame = pd.DataFrame(data, columns=list(COLUMNS))
+        if not self.count:  # no tick: the types the columns would have
+            frame = frame.astype({"tick": "int64", "inlet": bool, "outlet": bool})
+        return frame
+
+    def finish(self):  # -> pandas.DataFrame
+        frame = self.frame()
         if self._file is not None:
             self._file.flush()
             os.fsync(self._file.fileno())
@@ -230,7 +281,9 @@ def run_loop(
     reference : Reference or str
         θr(t), degrees (a spec as in :func:`~softbend.control.experiments.parse_reference`).
     duration_s : float
-        Run time, s (``round(duration_s/period_s)`` ticks).
+        Run time, s (``round(duration_s/period_s)`` ticks), in (0, 86400]; the
+        ticks are held to the ``loop_ticks`` limit and the memory the machine
+        has left (:func:`~softbend.control.budget.check_run_size`).
     period_s : float, default 0.001
         Tick of the controller and the valves, s.
     sensor_period_s : float, default 0.01
@@ -262,9 +315,10 @@ def run_loop(
         sensor_period_s, "sensor_period_s", "run_loop", low=period, high=10.0,
         low_inclusive=True, high_inclusive=True,
     )  # fmt: skip
-    duration = check_range(
-        duration_s, "duration_s", "run_loop", low=0.0, high=86400.0, high_inclusive=True
-    )
+    n = check_run_size(
+        duration_s, period, LOOP_BYTES_PER_TICK, what="A run", owner="run_loop",
+        duration_name="duration_s", step_name="period_s", step_word="period", name_options=False,
+    ).ticks  # fmt: skip
     flush = check_int(flush_every, "flush_every", "run_loop", low=1)
     limits = SafetyLimits() if limits is None else limits
     path = None if log_path is None else Path(log_path)
@@ -272,12 +326,6 @@ def run_loop(
         raise ValueError(
             f"The 'log_path' of run_loop must end in .csv or .parquet. Got {str(path)!r} instead."
         )
-    ticks = duration / period
-    check_limit(
-        "loop_ticks", round(ticks) if math.isfinite(ticks) else ticks,
-        f"A run of {duration:g} s at a period of {period:g} s",
-    )  # fmt: skip
-    n = max(1, round(duration / period))
     sensor_every = max(1, round(sensor / period))
     log = _Log(path, flush)
     controller.reset()

@@ -46,21 +46,24 @@ import math
 from bisect import bisect_left
 from typing import Any
 
-from softbend._validation import check_range
+from softbend.control._ranges import check_declared
 from softbend.control.controllers import (
     _CLOSED,
     _FILL,
     _VENT,
+    PRESSURE_BAND_RANGE,
     ValveCommand,
     _PressureTarget,
 )
 from softbend.control.rig import (
+    GAS_CONSTANT_J_KG_K,
     RigParams,
     chamber_pressure_rate_pa_s,
     iso6358_mass_flow_kg_s,
 )
+from softbend.parameters import Range, declare_ranges, declared_ranges
 
-__all__ = ["PneumaticCurves", "PredictivePulse"]
+__all__ = ["PneumaticCurves", "PredictivePulse", "curve_step_s", "fill_time_constant_s"]
 
 
 class PneumaticCurves:
@@ -70,12 +73,16 @@ class PneumaticCurves:
     ----------
     params : RigParams
         Supply, valves, chamber and gas of the rig (the valve delay is not used here).
-    step_s : float, default 2e-5
-        RK4 step of the integration.
+    step_s : float, optional
+        RK4 step of the integration; default 2e-5 s, or less for a chamber that
+        fills in under 10 ms (:func:`curve_step_s`), or more for one that takes
+        longer than a second, so that a curve takes tens of thousands of steps
+        whatever the rig.
     """
 
-    def __init__(self, params: RigParams, *, step_s: float = 2e-5) -> None:
+    def __init__(self, params: RigParams, *, step_s: float | None = None) -> None:
         q = params
+        step_s = curve_step_s(q) if step_s is None else step_s
         atm = q.atmosphere_mpa * 1e6
         supply = atm + q.supply_gauge_mpa * 1e6
         volume = q.volume_mm3 * 1e-9
@@ -121,6 +128,38 @@ class PneumaticCurves:
         return p_mpa  # shut (both open is never commanded: held as shut)
 
 
+def fill_time_constant_s(params: RigParams) -> float:
+    """The time the chamber takes to fill at its choked flow through the slower valve, s.
+
+    ``(p_supply − p_atm)·V_max / (n·R·T·ṁ)`` with ``V_max`` the chamber's largest
+    effective volume (compliance included) and ``ṁ`` the choked mass flow from
+    the supply: an upper estimate of the scale of the fill and vent curves.
+    """
+    q = params
+    atm = q.atmosphere_mpa * 1e6
+    supply = atm + q.supply_gauge_mpa * 1e6
+    span = supply - atm
+    compliance = q.compliance_mm3_per_mpa * 1e-15
+    n = q.polytropic_exponent
+    volume = q.volume_mm3 * 1e-9 + compliance * span + n * supply * compliance
+    conductance = min(q.inlet_conductance_m3_s_pa, q.outlet_conductance_m3_s_pa)
+    flow = iso6358_mass_flow_kg_s(supply, 0.0, conductance, q.critical_ratio, q.temperature_k)
+    return span * volume / (n * GAS_CONSTANT_J_KG_K * q.temperature_k * flow)
+
+
+def curve_step_s(params: RigParams) -> float:
+    """The RK4 step of :class:`PneumaticCurves` for ``params``, s.
+
+    2e-5 s (the default rig fills in about 0.7 s), kept within 1/40 000 and
+    1/500 of :func:`fill_time_constant_s`: a slow chamber takes at most about
+    50 000 steps per curve, a fast one at least 500; and at most 10 ms, so a
+    chamber too slow to fill within the 60 s a curve is followed for still has
+    thousands of points on it.
+    """
+    tau = fill_time_constant_s(params)
+    return min(max(2e-5, tau / 40_000.0), tau / 500.0, 0.01)
+
+
 def _integrate(
     start_pa: float, stop_pa: float, inlet: bool, rate: Any, h: float, atm: float
 ) -> tuple[list[float], list[float]]:
@@ -156,6 +195,25 @@ def _interp(xs: list[float], ys: list[float], x: float) -> float:
     return ys[i - 1] + (x - x0) / (x1 - x0) * (ys[i] - ys[i - 1])
 
 
+@declare_ranges(
+    deadband_mpa=PRESSURE_BAND_RANGE,
+    observer_gain=Range(
+        0.0, 1.0, "",
+        "weight of a new sample against the prediction: 0 would ignore the sensor, 1 trusts "
+        "each sample alone",
+        low_inclusive=False,
+    ),
+    preview_s=Range(
+        0.0, 2.0, "s",
+        "how far a ramping reference is extrapolated: at most the longest valve delay (1 s) "
+        "plus the longest angle lag (1 s) of the simulated rig",
+    ),
+    tick_s=Range(
+        1e-5, 0.1, "s",
+        "the period the controller is called at: from the rig's finest step (1e-5 s) to "
+        "0.1 s, beyond which a pulse cannot be timed within a move",
+    ),
+)  # fmt: skip
 class PredictivePulse(_PressureTarget):
     """Model-predictive pulses of the valves toward ``p* = θ⁻¹(θr)`` (see the module doc).
 
@@ -193,18 +251,19 @@ class PredictivePulse(_PressureTarget):
         owner = "PredictivePulse"
         super().__init__(angle_table, owner)
         self.params = RigParams() if params is None else params
-        self.deadband_mpa = check_range(
-            deadband_mpa, "deadband_mpa", owner, low=0.0, low_inclusive=True
+        ranges = declared_ranges(PredictivePulse)
+        self.deadband_mpa = check_declared(
+            deadband_mpa, "deadband_mpa", owner, ranges["deadband_mpa"]
         )
-        self.observer_gain = check_range(
-            observer_gain, "observer_gain", owner, low=0.0, high=1.0, high_inclusive=True
+        self.observer_gain = check_declared(
+            observer_gain, "observer_gain", owner, ranges["observer_gain"]
         )
-        self.tick_s = check_range(tick_s, "tick_s", owner, low=0.0, high=0.1, high_inclusive=True)
+        self.tick_s = check_declared(tick_s, "tick_s", owner, ranges["tick_s"])
         self.delay_s = self.params.valve_delay_s
         default_preview = self.delay_s + self.params.angle_time_constant_s
-        self.preview_s = check_range(
+        self.preview_s = check_declared(
             default_preview if preview_s is None else preview_s,
-            "preview_s", owner, low=0.0, high=1.0, low_inclusive=True,
+            "preview_s", owner, ranges["preview_s"],
         )  # fmt: skip
         self.curves = PneumaticCurves(self.params)
         self.reset()

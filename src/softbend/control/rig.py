@@ -47,12 +47,17 @@ from typing import Any, Protocol, runtime_checkable
 import numpy as np
 
 from softbend._validation import check_int, check_range
+from softbend.control._ranges import check_declared
 from softbend.design import SFRBADesign
+from softbend.parameters import Range, declare_ranges
+from softbend.plausibility import RANGES as PLAUSIBLE
 
 __all__ = [
     "ANR_DENSITY_KG_M3",
     "ANR_TEMPERATURE_K",
     "GAS_CONSTANT_J_KG_K",
+    "RIG_RANGES",
+    "TUBING_RANGE",
     "AngleTable",
     "Rig",
     "RigParams",
@@ -172,10 +177,104 @@ def cavity_compliance_mm3_per_mpa(
 
 _OWNER = "RigParams"
 
+#: The range of each field of :class:`RigParams` (declared on it; ``--rig-param``, a rig
+#: TOML's [simulation] table and RigParams itself are held to them).
+RIG_RANGES: dict[str, Range] = {
+    "supply_gauge_mpa": Range(
+        0.0, PLAUSIBLE["pressure_mpa"].high, "MPa",
+        "gauge, behind the inlet valve; "
+        f"{PLAUSIBLE['pressure_mpa'].high:g} MPa bursts any silicone actuator",
+        low_inclusive=False,
+    ),
+    "atmosphere_mpa": Range(
+        0.03, 0.11, "MPa",
+        "absolute: from a mountain top (0.034 MPa on the highest) to the highest sea-level "
+        "pressure on record (0.108 MPa)",
+    ),
+    "temperature_k": Range(
+        223.15, 373.15, "K", "−50 °C to 100 °C: compressed air within an elastomer's service range"
+    ),
+    "inlet_conductance_m3_s_pa": Range(
+        1e-12, 1e-7, "m³/(s·Pa)",
+        "ISO 6358 sonic conductance C from a needle valve nearly shut (1e-12: 1e-4 dm³/(s·bar)) "
+        "to a large solenoid valve (1e-7: 10 dm³/(s·bar))",
+    ),
+    "outlet_conductance_m3_s_pa": Range(
+        1e-12, 1e-7, "m³/(s·Pa)",
+        "as the inlet's: a needle valve nearly shut to a large solenoid valve",
+    ),
+    "critical_ratio": Range(
+        0.0, 0.95, "",
+        "ISO 6358 critical pressure ratio b: real valves lie in 0.1–0.6, and at 1 the "
+        "subsonic law divides by zero",
+    ),
+    "valve_delay_s": Range(
+        0.0, 1.0, "s",
+        "from a valve command to the valve switching: solenoid valves take 1–50 ms; a second "
+        "is beyond any valve",
+    ),
+    "volume_mm3": Range(
+        1.0, 1e8, "mm³",
+        "the chamber at 0 MPa gauge, from a droplet to 100 L, which holds the largest "
+        "design's cavity (½·π·100²·1000 mm³) with its tubing",
+    ),
+    "compliance_mm3_per_mpa": Range(
+        0.0, 1e9, "mm³/MPa",
+        "growth of the chamber with pressure: 0 is rigid; 1e9 (a cubic metre per MPa) is "
+        "beyond any design's cavity",
+    ),
+    "polytropic_exponent": Range(
+        1.0, 1.4, "", "1 isothermal to 1.4 adiabatic (air's ratio of specific heats)"
+    ),
+    "angle_time_constant_s": Range(
+        0.0, 1.0, "s",
+        "lag of the angle behind θ(p): tens of ms for an elastomer; an angle that has not "
+        "followed its pressure within a second is no longer quasi-static",
+    ),
+    "sensor_noise_mpa": Range(
+        0.0, 0.1, "MPa",
+        "standard deviation of the pressure reading: above 0.1 MPa, half the default supply, "
+        "a reading says nothing",
+    ),
+    "sensor_bits": Range(
+        0, 32, "bits", "resolution of the pressure sensor (0: none); 32 is finer than any ADC"
+    ),
+    "sensor_range_mpa": Range(
+        0.01, 10.0, "MPa", "full scale of the pressure sensor: transducers span 10 kPa to 10 MPa"
+    ),
+    "camera_fps": Range(
+        1.0, 1e5, "frames/s", "from one frame a second to a high-speed camera's 100 000"
+    ),
+    "camera_latency_s": Range(
+        0.0, 1.0, "s", "delay of the camera's angle; the frames in flight are queued"
+    ),
+    "camera_noise_deg": Range(
+        0.0, 10.0, "°",
+        "standard deviation of the camera angle: beyond 10° it says little of a 90° bend",
+    ),
+    "step_s": Range(
+        1e-5, 0.01, "s",
+        "integration step of the rig model: below 1e-5 s a run of the documented duration "
+        "would allocate gigabytes; above 0.01 s the step is longer than the valve timing and "
+        "the angle lag it resolves",
+    ),
+}  # fmt: skip
 
+#: The range of the tubing volume added to a design's cavity (:meth:`RigParams.for_design`).
+TUBING_RANGE = Range(
+    0.0, 1e6, "mm³",
+    "tubing between the inlet valve and the actuator: up to 1 L (80 m of 4 mm bore)",
+)  # fmt: skip
+
+
+@declare_ranges(**RIG_RANGES)
 @dataclass(frozen=True)
 class RigParams:
-    """Every parameter of :class:`SimulatedRig`, with units in the names (see the module doc)."""
+    """Every parameter of :class:`SimulatedRig`, with units in the names (see the module doc).
+
+    Each field is held to its declared range (:data:`RIG_RANGES`); a value out of
+    it, not finite or of the wrong kind is one ``ValueError`` naming it.
+    """
 
     supply_gauge_mpa: float = 0.2
     atmosphere_mpa: float = 0.101325
@@ -197,60 +296,12 @@ class RigParams:
     step_s: float = 0.001
 
     def __post_init__(self) -> None:
-        positive = (
-            "supply_gauge_mpa",
-            "atmosphere_mpa",
-            "temperature_k",
-            "inlet_conductance_m3_s_pa",
-            "outlet_conductance_m3_s_pa",
-            "volume_mm3",
-            "sensor_range_mpa",
-            "camera_fps",
-        )
-        for name in positive:
-            object.__setattr__(self, name, check_range(getattr(self, name), name, _OWNER, low=0.0))
-        nonneg = (
-            "valve_delay_s",
-            "compliance_mm3_per_mpa",
-            "angle_time_constant_s",
-            "sensor_noise_mpa",
-            "camera_latency_s",
-            "camera_noise_deg",
-        )
-        for name in nonneg:
-            value = check_range(getattr(self, name), name, _OWNER, low=0.0, low_inclusive=True)
-            object.__setattr__(self, name, value)
-        object.__setattr__(
-            self,
-            "critical_ratio",
-            check_range(
-                self.critical_ratio, "critical_ratio", _OWNER, low=0.0, high=1.0, low_inclusive=True
-            ),
-        )
-        object.__setattr__(
-            self,
-            "polytropic_exponent",
-            check_range(
-                self.polytropic_exponent,
-                "polytropic_exponent",
-                _OWNER,
-                low=1.0,
-                high=1.4,
-                low_inclusive=True,
-                high_inclusive=True,
-            ),
-        )
-        object.__setattr__(
-            self,
-            "step_s",
-            check_range(self.step_s, "step_s", _OWNER, low=0.0, high=0.01, high_inclusive=True),
-        )
-        bits = check_int(self.sensor_bits, "sensor_bits", _OWNER, low=0)
-        if bits > 32:
-            raise ValueError(
-                f"The 'sensor_bits' of {_OWNER} must be an integer in [0, 32] (0: no "
-                f"quantisation). Got {self.sensor_bits!r} instead."
-            )
+        for f in fields(self):
+            value = check_declared(
+                getattr(self, f.name), f.name, _OWNER, RIG_RANGES[f.name],
+                integer=f.name == "sensor_bits",
+            )  # fmt: skip
+            object.__setattr__(self, f.name, value)
 
     @classmethod
     def from_fem_sweep(cls, result: Any, *, tubing_mm3: float = 2000.0, **kwargs: Any) -> RigParams:
@@ -279,10 +330,16 @@ class RigParams:
         cls, design: SFRBADesign, *, tubing_mm3: float = 2000.0, **kwargs: Any
     ) -> RigParams:
         """Parameters with ``volume_mm3`` = ½·π·r²·l of ``design`` plus ``tubing_mm3``."""
-        tubing = check_range(
-            tubing_mm3, "tubing_mm3", "RigParams.for_design", low=0.0, low_inclusive=True
-        )
+        tubing = check_declared(tubing_mm3, "tubing_mm3", "RigParams.for_design", TUBING_RANGE)
         volume = design.cavity_volume_mm3 + tubing
+        declared = RIG_RANGES["volume_mm3"]
+        if not declared.contains(volume):
+            raise ValueError(
+                f"The chamber of the design {design} (its cavity, {design.cavity_volume_mm3:.4g} "
+                f"mm³, plus tubing_mm3 {tubing:g}) is {volume:.4g} mm³; the 'volume_mm3' of a "
+                f"simulated rig must be in {declared.describe()}: give more tubing_mm3, or "
+                "volume_mm3."
+            )
         return cls(volume_mm3=volume, **kwargs)
 
     def replace(self, **changes: Any) -> RigParams:

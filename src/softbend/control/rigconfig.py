@@ -74,13 +74,13 @@ import datetime
 import inspect
 import math
 import re
-import tomllib
 from collections.abc import Mapping
 from dataclasses import dataclass, field, fields
 from pathlib import Path
 from typing import Any
 
 from softbend._io import read_input_text
+from softbend._tomltext import parse_toml
 from softbend._validation import check_choice, check_int, check_range, short_repr
 from softbend.errors import DatasetError
 from softbend.plausibility import RANGES, implausible_index
@@ -497,31 +497,20 @@ def load_rig_config(path: str | Path) -> RigConfig:
     LimitError
         The file is larger than the ``file_mib`` limit of :mod:`softbend.limits`.
     DatasetError
-        One line naming the file: not UTF-8 text, not valid TOML (with the line
-        and column of the syntax error), or a section, key or value that is not
-        allowed (with the line and the key; see :meth:`RigConfig.from_dict`).
-        A ``ValueError``, as before.
+        One line naming the file: not UTF-8 text, arrays or tables nested deeper
+        than the ``nesting`` limit (counted on the text before it is parsed, as
+        for JSON files: :func:`softbend._tomltext.parse_toml`), not valid TOML
+        (with the line and column of the syntax error), or a section, key or
+        value that is not allowed (with the line and the key; see
+        :meth:`RigConfig.from_dict`). A ``ValueError``, as before.
     """
     p = Path(path)
     if not p.is_file():
         raise FileNotFoundError(f"The rig config {str(p)!r} does not exist or is not a file.")
     text = read_input_text(p, f"{p}: the rig config")
-    try:
-        data = tomllib.loads(text)
-    except tomllib.TOMLDecodeError as exc:
-        message = " ".join(str(exc).split())
-        at = _TOML_POSITION.search(message)
-        if at is None:
-            raise DatasetError(f"{p}: the rig config is not valid TOML: {message}.") from None
-        raise DatasetError(
-            f"{p}, line {at['line']}, column {at['column']}: the rig config is not valid "
-            f"TOML: {message[: at.start()]}."
-        ) from None
-    except RecursionError:
-        raise DatasetError(
-            f"{p}: the rig config is not valid TOML for softbend: arrays or inline tables "
-            "nested too deeply to read (a rig config has sections of plain keys)."
-        ) from None
+    if "\x00" in text:
+        raise DatasetError(f"{p}: the rig config is not text (it holds NUL bytes).")
+    data = parse_toml(text, str(p), DatasetError)  # the nesting limit, then line and column
     return RigConfig.from_dict(data, source=str(p), text=text)
 
 
@@ -543,7 +532,6 @@ _PRESSURE_KEYS: tuple[str, ...] = ("max_pressure_mpa", "valid_min_mpa", "valid_m
 #: The TOML type each key must have, from the annotations of the dataclasses.
 _KINDS: dict[str, str] = {"str": "a string", "int": "an integer", "float": "a number"}
 _KINDS.update({"bool": "true or false", "int | None": "an integer"})
-_TOML_POSITION = re.compile(r"\s*\(at line (?P<line>\d+), column (?P<column>\d+)\)$")
 
 
 def _controller(table: Any) -> ControllerConfig:
@@ -596,10 +584,23 @@ def _settings_signature() -> inspect.Signature:
 
 
 def simulation_settings_entry(**settings: Any) -> None:
-    """The settings of a simulated rig, as a signature that ``check_parameters`` reads."""
+    """The settings of a simulated rig, as a signature that ``check_parameters`` reads.
+
+    Its declared ranges are those of :class:`~softbend.control.rig.RigParams`
+    (:data:`~softbend.control.rig.RIG_RANGES`) and
+    :data:`~softbend.control.rig.TUBING_RANGE`.
+    """
 
 
-simulation_settings_entry.__signature__ = _settings_signature()  # type: ignore[attr-defined]
+def _declare_settings() -> None:
+    from softbend.control.rig import RIG_RANGES, TUBING_RANGE
+    from softbend.parameters import declare_ranges
+
+    simulation_settings_entry.__signature__ = _settings_signature()  # type: ignore[attr-defined]
+    declare_ranges(**RIG_RANGES, tubing_mm3=TUBING_RANGE)(simulation_settings_entry)
+
+
+_declare_settings()
 
 
 def check_simulation_settings(
@@ -607,36 +608,25 @@ def check_simulation_settings(
 ) -> dict[str, Any]:
     """Settings of a simulated rig (the [simulation] table, ``--rig-param``), checked.
 
-    Names and kinds by :func:`softbend.parameters.check_parameters` against the
-    fields of :class:`~softbend.control.rig.RigParams` and ``tubing_mm3``, then
-    the ranges of RigParams itself, name by name.
+    Names, kinds and declared ranges by
+    :func:`softbend.parameters.check_parameters` against the fields of
+    :class:`~softbend.control.rig.RigParams` and ``tubing_mm3``
+    (:func:`simulation_settings_entry`): the ranges RigParams itself holds its
+    fields to.
 
     Raises
     ------
     UnknownParameterError
         An unknown name; the message lists the known ones.
     ParameterValueError
-        A value of the wrong kind or out of range (``key`` names it).
+        A value of the wrong kind, not finite or out of range (``key`` names it).
     """
-    from softbend.control.rig import RigParams
-    from softbend.design import SFRBADesign
-    from softbend.parameters import ParameterValueError, check_parameters
+    from softbend.parameters import check_parameters
 
-    owner = "the simulated rig"
-    checked = check_parameters(
-        simulation_settings_entry, values, owner=owner, field=field, from_text=from_text
-    )
-    for key, value in checked.items():
-        try:
-            if key == "tubing_mm3":
-                RigParams.for_design(SFRBADesign(100, 6, 2, 2, 5, 8), tubing_mm3=value)
-            else:
-                RigParams(**{key: value})
-        except ValueError as exc:
-            message = str(exc).replace(" of RigParams.for_design", " of RigParams", 1)
-            message = message.replace(" of RigParams", f" of {owner} (in {field})", 1)
-            raise ParameterValueError(message, key) from None
-    return checked
+    return check_parameters(
+        simulation_settings_entry, values, owner="the simulated rig", field=field,
+        from_text=from_text,
+    )  # fmt: skip
 
 
 def _simulation(table: Any) -> tuple[tuple[str, Any], ...]:

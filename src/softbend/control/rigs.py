@@ -31,7 +31,7 @@ from softbend.control.rigconfig import (
     simulation_settings_entry,
 )
 from softbend.design import SFRBADesign
-from softbend.parameters import parse_assignments
+from softbend.parameters import declared_ranges, parse_assignments
 from softbend.registry import Registry
 
 __all__ = [
@@ -138,7 +138,7 @@ RIG_SETTINGS: dict[str, str] = {
     "temperature_k": "temperature of the air",
     "inlet_conductance_m3_s_pa": "ISO 6358 sonic conductance C of the inlet valve + throttle",
     "outlet_conductance_m3_s_pa": "ISO 6358 sonic conductance C of the outlet valve + throttle",
-    "critical_ratio": "ISO 6358 critical pressure ratio b of both valves, in [0, 1)",
+    "critical_ratio": "ISO 6358 critical pressure ratio b of both valves",
     "valve_delay_s": "delay from a valve command to the valve switching",
     "volume_mm3": "whole chamber volume at 0 MPa gauge (default: the design's cavity + tubing)",
     "tubing_mm3": "tubing volume added to the design's cavity (or give volume_mm3)",
@@ -151,19 +151,26 @@ RIG_SETTINGS: dict[str, str] = {
     "camera_fps": "frame rate of the camera that records the true angle",
     "camera_latency_s": "delay of the camera's angle",
     "camera_noise_deg": "standard deviation of the camera's Gaussian angle noise",
-    "step_s": "integration step of the rig model, at most 0.01",
+    "step_s": "integration step of the rig model",
 }
 
 
 def rig_parameter_catalog() -> list[dict[str, Any]]:
-    """Every setting of a simulated rig: ``{"name", "default", "what"}`` (RigParams, tubing_mm3).
+    """Every setting of a simulated rig: ``{"name", "default", "range", "what"}``.
 
-    ``default`` is the default of :class:`~softbend.control.rig.RigParams`
-    (``volume_mm3``: that of paper B's (100,6,2,2,5,8) actuator; a run computes
-    it for its design from ``tubing_mm3``).
+    The names are the fields of :class:`~softbend.control.rig.RigParams` and
+    ``tubing_mm3``; ``default`` is the default of RigParams (``volume_mm3``:
+    that of paper B's (100,6,2,2,5,8) actuator; a run computes it for its design
+    from ``tubing_mm3``); ``range`` is the declared range with its unit.
     """
+    ranges = declared_ranges(simulation_settings_entry)
     return [
-        {"name": p.name, "default": p.default, "what": RIG_SETTINGS.get(p.name, "")}
+        {
+            "name": p.name,
+            "default": p.default,
+            "range": ranges[p.name].describe(),
+            "what": RIG_SETTINGS.get(p.name, ""),
+        }
         for p in inspect.signature(simulation_settings_entry).parameters.values()
     ]
 

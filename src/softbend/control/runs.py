@@ -23,6 +23,7 @@ from typing import Any
 import numpy as np
 
 from softbend._validation import check_range
+from softbend.control.budget import LOOP_BYTES_PER_TICK, SIMULATE_BYTES_PER_STEP, check_run_size
 from softbend.control.experiments import ControlRun, Reference, parse_reference
 from softbend.control.rigconfig import RigConfig, load_rig_config
 from softbend.control.rigs import (
@@ -88,11 +89,17 @@ def simulate_control(
     the summary's ``support``; with ``strict`` the run is refused before it starts
     when the supply lies past it.
     """
-    from softbend.control.experiments import run_metrics, simulate
-    from softbend.control.rig import SimulatedRig
+    from softbend.control.experiments import run_metrics, simulate, summary_metrics
+    from softbend.control.rig import RigParams, SimulatedRig
 
     ref = parse_reference(reference)
     simulated = _rig_settings(rig_assignments, {}, supply_mpa, command)
+    duration_name, step_name = _option_names(command, "step_s")
+    check_run_size(
+        duration_s, simulated.get("step_s", RigParams.step_s), SIMULATE_BYTES_PER_STEP,
+        what="A simulated run", owner=command, duration_name=duration_name,
+        step_name=step_name, unit="rig steps",
+    )  # fmt: skip
     setup = prepare_control(
         controller=controller, assignments=assignments, design=design, model=model,
         plant=plant, rig_settings=simulated, command=command, strict=strict,
@@ -103,6 +110,8 @@ def simulate_control(
     beyond = beyond_support(setup, reached)
     if beyond is not None:
         warnings.warn(beyond, UserWarning, stacklevel=2)
+    reasons: dict[str, str] = {}
+    metrics, undefined = summary_metrics(run_metrics(run, reasons=reasons), reasons)
     summary = {
         "synthetic": True,
         "reference": reference,
@@ -111,7 +120,8 @@ def simulate_control(
         "seed": seed,
         "rig": setup.rig_params.as_dict(),
         "rig_settings": dict(setup.rig_settings),
-        "metrics": run_metrics(run),
+        "metrics": metrics,
+        "undefined_metrics": undefined,
         "support": {
             "supported_mpa": setup.supported_mpa,
             "max_pressure_mpa": reached,
@@ -208,8 +218,12 @@ class LoopPlan:
     def _summary(
         self, device: Any, result: Any, reached: float, beyond: str | None
     ) -> dict[str, Any]:
+        from softbend.control.experiments import summary_metrics
+
         synthetic = bool(getattr(device, "synthetic", False))
         record = self.setup.record()
+        reasons: dict[str, str] = {}
+        metrics, undefined = summary_metrics(result.metrics(reasons), reasons)
         summary = {
             "synthetic": synthetic,
             "rig": self.rig,
@@ -226,7 +240,8 @@ class LoopPlan:
             "fault_kind": result.fault_kind,
             "vented": result.vented,
             "jitter": result.jitter(),
-            "metrics": result.metrics(),
+            "metrics": metrics,
+            "undefined_metrics": undefined,
             "rig_config": self.rig_setup.config.to_toml(),
             "rig_params": self.setup.rig_params.as_dict() if synthetic else None,
             "rig_settings": dict(self.setup.rig_settings) if synthetic else None,
@@ -298,16 +313,20 @@ def plan_loop(
     sensor = settings.sensor_period_s if sensor_period_s is None else sensor_period_s
     table = dict(settings.simulation) if rig not in HARDWARE_RIGS else {}
     simulated = _rig_settings(rig_assignments, table, supply_mpa, command)
-    setup = prepare_control(
-        controller=controller, assignments=assignments, config=settings.controller,
-        design=design, model=model, plant=plant, rig_settings=simulated, command=command,
-        strict=strict,
-    )  # fmt: skip
-    check_range(duration_s, "duration", command, low=0.0, high=86400.0, high_inclusive=True)
     check_range(tick, "period", command, low=0.0, high=1.0, high_inclusive=True)
     check_range(
         sensor, "sensor_period", command, low=tick, high=10.0,
         low_inclusive=True, high_inclusive=True,
+    )  # fmt: skip
+    duration_name, step_name = _option_names(command, "period_s")
+    check_run_size(
+        duration_s, tick, LOOP_BYTES_PER_TICK, what="A loop run", owner=command,
+        duration_name=duration_name, step_name=step_name, unit="ticks",
+    )  # fmt: skip
+    setup = prepare_control(
+        controller=controller, assignments=assignments, config=settings.controller,
+        design=design, model=model, plant=plant, rig_settings=simulated, command=command,
+        strict=strict,
     )  # fmt: skip
     rig_setup = RigSetup(
         config=settings, config_path=None if config is None else Path(config),
@@ -360,6 +379,13 @@ def simulated_server(
     )
     rig = SimulatedRig(setup.plant_table, setup.rig_params, seed=seed)
     return SimulatedModbusServer(rig, settings, host=host, port=listen)
+
+
+def _option_names(command: str, step: str) -> tuple[str, str]:
+    """What the duration and the step are called in messages: options on the command line."""
+    if not command.startswith("softbend "):
+        return "duration_s", step
+    return "--duration", "--rig-param step_s" if step == "step_s" else "--period"
 
 
 def _rig_settings(
