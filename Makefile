@@ -36,10 +36,11 @@ typecheck: setup
 
 # The documentation site (Sphinx + MyST) into docs/_build/html, warnings as errors. The generated
 # pages are written first: the command-line reference, the performance page (from the benchmarks'
-# JSON in benchmarks/results/) and, after a `make run`, the validation page from its summary.json.
+# JSON in benchmarks/results/), the names-and-ranges page (from the declarations in the code) and, after a `make run`, the validation page from its summary.json.
 docs: setup
 	$(BIN)/python docs/gen_cli_reference.py
 	$(BIN)/python docs/gen_performance.py
+	$(BIN)/python docs/gen_ranges.py
 	@if [ -f $(OUT)/summary.json ]; then $(BIN)/python docs/gen_validation.py $(OUT)/summary.json; \
 	else echo "docs/validation.md kept: make run writes $(OUT)/summary.json"; fi
 	$(BIN)/sphinx-build -j auto -W --keep-going -q -b html docs docs/_build/html

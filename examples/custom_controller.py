@@ -6,7 +6,8 @@ close the valves before the angle reaches the band rather than after.
 Registered as ``"lead-bang-bang"``, it runs through the same code as the
 built-in controllers: ``softbend control simulate --controller lead-bang-bang
 --set lead=0.05`` works once this module is imported (e.g. from a plugin
-package), and its parameters are checked, listed and recorded like theirs.
+package), and its parameters are checked against their declared ranges, listed and recorded like
+theirs.
 
 The comparison it prints is an honest one: on the simulated rig the lead does
 not beat paper B's controller. The rate comes from successive readings of a
@@ -26,6 +27,7 @@ import math
 from softbend.control import CONTROLLERS
 from softbend.control.controllers import ValveCommand
 from softbend.control.runs import simulate_control
+from softbend.parameters import Range, declare_ranges
 
 
 class LeadBangBang:
@@ -77,10 +79,18 @@ class LeadBangBang:
         return self._command
 
 
+@declare_ranges(
+    deadzone=Range(0.0, 1.0, "fraction of |θr|", high_inclusive=False),
+    lead=Range(0.0, 1.0, "s", "longer than the slowest valve and angle lag together"),
+    period=Range(0.0, 1.0, "s", low_inclusive=False),
+)
 def lead_bang_bang(
     model, *, deadzone: float = 0.05, lead: float = 0.05, period: float = 0.01
 ) -> LeadBangBang:
     """Bang-bang on the virtual angle predicted ``lead`` seconds ahead.
+
+    Its parameters declare their ranges (``declare_ranges``): ``--set lead=5`` is
+    refused before the run, naming the range, as for the built-in controllers.
 
     Parameters
     ----------

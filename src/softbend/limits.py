@@ -20,7 +20,8 @@ name                default        what it bounds
 ``nesting``         64             nesting depth of a structured file (model JSON)
 ``epochs``          100 000        training epochs of one model (MLP fits and
                                    transfer refits; paper B's longest: 15 000)
-``loop_ticks``      10 000 000     ticks of one control-loop run (duration over
+``loop_ticks``      10 000 000     ticks of one control-loop run, and steps of a
+                                   simulated rig's run (duration over
                                    period: 2.8 h at 1 ms), each logged in memory
 ==================  =============  ================================================
 """
@@ -88,7 +89,7 @@ LIMITS: dict[str, Limit] = {
         Limit("designs", 1_000_000, "designs", "designs of one campaign or design space"),
         Limit("nesting", 64, "levels", "the nesting depth of a structured file"),
         Limit("epochs", 100_000, "epochs", "training epochs of one model"),
-        Limit("loop_ticks", 10_000_000, "ticks", "ticks of one control-loop run"),
+        Limit("loop_ticks", 10_000_000, "ticks", "ticks or rig steps of one control run"),
     )
 }
 
