@@ -142,9 +142,9 @@ def _ranged():
 @pytest.mark.parametrize(
     ("text", "shown"),
     [
-        ({"period": "1e-12"}, "must be [0.0001, 10] s. Got '1e-12'"),
+        ({"period": "1e-12"}, "must be in [0.0001, 10] s. Got '1e-12'"),
         ({"period": "11"}, "[0.0001, 10] s"),
-        ({"gain": "0"}, "must be (0, 1]. Got '0'"),
+        ({"gain": "0"}, "must be in (0, 1]. Got '0'"),
         ({"hidden_sizes": "0,0"}, "1 to 8 values, each in [1, 1024] units. Got 0,0"),
         ({"hidden_sizes": "100000,100000"}, "Got 100000,100000"),
         ({"hidden_sizes": "-3,4"}, "Got -3,4"),

@@ -131,6 +131,10 @@ class Range:
             text = f"1 to {self.max_items} values, each in {text}"
         return text
 
+    def requirement(self) -> str:
+        """What a value must be, for messages: ``in [1e-05, 0.01] s``, ``1 to 8 values, …``."""
+        return self.describe() if self.max_items is not None else f"in {self.describe()}"
+
     def contains(self, value: Any) -> bool:
         """Whether ``value`` (a number, or a tuple of them with ``max_items``) is accepted."""
         if isinstance(value, tuple | list):
@@ -407,11 +411,11 @@ def check_parameters(
             check_limit("epochs", result, f"The 'epochs' of {owner} (in {field})")
         declared = ranges.get(key)
         if declared is not None and not declared.contains(result):
-            shown = ",".join(map(str, result)) if isinstance(result, tuple) else _shown(value)
-            shown = shown if len(shown) <= 60 else f"{shown[:45]}... ({len(shown)} characters)"
+            shown = _shown(",".join(map(str, result))) if isinstance(result, tuple) else None
+            shown = shown.strip("'") if shown is not None else _shown(value)
             raise ParameterValueError(
                 f"The parameter {key!r} of {owner} (in {field}) must be "
-                f"{declared.describe()}. Got {shown} instead.",
+                f"{declared.requirement()}. Got {shown} instead.",
                 key,
             )
         checked[key] = result

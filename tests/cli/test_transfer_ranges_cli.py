@@ -70,16 +70,16 @@ def _refine(base, lab_csv, out, strategy, *settings):
             "residual-gp",
             "n_restarts=1000000000",  # hung
             "The parameter 'n_restarts' of transfer strategy 'residual-gp' (in --set) must be "
-            "[0, 100] restarts. Got '1000000000' instead.",
+            "in [0, 100] restarts. Got '1000000000' instead.",
         ),
         (
             "refined",
             "learning_rate=1e6",  # was a NaN model with exit 0
             "The parameter 'learning_rate' of transfer strategy 'refined' (in --set) must be "
-            "(0, 1] standardized units. Got '1e6' instead.",
+            "in (0, 1] standardized units. Got '1e6' instead.",
         ),
-        ("refined-ensemble", "n_members=100000", "must be [2, 100] networks"),
-        ("refined", "epochs=0", "must be [1, inf) Adam steps. Got '0' instead."),
+        ("refined-ensemble", "n_members=100000", "must be in [2, 100] networks"),
+        ("refined", "epochs=0", "must be in [1, inf) Adam steps. Got '0' instead."),
     ],
 )
 def test_refine_refuses_a_value_out_of_range_at_once(

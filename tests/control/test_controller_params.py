@@ -127,7 +127,7 @@ def test_set_deadzone_changes_the_run_and_is_recorded(tmp_path, capsys):
         (["--set", "deadzone=wide"], ["'deadzone'", "(in --set) must be a number. Got 'wide'"]),
         (
             ["--set", "deadzone=2"],
-            ["'deadzone' of controller 'bang-bang' (in --set) must be [0, 0.5] fraction of"],
+            ["'deadzone' of controller 'bang-bang' (in --set) must be in [0, 0.5] fraction of"],
         ),
         (["--set", "deadzone"], ["'--set' values must be NAME=VALUE"]),
         (["--controller", "pid"], ["Unknown controller 'pid' (in --controller); known: bang"]),
@@ -209,7 +209,7 @@ def test_a_controller_table_out_of_range_is_refused_with_its_line(tmp_path, caps
     assert main(["control", "run", "--config", str(config), "--out", str(tmp_path / "o")]) == 2
     line = _line(capsys)
     assert f"{config}, line 7: The parameter 'deadzone' of controller 'bang-bang'" in line
-    assert "(in [controller] of the rig config) must be [0, 0.5]" in line
+    assert "(in [controller] of the rig config) must be in [0, 0.5]" in line
 
 
 def test_the_config_dataclass_checks_its_controller():

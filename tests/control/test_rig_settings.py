@@ -73,7 +73,7 @@ def test_the_ranges_are_those_of_rigparams(item, interval):
         rig_settings([item])
     assert info.value.key == name
     assert f"The parameter '{name}' of the simulated rig (in --rig-param)" in str(info.value)
-    assert f"must be {interval}. Got '{text}' instead." in str(info.value)
+    assert f"must be in {interval}. Got '{text}' instead." in str(info.value)
     # the same declaration holds RigParams itself (and the tubing of for_design)
     with pytest.raises(ValueError, match=f"'{name}' of RigParams.* must be a number in"):
         if name == "tubing_mm3":

@@ -130,7 +130,7 @@ def _check_one(
             must, shown = _count_words(cls, key, count), _items(value)
         else:
             declared = _parameters.declared_ranges(cls).get(key)
-            must = declared.describe() if declared is not None else "a smaller number"
+            must = declared.requirement() if declared is not None else "a smaller number"
             shown = str(value).strip()
             shown = shown if len(shown) <= 40 else f"a number of {len(shown)} characters"
         raise _parameters.ParameterValueError(
