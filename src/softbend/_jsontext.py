@@ -16,7 +16,14 @@ import numpy as np
 
 from softbend.limits import LIMITS, check_limit, limit
 
-__all__ = ["Nesting", "check_json_nesting", "check_nesting", "json_nesting", "nesting_message"]
+__all__ = [
+    "Nesting",
+    "bracket_levels",
+    "check_json_nesting",
+    "check_nesting",
+    "json_nesting",
+    "nesting_message",
+]
 
 _STRING = re.compile(rb'"(?:[^"\\]|\\.)*"', re.DOTALL)
 _KEY = re.compile(rb'"((?:[^"\\]|\\.)*)"\s*:', re.DOTALL)
@@ -50,6 +57,18 @@ class Nesting:
         return self.bound is not None and self.depth > self.bound
 
 
+def bracket_levels(codes: np.ndarray, outside: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """The offsets of the brackets (``[{]}``) where ``outside`` holds, and the level after each.
+
+    ``codes`` are the bytes of the text; ``outside`` marks the bytes that are not
+    in a string (or a comment). Shared by the JSON and the TOML readers.
+    """
+    opens = (codes == ord("[")) | (codes == ord("{"))
+    closes = (codes == ord("]")) | (codes == ord("}"))
+    marks = np.flatnonzero((opens | closes) & outside)
+    return marks, np.cumsum(np.where(opens[marks], 1, -1))
+
+
 def json_nesting(text: str, bound: int | None = None) -> Nesting:
     """The nesting depth of the JSON ``text`` and where it first exceeds ``bound``.
 
@@ -63,13 +82,8 @@ def json_nesting(text: str, bound: int | None = None) -> Nesting:
     for match in _STRING.finditer(data):
         outside[match.start() : match.end()] = False
         starts.add(match.start())
-    opens = (codes == ord("[")) | (codes == ord("{"))
-    closes = (codes == ord("]")) | (codes == ord("}"))
-    marks = np.flatnonzero((opens | closes) & outside)
-    del outside, closes
-    if not marks.size:
-        return Nesting(0, bound)
-    level = np.cumsum(np.where(opens[marks], 1, -1))
+    marks, level = bracket_levels(codes, outside)
+    del outside
     depth = int(level.max(initial=0))
     if bound is None or depth <= bound:
         return Nesting(depth, bound)

@@ -26,7 +26,7 @@ from typing import Any
 import numpy as np
 
 from softbend._io import read_input_text
-from softbend._jsontext import Nesting, nesting_message
+from softbend._jsontext import Nesting, bracket_levels, nesting_message
 from softbend.errors import DatasetError
 from softbend.limits import limit
 
@@ -52,12 +52,7 @@ def toml_nesting(text: str, bound: int | None = None) -> Nesting:
     outside = np.ones(codes.size, dtype=bool)
     for match in _SKIPPED.finditer(data):
         outside[match.start() : match.end()] = False
-    opens = (codes == ord("[")) | (codes == ord("{"))
-    closes = (codes == ord("]")) | (codes == ord("}"))
-    marks = np.flatnonzero((opens | closes) & outside)
-    if not marks.size:
-        return Nesting(0, bound)
-    level = np.cumsum(np.where(opens[marks], 1, -1))
+    marks, level = bracket_levels(codes, outside)
     depth = int(level.max(initial=0))
     if bound is None or depth <= bound:
         return Nesting(depth, bound)

@@ -14,7 +14,7 @@ from __future__ import annotations
 import math
 
 import pytest
-from hypothesis import HealthCheck, given, settings
+from hypothesis import given
 from hypothesis import strategies as st
 
 from softbend.control.factory import (
@@ -34,23 +34,15 @@ from softbend.parameters import (
     parse_assignments,
 )
 
+from ..properties import NASTY_VALUES, property_settings
+
 EXAMPLES = 40
-SETTINGS = settings(
-    max_examples=EXAMPLES,
-    deadline=None,
-    derandomize=True,
-    suppress_health_check=[HealthCheck.function_scoped_fixture, HealthCheck.too_slow],
-)
+SETTINGS = property_settings(EXAMPLES)
 BUILT_IN = ("bang-bang", "bang-bang-closed", "pressure-pi", "pressure-relay", "predictive")
 DESIGN = SFRBADesign(100, 6, 2, 2, 5, 8)
 
 #: Text that breaks naive parsers.
-NASTY = [
-    "", " ", "nan", "NaN", "-nan", "inf", "-inf", "infinity", "1e308", "1e309", "-1e308",
-    "1e-320", "5e-324", "-0", "0", "-1", "1e-12", "1e12", "1e9", "0x10", "1_000", "1,5",
-    "true", "false", "null", "None", "abc", "'", '"', "=", "1=2", "\u00e9", "\x00", "٣",
-    "99999999999999999999999999", "1" * 400, "0.1.2", "--1", "+1", ".5", "5.",
-]  # fmt: skip
+NASTY = NASTY_VALUES
 
 
 def _values(declared) -> st.SearchStrategy[str]:

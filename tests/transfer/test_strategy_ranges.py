@@ -17,7 +17,7 @@ import time
 
 import numpy as np
 import pytest
-from hypothesis import HealthCheck, given, settings
+from hypothesis import given
 from hypothesis import strategies as st
 
 from softbend.errors import ConvergenceError, LimitError
@@ -39,6 +39,8 @@ from softbend.transfer.strategies import (
     describe_strategies,
     make_strategy,
 )
+
+from ..properties import NASTY_VALUES, property_settings
 
 
 # ------------------------------------------------------------ every number has a range
@@ -293,46 +295,8 @@ def test_a_diverged_network_is_an_error_not_a_model(
 # ------------------------------------------------------------------ property-based tests
 #: Random inputs per property test (over every built-in strategy together).
 EXAMPLES = 400
-SETTINGS = settings(
-    max_examples=EXAMPLES,
-    deadline=None,
-    derandomize=True,
-    suppress_health_check=[HealthCheck.function_scoped_fixture, HealthCheck.too_slow],
-)
-
-#: ``--set`` values that break naive readers.
-NASTY = [
-    "",
-    " ",
-    "nan",
-    "NaN",
-    "inf",
-    "-inf",
-    "1e308",
-    "1e309",
-    "-1e300",
-    "1e-320",
-    "-0",
-    "0",
-    "-1",
-    "1e6",
-    "0x1F",
-    "1_000",
-    "99999999999999999999999999",
-    "9" * 5000,
-    "1,5",
-    ",",
-    "1,,2",
-    "0,0",
-    "-3,4",
-    "100000,100000",
-    "true",
-    "none",
-    "abc",
-    "\x00",
-    "=",
-    "\n",
-]
+SETTINGS = property_settings(EXAMPLES)
+NASTY = NASTY_VALUES
 
 _ALLOWED = (ParameterValueError, UnknownParameterError, LimitError, ValueError)
 
