@@ -51,7 +51,7 @@ def test_a_valve_delay_changes_the_simulated_run(tmp_path, capsys):
         ),
         (
             ["--rig-param", "supply_gauge_mpa=5"],
-            ["'supply_gauge_mpa' of the simulated rig (in --rig-param) must be (0, 2] MPa"],
+            ["'supply_gauge_mpa' of the simulated rig (in --rig-param) must be in (0, 2] MPa"],
         ),
     ],
 )
