@@ -110,8 +110,10 @@ def test_run_campaign_checks_the_mesh_of_every_design_first(tmp_path):
 
 
 def test_the_mesh_rule_is_the_one_the_fem_applies_when_meshing():
-    pytest.importorskip("ngsolve")
+    import softbend._torch  # noqa: F401  (PyTorch before NGSolve, as softbend.fem loads them)
     from softbend.fem.geometry import mesh_actuator
+
+    pytest.importorskip("ngsolve")
 
     design = SFRBADesign(100, 6, 2, 2, 5, 10)
     with pytest.raises(ValueError) as info:

@@ -150,6 +150,8 @@ def test_cavity_compliance_of_a_constant_and_a_linear_dv_dp():
 
 @pytest.mark.slow
 def test_default_compliance_is_the_fem_cavity_of_the_default_design():
+    import softbend._torch  # noqa: F401  (PyTorch before NGSolve, as softbend.fem loads them)
+
     pytest.importorskip("ngsolve")
     from softbend.design import SFRBADesign
     from softbend.fem.model import FEMModel
