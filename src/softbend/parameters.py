@@ -143,7 +143,7 @@ class Range:
             return all(self.contains(v) for v in value)
         if isinstance(value, bool) or not isinstance(value, numbers.Real):
             return True  # not a number: the kind check speaks for it
-        number = value if isinstance(value, numbers.Integral) else float(value)
+        number: float | int = int(value) if isinstance(value, numbers.Integral) else float(value)
         if isinstance(number, float) and math.isnan(number):
             return False
         # Python compares an integer of any size with a float exactly: no float() overflow.
