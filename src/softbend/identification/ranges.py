@@ -151,14 +151,8 @@ def check_integer(value: Any, bounds: Range, label: str) -> int:
     ValueError
         ``The <label> must be an integer in [low, high]. Got <value> instead.``
     """
-    if isinstance(value, bool) or not isinstance(value, numbers.Integral):
-        good = False
-    else:  # int against float compares exactly, however long the int
-        number = int(value)
-        above_low = number > bounds.low or (number == bounds.low and bounds.low_inclusive)
-        below_high = number < bounds.high or (number == bounds.high and bounds.high_inclusive)
-        good = above_low and below_high
-    if not good:
+    integer = isinstance(value, numbers.Integral) and not isinstance(value, bool)
+    if not (integer and bounds.contains(value)):  # Range compares long integers exactly
         raise ValueError(
             f"The {label} must be an integer in {_integer_interval(bounds)}. "
             f"Got {_shown(value)} instead."
@@ -191,13 +185,9 @@ def check_number(value: Any, bounds: Range, label: str) -> float:
     message = f"The {label} must be a number in {bounds.interval()}. Got {_shown(value)} instead."
     if isinstance(value, bool) or not isinstance(value, numbers.Real):
         raise ValueError(message)
-    try:
-        number = float(value)
-    except OverflowError:  # an integer beyond the doubles
-        raise ValueError(message) from None
-    if not bounds.contains(number):
+    if not bounds.contains(value):  # Range compares long integers exactly
         raise ValueError(message)
-    return number
+    return float(value)
 
 
 def check_lags_fit(
