@@ -1,0 +1,777 @@
+"""Actuator descriptions: the named design parameters a lab's actuator is described by.
+
+softbend's learning pipeline (train → predict → transfer → design search →
+control) does not depend on an actuator's geometry, only on its description:
+the design parameters (name, unit, range, kind, manufacturing resolution), the
+constraints between them, and the pressure and angle columns with their units.
+Paper B's fiber-reinforced actuator is one registered description
+(``"sfrba"``); a lab's own actuator is another, registered in Python or read
+from the columns of its simulation table (:meth:`Actuator.from_table`).
+
+Every model saved by ``softbend train`` records the description it was
+trained with (:meth:`Actuator.to_dict`), so that predict, transfer, design
+search and control name the model's own parameters and check them in their
+own units::
+
+    from softbend.actuators import ACTUATORS, Actuator, DesignParameter
+
+    pneunet = Actuator(
+        name="my-pneunet",
+        title="PneuNet, 8 to 14 chambers",
+        parameters=(
+            DesignParameter("n_chambers", "", 8, 14, kind="integer"),
+            DesignParameter("wall_mm", "mm", 1.0, 3.0, resolution=0.1),
+            DesignParameter("layer", "", kind="categorical", levels=("paper", "fabric")),
+        ),
+        pressure_column="p_kpa",
+        pressure_unit="kPa",
+        constraints=("wall_mm <= 3",),
+    )
+    ACTUATORS.register(pneunet.name, pneunet)
+
+A categorical parameter's levels are stored as their index (0, 1, …) in
+every model input; :meth:`DesignParameter.encode` and
+:meth:`DesignParameter.decode` convert.
+"""
+
+from __future__ import annotations
+
+import ast
+import math
+import operator
+import re
+from collections.abc import Callable, Mapping, Sequence
+from dataclasses import dataclass, field
+from typing import Any, Literal
+
+import numpy as np
+
+from softbend.errors import SoftbendError
+from softbend.registry import Registry
+
+__all__ = [
+    "ACTUATORS",
+    "PRESSURE_UNITS",
+    "Actuator",
+    "ActuatorError",
+    "DesignParameter",
+    "get_actuator",
+    "pressure_to_mpa",
+]
+
+#: Factor from each accepted pressure unit to MPa.
+PRESSURE_UNITS: dict[str, float] = {"kPa": 1e-3, "MPa": 1.0, "bar": 0.1, "psi": 6.894757293168e-3}
+
+Kind = Literal["continuous", "integer", "categorical"]
+KINDS: tuple[str, ...] = ("continuous", "integer", "categorical")
+
+_NAME = re.compile(r"^[A-Za-z_][A-Za-z0-9_]{0,63}$")
+
+
+class ActuatorError(SoftbendError, ValueError):
+    """A description, design or table that breaks an actuator's declared parameters."""
+
+
+def pressure_to_mpa(unit: str, *, field: str = "pressure unit") -> float:
+    """The factor from ``unit`` (kPa, MPa, bar or psi; case as written) to MPa.
+
+    Raises
+    ------
+    ActuatorError
+        For any other unit, naming ``field`` and the four allowed.
+    """
+    if unit not in PRESSURE_UNITS:
+        lowered = {u.lower(): u for u in PRESSURE_UNITS}
+        hint = f" (did you mean {lowered[unit.lower()]}?)" if str(unit).lower() in lowered else ""
+        raise ActuatorError(
+            f"The {field} must be one of {', '.join(PRESSURE_UNITS)}; got {unit!r}{hint}."
+        )
+    return PRESSURE_UNITS[unit]
+
+
+def _check_name(name: object, what: str) -> str:
+    if not isinstance(name, str) or not _NAME.match(name):
+        raise ActuatorError(
+            f"The {what} must be a name of letters, digits and '_' (not starting with a digit, "
+            f"at most 64 characters); got {name!r}."
+        )
+    return name
+
+
+@dataclass(frozen=True)
+class DesignParameter:
+    """One named design parameter of an actuator.
+
+    Parameters
+    ----------
+    name : str
+        Column name in tables and models (``"l_mm"``, ``"n_chambers"``).
+    unit : str
+        Unit of its values (``"mm"``, ``"deg"``; ``""`` for a count or a level).
+    low, high : float
+        The range the description covers (inclusive). For a categorical
+        parameter they are taken from its levels (0 to len(levels) - 1).
+    kind : {"continuous", "integer", "categorical"}
+        Continuous values, whole numbers, or one of ``levels``.
+    levels : tuple, optional
+        A categorical parameter's levels (strings or numbers), in the order
+        of their index codes.
+    resolution : float, optional
+        Manufacturing resolution (the step a design search rounds to), in ``unit``.
+    description : str
+        What the parameter is, for tables and documentation.
+    """
+
+    name: str
+    unit: str = ""
+    low: float = -math.inf
+    high: float = math.inf
+    kind: Kind = "continuous"
+    levels: tuple[Any, ...] | None = None
+    resolution: float | None = None
+    description: str = ""
+
+    def __post_init__(self) -> None:
+        _check_name(self.name, "name of a design parameter")
+        if self.kind not in KINDS:
+            raise ActuatorError(
+                f"The kind of design parameter {self.name!r} must be one of "
+                f"{', '.join(KINDS)}; got {self.kind!r}."
+            )
+        if self.kind == "categorical":
+            if not self.levels or len(set(map(str, self.levels))) != len(self.levels):
+                raise ActuatorError(
+                    f"The categorical design parameter {self.name!r} needs two or more distinct "
+                    f"levels; got {self.levels!r}."
+                )
+            object.__setattr__(self, "levels", tuple(self.levels))
+            object.__setattr__(self, "low", 0.0)
+            object.__setattr__(self, "high", float(len(self.levels) - 1))
+        elif self.levels is not None:
+            raise ActuatorError(
+                f"Only a categorical design parameter has levels; {self.name!r} is {self.kind}."
+            )
+        low, high = float(self.low), float(self.high)
+        if math.isnan(low) or math.isnan(high) or low > high:
+            raise ActuatorError(
+                f"The range of design parameter {self.name!r} must have low <= high; "
+                f"got [{self.low}, {self.high}]."
+            )
+        object.__setattr__(self, "low", low)
+        object.__setattr__(self, "high", high)
+        if self.resolution is not None and not (
+            math.isfinite(self.resolution) and self.resolution > 0
+        ):
+            raise ActuatorError(
+                f"The resolution of design parameter {self.name!r} must be finite and > 0; "
+                f"got {self.resolution!r}."
+            )
+
+    @property
+    def label(self) -> str:
+        """``name (unit)`` for table headers and axis labels."""
+        return f"{self.name} ({self.unit})" if self.unit else self.name
+
+    def encode(self, value: Any) -> float:
+        """The model input of ``value``: a level's index for a categorical parameter."""
+        if self.kind == "categorical":
+            assert self.levels is not None
+            for index, level in enumerate(self.levels):
+                if str(level) == str(value).strip() or (
+                    not isinstance(level, str) and _same_number(level, value)
+                ):
+                    return float(index)
+            raise ActuatorError(
+                f"The design parameter {self.name!r} must be one of the levels "
+                f"{', '.join(map(str, self.levels))}; got {value!r}."
+            )
+        try:
+            number = float(value)
+        except (TypeError, ValueError):
+            raise ActuatorError(
+                f"The design parameter {self.name!r} must be a number ({self._what()}); "
+                f"got {value!r}."
+            ) from None
+        return number
+
+    def decode(self, code: float) -> Any:
+        """The value a model input ``code`` stands for (a level for a categorical parameter)."""
+        if self.kind == "categorical":
+            assert self.levels is not None
+            return self.levels[int(round(code))]
+        if self.kind == "integer":
+            return int(round(code))
+        return float(code)
+
+    def snap(self, values: np.ndarray) -> np.ndarray:
+        """``values`` moved to the nearest buildable value: a level, a whole number,
+        or a multiple of the resolution, inside the range."""
+        out = np.clip(np.asarray(values, dtype=float), self.low, self.high)
+        if self.kind in ("integer", "categorical"):
+            return np.clip(np.round(out), math.ceil(self.low), math.floor(self.high))
+        if self.resolution is not None:
+            out = np.round(out / self.resolution) * self.resolution
+            return np.clip(out, self.low, self.high)
+        return out
+
+    def check(self, codes: np.ndarray, *, where: str = "") -> None:
+        """Raise one :class:`ActuatorError` for the first code outside the range or kind."""
+        values = np.asarray(codes, dtype=float)
+        at = f" {where}" if where else ""
+        bad = ~np.isfinite(values)
+        if bad.any():
+            raise ActuatorError(
+                f"The design parameter {self.name!r}{at} must be finite; got "
+                f"{values[bad][0]!r} ({self._what()})."
+            )
+        eps = 1e-9 * max(1.0, abs(self.low), abs(self.high))
+        outside = (values < self.low - eps) | (values > self.high + eps)
+        if outside.any():
+            shown = self.decode(values[outside][0]) if self.kind == "categorical" else values[
+                outside
+            ][0]
+            raise ActuatorError(
+                f"The design parameter {self.name!r}{at} must be {self._what()}; got {shown:g}."
+                if isinstance(shown, float)
+                else f"The design parameter {self.name!r}{at} must be {self._what()}; "
+                f"got {shown!r}."
+            )
+        if self.kind in ("integer", "categorical"):
+            fractional = np.abs(values - np.round(values)) > 1e-9
+            if fractional.any():
+                raise ActuatorError(
+                    f"The design parameter {self.name!r}{at} must be a whole number "
+                    f"({self._what()}); got {values[fractional][0]:g}."
+                )
+
+    def _what(self) -> str:
+        if self.kind == "categorical":
+            assert self.levels is not None
+            return f"one of {', '.join(map(str, self.levels))}"
+        unit = f" {self.unit}" if self.unit else ""
+        span = f"in [{self.low:g}, {self.high:g}]{unit}"
+        return f"a whole number {span}" if self.kind == "integer" else span
+
+    def to_dict(self) -> dict[str, Any]:
+        """JSON-friendly form (:meth:`from_dict` reads it back)."""
+        out: dict[str, Any] = {"name": self.name, "unit": self.unit, "kind": self.kind}
+        if self.kind == "categorical":
+            out["levels"] = list(self.levels or ())
+        else:
+            out["low"], out["high"] = self.low, self.high
+        if self.resolution is not None:
+            out["resolution"] = self.resolution
+        if self.description:
+            out["description"] = self.description
+        return out
+
+    @classmethod
+    def from_dict(cls, data: Mapping[str, Any]) -> DesignParameter:
+        """The parameter :meth:`to_dict` wrote; one :class:`ActuatorError` for a bad record."""
+        if not isinstance(data, Mapping):
+            raise ActuatorError(f"A design parameter must be an object; got {data!r}.")
+        allowed = {"name", "unit", "kind", "levels", "low", "high", "resolution", "description"}
+        unknown = sorted(set(data) - allowed)
+        if unknown:
+            raise ActuatorError(
+                f"Unknown key(s) {', '.join(unknown)} in design parameter "
+                f"{data.get('name')!r}; allowed: {', '.join(sorted(allowed))}."
+            )
+        levels = data.get("levels")
+        return cls(
+            name=data.get("name"),  # type: ignore[arg-type]  # checked in __post_init__
+            unit=str(data.get("unit", "")),
+            low=_number(data.get("low", -math.inf)),
+            high=_number(data.get("high", math.inf)),
+            kind=data.get("kind", "continuous"),
+            levels=tuple(levels) if isinstance(levels, list | tuple) else levels,
+            resolution=None if data.get("resolution") is None else _number(data["resolution"]),
+            description=str(data.get("description", "")),
+        )
+
+
+def _number(value: Any) -> float:
+    if isinstance(value, bool) or not isinstance(value, int | float):
+        raise ActuatorError(f"A bound or resolution must be a number; got {value!r}.")
+    return float(value)
+
+
+def _same_number(level: Any, value: Any) -> bool:
+    try:
+        return float(level) == float(value)
+    except (TypeError, ValueError):
+        return False
+
+
+# --- constraints -------------------------------------------------------------------------------
+
+_COMPARE: dict[type, Callable[[Any, Any], Any]] = {
+    ast.Lt: operator.lt,
+    ast.LtE: operator.le,
+    ast.Gt: operator.gt,
+    ast.GtE: operator.ge,
+}
+_ARITHMETIC: dict[type, Callable[[Any, Any], Any]] = {
+    ast.Add: operator.add,
+    ast.Sub: operator.sub,
+    ast.Mult: operator.mul,
+    ast.Div: operator.truediv,
+}
+
+
+def _parse_constraint(text: str, names: Sequence[str]) -> ast.Compare:
+    """``text`` as one comparison of arithmetic on ``names`` and numbers (nothing else)."""
+    if not isinstance(text, str) or len(text) > 200:
+        raise ActuatorError(f"A constraint must be text of at most 200 characters; got {text!r}.")
+    try:
+        tree = ast.parse(text, mode="eval").body
+    except SyntaxError:
+        raise ActuatorError(
+            f"The constraint {text!r} is not a comparison such as 't_mm < r_mm' or "
+            "'2*wall_mm + gap_mm <= 10'."
+        ) from None
+    if not isinstance(tree, ast.Compare) or not all(type(op) in _COMPARE for op in tree.ops):
+        raise ActuatorError(
+            f"The constraint {text!r} must compare with <, <=, > or >= "
+            "(such as 't_mm < r_mm')."
+        )
+    for node in ast.walk(tree):
+        if isinstance(node, ast.Name) and node.id not in names:
+            raise ActuatorError(
+                f"The constraint {text!r} names {node.id!r}, which is not a design parameter "
+                f"({', '.join(names)})."
+            )
+        allowed = (ast.Compare, ast.BinOp, ast.UnaryOp, ast.USub, ast.UAdd, ast.Name, ast.Load)
+        if isinstance(node, ast.Constant):
+            if isinstance(node.value, bool) or not isinstance(node.value, int | float):
+                raise ActuatorError(f"The constraint {text!r} may hold only numbers and names.")
+        elif not isinstance(node, allowed) and type(node) not in _COMPARE and type(
+            node
+        ) not in _ARITHMETIC:
+            raise ActuatorError(
+                f"The constraint {text!r} may use only + - * / and comparisons of the "
+                "design parameters and numbers."
+            )
+    return tree
+
+
+def _evaluate(node: ast.AST, values: Mapping[str, np.ndarray]) -> Any:
+    if isinstance(node, ast.Constant):
+        return float(node.value)
+    if isinstance(node, ast.Name):
+        return values[node.id]
+    if isinstance(node, ast.UnaryOp):
+        inner = _evaluate(node.operand, values)
+        return -inner if isinstance(node.op, ast.USub) else inner
+    if isinstance(node, ast.BinOp):
+        return _ARITHMETIC[type(node.op)](
+            _evaluate(node.left, values), _evaluate(node.right, values)
+        )
+    assert isinstance(node, ast.Compare)
+    result = np.ones(np.shape(next(iter(values.values()))), dtype=bool)
+    left = _evaluate(node.left, values)
+    for op, comparator in zip(node.ops, node.comparators, strict=True):
+        right = _evaluate(comparator, values)
+        result &= np.asarray(_COMPARE[type(op)](left, right), dtype=bool)
+        left = right
+    return result
+
+
+# --- the description ---------------------------------------------------------------------------
+
+
+@dataclass(frozen=True)
+class Actuator:
+    """A bending actuator as the learning pipeline sees it.
+
+    Parameters
+    ----------
+    name : str
+        Registry name (``"sfrba"``) or a lab's own name.
+    title : str
+        One line saying what the actuator is, for reports.
+    parameters : tuple of DesignParameter
+        The design parameters, in the column order of every model input.
+    pressure_column : str
+        Name of the gauge-pressure input (``"pressure_mpa"``, ``"p_kpa"``).
+    pressure_unit : {"kPa", "MPa", "bar", "psi"}
+        Unit of the pressure column.
+    angle_column : str
+        Name of the bending-angle column, degrees.
+    constraints : tuple of str
+        Comparisons between parameters that every design meets
+        (``"t_mm < r_mm"``), in the parameters' units and codes.
+    fem_family : str, optional
+        The FEM actuator family that simulates this actuator, if any
+        (``design find --verify`` runs only then).
+    chamber_volume_mm3 : float, optional
+        Cavity volume at zero pressure, mm³, for the simulated rig (paper B's
+        actuator computes it from its geometry instead).
+    volume_growth_mm3_per_mpa : float, optional
+        Slope of the cavity volume with pressure, mm³/MPa, for the simulated rig.
+    """
+
+    name: str
+    title: str
+    parameters: tuple[DesignParameter, ...]
+    pressure_column: str = "pressure_mpa"
+    pressure_unit: str = "MPa"
+    angle_column: str = "angle_deg"
+    constraints: tuple[str, ...] = ()
+    fem_family: str | None = None
+    chamber_volume_mm3: float | None = None
+    volume_growth_mm3_per_mpa: float | None = None
+    _trees: tuple[ast.Compare, ...] = field(default=(), repr=False, compare=False)
+
+    def __post_init__(self) -> None:
+        _check_name(self.name.replace("-", "_"), "name of an actuator")
+        if not self.parameters:
+            raise ActuatorError(f"The actuator {self.name!r} needs at least one design parameter.")
+        object.__setattr__(self, "parameters", tuple(self.parameters))
+        names = [p.name for p in self.parameters]
+        _check_name(self.pressure_column, "pressure column")
+        _check_name(self.angle_column, "angle column")
+        columns = [*names, self.pressure_column, self.angle_column]
+        repeated = sorted({n for n in columns if columns.count(n) > 1})
+        if repeated:
+            raise ActuatorError(
+                f"The actuator {self.name!r} names the column(s) {', '.join(repeated)} twice; "
+                "design, pressure and angle columns must differ."
+            )
+        pressure_to_mpa(self.pressure_unit, field=f"pressure unit of actuator {self.name!r}")
+        for key in ("chamber_volume_mm3", "volume_growth_mm3_per_mpa"):
+            value = getattr(self, key)
+            if value is not None and not (math.isfinite(value) and value >= 0):
+                raise ActuatorError(
+                    f"The {key} of actuator {self.name!r} must be finite and >= 0; got {value!r}."
+                )
+        object.__setattr__(self, "constraints", tuple(self.constraints))
+        trees = tuple(_parse_constraint(text, names) for text in self.constraints)
+        object.__setattr__(self, "_trees", trees)
+
+    # --- names ---------------------------------------------------------------------------------
+
+    @property
+    def names(self) -> tuple[str, ...]:
+        """The design parameters' names, in model-input order."""
+        return tuple(p.name for p in self.parameters)
+
+    @property
+    def features(self) -> tuple[str, ...]:
+        """Model inputs: the design parameters then the pressure column."""
+        return (*self.names, self.pressure_column)
+
+    @property
+    def units(self) -> dict[str, str]:
+        """Unit of every input and of the angle."""
+        return {
+            **{p.name: p.unit for p in self.parameters},
+            self.pressure_column: self.pressure_unit,
+            self.angle_column: "deg",
+        }
+
+    @property
+    def to_mpa(self) -> float:
+        """Factor from the pressure column's unit to MPa."""
+        return PRESSURE_UNITS[self.pressure_unit]
+
+    def parameter(self, name: str) -> DesignParameter:
+        """The parameter called ``name``, or one error listing the names."""
+        for p in self.parameters:
+            if p.name == name:
+                return p
+        raise ActuatorError(
+            f"The actuator {self.name!r} has no design parameter {name!r}; "
+            f"its parameters are {', '.join(self.names)}."
+        )
+
+    # --- designs -------------------------------------------------------------------------------
+
+    def parse_design(self, text: str, *, field: str = "--design") -> np.ndarray:
+        """A design from text: ``A=1,B=2,...`` by name, or the values in column order.
+
+        Returns the model-input codes (levels as their index), checked against
+        the ranges, kinds and constraints.
+        """
+        if not isinstance(text, str) or not text.strip():
+            raise ActuatorError(
+                f"The {field} must be {self.design_hint()}; got {text!r}."
+            )
+        items = [item.strip() for item in text.split(",")]
+        if any("=" in item for item in items):
+            values: dict[str, Any] = {}
+            for item in items:
+                name, sep, value = item.partition("=")
+                name = name.strip()
+                if not sep:
+                    raise ActuatorError(
+                        f"The {field} mixes NAME=VALUE and bare values ({item!r}); "
+                        f"give {self.design_hint()}."
+                    )
+                if name not in self.names:
+                    raise ActuatorError(
+                        f"The {field} names {name!r}, which is not a design parameter of "
+                        f"{self.name}; its parameters are {', '.join(self.names)}."
+                    )
+                if name in values:
+                    raise ActuatorError(f"The {field} gives {name!r} twice.")
+                values[name] = value.strip()
+            missing = [n for n in self.names if n not in values]
+            if missing:
+                raise ActuatorError(
+                    f"The {field} lacks {', '.join(missing)}; give {self.design_hint()}."
+                )
+            return self.design_codes(values, field=field)
+        if len(items) != len(self.parameters):
+            raise ActuatorError(
+                f"The {field} must be {self.design_hint()} ({len(self.parameters)} values); "
+                f"got {len(items)} in {text!r}."
+            )
+        return self.design_codes(dict(zip(self.names, items, strict=True)), field=field)
+
+    def design_hint(self) -> str:
+        """``A=…,B=…`` with each parameter's unit, for messages and help."""
+        return ",".join(f"{p.name}=V" for p in self.parameters) + (
+            f" (or the values in that order; {self.units_text()})"
+        )
+
+    def units_text(self) -> str:
+        """``A in mm, B a whole number, C one of x/y`` for messages."""
+        parts = []
+        for p in self.parameters:
+            if p.kind == "categorical":
+                parts.append(f"{p.name} one of {'/'.join(map(str, p.levels or ()))}")
+            elif p.kind == "integer":
+                parts.append(f"{p.name} a whole number")
+            else:
+                parts.append(f"{p.name} in {p.unit}" if p.unit else p.name)
+        return ", ".join(parts)
+
+    def design_codes(self, values: Mapping[str, Any], *, field: str = "design") -> np.ndarray:
+        """Model-input codes of one design given by name, checked."""
+        codes = np.array([p.encode(values[p.name]) for p in self.parameters], dtype=float)
+        self.check_designs(codes[None, :], where=f"in {field}")
+        return codes
+
+    def check_designs(self, codes: Any, *, where: str = "") -> np.ndarray:
+        """Rows of design codes checked against ranges, kinds and constraints.
+
+        Returns the rows as a float array of shape (n, n_parameters).
+        """
+        rows = np.atleast_2d(np.asarray(codes, dtype=float))
+        if rows.shape[1] != len(self.parameters):
+            raise ActuatorError(
+                f"A design of {self.name} has {len(self.parameters)} values "
+                f"({', '.join(self.names)}); got {rows.shape[1]}."
+            )
+        for j, p in enumerate(self.parameters):
+            p.check(rows[:, j], where=where)
+        met = self.constraints_met(rows)
+        if not met.all():
+            i = int(np.argmin(met))
+            broken = next(
+                text
+                for text, tree in zip(self.constraints, self._trees, strict=True)
+                if not _evaluate(tree, self._columns(rows[i : i + 1]))[0]
+            )
+            raise ActuatorError(
+                f"The design {self.describe(rows[i])}{' ' + where if where else ''} breaks the "
+                f"constraint {broken} of {self.name}."
+            )
+        return rows
+
+    def constraints_met(self, codes: Any) -> np.ndarray:
+        """Whether each row of design codes meets every constraint (bool array)."""
+        rows = np.atleast_2d(np.asarray(codes, dtype=float))
+        met = np.ones(rows.shape[0], dtype=bool)
+        columns = self._columns(rows)
+        for tree in self._trees:
+            met &= np.asarray(_evaluate(tree, columns), dtype=bool)
+        return met
+
+    def _columns(self, rows: np.ndarray) -> dict[str, np.ndarray]:
+        return {name: rows[:, j] for j, name in enumerate(self.names)}
+
+    def describe(self, codes: Sequence[float]) -> str:
+        """``A=1, B=2.5 mm, layer=paper``: one design by name, in its units."""
+        parts = []
+        for p, code in zip(self.parameters, codes, strict=True):
+            value = p.decode(float(code))
+            shown = f"{value:g}" if isinstance(value, float) else str(value)
+            parts.append(f"{p.name}={shown}{' ' + p.unit if p.unit and p.kind != 'categorical' else ''}")
+        return ", ".join(parts)
+
+    def design_record(self, codes: Sequence[float]) -> dict[str, Any]:
+        """``{name: value}`` of one design (levels by name), JSON-friendly."""
+        return {
+            p.name: p.decode(float(code)) for p, code in zip(self.parameters, codes, strict=True)
+        }
+
+    def bounds(self) -> tuple[np.ndarray, np.ndarray]:
+        """Lower and upper bounds of the design codes (finite where declared)."""
+        return (
+            np.array([p.low for p in self.parameters]),
+            np.array([p.high for p in self.parameters]),
+        )
+
+    # --- serialisation -------------------------------------------------------------------------
+
+    def to_dict(self) -> dict[str, Any]:
+        """JSON-friendly form, saved in every model (:meth:`from_dict` reads it back)."""
+        out: dict[str, Any] = {
+            "name": self.name,
+            "title": self.title,
+            "parameters": [p.to_dict() for p in self.parameters],
+            "pressure_column": self.pressure_column,
+            "pressure_unit": self.pressure_unit,
+            "angle_column": self.angle_column,
+            "constraints": list(self.constraints),
+        }
+        for key in ("fem_family", "chamber_volume_mm3", "volume_growth_mm3_per_mpa"):
+            if getattr(self, key) is not None:
+                out[key] = getattr(self, key)
+        return out
+
+    @classmethod
+    def from_dict(cls, data: Mapping[str, Any]) -> Actuator:
+        """The description :meth:`to_dict` wrote; one :class:`ActuatorError` for a bad one."""
+        if not isinstance(data, Mapping):
+            raise ActuatorError(f"An actuator description must be an object; got {data!r}.")
+        allowed = {
+            "name",
+            "title",
+            "parameters",
+            "pressure_column",
+            "pressure_unit",
+            "angle_column",
+            "constraints",
+            "fem_family",
+            "chamber_volume_mm3",
+            "volume_growth_mm3_per_mpa",
+        }
+        unknown = sorted(set(data) - allowed)
+        if unknown:
+            raise ActuatorError(
+                f"Unknown key(s) {', '.join(unknown)} in an actuator description; "
+                f"allowed: {', '.join(sorted(allowed))}."
+            )
+        parameters = data.get("parameters")
+        if not isinstance(parameters, list | tuple):
+            raise ActuatorError("An actuator description's 'parameters' must be a list.")
+        constraints = data.get("constraints", [])
+        if not isinstance(constraints, list | tuple):
+            raise ActuatorError("An actuator description's 'constraints' must be a list of text.")
+        return cls(
+            name=str(data.get("name", "")),
+            title=str(data.get("title", "")),
+            parameters=tuple(DesignParameter.from_dict(p) for p in parameters),
+            pressure_column=data.get("pressure_column", "pressure_mpa"),
+            pressure_unit=data.get("pressure_unit", "MPa"),
+            angle_column=data.get("angle_column", "angle_deg"),
+            constraints=tuple(constraints),
+            fem_family=data.get("fem_family"),
+            chamber_volume_mm3=data.get("chamber_volume_mm3"),
+            volume_growth_mm3_per_mpa=data.get("volume_growth_mm3_per_mpa"),
+        )
+
+    @classmethod
+    def from_table(
+        cls,
+        table: Any,
+        *,
+        design_columns: Sequence[str],
+        pressure_column: str,
+        pressure_unit: str,
+        angle_column: str = "angle_deg",
+        name: str = "table",
+        title: str = "",
+        units: Mapping[str, str] | None = None,
+    ) -> Actuator:
+        """A description read off a simulation table's columns.
+
+        A numeric column of whole numbers becomes an integer parameter, a text
+        column a categorical one (its levels sorted), any other a continuous
+        one; each range is the column's span.
+        """
+        parameters = []
+        for column in design_columns:
+            values = table[column]
+            unit = (units or {}).get(column, _unit_from_name(column))
+            if values.dtype.kind in "OUSb" or str(values.dtype) in ("category", "string"):
+                levels = tuple(sorted({str(v) for v in values.dropna()}))
+                if len(levels) < 2:
+                    levels = (*levels, f"{levels[0]}_other") if levels else ("a", "b")
+                parameters.append(
+                    DesignParameter(column, "", kind="categorical", levels=levels)
+                )
+                continue
+            numbers = values.to_numpy(dtype=float)
+            finite = numbers[np.isfinite(numbers)]
+            low, high = (float(finite.min()), float(finite.max())) if finite.size else (0.0, 0.0)
+            whole = finite.size > 0 and bool(np.all(finite == np.round(finite)))
+            kind: Kind = "integer" if whole and values.dtype.kind in "iu" else "continuous"
+            parameters.append(DesignParameter(column, unit, low, high, kind=kind))
+        return cls(
+            name=name,
+            title=title or f"actuator of the table's {len(parameters)} design columns",
+            parameters=tuple(parameters),
+            pressure_column=pressure_column,
+            pressure_unit=pressure_unit,
+            angle_column=angle_column,
+        )
+
+
+def _unit_from_name(column: str) -> str:
+    """A unit guessed from a column's suffix (``wall_mm`` → mm), else ``""``."""
+    suffix = column.rsplit("_", 1)[-1] if "_" in column else ""
+    return suffix if suffix in ("mm", "cm", "m", "deg", "um", "g", "kpa") else ""
+
+
+#: Registered actuator descriptions, by name.
+ACTUATORS: Registry[Actuator] = Registry("actuator")
+
+
+def get_actuator(name: str, *, field: str = "--actuator") -> Actuator:
+    """The registered description ``name`` (one error listing the names otherwise)."""
+    return ACTUATORS.get(name, field=field)
+
+
+def _register_paper_b() -> Actuator:
+    """Paper B's fiber-reinforced actuator (SFRBA), as its FEM and Table 1 describe it."""
+    from softbend.design import _BOUNDS
+
+    described = {
+        "l_mm": ("mm", "chamber length"),
+        "r_mm": ("mm", "inner radius of the semicircular chamber"),
+        "t_mm": ("mm", "top wall thickness"),
+        "b_mm": ("mm", "bottom wall thickness"),
+        "phi_deg": ("deg", "fiber winding angle from the circumferential direction"),
+        "lc_mm": ("mm", "distal cap length"),
+    }
+    parameters = tuple(
+        DesignParameter(
+            name,
+            unit,
+            low,
+            high,
+            resolution=0.1 if unit == "mm" else 1.0,
+            description=text,
+        )
+        for name, (unit, text) in described.items()
+        for low, high, _ in [_BOUNDS[name]]
+    )
+    sfrba = Actuator(
+        name="sfrba",
+        title="paper B's soft fiber-reinforced bending actuator",
+        parameters=parameters,
+        pressure_column="pressure_mpa",
+        pressure_unit="MPa",
+        angle_column="angle_deg",
+        constraints=("t_mm < r_mm",),
+        fem_family="sfrba",
+    )
+    return ACTUATORS.register(sfrba.name, sfrba)
+
+
+#: Paper B's actuator: the description of every campaign and shipped model.
+SFRBA: Actuator = _register_paper_b()
