@@ -80,6 +80,7 @@ from softbend.errors import SchemaError
 from softbend.limits import check_limit, limit
 from softbend.plausibility import RANGES, implausible_index
 from softbend.surrogates.families import FAMILIES, Family, legacy_kinds
+from softbend.actuators import SFRBA, Actuator
 from softbend.surrogates.features import FEATURES, TARGET, UNITS
 from softbend.surrogates.jsonvalues import encode as _encode
 from softbend.surrogates.jsonvalues import encode_params
@@ -152,6 +153,19 @@ _HEADER_KEYS = (
 )
 
 
+def actuator_of(metadata: dict[str, Any]) -> Actuator:
+    """The actuator description recorded in a model's ``metadata["actuator"]``.
+
+    A model without one (every model of a softbend campaign, and every model
+    saved before descriptions existed) is paper B's actuator
+    (:data:`softbend.actuators.SFRBA`).
+    """
+    record = metadata.get("actuator") if isinstance(metadata, dict) else None
+    if record is None:
+        return SFRBA
+    return Actuator.from_dict(record)
+
+
 @dataclass(frozen=True)
 class SavedSurrogate:
     """A surrogate read back by :func:`load_surrogate`.
@@ -179,6 +193,11 @@ class SavedSurrogate:
     metadata: dict[str, Any] = field(default_factory=dict)
     softbend_version: str = ""
     created_utc: str = ""
+
+    @property
+    def actuator(self) -> Actuator:
+        """The actuator description the model was trained with (paper B's when unrecorded)."""
+        return actuator_of(self.metadata)
 
 
 def _stored(kind: str) -> Family:
@@ -798,6 +817,11 @@ class SavedState:
     params: dict[str, Any]
     state: dict[str, Any]
     metadata: dict[str, Any] = field(default_factory=dict)
+
+    @property
+    def actuator(self) -> Actuator:
+        """The actuator description the model was trained with (paper B's when unrecorded)."""
+        return actuator_of(self.metadata)
 
 
 def load_state(path: str | os.PathLike[str], kinds: tuple[str, ...]) -> SavedState | SavedSurrogate:
