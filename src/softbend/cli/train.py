@@ -10,8 +10,34 @@ from softbend.cli import _common
 
 
 def train(
-    db: Path = typer.Argument(..., help="Campaign database (DuckDB) to learn from."),
+    db: Path = typer.Argument(
+        ...,
+        metavar="TABLE",
+        help="What to learn from: a campaign database (DuckDB), or a simulation table "
+        "(CSV or Parquet, one row per design and pressure) described by --design-columns.",
+    ),
     out: Path = typer.Option(..., "--out", "-o", help="Folder for models, tables and figures."),
+    design_columns: str | None = typer.Option(
+        None,
+        "--design-columns",
+        help="A table's design-parameter columns, comma-separated, in model-input order "
+        "(such as n_chambers,wall_mm,height_mm).",
+    ),
+    pressure_column: str | None = typer.Option(
+        None, "--pressure-column", help="A table's gauge-pressure column."
+    ),
+    pressure_unit: str | None = typer.Option(
+        None, "--pressure-unit", help="Unit of the pressure column: kPa, MPa, bar or psi."
+    ),
+    angle_column: str = typer.Option(
+        "angle_deg", "--angle-column", help="A table's bending-angle column, in degrees."
+    ),
+    actuator: str | None = typer.Option(
+        None,
+        "--actuator",
+        help="A registered actuator description the table must fit (its columns become the "
+        "defaults); without it, the description is read off the table's columns.",
+    ),
     models: str = typer.Option(
         "plr,xgb,mlp",
         help="Comma-separated surrogate families: plr, xgb, mlp (paper B's) or any registered.",
@@ -56,6 +82,12 @@ def train(
     cross-validation, refits the best configuration on all designs, then saves
     the models and draws the figures (paper B, Figure 5) into the folder --out.
 
+    TABLE is a softbend campaign (paper B's actuator), or any actuator's
+    simulation table: a CSV or Parquet file whose columns --design-columns,
+    --pressure-column (in --pressure-unit) and --angle-column (degrees) name.
+    Integer columns stay integer parameters and text columns categorical ones;
+    every saved model records the actuator description it was trained with.
+
     Every finished configuration-fold is saved in a checkpoint file beside
     --out (.NAME.train-checkpoint.jsonl for an --out named NAME); the same
     command run again after an interruption resumes from it (a checkpoint of
@@ -66,6 +98,8 @@ def train(
 
     \b
         softbend train table1.duckdb --out surrogates --models plr,xgb,mlp
+        softbend train sims.csv --design-columns n_chambers,wall_mm \\
+            --pressure-column p_kpa --pressure-unit kPa --out pneunet
     """
     from softbend._validation import check_int
     from softbend.limits import check_limit
@@ -80,6 +114,9 @@ def train(
         check_int(plr_patience, "--plr-patience", "softbend train", low=1)
     if epochs is not None:
         check_limit("epochs", epochs, "--epochs")
+    source = _training_source(
+        db, design_columns, pressure_column, pressure_unit, angle_column, actuator
+    )
     _common.check_output_dir(out, "--out", inputs=(db,))
     # the folder is swapped whole: nothing but an earlier result of this command may be lost
     _common.check_replaceable_dir(
@@ -94,7 +131,7 @@ def train(
         _common.phase_progress(enabled=not as_json) as progress,
     ):
         _, summary = train_into(
-            db,
+            source,
             out,
             models=models,
             figures=training_figures,
@@ -119,6 +156,41 @@ def train(
         return
     print_summary(summary)
     _common.console.print(f"models, tables and figures written to {out}")
+
+
+def _training_source(
+    db: Path,
+    design_columns: str | None,
+    pressure_column: str | None,
+    pressure_unit: str | None,
+    angle_column: str,
+    actuator: str | None,
+) -> object:
+    """The campaign path, or a table's training data (checked before anything runs)."""
+    from softbend.surrogates.tables import TABLE_SUFFIXES
+
+    described = actuator is not None
+    table_options = (design_columns, pressure_column, pressure_unit)
+    if db.suffix.lower() not in TABLE_SUFFIXES:
+        if any(v is not None for v in table_options) or described or angle_column != "angle_deg":
+            raise typer.BadParameter(
+                f"{db} is a campaign database (paper B's actuator, its own columns); "
+                "--design-columns, --pressure-column, --pressure-unit, --angle-column and "
+                "--actuator describe a CSV or Parquet table.",
+                param_hint="TABLE",
+            )
+        return db
+    from softbend.actuators import get_actuator
+    from softbend.surrogates.tables import table_training_data
+
+    return table_training_data(
+        db,
+        design_columns=design_columns,
+        pressure_column=pressure_column,
+        pressure_unit=pressure_unit,
+        angle_column=angle_column,
+        actuator=get_actuator(actuator) if described else None,
+    )
 
 
 def print_summary(summary: dict) -> None:
@@ -161,8 +233,17 @@ def print_summary(summary: dict) -> None:
 
 def predict(
     model: Path = typer.Argument(..., help="A model saved by 'softbend train' (models/*.json)."),
-    design: str = typer.Option(..., help=_common.DESIGN_HELP),
-    pressures: str = typer.Option(..., help="Comma-separated pressures, MPa (such as 0.05,0.1)."),
+    design: str = typer.Option(
+        ...,
+        help="The design by the model's parameter names, NAME=VALUE,... (a categorical "
+        "parameter by its level), or the values in the model's column order; for paper B's "
+        "actuator l,r,t,b,phi,lc (mm, mm, mm, mm, deg, mm).",
+    ),
+    pressures: str = typer.Option(
+        ...,
+        help="Comma-separated gauge pressures in the model's pressure unit (MPa for paper "
+        "B's actuator; such as 0.05,0.1).",
+    ),
     strict: bool = typer.Option(
         False, "--strict", help="Refuse a design or pressure outside the model's training data."
     ),
@@ -181,6 +262,8 @@ def predict(
     \b
         softbend predict surrogates/models/mlp.json --design 100,6,2,2,5,8 \\
             --pressures 0.05,0.1,0.17
+        softbend predict pneunet/models/plr.json \\
+            --design n_chambers=10,n_layers=2,wall_mm=2,height_mm=12 --pressures 20,40
     """
     from softbend.surrogates.predict import INTERVAL_LEVEL, predict_text
 
@@ -199,7 +282,8 @@ def predict(
         _common.print_json(result.to_dict())
         return
     interval = result.interval_deg
-    columns = ["pressure (MPa)", "angle (°)"]
+    actuator = result.actuator
+    columns = [f"{actuator.pressure_column} ({actuator.pressure_unit})", "angle (°)"]
     rows = [
         [f"{p:g}", f"{a:.2f}"] for p, a in zip(result.pressure_mpa, result.angle_deg, strict=True)
     ]
@@ -211,4 +295,4 @@ def predict(
         columns.append("trained there")
         for row, ok in zip(rows, result.supported, strict=True):
             row.append("yes" if ok else "no")
-    _common.print_table(f"{result.kind} surrogate, design ({result.design})", columns, rows)
+    _common.print_table(f"{result.kind} surrogate, design ({result.design_text})", columns, rows)

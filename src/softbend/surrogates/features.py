@@ -10,6 +10,9 @@ with the design ids as CV groups so that a sweep never spans two folds.
 from __future__ import annotations
 
 import hashlib
+from collections.abc import Iterator, Sequence
+from contextlib import contextmanager
+from contextvars import ContextVar
 from dataclasses import dataclass
 from typing import TYPE_CHECKING
 
@@ -21,6 +24,8 @@ from softbend.errors import DatasetError
 
 if TYPE_CHECKING:  # a table only for training: predicting needs no pandas
     import pandas as pd
+
+    from softbend.actuators import Actuator
 
 #: Input columns, in the order every surrogate expects them (those of every model).
 FEATURES: tuple[str, ...] = DESIGN_FEATURES
@@ -39,6 +44,31 @@ UNITS: dict[str, str] = {
 
 #: Target column.
 TARGET = "angle_deg"
+
+_CURRENT: ContextVar[tuple[str, ...]] = ContextVar("softbend_model_features", default=FEATURES)
+
+
+def model_features() -> tuple[str, ...]:
+    """The input columns of the model being built, saved or read: :data:`FEATURES`
+    (paper B's actuator) unless :func:`using_features` says otherwise."""
+    return _CURRENT.get()
+
+
+@contextmanager
+def using_features(names: Sequence[str]) -> Iterator[tuple[str, ...]]:
+    """Within the block, models are checked against the input columns ``names``
+    (an actuator's design parameters then its pressure column)."""
+    token = _CURRENT.set(tuple(names))
+    try:
+        yield tuple(names)
+    finally:
+        _CURRENT.reset(token)
+
+
+def is_paper_b(names: Sequence[str] | None = None) -> bool:
+    """Whether ``names`` (default: :func:`model_features`) are paper B's inputs."""
+    return tuple(model_features() if names is None else names) == FEATURES
+
 
 #: Group column: one group per design (one pressure sweep).
 GROUP = "design_id"
@@ -61,6 +91,8 @@ class TrainingData:
         identifies the training data in a saved model's metadata.
     n_dropped : int
         Rows left out: not converged, or a non-finite input or angle.
+    actuator : Actuator, optional
+        The description of the actuator the rows are of (None: paper B's).
     """
 
     X: np.ndarray
@@ -68,6 +100,7 @@ class TrainingData:
     groups: np.ndarray
     data_hash: str
     n_dropped: int = 0
+    actuator: Actuator | None = None
 
     @property
     def n_samples(self) -> int:
@@ -94,7 +127,9 @@ def data_hash(X: ArrayLike, y: ArrayLike, groups: ArrayLike | None = None) -> st
     return digest.hexdigest()[:16]
 
 
-def training_data(samples: pd.DataFrame, *, converged_only: bool = True) -> TrainingData:
+def training_data(
+    samples: pd.DataFrame, *, converged_only: bool = True, actuator: Actuator | None = None
+) -> TrainingData:
     """Inputs, target and CV groups from a campaign samples table.
 
     Parameters
@@ -105,6 +140,9 @@ def training_data(samples: pd.DataFrame, *, converged_only: bool = True) -> Trai
         returned by :func:`softbend.campaign.load_samples`.
     converged_only : bool
         Leave out rows whose ``converged`` flag is false (default True).
+    actuator : Actuator, optional
+        Whose columns to read: its :attr:`~softbend.actuators.Actuator.features`
+        and angle column (default paper B's :data:`FEATURES` and ``angle_deg``).
 
     Returns
     -------
@@ -115,7 +153,9 @@ def training_data(samples: pd.DataFrame, *, converged_only: bool = True) -> Trai
     DatasetError
         If a column is missing or no usable row remains.
     """
-    needed = [*FEATURES, TARGET, GROUP]
+    features = FEATURES if actuator is None else actuator.features
+    target = TARGET if actuator is None else actuator.angle_column
+    needed = [*features, target, GROUP]
     missing = [c for c in needed if c not in samples.columns]
     if missing:
         raise DatasetError(
@@ -125,8 +165,8 @@ def training_data(samples: pd.DataFrame, *, converged_only: bool = True) -> Trai
     keep = np.ones(len(samples), dtype=bool)
     if converged_only and "converged" in samples.columns:
         keep &= samples["converged"].to_numpy(dtype=bool, na_value=False)
-    X = samples[list(FEATURES)].to_numpy(dtype=np.float64, na_value=np.nan)
-    y = samples[TARGET].to_numpy(dtype=np.float64, na_value=np.nan)
+    X = samples[list(features)].to_numpy(dtype=np.float64, na_value=np.nan)
+    y = samples[target].to_numpy(dtype=np.float64, na_value=np.nan)
     keep &= np.isfinite(X).all(axis=1) & np.isfinite(y)
     if not keep.any():
         raise DatasetError(
@@ -141,6 +181,7 @@ def training_data(samples: pd.DataFrame, *, converged_only: bool = True) -> Trai
         groups=groups,
         data_hash=data_hash(X, y, groups),
         n_dropped=int((~keep).sum()),
+        actuator=actuator,
     )
 
 
@@ -149,20 +190,21 @@ def check_features(X: ArrayLike, owner: str) -> np.ndarray:
 
     A single sample may be given as a 1-D array of length 7.
     """
+    features = model_features()
     array = np.asarray(X, dtype=np.float64)
     if array.ndim == 1:
         array = array[None, :]
-    if array.ndim != 2 or array.shape[1] != len(FEATURES):
+    if array.ndim != 2 or array.shape[1] != len(features):
         raise ValueError(
-            f"The 'X' of {owner} must have {len(FEATURES)} columns "
-            f"({', '.join(FEATURES)}). Got shape {np.shape(X)} instead."
+            f"The 'X' of {owner} must have {len(features)} columns "
+            f"({', '.join(features)}). Got shape {np.shape(X)} instead."
         )
     bad = ~np.isfinite(array)
     if bad.any():
         row, col = np.argwhere(bad)[0]
         raise ValueError(
             f"The 'X' of {owner} must be finite. Got {array[row, col]} in column "
-            f"'{FEATURES[col]}' of row {row}."
+            f"'{features[col]}' of row {row}."
         )
     return array
 
@@ -176,7 +218,7 @@ def training_ranges(X: ArrayLike) -> dict[str, list[float]]:
     array = check_features(X, "training_ranges")
     return {
         name: [float(array[:, j].min()), float(array[:, j].max())]
-        for j, name in enumerate(FEATURES)
+        for j, name in enumerate(model_features())
     }
 
 
@@ -192,7 +234,7 @@ def outside_training_ranges(ranges: dict[str, list[float]], X: ArrayLike) -> lis
     """
     array = check_features(X, "outside_training_ranges")
     out = []
-    for j, name in enumerate(FEATURES):
+    for j, name in enumerate(model_features()):
         if name not in ranges:
             continue
         low, high = (float(v) for v in ranges[name])

@@ -32,7 +32,7 @@ from softbend import __version__
 from softbend._extras import require
 from softbend._io import write_bytes_atomic
 from softbend.surrogates.families import FAMILIES
-from softbend.surrogates.features import FEATURES, TARGET, UNITS, check_features
+from softbend.surrogates.features import TARGET, check_features, model_features
 from softbend.surrogates.onnx_graphs import DEFAULT_OPSET, helper, onnx
 from softbend.surrogates.persistence import COMPOSITE_KINDS, check_fitted_surrogate
 
@@ -78,13 +78,16 @@ def to_onnx(model: Any, *, opset: int | None = None) -> onnx.ModelProto:
             f"({', '.join(exporting)}). Got a {kind} surrogate ({type(model).__name__}), "
             f"which has no ONNX export{hint}."
         )
+    from softbend.surrogates.persistence import current_units
+
     proto = export(model, opset)
     proto.producer_name = "softbend"
     proto.producer_version = __version__
-    proto.doc_string = f"softbend {kind} surrogate: {', '.join(FEATURES)} -> {TARGET} (deg)."
+    inputs = ", ".join(model_features())
+    proto.doc_string = f"softbend {kind} surrogate: {inputs} -> {TARGET} (deg)."
     props = {
-        "features": json.dumps(list(FEATURES)),
-        "units": json.dumps({name: UNITS[name] for name in (*FEATURES, TARGET)}),
+        "features": json.dumps(list(model_features())),
+        "units": json.dumps(current_units()),
         "kind": kind,
         "target": TARGET,
     }

@@ -66,6 +66,9 @@ import logging
 import math
 import os
 import sys
+from collections.abc import Iterator
+from contextlib import contextmanager
+from contextvars import ContextVar
 from dataclasses import dataclass, field
 from datetime import UTC, datetime
 from pathlib import Path
@@ -76,12 +79,19 @@ import numpy as np
 from softbend import __version__
 from softbend._io import json_safe, write_text_atomic
 from softbend._validation import short_repr
+from softbend.actuators import SFRBA, Actuator
 from softbend.errors import SchemaError
 from softbend.limits import check_limit, limit
 from softbend.plausibility import RANGES, implausible_index
 from softbend.surrogates.families import FAMILIES, Family, legacy_kinds
-from softbend.actuators import SFRBA, Actuator
-from softbend.surrogates.features import FEATURES, TARGET, UNITS
+from softbend.surrogates.features import (
+    FEATURES,
+    TARGET,
+    UNITS,
+    is_paper_b,
+    model_features,
+    using_features,
+)
 from softbend.surrogates.jsonvalues import encode as _encode
 from softbend.surrogates.jsonvalues import encode_params
 from softbend.surrogates.jsonvalues import plain_json as _plain_json
@@ -151,6 +161,33 @@ _HEADER_KEYS = (
     "params",
     "state",
 )
+
+
+_UNITS: ContextVar[tuple[tuple[str, str], ...]] = ContextVar(
+    "softbend_model_units", default=tuple((name, UNITS[name]) for name in (*FEATURES, TARGET))
+)
+
+
+def current_units() -> dict[str, str]:
+    """The units of the model being saved or read (paper B's unless :func:`describing`)."""
+    return dict(_UNITS.get())
+
+
+def model_units(actuator: Actuator) -> dict[str, str]:
+    """The ``units`` a saved model of ``actuator`` records: each input's, and degrees."""
+    units = actuator.units
+    return {**{name: units[name] for name in actuator.features}, TARGET: "deg"}
+
+
+@contextmanager
+def describing(actuator: Actuator) -> Iterator[None]:
+    """Within the block, models are saved and checked as models of ``actuator``."""
+    token = _UNITS.set(tuple(model_units(actuator).items()))
+    try:
+        with using_features(actuator.features):
+            yield
+    finally:
+        _UNITS.reset(token)
 
 
 def actuator_of(metadata: dict[str, Any]) -> Actuator:
@@ -309,15 +346,16 @@ def check_fitted_surrogate(model: Any, owner: str) -> str:
 
         raise NotFittedError(f"This {name} instance is not fitted yet. Call 'fit' before {owner}.")
     n_features = int(model.n_features_in_)
-    if n_features != len(FEATURES):
+    features = model_features()
+    if n_features != len(features):
         raise ValueError(
-            f"The 'model' of {owner} must be fitted on the {len(FEATURES)} surrogate inputs "
-            f"({', '.join(FEATURES)}). Got a {name} with n_features_in_ = {n_features} instead."
+            f"The 'model' of {owner} must be fitted on the {len(features)} surrogate inputs "
+            f"({', '.join(features)}). Got a {name} with n_features_in_ = {n_features} instead."
         )
     names = getattr(model, "feature_names_in_", None)
-    if names is not None and [str(n) for n in names] != list(FEATURES):
+    if names is not None and [str(n) for n in names] != list(features):
         raise ValueError(
-            f"The 'model' of {owner} must be fitted on the columns {', '.join(FEATURES)} in "
+            f"The 'model' of {owner} must be fitted on the columns {', '.join(features)} in "
             f"this order. Got a {name} fitted on {', '.join(map(str, names))} instead."
         )
     return kind
@@ -339,8 +377,8 @@ def _document(model: Any, kind: str, depth: int = 0) -> dict[str, Any]:
         "format": FORMAT,
         "schema_version": SCHEMA_VERSION,
         "kind": kind,
-        "features": list(FEATURES),
-        "units": {name: UNITS[name] for name in (*FEATURES, TARGET)},
+        "features": list(model_features()),
+        "units": dict(_UNITS.get()),
         "target": TARGET,
         "softbend_version": __version__,
         "created_utc": datetime.now(UTC).isoformat(timespec="seconds"),
@@ -425,9 +463,18 @@ def save_surrogate(
     sklearn.exceptions.NotFittedError
         If the model is not fitted.
     """
-    kind = check_fitted_surrogate(model, "save_surrogate")
     if metadata is None:
         metadata = {}
+    try:
+        actuator = actuator_of(metadata)
+    except ValueError as err:
+        raise ValueError(f"The metadata 'actuator' of save_surrogate is not valid: {err}") from None
+    with describing(actuator):
+        return _save(model, Path(path), metadata)
+
+
+def _save(model: Any, path: Path, metadata: dict[str, Any]) -> Path:
+    kind = check_fitted_surrogate(model, "save_surrogate")
     if not isinstance(metadata, dict) or not all(isinstance(k, str) for k in metadata):
         raise ValueError(
             "The 'metadata' of save_surrogate must be a dict with string keys. "
@@ -521,15 +568,22 @@ def _checked_document(document: Any, path: str) -> dict[str, Any]:
             f"{path} holds an unknown surrogate kind {shown}; "
             f"expected one of {', '.join(map(repr, saved_kinds()))}."
         )
-    if document["features"] != list(FEATURES) or document["target"] != TARGET:
-        raise SchemaError(
-            f"{path} maps {short_repr(document['features'])} -> {short_repr(document['target'])}"
-            f"; this softbend's surrogates map {list(FEATURES)} -> {TARGET!r}."
-        )
     for key in ("params", "state", "metadata", "units"):
         if not isinstance(document[key], dict):
             raise SchemaError(f"{path}: '{key}' must be a JSON object.")
-    units = {name: UNITS[name] for name in (*FEATURES, TARGET)}
+    if "actuator" in document["metadata"]:
+        try:
+            actuator = actuator_of(document["metadata"])
+        except ValueError as err:
+            raise SchemaError(f"{path}: metadata key 'actuator' is not valid: {err}") from None
+        features, units = list(actuator.features), model_units(actuator)
+    else:  # paper B's, or an inner model of the composite being read
+        features, units = list(model_features()), dict(_UNITS.get())
+    if document["features"] != features or document["target"] != TARGET:
+        raise SchemaError(
+            f"{path} maps {short_repr(document['features'])} -> {short_repr(document['target'])}"
+            f"; its actuator's surrogates map {features} -> {TARGET!r}."
+        )
     if document["units"] != units:
         wrong = next(
             (name for name in units if document["units"].get(name) != units[name]),
@@ -577,13 +631,14 @@ def _check_training_ranges(metadata: dict[str, Any], path: Path) -> None:
         return
     ranges = metadata["training_ranges"]
     where = f"{path}: metadata key 'training_ranges'"
+    features = model_features()
     if not isinstance(ranges, dict):
         raise SchemaError(
-            f"{where} must be an object of [low, high] per input ({', '.join(FEATURES)}); "
+            f"{where} must be an object of [low, high] per input ({', '.join(features)}); "
             f"got {short_repr(ranges)}."
         )
-    unknown = [name for name in ranges if name not in FEATURES]
-    missing = [name for name in FEATURES if name not in ranges]
+    unknown = [name for name in ranges if name not in features]
+    missing = [name for name in features if name not in ranges]
     if unknown or missing:
         found = (
             f"unknown input(s) {', '.join(map(repr, unknown))}"
@@ -591,8 +646,21 @@ def _check_training_ranges(metadata: dict[str, Any], path: Path) -> None:
             else f"no range for {', '.join(missing)}"
         )
         raise SchemaError(
-            f"{where} must give [low, high] for each input {', '.join(FEATURES)}; got {found}."
+            f"{where} must give [low, high] for each input {', '.join(features)}; got {found}."
         )
+    if not is_paper_b():  # another actuator: its own units, no plausible range known here
+        for name, pair in ranges.items():
+            if not (
+                isinstance(pair, list)
+                and len(pair) == 2
+                and all(type(v) in (int, float) and math.isfinite(v) for v in pair)
+                and pair[0] <= pair[1]
+            ):
+                raise SchemaError(
+                    f"{where}, field '{name}' must be [low, high]: two finite numbers with "
+                    f"low <= high; got {short_repr(pair)}."
+                )
+        return
     for name, pair in ranges.items():
         bounds = RANGES[QUANTITIES[name]]
         values: list[float] = []
@@ -707,10 +775,11 @@ def _check_against(
     except RuleError as err:
         raise SchemaError(f"{path}: the {kind} surrogate's {err}.") from None
     n_features = state.get("n_features_in_")
-    if isinstance(n_features, bool) or n_features != len(FEATURES):
+    features = model_features()
+    if isinstance(n_features, bool) or n_features != len(features):
         raise SchemaError(
-            f"{path}: the {kind} surrogate must take the {len(FEATURES)} inputs "
-            f"{', '.join(FEATURES)}; its state gives n_features_in_ {short_repr(n_features)}."
+            f"{path}: the {kind} surrogate must take the {len(features)} inputs "
+            f"{', '.join(features)}; its state gives n_features_in_ {short_repr(n_features)}."
         )
 
 
@@ -773,9 +842,10 @@ def load_surrogate(path: str | os.PathLike[str]) -> SavedSurrogate:
     """
     path = Path(path)
     document = _read_document(path)
-    _check_training_ranges(document["metadata"], path)
-    _check_support(document["metadata"], path)
-    return _saved_surrogate(document, path)
+    with describing(actuator_of(document["metadata"])):
+        _check_training_ranges(document["metadata"], path)
+        _check_support(document["metadata"], path)
+        return _saved_surrogate(document, path)
 
 
 def _saved_surrogate(document: dict[str, Any], path: Path) -> SavedSurrogate:
@@ -853,6 +923,13 @@ def load_state(path: str | os.PathLike[str], kinds: tuple[str, ...]) -> SavedSta
     """
     path = Path(path)
     document = _read_document(path)
+    with describing(actuator_of(document["metadata"])):
+        return _load_state(document, path, kinds)
+
+
+def _load_state(
+    document: dict[str, Any], path: Path, kinds: tuple[str, ...]
+) -> SavedState | SavedSurrogate:
     _check_training_ranges(document["metadata"], path)
     _check_support(document["metadata"], path)
     kind = document["kind"]

@@ -9,6 +9,7 @@ from typing import Any
 import numpy as np
 from numpy.typing import ArrayLike
 
+from softbend.actuators import SFRBA, Actuator
 from softbend.design import SFRBADesign
 from softbend.errors import SchemaError
 from softbend.models import check_pressures_mpa
@@ -36,9 +37,12 @@ class Prediction:
     kind : str
         The surrogate's kind: its family's name (``"plr"``, ``"xgb"``, ``"mlp"``, ...)
         or a composite kind (``"affine-corrected"``, ...).
-    design : SFRBADesign
+    design : SFRBADesign or ndarray
+        Paper B's design, or another actuator's design codes (in the order of
+        ``actuator.names``; a categorical level as its index).
     pressure_mpa, angle_deg : ndarray
-        The pressures asked for (MPa) and the predicted angles (degrees).
+        The pressures asked for, in the model's pressure unit (MPa for paper
+        B's actuator; ``actuator.pressure_unit``), and the predicted angles (degrees).
     outside_training_ranges : list of str
         One phrase per input outside the ranges the model was trained on
         (empty inside them, or when the file records none).
@@ -59,10 +63,12 @@ class Prediction:
         interval of the corrections); None otherwise.
     source : str
         The model file.
+    actuator : Actuator
+        The description the model was trained with.
     """
 
     kind: str
-    design: SFRBADesign
+    design: SFRBADesign | np.ndarray
     pressure_mpa: np.ndarray
     angle_deg: np.ndarray
     outside_training_ranges: list[str] = field(default_factory=list)
@@ -71,6 +77,21 @@ class Prediction:
     source: str = ""
     beyond_support: list[str] = field(default_factory=list)
     supported: np.ndarray | None = None
+    actuator: Actuator = SFRBA
+
+    @property
+    def design_codes(self) -> np.ndarray:
+        """The design as model inputs, in the order of ``actuator.names``."""
+        if isinstance(self.design, SFRBADesign):
+            return self.design.as_array()
+        return np.asarray(self.design, dtype=float)
+
+    @property
+    def design_text(self) -> str:
+        """The design by name, in its units."""
+        if isinstance(self.design, SFRBADesign):
+            return str(self.design)
+        return self.actuator.describe(self.design_codes)
 
     @property
     def extrapolated(self) -> list[str]:
@@ -85,8 +106,9 @@ class Prediction:
         payload: dict[str, Any] = {
             "model": self.source,
             "kind": self.kind,
-            "design": self.design.as_dict(),
-            "pressure_mpa": self.pressure_mpa.tolist(),
+            **({} if self.actuator == SFRBA else {"actuator": self.actuator.name}),
+            "design": self.actuator.design_record(self.design_codes),
+            self.actuator.pressure_column: self.pressure_mpa.tolist(),
             "angle_deg": self.angle_deg.tolist(),
             "outside_training_ranges": list(self.outside_training_ranges),
             "beyond_training_support": list(self.beyond_support),
@@ -116,7 +138,7 @@ def calibrated_interval(record: Any, angles: np.ndarray) -> tuple[np.ndarray, np
 
 
 def parse_pressures(text: str, name: str = "pressure") -> list[float]:
-    """Pressures (MPa) from comma-separated text such as ``"0.05,0.1"``.
+    """Pressures from comma-separated text such as ``"0.05,0.1"`` (in the model's unit).
 
     Raises
     ------
@@ -149,9 +171,11 @@ def predict_text(
     path : path
         A file written by :func:`softbend.surrogates.save_surrogate`.
     design : str
-        ``"l,r,t,b,phi,lc"`` in mm and degrees (:meth:`SFRBADesign.parse`).
+        ``"A=1,B=2,..."`` by the model's parameter names, or the values in the
+        model's column order (paper B's: ``"l,r,t,b,phi,lc"`` in mm and degrees).
     pressures : str
-        Comma-separated gauge pressures, MPa (:func:`parse_pressures`).
+        Comma-separated gauge pressures in the model's pressure unit
+        (:func:`parse_pressures`; MPa for paper B's actuator).
     strict : bool
         As :func:`predict_angles`.
     field : str, default "--pressures"
@@ -159,7 +183,7 @@ def predict_text(
     """
     return predict_angles(
         path,
-        SFRBADesign.parse(design),
+        design,
         parse_pressures(pressures, field),
         strict=strict,
         field=field,
@@ -168,7 +192,7 @@ def predict_text(
 
 def predict_angles(
     path: str | os.PathLike[str],
-    design: SFRBADesign,
+    design: SFRBADesign | str | ArrayLike,
     pressures_mpa: ArrayLike,
     *,
     strict: bool = False,
@@ -180,9 +204,14 @@ def predict_angles(
     ----------
     path : path
         A file written by :func:`softbend.surrogates.save_surrogate`.
-    design : SFRBADesign
+    design : SFRBADesign, str or array_like
+        Paper B's design; or, for any model, ``"A=1,B=2,..."`` by its
+        parameter names, the values in its column order as text, or the
+        design codes as numbers (checked against the model's actuator
+        description: ranges, kinds, constraints).
     pressures_mpa : array_like
-        Gauge pressures, MPa, finite and >= 0 (any order).
+        Gauge pressures in the model's pressure unit (MPa for paper B's
+        actuator), finite and >= 0 (any order).
     strict : bool, default False
         Refuse inputs outside the model's training ranges, and predictions
         beyond its training data's support (:mod:`softbend.surrogates.support`),
@@ -203,27 +232,35 @@ def predict_angles(
         interval end inside its training ranges (its parameters overflow). A
         non-finite number is never returned.
     """
-    from softbend.surrogates.features import outside_training_ranges
+    from softbend.surrogates.features import outside_training_ranges, using_features
     from softbend.surrogates.persistence import SavedState, load_state
 
-    if not isinstance(design, SFRBADesign):
-        raise ValueError(
-            f"The 'design' of predict_angles must be an SFRBADesign. Got {design!r} instead."
-        )
+    # an MLP predicts from its arrays (NumPy only); any other kind through its estimator
+    saved = load_state(path, ("mlp",))
+    actuator = saved.actuator
+    unit = actuator.pressure_unit
     pressures = np.asarray(pressures_mpa, dtype=float).ravel()
     if pressures.size == 0 or not np.all(np.isfinite(pressures)) or np.any(pressures < 0):
         raise ValueError(
-            f"The '{field}' must be finite and >= 0 MPa. "
+            f"The '{field}' must be finite and >= 0 {unit}. "
             f"Got {np.asarray(pressures_mpa).tolist()!r} instead."
         )
-    check_pressures_mpa(np.unique(pressures), "predict_angles", field)
-    # an MLP predicts from its arrays (NumPy only); any other kind through its estimator
-    saved = load_state(path, ("mlp",))
+    check_pressures_mpa(np.unique(pressures) * actuator.to_mpa, "predict_angles", field)
+    design = _design_of(design, actuator, path)
     model: Any = _MLPArrays(saved.state) if isinstance(saved, SavedState) else saved.model
-    rows = design.feature_rows(pressures)
+    codes = design.as_array() if isinstance(design, SFRBADesign) else design
+    rows = np.empty((pressures.size, codes.size + 1))
+    rows[:, :-1] = codes
+    rows[:, -1] = pressures
     ranges = saved.metadata.get("training_ranges")
     has_ranges = isinstance(ranges, dict)
-    outside = outside_training_ranges(ranges, rows) if isinstance(ranges, dict) else []
+    with using_features(actuator.features):
+        outside = outside_training_ranges(ranges, rows) if isinstance(ranges, dict) else []
+        inside = (
+            np.array([not outside_training_ranges(ranges, row) for row in rows])
+            if isinstance(ranges, dict)
+            else np.ones(len(rows), dtype=bool)
+        )
     if strict and outside:
         raise ValueError(
             f"The 'design' and 'pressure' must lie in the training data of {path}: "
@@ -240,8 +277,11 @@ def predict_angles(
         if callable(getattr(model, "predict_interval", None)):
             low, high = model.predict_interval(rows, INTERVAL_LEVEL)
             interval = (np.asarray(low, dtype=float), np.asarray(high, dtype=float))
-    _check_finite(path, saved.kind, pressures, angles, "angle", outside)
-    beyond, supported = _support_check(saved.metadata.get("support"), rows, angles)
+    _check_finite(path, saved.kind, pressures, angles, "angle", outside, unit)
+    with using_features(actuator.features):
+        beyond, supported = _support_check(saved.metadata.get("support"), rows, angles)
+    if supported is not None:  # one trust signal: inside the support and the ranges
+        supported = supported & inside
     if strict and beyond:
         raise ValueError(
             f"The 'design' and 'pressure' must lie in the training data of {path}: "
@@ -255,8 +295,10 @@ def predict_angles(
     calibrated = calibrated_interval(saved.metadata.get("interval"), angles)
     interval = calibrated if calibrated is not None else interval
     if interval is not None:
-        _check_finite(path, saved.kind, pressures, interval[0], "interval's low end", outside)
-        _check_finite(path, saved.kind, pressures, interval[1], "interval's high end", outside)
+        _check_finite(path, saved.kind, pressures, interval[0], "interval's low end", outside, unit)
+        _check_finite(
+            path, saved.kind, pressures, interval[1], "interval's high end", outside, unit
+        )
     return Prediction(
         saved.kind,
         design,
@@ -268,7 +310,28 @@ def predict_angles(
         str(path),
         beyond,
         supported,
+        actuator,
     )
+
+
+def _design_of(
+    design: SFRBADesign | str | ArrayLike, actuator: Actuator, path: str | os.PathLike[str]
+) -> SFRBADesign | np.ndarray:
+    """``design`` as paper B's design (its model) or the codes of ``actuator``'s, checked."""
+    if isinstance(design, SFRBADesign):
+        if actuator != SFRBA:
+            raise ValueError(
+                f"The model {path} is of the actuator {actuator.name} "
+                f"({', '.join(actuator.names)}), not paper B's; give its design by name."
+            )
+        return design
+    if isinstance(design, str):
+        codes = actuator.parse_design(design)
+    else:
+        codes = actuator.check_designs(np.asarray(design, dtype=float).ravel())[0]
+    if actuator == SFRBA:
+        return SFRBADesign.from_sequence(codes.tolist())
+    return codes
 
 
 def _support_check(
@@ -357,6 +420,7 @@ def _check_finite(
     values: np.ndarray,
     what: str,
     outside: list[str],
+    unit: str = "MPa",
 ) -> None:
     """Raise naming ``path`` at the first non-finite value of ``values``.
 
@@ -374,6 +438,6 @@ def _check_finite(
         )
         raise error(
             f"The model {path} ({kind} surrogate) predicts a non-finite {what} "
-            f"({values[i]}) at {pressures[i]:g} MPa; a prediction must be a finite number "
+            f"({values[i]}) at {pressures[i]:g} {unit}; a prediction must be a finite number "
             f"of degrees: {cause}."
         )

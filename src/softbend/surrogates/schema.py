@@ -34,7 +34,7 @@ import numpy as np
 from softbend._validation import short_repr
 from softbend.design import FEATURE_QUANTITIES
 from softbend.plausibility import RANGES, implausible_index
-from softbend.surrogates.features import FEATURES, TARGET
+from softbend.surrogates.features import FEATURES, TARGET, is_paper_b, model_features
 
 __all__ = [
     "COMPOSITE_SCHEMAS",
@@ -344,14 +344,15 @@ def _booster(value: Any) -> str:
         raise RuleError("must be XGBoost's JSON model; no 'learner' object")
     param = learner.get("learner_model_param")
     n_features = param.get("num_feature") if isinstance(param, dict) else None
-    if n_features is not None and str(n_features) != str(len(FEATURES)):
+    features = model_features()
+    if n_features is not None and str(n_features) != str(len(features)):
         raise RuleError(
-            f"must take the {len(FEATURES)} surrogate inputs; got {n_features} features"
+            f"must take the {len(features)} surrogate inputs; got {n_features} features"
         )
     names = learner.get("feature_names", [])
-    if names and names != list(FEATURES):  # empty: fitted on an array, no names recorded
+    if names and names != list(features):  # empty: fitted on an array, no names recorded
         raise RuleError(
-            f"must be fitted on the columns {', '.join(FEATURES)} in this order (or record no "
+            f"must be fitted on the columns {', '.join(features)} in this order (or record no "
             f"feature names); got feature_names {short_repr(names)}"
         )
     return value
@@ -359,19 +360,20 @@ def _booster(value: Any) -> str:
 
 def _check_inputs(state: dict[str, Any]) -> None:
     """Rules across keys shared by the polynomial and the MLP: the input standardization."""
-    d = len(FEATURES)
+    features = model_features()
+    d = len(features)
     if int(state["n_features_in_"]) != d:
         raise RuleError(
-            f"state key 'n_features_in_' must be {d} (the inputs {', '.join(FEATURES)}); "
+            f"state key 'n_features_in_' must be {d} (the inputs {', '.join(features)}); "
             f"got {state['n_features_in_']}"
         )
     for key in ("x_mean_", "x_scale_"):
         if state[key].shape != (d,):
             raise RuleError(f"state key '{key}' must have shape ({d},); got {state[key].shape}")
     names = state.get("feature_names_in_")
-    if names is not None and [str(n) for n in names] != list(FEATURES):
+    if names is not None and [str(n) for n in names] != list(features):
         raise RuleError(
-            f"state key 'feature_names_in_' must be {', '.join(FEATURES)}; "
+            f"state key 'feature_names_in_' must be {', '.join(features)}; "
             f"got {', '.join(map(str, names))}"
         )
 
@@ -379,10 +381,10 @@ def _check_inputs(state: dict[str, Any]) -> None:
 def _check_polynomial(state: dict[str, Any]) -> None:
     _check_inputs(state)
     powers, coef = state["powers_"], state["coef_"]
-    if powers.shape[0] < 1 or powers.shape[1] != len(FEATURES):
+    d = len(model_features())
+    if powers.shape[0] < 1 or powers.shape[1] != d:
         raise RuleError(
-            f"state key 'powers_' must have shape (n_terms >= 1, {len(FEATURES)}); "
-            f"got {powers.shape}"
+            f"state key 'powers_' must have shape (n_terms >= 1, {d}); got {powers.shape}"
         )
     if coef.shape != (powers.shape[0],):
         raise RuleError(
@@ -403,7 +405,7 @@ def _check_polynomial(state: dict[str, Any]) -> None:
 def _check_mlp(state: dict[str, Any]) -> None:
     _check_inputs(state)
     coefs, intercepts = state["coefs_"], state["intercepts_"]
-    d, h1, h2 = len(FEATURES), coefs[0].shape[1], coefs[1].shape[1]
+    d, h1, h2 = len(model_features()), coefs[0].shape[1], coefs[1].shape[1]
     expected = [(d, h1), (h1, h2), (h2, 1)]
     if [c.shape for c in coefs] != expected or 0 in (h1, h2):
         raise RuleError(
@@ -461,13 +463,14 @@ def _check_affine(state: dict[str, Any]) -> None:
     _check_residual_std(state)
 
 
-#: Names of the GP kernel's hyperparameters, in the order of ``kernel_theta_``.
-_GP_INPUTS: tuple[str, ...] = (*FEATURES, f"the base's {TARGET}")
-_GP_HYPERPARAMETERS: tuple[str, ...] = (
-    "constant",
-    *(f"length scale of {name}" for name in _GP_INPUTS),
-    "noise",
-)
+def _gp_inputs() -> tuple[str, ...]:
+    """The GP correction's inputs: the model's inputs and the base's angle."""
+    return (*model_features(), f"the base's {TARGET}")
+
+
+def _gp_hyperparameters() -> tuple[str, ...]:
+    """Names of the GP kernel's hyperparameters, in the order of ``kernel_theta_``."""
+    return ("constant", *(f"length scale of {name}" for name in _gp_inputs()), "noise")
 
 
 def _check_gp(state: dict[str, Any]) -> None:
@@ -485,7 +488,8 @@ def _check_gp(state: dict[str, Any]) -> None:
     kernel-width range in magnitude and the ``targets_`` (the base's errors,
     degrees) are plausible angles.
     """
-    d = len(_GP_INPUTS)  # the inputs and the base's angle
+    gp_inputs = _gp_inputs()
+    d = len(gp_inputs)  # the inputs and the base's angle
     for key in ("z_mean_", "z_scale_"):
         if state[key].shape != (d,):
             raise RuleError(f"state key '{key}' must have shape ({d},); got {state[key].shape}")
@@ -511,11 +515,16 @@ def _check_gp(state: dict[str, Any]) -> None:
             f"state key 'kernel_theta_' must hold the logarithms of the kernel's constant, "
             f"length scales and noise, each within {width.low:g} to {width.high:g} "
             f"(log {math.log(width.low):.4g} to {math.log(width.high):.4g}); got "
-            f"{_GP_HYPERPARAMETERS[bad]} {hyper[bad]:g} (log {state['kernel_theta_'][bad]:g}) "
+            f"{_gp_hyperparameters()[bad]} {hyper[bad]:g} (log {state['kernel_theta_'][bad]:g}) "
             f"at index {bad}"
         )
-    quantities = [QUANTITIES[name] for name in (*FEATURES, TARGET)]
-    for j, (name, quantity) in enumerate(zip(_GP_INPUTS, quantities, strict=True)):
+    # paper B's inputs have plausible ranges; another actuator's only its angle
+    named = (*FEATURES, TARGET) if is_paper_b() else (TARGET,)
+    quantities = [QUANTITIES[name] for name in named]
+    checked = gp_inputs if is_paper_b() else gp_inputs[-1:]
+    offset = d - len(checked)
+    for k, (name, quantity) in enumerate(zip(checked, quantities, strict=True)):
+        j = offset + k
         bounds = RANGES[quantity]
         mean, scale = float(state["z_mean_"][j]), float(state["z_scale_"][j])
         unit = f" {bounds.unit}" if bounds.unit else ""

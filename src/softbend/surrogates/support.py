@@ -51,8 +51,6 @@ RULE = (
     f"{1 + ANGLE_TOLERANCE:g} x the largest training angle"
 )
 
-_DESIGN = slice(0, len(PARAMETERS))
-
 
 @dataclass(frozen=True)
 class Support:
@@ -66,18 +64,26 @@ class Support:
         The largest pressure each design was trained at, MPa gauge.
     max_angle_deg : float
         The largest angle in the training data, degrees.
+    parameters : tuple of str
+        The design parameters' names (paper B's by default).
+    pressure_unit : str
+        Unit of ``max_pressure_mpa`` and of the pressure input: MPa for paper
+        B's actuator, the actuator's own unit for another.
     """
 
     designs: np.ndarray
     max_pressure_mpa: np.ndarray
     max_angle_deg: float
+    parameters: tuple[str, ...] = PARAMETERS
+    pressure_unit: str = "MPa"
 
     def __post_init__(self) -> None:
         designs = np.asarray(self.designs, dtype=np.float64)
         pmax = np.asarray(self.max_pressure_mpa, dtype=np.float64).ravel()
-        if designs.ndim != 2 or designs.shape[1] != len(PARAMETERS) or designs.shape[0] == 0:
+        d = len(self.parameters)
+        if designs.ndim != 2 or designs.shape[1] != d or designs.shape[0] == 0:
             raise ValueError(
-                f"The 'designs' of Support must have shape (n, {len(PARAMETERS)}) with n >= 1. "
+                f"The 'designs' of Support must have shape (n, {d}) with n >= 1. "
                 f"Got shape {designs.shape} instead."
             )
         if pmax.shape != (designs.shape[0],):
@@ -90,6 +96,7 @@ class Support:
                 "The 'designs' and 'max_pressure_mpa' of Support must be finite, the "
                 "pressures >= 0 MPa."
             )
+        object.__setattr__(self, "parameters", tuple(self.parameters))
         if not (math.isfinite(self.max_angle_deg) and self.max_angle_deg > 0):
             raise ValueError(
                 f"The 'max_angle_deg' of Support must be a finite angle > 0 degrees. "
@@ -106,7 +113,7 @@ class Support:
 
     def max_pressure(self, designs: ArrayLike) -> np.ndarray:
         """The largest supported pressure at each of ``designs`` (rows of 6), MPa."""
-        query = np.atleast_2d(np.asarray(designs, dtype=np.float64))[:, _DESIGN]
+        query = np.atleast_2d(np.asarray(designs, dtype=np.float64))[:, : len(self.parameters)]
         span = np.ptp(self.designs, axis=0)
         span = np.where(span > 0, span, 1.0)
         out = np.empty(query.shape[0])
@@ -139,9 +146,11 @@ class Support:
         over = rows[:, -1] > limit * (1 + 1e-9) + 1e-12
         if over.any():
             i = int(np.flatnonzero(over)[np.argmax(rows[over, -1] - limit[over])])
+            unit = self.pressure_unit
+            design = rows[i, : len(self.parameters)]
             phrases.append(
-                f"pressure {rows[i, -1]:g} MPa beyond the {limit[i]:.3g} MPa the training "
-                f"designs nearest to ({','.join(f'{v:g}' for v in rows[i, _DESIGN])}) "
+                f"pressure {rows[i, -1]:g} {unit} beyond the {limit[i]:.3g} {unit} the training "
+                f"designs nearest to ({','.join(f'{v:g}' for v in design)}) "
                 "were swept to"
             )
         if angles is not None:
@@ -161,17 +170,26 @@ class Support:
         unique, inverse = np.unique(designs, axis=0, return_inverse=True)
         best = np.zeros(unique.shape[0])
         np.maximum.at(best, inverse.ravel(), pmax)
-        return Support(unique, best, max(self.max_angle_deg, other.max_angle_deg))
+        return Support(
+            unique,
+            best,
+            max(self.max_angle_deg, other.max_angle_deg),
+            self.parameters,
+            self.pressure_unit,
+        )
 
     def to_dict(self) -> dict[str, Any]:
         """JSON-friendly record (the ``support`` metadata of a saved surrogate)."""
-        return {
+        out = {
             "rule": RULE,
-            "parameters": list(PARAMETERS),
+            "parameters": list(self.parameters),
             "designs": [[float(v) for v in row] for row in self.designs],
             "max_pressure_mpa": [float(v) for v in self.max_pressure_mpa],
             "max_angle_deg": self.max_angle_deg,
         }
+        if self.pressure_unit != "MPa":
+            out["pressure_unit"] = self.pressure_unit
+        return out
 
     @classmethod
     def from_dict(cls, data: Any) -> Support:
@@ -188,18 +206,30 @@ class Support:
         missing = [k for k in ("designs", "max_pressure_mpa", "max_angle_deg") if k not in data]
         if missing:
             raise ValueError(f"lacks {', '.join(missing)}")
-        if data.get("parameters", list(PARAMETERS)) != list(PARAMETERS):
-            raise ValueError(f"must list the parameters {', '.join(PARAMETERS)}")
+        from softbend.surrogates.features import model_features
+
+        expected = list(model_features()[:-1])
+        if data.get("parameters", list(PARAMETERS)) != expected:
+            raise ValueError(f"must list the parameters {', '.join(expected)}")
+        unit = data.get("pressure_unit", "MPa")
+        if not isinstance(unit, str):
+            raise ValueError("must give the pressure unit as text")
         try:
             designs = np.asarray(data["designs"], dtype=np.float64)
             pmax = np.asarray(data["max_pressure_mpa"], dtype=np.float64)
             angle = float(data["max_angle_deg"])
         except (TypeError, ValueError):
             raise ValueError("must hold numbers only") from None
-        return cls(designs, pmax, angle)
+        return cls(designs, pmax, angle, tuple(expected), unit)
 
 
-def support_from_rows(X: ArrayLike, y: ArrayLike) -> Support:
+def support_from_rows(
+    X: ArrayLike,
+    y: ArrayLike,
+    *,
+    parameters: tuple[str, ...] = PARAMETERS,
+    pressure_unit: str = "MPa",
+) -> Support:
     """The support of training rows ``X`` (7 inputs, mm, deg, MPa) and angles ``y`` (deg).
 
     Each distinct design (first six columns) keeps its largest pressure; the
@@ -207,13 +237,20 @@ def support_from_rows(X: ArrayLike, y: ArrayLike) -> Support:
     """
     rows = np.asarray(X, dtype=np.float64)
     angles = np.asarray(y, dtype=np.float64).ravel()
-    if rows.ndim != 2 or rows.shape[1] != len(PARAMETERS) + 1 or rows.shape[0] != angles.size:
+    d = len(parameters)
+    if rows.ndim != 2 or rows.shape[1] != d + 1 or rows.shape[0] != angles.size:
         raise ValueError(
-            f"The 'X' and 'y' of support_from_rows must be rows of {len(PARAMETERS) + 1} inputs "
+            f"The 'X' and 'y' of support_from_rows must be rows of {d + 1} inputs "
             f"and one angle per row. Got shapes {rows.shape} and {angles.shape} instead."
         )
-    unique, inverse = np.unique(rows[:, _DESIGN], axis=0, return_inverse=True)
+    unique, inverse = np.unique(rows[:, :d], axis=0, return_inverse=True)
     pmax = np.zeros(unique.shape[0])
     np.maximum.at(pmax, inverse.ravel(), rows[:, -1])
     finite = angles[np.isfinite(angles)]
-    return Support(unique, pmax, float(finite.max()) if finite.size else math.nan)
+    return Support(
+        unique,
+        pmax,
+        float(finite.max()) if finite.size else math.nan,
+        tuple(parameters),
+        pressure_unit,
+    )
