@@ -139,7 +139,8 @@ class DesignParameter:
                 f"{', '.join(KINDS)}; got {self.kind!r}."
             )
         if self.kind == "categorical":
-            if not self.levels or len(set(map(str, self.levels))) != len(self.levels):
+            levels = self.levels or ()
+            if len(levels) < 2 or len(set(map(str, levels))) != len(levels):
                 raise ActuatorError(
                     f"The categorical design parameter {self.name!r} needs two or more distinct "
                     f"levels; got {self.levels!r}."
@@ -198,9 +199,9 @@ class DesignParameter:
         """The value a model input ``code`` stands for (a level for a categorical parameter)."""
         if self.kind == "categorical":
             assert self.levels is not None
-            return self.levels[int(round(code))]
+            return self.levels[round(code)]
         if self.kind == "integer":
-            return int(round(code))
+            return round(code)
         return float(code)
 
     def snap(self, values: np.ndarray) -> np.ndarray:
@@ -227,9 +228,11 @@ class DesignParameter:
         eps = 1e-9 * max(1.0, abs(self.low), abs(self.high))
         outside = (values < self.low - eps) | (values > self.high + eps)
         if outside.any():
-            shown = self.decode(values[outside][0]) if self.kind == "categorical" else values[
-                outside
-            ][0]
+            shown = (
+                self.decode(values[outside][0])
+                if self.kind == "categorical"
+                else values[outside][0]
+            )
             raise ActuatorError(
                 f"The design parameter {self.name!r}{at} must be {self._what()}; got {shown:g}."
                 if isinstance(shown, float)
@@ -332,8 +335,7 @@ def _parse_constraint(text: str, names: Sequence[str]) -> ast.Compare:
         ) from None
     if not isinstance(tree, ast.Compare) or not all(type(op) in _COMPARE for op in tree.ops):
         raise ActuatorError(
-            f"The constraint {text!r} must compare with <, <=, > or >= "
-            "(such as 't_mm < r_mm')."
+            f"The constraint {text!r} must compare with <, <=, > or >= (such as 't_mm < r_mm')."
         )
     for node in ast.walk(tree):
         if isinstance(node, ast.Name) and node.id not in names:
@@ -345,9 +347,11 @@ def _parse_constraint(text: str, names: Sequence[str]) -> ast.Compare:
         if isinstance(node, ast.Constant):
             if isinstance(node.value, bool) or not isinstance(node.value, int | float):
                 raise ActuatorError(f"The constraint {text!r} may hold only numbers and names.")
-        elif not isinstance(node, allowed) and type(node) not in _COMPARE and type(
-            node
-        ) not in _ARITHMETIC:
+        elif (
+            not isinstance(node, allowed)
+            and type(node) not in _COMPARE
+            and type(node) not in _ARITHMETIC
+        ):
             raise ActuatorError(
                 f"The constraint {text!r} may use only + - * / and comparisons of the "
                 "design parameters and numbers."
@@ -494,9 +498,7 @@ class Actuator:
         the ranges, kinds and constraints.
         """
         if not isinstance(text, str) or not text.strip():
-            raise ActuatorError(
-                f"The {field} must be {self.design_hint()}; got {text!r}."
-            )
+            raise ActuatorError(f"The {field} must be {self.design_hint()}; got {text!r}.")
         items = [item.strip() for item in text.split(",")]
         if any("=" in item for item in items):
             values: dict[str, Any] = {}
@@ -598,7 +600,8 @@ class Actuator:
         for p, code in zip(self.parameters, codes, strict=True):
             value = p.decode(float(code))
             shown = f"{value:g}" if isinstance(value, float) else str(value)
-            parts.append(f"{p.name}={shown}{' ' + p.unit if p.unit and p.kind != 'categorical' else ''}")
+            unit = f" {p.unit}" if p.unit and p.kind != "categorical" else ""
+            parts.append(f"{p.name}={shown}{unit}")
         return ", ".join(parts)
 
     def design_record(self, codes: Sequence[float]) -> dict[str, Any]:
@@ -701,9 +704,7 @@ class Actuator:
                 levels = tuple(sorted({str(v) for v in values.dropna()}))
                 if len(levels) < 2:
                     levels = (*levels, f"{levels[0]}_other") if levels else ("a", "b")
-                parameters.append(
-                    DesignParameter(column, "", kind="categorical", levels=levels)
-                )
+                parameters.append(DesignParameter(column, "", kind="categorical", levels=levels))
                 continue
             numbers = values.to_numpy(dtype=float)
             finite = numbers[np.isfinite(numbers)]

@@ -1,0 +1,211 @@
+"""Training on any actuator's simulation table: columns, units, kinds, bad input, round trip."""
+
+from __future__ import annotations
+
+import json
+
+import numpy as np
+import pandas as pd
+import pytest
+
+from softbend.actuators import SFRBA, ActuatorError, get_actuator
+from softbend.errors import DatasetError
+from softbend.surrogates.persistence import load_surrogate
+from softbend.surrogates.predict import predict_angles
+from softbend.surrogates.tables import table_training_data
+from softbend.surrogates.workflow import train_surrogates
+
+COLUMNS = "n_chambers,wall_mm,height_mm,layer"
+
+
+def truth(n, wall, height, layer, p_kpa):
+    """A smooth made-up bending law (degrees) with a pre-curvature of -3 degrees."""
+    stiffness = wall * (1.3 if layer == "fabric" else 1.0)
+    return -3.0 + n * height * (p_kpa / 50.0) ** 1.2 / stiffness
+
+
+def table(designs: int = 24, seed: int = 0) -> pd.DataFrame:
+    rng = np.random.default_rng(seed)
+    rows = []
+    for i in range(designs):
+        n = int(rng.integers(6, 15))
+        wall = round(float(rng.uniform(1.0, 3.0)), 1)
+        height = round(float(rng.uniform(8.0, 16.0)), 1)
+        layer = str(rng.choice(["paper", "fabric"]))
+        for p in np.linspace(0.0, 50.0, 6):
+            rows.append(
+                {
+                    "design_id": f"d{i:02d}",
+                    "n_chambers": n,
+                    "wall_mm": wall,
+                    "height_mm": height,
+                    "layer": layer,
+                    "p_kpa": p,
+                    "angle_deg": truth(n, wall, height, layer, p),
+                }
+            )
+    return pd.DataFrame(rows)
+
+
+@pytest.fixture(scope="module")
+def sims(tmp_path_factory):
+    path = tmp_path_factory.mktemp("sims") / "sims.csv"
+    table().to_csv(path, index=False)
+    return path
+
+
+def read(path, **kwargs):
+    options = {
+        "design_columns": COLUMNS,
+        "pressure_column": "p_kpa",
+        "pressure_unit": "kPa",
+        **kwargs,
+    }
+    return table_training_data(path, **options)
+
+
+def test_a_table_becomes_training_data_grouped_by_design(sims):
+    data = read(sims)
+    assert data.X.shape == (24 * 6, 5)
+    assert data.n_groups == 24
+    a = data.actuator
+    assert a.features == ("n_chambers", "wall_mm", "height_mm", "layer", "p_kpa")
+    assert [p.kind for p in a.parameters] == ["integer", "continuous", "continuous", "categorical"]
+    assert a.pressure_unit == "kPa"
+    # a negative angle at zero pressure (pre-curved) is kept
+    assert data.y.min() == pytest.approx(-3.0)
+
+
+def test_parquet_reads_as_the_csv_does(sims, tmp_path):
+    pytest.importorskip("pyarrow")
+    parquet = tmp_path / "sims.parquet"
+    pd.read_csv(sims).to_parquet(parquet)
+    a, b = read(sims), read(parquet)
+    np.testing.assert_array_equal(a.X, b.X)
+    assert a.data_hash == b.data_hash
+
+
+@pytest.mark.parametrize(
+    ("kwargs", "match"),
+    [
+        ({"design_columns": "n_chambers,wall_mm,height_mm,lyr"}, "no column 'lyr'"),
+        ({"pressure_column": "p_mpa"}, "no column 'p_mpa'"),
+        ({"angle_column": "theta"}, "no column 'theta'"),
+        ({"pressure_unit": "Pa"}, "kPa, MPa, bar, psi"),
+        ({"angle_column": "angle_rad"}, "radians"),
+        ({"pressure_column": "wall_mm"}, "also one of the --design-columns"),
+        ({"design_columns": "wall_mm,wall_mm"}, "twice"),
+    ],
+)
+def test_bad_options_are_one_error_naming_the_column(sims, kwargs, match):
+    with pytest.raises(ActuatorError, match=match):
+        read(sims, **kwargs)
+
+
+def test_angles_in_radians_are_refused_with_the_factor(tmp_path):
+    frame = table()
+    frame["angle_deg"] = np.radians(frame["angle_deg"]) / 10
+    path = tmp_path / "rad.csv"
+    frame.to_csv(path, index=False)
+    with pytest.raises(ActuatorError, match=r"57\.2958"):
+        read(path)
+
+
+def test_a_table_outside_a_registered_description_names_the_parameter(tmp_path):
+    frame = pd.DataFrame(
+        {
+            "l_mm": [100.0, 100.0],
+            "r_mm": [6.0, 6.0],
+            "t_mm": [7.0, 7.0],  # thicker than the radius
+            "b_mm": [2.0, 2.0],
+            "phi_deg": [5.0, 5.0],
+            "lc_mm": [8.0, 8.0],
+            "pressure_mpa": [0.0, 0.1],
+            "angle_deg": [0.0, 30.0],
+        }
+    )
+    path = tmp_path / "b.csv"
+    frame.to_csv(path, index=False)
+    with pytest.raises(ActuatorError, match="t_mm < r_mm"):
+        table_training_data(path, actuator=get_actuator("sfrba"))
+
+
+def test_missing_options_without_a_description(sims):
+    with pytest.raises(ActuatorError, match="--design-columns"):
+        table_training_data(sims, pressure_column="p_kpa", pressure_unit="kPa")
+    with pytest.raises(ActuatorError, match="--pressure-unit"):
+        table_training_data(sims, design_columns=COLUMNS, pressure_column="p_kpa")
+
+
+def test_negative_pressure_and_unreadable_files(tmp_path):
+    frame = table(designs=3)
+    frame.loc[3, "p_kpa"] = -5.0
+    path = tmp_path / "neg.csv"
+    frame.to_csv(path, index=False)
+    with pytest.raises(ActuatorError, match=">= 0 kPa"):
+        read(path)
+    bad = tmp_path / "bad.txt"
+    bad.write_text("x")
+    with pytest.raises(DatasetError, match="CSV or Parquet"):
+        read(bad)
+
+
+@pytest.fixture(scope="module")
+def trained(sims, tmp_path_factory):
+    out = tmp_path_factory.mktemp("m")
+    _, summary = train_surrogates(
+        read(sims), out, models="plr", grid_name="quick", folds=3, export_onnx=False
+    )
+    return out / "models" / "plr.json", summary
+
+
+def test_a_model_of_a_table_records_its_description_and_round_trips(trained, sims):
+    path, summary = trained
+    assert summary["actuator"]["pressure_unit"] == "kPa"
+    saved = load_surrogate(path)
+    assert saved.actuator == read(sims).actuator
+    assert saved.actuator != SFRBA
+    document = json.loads(path.read_text())
+    assert document["features"] == list(saved.actuator.features)
+    assert document["units"]["p_kpa"] == "kPa"
+    assert set(document["metadata"]["training_ranges"]) == set(saved.actuator.features)
+
+
+def test_predict_by_name_matches_the_law_it_learned(trained):
+    path, _ = trained
+    pred = predict_angles(path, "n_chambers=10,wall_mm=2,height_mm=12,layer=paper", [0.0, 25, 50])
+    expected = [truth(10, 2.0, 12.0, "paper", p) for p in (0.0, 25, 50)]
+    np.testing.assert_allclose(pred.angle_deg, expected, atol=0.15 * max(expected))
+    record = pred.to_dict()
+    assert record["design"] == {
+        "n_chambers": 10,
+        "wall_mm": 2.0,
+        "height_mm": 12.0,
+        "layer": "paper",
+    }
+    assert "p_kpa" in record and "pressure_mpa" not in record
+
+
+def test_positional_design_equals_by_name(trained):
+    path, _ = trained
+    a = predict_angles(path, "n_chambers=9,wall_mm=1.5,height_mm=10,layer=fabric", [20.0])
+    b = predict_angles(path, "9,1.5,10,fabric", [20.0])
+    np.testing.assert_array_equal(a.angle_deg, b.angle_deg)
+
+
+def test_outside_the_training_ranges_is_not_supported(trained):
+    path, _ = trained
+    pred = predict_angles(path, "n_chambers=10,wall_mm=2,height_mm=12,layer=paper", [25.0, 80.0])
+    assert pred.supported is not None
+    assert pred.supported.tolist() == [True, False]
+    assert any("p_kpa" in phrase for phrase in pred.extrapolated)
+    with pytest.raises(ValueError, match="p_kpa"):
+        predict_angles(
+            path, "n_chambers=10,wall_mm=2,height_mm=12,layer=paper", [80.0], strict=True
+        )
+
+
+def test_paper_b_design_names_are_refused_for_another_actuator(trained):
+    path, _ = trained
+    with pytest.raises(ValueError, match="not a design parameter"):
+        predict_angles(path, "l_mm=100,r_mm=6,t_mm=2,b_mm=2,phi_deg=5,lc_mm=8", [10.0])
