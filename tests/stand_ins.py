@@ -4,6 +4,9 @@ from __future__ import annotations
 
 from pathlib import Path
 
+import numpy as np
+import pandas as pd
+
 from softbend.design import DesignSpace
 
 
@@ -74,3 +77,37 @@ class StuckOpen:
 
     def step(self, measurement_mpa, reference_deg, t_s):
         return (True, False)
+
+
+# --- an actuator other than paper B's: a simulation table by named columns -----------------
+
+ACTUATOR_COLUMNS = "n_chambers,wall_mm,height_mm,layer"
+
+
+def actuator_law(n, wall, height, layer, p_kpa):
+    """A made-up bending law of a four-parameter actuator, degrees (pre-curved by -3°)."""
+    stiffness = wall * (1.3 if layer == "fabric" else 1.0)
+    return -3.0 + n * height * (p_kpa / 50.0) ** 1.2 / stiffness
+
+
+def actuator_table(designs: int = 24, seed: int = 0) -> pd.DataFrame:
+    rng = np.random.default_rng(seed)
+    rows = []
+    for i in range(designs):
+        n = int(rng.integers(6, 15))
+        wall = round(float(rng.uniform(1.0, 3.0)), 1)
+        height = round(float(rng.uniform(8.0, 16.0)), 1)
+        layer = str(rng.choice(["paper", "fabric"]))
+        for p in np.linspace(0.0, 50.0, 6):
+            rows.append(
+                {
+                    "design_id": f"d{i:02d}",
+                    "n_chambers": n,
+                    "wall_mm": wall,
+                    "height_mm": height,
+                    "layer": layer,
+                    "p_kpa": p,
+                    "angle_deg": actuator_law(n, wall, height, layer, p),
+                }
+            )
+    return pd.DataFrame(rows)

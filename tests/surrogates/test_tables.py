@@ -15,36 +15,9 @@ from softbend.surrogates.predict import predict_angles
 from softbend.surrogates.tables import table_training_data
 from softbend.surrogates.workflow import train_surrogates
 
-COLUMNS = "n_chambers,wall_mm,height_mm,layer"
-
-
-def truth(n, wall, height, layer, p_kpa):
-    """A smooth made-up bending law (degrees) with a pre-curvature of -3 degrees."""
-    stiffness = wall * (1.3 if layer == "fabric" else 1.0)
-    return -3.0 + n * height * (p_kpa / 50.0) ** 1.2 / stiffness
-
-
-def table(designs: int = 24, seed: int = 0) -> pd.DataFrame:
-    rng = np.random.default_rng(seed)
-    rows = []
-    for i in range(designs):
-        n = int(rng.integers(6, 15))
-        wall = round(float(rng.uniform(1.0, 3.0)), 1)
-        height = round(float(rng.uniform(8.0, 16.0)), 1)
-        layer = str(rng.choice(["paper", "fabric"]))
-        for p in np.linspace(0.0, 50.0, 6):
-            rows.append(
-                {
-                    "design_id": f"d{i:02d}",
-                    "n_chambers": n,
-                    "wall_mm": wall,
-                    "height_mm": height,
-                    "layer": layer,
-                    "p_kpa": p,
-                    "angle_deg": truth(n, wall, height, layer, p),
-                }
-            )
-    return pd.DataFrame(rows)
+from ..stand_ins import ACTUATOR_COLUMNS as COLUMNS
+from ..stand_ins import actuator_law as truth
+from ..stand_ins import actuator_table as table
 
 
 @pytest.fixture(scope="module")
