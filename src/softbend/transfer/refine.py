@@ -27,7 +27,7 @@ import warnings
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass
 from pathlib import Path
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
@@ -35,6 +35,9 @@ from softbend.errors import ConvergenceError
 from softbend.transfer.conformal import Calibration, angle_floor, calibrate
 from softbend.transfer.parameters import check_parameters, recorded_parameters, takes
 from softbend.transfer.strategies import STRATEGIES, fit_strategy, learns
+
+if TYPE_CHECKING:
+    from softbend.actuators import Actuator
 
 __all__ = ["Refinement", "refinable_strategies", "refine_surrogate"]
 
@@ -189,14 +192,10 @@ def refine_surrogate(
         A refit that diverged, or whose predictions on the readings, training
         error, final loss or calibrated half-width is not finite.
     """
-    from softbend.surrogates.features import training_ranges
-    from softbend.surrogates.persistence import load_surrogate
-    from softbend.surrogates.support import Support, support_from_rows
-    from softbend.transfer.measurements import (
-        files_record,
-        load_measurements_files,
-        synthetic_label,
-    )
+    from softbend.actuators import SFRBA
+    from softbend.surrogates.persistence import describing, load_surrogate
+    from softbend.transfer.actuator_measurements import load_actuator_measurements
+    from softbend.transfer.measurements import load_measurements_files
 
     cls = STRATEGIES.get(strategy, field="strategy")
     if not learns(strategy):
@@ -209,11 +208,54 @@ def refine_surrogate(
         **check_parameters(strategy, cls, options),
     }
     files = [measurements] if isinstance(measurements, str | os.PathLike) else list(measurements)
-    data = load_measurements_files(files, force=force)
     start = load_surrogate(base)
+    actuator = start.actuator
+    data: Any
+    if actuator == SFRBA:
+        data = load_measurements_files(files, force=force)
+    else:  # another actuator's plain CSV: its own columns and units
+        data = load_actuator_measurements(files, actuator, force=force)
+    with describing(actuator):
+        return _refine(
+            strategy,
+            start,
+            data,
+            files,
+            base,
+            actuator,
+            seed=seed,
+            values=values,
+            calibrated=calibrated,
+        )
+
+
+def _refine(
+    strategy: str,
+    start: Any,
+    data: Any,
+    files: list[str | os.PathLike[str]],
+    base: str | os.PathLike[str],
+    actuator: Actuator,
+    *,
+    seed: int,
+    values: dict[str, Any],
+    calibrated: bool,
+) -> Refinement:
+    """:func:`refine_surrogate` once its inputs are read, as a model of ``actuator``."""
+    from softbend.actuators import SFRBA
+    from softbend.surrogates.features import training_ranges
+    from softbend.surrogates.support import Support, support_from_rows
+    from softbend.transfer.measurements import files_record, synthetic_label
+
+    cls = STRATEGIES.get(strategy, field="strategy")
     model = fit_strategy(strategy, start.model, data, seed=seed, **values)
     ranges = training_ranges(data.features)
-    support = support_from_rows(data.features, data.angle_deg)
+    support = support_from_rows(
+        data.features,
+        data.angle_deg,
+        parameters=actuator.names,
+        pressure_unit=actuator.pressure_unit,
+    )
     if takes(cls, "base"):  # the base's simulations and the measurements
         ranges = _merged_ranges(ranges, start.metadata.get("training_ranges"))
         if isinstance(start.metadata.get("support"), dict):
@@ -235,6 +277,8 @@ def refine_surrogate(
         "training_ranges": ranges,
         "support": support.to_dict(),
     }
+    if actuator != SFRBA:
+        metadata["actuator"] = actuator.to_dict()
     if hasattr(model, "loss_curve_"):
         metadata["final_training_mse_deg2"] = float(model.loss_curve_[-1])
     _check_finite_figures(
