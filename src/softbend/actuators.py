@@ -243,8 +243,8 @@ class DesignParameter:
             fractional = np.abs(values - np.round(values)) > 1e-9
             if fractional.any():
                 raise ActuatorError(
-                    f"The design parameter {self.name!r}{at} must be a whole number "
-                    f"({self._what()}); got {values[fractional][0]:g}."
+                    f"The design parameter {self.name!r}{at} must be {self._what()}; "
+                    f"got {values[fractional][0]:g}."
                 )
 
     def _what(self) -> str:

@@ -1,0 +1,100 @@
+"""Plain measurement CSVs of a described actuator: columns, units, designs, radians."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from softbend.actuators import Actuator, ActuatorError, DesignParameter
+from softbend.errors import DatasetError
+from softbend.transfer.actuator_measurements import load_actuator_measurements
+
+ACTUATOR = Actuator(
+    name="bellows",
+    title="a bellows for tests",
+    parameters=(
+        DesignParameter("n_folds", "", 3, 9, kind="integer"),
+        DesignParameter("wall_mm", "mm", 0.5, 2.0),
+        DesignParameter("skin", kind="categorical", levels=("latex", "fabric")),
+    ),
+    pressure_column="p_kpa",
+    pressure_unit="kPa",
+)
+HEADER = "actuator,n_folds,wall_mm,skin,p_kpa,angle_deg"
+GOOD = [
+    "A1,5,1.0,latex,0,0.5",
+    "A1,5,1.0,latex,20,31.0",
+    "A1,5,1.0,latex,40,58.2",
+    "A2,7,1.5,fabric,0,-1.0",
+    "A2,7,1.5,fabric,30,40.0",
+]
+
+
+def write(tmp_path, lines, name="lab.csv", header=HEADER, preamble=()):
+    path = tmp_path / name
+    path.write_text("\n".join([*preamble, header, *lines]) + "\n", encoding="utf-8")
+    return path
+
+
+def test_a_plain_file_reads_into_model_inputs(tmp_path):
+    data = load_actuator_measurements(write(tmp_path, GOOD), ACTUATOR)
+    assert data.actuator_ids == ("A1", "A2")
+    np.testing.assert_array_equal(data.features[3], [7, 1.5, 1, 0])
+    np.testing.assert_array_equal(data.angle_deg, [0.5, 31.0, 58.2, -1.0, 40.0])
+    assert data.per_actuator().loc["A1", "pmax"] == 40
+    assert len(data.subset(["A2"])) == 2
+    assert not data.synthetic.any()
+
+
+def test_the_key_value_header_is_optional_and_kept(tmp_path):
+    path = write(tmp_path, GOOD, preamble=("# synthetic: true", "# rig: bench 2"))
+    data = load_actuator_measurements(path, ACTUATOR)
+    assert data.metadata == {"synthetic": "true", "rig": "bench 2"}
+    assert data.synthetic.all()
+
+
+def test_several_files_join(tmp_path):
+    a = write(tmp_path, GOOD[:3], "a.csv")
+    b = write(tmp_path, GOOD[3:], "b.csv")
+    data = load_actuator_measurements([a, b], ACTUATOR)
+    assert data.actuator_ids == ("A1", "A2")
+    assert data.provenance["source"].tolist() == [str(a)] * 3 + [str(b)] * 2
+
+
+@pytest.mark.parametrize(
+    ("header", "lines", "match"),
+    [
+        ("actuator,n_folds,wall_mm,p_kpa,angle_deg", ["A1,5,1.0,0,0"], "lacks the column.*skin"),
+        (
+            "actuator,n_folds,wall,skin,p_kpa,angle_deg",
+            ["A1,5,1.0,latex,0,0"],
+            "lacks the column.*wall_mm.*has column.*wall",
+        ),
+        ("actuator,n_folds,wall_mm,skin,pressure_mpa,angle_deg", ["A1,5,1,latex,0,0"], "p_kpa"),
+        (HEADER, ["A1,5.5,1.0,latex,0,0"], "line 2.*'n_folds'.*whole number"),
+        (HEADER, ["A1,5,1.0,rubber,0,0"], "line 2, column 'skin'.*latex, fabric"),
+        (HEADER, ["A1,5,9.0,latex,0,0"], r"wall_mm.*\[0.5, 2\]"),
+        (HEADER, ["A1,5,1.0,latex,-3,0"], ">= 0 kPa"),
+        (HEADER, ["A1,5,1.0,latex,nan,0"], "finite"),
+        (HEADER, [",5,1.0,latex,0,0"], "names its actuator"),
+        (HEADER, ["A1,5,1.0,latex,0,0", "A1,6,1.0,latex,10,20"], "two designs"),
+        (HEADER, ["A1,5,1.0,latex,0,0", "A1,5,1.0,latex,40,0.9"], "radians"),
+    ],
+)
+def test_bad_files_are_one_error_naming_the_column(tmp_path, header, lines, match):
+    with pytest.raises(ActuatorError, match=match):
+        load_actuator_measurements(write(tmp_path, lines, header=header), ACTUATOR)
+
+
+def test_force_reads_small_angles_as_given(tmp_path):
+    path = write(tmp_path, ["A1,5,1.0,latex,0,0", "A1,5,1.0,latex,40,0.9"])
+    with pytest.warns(UserWarning, match="radians"):
+        data = load_actuator_measurements(path, ACTUATOR, force=True)
+    assert data.angle_deg[-1] == pytest.approx(0.9)
+
+
+def test_missing_and_empty_files(tmp_path):
+    with pytest.raises(DatasetError, match="not found"):
+        load_actuator_measurements(tmp_path / "none.csv", ACTUATOR)
+    with pytest.raises(DatasetError, match="no data rows"):
+        load_actuator_measurements(write(tmp_path, []), ACTUATOR)
