@@ -86,16 +86,17 @@ def test_train_missing_database(tmp_path, capsys):
     ("design", "pressure", "needle"),
     [
         ("100,6,2,2,5", "0.1", "6 values"),
-        ("100,6,2,2,5,x", "0.1", "'design' must be six comma-separated numbers"),
+        ("100,6,2,2,5,x", "0.1", "'lc_mm' must be a number"),
         ("100,6,-2,2,5,8", "0.1", "t_mm"),
+        ("l_mm=100,r_mm=6", "0.1", "lacks t_mm, b_mm, phi_deg, lc_mm"),
+        ("n_chambers=10", "0.1", "not a design parameter"),
         ("100,6,2,2,5,8", "0.1,abc", "'--pressures'"),
         ("100,6,2,2,5,8", "-0.1", "'--pressures'"),
     ],
 )
-def test_predict_bad_input(tmp_path, capsys, design, pressure, needle):
-    fake = tmp_path / "m.json"
-    fake.write_text("{}")
-    code, _, err = _run(["predict", str(fake), "--design", design, "--pressures", pressure], capsys)
+def test_predict_bad_input(small_base_file, capsys, design, pressure, needle):
+    model = str(small_base_file)
+    code, _, err = _run(["predict", model, "--design", design, "--pressures", pressure], capsys)
     assert code == 2
     assert needle in err and len(err.strip().splitlines()) == 1
 
