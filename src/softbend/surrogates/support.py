@@ -150,7 +150,7 @@ class Support:
             design = rows[i, : len(self.parameters)]
             phrases.append(
                 f"pressure {rows[i, -1]:g} {unit} beyond the {limit[i]:.3g} {unit} the training "
-                f"designs nearest to ({','.join(f'{v:g}' for v in design)}) "
+                f"designs nearest to ({self._design_text(design)}) "
                 "were swept to"
             )
         if angles is not None:
@@ -162,6 +162,12 @@ class Support:
                     f"({self.max_angle_deg:.4g}°)"
                 )
         return phrases
+
+    def _design_text(self, design: np.ndarray) -> str:
+        """Paper B's design as its six numbers, another actuator's by name."""
+        if self.parameters == PARAMETERS:
+            return ",".join(f"{v:g}" for v in design)
+        return ", ".join(f"{n}={v:g}" for n, v in zip(self.parameters, design, strict=True))
 
     def merged(self, other: Support) -> Support:
         """The union of two supports (a design in both keeps its larger pressure)."""

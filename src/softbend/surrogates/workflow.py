@@ -202,8 +202,7 @@ def _train(
                 data.X, data.y, parameters=actuator.names, pressure_unit=actuator.pressure_unit
             ).to_dict(),
         }
-        if not paper_b:
-            metadata["actuator"] = actuator.to_dict()
+        metadata["actuator"] = actuator.to_dict()  # every model names its actuator
         family = FAMILIES.get(name)
         if family.storage is not None:
             files[f"{name}_model"] = str(

@@ -242,7 +242,6 @@ def _refine(
     calibrated: bool,
 ) -> Refinement:
     """:func:`refine_surrogate` once its inputs are read, as a model of ``actuator``."""
-    from softbend.actuators import SFRBA
     from softbend.surrogates.features import training_ranges
     from softbend.surrogates.support import Support, support_from_rows
     from softbend.transfer.measurements import files_record, synthetic_label
@@ -277,8 +276,7 @@ def _refine(
         "training_ranges": ranges,
         "support": support.to_dict(),
     }
-    if actuator != SFRBA:
-        metadata["actuator"] = actuator.to_dict()
+    metadata["actuator"] = actuator.to_dict()  # every model names its actuator
     if hasattr(model, "loss_curve_"):
         metadata["final_training_mse_deg2"] = float(model.loss_curve_[-1])
     _check_finite_figures(
