@@ -35,6 +35,7 @@ STAGES: tuple[tuple[str, ...], ...] = (
     ("registry", "references", "parameters"),
     ("plausibility",),
     ("design", "metrics", "kinematics"),
+    ("actuators",),
     ("materials",),
     ("models",),
     ("analytical", "fem"),

@@ -149,3 +149,16 @@ tolerance = 5.0
     path.write_text("[[spec]\n")
     with pytest.raises(DatasetError, match="line 1, column 7: not valid TOML"):
         load_specifications(path)
+
+
+def test_paper_b_s_column_names_name_its_parameters_too(tmp_path):
+    ranges, _ = build_ranges(["phi_deg=10"], ["t_mm=3:4"])
+    assert ranges == {"phi": ParameterRange(10, 10), "t": ParameterRange(3, 4, 0.5)}
+    assert parse_objectives(["l_mm"], []) == (Objective("l"),)
+    path = tmp_path / "specs.toml"
+    path.write_text("[[spec]]\nangle = 90.0\nat = 0.08\nfix = {phi_deg = 10.0}\n")
+    (spec,) = load_specifications(path)
+    assert spec.ranges == {"phi": ParameterRange(10, 10)}
+    path.write_text("[[spec]]\nangle = 90.0\nat = 0.08\nfix = {phi = 10.0, phi_deg = 5.0}\n")
+    with pytest.raises(DatasetError, match="gives 'phi' twice"):
+        load_specifications(path)

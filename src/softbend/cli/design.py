@@ -1,5 +1,11 @@
 """``softbend design find``: the designs that meet a specification, verified by the FEM.
 
+The search names the model's own parameters (its recorded actuator
+description): paper B's ``l, r, t, b, phi, lc``, or another actuator's
+(``--fix layer=paper --range wall_mm=1:2 --minimize n_chambers``), with
+pressures in the model's pressure unit; ``--verify`` sweeps only an actuator
+the FEM models and otherwise says so in one line.
+
 Everything is checked before a design is scored: the output folder, every
 number against its declared range (:data:`VERIFY`, :data:`WORKERS`,
 :data:`softbend.design_search.search.TOP` and the target's), options that
@@ -122,19 +128,29 @@ def find(
     ctx: typer.Context,
     out: Path = typer.Option(..., "--out", "-o", help="Folder for the tables and figures."),
     model: Path = typer.Option(
-        None, help="Saved surrogate to search (default: the shipped FEM-trained MLP)."
+        None,
+        help="Saved surrogate to search (default: the shipped FEM-trained MLP); its actuator's "
+        "parameters are the names of --fix, --range, --resolution and --minimize.",
     ),
     spec: Path = typer.Option(
         None, help="A TOML file of [[spec]] tables, one folder of results per spec."
     ),
     angle: float = typer.Option(None, help="Target angle, deg (with --at or --max-pressure)."),
-    at: float = typer.Option(None, help="Pressure the target angle is read at, MPa."),
-    max_pressure: float = typer.Option(
-        None, help="Reach --angle at no more than this pressure, MPa (then --minimize pressure)."
+    at: float = typer.Option(
+        None, help="Pressure the target angle is read at, in the model's pressure unit (MPa)."
     ),
-    max_angle_at: float = typer.Option(None, help="Bend as far as possible at this pressure, MPa."),
+    max_pressure: float = typer.Option(
+        None,
+        help="Reach --angle at no more than this pressure, in the model's pressure unit "
+        "(then --minimize pressure).",
+    ),
+    max_angle_at: float = typer.Option(
+        None, help="Bend as far as possible at this pressure, in the model's pressure unit."
+    ),
     curve: str = typer.Option(
-        None, help="Follow the points P:ANGLE, comma-separated (MPa:deg), e.g. 0.05:40,0.1:95."
+        None,
+        help="Follow the points P:ANGLE, comma-separated (pressure in the model's unit:deg), "
+        "e.g. 0.05:40,0.1:95.",
     ),
     tolerance: float = typer.Option(3.0, help="How far the angle may miss, deg, in (0, 90]."),
     margin: float = typer.Option(
@@ -142,18 +158,26 @@ def find(
     ),
     minimize: list[str] = typer.Option(
         None,
-        help="Objectives to minimise: l, r, t, b, phi, lc, pressure, volume, "
-        "sensitivity, angle, error (comma-separated or repeated; default error).",
+        help="Objectives to minimise: a design parameter (l, r, t, b, phi, lc of paper B's "
+        "actuator), pressure, volume (paper B's), sensitivity, angle, error (comma-separated "
+        "or repeated; default error).",
     ),
     maximize: list[str] = typer.Option(None, help="Objectives to maximise (as --minimize)."),
-    fix: list[str] = typer.Option(None, help="Fix a parameter, NAME=VALUE (repeatable)."),
+    fix: list[str] = typer.Option(
+        None, help="Fix a parameter, NAME=VALUE (repeatable; a categorical one by level name)."
+    ),
     ranges: list[str] = typer.Option(
-        None, "--range", help="Range of a parameter, NAME=LOW:HIGH (repeatable)."
+        None,
+        "--range",
+        help="Range of a parameter, NAME=LOW:HIGH (repeatable; whole ends for an integer one, "
+        "none for a categorical one, whose levels are all searched unless fixed).",
     ),
     resolution: list[str] = typer.Option(
         None,
         help="Mould resolution: a number for every parameter or NAME=STEP (repeatable); "
-        "0 searches continuously. Default 0.5 mm and 1° of phi.",
+        "0 searches continuously. Default 0.5 mm and 1° of phi; for another actuator each "
+        "continuous parameter's declared resolution (else a round step, about 1/100 of its "
+        "range), integers by 1.",
     ),
     top: int = typer.Option(
         10, help="Candidates listed, 1 to 1000 (to 25 with a continuous parameter)."
@@ -162,7 +186,9 @@ def find(
         False, "--neighbours", help="Also list designs one step from a better one."
     ),
     verify: int = typer.Option(
-        0, help="Sweep the best N (at most 100) with --backend and compare."
+        0,
+        help="Sweep the best N (at most 100) with --backend and compare (paper B's actuator; "
+        "another is not verified, and the output says so).",
     ),
     backend: str = typer.Option("fem", help="Backend of the verification: fem or analytical."),
     workers: int = typer.Option(
@@ -192,16 +218,29 @@ def find(
     killed during the verification leaves a hidden .OUT.PID-*.new folder that
     the next run into --out removes.
 
+    The names are the model's own: paper B's l, r, t, b, phi, lc (mm, deg;
+    pressures in MPa), or the parameters of the actuator another model was
+    trained on, searched within its training ranges and its description's
+    (integers on whole numbers, a categorical parameter on every level unless
+    --fix names one, a continuous one on its declared resolution, else on a
+    round step of about a hundredth of its range), designs breaking the
+    description's constraints left out, pressures in the model's unit.
+    --verify checks only an actuator the FEM models; for another it says so (a
+    warning, and "verify_skipped" in search.json).
+
     Example:
 
     \b
         softbend design find --angle 90 --at 0.08 --minimize l --fix phi=10 \\
             --range t=3:4 --verify 5 --out design
+        softbend design find --model pneunet.json --angle 90 --at 30 \\
+            --minimize n_chambers --fix layer=paper --range wall_mm=1:2 --out design
     """
     from softbend._io import staged_dir
     from softbend.design_search import spec as specs
     from softbend.design_search.search import TOP, find_designs, searched_ranges
-    from softbend.design_search.verify import verify_candidates
+    from softbend.design_search.space import space_of
+    from softbend.design_search.verify import verify_candidates, verify_skipped
     from softbend.reports.design_outputs import FILES, write_search
     from softbend.surrogates.predict import load_predictor
     from softbend.transfer.base import shipped_base_path
@@ -215,6 +254,9 @@ def find(
     )
     _check_count(top, "--top", TOP)
     elastomer = _verification(ctx, verify, backend, workers, material)
+    predictor, saved = load_predictor(model_path)  # its actuator names the parameters
+    space = space_of(saved.actuator)
+    actuator = None if space.paper_b else space.actuator
     if spec is not None:
         for name, (flag, what) in _SPEC_GIVES.items():
             if _typed(ctx, name):
@@ -223,12 +265,15 @@ def find(
                     f"spec's {what}."
                 )
         chosen = specs.load_specifications(
-            spec, what=f"--spec {spec}", reserved=sorted({"search.json", *FILES})
+            spec,
+            what=f"--spec {spec}",
+            reserved=sorted({"search.json", *FILES}),
+            actuator=actuator,
         )
     else:
         target = specs.target_from_options(
             angle=angle, at=at, max_pressure=max_pressure, max_angle_at=max_angle_at,
-            curve=curve, tolerance=tolerance,
+            curve=curve, tolerance=tolerance, unit=space.pressure_unit,
         )  # fmt: skip
         if not 0 <= margin < tolerance:
             raise ValueError(
@@ -247,11 +292,14 @@ def find(
                 f"The '--resolution' must be a number or NAME=STEP. Got {numbers[0]!r} instead."
             ) from None
         given, steps = specs.build_ranges(
-            fix or (), ranges or (), [s for s in resolution or () if "=" in s], step=every
+            fix or (),
+            ranges or (),
+            [s for s in resolution or () if "=" in s],
+            step=every,
+            space=space,
         )
-        objectives = specs.parse_objectives(minimize or (), maximize or ())
-        chosen = [specs.Specification(target, given, objectives, "spec", steps, margin)]
-    predictor, saved = load_predictor(model_path)
+        objectives = specs.parse_objectives(minimize or (), maximize or (), space)
+        chosen = [specs.Specification(target, given, objectives, "spec", steps, margin, actuator)]
     training = saved.metadata.get("training_ranges")
     hint = (
         "coarsen --resolution or narrow the ranges (--range, --fix)"
@@ -279,8 +327,12 @@ def find(
             for one in chosen
         ]
     payload: list[dict[str, Any]] = []
+    skipped = verify_skipped(results[0], backend) if verify else None
+    if skipped is not None:  # another actuator: said once, and in each record
+        for result in results:
+            result.verify_skipped = skipped
     with _common.output_errors(out, "--out"), staged_dir(out) as stage:
-        if verify:  # the temporary campaign in the staging folder: a kill leaves it there
+        if verify and skipped is None:  # the temporary campaign in the staging folder
             with _common.library_progress(enabled=not as_json):
                 for result in results:
                     if result.candidates:
@@ -304,6 +356,8 @@ def find(
         line = result.message()
         if line is not None:
             _common.warning_line(line)
+    if skipped is not None:
+        _common.warning_line(f"--verify skipped: {skipped}; the answers are the surrogate's.")
     if as_json:
         _common.print_json(payload[0] if len(payload) == 1 else {"specs": payload})
         return
@@ -317,7 +371,8 @@ def _print_result(result: object) -> None:
 
     assert isinstance(result, SearchResult)
     spec = result.spec
-    columns = ["#", "l,r,t,b,φ,lc", "θ (°)", "miss (°)"]
+    design = "l,r,t,b,φ,lc" if spec.space.paper_b else "design"
+    columns = ["#", design, "θ (°)", "miss (°)"]
     columns += [f"{o.name}" for o in spec.objectives if o.name != "error"]
     verified = any(c.fem_meets is not None for c in result.candidates)
     if verified:

@@ -6,6 +6,11 @@ ranges and the mould's step, and what to minimise; :func:`find_designs` scores
 every design of the grid on a saved surrogate and ranks those that meet it;
 :func:`verify_candidates` sweeps the best with the FEM (the campaign machinery)
 and sets the FEM's angle beside the surrogate's.
+
+The parameters are those of the model's actuator
+(:class:`~softbend.design_search.space.SearchSpace`): paper B's six by their
+short names, or another description's own (``Specification(...,
+actuator=saved.actuator)``); only paper B's actuator is verified by the FEM.
 """
 
 from __future__ import annotations
@@ -16,14 +21,17 @@ from softbend._lazy import export as _export
 
 #: Public name -> the module that defines it.
 _EXPORTS: dict[str, str] = {
+    "ActuatorDesign": "space",
     "Candidate": "search",
     "SearchResult": "search",
     "find_designs": "search",
     "Objective": "spec",
     "ParameterRange": "spec",
+    "SearchSpace": "space",
     "Specification": "spec",
     "Target": "spec",
     "load_specifications": "spec",
+    "space_of": "space",
     "verify_candidates": "verify",
 }
 

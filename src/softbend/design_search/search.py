@@ -1,5 +1,11 @@
 """Find the designs that meet a specification, on a surrogate: exhaustive on the mould's grid.
 
+The parameters are those of the model's actuator
+(:mod:`softbend.design_search.space`): paper B's six, or another description's
+own, each on its kind's values (whole numbers, levels, multiples of a
+resolution) and the designs kept to its constraints; pressures are in the
+model's pressure unit.
+
 A saved surrogate answers in microseconds, so every design of the grid of
 manufacturable values (the step of each parameter, 0.5 mm by default: some
 2.7 million designs over Table 1's box) is scored, which is exact on that grid
@@ -32,6 +38,7 @@ from typing import Any
 import numpy as np
 
 from softbend.design import SFRBADesign
+from softbend.design_search.space import ActuatorDesign, SearchSpace, pressure_key, space_of
 from softbend.design_search.spec import (
     NAMES,
     UNITS,
@@ -94,13 +101,15 @@ class Candidate:
 
     Attributes
     ----------
-    design : SFRBADesign
+    design : SFRBADesign or ActuatorDesign
+        Paper B's design, or another actuator's (its codes).
     angle_deg : float
         The surrogate's angle at the target's pressure (degrees); for a curve,
         at its last point.
     pressure_mpa : float
         The target's pressure, or for ``pressure_for`` the pressure that reaches
-        the angle (MPa; NaN if it is not reached).
+        the angle (in ``pressure_unit``, MPa for paper B's actuator; NaN if it is
+        not reached).
     error_deg : float
         How far the surrogate misses the target (degrees; a curve's largest miss;
         0 for ``max_angle``).
@@ -118,9 +127,11 @@ class Candidate:
         Whether the FEM confirms the target within its tolerance.
     fem_curve : (ndarray, ndarray) or None
         The FEM's converged sweep, pressures (MPa) and angles (degrees).
+    pressure_unit : str
+        Unit of ``pressure_mpa`` (the model's pressure unit).
     """
 
-    design: SFRBADesign
+    design: SFRBADesign | ActuatorDesign
     angle_deg: float
     pressure_mpa: float
     error_deg: float
@@ -132,13 +143,19 @@ class Candidate:
     fem_error_deg: float | None = None
     fem_meets: bool | None = None
     fem_curve: tuple[np.ndarray, np.ndarray] | None = field(default=None, repr=False)
+    pressure_unit: str = "MPa"
 
     def to_dict(self) -> dict[str, Any]:
-        """JSON-friendly: the design by named parameters (mm, deg) and every figure."""
+        """JSON-friendly: the design by named parameters (mm, deg; another actuator's in its
+        units, levels by name) and every figure (the pressure keyed by its unit)."""
+        if isinstance(self.design, SFRBADesign):
+            design = dict(zip(NAMES, (float(v) for v in self.design.as_array()), strict=True))
+        else:
+            design = self.design.as_dict()
         out: dict[str, Any] = {
-            "design": dict(zip(NAMES, (float(v) for v in self.design.as_array()), strict=True)),
+            "design": design,
             "angle_deg": self.angle_deg,
-            "pressure_mpa": self.pressure_mpa,
+            pressure_key(self.pressure_unit): self.pressure_mpa,
             "error_deg": self.error_deg,
             "meets": self.meets,
             "objectives": dict(self.objectives),
@@ -177,6 +194,8 @@ class SearchResult:
         The model file.
     seconds : float
         Time of the search (not of any verification), s.
+    verify_skipped : str, optional
+        Why ``--verify`` checked nothing (the FEM does not model the actuator).
     """
 
     spec: Specification
@@ -189,11 +208,18 @@ class SearchResult:
     front: np.ndarray
     model: str
     seconds: float
+    verify_skipped: str | None = None
 
     def message(self) -> str | None:
         """One line when no design meets the target: the closest, and by how much it misses."""
         if self.feasible:
             return None
+        space = self.spec.space
+        if not self.candidates and self.n_designs == 0 and space.actuator.constraints:
+            return (
+                f"No design in the ranges searched meets the constraints of "
+                f"{space.actuator.name} ({'; '.join(space.actuator.constraints)})."
+            )
         if not self.candidates:
             return f"No design in the ranges searched meets {self.spec.target.describe()}."
         best = self.candidates[0]
@@ -205,30 +231,61 @@ class SearchResult:
         )
 
     def to_dict(self) -> dict[str, Any]:
-        """JSON-friendly: the specification, the search's figures and ``candidates``, best first."""
-        return {
+        """JSON-friendly: the specification, the search's figures and ``candidates``, best first.
+
+        For another actuator than paper B's the ranges name its parameters with
+        their unit (a categorical one its levels searched), the pressures are
+        keyed by their unit (``pressure_kpa``), and ``actuator`` and
+        ``pressure_unit`` say whose they are; a skipped ``--verify`` adds
+        ``verified`` (null) and ``verify_skipped`` (why).
+        """
+        space = self.spec.space
+        target = self.spec.target
+        out: dict[str, Any] = {
             "spec": {
                 "name": self.spec.name,
-                "target": self.spec.target.describe(),
-                "kind": self.spec.target.kind,
-                "angle_deg": _finite_or_none(self.spec.target.angle_deg),
-                "pressure_mpa": _finite_or_none(self.spec.target.pressure_mpa),
-                "tolerance_deg": self.spec.target.tolerance_deg,
+                "target": target.describe(),
+                "kind": target.kind,
+                "angle_deg": _finite_or_none(target.angle_deg),
+                pressure_key(target.unit): _finite_or_none(target.pressure_mpa),
+                "tolerance_deg": target.tolerance_deg,
                 "objectives": [str(o) for o in self.spec.objectives],
-                "ranges": {
-                    n: {"low": r.low, "high": r.high, "step": r.step}
-                    for n, r in self.ranges.items()
-                },
+                "ranges": {n: _range_record(space, n, r) for n, r in self.ranges.items()},
             },
-            "model": self.model,
-            "feasible": self.feasible,
-            "message": self.message(),
-            "n_designs": self.n_designs,
-            "n_meeting": self.n_meeting,
-            "n_passed_over": self.n_passed_over,
-            "search_s": self.seconds,
-            "candidates": [c.to_dict() for c in self.candidates],
         }
+        if not space.paper_b:
+            out["actuator"] = space.actuator.name
+            out["pressure_unit"] = space.pressure_unit
+        out.update(
+            {
+                "model": self.model,
+                "feasible": self.feasible,
+                "message": self.message(),
+                "n_designs": self.n_designs,
+                "n_meeting": self.n_meeting,
+                "n_passed_over": self.n_passed_over,
+                "search_s": self.seconds,
+                "candidates": [c.to_dict() for c in self.candidates],
+            }
+        )
+        if self.verify_skipped is not None:
+            out["verified"] = None
+            out["verify_skipped"] = self.verify_skipped
+        return out
+
+
+def _range_record(space: SearchSpace, name: str, r: ParameterRange) -> dict[str, Any]:
+    """A searched range for the JSON: paper B's low, high, step; another actuator's with its
+    unit, whole numbers as integers and a categorical parameter's levels."""
+    if space.paper_b:
+        return {"low": r.low, "high": r.high, "step": r.step}
+    kind = space.kind(name)
+    if kind == "categorical":
+        codes = [r.low] if r.fixed else r.values()
+        return {"levels": [space.decode(name, c) for c in codes]}
+    if kind == "integer":
+        return {"low": round(r.low), "high": round(r.high), "step": round(r.step or 1.0)}
+    return {"low": r.low, "high": r.high, "step": r.step, "unit": space.unit(name)}
 
 
 def _finite_or_none(value: float) -> float | None:
@@ -290,7 +347,7 @@ def grid_size(ranges: Mapping[str, ParameterRange]) -> int:
     A fixed parameter counts once, a continuous one :data:`CONTINUOUS_POINTS`
     times (its screening grid), a stepped one :meth:`ParameterRange.count` times.
     """
-    return math.prod(_axis_size(ranges[name]) for name in NAMES)
+    return math.prod(_axis_size(r) for r in ranges.values())
 
 
 def _axis_size(r: ParameterRange) -> int:
@@ -334,19 +391,28 @@ def searched_ranges(
     ValueError
         As :meth:`Specification.resolved`; a grid over :data:`MAX_DESIGNS`
         (counted arithmetically, naming each parameter's count and step); ranges
-        in which no design has a wall thinner than its radius (t < r); a ``top``
-        over :data:`TOP_CONTINUOUS` with a continuous parameter.
+        in which no design of paper B's actuator has a wall thinner than its
+        radius (t < r); a ``top`` over :data:`TOP_CONTINUOUS` with a continuous
+        parameter.
     """
     ranges = spec.resolved(
         training_ranges if isinstance(training_ranges, dict) else None,
         allow_extrapolation=allow_extrapolation,
     )
     total = grid_size(ranges)
+    space = spec.space
+    units = UNITS if space.paper_b else space.units
     if total > MAX_DESIGNS:
         shown = f"{total:,}" if total < 10**15 else f"{float(total):.3g}"
         counts = ", ".join(
             f"{n} {_axis_size(r):,}"
-            + ("" if r.fixed else f" at {r.step:g} {UNITS[n]}" if r.step else " (continuous)")
+            + (
+                ""
+                if r.fixed
+                else f" at {r.step:g} {units[n]}".rstrip()
+                if r.step
+                else " (continuous)"
+            )
             for n, r in ranges.items()
             if not r.fixed
         )
@@ -354,8 +420,8 @@ def searched_ranges(
             f"The ranges and steps hold {shown} designs ({counts}), more than the "
             f"{MAX_DESIGNS:,} one search scores; {hint}."
         )
-    t, r = ranges["t"], ranges["r"]
-    if t.low >= r.high:
+    t, r = (ranges["t"], ranges["r"]) if space.paper_b else (None, None)
+    if t is not None and r is not None and t.low >= r.high:
         raise ValueError(
             f"No design of the ranges has a wall thinner than its radius (t < r): t is at "
             f"least {t.low:g} mm and r at most {r.high:g} mm; widen the ranges of t or r."
@@ -377,11 +443,14 @@ class _Scorer:
         self.predict = predict
         self.target = spec.target
         self.need_sensitivity = any(o.name == "sensitivity" for o in spec.objectives)
+        # the finite difference's step in the target's unit (MPa: _DP itself)
+        self.dp = _DP if spec.target.unit == "MPa" else _DP / spec.space.to_mpa
 
     def _angles(self, designs: np.ndarray, pressure: float | np.ndarray) -> np.ndarray:
-        rows = np.empty((designs.shape[0], 7))
-        rows[:, :6] = designs
-        rows[:, 6] = pressure
+        d = designs.shape[1]
+        rows = np.empty((designs.shape[0], d + 1))
+        rows[:, :d] = designs
+        rows[:, d] = pressure
         return np.asarray(self.predict(rows), dtype=np.float64)
 
     def score(self, designs: np.ndarray) -> dict[str, np.ndarray]:
@@ -406,9 +475,10 @@ class _Scorer:
         out = {"angle": angle, "error": error, "pressure": pressure}
         if self.need_sensitivity:
             p = pressure if target.kind == "pressure_for" else target.pressure_mpa
-            lo = self._angles(designs, np.maximum(p - _DP, 0.0))
-            hi = self._angles(designs, p + _DP)
-            out["sensitivity"] = (hi - lo) / (np.minimum(p, _DP) + _DP)
+            dp = self.dp
+            lo = self._angles(designs, np.maximum(p - dp, 0.0))
+            hi = self._angles(designs, p + dp)
+            out["sensitivity"] = (hi - lo) / (np.minimum(p, dp) + dp)
         return out
 
     def _pressure_for(self, designs: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
@@ -440,9 +510,10 @@ def _objective_matrix(
 ) -> np.ndarray:
     """Each objective per design, signed so that smaller is better."""
     columns = []
+    names = spec.space.names
     for objective in spec.objectives:
-        if objective.name in NAMES:
-            value = designs[:, NAMES.index(objective.name)]
+        if objective.name in names:
+            value = designs[:, names.index(objective.name)]
         elif objective.name == "volume":
             value = elastomer_volume_mm3(designs)
         else:
@@ -455,9 +526,10 @@ def _objective_values(
     spec: Specification, design: np.ndarray, scores: Mapping[str, float]
 ) -> dict[str, float]:
     out = {}
+    names = spec.space.names
     for objective in spec.objectives:
-        if objective.name in NAMES:
-            out[objective.name] = float(design[NAMES.index(objective.name)])
+        if objective.name in names:
+            out[objective.name] = float(design[names.index(objective.name)])
         elif objective.name == "volume":
             out["volume"] = float(elastomer_volume_mm3(design)[0])
         else:
@@ -466,9 +538,9 @@ def _objective_values(
 
 
 def _grid(ranges: Mapping[str, ParameterRange]) -> list[np.ndarray]:
+    """The values of each parameter, in the order of ``ranges`` (the model's inputs)."""
     axes = []
-    for name in NAMES:
-        r = ranges[name]
+    for r in ranges.values():
         if r.fixed:
             axes.append(np.array([r.low]))
         elif r.step == 0:
@@ -521,17 +593,17 @@ def find_designs(
     ValueError
         A range outside the training ranges (without ``allow_extrapolation``),
         a grid over :data:`MAX_DESIGNS` (:func:`searched_ranges`), a ``top``
-        outside :data:`TOP` (:data:`TOP_CONTINUOUS` with a continuous parameter).
+        outside :data:`TOP` (:data:`TOP_CONTINUOUS` with a continuous parameter),
+        a specification of another actuator than the model's.
 
     Notes
     -----
     Designs of the grid whose wall is not thinner than their radius (t >= r)
-    are not actuators: they are left out of the scores and of ``n_designs``.
+    are not actuators: they are left out of the scores and of ``n_designs``;
+    for another actuator, the designs that break a constraint of its description.
     """
-    from softbend._progress import report
-    from softbend.surrogates.features import outside_training_ranges
+    from softbend.surrogates.persistence import describing
     from softbend.surrogates.predict import load_predictor
-    from softbend.surrogates.support import Support
 
     if isinstance(top, bool) or not isinstance(top, int) or not TOP.contains(top):
         raise ValueError(
@@ -540,7 +612,53 @@ def find_designs(
         )
     start = time.perf_counter()
     predictor, saved = load_predictor(model)
-    metadata = saved.metadata
+    _check_actuator(spec, saved.actuator, model)
+    with describing(saved.actuator):
+        return _find(
+            model,
+            predictor,
+            saved.metadata,
+            spec,
+            top=top,
+            allow_extrapolation=allow_extrapolation,
+            distinct=distinct,
+            progress=progress,
+            start=start,
+        )
+
+
+def _check_actuator(spec: Specification, actuator: Any, model: Any) -> None:
+    """Refuse a specification of another actuator than the model's, naming both."""
+    space = spec.space
+    if space == space_of(actuator):
+        return
+    mine = "paper B's actuator" if space.paper_b else f"the actuator {space.actuator.name}"
+    raise ValueError(
+        f"The specification {spec.name!r} names the parameters of {mine} "
+        f"({space.listing()}), but the model {model} is of the actuator {actuator.name} "
+        f"({', '.join(actuator.names)}); give the specification that actuator "
+        "(Specification(..., actuator=...), as the model records it)."
+    )
+
+
+def _find(
+    model: Any,
+    predictor: Any,
+    metadata: Mapping[str, Any],
+    spec: Specification,
+    *,
+    top: int,
+    allow_extrapolation: bool,
+    distinct: bool,
+    progress: Callable[[int, int], None] | None,
+    start: float,
+) -> SearchResult:
+    """:func:`find_designs` once the model is loaded (within its actuator's inputs)."""
+    from softbend._progress import report
+    from softbend.surrogates.features import outside_training_ranges
+    from softbend.surrogates.support import Support
+
+    space = spec.space
     training = metadata.get("training_ranges")
     ranges, total = searched_ranges(
         spec, training, allow_extrapolation=allow_extrapolation, top=top
@@ -556,7 +674,7 @@ def find_designs(
     for first in range(0, total, CHUNK):
         flat = np.arange(first, min(first + CHUNK, total))
         designs = _designs_at(axes, flat)
-        valid[flat] = _actuators(designs)
+        valid[flat] = space.feasible(designs)
         with np.errstate(all="ignore"):
             scores = scorer.score(designs)
             error[flat] = scores["error"]
@@ -583,8 +701,8 @@ def find_designs(
     interval = _interval_of(predictor, metadata)
     candidates: list[Candidate] = []
     passed_over = 0
-    continuous = [n for n in NAMES if not ranges[n].fixed and ranges[n].step == 0]
-    listed = _Listed(ranges)
+    continuous = [n for n in space.names if not ranges[n].fixed and ranges[n].step == 0]
+    listed = _Listed(ranges, space)
     for first in range(0, ranked.size, 4 * top):
         batch = ranked[first : first + 4 * top]
         designs = _designs_at(axes, batch)
@@ -593,7 +711,7 @@ def find_designs(
         with np.errstate(all="ignore"):
             scores = exact_scorer.score(designs)
         meets_all = np.isfinite(scores["error"]) & (scores["error"] <= tolerance)
-        rows = np.flatnonzero((meets_all | (not feasible_screen)) & _actuators(designs))
+        rows = np.flatnonzero((meets_all | (not feasible_screen)) & space.feasible(designs))
         cells = listed.cells_of(designs)
         outside = np.zeros(designs.shape[0], dtype=bool)
         known = np.zeros(designs.shape[0], dtype=bool)
@@ -623,7 +741,7 @@ def find_designs(
                 listed.add(design, cells[row])
             candidates.append(
                 Candidate(
-                    design=SFRBADesign.from_sequence(design.tolist()),
+                    design=space.design_of(design.tolist()),
                     angle_deg=one["angle"],
                     pressure_mpa=one["pressure"],
                     error_deg=one["error"],
@@ -631,6 +749,7 @@ def find_designs(
                     objectives=_objective_values(spec, design, one),
                     interval_deg=interval(design, one),
                     flags=flags,
+                    pressure_unit=space.pressure_unit,
                 )
             )
         if len(candidates) >= 2 * top:
@@ -702,21 +821,38 @@ class _Listed:
     its own, so a design one step from it finds its own cell filed. On a grid
     that is the rule exactly. A continuous parameter (polished values) takes no
     part in the cell: a filed cell is then checked against the listed designs.
+    For another actuator than paper B's, a continuous parameter's step is that of
+    its screening grid (polished designs that met at one optimum are one design)
+    and a categorical one has no neighbours (another level is another actuator).
     """
 
-    def __init__(self, ranges: Mapping[str, ParameterRange]) -> None:
-        chosen = [ranges[n] for n in NAMES]
+    def __init__(self, ranges: Mapping[str, ParameterRange], space: SearchSpace | None = None):
+        names = list(ranges) if space is None else list(space.names)
+        chosen = [ranges[n] for n in names]
         stepped = np.array([not r.fixed and r.step > 0 for r in chosen])
+        # another level is another actuator: a categorical parameter has no neighbours
+        levels = np.array(
+            [space is not None and not space.paper_b and space.kind(n) == "categorical"
+             for n in names]
+        )  # fmt: skip
         self.low = np.array([r.low for r in chosen])
         self.step = np.where(stepped, [r.step for r in chosen], 1.0)
         self.stepped = stepped
         self.exact = not any(not r.fixed and r.step == 0 for r in chosen)
-        self.tolerance = np.array([r.step for r in chosen]) + 1e-9
+        steps = [r.step for r in chosen]
+        if space is not None and not space.paper_b:
+            steps = [
+                (r.high - r.low) / (CONTINUOUS_POINTS - 1)
+                if not r.fixed and r.step == 0
+                else r.step
+                for r in chosen
+            ]
+        self.tolerance = np.where(levels, 0.0, steps) + 1e-9
         # Indices run from -1 to count: radix count + 2, so no neighbour wraps around.
         sizes = np.array([r.count() + 2 if s else 1 for r, s in zip(chosen, stepped, strict=True)])
         self.radix = np.concatenate([[1], np.cumprod(sizes[:-1])]).astype(np.int64)
-        dims = np.flatnonzero(stepped)
-        offsets = np.zeros((3**dims.size, len(NAMES)), dtype=np.int64)
+        dims = np.flatnonzero(stepped & ~levels)
+        offsets = np.zeros((3**dims.size, len(names)), dtype=np.int64)
         grids = np.meshgrid(*([np.array([-1, 0, 1])] * dims.size), indexing="ij")
         for k, grid in zip(dims, grids, strict=True):
             offsets[:, k] = grid.ravel()
@@ -744,11 +880,6 @@ class _Listed:
         self.designs.append(design)
 
 
-def _actuators(designs: np.ndarray) -> np.ndarray:
-    """Which rows of designs are actuators: a wall thinner than the radius (t < r)."""
-    return designs[:, NAMES.index("t")] < designs[:, NAMES.index("r")]
-
-
 def _outside_mask(
     designs: np.ndarray,
     scores: Mapping[str, np.ndarray],
@@ -757,8 +888,6 @@ def _outside_mask(
     support: Any,
 ) -> np.ndarray:
     """Which rows :func:`_flags` would flag, for a batch at once (the same comparisons)."""
-    from softbend.surrogates.features import FEATURES
-
     n = designs.shape[0]
     target = spec.target
     if target.kind == "pressure_for":
@@ -769,7 +898,7 @@ def _outside_mask(
         high = np.full(n, max(target.pressures_mpa))
     flagged = np.zeros(n, dtype=bool)
     if isinstance(training, dict):
-        for j, name in enumerate(FEATURES):
+        for j, name in enumerate(spec.space.features):
             if name not in training:
                 continue
             lo, hi = (float(v) for v in training[name])
@@ -836,7 +965,8 @@ def _polish(
     that still meets the target (SciPy's bounded Powell from the grid point)."""
     from scipy.optimize import minimize
 
-    which = [NAMES.index(n) for n in continuous]
+    space = spec.space
+    which = [space.names.index(n) for n in continuous]
     bounds = [(ranges[n].low, ranges[n].high) for n in continuous]
     tolerance = spec.target.tolerance_deg - spec.margin_deg
     first = spec.objectives[0]
@@ -847,7 +977,7 @@ def _polish(
         def cost(x: np.ndarray, design: np.ndarray = design) -> float:
             trial = design.copy()
             trial[which] = x
-            if not _actuators(trial[None, :])[0]:
+            if not space.feasible(trial[None, :])[0]:
                 return 1e12
             with np.errstate(all="ignore"):
                 scores = scorer.score(trial[None, :])
@@ -868,4 +998,7 @@ def _polish(
         )
         if cost(result.x) <= cost(design[which]):
             out[k, which] = result.x
+    if not space.paper_b:  # a polished value ends on the resolution its description declares
+        for j, name in zip(which, continuous, strict=True):
+            out[:, j] = space.snap(name, out[:, j], ranges[name].low, ranges[name].high)
     return out

@@ -19,6 +19,11 @@ A :class:`Specification` says what an actuator must do and what may be chosen:
   ``sensitivity`` (dθ/dp at the target pressure, deg/MPa), ``angle`` (at the
   target pressure) or ``error`` (the miss of the target, degrees, the default).
 
+A specification of another actuator (``actuator=``, the description its model
+was trained with) names that actuator's parameters (:mod:`.space`): a
+categorical one fixed by level name, an integer one on whole numbers, and its
+pressures in the actuator's pressure unit (``Target(..., unit="kPa")``).
+
 Specifications come from code, from command-line text (:func:`parse_assignment`,
 :func:`parse_range`) or from a TOML file (:func:`load_specifications`: one
 ``[[spec]]`` table per specification). Every number is held to a declared
@@ -38,7 +43,9 @@ from typing import Any
 
 from softbend._names import output_name
 from softbend._tomltext import read_toml
+from softbend.actuators import PRESSURE_UNITS, Actuator, ActuatorError
 from softbend.design import DESIGN_LIMITS, PARAMETERS
+from softbend.design_search.space import PAPER_B, SearchSpace, aligned, space_of
 from softbend.errors import DatasetError
 from softbend.parameters import Range
 
@@ -62,6 +69,9 @@ __all__ = [
     "parse_assignment",
     "parse_objectives",
     "parse_range",
+    "parse_span",
+    "parse_value",
+    "pressure_range",
     "target_from_options",
 ]
 
@@ -200,12 +210,16 @@ class Target:
     angle_deg : float
         The angle to reach, degrees (``angle_at``, ``pressure_for``).
     pressure_mpa : float
-        The pressure, MPa gauge: where the angle is read (``angle_at``,
-        ``max_angle``) or the most that may be used (``pressure_for``).
+        The pressure, gauge, in ``unit`` (MPa for paper B's actuator): where
+        the angle is read (``angle_at``, ``max_angle``) or the most that may
+        be used (``pressure_for``).
     tolerance_deg : float
         How far the angle may miss, degrees (not ``max_angle``).
     points : tuple of (float, float)
-        ``(pressure_mpa, angle_deg)`` of a ``curve``.
+        ``(pressure, angle_deg)`` of a ``curve``, pressures in ``unit``.
+    unit : {"MPa", "kPa", "bar", "psi"}
+        Unit of the pressures: the model's pressure input (its actuator's
+        ``pressure_unit``). Whatever the unit, a pressure is at most 1 MPa.
     """
 
     kind: str
@@ -213,8 +227,14 @@ class Target:
     pressure_mpa: float = math.nan
     tolerance_deg: float = 3.0
     points: tuple[tuple[float, float], ...] = ()
+    unit: str = "MPa"
 
     def __post_init__(self) -> None:
+        if not isinstance(self.unit, str) or self.unit not in PRESSURE_UNITS:
+            raise ValueError(
+                f"The 'unit' of a target must be one of {', '.join(PRESSURE_UNITS)}. "
+                f"Got {self.unit!r} instead."
+            )
         if self.kind not in TARGETS:
             raise ValueError(
                 f"The 'kind' of a target must be one of {', '.join(TARGETS)}. "
@@ -243,65 +263,75 @@ class Target:
                     raise ValueError(
                         f"A point of a 'curve' target must be (pressure, angle). Got {point!r}."
                     )
-                _check_pressure(point[0], "a point's pressure")
+                _check_pressure(point[0], "a point's pressure", unit=self.unit)
                 _check_angle(point[1], "a point's angle")
             pressures = [float(p) for p, _ in points]
             twice = sorted({p for p in pressures if pressures.count(p) > 1})
             if twice:
                 raise ValueError(
                     "A 'curve' target gives each pressure once (one angle at each); "
-                    f"{', '.join(f'{p:g}' for p in twice)} MPa is given more than once."
+                    f"{', '.join(f'{p:g}' for p in twice)} {self.unit} is given more than once."
                 )
             object.__setattr__(
                 self, "points", tuple(sorted((float(p), float(a)) for p, a in points))
             )
             return
-        _check_pressure(self.pressure_mpa, "pressure")
+        _check_pressure(self.pressure_mpa, "pressure", unit=self.unit)
         if self.kind != "max_angle":
             _check_angle(self.angle_deg, "angle")
 
     @property
     def pressures_mpa(self) -> tuple[float, ...]:
-        """The pressures the target reads the angle at, MPa."""
+        """The pressures the target reads the angle at, in :attr:`unit`."""
         if self.kind == "curve":
             return tuple(p for p, _ in self.points)
         return (self.pressure_mpa,)
 
     def describe(self) -> str:
         """The target in words, units included."""
+        unit = self.unit
         if self.kind == "angle_at":
-            return f"{self.angle_deg:g}° ± {self.tolerance_deg:g}° at {self.pressure_mpa:g} MPa"
+            return f"{self.angle_deg:g}° ± {self.tolerance_deg:g}° at {self.pressure_mpa:g} {unit}"
         if self.kind == "pressure_for":
             return (
                 f"{self.angle_deg:g}° ± {self.tolerance_deg:g}° at no more than "
-                f"{self.pressure_mpa:g} MPa"
+                f"{self.pressure_mpa:g} {unit}"
             )
         if self.kind == "max_angle":
-            return f"the largest angle at {self.pressure_mpa:g} MPa"
+            return f"the largest angle at {self.pressure_mpa:g} {unit}"
         pts = ", ".join(f"{a:g}° at {p:g}" for p, a in self.points)
-        return f"the curve {pts} MPa, each ± {self.tolerance_deg:g}°"
+        return f"the curve {pts} {unit}, each ± {self.tolerance_deg:g}°"
 
 
 @dataclass(frozen=True)
 class Objective:
-    """One quantity to minimise (``sense="min"``) or maximise (``"max"``): a name of
-    :data:`OBJECTIVES`."""
+    """One quantity to minimise (``sense="min"``) or maximise (``"max"``).
+
+    ``name`` is one of :data:`OBJECTIVES` (paper B's actuator); for another
+    actuator's search it is one of :attr:`SearchSpace.objectives
+    <softbend.design_search.space.SearchSpace.objectives>` and ``unit`` its
+    unit (:func:`parse_objectives` and :class:`Specification` set it).
+    """
 
     name: str
     sense: str = "min"
+    unit: str | None = None
 
     def __post_init__(self) -> None:
-        if self.name not in OBJECTIVES:
+        if self.unit is None and self.name not in OBJECTIVES:
             raise ValueError(
                 f"An objective must be one of {', '.join(OBJECTIVES)}. Got {self.name!r} instead."
             )
+        if not isinstance(self.name, str) or not isinstance(self.unit, str | None):
+            raise ValueError("The name and unit of an objective must be text.")
         if self.sense not in ("min", "max"):
             raise ValueError(
                 f"The sense of an objective must be 'min' or 'max'. Got {self.sense!r} instead."
             )
 
     def __str__(self) -> str:
-        return f"{self.sense} {self.name} ({OBJECTIVES[self.name]})"
+        unit = OBJECTIVES[self.name] if self.unit is None else self.unit
+        return f"{self.sense} {self.name} ({unit})" if unit else f"{self.sense} {self.name}"
 
 
 @dataclass(frozen=True)
@@ -312,28 +342,40 @@ class Specification:
     ----------
     target : Target
     ranges : dict of str to ParameterRange
-        Per short name of :data:`NAMES`; a parameter left out takes the model's
-        training range at its default step (:meth:`resolved`).
+        Per short name of :data:`NAMES` (paper B's actuator; its column names
+        ``l_mm`` … are read as those), or per parameter name of ``actuator``;
+        a parameter left out takes the model's training range (within
+        ``actuator``'s own range) at its default step (:meth:`resolved`). A
+        categorical parameter's values are its levels' indices.
     objectives : tuple of Objective
         Default: the smallest miss of the target (``max angle`` for ``max_angle``).
     name : str
         A label for tables and files.
     steps : dict of str to float
         The step of each parameter left out of ``ranges`` (default
-        :data:`DEFAULT_STEPS`; 0: continuous).
+        :data:`DEFAULT_STEPS` for paper B's actuator; for another,
+        :meth:`SearchSpace.default_step
+        <softbend.design_search.space.SearchSpace.default_step>`: a continuous
+        parameter's declared resolution, else a round step of about a hundredth
+        of its range, and 1 for an integer one; 0: continuous).
     margin_deg : float
         A design margin, degrees: on the surrogate a design must meet the target
         within ``tolerance − margin``, so that the surrogate's own error (a degree
         or two against the FEM) does not push the answers past the tolerance;
         the FEM check keeps the whole tolerance. In [0, tolerance).
+    actuator : Actuator, optional
+        The description of the actuator searched (that of the model): None or
+        :data:`softbend.actuators.SFRBA` for paper B's. The target's ``unit``
+        must be its pressure unit.
     """
 
     target: Target
     ranges: Mapping[str, ParameterRange] = field(default_factory=dict)
     objectives: tuple[Objective, ...] = ()
     name: str = "spec"
-    steps: Mapping[str, float] = field(default_factory=lambda: dict(DEFAULT_STEPS))
+    steps: Mapping[str, float] = field(default_factory=dict)
     margin_deg: float = 0.0
+    actuator: Actuator | None = None
 
     def __post_init__(self) -> None:
         margin = self.margin_deg
@@ -346,17 +388,34 @@ class Specification:
                 f"The margin must lie in [0, {self.target.tolerance_deg:g}) degrees (below the "
                 f"tolerance). Got {margin!r} instead."
             )
-        unknown = sorted(set(self.ranges) - set(NAMES))
+        space = self.space
+        if self.target.unit != space.pressure_unit:
+            raise ValueError(
+                f"The target's pressures are in {self.target.unit}, but the actuator "
+                f"{space.actuator.name} takes its pressure in {space.pressure_unit}; give the "
+                f"target in {space.pressure_unit} (Target(..., unit={space.pressure_unit!r}))."
+            )
+        ranges = {(space.canonical(k) or k): v for k, v in dict(self.ranges).items()}
+        unknown = sorted(set(ranges) - set(space.names))
         if unknown:
             raise ValueError(
                 f"The ranges of a specification must name parameters among "
-                f"{', '.join(NAMES)}. Got {', '.join(unknown)}."
+                f"{space.listing()}. Got {', '.join(unknown)}."
             )
         objectives = tuple(self.objectives) or (
             (Objective("angle", "max"),)
             if self.target.kind == "max_angle"
             else (Objective("error", "min"),)
         )
+        if not space.paper_b:
+            allowed = space.objectives
+            for o in objectives:
+                if o.name not in allowed:
+                    raise ValueError(
+                        f"An objective of a search of {space.actuator.name} must be one of "
+                        f"{', '.join(allowed)}. Got {o.name!r} instead."
+                    )
+            objectives = tuple(Objective(o.name, o.sense, allowed[o.name]) for o in objectives)
         names = [o.name for o in objectives]
         if len(set(names)) != len(names):
             raise ValueError(f"Each objective may be named once. Got {', '.join(names)}.")
@@ -368,8 +427,30 @@ class Specification:
         if "sensitivity" in names and self.target.kind == "curve":
             raise ValueError("The objective 'sensitivity' needs a target at one pressure.")
         object.__setattr__(self, "objectives", objectives)
-        object.__setattr__(self, "ranges", dict(self.ranges))
-        object.__setattr__(self, "steps", {**DEFAULT_STEPS, **dict(self.steps)})
+        object.__setattr__(self, "ranges", ranges)
+        steps = {(space.canonical(k) or k): v for k, v in dict(self.steps).items()}
+        if space.paper_b:
+            object.__setattr__(self, "steps", {**DEFAULT_STEPS, **steps})
+            return
+        for key, value in steps.items():
+            if key not in space.names:
+                raise ValueError(
+                    f"The steps of a specification must name parameters among "
+                    f"{space.listing()}. Got {key!r}."
+                )
+            if isinstance(value, bool) or not isinstance(value, int | float):
+                raise ValueError(f"The step of {key!r} must be a number. Got {value!r}.")
+            problem = None if STEP.contains(value) else "must be finite and >= 0"
+            problem = problem or space.step_problem(key, float(value))
+            if problem is not None:
+                raise ValueError(f"The step of {key!r} ({value:g}) {problem}.")
+        filled = {n: float(steps.get(n, space.default_step(n))) for n in space.names}
+        object.__setattr__(self, "steps", filled)
+
+    @property
+    def space(self) -> SearchSpace:
+        """The parameters searched (:mod:`softbend.design_search.space`)."""
+        return space_of(self.actuator)
 
     def resolved(
         self,
@@ -379,13 +460,21 @@ class Specification:
     ) -> dict[str, ParameterRange]:
         """Every parameter's range: given, or the model's training range at the default step.
 
+        For another actuator than paper B's, a parameter left out takes its
+        training range within the range its description declares; an integer or
+        categorical one takes whole numbers (levels' indices), a continuous one
+        with a step the multiples of the step inside its range.
+
         Raises
         ------
         ValueError
             A range reaching outside the training ranges (unless
-            ``allow_extrapolation``), a parameter without a range and without
-            training ranges to take one from, or a range holding no value on its step.
+            ``allow_extrapolation``) or outside the actuator's description, a
+            parameter without a range and without training ranges to take one
+            from, or a range holding no value on its step.
         """
+        if not self.space.paper_b:
+            return self._resolved_other(training_ranges, allow_extrapolation)
         out = {}
         for name in NAMES:
             trained = None
@@ -427,9 +516,101 @@ class Specification:
             out[name] = given
         return out
 
+    def _resolved_other(
+        self, training: Mapping[str, Sequence[float]] | None, allow_extrapolation: bool
+    ) -> dict[str, ParameterRange]:
+        """:meth:`resolved` for another actuator than paper B's."""
+        space = self.space
+        out: dict[str, ParameterRange] = {}
+        for name in space.names:
+            p = space.parameter(name)
+            unit = f" {p.unit}" if p.unit else ""
+            trained = None
+            if training is not None and p.name in training:
+                trained = tuple(float(v) for v in training[p.name])
+            given = self.ranges.get(name)
+            if given is None:
+                low, high = p.low, p.high
+                if trained is not None:
+                    low, high = max(low, trained[0]), min(high, trained[1])
+                if not (math.isfinite(low) and math.isfinite(high)):
+                    raise ValueError(
+                        f"The parameter {name!r} needs a range (--range {name}=LOW:HIGH or "
+                        f"--fix {name}=VALUE): the model records no training range of it and "
+                        f"the actuator {space.actuator.name} declares none."
+                    )
+                if p.kind != "continuous":
+                    low, high = float(math.ceil(low - 1e-9)), float(math.floor(high + 1e-9))
+                if low > high:
+                    raise ValueError(
+                        f"The model's training range of {name!r} does not meet the range "
+                        f"[{p.low:g}, {p.high:g}]{unit} the actuator {space.actuator.name} "
+                        f"describes; give it one (--range {name}=LOW:HIGH or --fix {name}=VALUE)."
+                    )
+                given = ParameterRange(low, high, float(self.steps[name]))
+            else:
+                for end in (given.low, given.high):
+                    problem = space.value_problem(name, end)
+                    if problem is None and p.kind == "categorical" and end != round(end):
+                        problem = "is not a level's index (a whole number)"
+                    if problem is not None:
+                        raise ValueError(
+                            f"The range of {name!r} ({given.low:g}:{given.high:g}{unit}) {problem}."
+                        )
+                outside = trained is not None and (
+                    given.low < trained[0] - 1e-9 or given.high > trained[1] + 1e-9
+                )
+                if outside and trained is not None and not allow_extrapolation:
+                    raise ValueError(
+                        f"The range of {name!r} ({given.low:g}:{given.high:g}{unit}) leaves the "
+                        f"model's training range [{trained[0]:g}, {trained[1]:g}]; narrow it, or "
+                        "pass --allow-extrapolation (the answers outside are then flagged)."
+                    )
+            out[name] = self._on_step(name, given, unit)
+        return out
+
+    def _on_step(self, name: str, given: ParameterRange, unit: str) -> ParameterRange:
+        """``given`` on the step of its kind: whole numbers, or multiples of the step."""
+        space = self.space
+        kind = space.kind(name)
+        if given.fixed:
+            return ParameterRange(given.low, given.high, 0.0)
+        if kind == "categorical":
+            return ParameterRange(given.low, given.high, 1.0)
+        step = given.step
+        if kind == "integer":
+            step = step or 1.0
+            problem = space.step_problem(name, step)
+            if problem is not None:
+                raise ValueError(f"The step of {name!r} ({step:g}) {problem}.")
+            return ParameterRange(given.low, given.high, step)
+        if step > 0:
+            problem = space.step_problem(name, step)
+            if problem is not None:
+                raise ValueError(f"The step of {name!r} ({step:g}{unit}) {problem}.")
+        else:
+            resolution = space.parameter(name).resolution
+            if resolution is None:
+                return given
+            step = resolution  # a continuous search still ends on the resolution: it must hold one
+        first, last = aligned(given.low, given.high, step)
+        if first > last:
+            raise ValueError(
+                f"The range of {name!r} ({given.low:g}:{given.high:g}{unit}) holds no multiple "
+                f"of its step {step:g}{unit}; widen it or refine the resolution."
+            )
+        if given.step == 0:
+            return given
+        return ParameterRange(first, last, step)
+
     def describe(self) -> str:
         """The specification in one line."""
-        fixed = [f"{n} = {r.low:g}" for n, r in self.ranges.items() if r.fixed]
+        space = self.space
+
+        def value(n: str, code: float) -> str:
+            return f"{code:g}" if space.paper_b else space.shown(n, code)
+
+        fixed = [f"{n} = {value(n, r.low)}" for n, r in self.ranges.items() if r.fixed]
         ranged = [f"{n} in {r.low:g}:{r.high:g}" for n, r in self.ranges.items() if not r.fixed]
         parts = [self.target.describe(), *fixed, *ranged, ", ".join(map(str, self.objectives))]
         return "; ".join(parts)
@@ -444,13 +625,26 @@ def _design_value_problem(name: str, value: float) -> str | None:
     return f"leaves the values a design may take, {allowed.describe()}"
 
 
-def _check_pressure(value: Any, what: str, where: str = "The target's ") -> None:
+def pressure_range(unit: str = "MPa") -> Range:
+    """:data:`PRESSURE` in ``unit`` (``(0, 1000] kPa``)."""
+    if unit == "MPa":
+        return PRESSURE
+    high = float(f"{PRESSURE.high / PRESSURE_UNITS[unit]:.6g}")
+    return Range(0.0, high, unit, "a gauge pressure of at most 1 MPa", low_inclusive=False)
+
+
+def _check_pressure(value: Any, what: str, where: str = "The target's ", unit: str = "MPa") -> None:
     if isinstance(value, bool) or not isinstance(value, int | float) or not math.isfinite(value):
-        raise ValueError(f"{where}{what} must be a number of MPa. Got {value!r} instead.")
-    if not PRESSURE.contains(value):
-        hint = "; a value in kPa? (0.08 MPa = 80 kPa)" if value > PRESSURE.high else "."
+        raise ValueError(f"{where}{what} must be a number of {unit}. Got {value!r} instead.")
+    allowed = pressure_range(unit)
+    if not allowed.contains(value):
+        hint = (
+            "; a value in kPa? (0.08 MPa = 80 kPa)"
+            if unit == "MPa" and value > PRESSURE.high
+            else "."
+        )
         raise ValueError(
-            f"{where}{what} must be a gauge pressure in {PRESSURE.describe()}. Got {value:g}{hint}"
+            f"{where}{what} must be a gauge pressure in {allowed.describe()}. Got {value:g}{hint}"
         )
 
 
@@ -464,9 +658,10 @@ def _check_angle(value: Any, what: str, where: str = "The target's ") -> None:
 
 
 def parse_assignment(text: str, field_name: str = "--fix") -> tuple[str, float]:
-    """``("phi", 10.0)`` from ``"phi=10"``; one clear line for anything else."""
+    """``("phi", 10.0)`` from ``"phi=10"`` (or ``"phi_deg=10"``); one clear line for
+    anything else. Paper B's parameters; :func:`parse_value` reads another actuator's."""
     name, sep, value = text.partition("=")
-    name = name.strip()
+    name = PAPER_B.canonical(name.strip()) or name.strip()
     if not sep or name not in NAMES:
         raise ValueError(
             f"The '{field_name}' must be NAME=VALUE with NAME among {', '.join(NAMES)}. "
@@ -485,9 +680,10 @@ def parse_assignment(text: str, field_name: str = "--fix") -> tuple[str, float]:
 
 
 def parse_range(text: str, field_name: str = "--range") -> tuple[str, float, float]:
-    """``("t", 3.0, 4.0)`` from ``"t=3:4"``; one clear line for anything else."""
+    """``("t", 3.0, 4.0)`` from ``"t=3:4"``; one clear line for anything else. Paper B's
+    parameters; :func:`parse_span` reads another actuator's."""
     name, sep, value = text.partition("=")
-    name = name.strip()
+    name = PAPER_B.canonical(name.strip()) or name.strip()
     low, colon, high = value.partition(":")
     if not sep or name not in NAMES or not colon:
         raise ValueError(
@@ -508,20 +704,132 @@ def parse_range(text: str, field_name: str = "--range") -> tuple[str, float, flo
     return name, a, b
 
 
-def parse_objectives(minimize: Sequence[str], maximize: Sequence[str]) -> tuple[Objective, ...]:
-    """Objectives from comma-separated names to minimise and to maximise, in order given."""
+def _named(space: SearchSpace, name: str, field_name: str, text: str) -> str:
+    """The parameter ``name`` of ``space``, or one line naming it and listing them."""
+    key = space.canonical(name)
+    if key is None:
+        raise ValueError(
+            f"The '{field_name}' names {name!r}, which is not a design parameter of the "
+            f"model's actuator {space.actuator.name}; its parameters are {space.listing()}. "
+            f"Got {text!r}."
+        )
+    return key
+
+
+def _unit_of(space: SearchSpace, name: str) -> str:
+    unit = space.unit(name)
+    return f" {unit}" if unit else ""
+
+
+def parse_value(space: SearchSpace, text: Any, field_name: str = "--fix") -> tuple[str, float]:
+    """``("layer", 1.0)`` from ``"layer=paper"``: a parameter of another actuator and the code
+    of its value (a level's index), checked against its description; one line otherwise."""
+    name, sep, value = str(text).partition("=")
+    name, value = name.strip(), value.strip()
+    if not sep or not name:
+        raise ValueError(
+            f"The '{field_name}' must be NAME=VALUE with NAME among {space.listing()}. "
+            f"Got {text!r} instead."
+        )
+    key = _named(space, name, field_name, str(text))
+    return key, _code_of(space, key, value, f"The '{field_name}' value of {key!r}")
+
+
+def _code_of(space: SearchSpace, key: str, value: Any, what: str) -> float:
+    """The code of ``value`` (a level, a whole number, a number) for ``key``, checked."""
+    p = space.parameter(key)
+    if p.kind == "categorical":
+        try:
+            code = p.encode(value)
+        except ActuatorError:
+            raise ValueError(
+                f"{what} must be one of its levels {', '.join(map(str, p.levels or ()))}. "
+                f"Got {value!r} instead."
+            ) from None
+        return code
+    if isinstance(value, bool):
+        value = "true" if value else "false"
+    try:
+        code = float(value)
+    except (TypeError, ValueError, OverflowError):
+        unit = space.unit(key)
+        kind = "a whole number" if p.kind == "integer" else "a number"
+        raise ValueError(
+            f"{what} must be {kind}{f' ({unit})' if unit else ''}. Got {value!r} instead."
+        ) from None
+    problem = space.value_problem(key, code)
+    if problem is None and p.kind == "continuous" and p.resolution is not None:
+        ratio = code / p.resolution
+        if abs(ratio - round(ratio)) > 1e-6:
+            problem = (
+                f"is not a multiple of the resolution {p.resolution:g}{_unit_of(space, key)} "
+                f"the actuator {space.actuator.name} declares"
+            )
+    if problem is not None:
+        raise ValueError(f"{what} ({value}) {problem}.")
+    return code
+
+
+def parse_span(
+    space: SearchSpace, text: str, field_name: str = "--range"
+) -> tuple[str, float, float]:
+    """``("wall_mm", 1.0, 2.0)`` from ``"wall_mm=1:2"``: a range of another actuator's
+    parameter inside its description (whole ends for an integer one); a categorical one
+    is refused (fix one level, or leave it out for every level)."""
+    name, sep, value = text.partition("=")
+    low, colon, high = value.partition(":")
+    if not sep or not colon or not name.strip():
+        raise ValueError(
+            f"The '{field_name}' must be NAME=LOW:HIGH with NAME among {space.listing()}. "
+            f"Got {text!r} instead."
+        )
+    key = _named(space, name.strip(), field_name, text)
+    p = space.parameter(key)
+    if p.kind == "categorical":
+        levels = list(map(str, p.levels or ()))
+        raise ValueError(
+            f"The '{field_name}' cannot span the categorical parameter {key!r}: fix one level "
+            f"(--fix {key}={levels[0]}) or leave it out to search every level "
+            f"({', '.join(levels)})."
+        )
+    try:
+        a, b = float(low), float(high)
+    except ValueError:
+        raise ValueError(
+            f"The '{field_name}' ends of {key!r} must be numbers. Got {value!r} instead."
+        ) from None
+    if not (math.isfinite(a) and math.isfinite(b)) or a > b:
+        raise ValueError(
+            f"The '{field_name}' of {key!r} must have finite LOW <= HIGH. Got {value!r}."
+        )
+    for end in (a, b):
+        problem = space.value_problem(key, end)
+        if problem is not None:
+            raise ValueError(f"The '{field_name}' of {key!r} ({value}): {end:g} {problem}.")
+    return key, a, b
+
+
+def parse_objectives(
+    minimize: Sequence[str], maximize: Sequence[str], space: SearchSpace | None = None
+) -> tuple[Objective, ...]:
+    """Objectives from comma-separated names to minimise and to maximise, in order given
+    (of ``space``'s objectives; default paper B's, :data:`OBJECTIVES`)."""
+    space = PAPER_B if space is None else space
+    allowed = OBJECTIVES if space.paper_b else space.objectives
     out = []
     for sense, texts in (("min", minimize), ("max", maximize)):
         for text in texts:
             for name in (n.strip() for n in text.split(",")):
                 if name:
-                    if name not in OBJECTIVES:
+                    name = space.canonical(name) or name
+                    if name not in allowed:
                         option = "--minimize" if sense == "min" else "--maximize"
                         raise ValueError(
                             f"The '{option}' must name objectives among "
-                            f"{', '.join(OBJECTIVES)}. Got {name!r} instead."
+                            f"{', '.join(allowed)}. Got {name!r} instead."
                         )
-                    out.append(Objective(name, sense))
+                    unit = None if space.paper_b else allowed[name]
+                    out.append(Objective(name, sense, unit))
     return tuple(out)
 
 
@@ -531,6 +839,7 @@ def build_ranges(
     steps: Sequence[str] = (),
     *,
     step: float | None = None,
+    space: SearchSpace | None = None,
 ) -> tuple[dict[str, ParameterRange], dict[str, float]]:
     """Ranges and steps from ``--fix NAME=V``, ``--range NAME=LOW:HIGH``, ``--resolution``.
 
@@ -538,7 +847,18 @@ def build_ranges(
     parameter not named there (None: :data:`DEFAULT_STEPS`). A parameter both
     fixed and ranged, or named twice, is refused. Returns the ranges given and
     the step of every parameter (for those left to their training range).
+
+    With the ``space`` of another actuator than paper B's, the names are its
+    parameters: ``--fix`` takes a level by name, a whole number or a number
+    (on the resolution the description declares), ``--range`` refuses a
+    categorical parameter and takes whole ends for an integer one, and
+    ``step`` is the step of the continuous parameters only (the others stay on
+    their whole numbers and levels; by default a continuous parameter's
+    resolution, else :meth:`SearchSpace.grid_steps
+    <softbend.design_search.space.SearchSpace.grid_steps>`' round step).
     """
+    if space is not None and not space.paper_b:
+        return _build_other(space, fixes, ranges, steps, step)
     if step is not None and not STEP.contains(step):
         raise ValueError(
             f"The '--resolution' must be a finite number >= 0 (mm and deg; {STEP.why}). "
@@ -568,6 +888,64 @@ def build_ranges(
     return out, per_step
 
 
+def _build_other(
+    space: SearchSpace,
+    fixes: Sequence[str],
+    ranges: Sequence[str],
+    steps: Sequence[str],
+    step: float | None,
+) -> tuple[dict[str, ParameterRange], dict[str, float]]:
+    """:func:`build_ranges` for another actuator than paper B's."""
+    if step is not None and not STEP.contains(step):
+        raise ValueError(
+            f"The '--resolution' must be a finite number >= 0 (in each continuous "
+            f"parameter's unit; {STEP.why}). Got {step!r} instead."
+        )
+    per_step = {n: space.default_step(n) for n in space.names}
+    if step is not None:
+        for name in space.names:
+            if space.kind(name) == "continuous":
+                problem = space.step_problem(name, float(step))
+                if problem is not None:
+                    raise ValueError(f"The '--resolution' {step:g} of {name!r} {problem}.")
+                per_step[name] = float(step)
+    for text in steps:
+        name, sep, value = text.partition("=")
+        if not sep:
+            raise ValueError(
+                f"The '--resolution' must be a number or NAME=STEP with NAME among "
+                f"{space.listing()}. Got {text!r} instead."
+            )
+        key = _named(space, name.strip(), "--resolution", text)
+        try:
+            number = float(value)
+        except ValueError:
+            raise ValueError(
+                f"The '--resolution' of {key!r} must be a number. Got {value!r} instead."
+            ) from None
+        if not STEP.contains(number):
+            raise ValueError(
+                f"The '--resolution' of {key!r} must be a finite number >= 0. Got {value!r}."
+            )
+        problem = space.step_problem(key, number)
+        if problem is not None:
+            raise ValueError(f"The '--resolution' of {key!r} ({value.strip()}) {problem}.")
+        per_step[key] = number
+    out: dict[str, ParameterRange] = {}
+    given: list[tuple[str, ParameterRange]] = []
+    for text in fixes:
+        key, code = parse_value(space, text, "--fix")
+        given.append((key, ParameterRange(code, code, 0.0)))
+    for text in ranges:
+        key, low, high = parse_span(space, text, "--range")
+        given.append((key, ParameterRange(low, high, per_step[key])))
+    for name, chosen in given:
+        if name in out:
+            raise ValueError(f"The parameter {name!r} is given twice (--fix or --range).")
+        out[name] = chosen
+    return out, {n: v for n, v in per_step.items() if space.kind(n) != "categorical"}
+
+
 def _check_design_value(name: str, values: Sequence[float], field: str, given: str) -> None:
     for value in values:
         problem = _design_value_problem(name, value)
@@ -576,7 +954,11 @@ def _check_design_value(name: str, values: Sequence[float], field: str, given: s
 
 
 def load_specifications(
-    path: str | os.PathLike[str], *, what: str | None = None, reserved: Collection[str] = ()
+    path: str | os.PathLike[str],
+    *,
+    what: str | None = None,
+    reserved: Collection[str] = (),
+    actuator: Actuator | None = None,
 ) -> list[Specification]:
     """The ``[[spec]]`` tables of a TOML file, each a :class:`Specification`.
 
@@ -594,7 +976,22 @@ def load_specifications(
         margin = 1.0              # degrees kept from the tolerance on the surrogate
 
     ``max_angle_at = P`` asks for the largest angle at P; ``curve = [[p, angle], ...]``
-    for a curve (each pressure once). The file is read by
+    for a curve (each pressure once).
+
+    For another actuator than paper B's (``actuator``, the model's), the
+    tables name its parameters and give its pressures in its unit::
+
+        [[spec]]
+        angle = 90.0
+        at = 30.0                 # kPa, the model's pressure unit
+        minimize = ["n_chambers"]
+        fix = {layer = "paper"}   # a level by name
+        range = {wall_mm = [1.0, 2.0]}
+        resolution = {wall_mm = 0.1}
+
+    ``resolution`` as one number is then the step of its continuous
+    parameters; an integer one steps by whole numbers, a categorical one
+    takes every level unless fixed (a ``range`` of it is refused). The file is read by
     :func:`softbend._tomltext.read_toml` (size, UTF-8 and nesting limits), and
     every key of every table is checked, with its type and range, before any
     search starts. Each ``name`` (default ``specN``) names the folder of that
@@ -610,6 +1007,8 @@ def load_specifications(
         The file as messages name it (default: the path), e.g. ``"--spec specs.toml"``.
     reserved : collection of str
         Names the caller writes beside the specs' folders (``search.json``).
+    actuator : Actuator, optional
+        The description of the model's actuator (None: paper B's).
 
     Returns
     -------
@@ -651,7 +1050,7 @@ def load_specifications(
         where = f"{source}, [[spec]] {i}"
         if not isinstance(table, dict):
             raise DatasetError(f"{where}: expected a table; found {_found(table)}.")
-        spec = _SpecTable(table, where).specification(f"spec{i}")
+        spec = _SpecTable(table, where, space_of(actuator)).specification(f"spec{i}")
         try:
             output_name(
                 spec.name, f"[[spec]] {i} 'name' of {source}", reserved=reserved, taken=names
@@ -721,9 +1120,10 @@ def _is_number(value: Any) -> bool:
 class _SpecTable:
     """One ``[[spec]]`` table read key by key; every error names ``where`` and the key."""
 
-    def __init__(self, table: dict[str, Any], where: str) -> None:
+    def __init__(self, table: dict[str, Any], where: str, space: SearchSpace = PAPER_B) -> None:
         self.table = table
         self.where = where
+        self.space = space
 
     def fail(self, key: str, expected: str, found: Any) -> DatasetError:
         """The error of ``key``: what was expected and what was found."""
@@ -738,20 +1138,35 @@ class _SpecTable:
         return float(value)
 
     def per_parameter(self, key: str, what: str) -> dict[str, Any]:
-        """The table at ``key`` whose keys are parameter names."""
+        """The table at ``key`` whose keys are parameter names (each once, by its name)."""
+        names = self.space.listing()
         value = self.table.get(key, {})
         if not isinstance(value, dict):
-            raise self.fail(key, f"a table of {what} by parameter ({', '.join(NAMES)})", value)
-        unknown = [k for k in value if k not in NAMES]
+            raise self.fail(key, f"a table of {what} by parameter ({names})", value)
+        unknown = [k for k in value if self.space.canonical(k) is None]
         if unknown:
             raise DatasetError(
-                f"{self.where} '{key}': expected parameters among {', '.join(NAMES)}; found "
+                f"{self.where} '{key}': expected parameters among {names}; found "
                 f"{', '.join(map(repr, unknown))}."
             )
-        return value
+        out: dict[str, Any] = {}
+        for k, v in value.items():
+            name = self.space.canonical(k)
+            assert name is not None  # checked above
+            if name in out:
+                raise DatasetError(f"{self.where} '{key}': gives {name!r} twice ({k!r}).")
+            out[name] = v
+        return out
 
     def design_number(self, key: str, name: str, value: Any) -> float:
-        """``value`` as a value of the parameter ``name`` of a design."""
+        """``value`` as a value of the parameter ``name`` of a design (its code)."""
+        if not self.space.paper_b:
+            if self.space.kind(name) != "categorical" and not _is_number(value):
+                raise self.fail(f"{key}.{name}", "a number", value)
+            try:
+                return _code_of(self.space, name, value, "it")
+            except ValueError as exc:
+                raise DatasetError(f"{self.where} '{key}.{name}': {exc}") from None
         low, high, low_inclusive = DESIGN_LIMITS[name]
         allowed = Range(low, high, UNITS[name], "the values a design may take", low_inclusive)
         return self.number(f"{key}.{name}", allowed, "a number", value)
@@ -759,6 +1174,7 @@ class _SpecTable:
     def target(self) -> Target:
         """The table's target, from exactly one of :data:`_TARGET_KEYS`."""
         table = self.table
+        unit = self.space.pressure_unit
         kinds = [k for k in _TARGET_KEYS if k in table]
         if len(kinds) != 1:
             found = " and ".join(map(repr, kinds)) if kinds else "none of them"
@@ -775,10 +1191,10 @@ class _SpecTable:
                 "leave it out."
             )
         if kind == "curve":
-            return Target("curve", tolerance_deg=tolerance, points=self.curve())
-        pressure = self.number(kind, PRESSURE, "a pressure")
+            return Target("curve", tolerance_deg=tolerance, points=self.curve(), unit=unit)
+        pressure = self.number(kind, pressure_range(unit), "a pressure")
         if kind == "max_angle_at":
-            return Target("max_angle", pressure_mpa=pressure, tolerance_deg=tolerance)
+            return Target("max_angle", pressure_mpa=pressure, tolerance_deg=tolerance, unit=unit)
         if "angle" not in table:
             raise DatasetError(f"{self.where} 'angle': expected with '{kind}'; found none.")
         angle = self.number("angle", ANGLE, "degrees")
@@ -787,13 +1203,15 @@ class _SpecTable:
             angle_deg=angle,
             pressure_mpa=pressure,
             tolerance_deg=tolerance,
+            unit=unit,
         )
 
     def curve(self) -> tuple[tuple[float, float], ...]:
         """The points of ``curve``: [[pressure, angle], ...], each pressure once."""
         value = self.table["curve"]
+        unit = self.space.pressure_unit
         expected = (
-            f"an array of {CURVE_POINTS.low:g} to {CURVE_POINTS.high:g} [pressure MPa, "
+            f"an array of {CURVE_POINTS.low:g} to {CURVE_POINTS.high:g} [pressure {unit}, "
             "angle deg] pairs"
         )
         if not isinstance(value, list) or not CURVE_POINTS.contains(len(value)):
@@ -802,34 +1220,42 @@ class _SpecTable:
         for k, point in enumerate(value, start=1):
             key = f"curve[{k}]"
             if not isinstance(point, list) or len(point) != 2:
-                raise self.fail(key, "a pair [pressure MPa, angle deg]", point)
-            pressure = self.number(key, PRESSURE, "a pressure first", point[0])
+                raise self.fail(key, f"a pair [pressure {unit}, angle deg]", point)
+            pressure = self.number(key, pressure_range(unit), "a pressure first", point[0])
             angle = self.number(key, ANGLE, "an angle second", point[1])
             if any(pressure == p for p, _ in points):
                 raise DatasetError(
-                    f"{self.where} '{key}': gives {pressure:g} MPa a second time; a curve "
+                    f"{self.where} '{key}': gives {pressure:g} {unit} a second time; a curve "
                     "gives each pressure once (one angle at each)."
                 )
             points.append((pressure, angle))
         return tuple(points)
 
     def objectives(self) -> tuple[Objective, ...]:
-        """``minimize`` and ``maximize``: names of :data:`OBJECTIVES`, an array or one text."""
+        """``minimize`` and ``maximize``: names of :data:`OBJECTIVES` (another actuator: of
+        its search's objectives), an array or one text."""
+        space = self.space
+        allowed = OBJECTIVES if space.paper_b else space.objectives
         out = []
         for key, sense in (("minimize", "min"), ("maximize", "max")):
             value = self.table.get(key, [])
             items = value.split(",") if isinstance(value, str) else value
-            expected = f"an array of objectives among {', '.join(OBJECTIVES)}"
+            expected = f"an array of objectives among {', '.join(allowed)}"
             if not isinstance(items, list):
                 raise self.fail(key, expected, value)
             for item in items:
-                if not isinstance(item, str) or item.strip() not in OBJECTIVES:
+                name = space.canonical(item.strip()) if isinstance(item, str) else None
+                name = name or (item.strip() if isinstance(item, str) else None)
+                if name not in allowed:
                     raise self.fail(key, expected, item)
-                out.append(Objective(item.strip(), sense))
+                assert name is not None
+                out.append(Objective(name, sense, None if space.paper_b else allowed[name]))
         return tuple(out)
 
     def steps(self) -> dict[str, float]:
         """``resolution``: one step for every parameter, or a table by parameter."""
+        if not self.space.paper_b:
+            return self._other_steps()
         value = self.table.get("resolution")
         what = "a step of the mould (mm, deg for phi)"
         if value is None:
@@ -843,16 +1269,53 @@ class _SpecTable:
             raise self.fail("resolution", f"{what}, or a table of steps by parameter", value)
         return dict.fromkeys(NAMES, self.number("resolution", STEP, what))
 
+    def _other_steps(self) -> dict[str, float]:
+        """``resolution`` of another actuator: one step of every continuous parameter, or a
+        table by parameter; each checked against its kind and declared resolution."""
+        space = self.space
+        value = self.table.get("resolution")
+        what = "a step (each parameter's unit; 0 searches continuously)"
+        steps = {n: space.default_step(n) for n in space.names if space.kind(n) != "categorical"}
+        if value is None:
+            return steps
+        if isinstance(value, dict):
+            given = {
+                name: (f"resolution.{name}", self.number(f"resolution.{name}", STEP, what, step))
+                for name, step in self.per_parameter("resolution", "steps").items()
+            }
+        elif _is_number(value):
+            step = self.number("resolution", STEP, what)
+            given = {n: ("resolution", step) for n in space.names if space.kind(n) == "continuous"}
+        else:
+            raise self.fail("resolution", f"{what}, or a table of steps by parameter", value)
+        for name, (key, step) in given.items():
+            problem = space.step_problem(name, step)
+            if problem is not None:
+                raise DatasetError(
+                    f"{self.where} '{key}': the step {step:g} of {name!r} {problem}."
+                )
+            steps[name] = step
+        return steps
+
     def ranges(self, steps: Mapping[str, float]) -> dict[str, ParameterRange]:
         """``fix`` (a value by parameter) and ``range`` ([low, high] by parameter)."""
+        space = self.space
         out: dict[str, ParameterRange] = {}
         for name, value in self.per_parameter("fix", "values").items():
             fixed = self.design_number("fix", name, value)
             out[name] = ParameterRange(fixed, fixed, 0.0)
         for name, value in self.per_parameter("range", "[low, high] pairs").items():
             key = f"range.{name}"
+            unit = UNITS[name] if space.paper_b else space.unit(name)
+            if not space.paper_b and space.kind(name) == "categorical":
+                levels = ", ".join(map(str, space.parameter(name).levels or ()))
+                raise DatasetError(
+                    f"{self.where} '{key}': a categorical parameter takes no range; fix one "
+                    f"level ('fix') or leave it out to search every level ({levels})."
+                )
             if not isinstance(value, list) or len(value) != 2:
-                raise self.fail(key, f"[low, high], two numbers of {UNITS[name]}", value)
+                numbers = f"two numbers of {unit}" if unit else "two numbers"
+                raise self.fail(key, f"[low, high], {numbers}", value)
             low, high = (self.design_number("range", name, v) for v in value)
             if low > high:
                 raise self.fail(key, "[low, high] with low <= high", value)
@@ -888,8 +1351,9 @@ class _SpecTable:
         if "margin" in table:
             allowed = Range(0.0, target.tolerance_deg, "deg", "below the tolerance", True, False)
             margin = self.number("margin", allowed, "degrees kept from the tolerance")
+        actuator = None if self.space.paper_b else self.space.actuator
         try:
-            return Specification(target, ranges, objectives, name, steps, margin)
+            return Specification(target, ranges, objectives, name, steps, margin, actuator)
         except ValueError as exc:
             keys = [k for k in ("minimize", "maximize") if k in table]
             about = f" '{' and '.join(keys)}'" if keys and "objective" in str(exc) else ""
@@ -904,9 +1368,11 @@ def target_from_options(
     max_angle_at: float | None = None,
     curve: str | None = None,
     tolerance: float = 3.0,
+    unit: str = "MPa",
 ) -> Target:
     """The :class:`Target` a command line names (``--angle`` with ``--at`` or
-    ``--max-pressure``, ``--max-angle-at``, or ``--curve P:ANGLE,...``).
+    ``--max-pressure``, ``--max-angle-at``, or ``--curve P:ANGLE,...``), its
+    pressures in ``unit`` (the model's pressure unit).
 
     Raises
     ------
@@ -939,7 +1405,7 @@ def target_from_options(
         ("--max-angle-at", max_angle_at),
     ):
         if value is not None:
-            _check_pressure(value, "", f"The '{option}'")
+            _check_pressure(value, "", f"The '{option}'", unit)
     if angle is not None:
         _check_angle(angle, "", "The '--angle'")
     if curve is not None:
@@ -948,19 +1414,23 @@ def target_from_options(
                 "The '--angle' has no meaning with --curve (the curve gives its angles); "
                 "leave it out."
             )
-        return Target("curve", tolerance_deg=tolerance, points=_curve_points(curve))
+        return Target(
+            "curve", tolerance_deg=tolerance, points=_curve_points(curve, unit), unit=unit
+        )
     if max_angle_at is not None:
         if angle is not None:
             raise ValueError("The '--angle' has no meaning with --max-angle-at; leave it out.")
-        return Target("max_angle", pressure_mpa=max_angle_at, tolerance_deg=tolerance)
+        return Target("max_angle", pressure_mpa=max_angle_at, tolerance_deg=tolerance, unit=unit)
     if angle is None:
         raise ValueError(f"The target {given[0]} needs '--angle' (degrees).")
     kind, pressure = ("angle_at", at) if at is not None else ("pressure_for", max_pressure)
     assert pressure is not None  # exactly one of --at and --max-pressure, checked above
-    return Target(kind, angle_deg=angle, pressure_mpa=float(pressure), tolerance_deg=tolerance)
+    return Target(
+        kind, angle_deg=angle, pressure_mpa=float(pressure), tolerance_deg=tolerance, unit=unit
+    )
 
 
-def _curve_points(text: str) -> tuple[tuple[float, float], ...]:
+def _curve_points(text: str, unit: str = "MPa") -> tuple[tuple[float, float], ...]:
     """The points of ``--curve P:ANGLE,...``: each pressure once, each number in its range."""
     items = [x.strip() for x in text.split(",") if x.strip()]
     if not CURVE_POINTS.contains(len(items)):
@@ -976,16 +1446,16 @@ def _curve_points(text: str) -> tuple[tuple[float, float], ...]:
             pressure, angle = float(p), float(a)
         except ValueError:
             raise ValueError(
-                f"The '--curve' must be PRESSURE:ANGLE pairs (MPa:deg), e.g. 0.05:40,0.1:95. "
-                f"Got {item!r} instead."
+                f"The '--curve' must be PRESSURE:ANGLE pairs ({unit}:deg), e.g. "
+                f"{'0.05:40,0.1:95' if unit == 'MPa' else '10:40,20:95'}. Got {item!r} instead."
             ) from None
         if not colon:
             raise ValueError(f"The '--curve' point {item!r} lacks ':ANGLE'.")
-        _check_pressure(pressure, f" point {item!r}", "The '--curve'")
+        _check_pressure(pressure, f" point {item!r}", "The '--curve'", unit)
         _check_angle(angle, f" point {item!r}", "The '--curve'")
         if pressure in seen:
             raise ValueError(
-                f"The '--curve' gives {pressure:g} MPa twice ({seen[pressure]!r} and {item!r}); "
+                f"The '--curve' gives {pressure:g} {unit} twice ({seen[pressure]!r} and {item!r}); "
                 "a curve gives each pressure once (one angle at each)."
             )
         seen[pressure] = item

@@ -9,6 +9,11 @@ the candidate's pressure (linear interpolation between converged steps); a
 candidate whose FEM angle misses the target by more than its tolerance is
 marked (``fem_meets`` False). For ``max_angle`` (no target angle) the check is
 that the FEM confirms the surrogate's angle within the tolerance.
+
+The backends simulate paper B's actuator only (the FEM family ``"sfrba"``): a
+search of another actuator is not verified, and says so
+(:attr:`SearchResult.verify_skipped
+<softbend.design_search.search.SearchResult.verify_skipped>`, :func:`verify_skipped`).
 """
 
 from __future__ import annotations
@@ -23,7 +28,7 @@ import numpy as np
 
 from softbend.design_search.search import Candidate, SearchResult
 
-__all__ = ["fem_angle_at", "verify_candidates"]
+__all__ = ["fem_angle_at", "verify_candidates", "verify_skipped"]
 
 #: Pressure step of a verification sweep, MPa (the campaign's default grid step).
 PRESSURE_STEP_MPA = 0.005
@@ -39,6 +44,19 @@ def fem_angle_at(pressures: np.ndarray, angles: np.ndarray, pressure_mpa: float)
         return math.nan
     order = np.argsort(p)
     return float(np.interp(pressure_mpa, p[order], a[order]))
+
+
+def verify_skipped(result: SearchResult, backend: str = "fem") -> str | None:
+    """Why the candidates of ``result`` cannot be swept by ``backend`` (None: they can).
+
+    The campaign backends simulate the actuator of the FEM family ``"sfrba"``
+    (paper B's); any other actuator's designs are not theirs to check.
+    """
+    space = result.spec.space
+    if space.verifiable:
+        return None
+    who = "the FEM" if backend == "fem" else f"the {backend} backend"
+    return f"{who} does not model actuator {space.actuator.name}"
 
 
 def _sweep_pressures(result: SearchResult, candidates: Sequence[Candidate]) -> np.ndarray:
@@ -117,7 +135,8 @@ def verify_candidates(
     list of Candidate
         The candidates verified (with ``fem_angle_deg``, ``fem_error_deg`` and
         ``fem_meets`` set; NaN and False for a sweep that failed or stopped before
-        the pressure).
+        the pressure). Empty for another actuator than the FEM's: then
+        ``result.verify_skipped`` says why (:func:`verify_skipped`) and nothing runs.
 
     Raises
     ------
@@ -131,6 +150,10 @@ def verify_candidates(
 
     if isinstance(k, bool) or not isinstance(k, int) or k < 1:
         raise ValueError(f"The 'k' of verify_candidates must be an integer >= 1. Got {k!r}.")
+    skipped = verify_skipped(result, backend)
+    if skipped is not None:
+        result.verify_skipped = skipped
+        return []
     chosen = result.candidates[:k]
     if not chosen:
         return []

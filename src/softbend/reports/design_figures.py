@@ -16,7 +16,8 @@ _DPI = 120
 
 
 def _label(objective: Any) -> str:
-    return f"{objective.name} ({OBJECTIVES[objective.name]})"
+    unit = OBJECTIVES[objective.name] if objective.unit is None else objective.unit
+    return f"{objective.name} ({unit})" if unit else objective.name
 
 
 def front_figure(result: Any, path: str | Path) -> Path:
@@ -114,7 +115,7 @@ def curves_figure(result: Any, predictor: Any, path: str | Path, *, count: int =
             ms=10,
             label="target" if target.kind == "angle_at" else "target (at most this pressure)",
         )
-    ax.set_xlabel("pressure (MPa)")
+    ax.set_xlabel(f"pressure ({target.unit})")
     ax.set_ylabel("bending angle (°)")
     verified = any(c.fem_curve is not None for c in result.candidates[:count])
     ax.set_title(

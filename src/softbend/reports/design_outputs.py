@@ -1,4 +1,10 @@
-"""A design search's files: the ranked table, the record, and the figures."""
+"""A design search's files: the ranked table, the record, and the figures.
+
+Every column names the model's own parameters: paper B's as ``l_mm`` …
+``lc_mm``, another actuator's by its parameter names (whole numbers as
+integers, a categorical parameter by its level's name), and the pressure by
+its unit (``pressure_mpa``, ``pressure_kpa`` …).
+"""
 
 from __future__ import annotations
 
@@ -8,7 +14,9 @@ import math
 from pathlib import Path
 from typing import Any
 
+from softbend.design import SFRBADesign
 from softbend.design_search.search import SearchResult
+from softbend.design_search.space import pressure_key
 from softbend.design_search.spec import NAMES, UNITS
 
 __all__ = ["FIGURE_CANDIDATES", "FILES", "candidate_rows", "write_search"]
@@ -21,14 +29,21 @@ FIGURE_CANDIDATES = 50
 
 
 def candidate_rows(result: SearchResult) -> list[dict[str, Any]]:
-    """One flat row per candidate, best first: rank, design (mm, deg), angles, miss, objectives."""
+    """One flat row per candidate, best first: rank, design (mm, deg; another actuator's by
+    its parameters), the pressure, angles, miss, objectives."""
     rows = []
     for rank, c in enumerate(result.candidates, start=1):
         row: dict[str, Any] = {"rank": rank}
-        row.update(
-            {f"{n}_{UNITS[n]}": float(v) for n, v in zip(NAMES, c.design.as_array(), strict=True)}
-        )
-        row["pressure_mpa"] = c.pressure_mpa
+        if isinstance(c.design, SFRBADesign):
+            row.update(
+                {
+                    f"{n}_{UNITS[n]}": float(v)
+                    for n, v in zip(NAMES, c.design.as_array(), strict=True)
+                }
+            )
+        else:
+            row.update(c.design.as_dict())
+        row[pressure_key(c.pressure_unit)] = c.pressure_mpa
         row["angle_deg"] = c.angle_deg
         row["error_deg"] = c.error_deg
         row["meets"] = c.meets
@@ -54,6 +69,7 @@ def write_search(result: SearchResult, predictor: Any, folder: str | Path) -> di
     """
     from softbend._io import json_text
     from softbend.reports import design_figures
+    from softbend.surrogates.persistence import describing
 
     out = Path(folder)
     out.mkdir(parents=True, exist_ok=True)
@@ -71,5 +87,6 @@ def write_search(result: SearchResult, predictor: Any, folder: str | Path) -> di
     (out / "search.json").write_text(json_text(result.to_dict()) + "\n", encoding="utf-8")
     shown = dataclasses.replace(result, candidates=result.candidates[:FIGURE_CANDIDATES])
     design_figures.front_figure(shown, out / "front.png")
-    design_figures.curves_figure(result, predictor, out / "curves.png")
+    with describing(result.spec.space.actuator):  # the model's own inputs
+        design_figures.curves_figure(result, predictor, out / "curves.png")
     return {name: str(out / name) for name in FILES}

@@ -1,0 +1,355 @@
+"""The design parameters a search names: paper B's six, or a model's own description.
+
+A design search works over the parameters of the actuator its model was trained
+on (:attr:`SavedSurrogate.actuator <softbend.surrogates.persistence.SavedSurrogate.actuator>`).
+:class:`SearchSpace` says how a specification names them and what they are:
+
+- paper B's actuator (:data:`softbend.actuators.SFRBA`) keeps the short names
+  ``l, r, t, b, phi, lc`` (mm and degrees; its column names ``l_mm`` … are
+  accepted too), the mould's default step (0.5 mm, 1°), the rule ``t < r``,
+  the objective ``volume`` (of elastomer) and the FEM check;
+- any other actuator is named by its description's parameters
+  (``n_chambers``, ``wall_mm``, ``layer``), each searched on its own kind: an
+  integer on whole numbers, a categorical parameter on its levels (stored as
+  their index; a level is given and shown by name), a continuous one on
+  multiples of its step (by default its declared resolution, else a round
+  step of about a hundredth of its range, :meth:`SearchSpace.grid_steps`); its
+  constraints
+  (:meth:`~softbend.actuators.Actuator.constraints_met`) decide which designs
+  are actuators, and its pressure unit is the unit of every pressure of the
+  search.
+
+:class:`ActuatorDesign` is one design of such an actuator, by its codes.
+"""
+
+from __future__ import annotations
+
+import hashlib
+import math
+from collections.abc import Sequence
+from dataclasses import dataclass, field
+from typing import Any
+
+import numpy as np
+
+from softbend.actuators import PRESSURE_UNITS, SFRBA, Actuator, DesignParameter
+from softbend.design import PARAMETERS, SFRBADesign
+
+__all__ = [
+    "DEFAULT_GRID",
+    "GRID_INTERVALS",
+    "PAPER_B",
+    "QUANTITIES",
+    "ActuatorDesign",
+    "SearchSpace",
+    "aligned",
+    "pressure_key",
+    "round_step",
+    "space_of",
+]
+
+#: Objectives that are not design parameters (``volume`` for paper B's actuator only).
+QUANTITIES: tuple[str, ...] = ("pressure", "volume", "sensitivity", "angle", "error")
+
+#: About how many designs the default grid of a description holds
+#: (:meth:`SearchSpace.grid_steps`).
+DEFAULT_GRID = 1_000_000
+
+#: The intervals a continuous parameter without a resolution is split into by
+#: default: at least, at most (:meth:`SearchSpace.grid_steps`).
+GRID_INTERVALS = (10, 100)
+
+
+def pressure_key(unit: str) -> str:
+    """The key of a pressure in tables and JSON: ``pressure_mpa``, ``pressure_kpa`` …"""
+    return f"pressure_{unit.lower()}"
+
+
+@dataclass(frozen=True)
+class ActuatorDesign:
+    """One design of an actuator other than paper B's: its model-input codes.
+
+    Attributes
+    ----------
+    actuator : Actuator
+    codes : tuple of float
+        The design parameters in the order of ``actuator.names``; a categorical
+        level as its index.
+    """
+
+    actuator: Actuator = field(repr=False)
+    codes: tuple[float, ...]
+
+    def as_array(self) -> np.ndarray:
+        """The codes as a float array."""
+        return np.array(self.codes, dtype=float)
+
+    def as_dict(self) -> dict[str, Any]:
+        """``{name: value}``: whole numbers as integers, levels by name."""
+        return self.actuator.design_record(self.codes)
+
+    @property
+    def design_id(self) -> str:
+        """Stable 16-hex-digit identifier: a SHA-1 of the actuator and its codes."""
+        canonical = self.actuator.name + ":" + ",".join(f"{v:.6f}" for v in self.codes)
+        return hashlib.sha1(canonical.encode()).hexdigest()[:16]
+
+    def feature_rows(self, pressures: Sequence[float] | np.ndarray) -> np.ndarray:
+        """Model inputs for this design at each pressure (the actuator's unit), one row each."""
+        p = np.asarray(pressures, dtype=float).reshape(-1)
+        rows = np.empty((p.size, len(self.codes) + 1))
+        rows[:, :-1] = self.codes
+        rows[:, -1] = p
+        return rows
+
+    def __str__(self) -> str:
+        return self.actuator.describe(self.codes)
+
+
+@dataclass(frozen=True)
+class SearchSpace:
+    """The parameters of one actuator as a design search names them.
+
+    Attributes
+    ----------
+    actuator : Actuator
+    names : tuple of str
+        The names a specification gives them, in model-input order: paper B's
+        short names, or the description's own.
+    """
+
+    actuator: Actuator
+    names: tuple[str, ...]
+
+    def __post_init__(self) -> None:
+        clash = [n for n in self.names if n in QUANTITIES]
+        if clash:
+            raise ValueError(
+                f"The actuator {self.actuator.name} has a design parameter called "
+                f"{clash[0]!r}, the name of an objective of the design search "
+                f"({', '.join(QUANTITIES)}); rename the parameter to search its designs."
+            )
+
+    @property
+    def paper_b(self) -> bool:
+        """Whether this is paper B's actuator (short names, its geometry, the FEM check)."""
+        return self.actuator == SFRBA
+
+    @property
+    def columns(self) -> tuple[str, ...]:
+        """The model-input column of each name."""
+        return self.actuator.names
+
+    @property
+    def features(self) -> tuple[str, ...]:
+        """The model inputs: the design columns then the pressure column."""
+        return self.actuator.features
+
+    @property
+    def pressure_unit(self) -> str:
+        """Unit of every pressure of a search (the model's pressure input)."""
+        return self.actuator.pressure_unit
+
+    @property
+    def to_mpa(self) -> float:
+        """Factor from :attr:`pressure_unit` to MPa."""
+        return PRESSURE_UNITS[self.pressure_unit]
+
+    @property
+    def verifiable(self) -> bool:
+        """Whether the FEM simulates this actuator (``--verify``)."""
+        return self.paper_b and self.actuator.fem_family == "sfrba"
+
+    def parameter(self, name: str) -> DesignParameter:
+        """The description of the parameter ``name`` (a name of :attr:`names`)."""
+        return self.actuator.parameters[self.names.index(name)]
+
+    def kind(self, name: str) -> str:
+        """``continuous``, ``integer`` or ``categorical``."""
+        return self.parameter(name).kind
+
+    def unit(self, name: str) -> str:
+        """The unit of ``name`` (``""`` for a count or a level)."""
+        return self.parameter(name).unit
+
+    @property
+    def units(self) -> dict[str, str]:
+        """Unit of every name."""
+        return {n: self.unit(n) for n in self.names}
+
+    def canonical(self, text: str) -> str | None:
+        """The name ``text`` stands for (paper B's column ``l_mm`` is ``l``), or None."""
+        if text in self.names:
+            return text
+        if text in self.columns:
+            return self.names[self.columns.index(text)]
+        return None
+
+    @property
+    def objectives(self) -> dict[str, str]:
+        """What an objective may name, with its unit: a parameter (not a categorical one),
+        ``pressure``, ``volume`` (paper B's actuator), ``sensitivity``, ``angle``, ``error``."""
+        unit = self.pressure_unit
+        out = {n: self.unit(n) for n in self.names if self.kind(n) != "categorical"}
+        out["pressure"] = unit
+        if self.paper_b:
+            out["volume"] = "mm³"
+        out.update({"sensitivity": f"deg/{unit}", "angle": "deg", "error": "deg"})
+        return out
+
+    def listing(self) -> str:
+        """The names, comma-separated, for messages."""
+        return ", ".join(self.names)
+
+    def feasible(self, designs: np.ndarray) -> np.ndarray:
+        """Which rows of designs are actuators: a wall thinner than the radius (paper B's
+        ``t < r``), or every constraint of the description met."""
+        if self.paper_b:
+            return designs[:, self.names.index("t")] < designs[:, self.names.index("r")]
+        if not self.actuator.constraints:
+            return np.ones(designs.shape[0], dtype=bool)
+        return self.actuator.constraints_met(designs)
+
+    def design_of(self, codes: Sequence[float]) -> SFRBADesign | ActuatorDesign:
+        """One design: paper B's :class:`~softbend.design.SFRBADesign`, else an
+        :class:`ActuatorDesign`."""
+        values = [float(v) for v in codes]
+        if self.paper_b:
+            return SFRBADesign.from_sequence(values)
+        return ActuatorDesign(self.actuator, tuple(values))
+
+    def decode(self, name: str, code: float) -> Any:
+        """The value of ``name`` a code stands for (a level by name, a whole number)."""
+        return self.parameter(name).decode(code)
+
+    def shown(self, name: str, code: float) -> str:
+        """A value of ``name`` for messages and tables (``10``, ``1.5``, ``paper``)."""
+        value = self.decode(name, code)
+        return f"{value:g}" if isinstance(value, float) else str(value)
+
+    # --- another actuator's rules (paper B's are those of spec.py) -------------------------
+
+    def default_step(self, name: str) -> float:
+        """The step of ``name`` when none is given: a continuous parameter's declared
+        resolution, else :meth:`grid_steps`' round step (0, continuous, for an unbounded
+        range), 1 for an integer or a level."""
+        p = self.parameter(name)
+        if p.kind == "continuous":
+            if p.resolution is not None:
+                return float(p.resolution)
+            return self.grid_steps().get(name, 0.0)
+        return 1.0
+
+    def grid_steps(self) -> dict[str, float]:
+        """The step of each continuous parameter that declares no resolution (and a finite
+        range): the round step (1, 2, 2.5 or 5 × 10^k) that splits its described range
+        into ``n`` intervals at most, ``n`` the same for all of them and as large as keeps
+        the grid of the whole description near :data:`DEFAULT_GRID` designs, held to 10
+        to 100."""
+        free, others = [], 1
+        for p, name in zip(self.actuator.parameters, self.names, strict=True):
+            span = p.high - p.low
+            if not math.isfinite(span):
+                continue
+            if p.kind == "continuous" and p.resolution is None:
+                if span > 0:
+                    free.append((name, span))
+            elif p.kind == "continuous":
+                others *= math.floor(span / p.resolution + 1e-9) + 1  # type: ignore[operator]
+            else:
+                others *= math.floor(p.high + 1e-9) - math.ceil(p.low - 1e-9) + 1
+        if not free:
+            return {}
+        n = math.floor((DEFAULT_GRID / max(others, 1)) ** (1.0 / len(free)) + 1e-9)
+        n = min(max(n, GRID_INTERVALS[0]), GRID_INTERVALS[1])
+        return {name: round_step(span, n) for name, span in free}
+
+    def value_problem(self, name: str, code: float) -> str | None:
+        """Why ``code`` cannot be a value of ``name`` (outside the description, not a
+        whole number), or None."""
+        p = self.parameter(name)
+        eps = 1e-9 * max(1.0, abs(p.low), abs(p.high))
+        if not math.isfinite(code):
+            return "is not a finite number"
+        if code < p.low - eps or code > p.high + eps:
+            span = f"[{p.low:g}, {p.high:g}]" + (f" {p.unit}" if p.unit else "")
+            return f"leaves the range {span} the actuator {self.actuator.name} describes"
+        if p.kind == "integer" and abs(code - round(code)) > 1e-9:
+            return f"is not a whole number ({name} is an integer parameter)"
+        return None
+
+    def step_problem(self, name: str, step: float) -> str | None:
+        """Why ``step`` cannot be the step of ``name``, or None."""
+        p = self.parameter(name)
+        if p.kind == "categorical":
+            return (
+                f"does not apply to the categorical parameter {name!r}: every level "
+                f"({'/'.join(map(str, p.levels or ()))}) is searched"
+            )
+        if p.kind == "integer" and (step < 1 or abs(step - round(step)) > 1e-9):
+            return f"must be a whole number >= 1 ({name} is an integer parameter)"
+        if p.kind == "continuous" and step > 0 and p.resolution is not None:
+            ratio = step / p.resolution
+            if abs(ratio - round(ratio)) > 1e-6 or round(ratio) < 1:
+                return (
+                    f"must be 0 or a whole multiple of the resolution {p.resolution:g}"
+                    + (f" {p.unit}" if p.unit else "")
+                    + f" the actuator {self.actuator.name} declares for {name!r}"
+                )
+        return None
+
+    def snap(self, name: str, values: np.ndarray, low: float, high: float) -> np.ndarray:
+        """``values`` of a continuous ``name`` moved to the nearest multiple of its declared
+        resolution inside ``[low, high]`` (unchanged where it declares none)."""
+        resolution = self.parameter(name).resolution
+        if resolution is None:
+            return values
+        first, last = _multiples(low, high, resolution)
+        snapped = np.round(np.asarray(values, dtype=float) / resolution) * resolution
+        return np.round(np.clip(snapped, first, last), 9)
+
+
+def round_step(span: float, intervals: int) -> float:
+    """The smallest step of 1, 2, 2.5 or 5 × 10^k that splits ``span`` into at most
+    ``intervals``."""
+    raw = span / intervals
+    exponent = math.floor(math.log10(raw))
+    for mantissa in (1.0, 2.0, 2.5, 5.0, 10.0):
+        step = float(f"{mantissa * 10.0**exponent:.12g}")
+        if step >= raw * (1 - 1e-12):
+            return step
+    return float(f"{10.0 ** (exponent + 1):.12g}")  # pragma: no cover - 10 × 10^k ends it
+
+
+def _multiples(low: float, high: float, step: float) -> tuple[float, float]:
+    """The first and last multiple of ``step`` in ``[low, high]`` (first > last: none)."""
+    first = round(math.ceil(low / step - 1e-9) * step, 9)
+    last = round(math.floor(high / step + 1e-9) * step, 9)
+    return first, last
+
+
+def aligned(low: float, high: float, step: float) -> tuple[float, float]:
+    """``[low, high]`` narrowed to its first and last multiple of ``step`` (first > last: none)."""
+    return _multiples(low, high, step)
+
+
+def _short(column: str) -> str:
+    return column.rsplit("_", 1)[0]
+
+
+#: Paper B's actuator, by the short names of :data:`softbend.design_search.spec.NAMES`.
+PAPER_B = SearchSpace(SFRBA, tuple(_short(c) for c in PARAMETERS))
+
+
+def space_of(actuator: Actuator | None) -> SearchSpace:
+    """The search space of ``actuator``: :data:`PAPER_B` for None and for any record of
+    paper B's actuator (its six columns, MPa, the FEM family ``"sfrba"``), else its own."""
+    if actuator is None or actuator == SFRBA:
+        return PAPER_B
+    if (
+        actuator.names == SFRBA.names
+        and actuator.pressure_unit == SFRBA.pressure_unit
+        and actuator.fem_family == SFRBA.fem_family
+    ):
+        return PAPER_B
+    return SearchSpace(actuator, actuator.names)
