@@ -53,7 +53,16 @@ def simulate_cmd(
     """Run a controller on the simulated rig and score it.
 
     Scores the run as paper B, Figure 9 (synthetic data). metrics.json records
-    the controller and the rig, with every one of their parameters as used.
+    the controller and the rig, with every one of their parameters as used, and
+    the controller's model. That model (θ(p) and virtual angle sensor) is
+    --model, else the --plant when it is a saved surrogate (a refined model is
+    its own soft sensor, as in paper B), else the shipped FEM-trained MLP;
+    --model with another --plant .json is a deliberate mismatch, and the table
+    names both. A model of any actuator may be used: --design names its
+    parameters (NAME=VALUE pairs), its pressures are converted from the rig's MPa
+    (--supply, --rig-param and the scores stay in MPa), and the chamber is its
+    description's (else --rig-param volume_mm3). A design outside the model's
+    training ranges is a warning naming the parameter; --strict refuses it.
     A score the run does not define (an angle that did not settle within the
     run, a run without a rising edge) is null in metrics.json and --json, with
     the reason under undefined_metrics, and 'null (the reason)' in the table;
@@ -104,10 +113,11 @@ def simulate_cmd(
     if as_json:
         _common.print_json(payload)
         return
+    note, named = control_run.model_lines(result.setup)
     _common.print_table(
-        f"{name} on {actuator}, {reference}: simulated rig (SYNTHETIC)",
+        f"{name} on {actuator}, {reference}: simulated rig (SYNTHETIC){note}",
         ["metric", "value"],
-        control_run.metric_rows(payload["metrics"], payload["undefined_metrics"]),
+        named + control_run.metric_rows(payload["metrics"], payload["undefined_metrics"]),
     )
     _common.console.print(f"run written to {out}")
 
@@ -210,6 +220,7 @@ def serve_cmd(
     import time
 
     from softbend._validation import check_range
+    from softbend.control.designs import DEFAULT_DESIGN
     from softbend.control.runs import simulated_server
 
     command = "softbend control serve"
@@ -223,7 +234,8 @@ def serve_cmd(
     try:
         server.start()
         _common.console.print(
-            f"simulated rig {design} serving on {server.config.connection.where} "
+            f"simulated rig {design or DEFAULT_DESIGN} serving on "
+            f"{server.config.connection.where} "
             f"({'Ctrl-C to stop' if duration == 0 else f'for {duration:g} s'})"
         )
         end = time.monotonic() + (duration if duration > 0 else float("inf"))

@@ -4,8 +4,6 @@ from __future__ import annotations
 
 import typer
 
-from softbend.cli._common import DESIGN_HELP
-
 REFERENCE = typer.Option(
     "step:90",
     help="step:AMP[:T0_S], square:AMP:PERIOD_S[:LOW] or triangle:FREQ_HZ:AMP[:LOW] (degrees).",
@@ -23,16 +21,28 @@ SET = typer.Option(
     help="A controller parameter NAME=VALUE, repeatable (e.g. --set deadzone=0.02 for "
     "bang-bang; 'softbend control controllers' lists them).",
 )
-DESIGN = typer.Option("100,6,2,2,5,8", help=DESIGN_HELP)
+DESIGN = typer.Option(
+    None,
+    metavar="DESIGN",
+    help="The actuator's design, read by the actuator of the controller's model: paper B's "
+    "l,r,t,b,phi,lc in mm and degrees (default 100,6,2,2,5,8), or NAME=VALUE pairs by the "
+    "parameters of another model's actuator, in its units (e.g. "
+    "n_chambers=10,wall_mm=2,layer=paper; required for such a model).",
+)
 MODEL = typer.Option(
-    None, "--model", help="Saved surrogate for θ(p) (default: the shipped FEM-trained MLP)."
+    None,
+    "--model",
+    help="Saved surrogate (of any actuator) the controller uses: θ(p) and virtual angle sensor "
+    "(default: the --plant when it is a saved surrogate, else the shipped FEM-trained MLP); "
+    "with another --plant .json, a deliberate model mismatch.",
 )
 PLANT = typer.Option(
     "surrogate",
     help="θ(p) of the actuator: surrogate (the controller's own model), fem (the design's "
     "FEM sweep), lab (its virtual-lab readings: model mismatch), or a file of your own "
-    "actuator: a saved surrogate .json (e.g. from 'softbend transfer refine') or a "
-    "measurements .csv (its loading readings, smoothed).",
+    "actuator: a saved surrogate .json (e.g. from 'softbend transfer refine'; also the "
+    "controller's model unless --model is given) or a measurements .csv (its loading "
+    "readings, smoothed). fem, lab and .csv are paper B's actuator's only.",
 )
 RIG_PARAM = typer.Option(
     None,
@@ -41,17 +51,22 @@ RIG_PARAM = typer.Option(
     help="A parameter of the simulated rig NAME=VALUE, repeatable: valves "
     "(inlet_conductance_m3_s_pa, outlet_conductance_m3_s_pa, critical_ratio, valve_delay_s), "
     "tubing_mm3, supply_gauge_mpa, sensor (sensor_noise_mpa, sensor_bits, sensor_range_mpa), "
-    "camera_noise_deg and more (the command 'control rig-parameters' lists them all).",
+    "camera_noise_deg and more (the command 'control rig-parameters' lists them all). The "
+    "chamber is paper B's design's cavity plus tubing_mm3; another actuator's is its "
+    "description's chamber_volume_mm3 plus tubing_mm3, growing by its "
+    "volume_growth_mm3_per_mpa (else rigid, with a warning): without a described volume, "
+    "give volume_mm3 (measured, tubing included) or the run is refused.",
 )
 SUPPLY = typer.Option(
     None,
-    help="Supply pressure of the simulated rig, MPa gauge (default 0.2; the same as "
-    "--rig-param supply_gauge_mpa).",
+    help="Supply pressure of the simulated rig, MPa gauge, whatever the model's pressure "
+    "unit (default 0.2; the same as --rig-param supply_gauge_mpa).",
 )
 STRICT = typer.Option(
     False,
     "--strict",
-    help="Refuse a controller model or plant surrogate whose θ(p) of the design, up to the "
-    "supply, leaves its training data (a pressure past what the designs nearest to it were "
-    "swept to, an angle past the largest trained on).",
+    help="Refuse a design outside the training ranges of the controller's model, and a "
+    "controller model or plant surrogate whose θ(p) of the design, up to the supply, leaves "
+    "its training data (a pressure past what the designs nearest to it were swept to, an "
+    "angle past the largest trained on); without it, each is a warning.",
 )

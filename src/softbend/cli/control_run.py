@@ -140,10 +140,11 @@ def run_cmd(
     if as_json:
         _common.print_json(payload)
     else:
-        rows = metric_rows(payload["metrics"], payload["undefined_metrics"])
+        note, named = model_lines(plan.setup)
+        rows = named + metric_rows(payload["metrics"], payload["undefined_metrics"])
         rows += [[k, v] for k, v in payload["jitter"].items()]
         _common.print_table(
-            f"{name} on {actuator}, {reference}, rig {rig}", ["metric", "value"], rows
+            f"{name} on {actuator}, {reference}, rig {rig}{note}", ["metric", "value"], rows
         )
         _common.console.print(f"run written to {out}")
     if result.loop.fault_kind == "interrupted":
@@ -162,6 +163,24 @@ def metric_rows(metrics: dict[str, Any], undefined: dict[str, str]) -> list[list
     ]
 
 
+def model_lines(setup: Any) -> tuple[str, list[list[Any]]]:
+    """What a run's table says of its models: a note for the title and rows naming them.
+
+    Nothing for the shipped MLP against a named plant (paper B's runs); one row when
+    the plant is the controller's model; a row each otherwise, and the title's note
+    "model mismatch" when a saved surrogate plays the plant and the controller uses another.
+    """
+    from softbend.control.plants import plant_file
+
+    plant, model = setup.plant, setup.model_path
+    if setup.model_from == "shipped" and plant_file(plant) is None:
+        return "", []
+    if setup.plant_is_model:
+        return "", [["plant and controller's model", model]]
+    rows = [["plant", plant], ["controller's model", model]]
+    return ("; model mismatch" if setup.mismatch else ""), rows
+
+
 def terminate_as_interrupt() -> Any:
     """Make SIGTERM (``kill``, a service stop) end a loop or a server as Ctrl-C does: vented.
 
@@ -177,4 +196,4 @@ def terminate_as_interrupt() -> Any:
     return signal.signal(signal.SIGTERM, interrupt)
 
 
-__all__ = ["metric_rows", "run_cmd", "terminate_as_interrupt"]
+__all__ = ["metric_rows", "model_lines", "run_cmd", "terminate_as_interrupt"]

@@ -51,6 +51,8 @@ _EXPORTS: dict[str, str] = {
     "run_metrics": "experiments",
     "simulate": "experiments",
     "run_loop": "loop",
+    "ModelDesign": "designs",
+    "control_design": "designs",
     "ControlSetup": "setup",
     "prepare_control": "setup",
     "plan_loop": "runs",

@@ -27,7 +27,6 @@ import numpy as np
 
 from softbend._validation import check_choice
 from softbend.control._ranges import check_declared
-from softbend.design import SFRBADesign
 from softbend.parameters import Range, declare_ranges, declared_ranges
 
 __all__ = [
@@ -65,21 +64,35 @@ class Controller(Protocol):
     def reset(self) -> None: ...
 
 
-def mlp_virtual_sensor(model: Any, design: SFRBADesign) -> Callable[[float], float]:
+def mlp_virtual_sensor(model: Any, design: Any) -> Callable[[float], float]:
     """Paper B's virtual angle sensor: θp = MLP(design, p), one fast call per reading.
 
     ``model`` is a fitted :class:`softbend.surrogates.mlp.NormalizedMLPRegressor`
-    (its ``.predictor()`` is used); returns ``f(p_mpa) -> degrees``.
+    (its ``.predictor()`` is used); returns ``f(p_mpa) -> degrees``. ``design``
+    is paper B's :class:`~softbend.design.SFRBADesign` or a
+    :class:`~softbend.control.designs.ModelDesign` of another actuator, whose
+    model takes the pressure in its own unit (the reading in MPa is converted).
     """
     predict = model.predictor()
-    row = np.empty(7)
-    row[:6] = design.as_array()
+    codes = design.as_array()
+    row = np.empty(codes.size + 1)
+    row[:-1] = codes
+    scale = float(getattr(design, "pressure_scale", 1.0))
+    last = codes.size
 
-    def sensor(p_mpa: float) -> float:
-        row[6] = p_mpa
+    if scale == 1.0:
+
+        def sensor(p_mpa: float) -> float:
+            row[last] = p_mpa
+            return predict(row)
+
+        return sensor
+
+    def scaled(p_mpa: float) -> float:
+        row[last] = p_mpa * scale
         return predict(row)
 
-    return sensor
+    return scaled
 
 
 #: The sample period of every controller, s.

@@ -28,6 +28,7 @@ from softbend.control.controllers import (
     PressureRelay,
     mlp_virtual_sensor,
 )
+from softbend.control.designs import ModelDesign
 from softbend.control.predictive import PredictivePulse
 from softbend.control.rig import AngleTable, RigParams
 from softbend.design import SFRBADesign
@@ -81,10 +82,20 @@ class ControllerModel:
 
     @classmethod
     def from_surrogate(
-        cls, model: Any, design: SFRBADesign, rig: RigParams | None = None
+        cls,
+        model: Any,
+        design: SFRBADesign | ModelDesign,
+        rig: RigParams | None = None,
+        *,
+        pmax_mpa: float = 0.5,
     ) -> ControllerModel:
-        """θ(p) of ``model`` for ``design``; its ``.predictor()`` is the virtual sensor, if any."""
-        table = AngleTable.from_surrogate(model, design)
+        """θ(p) of ``model`` for ``design``; its ``.predictor()`` is the virtual sensor, if any.
+
+        ``design`` is paper B's, or a :class:`~softbend.control.designs.ModelDesign`
+        of the model's actuator (its pressures converted from MPa); the table spans
+        0 to ``pmax_mpa`` MPa gauge.
+        """
+        table = AngleTable.from_surrogate(model, design, pmax_mpa=pmax_mpa)
         sensor = mlp_virtual_sensor(model, design) if hasattr(model, "predictor") else table
         return cls(table, sensor, rig)
 

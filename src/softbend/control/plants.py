@@ -12,21 +12,28 @@ A lab's own actuator plays the plant from a file instead of a name: a saved
 surrogate (``model.json``, e.g. the one ``softbend transfer refine`` wrote for
 it) or a measurements CSV (``readings.csv``: its loading readings of the
 design, smoothed), as ``--plant model.json`` or ``--plant readings.csv``.
+
+A saved surrogate of any actuator plays the plant of its design
+(:class:`~softbend.control.designs.ModelDesign`): its θ(p) is tabulated in MPa,
+the rig's unit, from the model's own pressure unit. ``fem``, ``lab`` and a
+measurements CSV are paper B's actuator's only.
 """
 
 from __future__ import annotations
 
 from collections.abc import Callable
 from pathlib import Path
-from typing import Any
+from typing import Any, cast
 
 import numpy as np
 
+from softbend.control.designs import ModelDesign, actuator_of_design, control_design
 from softbend.control.rig import AngleTable
 from softbend.design import SFRBADesign
 from softbend.registry import Registry, UnknownNameError
 
 __all__ = [
+    "PAPER_B_PLANTS",
     "PLANTS",
     "check_plant",
     "fem_angle_table",
@@ -43,6 +50,9 @@ __all__ = [
 
 #: Plant factories by name: ``factory(design, model_table) -> AngleTable``.
 PLANTS: Registry[Callable[[SFRBADesign, AngleTable], AngleTable]] = Registry("plant")
+
+#: The plants that are of paper B's actuator alone (its FEM, its virtual lab).
+PAPER_B_PLANTS: frozenset[str] = frozenset({"fem", "lab"})
 
 
 def plant_file(name: str) -> Path | None:
@@ -71,7 +81,12 @@ def check_plant(name: str, *, field: str = "plant") -> str:
 
 
 def plant_table(
-    name: str, design: SFRBADesign, model_table: AngleTable, *, field: str = "plant_table"
+    name: str,
+    design: SFRBADesign | ModelDesign,
+    model_table: AngleTable,
+    *,
+    field: str = "plant_table",
+    pmax_mpa: float = 0.5,
 ) -> AngleTable:
     """The plant ``name`` of ``design``: a name of :data:`PLANTS`, or a plant file.
 
@@ -83,21 +98,40 @@ def plant_table(
         CSV (``.csv``: the design's loading readings, smoothed as
         :func:`lab_angle_table` does). Anything else raises
         :class:`~softbend.registry.UnknownNameError` listing the known names.
-    design : SFRBADesign
+    design : SFRBADesign or ModelDesign
+        Paper B's design, or a design of another actuator (then the plant is
+        ``surrogate``, a saved surrogate of that actuator, or a registered plant
+        that takes such a design; ``fem``, ``lab`` and a CSV are refused).
     model_table : AngleTable
         θ(p) of the controllers' own model.
     field : str
         Where ``name`` came from, for the message (``"--plant"``).
+    pmax_mpa : float, default 0.5
+        The top of a saved surrogate's table, MPa gauge.
     """
     path = plant_file(name)
+    if isinstance(design, ModelDesign) and (
+        name in PAPER_B_PLANTS or (path is not None and path.suffix.lower() == ".csv")
+    ):
+        raise ValueError(
+            f"The plant {name!r} (in {field}) is of paper B's actuator only; the design "
+            f"{design} is of the actuator {design.actuator.name}: use the plant 'surrogate' "
+            "(the controller's model) or a saved surrogate .json of that actuator."
+        )
     if path is None:
-        return PLANTS.get(check_plant(name, field=field), field=field)(design, model_table)
+        factory = PLANTS.get(check_plant(name, field=field), field=field)
+        # paper B's plants were refused above for another actuator's design; a registered
+        # one receives the design the controller's model takes
+        return factory(cast(SFRBADesign, design), model_table)
     if path.suffix.lower() == ".json":
         from softbend.surrogates.persistence import load_surrogate
 
-        return AngleTable.from_surrogate(load_surrogate(path).model, design)
+        saved = load_surrogate(path)
+        own = control_design(design, saved.actuator, field="design", source=f"the plant {path}")
+        return AngleTable.from_surrogate(saved.model, own, pmax_mpa=pmax_mpa)
     from softbend.transfer.measurements import load_measurements
 
+    assert isinstance(design, SFRBADesign)
     return lab_angle_table(design, measurements=load_measurements(path), source=str(path))
 
 
@@ -131,7 +165,7 @@ def fem_plant(design: SFRBADesign, model_table: AngleTable) -> AngleTable:
 
 def support_warnings(
     saved: Any,
-    design: SFRBADesign,
+    design: SFRBADesign | ModelDesign,
     up_to_mpa: float,
     *,
     role: str = "the controller's model",
@@ -146,8 +180,10 @@ def support_warnings(
     Parameters
     ----------
     saved : SavedSurrogate
-        A loaded surrogate file (``.model`` and ``.metadata``).
-    design : SFRBADesign
+        A loaded surrogate file (``.model`` and ``.metadata``), of any actuator.
+    design : SFRBADesign or ModelDesign
+        The design, of the actuator of ``saved`` (a design of another actuator
+        with the same parameters is taken by its values).
     up_to_mpa : float
         The largest pressure the rig reaches (its supply), MPa gauge.
     role : str
@@ -159,30 +195,48 @@ def support_warnings(
         The largest supported pressure at ``design``, MPa; None when the file
         records no support.
     pressure_note : str or None
-        A phrase when ``up_to_mpa`` lies past ``supported_mpa``.
+        A phrase when ``up_to_mpa`` lies past ``supported_mpa`` (pressures in the
+        model's unit).
     angle_note : str or None
         A phrase when θ(p) up to the supported pressure passes the largest
         angle trained on.
     """
+    from softbend.surrogates.features import using_features
     from softbend.surrogates.support import Support
 
     record = saved.metadata.get("support")
     if not isinstance(record, dict):
         return None, None, None
-    support = Support.from_dict(record)
-    limit = float(support.max_pressure(design.as_array()[None, :])[0])
+    actuator = getattr(saved, "actuator", actuator_of_design(design))
+    own = control_design(design, actuator, field="design", source=role)
+    with using_features(actuator.features):
+        support = Support.from_dict(record)
+    if isinstance(own, SFRBADesign):
+        limit = float(support.max_pressure(own.as_array()[None, :])[0])
+        shown_limit, shown_supply = f"{limit:.3g} MPa", f"{up_to_mpa:g} MPa"
+    else:
+        native = float(support.max_pressure(own.as_array()[None, :])[0])
+        limit = native / own.pressure_scale
+        unit = actuator.pressure_unit
+        shown_limit = f"{native:.3g} {unit}"
+        shown_supply = f"{up_to_mpa * own.pressure_scale:g} {unit}"
     pressure_note = angle_note = None
     if up_to_mpa > limit * (1 + 1e-9):
         pressure_note = (
-            f"{role} was trained near the design {design} up to {limit:.3g} MPa only: its "
-            f"θ(p) from there to the supply ({up_to_mpa:g} MPa) is an extrapolation"
+            f"{role} was trained near the design {own} up to {shown_limit} only: its "
+            f"θ(p) from there to the supply ({shown_supply}) is an extrapolation"
         )
     reach = min(up_to_mpa, limit)
-    angles = np.asarray(saved.model.predict(design.feature_rows(np.linspace(0.0, reach, 101))))
+    angles = np.asarray(saved.model.predict(own.feature_rows(np.linspace(0.0, reach, 101))))
     if np.max(angles) > support.angle_limit_deg:
+        reach_text = (
+            f"{reach:.3g} MPa"
+            if isinstance(own, SFRBADesign)
+            else f"{reach * own.pressure_scale:.3g} {actuator.pressure_unit}"
+        )
         angle_note = (
-            f"{role} predicts {np.max(angles):.4g}° for the design {design} below "
-            f"{reach:.3g} MPa, beyond the largest angle it was trained on "
+            f"{role} predicts {np.max(angles):.4g}° for the design {own} below "
+            f"{reach_text}, beyond the largest angle it was trained on "
             f"({support.max_angle_deg:.4g}°)"
         )
     return limit, pressure_note, angle_note

@@ -19,10 +19,12 @@ own (every one a field of :class:`RigParams`, with its unit in its name):
 - the chamber holds ideal gas in ``V(p) = V0 + (dV/dp)·p`` (p gauge); ``V0`` =
   7655 mm³ = the semicircular cavity ½·π·r²·l of the (100,6,2,2,5,8) actuator
   (5655 mm³) plus 2000 mm³ of tubing (:meth:`RigParams.for_design` recomputes
-  it for another design); ``dV/dp`` = 50 600 mm³/MPa, the FEM's: the cavity
-  volume of the (100,6,2,2,5,8) actuator integrated from its FEM sweep's dV/dp
-  and fitted by a line up to the supply (:func:`cavity_compliance_mm3_per_mpa`,
-  :meth:`RigParams.from_fem_sweep`; the cavity grows 2.7-fold by 0.18 MPa);
+  it for another design; :func:`softbend.control.rigs.rig_params_for` takes another
+  actuator's from its description or a measured value); ``dV/dp`` = 50 600 mm³/MPa,
+  the FEM's: the cavity volume of the (100,6,2,2,5,8) actuator integrated from
+  its FEM sweep's dV/dp and fitted by a line up to the supply
+  (:func:`cavity_compliance_mm3_per_mpa`, :meth:`RigParams.from_fem_sweep`; the
+  cavity grows 2.7-fold by 0.18 MPa);
   isothermal (polytropic exponent 1.0) unless set;
 - the angle follows the quasi-static θ(p) through a first-order lag of 30 ms;
 - the pressure sensor has 0.5 kPa Gaussian noise and 12-bit quantisation over
@@ -406,9 +408,15 @@ class AngleTable:
 
     @classmethod
     def from_surrogate(
-        cls, model: Any, design: SFRBADesign, pmax_mpa: float = 0.5, points: int = 501
+        cls, model: Any, design: Any, pmax_mpa: float = 0.5, points: int = 501
     ) -> AngleTable:
-        """Tabulate a fitted surrogate (``.predict`` on :data:`softbend.design.FEATURES` rows)."""
+        """Tabulate a fitted surrogate (``.predict`` on the rows ``design.feature_rows(p)``).
+
+        ``design`` is paper B's :class:`~softbend.design.SFRBADesign` (rows of
+        :data:`softbend.design.FEATURES`) or a
+        :class:`~softbend.control.designs.ModelDesign` of another actuator (rows of
+        its design codes and the pressure in its model's unit); the table is in MPa.
+        """
         return cls.from_callable(
             lambda p: model.predict(design.feature_rows(p)), pmax_mpa=pmax_mpa, points=points
         )

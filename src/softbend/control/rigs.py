@@ -12,7 +12,9 @@ A simulated rig is described by :class:`~softbend.control.rig.RigParams`:
 :func:`rig_settings` checks ``NAME=VALUE`` text (``--rig-param``) and a rig
 TOML's [simulation] table against its fields (plus ``tubing_mm3``, the tubing
 volume added to the design's cavity) and :func:`rig_params_for` builds the
-parameters of a design from them; :data:`RIG_SETTINGS` says what each name means.
+parameters of a design from them (paper B's cavity from its geometry; another
+actuator's chamber from its description or a measured ``volume_mm3``);
+:data:`RIG_SETTINGS` says what each name means.
 """
 
 from __future__ import annotations
@@ -23,6 +25,7 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
+from softbend.control.designs import ModelDesign
 from softbend.control.rig import AngleTable, Rig, RigParams, SimulatedRig
 from softbend.control.rigconfig import (
     DEFAULT_TUBING_MM3,
@@ -140,9 +143,11 @@ RIG_SETTINGS: dict[str, str] = {
     "outlet_conductance_m3_s_pa": "ISO 6358 sonic conductance C of the outlet valve + throttle",
     "critical_ratio": "ISO 6358 critical pressure ratio b of both valves",
     "valve_delay_s": "delay from a valve command to the valve switching",
-    "volume_mm3": "whole chamber volume at 0 MPa gauge (default: the design's cavity + tubing)",
+    "volume_mm3": "whole chamber volume at 0 MPa gauge (default: the design's cavity + tubing; "
+    "another actuator's: its description's chamber_volume_mm3 + tubing)",
     "tubing_mm3": "tubing volume added to the design's cavity (or give volume_mm3)",
-    "compliance_mm3_per_mpa": "growth of the chamber volume with gauge pressure, dV/dp",
+    "compliance_mm3_per_mpa": "growth of the chamber volume with gauge pressure, dV/dp "
+    "(another actuator's default: its description's volume_growth_mm3_per_mpa, else 0)",
     "polytropic_exponent": "of the gas in the chamber: 1 isothermal to 1.4 adiabatic",
     "angle_time_constant_s": "first-order lag of the angle behind its quasi-static θ(p)",
     "sensor_noise_mpa": "standard deviation of the pressure sensor's Gaussian noise",
@@ -245,17 +250,73 @@ def rig_settings(
 
 
 def rig_params_for(
-    design: SFRBADesign, settings: Mapping[str, Any] | None = None, **defaults: Any
+    design: SFRBADesign | ModelDesign, settings: Mapping[str, Any] | None = None, **defaults: Any
 ) -> RigParams:
     """The simulated rig of ``design`` with ``settings`` (:func:`rig_settings`) applied.
 
-    The chamber volume is the design's cavity plus ``tubing_mm3``
-    (:meth:`RigParams.for_design`) unless ``volume_mm3`` is given; ``defaults``
-    are RigParams fields the library derives (an FEM compliance), which
-    ``settings`` override.
+    Paper B's design: the chamber volume is the design's cavity plus
+    ``tubing_mm3`` (:meth:`RigParams.for_design`) unless ``volume_mm3`` is given.
+    A design of another actuator (:class:`~softbend.control.designs.ModelDesign`):
+    the chamber volume is ``volume_mm3`` when given (measured: the whole air
+    volume, tubing included), else the description's ``chamber_volume_mm3`` plus
+    ``tubing_mm3``; its growth with pressure is ``compliance_mm3_per_mpa`` when
+    given, else the description's ``volume_growth_mm3_per_mpa``, else 0 (a
+    rigid chamber, with a warning). ``defaults`` are RigParams fields the
+    library derives (an FEM compliance), which ``settings`` override.
+
+    Raises
+    ------
+    ValueError
+        A design of another actuator whose description gives no chamber volume,
+        without ``volume_mm3`` (one line saying to give ``--rig-param volume_mm3=...``).
     """
     chosen = {**defaults, **(settings or {})}
     tubing = chosen.pop("tubing_mm3", DEFAULT_TUBING_MM3)
+    if isinstance(design, ModelDesign):
+        return _rig_of_actuator(design, chosen, tubing)
     if "volume_mm3" in chosen:
         return RigParams(**chosen)
     return RigParams.for_design(design, tubing_mm3=tubing, **chosen)
+
+
+def _rig_of_actuator(design: ModelDesign, chosen: dict[str, Any], tubing: float) -> RigParams:
+    """The rig of a design of an actuator other than paper B's: its described chamber."""
+    import warnings
+
+    from softbend.control._ranges import check_declared
+    from softbend.control.rig import RIG_RANGES, TUBING_RANGE
+
+    actuator = design.actuator
+    if "volume_mm3" not in chosen:
+        if actuator.chamber_volume_mm3 is None:
+            raise ValueError(
+                f"The simulated rig needs the chamber volume of the actuator {actuator.name}, "
+                "which its description does not give (chamber_volume_mm3): give --rig-param "
+                "volume_mm3=V, the air volume at 0 MPa gauge with the tubing, in mm³ (or "
+                "volume_mm3 in the [simulation] table of the rig config)."
+            )
+        tubing = check_declared(tubing, "tubing_mm3", "the simulated rig", TUBING_RANGE)
+        volume = actuator.chamber_volume_mm3 + tubing
+        declared = RIG_RANGES["volume_mm3"]
+        if not declared.contains(volume):
+            raise ValueError(
+                f"The chamber of the actuator {actuator.name} (chamber_volume_mm3 "
+                f"{actuator.chamber_volume_mm3:.4g} mm³ of its description, plus tubing_mm3 "
+                f"{tubing:g}) is {volume:.4g} mm³; the 'volume_mm3' of a simulated rig must be "
+                f"in {declared.describe()}: give more tubing_mm3, or volume_mm3."
+            )
+        chosen["volume_mm3"] = volume
+    if "compliance_mm3_per_mpa" not in chosen:
+        growth = actuator.volume_growth_mm3_per_mpa
+        if growth is None:
+            warnings.warn(
+                f"The description of the actuator {actuator.name} gives no growth of its "
+                "chamber with pressure (volume_growth_mm3_per_mpa): the simulated chamber is "
+                "rigid (compliance_mm3_per_mpa 0); give --rig-param compliance_mm3_per_mpa=K "
+                "(mm³/MPa) if it was measured.",
+                UserWarning,
+                stacklevel=4,
+            )
+            growth = 0.0
+        chosen["compliance_mm3_per_mpa"] = growth
+    return RigParams(**chosen)

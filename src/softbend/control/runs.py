@@ -35,7 +35,6 @@ from softbend.control.rigs import (
     rig_settings,
 )
 from softbend.control.setup import (
-    DEFAULT_DESIGN,
     ControlSetup,
     beyond_support,
     check_supply,
@@ -66,7 +65,7 @@ def simulate_control(
     reference: str = "step:90",
     controller: str | None = None,
     assignments: Sequence[str] = (),
-    design: str = DEFAULT_DESIGN,
+    design: str | None = None,
     model: str | Path | None = None,
     plant: str = "surrogate",
     duration_s: float = 10.0,
@@ -78,7 +77,9 @@ def simulate_control(
 ) -> Simulation:
     """Run a controller on the simulated rig of ``design`` and score it (synthetic).
 
-    Parameters are those of :func:`~softbend.control.setup.prepare_control`, plus the
+    Parameters are those of :func:`~softbend.control.setup.prepare_control` (``design``
+    default: paper B's (100,6,2,2,5,8); ``model`` default: the plant when it is a saved
+    surrogate, else the shipped MLP), plus the
     ``reference`` spec (:func:`~softbend.control.experiments.parse_reference`,
     degrees), ``duration_s`` (s), ``seed`` (sensor and camera noise) and
     ``rig_assignments``: ``NAME=VALUE`` settings of the simulated rig
@@ -265,7 +266,7 @@ def plan_loop(
     reference: str = "step:90",
     controller: str | None = None,
     assignments: Sequence[str] = (),
-    design: str = DEFAULT_DESIGN,
+    design: str | None = None,
     model: str | Path | None = None,
     plant: str = "surrogate",
     duration_s: float = 10.0,
@@ -326,7 +327,7 @@ def plan_loop(
     setup = prepare_control(
         controller=controller, assignments=assignments, config=settings.controller,
         design=design, model=model, plant=plant, rig_settings=simulated, command=command,
-        strict=strict,
+        strict=strict, simulated=rig not in HARDWARE_RIGS,
     )  # fmt: skip
     rig_setup = RigSetup(
         config=settings, config_path=None if config is None else Path(config),
@@ -343,7 +344,7 @@ def simulated_server(
     config: str | Path | None = None,
     host: str = "127.0.0.1",
     port: int | None = None,
-    design: str = DEFAULT_DESIGN,
+    design: str | None = None,
     model: str | Path | None = None,
     plant: str = "surrogate",
     supply_mpa: float | None = None,

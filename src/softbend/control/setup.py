@@ -3,14 +3,21 @@
 :func:`prepare_control` is what ``softbend control simulate``, ``run`` and
 ``serve`` share: it checks every name and value first (an unknown controller,
 plant or parameter is one line listing the known names), then loads the
-controllers' model (default: the shipped FEM-trained MLP, paper B's virtual
-angle sensor) and builds the plant's θ(p) and the controller. The controller's
+controllers' model and builds the plant's θ(p) and the controller. The
+controllers' model (their θ(p) and paper B's virtual angle sensor) is
+``model`` when given; else the plant when the plant is a saved surrogate (the
+lab's refined model serves as its own soft sensor, as in paper B); else the
+shipped FEM-trained MLP. A model of any actuator may be used: the design is
+parsed by the model's actuator description
+(:func:`~softbend.control.designs.control_design`) and its pressures converted
+from the rig's MPa to the model's unit. The controller's
 name and parameters come from the caller, else from a rig TOML's
 ``[controller]`` table (:class:`~softbend.control.rigconfig.ControllerConfig`),
 else :data:`~softbend.control.factory.DEFAULT_CONTROLLER` with its defaults;
 ``--set NAME=VALUE`` text overrides the table's values. The simulated rig's
 parameters are :class:`~softbend.control.rig.RigParams` of the design with the
-settings of :func:`~softbend.control.rigs.rig_settings` applied.
+settings of :func:`~softbend.control.rigs.rig_settings` applied
+(:func:`~softbend.control.rigs.rig_params_for`).
 """
 
 from __future__ import annotations
@@ -21,7 +28,9 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
+from softbend.actuators import SFRBA, Actuator
 from softbend.control.controllers import Controller
+from softbend.control.designs import DEFAULT_DESIGN, ModelDesign, control_design
 from softbend.control.factory import (
     CONTROLLERS,
     DEFAULT_CONTROLLER,
@@ -40,12 +49,10 @@ __all__ = [
     "ControlSetup",
     "beyond_support",
     "check_supply",
+    "model_of_run",
     "prepare_control",
     "resolve_controller",
 ]
-
-#: The actuator of paper B's control experiments (l, r, t, b, phi, lc in mm and degrees).
-DEFAULT_DESIGN = "100,6,2,2,5,8"
 
 _TOML = "[controller] of the rig config"
 
@@ -56,13 +63,14 @@ class ControlSetup:
 
     Attributes
     ----------
-    design : SFRBADesign
+    design : SFRBADesign or ModelDesign
+        Paper B's design, or a design of the actuator of the controller's model.
     rig_params : RigParams
         Pneumatics of the simulated rig (and the predictive controller's model).
     plant : str
-        Name of the plant (:data:`~softbend.control.plants.PLANTS`).
+        Name of the plant (:data:`~softbend.control.plants.PLANTS`) or its file.
     plant_table : AngleTable
-        θ(p) of the simulated actuator, degrees.
+        θ(p) of the simulated actuator, degrees (pressures in MPa gauge).
     model : ControllerModel
         The controller's θ(p) table and virtual sensor.
     controller_name : str
@@ -73,13 +81,24 @@ class ControlSetup:
         The largest pressure the controller's model (and a plant surrogate) were
         trained to near the design, MPa; None when they record no support.
     support_notes : list of str
-        Where their θ(p) up to the supply leaves the training data.
+        Where the design leaves the training ranges of the controller's model
+        (``design_notes``), and where their θ(p) up to the supply leaves the
+        training data.
     rig_settings : dict
         The settings of the simulated rig given (:func:`~softbend.control.rigs.rig_settings`);
         ``rig_params`` holds them all, defaults filled in.
+    model_path : str
+        The file of the controller's model (the shipped MLP's when none was given).
+    model_from : {"model", "plant", "shipped"}
+        Where it came from: the ``model`` given, the plant (a saved surrogate), or
+        the shipped FEM-trained MLP.
+    actuator : Actuator
+        The description of the controller's model (paper B's, or the model's own).
+    design_notes : list of str
+        Where the design leaves the training ranges of the controller's model.
     """
 
-    design: SFRBADesign
+    design: SFRBADesign | ModelDesign
     rig_params: RigParams
     plant: str
     plant_table: AngleTable
@@ -90,15 +109,40 @@ class ControlSetup:
     supported_mpa: float | None = None
     support_notes: list[str] = field(default_factory=list)
     rig_settings: dict[str, Any] = field(default_factory=dict)
+    model_path: str = ""
+    model_from: str = "shipped"
+    actuator: Actuator = SFRBA
+    design_notes: list[str] = field(default_factory=list)
+
+    @property
+    def mismatch(self) -> bool:
+        """Whether the plant is a saved surrogate other than the controller's model."""
+        return _plant_model(self.plant) is not None and not self.plant_is_model
+
+    @property
+    def plant_is_model(self) -> bool:
+        """Whether the plant is the controller's model itself (``surrogate``, or its file)."""
+        path = _plant_model(self.plant)
+        return self.plant == "surrogate" or (
+            path is not None and _same_file(path, Path(self.model_path))
+        )
 
     def record(self) -> dict[str, Any]:
-        """The controller, its parameters, the plant and the design, for a run's summary."""
-        return {
+        """The controller, its parameters, the plant, the controller's model and the design,
+        for a run's summary (another actuator's design also by name, with its actuator)."""
+        out: dict[str, Any] = {
             "controller": self.controller_name,
             "controller_params": dict(self.controller_params),
             "plant": self.plant,
+            "model": self.model_path,
+            "model_from": self.model_from,
             "design": str(self.design),
         }
+        if isinstance(self.design, ModelDesign):
+            out["actuator"] = self.actuator.name
+            out["design_parameters"] = self.design.as_record()
+            out["model_pressure_unit"] = self.actuator.pressure_unit
+        return out
 
 
 def check_supply(supply_mpa: float, command: str, field: str = "--supply") -> float:
@@ -170,18 +214,37 @@ def resolve_controller(
     return chosen, params, given
 
 
+def model_of_run(model: str | Path | None, plant: str) -> tuple[Path | None, str]:
+    """The file of the controllers' model of a run, and where it came from.
+
+    ``model`` when given (``"model"``); else the plant when it is a saved
+    surrogate (``"plant"``: the model that plays the actuator is its own soft
+    sensor, as paper B ran its refined model); else None, the shipped
+    FEM-trained MLP (``"shipped"``).
+    """
+    from softbend.control.plants import plant_file
+
+    if model is not None:
+        return Path(model), "model"
+    path = plant_file(plant)
+    if path is not None and path.suffix.lower() == ".json":
+        return path, "plant"
+    return None, "shipped"
+
+
 def prepare_control(
     *,
     controller: str | None = None,
     assignments: Sequence[str] = (),
     config: ControllerConfig | None = None,
-    design: str | SFRBADesign = DEFAULT_DESIGN,
+    design: str | SFRBADesign | ModelDesign | None = None,
     model: str | Path | None = None,
     plant: str = "surrogate",
     supply_mpa: float = 0.2,
     command: str = "prepare_control",
     strict: bool = False,
     rig_settings: Mapping[str, Any] | None = None,
+    simulated: bool = True,
 ) -> ControlSetup:
     """Check the names and values of a control run, then build its plant and controller.
 
@@ -189,14 +252,21 @@ def prepare_control(
     ----------
     controller, assignments, config
         The controller and its parameters (see :func:`resolve_controller`).
-    design : str or SFRBADesign
-        The actuator, ``"l,r,t,b,phi,lc"`` (mm, degrees).
+    design : str, SFRBADesign or ModelDesign, optional
+        The actuator's design, parsed by the actuator of the controller's model:
+        paper B's ``"l,r,t,b,phi,lc"`` (mm, degrees; default
+        :data:`~softbend.control.designs.DEFAULT_DESIGN`), or ``"A=1,B=2,..."``
+        by another actuator's parameter names, in its units (required then).
     model : path, optional
-        A saved surrogate for the controller's θ(p) (default: the shipped FEM-trained MLP).
+        A saved surrogate for the controller's θ(p) and virtual sensor, of any
+        actuator. Default: the plant, when the plant is a saved surrogate; else
+        the shipped FEM-trained MLP.
     plant : str
         The actuator's θ(p): a name of :data:`~softbend.control.plants.PLANTS`, or a
         saved surrogate ``.json`` / measurements ``.csv`` of the lab's own actuator
-        (:func:`~softbend.control.plants.plant_table`).
+        (:func:`~softbend.control.plants.plant_table`). A saved surrogate and
+        ``model`` must describe the same design parameters (their pressure units
+        may differ).
     supply_mpa : float, default 0.2
         Supply pressure of the simulated rig, MPa gauge (``supply_gauge_mpa`` of
         ``rig_settings``, when given, replaces it: :func:`~softbend.control.rigs.rig_settings`
@@ -204,26 +274,32 @@ def prepare_control(
     command : str
         The command asking, for messages.
     strict : bool, default False
-        Refuse a controller model or plant surrogate whose θ(p) of the design up
+        Refuse a design outside the training ranges of the controller's model,
+        and a controller model or plant surrogate whose θ(p) of the design up
         to the supply leaves its training data's support
         (:func:`~softbend.control.plants.support_warnings`), instead of warning.
     rig_settings : mapping, optional
         Parameters of the simulated rig, ``{name: value}``: fields of
         :class:`~softbend.control.rig.RigParams` and ``tubing_mm3``, checked by
         :func:`~softbend.control.rigs.rig_settings`; the others keep their defaults
-        and the chamber volume follows the design.
+        and the chamber volume follows the design (another actuator's: its
+        description's, else ``volume_mm3`` must be given).
+    simulated : bool, default True
+        Whether the rig is simulated. On hardware only the ``predictive`` controller
+        models the pneumatics: another actuator's chamber is then not required.
 
     Raises
     ------
     ValueError
         One line: an unknown controller, parameter or plant (listing the known
         names), a value of the wrong kind or out of range, an implausible supply, a
-        design the plant has no data for; with ``strict``, a model used beyond its
-        training data.
+        design the plant has no data for or that is not one of the model's
+        actuator, a chamber volume unknown; with ``strict``, a model used beyond
+        its training data.
     """
     from softbend.control.rigs import rig_params_for
     from softbend.control.rigs import rig_settings as check_rig_settings
-    from softbend.transfer.base import load_base_saved
+    from softbend.transfer.base import load_base_saved, shipped_base_path
 
     name, params, given = resolve_controller(controller, assignments, config)
     check_plant(plant, field="--plant")
@@ -232,23 +308,49 @@ def prepare_control(
     supply_mpa = settings.get("supply_gauge_mpa", supply_mpa)
     check_supply(supply_mpa, command, supply_field)
     chosen = {**settings, "supply_gauge_mpa": supply_mpa}
-    actuator = design if isinstance(design, SFRBADesign) else SFRBADesign.parse(design)
-    rig = rig_params_for(actuator, chosen)
-    if plant == "fem" and not in_table1(actuator):
+    model_path, model_from = model_of_run(model, plant)
+    saved = load_base_saved(model_path)
+    label = str(model_path) if model_path is not None else str(shipped_base_path())
+    source = "the shipped MLP" if model_path is None else f"the model {model_path}"
+    actuator = saved.actuator
+    actuator_design = control_design(design, actuator, field="--design", source=source)
+    plant_path = _plant_model(plant)
+    shared = (
+        plant_path is not None and model_path is not None and _same_file(plant_path, model_path)
+    )
+    if plant_path is not None and not shared:
+        _check_same_parameters(plant_path, actuator, model_path)
+    if simulated or name == "predictive" or isinstance(actuator_design, SFRBADesign):
+        rig = rig_params_for(actuator_design, chosen)
+    else:  # hardware: its pneumatics are what they are, and no controller models them
+        rig = RigParams(**chosen)
+    if (
+        plant == "fem"
+        and isinstance(actuator_design, SFRBADesign)
+        and not in_table1(actuator_design)
+    ):
         # The design's own FEM sweep (solved once, cached) gives its chamber's compliance.
         from softbend.control.fem_plant import fem_curve
 
-        compliance = fem_curve(actuator).compliance_mm3_per_mpa(supply_mpa)
-        rig = rig_params_for(actuator, chosen, compliance_mm3_per_mpa=compliance)
-    saved = load_base_saved(model)
+        compliance = fem_curve(actuator_design).compliance_mm3_per_mpa(supply_mpa)
+        rig = rig_params_for(actuator_design, chosen, compliance_mm3_per_mpa=compliance)
     surrogate = saved.model
-    supported, notes = _support_check(saved, model, plant, actuator, supply_mpa, strict)
-    controller_model = ControllerModel.from_surrogate(surrogate, actuator, rig)
-    actuator_table = plant_table(plant, actuator, controller_model.angle_table, field="--plant")
+    design_notes = _design_check(model_path, label, actuator_design, strict)
+    supported, notes = _support_check(
+        saved, model_path, plant_path, shared, actuator_design, supply_mpa, strict
+    )
+    # Paper B's tables span 0–0.5 MPa as always; another actuator's, 0 to the supply.
+    pmax = 0.5 if isinstance(actuator_design, SFRBADesign) else supply_mpa
+    controller_model = ControllerModel.from_surrogate(
+        surrogate, actuator_design, rig, pmax_mpa=pmax
+    )
+    actuator_table = plant_table(
+        plant, actuator_design, controller_model.angle_table, field="--plant", pmax_mpa=pmax
+    )
     origin = " and ".join(given) or "make_controller"
     built = build_controller(name, controller_model, _flat(given), field=origin)
     return ControlSetup(
-        design=actuator,
+        design=actuator_design,
         rig_params=rig,
         plant=plant,
         plant_table=actuator_table,
@@ -257,35 +359,103 @@ def prepare_control(
         controller_params=params,
         controller=built,
         supported_mpa=supported,
-        support_notes=notes,
+        support_notes=[*design_notes, *notes],
         rig_settings=dict(settings),
+        model_path=label,
+        model_from=model_from,
+        actuator=actuator,
+        design_notes=design_notes,
     )
+
+
+def _plant_model(plant: str) -> Path | None:
+    """The plant as a saved surrogate's file, else None."""
+    from softbend.control.plants import plant_file
+
+    path = plant_file(plant)
+    return path if path is not None and path.suffix.lower() == ".json" else None
+
+
+def _same_file(a: Path, b: Path) -> bool:
+    """Whether two paths name the same file."""
+    try:
+        return a.resolve() == b.resolve() or (a.exists() and b.exists() and a.samefile(b))
+    except OSError:
+        return False
+
+
+def _check_same_parameters(plant_path: Path, actuator: Actuator, model_path: Path | None) -> None:
+    """A plant surrogate must be of an actuator with the controller's model's parameters."""
+    from softbend.surrogates.persistence import load_surrogate
+
+    other = load_surrogate(plant_path).actuator
+    if other.names != actuator.names:
+        raise ValueError(
+            f"The plant {plant_path} is a model of the actuator {other.name} "
+            f"({', '.join(other.names)}), the controller's model {model_path or 'the shipped MLP'} "
+            f"of {actuator.name} ({', '.join(actuator.names)}): a plant and a controller's "
+            "model must describe the same design parameters."
+        )
+
+
+def _design_check(
+    model_path: Path | None,
+    label: str,
+    design: SFRBADesign | ModelDesign,
+    strict: bool,
+) -> list[str]:
+    """Where ``design`` leaves the training ranges of the controller's model: a warning each
+    (naming the model and the parameters), or with ``strict`` a refusal."""
+    from softbend.surrogates.predict import predict_angles
+    from softbend.transfer.base import shipped_base_path
+
+    path = shipped_base_path() if model_path is None else model_path
+    codes: Any = design if isinstance(design, SFRBADesign) else design.as_array()
+    outside = predict_angles(path, codes, [0.0]).outside_training_ranges
+    names = set(design.actuator.names if isinstance(design, ModelDesign) else SFRBA.names)
+    phrases = [phrase for phrase in outside if phrase.split(" ", 1)[0] in names]
+    if not phrases:
+        return []
+    note = (
+        f"The design {design} lies outside the training ranges of the controller's model "
+        f"{label}: {'; '.join(phrases)}; its θ(p) there is an extrapolation"
+    )
+    if strict:
+        raise ValueError(f"The design must lie in its model's training data (--strict): {note}.")
+    warnings.warn(f"{note} (--strict refuses it).", UserWarning, stacklevel=3)
+    return [note]
 
 
 def _support_check(
     saved: Any,
-    model: str | Path | None,
-    plant: str,
-    design: SFRBADesign,
+    model: Path | None,
+    plant: Path | None,
+    shared: bool,
+    design: SFRBADesign | ModelDesign,
     supply_mpa: float,
     strict: bool,
 ) -> tuple[float | None, list[str]]:
     """The lowest supported pressure of the model and a plant surrogate, and the notes
     on where θ(p) up to the supply leaves their data; with ``strict`` any note refuses.
 
-    A note on angles warns at once; one on pressure waits for the run, which may
-    never reach it (:func:`beyond_support`).
+    ``plant`` is the file of a plant surrogate (None when there is none); when it is the
+    controller's model (``shared``) it is checked once, named as both. A note on
+    angles warns at once; one on pressure waits for the run, which may never reach it
+    (:func:`beyond_support`).
     """
-    from softbend.control.plants import plant_file, support_warnings
+    from softbend.control.plants import support_warnings
     from softbend.surrogates.persistence import load_surrogate
 
-    role = f"the controller's model ({model or 'the shipped MLP'})"
+    role = (
+        f"the plant and controller's model ({model})"
+        if shared
+        else f"the controller's model ({model or 'the shipped MLP'})"
+    )
     limits, notes = [], []
-    for one, who in [(saved, role)] + [
-        (load_surrogate(path), f"the plant ({path})")
-        for path in [plant_file(plant)]
-        if path is not None and path.suffix.lower() == ".json"
-    ]:
+    checked = [(saved, role)]
+    if plant is not None and not shared:
+        checked.append((load_surrogate(plant), f"the plant ({plant})"))
+    for one, who in checked:
         limit, pressure_note, angle_note = support_warnings(one, design, supply_mpa, role=who)
         limits += [limit] if limit is not None else []
         notes += [n for n in (pressure_note, angle_note) if n is not None]
@@ -297,12 +467,21 @@ def _support_check(
 
 
 def beyond_support(setup: ControlSetup, max_pressure_mpa: float) -> str | None:
-    """One line when a run reached past the pressure its models were trained to, else None."""
+    """One line when a run reached past the pressure its models were trained to, else None.
+
+    The pressures are in MPa for paper B's actuator, in the model's unit for another.
+    """
     limit = setup.supported_mpa
     if limit is None or not max_pressure_mpa > limit * (1 + 1e-9):
         return None
+    if isinstance(setup.design, ModelDesign):
+        scale, unit = setup.design.pressure_scale, setup.actuator.pressure_unit
+        reached = f"{max_pressure_mpa * scale:.3g} {unit}"
+        trained = f"{limit * scale:.3g} {unit}"
+    else:
+        reached, trained = f"{max_pressure_mpa:.3g} MPa", f"{limit:.3g} MPa"
     return (
-        f"The run reached {max_pressure_mpa:.3g} MPa, past the {limit:.3g} MPa the models "
+        f"The run reached {reached}, past the {trained} the models "
         f"were trained to near the design {setup.design}: the angles above it are "
         "extrapolated (--strict refuses such a run)."
     )
