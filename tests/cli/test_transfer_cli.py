@@ -159,7 +159,7 @@ def test_unknown_strategy_and_bad_out_are_refused_before_work(
     )
     line = one_error_line(capsys)
     assert code == 2 and "Unknown transfer strategy 'magic' (in strategies)" in line
-    assert "known: fem-only, analytical" in line
+    assert "known: fem-only, base-mean-residual, analytical" in line
     a_file = tmp_path / "file.txt"
     a_file.write_text("x")
     code = main(
@@ -338,7 +338,7 @@ def test_strategies_lists_every_strategy_with_its_parameters(capsys):
     assert main(["transfer", "strategies", "--json"]) == 0
     rows = json.loads(capsys.readouterr().out)
     by_name = {r["name"]: r for r in rows}
-    assert list(by_name)[:2] == ["fem-only", "analytical"]
+    assert list(by_name)[:3] == ["fem-only", "base-mean-residual", "analytical"]
     assert by_name["refined"]["parameters"] == {
         "epochs": 1000,
         "learning_rate": 6e-4,

@@ -130,4 +130,6 @@ def test_an_unregistered_strategy_is_unknown_again(files, tmp_path, capsys):
     assert "toy" not in STRATEGIES
     assert main([*argv, "--strategy", "toy"]) == 2
     line = _error_line(capsys)
-    assert "Unknown transfer strategy 'toy'" in line and "known: fem-only, analytical" in line
+    assert (
+        "Unknown transfer strategy 'toy'" in line and "known: fem-only, base-mean-residual" in line
+    )

@@ -101,6 +101,7 @@ def test_the_declared_ranges_are_the_documented_ones():
         for key, declared in declared_ranges(STRATEGIES.get(name)).items()
     }
     assert table == {
+        ("base-mean-residual", "n_bins"): (1, 100, None),
         ("experimental", "hidden_sizes"): (1, 1024, 2),
         ("experimental", "epochs"): (1, math.inf, None),
         ("experimental", "learning_rate"): (0, 1, None),

@@ -153,10 +153,17 @@ def loco(
 
 
 def print_loco_summary(result: LocoResult) -> None:
-    """The per-strategy table beside paper B's refined MLP (paper B §4.3, Fig. 7)."""
+    """The per-strategy table beside paper B's refined MLP (paper B §4.3, Fig. 7).
+
+    The "vs baseline" column is each strategy's mean RMSE relative to the
+    baseline's (:data:`~softbend.transfer.loco.BASELINE_STRATEGY`, the base plus
+    the mean residual against pressure): −23 % is 23 % lower. A dash when the
+    baseline is not in the run.
+    """
     import pandas as pd
 
     from softbend.references import TRANSFER_RESULTS, values
+    from softbend.transfer.loco import BASELINE_STRATEGY
 
     paper = values(TRANSFER_RESULTS)
 
@@ -167,12 +174,22 @@ def print_loco_summary(result: LocoResult) -> None:
             return "—"
         return f"{100 * coverage:.1f} % ({float(r['calibrated_width_deg']):.1f})"
 
+    def _baseline_cell(r: pd.Series) -> str:
+        """The mean RMSE relative to the baseline's, e.g. "−23 %", or a dash."""
+        if r["strategy"] == BASELINE_STRATEGY:
+            return "(baseline)"
+        change = float(r.get("rmse_vs_baseline_pct", float("nan")))
+        if change != change:
+            return "—"
+        return f"{change:+.0f} %".replace("-", "\u2212")
+
     rows = []
     for _, r in result.summary.iterrows():
         rows.append(
             [
                 r["strategy"],
                 float(r["rmse_deg"]),
+                _baseline_cell(r),
                 float(r["mape_pct"]),
                 float(r["max_error_deg"]),
                 "—" if r["coverage"] != r["coverage"] else f"{100 * r['coverage']:.1f} %",
@@ -184,6 +201,7 @@ def print_loco_summary(result: LocoResult) -> None:
         [
             "paper B refined MLP",
             paper["rmse_deg"],
+            "—",
             paper["mape_pct"],
             "—",
             "—",
@@ -197,6 +215,7 @@ def print_loco_summary(result: LocoResult) -> None:
         [
             "strategy",
             "mean RMSE °",
+            "vs baseline",
             "mean MAPE %",
             "max |e| °",
             "coverage",

@@ -33,6 +33,7 @@ PAPER_B_FINAL_LOSS: dict[str, float] = values(TRANSFER_LOSS)
 
 _STYLE = {
     "fem-only": ("tab:gray", "--"),
+    "base-mean-residual": ("tab:pink", ":"),
     "analytical": ("tab:brown", ":"),
     "experimental": ("tab:purple", "-."),
     "refined": ("tab:red", "-"),

@@ -28,6 +28,7 @@ _EXPORTS = {
     "VirtualLab": "lab",
     "actuator_id": "lab",
     "shipped_measurements": "lab",
+    "BASELINE_STRATEGY": "loco",
     "DEFAULT_STRATEGIES": "loco",
     "LocoResult": "loco",
     "leave_one_configuration_out": "loco",

@@ -10,6 +10,12 @@ is calibrated on the leave-one-out errors of the other actuators, each from a
 model fitted without it and without the held-out one, as a lab with those
 actuators alone would have calibrated it. A learning curve repeats this with
 1, 2, ... of the other actuators measured.
+
+Every strategy's mean RMSE is also stated relative to the baseline's,
+``base-mean-residual`` (:data:`BASELINE_STRATEGY`: the base plus the training
+actuators' mean residual as a function of pressure alone, nothing learned about
+the design): a strategy that does not beat it has learned nothing about the
+design either.
 """
 
 from __future__ import annotations
@@ -40,6 +46,7 @@ from softbend.transfer.strategies import (
 )
 
 __all__ = [
+    "BASELINE_STRATEGY",
     "DEFAULT_STRATEGIES",
     "MIN_CALIBRATION_ACTUATORS",
     "LocoResult",
@@ -54,6 +61,10 @@ DEFAULT_STRATEGIES: tuple[str, ...] = BUILTIN_STRATEGIES
 
 #: Strategies left out of the learning curve and the nested calibration (the longest training).
 _SLOW = ("experimental", "refined-ensemble")
+
+#: The strategy every other is judged against (``rmse_vs_baseline_pct`` of the summary): the
+#: base plus the mean residual of the training actuators as a function of pressure alone.
+BASELINE_STRATEGY = "base-mean-residual"
 
 _OWNER = "leave_one_configuration_out"
 
@@ -77,7 +88,14 @@ class LocoResult:
         ``calibration_half_width_deg``, ``calibration_guaranteed``, ``fit_s``.
     summary : DataFrame
         One row per strategy: the means over actuators (coverages weighted by
-        readings), the worst actuator and its RMSE and MAPE.
+        readings), the worst actuator and its RMSE and MAPE. ``rmse_deg`` and
+        ``rmse_deg_mean`` are the same figure, the mean over held-out actuators
+        of their RMSE (degrees; an actuator with no finite prediction left
+        out); ``rmse_vs_baseline_pct`` is ``100 · (rmse_deg_mean /
+        baseline's − 1)`` against :data:`BASELINE_STRATEGY` (NaN when it is not
+        in the run); ``calibrated_coverage`` is the share of held-out readings
+        inside the calibrated interval, and ``calibrated_coverage_reason`` says
+        why it is NaN (None when it is not).
     predictions : DataFrame
         Every held-out reading with each strategy's prediction (``lo``/``hi`` for
         interval strategies, ``cal_lo_deg``/``cal_hi_deg`` for the calibrated
@@ -91,7 +109,9 @@ class LocoResult:
     level : float
         Probability of the intervals.
     settings : dict
-        Strategies, seed, interval level, time taken.
+        Strategies, seed, interval level, time taken; ``baseline``, the
+        strategy ``rmse_vs_baseline_pct`` is relative to (None when it is not
+        in the run).
     calibrations : dict of str to dict
         Per calibrated strategy, the calibration on all the actuators (what
         ``softbend transfer refine`` would record; :meth:`Calibration.to_dict`).
@@ -382,7 +402,7 @@ def leave_one_configuration_out(
     per_actuator = pd.DataFrame(scores)
     return LocoResult(
         per_actuator=per_actuator,
-        summary=_summarize(per_actuator, names),
+        summary=_summarize(per_actuator, names, calibrated=calibrated),
         predictions=pd.concat(predictions, ignore_index=True),
         learning_curve=pd.DataFrame(
             curve, columns=["strategy", "n_actuators", "held_out", "rmse_deg", "mape_pct"]
@@ -410,6 +430,7 @@ def leave_one_configuration_out(
                 for name in names
             },
             "calibrated": list(nested_names),
+            "baseline": BASELINE_STRATEGY if BASELINE_STRATEGY in names else None,
             "fits": len(tasks),
             "wall_time_s": time.perf_counter() - start,
         },
@@ -548,15 +569,38 @@ def _weighted(part: pd.DataFrame, column: str) -> float:
     return float((part[column] * part["n_points"]).sum() / part["n_points"].sum())
 
 
-def _summarize(per_actuator: pd.DataFrame, names: Sequence[str]) -> pd.DataFrame:
+def _coverage_reason(name: str, calibrated: bool, coverage: float) -> str | None:
+    """Why a strategy's summary has no calibrated coverage; None when it has one."""
+    if coverage == coverage:
+        return None
+    if not calibrated:
+        return "not calibrated: the calibration was not asked for (--calibrate; calibrated=True)"
+    if name in _SLOW:
+        return (
+            f"not calibrated: {' and '.join(_SLOW)} never are (their training would "
+            "dominate the time)"
+        )
+    return (
+        "not calibrated on every held-out actuator: the leave-one-out errors of an "
+        "actuator were not finite"
+    )
+
+
+def _summarize(
+    per_actuator: pd.DataFrame, names: Sequence[str], *, calibrated: bool = False
+) -> pd.DataFrame:
     rows = []
     for name in names:
         part = per_actuator[per_actuator["strategy"] == name]
         worst = part.loc[part["rmse_deg"].idxmax()] if part["rmse_deg"].notna().any() else None
+        mean_rmse = float(part["rmse_deg"].mean())
+        calibrated_coverage = _weighted(part, "calibrated_coverage")
         rows.append(
             {
                 "strategy": name,
-                "rmse_deg": float(part["rmse_deg"].mean()),
+                "rmse_deg": mean_rmse,
+                "rmse_deg_mean": mean_rmse,
+                "rmse_vs_baseline_pct": np.nan,
                 "mape_pct": float(part["mape_pct"].mean()),
                 "max_error_deg": float(part["max_error_deg"].max()),
                 "coverage": float(
@@ -564,7 +608,10 @@ def _summarize(per_actuator: pd.DataFrame, names: Sequence[str]) -> pd.DataFrame
                 )
                 if part["coverage"].notna().all()
                 else np.nan,
-                "calibrated_coverage": _weighted(part, "calibrated_coverage"),
+                "calibrated_coverage": calibrated_coverage,
+                "calibrated_coverage_reason": _coverage_reason(
+                    name, calibrated, calibrated_coverage
+                ),
                 "calibrated_width_deg": _weighted(part, "calibrated_width_deg"),
                 "worst_actuator": None if worst is None else worst["actuator_id"],
                 "worst_rmse_deg": np.nan if worst is None else float(worst["rmse_deg"]),
@@ -572,7 +619,13 @@ def _summarize(per_actuator: pd.DataFrame, names: Sequence[str]) -> pd.DataFrame
                 "fit_s": float(part["fit_s"].mean()),
             }
         )
-    return pd.DataFrame(rows)
+    summary = pd.DataFrame(rows)
+    baseline = summary.loc[summary["strategy"] == BASELINE_STRATEGY, "rmse_deg_mean"]
+    if len(baseline) and np.isfinite(baseline.iloc[0]) and baseline.iloc[0] > 0:
+        summary["rmse_vs_baseline_pct"] = 100.0 * (
+            summary["rmse_deg_mean"] / float(baseline.iloc[0]) - 1.0
+        )
+    return summary
 
 
 def strategy_options(

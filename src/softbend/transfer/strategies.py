@@ -5,23 +5,26 @@ Every strategy is a scikit-learn regressor on the rows of
 starts from a fitted *base* surrogate (any estimator with ``predict``; the MLP
 trained on the FEM dataset by default):
 
-====================  ============================================================
-``fem-only``          the base, unchanged (paper B's "NMLPR"), a baseline
-``analytical``        the analytical model of the actuator, a baseline (no base)
-``refined``           paper B's refined MLP: every layer trained further from the
-                      base's weights on the measurements, input scaling kept
-``experimental``      paper B's experimental MLP: from scratch, measurements only
-``residual-gp``       the base frozen, a Gaussian process on its error with a
-                      noise term; gives prediction intervals
-``scale-offset``      the base frozen, ``θ = a·θ_base + c`` by least squares
-``pressure-scale``    the base frozen and asked at ``s·p``: one number for an
-                      elastomer softer or stiffer than the simulated one
-                      (:mod:`softbend.transfer.pressure_map`); gives intervals
-``refined-ensemble``  refined MLPs on bootstrap draws of the measured
-                      actuators; mean, and an interval from their spread
-``scaled-refined``    the pressure scale fitted first and folded into the MLP,
-                      then paper B's refinement from that start
-====================  ============================================================
+======================  ============================================================
+``fem-only``            the base, unchanged (paper B's "NMLPR"), a baseline
+``base-mean-residual``  the base frozen, plus the measured actuators' mean residual as
+                        a function of pressure alone: the baseline every strategy is
+                        judged against (it knows nothing of the design)
+``analytical``          the analytical model of the actuator, a baseline (no base)
+``refined``             paper B's refined MLP: every layer trained further from the
+                        base's weights on the measurements, input scaling kept
+``experimental``        paper B's experimental MLP: from scratch, measurements only
+``residual-gp``         the base frozen, a Gaussian process on its error with a
+                        noise term; gives prediction intervals
+``scale-offset``        the base frozen, ``θ = a·θ_base + c`` by least squares
+``pressure-scale``      the base frozen and asked at ``s·p``: one number for an
+                        elastomer softer or stiffer than the simulated one
+                        (:mod:`softbend.transfer.pressure_map`); gives intervals
+``refined-ensemble``    refined MLPs on bootstrap draws of the measured
+                        actuators; mean, and an interval from their spread
+``scaled-refined``      the pressure scale fitted first and folded into the MLP,
+                        then paper B's refinement from that start
+======================  ============================================================
 
 Strategies with intervals have ``predict_interval(X, level)``.
 
@@ -54,6 +57,7 @@ from typing import Any, ClassVar, Literal, overload
 
 import numpy as np
 from numpy.typing import ArrayLike
+from scipy.stats import norm
 from sklearn.base import BaseEstimator, RegressorMixin
 from sklearn.exceptions import ConvergenceWarning
 from sklearn.gaussian_process import GaussianProcessRegressor
@@ -89,6 +93,7 @@ __all__ = [
     "NETWORK_STRATEGIES",
     "STRATEGIES",
     "AnalyticalBaseline",
+    "BaseMeanResidual",
     "BaseOnly",
     "ExperimentalMLP",
     "PressureScale",
@@ -298,6 +303,167 @@ class BaseOnly(_Strategy):
     def predict(self, X: ArrayLike) -> np.ndarray:
         """The base's angle, degrees."""
         return np.asarray(self.base.predict(self._check_rows(X)), dtype=np.float64)
+
+
+@declare_ranges(
+    n_bins=Range(
+        1,
+        100,
+        "pressure bands",
+        "1 band is one constant offset at every pressure; each band averages the residuals of "
+        "the readings in it, so more bands than distinct measured pressures leave each "
+        "pressure a band of its own, and a band of a single reading carries its noise",
+    )
+)
+class BaseMeanResidual(_Strategy):
+    """The base plus the training actuators' mean residual at each pressure, ``θ_base + r(p)``.
+
+    The simplest multi-fidelity correction, and the baseline every other strategy
+    is judged against (``softbend transfer loco`` reports each strategy's mean
+    RMSE relative to it): what the measurements say about the gap between the
+    simulation and the rig *on average over the measured actuators*, as a
+    function of pressure alone. It learns nothing about the design, so a
+    strategy that does not beat it has learned nothing about the design
+    either. A baseline: nothing is saved (``softbend transfer refine`` does not
+    offer it).
+
+    How ``r(p)`` is fitted on the training rows:
+
+    1. each row's residual ``e = θ_measured − θ_base`` (degrees);
+    2. the rows are split into at most ``n_bins`` pressure bands holding about
+       as many readings each (quantiles of the measured pressures); readings at
+       one pressure are never split, and with ``n_bins`` distinct pressures or
+       fewer each pressure is a band of its own;
+    3. in each band every actuator (a distinct design) gives the mean of its
+       residuals and of its pressures, and the band's node is the mean over the
+       actuators in it: each actuator weighs alike, however many readings it has;
+    4. ``r(p)`` joins the nodes linearly (:func:`numpy.interp`); the first and
+       last segments are carried straight on to the lowest and highest measured
+       pressures, and ``r`` is constant beyond them: no trend is extrapolated
+       past the measured pressures.
+
+    Averaging over bands and actuators keeps it steady with 1 to 6 measured
+    actuators (a band of one actuator is the mean of its few readings); it is
+    exact where the gap is a function of pressure alone that is linear between
+    the nodes (or any function, at the measured pressures, when each is a band).
+    The interval is Gaussian with the standard deviation of the residuals about
+    ``r(p)`` (degrees of freedom: readings − nodes, at least 1).
+
+    Parameters
+    ----------
+    base : estimator
+        Any fitted surrogate.
+    n_bins : int, default 8
+        The most pressure bands, in [1, 100]; 1 is a constant offset.
+
+    Attributes
+    ----------
+    pressure_nodes_mpa_ : ndarray
+        The nodes' pressures, MPa, increasing: the bands' and, with two bands or
+        more, the lowest and highest measured pressures.
+    residual_nodes_deg_ : ndarray
+        ``r`` at the nodes, degrees.
+    residual_std_ : float
+        Standard deviation of the residuals about ``r(p)`` on the training rows, degrees.
+    """
+
+    learns: ClassVar[bool] = False
+
+    def __init__(self, base: Any = None, *, n_bins: int = 8) -> None:
+        self.base = base
+        self.n_bins = n_bins
+
+    def fit(self, X: ArrayLike, y: ArrayLike) -> BaseMeanResidual:
+        """Fit ``r(p)`` to the residuals ``y − base(X)`` of the rows."""
+        self._check_parameters()
+        _check_base(self.base, type(self).__name__)
+        n_bins = check_int(self.n_bins, "n_bins", type(self).__name__, low=1)
+        X, y = self._check_fit_data(X, y)
+        if y.size < 2:
+            raise ValueError(
+                "The 'base-mean-residual' strategy fits the mean residual and the spread of the "
+                f"readings around it: it needs at least 2 readings. Got {y.size}."
+            )
+        with np.errstate(over="ignore", invalid="ignore"):  # checked below
+            residual = y - _base_angles(self.base, X, "base-mean-residual")
+        pressure = X[:, -1]
+        band = _pressure_bands(pressure, n_bins)
+        _, actuator = np.unique(X[:, :-1], axis=0, return_inverse=True)
+        actuator = actuator.ravel()
+        nodes_p, nodes_r = [], []
+        for b in range(int(band.max()) + 1):
+            rows = band == b
+            members = [rows & (actuator == a) for a in np.unique(actuator[rows])]
+            nodes_p.append(np.mean([pressure[m].mean() for m in members]))
+            with np.errstate(over="ignore", invalid="ignore"):  # checked below
+                nodes_r.append(np.mean([residual[m].mean() for m in members]))
+        with np.errstate(over="ignore", invalid="ignore"):  # checked below
+            nodes = _end_nodes(nodes_p, nodes_r, float(pressure.min()), float(pressure.max()))
+        self.pressure_nodes_mpa_, self.residual_nodes_deg_ = nodes
+        with np.errstate(over="ignore", invalid="ignore"):  # checked below
+            about = residual - self._residual(pressure)
+            dof = max(y.size - len(nodes_p), 1)
+            self.residual_std_ = float(np.sqrt(np.sum(about**2) / dof))
+        _check_finite_fit(
+            "base-mean-residual",
+            residual_nodes=self.residual_nodes_deg_,
+            residual_std=self.residual_std_,
+        )
+        return self
+
+    def _residual(self, pressure: np.ndarray) -> np.ndarray:
+        """``r(p)``, degrees: the nodes joined linearly, constant beyond the end nodes."""
+        return np.interp(pressure, self.pressure_nodes_mpa_, self.residual_nodes_deg_)
+
+    def predict(self, X: ArrayLike) -> np.ndarray:
+        """The base's angle plus the mean residual at the row's pressure, degrees."""
+        X = self._check_rows(X)
+        return np.asarray(self.base.predict(X), dtype=np.float64) + self._residual(X[:, -1])
+
+    def predict_interval(self, X: ArrayLike, level: float = 0.9) -> tuple[np.ndarray, np.ndarray]:
+        """Central interval of probability ``level`` for a new reading (Gaussian), degrees."""
+        level = _check_level(level, type(self).__name__)
+        mean = self.predict(X)
+        half = float(norm.ppf(0.5 + level / 2)) * self.residual_std_
+        return mean - half, mean + half
+
+
+def _end_nodes(
+    pressures: list[float], residuals: list[float], low: float, high: float
+) -> tuple[np.ndarray, np.ndarray]:
+    """The bands' nodes, with the first and last segments carried to ``low`` and ``high``.
+
+    A band's node lies inside the band, so the readings of the lowest and highest
+    pressures are beyond the end nodes; the end segments are extended to them
+    (straight), so that a gap linear in pressure is met exactly over the measured
+    range. One node stays one (a constant).
+    """
+    p = np.asarray(pressures, dtype=np.float64)
+    r = np.asarray(residuals, dtype=np.float64)
+    if p.size < 2:
+        return p, r
+    first = r[0] + (r[1] - r[0]) / (p[1] - p[0]) * (low - p[0])
+    last = r[-1] + (r[-1] - r[-2]) / (p[-1] - p[-2]) * (high - p[-1])
+    below, above = bool(low < p[0]), bool(high > p[-1])
+    return (
+        np.concatenate([[low] * below, p, [high] * above]),
+        np.concatenate([[first] * below, r, [last] * above]),
+    )
+
+
+def _pressure_bands(pressure: np.ndarray, n_bins: int) -> np.ndarray:
+    """Each row's pressure band, 0, 1, ... in increasing pressure (none empty).
+
+    At most ``n_bins`` bands of about as many rows each (quantiles); rows at one
+    pressure share a band, and with ``n_bins`` distinct pressures or fewer each
+    pressure is a band.
+    """
+    distinct = np.unique(pressure)
+    if distinct.size <= n_bins:
+        return np.searchsorted(distinct, pressure)
+    edges = np.quantile(pressure, np.arange(1, n_bins) / n_bins)
+    _, band = np.unique(np.searchsorted(edges, pressure, side="right"), return_inverse=True)
+    return band.ravel()
 
 
 class AnalyticalBaseline(_Strategy):
@@ -889,6 +1055,7 @@ class RefinedEnsemble(_Corrected):
 
 for _name, _cls in (
     ("fem-only", BaseOnly),
+    ("base-mean-residual", BaseMeanResidual),
     ("analytical", AnalyticalBaseline),
     ("experimental", ExperimentalMLP),
     ("refined", RefinedMLP),
