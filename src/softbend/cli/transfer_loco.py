@@ -3,7 +3,7 @@
 from __future__ import annotations
 
 from pathlib import Path
-from typing import TYPE_CHECKING
+from typing import TYPE_CHECKING, Any
 
 import typer
 
@@ -84,8 +84,10 @@ def loco(
         softbend transfer loco lab.csv bench.csv --out loco
     """
     from softbend._io import staged_dir
+    from softbend.actuators import SFRBA
     from softbend.reports import transfer_figures
-    from softbend.transfer.base import load_base
+    from softbend.transfer.actuator_measurements import load_actuator_measurements
+    from softbend.transfer.base import load_base_saved
     from softbend.transfer.loco import (
         DEFAULT_STRATEGIES,
         check_calibration,
@@ -98,13 +100,20 @@ def loco(
     inputs = tuple(measurements) if base is None else (*measurements, base)
     _common.check_output_dir(out, "--out", inputs=inputs, files=LOCO_FILES)
     _common.check_replaceable_dir(out, "--out", "transfer loco", inputs=inputs, files=LOCO_FILES)
+    saved = load_base_saved(base)
+    actuator = saved.actuator
+    paper_b = actuator == SFRBA
     names = (
-        list(DEFAULT_STRATEGIES)
+        [n for n in DEFAULT_STRATEGIES if paper_b or n != "analytical"]
         if strategies.strip() == "all"
         else [n.strip() for n in strategies.split(",") if n.strip()]
     )
     options = strategy_options(names, _common.parse_assignments(settings or ()))
-    data = load_measurements_files(measurements, force=force)
+    data: Any = (
+        load_measurements_files(measurements, force=force)
+        if paper_b
+        else load_actuator_measurements(measurements, actuator, force=force)
+    )
     if calibrate:  # before the base is read and any strategy fitted
         check_calibration(
             data.actuator_ids,
@@ -113,7 +122,7 @@ def loco(
             data_field="MEASUREMENTS",
             owner="softbend transfer loco",
         )
-    model = load_base(base)
+    model = saved.model
     with _common.library_progress(enabled=not as_json) as progress:
         result = leave_one_configuration_out(
             data,
@@ -197,18 +206,19 @@ def print_loco_summary(result: LocoResult) -> None:
                 f"{r['worst_actuator']} ({r['worst_rmse_deg']:.1f}°)",
             ]
         )
-    rows.append(
-        [
-            "paper B refined MLP",
-            paper["rmse_deg"],
-            "—",
-            paper["mape_pct"],
-            "—",
-            "—",
-            "—",
-            f"{paper['worst']} ({paper['worst_rmse_deg']:.2f}°)",
-        ]
-    )
+    if "actuator" not in result.settings:  # paper B's figure, for paper B's actuator only
+        rows.append(
+            [
+                "paper B refined MLP",
+                paper["rmse_deg"],
+                "—",
+                paper["mape_pct"],
+                "—",
+                "—",
+                "—",
+                f"{paper['worst']} ({paper['worst_rmse_deg']:.2f}°)",
+            ]
+        )
     _common.print_table(
         f"Leave one configuration out ({len(result.settings['actuators'])} actuators, "
         f"{result.settings['n_measurements']} readings; intervals {result.level:.0%})",

@@ -86,6 +86,8 @@ def loss_curves(result: LocoResult, path: Path) -> Path:
 
 def actuator_panels(result: LocoResult, path: Path, *, synthetic: bool = True) -> Path:
     """Paper B Fig. 7: held-out actuators, measured and predicted angle against pressure."""
+    pcol = str(result.settings.get("pressure_column", "pressure_mpa"))
+    punit = str(result.settings.get("pressure_unit", "MPa"))
     from matplotlib.figure import Figure
 
     pred = result.predictions
@@ -102,7 +104,7 @@ def actuator_panels(result: LocoResult, path: Path, *, synthetic: bool = True) -
             rows = first[first["direction"] == direction]
             if len(rows):
                 ax.plot(
-                    rows["pressure_mpa"],
+                    rows[pcol],
                     rows["angle_deg"],
                     marker,
                     ms=3.5,
@@ -111,7 +113,7 @@ def actuator_panels(result: LocoResult, path: Path, *, synthetic: bool = True) -
                     label=f"measured ({direction})",
                 )
         for name in names:
-            rows = part[part["strategy"] == name].sort_values("pressure_mpa")
+            rows = part[part["strategy"] == name].sort_values(pcol)
             rows = rows[rows["direction"] == rows["direction"].iloc[0]]
             color, line = _style(name)
             score = result.per_actuator[
@@ -119,7 +121,7 @@ def actuator_panels(result: LocoResult, path: Path, *, synthetic: bool = True) -
                 & (result.per_actuator["actuator_id"] == actuator)
             ]["rmse_deg"]
             ax.plot(
-                rows["pressure_mpa"],
+                rows[pcol],
                 rows["predicted_deg"],
                 color=color,
                 ls=line,
@@ -128,7 +130,7 @@ def actuator_panels(result: LocoResult, path: Path, *, synthetic: bool = True) -
             )
             if "lo_deg" in rows and rows["lo_deg"].notna().all():
                 ax.fill_between(
-                    rows["pressure_mpa"],
+                    rows[pcol],
                     rows["lo_deg"],
                     rows["hi_deg"],
                     color=color,
@@ -136,7 +138,7 @@ def actuator_panels(result: LocoResult, path: Path, *, synthetic: bool = True) -
                     lw=0,
                 )
         ax.set_title(f"held out ({actuator})", fontsize=9)
-        ax.set_xlabel("pressure (MPa)")
+        ax.set_xlabel(f"pressure ({punit})")
         ax.set_ylabel("bending angle (°)")
         ax.grid(True, alpha=0.3)
         ax.legend(fontsize=6, loc="upper left")

@@ -229,6 +229,7 @@ def _read_one(path: Path, actuator: Actuator, force: bool) -> tuple[pd.DataFrame
                 f"got {raw[column].iloc[pos]!r}."
             )
         frame[name] = values
+    frame["direction"] = "loading"  # a plain file records the loading branch
     pressure = frame[actuator.pressure_column].to_numpy()
     if (pressure < 0).any():
         pos = int(np.argmax(pressure < 0))

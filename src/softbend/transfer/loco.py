@@ -34,6 +34,7 @@ from softbend._io import json_text, write_text_atomic
 from softbend._validation import check_int, check_range
 from softbend.metrics import rmse, thresholded_mape
 from softbend.registry import UnknownNameError
+from softbend.transfer.actuator_measurements import ActuatorMeasurements
 from softbend.transfer.conformal import Calibration, angle_floor, calibrate
 from softbend.transfer.measurements import Measurements
 from softbend.transfer.parameters import check_parameters, recorded_parameters
@@ -212,7 +213,7 @@ def _fit_all(
 
 
 def leave_one_configuration_out(
-    measurements: Measurements,
+    measurements: Measurements | ActuatorMeasurements,
     base: Any,
     strategies: Sequence[str] = DEFAULT_STRATEGIES,
     *,
@@ -270,11 +271,65 @@ def leave_one_configuration_out(
         Bad input; among them ``calibrated`` with too few actuators or only
         the slowest strategies (:func:`check_calibration`).
     """
-    if not isinstance(measurements, Measurements):
+    if not isinstance(measurements, Measurements | ActuatorMeasurements):
         raise ValueError(
-            f"The 'measurements' of {_OWNER} must be Measurements (see load_measurements). "
-            f"Got {type(measurements).__name__} instead."
+            f"The 'measurements' of {_OWNER} must be Measurements (see load_measurements) or "
+            f"ActuatorMeasurements. Got {type(measurements).__name__} instead."
         )
+    if isinstance(measurements, ActuatorMeasurements):  # another actuator: its own inputs
+        from softbend.surrogates.persistence import describing
+
+        actuator = measurements.actuator
+        if "analytical" in strategies:
+            raise ValueError(
+                f"The 'analytical' strategy models paper B's actuator only; the measurements "
+                f"are of {actuator.name}. Leave it out of the strategies."
+            )
+        with describing(actuator):
+            result = _leave_one_out(
+                measurements,
+                base,
+                strategies,
+                level=level,
+                learning_curve=learning_curve,
+                calibrated=calibrated,
+                fallback=fallback,
+                seed=seed,
+                options=options,
+                progress=progress,
+            )
+        result.settings["actuator"] = actuator.to_dict()
+        result.settings["pressure_column"] = actuator.pressure_column
+        result.settings["pressure_unit"] = actuator.pressure_unit
+        return result
+    return _leave_one_out(
+        measurements,
+        base,
+        strategies,
+        level=level,
+        learning_curve=learning_curve,
+        calibrated=calibrated,
+        fallback=fallback,
+        seed=seed,
+        options=options,
+        progress=progress,
+    )
+
+
+def _leave_one_out(
+    measurements: Any,
+    base: Any,
+    strategies: Sequence[str],
+    *,
+    level: float,
+    learning_curve: bool,
+    calibrated: bool,
+    fallback: str,
+    seed: int,
+    options: dict[str, dict[str, Any]] | None,
+    progress: Callable[[int, int, str], None] | None,
+) -> LocoResult:
+    """:func:`leave_one_configuration_out` once the measurements' kind is known."""
     names = tuple(strategies)
     if not names:
         raise ValueError(

@@ -64,7 +64,7 @@ from sklearn.gaussian_process import GaussianProcessRegressor
 from sklearn.utils.validation import check_is_fitted, validate_data
 
 from softbend._validation import check_int, check_range
-from softbend.design import FEATURES, SFRBADesign
+from softbend.design import SFRBADesign
 from softbend.errors import ConvergenceError
 from softbend.parameters import Range, declare_ranges, declared_ranges
 from softbend.plausibility import RANGES as PLAUSIBLE
@@ -78,6 +78,7 @@ from softbend.surrogates.corrected import (
     gp_kernel,
     scaled_pressure_rows,
 )
+from softbend.surrogates.features import is_paper_b, model_features
 from softbend.transfer.finetune import check_mlp, fine_tune_many, row_weights
 from softbend.transfer.parameters import (
     check_estimator,
@@ -246,14 +247,16 @@ class _Strategy(RegressorMixin, BaseEstimator):
     def _check_fit_data(self, X: ArrayLike, y: ArrayLike) -> tuple[np.ndarray, np.ndarray]:
         X_arr, y_arr = validate_data(self, X, y, dtype=np.float64, y_numeric=True)
         owner = f"{type(self).__name__}.fit"
-        if X_arr.shape[1] != len(FEATURES):
+        features = model_features()
+        if X_arr.shape[1] != len(features):
             raise ValueError(
-                f"The 'X' of {owner} must have the {len(FEATURES)} columns "
-                f"{', '.join(FEATURES)}. Got {X_arr.shape[1]} columns instead."
+                f"The 'X' of {owner} must have the {len(features)} columns "
+                f"{', '.join(features)}. Got {X_arr.shape[1]} columns instead."
             )
-        check_plausible(
-            X_arr[:, -1], "pressure_mpa", source=owner, column="pressure_mpa", where=_row
-        )
+        if is_paper_b(features):  # another actuator's pressure is in its own unit
+            check_plausible(
+                X_arr[:, -1], "pressure_mpa", source=owner, column="pressure_mpa", where=_row
+            )
         check_plausible(y_arr, "angle_deg", source=owner, column="y", where=_row)
         return X_arr, y_arr
 
