@@ -2,8 +2,9 @@
 fresh folder.
 
 Set-up lines (``make …``, ``export PATH=…``) are left out: the test runs with this
-environment's softbend first on PATH. The folder holds a link to the repository's ``src`` so
-that the tutorials' paths to the shipped data work as they do from the repository's folder.
+environment's softbend first on PATH. The folder holds links to the repository's ``src`` and
+``examples`` so that the tutorials' paths to the shipped data work as they do from the
+repository's folder.
 """
 
 from __future__ import annotations
@@ -39,6 +40,7 @@ def test_a_tutorial_runs_as_written(page, tmp_path):
     if bash is None:
         pytest.skip("bash is needed to run the tutorials")
     (tmp_path / "src").symlink_to(ROOT / "src", target_is_directory=True)
+    (tmp_path / "examples").symlink_to(ROOT / "examples", target_is_directory=True)
     env = {**os.environ, "PATH": f"{Path(sys.executable).parent}{os.pathsep}{os.environ['PATH']}"}
     done = subprocess.run(
         [bash, "-c", _script(page)],

@@ -37,8 +37,10 @@ every model input; :meth:`DesignParameter.encode` and
 from __future__ import annotations
 
 import ast
+import json
 import math
 import operator
+import os
 import re
 from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass, field
@@ -55,7 +57,9 @@ __all__ = [
     "Actuator",
     "ActuatorError",
     "DesignParameter",
+    "actuator_from",
     "get_actuator",
+    "load_actuator",
     "pressure_to_mpa",
 ]
 
@@ -726,6 +730,42 @@ def _unit_from_name(column: str) -> str:
     """A unit guessed from a column's suffix (``wall_mm`` → mm), else ``""``."""
     suffix = column.rsplit("_", 1)[-1] if "_" in column else ""
     return suffix if suffix in ("mm", "cm", "m", "deg", "um", "g", "kpa") else ""
+
+
+def load_actuator(path: str | os.PathLike[str]) -> Actuator:
+    """An actuator description from a JSON file (the form :meth:`Actuator.to_dict` writes).
+
+    Raises
+    ------
+    ActuatorError
+        A file that is not such a description, naming the file.
+    """
+    from pathlib import Path
+
+    from softbend._jsontext import check_json_nesting
+    from softbend.limits import check_file_size
+
+    source = Path(path)
+    if not source.is_file():
+        raise ActuatorError(f"No actuator description at {source}.")
+    check_file_size(source, str(source))
+    try:
+        text = source.read_text(encoding="utf-8")
+        check_json_nesting(text, str(source))
+        data = json.loads(text)
+    except (UnicodeDecodeError, json.JSONDecodeError) as err:
+        raise ActuatorError(f"{source} is not a JSON actuator description ({err}).") from None
+    try:
+        return Actuator.from_dict(data)
+    except ActuatorError as err:
+        raise ActuatorError(f"{source}: {err}") from None
+
+
+def actuator_from(text: str, *, field: str = "--actuator") -> Actuator:
+    """A registered description by name, or one read from a ``.json`` file."""
+    if text.lower().endswith(".json"):
+        return load_actuator(text)
+    return get_actuator(text, field=field)
 
 
 #: Registered actuator descriptions, by name.

@@ -35,8 +35,9 @@ def train(
     actuator: str | None = typer.Option(
         None,
         "--actuator",
-        help="A registered actuator description the table must fit (its columns become the "
-        "defaults); without it, the description is read off the table's columns.",
+        help="The actuator description the table must fit: a registered name (sfrba) or a "
+        "JSON file (its columns become the defaults; ranges, kinds, resolutions and "
+        "constraints are checked); without it, the description is read off the table.",
     ),
     models: str = typer.Option(
         "plr,xgb,mlp",
@@ -180,7 +181,7 @@ def _training_source(
                 param_hint="TABLE",
             )
         return db
-    from softbend.actuators import get_actuator
+    from softbend.actuators import actuator_from
     from softbend.surrogates.tables import table_training_data
 
     return table_training_data(
@@ -189,7 +190,7 @@ def _training_source(
         pressure_column=pressure_column,
         pressure_unit=pressure_unit,
         angle_column=angle_column,
-        actuator=get_actuator(actuator) if described else None,
+        actuator=actuator_from(actuator) if described else None,
     )
 
 

@@ -77,7 +77,17 @@ def loss_curves(result: LocoResult, path: Path) -> Path:
     ax.set_xlabel("epoch")
     ax.set_ylabel("training MSE (deg²)")
     ax.set_title("Training loss on all measured actuators (cf. paper B Fig. 6)", fontsize=10)
-    ax.legend(fontsize=7)
+    if ax.get_legend_handles_labels()[0]:
+        ax.legend(fontsize=7)
+    else:  # no strategy of this run trains a network (a base without a loss curve)
+        ax.text(
+            0.5,
+            0.5,
+            "no strategy of this run records a training loss",
+            ha="center",
+            va="center",
+            transform=ax.transAxes,
+        )
     ax.grid(True, which="both", alpha=0.3)
     fig.tight_layout()
     fig.savefig(path, dpi=_DPI)
