@@ -195,7 +195,9 @@ def _training_source(
 
 
 def print_summary(summary: dict) -> None:
-    """The per-family table beside paper B's figures (a dash for a family it lacks)."""
+    """The per-family table, beside paper B's figures for paper B's actuator (a dash for a
+    family it lacks); another actuator's table names it and leaves paper B out."""
+    paper_b = "actuator" not in summary
     rows = []
     for name, m in summary["models"].items():
         paper = m["paper_b"]
@@ -212,11 +214,16 @@ def print_summary(summary: dict) -> None:
                 f"{m['max_abs_error_deg']:.2f}",
                 f"{m['inference_single_us']:.1f}",
                 f"{m['inference_batch_ms']:.2f}",
-                theirs,
+                *([theirs] if paper_b else []),
             ]
         )
+    title = "Surrogates: grouped cross-validation (held-out designs) and inference"
+    if not paper_b:
+        actuator = summary["actuator"]
+        names = ", ".join(p["name"] for p in actuator["parameters"])
+        title += f"; actuator {actuator['name']} ({names}; {actuator['pressure_unit']})"
     _common.print_table(
-        "Surrogates: grouped cross-validation (held-out designs) and inference",
+        title,
         [
             "model",
             "best configuration",
@@ -226,7 +233,7 @@ def print_summary(summary: dict) -> None:
             "max |e| °",
             "1 sample µs",
             "10k batch ms",
-            "paper B R² / MAPE / IT",
+            *(["paper B R² / MAPE / IT"] if paper_b else []),
         ],
         rows,
     )
