@@ -149,9 +149,9 @@ class DesignParameter:
                     f"The categorical design parameter {self.name!r} needs two or more distinct "
                     f"levels; got {self.levels!r}."
                 )
-            object.__setattr__(self, "levels", tuple(self.levels))
+            object.__setattr__(self, "levels", tuple(levels))
             object.__setattr__(self, "low", 0.0)
-            object.__setattr__(self, "high", float(len(self.levels) - 1))
+            object.__setattr__(self, "high", float(len(levels) - 1))
         elif self.levels is not None:
             raise ActuatorError(
                 f"Only a categorical design parameter has levels; {self.name!r} is {self.kind}."
@@ -364,8 +364,8 @@ def _parse_constraint(text: str, names: Sequence[str]) -> ast.Compare:
 
 
 def _evaluate(node: ast.AST, values: Mapping[str, np.ndarray]) -> Any:
-    if isinstance(node, ast.Constant):
-        return float(node.value)
+    if isinstance(node, ast.Constant):  # a number: _parse_constraint allows no other constant
+        return float(node.value)  # type: ignore[arg-type]
     if isinstance(node, ast.Name):
         return values[node.id]
     if isinstance(node, ast.UnaryOp):
@@ -598,7 +598,7 @@ class Actuator:
     def _columns(self, rows: np.ndarray) -> dict[str, np.ndarray]:
         return {name: rows[:, j] for j, name in enumerate(self.names)}
 
-    def describe(self, codes: Sequence[float]) -> str:
+    def describe(self, codes: Sequence[float] | np.ndarray) -> str:
         """``A=1, B=2.5 mm, layer=paper``: one design by name, in its units."""
         parts = []
         for p, code in zip(self.parameters, codes, strict=True):
@@ -608,7 +608,7 @@ class Actuator:
             parts.append(f"{p.name}={shown}{unit}")
         return ", ".join(parts)
 
-    def design_record(self, codes: Sequence[float]) -> dict[str, Any]:
+    def design_record(self, codes: Sequence[float] | np.ndarray) -> dict[str, Any]:
         """``{name: value}`` of one design (levels by name), JSON-friendly."""
         return {
             p.name: p.decode(float(code)) for p, code in zip(self.parameters, codes, strict=True)

@@ -190,7 +190,7 @@ def _training_source(
         pressure_column=pressure_column,
         pressure_unit=pressure_unit,
         angle_column=angle_column,
-        actuator=actuator_from(actuator) if described else None,
+        actuator=actuator_from(actuator) if actuator is not None else None,
     )
 
 
