@@ -371,7 +371,20 @@ def _cli(argv: Sequence[str] | None = None) -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--seed", type=int, default=0, help="random seed (default 0)")
     parser.add_argument("--out", type=Path, default=None, help="output folder (default: here)")
+    parser.add_argument(
+        "--angle",
+        metavar="N_CHAMBERS,N_LAYERS,WALL_MM,HEIGHT_MM",
+        help="print one design's simulated and as-built angle at --at instead of writing files",
+    )
+    parser.add_argument("--at", type=float, default=40.0, help="pressure for --angle, kPa")
     args = parser.parse_args(argv)
+    if args.angle:
+        n, layers, wall, height = (float(v) for v in args.angle.split(","))
+        design = (int(n), int(layers), wall, height)
+        simulated = bending_angle_deg(args.at, *design)
+        built = bending_angle_deg(args.at, *design, build=AS_BUILT)
+        print(f"at {args.at:g} kPa: simulated {simulated:.1f} deg, as built {built:.1f} deg")
+        return
     for path in main(args.seed, args.out).values():
         print(path)
 
