@@ -115,15 +115,16 @@ def train_surrogates(
         written, and ``resumed_config_folds`` (folds loaded from ``checkpoint``).
     """
     from softbend.actuators import SFRBA
-    from softbend.surrogates.persistence import describing
+    from softbend.surrogates.features import training_ranges
+    from softbend.surrogates.persistence import describing, save_surrogate
+    from softbend.surrogates.support import support_from_rows
 
     data = _load_data(source)
     actuator = data.actuator or SFRBA
-    with describing(actuator):
-        return _train(
+    with describing(actuator):  # every check and file names this actuator
+        paper_b = actuator == SFRBA
+        result = search(
             data,
-            actuator,
-            out_dir,
             models=models,
             grid_name=grid_name,
             folds=folds,
@@ -131,7 +132,6 @@ def train_surrogates(
             device=device,
             n_jobs=n_jobs,
             epochs=epochs,
-            export_onnx=export_onnx,
             progress=progress,
             cv=cv,
             halving=halving,
@@ -140,113 +140,67 @@ def train_surrogates(
             checkpoint=checkpoint,
             tf32=tf32,
         )
+        out = Path(out_dir)
+        (out / "models").mkdir(parents=True, exist_ok=True)
+        files: dict[str, str] = {}
+        families: dict[str, Any] = {}
+        for name, fam in result.families.items():
+            metadata = {
+                "data_hash": data.data_hash,
+                "n_samples": data.n_samples,
+                "n_designs": data.n_groups,
+                "cv": {k: float(v) for k, v in fam.cv.items()},
+                "search": {**result.settings, "params": describe(fam.params)},
+                "training_ranges": training_ranges(data.X),
+                "support": support_from_rows(
+                    data.X, data.y, parameters=actuator.names, pressure_unit=actuator.pressure_unit
+                ).to_dict(),
+            }
+            metadata["actuator"] = actuator.to_dict()  # every model names its actuator
+            family = FAMILIES.get(name)
+            if family.storage is not None:
+                files[f"{name}_model"] = str(
+                    save_surrogate(fam.model, out / "models" / f"{name}.json", metadata=metadata)
+                )
+            entry: dict[str, Any] = {
+                "params": describe(fam.params),
+                **{k: float(v) for k, v in fam.cv.items()},
+                **{f"inference_{k}": v for k, v in fam.timing.items()},
+                "fit_s": fam.fit_s,
+                "search_s": fam.search_s,
+                "paper_b": _paper_b(name) if paper_b else {},
+            }
+            if export_onnx and family.onnx is not None:
+                from softbend.surrogates.onnx_export import onnx_predict, save_onnx
 
-
-def _train(
-    data: TrainingData,
-    actuator: Any,
-    out_dir: str | os.PathLike[str],
-    *,
-    models: str | Sequence[str],
-    grid_name: str,
-    folds: int,
-    seed: int,
-    device: str,
-    n_jobs: int | None,
-    epochs: int | None,
-    export_onnx: bool,
-    progress: Progress | None,
-    cv: str,
-    halving: int | None,
-    halving_rungs: int | None,
-    plr_patience: int | None,
-    checkpoint: SearchCheckpoint | None,
-    tf32: bool,
-) -> tuple[SearchResult, dict[str, Any]]:
-    from softbend.actuators import SFRBA
-    from softbend.surrogates.features import training_ranges
-    from softbend.surrogates.persistence import save_surrogate
-    from softbend.surrogates.support import support_from_rows
-
-    paper_b = actuator == SFRBA
-    result = search(
-        data,
-        models=models,
-        grid_name=grid_name,
-        folds=folds,
-        seed=seed,
-        device=device,
-        n_jobs=n_jobs,
-        epochs=epochs,
-        progress=progress,
-        cv=cv,
-        halving=halving,
-        halving_rungs=halving_rungs,
-        plr_patience=plr_patience,
-        checkpoint=checkpoint,
-        tf32=tf32,
-    )
-    out = Path(out_dir)
-    (out / "models").mkdir(parents=True, exist_ok=True)
-    files: dict[str, str] = {}
-    families: dict[str, Any] = {}
-    for name, fam in result.families.items():
-        metadata = {
-            "data_hash": data.data_hash,
-            "n_samples": data.n_samples,
-            "n_designs": data.n_groups,
-            "cv": {k: float(v) for k, v in fam.cv.items()},
-            "search": {**result.settings, "params": describe(fam.params)},
-            "training_ranges": training_ranges(data.X),
-            "support": support_from_rows(
-                data.X, data.y, parameters=actuator.names, pressure_unit=actuator.pressure_unit
-            ).to_dict(),
+                onnx_path = save_onnx(fam.model, out / "models" / f"{name}.onnx")
+                rows = data.X[np.random.default_rng(seed).integers(0, data.n_samples, 2000)]
+                expected = fam.model.predict(rows)
+                entry["onnx_max_abs_diff_deg"] = float(
+                    np.max(np.abs(onnx_predict(onnx_path, rows) - expected))
+                )
+                files[f"{name}_onnx"] = str(onnx_path)
+            families[name] = entry
+        cv_path = out / "cv_results.csv"
+        write_text_atomic(cv_path, result.cv_results.to_csv(index=False))
+        summary_table = result.summary()
+        for key in ("params", "r2", "mape_pct", "inference_ms"):
+            summary_table[f"paper_b_{key}"] = [
+                _paper_b(m).get(key) if paper_b else None for m in summary_table["model"]
+            ]
+        write_text_atomic(out / "summary.csv", summary_table.to_csv(index=False))
+        files["cv_results"] = str(cv_path)
+        files["summary"] = str(out / "summary.csv")
+        best = min(result.families, key=lambda m: result.families[m].cv["mape_pct"], default=None)
+        summary = {
+            **({} if paper_b else {"actuator": actuator.to_dict()}),
+            "settings": result.settings,
+            "models": families,
+            "best_by_mape": best,
+            "resumed_config_folds": result.resumed,
+            "files": files,
         }
-        metadata["actuator"] = actuator.to_dict()  # every model names its actuator
-        family = FAMILIES.get(name)
-        if family.storage is not None:
-            files[f"{name}_model"] = str(
-                save_surrogate(fam.model, out / "models" / f"{name}.json", metadata=metadata)
-            )
-        entry: dict[str, Any] = {
-            "params": describe(fam.params),
-            **{k: float(v) for k, v in fam.cv.items()},
-            **{f"inference_{k}": v for k, v in fam.timing.items()},
-            "fit_s": fam.fit_s,
-            "search_s": fam.search_s,
-            "paper_b": _paper_b(name) if paper_b else {},
-        }
-        if export_onnx and family.onnx is not None:
-            from softbend.surrogates.onnx_export import onnx_predict, save_onnx
-
-            onnx_path = save_onnx(fam.model, out / "models" / f"{name}.onnx")
-            rows = data.X[np.random.default_rng(seed).integers(0, data.n_samples, 2000)]
-            expected = fam.model.predict(rows)
-            entry["onnx_max_abs_diff_deg"] = float(
-                np.max(np.abs(onnx_predict(onnx_path, rows) - expected))
-            )
-            files[f"{name}_onnx"] = str(onnx_path)
-        families[name] = entry
-    cv_path = out / "cv_results.csv"
-    write_text_atomic(cv_path, result.cv_results.to_csv(index=False))
-    summary_table = result.summary()
-    for key in ("params", "r2", "mape_pct", "inference_ms"):
-        summary_table[f"paper_b_{key}"] = [
-            _paper_b(m).get(key) if paper_b else None for m in summary_table["model"]
-        ]
-    write_text_atomic(out / "summary.csv", summary_table.to_csv(index=False))
-    files["cv_results"] = str(cv_path)
-    files["summary"] = str(out / "summary.csv")
-    best = min(result.families, key=lambda m: result.families[m].cv["mape_pct"], default=None)
-    summary = {
-        **({} if paper_b else {"actuator": actuator.to_dict()}),
-        "settings": result.settings,
-        "models": families,
-        "best_by_mape": best,
-        "resumed_config_folds": result.resumed,
-        "files": files,
-    }
-    return result, summary
+        return result, summary
 
 
 def train_into(

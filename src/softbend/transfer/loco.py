@@ -276,44 +276,33 @@ def leave_one_configuration_out(
             f"The 'measurements' of {_OWNER} must be Measurements (see load_measurements) or "
             f"ActuatorMeasurements. Got {type(measurements).__name__} instead."
         )
-    if isinstance(measurements, ActuatorMeasurements):  # another actuator: its own inputs
-        from softbend.surrogates.persistence import describing
+    from softbend.actuators import SFRBA
+    from softbend.surrogates.persistence import describing
 
-        actuator = measurements.actuator
-        if "analytical" in strategies:
-            raise ValueError(
-                f"The 'analytical' strategy models paper B's actuator only; the measurements "
-                f"are of {actuator.name}. Leave it out of the strategies."
-            )
-        with describing(actuator):
-            result = _leave_one_out(
-                measurements,
-                base,
-                strategies,
-                level=level,
-                learning_curve=learning_curve,
-                calibrated=calibrated,
-                fallback=fallback,
-                seed=seed,
-                options=options,
-                progress=progress,
-            )
+    actuator = getattr(measurements, "actuator", SFRBA)  # paper B's Measurements: SFRBA
+    if actuator != SFRBA and "analytical" in strategies:
+        raise ValueError(
+            f"The 'analytical' strategy models paper B's actuator only; the measurements "
+            f"are of {actuator.name}. Leave it out of the strategies."
+        )
+    with describing(actuator):  # the strategies check the inputs of this actuator
+        result = _leave_one_out(
+            measurements,
+            base,
+            strategies,
+            level=level,
+            learning_curve=learning_curve,
+            calibrated=calibrated,
+            fallback=fallback,
+            seed=seed,
+            options=options,
+            progress=progress,
+        )
+    if actuator != SFRBA:
         result.settings["actuator"] = actuator.to_dict()
         result.settings["pressure_column"] = actuator.pressure_column
         result.settings["pressure_unit"] = actuator.pressure_unit
-        return result
-    return _leave_one_out(
-        measurements,
-        base,
-        strategies,
-        level=level,
-        learning_curve=learning_curve,
-        calibrated=calibrated,
-        fallback=fallback,
-        seed=seed,
-        options=options,
-        progress=progress,
-    )
+    return result
 
 
 def _leave_one_out(
