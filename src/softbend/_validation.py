@@ -1,8 +1,13 @@
 """Input checks that produce one message format everywhere.
 
-The format follows scikit-learn's parameter validation::
+Every check raises an :class:`~softbend.errors.InputError` (a ``ValueError``)
+that carries the input's key and says what the value must be and what it was::
 
-    The 'wall_thickness_mm' of SFRBADesign must be in (0, inf). Got -2.0 instead.
+    t_mm: must be a number in (0, inf); got -2.0
+
+The command line names the option for the key (:mod:`softbend.cli._options`);
+the same wording serves the declared ranges of :mod:`softbend.parameters`, the
+rig file and the table readers.
 """
 
 from __future__ import annotations
@@ -14,7 +19,7 @@ from typing import Any
 
 import numpy as np
 
-from softbend.errors import DatasetError
+from softbend.errors import DatasetError, InputError
 
 
 def _fmt_bound(value: float) -> str:
@@ -23,27 +28,38 @@ def _fmt_bound(value: float) -> str:
     return f"{value:g}"
 
 
+def interval_text(
+    low: float, high: float, *, low_inclusive: bool = False, high_inclusive: bool = False
+) -> str:
+    """An interval as text: ``(0, inf)``, ``[100, 160]`` (infinite bounds are always open)."""
+    left = "[" if low_inclusive and math.isfinite(low) else "("
+    right = "]" if high_inclusive and math.isfinite(high) else ")"
+    return f"{left}{_fmt_bound(low)}, {_fmt_bound(high)}{right}"
+
+
+def must_be(requirement: str, value: Any) -> str:
+    """The one wording of a failed check: ``must be <requirement>; got <value>``."""
+    return f"must be {requirement}; got {short_repr(value)}"
+
+
 def check_range(
     value: Any,
-    name: str,
-    owner: str,
+    key: str,
     *,
     low: float = -math.inf,
     high: float = math.inf,
     low_inclusive: bool = False,
     high_inclusive: bool = False,
 ) -> float:
-    """Return ``value`` as a float if it lies in the interval, else raise ``ValueError``.
+    """Return ``value`` as a float if it lies in the interval, else raise :class:`InputError`.
 
     Parameters
     ----------
-    value : Any
+    value : object
         The value to check; must convert to a finite float (``inf`` only if a
         bound allows it).
-    name : str
-        Field name used in the message, with its unit suffix (``"t_mm"``).
-    owner : str
-        Name of the object or function the field belongs to.
+    key : str
+        The input's name, with its unit suffix (``"t_mm"``).
     low, high : float
         Interval bounds.
     low_inclusive, high_inclusive : bool
@@ -54,62 +70,55 @@ def check_range(
     float
         The validated value.
     """
-    interval = (
-        ("[" if low_inclusive else "(")
-        + f"{_fmt_bound(low)}, {_fmt_bound(high)}"
-        + ("]" if high_inclusive else ")")
-    )
-    message = f"The '{name}' of {owner} must be a number in {interval}. Got {value!r} instead."
+    interval = interval_text(low, high, low_inclusive=low_inclusive, high_inclusive=high_inclusive)
+    error = InputError(must_be(f"a number in {interval}", value), key=key)
     if isinstance(value, bool):
-        raise ValueError(message)
+        raise error
     try:
         number = float(value)
-    except (TypeError, ValueError):
-        raise ValueError(message) from None
+    except (TypeError, ValueError, OverflowError):
+        raise error from None
     if math.isnan(number):
-        raise ValueError(message)
+        raise error
     below = number < low or (number == low and not low_inclusive)
     above = number > high or (number == high and not high_inclusive)
     if below or above:
-        raise ValueError(message)
+        raise error
     return number
 
 
-def check_choice(value: Any, name: str, owner: str, choices: Iterable[Any]) -> Any:
-    """Return ``value`` if it is one of ``choices``, else raise ``ValueError``."""
+def check_choice(value: Any, key: str, choices: Iterable[Any]) -> Any:
+    """Return ``value`` if it is one of ``choices``, else raise :class:`InputError`."""
     options = list(choices)
     if value not in options:
         allowed = ", ".join(repr(c) for c in options)
-        raise ValueError(
-            f"The '{name}' of {owner} must be one of {allowed}. Got {value!r} instead."
-        )
+        raise InputError(must_be(f"one of {allowed}", value), key=key)
     return value
 
 
-def check_int(value: Any, name: str, owner: str, *, low: int = 0) -> int:
+def check_int(value: Any, key: str, *, low: int = 0) -> int:
     """Return ``value`` as an int if it is an integer (not a bool) ``>= low``, else raise.
 
     Raises
     ------
-    ValueError
-        ``The 'name' of owner must be an integer in [low, inf). Got ... instead.``
+    InputError
+        ``key: must be an integer in [low, inf); got ...``.
     """
     if isinstance(value, bool) or not isinstance(value, numbers.Integral) or value < low:
-        raise ValueError(
-            f"The '{name}' of {owner} must be an integer in [{low}, inf). Got {value!r} instead."
-        )
+        raise InputError(must_be(f"an integer in [{low}, inf)", value), key=key)
     return int(value)
 
 
-def check_finite_array(values: Any, name: str, owner: str) -> np.ndarray:
+def check_finite_array(values: Any, key: str) -> np.ndarray:
     """Convert to a float array and raise :class:`DatasetError` if anything is NaN or infinite."""
     array = np.asarray(values, dtype=float)
     bad = ~np.isfinite(array)
     if bad.any():
         first = int(np.flatnonzero(bad.ravel())[0])
         raise DatasetError(
-            f"The '{name}' of {owner} must be finite. Got {array.ravel()[first]!r} "
-            f"at position {first} ({int(bad.sum())} non-finite values in all)."
+            f"must be finite; got {array.ravel()[first]!r} at position {first} "
+            f"({int(bad.sum())} non-finite values in all)",
+            key=key,
         )
     return array
 

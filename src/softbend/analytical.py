@@ -188,9 +188,8 @@ def section_quadrature(
         Number of nodes through the wall, along the quarter arc and through the
         bottom wall, each >= 1.
     """
-    owner = "section_quadrature"
     orders = [
-        int(check_range(n, name, owner, low=1, high=1000, low_inclusive=True, high_inclusive=True))
+        int(check_range(n, name, low=1, high=1000, low_inclusive=True, high_inclusive=True))
         for n, name in ((n_radial, "n_radial"), (n_angular, "n_angular"), (n_bottom, "n_bottom"))
     ]
     return _quadrature_cached(design.r_mm, design.t_mm, design.b_mm, *orders)
@@ -249,7 +248,7 @@ def elastomer_moment_nmm(
 
 
 def _validate_pressures(pressures_mpa: ArrayLike, owner: str) -> np.ndarray:
-    pressures = check_finite_array(pressures_mpa, "pressures_mpa", owner)
+    pressures = check_finite_array(pressures_mpa, "pressures_mpa")
     negative = pressures < 0.0
     if negative.any():
         first = int(np.flatnonzero(negative.ravel())[0])
@@ -307,9 +306,7 @@ def bending_angle_deg(
     owner = "bending_angle_deg"
     pressures = _validate_pressures(pressures_mpa, owner)
     theta_max = math.radians(
-        check_range(
-            max_angle_deg, "max_angle_deg", owner, low=0.0, high=3600.0, high_inclusive=True
-        )
+        check_range(max_angle_deg, "max_angle_deg", low=0.0, high=3600.0, high_inclusive=True)
     )
     model = _resolve_model(material, owner)
 
@@ -449,7 +446,6 @@ class AnalyticalModel:
             limit = check_range(
                 self.max_angle_deg,
                 "max_angle_deg",
-                "AnalyticalModel",
                 low=0.0,
                 high=3600.0,
                 high_inclusive=True,

@@ -110,7 +110,6 @@ class SFRBADesign:
             value = check_range(
                 getattr(self, name),
                 name,
-                "SFRBADesign",
                 low=low,
                 high=high,
                 low_inclusive=low_inclusive,
@@ -306,8 +305,8 @@ class DesignSpace:
         """
         from scipy.stats import qmc
 
-        n = int(check_range(n, "n", "DesignSpace.sample", low=1, low_inclusive=True))
-        check_choice(method, "method", "DesignSpace.sample", ("lhs", "sobol"))
+        n = int(check_range(n, "n", low=1, low_inclusive=True))
+        check_choice(method, "method", ("lhs", "sobol"))
         bounds = bounds or {p: (min(v), max(v)) for p, v in TABLE1_LEVELS.items()}
         low = np.array([bounds[p][0] for p in PARAMETERS], dtype=float)
         high = np.array([bounds[p][1] for p in PARAMETERS], dtype=float)

@@ -118,9 +118,9 @@ def tip_position(
         If ``rest_length_mm`` is not a finite number > 0.
     """
     owner = "tip_position"
-    rest = check_range(rest_length_mm, "rest_length_mm", owner, low=0.0)
-    rho_arr = check_finite_array(rho, "rho", owner)
-    length = check_finite_array(length_mm, "length_mm", owner)
+    rest = check_range(rest_length_mm, "rest_length_mm", low=0.0)
+    rho_arr = check_finite_array(rho, "rho")
+    length = check_finite_array(length_mm, "length_mm")
     _positive_array(length, "length_mm", owner)
     rho_arr, length = _broadcast(rho_arr, length, ("rho", "length_mm"), owner)
 
@@ -177,9 +177,9 @@ def bending_from_tip(
         If ``rest_length_mm`` is not a finite number > 0.
     """
     owner = "bending_from_tip"
-    rest = check_range(rest_length_mm, "rest_length_mm", owner, low=0.0)
-    x = check_finite_array(x_mm, "x_mm", owner)
-    y = check_finite_array(y_mm, "y_mm", owner)
+    rest = check_range(rest_length_mm, "rest_length_mm", low=0.0)
+    x = check_finite_array(x_mm, "x_mm")
+    y = check_finite_array(y_mm, "y_mm")
     x, y = _broadcast(x, y, ("x_mm", "y_mm"), owner)
 
     u = rest - y
@@ -281,7 +281,7 @@ _PRATT_INV = np.linalg.inv(_PRATT)
 
 def _as_polyline(points_mm: object) -> np.ndarray:
     owner = "fit_arc"
-    points = check_finite_array(points_mm, "points_mm", owner)
+    points = check_finite_array(points_mm, "points_mm")
     if points.ndim != 2 or points.shape[1] != 2 or points.shape[0] < 3:
         raise DatasetError(
             f"The 'points_mm' of {owner} must be an array of shape (n, 2) with n >= 3, "
@@ -417,7 +417,6 @@ def fit_arc(points_mm: np.ndarray, *, straight_tolerance_rad: float = 1e-9) -> A
     tolerance = check_range(
         straight_tolerance_rad,
         "straight_tolerance_rad",
-        "fit_arc",
         low=0.0,
         high=1.0,
         low_inclusive=True,

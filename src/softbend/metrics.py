@@ -79,7 +79,7 @@ def _pair(y: ArrayLike, y_hat: ArrayLike, owner: str) -> tuple[np.ndarray, np.nd
             f"The 'y_hat' of {owner} must have the length of 'y' ({measured.size}). "
             f"Got {predicted.size} instead."
         )
-    check_finite_array(measured, "y", owner)
+    check_finite_array(measured, "y")
     return measured, predicted
 
 
@@ -245,9 +245,9 @@ def thresholded_mape(
     DatasetError
         If an input is NaN or infinite.
     """
-    threshold = check_range(threshold, "threshold", "thresholded_mape", low=0.0, low_inclusive=True)
-    obs = check_finite_array(observed, "observed", "thresholded_mape").ravel()
-    pred = check_finite_array(predicted, "predicted", "thresholded_mape").ravel()
+    threshold = check_range(threshold, "threshold", low=0.0, low_inclusive=True)
+    obs = check_finite_array(observed, "observed").ravel()
+    pred = check_finite_array(predicted, "predicted").ravel()
     if obs.shape != pred.shape:
         raise ValueError(
             f"The 'predicted' of thresholded_mape must have the shape of 'observed' {obs.shape}. "

@@ -78,8 +78,8 @@ def default_pressures_mpa(
         ``round(pmax/step) + 1`` increasing pressures starting at 0.
     """
     pmax_name, step_name = names
-    pmax = check_range(pmax_mpa, pmax_name, owner, low=0.0, high=100.0, high_inclusive=True)
-    step = check_range(step_mpa, step_name, owner, low=0.0, high=pmax, high_inclusive=True)
+    pmax = check_range(pmax_mpa, pmax_name, low=0.0, high=100.0, high_inclusive=True)
+    step = check_range(step_mpa, step_name, low=0.0, high=pmax, high_inclusive=True)
     n_steps = round(pmax / step)
     if abs(n_steps * step - pmax) > 1e-9 * pmax:
         raise ValueError(
@@ -224,15 +224,13 @@ class SweepResult:
                 f"last pressure (the sweep ends at the first failure). Got False at position "
                 f"{int(failed[0])} of {len(self.converged)} instead."
             )
-        wall = check_range(
-            self.wall_time_s, "wall_time_s", "SweepResult", low=0.0, low_inclusive=True
-        )
+        wall = check_range(self.wall_time_s, "wall_time_s", low=0.0, low_inclusive=True)
         object.__setattr__(self, "wall_time_s", wall)
         if self.mesh_size is not None:
             object.__setattr__(
                 self,
                 "mesh_size",
-                int(check_range(self.mesh_size, "mesh_size", "SweepResult", low=0.0)),
+                int(check_range(self.mesh_size, "mesh_size", low=0.0)),
             )
         object.__setattr__(self, "stats", dict(self.stats))
 

@@ -257,9 +257,7 @@ def _check_arguments(
         raise ValueError(
             f"The 'target' of {_OWNER} must not be one of the features. Got {target!r} instead."
         )
-    mape_threshold = check_range(
-        mape_threshold, "mape_threshold", _OWNER, low=0.0, low_inclusive=True
-    )
+    mape_threshold = check_range(mape_threshold, "mape_threshold", low=0.0, low_inclusive=True)
     return features, mape_threshold
 
 

@@ -202,7 +202,6 @@ def _make_fault_injection(
     delay = check_range(
         delay_s,
         "delay_s",
-        "FaultInjectionBackend",
         low=0.0,
         high=3600.0,
         low_inclusive=True,

@@ -143,16 +143,13 @@ def check_run_options(
     if workers is None:
         workers = os.cpu_count() or 1
     workers = int(
-        check_range(
-            workers, "workers", _OWNER, low=0, low_inclusive=True, high=4096, high_inclusive=True
-        )
+        check_range(workers, "workers", low=0, low_inclusive=True, high=4096, high_inclusive=True)
     )
     if chunk_size is not None:
         chunk_size = int(
             check_range(
                 chunk_size,
                 "chunk_size",
-                _OWNER,
                 low=1,
                 low_inclusive=True,
                 high=100_000,
@@ -160,7 +157,7 @@ def check_run_options(
             )
         )
     timeout_s = check_range(
-        connect_timeout_s, "connect_timeout_s", _OWNER, low=0.0, high=600.0, high_inclusive=True
+        connect_timeout_s, "connect_timeout_s", low=0.0, high=600.0, high_inclusive=True
     )
     return workers, chunk_size, timeout_s
 

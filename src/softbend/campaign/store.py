@@ -789,8 +789,8 @@ class CampaignStore:
             The file could not be written (a full disk, a read-only folder); it
             names ``path``, and nothing is left of the export.
         """
-        check_choice(format, "format", "CampaignStore.export", ("parquet", "csv"))
-        check_choice(table, "table", "CampaignStore.export", ("samples", "designs"))
+        check_choice(format, "format", ("parquet", "csv"))
+        check_choice(table, "table", ("samples", "designs"))
         target = Path(path)
         if not target.parent.is_dir():
             raise FileNotFoundError(

@@ -15,7 +15,7 @@ from collections.abc import Sequence
 
 import typer
 
-from softbend.cli import _common
+from softbend.cli import _common, _options
 
 app = typer.Typer(
     name="softbend",
@@ -88,11 +88,14 @@ def main(argv: Sequence[str] | None = None) -> int:
         _common.error_line(message + where)
         return int(getattr(exc, "exit_code", 2))
     except (ValueError, FileNotFoundError, NotADirectoryError, PermissionError) as exc:
-        # SoftbendError input errors derive from ValueError.
-        _common.error_line(_common.os_error_message(exc) if isinstance(exc, OSError) else str(exc))
+        # SoftbendError input errors derive from ValueError; their key names the option.
+        if isinstance(exc, OSError) and not isinstance(exc, _common.SoftbendError):
+            _common.error_line(_common.os_error_message(exc))
+        else:
+            _common.error_line(_options.error_text(app, args, exc))
         return 2
     except _common.SoftbendError as exc:
-        _common.error_line(str(exc))
+        _common.error_line(_options.error_text(app, args, exc))
         return 2
     except OSError as exc:  # last resort: an OS error no command named an option for
         _common.error_line(_common.os_error_message(exc))

@@ -174,8 +174,8 @@ def export(
 
     if format is None:
         format = "csv" if out.suffix.lower() == ".csv" else "parquet"
-    check_choice(format, "--format", "softbend campaign export", ("parquet", "csv"))
-    check_choice(table, "--table", "softbend campaign export", ("samples", "designs"))
+    check_choice(format, "--format", ("parquet", "csv"))
+    check_choice(table, "--table", ("samples", "designs"))
     _common.check_output_file(out, "--out", inputs=(db,), kind=format)
     with CampaignStore(db, read_only=True) as store, _common.output_errors(out, "--out"):
         path = store.export(out, format=format, table=table)

@@ -224,7 +224,7 @@ def serve_cmd(
     from softbend.control.runs import simulated_server
 
     command = "softbend control serve"
-    check_range(duration, "duration", command, low=0.0, low_inclusive=True)
+    check_range(duration, "duration", low=0.0, low_inclusive=True)
     with _common.library_progress():  # an FEM plant's sweep, if any
         server = simulated_server(
             config=config, host=host, port=port, design=design, model=model, plant=plant,

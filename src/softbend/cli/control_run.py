@@ -94,7 +94,7 @@ def run_cmd(
     from softbend.reports import control_figures
 
     command = "softbend control run"
-    check_choice(log_format, "log_format", command, _LOG_FORMATS)
+    check_choice(log_format, "log_format", _LOG_FORMATS)
     log_name = f"ticks.{log_format}"
     _common.check_output_dir(out, "--out", files=(log_name, "run.json", "run.png"))
     _common.check_replaceable_dir(

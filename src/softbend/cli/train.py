@@ -108,11 +108,11 @@ def train(
     from softbend.surrogates.workflow import train_into
 
     if workers is not None:
-        check_int(workers, "--workers", "softbend train", low=1)
+        check_int(workers, "--workers", low=1)
     if halving_rungs is not None:
-        check_int(halving_rungs, "--halving-rungs", "softbend train", low=1)
+        check_int(halving_rungs, "--halving-rungs", low=1)
     if plr_patience is not None:
-        check_int(plr_patience, "--plr-patience", "softbend train", low=1)
+        check_int(plr_patience, "--plr-patience", low=1)
     if epochs is not None:
         check_limit("epochs", epochs, "--epochs")
     source = _training_source(

@@ -128,9 +128,9 @@ def check_run_size(
         More rows than the ``loop_ticks`` limit (``SOFTBEND_MAX_LOOP_TICKS``).
     """
     duration = check_range(
-        duration_s, duration_name, owner, low=0.0, high=MAX_DURATION_S, high_inclusive=True
+        duration_s, duration_name, low=0.0, high=MAX_DURATION_S, high_inclusive=True
     )
-    step = check_range(step_s, step_name, owner, low=0.0)
+    step = check_range(step_s, step_name, low=0.0)
     word = unit.removesuffix("s") if step_word is None else step_word
     said = (
         f"{what} of {duration:g} s{f' ({duration_name})' if name_options else ''} at a {word} "

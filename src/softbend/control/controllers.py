@@ -155,7 +155,7 @@ class BangBang:
             )
         self.virtual_sensor = virtual_sensor
         self.deadzone_fraction = _check(BangBang, deadzone_fraction, "deadzone_fraction")
-        self.mode = check_choice(mode, "mode", owner, ("hold", "closed"))
+        self.mode = check_choice(mode, "mode", ("hold", "closed"))
         self.period_s = _check(BangBang, period_s, "period_s")
         self.reset()
 

@@ -112,7 +112,7 @@ def parse_reference(spec: str) -> Reference:
             ) from None
         low, high, inclusive = bounds[name]
         values[name] = check_range(
-            number, name, owner, low=low, high=high, low_inclusive=inclusive, high_inclusive=True
+            number, name, low=low, high=high, low_inclusive=inclusive, high_inclusive=True
         )
     low = values.get("low_deg", 0.0)
     if low >= values["amplitude_deg"]:
@@ -244,9 +244,7 @@ def simulate(
         duration_name="duration_s", step_name="the rig's step_s", unit="rig steps",
         name_options=False,
     ).ticks  # fmt: skip
-    sensor_every = max(
-        1, round(check_range(sensor_period_s, "sensor_period_s", "simulate", low=0.0) / h)
-    )
+    sensor_every = max(1, round(check_range(sensor_period_s, "sensor_period_s", low=0.0) / h))
     # The log is kept in preallocated arrays of machine numbers (8 bytes a value, 1 a
     # valve state), not lists of Python floats (32): a long run's memory is known in
     # advance (softbend.control.budget) and four times smaller.

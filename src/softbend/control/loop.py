@@ -310,16 +310,16 @@ def run_loop(
         rig answers the vent command; the stop reason says which).
     """
     ref = parse_reference(reference) if isinstance(reference, str) else reference
-    period = check_range(period_s, "period_s", "run_loop", low=0.0, high=1.0, high_inclusive=True)
+    period = check_range(period_s, "period_s", low=0.0, high=1.0, high_inclusive=True)
     sensor = check_range(
-        sensor_period_s, "sensor_period_s", "run_loop", low=period, high=10.0,
+        sensor_period_s, "sensor_period_s", low=period, high=10.0,
         low_inclusive=True, high_inclusive=True,
     )  # fmt: skip
     n = check_run_size(
         duration_s, period, LOOP_BYTES_PER_TICK, what="A run", owner="run_loop",
         duration_name="duration_s", step_name="period_s", step_word="period", name_options=False,
     ).ticks  # fmt: skip
-    flush = check_int(flush_every, "flush_every", "run_loop", low=1)
+    flush = check_int(flush_every, "flush_every", low=1)
     limits = SafetyLimits() if limits is None else limits
     path = None if log_path is None else Path(log_path)
     if path is not None and path.suffix.lower() not in (".csv", ".parquet"):

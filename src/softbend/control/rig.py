@@ -401,8 +401,8 @@ class AngleTable:
         points: int = 501,
     ) -> AngleTable:
         """Tabulate a vectorised ``θ(p)`` (array of MPa gauge → degrees) on ``points`` values."""
-        pmax = check_range(pmax_mpa, "pmax_mpa", "AngleTable.from_callable", low=0.0)
-        n = check_int(points, "points", "AngleTable.from_callable", low=2)
+        pmax = check_range(pmax_mpa, "pmax_mpa", low=0.0)
+        n = check_int(points, "points", low=2)
         p = np.linspace(0.0, pmax, n)
         return cls(p, np.asarray(angle_of_pressure(p), dtype=float).reshape(-1))
 
@@ -529,7 +529,7 @@ class SimulatedRig:
         self.params = RigParams() if params is None else params
         self.angle_map = angle_map
         self.step_s = self.params.step_s
-        self.seed = check_int(seed, "seed", "SimulatedRig", low=0)
+        self.seed = check_int(seed, "seed", low=0)
         self._derive()
         self.reset(seed)
 

@@ -122,24 +122,24 @@ class ConnectionConfig:
 
     def __post_init__(self) -> None:
         owner = f"[connection] of the {_OWNER}"
-        check_choice(self.transport, "transport", owner, ("tcp", "rtu"))
-        check_choice(self.parity, "parity", owner, ("N", "E", "O"))
-        check_choice(self.stopbits, "stopbits", owner, (1, 2))
-        check_int(self.port, "port", owner, low=0)
+        check_choice(self.transport, "transport", ("tcp", "rtu"))
+        check_choice(self.parity, "parity", ("N", "E", "O"))
+        check_choice(self.stopbits, "stopbits", (1, 2))
+        check_int(self.port, "port", low=0)
         if self.port > 65535:
             raise ValueError(
                 f"The 'port' of {owner} must be an integer in [0, 65535]. "
                 f"Got {self.port!r} instead."
             )
-        check_int(self.baudrate, "baudrate", owner, low=1)
-        check_int(self.retries, "retries", owner, low=0)
-        device = check_int(self.device_id, "device_id", owner, low=0)
+        check_int(self.baudrate, "baudrate", low=1)
+        check_int(self.retries, "retries", low=0)
+        device = check_int(self.device_id, "device_id", low=0)
         if device > 247:
             raise ValueError(
                 f"The 'device_id' of {owner} must be an integer in [0, 247]. "
                 f"Got {self.device_id!r} instead."
             )
-        check_range(self.timeout_s, "timeout_s", owner, low=0.0, high=10.0, high_inclusive=True)
+        check_range(self.timeout_s, "timeout_s", low=0.0, high=10.0, high_inclusive=True)
         if self.transport == "tcp" and not (isinstance(self.host, str) and self.host.strip()):
             raise ValueError(
                 f"The 'host' of {owner} must name the rig (e.g. '192.168.0.10') when transport "
@@ -173,7 +173,7 @@ class RegisterConfig:
 
     def __post_init__(self) -> None:
         owner = f"[{self.section}] of the {_OWNER}"
-        check_choice(self.table, "table", owner, ("input", "holding"))
+        check_choice(self.table, "table", ("input", "holding"))
         _check_address(self.address, "address", owner)
         if self.counter_address is not None:
             _check_address(self.counter_address, "counter_address", owner)
@@ -192,7 +192,7 @@ class RegisterConfig:
             raise ValueError(
                 f"The 'scale' of {owner} must be a finite non-zero number. Got {self.scale!r}."
             )
-        check_range(self.offset, "offset", owner, low=-1e9, high=1e9)
+        check_range(self.offset, "offset", low=-1e9, high=1e9)
 
     def decode(self, count: int) -> float:
         """Engineering value of a raw 16-bit register ``count``."""
@@ -250,17 +250,17 @@ class SafetyLimits:
 
     def __post_init__(self) -> None:
         owner = f"[safety] of the {_OWNER}"
-        check_range(self.max_pressure_mpa, "max_pressure_mpa", owner, low=0.0, high=10.0)
-        check_range(self.valid_min_mpa, "valid_min_mpa", owner, low=-10.0, high=10.0)
-        check_range(self.valid_max_mpa, "valid_max_mpa", owner, low=-10.0, high=10.0)
+        check_range(self.max_pressure_mpa, "max_pressure_mpa", low=0.0, high=10.0)
+        check_range(self.valid_min_mpa, "valid_min_mpa", low=-10.0, high=10.0)
+        check_range(self.valid_max_mpa, "valid_max_mpa", low=-10.0, high=10.0)
         if not self.valid_min_mpa < self.max_pressure_mpa < self.valid_max_mpa:
             raise ValueError(
                 f"The limits of {owner} must satisfy valid_min_mpa < max_pressure_mpa < "
                 f"valid_max_mpa. Got {self.valid_min_mpa:g}, {self.max_pressure_mpa:g}, "
                 f"{self.valid_max_mpa:g} instead."
             )
-        check_range(self.stale_after_s, "stale_after_s", owner, low=0.0, high=60.0)
-        check_int(self.max_missed_reads, "max_missed_reads", owner, low=1)
+        check_range(self.stale_after_s, "stale_after_s", low=0.0, high=60.0)
+        check_int(self.max_missed_reads, "max_missed_reads", low=1)
 
 
 @dataclass(frozen=True)
@@ -319,10 +319,9 @@ class RigConfig:
         given = dict(self.simulation)
         checked = check_simulation_settings(given, f"[simulation] of the {_OWNER}")
         object.__setattr__(self, "simulation", tuple((k, checked[k]) for k in given))
-        loop = f"[loop] of the {_OWNER}"
-        check_range(self.period_s, "period_s", loop, low=0.0, high=1.0, high_inclusive=True)
+        check_range(self.period_s, "period_s", low=0.0, high=1.0, high_inclusive=True)
         check_range(
-            self.sensor_period_s, "sensor_period_s", loop, low=self.period_s, high=10.0,
+            self.sensor_period_s, "sensor_period_s", low=self.period_s, high=10.0,
             low_inclusive=True, high_inclusive=True,
         )  # fmt: skip
         used = {(self.pressure.table, self.pressure.address): "[pressure] address"}
@@ -769,7 +768,7 @@ def _line_of(text: str, section: str | None, key: str | None) -> int | None:
 
 
 def _check_address(value: Any, name: str, owner: str) -> int:
-    address = check_int(value, name, owner, low=0)
+    address = check_int(value, name, low=0)
     if address > 0xFFFF:
         raise ValueError(
             f"The '{name}' of {owner} must be an integer in [0, 65535]. Got {value!r} instead."

@@ -314,9 +314,9 @@ def plan_loop(
     sensor = settings.sensor_period_s if sensor_period_s is None else sensor_period_s
     table = dict(settings.simulation) if rig not in HARDWARE_RIGS else {}
     simulated = _rig_settings(rig_assignments, table, supply_mpa, command)
-    check_range(tick, "period", command, low=0.0, high=1.0, high_inclusive=True)
+    check_range(tick, "period", low=0.0, high=1.0, high_inclusive=True)
     check_range(
-        sensor, "sensor_period", command, low=tick, high=10.0,
+        sensor, "sensor_period", low=tick, high=10.0,
         low_inclusive=True, high_inclusive=True,
     )  # fmt: skip
     duration_name, step_name = _option_names(command, "period_s")

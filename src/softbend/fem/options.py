@@ -167,7 +167,6 @@ class FEMOptions:
             value = check_range(
                 getattr(self, name),
                 name,
-                owner,
                 low=low,
                 high=high,
                 low_inclusive=low_inclusive,
@@ -176,7 +175,7 @@ class FEMOptions:
             object.__setattr__(self, name, value)
 
         number("maxh_mm", 0.0, 20.0)
-        order = check_int(self.order, "order", owner, low=1)
+        order = check_int(self.order, "order", low=1)
         if order not in (2, 3):
             raise ValueError(f"The 'order' of {owner} must be one of 2, 3. Got {order!r} instead.")
         number("base_cap_mm", 0.0, 50.0)
@@ -199,8 +198,8 @@ class FEMOptions:
         number("fiber_radius_mm", 0.0, 5.0)
         if self.fiber_pitch_mm is not None:
             number("fiber_pitch_mm", 0.0, 1000.0)
-        check_choice(self.fiber_law, "fiber_law", owner, FIBER_LAWS)
-        check_choice(self.gravity, "gravity", owner, GRAVITY_DIRECTIONS)
+        check_choice(self.fiber_law, "fiber_law", FIBER_LAWS)
+        check_choice(self.gravity, "gravity", GRAVITY_DIRECTIONS)
         number("gravity_mm_s2", 0.0, 1e6, low_inclusive=True)
         number("max_angle_deg", 0.0, 340.0)
         number("max_stretch", 1.0, 50.0)
@@ -209,10 +208,10 @@ class FEMOptions:
         number("min_step_mpa", 0.0, self.initial_step_mpa)
         number("predictor_error_mm", 0.0, 10.0)
         number("rtol", 0.0, 1e-3)
-        check_int(self.max_iterations, "max_iterations", owner, low=3)
-        check_choice(self.output, "output", owner, OUTPUT_MODES)
-        check_int(self.backbone_points, "backbone_points", owner, low=5)
-        check_int(self.threads, "threads", owner, low=1)
+        check_int(self.max_iterations, "max_iterations", low=3)
+        check_choice(self.output, "output", OUTPUT_MODES)
+        check_int(self.backbone_points, "backbone_points", low=5)
+        check_int(self.threads, "threads", low=1)
 
     @property
     def elastomer_model(self) -> HyperelasticModel:

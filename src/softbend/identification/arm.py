@@ -222,14 +222,12 @@ class SoftArm:
             "substep_s": positive,
         }
         for name, bounds in checks.items():
-            object.__setattr__(self, name, check_range(getattr(self, name), name, _OWNER, **bounds))
+            object.__setattr__(self, name, check_range(getattr(self, name), name, **bounds))
         angles = tuple(
-            check_range(
-                a, "chamber_angles_deg", _OWNER, low=-360.0, high=360.0, high_inclusive=True
-            )
+            check_range(a, "chamber_angles_deg", low=-360.0, high=360.0, high_inclusive=True)
             for a in self.chamber_angles_deg
         )
-        taus = tuple(check_range(t, "tau_s", _OWNER, low=0.0, high=math.inf) for t in self.tau_s)
+        taus = tuple(check_range(t, "tau_s", low=0.0, high=math.inf) for t in self.tau_s)
         if not angles:
             raise ValueError(
                 f"The 'chamber_angles_deg' of {_OWNER} must name at least one chamber. "
@@ -403,7 +401,7 @@ class SoftArm:
                 f"The 'pressures_kpa' of {where} must have shape ({time.size}, "
                 f"{self.n_chambers}), one row per time sample. Got {command.shape} instead."
             )
-        seed = check_int(seed, "seed", where)
+        seed = check_int(seed, "seed")
 
         h = self.substep_s
         span = (time[-1] - time[0]) / h
@@ -485,10 +483,10 @@ def arm_excitation(
     if kind not in ARM_EXCITATIONS:
         allowed = ", ".join(repr(k) for k in ARM_EXCITATIONS)
         raise ValueError(f"The 'kind' of {owner} must be one of {allowed}. Got {kind!r} instead.")
-    n = check_int(n_samples, "n_samples", owner, low=2)
-    rate = check_range(rate_hz, "rate_hz", owner, low=0.0, high=math.inf)
-    peak = check_range(peak_kpa, "peak_kpa", owner, low=0.0, high=math.inf)
-    k = check_int(n_chambers, "n_chambers", owner, low=1)
+    n = check_int(n_samples, "n_samples", low=2)
+    rate = check_range(rate_hz, "rate_hz", low=0.0, high=math.inf)
+    peak = check_range(peak_kpa, "peak_kpa", low=0.0, high=math.inf)
+    k = check_int(n_chambers, "n_chambers", low=1)
     rng = np.random.default_rng(seed)
     lead = min(n - 1, round(rate))
     body = n - lead
@@ -579,12 +577,12 @@ def arm_experiments(
         ``y_mm``, time column ``time_s``.
     """
     owner = "arm_experiments"
-    n_tr = check_int(n_train, "n_train", owner, low=1)
-    n_va = check_int(n_validate, "n_validate", owner, low=0)
-    duration = check_range(duration_s, "duration_s", owner, low=0.0, high=math.inf)
-    rate = check_range(sample_rate_hz, "sample_rate_hz", owner, low=0.0, high=math.inf)
-    peak = check_range(peak_kpa, "peak_kpa", owner, low=0.0, high=math.inf)
-    master = check_int(seed, "seed", owner)
+    n_tr = check_int(n_train, "n_train", low=1)
+    n_va = check_int(n_validate, "n_validate", low=0)
+    duration = check_range(duration_s, "duration_s", low=0.0, high=math.inf)
+    rate = check_range(sample_rate_hz, "sample_rate_hz", low=0.0, high=math.inf)
+    peak = check_range(peak_kpa, "peak_kpa", low=0.0, high=math.inf)
+    master = check_int(seed, "seed")
     plant = SoftArm() if arm is None else arm
     if not isinstance(plant, SoftArm):
         raise ValueError(

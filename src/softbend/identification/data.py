@@ -145,9 +145,7 @@ class Experiment:
         object.__setattr__(
             self,
             "rest_length_mm",
-            check_range(
-                self.rest_length_mm, "rest_length_mm", "Experiment", low=0.0, high=math.inf
-            ),
+            check_range(self.rest_length_mm, "rest_length_mm", low=0.0, high=math.inf),
         )
         object.__setattr__(self, "synthetic", bool(self.synthetic))
         object.__setattr__(self, "metadata", dict(self.metadata or {}))
@@ -494,9 +492,7 @@ def load_experiments(
         are parsed), or a ``# metadata`` comment nested deeper than ``nesting``.
     """
     if rest_length_mm is not None:
-        rest_length_mm = check_range(
-            rest_length_mm, "rest_length_mm", "load_experiments", low=0.0, high=math.inf
-        )
+        rest_length_mm = check_range(rest_length_mm, "rest_length_mm", low=0.0, high=math.inf)
     source = Path(path)
     files = experiment_files(source)
     experiments: list[Experiment] = []

@@ -133,7 +133,7 @@ def gg_scale(shape: float) -> float:
     float
         g(γ); 1/√2 at γ = 2, √2 at γ = 1, tending to 1/√3 as γ → ∞.
     """
-    gamma = check_range(shape, "shape", "gg_scale", low=0.0)
+    gamma = check_range(shape, "shape", low=0.0)
     return math.exp(0.5 * (gammaln(3.0 / gamma) - gammaln(1.0 / gamma)))
 
 
@@ -153,8 +153,8 @@ def gg_normalization(sigma: float, shape: float) -> float:
         c, in 1/(input unit): the peak value of the 1-D density
         (1/(σ√(2π)) for γ = 2, 1/(σ√2) for γ = 1).
     """
-    s = check_range(sigma, "sigma", "gg_normalization", low=0.0)
-    gamma = check_range(shape, "shape", "gg_normalization", low=0.0)
+    s = check_range(sigma, "sigma", low=0.0)
+    gamma = check_range(shape, "shape", low=0.0)
     return math.exp(math.log(gg_scale(gamma) * gamma / (2.0 * s)) - gammaln(1.0 / gamma))
 
 
@@ -208,7 +208,7 @@ def gg_radial_kurtosis(shape: float | np.ndarray, dim: float = 1.0) -> float | n
     float or ndarray
         The ratio, dimensionless; a float for a scalar ``shape``.
     """
-    d = check_range(dim, "dim", "gg_radial_kurtosis", low=0.0)
+    d = check_range(dim, "dim", low=0.0)
     gamma = np.asarray(shape, dtype=float)
     if np.any(~(gamma > 0.0)) or np.any(~np.isfinite(gamma)):
         bad = gamma[~((gamma > 0.0) & np.isfinite(gamma))].ravel()[0]
@@ -223,7 +223,7 @@ def gg_radial_kurtosis(shape: float | np.ndarray, dim: float = 1.0) -> float | n
 
 def _as_2d(values: object, name: str, owner: str) -> np.ndarray:
     """Finite float array of shape (n, d); a 1-D input is one feature."""
-    array = check_finite_array(values, name, owner)
+    array = check_finite_array(values, name)
     if array.ndim == 1:
         array = array[:, np.newaxis]
     if array.ndim != 2:
@@ -342,8 +342,8 @@ def generalized_gaussian_kernel(
         If σ ≤ 0, γ outside (0, 2], inputs are not finite or the feature counts differ.
     """
     owner = "generalized_gaussian_kernel"
-    s = check_range(sigma, "sigma", owner, low=0.0)
-    gamma = check_range(shape, "shape", owner, low=0.0, high=2.0, high_inclusive=True)
+    s = check_range(sigma, "sigma", low=0.0)
+    gamma = check_range(shape, "shape", low=0.0, high=2.0, high_inclusive=True)
     X = _as_2d(X, "X", owner)
     if Z is None:
         sqdist = squareform(pdist(X, "sqeuclidean"))
@@ -426,7 +426,7 @@ def _weighted_rows(
     if sample_weight is None:
         weight = np.ones(n)
     else:
-        weight = check_finite_array(sample_weight, "sample_weight", owner)
+        weight = check_finite_array(sample_weight, "sample_weight")
         if weight.shape != (n,):
             raise ValueError(
                 f"The 'sample_weight' of {owner} must have shape ({n},) like the samples. "
@@ -723,7 +723,7 @@ def _kernel_shape_estimate(
     X: object, sample_weight: object, moments_of: str, owner: str
 ) -> ShapeEstimate:
     """:func:`estimate_kernel_shape` without the warning (callers decide whether to warn)."""
-    check_choice(moments_of, "moments_of", owner, MOMENTS_OF)
+    check_choice(moments_of, "moments_of", MOMENTS_OF)
     if moments_of == "components":
         sigma, kurtosis = _pooled_moments(X, sample_weight, owner, name="X")
         dim, effective, gaussian = 1, 1.0, 3.0

@@ -86,9 +86,9 @@ class _Segments:
 def _lag_structure(
     output_lags: Any, input_lags: Any, include_current_input: Any, owner: str
 ) -> _LagStructure:
-    na = check_int(output_lags, "output_lags", owner, low=1)
-    nb = check_int(input_lags, "input_lags", owner, low=1)
-    check_choice(include_current_input, "include_current_input", owner, (True, False))
+    na = check_int(output_lags, "output_lags", low=1)
+    nb = check_int(input_lags, "input_lags", low=1)
+    check_choice(include_current_input, "include_current_input", (True, False))
     first = 0 if include_current_input else 1
     input_offsets = np.arange(first, first + nb)
     return _LagStructure(
@@ -114,7 +114,7 @@ def _as_inputs(X: ArrayLike, owner: str) -> np.ndarray:
             f"The 'X' of {owner} must be a non-empty array (n_samples,) or "
             f"(n_samples, n_inputs). Got shape {np.shape(X)} instead."
         )
-    return check_finite_array(array, "X", owner)
+    return check_finite_array(array, "X")
 
 
 def _as_output(y: ArrayLike, name: str, owner: str, n_samples: int) -> np.ndarray:
@@ -248,7 +248,7 @@ def lagged_matrix(
     owner = "lagged_matrix"
     structure = _lag_structure(output_lags, input_lags, include_current_input, owner)
     inputs = _as_inputs(X, owner)
-    output = check_finite_array(_as_output(y, "y", owner, inputs.shape[0]), "y", owner)
+    output = check_finite_array(_as_output(y, "y", owner, inputs.shape[0]), "y")
     segments = _segments(groups, inputs.shape[0], structure.max_lag, owner)
     index = _row_index(segments, structure.max_lag)
     return _rows(inputs, output, index, structure), output[index], index
@@ -394,10 +394,10 @@ class NARXRegressor(RegressorMixin, BaseEstimator):
             NaN/inf in ``X`` or ``y``, or an experiment shorter than max_lag + 1.
         """
         structure = self._structure()
-        check_choice(self.scale, "scale", _OWNER, (True, False))
+        check_choice(self.scale, "scale", (True, False))
         estimator = self._make_estimator()
         inputs = _as_inputs(X, _OWNER)
-        output = check_finite_array(_as_output(y, "y", _OWNER, inputs.shape[0]), "y", _OWNER)
+        output = check_finite_array(_as_output(y, "y", _OWNER, inputs.shape[0]), "y")
         segments = _segments(groups, inputs.shape[0], structure.max_lag, _OWNER)
 
         if self.scale:
@@ -502,7 +502,7 @@ class NARXRegressor(RegressorMixin, BaseEstimator):
         """
         owner = f"{_OWNER}.predict_one_step"
         inputs, segments, structure = self._prepare(X, groups, "predict_one_step")
-        output = check_finite_array(_as_output(y, "y", owner, inputs.shape[0]), "y", owner)
+        output = check_finite_array(_as_output(y, "y", owner, inputs.shape[0]), "y")
         y_mean, y_std, u_mean, u_std = self._affine()
         index = _row_index(segments, structure.max_lag)
         Phi = _rows((inputs - u_mean) / u_std, (output - y_mean) / y_std, index, structure)
@@ -617,7 +617,7 @@ class NARXRegressor(RegressorMixin, BaseEstimator):
                 f"({n_samples},) or initial conditions of shape ({n_experiments}, {m}). "
                 f"Got shape {array.shape} instead."
             )
-        return check_finite_array(initial, "y_init", owner)
+        return check_finite_array(initial, "y_init")
 
     def score(self, X: ArrayLike, y: ArrayLike, groups: ArrayLike | None = None) -> float:
         """R² of the free-run simulation (not of the one-step prediction).
@@ -644,7 +644,7 @@ class NARXRegressor(RegressorMixin, BaseEstimator):
         owner = f"{_OWNER}.score"
         inputs, _, _ = self._prepare(X, groups, "score")
         n_samples = inputs.shape[0]
-        output = check_finite_array(_as_output(y, "y", owner, n_samples), "y", owner)
+        output = check_finite_array(_as_output(y, "y", owner, n_samples), "y")
         simulated = self.simulate(X, output, groups=groups)
         keep = ~self.warmup_mask(n_samples, groups=groups)
         return r2(output[keep], simulated[keep])

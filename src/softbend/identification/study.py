@@ -87,8 +87,8 @@ class IdentificationConfig:
         check_settings(
             C=self.C, epsilon=self.epsilon, output_lags=self.output_lags, input_lags=self.input_lags
         )
-        check_choice(self.kernel, "kernel", "IdentificationConfig", ("moments", "cv"))
-        check_choice(self.moments_of, "moments_of", "IdentificationConfig", MOMENTS_OF)
+        check_choice(self.kernel, "kernel", ("moments", "cv"))
+        check_choice(self.moments_of, "moments_of", MOMENTS_OF)
 
 
 def _label(name: str, names: Mapping[str, str] | None) -> str:
@@ -177,7 +177,7 @@ class IdentificationResult:
 
 def output_values(experiment: Experiment, output: str) -> np.ndarray:
     """The measured output series ``output`` ("rho" or "length_mm") of an experiment."""
-    check_choice(output, "output", "output_values", OUTPUTS)
+    check_choice(output, "output", OUTPUTS)
     return np.asarray(getattr(experiment, output), dtype=float)
 
 

@@ -542,19 +542,19 @@ class GeneralizedGaussianSVR(RegressorMixin, BaseEstimator):
         ConvergenceError
             If the solver returns non-finite coefficients.
         """
-        C = check_range(self.C, "C", _OWNER, low=0.0)
-        epsilon = check_range(self.epsilon, "epsilon", _OWNER, low=0.0, low_inclusive=True)
-        tol = check_range(self.tol, "tol", _OWNER, low=0.0)
-        cache_size = check_range(self.cache_size, "cache_size", _OWNER, low=0.0)
+        C = check_range(self.C, "C", low=0.0)
+        epsilon = check_range(self.epsilon, "epsilon", low=0.0, low_inclusive=True)
+        tol = check_range(self.tol, "tol", low=0.0)
+        cache_size = check_range(self.cache_size, "cache_size", low=0.0)
         max_iter = _check_max_iter(self.max_iter)
-        max_working_set = check_int(self.max_working_set, "max_working_set", _OWNER, low=8)
-        normalize = bool(check_choice(self.normalize, "normalize", _OWNER, (True, False)))
-        moments_of = check_choice(self.moments_of, "moments_of", _OWNER, MOMENTS_OF)
-        sigma = None if self.sigma is None else check_range(self.sigma, "sigma", _OWNER, low=0.0)
+        max_working_set = check_int(self.max_working_set, "max_working_set", low=8)
+        normalize = bool(check_choice(self.normalize, "normalize", (True, False)))
+        moments_of = check_choice(self.moments_of, "moments_of", MOMENTS_OF)
+        sigma = None if self.sigma is None else check_range(self.sigma, "sigma", low=0.0)
         shape = (
             None
             if self.shape is None
-            else check_range(self.shape, "shape", _OWNER, low=0.0, high=2.0, high_inclusive=True)
+            else check_range(self.shape, "shape", low=0.0, high=2.0, high_inclusive=True)
         )
 
         X, y = validate_data(self, X, y, dtype=np.float64, y_numeric=True)

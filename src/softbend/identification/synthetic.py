@@ -224,24 +224,23 @@ class CurlingActuator:
             "substep_s": positive,
         }
         for name, bounds in checks.items():
-            object.__setattr__(self, name, check_range(getattr(self, name), name, _OWNER, **bounds))
+            object.__setattr__(self, name, check_range(getattr(self, name), name, **bounds))
         rest = self.rest_length_mm
         object.__setattr__(
             self,
             "max_length_mm",
-            check_range(self.max_length_mm, "max_length_mm", _OWNER, low=rest, high=math.inf),
+            check_range(self.max_length_mm, "max_length_mm", low=rest, high=math.inf),
         )
         object.__setattr__(
             self,
             "min_length_mm",
-            check_range(self.min_length_mm, "min_length_mm", _OWNER, low=0.0, high=rest),
+            check_range(self.min_length_mm, "min_length_mm", low=0.0, high=rest),
         )
         radii = tuple(
-            check_range(r, "play_radii_kpa", _OWNER, low=0.0, high=math.inf)
-            for r in self.play_radii_kpa
+            check_range(r, "play_radii_kpa", low=0.0, high=math.inf) for r in self.play_radii_kpa
         )
         weights = tuple(
-            check_range(w, "play_weights", _OWNER, low=0.0, high=1.0, low_inclusive=True)
+            check_range(w, "play_weights", low=0.0, high=1.0, low_inclusive=True)
             for w in self.play_weights
         )
         if len(radii) != len(weights):
@@ -541,18 +540,14 @@ def pressure_profile(
     pressure_kpa : numpy.ndarray
         Commanded pressure, kPa.
     """
-    check_choice(kind, "kind", "pressure_profile", ALL_PROFILE_KINDS)
-    n = int(
-        check_range(
-            n_samples, "n_samples", "pressure_profile", low=16, high=math.inf, low_inclusive=True
-        )
-    )
+    check_choice(kind, "kind", ALL_PROFILE_KINDS)
+    n = int(check_range(n_samples, "n_samples", low=16, high=math.inf, low_inclusive=True))
     if n != n_samples:
         raise ValueError(
             f"The 'n_samples' of pressure_profile must be an integer. Got {n_samples!r} instead."
         )
-    dt = check_range(dt_s, "dt_s", "pressure_profile", low=0.0, high=math.inf)
-    peak = check_range(peak_kpa, "peak_kpa", "pressure_profile", low=-math.inf, high=math.inf)
+    dt = check_range(dt_s, "dt_s", low=0.0, high=math.inf)
+    peak = check_range(peak_kpa, "peak_kpa", low=-math.inf, high=math.inf)
     if peak == 0.0:
         raise ValueError("The 'peak_kpa' of pressure_profile must be nonzero. Got 0.0 instead.")
     rng = np.random.default_rng(seed)
@@ -716,7 +711,6 @@ def synthetic_dataset(
     count = check_range(
         n_experiments,
         "n_experiments",
-        "synthetic_dataset",
         low=1,
         high=math.inf,
         low_inclusive=True,
@@ -727,7 +721,7 @@ def synthetic_dataset(
             f"Got {n_experiments!r} instead."
         )
     count = int(count)
-    check_choice(excitation, "excitation", "synthetic_dataset", EXCITATIONS)
+    check_choice(excitation, "excitation", EXCITATIONS)
     check_synthetic_size(n_samples, dt_s, samples="'n_samples' of synthetic_dataset")
     plant = CurlingActuator() if actuator is None else actuator
     if not isinstance(plant, CurlingActuator):

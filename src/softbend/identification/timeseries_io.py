@@ -453,7 +453,7 @@ def check_experiments_for_lags(data: TimeSeriesSet, max_lag: int) -> None:
     ValueError
         ``max_lag`` not an integer >= 0.
     """
-    max_lag = check_int(max_lag, "max_lag", "check_experiments_for_lags")
+    max_lag = check_int(max_lag, "max_lag")
     need = max_lag + 1
     short = [e for e in data.experiments if e.n_samples < need]
     if short:

@@ -125,7 +125,7 @@ class FitResult:
         object.__setattr__(
             self,
             "rmse_mpa",
-            check_range(self.rmse_mpa, "rmse_mpa", "FitResult", low=0.0, low_inclusive=True),
+            check_range(self.rmse_mpa, "rmse_mpa", low=0.0, low_inclusive=True),
         )
         object.__setattr__(self, "stretch_range", tuple(float(s) for s in self.stretch_range))
         object.__setattr__(self, "at_bound", tuple(self.at_bound))
@@ -494,8 +494,8 @@ def _problem(model_name: str, lam: np.ndarray, y: np.ndarray) -> _Problem:
 
 
 def _check_data(stretch: ArrayLike, stress: ArrayLike, owner: str) -> tuple[np.ndarray, np.ndarray]:
-    lam = check_finite_array(stretch, "stretch", owner)
-    y = check_finite_array(stress, "nominal_stress_mpa", owner)
+    lam = check_finite_array(stretch, "stretch")
+    y = check_finite_array(stress, "nominal_stress_mpa")
     if lam.ndim != 1 or y.shape != lam.shape:
         raise DatasetError(
             f"The 'stretch' and 'nominal_stress_mpa' of {owner} must be 1-D arrays of one "
@@ -520,7 +520,7 @@ def _select(
                 f"Got {lam.size} instead."
             )
         return lam, y
-    limit = check_range(max_stretch, "max_stretch", owner, low=1.0)
+    limit = check_range(max_stretch, "max_stretch", low=1.0)
     keep = lam <= limit
     if int(keep.sum()) < MIN_FIT_POINTS:
         raise ValueError(

@@ -89,7 +89,7 @@ def check_constants(
 
 def _positive_stretch(stretch: ArrayLike, owner: str) -> np.ndarray:
     """Stretch as a float array; finite and strictly positive, else ``ValueError``."""
-    values = check_finite_array(stretch, "stretch", owner)
+    values = check_finite_array(stretch, "stretch")
     bad = values <= 0.0
     if bad.any():
         first = int(np.flatnonzero(bad.ravel())[0])
@@ -183,7 +183,7 @@ class HyperelasticModel:
         if cls is HyperelasticModel:
             return get_model_class(name).from_dict(data)
         if name is not None:
-            check_choice(name, "model", f"{cls.__name__}.from_dict", (cls.name,))
+            check_choice(name, "model", (cls.name,))
         params = check_constants(
             data,
             f"{cls.__name__}.from_dict",
@@ -208,7 +208,7 @@ class NeoHookean(HyperelasticModel):
     c10_mpa: float
 
     def __post_init__(self) -> None:
-        value = check_range(self.c10_mpa, "c10_mpa", "NeoHookean", low=0.0)
+        value = check_range(self.c10_mpa, "c10_mpa", low=0.0)
         object.__setattr__(self, "c10_mpa", value)
 
     def energy(self, I1: Any) -> Any:
@@ -241,9 +241,9 @@ class Yeoh(HyperelasticModel):
     c30_mpa: float = 0.0
 
     def __post_init__(self) -> None:
-        object.__setattr__(self, "c10_mpa", check_range(self.c10_mpa, "c10_mpa", "Yeoh", low=0.0))
+        object.__setattr__(self, "c10_mpa", check_range(self.c10_mpa, "c10_mpa", low=0.0))
         for field_name in ("c20_mpa", "c30_mpa"):
-            value = check_range(getattr(self, field_name), field_name, "Yeoh")
+            value = check_range(getattr(self, field_name), field_name)
             object.__setattr__(self, field_name, value)
 
     def energy(self, I1: Any) -> Any:
@@ -294,12 +294,8 @@ class ArrudaBoyce(HyperelasticModel):
     lambda_m: float
 
     def __post_init__(self) -> None:
-        object.__setattr__(
-            self, "mu_mpa", check_range(self.mu_mpa, "mu_mpa", "ArrudaBoyce", low=0.0)
-        )
-        object.__setattr__(
-            self, "lambda_m", check_range(self.lambda_m, "lambda_m", "ArrudaBoyce", low=1.0)
-        )
+        object.__setattr__(self, "mu_mpa", check_range(self.mu_mpa, "mu_mpa", low=0.0))
+        object.__setattr__(self, "lambda_m", check_range(self.lambda_m, "lambda_m", low=1.0))
 
     def _scaled_coeffs(self) -> list[float]:
         return [c / self.lambda_m ** (2 * i) for i, c in enumerate(_AB_COEFFS)]

@@ -67,12 +67,8 @@ class LinearElastic:
     nu: float
 
     def __post_init__(self) -> None:
-        object.__setattr__(
-            self, "e_mpa", check_range(self.e_mpa, "e_mpa", "LinearElastic", low=0.0)
-        )
-        object.__setattr__(
-            self, "nu", check_range(self.nu, "nu", "LinearElastic", low=-1.0, high=0.5)
-        )
+        object.__setattr__(self, "e_mpa", check_range(self.e_mpa, "e_mpa", low=0.0))
+        object.__setattr__(self, "nu", check_range(self.nu, "nu", low=-1.0, high=0.5))
 
     @property
     def shear_modulus_mpa(self) -> float:
@@ -93,7 +89,7 @@ class LinearElastic:
         """Rebuild from :meth:`to_dict` output (checked as :func:`check_constants` says)."""
         owner = "LinearElastic.from_dict"
         if isinstance(data, Mapping):
-            check_choice(data.get("model", cls.name), "model", owner, (cls.name,))
+            check_choice(data.get("model", cls.name), "model", (cls.name,))
         params = check_constants(data, owner, ("e_mpa", "nu"), ("e_mpa", "nu"))
         return cls(**params)
 
@@ -135,7 +131,7 @@ class Material:
                 "The 'model' of Material must be a HyperelasticModel (NeoHookean, Yeoh, "
                 f"ArrudaBoyce) or LinearElastic. Got {self.model!r} instead."
             )
-        density = check_range(self.density_t_per_mm3, "density_t_per_mm3", "Material", low=0.0)
+        density = check_range(self.density_t_per_mm3, "density_t_per_mm3", low=0.0)
         object.__setattr__(self, "density_t_per_mm3", density)
         if not isinstance(self.source, str):
             raise ValueError(

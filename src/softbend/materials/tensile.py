@@ -133,10 +133,8 @@ class TensileTest:
                     f"The '{text_field}' of TensileTest must be a non-empty string. "
                     f"Got {value!r} instead."
                 )
-        strain = check_finite_array(self.engineering_strain, "engineering_strain", "TensileTest")
-        stress = check_finite_array(
-            self.engineering_stress_mpa, "engineering_stress_mpa", "TensileTest"
-        )
+        strain = check_finite_array(self.engineering_strain, "engineering_strain")
+        stress = check_finite_array(self.engineering_stress_mpa, "engineering_stress_mpa")
         if strain.ndim != 1 or stress.shape != strain.shape:
             raise DatasetError(
                 "The 'engineering_strain' and 'engineering_stress_mpa' of TensileTest must be "
@@ -466,7 +464,7 @@ def load_shipped(name: str) -> TensileTest:
         If ``name`` is not a shipped test; the message lists the allowed names.
     """
     files = _shipped_files()
-    check_choice(name, "name", "load_shipped", files)
+    check_choice(name, "name", files)
     entry = _shipped_dir().joinpath(files[name])
     return _parse_tensile_text(
         entry.read_text(encoding="utf-8-sig"),

@@ -81,7 +81,7 @@ def fit_figure(
     ValueError
         If ``x_axis`` is not ``"stretch"`` or ``"strain"``, or ``results`` is empty.
     """
-    check_choice(x_axis, "x_axis", "fit_figure", ("stretch", "strain"))
+    check_choice(x_axis, "x_axis", ("stretch", "strain"))
     fits = list(results.values()) if isinstance(results, Mapping) else list(results)
     if not fits:
         raise ValueError(

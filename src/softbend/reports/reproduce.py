@@ -221,7 +221,6 @@ def run_reproduce(
             check_range(
                 workers,
                 "workers",
-                "run_reproduce",
                 low=0,
                 low_inclusive=True,
                 high=4096,

@@ -379,11 +379,11 @@ def train_mlp_grid(
     X, y = check_data(X, y)
     split_list = check_splits(splits, X.shape[0])
     configs = check_hidden_sizes(hidden_sizes)
-    epochs = check_int(epochs, "epochs", _OWNER, low=1)
+    epochs = check_int(epochs, "epochs", low=1)
     check_limit("epochs", epochs, f"The 'epochs' of {_OWNER}")
-    batch_size = check_int(batch_size, "batch_size", _OWNER, low=1)
-    learning_rate = check_range(learning_rate, "learning_rate", _OWNER, low=0.0, high=math.inf)
-    seed = check_int(seed, "seed", _OWNER, low=0)
+    batch_size = check_int(batch_size, "batch_size", low=1)
+    learning_rate = check_range(learning_rate, "learning_rate", low=0.0, high=math.inf)
+    seed = check_int(seed, "seed", low=0)
     device = resolve_device(device)
     dtype = check_dtype(dtype)
     if progress is not None and not callable(progress):
@@ -391,12 +391,12 @@ def train_mlp_grid(
             f"The 'progress' of {_OWNER} must be a callable or None. Got {progress!r} instead."
         )
     if max_models_per_pass is not None:
-        max_models_per_pass = check_int(max_models_per_pass, "max_models_per_pass", _OWNER, low=1)
+        max_models_per_pass = check_int(max_models_per_pass, "max_models_per_pass", low=1)
     if max_memory_mb is not None:
-        max_memory_mb = check_range(max_memory_mb, "max_memory_mb", _OWNER, low=0.0)
+        max_memory_mb = check_range(max_memory_mb, "max_memory_mb", low=0.0)
     if num_threads is not None:
-        num_threads = check_int(num_threads, "num_threads", _OWNER, low=1)
-    check_choice(shuffle, "shuffle", _OWNER, ("auto", "host", "device"))
+        num_threads = check_int(num_threads, "num_threads", low=1)
+    check_choice(shuffle, "shuffle", ("auto", "host", "device"))
     if shuffle == "auto":
         shuffle = "device" if device == "cuda" else "host"
     for name, flag in (("tf32", tf32), ("compile_step", compile_step)):

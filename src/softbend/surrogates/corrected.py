@@ -63,7 +63,7 @@ def scaled_pressure_rows(X: ArrayLike, scale: float) -> np.ndarray:
 
 def _half_width(level: float, std: np.ndarray | float, owner: str) -> np.ndarray | float:
     """Half the central interval of probability ``level`` of a Gaussian of ``std``."""
-    level = check_range(level, "level", f"{owner}.predict_interval", low=0.0, high=1.0)
+    level = check_range(level, "level", low=0.0, high=1.0)
     return norm.ppf(0.5 + level / 2) * std
 
 
@@ -119,7 +119,7 @@ class PressureScaled:
 
     def __init__(self, base: Any, scale: float, residual_std: float) -> None:
         self.base = base
-        self.scale_ = check_range(scale, "scale", type(self).__name__, low=0.0)
+        self.scale_ = check_range(scale, "scale", low=0.0)
         self.residual_std_ = float(residual_std)
         self.n_features_in_ = int(base.n_features_in_)
 

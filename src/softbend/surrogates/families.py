@@ -225,7 +225,7 @@ class Family:
 
     def configs(self, grid_name: str) -> list[dict[str, Any]]:
         """New copies of the configurations of the grid ``grid_name`` (``quick``, ``paper``)."""
-        check_choice(grid_name, "grid", "surrogate search", GRID_NAMES)
+        check_choice(grid_name, "grid", GRID_NAMES)
         return [dict(config) for config in self.grids[grid_name]]
 
 

@@ -150,12 +150,10 @@ class NormalizedMLPRegressor(RegressorMixin, BaseEstimator):
             If training produced non-finite weights.
         """
         hidden = check_hidden_pair(self.hidden_sizes, "hidden_sizes", _OWNER)
-        epochs = check_int(self.epochs, "epochs", _OWNER, low=1)
-        batch_size = check_int(self.batch_size, "batch_size", _OWNER, low=1)
-        learning_rate = check_range(
-            self.learning_rate, "learning_rate", _OWNER, low=0.0, high=math.inf
-        )
-        seed = check_int(self.seed, "seed", _OWNER, low=0)
+        epochs = check_int(self.epochs, "epochs", low=1)
+        batch_size = check_int(self.batch_size, "batch_size", low=1)
+        learning_rate = check_range(self.learning_rate, "learning_rate", low=0.0, high=math.inf)
+        seed = check_int(self.seed, "seed", low=0)
         device = resolve_device(self.device, _OWNER)
         # PyTorch only for training: loading and predicting stay NumPy
         from softbend.surrogates.batched import train_mlp_grid

@@ -100,7 +100,7 @@ def resolve_device(device: object, owner: str = "train_mlp_grid") -> str:
     ValueError
         For another value, or ``"cuda"`` without a usable GPU.
     """
-    check_choice(device, "device", owner, ("auto", "cpu", "cuda"))
+    check_choice(device, "device", ("auto", "cpu", "cuda"))
     # PyTorch only here (training): a fitted model predicts with NumPy alone
     from softbend._torch import require_torch
 

@@ -58,8 +58,8 @@ def n_terms(n_features: int, degree: int) -> int:
         T = C(d + degree, degree), the constant term included (7 inputs:
         degree 4 → 330, degree 9 → 11440, degree 10 → 19448).
     """
-    n_features = check_int(n_features, "n_features", "n_terms", low=1)
-    degree = check_int(degree, "degree", "n_terms", low=0)
+    n_features = check_int(n_features, "n_features", low=1)
+    degree = check_int(degree, "degree", low=0)
     return math.comb(n_features + degree, degree)
 
 
@@ -330,10 +330,10 @@ class PolynomialRegressor(RegressorMixin, BaseEstimator):
         ConvergenceError
             If the solve produces non-finite coefficients.
         """
-        degree = check_int(self.degree, "degree", _OWNER, low=1)
-        alpha = check_range(self.alpha, "alpha", _OWNER, low=0.0, low_inclusive=True)
-        chunk_rows = check_int(self.chunk_rows, "chunk_rows", _OWNER, low=1)
-        limit = check_range(self.max_memory_mb, "max_memory_mb", _OWNER, low=0.0)
+        degree = check_int(self.degree, "degree", low=1)
+        alpha = check_range(self.alpha, "alpha", low=0.0, low_inclusive=True)
+        chunk_rows = check_int(self.chunk_rows, "chunk_rows", low=1)
+        limit = check_range(self.max_memory_mb, "max_memory_mb", low=0.0)
 
         y_values = np.asarray(y)
         if y_values.dtype.kind == "f" and y_values.ndim in (1, 2):

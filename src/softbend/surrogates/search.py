@@ -107,7 +107,7 @@ def grid(name: str, model: str) -> list[dict[str, Any]]:
     ValueError
         An unknown grid; :class:`~softbend.registry.UnknownNameError` an unknown family.
     """
-    check_choice(name, "grid", "surrogate search", GRID_NAMES)
+    check_choice(name, "grid", GRID_NAMES)
     return FAMILIES.get(model, field="model").configs(name)
 
 
@@ -133,7 +133,6 @@ def grouped_splits(
         check_range(
             n_splits,
             "folds",
-            "grouped_splits",
             low=2,
             low_inclusive=True,
             high=max(2, n_groups),
@@ -170,7 +169,6 @@ def random_splits(
         check_range(
             n_splits,
             "folds",
-            "random_splits",
             low=2,
             low_inclusive=True,
             high=max(2, n_samples),
@@ -420,7 +418,7 @@ def halving_rungs(
         while rungs < 4 and math.ceil(n_configs / eta**rungs) >= eta:
             rungs += 1
     else:
-        rungs = check_int(rungs, "rungs", "halving_rungs", low=1)
+        rungs = check_int(rungs, "rungs", low=1)
         most = _most_rungs(n_configs, epochs, eta)
         if rungs > most:
             raise ValueError(
@@ -672,24 +670,20 @@ def search(
     """
     owner = "surrogate search"
     models = list(family_names(models, field="models"))
-    check_choice(grid_name, "grid", owner, GRID_NAMES)
-    check_choice(device, "device", owner, ("auto", "cpu", "cuda"))
+    check_choice(grid_name, "grid", GRID_NAMES)
+    check_choice(device, "device", ("auto", "cpu", "cuda"))
     epochs = (
         MLP_EPOCHS[grid_name]
         if epochs is None
-        else int(check_range(epochs, "epochs", owner, low=1, low_inclusive=True))
+        else int(check_range(epochs, "epochs", low=1, low_inclusive=True))
     )
-    check_choice(cv, "cv", owner, CV_PROTOCOLS)
+    check_choice(cv, "cv", CV_PROTOCOLS)
     if not isinstance(tf32, bool):
         raise ValueError(f"The 'tf32' of {owner} must be True or False. Got {tf32!r}.")
     if halving is not None:
-        halving = check_int(halving, "halving", owner, low=2)
-    n_rungs = (
-        None if halving_rungs is None else check_int(halving_rungs, "halving_rungs", owner, low=1)
-    )
-    patience = (
-        None if plr_patience is None else check_int(plr_patience, "plr_patience", owner, low=1)
-    )
+        halving = check_int(halving, "halving", low=2)
+    n_rungs = None if halving_rungs is None else check_int(halving_rungs, "halving_rungs", low=1)
+    patience = None if plr_patience is None else check_int(plr_patience, "plr_patience", low=1)
     if n_rungs is not None and halving is None:
         raise ValueError(
             f"The 'halving_rungs' of {owner} needs 'halving' (the factor, e.g. 3). "

@@ -82,7 +82,7 @@ def min_actuators(level: float) -> int:
 
     ``⌈level / (1 − level)⌉``: 9 at 90 %, 19 at 95 %.
     """
-    level = check_range(level, "level", "min_actuators", low=0.0, high=1.0)
+    level = check_range(level, "level", low=0.0, high=1.0)
     return math.ceil(level / (1.0 - level) - 1e-12)
 
 
@@ -113,7 +113,7 @@ def conformal_half_width(
     ValueError
         No actuator, an actuator without finite errors, or a level outside (0, 1).
     """
-    level = check_range(level, "level", "conformal_half_width", low=0.0, high=1.0)
+    level = check_range(level, "level", low=0.0, high=1.0)
     groups = []
     for name, values in residuals.items():
         r = np.abs(np.asarray(values, dtype=np.float64).ravel())

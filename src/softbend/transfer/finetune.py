@@ -108,9 +108,9 @@ def fine_tune_many(
     device = resolve_device(device, owner)
     starts = [check_mlp(b, owner) for b in (base if isinstance(base, list) else [base])]
     base = starts[0]
-    epochs = check_int(epochs, "epochs", owner, low=1)
+    epochs = check_int(epochs, "epochs", low=1)
     check_limit("epochs", epochs, f"The 'epochs' of {owner}")
-    learning_rate = check_range(learning_rate, "learning_rate", owner, low=0.0)
+    learning_rate = check_range(learning_rate, "learning_rate", low=0.0)
     X = np.asarray(X, dtype=np.float64)
     y = np.asarray(y, dtype=np.float64).ravel()
     w = np.asarray(weights, dtype=np.float64)

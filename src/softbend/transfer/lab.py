@@ -137,13 +137,12 @@ def _checked_settings(
     if "plant" in settings:
         PLANTS.check(settings["plant"], field=name("plant"))
     if "elastomer" in settings:
-        check_choice(settings["elastomer"], name("elastomer"), owner, shipped_tensile_tests())
+        check_choice(settings["elastomer"], name("elastomer"), shipped_tensile_tests())
     for key, (low, high, low_inclusive, high_inclusive) in _BOUNDS.items():
         if key in settings:
             out[key] = check_range(
                 settings[key],
                 name(key),
-                owner,
                 low=low,
                 high=high,
                 low_inclusive=low_inclusive,
@@ -155,10 +154,10 @@ def _checked_settings(
             f"Got {settings['unloading']!r} instead."
         )
     if "cycles" in settings:
-        out["cycles"] = check_int(settings["cycles"], name("cycles"), owner, low=1)
+        out["cycles"] = check_int(settings["cycles"], name("cycles"), low=1)
         check_limit("cycles", out["cycles"], f"The '{name('cycles')}' of {owner}")
     if "seed" in settings:
-        out["seed"] = check_int(settings["seed"], name("seed"), owner, low=0)
+        out["seed"] = check_int(settings["seed"], name("seed"), low=0)
     if settings.get("material") is not None:
         from softbend.materials.choice import material_from_spec
 

@@ -328,8 +328,8 @@ def _leave_one_out(
         STRATEGIES.check(name, field="strategies")
     if len(set(names)) != len(names):
         raise ValueError(f"The 'strategies' of {_OWNER} must be distinct. Got {list(names)}.")
-    level = check_range(level, "level", _OWNER, low=0.0, high=1.0)
-    seed = check_int(seed, "seed", _OWNER, low=0)
+    level = check_range(level, "level", low=0.0, high=1.0)
+    seed = check_int(seed, "seed", low=0)
     options = {
         name: check_parameters(name, STRATEGIES.get(name, field="options"), values)
         for name, values in dict(options or {}).items()

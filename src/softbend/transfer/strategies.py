@@ -199,7 +199,7 @@ def _check_same(estimators: list, names: tuple[str, ...], owner: str) -> None:
 
 
 def _check_level(level: float, owner: str) -> float:
-    return check_range(level, "level", f"{owner}.predict_interval", low=0.0, high=1.0)
+    return check_range(level, "level", low=0.0, high=1.0)
 
 
 def _row(index: int) -> str:
@@ -380,7 +380,7 @@ class BaseMeanResidual(_Strategy):
         """Fit ``r(p)`` to the residuals ``y − base(X)`` of the rows."""
         self._check_parameters()
         _check_base(self.base, type(self).__name__)
-        n_bins = check_int(self.n_bins, "n_bins", type(self).__name__, low=1)
+        n_bins = check_int(self.n_bins, "n_bins", low=1)
         X, y = self._check_fit_data(X, y)
         if y.size < 2:
             raise ValueError(
@@ -897,7 +897,7 @@ class ResidualGP(_Corrected):
         """Fit the GP to ``y − base(X)``."""
         self._check_parameters()
         _check_base(self.base, type(self).__name__)
-        n_restarts = check_int(self.n_restarts, "n_restarts", type(self).__name__, low=0)
+        n_restarts = check_int(self.n_restarts, "n_restarts", low=0)
         X, y = self._check_fit_data(X, y)
         theta = _base_angles(self.base, X, "residual-gp")
         Z = np.column_stack([X, theta])
@@ -1005,7 +1005,7 @@ class RefinedEnsemble(_Corrected):
 
     def _draws(self, X: np.ndarray, rows: np.ndarray) -> list[np.ndarray]:
         """The members' rows: a seeded draw, with replacement, of the actuators in ``rows``."""
-        n_members = check_int(self.n_members, "n_members", type(self).__name__, low=2)
+        n_members = check_int(self.n_members, "n_members", low=2)
         _, group = np.unique(X[rows, :-1], axis=0, return_inverse=True)
         group = group.ravel()
         n_groups = int(group.max()) + 1
@@ -1152,7 +1152,7 @@ def make_strategy(name: str, base: Any = None, *, seed: int = 0, **options: Any)
     cls = STRATEGIES.get(name, field="strategy")
     options = check_parameters(name, cls, options)
     if takes(cls, "seed"):
-        seed = check_int(seed, "seed", f"transfer strategy {name!r}", low=0)
+        seed = check_int(seed, "seed", low=0)
     filled = {"base": base, "seed": seed}
     return cls(**{k: v for k, v in filled.items() if takes(cls, k)}, **options)
 
