@@ -116,7 +116,7 @@ def check_finite_array(values: Any, key: str) -> np.ndarray:
     if bad.any():
         first = int(np.flatnonzero(bad.ravel())[0])
         raise DatasetError(
-            f"must be finite; got {array.ravel()[first]!r} at position {first} "
+            f"must be finite; got {float(array.ravel()[first])} at position {first} "
             f"({int(bad.sum())} non-finite values in all)",
             key=key,
         )

@@ -43,6 +43,7 @@ class SoftbendError(Exception):
     """
 
     key: str | None = None
+    inner_key: str | None = None
     file: str | None = None
     line: int | None = None
     column: int | None = None
@@ -93,21 +94,25 @@ def keyed(key: str, *, file: str | None = None) -> Iterator[None]:
 
     For a function that passes one of its parameters on: the error a callee
     raises about the value then names the caller's parameter, which the command
-    line maps to the option the user typed. The outermost ``keyed`` wins.
+    line maps to the option the user typed. The outermost ``keyed`` wins; a key
+    it replaces first (the innermost) moves into the message, so the part at fault stays named.
 
     Examples
     --------
     >>> from softbend.errors import InputError, keyed
     >>> try:
     ...     with keyed("fix"):
-    ...         raise InputError("l_mm must be in [100, 160]; got 200", key="design")
+    ...         raise InputError("must be in [100, 160]; got 200", key="l_mm")
     ... except InputError as error:
     ...     print(error)
-    fix: l_mm must be in [100, 160]; got 200
+    fix: l_mm: must be in [100, 160]; got 200
     """
     try:
         yield
     except SoftbendError as error:
+        if error.key is not None and error.key != key and error.inner_key is None:
+            error.inner_key = error.key
+            error.args = (f"{error.key}: {error.detail}",)
         error.key = key
         if file is not None and error.file is None:
             error.file = str(file)

@@ -54,7 +54,13 @@ def test_the_printed_line_leads_with_the_option_and_keeps_the_place() -> None:
 def test_keyed_names_the_callers_parameter_outermost_first() -> None:
     try:
         with keyed("fix"), keyed("design"):
-            raise InputError("l_mm must be in [100, 160]; got 200", key="values")
+            raise InputError("must be in [100, 160]; got 200", key="l_mm")
     except InputError as error:
-        assert error.key == "fix"
+        assert error.key == "fix" and error.inner_key == "l_mm"
+        assert str(error) == "fix: l_mm: must be in [100, 160]; got 200"
         assert error_text(app, ["campaign", "run", "t"], error) == str(error)
+    try:
+        with keyed("design"):
+            raise InputError("must be a number", key="design")
+    except InputError as error:  # the same key: nothing moves
+        assert str(error) == "design: must be a number"

@@ -27,6 +27,33 @@ ALIASES: dict[str, str] = {
     "settings": "set",
     "controller_parameters": "set",
     "rig_parameters": "rig_param",
+    "campaign run:ranges": "ranges",
+    "design find:ranges": "ranges",
+    "design find:fixes": "fix",
+    "design find:steps": "resolution",
+    "design find:step": "resolution",
+    "reproduce:out_dir": "out",
+    "campaign run:connect_timeout_s": "connect_timeout",
+    "maxh_mm": "maxh",
+    "pmax_mpa": "pmax",
+    "step_mpa": "pstep",
+    "lab measure:actuators": "designs",
+    "lab measure:fabrication_error_mm": "fabrication_error",
+    "lab measure:camera_noise_deg": "camera_noise",
+    "lab measure:pmax_mpa": "pmax",
+    "lab measure:pressure_step_mpa": "pstep",
+    "lab measure:max_angle_deg": "max_angle",
+    "transfer refine:X": "measurements",
+    "transfer loco:X": "measurements",
+    "transfer loco:calibrated": "calibrate",
+    "transfer refine:settings": "settings",
+    "transfer loco:settings": "settings",
+    "analyze:mape_threshold": "mape_threshold_deg",
+    "analyze:samples": "db",
+    "curling simulate:n_samples": "samples",
+    "curling simulate:dt_s": "dt",
+    "curling simulate:n_experiments": "experiments",
+    "curling identify:C": "c",
 }
 
 
@@ -66,8 +93,11 @@ def option_for(app: typer.Typer, argv: Sequence[str], key: str) -> str | None:
 
 
 def error_text(app: typer.Typer, argv: Sequence[str], error: BaseException) -> str:
-    """The one line printed for ``error``: its key replaced by the option the user typed."""
-    if not isinstance(error, SoftbendError) or error.key is None:
-        return str(error)
+    """The one line printed for ``error``: its key replaced by the option the user typed.
+
+    An error located in a file keeps its key: there it names the file's field.
+    """
+    if not isinstance(error, SoftbendError) or error.key is None or error.file is not None:
+        return str(error)  # a key inside a file is the file's own name for the field
     option = option_for(app, argv, error.key)
     return error.described(option) if option is not None else str(error)
