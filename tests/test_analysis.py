@@ -182,30 +182,33 @@ def test_constant_feature_is_dropped_with_warning():
 
 def test_bad_inputs_raise_clear_errors():
     df = _linear_frame(noise=1.0)
-    with pytest.raises(DatasetError, match="'missing_col'"):
+    with pytest.raises(DatasetError, match=r"^df: the samples lack the column.*'missing_col'"):
         standardized_regression(df, ["x1", "missing_col"], "y")
-    with pytest.raises(DatasetError, match="'angle_deg'"):
+    with pytest.raises(DatasetError, match=r"^df: .*'angle_deg'"):
         standardized_regression(df, ["x1"])
-    with pytest.raises(DatasetError, match="constant"):
+    with pytest.raises(DatasetError, match=r"^target: must not be constant"):
         standardized_regression(df.assign(y=1.0), ["x1"], "y")
-    with pytest.raises(DatasetError, match="Every feature"), warnings.catch_warnings():
+    with (
+        pytest.raises(DatasetError, match=r"^features: must not all be constant"),
+        warnings.catch_warnings(),
+    ):
         warnings.simplefilter("ignore", ConstantFeatureWarning)
         standardized_regression(df.assign(c=1.0), ["c"], "y")
-    with pytest.raises(DatasetError, match="linearly dependent"):
+    with pytest.raises(DatasetError, match=r"^features: must not be linearly dependent"):
         standardized_regression(df.assign(x3=2.0 * df["x1"] + df["x2"]), ["x1", "x2", "x3"], "y")
-    with pytest.raises(DatasetError, match="more samples than parameters"):
+    with pytest.raises(DatasetError, match=r"^df: must hold more samples than parameters"):
         standardized_regression(df.iloc[:3], ["x1", "x2"], "y")
-    with pytest.raises(DatasetError, match="numeric"):
+    with pytest.raises(DatasetError, match=r"^df: .*must be numeric"):
         standardized_regression(df.assign(x1="a"), ["x1"], "y")
-    with pytest.raises(ValueError, match=r"'mape_threshold'.*Got -1"):
+    with pytest.raises(ValueError, match=r"^mape_threshold: .*got -1"):
         standardized_regression(df, ["x1"], "y", mape_threshold=-1)
-    with pytest.raises(ValueError, match="distinct"):
+    with pytest.raises(ValueError, match=r"^features: must be distinct"):
         standardized_regression(df, ["x1", "x1"], "y")
-    with pytest.raises(ValueError, match="'target'"):
+    with pytest.raises(ValueError, match=r"^target: must not be one of the features"):
         standardized_regression(df, ["x1", "y"], "y")
-    with pytest.raises(DatasetError, match=r"'converged'.*booleans"):
+    with pytest.raises(DatasetError, match=r"^df: the 'converged' column must hold booleans"):
         standardized_regression(df.assign(converged="yes"), ["x1"], "y")
-    with pytest.raises(DatasetError, match="DataFrame"):
+    with pytest.raises(DatasetError, match=r"^df: must be a pandas DataFrame"):
         standardized_regression(df.to_numpy(), ["x1"], "y")
 
 
@@ -274,9 +277,9 @@ def test_correlation_matrix_subset_exact_linear_and_constant():
 
 def test_correlation_matrix_bad_input():
     df = _linear_frame()
-    with pytest.raises(DatasetError, match="'nope'"):
+    with pytest.raises(DatasetError, match=r"^df: .*'nope'"):
         correlation_matrix(df, ["x1", "nope"])
-    with pytest.raises(DatasetError, match="at least 2"):
+    with pytest.raises(DatasetError, match=r"^df: must be at least 2"):
         correlation_matrix(df.iloc[:1], ["x1", "x2"])
     with pytest.raises(DatasetError, match="pressure_mpa"):
         correlation_matrix(df)
@@ -326,11 +329,11 @@ def test_analysis_to_dict_is_the_report_plus_correlations_and_round_trips_json()
 
 
 def test_analyze_samples_rejects_empty_and_bad_samples():
-    with pytest.raises(DatasetError, match="no rows"):
+    with pytest.raises(DatasetError, match=r"^samples: must hold rows"):
         analyze_samples(_campaign_like_frame().iloc[:0])
-    with pytest.raises(DatasetError, match="lack the column"):
+    with pytest.raises(DatasetError, match=r"^samples: the samples lack the column"):
         analyze_samples(_linear_frame())
-    with pytest.raises(ValueError, match="mape_threshold"):
+    with pytest.raises(ValueError, match=r"^mape_threshold: "):
         analyze_samples(_campaign_like_frame(), mape_threshold=-1.0)
 
 

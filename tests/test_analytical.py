@@ -6,6 +6,7 @@ import pytest
 from scipy.integrate import dblquad
 
 from softbend.analytical import (
+    AnalyticalModel,
     bending_angle_deg,
     elastomer_moment_nmm,
     nominal_axial_stress_mpa,
@@ -208,26 +209,26 @@ def test_softening_law_warns_about_the_limit_point_and_returns_the_first_equilib
 
 @pytest.mark.parametrize("pressures", [[-0.01], [0.1, -1e-9]])
 def test_negative_pressure_raises(pressures):
-    with pytest.raises(
-        ValueError, match=r"The 'pressures_mpa' of bending_angle_deg must be in \[0, inf\)"
-    ):
+    with pytest.raises(ValueError, match=r"^pressures_mpa: must be in \[0, inf\); got -"):
         bending_angle_deg(BASE, pressures)
 
 
 @pytest.mark.parametrize("bad", [np.nan, np.inf])
 def test_non_finite_pressure_raises(bad):
-    with pytest.raises(
-        DatasetError, match="The 'pressures_mpa' of bending_angle_deg must be finite"
-    ):
+    with pytest.raises(DatasetError, match=r"^pressures_mpa: must be finite"):
         bending_angle_deg(BASE, [0.1, bad])
 
 
 def test_bad_options_raise_naming_the_field():
-    with pytest.raises(ValueError, match="The 'max_angle_deg' of bending_angle_deg"):
+    with pytest.raises(ValueError, match=r"^max_angle_deg: must be a number in"):
         bending_angle_deg(BASE, [0.1], max_angle_deg=0.0)
-    with pytest.raises(ValueError, match="The 'material' of bending_angle_deg"):
+    with pytest.raises(ValueError, match=r"^material: must be a hyperelastic model"):
         bending_angle_deg(BASE, [0.1], KEVLAR_FIBER)
-    with pytest.raises(ValueError, match="The 'n_radial' of section_quadrature"):
+    with pytest.raises(ValueError, match=r"^material: must be a hyperelastic model"):
+        AnalyticalModel(material=KEVLAR_FIBER)
+    with pytest.raises(ValueError, match=r"^material: Unknown material"):
+        AnalyticalModel(material="no-such-silicone")
+    with pytest.raises(ValueError, match=r"^n_radial: must be a number in \[1, 1000\]"):
         section_quadrature(BASE, n_radial=0)
 
 

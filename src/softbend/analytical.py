@@ -42,7 +42,7 @@ import time
 import warnings
 from dataclasses import dataclass, field
 from functools import lru_cache
-from typing import Any
+from typing import Any, cast
 
 import numpy as np
 from numpy.typing import ArrayLike
@@ -50,6 +50,7 @@ from scipy.optimize import brentq
 
 from softbend._validation import check_finite_array, check_range
 from softbend.design import SFRBADesign
+from softbend.errors import InputError, keyed
 from softbend.materials.models import HyperelasticModel
 from softbend.materials.presets import DRAGON_SKIN_30, Material
 from softbend.models import SweepResult
@@ -80,7 +81,8 @@ _N_BOTTOM = 12
 _N_GRID = 256
 
 
-def _resolve_model(material: Material | HyperelasticModel | None, owner: str) -> HyperelasticModel:
+def _resolve_model(material: Material | HyperelasticModel | None) -> HyperelasticModel:
+    """The hyperelastic law of ``material`` (default Dragon Skin 30); errors keyed ``material``."""
     if material is None:
         model = DRAGON_SKIN_30.model
     elif isinstance(material, Material):
@@ -88,9 +90,10 @@ def _resolve_model(material: Material | HyperelasticModel | None, owner: str) ->
     else:
         model = material
     if not isinstance(model, HyperelasticModel):
-        raise ValueError(
-            f"The 'material' of {owner} must be a hyperelastic model (NeoHookean, Yeoh, "
-            f"ArrudaBoyce) or a Material holding one. Got {material!r} instead."
+        raise InputError(
+            "must be a hyperelastic model (NeoHookean, Yeoh, ArrudaBoyce) or a Material "
+            f"holding one; got {material!r}",
+            key="material",
         )
     return model
 
@@ -239,7 +242,7 @@ def elastomer_moment_nmm(
     numpy.ndarray
         Moment in N·mm, the shape of ``angle_rad``.
     """
-    model = _resolve_model(material, "elastomer_moment_nmm")
+    model = _resolve_model(material)
     theta = np.asarray(angle_rad, dtype=float)
     quad = section_quadrature(design)
     stretch = 1.0 + theta[..., None] * (quad.heights_mm / design.l_mm)
@@ -247,14 +250,14 @@ def elastomer_moment_nmm(
     return stress @ (quad.weights_mm2 * quad.heights_mm)
 
 
-def _validate_pressures(pressures_mpa: ArrayLike, owner: str) -> np.ndarray:
+def _validate_pressures(pressures_mpa: ArrayLike) -> np.ndarray:
     pressures = check_finite_array(pressures_mpa, "pressures_mpa")
     negative = pressures < 0.0
     if negative.any():
         first = int(np.flatnonzero(negative.ravel())[0])
-        raise ValueError(
-            f"The 'pressures_mpa' of {owner} must be in [0, inf). "
-            f"Got {pressures.ravel()[first]!r} at position {first} instead."
+        raise InputError(
+            f"must be in [0, inf); got {float(pressures.ravel()[first])!r} at position {first}",
+            key="pressures_mpa",
         )
     return pressures
 
@@ -303,12 +306,11 @@ def bending_angle_deg(
         material is not hyperelastic; :class:`softbend.errors.DatasetError` (a
         ``ValueError``) if a pressure is NaN or infinite.
     """
-    owner = "bending_angle_deg"
-    pressures = _validate_pressures(pressures_mpa, owner)
+    pressures = _validate_pressures(pressures_mpa)
     theta_max = math.radians(
         check_range(max_angle_deg, "max_angle_deg", low=0.0, high=3600.0, high_inclusive=True)
     )
-    model = _resolve_model(material, owner)
+    model = _resolve_model(material)
 
     quad = section_quadrature(design)
     moment_weights = quad.weights_mm2 * quad.heights_mm
@@ -425,21 +427,23 @@ class AnalyticalModel:
         :mod:`softbend.analytical` (720).
     """
 
-    material: Any = None
+    material: Material | HyperelasticModel | str | None = None
     max_angle_deg: float | None = None
     name: str = field(default="analytical", init=False)
 
     def __post_init__(self) -> None:
-        from softbend.materials.presets import get_preset
+        from softbend.materials.presets import PRESETS
 
         material = self.material
         if isinstance(material, str):
-            material = get_preset(material)
+            with keyed("material"):
+                material = PRESETS.get(material)
         model = material.model if isinstance(material, Material) else material
         if material is not None and not isinstance(model, HyperelasticModel):
-            raise ValueError(
-                "The 'material' of AnalyticalModel must be a hyperelastic model, a Material "
-                f"holding one, or a preset name. Got {self.material!r} instead."
+            raise InputError(
+                "must be a hyperelastic model, a Material holding one, or a preset name; "
+                f"got {self.material!r}",
+                key="material",
             )
         object.__setattr__(self, "material", material)
         if self.max_angle_deg is not None:
@@ -456,9 +460,10 @@ class AnalyticalModel:
         """Solve the moment balance at every pressure of the grid, in MPa."""
         start = time.perf_counter()
         options = {} if self.max_angle_deg is None else {"max_angle_deg": self.max_angle_deg}
+        material = cast("Material | HyperelasticModel | None", self.material)  # no name left
         with warnings.catch_warnings(record=True) as caught:
             warnings.simplefilter("always")
-            angle = bending_angle_deg(design, pressures_mpa, self.material, **options)
+            angle = bending_angle_deg(design, pressures_mpa, material, **options)
         tip_x, tip_z = tip_position_mm(design, angle)
         stats: dict[str, Any] = {
             "model": "Polygerinos et al. 2015, quasi-static",
@@ -477,7 +482,7 @@ class AnalyticalModel:
         )
 
 
-def _describe_material(material: Any) -> str:
+def _describe_material(material: Material | HyperelasticModel | str | None) -> str:
     if material is None:
         material = DRAGON_SKIN_30
     if isinstance(material, Material):

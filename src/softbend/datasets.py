@@ -160,7 +160,7 @@ def _sha256(path: Path) -> str:
     return digest.hexdigest()
 
 
-def _provenance_files(provenance: Any, record: Path) -> dict[str, dict[str, Any]]:
+def _provenance_files(provenance: object, record: Path) -> dict[str, dict[str, Any]]:
     """The ``files`` of a provenance record, its shape and types checked.
 
     Raises

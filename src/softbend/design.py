@@ -21,7 +21,8 @@ from typing import Literal
 
 import numpy as np
 
-from softbend._validation import check_choice, check_range
+from softbend._validation import check_choice, check_range, must_be
+from softbend.errors import InputError, keyed
 from softbend.references import DESIGN_SPACE, MATERIALS, MEASURED_ACTUATORS
 
 #: Order of the design parameters in tables, arrays and CLI strings.
@@ -117,9 +118,10 @@ class SFRBADesign:
             )
             object.__setattr__(self, name, value)
         if self.t_mm >= self.r_mm:
-            raise ValueError(
-                "The 't_mm' of SFRBADesign must be less than its 'r_mm' (a wall thinner than "
-                f"the chamber radius). Got t_mm={self.t_mm:g} and r_mm={self.r_mm:g} instead."
+            raise InputError(
+                f"must be less than r_mm ({self.r_mm:g}): a wall thinner than the chamber "
+                f"radius; got {self.t_mm:g}",
+                key="t_mm",
             )
 
     @classmethod
@@ -127,23 +129,28 @@ class SFRBADesign:
         """Build a design from ``(l, r, t, b, phi, lc)`` in that order."""
         values = list(values)
         if len(values) != len(PARAMETERS):
-            raise ValueError(
-                f"A design needs {len(PARAMETERS)} values ({', '.join(PARAMETERS)}). "
-                f"Got {len(values)} instead."
+            raise InputError(  # the wording other messages quote: "A design needs 6 values"
+                f"A design needs {len(PARAMETERS)} values ({', '.join(PARAMETERS)}); "
+                f"got {len(values)}"
             )
         return cls(*values)
 
     @classmethod
     def parse(cls, text: str) -> SFRBADesign:
-        """Parse ``"100,6,2,2,5,10"`` (l, r, t, b, phi, lc) as used on the CLI."""
+        """Parse ``"100,6,2,2,5,10"`` (l, r, t, b, phi, lc) as used on the CLI.
+
+        Errors are keyed ``design`` and name the value at fault in the message
+        (``design: t_mm: must be less than r_mm (6) ...``).
+        """
         try:
             values = [float(v) for v in text.split(",")]
         except ValueError:
-            raise ValueError(
-                f"The 'design' must be six comma-separated numbers "
-                f"({', '.join(PARAMETERS)}). Got {text!r} instead."
+            raise InputError(
+                must_be(f"six comma-separated numbers ({', '.join(PARAMETERS)})", text),
+                key="design",
             ) from None
-        return cls.from_sequence(values)
+        with keyed("design"):
+            return cls.from_sequence(values)
 
     @property
     def cavity_volume_mm3(self) -> float:
@@ -220,9 +227,7 @@ class DesignSpace:
         ids = [d.design_id for d in self.designs]
         if len(set(ids)) != len(ids):
             duplicates = len(ids) - len(set(ids))
-            raise ValueError(
-                f"The 'designs' of DesignSpace must be unique. Got {duplicates} duplicates."
-            )
+            raise InputError(f"must be unique; got {duplicates} duplicates", key="designs")
 
     def __len__(self) -> int:
         return len(self.designs)
@@ -247,14 +252,9 @@ class DesignSpace:
             ``count < 1`` or ``index`` not in ``0 … count − 1``.
         """
         if isinstance(count, bool) or not isinstance(count, int) or count < 1:
-            raise ValueError(
-                f"The shard 'count' of DesignSpace.shard must be an integer >= 1. Got {count!r}."
-            )
+            raise InputError(must_be("an integer in [1, inf)", count), key="count")
         if isinstance(index, bool) or not isinstance(index, int) or not 0 <= index < count:
-            raise ValueError(
-                f"The shard 'index' of DesignSpace.shard must be an integer in 0..{count - 1}. "
-                f"Got {index!r} instead."
-            )
+            raise InputError(must_be(f"an integer in [0, {count - 1}]", index), key="index")
         return DesignSpace(self.designs[index::count], name=f"{self.name}[{index}/{count}]")
 
     @classmethod
@@ -263,9 +263,9 @@ class DesignSpace:
         missing = [p for p in PARAMETERS if p not in levels]
         extra = [p for p in levels if p not in PARAMETERS]
         if missing or extra:
-            raise ValueError(
-                f"The 'levels' of DesignSpace.grid must name exactly {', '.join(PARAMETERS)}. "
-                f"Missing {missing}, unknown {extra}."
+            raise InputError(
+                f"must name exactly {', '.join(PARAMETERS)}; missing {missing}, unknown {extra}",
+                key="levels",
             )
         combos = itertools.product(*(levels[p] for p in PARAMETERS))
         return cls(tuple(SFRBADesign(*c) for c in combos), name=name)

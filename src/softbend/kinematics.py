@@ -53,24 +53,26 @@ logger = logging.getLogger(__name__)
 CURLING_REST_LENGTH_MM = 15.25
 
 
-def _positive_array(values: np.ndarray, name: str, owner: str) -> None:
-    """Raise :class:`DatasetError` unless every element of ``values`` is > 0."""
+def _positive_array(values: np.ndarray, key: str) -> None:
+    """Raise :class:`DatasetError` keyed ``key`` unless every element of ``values`` is > 0."""
     bad = ~(values > 0)
     if bad.any():
         first = int(np.flatnonzero(bad.ravel())[0])
         raise DatasetError(
-            f"The '{name}' of {owner} must be in (0, inf). Got {values.ravel()[first]!r} "
-            f"at position {first} ({int(bad.sum())} values out of range in all) instead."
+            f"must be in (0, inf); got {float(values.ravel()[first])!r} at position {first} "
+            f"({int(bad.sum())} values out of range in all)",
+            key=key,
         )
 
 
-def _broadcast(a: np.ndarray, b: np.ndarray, names: tuple[str, str], owner: str):
+def _broadcast(a: np.ndarray, b: np.ndarray, keys: tuple[str, str]) -> tuple[np.ndarray, ...]:
+    """``a`` and ``b`` broadcast together; the error is keyed by the second of ``keys``."""
     try:
         return np.broadcast_arrays(a, b)
     except ValueError:
         raise DatasetError(
-            f"The '{names[0]}' and '{names[1]}' of {owner} must have broadcastable shapes. "
-            f"Got {a.shape} and {b.shape} instead."
+            f"must have a shape that broadcasts with '{keys[0]}'; got {b.shape} and {a.shape}",
+            key=keys[1],
         ) from None
 
 
@@ -117,12 +119,11 @@ def tip_position(
     ValueError
         If ``rest_length_mm`` is not a finite number > 0.
     """
-    owner = "tip_position"
     rest = check_range(rest_length_mm, "rest_length_mm", low=0.0)
     rho_arr = check_finite_array(rho, "rho")
     length = check_finite_array(length_mm, "length_mm")
-    _positive_array(length, "length_mm", owner)
-    rho_arr, length = _broadcast(rho_arr, length, ("rho", "length_mm"), owner)
+    _positive_array(length, "length_mm")
+    rho_arr, length = _broadcast(rho_arr, length, ("rho", "length_mm"))
 
     chord = length * np.sinc(rho_arr)  # s = L sin(alpha) / alpha, signed beyond |rho| = 1
     half = np.pi * rho_arr
@@ -176,20 +177,19 @@ def bending_from_tip(
     ValueError
         If ``rest_length_mm`` is not a finite number > 0.
     """
-    owner = "bending_from_tip"
     rest = check_range(rest_length_mm, "rest_length_mm", low=0.0)
     x = check_finite_array(x_mm, "x_mm")
     y = check_finite_array(y_mm, "y_mm")
-    x, y = _broadcast(x, y, ("x_mm", "y_mm"), owner)
+    y, x = _broadcast(y, x, ("y_mm", "x_mm"))
 
     u = rest - y
     unreachable = (x == 0) & ~(u > 0)
     if unreachable.any():
         first = int(np.flatnonzero(unreachable.ravel())[0])
         raise DatasetError(
-            f"The 'y_mm' of bending_from_tip must be < rest_length_mm ({rest:g}) where "
-            f"x_mm == 0, since a tip on the rest axis lies below the base. "
-            f"Got {y.ravel()[first]!r} at position {first} instead."
+            f"must be < rest_length_mm ({rest:g}) where x_mm == 0, since a tip on the rest "
+            f"axis lies below the base; got {float(y.ravel()[first])!r} at position {first}",
+            key="y_mm",
         )
 
     abs_x = np.abs(x)
@@ -206,9 +206,9 @@ def bending_from_tip(
     if not np.all(np.isfinite(length)):
         first = int(np.flatnonzero(~np.isfinite(length).ravel())[0])
         raise DatasetError(
-            f"The 'x_mm' of bending_from_tip must not be vanishingly small on the far side of "
-            f"the base (the arc length diverges). Got {x.ravel()[first]!r} at position "
-            f"{first} instead."
+            "must not be vanishingly small on the far side of the base (the arc length "
+            f"diverges); got {float(x.ravel()[first])!r} at position {first}",
+            key="x_mm",
         )
     rho_out = np.sign(x) * alpha / np.pi
     return _out(rho_out), _out(length)
@@ -280,18 +280,19 @@ _PRATT_INV = np.linalg.inv(_PRATT)
 
 
 def _as_polyline(points_mm: object) -> np.ndarray:
-    owner = "fit_arc"
     points = check_finite_array(points_mm, "points_mm")
     if points.ndim != 2 or points.shape[1] != 2 or points.shape[0] < 3:
         raise DatasetError(
-            f"The 'points_mm' of {owner} must be an array of shape (n, 2) with n >= 3, "
-            f"ordered from base to tip. Got shape {points.shape} instead."
+            "must be an array of shape (n, 2) with n >= 3, ordered from base to tip; "
+            f"got shape {points.shape}",
+            key="points_mm",
         )
     distinct = np.unique(points, axis=0).shape[0]
     if distinct < 3:
         raise DatasetError(
-            f"The 'points_mm' of {owner} must contain at least 3 distinct points. "
-            f"Got {distinct} distinct of {points.shape[0]} instead."
+            "must contain at least 3 distinct points; "
+            f"got {distinct} distinct of {points.shape[0]}",
+            key="points_mm",
         )
     return points
 
@@ -310,9 +311,7 @@ def _pratt_fit(q: np.ndarray) -> np.ndarray:
         coef = vt.T @ np.diag(1.0 / sv) @ vt @ vectors[:, 1]
     norm = float(coef @ _PRATT @ coef)
     if not norm > 0:
-        raise DatasetError(
-            "The 'points_mm' of fit_arc must not be degenerate: no circle or line fits them."
-        )
+        raise DatasetError("must not be degenerate: no circle or line fits them", key="points_mm")
     return coef / math.sqrt(norm)
 
 

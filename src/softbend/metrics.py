@@ -37,12 +37,12 @@ mean of ``y`` gives r2 = 0 and fit = 0.
 from __future__ import annotations
 
 import math
-from typing import Any
 
 import numpy as np
 from numpy.typing import ArrayLike
 
 from softbend._validation import check_finite_array, check_range
+from softbend.errors import InputError
 
 __all__ = [
     "fit_percent",
@@ -54,30 +54,27 @@ __all__ = [
 ]
 
 
-def _pair(y: ArrayLike, y_hat: ArrayLike, owner: str) -> tuple[np.ndarray, np.ndarray]:
+def _pair(y: ArrayLike, y_hat: ArrayLike) -> tuple[np.ndarray, np.ndarray]:
     """Validate a (measurement, prediction) pair and return two 1-D float arrays."""
     arrays = []
-    for name, values in (("y", y), ("y_hat", y_hat)):
+    for key, values in (("y", y), ("y_hat", y_hat)):
         try:
             array = np.asarray(values, dtype=float)
         except (TypeError, ValueError):
-            raise ValueError(
-                f"The '{name}' of {owner} must be a 1-D array of numbers. "
-                f"Got {type(values).__name__} instead."
+            raise InputError(
+                f"must be a 1-D array of numbers; got {type(values).__name__}", key=key
             ) from None
         if array.ndim == 2 and array.shape[1] == 1:
             array = array[:, 0]
         if array.ndim != 1 or array.size == 0:
-            raise ValueError(
-                f"The '{name}' of {owner} must be a non-empty 1-D array (n_samples,). "
-                f"Got shape {array.shape} instead."
+            raise InputError(
+                f"must be a non-empty 1-D array (n_samples,); got shape {array.shape}", key=key
             )
         arrays.append(array)
     measured, predicted = arrays
     if measured.shape != predicted.shape:
-        raise ValueError(
-            f"The 'y_hat' of {owner} must have the length of 'y' ({measured.size}). "
-            f"Got {predicted.size} instead."
+        raise InputError(
+            f"must have the length of 'y' ({measured.size}); got {predicted.size}", key="y_hat"
         )
     check_finite_array(measured, "y")
     return measured, predicted
@@ -108,7 +105,7 @@ def rmse(y: ArrayLike, y_hat: ArrayLike) -> float:
         √(mean((y − ŷ)²)) in the unit of ``y``; NaN if ``y_hat`` has NaN, inf if
         it has infinite values.
     """
-    measured, predicted = _pair(y, y_hat, "rmse")
+    measured, predicted = _pair(y, y_hat)
     return math.sqrt(_sum_squared_error(measured, predicted) / measured.size)
 
 
@@ -132,7 +129,7 @@ def nrmse(y: ArrayLike, y_hat: ArrayLike) -> float:
     number comparable between ρ (≈ 0.5 range) and L (mm) and between
     experiments with small and large excursions.
     """
-    measured, predicted = _pair(y, y_hat, "nrmse")
+    measured, predicted = _pair(y, y_hat)
     if _is_constant(measured):
         return math.nan
     error = math.sqrt(_sum_squared_error(measured, predicted) / measured.size)
@@ -155,7 +152,7 @@ def r2(y: ArrayLike, y_hat: ArrayLike) -> float:
         scikit-learn's ``r2_score``, which returns 1 or 0 there); NaN or −inf
         propagate from ``y_hat``.
     """
-    measured, predicted = _pair(y, y_hat, "r2")
+    measured, predicted = _pair(y, y_hat)
     if _is_constant(measured):
         return math.nan
     total = float(np.sum((measured - measured.mean()) ** 2))
@@ -178,7 +175,7 @@ def fit_percent(y: ArrayLike, y_hat: ArrayLike) -> float:
         fit = 100 · (1 − √(1 − R²)). NaN if ``y`` is constant; NaN or −inf
         propagate from ``y_hat``.
     """
-    measured, predicted = _pair(y, y_hat, "fit_percent")
+    measured, predicted = _pair(y, y_hat)
     if _is_constant(measured):
         return math.nan
     total = float(np.sum((measured - measured.mean()) ** 2))
@@ -200,7 +197,7 @@ def regression_metrics(y: ArrayLike, y_hat: ArrayLike) -> dict[str, float]:
     dict
         ``{"rmse", "nrmse", "r2", "fit_percent"}`` as defined in this module.
     """
-    measured, predicted = _pair(y, y_hat, "regression_metrics")
+    measured, predicted = _pair(y, y_hat)
     return {
         "rmse": rmse(measured, predicted),
         "nrmse": nrmse(measured, predicted),
@@ -210,8 +207,8 @@ def regression_metrics(y: ArrayLike, y_hat: ArrayLike) -> dict[str, float]:
 
 
 def thresholded_mape(
-    observed: Any,
-    predicted: Any,
+    observed: ArrayLike,
+    predicted: ArrayLike,
     *,
     threshold: float = 1.0,
 ) -> tuple[float, int]:
@@ -249,9 +246,8 @@ def thresholded_mape(
     obs = check_finite_array(observed, "observed").ravel()
     pred = check_finite_array(predicted, "predicted").ravel()
     if obs.shape != pred.shape:
-        raise ValueError(
-            f"The 'predicted' of thresholded_mape must have the shape of 'observed' {obs.shape}. "
-            f"Got {pred.shape} instead."
+        raise InputError(
+            f"must have the shape of 'observed' {obs.shape}; got {pred.shape}", key="predicted"
         )
     keep = (np.abs(obs) >= threshold) & (obs != 0.0)
     n_excluded = int((~keep).sum())

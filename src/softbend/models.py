@@ -29,8 +29,9 @@ from typing import Any, Protocol, runtime_checkable
 import numpy as np
 from numpy.typing import ArrayLike
 
-from softbend._validation import check_range
+from softbend._validation import check_range, must_be
 from softbend.design import SFRBADesign
+from softbend.errors import InputError
 
 __all__ = [
     "DEFAULT_PMAX_MPA",
@@ -49,9 +50,6 @@ DEFAULT_PSTEP_MPA = 0.005
 def default_pressures_mpa(
     pmax_mpa: float = DEFAULT_PMAX_MPA,
     step_mpa: float = DEFAULT_PSTEP_MPA,
-    *,
-    names: tuple[str, str] = ("pmax_mpa", "step_mpa"),
-    owner: str = "default_pressures_mpa",
 ) -> np.ndarray:
     """Uniform gauge-pressure grid ``0, step, 2·step, ..., pmax`` in MPa.
 
@@ -67,78 +65,74 @@ def default_pressures_mpa(
         (to 1e-9 relative).
     step_mpa : float
         Step, MPa, in (0, pmax_mpa].
-    names : (str, str)
-        What the caller calls the two, for messages (a command line: ``("--pmax", "--pstep")``).
-    owner : str
-        Who asks, for messages.
 
     Returns
     -------
     numpy.ndarray
         ``round(pmax/step) + 1`` increasing pressures starting at 0.
+
+    Raises
+    ------
+    InputError
+        Keyed ``pmax_mpa`` or ``step_mpa``.
     """
-    pmax_name, step_name = names
-    pmax = check_range(pmax_mpa, pmax_name, low=0.0, high=100.0, high_inclusive=True)
-    step = check_range(step_mpa, step_name, low=0.0, high=pmax, high_inclusive=True)
+    pmax = check_range(pmax_mpa, "pmax_mpa", low=0.0, high=100.0, high_inclusive=True)
+    step = check_range(step_mpa, "step_mpa", low=0.0, high=pmax, high_inclusive=True)
     n_steps = round(pmax / step)
     if abs(n_steps * step - pmax) > 1e-9 * pmax:
-        raise ValueError(
-            f"The '{pmax_name}' of {owner} must be a whole number of steps of {step:g} MPa "
-            f"(the '{step_name}'). "
-            f"Got {pmax:g} MPa ({pmax / step:.6g} steps) instead."
+        raise InputError(
+            must_be(f"a whole number of steps of {step:g} MPa", pmax)
+            + f" ({pmax / step:.6g} steps)",
+            key="pmax_mpa",
         )
     if n_steps > 100_000:
-        raise ValueError(
-            f"The pressure grid of {owner} must have at most 100001 values. "
-            f"Got {n_steps + 1} ({pmax:g} MPa in steps of {step:g} MPa) instead."
+        raise InputError(
+            f"must give a grid of at most 100001 pressures in steps of {step:g} MPa; "
+            f"got {n_steps + 1} pressures up to {pmax:g} MPa",
+            key="pmax_mpa",
         )
     return np.round(np.arange(n_steps + 1) * step, 12)
 
 
 def check_pressures_mpa(
-    pressures_mpa: ArrayLike, owner: str, name: str = "pressures_mpa"
+    pressures_mpa: ArrayLike,
+    owner: str | None = None,  # transitional: ignored; callers outside this module still pass it
+    key: str = "pressures_mpa",
 ) -> np.ndarray:
     """Validate a sweep grid: 1-D, finite, >= 0 MPa and strictly increasing.
 
-    Returns the grid as a new read-only float array; raises ``ValueError`` naming
-    the field, the rule and the first offending value.
+    Returns the grid as a new read-only float array; raises :class:`InputError`
+    keyed ``key`` that names the rule and the first offending value.
     """
     try:
         grid = np.array(pressures_mpa, dtype=float)
     except (TypeError, ValueError):
-        raise ValueError(
-            f"The '{name}' of {owner} must be a 1-D sequence of numbers. "
-            f"Got {pressures_mpa!r} instead."
-        ) from None
+        raise InputError(must_be("a 1-D sequence of numbers", pressures_mpa), key=key) from None
     if grid.ndim != 1 or grid.size == 0:
-        raise ValueError(
-            f"The '{name}' of {owner} must be a non-empty 1-D sequence. "
-            f"Got shape {grid.shape} instead."
-        )
+        raise InputError(f"must be a non-empty 1-D sequence; got shape {grid.shape}", key=key)
     bad = ~np.isfinite(grid) | (grid < 0.0)
     if bad.any():
         i = int(np.flatnonzero(bad)[0])
-        raise ValueError(
-            f"The '{name}' of {owner} must be finite and in [0, inf) MPa. "
-            f"Got {float(grid[i])!r} at position {i} instead."
+        raise InputError(
+            f"must be finite and in [0, inf) MPa; got {float(grid[i])!r} at position {i}",
+            key=key,
         )
     steps = np.diff(grid)
     if (steps <= 0.0).any():
         i = int(np.flatnonzero(steps <= 0.0)[0]) + 1
-        raise ValueError(
-            f"The '{name}' of {owner} must be strictly increasing. "
-            f"Got {float(grid[i])!r} after {float(grid[i - 1])!r} at position {i} instead."
+        raise InputError(
+            f"must be strictly increasing; got {float(grid[i])!r} after "
+            f"{float(grid[i - 1])!r} at position {i}",
+            key=key,
         )
     grid.setflags(write=False)
     return grid
 
 
-def _as_vector(values: ArrayLike, dtype: type, name: str) -> np.ndarray:
+def _as_vector(values: ArrayLike, dtype: type, key: str) -> np.ndarray:
     array: np.ndarray = np.array(values, dtype=dtype)
     if array.ndim != 1:
-        raise ValueError(
-            f"The '{name}' of SweepResult must be 1-D. Got shape {array.shape} instead."
-        )
+        raise InputError(f"must be 1-D; got shape {array.shape}", key=key)
     array.setflags(write=False)
     return array
 
@@ -197,9 +191,7 @@ class SweepResult:
 
     def __post_init__(self) -> None:
         if not isinstance(self.design, SFRBADesign):
-            raise ValueError(
-                f"The 'design' of SweepResult must be an SFRBADesign. Got {self.design!r} instead."
-            )
+            raise InputError(must_be("an SFRBADesign", self.design), key="design")
         arrays = {
             "pressure_mpa": float,
             "angle_deg": float,
@@ -212,17 +204,21 @@ class SweepResult:
             object.__setattr__(self, name, _as_vector(getattr(self, name), dtype, name))
         lengths = {name: len(getattr(self, name)) for name in arrays}
         if len(set(lengths.values())) != 1:
-            raise ValueError(
-                f"The arrays of SweepResult must have equal lengths. Got {lengths} instead."
+            odd = next(name for name in arrays if lengths[name] != lengths["pressure_mpa"])
+            raise InputError(
+                f"must have the length of 'pressure_mpa' like every array of the sweep; "
+                f"got lengths {lengths}",
+                key=odd,
             )
         if len(self.pressure_mpa):
-            check_pressures_mpa(self.pressure_mpa, "SweepResult", "pressure_mpa")
+            check_pressures_mpa(self.pressure_mpa, key="pressure_mpa")
         failed = np.flatnonzero(~self.converged)
         if failed.size and failed[0] != len(self.converged) - 1:
-            raise ValueError(
-                "The 'converged' of SweepResult must be True everywhere but possibly at the "
-                f"last pressure (the sweep ends at the first failure). Got False at position "
-                f"{int(failed[0])} of {len(self.converged)} instead."
+            raise InputError(
+                "must be True everywhere but possibly at the last pressure (the sweep ends "
+                f"at the first failure); got False at position {int(failed[0])} of "
+                f"{len(self.converged)}",
+                key="converged",
             )
         wall = check_range(self.wall_time_s, "wall_time_s", low=0.0, low_inclusive=True)
         object.__setattr__(self, "wall_time_s", wall)

@@ -37,6 +37,8 @@ from collections.abc import Mapping
 from dataclasses import dataclass
 from typing import Any
 
+from softbend.errors import InputError
+
 __all__ = [
     "CONTROL_LOOP",
     "CONTROL_RESULTS",
@@ -102,20 +104,16 @@ class Reference:
 
     def __post_init__(self) -> None:
         if self.paper not in PAPERS:
-            raise ValueError(
-                f"The 'paper' of Reference must be one of 'A', 'B'. Got {self.paper!r} instead."
-            )
+            raise InputError(f"must be one of 'A', 'B'; got {self.paper!r}", key="paper")
         if not isinstance(self.source, str) or not _SOURCE.search(self.source):
-            raise ValueError(
-                "The 'source' of Reference must name a Table, Fig., Sec., Eq. or p. with its "
-                f"number (e.g. 'Sec. 4.3, Fig. 7c'). Got {self.source!r} instead."
+            raise InputError(
+                "must name a Table, Fig., Sec., Eq. or p. with its number (e.g. 'Sec. 4.3, "
+                f"Fig. 7c'); got {self.source!r}",
+                key="source",
             )
         for name in ("unit", "note"):
             if not isinstance(getattr(self, name), str):
-                raise ValueError(
-                    f"The '{name}' of Reference must be a string. "
-                    f"Got {getattr(self, name)!r} instead."
-                )
+                raise InputError(f"must be a string; got {getattr(self, name)!r}", key=name)
 
     def cite(self) -> str:
         """Where the value comes from, as the report writes it: ``"paper B, Sec. 4.3"``."""
@@ -126,15 +124,18 @@ class Reference:
         return f"{self.value}{unit} ({self.cite()})"
 
 
-def _ref(value: Any, unit: str, paper: str, source: str, note: str = "") -> Reference:
+_Value = float | str | tuple[object, ...]
+
+
+def _ref(value: _Value, unit: str, paper: str, source: str, note: str = "") -> Reference:
     return Reference(value, unit, paper, source, note)
 
 
-def _a(value: Any, unit: str, source: str, note: str = "") -> Reference:
+def _a(value: _Value, unit: str, source: str, note: str = "") -> Reference:
     return _ref(value, unit, "A", source, note)
 
 
-def _b(value: Any, unit: str, source: str, note: str = "") -> Reference:
+def _b(value: _Value, unit: str, source: str, note: str = "") -> Reference:
     return _ref(value, unit, "B", source, note)
 
 
@@ -368,14 +369,14 @@ def values(group: Mapping[str, Any]) -> dict[str, Any]:
         elif isinstance(entry, Mapping):
             out[name] = values(entry)
         else:
-            raise ValueError(
-                f"The entry {name!r} of a reference group must be a Reference or a mapping of "
-                f"them. Got {type(entry).__name__} instead."
+            raise InputError(
+                f"{name} must be a Reference or a mapping of them; got {type(entry).__name__}",
+                key="group",
             )
     return out
 
 
-def _walk(prefix: str, entry: Any, out: dict[str, Reference]) -> None:
+def _walk(prefix: str, entry: Reference | Mapping[str, Any], out: dict[str, Reference]) -> None:
     if isinstance(entry, Reference):
         out[prefix] = entry
     else:

@@ -83,6 +83,6 @@ def test_missing_data_path_and_bad_options_exit_2(tmp_path, capsys):
     assert (
         main(["curling", "identify", str(tmp_path), "--out", str(tmp_path), "--kernel", "x"]) == 2
     )
-    assert "'kernel'" in one_error_line(capsys)
+    assert "--kernel: must be one of 'moments', 'cv'" in one_error_line(capsys)
     assert main(["curling", "simulate", "--out", str(tmp_path), "--samples", "abc"]) == 2
     one_error_line(capsys)

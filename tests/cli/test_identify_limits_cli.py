@@ -51,11 +51,11 @@ def _recording(path, z_of=None):
 @pytest.mark.parametrize(
     ("option", "value", "said"),
     [
-        ("--seed", "-1", r"'--seed' must be an integer in [0, 4294967295]. Got -1 instead."),
-        ("--folds", "1", r"'--folds' must be an integer in [2, 1000]. Got 1 instead."),
-        ("--folds", "99999999999999999999", "Got 99999999999999999999 instead."),
-        ("--max-memory-mb", "nan", r"'--max-memory-mb' must be a number in (0, 1e+09]."),
-        ("--max-memory-mb", "-1", r"'--max-memory-mb' must be a number in (0, 1e+09]."),
+        ("--seed", "-1", r"--seed: must be an integer in [0, 4294967295]; got -1"),
+        ("--folds", "1", r"--folds: must be an integer in [2, 1000]; got 1"),
+        ("--folds", "99999999999999999999", "; got 99999999999999999999"),
+        ("--max-memory-mb", "nan", r"--max-memory-mb: must be a number in (0, 1e+09]"),
+        ("--max-memory-mb", "-1", r"--max-memory-mb: must be a number in (0, 1e+09]"),
     ],
 )
 def test_identify_options_out_of_range(tmp_path, capsys, no_fit, option, value, said):
@@ -70,9 +70,9 @@ def test_identify_options_out_of_range(tmp_path, capsys, no_fit, option, value, 
 @pytest.mark.parametrize(
     ("held", "said"),
     [
-        ("a,a", "The '--validate-on' must name each experiment once. Got 'a' more than once."),
-        ("a,zz", "The '--validate-on' must name experiments of the data (a, b, c, d). Got 'zz'"),
-        ("a,b,c", "The '--validate-on' must leave at least 2 of the 4 experiments to train on"),
+        ("a,a", "--validate-on: must name each experiment once; got 'a' more than once"),
+        ("a,zz", "--validate-on: must name experiments of the data (a, b, c, d); got 'zz'"),
+        ("a,b,c", "--validate-on: must leave at least 2 of the 4 experiments to train on"),
     ],
 )
 def test_identify_validate_on_is_checked_before_any_fit(tmp_path, capsys, no_fit, held, said):
@@ -119,19 +119,19 @@ def test_identify_refuses_an_output_whose_figures_could_not_be_finite(
         (
             "--input-lags",
             "1000000000",
-            "The '--input-lags' must be an integer in [1, 50]. Got 1000000000 instead.",
+            "--input-lags: must be an integer in [1, 50]; got 1000000000",
         ),
         (
             "--output-lags",
             "99999999999999999999",
-            "The '--output-lags' must be an integer in [1, 50]. Got 99999999999999999999 instead.",
+            "--output-lags: must be an integer in [1, 50]; got 99999999999999999999",
         ),
-        ("--output-lags", "0", "The '--output-lags' must be an integer in [1, 50]. Got 0 instead."),
-        ("--C", "1e300", "The '--C' must be a number in (0, 10000]. Got 1e+300 instead."),
-        ("--C", "0", "The '--C' must be a number in (0, 10000]. Got 0.0 instead."),
-        ("--epsilon", "nan", "The '--epsilon' must be a number in [0, 10]. Got nan instead."),
-        ("--epsilon", "-0.1", "The '--epsilon' must be a number in [0, 10]. Got -0.1 instead."),
-        ("--max-memory-mb", "inf", "The '--max-memory-mb' must be a number in (0, 1e+09]."),
+        ("--output-lags", "0", "--output-lags: must be an integer in [1, 50]; got 0"),
+        ("--C", "1e300", "--C: must be a number in (0, 10000]; got 1e+300"),
+        ("--C", "0", "--C: must be a number in (0, 10000]; got 0.0"),
+        ("--epsilon", "nan", "--epsilon: must be a number in [0, 10]; got nan"),
+        ("--epsilon", "-0.1", "--epsilon: must be a number in [0, 10]; got -0.1"),
+        ("--max-memory-mb", "inf", "--max-memory-mb: must be a number in (0, 1e+09]"),
     ],
 )
 def test_curling_identify_options_out_of_range(tmp_path, capsys, no_fit, option, value, said):
@@ -152,8 +152,8 @@ def test_curling_identify_refuses_lags_the_shortest_experiment_cannot_hold(
     out = tmp_path / "out"
     assert main(["curling", "identify", str(folder), "--output-lags", "20", "-o", str(out)]) == 2
     line = one_error_line(capsys)
-    assert "The '--output-lags' must be an integer in [1, 12] for these experiments" in line
-    assert "16 sample(s)" in line and "Got 20 instead." in line and not out.exists()
+    assert "--output-lags: must be an integer in [1, 12] for these experiments" in line
+    assert "16 sample(s)" in line and "; got 20" in line and not out.exists()
 
 
 def test_curling_identify_refuses_an_experiment_with_a_constant_output(tmp_path, capsys, no_fit):

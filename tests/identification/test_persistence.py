@@ -50,7 +50,7 @@ def test_newer_schema_and_foreign_files_are_refused(tmp_path):
     with pytest.raises(SchemaError, match="schema version 99"):
         load_narx(path)
     path.write_text("{}")
-    with pytest.raises(SchemaError, match="Not a saved softbend NARX model"):
+    with pytest.raises(SchemaError, match="not a saved softbend NARX model"):
         load_narx(path)
     path.write_text("not json")
     with pytest.raises(SchemaError, match="not valid JSON"):
@@ -92,53 +92,61 @@ _CORRUPTIONS = [
     (
         "nan dual coef",
         lambda d: d["estimator"]["dual_coef"].__setitem__(0, float("nan")),
-        r"'estimator.dual_coef\[0\]' must be a finite number",
+        r"estimator.dual_coef\[0\]: must be a finite number",
     ),
     (
         "string dual coef",
         lambda d: d["estimator"]["dual_coef"].__setitem__(0, "0.5"),
-        r"'estimator.dual_coef\[0\]' must be a finite number",
+        r"estimator.dual_coef\[0\]: must be a finite number",
     ),
     ("nan support vector", _first_row("support_vectors"), r"support_vectors\[0\]\[0\]"),
     (
         "support vector removed",
         lambda d: d["estimator"]["support_vectors"].pop(),
-        "'estimator.support_vectors' must be a list of",
+        "estimator.support_vectors: must be a list of",
     ),
     (
         "support vector column removed",
         lambda d: d["estimator"]["support_vectors"][0].pop(),
-        r"'estimator.support_vectors\[0\]' must be a list of 4 numbers",
+        r"estimator.support_vectors\[0\]: must be a list of 4 numbers",
     ),
-    ("zero sigma", lambda d: d["estimator"].update(sigma=0.0), "'estimator.sigma' .* > 0"),
-    ("string sigma", lambda d: d["estimator"].update(sigma="1.0"), "'estimator.sigma'"),
-    ("shape above 2", lambda d: d["estimator"].update(shape=3.0), "'estimator.shape'.*<= 2"),
+    (
+        "zero sigma",
+        lambda d: d["estimator"].update(sigma=0.0),
+        r"estimator.sigma: must be a number in \(0, inf\)",
+    ),
+    ("string sigma", lambda d: d["estimator"].update(sigma="1.0"), "estimator.sigma: must"),
+    (
+        "shape above 2",
+        lambda d: d["estimator"].update(shape=3.0),
+        r"estimator.shape: must be a number in \(0, 2\]",
+    ),
     (
         "negative kernel scale",
         lambda d: d["estimator"].update(kernel_scale=-1.0),
-        "'estimator.kernel_scale'",
+        "estimator.kernel_scale: must",
     ),
     (
         "infinite intercept",
         lambda d: d["estimator"].update(intercept=float("inf")),
-        "'estimator.intercept'",
+        "estimator.intercept: must",
     ),
     (
         "wrong feature count",
         lambda d: d["estimator"].update(n_features_in=5),
-        "'estimator.n_features_in' must be 4",
+        "estimator.n_features_in: must be 4",
     ),
-    ("other estimator", lambda d: d["estimator"].update({"class": "SVR"}), "'estimator.class'"),
-    ("bad C", lambda d: d["estimator"]["params"].update(C=-1), "'estimator.params.C'"),
+    ("other estimator", lambda d: d["estimator"].update({"class": "SVR"}), "estimator.class: must"),
+    ("bad C", lambda d: d["estimator"]["params"].update(C=-1), "estimator.params.C: must"),
     (
         "bad moments_of",
         lambda d: d["estimator"]["params"].update(moments_of="pairs"),
-        "'estimator.params.moments_of' must be one of 'differences'",
+        "estimator.params.moments_of: must be one of 'differences'",
     ),
     (
         "bad max_working_set",
         lambda d: d["estimator"]["params"].update(max_working_set=2),
-        "'estimator.params.max_working_set' must be an integer >= 8",
+        "estimator.params.max_working_set: must be an integer in \\[8, inf\\)",
     ),
     (
         "unknown estimator key",
@@ -155,35 +163,35 @@ _CORRUPTIONS = [
     (
         "lags and offsets disagree",
         lambda d: d["narx"].update(output_offsets=[1, 3]),
-        "'narx.output_offsets' must be \\[1, 2\\]",
+        "narx.output_offsets: must be \\[1, 2\\]",
     ),
     (
         "string lag",
         lambda d: d["narx"]["params"].update(output_lags="2"),
-        "'narx.params.output_lags' must be an integer >= 1",
+        "narx.params.output_lags: must be an integer in \\[1, inf\\)",
     ),
     (
         "zero scale",
         lambda d: d["narx"]["y_scaler"].update(scale=[0.0]),
-        r"'narx.y_scaler.scale\[0\]' must be a finite number > 0",
+        r"narx.y_scaler.scale\[0\]: must be a number in \(0, inf\)",
     ),
     (
         "nan mean",
         lambda d: d["narx"]["u_scaler"].update(mean=[float("nan")]),
-        r"'narx.u_scaler.mean\[0\]'",
+        r"narx.u_scaler.mean\[0\]: must",
     ),
     (
         "scaler for two inputs",
         lambda d: d["narx"]["u_scaler"].update(mean=[0.0, 1.0]),
-        "'narx.u_scaler.mean' must be a list of 1 numbers",
+        "narx.u_scaler.mean: must be a list of 1 numbers",
     ),
     (
         "scaler without scaling",
         lambda d: d["narx"]["params"].update(scale=False),
-        "'narx.y_scaler' must be null",
+        "narx.y_scaler: must be null",
     ),
-    ("metadata not an object", lambda d: d.update(metadata=[1]), "'metadata' must be a JSON"),
-    ("not an object", lambda d: d["narx"].update(params=[2, 2]), "'narx.params' must be a JSON"),
+    ("metadata not an object", lambda d: d.update(metadata=[1]), "metadata: must be a JSON"),
+    ("not an object", lambda d: d["narx"].update(params=[2, 2]), "narx.params: must be a JSON"),
 ]
 
 
@@ -206,8 +214,9 @@ def test_hand_edited_models_are_refused_in_one_line_naming_file_and_key(tmp_path
 def test_json_that_is_not_an_object_is_refused(tmp_path, text):
     path = tmp_path / "m.json"
     path.write_text(text)
-    with pytest.raises(SchemaError, match=f"Not a saved softbend NARX model: {path}"):
+    with pytest.raises(SchemaError, match="not a saved softbend NARX model") as info:
         load_narx(path)
+    assert str(info.value).startswith(f"{path}: format: must be")
 
 
 def test_version_1_files_load_with_the_reading_they_were_fitted_with(tmp_path):

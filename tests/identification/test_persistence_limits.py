@@ -46,33 +46,33 @@ def _write(source, target, change):
     [
         pytest.param(
             lambda d: d["estimator"].update(sigma=1e-300),
-            r"'estimator.sigma': 1e-300 is not a plausible kernel width "
+            r"estimator.sigma: 1e-300 is not a plausible kernel width "
             r"\(allowed 1e-06 to 1e\+06\)",
             id="tiny sigma",
         ),
         pytest.param(
             lambda d: d["estimator"].update(sigma=1e300),
-            r"'estimator.sigma': 1e\+300 is not a plausible kernel width",
+            r"estimator.sigma: 1e\+300 is not a plausible kernel width",
             id="huge sigma",
         ),
         pytest.param(
             lambda d: d["estimator"]["params"].update(sigma=5e7),
-            r"'estimator.params.sigma': 5e\+07 is not a plausible kernel width",
+            r"estimator.params.sigma: 5e\+07 is not a plausible kernel width",
             id="huge sigma parameter",
         ),
         pytest.param(
             lambda d: d["estimator"].update(sigma=float("nan")),
-            r"'estimator.sigma' must be a finite number > 0; got NaN",
+            r"estimator.sigma: must be a number in \(0, inf\); got NaN",
             id="nan sigma",
         ),
         pytest.param(
             lambda d: d["narx"]["params"].update(output_lags=10**11),
-            r"'narx.output_offsets' must be a list of 100000000000 integers; got \[1, 2\]",
+            r"narx.output_offsets: must be a list of 100000000000 integers; got \[1, 2\]",
             id="huge lag",
         ),
         pytest.param(
             lambda d: d["narx"]["params"].update(input_lags=10**11),
-            r"'narx.input_offsets' must be a list of 100000000000 integers",
+            r"narx.input_offsets: must be a list of 100000000000 integers",
             id="huge input lag",
         ),
     ],

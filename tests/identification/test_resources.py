@@ -58,7 +58,7 @@ def test_the_guard_refuses_before_reading_with_one_clear_line(folder, monkeypatc
 
 
 def test_the_limit_must_be_positive_and_defaults_to_the_memory_available(folder):
-    with pytest.raises(ValueError, match="'max_memory_mb' of check_identify_memory"):
+    with pytest.raises(ValueError, match=r"^max_memory_mb: must be a number"):
         check_identify_memory(folder, max_memory_mb=0)
     available = available_memory_bytes()
     assert available is None or available > 0

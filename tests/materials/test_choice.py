@@ -33,9 +33,12 @@ def test_a_fit_file_gives_its_best_or_named_model(fit_file):
 
 
 def test_bad_specs_are_one_line(fit_file):
-    with pytest.raises(UnknownNameError, match="known: dragon-skin-30, fiberglass, kevlar"):
+    with pytest.raises(UnknownNameError, match="known: dragon-skin-30, fiberglass, kevlar") as info:
         material_from_spec("ecoflex")
-    with pytest.raises(SchemaError, match=r"names model 'ogden'.*holds neo-hookean, yeoh"):
+    assert info.value.key == "spec" and "or a fit.json of 'softbend materials fit'" in str(
+        info.value
+    )
+    with pytest.raises(SchemaError, match=r"^spec: names model 'ogden'.*holds neo-hookean, yeoh"):
         material_from_spec(f"{fit_file}#ogden")
 
 

@@ -166,33 +166,35 @@ def test_unknown_model_lists_allowed_names():
     with pytest.raises(ValueError, match="Unknown material model 'mooney-rivlin'") as info:
         fit_model("mooney-rivlin", STRETCH, STRETCH - 1.0)
     assert f"known: {', '.join(DEFAULT_MODELS)}." in str(info.value)
-    with pytest.raises(ValueError, match=r"'mooney' \(in models\)"):
+    with pytest.raises(ValueError, match=r"^models: Unknown material model 'mooney'"):
         fit_models((STRETCH, STRETCH - 1.0), ["yeoh", "mooney"])
 
 
 def test_bad_model_lists():
     data = (STRETCH, 0.3 * (STRETCH - 1.0))
-    with pytest.raises(ValueError, match="at least one"):
+    with pytest.raises(ValueError, match=r"^models: must be at least one of"):
         fit_models(data, [])
-    with pytest.raises(ValueError, match="distinct"):
+    with pytest.raises(ValueError, match=r"^models: must be distinct"):
         fit_models(data, ["yeoh", "yeoh"])
-    with pytest.raises(ValueError, match="TensileTest or a"):
+    with pytest.raises(ValueError, match=r"^data: must be a TensileTest or a"):
         fit_models(STRETCH)
 
 
 def test_bad_data():
     stress = 0.3 * (STRETCH - 1.0)
-    with pytest.raises(DatasetError, match="'nominal_stress_mpa' of fit_model must be finite"):
+    with pytest.raises(DatasetError, match=r"^nominal_stress_mpa: must be finite"):
         fit_model("yeoh", STRETCH, np.where(STRETCH > 3, np.nan, stress))
-    with pytest.raises(DatasetError, match=r"'stretch' of fit_model must be in \(0, inf\)"):
+    with pytest.raises(DatasetError, match=r"^stretch: must be in \(0, inf\)"):
         fit_model("yeoh", STRETCH - 2.0, stress)
-    with pytest.raises(DatasetError, match="one length"):
+    with pytest.raises(DatasetError, match=r"^nominal_stress_mpa: .* the length of 'stretch'"):
         fit_model("yeoh", STRETCH, stress[:-1])
-    with pytest.raises(DatasetError, match=r"at least 5 points\. Got 4"):
+    with pytest.raises(DatasetError, match=r"^stretch: must be at least 5 points; got 4"):
         fit_model("yeoh", STRETCH[:4], stress[:4])
-    with pytest.raises(ValueError, match=r"'max_stretch' of fit_model must be a number in \(1"):
+    with pytest.raises(ValueError, match=r"^max_stretch: must be a number in \(1"):
         fit_model("yeoh", STRETCH, stress, max_stretch=0.9)
-    with pytest.raises(ValueError, match=r"keep at least 5 points.*Got 1.2 \(3 points\)"):
+    with pytest.raises(
+        ValueError, match=r"^max_stretch: must keep at least 5 points.*got 1.2 \(3 points\)"
+    ):
         fit_model("yeoh", STRETCH, stress, max_stretch=1.2)
 
 
@@ -215,5 +217,5 @@ def test_fit_result_dict_is_json(ds30_fits):
     assert payload["model"] == "arruda-boyce"
     assert set(payload["parameters"]) == {"mu_mpa", "lambda_m"}
     assert payload["initial_shear_modulus_mpa"] > payload["parameters"]["mu_mpa"]
-    with pytest.raises(ValueError, match="'model' of FitResult"):
+    with pytest.raises(ValueError, match=r"^model: must be a HyperelasticModel"):
         FitResult(model="yeoh", r2=1.0, rmse_mpa=0.0, n_points=5, stretch_range=(1.0, 2.0))

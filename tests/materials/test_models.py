@@ -193,7 +193,7 @@ def test_registry_names_and_classes():
 def test_unknown_model_name_lists_the_allowed_names():
     with pytest.raises(
         ValueError,
-        match=r"Unknown material model 'mooney' \(in model\); known: neo-hookean, yeoh, arruda",
+        match=r"^model: Unknown material model 'mooney'; known: neo-hookean, yeoh, arruda",
     ):
         get_model_class("mooney")
     with pytest.raises(ValueError, match="Unknown material model 'ogden'"):
@@ -202,7 +202,7 @@ def test_unknown_model_name_lists_the_allowed_names():
         model_from_dict({"mu_mpa": 1.0})
     with pytest.raises(ValueError, match="'yeoh'"):
         Yeoh.from_dict({"model": "neo-hookean", "c10_mpa": 1.0})
-    with pytest.raises(ValueError, match=r"'c20_mpa' in 'NeoHookean\.from_dict'; allowed keys"):
+    with pytest.raises(ValueError, match=r"'c20_mpa' in 'neo-hookean'; allowed keys"):
         NeoHookean.from_dict({"model": "neo-hookean", "c10_mpa": 1.0, "c20_mpa": 2.0})
     with pytest.raises(ValueError, match=r"Unknown material preset 'ecoflex'.*dragon-skin-30"):
         get_preset("ecoflex")
@@ -228,8 +228,9 @@ def test_unknown_model_name_lists_the_allowed_names():
     ],
 )
 def test_bad_values_raise_naming_the_field(factory, field, value):
-    with pytest.raises(ValueError, match=f"The '{field}' of .* must be"):
+    with pytest.raises(ValueError, match=rf"^{field}: must be") as info:
         factory(value)
+    assert info.value.key == field
 
 
 def test_yeoh_accepts_negative_higher_order_terms():
@@ -240,9 +241,7 @@ def test_yeoh_accepts_negative_higher_order_terms():
 
 @pytest.mark.parametrize("stretch", [0.0, -1.0, [1.0, np.nan]])
 def test_bad_stretch_raises_naming_the_field(stretch):
-    with pytest.raises(
-        ValueError, match=r"The 'stretch' of NeoHookean\.uniaxial_nominal_stress_mpa"
-    ):
+    with pytest.raises(ValueError, match=r"^stretch: must be"):
         NeoHookean(0.1).uniaxial_nominal_stress_mpa(stretch)
 
 

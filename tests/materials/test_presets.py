@@ -44,18 +44,18 @@ def test_linear_elastic_moduli_follow_the_isotropic_relations():
 def test_get_preset_and_bad_materials_name_the_field():
     assert get_preset("dragon-skin-30") is DRAGON_SKIN_30
     with pytest.raises(
-        ValueError, match=r"Unknown material preset 'ecoflex' \(in --material\); known: dragon"
+        ValueError, match=r"^name: Unknown material preset 'ecoflex'; known: dragon"
     ):
-        get_preset("ecoflex", field="--material")
-    with pytest.raises(ValueError, match="'nu' of LinearElastic"):
+        get_preset("ecoflex")
+    with pytest.raises(ValueError, match=r"^nu: must be a number in"):
         LinearElastic(e_mpa=1.0, nu=0.5)
-    with pytest.raises(ValueError, match="'e_mpa' of LinearElastic"):
+    with pytest.raises(ValueError, match=r"^e_mpa: must be a number in"):
         LinearElastic(e_mpa=-1.0, nu=0.3)
-    with pytest.raises(ValueError, match="'name' of Material"):
+    with pytest.raises(ValueError, match=r"^name: must be a non-empty string"):
         Material(name=" ", model=DRAGON_SKIN_30.model, density_t_per_mm3=1e-9)
-    with pytest.raises(ValueError, match="'model' of Material"):
+    with pytest.raises(ValueError, match=r"^model: must be a HyperelasticModel"):
         Material(name="x", model=3.0, density_t_per_mm3=1e-9)
-    with pytest.raises(ValueError, match="'density_t_per_mm3' of Material"):
+    with pytest.raises(ValueError, match=r"^density_t_per_mm3: must be a number in"):
         Material(name="x", model=DRAGON_SKIN_30.model, density_t_per_mm3=0.0)
-    with pytest.raises(ValueError, match=r"'model' of LinearElastic\.from_dict"):
+    with pytest.raises(ValueError, match=r"^model: must be one of 'linear-elastic'"):
         LinearElastic.from_dict({"model": "yeoh", "e_mpa": 1.0, "nu": 0.3})

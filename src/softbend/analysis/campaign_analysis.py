@@ -11,7 +11,7 @@ import pandas as pd
 from softbend.analysis.correlation import correlation_matrix
 from softbend.analysis.regression import RegressionReport, standardized_regression
 from softbend.analysis.samples import DEFAULT_FEATURES, DEFAULT_TARGET
-from softbend.errors import DatasetError
+from softbend.errors import DatasetError, SoftbendError
 
 __all__ = ["CampaignAnalysis", "analyze_samples"]
 
@@ -96,10 +96,13 @@ def analyze_samples(
         On a bad ``features``, ``target`` or ``mape_threshold``.
     """
     if isinstance(samples, pd.DataFrame) and len(samples) == 0:
-        raise DatasetError(
-            "The 'samples' of analyze_samples hold no rows; there is nothing to analyze."
-        )
+        raise DatasetError("must hold rows; got none: there is nothing to analyze", key="samples")
     names = [features] if isinstance(features, str) else [str(f) for f in features]
-    regression = standardized_regression(samples, names, target, mape_threshold=mape_threshold)
-    correlation = correlation_matrix(samples, [*names, target])
+    try:
+        regression = standardized_regression(samples, names, target, mape_threshold=mape_threshold)
+        correlation = correlation_matrix(samples, [*names, target])
+    except SoftbendError as error:
+        if error.key == "df":  # the table the two analyses were given is ``samples`` here
+            error.key = "samples"
+        raise
     return CampaignAnalysis(regression=regression, correlation=correlation)

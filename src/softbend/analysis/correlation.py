@@ -7,6 +7,7 @@ from collections.abc import Sequence
 import numpy as np
 import pandas as pd
 
+from softbend._validation import must_be
 from softbend.analysis.samples import DEFAULT_FEATURES, DEFAULT_TARGET, clean_samples, is_constant
 from softbend.errors import DatasetError
 
@@ -44,12 +45,10 @@ def correlation_matrix(
     """
     cols = list((*DEFAULT_FEATURES, DEFAULT_TARGET) if columns is None else columns)
     if not cols:
-        raise DatasetError("The 'columns' of correlation_matrix must name at least one column.")
-    data, _ = clean_samples(df, cols, "correlation_matrix")
+        raise DatasetError(must_be("at least one column name", cols), key="columns")
+    data, _ = clean_samples(df, cols)
     if len(data) < 2:
-        raise DatasetError(
-            f"correlation_matrix needs at least 2 complete, converged rows. Got {len(data)}."
-        )
+        raise DatasetError(must_be("at least 2 complete, converged rows", len(data)), key="df")
     values = data[cols].to_numpy()
     centred = values - values.mean(axis=0)
     norms = np.sqrt((centred**2).sum(axis=0))

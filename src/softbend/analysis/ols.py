@@ -82,7 +82,7 @@ class ZScoredFit:
     fitted: np.ndarray
 
 
-def fit_zscored(data: pd.DataFrame, features: Sequence[str], target: str, owner: str) -> ZScoredFit:
+def fit_zscored(data: pd.DataFrame, features: Sequence[str], target: str) -> ZScoredFit:
     """Fit ``z(y) = Σ_j β*_j z(x_j) + β*_0`` by ordinary least squares.
 
     Parameters
@@ -93,8 +93,6 @@ def fit_zscored(data: pd.DataFrame, features: Sequence[str], target: str, owner:
         Feature columns, none constant in ``data``.
     target : str
         Target column, not constant in ``data``.
-    owner : str
-        Name of the calling function, for error messages.
 
     Returns
     -------
@@ -103,7 +101,7 @@ def fit_zscored(data: pd.DataFrame, features: Sequence[str], target: str, owner:
     Raises
     ------
     DatasetError
-        If the features are linearly dependent in the data.
+        Keyed ``features``, if they are linearly dependent in the data.
     """
     import statsmodels.api as sm
 
@@ -118,9 +116,9 @@ def fit_zscored(data: pd.DataFrame, features: Sequence[str], target: str, owner:
     rank = int(np.linalg.matrix_rank(Z))
     if rank < p + 1:
         raise DatasetError(
-            f"The features {', '.join(map(repr, used))} of {owner} are linearly dependent "
-            f"in the data (rank {rank} < {p + 1} with the intercept); drop one of the "
-            "collinear columns."
+            f"must not be linearly dependent in the data; got {', '.join(map(repr, used))} "
+            f"(rank {rank} < {p + 1} with the intercept): drop one of the collinear columns",
+            key="features",
         )
     with np.errstate(divide="ignore", invalid="ignore"):
         result = sm.OLS(zy, Z).fit()

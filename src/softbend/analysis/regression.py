@@ -29,17 +29,15 @@ from typing import Any
 import numpy as np
 import pandas as pd
 
-from softbend._validation import check_range
+from softbend._validation import check_range, must_be
 from softbend.analysis.ols import CoefficientTests, ZScoredFit, coefficient_tests, fit_zscored
 from softbend.analysis.samples import DEFAULT_FEATURES, DEFAULT_TARGET, clean_samples, is_constant
-from softbend.errors import DatasetError
+from softbend.errors import DatasetError, InputError
 from softbend.metrics import thresholded_mape
 
 __all__ = ["ConstantFeatureWarning", "RegressionReport", "standardized_regression"]
 
 logger = logging.getLogger(__name__)
-
-_OWNER = "standardized_regression"
 
 
 class ConstantFeatureWarning(UserWarning):
@@ -207,15 +205,16 @@ def standardized_regression(
         If ``features`` is empty or repeats a name, or ``mape_threshold`` < 0.
     """
     features, mape_threshold = _check_arguments(features, target, mape_threshold)
-    data, n_excluded = clean_samples(df, [*features, target], _OWNER)
+    data, n_excluded = clean_samples(df, [*features, target])
     n = len(data)
     if n < 3:
         raise DatasetError(
-            f"{_OWNER} needs at least 3 complete, converged samples. Got {n} "
-            f"({n_excluded} rows left out)."
+            f"must hold at least 3 complete, converged samples; got {n} "
+            f"({n_excluded} rows left out)",
+            key="df",
         )
     used, dropped = _select_features(data, features, target)
-    fit = fit_zscored(data, used, target, _OWNER)
+    fit = fit_zscored(data, used, target)
     tests = coefficient_tests(fit)
     report = _build_report(
         used,
@@ -228,8 +227,7 @@ def standardized_regression(
         mape_threshold=mape_threshold,
     )
     logger.info(
-        "%s: n=%d, R2=%.4f, F=%.4g, MAPE=%.3g %% (%d below %g left out)",
-        _OWNER,
+        "standardized regression: n=%d, R2=%.4f, F=%.4g, MAPE=%.3g %% (%d below %g left out)",
         n,
         tests.r2,
         tests.f_value,
@@ -246,17 +244,11 @@ def _check_arguments(
     """The feature names as a list of str and the checked ``mape_threshold``."""
     features = [str(f) for f in features] if not isinstance(features, str) else [features]
     if not features:
-        raise ValueError(
-            f"The 'features' of {_OWNER} must name at least one column. Got [] instead."
-        )
+        raise InputError(must_be("at least one column name", features), key="features")
     if len(set(features)) != len(features):
-        raise ValueError(
-            f"The 'features' of {_OWNER} must be distinct column names. Got {features!r} instead."
-        )
+        raise InputError(must_be("distinct column names", features), key="features")
     if target in features:
-        raise ValueError(
-            f"The 'target' of {_OWNER} must not be one of the features. Got {target!r} instead."
-        )
+        raise InputError(f"must not be one of the features; got {target!r}", key="target")
     mape_threshold = check_range(mape_threshold, "mape_threshold", low=0.0, low_inclusive=True)
     return features, mape_threshold
 
@@ -273,8 +265,9 @@ def _select_features(
     y = data[target].to_numpy()
     if is_constant(y):
         raise DatasetError(
-            f"The target {target!r} of {_OWNER} is constant ({y[0]:g}) over the {n} samples; "
-            "there is nothing to explain."
+            f"must not be constant over the samples; got {target!r}, constant ({y[0]:g}) over "
+            f"the {n} samples: there is nothing to explain",
+            key="target",
         )
     used: list[str] = []
     dropped: list[str] = []
@@ -291,13 +284,16 @@ def _select_features(
             used.append(name)
     if not used:
         raise DatasetError(
-            f"Every feature of {_OWNER} is constant in the data ({', '.join(features)})."
+            f"must not all be constant in the data; got every feature constant "
+            f"({', '.join(features)})",
+            key="features",
         )
     p = len(used)
     if n <= p + 1:
         raise DatasetError(
-            f"{_OWNER} needs more samples than parameters: {n} samples for {p} features "
-            "plus an intercept."
+            f"must hold more samples than parameters; got {n} samples for {p} features "
+            "plus an intercept",
+            key="df",
         )
     return used, dropped
 

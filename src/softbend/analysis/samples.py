@@ -29,7 +29,7 @@ DEFAULT_FEATURES: tuple[str, ...] = FEATURES
 DEFAULT_TARGET = "angle_deg"
 
 
-def clean_samples(df: pd.DataFrame, columns: Sequence[str], owner: str) -> tuple[pd.DataFrame, int]:
+def clean_samples(df: pd.DataFrame, columns: Sequence[str]) -> tuple[pd.DataFrame, int]:
     """Keep converged rows and drop rows with NaN or inf in ``columns``.
 
     Parameters
@@ -38,8 +38,6 @@ def clean_samples(df: pd.DataFrame, columns: Sequence[str], owner: str) -> tuple
         Campaign samples, one row per design and pressure.
     columns : sequence of str
         Columns to keep (repeated names are kept once).
-    owner : str
-        Name of the calling function, for error and log messages.
 
     Returns
     -------
@@ -52,18 +50,17 @@ def clean_samples(df: pd.DataFrame, columns: Sequence[str], owner: str) -> tuple
     ------
     DatasetError
         If ``df`` is not a DataFrame, a column is missing or not numeric, or the
-        ``converged`` column does not hold booleans.
+        ``converged`` column does not hold booleans; keyed ``df``.
     """
     if not isinstance(df, pd.DataFrame):
-        raise DatasetError(
-            f"The 'samples' of {owner} must be a pandas DataFrame. Got {type(df).__name__} instead."
-        )
+        raise DatasetError(f"must be a pandas DataFrame; got {type(df).__name__}", key="df")
     columns = list(dict.fromkeys(columns))
     missing = [c for c in columns if c not in df.columns]
     if missing:
         raise DatasetError(
-            f"The samples passed to {owner} lack the column(s) {', '.join(map(repr, missing))}; "
-            f"present: {', '.join(map(repr, map(str, df.columns)))}."
+            f"the samples lack the column(s) {', '.join(map(repr, missing))}; "
+            f"present: {', '.join(map(repr, map(str, df.columns)))}",
+            key="df",
         )
     n_rows = len(df)
     table = df
@@ -72,24 +69,24 @@ def clean_samples(df: pd.DataFrame, columns: Sequence[str], owner: str) -> tuple
             converged = df["converged"].astype("boolean").fillna(False).to_numpy(dtype=bool)
         except (TypeError, ValueError):
             raise DatasetError(
-                f"The 'converged' column passed to {owner} must hold booleans. "
-                f"Got dtype {df['converged'].dtype} instead."
+                f"the 'converged' column must hold booleans; got dtype {df['converged'].dtype}",
+                key="df",
             ) from None
         n_failed = int((~converged).sum())
         if n_failed:
-            logger.info("%s: dropped %d non-converged rows", owner, n_failed)
+            logger.info("dropped %d non-converged rows", n_failed)
         table = df.loc[converged]
     try:
         numeric = table[columns].apply(pd.to_numeric, errors="raise").astype(float)
     except (TypeError, ValueError) as exc:
         raise DatasetError(
-            f"The columns {', '.join(map(repr, columns))} passed to {owner} must be numeric: {exc}"
+            f"the columns {', '.join(map(repr, columns))} must be numeric: {exc}", key="df"
         ) from None
     numeric = numeric.replace([np.inf, -np.inf], np.nan)
     complete = numeric.notna().all(axis=1)
     n_nan = int((~complete).sum())
     if n_nan:
-        logger.info("%s: dropped %d rows with missing or infinite values", owner, n_nan)
+        logger.info("dropped %d rows with missing or infinite values", n_nan)
     numeric = numeric.loc[complete].reset_index(drop=True)
     return numeric, n_rows - len(numeric)
 

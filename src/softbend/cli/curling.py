@@ -53,7 +53,7 @@ def simulate(
     from softbend.identification.data import save_experiments
     from softbend.identification.synthetic import check_synthetic_size, synthetic_dataset
 
-    check_synthetic_size(samples, dt, samples="'--samples'", dt="'--dt'")
+    check_synthetic_size(samples, dt)
     out = Path(out)
     _common.check_output_dir(out, "--out")
     _common.check_replaceable_dir(
@@ -209,13 +209,9 @@ def identify(
 
     # every numeric option within its declared range (softbend.identification.ranges),
     # before anything is read: lags of 10**9 would allocate GiB before the first fit
-    options = {"C": "--C", "epsilon": "--epsilon"}
-    options |= {"output_lags": "--output-lags", "input_lags": "--input-lags"}
-    check_settings(
-        C=c, epsilon=epsilon, output_lags=output_lags, input_lags=input_lags, names=options
-    )
+    check_settings(C=c, epsilon=epsilon, output_lags=output_lags, input_lags=input_lags)
     if max_memory_mb is not None:
-        check_number(max_memory_mb, MAX_MEMORY_MB_RANGE, "'--max-memory-mb'")
+        check_number(max_memory_mb, MAX_MEMORY_MB_RANGE, "max_memory_mb")
     choices: dict[str, Any] = {"kernel": kernel, "moments_of": moments_of}  # checked there
     config = IdentificationConfig(
         C=c, epsilon=epsilon, output_lags=output_lags, input_lags=input_lags, **choices
@@ -235,7 +231,7 @@ def identify(
             highlight=False,
         )
     experiments = load_experiments(data)
-    check_experiments(experiments, config, names=options)  # lags the data can hold, before fits
+    check_experiments(experiments, config)  # lags the data can hold, before fits
     with _common.progress_bar(
         "fitting NARX models", n_fits(experiments), enabled=not as_json
     ) as bar:

@@ -6,13 +6,16 @@ from pathlib import Path
 
 import typer
 
+from softbend._validation import must_be
 from softbend.cli import _common
+from softbend.errors import InputError
 
 
-def _names(text: str | None, option: str) -> list[str]:
+def _names(text: str | None, key: str) -> list[str]:
+    """The comma-separated names of the option whose parameter is ``key``."""
     names = [n.strip() for n in (text or "").split(",") if n.strip()]
     if text is not None and not names:
-        raise ValueError(f"The '{option}' must name at least one column. Got {text!r} instead.")
+        raise InputError(must_be("at least one name", text), key=key)
     return names
 
 
@@ -74,10 +77,10 @@ def identify(
 
     out = Path(out)
     # every numeric option within its declared range (softbend.identification.ranges)
-    check_integer(folds, FOLDS_RANGE, "'--folds'")
-    check_integer(seed, SEED_RANGE, "'--seed'")
+    check_integer(folds, FOLDS_RANGE, "folds")
+    check_integer(seed, SEED_RANGE, "seed")
     if max_memory_mb is not None:
-        check_number(max_memory_mb, MAX_MEMORY_MB_RANGE, "'--max-memory-mb'")
+        check_number(max_memory_mb, MAX_MEMORY_MB_RANGE, "max_memory_mb")
     _common.check_output_dir(out, "--out", inputs=(data,))
     _common.check_replaceable_dir(
         out, "--out", "identify", inputs=(data,), files=FILES, marker="selection.json"
@@ -86,12 +89,12 @@ def identify(
     check_identify_memory(data, max_memory_mb=max_memory_mb)
     series = load_timeseries(
         data,
-        _names(inputs, "--inputs"),
-        _names(outputs, "--outputs"),
+        _names(inputs, "inputs"),
+        _names(outputs, "outputs"),
         experiment=experiment,
         time=time,
     )
-    held = _names(validate_on, "--validate-on") if validate_on is not None else None
+    held = _names(validate_on, "validate_on") if validate_on is not None else None
     check_holdout(series, held, label="'--validate-on'")
     check_signals(series, held)  # a constant or huge output: refused before any fit
     # every candidate's regressor must fit in every experiment (the longest lags: 3)

@@ -83,7 +83,8 @@ from scipy.optimize import brentq
 from scipy.spatial.distance import cdist, pdist, squareform
 from scipy.special import gammaln
 
-from softbend._validation import check_choice, check_finite_array, check_range
+from softbend._validation import check_choice, check_finite_array, check_range, must_be
+from softbend.errors import InputError
 
 logger = logging.getLogger(__name__)
 
@@ -178,9 +179,7 @@ def gg_kurtosis(shape: float | np.ndarray) -> float | np.ndarray:
     gamma = np.asarray(shape, dtype=float)
     if np.any(~(gamma > 0.0)) or np.any(~np.isfinite(gamma)):
         bad = gamma[~((gamma > 0.0) & np.isfinite(gamma))].ravel()[0]
-        raise ValueError(
-            f"The 'shape' of gg_kurtosis must be a number in (0, inf). Got {bad!r} instead."
-        )
+        raise InputError(must_be("a number in (0, inf)", float(bad)), key="shape")
     value = np.exp(gammaln(5.0 / gamma) + gammaln(1.0 / gamma) - 2.0 * gammaln(3.0 / gamma))
     return float(value) if value.ndim == 0 else value
 
@@ -212,24 +211,21 @@ def gg_radial_kurtosis(shape: float | np.ndarray, dim: float = 1.0) -> float | n
     gamma = np.asarray(shape, dtype=float)
     if np.any(~(gamma > 0.0)) or np.any(~np.isfinite(gamma)):
         bad = gamma[~((gamma > 0.0) & np.isfinite(gamma))].ravel()[0]
-        raise ValueError(
-            f"The 'shape' of gg_radial_kurtosis must be a number in (0, inf). Got {bad!r} instead."
-        )
+        raise InputError(must_be("a number in (0, inf)", float(bad)), key="shape")
     value = np.exp(
         gammaln((d + 4.0) / gamma) + gammaln(d / gamma) - 2.0 * gammaln((d + 2.0) / gamma)
     )
     return float(value) if value.ndim == 0 else value
 
 
-def _as_2d(values: object, name: str, owner: str) -> np.ndarray:
-    """Finite float array of shape (n, d); a 1-D input is one feature."""
-    array = check_finite_array(values, name)
+def _as_2d(values: object, key: str) -> np.ndarray:
+    """Finite float array of shape (n, d); a 1-D input is one feature. Errors keyed ``key``."""
+    array = check_finite_array(values, key)
     if array.ndim == 1:
         array = array[:, np.newaxis]
     if array.ndim != 2:
-        raise ValueError(
-            f"The '{name}' of {owner} must be a 1-D or 2-D array. "
-            f"Got an array with {array.ndim} dimensions instead."
+        raise InputError(
+            f"must be a 1-D or 2-D array; got an array with {array.ndim} dimensions", key=key
         )
     return array
 
@@ -341,19 +337,15 @@ def generalized_gaussian_kernel(
     ValueError
         If σ ≤ 0, γ outside (0, 2], inputs are not finite or the feature counts differ.
     """
-    owner = "generalized_gaussian_kernel"
     s = check_range(sigma, "sigma", low=0.0)
     gamma = check_range(shape, "shape", low=0.0, high=2.0, high_inclusive=True)
-    X = _as_2d(X, "X", owner)
+    X = _as_2d(X, "X")
     if Z is None:
         sqdist = squareform(pdist(X, "sqeuclidean"))
     else:
-        Z = _as_2d(Z, "Z", owner)
+        Z = _as_2d(Z, "Z")
         if Z.shape[1] != X.shape[1]:
-            raise ValueError(
-                f"The 'Z' of {owner} must have {X.shape[1]} features like X. "
-                f"Got {Z.shape[1]} instead."
-            )
+            raise InputError(f"must have {X.shape[1]} features like X; got {Z.shape[1]}", key="Z")
         sqdist = cdist(X, Z, "sqeuclidean")
     scale = gg_normalization(s, gamma) if normalize else 1.0
     return _kernel_from_sqdist(sqdist, sigma=s, shape=gamma, scale=scale)
@@ -418,70 +410,75 @@ def _shape_from_kurtosis(kurtosis: float) -> float:
 
 
 def _weighted_rows(
-    samples: object, sample_weight: object, owner: str, name: str
+    samples: object, sample_weight: object, key: str
 ) -> tuple[np.ndarray, np.ndarray]:
-    """Varying columns of the positive-weight rows and the normalized weights."""
-    X = _as_2d(samples, name, owner)
+    """Varying columns of the positive-weight rows and the normalized weights.
+
+    ``key`` names the samples' parameter in the errors about them.
+    """
+    X = _as_2d(samples, key)
     n = X.shape[0]
     if sample_weight is None:
         weight = np.ones(n)
     else:
         weight = check_finite_array(sample_weight, "sample_weight")
         if weight.shape != (n,):
-            raise ValueError(
-                f"The 'sample_weight' of {owner} must have shape ({n},) like the samples. "
-                f"Got shape {weight.shape} instead."
+            raise InputError(
+                f"must have shape ({n},) like the samples; got shape {weight.shape}",
+                key="sample_weight",
             )
         if np.any(weight < 0.0):
-            raise ValueError(
-                f"The 'sample_weight' of {owner} must be non-negative. "
-                f"Got {weight[weight < 0.0][0]!r} instead."
+            raise InputError(
+                must_be("non-negative", float(weight[weight < 0.0][0])), key="sample_weight"
             )
         keep = weight > 0.0
         X, weight = X[keep], weight[keep]
         n = X.shape[0]
     if n < _MIN_SAMPLES:
-        raise ValueError(
-            f"The '{name}' of {owner} must contain at least {_MIN_SAMPLES} samples "
-            f"(with positive weight) to estimate a fourth moment. Got n_samples = {n} instead."
+        raise InputError(
+            f"must contain at least {_MIN_SAMPLES} samples (with positive weight) to "
+            f"estimate a fourth moment; got n_samples = {n}",
+            key=key,
         )
     varying = np.ptp(X, axis=0) > 0.0
     if not varying.any():
-        raise ValueError(
-            f"The '{name}' of {owner} must not be constant: the width and the kurtosis are "
-            f"undefined. Got {n} samples with a single value per feature instead."
+        raise InputError(
+            "must not be constant: the width and the kurtosis are undefined; "
+            f"got {n} samples with a single value per feature",
+            key=key,
         )
     if not varying.all():
-        logger.debug("%s: ignoring %d constant column(s)", owner, int((~varying).sum()))
+        logger.debug("ignoring %d constant column(s) of %s", int((~varying).sum()), key)
         X = X[:, varying]
     return X, weight / weight.sum()
 
 
-def _check_moments(sigma: float, kurtosis: float, owner: str, name: str) -> None:
+def _check_moments(sigma: float, kurtosis: float, key: str) -> None:
     if not (math.isfinite(sigma) and sigma > 0.0 and math.isfinite(kurtosis)):
-        raise ValueError(
-            f"The '{name}' of {owner} must have finite, non-zero moments; rescale it. "
-            f"Got sigma = {sigma!r} and kurtosis = {kurtosis!r} instead."
+        raise InputError(
+            "must have finite, non-zero moments (rescale it); "
+            f"got sigma = {sigma!r} and kurtosis = {kurtosis!r}",
+            key=key,
         )
 
 
 def _pooled_moments(
-    samples: object, sample_weight: object, owner: str, name: str = "samples"
+    samples: object, sample_weight: object, key: str = "samples"
 ) -> tuple[float, float]:
     """Pooled width σ and standardized kurtosis κ (see :func:`estimate_gg_shape`)."""
-    X, p = _weighted_rows(samples, sample_weight, owner, name)
+    X, p = _weighted_rows(samples, sample_weight, key)
     centred = X - p @ X
     squares = centred * centred
     variance = p @ squares  # per column, population
     fourth = p @ (squares * squares)
     sigma = math.sqrt(float(variance.mean()))
     kurtosis = float(np.mean(fourth / variance**2))
-    _check_moments(sigma, kurtosis, owner, name)
+    _check_moments(sigma, kurtosis, key)
     return sigma, kurtosis
 
 
 def _radial_moments(
-    samples: object, sample_weight: object, owner: str, name: str, *, pairwise: bool
+    samples: object, sample_weight: object, key: str, *, pairwise: bool
 ) -> tuple[float, float, int, float]:
     """σ, radial fourth-moment ratio, dimension and effective dimension of the kernel argument.
 
@@ -493,7 +490,7 @@ def _radial_moments(
     effective dimension is d_eff = (tr M)²/‖M‖_F², the same for the rows and
     the differences, and the Gaussian value of the ratio is 1 + 2/d_eff.
     """
-    X, p = _weighted_rows(samples, sample_weight, owner, name)
+    X, p = _weighted_rows(samples, sample_weight, key)
     centred = X - p @ X
     second = (centred * p[:, None]).T @ centred  # M, (d, d)
     squared_norm = np.einsum("ij,ij->i", centred, centred)
@@ -505,7 +502,7 @@ def _radial_moments(
         ratio = (2.0 * fourth + 2.0 * trace**2 + 4.0 * frobenius) / (4.0 * trace**2)
     else:
         ratio = fourth / trace**2
-    _check_moments(sigma, ratio, owner, name)
+    _check_moments(sigma, ratio, key)
     return sigma, ratio, X.shape[1], trace**2 / frobenius
 
 
@@ -645,7 +642,7 @@ def estimate_gg_shape(
         not positive definite), γ is set to 2; if it is beyond the kurtosis of
         γ = 0.05, γ is set to 0.05.
     """
-    sigma, kurtosis = _pooled_moments(samples, sample_weight, "estimate_gg_shape")
+    sigma, kurtosis = _pooled_moments(samples, sample_weight)
     shape = _shape_from_kurtosis(kurtosis)
     logger.debug("estimate_gg_shape: sigma=%.6g kurtosis=%.6g shape=%.6g", sigma, kurtosis, shape)
     return sigma, shape
@@ -704,7 +701,7 @@ def estimate_kernel_shape(
         If the root lies above 2 (lighter tails than Gaussian; the kernel would
         not be positive definite) or below 0.05, and γ was clipped.
     """
-    estimate = _kernel_shape_estimate(X, sample_weight, moments_of, "estimate_kernel_shape")
+    estimate = _kernel_shape_estimate(X, sample_weight, moments_of)
     if estimate.clipped:
         _warn_clipped(estimate, stacklevel=3)
     logger.debug("estimate_kernel_shape: %s", estimate)
@@ -719,17 +716,15 @@ def _warn_clipped(estimate: ShapeEstimate, stacklevel: int) -> None:
     )
 
 
-def _kernel_shape_estimate(
-    X: object, sample_weight: object, moments_of: str, owner: str
-) -> ShapeEstimate:
+def _kernel_shape_estimate(X: object, sample_weight: object, moments_of: str) -> ShapeEstimate:
     """:func:`estimate_kernel_shape` without the warning (callers decide whether to warn)."""
     check_choice(moments_of, "moments_of", MOMENTS_OF)
     if moments_of == "components":
-        sigma, kurtosis = _pooled_moments(X, sample_weight, owner, name="X")
+        sigma, kurtosis = _pooled_moments(X, sample_weight, "X")
         dim, effective, gaussian = 1, 1.0, 3.0
     else:
         sigma, kurtosis, dim, effective = _radial_moments(
-            X, sample_weight, owner, "X", pairwise=moments_of == "differences"
+            X, sample_weight, "X", pairwise=moments_of == "differences"
         )
         gaussian = 1.0 + 2.0 / effective
     shape, unclipped = _solve_shape(kurtosis / gaussian, float(dim))

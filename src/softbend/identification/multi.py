@@ -10,7 +10,7 @@ body that carries both; a model that sees only its own output's past cannot
 say so. Free-run simulation feeds every output's prediction back into every
 regressor, all experiments stepped together.
 
-The static maps are one of :data:`FAMILIES`:
+The static maps are one of :data:`STRUCTURES`:
 
 - ``arx``: linear (least squares with a tiny ridge), the baseline every model
   must beat;
@@ -36,21 +36,25 @@ from pathlib import Path
 from typing import Any
 
 import numpy as np
+from numpy.typing import ArrayLike
 
-from softbend.errors import SchemaError
+from softbend._validation import check_choice, check_finite_array, check_int, must_be
+from softbend.errors import InputError, SchemaError, SoftbendError
 from softbend.identification.narx import _row_index, _segments
 from softbend.identification.persistence import svr_from_state, svr_state
+from softbend.identification.svr import GeneralizedGaussianSVR
 
 __all__ = [
-    "FAMILIES",
     "FREE_RUN_MARGIN",
+    "STRUCTURES",
     "MultiNARX",
     "load_multi_narx",
     "save_multi_narx",
 ]
 
-#: The static maps a :class:`MultiNARX` may use.
-FAMILIES: tuple[str, ...] = ("arx", "poly2", "gg-svr")
+#: The static maps a :class:`MultiNARX` may use (its ``family``; not the surrogate
+#: families of :data:`softbend.surrogates.FAMILIES`).
+STRUCTURES: tuple[str, ...] = ("arx", "poly2", "gg-svr")
 
 #: A free run stays within the training range widened by this many ranges per side.
 FREE_RUN_MARGIN = 1.0
@@ -58,7 +62,6 @@ FREE_RUN_MARGIN = 1.0
 _FORMAT = "softbend-multi-narx"
 _SCHEMA = 1
 _RIDGE = 1e-8
-_OWNER = "MultiNARX"
 
 
 class _Ridge:
@@ -134,20 +137,10 @@ class MultiNARX:
         params: Mapping[str, Any] | None = None,
         max_rows: int = 4000,
     ) -> None:
-        if family not in FAMILIES:
-            raise ValueError(
-                f"The 'family' of MultiNARX must be one of {', '.join(FAMILIES)}. "
-                f"Got {family!r} instead."
-            )
-        for name, value in (("output_lags", output_lags), ("input_lags", input_lags)):
-            if isinstance(value, bool) or not isinstance(value, int) or value < 1:
-                raise ValueError(
-                    f"The '{name}' of MultiNARX must be an integer >= 1. Got {value!r}."
-                )
-        if isinstance(max_rows, bool) or not isinstance(max_rows, int) or max_rows < 10:
-            raise ValueError(
-                f"The 'max_rows' of MultiNARX must be an integer >= 10. Got {max_rows!r}."
-            )
+        check_choice(family, "family", STRUCTURES)
+        check_int(output_lags, "output_lags", low=1)
+        check_int(input_lags, "input_lags", low=1)
+        check_int(max_rows, "max_rows", low=10)
         self.family = family
         self.output_lags = output_lags
         self.input_lags = input_lags
@@ -166,13 +159,11 @@ class MultiNARX:
         text = f"{self.family} na={self.output_lags} nb={self.input_lags}"
         return f"{text} ({settings})" if settings else text
 
-    def _map(self) -> Any:
+    def _map(self) -> _Ridge | GeneralizedGaussianSVR:
         if self.family == "arx":
             return _Ridge(1)
         if self.family == "poly2":
             return _Ridge(2)
-        from softbend.identification.svr import GeneralizedGaussianSVR
-
         return GeneralizedGaussianSVR(**{"C": 100.0, "epsilon": 0.1, **self.params})
 
     def _regressors(self, U: np.ndarray, Y: np.ndarray, t: np.ndarray) -> np.ndarray:
@@ -181,7 +172,7 @@ class MultiNARX:
         blocks = [Y[t - k] for k in range(1, na + 1)] + [U[t - k] for k in range(nb)]
         return np.hstack(blocks)
 
-    def fit(self, U: Any, Y: Any, groups: Any = None) -> MultiNARX:
+    def fit(self, U: ArrayLike, Y: ArrayLike, groups: ArrayLike | None = None) -> MultiNARX:
         """Fit every output's map on the one-step regressors of every experiment.
 
         Parameters
@@ -195,7 +186,7 @@ class MultiNARX:
         """
         U, Y = self._arrays(U, Y)
         lag = self.max_lag
-        segments = _segments(groups, U.shape[0], lag, _OWNER)
+        segments = _segments(groups, U.shape[0], lag)
         self.u_mean_, self.u_std_ = U.mean(axis=0), U.std(axis=0)
         self.y_mean_, self.y_std_ = Y.mean(axis=0), Y.std(axis=0)
         self.u_std_[self.u_std_ == 0] = 1.0
@@ -216,38 +207,47 @@ class MultiNARX:
         self.n_train_rows_ = int(Phi.shape[0])
         return self
 
-    def _arrays(self, U: Any, Y: Any) -> tuple[np.ndarray, np.ndarray]:
-        U = np.asarray(U, dtype=np.float64)
-        Y = np.asarray(Y, dtype=np.float64)
+    def _arrays(
+        self, inputs: ArrayLike, outputs: ArrayLike, outputs_key: str = "Y"
+    ) -> tuple[np.ndarray, np.ndarray]:
+        U = check_finite_array(inputs, "U")
+        Y = check_finite_array(outputs, outputs_key)
         U = U[:, None] if U.ndim == 1 else U
         Y = Y[:, None] if Y.ndim == 1 else Y
-        if U.ndim != 2 or Y.ndim != 2 or U.shape[0] != Y.shape[0]:
-            raise ValueError(
-                f"The inputs and outputs must be (n, k) and (n, m) with the same n. "
-                f"Got {U.shape} and {Y.shape}."
+        if U.ndim != 2:
+            raise InputError(f"must be an array (n, k); got shape {U.shape}", key="U")
+        if Y.ndim != 2 or U.shape[0] != Y.shape[0]:
+            raise InputError(
+                f"must be an array (n, m) with the n of U ({U.shape[0]}); got shape {Y.shape}",
+                key=outputs_key,
             )
-        if not (np.isfinite(U).all() and np.isfinite(Y).all()):
-            raise ValueError("The inputs and outputs must be finite (no NaN or inf).")
         return U, Y
 
     def _check_fitted(self, U: np.ndarray) -> None:
         if not hasattr(self, "estimators_"):
             raise ValueError("This MultiNARX is not fitted yet: call fit first.")
         if U.shape[1] != self.n_inputs_:
-            raise ValueError(f"The model has {self.n_inputs_} inputs. Got {U.shape[1]}.")
+            raise InputError(
+                f"must have the {self.n_inputs_} input column(s) of fit; got {U.shape[1]}",
+                key="U",
+            )
 
-    def predict_one_step(self, U: Any, Y: Any, groups: Any = None) -> np.ndarray:
+    def predict_one_step(
+        self, U: ArrayLike, Y: ArrayLike, groups: ArrayLike | None = None
+    ) -> np.ndarray:
         """Each output at t from the measured past (NaN for the initial conditions)."""
         U, Y = self._arrays(U, Y)
         self._check_fitted(U)
         Us, Ys = (U - self.u_mean_) / self.u_std_, (Y - self.y_mean_) / self.y_std_
         out = np.full(Y.shape, np.nan)
-        index = _row_index(_segments(groups, U.shape[0], self.max_lag, _OWNER), self.max_lag)
+        index = _row_index(_segments(groups, U.shape[0], self.max_lag), self.max_lag)
         Phi = self._regressors(Us, Ys, index)
         out[index] = np.column_stack([e.predict(Phi) for e in self.estimators_])
         return out * self.y_std_ + self.y_mean_
 
-    def simulate(self, U: Any, Y_init: Any, groups: Any = None) -> np.ndarray:
+    def simulate(
+        self, U: ArrayLike, Y_init: ArrayLike, groups: ArrayLike | None = None
+    ) -> np.ndarray:
         """Free run: every output fed back, every experiment stepped together.
 
         Parameters
@@ -265,10 +265,10 @@ class MultiNARX:
         ndarray, shape (n, m)
             The simulated outputs (the initial conditions copied).
         """
-        U, Y0 = self._arrays(U, Y_init)
+        U, Y0 = self._arrays(U, Y_init, "Y_init")
         self._check_fitted(U)
         lag = self.max_lag
-        segments = _segments(groups, U.shape[0], lag, _OWNER)
+        segments = _segments(groups, U.shape[0], lag)
         Us = (U - self.u_mean_) / self.u_std_
         Ys = (Y0 - self.y_mean_) / self.y_std_
         low = (self.y_low_ - self.y_mean_) / self.y_std_
@@ -291,7 +291,10 @@ class MultiNARX:
         """The fitted model as JSON-ready data (:func:`save_multi_narx`)."""
         if not hasattr(self, "estimators_"):
             raise ValueError("This MultiNARX is not fitted yet: call fit first.")
-        maps = [svr_state(e) if self.family == "gg-svr" else e.state() for e in self.estimators_]
+        maps = [
+            svr_state(e) if isinstance(e, GeneralizedGaussianSVR) else e.state()
+            for e in self.estimators_
+        ]
         return {
             "format": _FORMAT,
             "schema_version": _SCHEMA,
@@ -312,14 +315,24 @@ class MultiNARX:
         }
 
     @classmethod
-    def from_dict(cls, data: Mapping[str, Any], *, source: str = "the saved model") -> MultiNARX:
-        """Rebuild a fitted model from :meth:`to_dict` data (a SchemaError names ``source``)."""
+    def from_dict(cls, data: object) -> MultiNARX:
+        """Rebuild a fitted model from :meth:`to_dict` data.
+
+        Raises
+        ------
+        SchemaError
+            Keyed by the entry at fault (``"u_mean"``); ``"format"`` for data that
+            is not a saved model.
+        """
         if not isinstance(data, Mapping) or data.get("format") != _FORMAT:
-            raise SchemaError(f"{source} is not a saved softbend multi-output NARX model.")
+            raise SchemaError(
+                f"must be {_FORMAT!r}: the data is not a saved softbend multi-output NARX model",
+                key="format",
+            )
         if data.get("schema_version") != _SCHEMA:
             raise SchemaError(
-                f"{source} has schema version {data.get('schema_version')!r}; this softbend "
-                f"reads version {_SCHEMA}."
+                must_be(f"{_SCHEMA}, the version this softbend reads", data.get("schema_version")),
+                key="schema_version",
             )
         try:
             model = cls(
@@ -336,17 +349,21 @@ class MultiNARX:
             for name, size in sizes.items():
                 values = np.asarray(data[name], dtype=np.float64)
                 if values.shape != (size,) or not np.isfinite(values).all():
-                    raise ValueError(f"'{name}' must hold {size} finite numbers")
+                    raise SchemaError(f"must hold {size} finite numbers", key=name)
                 setattr(model, f"{name}_", values)
             maps = data["maps"]
             if not isinstance(maps, list) or len(maps) != model.n_outputs_:
-                raise ValueError(f"'maps' must hold one map per output ({model.n_outputs_})")
+                raise SchemaError(f"must hold one map per output ({model.n_outputs_})", key="maps")
             model.estimators_ = [
                 svr_from_state(m) if model.family == "gg-svr" else _Ridge.from_state(m)
                 for m in maps
             ]
-        except (KeyError, TypeError, ValueError) as err:
-            raise SchemaError(f"{source}: {err}.") from None
+        except SoftbendError as err:
+            raise SchemaError(err.detail, key=err.key) from None
+        except KeyError as err:
+            raise SchemaError("is missing", key=str(err.args[0])) from None
+        except (TypeError, ValueError) as err:
+            raise SchemaError(f"is not a saved model's entry: {err}") from None
         return model
 
 
@@ -379,8 +396,12 @@ def load_multi_narx(path: str | os.PathLike[str]) -> tuple[MultiNARX, dict[str, 
     try:
         data = json.loads(file.read_text(encoding="utf-8"))
     except json.JSONDecodeError as err:
-        raise SchemaError(f"{file} is not JSON: {err}.") from None
-    model = MultiNARX.from_dict(data, source=str(file))
+        raise SchemaError(f"is not JSON: {err}", file=str(file)) from None
+    try:
+        model = MultiNARX.from_dict(data)
+    except SchemaError as error:
+        error.file = str(file)
+        raise
     return model, dict(data.get("metadata", {}))
 
 

@@ -38,15 +38,13 @@ from sklearn.base import BaseEstimator, RegressorMixin, clone
 from sklearn.preprocessing import StandardScaler
 from sklearn.utils.validation import check_is_fitted
 
-from softbend._validation import check_choice, check_finite_array, check_int
-from softbend.errors import DatasetError
+from softbend._validation import check_choice, check_finite_array, check_int, must_be
+from softbend.errors import DatasetError, InputError
 from softbend.metrics import r2
 
 __all__ = ["NARXRegressor", "lagged_matrix"]
 
 logger = logging.getLogger(__name__)
-
-_OWNER = "NARXRegressor"
 
 
 @dataclass(frozen=True)
@@ -84,7 +82,7 @@ class _Segments:
 
 
 def _lag_structure(
-    output_lags: Any, input_lags: Any, include_current_input: Any, owner: str
+    output_lags: object, input_lags: object, include_current_input: object
 ) -> _LagStructure:
     na = check_int(output_lags, "output_lags", low=1)
     nb = check_int(input_lags, "input_lags", low=1)
@@ -98,50 +96,51 @@ def _lag_structure(
     )
 
 
-def _as_inputs(X: ArrayLike, owner: str) -> np.ndarray:
+def _as_inputs(X: ArrayLike) -> np.ndarray:
     """Time-ordered inputs as a finite float array of shape (n_samples, n_inputs)."""
     try:
         array = np.asarray(X, dtype=float)
     except (TypeError, ValueError):
-        raise ValueError(
-            f"The 'X' of {owner} must be a numeric array (n_samples,) or "
-            f"(n_samples, n_inputs). Got {type(X).__name__} instead."
+        raise InputError(
+            "must be a numeric array (n_samples,) or (n_samples, n_inputs); "
+            f"got {type(X).__name__}",
+            key="X",
         ) from None
     if array.ndim == 1:
         array = array[:, None]
     if array.ndim != 2 or array.shape[0] == 0 or array.shape[1] == 0:
-        raise ValueError(
-            f"The 'X' of {owner} must be a non-empty array (n_samples,) or "
-            f"(n_samples, n_inputs). Got shape {np.shape(X)} instead."
+        raise InputError(
+            "must be a non-empty array (n_samples,) or (n_samples, n_inputs); "
+            f"got shape {np.shape(X)}",
+            key="X",
         )
     return check_finite_array(array, "X")
 
 
-def _as_output(y: ArrayLike, name: str, owner: str, n_samples: int) -> np.ndarray:
+def _as_output(y: ArrayLike, key: str, n_samples: int) -> np.ndarray:
     """One output series as a 1-D float array of length ``n_samples`` (NaN not checked)."""
     try:
         array = np.asarray(y, dtype=float)
     except (TypeError, ValueError):
-        raise ValueError(
-            f"The '{name}' of {owner} must be a numeric array (n_samples,). "
-            f"Got {type(y).__name__} instead."
+        raise InputError(
+            f"must be a numeric array (n_samples,); got {type(y).__name__}", key=key
         ) from None
     if array.ndim == 2 and array.shape[1] == 1:
         array = array[:, 0]
     if array.ndim != 1:
-        raise ValueError(
-            f"The '{name}' of {owner} must be one output of shape (n_samples,); fit one "
-            f"model per output. Got shape {array.shape} instead."
+        raise InputError(
+            "must be one output of shape (n_samples,), one model per output; "
+            f"got shape {array.shape}",
+            key=key,
         )
     if array.size != n_samples:
-        raise ValueError(
-            f"The '{name}' of {owner} must have one value per sample of 'X' "
-            f"({n_samples}). Got {array.size} instead."
+        raise InputError(
+            f"must have one value per sample of 'X' ({n_samples}); got {array.size}", key=key
         )
     return array
 
 
-def _segments(groups: ArrayLike | None, n_samples: int, max_lag: int, owner: str) -> _Segments:
+def _segments(groups: ArrayLike | None, n_samples: int, max_lag: int) -> _Segments:
     """Split ``0 … n_samples−1`` at every change of the ``groups`` label."""
     if groups is None:
         starts = np.array([0])
@@ -149,9 +148,10 @@ def _segments(groups: ArrayLike | None, n_samples: int, max_lag: int, owner: str
     else:
         labels_array = np.asarray(groups)
         if labels_array.ndim != 1 or labels_array.size != n_samples:
-            raise ValueError(
-                f"The 'groups' of {owner} must be a 1-D array with one experiment label "
-                f"per sample ({n_samples}). Got shape {labels_array.shape} instead."
+            raise InputError(
+                f"must be a 1-D array with one experiment label per sample ({n_samples}); "
+                f"got shape {labels_array.shape}",
+                key="groups",
             )
         change = np.asarray(labels_array[1:] != labels_array[:-1], dtype=bool)
         starts = np.concatenate(([0], np.flatnonzero(change) + 1))
@@ -162,14 +162,15 @@ def _segments(groups: ArrayLike | None, n_samples: int, max_lag: int, owner: str
         k = int(short[0])
         if groups is None:
             raise DatasetError(
-                f"The 'X' of {owner} must have at least max_lag + 1 = {max_lag + 1} "
-                f"samples (the first {max_lag} are initial conditions). Got "
-                f"{int(lengths[k])} instead."
+                f"must have at least max_lag + 1 = {max_lag + 1} samples (the first "
+                f"{max_lag} are initial conditions); got {int(lengths[k])}",
+                key="X",
             )
         raise DatasetError(
-            f"The 'groups' of {owner} must label experiments of at least max_lag + 1 = "
-            f"{max_lag + 1} samples (the first {max_lag} are initial conditions). Got "
-            f"experiment {labels[k]!r} with {int(lengths[k])} samples instead."
+            f"must label experiments of at least max_lag + 1 = {max_lag + 1} samples (the "
+            f"first {max_lag} are initial conditions); got experiment {labels[k]!r} with "
+            f"{int(lengths[k])} samples",
+            key="groups",
         )
     return _Segments(starts=starts, lengths=lengths, labels=labels)
 
@@ -245,11 +246,10 @@ def lagged_matrix(
         ``max_lag`` samples of every experiment have no row, so
         n_rows = Σ_k (n_k − max_lag), with max_lag = max(na, largest input lag).
     """
-    owner = "lagged_matrix"
-    structure = _lag_structure(output_lags, input_lags, include_current_input, owner)
-    inputs = _as_inputs(X, owner)
-    output = check_finite_array(_as_output(y, "y", owner, inputs.shape[0]), "y")
-    segments = _segments(groups, inputs.shape[0], structure.max_lag, owner)
+    structure = _lag_structure(output_lags, input_lags, include_current_input)
+    inputs = _as_inputs(X)
+    output = check_finite_array(_as_output(y, "y", inputs.shape[0]), "y")
+    segments = _segments(groups, inputs.shape[0], structure.max_lag)
     index = _row_index(segments, structure.max_lag)
     return _rows(inputs, output, index, structure), output[index], index
 
@@ -311,7 +311,7 @@ class NARXRegressor(RegressorMixin, BaseEstimator):
     def __init__(
         self,
         *,
-        estimator: Any = None,
+        estimator: object = None,
         output_lags: int = 2,
         input_lags: int = 2,
         include_current_input: bool = True,
@@ -325,7 +325,7 @@ class NARXRegressor(RegressorMixin, BaseEstimator):
 
     # ------------------------------------------------------------------ helpers
     def _structure(self) -> _LagStructure:
-        return _lag_structure(self.output_lags, self.input_lags, self.include_current_input, _OWNER)
+        return _lag_structure(self.output_lags, self.input_lags, self.include_current_input)
 
     def _make_estimator(self) -> Any:
         if self.estimator is None:
@@ -333,9 +333,9 @@ class NARXRegressor(RegressorMixin, BaseEstimator):
 
             return GeneralizedGaussianSVR(C=100.0, epsilon=0.1)
         if not (hasattr(self.estimator, "fit") and hasattr(self.estimator, "predict")):
-            raise ValueError(
-                f"The 'estimator' of {_OWNER} must be None or a regressor with fit and "
-                f"predict. Got {type(self.estimator).__name__} instead."
+            raise InputError(
+                must_be("None or a regressor with fit and predict", type(self.estimator).__name__),
+                key="estimator",
             )
         return clone(self.estimator)
 
@@ -355,17 +355,16 @@ class NARXRegressor(RegressorMixin, BaseEstimator):
         )
 
     def _prepare(
-        self, X: ArrayLike, groups: ArrayLike | None, method: str
+        self, X: ArrayLike, groups: ArrayLike | None
     ) -> tuple[np.ndarray, _Segments, _LagStructure]:
         structure = self._fitted_structure()
-        owner = f"{_OWNER}.{method}"
-        inputs = _as_inputs(X, owner)
+        inputs = _as_inputs(X)
         if inputs.shape[1] != self.n_inputs_:
-            raise ValueError(
-                f"The 'X' of {owner} must have {self.n_inputs_} input column(s) as in "
-                f"fit. Got {inputs.shape[1]} instead."
+            raise InputError(
+                f"must have {self.n_inputs_} input column(s) as in fit; got {inputs.shape[1]}",
+                key="X",
             )
-        segments = _segments(groups, inputs.shape[0], structure.max_lag, owner)
+        segments = _segments(groups, inputs.shape[0], structure.max_lag)
         return inputs, segments, structure
 
     # ---------------------------------------------------------------------- API
@@ -396,9 +395,9 @@ class NARXRegressor(RegressorMixin, BaseEstimator):
         structure = self._structure()
         check_choice(self.scale, "scale", (True, False))
         estimator = self._make_estimator()
-        inputs = _as_inputs(X, _OWNER)
-        output = check_finite_array(_as_output(y, "y", _OWNER, inputs.shape[0]), "y")
-        segments = _segments(groups, inputs.shape[0], structure.max_lag, _OWNER)
+        inputs = _as_inputs(X)
+        output = check_finite_array(_as_output(y, "y", inputs.shape[0]), "y")
+        segments = _segments(groups, inputs.shape[0], structure.max_lag)
 
         if self.scale:
             self.u_scaler_ = StandardScaler().fit(inputs)
@@ -464,11 +463,8 @@ class NARXRegressor(RegressorMixin, BaseEstimator):
         """
         structure = self._fitted_structure()
         if isinstance(n_samples, bool) or not isinstance(n_samples, numbers.Integral):
-            raise ValueError(
-                f"The 'n_samples' of {_OWNER}.warmup_mask must be an integer. "
-                f"Got {n_samples!r} instead."
-            )
-        segments = _segments(groups, int(n_samples), structure.max_lag, f"{_OWNER}.warmup_mask")
+            raise InputError(must_be("an integer", n_samples), key="n_samples")
+        segments = _segments(groups, int(n_samples), structure.max_lag)
         mask = np.zeros(int(n_samples), dtype=bool)
         for start in segments.starts:
             mask[start : start + structure.max_lag] = True
@@ -500,9 +496,8 @@ class NARXRegressor(RegressorMixin, BaseEstimator):
             experiment are the measured values (initial conditions); leave them
             out of metrics (:meth:`warmup_mask`).
         """
-        owner = f"{_OWNER}.predict_one_step"
-        inputs, segments, structure = self._prepare(X, groups, "predict_one_step")
-        output = check_finite_array(_as_output(y, "y", owner, inputs.shape[0]), "y")
+        inputs, segments, structure = self._prepare(X, groups)
+        output = check_finite_array(_as_output(y, "y", inputs.shape[0]), "y")
         y_mean, y_std, u_mean, u_std = self._affine()
         index = _row_index(segments, structure.max_lag)
         Phi = _rows((inputs - u_mean) / u_std, (output - y_mean) / y_std, index, structure)
@@ -543,12 +538,11 @@ class NARXRegressor(RegressorMixin, BaseEstimator):
             experiment's prediction becomes non-finite, a ``RuntimeWarning`` is
             issued and the rest of that experiment is NaN; the others go on.
         """
-        owner = f"{_OWNER}.simulate"
-        inputs, segments, structure = self._prepare(X, groups, "simulate")
+        inputs, segments, structure = self._prepare(X, groups)
         n_samples = inputs.shape[0]
         m = structure.max_lag
         na = structure.output_offsets.size
-        initial = self._initial_conditions(y_init, segments, m, n_samples, owner)
+        initial = self._initial_conditions(y_init, segments, m, n_samples)
 
         y_mean, y_std, u_mean, u_std = self._affine()
         index = _row_index(segments, m)
@@ -602,7 +596,7 @@ class NARXRegressor(RegressorMixin, BaseEstimator):
 
     @staticmethod
     def _initial_conditions(
-        y_init: ArrayLike, segments: _Segments, m: int, n_samples: int, owner: str
+        y_init: ArrayLike, segments: _Segments, m: int, n_samples: int
     ) -> np.ndarray:
         """Initial outputs as an array (n_experiments, m), checked finite."""
         n_experiments = segments.starts.size
@@ -612,10 +606,10 @@ class NARXRegressor(RegressorMixin, BaseEstimator):
         elif array.shape == (n_experiments, m):
             initial = array
         else:
-            raise ValueError(
-                f"The 'y_init' of {owner} must be the measured output of shape "
-                f"({n_samples},) or initial conditions of shape ({n_experiments}, {m}). "
-                f"Got shape {array.shape} instead."
+            raise InputError(
+                f"must be the measured output of shape ({n_samples},) or initial conditions "
+                f"of shape ({n_experiments}, {m}); got shape {array.shape}",
+                key="y_init",
             )
         return check_finite_array(initial, "y_init")
 
@@ -641,10 +635,9 @@ class NARXRegressor(RegressorMixin, BaseEstimator):
         float
             1 − Σ(y − ŷ)² / Σ(y − ȳ)² over the simulated samples.
         """
-        owner = f"{_OWNER}.score"
-        inputs, _, _ = self._prepare(X, groups, "score")
+        inputs, _, _ = self._prepare(X, groups)
         n_samples = inputs.shape[0]
-        output = check_finite_array(_as_output(y, "y", owner, n_samples), "y")
+        output = check_finite_array(_as_output(y, "y", n_samples), "y")
         simulated = self.simulate(X, output, groups=groups)
         keep = ~self.warmup_mask(n_samples, groups=groups)
         return r2(output[keep], simulated[keep])

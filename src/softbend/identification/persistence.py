@@ -21,8 +21,8 @@ from sklearn.preprocessing import StandardScaler
 from softbend import __version__
 from softbend._io import json_text, write_text_atomic
 from softbend._jsontext import check_nesting
-from softbend._validation import check_object_keys, short_repr
-from softbend.errors import SchemaError
+from softbend._validation import check_object_keys, interval_text, must_be
+from softbend.errors import InputError, SchemaError
 from softbend.identification.kernels import MOMENTS_OF
 from softbend.identification.narx import NARXRegressor, _lag_structure, _regressor_names
 from softbend.identification.svr import DEFAULT_MAX_WORKING_SET, GeneralizedGaussianSVR
@@ -64,9 +64,10 @@ def narx_to_dict(model: NARXRegressor, metadata: dict[str, Any] | None = None) -
     """The state of a fitted NARX model with a GG-SVR inside, as JSON-ready data."""
     svr = getattr(model, "estimator_", None)
     if not isinstance(svr, GeneralizedGaussianSVR):
-        raise ValueError(
-            "The 'model' of narx_to_dict must be a fitted NARXRegressor whose estimator is a "
-            f"GeneralizedGaussianSVR. Got estimator {type(svr).__name__} instead."
+        raise InputError(
+            "must be a fitted NARXRegressor whose estimator is a GeneralizedGaussianSVR; "
+            f"got estimator {type(svr).__name__}",
+            key="model",
         )
     return {
         "format": FORMAT,
@@ -98,114 +99,109 @@ def narx_to_dict(model: NARXRegressor, metadata: dict[str, Any] | None = None) -
 # Loading validates the whole document before building anything: the keys of every object
 # (an unknown key is refused), the type of every value, the shapes of the arrays (support
 # vectors (n_sv, n_features), scaler vectors per signal), finiteness and bounds (kernel width
-# and scales > 0), and the lag structure against the NARX parameters.
+# and scales > 0), and the lag structure against the NARX parameters. Every check raises a
+# SchemaError keyed by the value's place in the document ("narx.params.output_lags") with
+# the shared wording of softbend._validation; load_narx adds the file.
 
 
-class _RuleError(Exception):
-    """A value breaks its rule; the message names the key and the rule (not the file)."""
+def _object(value: object, key: str, keys: tuple[str, ...]) -> Mapping[str, Any]:
+    if not isinstance(value, Mapping):
+        raise SchemaError(must_be("a JSON object", value), key=key)
+    return check_object_keys(value, key, keys, keys, SchemaError)
 
 
-def _is_real(value: Any) -> bool:
-    return type(value) in (int, float)  # JSON numbers, not bool
-
-
-def _object(value: Any, where: str, keys: tuple[str, ...]) -> Mapping[str, Any]:
-    return check_object_keys(value, where, keys, keys, _RuleError)
-
-
-def _int(value: Any, where: str, low: int) -> int:
+def _int(value: object, key: str, low: int) -> int:
     if type(value) is not int or value < low:
-        raise _RuleError(f"'{where}' must be an integer >= {low}; got {short_repr(value)}")
+        raise SchemaError(must_be(f"an integer in [{low}, inf)", value), key=key)
     return value
 
 
-def _bool(value: Any, where: str) -> bool:
+def _bool(value: object, key: str) -> bool:
     if not isinstance(value, bool):
-        raise _RuleError(f"'{where}' must be true or false; got {short_repr(value)}")
+        raise SchemaError(must_be("true or false", value), key=key)
     return value
 
 
 def _real(
-    value: Any,
-    where: str,
+    value: object,
+    key: str,
     *,
-    low: float | None = None,
+    low: float = -math.inf,
     strict: bool = False,
-    high: float | None = None,
+    high: float = math.inf,
 ) -> float:
-    rule = "a finite number"
-    if low is not None:
-        rule += f" {'>' if strict else '>='} {low:g}"
-    if high is not None:
-        rule += f" and <= {high:g}"
-    ok = _is_real(value) and math.isfinite(value)
-    if ok and low is not None:
-        ok = value > low if strict else value >= low
-    if ok and high is not None:
-        ok = value <= high
-    if not ok:
-        raise _RuleError(f"'{where}' must be {rule}; got {short_repr(value)}")
-    return float(value)
+    """A finite JSON number in ``[low, high]`` (``(low, high]`` if ``strict``)."""
+    if math.isinf(low) and math.isinf(high):
+        rule = "a finite number"
+    else:
+        rule = "a number in " + interval_text(
+            low, high, low_inclusive=not strict, high_inclusive=True
+        )
+    json_number = isinstance(value, int | float) and not isinstance(value, bool)
+    number = float(value) if json_number and isinstance(value, int | float) else math.nan
+    inside = (number > low if strict else number >= low) and number <= high
+    if not (math.isfinite(number) and inside):
+        raise SchemaError(must_be(rule, value), key=key)
+    return number
 
 
 def _vector(
-    value: Any,
-    where: str,
+    value: object,
+    key: str,
     length: int | None = None,
     *,
-    low: float | None = None,
+    low: float = -math.inf,
     strict: bool = False,
 ) -> np.ndarray:
     if not isinstance(value, list) or (length is not None and len(value) != length):
         size = f"{length} " if length is not None else ""
-        raise _RuleError(f"'{where}' must be a list of {size}numbers; got {short_repr(value)}")
+        raise SchemaError(must_be(f"a list of {size}numbers", value), key=key)
     for i, item in enumerate(value):
-        _real(item, f"{where}[{i}]", low=low, strict=strict)
+        _real(item, f"{key}[{i}]", low=low, strict=strict)
     return np.asarray(value, dtype=float)
 
 
-def _kernel_width(value: Any, where: str) -> float:
+def _kernel_width(value: object, key: str) -> float:
     """A kernel width σ: a finite number in the plausible range of kernel widths."""
-    width = _real(value, where, low=0.0, strict=True)
+    width = _real(value, key, low=0.0, strict=True)
     problem = implausible_text(width, "kernel_width")
     if problem is not None:
-        raise _RuleError(f"'{where}': {problem.rstrip('.')}")
+        raise SchemaError(problem.rstrip("."), key=key)
     return width
 
 
-def _int_vector(value: Any, where: str, length: int | None = None) -> np.ndarray:
+def _int_vector(value: object, key: str, length: int | None = None) -> np.ndarray:
     if not isinstance(value, list) or (length is not None and len(value) != length):
         size = f"{length} " if length is not None else ""
-        raise _RuleError(f"'{where}' must be a list of {size}integers; got {short_repr(value)}")
+        raise SchemaError(must_be(f"a list of {size}integers", value), key=key)
     for i, item in enumerate(value):
-        _int(item, f"{where}[{i}]", 0)
+        _int(item, f"{key}[{i}]", 0)
     return np.asarray(value, dtype=int)
 
 
-def _matrix(value: Any, where: str, rows: int, columns: int) -> np.ndarray:
+def _matrix(value: object, key: str, rows: int, columns: int) -> np.ndarray:
     if not isinstance(value, list) or len(value) != rows:
-        raise _RuleError(
-            f"'{where}' must be a list of {rows} rows (one per dual coefficient); "
-            f"got {short_repr(value)}"
+        raise SchemaError(
+            must_be(f"a list of {rows} rows (one per dual coefficient)", value), key=key
         )
     for i, row in enumerate(value):
-        _vector(row, f"{where}[{i}]", columns)
+        _vector(row, f"{key}[{i}]", columns)
     return np.asarray(value, dtype=float).reshape(rows, columns)
 
 
 _SCALER_KEYS = ("mean", "scale", "var", "n_samples_seen")
 
 
-def _scaler(value: Any, where: str, scale: bool, size: int) -> Mapping[str, Any] | None:
+def _scaler(value: object, key: str, scale: bool, size: int) -> Mapping[str, Any] | None:
     if not scale:
         if value is not None:
-            raise _RuleError(f"'{where}' must be null when 'narx.params.scale' is false")
+            raise SchemaError(must_be("null when 'narx.params.scale' is false", value), key=key)
         return None
-    state = _object(value, where, _SCALER_KEYS)
-    _vector(state["mean"], f"{where}.mean", size)
-    _vector(state["scale"], f"{where}.scale", size, low=0.0, strict=True)
-    _vector(state["var"], f"{where}.var", size, low=0.0)
-    _int(state["n_samples_seen"], f"{where}.n_samples_seen", 1)
+    state = _object(value, key, _SCALER_KEYS)
+    _vector(state["mean"], f"{key}.mean", size)
+    _vector(state["scale"], f"{key}.scale", size, low=0.0, strict=True)
+    _vector(state["var"], f"{key}.var", size, low=0.0)
+    _int(state["n_samples_seen"], f"{key}.n_samples_seen", 1)
     return state
 
 
@@ -236,7 +232,7 @@ _ESTIMATOR_KEYS = (
 )
 
 
-def _svr_params(value: Any) -> Mapping[str, Any]:
+def _svr_params(value: object) -> Mapping[str, Any]:
     where = "estimator.params"
     params = _object(value, where, tuple(GeneralizedGaussianSVR._get_param_names()))
     for key in ("C", "tol", "cache_size"):
@@ -250,22 +246,20 @@ def _svr_params(value: Any) -> Mapping[str, Any]:
     _int(params["max_iter"], f"{where}.max_iter", -1)
     _int(params["max_working_set"], f"{where}.max_working_set", 8)
     if params["moments_of"] not in MOMENTS_OF:
-        raise _RuleError(
-            f"'{where}.moments_of' must be one of {', '.join(map(repr, MOMENTS_OF))}; "
-            f"got {short_repr(params['moments_of'])}"
+        raise SchemaError(
+            must_be(f"one of {', '.join(map(repr, MOMENTS_OF))}", params["moments_of"]),
+            key=f"{where}.moments_of",
         )
     return params
 
 
 def _check_document(data: dict[str, Any]) -> None:
-    """Raise :class:`_RuleError` unless ``data`` holds a complete, consistent model."""
+    """Raise :class:`SchemaError` (keyed) unless ``data`` holds a complete, consistent model."""
     _object(data, "(top level)", _TOP_KEYS)
     if not isinstance(data["softbend_version"], str):
-        raise _RuleError(
-            f"'softbend_version' must be a string; got {short_repr(data['softbend_version'])}"
-        )
+        raise SchemaError(must_be("a string", data["softbend_version"]), key="softbend_version")
     if not isinstance(data["metadata"], dict):
-        raise _RuleError(f"'metadata' must be a JSON object; got {short_repr(data['metadata'])}")
+        raise SchemaError(must_be("a JSON object", data["metadata"]), key="metadata")
 
     narx = _object(data["narx"], "narx", _NARX_KEYS)
     params = _object(narx["params"], "narx.params", _NARX_PARAMS)
@@ -277,7 +271,7 @@ def _check_document(data: dict[str, Any]) -> None:
     # The offsets are lists in the file: their lengths bound the lags before any array is made.
     _int_vector(narx["output_offsets"], "narx.output_offsets", na)
     _int_vector(narx["input_offsets"], "narx.input_offsets", nb)
-    structure = _lag_structure(na, nb, current, "load_narx")
+    structure = _lag_structure(na, nb, current)
     for key, expected in (
         ("max_lag", structure.max_lag),
         ("output_offsets", structure.output_offsets.tolist()),
@@ -289,9 +283,13 @@ def _check_document(data: dict[str, Any]) -> None:
         else:
             _int_vector(found, f"narx.{key}")
         if found != expected:
-            raise _RuleError(
-                f"'narx.{key}' must be {expected} for output_lags={na}, input_lags={nb}, "
-                f"include_current_input={str(current).lower()}; got {short_repr(found)}"
+            raise SchemaError(
+                must_be(
+                    f"{expected} for output_lags={na}, input_lags={nb}, "
+                    f"include_current_input={str(current).lower()}",
+                    found,
+                ),
+                key=f"narx.{key}",
             )
     _int(narx["n_train_rows"], "narx.n_train_rows", 0)
     _int(narx["n_experiments"], "narx.n_experiments", 0)
@@ -300,16 +298,17 @@ def _check_document(data: dict[str, Any]) -> None:
 
     estimator = _object(data["estimator"], "estimator", _ESTIMATOR_KEYS)
     if estimator["class"] != "GeneralizedGaussianSVR":
-        raise _RuleError(
-            "'estimator.class' must be 'GeneralizedGaussianSVR'; "
-            f"got {short_repr(estimator['class'])}"
+        raise SchemaError(
+            must_be("'GeneralizedGaussianSVR'", estimator["class"]), key="estimator.class"
         )
     _svr_params(estimator["params"])
     n_features = na + n_inputs * nb
     if estimator["n_features_in"] != n_features or type(estimator["n_features_in"]) is not int:
-        raise _RuleError(
-            f"'estimator.n_features_in' must be {n_features} (output_lags + n_inputs x "
-            f"input_lags); got {short_repr(estimator['n_features_in'])}"
+        raise SchemaError(
+            must_be(
+                f"{n_features} (output_lags + n_inputs x input_lags)", estimator["n_features_in"]
+            ),
+            key="estimator.n_features_in",
         )
     _kernel_width(estimator["sigma"], "estimator.sigma")
     _real(estimator["shape"], "estimator.shape", low=0.0, strict=True, high=2.0)
@@ -356,36 +355,33 @@ def svr_from_state(state: Mapping[str, Any]) -> GeneralizedGaussianSVR:
     return svr
 
 
-def narx_from_dict(data: dict[str, Any], *, source: str = "the saved model") -> NARXRegressor:
+def narx_from_dict(data: object) -> NARXRegressor:
     """Rebuild a fitted NARX model from :func:`narx_to_dict` data.
 
-    Every key and value is checked first (see the schema above); ``source`` (the
-    file, for :func:`load_narx`) starts the one-line :class:`SchemaError` message.
+    Every key and value is checked first (see the schema above); a
+    :class:`SchemaError` is keyed by the place of the value at fault.
     """
     if not isinstance(data, dict) or data.get("format") != FORMAT:
         found = data.get("format") if isinstance(data, dict) else type(data).__name__
         raise SchemaError(
-            f"Not a saved softbend NARX model: {source} has format {found!r}, expected {FORMAT!r}."
+            f"must be {FORMAT!r}: not a saved softbend NARX model; got {found!r}", key="format"
         )
     version = data.get("schema_version")
     if isinstance(version, bool) or not isinstance(version, int) or version < 1:
         raise SchemaError(
-            f"{source} has an invalid schema version {version!r}; expected an integer from 1 "
-            f"to {SCHEMA_VERSION}."
+            must_be(f"an integer in [1, {SCHEMA_VERSION}]", version), key="schema_version"
         )
     if version > SCHEMA_VERSION:
         raise SchemaError(
-            f"{source} has schema version {version}; this softbend ({__version__}) "
-            f"reads versions up to {SCHEMA_VERSION}. Upgrade softbend to load it."
+            f"must be at most {SCHEMA_VERSION}, the newest this softbend ({__version__}) "
+            f"reads; got schema version {version}: upgrade softbend to load it",
+            key="schema_version",
         )
     estimator = data.get("estimator")
     if version == 1 and isinstance(estimator, dict) and isinstance(estimator.get("params"), dict):
         data = {**data, "estimator": {**estimator}}  # the caller's dict stays as it was
         data["estimator"]["params"] = {**_V1_DEFAULTS, **estimator["params"]}
-    try:
-        _check_document(data)
-    except _RuleError as err:
-        raise SchemaError(f"{source}: {err}.") from None
+    _check_document(data)
 
     state = data["estimator"]
     svr = svr_from_state(state)
@@ -446,7 +442,12 @@ def load_narx(path: str | Path) -> tuple[NARXRegressor, dict[str, Any]]:
         check_nesting(text, str(path), SchemaError)
         data = json.loads(text)
     except (json.JSONDecodeError, UnicodeDecodeError) as err:
-        raise SchemaError(f"{path} is not valid JSON: {err}.") from None
+        raise SchemaError(f"is not valid JSON: {err}", file=str(path)) from None
     except RecursionError:
-        raise SchemaError(f"{path} is nested too deeply to read.") from None
-    return narx_from_dict(data, source=str(path)), dict(data["metadata"])
+        raise SchemaError("is nested too deeply to read", file=str(path)) from None
+    try:
+        model = narx_from_dict(data)
+    except SchemaError as error:
+        error.file = str(path)
+        raise
+    return model, dict(data["metadata"])

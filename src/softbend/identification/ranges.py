@@ -6,8 +6,8 @@ solver's time grows with the penalty C (minutes at 10⁶ on a few short
 experiments, where paper A's 100 takes seconds). Each range is far
 beyond what a real identification uses, yet stops such values before anything
 is read or fitted, with one line naming the setting, its range and the value
-given (``The '--input-lags' must be an integer in [1, 50]. Got 1000000000
-instead.``).
+given (``--input-lags: must be an integer in [1, 50]; got 1000000000``: the
+error is keyed ``input_lags`` and the command line names its option).
 
 ==================  ================  ==========================================
 setting             range             why
@@ -41,8 +41,8 @@ from __future__ import annotations
 
 import math
 import numbers
-from typing import Any
 
+from softbend.errors import InputError
 from softbend.parameters import Range
 
 __all__ = [
@@ -105,7 +105,7 @@ MIN_OUTPUT_RANGE = 1e-100
 _SHOWN_DIGITS = 40
 
 
-def _shown(value: Any) -> str:
+def _shown(value: object) -> str:
     """``repr(value)``, or the digit count of an integer too long to show (or to print)."""
     if isinstance(value, numbers.Integral) and not isinstance(value, bool):
         digits = len(str(abs(int(value)))) if int(value).bit_length() < 10_000 else None
@@ -128,18 +128,17 @@ def _integer_interval(bounds: Range) -> str:
     return f"{left}{_bound(bounds.low)}, {_bound(bounds.high)}{right}"
 
 
-def check_integer(value: Any, bounds: Range, label: str) -> int:
-    """``value`` as an int if it is an integer (not a bool) in ``bounds``, else ``ValueError``.
+def check_integer(value: object, bounds: Range, key: str) -> int:
+    """``value`` as an int if it is an integer (not a bool) in ``bounds``, else raise.
 
     Parameters
     ----------
-    value : Any
+    value : object
         The value given.
     bounds : Range
         Its declared range (inclusive bounds).
-    label : str
-        The setting as the message names it, quoted: ``"'--input-lags'"`` or
-        ``"'input_lags' of IdentificationConfig"``.
+    key : str
+        The setting's parameter (``"input_lags"``).
 
     Returns
     -------
@@ -148,29 +147,28 @@ def check_integer(value: Any, bounds: Range, label: str) -> int:
 
     Raises
     ------
-    ValueError
-        ``The <label> must be an integer in [low, high]. Got <value> instead.``
+    InputError
+        ``key: must be an integer in [low, high]; got <value>``.
     """
     integer = isinstance(value, numbers.Integral) and not isinstance(value, bool)
-    if not (integer and bounds.contains(value)):  # Range compares long integers exactly
-        raise ValueError(
-            f"The {label} must be an integer in {_integer_interval(bounds)}. "
-            f"Got {_shown(value)} instead."
-        )
-    return int(value)
+    if integer and isinstance(value, numbers.Integral) and bounds.contains(value):
+        return int(value)  # Range compares long integers exactly
+    raise InputError(
+        f"must be an integer in {_integer_interval(bounds)}; got {_shown(value)}", key=key
+    )
 
 
-def check_number(value: Any, bounds: Range, label: str) -> float:
+def check_number(value: object, bounds: Range, key: str) -> float:
     """``value`` as a float if it is a number (not a bool, not NaN) in ``bounds``, else raise.
 
     Parameters
     ----------
-    value : Any
+    value : object
         The value given.
     bounds : Range
         Its declared range.
-    label : str
-        The setting as the message names it, quoted (``"'--C'"``).
+    key : str
+        The setting's parameter (``"C"``).
 
     Returns
     -------
@@ -179,14 +177,14 @@ def check_number(value: Any, bounds: Range, label: str) -> float:
 
     Raises
     ------
-    ValueError
-        ``The <label> must be a number in (low, high]. Got <value> instead.``
+    InputError
+        ``key: must be a number in (low, high]; got <value>``.
     """
-    message = f"The {label} must be a number in {bounds.interval()}. Got {_shown(value)} instead."
+    error = InputError(f"must be a number in {bounds.interval()}; got {_shown(value)}", key=key)
     if isinstance(value, bool) or not isinstance(value, numbers.Real):
-        raise ValueError(message)
+        raise error
     if not bounds.contains(value):  # Range compares long integers exactly
-        raise ValueError(message)
+        raise error
     return float(value)
 
 
@@ -194,7 +192,6 @@ def check_lags_fit(
     output_lags: int,
     input_lags: int,
     shortest: tuple[str, int],
-    labels: tuple[str, str],
     *,
     predicted: int = 1,
 ) -> None:
@@ -209,26 +206,25 @@ def check_lags_fit(
         The lags (already within :data:`LAGS_RANGE`).
     shortest : tuple of (str, int)
         The name and sample count of the shortest experiment.
-    labels : tuple of str
-        How the message names the output lags and the input lags, quoted.
     predicted : int, default 1
         The samples that must follow the initial conditions (regressor rows).
 
     Raises
     ------
-    ValueError
-        One line naming the setting, its range for these experiments, the value
-        and the shortest experiment.
+    InputError
+        Keyed ``output_lags`` or ``input_lags``: its range for these
+        experiments, the value and the shortest experiment.
     """
     name, samples = shortest
-    for label, value, most in (
-        (labels[0], output_lags, samples - predicted),
-        (labels[1], input_lags, samples - predicted + 1),
+    for key, value, most in (
+        ("output_lags", output_lags, samples - predicted),
+        ("input_lags", input_lags, samples - predicted + 1),
     ):
         if value > most:
             leave = "one" if predicted == 1 else str(predicted)
-            raise ValueError(
-                f"The {label} must be an integer in [1, {max(most, 0)}] for these experiments: "
-                f"the shortest, {name!r}, has {samples} sample(s), and its initial conditions "
-                f"must leave {leave} to predict. Got {value} instead."
+            raise InputError(
+                f"must be an integer in [1, {max(most, 0)}] for these experiments (the "
+                f"shortest, {name!r}, has {samples} sample(s), and its initial conditions "
+                f"must leave {leave} to predict); got {value}",
+                key=key,
             )

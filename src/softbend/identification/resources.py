@@ -205,9 +205,7 @@ def check_identify_memory(
         limit = available_memory_bytes()
         source = "the memory available"
     else:
-        checked = check_number(
-            max_memory_mb, MAX_MEMORY_MB_RANGE, "'max_memory_mb' of check_identify_memory"
-        )
+        checked = check_number(max_memory_mb, MAX_MEMORY_MB_RANGE, "max_memory_mb")
         limit = int(checked * MIB)
         source = "--max-memory-mb"
     estimate = estimate_identify_memory(

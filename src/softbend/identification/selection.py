@@ -30,17 +30,20 @@ import time
 import warnings
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass, field
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
-from softbend.errors import ConvergenceError, DatasetError
+from softbend.errors import ConvergenceError, DatasetError, InputError
 from softbend.identification.kernels import ShapeClippedWarning
 from softbend.identification.multi import MultiNARX, nrmse
 from softbend.identification.ranges import FOLDS_RANGE, SEED_RANGE, check_integer
 from softbend.identification.timeseries import TimeSeriesSet
 from softbend.identification.timeseries_io import check_signals
 from softbend.parameters import Range
+
+if TYPE_CHECKING:
+    import pandas as pd
 
 __all__ = [
     "FIRST_RUNG_ROWS",
@@ -97,8 +100,8 @@ def default_candidates(seed: int = 0, n_kernel: int = 6) -> list[Candidate]:
     n_kernel : int, default 6
         Kernel candidates, in [0, 1000].
     """
-    seed = check_integer(seed, SEED_RANGE, "'seed' of default_candidates")
-    n_kernel = check_integer(n_kernel, _N_KERNEL_RANGE, "'n_kernel' of default_candidates")
+    seed = check_integer(seed, SEED_RANGE, "seed")
+    n_kernel = check_integer(n_kernel, _N_KERNEL_RANGE, "n_kernel")
     lags = [(na, nb) for na in (1, 2, 3) for nb in (1, 2, 3)]
     out = [Candidate(f"arx-{na}-{nb}", "arx", na, nb) for na, nb in lags]
     out += [Candidate(f"poly2-{na}-{nb}", "poly2", na, nb) for na, nb in lags if na + nb <= 4]
@@ -292,25 +295,27 @@ def select_model(
     held = tuple(validate_on or ())
     unknown = [n for n in held if n not in data.names]
     if unknown:
-        raise ValueError(
-            f"Unknown validation experiment(s) {', '.join(map(repr, unknown))}; the "
-            f"experiments are {', '.join(data.names)}."
+        raise InputError(
+            f"must name experiments of the data ({', '.join(data.names)}); "
+            f"got {', '.join(map(repr, unknown))}",
+            key="validate_on",
         )
     repeated = sorted({n for n in held if held.count(n) > 1})
     if repeated:
-        raise ValueError(
-            f"The 'validate_on' of select_model must name each experiment once. "
-            f"Got {', '.join(map(repr, repeated))} more than once."
+        raise InputError(
+            f"must name each experiment once; got {', '.join(map(repr, repeated))} more than once",
+            key="validate_on",
         )
     train_names = tuple(n for n in data.names if n not in held)
     if len(train_names) < 2:
-        raise ValueError(
-            f"Selecting a model needs at least 2 training experiments to hold one out; "
+        raise InputError(
+            f"must leave at least 2 training experiments to hold one out; "
             f"{len(train_names)} remain{'s' if len(train_names) == 1 else ''} "
-            f"({', '.join(train_names) or 'none'})."
+            f"({', '.join(train_names) or 'none'})",
+            key="validate_on",
         )
-    folds = min(check_integer(folds, FOLDS_RANGE, "'folds' of select_model"), len(train_names))
-    seed = check_integer(seed, SEED_RANGE, "'seed' of select_model")
+    folds = min(check_integer(folds, FOLDS_RANGE, "folds"), len(train_names))
+    seed = check_integer(seed, SEED_RANGE, "seed")
     check_signals(data, held)
     train = data.subset(train_names)
     ranges = np.ptp(np.vstack([e.outputs for e in train.experiments]), axis=0)
@@ -442,7 +447,7 @@ def _check_kernel_rows(
             )
 
 
-def _check_finite(table: Any, *, validated: bool) -> None:
+def _check_finite(table: pd.DataFrame, *, validated: bool) -> None:
     """Raise :class:`ConvergenceError` naming the first figure of ``table`` that is not finite.
 
     The validation error is NaN by design without validation experiments and for

@@ -16,9 +16,9 @@ from __future__ import annotations
 
 import logging
 import warnings
-from collections.abc import Callable, Mapping, Sequence
+from collections.abc import Callable, Sequence
 from dataclasses import dataclass, field
-from typing import Any, Literal
+from typing import TYPE_CHECKING, Any, Literal
 
 import numpy as np
 import pandas as pd
@@ -37,6 +37,9 @@ from softbend.identification.ranges import (
     check_number,
 )
 from softbend.metrics import regression_metrics
+
+if TYPE_CHECKING:
+    from softbend.identification.svr import GeneralizedGaussianSVR
 
 logger = logging.getLogger(__name__)
 
@@ -91,20 +94,12 @@ class IdentificationConfig:
         check_choice(self.moments_of, "moments_of", MOMENTS_OF)
 
 
-def _label(name: str, names: Mapping[str, str] | None) -> str:
-    """How a message names the setting ``name``: its option, else its field."""
-    if names is not None and name in names:
-        return f"'{names[name]}'"
-    return f"'{name}' of IdentificationConfig"
-
-
 def check_settings(
     *,
-    C: Any,
-    epsilon: Any,
-    output_lags: Any,
-    input_lags: Any,
-    names: Mapping[str, str] | None = None,
+    C: object,
+    epsilon: object,
+    output_lags: object,
+    input_lags: object,
 ) -> None:
     """Hold the numeric settings of :class:`IdentificationConfig` to their declared ranges.
 
@@ -112,19 +107,16 @@ def check_settings(
     ----------
     C, epsilon, output_lags, input_lags
         The values given (see :class:`IdentificationConfig`).
-    names : mapping of str to str, optional
-        The option that set each field (``{"input_lags": "--input-lags"}``), for
-        the message; default the field of ``IdentificationConfig``.
 
     Raises
     ------
-    ValueError
-        One line naming the first setting out of its range, the range and the value.
+    InputError
+        Keyed by the first setting out of its range: the range and the value.
     """
-    check_number(C, C_RANGE, _label("C", names))
-    check_number(epsilon, EPSILON_RANGE, _label("epsilon", names))
-    check_integer(output_lags, LAGS_RANGE, _label("output_lags", names))
-    check_integer(input_lags, LAGS_RANGE, _label("input_lags", names))
+    check_number(C, C_RANGE, "C")
+    check_number(epsilon, EPSILON_RANGE, "epsilon")
+    check_integer(output_lags, LAGS_RANGE, "output_lags")
+    check_integer(input_lags, LAGS_RANGE, "input_lags")
 
 
 @dataclass
@@ -239,7 +231,7 @@ def select_kernel_by_cv(
     return best[1] if best is not None else {"sigma": 1.0, "shape": 2.0}
 
 
-def _kernel_report(svr: Any, config: IdentificationConfig) -> dict[str, Any]:
+def _kernel_report(svr: GeneralizedGaussianSVR, config: IdentificationConfig) -> dict[str, Any]:
     """Kernel of a fitted final model and why it has its shape (``kernel_params`` entry)."""
     estimate = svr.shape_estimate_ if config.kernel == "moments" else None
     if estimate is not None:
@@ -267,8 +259,6 @@ def _kernel_report(svr: Any, config: IdentificationConfig) -> dict[str, Any]:
 def check_experiments(
     experiments: Sequence[Experiment],
     config: IdentificationConfig,
-    *,
-    names: Mapping[str, str] | None = None,
 ) -> None:
     """Refuse, before any fit, experiments :func:`identify` cannot score.
 
@@ -278,9 +268,6 @@ def check_experiments(
         The experiments.
     config : IdentificationConfig
         The settings.
-    names : mapping of str to str, optional
-        The option that set each field of ``config``, for the message (as in
-        :func:`check_settings`).
 
     Raises
     ------
@@ -308,7 +295,6 @@ def check_experiments(
         config.output_lags,
         config.input_lags,
         (shortest.name, shortest.n_samples),
-        (_label("output_lags", names), _label("input_lags", names)),
         predicted=MIN_PREDICTED,
     )
     for experiment in experiments:

@@ -50,8 +50,8 @@ from sklearn.exceptions import ConvergenceWarning, NotFittedError
 from sklearn.svm import SVR
 from sklearn.utils.validation import _check_sample_weight, check_is_fitted, validate_data
 
-from softbend._validation import check_choice, check_int, check_range
-from softbend.errors import ConvergenceError
+from softbend._validation import check_choice, check_int, check_range, must_be
+from softbend.errors import ConvergenceError, InputError
 from softbend.identification.kernels import (
     MOMENTS_OF,
     ShapeEstimate,
@@ -88,10 +88,7 @@ _FAST_EXPONENT = 50.0
 
 def _check_max_iter(value: object) -> int:
     if isinstance(value, bool) or not isinstance(value, Integral) or value < -1 or value == 0:
-        raise ValueError(
-            f"The 'max_iter' of {_OWNER} must be -1 (no limit) or a positive integer. "
-            f"Got {value!r} instead."
-        )
+        raise InputError(must_be("-1 (no limit) or a positive integer", value), key="max_iter")
     return int(value)
 
 
@@ -565,14 +562,17 @@ class GeneralizedGaussianSVR(RegressorMixin, BaseEstimator):
         if sigma is None or shape is None:
             n_distinct = X_fit.shape[0]
             if n_distinct < 4:
-                raise ValueError(
-                    f"The 'X' of {_OWNER} must contain at least 4 distinct samples to "
-                    f"estimate sigma/shape (or pass both). Got n_samples = {n_distinct} instead."
+                raise InputError(
+                    "must contain at least 4 distinct samples to estimate sigma/shape (or "
+                    f"pass both); got n_samples = {n_distinct}",
+                    key="X",
                 )
             try:
-                estimate = _kernel_shape_estimate(X_fit, w_fit, moments_of, _OWNER)
-            except ValueError as err:
-                raise ValueError(f"{err} Pass sigma and shape explicitly.") from None
+                estimate = _kernel_shape_estimate(X_fit, w_fit, moments_of)
+            except InputError as err:
+                raise InputError(
+                    f"{err.detail}: pass sigma and shape explicitly", key=err.key
+                ) from None
             if sigma is None:
                 sigma = estimate.sigma
             if shape is None:
@@ -724,16 +724,11 @@ class GeneralizedGaussianSVR(RegressorMixin, BaseEstimator):
         def predict_one(x: ArrayLike) -> float:
             x = np.asarray(x, dtype=np.float64)
             if x.shape != x_shape:
-                raise ValueError(
-                    f"The 'x' of {_OWNER}.predictor() must have shape {x_shape}. "
-                    f"Got shape {x.shape} instead."
-                )
+                raise InputError(f"must have shape {x_shape}; got shape {x.shape}", key="x")
             # |x − m|: NaN or inf for a non-finite x (math.dist is one C call).
             far = rate * math.dist(x.tolist(), center) ** 2
             if not math.isfinite(far):
-                raise ValueError(
-                    f"The 'x' of {_OWNER}.predictor() must be finite. Got {x!r} instead."
-                )
+                raise InputError(must_be("finite", x.tolist()), key="x")
             if fast and far <= _FAST_EXPONENT:
                 row = fast_matrix @ x
                 row += fast_bias

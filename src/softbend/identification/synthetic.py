@@ -62,7 +62,8 @@ from typing import Any, Literal
 import numpy as np
 from numpy.typing import ArrayLike
 
-from softbend._validation import check_choice, check_range
+from softbend._validation import check_choice, check_range, must_be
+from softbend.errors import InputError, keyed
 from softbend.identification.data import Experiment
 from softbend.limits import check_limit
 from softbend.plausibility import RANGES
@@ -93,7 +94,6 @@ SYNTHETIC_LABEL = (
 
 ProfileKind = Literal["random_hold", "staircase", "triangle", "step", "sine", "ramp", "impulsive"]
 Excitation = Literal["mixed", "impulsive"]
-_OWNER = "CurlingActuator"
 
 
 def _saturating(fraction: np.ndarray | float, stiffening: float) -> np.ndarray | float:
@@ -244,14 +244,13 @@ class CurlingActuator:
             for w in self.play_weights
         )
         if len(radii) != len(weights):
-            raise ValueError(
-                f"The 'play_weights' of {_OWNER} must have one weight per play radius "
-                f"({len(radii)}). Got {len(weights)} instead."
+            raise InputError(
+                f"must have one weight per play radius ({len(radii)}); got {len(weights)}",
+                key="play_weights",
             )
         if sum(weights) >= 1.0:
-            raise ValueError(
-                f"The 'play_weights' of {_OWNER} must sum to less than 1. "
-                f"Got {sum(weights)!r} instead."
+            raise InputError(
+                must_be("weights summing to less than 1", sum(weights)), key="play_weights"
             )
         object.__setattr__(self, "play_radii_kpa", radii)
         object.__setattr__(self, "play_weights", weights)
@@ -327,23 +326,25 @@ class CurlingActuator:
         time = np.asarray(time_s, dtype=float)
         command = np.asarray(pressure_kpa, dtype=float)
         if time.ndim != 1 or command.shape != time.shape or time.size < 2:
-            raise ValueError(
-                "The 'time_s' and 'pressure_kpa' of CurlingActuator.response must be 1-D arrays "
-                f"of equal length >= 2. Got shapes {time.shape} and {command.shape} instead."
+            raise InputError(
+                "must be a 1-D array of the length of 'time_s', both of length >= 2; "
+                f"got shapes {command.shape} and {time.shape} (time_s)",
+                key="pressure_kpa",
             )
-        for name, values in (("time_s", time), ("pressure_kpa", command)):
+        for key, values in (("time_s", time), ("pressure_kpa", command)):
             if not np.all(np.isfinite(values)):
-                raise ValueError(
-                    f"The '{name}' of CurlingActuator.response must be finite. "
-                    f"Got {float(values[~np.isfinite(values)][0])!r} at position "
-                    f"{int(np.flatnonzero(~np.isfinite(values))[0])} instead."
+                raise InputError(
+                    f"must be finite; got {float(values[~np.isfinite(values)][0])!r} at "
+                    f"position {int(np.flatnonzero(~np.isfinite(values))[0])}",
+                    key=key,
                 )
         steps = np.diff(time)
         if np.any(steps <= 0):
             first = int(np.flatnonzero(steps <= 0)[0]) + 1
-            raise ValueError(
-                "The 'time_s' of CurlingActuator.response must increase strictly. "
-                f"Got {float(time[first])!r} after {float(time[first - 1])!r} at position {first}."
+            raise InputError(
+                f"must increase strictly; got {float(time[first])!r} after "
+                f"{float(time[first - 1])!r} at position {first}",
+                key="time_s",
             )
 
         radii = self.play_radii_kpa
@@ -543,13 +544,11 @@ def pressure_profile(
     check_choice(kind, "kind", ALL_PROFILE_KINDS)
     n = int(check_range(n_samples, "n_samples", low=16, high=math.inf, low_inclusive=True))
     if n != n_samples:
-        raise ValueError(
-            f"The 'n_samples' of pressure_profile must be an integer. Got {n_samples!r} instead."
-        )
+        raise InputError(must_be("an integer", n_samples), key="n_samples")
     dt = check_range(dt_s, "dt_s", low=0.0, high=math.inf)
     peak = check_range(peak_kpa, "peak_kpa", low=-math.inf, high=math.inf)
     if peak == 0.0:
-        raise ValueError("The 'peak_kpa' of pressure_profile must be nonzero. Got 0.0 instead.")
+        raise InputError(must_be("nonzero", 0.0), key="peak_kpa")
     rng = np.random.default_rng(seed)
     time = dt * np.arange(n)
     lead = min(max(1, round(0.2 / dt)), n // 4)
@@ -627,9 +626,7 @@ def pressure_profile(
     return time, pressure
 
 
-def check_synthetic_size(
-    n_samples: Any, dt_s: Any, *, samples: str = "n_samples", dt: str = "dt_s"
-) -> None:
+def check_synthetic_size(n_samples: object, dt_s: object) -> None:
     """Refuse experiments that the experiment CSV reader would refuse to read back.
 
     Each experiment is written as one CSV file of ``n_samples`` rows, so
@@ -643,24 +640,23 @@ def check_synthetic_size(
         Samples per experiment.
     dt_s : float
         Sample interval, s (> 0 and finite; checked here only against the span).
-    samples, dt : str
-        How messages name the two (e.g. the options ``--samples`` and ``--dt``).
 
     Raises
     ------
     LimitError
-        ``n_samples`` over the ``csv_rows`` limit.
-    ValueError
-        A time axis longer than the plausible range of time.
+        ``n_samples`` over the ``csv_rows`` limit (keyed ``n_samples``).
+    InputError
+        A time axis longer than the plausible range of time (keyed ``dt_s``).
     """
     if isinstance(n_samples, int) and not isinstance(n_samples, bool):
-        check_limit("csv_rows", n_samples, samples)
+        with keyed("n_samples"):
+            check_limit("csv_rows", n_samples, "the sample count")
         span = RANGES["time_s"].high
         if isinstance(dt_s, int | float) and math.isfinite(dt_s) and dt_s * (n_samples - 1) > span:
-            raise ValueError(
-                f"The {dt} times the {samples} make an experiment "
-                f"{dt_s * (n_samples - 1):.4g} s long, more than the plausible time of "
-                f"{span:g} s a file may hold. Got {dt} = {dt_s!r} and {n_samples} samples."
+            raise InputError(
+                f"must make {n_samples} samples at most the plausible time of {span:g} s a "
+                f"file may hold; got {dt_s!r} ({dt_s * (n_samples - 1):.4g} s)",
+                key="dt_s",
             )
 
 
@@ -716,18 +712,14 @@ def synthetic_dataset(
         low_inclusive=True,
     )
     if count != int(count):
-        raise ValueError(
-            "The 'n_experiments' of synthetic_dataset must be an integer. "
-            f"Got {n_experiments!r} instead."
-        )
+        raise InputError(must_be("an integer", n_experiments), key="n_experiments")
     count = int(count)
     check_choice(excitation, "excitation", EXCITATIONS)
-    check_synthetic_size(n_samples, dt_s, samples="'n_samples' of synthetic_dataset")
+    check_synthetic_size(n_samples, dt_s)
     plant = CurlingActuator() if actuator is None else actuator
     if not isinstance(plant, CurlingActuator):
-        raise ValueError(
-            f"The 'actuator' of synthetic_dataset must be a CurlingActuator or None. "
-            f"Got {type(actuator).__name__} instead."
+        raise InputError(
+            must_be("a CurlingActuator or None", type(actuator).__name__), key="actuator"
         )
     children = np.random.SeedSequence(seed).generate_state(4 * count).reshape(2, count, 2)
     dataset: dict[str, list[Experiment]] = {}

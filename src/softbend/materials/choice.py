@@ -27,6 +27,7 @@ from softbend.materials.presets import (
     PRESETS,
     Material,
 )
+from softbend.registry import UnknownNameError
 
 __all__ = ["material_from_spec", "material_spec_record"]
 
@@ -35,7 +36,6 @@ def material_from_spec(
     spec: str | os.PathLike[str],
     *,
     density_g_per_cm3: float | None = None,
-    field: str = "--material",
 ) -> Material:
     """The material ``spec`` names: a preset, or a model of a ``materials fit`` file.
 
@@ -46,8 +46,6 @@ def material_from_spec(
     density_g_per_cm3 : float, optional
         Density of a fitted material, g/cm³ (default: Dragon Skin 30's, 1.08);
         ignored for a preset, which has its own.
-    field : str, default "--material"
-        Where ``spec`` came from, named in messages.
 
     Returns
     -------
@@ -61,26 +59,36 @@ def material_from_spec(
     SchemaError
         The file is not a valid ``fit.json`` (as :func:`~softbend.materials.fit.load_fit_json`),
         names an unknown model after ``#``, or has no model with a finite R².
+
+    An error about the name is keyed ``spec`` (a caller that hands its own
+    parameter on names it with :func:`softbend.errors.keyed`); an error in the
+    file names the file and the entry.
     """
     text = os.fspath(spec)
     path_text, _, model_name = text.partition("#")
     path = Path(path_text)
     if not path.is_file():
-        return PRESETS.get(text, field=f"{field}; or a fit.json of 'softbend materials fit'")
+        try:
+            return PRESETS.get(text)
+        except UnknownNameError as error:
+            raise UnknownNameError(
+                f"{error.detail.rstrip('.')}; or a fit.json of 'softbend materials fit'",
+                key="spec",
+            ) from None
     from softbend.materials.fit import load_fit_json
 
-    fits = load_fit_json(path)
+    fits = load_fit_json(path)  # its errors name the file
     if model_name:
         if model_name not in fits:
             raise SchemaError(
-                f"The '{field}' names model {model_name!r} of {path}, which holds "
-                f"{', '.join(fits)}."
+                f"names model {model_name!r} of {path}, which holds {', '.join(fits)}",
+                key="spec",
             )
         chosen = fits[model_name]
     else:
         ranked = [f for f in fits.values() if f.r2 == f.r2]
         if not ranked:
-            raise SchemaError(f"The fits in {path} ('{field}') have no finite R² to pick one by.")
+            raise SchemaError(f"the fits in {path} have no finite R² to pick one by", key="spec")
         chosen = max(ranked, key=lambda f: f.r2)
     if density_g_per_cm3 is None:
         density = DRAGON_SKIN_30.density_g_per_cm3

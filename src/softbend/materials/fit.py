@@ -30,7 +30,8 @@ import json
 import logging
 import math
 import os
-from collections.abc import Callable, Mapping, Sequence
+from collections.abc import Callable, Iterator, Mapping, Sequence
+from contextlib import contextmanager
 from dataclasses import dataclass, fields
 from pathlib import Path
 from typing import Any
@@ -45,9 +46,15 @@ from softbend._validation import (
     check_finite_array,
     check_object_keys,
     check_range,
-    short_repr,
+    must_be,
 )
-from softbend.errors import ConvergenceError, DatasetError, SchemaError
+from softbend.errors import (
+    ConvergenceError,
+    DatasetError,
+    InputError,
+    SchemaError,
+    keyed,
+)
 from softbend.limits import check_file_size
 from softbend.materials.models import (
     _AB_COEFFS,
@@ -118,9 +125,7 @@ class FitResult:
 
     def __post_init__(self) -> None:
         if not isinstance(self.model, HyperelasticModel):
-            raise ValueError(
-                f"The 'model' of FitResult must be a HyperelasticModel. Got {self.model!r} instead."
-            )
+            raise InputError(f"must be a HyperelasticModel; got {self.model!r}", key="model")
         object.__setattr__(self, "r2", float(self.r2))
         object.__setattr__(
             self,
@@ -161,7 +166,7 @@ class FitResult:
         }
 
     @classmethod
-    def from_dict(cls, data: Any, *, source: str = "FitResult.from_dict") -> FitResult:
+    def from_dict(cls, data: object) -> FitResult:
         """Rebuild a result written by :meth:`to_dict` (an entry of ``fit.json``).
 
         Every key and value is checked first: the keys of :meth:`to_dict` and no
@@ -177,19 +182,18 @@ class FitResult:
         ----------
         data : mapping
             One fit, as :meth:`to_dict` writes it.
-        source : str
-            Where ``data`` comes from (the file and the entry), for messages.
 
         Raises
         ------
         SchemaError
-            One line naming ``source`` and the key, what is allowed and the value.
+            Keyed by the entry at fault (``"r2"``, ``"parameters.c10_mpa"``): what
+            is allowed and the value.
         """
         try:
             return _fit_from_dict(data)
-        except ValueError as exc:  # SchemaError included
-            text = str(exc)
-            raise SchemaError(f"{source}: {text}{'' if text.endswith('.') else '.'}") from None
+        except InputError as exc:  # a constant out of its model's range
+            key = f"parameters.{exc.key}" if exc.key else "parameters"
+            raise SchemaError(exc.detail, key=key) from None
 
 
 #: Keys of the ``fit.json`` file that ``softbend materials fit`` writes.
@@ -207,72 +211,81 @@ _FIT_KEYS: tuple[str, ...] = (
 )
 
 
-def _number(value: Any, where: str, quantity: str | None = None) -> float:
+def _number(value: object, key: str, quantity: str | None = None) -> float:
     if isinstance(value, bool) or not isinstance(value, int | float) or not math.isfinite(value):
-        raise SchemaError(f"'{where}' must be a finite number; got {short_repr(value)}")
+        raise SchemaError(must_be("a finite number", value), key=key)
     if quantity is not None and implausible_index([value], quantity) is not None:
         bounds = RANGES[quantity]
         raise SchemaError(
-            f"'{where}' must be a plausible {bounds.label} ({bounds.low:g} to {bounds.high:g} "
-            f"{bounds.unit}); got {value!r}"
+            must_be(
+                f"a plausible {bounds.label} ({bounds.low:g} to {bounds.high:g} {bounds.unit})",
+                value,
+            ),
+            key=key,
         )
     return float(value)
 
 
-def _stretch(value: Any, where: str) -> float:
+def _stretch(value: object, key: str) -> float:
     """A stretch ``1 + strain``: finite, with a plausible engineering strain."""
-    stretch = _number(value, where)
+    stretch = _number(value, key)
     if implausible_index([stretch - 1.0], "strain") is not None:
         bounds = RANGES["strain"]
         raise SchemaError(
-            f"'{where}' must be a stretch whose strain (stretch - 1) is plausible "
-            f"({bounds.low:g} to {bounds.high:g}); got {value!r}"
+            must_be(
+                f"a stretch whose strain (stretch - 1) is plausible "
+                f"({bounds.low:g} to {bounds.high:g})",
+                value,
+            ),
+            key=key,
         )
     return stretch
 
 
-def _fit_from_dict(data: Any) -> FitResult:
-    check_object_keys(data, "fit", _FIT_KEYS, _FIT_KEYS, SchemaError)
-    name = data["model"]
+def _fit_from_dict(data: object) -> FitResult:
+    entry = check_object_keys(data, "fit", _FIT_KEYS, _FIT_KEYS, SchemaError)
+    name = entry["model"]
     if not isinstance(name, str) or name not in MODELS:
-        raise SchemaError(
-            f"'model' must be one of {', '.join(map(repr, MODELS))}; got {short_repr(name)}"
-        )
-    parameters = data["parameters"]
+        raise SchemaError(must_be(f"one of {', '.join(map(repr, MODELS))}", name), key="model")
+    parameters = entry["parameters"]
     if not isinstance(parameters, Mapping):
-        raise SchemaError(f"'parameters' must be a JSON object; got {short_repr(parameters)}")
-    model = MODELS.get(name).from_dict({"model": name, **parameters})
-    shear = _number(data["initial_shear_modulus_mpa"], "initial_shear_modulus_mpa", "modulus_mpa")
+        raise SchemaError(must_be("a JSON object", parameters), key="parameters")
+    try:
+        model = MODELS.get(name).from_dict({"model": name, **parameters})
+    except SchemaError as error:
+        error.key = f"parameters.{error.key}" if error.key else "parameters"
+        raise error
+    shear = _number(entry["initial_shear_modulus_mpa"], "initial_shear_modulus_mpa", "modulus_mpa")
     if not math.isclose(shear, model.initial_shear_modulus_mpa, rel_tol=1e-9, abs_tol=1e-15):
         raise SchemaError(
-            f"'initial_shear_modulus_mpa' must be {model.initial_shear_modulus_mpa!r}, the "
-            f"initial shear modulus of its parameters; got {shear!r}"
+            must_be(
+                f"{model.initial_shear_modulus_mpa!r}, the initial shear modulus of its parameters",
+                shear,
+            ),
+            key="initial_shear_modulus_mpa",
         )
-    r2 = data["r2"]
+    r2 = entry["r2"]
     r2 = math.nan if r2 is None else _number(r2, "r2")
     if r2 > 1.0:
-        raise SchemaError(f"'r2' must be a number <= 1 or null; got {r2!r}")
-    rmse = _number(data["rmse_mpa"], "rmse_mpa", "stress_mpa")
+        raise SchemaError(must_be("a number <= 1 or null", r2), key="r2")
+    rmse = _number(entry["rmse_mpa"], "rmse_mpa", "stress_mpa")
     if rmse < 0.0:
-        raise SchemaError(f"'rmse_mpa' must be >= 0; got {rmse!r}")
-    n_points = data["n_points"]
+        raise SchemaError(must_be(">= 0", rmse), key="rmse_mpa")
+    n_points = entry["n_points"]
     if type(n_points) is not int or n_points < MIN_FIT_POINTS:
-        raise SchemaError(
-            f"'n_points' must be an integer >= {MIN_FIT_POINTS}; got {short_repr(n_points)}"
-        )
-    low = _stretch(data["stretch_min"], "stretch_min")
-    high = _stretch(data["stretch_max"], "stretch_max")
+        raise SchemaError(must_be(f"an integer >= {MIN_FIT_POINTS}", n_points), key="n_points")
+    low = _stretch(entry["stretch_min"], "stretch_min")
+    high = _stretch(entry["stretch_max"], "stretch_max")
     if not 0.0 < low <= high:
         raise SchemaError(
-            f"'stretch_min' and 'stretch_max' must satisfy 0 < stretch_min <= stretch_max; "
-            f"got {low!r} and {high!r}"
+            f"must satisfy 0 < stretch_min <= stretch_max; got {low!r} and {high!r}",
+            key="stretch_max",
         )
     names = [f.name for f in fields(model)]
-    at_bound = data["at_bound"]
+    at_bound = entry["at_bound"]
     if not isinstance(at_bound, list) or any(item not in names for item in at_bound):
         raise SchemaError(
-            f"'at_bound' must be a list of names among {', '.join(names)}; "
-            f"got {short_repr(at_bound)}"
+            must_be(f"a list of names among {', '.join(names)}", at_bound), key="at_bound"
         )
     return FitResult(
         model=model,
@@ -336,7 +349,9 @@ def load_fit_json(path: str | os.PathLike[str]) -> dict[str, FitResult]:
         If the file is not strict JSON (a bare ``NaN`` or ``Infinity`` included),
         is nested deeper than the ``nesting`` limit of :mod:`softbend.limits`,
         has a key other than :data:`FIT_FILE_KEYS`, or a fit fails
-        :meth:`FitResult.from_dict`; the one-line message names the file and the key.
+        :meth:`FitResult.from_dict`; the one-line message names the file (its
+        ``file``) and the entry at fault (``fits[0].r2 must be ...``), so that it
+        survives a caller's :func:`~softbend.errors.keyed`.
     """
     file = Path(path)
     if not file.is_file():
@@ -354,34 +369,50 @@ def load_fit_json(path: str | os.PathLike[str]) -> dict[str, FitResult]:
         raise SchemaError(f"{file} is not valid JSON: {exc}.") from None
     except RecursionError:
         raise SchemaError(f"{file} is nested too deeply to read.") from None
-    try:
-        check_object_keys(data, "(top level)", FIT_FILE_KEYS, ("fits",), SchemaError)
-        fits = data["fits"]
+    with _naming_the_entry(file):
+        top = check_object_keys(data, "(top level)", FIT_FILE_KEYS, ("fits",), SchemaError)
+        fits = top["fits"]
         if not isinstance(fits, list) or not fits:
-            raise SchemaError(f"'fits' must be a non-empty list; got {short_repr(fits)}")
+            raise SchemaError(must_be("a non-empty list", fits), key="fits")
         for key in ("test", "files"):
-            if data.get(key) is not None and not isinstance(data[key], dict):
-                raise SchemaError(
-                    f"'{key}' must be a JSON object or null; got {short_repr(data[key])}"
-                )
-        max_stretch = data.get("max_stretch")
+            if top.get(key) is not None and not isinstance(top[key], dict):
+                raise SchemaError(must_be("a JSON object or null", top[key]), key=key)
+        max_stretch = top.get("max_stretch")
         if max_stretch is not None and _stretch(max_stretch, "max_stretch") <= 1.0:
-            raise SchemaError(f"'max_stretch' must be null or > 1; got {max_stretch!r}")
-    except SchemaError as exc:
-        raise SchemaError(f"{file}: {exc}.") from None
+            raise SchemaError(must_be("null or > 1", max_stretch), key="max_stretch")
     results: dict[str, FitResult] = {}
     for i, entry in enumerate(fits):
-        result = FitResult.from_dict(entry, source=f"{file}, fits[{i}]")
-        if result.name in results:
-            raise SchemaError(f"{file}, fits[{i}]: the model {result.name!r} is fitted twice.")
+        with _naming_the_entry(file, f"fits[{i}]"):
+            result = FitResult.from_dict(entry)
+            if result.name in results:
+                raise SchemaError(f"the model {result.name!r} is fitted twice")
         results[result.name] = result
-    best = data.get("best_model")
+    best = top.get("best_model")
     if best is not None and (not isinstance(best, str) or best not in results):
-        raise SchemaError(
-            f"{file}: 'best_model' must be null or one of the fitted models "
-            f"({', '.join(map(repr, results))}); got {short_repr(best)}."
-        )
+        with _naming_the_entry(file):
+            raise SchemaError(
+                must_be(
+                    f"null or one of the fitted models ({', '.join(map(repr, results))})", best
+                ),
+                key="best_model",
+            )
     return results
+
+
+@contextmanager
+def _naming_the_entry(file: Path, entry: str = "") -> Iterator[None]:
+    """Re-raise a :class:`SchemaError` of ``file`` with its entry in the message.
+
+    The entry inside the file (``fits[0].r2``) leads the message, so that a
+    caller's :func:`~softbend.errors.keyed` keeps it; the error keeps no key.
+    """
+    try:
+        yield
+    except SchemaError as error:
+        where = ".".join(part for part in (entry, error.key) if part)
+        raise SchemaError(
+            f"{where}: {error.detail}" if where else error.detail, file=str(file)
+        ) from None
 
 
 def _g(lam: np.ndarray) -> np.ndarray:
@@ -490,43 +521,45 @@ _PROBLEMS.register(ArrudaBoyce.name, _arruda_boyce_problem)
 
 
 def _problem(model_name: str, lam: np.ndarray, y: np.ndarray) -> _Problem:
-    return _PROBLEMS.get(model_name, field="model")(model_name, lam, y)
+    with keyed("model_name"):
+        return _PROBLEMS.get(model_name)(model_name, lam, y)
 
 
-def _check_data(stretch: ArrayLike, stress: ArrayLike, owner: str) -> tuple[np.ndarray, np.ndarray]:
+def _check_data(stretch: ArrayLike, stress: ArrayLike) -> tuple[np.ndarray, np.ndarray]:
     lam = check_finite_array(stretch, "stretch")
     y = check_finite_array(stress, "nominal_stress_mpa")
     if lam.ndim != 1 or y.shape != lam.shape:
         raise DatasetError(
-            f"The 'stretch' and 'nominal_stress_mpa' of {owner} must be 1-D arrays of one "
-            f"length. Got shapes {lam.shape} and {y.shape} instead."
+            f"must be a 1-D array of the length of 'stretch'; got shapes {lam.shape} "
+            f"(stretch) and {y.shape}",
+            key="nominal_stress_mpa",
         )
     bad = np.flatnonzero(lam <= 0.0)
     if bad.size:
         raise DatasetError(
-            f"The 'stretch' of {owner} must be in (0, inf). "
-            f"Got {lam[bad[0]]!r} at position {int(bad[0])} instead."
+            f"must be in (0, inf); got {float(lam[bad[0]])!r} at position {int(bad[0])}",
+            key="stretch",
         )
     return lam, y
 
 
 def _select(
-    lam: np.ndarray, y: np.ndarray, max_stretch: float | None, owner: str
+    lam: np.ndarray, y: np.ndarray, max_stretch: float | None
 ) -> tuple[np.ndarray, np.ndarray]:
     if max_stretch is None:
         if lam.size < MIN_FIT_POINTS:
             raise DatasetError(
-                f"The 'stretch' of {owner} must have at least {MIN_FIT_POINTS} points. "
-                f"Got {lam.size} instead."
+                must_be(f"at least {MIN_FIT_POINTS} points", lam.size), key="stretch"
             )
         return lam, y
     limit = check_range(max_stretch, "max_stretch", low=1.0)
     keep = lam <= limit
     if int(keep.sum()) < MIN_FIT_POINTS:
-        raise ValueError(
-            f"The 'max_stretch' of {owner} must keep at least {MIN_FIT_POINTS} points of "
-            f"the data (stretch {lam.min():.4g} to {lam.max():.4g}). Got {max_stretch!r} "
-            f"({int(keep.sum())} points) instead."
+        raise InputError(
+            f"must keep at least {MIN_FIT_POINTS} points of the data (stretch "
+            f"{lam.min():.4g} to {lam.max():.4g}); got {max_stretch!r} "
+            f"({int(keep.sum())} points)",
+            key="max_stretch",
         )
     return lam[keep], y[keep]
 
@@ -575,9 +608,10 @@ def fit_model(
     (Arruda–Boyce); ``C20`` and ``C30`` are free. See the module docstring for the
     starting points.
     """
-    _PROBLEMS.check(model_name, field="model")
-    lam, y = _check_data(stretch, nominal_stress_mpa, "fit_model")
-    lam, y = _select(lam, y, max_stretch, "fit_model")
+    with keyed("model_name"):
+        _PROBLEMS.check(model_name)
+    lam, y = _check_data(stretch, nominal_stress_mpa)
+    lam, y = _select(lam, y, max_stretch)
     problem = _problem(model_name, lam, y)
     span = problem.upper - problem.lower
     margin = np.where(np.isfinite(span), 1e-9 * span, 0.0)
@@ -643,9 +677,9 @@ def _stretch_and_stress(
         return data.stretch, data.engineering_stress_mpa
     if isinstance(data, tuple | list) and len(data) == 2:
         return data[0], data[1]
-    raise ValueError(
-        "The 'data' of fit_models must be a TensileTest or a (stretch, nominal_stress_mpa) "
-        f"pair. Got {type(data).__name__} instead."
+    raise InputError(
+        f"must be a TensileTest or a (stretch, nominal_stress_mpa) pair; got {type(data).__name__}",
+        key="data",
     )
 
 
@@ -691,15 +725,14 @@ def fit_models(
     """
     names = (models,) if isinstance(models, str) else tuple(models)
     if not names:
-        raise ValueError(
-            "The 'models' of fit_models must name at least one of "
-            f"{', '.join(repr(m) for m in _PROBLEMS)}. Got {models!r} instead."
+        raise InputError(
+            must_be(f"at least one of {', '.join(repr(m) for m in _PROBLEMS)}", models),
+            key="models",
         )
-    for name in names:
-        _PROBLEMS.check(name, field="models")
+    with keyed("models"):
+        for name in names:
+            _PROBLEMS.check(name)
     if len(set(names)) != len(names):
-        raise ValueError(
-            f"The 'models' of fit_models must be distinct. Got {list(names)!r} instead."
-        )
+        raise InputError(must_be("distinct names", list(names)), key="models")
     stretch, stress = _stretch_and_stress(data)
     return {name: fit_model(name, stretch, stress, max_stretch=max_stretch) for name in names}

@@ -35,9 +35,9 @@ from softbend._validation import (
     check_finite_array,
     check_object_keys,
     check_range,
-    short_repr,
+    must_be,
 )
-from softbend.errors import SchemaError
+from softbend.errors import InputError, SchemaError, keyed
 from softbend.plausibility import RANGES, implausible_index
 from softbend.registry import Registry
 
@@ -54,48 +54,51 @@ __all__ = [
 
 
 def check_constants(
-    data: Any, owner: str, allowed: Iterable[str], required: Iterable[str]
+    data: object, allowed: Iterable[str], required: Iterable[str]
 ) -> dict[str, float]:
     """The constants of a stored material model, checked before the model is built.
 
     ``data`` must be a mapping whose keys are among ``allowed`` (and ``"model"``,
     which is dropped) and include ``required``
-    (:func:`softbend._validation.check_object_keys`); every value must be a
-    finite real number (not a bool or a string), and a constant in MPa (a key
-    ending in ``_mpa``) must lie in the plausible range of material constants
-    (``modulus_mpa`` of :mod:`softbend.plausibility`).
+    (:func:`softbend._validation.check_object_keys`, naming the object by its
+    ``"model"``); every value must be a finite real number (not a bool or a
+    string), and a constant in MPa (a key ending in ``_mpa``) must lie in the
+    plausible range of material constants (``modulus_mpa`` of
+    :mod:`softbend.plausibility`).
 
     Raises
     ------
     SchemaError
-        Naming ``owner``, the key, what is allowed and the value received.
+        Keyed by the constant at fault: what is allowed and the value received.
     """
-    check_object_keys(data, owner, ["model", *allowed], list(required), SchemaError)
-    params = {k: v for k, v in data.items() if k != "model"}
+    where = str(data.get("model") or "constants") if isinstance(data, Mapping) else "constants"
+    checked = check_object_keys(data, where, ["model", *allowed], list(required), SchemaError)
+    params = {k: v for k, v in checked.items() if k != "model"}
     limits = RANGES["modulus_mpa"]
     for key, value in params.items():
         real = isinstance(value, numbers.Real) and not isinstance(value, bool | np.bool_)
         if not real or not math.isfinite(value):
-            raise SchemaError(
-                f"The '{key}' of {owner} must be a finite number. Got {short_repr(value)} instead."
-            )
+            raise SchemaError(must_be("a finite number", value), key=key)
         if key.endswith("_mpa") and implausible_index([value], "modulus_mpa") is not None:
             raise SchemaError(
-                f"The '{key}' of {owner} must be a plausible {limits.label} "
-                f"({limits.low:g} to {limits.high:g} {limits.unit}). Got {value!r} instead."
+                must_be(
+                    f"a plausible {limits.label} ({limits.low:g} to {limits.high:g} {limits.unit})",
+                    value,
+                ),
+                key=key,
             )
     return {k: float(v) for k, v in params.items()}
 
 
-def _positive_stretch(stretch: ArrayLike, owner: str) -> np.ndarray:
-    """Stretch as a float array; finite and strictly positive, else ``ValueError``."""
+def _positive_stretch(stretch: ArrayLike) -> np.ndarray:
+    """Stretch as a float array; finite and strictly positive, else an error keyed ``stretch``."""
     values = check_finite_array(stretch, "stretch")
     bad = values <= 0.0
     if bad.any():
         first = int(np.flatnonzero(bad.ravel())[0])
-        raise ValueError(
-            f"The 'stretch' of {owner} must be in (0, inf). "
-            f"Got {values.ravel()[first]!r} at position {first} instead."
+        raise InputError(
+            f"must be in (0, inf); got {float(values.ravel()[first])!r} at position {first}",
+            key="stretch",
         )
     return values
 
@@ -149,7 +152,7 @@ class HyperelasticModel:
         numpy.ndarray
             Nominal stress in MPa, same shape as ``stretch``.
         """
-        lam = _positive_stretch(stretch, f"{type(self).__name__}.uniaxial_nominal_stress_mpa")
+        lam = _positive_stretch(stretch)
         I1 = lam**2 + 2.0 / lam
         return 2.0 * (lam - lam**-2) * self.dW_dI1(I1)
 
@@ -158,8 +161,8 @@ class HyperelasticModel:
         return {"model": self.name, **{f.name: getattr(self, f.name) for f in fields(self)}}
 
     @classmethod
-    def from_dict(cls, data: Mapping[str, Any]) -> HyperelasticModel:
-        """Rebuild a model written by :meth:`to_dict`.
+    def from_dict(cls, data: object) -> HyperelasticModel:
+        """Rebuild a model written by :meth:`to_dict` (any value is checked first).
 
         Called on :class:`HyperelasticModel` itself it dispatches on ``data["model"]``
         (a name of :data:`MODELS`); called on a concrete class, a ``"model"``
@@ -175,10 +178,7 @@ class HyperelasticModel:
             range of material constants; see :func:`check_constants`.
         """
         if not isinstance(data, Mapping):
-            raise SchemaError(
-                f"The data of {cls.__name__}.from_dict must be a mapping of constants. "
-                f"Got {short_repr(data)} instead."
-            )
+            raise SchemaError(must_be("a mapping of constants", data), key="data")
         name = data.get("model")
         if cls is HyperelasticModel:
             return get_model_class(name).from_dict(data)
@@ -186,7 +186,6 @@ class HyperelasticModel:
             check_choice(name, "model", (cls.name,))
         params = check_constants(
             data,
-            f"{cls.__name__}.from_dict",
             [f.name for f in fields(cls)],
             [f.name for f in fields(cls) if f.default is MISSING],
         )
@@ -332,7 +331,8 @@ def get_model_class(name: str | None) -> type[HyperelasticModel]:
     UnknownNameError
         If ``name`` is not a name of :data:`MODELS` (the message lists them).
     """
-    return MODELS.get(name, field="model")
+    with keyed("model"):
+        return MODELS.get(name)
 
 
 def model_from_dict(data: Mapping[str, Any]) -> HyperelasticModel:

@@ -21,8 +21,8 @@ from collections.abc import Mapping
 from dataclasses import dataclass
 from typing import Any, ClassVar
 
-from softbend._validation import check_choice, check_object_keys, check_range, short_repr
-from softbend.errors import SchemaError
+from softbend._validation import check_choice, check_object_keys, check_range, must_be
+from softbend.errors import InputError, SchemaError, keyed
 from softbend.materials.models import HyperelasticModel, Yeoh, check_constants
 from softbend.references import MATERIALS, values
 from softbend.registry import Registry
@@ -87,14 +87,13 @@ class LinearElastic:
     @classmethod
     def from_dict(cls, data: Mapping[str, Any]) -> LinearElastic:
         """Rebuild from :meth:`to_dict` output (checked as :func:`check_constants` says)."""
-        owner = "LinearElastic.from_dict"
         if isinstance(data, Mapping):
             check_choice(data.get("model", cls.name), "model", (cls.name,))
-        params = check_constants(data, owner, ("e_mpa", "nu"), ("e_mpa", "nu"))
+        params = check_constants(data, ("e_mpa", "nu"), ("e_mpa", "nu"))
         return cls(**params)
 
 
-def _model_from_dict(data: Any) -> HyperelasticModel | LinearElastic:
+def _model_from_dict(data: object) -> HyperelasticModel | LinearElastic:
     if isinstance(data, Mapping) and data.get("model") == LinearElastic.name:
         return LinearElastic.from_dict(data)
     return HyperelasticModel.from_dict(data)
@@ -123,20 +122,17 @@ class Material:
 
     def __post_init__(self) -> None:
         if not isinstance(self.name, str) or not self.name.strip():
-            raise ValueError(
-                f"The 'name' of Material must be a non-empty string. Got {self.name!r} instead."
-            )
+            raise InputError(must_be("a non-empty string", self.name), key="name")
         if not isinstance(self.model, HyperelasticModel | LinearElastic):
-            raise ValueError(
-                "The 'model' of Material must be a HyperelasticModel (NeoHookean, Yeoh, "
-                f"ArrudaBoyce) or LinearElastic. Got {self.model!r} instead."
+            raise InputError(
+                "must be a HyperelasticModel (NeoHookean, Yeoh, ArrudaBoyce) or "
+                f"LinearElastic; got {self.model!r}",
+                key="model",
             )
         density = check_range(self.density_t_per_mm3, "density_t_per_mm3", low=0.0)
         object.__setattr__(self, "density_t_per_mm3", density)
         if not isinstance(self.source, str):
-            raise ValueError(
-                f"The 'source' of Material must be a string. Got {self.source!r} instead."
-            )
+            raise InputError(must_be("a string", self.source), key="source")
 
     @property
     def density_g_per_cm3(self) -> float:
@@ -167,15 +163,11 @@ class Material:
         ValueError
             A value out of range (as the constructor says).
         """
-        owner = "Material.from_dict"
         keys = ("name", "model", "density_t_per_mm3", "source")
-        check_object_keys(data, owner, keys, keys[:3], SchemaError)
+        check_object_keys(data, "material", keys, keys[:3], SchemaError)
         density = data["density_t_per_mm3"]
         if isinstance(density, bool) or not isinstance(density, int | float):
-            raise SchemaError(
-                f"The 'density_t_per_mm3' of {owner} must be a number (tonne/mm³). "
-                f"Got {short_repr(density)} instead."
-            )
+            raise SchemaError(must_be("a number (tonne/mm³)", density), key="density_t_per_mm3")
         return cls(
             name=data["name"],
             model=_model_from_dict(data["model"]),
@@ -220,19 +212,18 @@ PRESETS.register("fiberglass", FIBERGLASS_LAYER)
 PRESETS.register("kevlar", KEVLAR_FIBER)
 
 
-def get_preset(name: str, *, field: str | None = None) -> Material:
+def get_preset(name: str) -> Material:
     """Return the preset registered under ``name`` (``"dragon-skin-30"``, ...).
 
     Parameters
     ----------
     name : str
         A name of :data:`PRESETS`.
-    field : str, optional
-        The option or file field the name came from, named in the message.
 
     Raises
     ------
     UnknownNameError
-        Listing the known names.
+        Keyed ``name``, listing the known names.
     """
-    return PRESETS.get(name, field=field)
+    with keyed("name"):
+        return PRESETS.get(name)
