@@ -33,7 +33,7 @@ STAGES: tuple[tuple[str, ...], ...] = (
         "limits",
     ),
     ("registry", "references", "parameters"),
-    ("plausibility",),
+    ("plausibility", "tables"),
     ("design", "metrics", "kinematics"),
     ("actuators",),
     ("materials",),

@@ -44,7 +44,7 @@ def test_text_is_read_by_each_parameters_kind():
         "preview": "0.5",
         "sizes": "63,65",
     }
-    checked = check_parameters(factory, given, owner="toy", field="--set", from_text=True)
+    checked = check_parameters(factory, given, from_text=True)
     assert checked == {
         "gain": 2.0,
         "steps": 5,
@@ -57,17 +57,13 @@ def test_text_is_read_by_each_parameters_kind():
 
 
 def test_data_values_are_checked_and_normalised():
-    checked = check_parameters(
-        factory, {"gain": 2, "steps": np.int64(4), "sizes": [3, 4]}, owner="toy", field="TOML"
-    )
+    checked = check_parameters(factory, {"gain": 2, "steps": np.int64(4), "sizes": [3, 4]})
     assert checked == {"gain": 2.0, "steps": 4, "sizes": (3, 4)}
     assert type(checked["steps"]) is int
-    with pytest.raises(
-        ParameterValueError, match="'steps' of toy \\(in TOML\\) must be an integer"
-    ):
-        check_parameters(factory, {"steps": 2.5}, owner="toy", field="TOML")
+    with pytest.raises(ParameterValueError, match=r"^steps: must be an integer; got 2.5$"):
+        check_parameters(factory, {"steps": 2.5})
     with pytest.raises(ParameterValueError, match="must be true or false"):
-        check_parameters(factory, {"on": 1}, owner="toy", field="TOML")
+        check_parameters(factory, {"on": 1})
 
 
 @pytest.mark.parametrize(
@@ -75,8 +71,8 @@ def test_data_values_are_checked_and_normalised():
     [("gain", "fast"), ("gain", "nan"), ("steps", "1.5"), ("on", "maybe"), ("sizes", "63;65")],
 )
 def test_bad_text_is_one_line_naming_the_parameter(key, text):
-    with pytest.raises(ParameterValueError, match=f"'{key}' of toy \\(in --set\\)") as info:
-        check_parameters(factory, {key: text}, owner="toy", field="--set", from_text=True)
+    with pytest.raises(ParameterValueError, match=f"^{key}: must be ") as info:
+        check_parameters(factory, {key: text}, from_text=True)
     assert info.value.key == key and "\n" not in str(info.value)
 
 
@@ -84,13 +80,14 @@ def test_unknown_name_lists_the_known_ones_and_hints_at_filled_ones():
     with pytest.raises(
         UnknownParameterError, match="known: gain, steps, on, tag, preview, sizes, epochs"
     ):
-        check_parameters(factory, {"gian": "1"}, owner="toy", field="--set", from_text=True)
-    with pytest.raises(UnknownParameterError, match="\\(set once per run\\); known: epochs\\."):
+        check_parameters(factory, {"gian": "1"}, from_text=True)
+    with pytest.raises(
+        UnknownParameterError,
+        match=r"^seed: is not a parameter \(set once per run\); known: epochs$",
+    ):
         check_parameters(
             Strategy,
             {"seed": 1},
-            owner="s",
-            field="--set",
             skip=("base", "seed"),
             keyword_only=False,
             hints={"seed": "set once per run"},
@@ -98,10 +95,8 @@ def test_unknown_name_lists_the_known_ones_and_hints_at_filled_ones():
 
 
 def test_epochs_are_held_to_the_limit():
-    with pytest.raises(LimitError, match="epochs"):
-        check_parameters(
-            factory, {"epochs": "1000000000"}, owner="toy", field="--set", from_text=True
-        )
+    with pytest.raises(LimitError, match=r"^epochs: the value is 1,000,000,000 epochs"):
+        check_parameters(factory, {"epochs": "1000000000"}, from_text=True)
 
 
 def test_defaults_and_the_record_of_a_run():
@@ -114,9 +109,9 @@ def test_defaults_and_the_record_of_a_run():
 
 def test_assignments():
     assert parse_assignments(["a=1", " b = x "]) == {"a": "1", "b": "x"}
-    with pytest.raises(ValueError, match="NAME=VALUE"):
+    with pytest.raises(ValueError, match=r"^items: must be NAME=VALUE"):
         parse_assignments(["a"])
-    with pytest.raises(ValueError, match="given twice"):
+    with pytest.raises(ValueError, match=r"^items: gives the parameter 'a' twice"):
         parse_assignments(["a=1", "a=2"])
 
 
@@ -142,21 +137,21 @@ def _ranged():
 @pytest.mark.parametrize(
     ("text", "shown"),
     [
-        ({"period": "1e-12"}, "must be in [0.0001, 10] s. Got '1e-12'"),
+        ({"period": "1e-12"}, "must be in [0.0001, 10] s; got '1e-12'"),
         ({"period": "11"}, "[0.0001, 10] s"),
-        ({"gain": "0"}, "must be in (0, 1]. Got '0'"),
-        ({"hidden_sizes": "0,0"}, "1 to 8 values, each in [1, 1024] units. Got 0,0"),
-        ({"hidden_sizes": "100000,100000"}, "Got 100000,100000"),
-        ({"hidden_sizes": "-3,4"}, "Got -3,4"),
+        ({"gain": "0"}, "must be in (0, 1]; got '0'"),
+        ({"hidden_sizes": "0,0"}, "1 to 8 values, each in [1, 1024] units; got 0,0"),
+        ({"hidden_sizes": "100000,100000"}, "got 100000,100000"),
+        ({"hidden_sizes": "-3,4"}, "got -3,4"),
         ({"hidden_sizes": ",".join(["4"] * 9)}, "1 to 8 values"),
     ],
 )
 def test_a_value_outside_its_declared_range_is_refused(text, shown):
     with pytest.raises(ParameterValueError) as info:
-        check_parameters(_ranged(), text, owner="controller 'x'", field="--set", from_text=True)
+        check_parameters(_ranged(), text, from_text=True)
     message = str(info.value)
     assert shown in message
-    assert message.startswith(f"The parameter {next(iter(text))!r} of controller 'x' (in --set)")
+    assert message.startswith(f"{next(iter(text))}: must be ")
     assert info.value.key == next(iter(text))
 
 
@@ -164,12 +159,10 @@ def test_values_inside_their_ranges_pass_and_undeclared_ones_are_not_bounded():
     checked = check_parameters(
         _ranged(),
         {"period": "10", "gain": "1", "hidden_sizes": "1024,1", "name": "b"},
-        owner="x",
-        field="--set",
         from_text=True,
     )
     assert checked == {"period": 10.0, "gain": 1.0, "hidden_sizes": (1024, 1), "name": "b"}
-    data = check_parameters(_ranged(), {"period": 1e-4}, owner="x", field="[controller]")
+    data = check_parameters(_ranged(), {"period": 1e-4})
     assert data == {"period": 1e-4}
 
 
@@ -208,4 +201,4 @@ def test_an_integer_of_any_size_is_compared_without_overflow():
     assert not Range(0, 100).contains(-(10**400))
     assert Range(0, 100).contains(100)
     with pytest.raises(ParameterValueError, match="characters"):
-        check_parameters(_ranged(), {"period": 10**400}, owner="x", field="[controller]")
+        check_parameters(_ranged(), {"period": 10**400})

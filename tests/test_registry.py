@@ -18,14 +18,17 @@ def test_register_get_and_order():
     assert list(reg) == ["b", "a"] and len(reg) == 2
 
 
-def test_unknown_name_lists_known_names_and_field():
+def test_unknown_name_lists_known_names_and_the_caller_keys_it():
+    from softbend.errors import keyed
+
     reg: Registry[int] = Registry("controller")
     reg.register("bang-bang", 1)
     reg.register("pressure-pi", 2)
-    with pytest.raises(UnknownNameError) as info:
-        reg.get("bangbang", field="--controller")
+    with pytest.raises(UnknownNameError) as info, keyed("controller"):
+        reg.get("bangbang")
     message = str(info.value)
-    assert "'bangbang'" in message and "--controller" in message
+    assert message.startswith("controller: Unknown controller 'bangbang'; known: ")
+    assert info.value.key == "controller"
     assert "bang-bang, pressure-pi" in message
     assert isinstance(info.value, ValueError) and isinstance(info.value, SoftbendError)
     assert "\n" not in message

@@ -10,9 +10,9 @@ from softbend.errors import ConvergenceError, DatasetError, SoftbendError
 def test_check_range_message_format_matches_the_project_convention():
     with pytest.raises(ValueError) as info:
         check_range(-2.0, "wall_thickness_mm", low=0.0)
-    assert str(info.value) == (
-        "The 'wall_thickness_mm' of SFRBADesign must be a number in (0, inf). Got -2.0 instead."
-    )
+    assert str(info.value) == "wall_thickness_mm: must be a number in (0, inf); got -2.0"
+    assert info.value.key == "wall_thickness_mm"
+    assert info.value.detail == "must be a number in (0, inf); got -2.0"
 
 
 @pytest.mark.parametrize("value", [math.nan, "abc", None, True, 0.0, 1.0])
@@ -27,13 +27,13 @@ def test_check_range_accepts_inclusive_bounds_and_converts():
 
 
 def test_check_choice_lists_the_allowed_values():
-    with pytest.raises(ValueError, match=r"one of 'a', 'b'\. Got 'c'"):
+    with pytest.raises(ValueError, match=r"^mode: must be one of 'a', 'b'; got \"c\"$"):
         check_choice("c", "mode", ("a", "b"))
 
 
 def test_check_finite_array_points_at_the_first_bad_value():
     with pytest.raises(
-        DatasetError, match=r"'pressure_kpa' of f must be finite.*position 2 \(2 non"
+        DatasetError, match=r"^pressure_kpa: must be finite; got .*nan.* at position 2 \(2 non"
     ):
         check_finite_array([1.0, 2.0, np.nan, np.inf], "pressure_kpa")
 
@@ -48,7 +48,7 @@ def test_error_hierarchy_lets_standard_handlers_catch_input_errors():
 
 @pytest.mark.parametrize("value", [0, -1, 1.0, 2.5, True, "3", None])
 def test_check_int_rejects_non_integers_and_values_below_low(value):
-    with pytest.raises(ValueError, match=r"The 'epochs' of f must be an integer in \[1, inf\)"):
+    with pytest.raises(ValueError, match=r"^epochs: must be an integer in \[1, inf\); got "):
         check_int(value, "epochs", low=1)
 
 

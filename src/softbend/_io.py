@@ -6,9 +6,9 @@ file it replaces, or ``0o666`` less the process umask for a new file (a temporar
 file from :func:`tempfile.mkstemp` alone would be ``0o600``).
 
 Reads: :func:`read_header_csv` walks a CSV file whose ``# key: value`` comments
-before the column header carry metadata (the experiment CSV of
-:mod:`softbend.identification.data`, the measurement CSV of
-:mod:`softbend.transfer.measurements`), within the limits of :mod:`softbend.limits`.
+before the column header carry metadata, within the limits of
+:mod:`softbend.limits`; :mod:`softbend.tables` reads every CSV format of the
+project through it.
 """
 
 from __future__ import annotations
@@ -23,9 +23,8 @@ import sys
 import tempfile
 from collections.abc import Iterator
 from contextlib import contextmanager
-from dataclasses import dataclass
 from pathlib import Path
-from typing import IO, Any, Literal
+from typing import IO, Any, Literal, NamedTuple
 
 __all__ = [
     "CSVLine",
@@ -151,8 +150,7 @@ def read_input_text(
         ) from None
 
 
-@dataclass(frozen=True)
-class CSVLine:
+class CSVLine(NamedTuple):
     """One line of a commented CSV file that carries something (see :func:`read_header_csv`).
 
     Attributes
@@ -178,7 +176,9 @@ class CSVLine:
     value: str = ""
 
 
-def read_header_csv(path: str | os.PathLike[str], *, line_word: str = "line") -> Iterator[CSVLine]:
+def read_header_csv(
+    path: str | os.PathLike[str], *, separator: str = ",", max_rows: int | None = None
+) -> Iterator[CSVLine]:
     """The lines of a CSV file with ``# key: value`` comments before its header, in order.
 
     The file is read as UTF-8 (a byte-order mark is dropped) after the
@@ -196,8 +196,11 @@ def read_header_csv(path: str | os.PathLike[str], *, line_word: str = "line") ->
     ----------
     path : path
         The file (its existence is the caller's to check and name).
-    line_word : str, default "line"
-        How messages name a line (``"row"`` for the experiment CSV).
+    separator : str, default ","
+        The cell separator.
+    max_rows : int, optional
+        The most data rows, in place of the ``csv_rows`` limit (a simulation
+        table of millions of rows).
 
     Yields
     ------
@@ -208,9 +211,9 @@ def read_header_csv(path: str | os.PathLike[str], *, line_word: str = "line") ->
     ------
     DatasetError
         Bytes that are not UTF-8, or a line the :mod:`csv` module cannot read
-        (``"<path>, <line_word> <n>: not a CSV row (<reason>)."``).
+        (``"<path>:<n>: not a CSV row (<reason>)"``, the file and line as keywords).
     LimitError
-        A file over the ``file_mib`` or ``csv_rows`` limit.
+        A file over the ``file_mib`` or ``csv_rows`` limit (or ``max_rows``).
     """
     import csv
 
@@ -220,9 +223,18 @@ def read_header_csv(path: str | os.PathLike[str], *, line_word: str = "line") ->
     text = read_input_text(path, str(path), encoding="utf-8-sig")
     lines = text.replace("\r\n", "\n").replace("\r", "\n").split("\n")
     del text
-    if len(lines) > limit("csv_rows"):  # may be over: count the data rows (cheap)
-        n_rows = sum(1 for line in lines if line.strip() and not line.lstrip().startswith("#"))
-        check_limit("csv_rows", max(n_rows - 1, 0), str(path))
+    bound = limit("csv_rows") if max_rows is None else max_rows
+    if len(lines) > bound:  # may be over: count the data rows (cheap)
+        n_rows = max(
+            sum(1 for line in lines if line.strip() and not line.lstrip().startswith("#")) - 1, 0
+        )
+        if max_rows is None:
+            check_limit("csv_rows", n_rows, str(path))
+        elif n_rows > max_rows:
+            raise DatasetError(
+                f"has {n_rows} data rows; at most {max_rows} are read", file=str(path)
+            )
+    field_limit = csv.field_size_limit()
     in_header = True
     for number, line in enumerate(lines, start=1):
         stripped = line.strip()
@@ -234,10 +246,13 @@ def read_header_csv(path: str | os.PathLike[str], *, line_word: str = "line") ->
             if in_header and sep and key:
                 yield CSVLine(number, "meta", key=key, value=value.strip())
             continue
-        try:
-            cells = tuple(cell.strip() for cell in next(csv.reader([line])))
-        except csv.Error as exc:
-            raise DatasetError(f"{path}, {line_word} {number}: not a CSV row ({exc}).") from None
+        if '"' in line or "\0" in line or len(line) > field_limit:  # what csv must read
+            try:
+                cells = tuple(map(str.strip, next(csv.reader([line], delimiter=separator))))
+            except csv.Error as exc:
+                raise DatasetError(f"not a CSV row ({exc})", file=str(path), line=number) from None
+        else:  # what csv reads from a line without quotes, faster
+            cells = tuple(map(str.strip, line.split(separator)))
         yield CSVLine(number, "header" if in_header else "row", cells)
         in_header = False
 

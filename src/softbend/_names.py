@@ -27,6 +27,9 @@ from __future__ import annotations
 import re
 from collections.abc import Collection, Iterable
 
+from softbend._validation import short_repr
+from softbend.errors import InputError
+
 __all__ = ["MAX_NAME_CHARS", "NAME_RULE", "check_output_names", "output_name"]
 
 #: The longest name accepted, characters.
@@ -43,16 +46,18 @@ _DEVICES = {"con", "prn", "aux", "nul"} | {f"{p}{i}" for p in ("com", "lpt") for
 
 
 def output_name(
-    name: object, field: str, *, reserved: Collection[str] = (), taken: Collection[str] = ()
+    name: object,
+    field: str | None = None,  # transitional: ignored, removed once callers pass no option names
+    *,
+    reserved: Collection[str] = (),
+    taken: Collection[str] = (),
 ) -> str:
-    """``name`` as the name of one entry of an output folder, or one ``ValueError``.
+    """``name`` as the name of one entry of an output folder, or one :class:`InputError`.
 
     Parameters
     ----------
     name : object
         The name as given (a string from a file or an option).
-    field : str
-        Where it was given, for the message (``"[[spec]] 2 'name' of specs.toml"``).
     reserved : collection of str
         Names the command writes into the same folder itself.
     taken : collection of str
@@ -65,33 +70,40 @@ def output_name(
 
     Raises
     ------
-    ValueError
-        One line naming ``field``, the rule and the name at fault.
+    InputError
+        One line with the key ``name``, naming the rule and the name at fault; a
+        caller that hands its own parameter on re-keys it with
+        :func:`softbend.errors.keyed`.
     """
-    shown = repr(name) if len(repr(name)) <= 80 else repr(name)[:77] + "..."
+    shown = short_repr(name, 80) if not isinstance(name, str) else _shown(name)
     if not isinstance(name, str):
-        raise ValueError(f"The {field} must be a text name ({NAME_RULE}). Got {shown} instead.")
+        raise InputError(f"must be a text name ({NAME_RULE}); got {shown}", key="name")
     problem = _problem(name)
     if problem is not None:
-        raise ValueError(
-            f"The {field} must be a plain name of a folder or file ({NAME_RULE}); {shown} "
-            f"{problem}."
+        raise InputError(
+            f"must be a plain name of a folder or file ({NAME_RULE}); {shown} {problem}",
+            key="name",
         )
     folded = name.casefold()
     clash = next((r for r in reserved if r.casefold() == folded), None)
     if clash is not None:
-        raise ValueError(
-            f"The {field} {shown} is a name the command writes itself "
-            f"({', '.join(sorted(set(reserved)))}); choose another."
+        raise InputError(
+            f"must not be a name the command writes itself ({', '.join(sorted(set(reserved)))}); "
+            f"got {shown}",
+            key="name",
         )
     other = next((t for t in taken if t.casefold() == folded), None)
     if other is not None:
         same = "is given twice" if other == name else f"differs from {other!r} only in case"
-        raise ValueError(
-            f"The {field} {shown} {same}; each result needs a name of its own, or one "
-            "would replace the other."
+        raise InputError(
+            f"must be a name of its own, or one result would replace the other; {shown} {same}",
+            key="name",
         )
     return name
+
+
+def _shown(name: str) -> str:
+    return repr(name) if len(repr(name)) <= 80 else repr(name)[:77] + "..."
 
 
 def _problem(name: str) -> str | None:
@@ -117,18 +129,20 @@ def _problem(name: str) -> str | None:
 
 
 def check_output_names(
-    names: Iterable[object], field: str, *, reserved: Collection[str] = ()
+    names: Iterable[object],
+    field: str | None = None,  # transitional: ignored, removed once callers pass no option names
+    *,
+    reserved: Collection[str] = (),
 ) -> list[str]:
     """Every name of ``names`` through :func:`output_name`, each unlike the others.
 
-    ``field`` may hold ``{index}`` (from 1) to say which one is at fault:
-    ``"[[spec]] {index} 'name' of specs.toml"``.
+    An error has the key ``names`` and says which one is at fault, from 1:
+    ``names: name 2 must be a name of its own, ...``.
     """
     checked: list[str] = []
     for index, name in enumerate(names, start=1):
-        checked.append(
-            output_name(
-                name, field.replace("{index}", str(index)), reserved=reserved, taken=checked
-            )
-        )
+        try:
+            checked.append(output_name(name, reserved=reserved, taken=checked))
+        except InputError as error:
+            raise InputError(f"name {index} {error.detail}", key="names") from None
     return checked

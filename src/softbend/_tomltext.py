@@ -64,7 +64,7 @@ def toml_nesting(text: str, bound: int | None = None) -> Nesting:
     return Nesting(depth, bound, data.count(b"\n", 0, offset) + 1, key)
 
 
-def _data_depth(value: Any) -> int:
+def _data_depth(value: object) -> int:
     """The nesting depth of parsed TOML data (tables and arrays), without recursion."""
     deepest = 0
     stack = [(value, 0)]

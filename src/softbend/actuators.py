@@ -44,12 +44,17 @@ import os
 import re
 from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass, field
-from typing import Any, Literal
+from typing import TYPE_CHECKING, Any, Literal
 
 import numpy as np
+from numpy.typing import ArrayLike
 
-from softbend.errors import SoftbendError
+from softbend._validation import must_be, short_repr
+from softbend.errors import SoftbendError, keyed
 from softbend.registry import Registry
+
+if TYPE_CHECKING:
+    import pandas as pd
 
 __all__ = [
     "ACTUATORS",
@@ -76,19 +81,23 @@ class ActuatorError(SoftbendError, ValueError):
     """A description, design or table that breaks an actuator's declared parameters."""
 
 
-def pressure_to_mpa(unit: str, *, field: str = "pressure unit") -> float:
+def pressure_to_mpa(
+    unit: str,
+    *,
+    field: str | None = None,  # transitional: ignored, removed once callers pass no option names
+) -> float:
     """The factor from ``unit`` (kPa, MPa, bar or psi; case as written) to MPa.
 
     Raises
     ------
     ActuatorError
-        For any other unit, naming ``field`` and the four allowed.
+        For any other unit (key ``pressure_unit``), naming the four allowed.
     """
     if unit not in PRESSURE_UNITS:
         lowered = {u.lower(): u for u in PRESSURE_UNITS}
         hint = f" (did you mean {lowered[unit.lower()]}?)" if str(unit).lower() in lowered else ""
         raise ActuatorError(
-            f"The {field} must be one of {', '.join(PRESSURE_UNITS)}; got {unit!r}{hint}."
+            must_be(f"one of {', '.join(PRESSURE_UNITS)}", unit) + hint, key="pressure_unit"
         )
     return PRESSURE_UNITS[unit]
 
@@ -177,7 +186,7 @@ class DesignParameter:
         """``name (unit)`` for table headers and axis labels."""
         return f"{self.name} ({self.unit})" if self.unit else self.name
 
-    def encode(self, value: Any) -> float:
+    def encode(self, value: object) -> float:
         """The model input of ``value``: a level's index for a categorical parameter."""
         if self.kind == "categorical":
             assert self.levels is not None
@@ -187,15 +196,14 @@ class DesignParameter:
                 ):
                     return float(index)
             raise ActuatorError(
-                f"The design parameter {self.name!r} must be one of the levels "
-                f"{', '.join(map(str, self.levels))}; got {value!r}."
+                f"{self.name} must be one of the levels {', '.join(map(str, self.levels))}; "
+                f"got {short_repr(value)}"
             )
         try:
-            number = float(value)
+            number = float(value)  # type: ignore[arg-type]  # refused by except
         except (TypeError, ValueError):
             raise ActuatorError(
-                f"The design parameter {self.name!r} must be a number ({self._what()}); "
-                f"got {value!r}."
+                f"{self.name} must be a number ({self._what()}); got {short_repr(value)}"
             ) from None
         return number
 
@@ -219,15 +227,17 @@ class DesignParameter:
             return np.clip(out, self.low, self.high)
         return out
 
-    def check(self, codes: np.ndarray, *, where: str = "") -> None:
-        """Raise one :class:`ActuatorError` for the first code outside the range or kind."""
+    def check(self, codes: np.ndarray) -> None:
+        """Raise one :class:`ActuatorError` for the first code outside the range or kind.
+
+        The message names the parameter (``n_folds must be a whole number in [3, 9];
+        got 5.5``), so an error re-keyed to the input it came from keeps it.
+        """
         values = np.asarray(codes, dtype=float)
-        at = f" {where}" if where else ""
         bad = ~np.isfinite(values)
         if bad.any():
             raise ActuatorError(
-                f"The design parameter {self.name!r}{at} must be finite; got "
-                f"{values[bad][0]!r} ({self._what()})."
+                f"{self.name} must be finite ({self._what()}); got {float(values[bad][0])!r}"
             )
         eps = 1e-9 * max(1.0, abs(self.low), abs(self.high))
         outside = (values < self.low - eps) | (values > self.high + eps)
@@ -237,18 +247,13 @@ class DesignParameter:
                 if self.kind == "categorical"
                 else values[outside][0]
             )
-            raise ActuatorError(
-                f"The design parameter {self.name!r}{at} must be {self._what()}; got {shown:g}."
-                if isinstance(shown, float)
-                else f"The design parameter {self.name!r}{at} must be {self._what()}; "
-                f"got {shown!r}."
-            )
+            got = f"{shown:g}" if isinstance(shown, float) else repr(shown)
+            raise ActuatorError(f"{self.name} must be {self._what()}; got {got}")
         if self.kind in ("integer", "categorical"):
             fractional = np.abs(values - np.round(values)) > 1e-9
             if fractional.any():
                 raise ActuatorError(
-                    f"The design parameter {self.name!r}{at} must be {self._what()}; "
-                    f"got {values[fractional][0]:g}."
+                    f"{self.name} must be {self._what()}; got {values[fractional][0]:g}"
                 )
 
     def _what(self) -> str:
@@ -297,15 +302,15 @@ class DesignParameter:
         )
 
 
-def _number(value: Any) -> float:
+def _number(value: object) -> float:
     if isinstance(value, bool) or not isinstance(value, int | float):
         raise ActuatorError(f"A bound or resolution must be a number; got {value!r}.")
     return float(value)
 
 
-def _same_number(level: Any, value: Any) -> bool:
+def _same_number(level: object, value: object) -> bool:
     try:
-        return float(level) == float(value)
+        return float(level) == float(value)  # type: ignore[arg-type]  # refused by except
     except (TypeError, ValueError):
         return False
 
@@ -446,7 +451,8 @@ class Actuator:
                 f"The actuator {self.name!r} names the column(s) {', '.join(repeated)} twice; "
                 "design, pressure and angle columns must differ."
             )
-        pressure_to_mpa(self.pressure_unit, field=f"pressure unit of actuator {self.name!r}")
+        with keyed("pressure_unit"):
+            pressure_to_mpa(self.pressure_unit)
         for key in ("chamber_volume_mm3", "volume_growth_mm3_per_mpa"):
             value = getattr(self, key)
             if value is not None and not (math.isfinite(value) and value >= 0):
@@ -495,14 +501,20 @@ class Actuator:
 
     # --- designs -------------------------------------------------------------------------------
 
-    def parse_design(self, text: str, *, field: str = "--design") -> np.ndarray:
+    def parse_design(
+        self,
+        text: str,
+        *,
+        field: str
+        | None = None,  # transitional: ignored, removed once callers pass no option names
+    ) -> np.ndarray:
         """A design from text: ``A=1,B=2,...`` by name, or the values in column order.
 
         Returns the model-input codes (levels as their index), checked against
-        the ranges, kinds and constraints.
+        the ranges, kinds and constraints. Errors carry the key ``design``.
         """
         if not isinstance(text, str) or not text.strip():
-            raise ActuatorError(f"The {field} must be {self.design_hint()}; got {text!r}.")
+            raise ActuatorError(must_be(self.design_hint(), text), key="design")
         items = [item.strip() for item in text.split(",")]
         if any("=" in item for item in items):
             values: dict[str, Any] = {}
@@ -511,29 +523,31 @@ class Actuator:
                 name = name.strip()
                 if not sep:
                     raise ActuatorError(
-                        f"The {field} mixes NAME=VALUE and bare values ({item!r}); "
-                        f"give {self.design_hint()}."
+                        f"mixes NAME=VALUE and bare values ({item!r}); give {self.design_hint()}",
+                        key="design",
                     )
                 if name not in self.names:
                     raise ActuatorError(
-                        f"The {field} names {name!r}, which is not a design parameter of "
-                        f"{self.name}; its parameters are {', '.join(self.names)}."
+                        f"names {name!r}, which is not a design parameter of {self.name}; "
+                        f"its parameters are {', '.join(self.names)}",
+                        key="design",
                     )
                 if name in values:
-                    raise ActuatorError(f"The {field} gives {name!r} twice.")
+                    raise ActuatorError(f"gives {name!r} twice", key="design")
                 values[name] = value.strip()
             missing = [n for n in self.names if n not in values]
             if missing:
                 raise ActuatorError(
-                    f"The {field} lacks {', '.join(missing)}; give {self.design_hint()}."
+                    f"lacks {', '.join(missing)}; give {self.design_hint()}", key="design"
                 )
-            return self.design_codes(values, field=field)
+            return self.design_codes(values)
         if len(items) != len(self.parameters):
             raise ActuatorError(
-                f"The {field} must be {self.design_hint()} ({len(self.parameters)} values); "
-                f"got {len(items)} in {text!r}."
+                f"must be {self.design_hint()} ({len(self.parameters)} values); "
+                f"got {len(items)} in {text!r}",
+                key="design",
             )
-        return self.design_codes(dict(zip(self.names, items, strict=True)), field=field)
+        return self.design_codes(dict(zip(self.names, items, strict=True)))
 
     def design_hint(self) -> str:
         """``A=…,B=…`` with each parameter's unit, for messages and help."""
@@ -553,25 +567,33 @@ class Actuator:
                 parts.append(f"{p.name} in {p.unit}" if p.unit else p.name)
         return ", ".join(parts)
 
-    def design_codes(self, values: Mapping[str, Any], *, field: str = "design") -> np.ndarray:
-        """Model-input codes of one design given by name, checked."""
-        codes = np.array([p.encode(values[p.name]) for p in self.parameters], dtype=float)
-        self.check_designs(codes[None, :], where=f"in {field}")
+    def design_codes(
+        self,
+        values: Mapping[str, Any],
+        *,
+        field: str
+        | None = None,  # transitional: ignored, removed once callers pass no option names
+    ) -> np.ndarray:
+        """Model-input codes of one design given by name, checked (errors keyed ``design``)."""
+        with keyed("design"):
+            codes = np.array([p.encode(values[p.name]) for p in self.parameters], dtype=float)
+            self.check_designs(codes[None, :])
         return codes
 
-    def check_designs(self, codes: Any, *, where: str = "") -> np.ndarray:
+    def check_designs(self, codes: ArrayLike) -> np.ndarray:
         """Rows of design codes checked against ranges, kinds and constraints.
 
-        Returns the rows as a float array of shape (n, n_parameters).
+        Returns the rows as a float array of shape (n, n_parameters). An error
+        names the parameter or constraint at fault in its message.
         """
         rows = np.atleast_2d(np.asarray(codes, dtype=float))
         if rows.shape[1] != len(self.parameters):
             raise ActuatorError(
-                f"A design of {self.name} has {len(self.parameters)} values "
-                f"({', '.join(self.names)}); got {rows.shape[1]}."
+                f"a design of {self.name} has {len(self.parameters)} values "
+                f"({', '.join(self.names)}); got {rows.shape[1]}"
             )
         for j, p in enumerate(self.parameters):
-            p.check(rows[:, j], where=where)
+            p.check(rows[:, j])
         met = self.constraints_met(rows)
         if not met.all():
             i = int(np.argmin(met))
@@ -581,12 +603,11 @@ class Actuator:
                 if not _evaluate(tree, self._columns(rows[i : i + 1]))[0]
             )
             raise ActuatorError(
-                f"The design {self.describe(rows[i])}{' ' + where if where else ''} breaks the "
-                f"constraint {broken} of {self.name}."
+                f"the design {self.describe(rows[i])} breaks the constraint {broken} of {self.name}"
             )
         return rows
 
-    def constraints_met(self, codes: Any) -> np.ndarray:
+    def constraints_met(self, codes: ArrayLike) -> np.ndarray:
         """Whether each row of design codes meets every constraint (bool array)."""
         rows = np.atleast_2d(np.asarray(codes, dtype=float))
         met = np.ones(rows.shape[0], dtype=bool)
@@ -684,7 +705,7 @@ class Actuator:
     @classmethod
     def from_table(
         cls,
-        table: Any,
+        table: pd.DataFrame,
         *,
         design_columns: Sequence[str],
         pressure_column: str,
@@ -761,20 +782,29 @@ def load_actuator(path: str | os.PathLike[str]) -> Actuator:
         raise ActuatorError(f"{source}: {err}") from None
 
 
-def actuator_from(text: str, *, field: str = "--actuator") -> Actuator:
+def actuator_from(
+    text: str,
+    *,
+    field: str | None = None,  # transitional: ignored, removed once callers pass no option names
+) -> Actuator:
     """A registered description by name, or one read from a ``.json`` file."""
     if text.lower().endswith(".json"):
         return load_actuator(text)
-    return get_actuator(text, field=field)
+    return get_actuator(text)
 
 
 #: Registered actuator descriptions, by name.
 ACTUATORS: Registry[Actuator] = Registry("actuator")
 
 
-def get_actuator(name: str, *, field: str = "--actuator") -> Actuator:
-    """The registered description ``name`` (one error listing the names otherwise)."""
-    return ACTUATORS.get(name, field=field)
+def get_actuator(
+    name: str,
+    *,
+    field: str | None = None,  # transitional: ignored, removed once callers pass no option names
+) -> Actuator:
+    """The registered description ``name`` (one error, keyed ``actuator``, listing the names)."""
+    with keyed("actuator"):
+        return ACTUATORS.get(name)
 
 
 def _register_paper_b() -> Actuator:

@@ -39,7 +39,8 @@ from collections.abc import Callable, Collection, Mapping, Sequence
 from dataclasses import dataclass
 from typing import Any, TypeVar
 
-from softbend.errors import SoftbendError
+from softbend._validation import must_be
+from softbend.errors import InputError, SoftbendError, keyed
 from softbend.limits import check_limit
 from softbend.registry import UnknownNameError
 
@@ -70,19 +71,40 @@ _FALSE = ("false", "no", "off", "0")
 
 
 class UnknownParameterError(UnknownNameError):
-    """A parameter name that an implementation does not take; ``key`` is the name."""
+    """A parameter name that an implementation does not take; ``key`` is the name.
 
-    def __init__(self, message: str, key: str) -> None:
-        super().__init__(message)
-        self.key = key
+    The message is the predicate (``is not a parameter; known: a, b``):
+    ``str(error)`` puts the key in front.
+    """
+
+    def __init__(
+        self,
+        message: str,
+        key: str | None = None,
+        *,
+        file: str | None = None,
+        line: int | None = None,
+        column: int | None = None,
+    ) -> None:
+        super().__init__(message, key=key, file=file, line=line, column=column)
 
 
 class ParameterValueError(SoftbendError, ValueError):
-    """A parameter value of the wrong kind; ``key`` is the parameter's name."""
+    """A parameter value of the wrong kind; ``key`` is the parameter's name.
 
-    def __init__(self, message: str, key: str) -> None:
-        super().__init__(message)
-        self.key = key
+    The message is the predicate (``must be an integer; got 2.5``).
+    """
+
+    def __init__(
+        self,
+        message: str,
+        key: str | None = None,
+        *,
+        file: str | None = None,
+        line: int | None = None,
+        column: int | None = None,
+    ) -> None:
+        super().__init__(message, key=key, file=file, line=line, column=column)
 
 
 def _bound(value: float) -> str:
@@ -135,7 +157,7 @@ class Range:
         """What a value must be, for messages: ``in [1e-05, 0.01] s``, ``1 to 8 values, …``."""
         return self.describe() if self.max_items is not None else f"in {self.describe()}"
 
-    def contains(self, value: Any) -> bool:
+    def contains(self, value: object) -> bool:
         """Whether ``value`` (a number, or a tuple of them with ``max_items``) is accepted."""
         if isinstance(value, tuple | list):
             if self.max_items is not None and not 1 <= len(value) <= self.max_items:
@@ -152,7 +174,7 @@ class Range:
         return not (below or above)
 
 
-def _shown(value: Any) -> str:
+def _shown(value: object) -> str:
     """``repr(value)`` for a message, cut short (an integer of 400 digits is not read)."""
     text = repr(value)
     return text if len(text) <= 60 else f"{text[:45]}... ({len(text)} characters)"
@@ -236,39 +258,41 @@ def effective_parameters(
     return {**parameter_defaults(entry, skip=skip, keyword_only=keyword_only), **(checked or {})}
 
 
-def parse_assignments(items: Sequence[str] | None, field: str = "--set") -> dict[str, str]:
+def parse_assignments(
+    items: Sequence[str] | None,
+    field: str | None = None,  # transitional: ignored, removed once callers pass no option names
+) -> dict[str, str]:
     """``["NAME=VALUE", ...]`` as ``{name: text}`` (the values are read later, by kind).
 
     Parameters
     ----------
     items : sequence of str, optional
         The assignments, e.g. the repeated values of ``--set``.
-    field : str, default "--set"
-        Where they came from, for messages.
 
     Raises
     ------
-    ValueError
-        An item without ``=``, with an empty name, or a name given twice.
+    InputError
+        With the key ``items`` (a caller re-keys it with
+        :func:`softbend.errors.keyed`): an item without ``=``, with an empty
+        name, or a name given twice.
     """
     values: dict[str, str] = {}
     for item in items or ():
         name, sep, text = str(item).partition("=")
         name = name.strip()
         if not sep or not name:
-            raise ValueError(
-                f"The '{field}' values must be NAME=VALUE (e.g. epochs=500). Got {item!r} instead."
-            )
+            raise InputError(must_be("NAME=VALUE (e.g. epochs=500)", item), key="items")
         if name in values:
-            raise ValueError(
-                f"The '{field}' parameter {name!r} is given twice ({values[name]!r} and "
-                f"{text.strip()!r}); give it once."
+            raise InputError(
+                f"gives the parameter {name!r} twice ({values[name]!r} and "
+                f"{text.strip()!r}); give it once",
+                key="items",
             )
         values[name] = text.strip()
     return values
 
 
-def _is_ints(value: Any) -> bool:
+def _is_ints(value: object) -> bool:
     return isinstance(value, tuple | list) and all(
         isinstance(v, numbers.Integral) and not isinstance(v, bool) for v in value
     )
@@ -337,8 +361,8 @@ def check_parameters(
     entry: Callable[..., Any],
     values: Mapping[str, Any] | None,
     *,
-    owner: str,
-    field: str,
+    owner: str | None = None,  # transitional: ignored, removed once callers pass no option names
+    field: str | None = None,  # transitional: ignored, removed once callers pass no option names
     from_text: bool = False,
     skip: Collection[str] = (),
     keyword_only: bool = True,
@@ -353,10 +377,6 @@ def check_parameters(
         ``**kwargs`` also accepts any other name.
     values : mapping, optional
         ``{name: value}``: text from a command line (``from_text``) or data (TOML, Python).
-    owner : str
-        What the parameters belong to, for messages (``"controller 'bang-bang'"``).
-    field : str
-        Where the values came from, for messages (``"--set"``).
     from_text : bool, default False
         Read text values by each parameter's kind.
     skip, keyword_only
@@ -374,10 +394,10 @@ def check_parameters(
     Raises
     ------
     UnknownParameterError
-        A name ``entry`` does not take; the message lists the known names.
+        A name ``entry`` does not take (the key); the message lists the known names.
     ParameterValueError
         A value that is not of the parameter's kind, a number that is not finite,
-        or a value outside its declared :class:`Range`.
+        or a value outside its declared :class:`Range`; the key is the parameter.
     LimitError
         ``epochs`` over the ``epochs`` limit of :mod:`softbend.limits`.
     """
@@ -388,35 +408,22 @@ def check_parameters(
         if key not in known and not open_ended:
             hint = f" ({hints[key]})" if hints and key in hints else ""
             raise UnknownParameterError(
-                f"Unknown parameter {key!r} of {owner} (in {field}){hint}; known: "
-                f"{', '.join(known) or 'none'}.",
-                key,
+                f"is not a parameter{hint}; known: {', '.join(known) or 'none'}", key
             )
         kind = _kind(known[key]) if key in known else "any"
         try:
             result = _from_text(str(value), kind) if from_text else _typed(value, kind)
         except (ValueError, OverflowError):  # an integer too large for a float is no number
-            raise ParameterValueError(
-                f"The parameter {key!r} of {owner} (in {field}) must be {_WORDS[kind]}. "
-                f"Got {_shown(value)} instead.",
-                key,
-            ) from None
+            raise ParameterValueError(f"must be {_WORDS[kind]}; got {_shown(value)}", key) from None
         if isinstance(result, float) and not math.isfinite(result):
-            raise ParameterValueError(
-                f"The parameter {key!r} of {owner} (in {field}) must be a finite number. "
-                f"Got {_shown(value)} instead.",
-                key,
-            )
+            raise ParameterValueError(f"must be a finite number; got {_shown(value)}", key)
         if key == "epochs" and kind == "int":
-            check_limit("epochs", result, f"The 'epochs' of {owner} (in {field})")
+            with keyed(key):
+                check_limit("epochs", result, "the value")
         declared = ranges.get(key)
         if declared is not None and not declared.contains(result):
             shown = _shown(",".join(map(str, result))) if isinstance(result, tuple) else None
             shown = shown.strip("'") if shown is not None else _shown(value)
-            raise ParameterValueError(
-                f"The parameter {key!r} of {owner} (in {field}) must be "
-                f"{declared.requirement()}. Got {shown} instead.",
-                key,
-            )
+            raise ParameterValueError(f"must be {declared.requirement()}; got {shown}", key)
         checked[key] = result
     return checked

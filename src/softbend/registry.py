@@ -82,27 +82,41 @@ class Registry(Generic[T]):
         self.check(name)
         del self._entries[name]
 
-    def check(self, name: object, *, field: str | None = None) -> str:
+    def check(
+        self,
+        name: object,
+        *,
+        field: str
+        | None = None,  # transitional: ignored, removed once callers pass no option names
+    ) -> str:
         """Return ``name`` if registered, else raise :class:`UnknownNameError`.
 
         Parameters
         ----------
         name : object
             The name to look up.
-        field : str, optional
-            The option or file field the name came from (``"--controller"``); it is
-            named in the message.
+
+        Raises
+        ------
+        UnknownNameError
+            ``Unknown controller 'x'; known: a, b.`` with no key: the caller that
+            hands its parameter on names it with :func:`softbend.errors.keyed`.
         """
         if isinstance(name, str) and name in self._entries:
             return name
-        where = f" (in {field})" if field else ""
         raise UnknownNameError(
-            f"Unknown {self.kind} {name!r}{where}; known: {', '.join(self._entries) or 'none'}."
+            f"Unknown {self.kind} {name!r}; known: {', '.join(self._entries) or 'none'}."
         )
 
-    def get(self, name: object, *, field: str | None = None) -> T:
+    def get(
+        self,
+        name: object,
+        *,
+        field: str
+        | None = None,  # transitional: ignored, removed once callers pass no option names
+    ) -> T:
         """The entry registered as ``name``; an unknown name raises :class:`UnknownNameError`."""
-        return self._entries[self.check(name, field=field)]
+        return self._entries[self.check(name)]
 
     def names(self) -> tuple[str, ...]:
         """Registered names, in registration order."""

@@ -96,7 +96,7 @@ def test_experiment_rejects_bad_columns(kwargs, pattern):
 def test_experiment_rejects_empty_name_and_bad_rest_length():
     with pytest.raises(ValueError, match="'name' of Experiment"):
         Experiment(" ", [0, 1, 2.0], [0.0] * 3, [0.0] * 3, [0.0] * 3)
-    with pytest.raises(ValueError, match=r"'rest_length_mm' of Experiment.*\(0, inf\)"):
+    with pytest.raises(ValueError, match=r"rest_length_mm: must be a number in \(0, inf\)"):
         Experiment("r", [0, 1, 2.0], [0.0] * 3, [0.0] * 3, [0.0] * 3, rest_length_mm=-1)
 
 
@@ -211,49 +211,52 @@ def test_folder_without_csv(tmp_path):
 
 
 def test_empty_file(tmp_path):
-    assert "is empty" in _error(_write(tmp_path / "e.csv", ""))
+    assert "has no column header" in _error(_write(tmp_path / "e.csv", ""))
     message = _error(_write(tmp_path / "c.csv", "# only comments\n\n"))
-    assert "is empty" in message and "time_s, pressure_kpa, x_mm, y_mm" in message
+    assert "has no column header" in message and "time_s, pressure_kpa, x_mm, y_mm" in message
 
 
 def test_header_without_rows(tmp_path):
-    assert "no data rows" in _error(_write(tmp_path / "h.csv", "time_s,pressure_kpa,x_mm,y_mm\n"))
+    assert "followed by 0 data row(s)" in _error(
+        _write(tmp_path / "h.csv", "time_s,pressure_kpa,x_mm,y_mm\n")
+    )
 
 
 def test_missing_columns_are_named_with_the_required_list(tmp_path):
     message = _error(_write(tmp_path / "m.csv", "time_s,pressure,x_mm\n0,0,0\n"))
-    assert "missing column(s) pressure_kpa, y_mm" in message
-    assert "required columns are time_s, pressure_kpa, x_mm, y_mm" in message
+    assert "m.csv:1: pressure_kpa: lacks the column(s) pressure_kpa, y_mm" in message
+    assert "has the columns time_s, pressure_kpa, x_mm, y_mm" in message
 
 
 def test_non_numeric_value_names_column_and_row(tmp_path):
     text = "# header comment\n" + GOOD.replace("0.02,10,0.5", "0.02,ten,0.5")
     message = _error(_write(tmp_path / "n.csv", text))
-    assert "row 4" in message and "'pressure_kpa'" in message and "'ten'" in message
+    assert 'n.csv:4:2: pressure_kpa: must be a finite number; got "ten"' in message
 
 
 @pytest.mark.parametrize("cell", ["", "nan", "NaN"])
 def test_missing_value_names_column_and_row(tmp_path, cell):
     text = GOOD.replace("0.04,20,1.0,0.3", f"0.04,20,{cell},0.3")
     message = _error(_write(tmp_path / "v.csv", text))
-    assert "row 4" in message and "'x_mm'" in message and "missing value" in message
+    assert "v.csv:4:3: x_mm: must be a finite number; got " in message
 
 
 def test_infinite_value_is_refused(tmp_path):
     message = _error(_write(tmp_path / "i.csv", GOOD.replace("0.1\n", "inf\n")))
-    assert "row 3" in message and "'y_mm'" in message and "not finite" in message
+    assert 'i.csv:3:4: y_mm: must be a finite number; got "inf"' in message
 
 
 def test_ragged_row(tmp_path):
     message = _error(_write(tmp_path / "r.csv", GOOD + "0.06,1,2\n"))
-    assert "row 5" in message and "3 fields" in message
+    assert "r.csv:5: has 3 cells" in message
 
 
 def test_non_increasing_time_names_experiment_and_row(tmp_path):
     text = "experiment,time_s,pressure_kpa,x_mm,y_mm\n"
     text += "a,0,0,0,0\nb,0,0,0,0\na,0.02,1,0,0\nb,0.02,1,0,0\na,0.02,2,0,0\n"
     message = _error(_write(tmp_path / "t.csv", text))
-    assert "experiment 'a'" in message and "row 6" in message and "row 4" in message
+    assert "t.csv:6:2: time_s: 0.02 does not increase after 0.02 (line 4)" in message
+    assert "experiment 'a'" in message
     assert "increase strictly" in message
 
 
@@ -276,17 +279,17 @@ def test_duplicate_names_across_files(tmp_path):
 
 def test_bad_header_comment(tmp_path):
     message = _error(_write(tmp_path / "h.csv", "# rest_length_mm: long\n" + GOOD))
-    assert "row 1" in message and "rest_length_mm" in message
+    assert "h.csv:1: rest_length_mm: must be a positive number (mm); got 'long'" in message
 
 
 def test_unreachable_tip_is_a_dataset_error(tmp_path):
     # On the rest axis above the base: no arc of positive length ends there.
     message = _error(_write(tmp_path / "u.csv", GOOD.replace("0,0,0,0\n", "0,0,0,20\n")))
-    assert "row 2" in message and "y_mm=20.0" in message and "u.csv" in message
+    assert "u.csv:2:3: x_mm: the tip" in message and "y_mm=20.0" in message
 
 
 def test_bad_rest_length_argument(tmp_path):
-    with pytest.raises(ValueError, match=r"'rest_length_mm' of load_experiments.*\(0, inf\)"):
+    with pytest.raises(ValueError, match=r"rest_length_mm: must be a number in \(0, inf\)"):
         load_experiments(_write(tmp_path / "g.csv", GOOD), rest_length_mm=0.0)
 
 

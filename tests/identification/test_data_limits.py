@@ -38,7 +38,9 @@ def test_more_rows_than_the_limit_are_refused_before_any_row_is_parsed(tmp_path,
     assert str(path) in message and "6 rows" in message and "5 rows" in message
     assert "SOFTBEND_MAX_CSV_ROWS" in message
     monkeypatch.setenv("SOFTBEND_MAX_CSV_ROWS", "6")
-    with pytest.raises(DatasetError, match="'not a number' is not a number"):
+    with pytest.raises(
+        DatasetError, match='pressure_kpa: must be a finite number; got "not a number"'
+    ):
         load_experiments(path)
 
 
@@ -57,26 +59,28 @@ def test_an_absurd_value_names_file_line_and_column(tmp_path, row, column, needl
     with pytest.raises(DatasetError) as info:
         load_experiments(path)
     message = str(info.value)
-    assert message.startswith(f"{path}, line 7, column '{column}': ")
+    position = HEADER.strip().split(",").index(column) + 1
+    assert message.startswith(f"{path}:7:{position}: {column}: ")
+    assert (info.value.file, info.value.line, info.value.key) == (str(path), 7, column)
     assert needle in message and "\n" not in message
 
 
 def test_the_first_absurd_value_in_the_file_is_the_one_named(tmp_path):
     rows = [*GOOD_ROWS, "0.08,40,1.4,-1e12", "1e300,1e9,1.4,0.5"]
-    with pytest.raises(DatasetError, match=r"line 6, column 'y_mm'"):
+    with pytest.raises(DatasetError, match=r"two.csv:6:4: y_mm: "):
         load_experiments(_write(tmp_path / "two.csv", rows))
     rows = [*GOOD_ROWS[:2], "0.04,5000,1,0.3", "1e300,30,1.2,0.4"]
-    with pytest.raises(DatasetError, match=r"line 4, column 'pressure_kpa'"):
+    with pytest.raises(DatasetError, match=r"three.csv:4:2: pressure_kpa: "):
         load_experiments(_write(tmp_path / "three.csv", rows))
 
 
 @pytest.mark.parametrize(
     ("value", "needle"),
     [
-        ("1e300", "line 1, column 'rest_length_mm': 1e+300 is not a plausible length"),
-        ("nan", "row 1: 'rest_length_mm' must be a positive number (mm). Got 'nan'"),
-        ("-3", "row 1: 'rest_length_mm' must be a positive number (mm). Got '-3'"),
-        ("inf", "row 1: 'rest_length_mm' must be a positive number"),
+        ("1e300", ":1: rest_length_mm: 1e+300 is not a plausible length"),
+        ("nan", ":1: rest_length_mm: must be a positive number (mm); got 'nan'"),
+        ("-3", ":1: rest_length_mm: must be a positive number (mm); got '-3'"),
+        ("inf", ":1: rest_length_mm: must be a positive number"),
     ],
 )
 def test_an_absurd_rest_length_comment_names_the_file_and_line(tmp_path, value, needle):
@@ -92,13 +96,13 @@ def test_a_deeply_nested_metadata_comment_is_a_limit_not_a_recursion_error(tmp_p
     with pytest.raises(LimitError) as info:
         load_experiments(path)
     message = str(info.value)
-    assert f"{path}, row 1: 'metadata'" in message and "SOFTBEND_MAX_NESTING" in message
+    assert f"{path}:1: metadata: the value is" in message and "SOFTBEND_MAX_NESTING" in message
 
 
 def test_a_field_too_long_for_the_csv_module_is_one_dataset_error(tmp_path):
     rows = [*GOOD_ROWS, "0.08,40,1.4," + "1" * 200_000]
     path = _write(tmp_path / "field.csv", rows)
-    with pytest.raises(DatasetError, match=rf"{path.name}, row 6: not a CSV row"):
+    with pytest.raises(DatasetError, match=rf"{path.name}:6: not a CSV row"):
         load_experiments(path)
 
 

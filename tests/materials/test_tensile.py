@@ -107,10 +107,10 @@ def test_attribution_and_licence_ship_beside_the_data():
 
 
 def test_unknown_shipped_name_lists_the_allowed_names():
-    with pytest.raises(ValueError, match="'name' of load_shipped") as info:
+    with pytest.raises(ValueError, match=r"^name: must be one of 'dragon-skin-10-medium'") as info:
         load_shipped("dragon-skin-40")
     message = str(info.value)
-    assert "'dragon-skin-40'" in message
+    assert '"dragon-skin-40"' in message
     for name in SHIPPED_ROWS:
         assert repr(name) in message
 

@@ -126,15 +126,13 @@ def test_kpa_in_the_mpa_column_is_caught_even_with_force(tmp_path):
     # Above 2 MPa no strategy or surrogate accepts a pressure: force cannot help.
     path = _write(tmp_path, "kpa.csv", KPA)
     for force in (False, True):
-        with pytest.raises(
-            DatasetError, match=r"kpa\.csv, line 3, column 'pressure_mpa'.*looks like kPa"
-        ):
+        with pytest.raises(DatasetError, match=r"kpa\.csv:3:7: pressure_mpa: .*looks like kPa"):
             load_measurements_files([_write(tmp_path, "ok.csv", BENCH), path], force=force)
 
 
 def test_radians_in_the_degree_column_are_caught_and_force_reads_them(tmp_path):
     path = _write(tmp_path, "rad.csv", RADIANS)
-    with pytest.raises(DatasetError, match=r"rad\.csv, line 3, column 'angle_deg'.*radians"):
+    with pytest.raises(DatasetError, match=r"rad\.csv:3:8: angle_deg: .*radians"):
         load_measurements(path)
     with pytest.warns(UserWarning, match="radians"):
         data = load_measurements_files([path], force=True)

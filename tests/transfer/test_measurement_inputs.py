@@ -7,7 +7,7 @@ import pytest
 
 from softbend.errors import DatasetError, LimitError
 from softbend.transfer import measurements as measurements_module
-from softbend.transfer.lab import PLANTS
+from softbend.transfer.lab import LAB_MODELS
 from softbend.transfer.measurements import (
     METADATA_KEYS,
     Measurements,
@@ -66,22 +66,22 @@ def test_a_cell_too_long_for_csv_is_one_error_naming_the_line(tmp_path):
     with pytest.raises(DatasetError) as error:
         load_measurements(path)
     message = _one_line(error)
-    assert message.startswith(f"{path}, line 3:") and "not a CSV row" in message
+    assert message.startswith(f"{path}:3:") and "not a CSV row" in message
 
 
 # ---------------------------------------------------------------- plausibility
 IMPLAUSIBLE = [
-    ("angle", f"{ROW}\n100,6,2,2,5,8,0.2,1e300\n", "line 3", "'angle_deg'", "-3600 to 3600"),
-    ("angle-low", "100,6,2,2,5,8,0.2,-4000\n", "line 2", "'angle_deg'", "-3600 to 3600"),
-    ("pressure", "100,6,2,2,5,8,5,20\n", "line 2", "'pressure_mpa'", "It looks like kPa"),
-    ("pressure-huge", "100,6,2,2,5,8,1e300,20\n", "line 2", "'pressure_mpa'", "0.1013 to 2"),
-    ("l", "20000,6,2,2,5,8,0.1,20\n", "line 2", "column 'l'", "0 to 10000"),
-    ("r", "100,1e300,2,2,5,8,0.1,20\n", "line 2", "column 'r'", "0 to 10000"),
-    ("t", "100,6,-1e300,2,5,8,0.1,20\n", "line 2", "column 't'", "0 to 10000"),
-    ("b", "100,6,2,1e300,5,8,0.1,20\n", "line 2", "column 'b'", "0 to 10000"),
-    ("phi", "100,6,2,2,95,8,0.1,20\n", "line 2", "column 'phi'", "fiber winding angle"),
-    ("phi-negative", "100,6,2,2,-1e300,8,0.1,20\n", "line 2", "column 'phi'", "0 to 90"),
-    ("lc", "100,6,2,2,5,1e300,0.1,20\n", "line 2", "column 'lc'", "0 to 10000"),
+    ("angle", f"{ROW}\n100,6,2,2,5,8,0.2,1e300\n", "3", "angle_deg", "-3600 to 3600"),
+    ("angle-low", "100,6,2,2,5,8,0.2,-4000\n", "2", "angle_deg", "-3600 to 3600"),
+    ("pressure", "100,6,2,2,5,8,5,20\n", "2", "pressure_mpa", "It looks like kPa"),
+    ("pressure-huge", "100,6,2,2,5,8,1e300,20\n", "2", "pressure_mpa", "0.1013 to 2"),
+    ("l", "20000,6,2,2,5,8,0.1,20\n", "2", "l", "0 to 10000"),
+    ("r", "100,1e300,2,2,5,8,0.1,20\n", "2", "r", "0 to 10000"),
+    ("t", "100,6,-1e300,2,5,8,0.1,20\n", "2", "t", "0 to 10000"),
+    ("b", "100,6,2,1e300,5,8,0.1,20\n", "2", "b", "0 to 10000"),
+    ("phi", "100,6,2,2,95,8,0.1,20\n", "2", "phi", "fiber winding angle"),
+    ("phi-negative", "100,6,2,2,-1e300,8,0.1,20\n", "2", "phi", "0 to 90"),
+    ("lc", "100,6,2,2,5,1e300,0.1,20\n", "2", "lc", "0 to 10000"),
 ]
 
 
@@ -97,8 +97,9 @@ def test_an_implausible_number_names_file_line_column_and_range(
     with pytest.raises(DatasetError) as error:
         load_measurements(path)
     message = _one_line(error)
-    assert message.startswith(f"{path}, {line}, ")
-    assert column in message and "plausible" in message and allowed in message
+    assert message.startswith(f"{path}:{line}:") and f": {column}: " in message
+    assert (error.value.file, error.value.line, error.value.key) == (str(path), int(line), column)
+    assert "plausible" in message and allowed in message
 
 
 def test_an_implausible_number_in_a_frame_names_its_row():
@@ -115,31 +116,36 @@ def test_an_implausible_number_in_a_frame_names_its_row():
         },
         index=[7, 8, 9],
     )
-    with pytest.raises(DatasetError, match=r"^lab, row 9, column 'angle_deg': 1e\+300 .*3600"):
+    with pytest.raises(DatasetError, match=r"^lab: angle_deg: row 9: 1e\+300 .*3600"):
         Measurements.from_frame(frame, source="lab")
     frame["angle_deg"] = [0.0, 20.0, 30.0]
     frame["pressure_mpa"] = [0.0, 10.0, 20.0]
-    with pytest.raises(DatasetError, match=r"row 8, column 'pressure_mpa'.*looks like kPa"):
+    with pytest.raises(DatasetError, match=r"^pressure_mpa: row 8: .*looks like kPa"):
         Measurements.from_frame(frame)
 
 
 # -------------------------------------------------------------------- metadata
 BAD_HEADERS = [
-    ("unknown", "# temperature: 21 C\n", "line 2", ["unknown metadata key 'temperature'", "rig"]),
+    ("unknown", "# temperature: 21 C\n", "line 2", ["temperature: is not a header key", "rig"]),
     (
         "synthetic",
         "# synthetic: maybe\n",
         "line 2",
-        ["'synthetic'", "'true' or 'false'", "'maybe'"],
+        ["synthetic: must be 'true' or 'false'; got 'maybe'"],
     ),
-    ("synthetic-case", "# synthetic: True\n", "line 2", ["'synthetic'", "'True'"]),
-    ("seed", "# lab.seed: -1\n", "line 2", ["'lab.seed'", "integer >= 0", "'-1'"]),
-    ("cycles", "# lab.cycles: two\n", "line 2", ["'lab.cycles'", "integer >= 1"]),
-    ("noise", "# lab.camera_noise_deg: nan\n", "line 2", ["'lab.camera_noise_deg'", "finite"]),
-    ("plant", "# lab.plant: abaqus\n", "line 2", ["'lab.plant'", "'fem' or 'analytical'"]),
-    ("unloading", "# lab.unloading: yes\n", "line 2", ["'lab.unloading'", "'True' or 'False'"]),
-    ("date", "# date: 12/03/2024\n", "line 2", ["'date'", "ISO 8601", "'12/03/2024'"]),
-    ("lab-unknown", "# lab.colour: red\n", "line 2", ["unknown metadata key 'lab.colour'"]),
+    ("synthetic-case", "# synthetic: True\n", "line 2", ["synthetic: must be", "'True'"]),
+    ("seed", "# lab.seed: -1\n", "line 2", ["lab.seed: must be an integer >= 0; got '-1'"]),
+    ("cycles", "# lab.cycles: two\n", "line 2", ["lab.cycles: must be an integer >= 1"]),
+    (
+        "noise",
+        "# lab.camera_noise_deg: nan\n",
+        "line 2",
+        ["lab.camera_noise_deg: must be a finite"],
+    ),
+    ("plant", "# lab.plant: abaqus\n", "line 2", ["lab.plant: must be 'fem' or 'analytical'"]),
+    ("unloading", "# lab.unloading: yes\n", "line 2", ["lab.unloading: must be 'True' or 'False'"]),
+    ("date", "# date: 12/03/2024\n", "line 2", ["date: must be an ISO 8601", "'12/03/2024'"]),
+    ("lab-unknown", "# lab.colour: red\n", "line 2", ["lab.colour: is not a header key"]),
 ]
 
 
@@ -153,7 +159,7 @@ def test_a_bad_metadata_header_is_one_error_naming_file_and_line(tmp_path, heade
     with pytest.raises(DatasetError) as error:
         load_measurements(path)
     message = _one_line(error)
-    assert message.startswith(f"{path}, {line}: ")
+    assert message.startswith(f"{path}:{line.split()[1]}: ")
     for part in expected:
         assert part in message
 
@@ -183,7 +189,7 @@ def test_in_memory_metadata_is_held_to_what_a_file_can_read_back(tmp_path):
 
 def test_every_virtual_lab_key_is_a_known_metadata_key(quick_lab, quick_measurements, tmp_path):
     assert set(quick_lab.metadata()) <= set(METADATA_KEYS)
-    assert all(METADATA_KEYS["lab.plant"][1](plant) for plant in PLANTS)
+    assert all(METADATA_KEYS["lab.plant"][1](plant) for plant in LAB_MODELS)
     path = save_measurements(quick_measurements, tmp_path / "lab.csv")
     assert path.read_text(encoding="utf-8") == format_measurements(quick_measurements)
     assert load_measurements(path) == quick_measurements

@@ -166,16 +166,16 @@ def test_integer_actuator_ids_become_text_and_frame_errors_name_rows():
     m = Measurements.from_frame(_frame(actuator_id=[7, 7, 8, 8, 7]))
     assert m.actuator_ids == ("7", "8")
     frame = _frame(cycle=[1, 1, 0, 1, 1])
-    with pytest.raises(DatasetError, match=r"^lab, row 2, column 'cycle': .*integer >= 1"):
+    with pytest.raises(DatasetError, match=r"^lab: cycle: row 2: must be an integer >= 1"):
         Measurements.from_frame(frame, source="lab")
     frame.index = [10, 11, 12, 13, 14]
-    with pytest.raises(DatasetError, match=r"Measurements frame, row 12, column 'cycle'"):
+    with pytest.raises(DatasetError, match=r"^cycle: row 12: must be"):
         Measurements.from_frame(frame)
-    with pytest.raises(DatasetError, match=r"row 1, column 'direction'.*'loading', 'unloading'"):
+    with pytest.raises(DatasetError, match=r"^direction: row 1: .*'loading', 'unloading'"):
         Measurements.from_frame(_frame(direction=["loading", None, "loading", "loading", "x"]))
-    with pytest.raises(DatasetError, match=r"row 3, column 'l': .*Got inf instead"):
+    with pytest.raises(DatasetError, match=r"^l: row 3: must be a finite number; got inf"):
         Measurements.from_frame(_frame(l=[100, 100, 120, np.inf, 100]))
-    with pytest.raises(DatasetError, match=r"row 4, column 'angle_deg'.*missing value"):
+    with pytest.raises(DatasetError, match=r"^angle_deg: row 4: .*a missing value"):
         Measurements.from_frame(_frame(angle_deg=[0, 1, 2, 3, np.nan]))
     with pytest.raises(DatasetError, match=r"missing required column\(s\) 'angle_deg'"):
         Measurements.from_frame(_frame(angle_deg=None))
@@ -189,47 +189,59 @@ def test_integer_actuator_ids_become_text_and_frame_errors_name_rows():
 ROW_A = f"{DESIGN_A},0.1,20"
 
 BAD_FILES = [
-    ("empty", "", ["no header row"]),
-    ("comments-only", "# rig: x\n\n# nothing else\n", ["no header row"]),
-    ("missing", "l,r,t,b,phi,lc,pressure_mpa\n1,2,3,4,5,6,7\n", ["line 1", "'angle_deg'"]),
-    ("unknown", f"# rig: v\n{HEADER},temp_c\n{ROW_A},21\n", ["line 2", "'temp_c'", "direction"]),
-    ("case", "L,r,t,b,phi,lc,pressure_mpa,angle_deg\n", ["line 1", "'L'", "case-sensitive"]),
-    ("duplicate", f"{HEADER},phi\n{ROW_A},5\n", ["line 1", "duplicate", "'phi'"]),
-    ("cells", f"{HEADER}\n{ROW_A}\n{ROW_A},9\n", ["line 3", "9 cells", "8 columns"]),
-    ("no-rows", f"# operator: b\n{HEADER}\n\n", ["line 2", "no data rows"]),
-    ("text", f"{HEADER}\n{ROW_A}\n{DESIGN_A},high,1\n", ["line 3", "'pressure_mpa'", "'high'"]),
-    ("empty-cell", f"{HEADER}\n{DESIGN_A},,1\n", ["line 2", "'pressure_mpa'", "empty cell"]),
-    ("nan", f"{HEADER}\n{ROW_A}\n{DESIGN_A},0.2,nan\n", ["line 3", "'angle_deg'", "'nan'"]),
-    ("inf", f"{HEADER}\n{ROW_A}\ninf,6,2,2,5,8,0.2,1\n", ["line 3", "column 'l'", "finite"]),
-    ("negative", f"{HEADER}\n{DESIGN_A},-0.01,1\n", ["line 2", "'pressure_mpa'", ">= 0"]),
+    ("empty", "", ["has no column header"]),
+    ("comments-only", "# rig: x\n\n# nothing else\n", ["has no column header"]),
+    (
+        "missing",
+        "l,r,t,b,phi,lc,pressure_mpa\n1,2,3,4,5,6,7\n",
+        [":1: angle_deg: lacks the column(s) angle_deg"],
+    ),
+    (
+        "unknown",
+        f"# rig: v\n{HEADER},temp_c\n{ROW_A},21\n",
+        [":2:9: temp_c: has column(s) temp_c", "direction"],
+    ),
+    (
+        "case",
+        "L,r,t,b,phi,lc,pressure_mpa,angle_deg\n",
+        [":1:1: L: lacks the column(s) l and has column(s) L", "case-sensitive"],
+    ),
+    ("duplicate", f"{HEADER},phi\n{ROW_A},5\n", [":1:9: phi:", "appears twice"]),
+    ("cells", f"{HEADER}\n{ROW_A}\n{ROW_A},9\n", [":3: has 9 cells", "8 columns"]),
+    ("no-rows", f"# operator: b\n{HEADER}\n\n", [":2: ", "0 data row(s)"]),
+    ("text", f"{HEADER}\n{ROW_A}\n{DESIGN_A},high,1\n", [":3:7: pressure_mpa:", '"high"']),
+    ("empty-cell", f"{HEADER}\n{DESIGN_A},,1\n", [":2:7: pressure_mpa:", "empty cell"]),
+    ("nan", f"{HEADER}\n{ROW_A}\n{DESIGN_A},0.2,nan\n", [":3:8: angle_deg:", '"nan"']),
+    ("inf", f"{HEADER}\n{ROW_A}\ninf,6,2,2,5,8,0.2,1\n", [":3:1: l:", "finite"]),
+    ("negative", f"{HEADER}\n{DESIGN_A},-0.01,1\n", [":2:7: pressure_mpa:", ">= 0"]),
     (
         "design",
         f"# rig: v\n\n{HEADER}\n{ROW_A}\n100,6,2,2,61,8,0.1,1\n",
-        ["line 5", "column 'phi'", "'phi_deg' of SFRBADesign"],
+        [":5:5: phi: phi_deg must be"],
     ),
     (
         "cycle-zero",
         f"{HEADER},cycle\n{ROW_A},1\n{ROW_A},0\n",
-        ["line 3", "column 'cycle'", "integer >= 1"],
+        [":3:9: cycle:", "integer >= 1"],
     ),
-    ("cycle-float", f"{HEADER},cycle\n{ROW_A},1.5\n", ["line 2", "column 'cycle'", "'1.5'"]),
+    ("cycle-float", f"{HEADER},cycle\n{ROW_A},1.5\n", [":2:9: cycle:", '"1.5"']),
     (
         "direction",
         f"{HEADER},direction\n{ROW_A},Loading\n",
-        ["line 2", "column 'direction'", "'loading', 'unloading'", "'Loading'"],
+        [":2:9: direction:", "'loading', 'unloading'", '"Loading"'],
     ),
     (
         "two-designs",
         f"{HEADER},actuator_id\n{ROW_A},A1\n{DESIGN_B},0.1,20,A2\n{DESIGN_B},0.2,30,A1\n",
-        ["line 4", "column 'actuator_id'", "'A1'", "line 2"],
+        [":4:9: actuator_id:", "'A1'", "line 2"],
     ),
     (
         "default-id-collision",
         f"{HEADER}\n{ROW_A}\n100.0000001,6,2,2,5,8,0.1,20\n",
-        ["line 3", "column 'actuator_id'", "add an actuator_id column"],
+        [":3: actuator_id:", "add an actuator_id column"],
     ),
-    ("empty-id", f"{HEADER},actuator_id\n{ROW_A},\n", ["line 2", "column 'actuator_id'"]),
-    ("metadata-twice", f"# rig: a\n# rig: b\n{HEADER}\n{ROW_A}\n", ["line 2", "'rig'"]),
+    ("empty-id", f"{HEADER},actuator_id\n{ROW_A},\n", [":2:9: actuator_id:"]),
+    ("metadata-twice", f"# rig: a\n# rig: b\n{HEADER}\n{ROW_A}\n", [":2: rig: is set twice"]),
 ]
 
 
@@ -251,7 +263,7 @@ def test_bad_files_raise_one_line_naming_file_line_and_column(tmp_path, text, ex
 
 
 def test_missing_folder_and_non_utf8_files(tmp_path):
-    with pytest.raises(DatasetError, match=r"not found.*nowhere\.csv"):
+    with pytest.raises(DatasetError, match=r"nowhere\.csv: no such file"):
         load_measurements(tmp_path / "nowhere.csv")
     with pytest.raises(DatasetError, match="is a folder"):
         load_measurements(tmp_path)

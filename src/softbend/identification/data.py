@@ -44,14 +44,15 @@ from pathlib import Path
 from typing import TYPE_CHECKING, Any, Literal
 
 import numpy as np
+from numpy.typing import ArrayLike
 
-from softbend._io import new_file_mode, read_header_csv
+from softbend._io import new_file_mode
 from softbend._jsontext import check_json_nesting
-from softbend._validation import check_range
-from softbend.errors import DatasetError
+from softbend._validation import check_range, must_be
+from softbend.errors import DatasetError, LimitError, keyed
 from softbend.kinematics import bending_from_tip
 from softbend.limits import check_file_size
-from softbend.plausibility import check_plausible, check_plausible_columns
+from softbend.tables import Column, HeaderKey, Table, TableFormat, read_table
 
 if TYPE_CHECKING:
     import pandas as pd
@@ -76,7 +77,7 @@ _FORMAT_LINE = "softbend experiment CSV v1"
 _SAFE_NAME = re.compile(r"[A-Za-z0-9][A-Za-z0-9._-]*")
 
 
-def _readonly(values: Any, name: str) -> np.ndarray:
+def _readonly(values: ArrayLike, name: str) -> np.ndarray:
     array = np.array(values, dtype=float)  # a private copy
     if array.ndim != 1:
         raise DatasetError(
@@ -258,167 +259,134 @@ class Experiment:
 
 
 # --------------------------------------------------------------------- loading
-def _parse_header_comment(
-    key: str, value: str, header: dict[str, Any], path: Path, number: int
-) -> None:
-    """Read one ``# key: value`` comment before the column header (row ``number``).
+def _is_flag(text: str) -> bool:
+    return text.lower() in ("true", "false")
 
-    The keys ``synthetic``, ``rest_length_mm`` and ``metadata`` are read (in any
-    case); other keys are remarks and are ignored.
-    """
-    where = f"{path}, row {number}"
-    key = key.lower()
-    if key == "synthetic":
-        if value.lower() not in {"true", "false"}:
-            raise DatasetError(
-                f"{where}: 'synthetic' must be true or false. Got {value!r} instead."
-            )
-        header["synthetic"] = value.lower() == "true"
-    elif key == "rest_length_mm":
+
+def _is_length(text: str) -> bool:
+    try:
+        return 0.0 < float(text) < math.inf
+    except ValueError:
+        return False
+
+
+#: The experiment CSV as :mod:`softbend.tables` reads it: the required columns
+#: with their plausible ranges, the optional experiment column, the header keys
+#: (in any case; other keys are remarks) and other columns ignored.
+EXPERIMENT_FORMAT = TableFormat(
+    name="experiment CSV",
+    columns=(
+        *(
+            Column(name, unit, quantity=COLUMN_QUANTITIES[name])
+            for name, unit in zip(REQUIRED_COLUMNS, ("s", "kPa", "mm", "mm"), strict=True)
+        ),
+        Column(EXPERIMENT_COLUMN, kind="text", required=False),
+    ),
+    header=(
+        HeaderKey("synthetic", "true or false", _is_flag),
+        HeaderKey("rest_length_mm", "a positive number (mm)", _is_length, quantity="length_mm"),
+        HeaderKey("metadata", "a JSON object"),
+    ),
+    other_keys="ignore",
+    other_columns="ignore",
+    fold_keys=True,
+    repeated_keys=True,
+)
+
+
+def _metadata(table: Table) -> dict[str, Any]:
+    """The ``# metadata`` line of a file as a JSON object (empty without one)."""
+    if "metadata" not in table.header:
+        return {}
+    value = table.header["metadata"]
+    line = table.header_lines["metadata"]
+    with keyed("metadata", file=table.file):
         try:
-            length = float(value)
-        except ValueError:
-            length = math.nan
-        if not 0.0 < length < math.inf:
-            raise DatasetError(
-                f"{where}: 'rest_length_mm' must be a positive number (mm). Got {value!r} instead."
-            )
-        check_plausible(
-            [length], "length_mm", source=str(path), column="rest_length_mm", first_line=number
+            check_json_nesting(value, "the value")
+        except LimitError as error:
+            error.line = line
+            raise
+    try:
+        metadata = json.loads(value)
+    except json.JSONDecodeError as exc:
+        raise DatasetError(
+            f"must be a JSON object; got invalid JSON ({exc.msg})",
+            key="metadata",
+            file=table.file,
+            line=line,
+        ) from None
+    except RecursionError:
+        raise DatasetError(
+            "is nested too deeply to read", key="metadata", file=table.file, line=line
+        ) from None
+    if not isinstance(metadata, dict):
+        raise DatasetError(
+            must_be("a JSON object", value), key="metadata", file=table.file, line=line
         )
-        header["rest_length_mm"] = length
-    elif key == "metadata":
-        check_json_nesting(value, f"{where}: 'metadata'")
-        try:
-            metadata = json.loads(value)
-        except json.JSONDecodeError as exc:
-            raise DatasetError(f"{where}: 'metadata' is not valid JSON ({exc.msg}).") from None
-        except RecursionError:
-            raise DatasetError(f"{where}: 'metadata' is nested too deeply to read.") from None
-        if not isinstance(metadata, dict):
-            raise DatasetError(f"{where}: 'metadata' must be a JSON object. Got {value!r} instead.")
-        header["metadata"] = metadata
+    return metadata
 
 
 def _read_csv(path: Path, rest_length_mm: float | None) -> list[Experiment]:
-    header_info: dict[str, Any] = {}
-    columns: list[str] | None = None
-    header_row = 0
-    records: list[tuple[int, tuple[str, ...]]] = []
-    for line in read_header_csv(path, line_word="row"):
-        if line.kind == "meta":
-            _parse_header_comment(line.key, line.value, header_info, path, line.number)
-        elif line.kind == "header":
-            columns, header_row = list(line.cells), line.number
-        else:
-            records.append((line.number, line.cells))
-
-    required = ", ".join(REQUIRED_COLUMNS)
-    if columns is None:
-        raise DatasetError(f"{path} is empty: expected a header row with the columns {required}.")
-    duplicates = sorted({c for c in columns if columns.count(c) > 1})
-    if duplicates:
-        raise DatasetError(
-            f"{path}, row {header_row}: duplicate column(s) {', '.join(duplicates)}."
-        )
-    missing = [c for c in REQUIRED_COLUMNS if c not in columns]
-    if missing:
-        raise DatasetError(
-            f"{path}: missing column(s) {', '.join(missing)}; the required columns are "
-            f"{required} (optional: {EXPERIMENT_COLUMN}). Got {', '.join(columns)}."
-        )
-    if not records:
-        raise DatasetError(f"{path} has a header row but no data rows.")
-
-    index = {c: columns.index(c) for c in REQUIRED_COLUMNS}
-    named = EXPERIMENT_COLUMN in columns
-    groups: dict[str, dict[str, list]] = {}
-    every: dict[str, list[float]] = {c: [] for c in REQUIRED_COLUMNS}
-    every_line: list[int] = []
-    for number, fields in records:
-        if len(fields) != len(columns):
-            raise DatasetError(
-                f"{path}, row {number}: {len(fields)} fields, but the header has {len(columns)}."
-            )
-        name = fields[columns.index(EXPERIMENT_COLUMN)] if named else path.stem
-        if not name:
-            raise DatasetError(
-                f"{path}, row {number}, column '{EXPERIMENT_COLUMN}': name is empty."
-            )
-        group = groups.setdefault(name, {"rows": [], **{c: [] for c in REQUIRED_COLUMNS}})
-        group["rows"].append(number)
-        for column, position in index.items():
-            cell = fields[position]
-            try:
-                value = float(cell) if cell else math.nan
-            except ValueError:
-                raise DatasetError(
-                    f"{path}, row {number}, column '{column}': {cell!r} is not a number."
-                ) from None
-            if math.isnan(value):
-                raise DatasetError(
-                    f"{path}, row {number}, column '{column}': missing value "
-                    f"({'empty cell' if not cell else repr(cell)})."
-                )
-            if math.isinf(value):
-                raise DatasetError(
-                    f"{path}, row {number}, column '{column}': {cell!r} is not finite."
-                )
-            group[column].append(value)
-            every[column].append(value)
-        every_line.append(number)
-    check_plausible_columns(
-        {column: (every[column], quantity) for column, quantity in COLUMN_QUANTITIES.items()},
-        source=str(path),
-        lines=every_line,
+    table = read_table(path, EXPERIMENT_FORMAT)
+    metadata = _metadata(table)
+    frame = table.frame
+    if EXPERIMENT_COLUMN in frame.columns:
+        names = frame[EXPERIMENT_COLUMN].to_numpy(dtype=object)
+    else:
+        names = np.full(len(frame), path.stem, dtype=object)
+    rest = (
+        rest_length_mm
+        if rest_length_mm is not None
+        else float(table.header.get("rest_length_mm", DEFAULT_REST_LENGTH_MM))
     )
-    del every, every_line
-
+    synthetic = table.header.get("synthetic", "false").lower() == "true"
+    columns = {c: frame[c].to_numpy(dtype=np.float64) for c in REQUIRED_COLUMNS}
     experiments = []
-    for name, group in groups.items():
-        rows = group["rows"]
-        times = group["time_s"]
-        for i in range(1, len(times)):
-            if times[i] <= times[i - 1]:
-                raise DatasetError(
-                    f"{path}, experiment {name!r}, row {rows[i]}: time_s {times[i]!r} does not "
-                    f"increase after {times[i - 1]!r} (row {rows[i - 1]}); time must increase "
-                    "strictly."
-                )
-        if len(times) < 3:
-            raise DatasetError(
-                f"{path}, experiment {name!r}: {len(times)} sample(s); at least 3 are needed."
+    for name in dict.fromkeys(names.tolist()):
+        rows = np.flatnonzero(names == name)
+        times = columns["time_s"][rows]
+        steps = np.flatnonzero(np.diff(times) <= 0)
+        if steps.size:
+            k = int(steps[0]) + 1
+            raise table.error(
+                f"{float(times[k])!r} does not increase after {float(times[k - 1])!r} (line "
+                f"{table.lines[rows[k - 1]]}) in experiment {name!r}; time must increase strictly",
+                row=int(rows[k]),
+                column="time_s",
             )
-        rest = (
-            rest_length_mm
-            if rest_length_mm is not None
-            else header_info.get("rest_length_mm", DEFAULT_REST_LENGTH_MM)
-        )
+        if rows.size < 3:
+            raise DatasetError(
+                f"experiment {name!r} has {rows.size} sample(s); at least 3 are needed",
+                file=table.file,
+            )
+        x, y = columns["x_mm"][rows], columns["y_mm"][rows]
         try:
             experiment = Experiment(
                 name=name,
-                time_s=np.asarray(times),
-                pressure_kpa=np.asarray(group["pressure_kpa"]),
-                x_mm=np.asarray(group["x_mm"]),
-                y_mm=np.asarray(group["y_mm"]),
+                time_s=times,
+                pressure_kpa=columns["pressure_kpa"][rows],
+                x_mm=x,
+                y_mm=y,
                 rest_length_mm=rest,
-                synthetic=header_info.get("synthetic", False),
-                metadata=header_info.get("metadata", {}),
+                synthetic=synthetic,
+                metadata=metadata,
             )
         except DatasetError:
             # Columns were checked above, so the tip is out of reach: find its row.
-            for k in range(len(times)):
+            for k in range(rows.size):
                 try:
-                    bending_from_tip(group["x_mm"][k], group["y_mm"][k], rest_length_mm=rest)
+                    bending_from_tip(x[k], y[k], rest_length_mm=rest)
                 except DatasetError:
-                    raise DatasetError(
-                        f"{path}, experiment {name!r}, row {rows[k]}: the tip "
-                        f"(x_mm={group['x_mm'][k]!r}, y_mm={group['y_mm'][k]!r}) is not "
-                        f"reachable by a constant-curvature arc of rest length {rest:g} mm."
+                    raise table.error(
+                        f"the tip (x_mm={float(x[k])!r}, y_mm={float(y[k])!r}) of experiment "
+                        f"{name!r} is not reachable by a constant-curvature arc of rest length "
+                        f"{rest:g} mm",
+                        row=int(rows[k]),
+                        column="x_mm",
                     ) from None
             raise
         except ValueError as exc:
-            raise DatasetError(f"{path}, experiment {name!r}: {exc}") from None
+            raise DatasetError(f"experiment {name!r}: {exc}", file=table.file) from None
         experiments.append(experiment)
     return experiments
 
@@ -501,8 +469,9 @@ def load_experiments(
         for experiment in _read_csv(file, rest_length_mm):
             if experiment.name in seen:
                 raise DatasetError(
-                    f"{file}: experiment {experiment.name!r} was already read from "
-                    f"{seen[experiment.name]}; experiment names must be unique."
+                    f"experiment {experiment.name!r} was already read from "
+                    f"{seen[experiment.name]}; experiment names must be unique",
+                    file=str(file),
                 )
             seen[experiment.name] = file
             experiments.append(experiment)

@@ -15,7 +15,7 @@ comments, and blank lines are skipped. A folder holds one experiment per
 into contiguous runs of the same value. Without a time column the sample index
 (0, 1, 2, ...) is the time. Errors are one line naming the file, the line as an
 editor numbers it (from 1, comments and blank lines counted) and the column.
-Files are read with :func:`softbend._io.read_header_csv`, within the
+Files are read with :func:`softbend.tables.read_table`, within the
 ``file_mib`` and ``csv_rows`` limits of :mod:`softbend.limits`.
 
 :func:`save_timeseries` writes a set as one such file with an ``experiment``
@@ -28,19 +28,19 @@ from __future__ import annotations
 import csv
 import io
 import logging
-import math
 import os
 from collections.abc import Sequence
 from pathlib import Path
 
 import numpy as np
 
-from softbend._io import atomic_file, read_header_csv
-from softbend._validation import check_int
-from softbend.errors import DatasetError
+from softbend._io import atomic_file
+from softbend._validation import check_int, must_be
+from softbend.errors import DatasetError, InputError
 from softbend.identification.data import experiment_files
 from softbend.identification.ranges import MAX_ABS_VALUE, MIN_OUTPUT_RANGE
 from softbend.identification.timeseries import Series, TimeSeriesSet
+from softbend.tables import Column, Table, TableFormat, read_table
 
 logger = logging.getLogger(__name__)
 
@@ -62,32 +62,25 @@ _FORMAT_LINE = "softbend time series v1"
 
 
 # --------------------------------------------------------------------- loading
-def _names(value: str | Sequence[str], field: str) -> tuple[str, ...]:
-    """Column names given as one name or a sequence of names, checked."""
+def _names(value: str | Sequence[str], key: str) -> tuple[str, ...]:
+    """Column names given as one name or a sequence of names, checked (``key`` is the parameter)."""
     names = (value,) if isinstance(value, str) else tuple(value)
     if not names or not all(isinstance(n, str) and n.strip() for n in names):
-        raise ValueError(
-            f"The '{field}' of load_timeseries must be one or more non-empty column names. "
-            f"Got {value!r} instead."
-        )
+        raise InputError(must_be("one or more non-empty column names", value), key=key)
     names = tuple(n.strip() for n in names)
     duplicates = sorted({n for n in names if names.count(n) > 1})
     if duplicates:
-        raise ValueError(
-            f"The '{field}' of load_timeseries must name distinct columns. "
-            f"Got {', '.join(duplicates)} more than once."
+        raise InputError(
+            f"must name distinct columns; got {', '.join(duplicates)} more than once", key=key
         )
     return names
 
 
-def _column(value: str | None, field: str) -> str | None:
+def _column(value: str | None, key: str) -> str | None:
     if value is None:
         return None
     if not isinstance(value, str) or not value.strip():
-        raise ValueError(
-            f"The '{field}' of load_timeseries must be a non-empty column name or None. "
-            f"Got {value!r} instead."
-        )
+        raise InputError(must_be("a non-empty column name or None", value), key=key)
     return value.strip()
 
 
@@ -104,54 +97,26 @@ def _check_roles(
     ):
         for name in names:
             if name in roles:
-                raise ValueError(
-                    f"The '{role}' of load_timeseries must not name a column that is already "
-                    f"in '{roles[name]}'. Got {name!r} in both."
+                raise InputError(
+                    f"must not name a column that is already in {roles[name]!r}; "
+                    f"got {name!r} in both",
+                    key=role,
                 )
             roles[name] = role
 
 
-def _first_bad_cell(cells: list[str]) -> tuple[int, str]:
-    """Index of the first cell that is not a finite number, and why."""
-    for index, cell in enumerate(cells):
-        if not cell:
-            return index, "missing value (empty cell)"
-        try:
-            value = float(cell)
-        except ValueError:
-            return index, f"{cell!r} is not a number"
-        if not math.isfinite(value):
-            return index, f"{cell!r} is not finite (NaN and infinite values are not allowed)"
-    raise AssertionError("no bad cell")  # pragma: no cover - only called after a failure
+def _format(
+    inputs: tuple[str, ...], outputs: tuple[str, ...], experiment: str | None, time: str | None
+) -> TableFormat:
+    """The time-series CSV of these columns, as :mod:`softbend.tables` reads it."""
+    columns = [Column(experiment, kind="text")] if experiment else []
+    columns += [Column(name) for name in (*([time] if time else []), *inputs, *outputs)]
+    return TableFormat("time-series CSV", tuple(columns), other_columns="ignore")
 
 
-def _numbers(columns: dict[str, list[str]], lines: list[int], path: Path) -> dict[str, np.ndarray]:
-    """The cells of each column as floats; the first bad cell of the file is an error."""
-    values: dict[str, np.ndarray] = {}
-    bad: list[tuple[int, int, str, str]] = []  # (row, column order, column, reason)
-    for order, (name, cells) in enumerate(columns.items()):
-        try:
-            array = np.fromiter(map(float, cells), dtype=np.float64, count=len(cells))
-        except ValueError:
-            row, reason = _first_bad_cell(cells)
-            bad.append((row, order, name, reason))
-            continue
-        infinite = np.flatnonzero(~np.isfinite(array))
-        if infinite.size:
-            row, reason = _first_bad_cell(cells[: int(infinite[0]) + 1])
-            bad.append((row, order, name, reason))
-            continue
-        values[name] = array
-    if bad:
-        row, _, name, reason = min(bad)
-        raise DatasetError(f"{path}, line {lines[row]}, column '{name}': {reason}.")
-    return values
-
-
-def _runs(
-    names: list[str], lines: list[int], path: Path, column: str
-) -> list[tuple[str, int, int]]:
+def _runs(table: Table, column: str) -> list[tuple[str, int, int]]:
     """Contiguous runs ``(name, start, stop)`` of the experiment column, checked."""
+    names = table.frame[column].tolist()
     runs: list[tuple[str, int, int]] = []
     seen: dict[str, int] = {}
     start = 0
@@ -159,15 +124,12 @@ def _runs(
         if i < len(names) and names[i] == names[start]:
             continue
         name = names[start]
-        if not name:
-            raise DatasetError(
-                f"{path}, line {lines[start]}, column '{column}': the experiment name is empty."
-            )
         if name in seen:
-            raise DatasetError(
-                f"{path}, line {lines[start]}, column '{column}': experiment {name!r} appears "
-                f"again after {runs[-1][0]!r} (its rows ended at line {lines[seen[name]]}); "
-                "the rows of an experiment must be contiguous."
+            raise table.error(
+                f"experiment {name!r} appears again after {runs[-1][0]!r} (its rows ended at "
+                f"line {table.lines[seen[name]]}); the rows of an experiment must be contiguous",
+                row=start,
+                column=column,
             )
         seen[name] = i - 1
         runs.append((name, start, i))
@@ -184,64 +146,30 @@ def _read_file(
     first: tuple[Path, tuple[str, ...]] | None,
 ) -> tuple[list[Series], tuple[str, ...]]:
     """The experiments of one CSV file, and its columns."""
-    named = [*([experiment] if experiment else []), *([time] if time else []), *inputs, *outputs]
-    header: tuple[str, ...] | None = None
-    header_line = 0
-    rows: list[tuple[str, ...]] = []
-    lines: list[int] = []
-    for line in read_header_csv(path):
-        if line.kind == "header":
-            header, header_line = line.cells, line.number
-        elif line.kind == "row":
-            rows.append(line.cells)
-            lines.append(line.number)
-    if header is None:
-        raise DatasetError(
-            f"{path} is empty: expected a header line with the columns {', '.join(named)}."
-        )
-    missing = [c for c in named if c not in header]
-    if missing:
-        unlike = ""
-        if first is not None:
-            unlike = f" (unlike the first file {first[0]}, which has {', '.join(first[1])})"
-        raise DatasetError(
-            f"{path}, line {header_line}: missing column(s) {', '.join(missing)}; the file's "
-            f"columns are {', '.join(header)}{unlike}."
-        )
-    duplicates = [c for c in named if header.count(c) > 1]
-    if duplicates:
-        raise DatasetError(
-            f"{path}, line {header_line}, column '{duplicates[0]}': the column appears "
-            f"{header.count(duplicates[0])} times in the header."
-        )
-    if not rows:
-        raise DatasetError(f"{path} has a header line (line {header_line}) but no data lines.")
-    width = len(header)
-    for cells, number in zip(rows, lines, strict=True):
-        if len(cells) != width:
-            raise DatasetError(
-                f"{path}, line {number}: {len(cells)} fields, but the header has {width}."
-            )
-    position = {c: header.index(c) for c in named}
-    numeric = [c for c in named if c != experiment]
-    values = _numbers({c: [r[position[c]] for r in rows] for c in numeric}, lines, path)
-    if experiment:
-        runs = _runs([r[position[experiment]] for r in rows], lines, path, experiment)
-    else:
-        runs = [(path.stem, 0, len(rows))]
+    try:
+        table = read_table(path, _format(inputs, outputs, experiment, time))
+    except DatasetError as error:
+        if first is not None and error.detail.startswith("lacks the column"):
+            error.args = (f"{error.detail} (unlike the first file {first[0]}, which has "
+                          f"{', '.join(first[1])})",)  # fmt: skip
+        raise
+    runs = _runs(table, experiment) if experiment else [(path.stem, 0, len(table.frame))]
+    values = {c: table.frame[c].to_numpy(dtype=np.float64) for c in (*inputs, *outputs)}
     inputs_array = np.column_stack([values[c] for c in inputs])
     outputs_array = np.column_stack([values[c] for c in outputs])
     series = []
     for name, start, stop in runs:
         if time:
-            times = values[time][start:stop]
+            times = table.frame[time].to_numpy(dtype=np.float64)[start:stop]
             steps = np.flatnonzero(np.diff(times) <= 0)
             if steps.size:
-                k = start + int(steps[0]) + 1
-                raise DatasetError(
-                    f"{path}, line {lines[k]}, column '{time}': {float(values[time][k])!r} does "
-                    f"not increase after {float(values[time][k - 1])!r} (line {lines[k - 1]}) "
-                    f"in experiment {name!r}; time must increase strictly."
+                k = int(steps[0]) + 1
+                raise table.error(
+                    f"{float(times[k])!r} does not increase after {float(times[k - 1])!r} "
+                    f"(line {table.lines[start + k - 1]}) in experiment {name!r}; time must "
+                    "increase strictly",
+                    row=start + k,
+                    column=time,
                 )
         else:
             times = np.arange(stop - start, dtype=np.float64)
@@ -254,7 +182,7 @@ def _read_file(
                 source=str(path),
             )
         )
-    return series, header
+    return series, table.columns
 
 
 def load_timeseries(
@@ -324,8 +252,9 @@ def load_timeseries(
         for item in series:
             if item.name in seen:
                 raise DatasetError(
-                    f"{file}: experiment {item.name!r} was already read from "
-                    f"{seen[item.name]}; experiment names must be unique."
+                    f"experiment {item.name!r} was already read from "
+                    f"{seen[item.name]}; experiment names must be unique",
+                    file=str(file),
                 )
             seen[item.name] = item.source
             experiments.append(item)
@@ -473,7 +402,7 @@ def check_holdout(
     data: TimeSeriesSet,
     validate_on: str | Sequence[str] | None,
     *,
-    label: str = "'validate_on' of check_holdout",
+    label: str | None = None,  # transitional: ignored, removed once callers pass no option names
 ) -> None:
     """Check that experiments can be held out for validation and the rest selected on.
 
@@ -484,13 +413,12 @@ def check_holdout(
     validate_on : str or sequence of str, optional
         The experiments held out (one name or several). None: one experiment is
         to be held out at a time, which needs at least two.
-    label : str, default "'validate_on' of check_holdout"
-        How the message names ``validate_on``, quoted (``"'--validate-on'"``).
 
     Raises
     ------
-    ValueError
-        A name that is not an experiment of ``data`` (the message lists them),
+    InputError
+        With the key ``validate_on``: a name that is not an experiment of
+        ``data`` (the message lists them),
         a name given twice, ``validate_on`` empty or leaving fewer than two
         experiments to train on (the selection holds one out at a time), or
         ``validate_on`` None with a single experiment (nothing to hold out).
@@ -498,32 +426,37 @@ def check_holdout(
     known = data.names
     if validate_on is None:
         if len(known) < 2:
-            raise ValueError(
-                f"There is nothing to hold out: the data has one experiment ({known[0]!r}); "
-                "validation needs at least two (one to train on, one to hold out)."
+            raise InputError(
+                f"has nothing to hold out: the data has one experiment ({known[0]!r}); "
+                "validation needs at least two (one to train on, one to hold out)",
+                key="validate_on",
             )
         return
     names = (validate_on,) if isinstance(validate_on, str) else tuple(validate_on)
     if not names:
-        raise ValueError(f"The {label} must name at least one experiment, or be None. Got none.")
+        raise InputError(
+            "must name at least one experiment, or be None; got none", key="validate_on"
+        )
     unknown = [n for n in names if n not in known]
     if unknown:
-        raise ValueError(
-            f"The {label} must name experiments of the data ({', '.join(known)}). "
-            f"Got {', '.join(map(repr, unknown))} instead."
+        raise InputError(
+            f"must name experiments of the data ({', '.join(known)}); "
+            f"got {', '.join(map(repr, unknown))}",
+            key="validate_on",
         )
     repeated = sorted({n for n in names if names.count(n) > 1})
     if repeated:
-        raise ValueError(
-            f"The {label} must name each experiment once. "
-            f"Got {', '.join(map(repr, repeated))} more than once."
+        raise InputError(
+            f"must name each experiment once; got {', '.join(map(repr, repeated))} more than once",
+            key="validate_on",
         )
     left = [n for n in known if n not in names]
     if len(left) < 2:
-        raise ValueError(
-            f"The {label} must leave at least 2 of the {len(known)} experiments to train on "
-            f"(the selection holds one out at a time). Got {', '.join(map(repr, names))}, "
-            f"which leaves {', '.join(map(repr, left)) or 'none'}."
+        raise InputError(
+            f"must leave at least 2 of the {len(known)} experiments to train on "
+            f"(the selection holds one out at a time); got {', '.join(map(repr, names))}, "
+            f"which leaves {', '.join(map(repr, left)) or 'none'}",
+            key="validate_on",
         )
 
 

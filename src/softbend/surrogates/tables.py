@@ -32,10 +32,13 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
+from softbend._validation import must_be
 from softbend.actuators import Actuator, ActuatorError, pressure_to_mpa
 from softbend.errors import DatasetError
 from softbend.limits import check_file_size
 from softbend.surrogates.features import GROUP, TrainingData, data_hash
+from softbend.tables import Column, TableFormat, check_columns
+from softbend.tables import read_table as read_csv_table
 
 if TYPE_CHECKING:
     import pandas as pd
@@ -49,8 +52,20 @@ MAX_ROWS = 5_000_000
 _RADIAN_MAX = 2.0 * math.pi * 1.05
 
 
+#: A simulation table as :mod:`softbend.tables` reads a CSV of it: any columns,
+#: each read as numbers where every filled cell is one, else as text (empty
+#: cells NaN); ``# key: value`` lines are remarks.
+SIMULATION_TABLE = TableFormat(
+    name="simulation table", columns=(), other_columns="keep", max_rows=MAX_ROWS
+)
+
+
 def read_table(path: str | os.PathLike[str]) -> pd.DataFrame:
-    """A CSV (``#`` comment lines allowed) or Parquet file as a DataFrame, or one clear error."""
+    """A CSV (``#`` comment lines allowed) or Parquet file as a DataFrame, or one clear error.
+
+    A CSV goes through :func:`softbend.tables.read_table`; a Parquet file is
+    read by pandas. Both hold at most :data:`MAX_ROWS` rows.
+    """
     import pandas as pd
 
     source = Path(path)
@@ -58,47 +73,46 @@ def read_table(path: str | os.PathLike[str]) -> pd.DataFrame:
         raise FileNotFoundError(f"No table at {source}.")
     check_file_size(source, str(source))
     suffix = source.suffix.lower()
+    if suffix == ".csv":
+        return read_csv_table(source, SIMULATION_TABLE).frame
+    if suffix not in (".parquet", ".pq"):
+        raise DatasetError(
+            f"a training table must be a CSV or Parquet file ({', '.join(TABLE_SUFFIXES)}) "
+            f"or a campaign database; got {suffix or 'no suffix'}",
+            file=str(source),
+        )
     try:
-        if suffix == ".csv":
-            frame = pd.read_csv(source, comment="#", skipinitialspace=True)
-        elif suffix in (".parquet", ".pq"):
-            frame = pd.read_parquet(source)
-        else:
-            raise DatasetError(
-                f"{source}: a training table must be a CSV or Parquet file "
-                f"({', '.join(TABLE_SUFFIXES)}) or a campaign database; "
-                f"got {suffix or 'no suffix'}."
-            )
-    except (UnicodeDecodeError, pd.errors.ParserError, pd.errors.EmptyDataError, OSError) as err:
-        if isinstance(err, FileNotFoundError):
-            raise
-        raise DatasetError(f"{source}: not a readable {suffix[1:]} table ({err}).") from None
-    except ValueError as err:  # pyarrow: not a Parquet file
-        raise DatasetError(f"{source}: not a readable {suffix[1:]} table ({err}).") from None
+        frame = pd.read_parquet(source)
+    except (OSError, ValueError) as err:  # pyarrow: not a Parquet file
+        raise DatasetError(
+            f"is not a readable {suffix[1:]} table ({err})", file=str(source)
+        ) from None
     if len(frame) > MAX_ROWS:
         raise DatasetError(
-            f"{source} has {len(frame)} rows; a training table holds at most {MAX_ROWS}."
+            f"has {len(frame)} rows; a training table holds at most {MAX_ROWS}", file=str(source)
         )
     frame.columns = [str(c).strip() for c in frame.columns]
     return frame
 
 
-def _columns(text: str | Sequence[str], option: str) -> list[str]:
+def _columns(text: str | Sequence[str], key: str) -> list[str]:
+    """Column names given as ``"a,b,c"`` or a sequence; ``key`` is the parameter."""
     names = [c.strip() for c in text.split(",")] if isinstance(text, str) else list(text)
     if not names or any(not n for n in names):
-        raise ActuatorError(f"The {option} must be comma-separated column names; got {text!r}.")
+        raise ActuatorError(must_be("comma-separated column names", text), key=key)
     repeated = sorted({n for n in names if names.count(n) > 1})
     if repeated:
-        raise ActuatorError(f"The {option} names {', '.join(repeated)} twice.")
+        raise ActuatorError(f"names {', '.join(repeated)} twice", key=key)
     return names
 
 
-def _check_present(frame: pd.DataFrame, names: Sequence[str], option: str, source: str) -> None:
+def _check_present(frame: pd.DataFrame, names: Sequence[str], key: str, source: str) -> None:
     missing = [n for n in names if n not in frame.columns]
     if missing:
         raise ActuatorError(
-            f"{source} has no column {', '.join(map(repr, missing))} (from {option}); its columns "
-            f"are {', '.join(map(str, frame.columns))}."
+            f"names no column {', '.join(map(repr, missing))} of {source}; its columns are "
+            f"{', '.join(map(str, frame.columns))}",
+            key=key,
         )
 
 
@@ -139,58 +153,74 @@ def table_training_data(
     ------
     softbend.actuators.ActuatorError
         A missing column (naming it and the table's columns), a unit not one of
-        the four, a design outside ``actuator``'s description, radians.
+        the four, a design outside ``actuator``'s description, radians; the key
+        is the parameter at fault (``design_columns``, ``pressure_unit``, ...).
     softbend.errors.DatasetError
-        An unreadable file, or no usable row.
+        An unreadable file, no usable row, or a pressure or angle column that
+        is not numbers or a negative pressure (:func:`softbend.tables.check_columns`).
     """
     source = Path(path)
     frame = read_table(source)
     if actuator is not None:
-        designs = _columns(design_columns or actuator.names, "--design-columns")
+        designs = _columns(design_columns or actuator.names, "design_columns")
         if designs != list(actuator.names):
             raise ActuatorError(
-                f"The --design-columns {','.join(designs)} are not those of the actuator "
-                f"{actuator.name} ({','.join(actuator.names)})."
+                f"must be those of the actuator {actuator.name} ({','.join(actuator.names)}); "
+                f"got {','.join(designs)}",
+                key="design_columns",
             )
         pressure_column = pressure_column or actuator.pressure_column
         unit = pressure_unit or actuator.pressure_unit
         if unit != actuator.pressure_unit:
             raise ActuatorError(
-                f"The --pressure-unit {unit} is not that of the actuator {actuator.name} "
-                f"({actuator.pressure_unit})."
+                f"must be that of the actuator {actuator.name} ({actuator.pressure_unit}); "
+                f"got {unit}",
+                key="pressure_unit",
             )
     else:
         if design_columns is None:
             raise ActuatorError(
-                f"Training on the table {source} needs --design-columns (the design "
-                "parameters' columns, such as n_chambers,wall_mm)."
+                f"is required to train on the table {source} (the design parameters' columns, "
+                "such as n_chambers,wall_mm)",
+                key="design_columns",
             )
-        designs = _columns(design_columns, "--design-columns")
+        designs = _columns(design_columns, "design_columns")
         if pressure_column is None:
-            raise ActuatorError(f"Training on the table {source} needs --pressure-column.")
+            raise ActuatorError(
+                f"is required to train on the table {source}", key="pressure_column"
+            )
         if pressure_unit is None:
             raise ActuatorError(
-                f"Training on the table {source} needs --pressure-unit (kPa, MPa, bar or psi)."
+                f"is required to train on the table {source} (kPa, MPa, bar or psi)",
+                key="pressure_unit",
             )
         unit = pressure_unit
-    pressure_to_mpa(unit, field="--pressure-unit")
+    pressure_to_mpa(unit)
     if angle_column.lower().endswith("_rad"):
         raise ActuatorError(
-            f"The --angle-column {angle_column!r} looks like radians; softbend learns angles "
-            "in degrees: multiply by 180/π (57.2958) and name the column e.g. angle_deg."
+            f"{angle_column!r} looks like radians; softbend learns angles in degrees: multiply "
+            "by 180/π (57.2958) and name the column e.g. angle_deg",
+            key="angle_column",
         )
-    for label, column in (("--pressure-column", pressure_column), ("--angle-column", angle_column)):
+    for key, column in (("pressure_column", pressure_column), ("angle_column", angle_column)):
         if column in designs:
-            raise ActuatorError(f"The {label} {column!r} is also one of the --design-columns.")
-    _check_present(frame, designs, "--design-columns", str(source))
-    _check_present(frame, [pressure_column], "--pressure-column", str(source))
-    _check_present(frame, [angle_column], "--angle-column", str(source))
-    for column in (pressure_column, angle_column):
-        if frame[column].dtype.kind not in "iuf":
             raise ActuatorError(
-                f"{source}, column {column!r} must hold numbers; got {frame[column].dtype} values "
-                f"such as {frame[column].iloc[0]!r}."
+                f"{column!r} is also one of the design columns ({','.join(designs)})", key=key
             )
+    _check_present(frame, designs, "design_columns", str(source))
+    _check_present(frame, [pressure_column], "pressure_column", str(source))
+    _check_present(frame, [angle_column], "angle_column", str(source))
+    check_columns(
+        frame,
+        TableFormat(
+            name="simulation table",
+            columns=(
+                Column(pressure_column, unit, low=0.0, missing=True),
+                Column(angle_column, "deg", missing=True),
+            ),
+        ),
+        file=str(source),
+    )
     if actuator is None:
         actuator = Actuator.from_table(
             frame,
@@ -212,8 +242,9 @@ def table_training_data(
         else:
             if column.dtype.kind not in "iuf":
                 raise ActuatorError(
-                    f"{source}, column {parameter.name!r} must hold numbers ({parameter.kind}); "
-                    f"got values such as {column.iloc[0]!r}."
+                    must_be(f"numbers ({parameter.kind})", f"values such as {column.iloc[0]!r}"),
+                    key=parameter.name,
+                    file=str(source),
                 )
             codes[:, j] = column.to_numpy(dtype=np.float64, na_value=np.nan)
     pressures = frame[pressure_column].to_numpy(dtype=np.float64, na_value=np.nan)
@@ -221,16 +252,15 @@ def table_training_data(
     keep = np.isfinite(codes).all(axis=1) & np.isfinite(pressures) & np.isfinite(angles)
     if not keep.any():
         raise DatasetError(
-            f"{source} has no row with finite "
-            f"{', '.join([*designs, pressure_column, angle_column])} ({len(frame)} rows in all)."
+            f"has no row with finite {', '.join([*designs, pressure_column, angle_column])} "
+            f"({len(frame)} rows in all)",
+            file=str(source),
         )
     codes, pressures, angles = codes[keep], pressures[keep], angles[keep]
-    if (pressures < 0).any():
-        raise ActuatorError(
-            f"{source}, column {pressure_column!r}: gauge pressures must be >= 0 {unit}; "
-            f"got {pressures.min():g}."
-        )
-    actuator.check_designs(codes, where=f"in {source}")
+    try:
+        actuator.check_designs(codes)
+    except ActuatorError as err:
+        raise ActuatorError(err.detail, file=str(source)) from None
     if GROUP in frame.columns:
         groups = frame[GROUP].astype(str).to_numpy()[keep]
     else:
@@ -238,9 +268,10 @@ def table_training_data(
         groups = np.array([f"d{i:05d}" for i in index.ravel()])
     if np.unique(groups).size > 1 and np.abs(angles).max() <= _RADIAN_MAX:
         raise ActuatorError(
-            f"{source}, column {angle_column!r}: no |angle| exceeds {np.abs(angles).max():.4g} "
-            "over the whole table; they look like radians: multiply by 180/π (57.2958) for "
-            "degrees."
+            f"no |angle| exceeds {np.abs(angles).max():.4g} over the whole table; they look "
+            "like radians: multiply by 180/π (57.2958) for degrees",
+            key=angle_column,
+            file=str(source),
         )
     X = np.ascontiguousarray(np.column_stack([codes, pressures]))
     y = np.ascontiguousarray(angles)

@@ -36,16 +36,20 @@ import warnings
 from collections.abc import Iterable, Mapping, Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
-from typing import Any
 
 import numpy as np
 import pandas as pd
 
 from softbend.actuators import Actuator, ActuatorError
 from softbend.errors import DatasetError
-from softbend.limits import check_file_size
+from softbend.tables import Column, TableFormat, read_table
 
-__all__ = ["ACTUATOR_COLUMN", "ActuatorMeasurements", "load_actuator_measurements"]
+__all__ = [
+    "ACTUATOR_COLUMN",
+    "ActuatorMeasurements",
+    "load_actuator_measurements",
+    "measurement_format",
+]
 
 #: The column naming the built actuator of each reading.
 ACTUATOR_COLUMN = "actuator"
@@ -149,109 +153,86 @@ class ActuatorMeasurements:
         )
 
 
-def _read_one(path: Path, actuator: Actuator, force: bool) -> tuple[pd.DataFrame, dict[str, str]]:
-    if not path.exists():
-        raise DatasetError(f"Measurement file not found: {path}.")
-    if path.is_dir():
-        raise DatasetError(f"{path} is a folder; a measurement CSV file is required.")
-    check_file_size(path, str(path))
-    try:
-        text = path.read_text(encoding="utf-8-sig")
-    except UnicodeDecodeError:
-        raise DatasetError(f"{path} is not UTF-8 text; a measurement file is a CSV.") from None
-    metadata: dict[str, str] = {}
-    body: list[str] = []
-    numbers: list[int] = []
-    for number, line in enumerate(text.splitlines(), start=1):
-        stripped = line.strip()
-        if not stripped:
-            continue
-        if stripped.startswith("#"):
-            key, sep, value = stripped[1:].partition(":")
-            if sep and not body and key.strip() and " " not in key.strip():
-                metadata[key.strip()] = value.strip()
-            continue
-        body.append(line)
-        numbers.append(number)
-    if not body:
-        raise DatasetError(f"{path} has no header row.")
-    from io import StringIO
+def measurement_format(actuator: Actuator) -> TableFormat:
+    """The plain measurement CSV of ``actuator``, as :mod:`softbend.tables` reads it.
 
+    The id column, the design columns (read as text: a categorical parameter
+    gives its level), the pressure column (>= 0, the actuator's unit) and the
+    angle column (degrees); any ``# key: value`` line without spaces in its key
+    is kept.
+    """
+    return TableFormat(
+        name=f"measurement file of the actuator {actuator.name}",
+        columns=(
+            Column(ACTUATOR_COLUMN, kind="text"),
+            *(Column(p.name, p.unit, kind="text") for p in actuator.parameters),
+            Column(actuator.pressure_column, actuator.pressure_unit, low=0.0),
+            Column(actuator.angle_column, "deg"),
+        ),
+        other_keys="keep",
+        other_columns="error",
+    )
+
+
+def _read_one(path: Path, actuator: Actuator, force: bool) -> tuple[pd.DataFrame, dict[str, str]]:
     try:
-        raw = pd.read_csv(StringIO("\n".join(body)), dtype=str, skipinitialspace=True)
-    except (pd.errors.ParserError, pd.errors.EmptyDataError) as err:
-        raise DatasetError(f"{path}: not a readable CSV ({err}).") from None
-    raw.columns = [str(c).strip() for c in raw.columns]
-    expected = [ACTUATOR_COLUMN, *actuator.names, actuator.pressure_column, actuator.angle_column]
-    missing = [c for c in expected if c not in raw.columns]
-    unknown = [c for c in raw.columns if c not in expected]
-    if missing or unknown:
-        parts = []
-        if missing:
-            parts.append(f"lacks the column(s) {', '.join(missing)}")
-        if unknown:
-            parts.append(f"has column(s) {', '.join(unknown)} the model does not know")
+        table = read_table(path, measurement_format(actuator))
+    except DatasetError as error:
+        if error.key is None:  # the file itself: missing, not text, no rows
+            raise
         raise ActuatorError(
-            f"{path} {' and '.join(parts)}; a measurement file of the actuator {actuator.name} "
-            f"has the columns {', '.join(expected)}."
-        )
-    if raw.empty:
-        raise DatasetError(f"{path}: the header row is followed by no data rows.")
-    line_of = dict(enumerate(numbers[1:]))
-    frame = pd.DataFrame({"actuator_id": raw[ACTUATOR_COLUMN].fillna("").str.strip()})
-    empty = frame["actuator_id"] == ""
-    if empty.any():
-        raise ActuatorError(
-            f"{path}, line {line_of[int(np.argmax(empty))]}, column {ACTUATOR_COLUMN!r}: "
-            "every reading names its actuator."
-        )
+            error.detail, key=error.key, file=error.file, line=error.line, column=error.column
+        ) from None
+    raw = table.frame
+    frame = pd.DataFrame({"actuator_id": raw[ACTUATOR_COLUMN]})
     for parameter in actuator.parameters:
+        column = table.positions[parameter.name]
         codes = []
         for pos, cell in enumerate(raw[parameter.name].tolist()):
-            where = f"{path}, line {line_of[pos]}, column {parameter.name!r}"
-            if not isinstance(cell, str) or not cell.strip():
-                raise ActuatorError(f"{where}: an empty cell; every reading gives its design.")
             try:
-                codes.append(parameter.encode(cell.strip()))
+                codes.append(parameter.encode(cell))
             except ActuatorError as err:
-                raise ActuatorError(f"{where}: {err}") from None
-        frame[parameter.name] = np.asarray(codes, dtype=np.float64)
-    for column, name in (
-        (actuator.pressure_column, actuator.pressure_column),
-        (actuator.angle_column, "angle_deg"),
-    ):
-        values = pd.to_numeric(raw[column], errors="coerce").to_numpy(dtype=np.float64)
-        bad = ~np.isfinite(values)
-        if bad.any():
-            pos = int(np.argmax(bad))
-            raise ActuatorError(
-                f"{path}, line {line_of[pos]}, column {column!r}: must be a finite number; "
-                f"got {raw[column].iloc[pos]!r}."
-            )
-        frame[name] = values
+                raise ActuatorError(
+                    err.detail, file=table.file, line=int(table.lines[pos]), column=column
+                ) from None
+        values = np.asarray(codes, dtype=np.float64)
+        try:
+            parameter.check(values)
+        except ActuatorError:  # find the first row at fault
+            for pos, value in enumerate(values):
+                try:
+                    parameter.check(value[None])
+                except ActuatorError as err:
+                    raise ActuatorError(
+                        err.detail, file=table.file, line=int(table.lines[pos]), column=column
+                    ) from None
+            raise
+        frame[parameter.name] = values
+    frame[actuator.pressure_column] = raw[actuator.pressure_column]
+    frame["angle_deg"] = raw[actuator.angle_column]
     frame["direction"] = "loading"  # a plain file records the loading branch
     pressure = frame[actuator.pressure_column].to_numpy()
-    if (pressure < 0).any():
-        pos = int(np.argmax(pressure < 0))
-        raise ActuatorError(
-            f"{path}, line {line_of[pos]}, column {actuator.pressure_column!r}: gauge pressures "
-            f"are >= 0 {actuator.pressure_unit}; got {pressure[pos]:g}."
-        )
-    for pos, row in enumerate(frame[list(actuator.names)].to_numpy()):
+    met = actuator.constraints_met(frame[list(actuator.names)].to_numpy())
+    if not met.all():
+        pos = int(np.argmin(met))
         try:
-            actuator.check_designs(row[None, :])
+            actuator.check_designs(frame[list(actuator.names)].to_numpy()[pos])
         except ActuatorError as err:
-            raise ActuatorError(f"{path}, line {line_of[pos]}: {err}") from None
+            raise ActuatorError(err.detail, file=table.file, line=int(table.lines[pos])) from None
     angles = np.abs(frame["angle_deg"].to_numpy())
     if angles.max() <= _RADIAN_MAX and pressure.max() > 0:
         message = (
-            f"{path}, column {actuator.angle_column!r}: the angles reach only {angles.max():.4g} "
-            "over the whole file; they look like radians: multiply by 180/π (57.2958) for degrees"
+            f"the angles reach only {angles.max():.4g} over the whole file; they look like "
+            "radians: multiply by 180/π (57.2958) for degrees"
         )
+        angle, file = actuator.angle_column, table.file
         if not force:
-            raise ActuatorError(message + " (or read them as given with --force).")
-        warnings.warn(message + "; read as given (force).", UserWarning, stacklevel=3)
-    return frame, metadata
+            raise ActuatorError(
+                message + " (or read them as given with --force)", key=angle, file=file
+            )
+        warning = ActuatorError(message, key=angle, file=file)
+        warnings.warn(f"{warning}; read as given (force).", UserWarning, stacklevel=3)
+    return frame, table.header
 
 
 def load_actuator_measurements(
@@ -297,8 +278,9 @@ def load_actuator_measurements(
     twice = designs.index[(designs > 1).any(axis=1)].tolist()
     if twice:
         raise ActuatorError(
-            f"The actuator {twice[0]!r} has two designs in {', '.join(map(str, files))}; "
-            "each built actuator has one (give the others their own ids)."
+            f"the actuator {twice[0]!r} has two designs in {', '.join(map(str, files))}; "
+            "each built actuator has one (give the others their own ids)",
+            key=ACTUATOR_COLUMN,
         )
     return ActuatorMeasurements(
         frame,
@@ -309,6 +291,6 @@ def load_actuator_measurements(
     )
 
 
-def is_actuator_measurements(data: Any) -> bool:
+def is_actuator_measurements(data: object) -> bool:
     """Whether ``data`` holds readings of a described actuator (not paper B's format)."""
     return isinstance(data, ActuatorMeasurements)

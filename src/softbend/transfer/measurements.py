@@ -85,10 +85,12 @@ from typing import Any
 import numpy as np
 import pandas as pd
 
-from softbend._io import read_header_csv, write_text_atomic
+from softbend._io import write_text_atomic
+from softbend._validation import must_be
 from softbend.design import FEATURE_QUANTITIES, FEATURES, PARAMETERS, SFRBADesign
-from softbend.errors import DatasetError
-from softbend.plausibility import check_plausible
+from softbend.errors import DatasetError, InputError, SoftbendError
+from softbend.plausibility import implausible_index, implausible_text
+from softbend.tables import Column, HeaderKey, Table, TableFormat, read_table
 
 logger = logging.getLogger(__name__)
 
@@ -221,12 +223,56 @@ def _metadata_problem(key: str, value: str) -> str | None:
         )
     kind, check = METADATA_KEYS[key]
     if not check(value):
-        return f"the metadata {key!r} must be {kind}. Got {value!r} instead"
+        return f"the metadata {key!r} must be {kind}; got {value!r}"
     return None
 
 
-# (owner, where): owner names the file or frame; where(pos) names a row ("line 7").
-_Where = Callable[[int], str]
+#: The measurement CSV as :mod:`softbend.tables` reads it: the columns with their
+#: units, kinds and plausible ranges, and the header keys of :data:`METADATA_KEYS`.
+MEASUREMENT_FORMAT = TableFormat(
+    name="measurement CSV",
+    columns=(
+        *(
+            Column(column, unit, quantity=_PLAUSIBLE[column])
+            for column, unit in zip(
+                _DESIGN_COLUMNS, ("mm", "mm", "mm", "mm", "deg", "mm"), strict=True
+            )
+        ),
+        Column("pressure_mpa", "MPa", quantity="pressure_mpa", low=0.0),
+        Column("angle_deg", "deg", quantity="angle_deg"),
+        Column("actuator_id", kind="text", required=False),
+        Column("cycle", kind="integer", required=False, low=1),
+        Column("direction", kind="choice", required=False, choices=DIRECTIONS),
+    ),
+    header=tuple(HeaderKey(key, kind, check) for key, (kind, check) in METADATA_KEYS.items()),
+    other_keys="error",
+    other_columns="error",
+)
+
+
+class _Rows:
+    """Where the rows being checked come from, for errors: a file's lines or a frame's labels."""
+
+    def __init__(
+        self, source: str, *, table: Table | None = None, index: pd.Index | None = None
+    ) -> None:
+        self.source = source
+        self.table = table
+        self.index = index
+
+    def where(self, pos: int) -> str:
+        """The row at position ``pos`` in words: ``line 7`` of a file, ``row 3`` of a frame."""
+        if self.table is not None:
+            return f"line {self.table.lines[pos]}"
+        label = self.index[pos] if self.index is not None else pos
+        return f"row {label}" if isinstance(label, numbers.Integral) else f"row {label!r}"
+
+    def error(self, message: str, pos: int | None, column: str | None) -> DatasetError:
+        """A :class:`DatasetError` about the row at ``pos`` and ``column`` (the key)."""
+        if self.table is not None:
+            return self.table.error(message, row=pos, column=column)
+        where = f"{self.where(pos)}: " if pos is not None else ""
+        return DatasetError(where + message, key=column, file=self.source or None)
 
 
 class _CellError(Exception):
@@ -234,13 +280,13 @@ class _CellError(Exception):
 
 
 # ------------------------------------------------------------------ cell checks
-def _is_missing(value: Any) -> bool:
+def _is_missing(value: object) -> bool:
     if value is None or value is pd.NA or value is pd.NaT:
         return True
     return isinstance(value, float) and math.isnan(value)
 
 
-def _got(value: Any) -> str:
+def _got(value: object) -> str:
     if isinstance(value, np.generic):
         value = value.item()  # np.float64(1.5) -> 1.5
     if _is_missing(value):
@@ -250,9 +296,9 @@ def _got(value: Any) -> str:
     return repr(value)
 
 
-def _to_float(value: Any) -> float:
+def _to_float(value: object) -> float:
     """``value`` as a finite float: a real number (not a bool) or a numeric string."""
-    message = f"must be a finite number. Got {_got(value)} instead."
+    message = f"must be a finite number; got {_got(value)}"
     if isinstance(value, str):
         try:
             number = float(value.strip())
@@ -267,9 +313,9 @@ def _to_float(value: Any) -> float:
     return number
 
 
-def _to_cycle(value: Any) -> int:
+def _to_cycle(value: object) -> int:
     """``value`` as an integer >= 1 (``2`` and ``2.0`` pass, ``2.5`` does not)."""
-    message = f"must be an integer >= 1. Got {_got(value)} instead."
+    message = f"must be an integer >= 1; got {_got(value)}"
     if isinstance(value, numbers.Integral) and not isinstance(value, bool | np.bool_):
         number = int(value)
     else:
@@ -285,39 +331,37 @@ def _to_cycle(value: Any) -> int:
     return number
 
 
-def _to_direction(value: Any) -> str:
+def _to_direction(value: object) -> str:
     text = value.strip() if isinstance(value, str) else None
     if text not in DIRECTIONS:
         allowed = ", ".join(repr(d) for d in DIRECTIONS)
-        raise _CellError(f"must be one of {allowed}. Got {_got(value)} instead.")
+        raise _CellError(f"must be one of {allowed}; got {_got(value)}")
     return text
 
 
-def _to_actuator_id(value: Any) -> str:
+def _to_actuator_id(value: object) -> str:
     """A non-empty single-line string; integers are accepted and written as text."""
     if isinstance(value, numbers.Integral) and not isinstance(value, bool | np.bool_):
         return str(int(value))
     text = value.strip() if isinstance(value, str) else ""
     if not text or "\n" in text or "\r" in text:
-        raise _CellError(
-            f"must be a non-empty text on one line (or an integer). Got {_got(value)} instead."
-        )
+        raise _CellError(f"must be a non-empty text on one line (or an integer); got {_got(value)}")
     return text
 
 
 def _convert(
-    values: np.ndarray, convert: Callable[[Any], Any], owner: str, where: _Where, column: str
+    values: np.ndarray, convert: Callable[[Any], Any], rows: _Rows, column: str
 ) -> list[Any]:
     out = []
     for pos, value in enumerate(values):
         try:
             out.append(convert(value))
         except _CellError as exc:
-            raise DatasetError(f"{owner}, {where(pos)}, column '{column}': {exc}") from None
+            raise rows.error(str(exc), pos, column) from None
     return out
 
 
-def _float_column(series: pd.Series, owner: str, where: _Where, column: str) -> np.ndarray:
+def _float_column(series: pd.Series, rows: _Rows, column: str) -> np.ndarray:
     """A column as finite float64 values, raising at the first bad cell."""
     dtype = series.dtype
     if pd.api.types.is_numeric_dtype(dtype) and not pd.api.types.is_bool_dtype(dtype):
@@ -326,36 +370,39 @@ def _float_column(series: pd.Series, owner: str, where: _Where, column: str) -> 
         if bad.size:
             pos = int(bad[0])
             raw = series.iloc[pos]
-            raise DatasetError(
-                f"{owner}, {where(pos)}, column '{column}': must be a finite number. "
-                f"Got {_got(raw)} instead."
-            )
+            raise rows.error(f"must be a finite number; got {_got(raw)}", pos, column)
         return values
     raw = series.to_numpy(dtype=object)
-    return np.array(_convert(raw, _to_float, owner, where, column), dtype=float)
+    return np.array(_convert(raw, _to_float, rows, column), dtype=float)
 
 
 # ---------------------------------------------------------------- frame checks
-def _check_columns(columns: list[Any], prefix: str) -> None:
+def _check_columns(columns: list[Any], source: str) -> None:
     """Raise unless ``columns`` holds each required column once and nothing unknown."""
-    allowed = ", ".join(_ALL_COLUMNS)
+    file = source or None
     duplicates = [c for i, c in enumerate(columns) if c in columns[:i]]
     if duplicates:
-        names = ", ".join(repr(c) for c in dict.fromkeys(duplicates))
-        raise DatasetError(f"{prefix}: duplicate column(s) {names}; each column may appear once.")
+        raise DatasetError(
+            "appears twice in the columns; each column may appear once",
+            key=str(duplicates[0]),
+            file=file,
+        )
     unknown = [c for c in columns if c not in _ALL_COLUMNS]
     if unknown:
-        names = ", ".join(repr(c) for c in unknown)
         raise DatasetError(
-            f"{prefix}: unknown column(s) {names}; the allowed columns are {allowed} "
-            "(names are case-sensitive)."
+            f"is not a column of the {MEASUREMENT_FORMAT.name}; the columns are "
+            f"{MEASUREMENT_FORMAT.columns_text()} (names are case-sensitive)",
+            key=str(unknown[0]),
+            file=file,
         )
     missing = [c for c in MEASUREMENT_COLUMNS if c not in columns]
     if missing:
         names = ", ".join(repr(c) for c in missing)
         raise DatasetError(
-            f"{prefix}: missing required column(s) {names}; the required columns are "
-            f"{', '.join(MEASUREMENT_COLUMNS)} (optional: {', '.join(OPTIONAL_COLUMNS)})."
+            f"missing required column(s) {names}; the required columns are "
+            f"{', '.join(MEASUREMENT_COLUMNS)} (optional: {', '.join(OPTIONAL_COLUMNS)})",
+            key=missing[0],
+            file=file,
         )
 
 
@@ -363,31 +410,23 @@ def _design_text(values: Iterable[float]) -> str:
     return ", ".join(f"{c}={float(v)!r}" for c, v in zip(_DESIGN_COLUMNS, values, strict=True))
 
 
-def _check_column_plausible(
-    values: np.ndarray, column: str, owner: str, where: _Where, lines: Sequence[int] | None
-) -> None:
+def _check_column_plausible(values: np.ndarray, column: str, rows: _Rows) -> None:
     """Raise :class:`DatasetError` at the first implausible value of a numeric column."""
-    locate = None if lines is not None else where  # a file: by line; a table: by row
-    check_plausible(
-        values, _PLAUSIBLE[column], source=owner, column=column, lines=lines, where=locate
-    )
+    pos = implausible_index(values, _PLAUSIBLE[column])
+    if pos is not None:
+        text = implausible_text(float(values[pos]), _PLAUSIBLE[column]) or "is not plausible"
+        raise rows.error(text, pos, column)
 
 
-def _normalize(
-    frame: Any, owner: str, where: _Where, lines: Sequence[int] | None = None
-) -> tuple[pd.DataFrame, dict[str, SFRBADesign]]:
+def _normalize(frame: object, rows: _Rows) -> tuple[pd.DataFrame, dict[str, SFRBADesign]]:
     """Check a table of measurements and return it in canonical form with its designs.
 
     Parameters
     ----------
     frame : pandas.DataFrame
         Required columns, optional columns or not; cells numbers or text.
-    owner : str
-        The file or frame the rows come from, first in every message.
-    where : callable
-        ``where(pos)`` names the row at position ``pos`` (``"line 7"``, ``"row 3"``).
-    lines : sequence of int, optional
-        The file line of each row, when the rows come from a file.
+    rows : _Rows
+        Where the rows come from (a file's lines or a frame's labels), for errors.
 
     Returns
     -------
@@ -398,24 +437,28 @@ def _normalize(
     """
     if not isinstance(frame, pd.DataFrame):
         raise DatasetError(
-            f"The 'frame' of {owner} must be a pandas DataFrame. "
-            f"Got {type(frame).__name__} instead."
+            must_be("a pandas DataFrame", type(frame).__name__),
+            key="frame",
+            file=rows.source or None,
         )
-    _check_columns(list(frame.columns), owner)
+    _check_columns(list(frame.columns), rows.source)
     n = len(frame)
     if n == 0:
-        raise DatasetError(f"{owner}: no data rows; at least one measurement is required.")
+        raise DatasetError(
+            "has no data rows; at least one measurement is required", file=rows.source or None
+        )
 
     data: dict[str, Any] = {}
     for column in MEASUREMENT_COLUMNS:
-        data[column] = _float_column(frame[column], owner, where, column)
-        _check_column_plausible(data[column], column, owner, where, lines)
+        data[column] = _float_column(frame[column], rows, column)
+        _check_column_plausible(data[column], column, rows)
     negative = np.flatnonzero(data["pressure_mpa"] < 0)
     if negative.size:
         pos = int(negative[0])
-        raise DatasetError(
-            f"{owner}, {where(pos)}, column 'pressure_mpa': must be a gauge pressure >= 0 MPa. "
-            f"Got {float(data['pressure_mpa'][pos])!r} instead."
+        raise rows.error(
+            f"must be a gauge pressure >= 0 MPa; got {float(data['pressure_mpa'][pos])!r}",
+            pos,
+            "pressure_mpa",
         )
 
     # Designs: check each distinct tuple once, at its first row.
@@ -427,20 +470,16 @@ def _normalize(
         try:
             design_of_code.append(SFRBADesign(*design_values[pos].tolist()))
         except ValueError as exc:
-            bad_column = next(
-                (
-                    c
-                    for p, c in zip(PARAMETERS, _DESIGN_COLUMNS, strict=True)
-                    if f"'{p}'" in str(exc)
-                ),
-                None,
-            )
-            at = f", column '{bad_column}'" if bad_column else ""
-            raise DatasetError(f"{owner}, {where(int(pos))}{at}: {exc}") from None
+            key = exc.key if isinstance(exc, SoftbendError) else None
+            if key is None:  # a check that names its parameters in the text
+                key = next((p for p in PARAMETERS if f"'{p}'" in str(exc)), None)
+            detail = exc.detail if isinstance(exc, SoftbendError) else str(exc)
+            text = f"{key} {detail}" if isinstance(exc, SoftbendError) and key else detail
+            raise rows.error(text, int(pos), _COLUMN_OF.get(key or "")) from None
 
     if "actuator_id" in frame.columns:
         raw = frame["actuator_id"].to_numpy(dtype=object)
-        ids = np.array(_convert(raw, _to_actuator_id, owner, where, "actuator_id"), dtype=object)
+        ids = np.array(_convert(raw, _to_actuator_id, rows, "actuator_id"), dtype=object)
         defaulted = False
     else:
         labels = np.array([str(d) for d in design_of_code], dtype=object)
@@ -461,11 +500,12 @@ def _normalize(
             if defaulted
             else ""
         )
-        raise DatasetError(
-            f"{owner}, {where(pos)}, column 'actuator_id': the actuator {ids[pos]!r} has the "
-            f"design ({_design_text(design_values[pos])}) here but "
-            f"({_design_text(design_values[first])}) on {where(first)}; one actuator_id "
-            f"must keep one design{hint}."
+        raise rows.error(
+            f"the actuator {ids[pos]!r} has the design ({_design_text(design_values[pos])}) "
+            f"here but ({_design_text(design_values[first])}) on {rows.where(first)}; one "
+            f"actuator_id must keep one design{hint}",
+            pos,
+            "actuator_id",
         )
     order = np.sort(first_of_id)
     designs = {str(ids[pos]): design_of_code[codes[pos]] for pos in order}
@@ -477,20 +517,17 @@ def _normalize(
             bad = np.flatnonzero(values < 1)
             if bad.size:
                 pos = int(bad[0])
-                raise DatasetError(
-                    f"{owner}, {where(pos)}, column 'cycle': must be an integer >= 1. "
-                    f"Got {int(values[pos])!r} instead."
-                )
+                raise rows.error(f"must be an integer >= 1; got {int(values[pos])!r}", pos, "cycle")
             cycle = values
         else:
             raw = series.to_numpy(dtype=object)
-            cycle = np.array(_convert(raw, _to_cycle, owner, where, "cycle"), dtype=np.int64)
+            cycle = np.array(_convert(raw, _to_cycle, rows, "cycle"), dtype=np.int64)
     else:
         cycle = np.ones(n, dtype=np.int64)
 
     if "direction" in frame.columns:
         raw = frame["direction"].to_numpy(dtype=object)
-        direction = np.array(_convert(raw, _to_direction, owner, where, "direction"), dtype=object)
+        direction = np.array(_convert(raw, _to_direction, rows, "direction"), dtype=object)
     else:
         direction = np.full(n, DIRECTIONS[0], dtype=object)
 
@@ -503,35 +540,32 @@ def _normalize(
     return pd.DataFrame(columns, columns=list(_ALL_COLUMNS)), designs
 
 
-def _check_metadata(metadata: Mapping[str, Any], owner: str) -> dict[str, str]:
+def _check_metadata(metadata: object) -> dict[str, str]:
     """A stripped ``{str: str}`` copy that a ``# key: value`` line writes and reads back."""
     if not isinstance(metadata, Mapping):
-        raise ValueError(
-            f"The 'metadata' of {owner} must be a mapping of text to text. "
-            f"Got {type(metadata).__name__} instead."
+        raise InputError(
+            must_be("a mapping of text to text", type(metadata).__name__), key="metadata"
         )
     out: dict[str, str] = {}
     for key, value in metadata.items():
         if not isinstance(key, str):
-            raise ValueError(f"The 'metadata' keys of {owner} must be text. Got {key!r} instead.")
+            raise InputError(must_be("text keys", key), key="metadata")
         name, text = key.strip(), str(value).strip()
         if not name or ":" in name or any(ch in name for ch in "\r\n"):
-            raise ValueError(
-                f"The 'metadata' keys of {owner} must be non-empty text on one line "
-                f"without ':'. Got {key!r} instead."
+            raise InputError(
+                must_be("keys of non-empty text on one line without ':'", key), key="metadata"
             )
         if any(ch in text for ch in "\r\n"):
-            raise ValueError(
-                f"The 'metadata' value {name!r} of {owner} must be text on one line. "
-                f"Got {value!r} instead."
+            raise InputError(
+                f"value {name!r} must be text on one line; got {value!r}", key="metadata"
             )
         if name in out:
-            raise ValueError(
-                f"The 'metadata' keys of {owner} must be unique after stripping. Got {key!r} twice."
+            raise InputError(
+                f"keys must be unique after stripping; got {key!r} twice", key="metadata"
             )
         problem = _metadata_problem(name, text)
         if problem is not None:  # what a file could not read back
-            raise ValueError(f"The 'metadata' of {owner}: {problem}.")
+            raise InputError(problem, key="metadata")
         out[name] = text
     return out
 
@@ -550,7 +584,7 @@ def _provenance_of(n: int, source: str, metadata: Mapping[str, str]) -> pd.DataF
 
 
 def _check_provenance(
-    provenance: Any, n: int, source: str, metadata: Mapping[str, str]
+    provenance: object, n: int, source: str, metadata: Mapping[str, str]
 ) -> pd.DataFrame:
     """The provenance table of ``n`` readings, checked and copied (default: one source)."""
     if provenance is None:
@@ -570,14 +604,6 @@ def _check_provenance(
     out = provenance.reset_index(drop=True).copy()
     out["synthetic"] = out["synthetic"].astype(bool)
     return out
-
-
-def _row_label(index: pd.Index) -> _Where:
-    def where(pos: int) -> str:
-        label = index[pos]
-        return f"row {label}" if isinstance(label, numbers.Integral) else f"row {label!r}"
-
-    return where
 
 
 # ---------------------------------------------------------------- Measurements
@@ -644,10 +670,9 @@ class Measurements:
             raise ValueError(
                 f"The 'source' of Measurements must be text. Got {type(source).__name__} instead."
             )
-        owner = source or "the Measurements frame"
-        where = _row_label(self.frame.index) if isinstance(self.frame, pd.DataFrame) else str
-        frame, designs = _normalize(self.frame, owner, where)
-        metadata = _check_metadata(self.metadata, "Measurements")
+        index = self.frame.index if isinstance(self.frame, pd.DataFrame) else None
+        frame, designs = _normalize(self.frame, _Rows(source, index=index))
+        metadata = _check_metadata(self.metadata)
         object.__setattr__(self, "source", source)
         object.__setattr__(self, "frame", frame)
         object.__setattr__(self, "metadata", metadata)
@@ -795,7 +820,7 @@ class Measurements:
 
 
 # --------------------------------------------------------------------- loading
-def _check_angle_unit(frame: pd.DataFrame, source: Path, lines: Sequence[int], force: bool) -> None:
+def _check_angle_unit(frame: pd.DataFrame, table: Table, force: bool) -> None:
     """Raise (or, with ``force``, warn) when the file's angles look like radians.
 
     The rule of the module docstring (Units): the pressures reach above
@@ -808,13 +833,17 @@ def _check_angle_unit(frame: pd.DataFrame, source: Path, lines: Sequence[int], f
         return
     pos = int(np.argmax(pressure))
     text = (
-        f"{source}, line {lines[pos]}, column 'angle_deg': the angles reach only "
-        f"{angle.max():.4g} while the pressure reaches {pressure[pos]:g} MPa; they look like "
-        "radians: multiply by 180/π (57.2958) for degrees"
+        f"the angles reach only {angle.max():.4g} while the pressure reaches "
+        f"{pressure[pos]:g} MPa; they look like radians: multiply by 180/π (57.2958) for degrees"
     )
+    error = table.error(text, row=pos, column="angle_deg")
     if not force:
-        raise DatasetError(f"{text}, or pass force=True (--force) to read them as degrees.")
-    warnings.warn(f"{text}; read as degrees as given (force).", UserWarning, stacklevel=3)
+        raise table.error(
+            f"{text}, or pass force=True (--force) to read them as degrees",
+            row=pos,
+            column="angle_deg",
+        )
+    warnings.warn(f"{error}; read as degrees as given (force).", UserWarning, stacklevel=3)
 
 
 def load_measurements(path: str | os.PathLike[str], *, force: bool = False) -> Measurements:
@@ -852,58 +881,10 @@ def load_measurements(path: str | os.PathLike[str], *, force: bool = False) -> M
         rows are parsed.
     """
     source = Path(path)
-    if not source.exists():
-        raise DatasetError(f"Measurement file not found: {source}.")
-    if source.is_dir():
-        raise DatasetError(f"{source} is a folder; a measurement CSV file is required.")
-    metadata: dict[str, str] = {}
-    metadata_line: dict[str, int] = {}
-    columns: list[str] | None = None
-    header_line = 0
-    rows: list[list[str]] = []
-    line_of_row: list[int] = []
-    for line in read_header_csv(source):
-        number = line.number
-        if line.kind == "meta":
-            key, value = line.key, line.value
-            if key in metadata:
-                raise DatasetError(
-                    f"{source}, line {number}: the metadata key {key!r} was already set "
-                    f"on line {metadata_line[key]}; each key may appear once."
-                )
-            problem = _metadata_problem(key, value)
-            if problem is not None:
-                raise DatasetError(f"{source}, line {number}: {problem}.")
-            metadata[key] = value
-            metadata_line[key] = number
-            continue
-        cells = list(line.cells)
-        if columns is None:
-            _check_columns(cells, f"{source}, line {number}")
-            columns, header_line = cells, number
-            continue
-        if len(cells) != len(columns):
-            raise DatasetError(
-                f"{source}, line {number}: {len(cells)} cells, but the header (line "
-                f"{header_line}) has {len(columns)} columns."
-            )
-        rows.append(cells)
-        line_of_row.append(number)
-
-    if columns is None:
-        raise DatasetError(
-            f"{source} has no header row: expected the columns {', '.join(MEASUREMENT_COLUMNS)} "
-            f"(optional: {', '.join(OPTIONAL_COLUMNS)})."
-        )
-    if not rows:
-        raise DatasetError(
-            f"{source}, line {header_line}: the header row is followed by no data rows."
-        )
-    raw = pd.DataFrame(rows, columns=columns, dtype=object)
-    frame, _ = _normalize(
-        raw, str(source), lambda pos: f"line {line_of_row[pos]}", lines=line_of_row
-    )
-    _check_angle_unit(frame, source, line_of_row, force)
+    table = read_table(source, MEASUREMENT_FORMAT)
+    frame, _ = _normalize(table.frame, _Rows(str(source), table=table))
+    _check_angle_unit(frame, table, force)
+    metadata = table.header
     measurements = Measurements(frame, metadata=metadata, source=str(source))
     logger.debug(
         "Loaded %d measurement(s) of %d actuator(s) from %s.",
