@@ -11,13 +11,13 @@ def test_bad_controller_is_one_line(capsys):
     code = main(["control", "simulate", "--out", "x", "--controller", "pid"])
     assert code == 2
     err = capsys.readouterr().err.strip().splitlines()
-    assert len(err) == 1 and "Unknown controller 'pid' (in --controller)" in err[0]
+    assert len(err) == 1 and "--controller: Unknown controller 'pid'" in err[0]
     assert "known: bang-bang, bang-bang-closed, pressure-pi, pressure-relay, predictive" in err[0]
 
 
 def test_bad_reference_is_one_line(capsys):
     assert main(["control", "simulate", "--out", "x", "--reference", "step:x"]) == 2
-    assert "'amplitude_deg' of reference step" in capsys.readouterr().err
+    assert "--reference: amplitude_deg of the step must be" in capsys.readouterr().err
 
 
 @pytest.mark.parametrize("controller", ["bang-bang", "pressure-pi"])
@@ -48,18 +48,21 @@ def test_simulate_writes_run(tmp_path, capsys, controller):
     [
         (
             ["run", "--rig", "usb"],
-            ["Unknown rig 'usb' (in --rig); known: sim, sim-realtime, modbus"],
+            ["--rig: Unknown rig 'usb'; known: sim, sim-realtime, modbus"],
         ),
-        (["run", "--rig", "modbus"], ["'--config' of softbend control run"]),
-        (["run", "--log-format", "xml"], ["'log_format'", "'parquet'"]),
-        (["run", "--period", "0.02", "--sensor-period", "0.01"], ["'sensor_period'"]),
-        (["run", "--duration", "-1"], ["'--duration' of softbend control run"]),
+        (["run", "--rig", "modbus"], ["--config: must name a rig TOML file"]),
+        (["run", "--log-format", "xml"], ["--log-format:", "'parquet'"]),
+        (["run", "--period", "0.02", "--sensor-period", "0.01"], ["--sensor-period:"]),
+        (["run", "--duration", "-1"], ["--duration: must be a number in (0, 86400]"]),
         (["run", "--rig", "modbus", "--config", "nope.toml"], ["does not exist"]),
         (["serve", "--config", "nope.toml"], ["does not exist"]),
-        (["serve", "--duration", "-2"], ["'duration'"]),
-        (["serve", "--port", "70000"], ["'--port' of softbend control serve"]),
-        (["simulate", "--plant", "lab", "--design", "160,10,4,4,15,12"], ["no measured"]),
-        (["simulate", "--plant", "fem", "--design", "0,6,2,2,5,8"], ["l_mm"]),
+        (["serve", "--duration", "-2"], ["--duration: must be a number in [0, inf)"]),
+        (["serve", "--port", "70000"], ["--port: must be an integer in [0, 65535]"]),
+        (
+            ["simulate", "--plant", "lab", "--design", "160,10,4,4,15,12"],
+            ["--plant: ", "has no measured loading curve"],
+        ),
+        (["simulate", "--plant", "fem", "--design", "0,6,2,2,5,8"], ["--design: l_mm"]),
     ],
 )
 def test_bad_input_of_every_control_command_is_one_line(tmp_path, capsys, args, needles):
@@ -77,7 +80,7 @@ def test_a_rig_config_with_an_unknown_key_is_one_line(tmp_path, capsys):
     config.write_text("[pressure]\nadress = 3\n")
     code = main(["control", "run", "--rig", "modbus", "--config", str(config), "--out", "o"])
     assert code == 2
-    assert "key 'adress' of [pressure]" in capsys.readouterr().err
+    assert f"{config}:2: pressure.adress: is not a key of [pressure]" in capsys.readouterr().err
 
 
 def test_rig_config_writes_a_template_that_loads_and_refuses_a_folder(tmp_path, capsys):

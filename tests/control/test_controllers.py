@@ -35,16 +35,18 @@ def test_bang_bang_samples_at_its_period_and_resets():
 
 
 def test_controller_validation():
-    with pytest.raises(ValueError, match="'mode' of BangBang must be one of 'hold', 'closed'"):
+    with pytest.raises(ValueError, match="mode: must be one of 'hold', 'closed'"):
         BangBang(angle_sensor, mode="open")
-    with pytest.raises(ValueError, match="'deadzone_fraction' of BangBang"):
-        BangBang(angle_sensor, deadzone_fraction=-0.1)
-    with pytest.raises(ValueError, match="'angle_table' of PressurePI"):
+    with pytest.raises(ValueError, match=r"deadzone: must be a number in \[0, 0.5\]"):
+        BangBang(angle_sensor, deadzone=-0.1)
+    with pytest.raises(ValueError, match="angle_table: must be an AngleTable"):
         PressurePI(angle_sensor)
+    with pytest.raises(ValueError, match="virtual_sensor: must be callable"):
+        BangBang(0.5)
 
 
 def test_pressure_pi_pwm_duty(table):
-    c = PressurePI(table, kp_per_mpa=10.0, ki_per_mpa_s=0.0, pwm_period_s=0.02)
+    c = PressurePI(table, kp=10.0, ki=0.0, pwm_period=0.02)
     target = table.inverse(90.0)
     # error 0.05 MPa -> u = 0.5 -> inlet open for 10 of 20 ms
     states = [c.step(target - 0.05, 90.0, i * 0.001).inlet for i in range(20)]

@@ -24,13 +24,13 @@ def test_parse_references():
 @pytest.mark.parametrize(
     ("spec", "message"),
     [
-        ("ramp:90", "'reference' kind must be one of 'step', 'square', 'triangle'"),
-        ("90", "'reference' must be one of"),
-        ("step:abc", "'amplitude_deg' of reference step must be a number"),
-        ("step:-5", "'amplitude_deg' of reference step must be a number in \\(0, 720\\]"),
-        ("square:90", "'reference' square takes 2–3 values"),
-        ("triangle:0:90", "'freq_hz' of reference triangle must be a number in \\(0, 50\\]"),
-        ("square:90:2:95", "'low_deg' of reference square must be below its 'amplitude_deg'"),
+        ("ramp:90", "reference: kind must be one of 'step', 'square', 'triangle'"),
+        ("90", "reference: must be one of"),
+        ("step:abc", "reference: amplitude_deg of the step must be a number"),
+        ("step:-5", "reference: amplitude_deg of the step must be a number in \\(0, 720\\]"),
+        ("square:90", "reference: square takes 2–3 values"),
+        ("triangle:0:90", "reference: freq_hz of the triangle must be a number in \\(0, 50\\]"),
+        ("square:90:2:95", "reference: low_deg of the square must be below its amplitude_deg"),
     ],
 )
 def test_parse_reference_errors_name_the_field(spec, message):

@@ -1,4 +1,4 @@
-"""A controller added from outside the package: one factory, one register call, used by the CLI."""
+"""A controller added from outside the package: one class, one register call, used by the CLI."""
 
 import json
 import math
@@ -6,38 +6,37 @@ import math
 import pytest
 
 from softbend.cli import main
-from softbend.control import CONTROLLERS
+from softbend.control import CONTROLLERS, ControllerModel
 from softbend.control.controllers import ValveCommand
+from softbend.parameters import Range, declare_ranges
 
 
+@declare_ranges(limit=Range(0.0, 0.5, "MPa", "the pressure to fill to: at most the supply"))
 class HoldPressure:
-    """A toy controller: fill up to ``limit_mpa`` and shut the valves, whatever θr says."""
+    """Fill to a fixed pressure and hold it (a test double).
 
-    def __init__(self, limit_mpa: float) -> None:
-        self.limit_mpa = limit_mpa
+    Parameters
+    ----------
+    model : ControllerModel
+        What the controller knows (unused: it watches the pressure only).
+    limit : float, default 0.03
+        Pressure to fill to, MPa gauge.
+    """
+
+    def __init__(self, model: ControllerModel, *, limit: float = 0.03) -> None:
+        self.limit = limit
         self.reset()
 
     def reset(self) -> None:
         self.predicted_deg = math.nan
 
     def step(self, measurement_mpa: float, reference_deg: float, t_s: float) -> ValveCommand:
-        return ValveCommand(measurement_mpa < self.limit_mpa, False)
-
-
-def make_hold(model, *, limit: float = 0.03) -> HoldPressure:
-    """Fill to a fixed pressure and hold it (a test double).
-
-    Parameters
-    ----------
-    limit : float, default 0.03
-        Pressure to fill to, MPa gauge.
-    """
-    return HoldPressure(limit)
+        return ValveCommand(measurement_mpa < self.limit, False)
 
 
 @pytest.fixture
 def toy():
-    CONTROLLERS.register("toy", make_hold)
+    CONTROLLERS.register("toy", HoldPressure)
     try:
         yield "toy"
     finally:
@@ -79,7 +78,7 @@ def test_the_registry_lists_the_toy_and_forgets_it(tmp_path, capsys, toy):
         code = main(["control", "simulate", "--out", str(tmp_path / "o"), "--controller", "toy"])
         assert code == 2 and "Unknown controller 'toy'" in capsys.readouterr().err
     finally:
-        CONTROLLERS.register("toy", make_hold)  # for the fixture's unregister
+        CONTROLLERS.register("toy", HoldPressure)  # for the fixture's unregister
 
 
 def test_a_toy_controller_from_a_rig_toml_runs_in_the_loop(tmp_path, capsys, toy):
@@ -91,3 +90,25 @@ def test_a_toy_controller_from_a_rig_toml_runs_in_the_loop(tmp_path, capsys, toy
     payload = json.loads(capsys.readouterr().out)
     assert payload["controller"] == "toy" and payload["controller_params"] == {"limit": 0.05}
     assert json.loads((out / "run.json").read_text())["controller_params"] == {"limit": 0.05}
+
+
+def test_its_declared_range_holds_set_values(tmp_path, capsys, toy):
+    args = ["control", "simulate", "--out", str(tmp_path / "o"), "--controller", toy]
+    assert main([*args, "--set", "limit=5"]) == 2
+    err = capsys.readouterr().err.strip()
+    assert err == "softbend: error: --set: limit: must be in [0, 0.5] MPa; got '5'"
+    assert main([*args, "--set", "limt=0.1"]) == 2
+    assert "--set: limt: is not a parameter; known: limit" in capsys.readouterr().err
+
+
+def test_a_factory_function_registers_the_same_way(tmp_path, capsys):
+    def make_hold(model, *, limit: float = 0.04):
+        """Fill to a fixed pressure (a factory)."""
+        return HoldPressure(model, limit=limit)
+
+    CONTROLLERS.register("toy-factory", make_hold)
+    try:
+        payload, _ = _simulate(tmp_path, capsys, "factory", "--controller", "toy-factory")
+        assert payload["controller_params"] == {"limit": 0.04}
+    finally:
+        CONTROLLERS.unregister("toy-factory")

@@ -61,5 +61,5 @@ def test_unregistered_names_are_one_line_listing_the_known(tmp_path, capsys):
     code = main(["control", "run", "--rig", "counting", "--out", str(tmp_path / "o")])
     assert code == 2
     err = capsys.readouterr().err.strip().splitlines()
-    assert err == ["softbend: error: Unknown rig 'counting' (in --rig); known: sim, sim-realtime, "
+    assert err == ["softbend: error: --rig: Unknown rig 'counting'; known: sim, sim-realtime, "
                    "modbus."]  # fmt: skip

@@ -185,9 +185,9 @@ def test_a_csv_log_is_streamed_while_the_run_goes(tmp_path, table):
 
 def test_bad_arguments_are_one_line(table):
     rig = SimulatedRig(table)
-    with pytest.raises(ValueError, match="'period_s' of run_loop"):
+    with pytest.raises(ValueError, match=r"^period_s: must be a number in \(0, 1\]"):
         run_loop(rig, BangBang(table), "step:90", 1.0, period_s=0)
-    with pytest.raises(ValueError, match=r"'log_path' of run_loop must end in \.csv"):
+    with pytest.raises(ValueError, match=r"^log_path: must be a file ending in \.csv"):
         run_loop(rig, BangBang(table), "step:90", 1.0, log_path="x.txt")
 
 

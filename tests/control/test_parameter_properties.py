@@ -72,7 +72,7 @@ def curves():
 def _one_line_naming(exc: BaseException, name: str) -> None:
     message = str(exc)
     assert "\n" not in message and message.strip() == message, message
-    assert f"'{name}'" in message, message
+    assert message.startswith(f"{name}: ") or f" {name}: " in message, message
 
 
 def _controller_names() -> list[tuple[str, str]]:
@@ -93,20 +93,20 @@ def test_set_values_are_checked_or_refused_in_one_line(
     text = data.draw(_values(declared))
     fuzz_counter["--set values"] += 1
     try:
-        texts = parse_assignments([f"{name}={text}"], "--set")
-        typed = controller_parameters(controller, texts, field="--set", from_text=True)
+        texts = parse_assignments([f"{name}={text}"])
+        typed = controller_parameters(controller, texts, from_text=True)
     except (ParameterValueError, UnknownParameterError) as exc:
         _one_line_naming(exc, name)
         assert exc.key == name
         return
     except ValueError as exc:  # parse_assignments: not NAME=VALUE
-        _one_line_naming(exc, "--set")
+        _one_line_naming(exc, "items")
         return
     value = typed[name]
     assert isinstance(value, float) and math.isfinite(value) and declared.contains(value)
     model = ControllerModel(table, table, RigParams())
     monkeypatch.setattr("softbend.control.predictive.PneumaticCurves", lambda params: curves)
-    build_controller(controller, model, {name: value}, field="--set")  # the class takes it
+    build_controller(controller, model, {name: value})  # the class takes it
 
 
 def test_a_text_value_is_read_by_kind_then_held_to_its_range(table):
@@ -132,10 +132,10 @@ def test_rig_param_values_are_checked_or_refused_in_one_line(fuzz_counter, name,
         checked = rig_settings([f"{name}={text}"])
     except (ParameterValueError, UnknownParameterError) as exc:
         _one_line_naming(exc, name)
-        assert exc.key == name
+        assert exc.key == "rig_assignments"
         return
     except ValueError as exc:  # not NAME=VALUE
-        _one_line_naming(exc, "--rig-param")
+        _one_line_naming(exc, "rig_assignments")
         return
     value = checked[name]
     assert declared.contains(value) and math.isfinite(value)

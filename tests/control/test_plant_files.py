@@ -59,7 +59,7 @@ def test_a_measurements_file_is_the_plant(own_readings):
 
 def test_an_unknown_plant_names_the_files_it_could_be():
     with pytest.raises(UnknownNameError, match="known: surrogate, fem, lab"):
-        plant_table("moon.txt", OWN, model_table=None, field="--plant")
+        plant_table("moon.txt", OWN, model_table=None)
 
 
 def test_control_simulate_on_the_lab_actuator(own_readings, tmp_path, capsys):

@@ -43,7 +43,7 @@ def test_a_loop_run_keeps_the_same_watch_on_where_its_model_holds():
     from softbend.control.runs import plan_loop
 
     with pytest.raises(ValueError, match=r"--strict.*0\.17 MPa"):
-        plan_loop(supply_mpa=0.2, strict=True, command="softbend control run")
+        plan_loop(supply_mpa=0.2, strict=True)
     plan = plan_loop(reference="step:295", duration_s=1.5, supply_mpa=0.2)
     with pytest.warns(UserWarning, match="past the 0.17 MPa"):
         high = plan.run()

@@ -74,7 +74,7 @@ def test_cli_plant_option(tmp_path, capsys):
     assert payload["plant"] == "lab" and payload["metrics"]["mape_pct"] > 8.0
     assert main(["control", "simulate", "--plant", "camera", "--out", str(out)]) == 2
     err = capsys.readouterr().err
-    assert "Unknown plant 'camera' (in --plant); known: surrogate, fem, lab." in err
+    assert "--plant: Unknown plant 'camera'; known: surrogate, fem, lab." in err
     assert len(err.strip().splitlines()) == 1
 
 
@@ -83,13 +83,13 @@ def test_plant_table_by_name():
     assert plant_table("surrogate", DESIGN, model) is model
     assert plant_table("fem", DESIGN, model)(0.1) == pytest.approx(fem_angle_table(DESIGN)(0.1))
     assert plant_table("lab", DESIGN, model)(0.1) == pytest.approx(lab_angle_table(DESIGN)(0.1))
-    with pytest.raises(ValueError, match=r"Unknown plant 'camera' \(in plant_table\); known: "):
+    with pytest.raises(ValueError, match=r"^plant: Unknown plant 'camera'; known: "):
         plant_table("camera", DESIGN, model)
 
 
 def test_serve_checks_its_plant(capsys):
     # --plant was once accepted by serve and ignored
     assert main(["control", "serve", "--plant", "camera", "--duration", "0.1"]) == 2
-    assert "Unknown plant 'camera' (in --plant); known: surrogate" in capsys.readouterr().err
+    assert "--plant: Unknown plant 'camera'; known: surrogate" in capsys.readouterr().err
     code = main(["control", "serve", "--plant", "lab", "--design", "160,10,4,4,15,12"])
     assert code == 2 and "no measured loading curve" in capsys.readouterr().err

@@ -89,10 +89,10 @@ def test_on_a_step_it_lands_with_one_pulse(table):
 
 @pytest.mark.parametrize(
     ("kwargs", "field"),
-    [({"observer_gain": 0.0}, "observer_gain"), ({"deadband_mpa": -1}, "deadband_mpa")],
+    [({"observer_gain": 0.0}, "observer_gain"), ({"deadband": -1}, "deadband")],
 )
 def test_bad_settings_are_one_error(table, kwargs, field):
-    with pytest.raises(ValueError, match=f"'{field}' of PredictivePulse"):
+    with pytest.raises(ValueError, match=f"^{field}: must be a number in "):
         PredictivePulse(table, **kwargs)
 
 

@@ -109,13 +109,11 @@ def test_sensor_quantised_and_seeded(table):
 
 
 def test_params_validation_names_field():
-    with pytest.raises(
-        ValueError, match=r"'valve_delay_s' of RigParams must be a number in \[0, 1\] s\. Got -1"
-    ):
+    with pytest.raises(ValueError, match=r"^valve_delay_s: must be a number in \[0, 1\] s; got -1"):
         RigParams(valve_delay_s=-1)
-    with pytest.raises(ValueError, match="'polytropic_exponent' of RigParams"):
+    with pytest.raises(ValueError, match=r"^polytropic_exponent: must be a number in"):
         RigParams(polytropic_exponent=2.0)
-    with pytest.raises(ValueError, match="'sensor_bits' of RigParams"):
+    with pytest.raises(ValueError, match=r"^sensor_bits: must be an integer in"):
         RigParams(sensor_bits=1.5)
 
 

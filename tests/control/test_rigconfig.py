@@ -45,18 +45,18 @@ def _write(tmp_path, text):
 @pytest.mark.parametrize(
     ("text", "needle"),
     [
-        ("[pressure]\naddress = 0\n[valvez]\n", "section 'valvez'"),
-        ("[pressure]\nadress = 0\n", "key 'adress' of [pressure]"),
+        ("[pressure]\naddress = 0\n[valvez]\n", ":3: [valvez]: is not a section"),
+        ("[pressure]\nadress = 0\n", ":2: pressure.adress: is not a key of [pressure]"),
         ("[connection]\nport = 5\n", "must have a [pressure] section"),
-        ('[pressure]\n[connection]\ntransport = "udp"\n', "'transport' of [connection]"),
-        ('[pressure]\n[connection]\ntransport = "rtu"\n', "'serial_port' of [connection]"),
-        ("[pressure]\nscale = 0\n", "'scale' of [pressure]"),
-        ("[pressure]\naddress = 70000\n", "'address' of [pressure]"),
+        ('[pressure]\n[connection]\ntransport = "udp"\n', ":3: connection.transport: must"),
+        ('[pressure]\n[connection]\ntransport = "rtu"\n', "connection.serial_port: must"),
+        ("[pressure]\nscale = 0\n", ":2: pressure.scale: must be a finite non-zero number"),
+        ("[pressure]\naddress = 70000\n", ":2: pressure.address: must be an integer in"),
         ("[pressure]\naddress = 1\n[angle]\naddress = 1\n", "must not share input register 1"),
-        ("[pressure]\n[valves]\ninlet_coil = 3\noutlet_coil = 3\n", "'outlet_coil' of [valves]"),
+        ("[pressure]\n[valves]\ninlet_coil = 3\noutlet_coil = 3\n", ":4: valves.outlet_coil:"),
         ("[pressure]\n[safety]\nmax_pressure_mpa = 0.7\n", "valid_min_mpa < max_pressure_mpa"),
-        ("[pressure]\n[loop]\nperiod_s = -0.01\n", "'period_s' of [loop]"),
-        ("[pressure]\n[connection]\ndevice_id = 300\n", "'device_id' of [connection]"),
+        ("[pressure]\n[loop]\nperiod_s = -0.01\n", ":3: loop.period_s: must be a number"),
+        ("[pressure]\n[connection]\ndevice_id = 300\n", ":3: connection.device_id: must"),
     ],
 )
 def test_bad_config_is_one_error_naming_the_field(tmp_path, text, needle):

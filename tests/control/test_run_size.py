@@ -42,20 +42,19 @@ def test_the_size_is_ticks_and_memory():
 
 @pytest.mark.parametrize("duration", [0.0, -1.0, 1e5, math.nan, math.inf])
 def test_a_duration_out_of_range_is_refused(duration):
-    with pytest.raises(ValueError, match=r"'--duration' of x must be a number in \(0, 86400\]"):
-        check_run_size(duration, 1e-3, 300, owner="x", duration_name="--duration")
+    with pytest.raises(ValueError, match=r"^duration_s: must be a number in \(0, 86400\]"):
+        check_run_size(duration, 1e-3, 300)
 
 
 def test_the_loop_ticks_limit_names_the_options(monkeypatch):
     monkeypatch.setenv("SOFTBEND_MAX_LOOP_TICKS", "500")
     with pytest.raises(LimitError) as info:
         check_run_size(
-            1.0, 1e-3, 300, what="A simulated run", duration_name="--duration",
-            step_name="--rig-param step_s", unit="rig steps", available_bytes=None,
-        )  # fmt: skip
+            1.0, 1e-3, 300, what="A simulated run", unit="rig steps", available_bytes=None
+        )
     message = str(info.value)
     assert message.startswith(
-        "A simulated run of 1 s (--duration) at a rig step of 0.001 s (--rig-param step_s) "
+        "duration_s: A simulated run of 1 s at a rig step of 0.001 s "
         "is 1,000 ticks, more than the limit of 500 ticks"
     )
     assert "SOFTBEND_MAX_LOOP_TICKS" in message
@@ -63,23 +62,23 @@ def test_the_loop_ticks_limit_names_the_options(monkeypatch):
 
 def test_a_run_that_would_not_fit_in_memory_is_refused():
     with pytest.raises(ValueError) as info:
-        check_run_size(
-            8000.0, 1e-3, 300, what="A loop run", duration_name="--duration",
-            step_name="--period", available_bytes=2**30,
-        )  # fmt: skip
+        check_run_size(8000.0, 1e-3, 300, what="A loop run", available_bytes=2**30)
     message = str(info.value)
+    assert message.startswith("duration_s: A loop run of 8000 s at a tick of 0.001 s logs")
     assert "logs 8,000,000 ticks: about 2.6 GiB of memory, more than the 1.0 GiB" in message
-    assert message.endswith("shorten --duration or lengthen --period.")
+    assert message.endswith("shorten the run or lengthen its tick")
 
 
 def test_the_library_functions_apply_the_same_limit(table, monkeypatch):
     monkeypatch.setenv("SOFTBEND_MAX_LOOP_TICKS", "100")
     rig = SimulatedRig(table, RigParams())
     with pytest.raises(
-        LimitError, match=r"A simulated run of 0\.2 s at a rig step of 0\.001 s is 200 ticks"
+        LimitError, match=r"^duration_s: A simulated run of 0\.2 s at a rig step of 0\.001 s is 200"
     ):
         simulate(rig, BangBang(table), "step:90", 0.2)
-    with pytest.raises(LimitError, match=r"A run of 0\.2 s at a period of 0\.001 s is 200 ticks"):
+    with pytest.raises(
+        LimitError, match=r"^duration_s: A run of 0\.2 s at a period of 0\.001 s is"
+    ):
         run_loop(rig, BangBang(table), "step:90", 0.2)
     assert simulate(rig, BangBang(table), "step:90", 0.1).t_s.size == 100
 
@@ -91,17 +90,17 @@ def test_both_commands_apply_loop_ticks_before_any_work(tmp_path, capsys, monkey
     args = ["control", command, "--out", str(tmp_path / "o"), "--duration", "2"]
     assert main([*args, "--model", str(tmp_path / "none.json")]) == 2
     line = one_error_line(capsys)
-    assert "(--duration)" in line and "SOFTBEND_MAX_LOOP_TICKS" in line
-    assert ("(--rig-param step_s)" if command == "simulate" else "(--period)") in line
+    assert "--duration: A " in line and "SOFTBEND_MAX_LOOP_TICKS" in line
+    assert ("at a rig step of 0.001 s" if command == "simulate" else "at a tick of 0.001") in line
     assert not (tmp_path / "o").exists()
 
 
 @pytest.mark.parametrize(
     ("args", "needles"),
     [
-        (["--duration", "80000"], ["80,000,000 ticks", "(--duration)", "(--rig-param step_s)"]),
-        (["--rig-param", "step_s=1e-9"], ["'step_s'", "[1e-05, 0.01] s", "'1e-9'"]),
-        (["--duration", "100000"], ["'--duration'", "(0, 86400]"]),
+        (["--duration", "80000"], ["--duration: ", "80,000,000 ticks", "rig step of 0.001 s"]),
+        (["--rig-param", "step_s=1e-9"], ["--rig-param: step_s: must be in [1e-05, 0.01] s"]),
+        (["--duration", "100000"], ["--duration: must be a number in (0, 86400]"]),
     ],
 )
 def test_simulate_refuses_a_run_too_large_in_one_line(tmp_path, capsys, args, needles):
@@ -120,7 +119,8 @@ def test_simulate_refuses_a_run_the_machine_has_no_memory_for(tmp_path, capsys, 
     assert main(args) == 2
     line = one_error_line(capsys)
     assert "logs 1,000,000 rig steps" in line and "more than the 0.5 GiB" in line
-    assert "shorten --duration or lengthen --rig-param step_s" in line
+    assert line.startswith("softbend: error: --duration: ")
+    assert "shorten the run or lengthen its rig step" in line
 
 
 def _peak_bytes(work) -> int:

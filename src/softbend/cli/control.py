@@ -35,17 +35,18 @@ def simulate_cmd(
     ),
     reference: str = opt.REFERENCE,
     controller: str = opt.CONTROLLER,
-    settings: list[str] = opt.SET,
+    assignments: list[str] = opt.SET,
     design: str = opt.DESIGN,
     model: Path = opt.MODEL,
     plant: str = opt.PLANT,
-    duration: float = typer.Option(
+    duration_s: float = typer.Option(
         10.0,
+        "--duration",
         help="Simulated time, s: in (0, 86400] and at most SOFTBEND_MAX_LOOP_TICKS rig steps "
         "(default 10 000 000: 10 000 s at the default step_s of 1 ms), each logged in memory.",
     ),
-    supply: float = opt.SUPPLY,
-    rig_params: list[str] = opt.RIG_PARAM,
+    supply_mpa: float = opt.SUPPLY,
+    rig_assignments: list[str] = opt.RIG_PARAM,
     seed: int = typer.Option(0, help="Seed of the sensor and camera noise."),
     strict: bool = opt.STRICT,
     as_json: bool = typer.Option(False, "--json", help="Print the metrics as JSON."),
@@ -82,17 +83,16 @@ def simulate_cmd(
     from softbend.control.runs import simulate_control
     from softbend.reports import control_figures
 
-    command = "softbend control simulate"
     _common.check_output_dir(out, "--out", files=_FILES)
     _common.check_replaceable_dir(out, "--out", "control simulate", files=_FILES, marker=_FILES[1])
     previous = control_run.terminate_as_interrupt()  # `kill`: staged results removed
     try:
         with _common.library_progress(enabled=not as_json):  # an FEM plant's sweep, if any
             result = simulate_control(
-                reference=reference, controller=controller, assignments=settings or (),
-                design=design, model=model, plant=plant, duration_s=duration,
-                supply_mpa=supply, rig_assignments=rig_params or (), seed=seed,
-                command=command, strict=strict,
+                reference=reference, controller=controller, assignments=assignments or (),
+                design=design, model=model, plant=plant, duration_s=duration_s,
+                supply_mpa=supply_mpa, rig_assignments=rig_assignments or (), seed=seed,
+                strict=strict,
             )  # fmt: skip
         payload = dict(result.summary)
         name, actuator = payload["controller"], payload["design"]
@@ -200,10 +200,12 @@ def serve_cmd(
     design: str = opt.DESIGN,
     model: Path = opt.MODEL,
     plant: str = opt.PLANT,
-    supply: float = opt.SUPPLY,
-    rig_params: list[str] = opt.RIG_PARAM,
+    supply_mpa: float = opt.SUPPLY,
+    rig_assignments: list[str] = opt.RIG_PARAM,
     seed: int = typer.Option(0, help="Seed of the sensor and camera noise."),
-    duration: float = typer.Option(0.0, help="Serve for this long, s (0: until Ctrl-C)."),
+    duration_s: float = typer.Option(
+        0.0, "--duration", help="Serve for this long, s (0: until Ctrl-C)."
+    ),
 ) -> None:
     """Serve the simulated rig as a Modbus TCP device.
 
@@ -223,12 +225,11 @@ def serve_cmd(
     from softbend.control.designs import DEFAULT_DESIGN
     from softbend.control.runs import simulated_server
 
-    command = "softbend control serve"
-    check_range(duration, "duration", low=0.0, low_inclusive=True)
+    duration = check_range(duration_s, "duration_s", low=0.0, low_inclusive=True)
     with _common.library_progress():  # an FEM plant's sweep, if any
         server = simulated_server(
             config=config, host=host, port=port, design=design, model=model, plant=plant,
-            supply_mpa=supply, rig_assignments=rig_params or (), seed=seed, command=command,
+            supply_mpa=supply_mpa, rig_assignments=rig_assignments or (), seed=seed,
         )  # fmt: skip
     previous = control_run.terminate_as_interrupt()  # `kill` stops it as Ctrl-C does
     try:
@@ -271,15 +272,14 @@ def rig_config_cmd(
         softbend control rig-config --out rig.toml --port 502
     """
     from softbend._io import write_text_atomic
+    from softbend._validation import must_be
     from softbend.control.rigconfig import rig_config_template
+    from softbend.errors import InputError
 
     if not 0 <= port <= 65535:
-        raise ValueError(
-            f"The '--port' of softbend control rig-config must be an integer in [0, 65535]. "
-            f"Got {port} instead."
-        )
+        raise InputError(must_be("an integer in [0, 65535]", port), key="port")
     if not host.strip():
-        raise ValueError("The '--host' of softbend control rig-config must not be empty.")
+        raise InputError(must_be("a host name or address", host), key="host")
     text = rig_config_template(host, port)
     _common.check_output_file(out, "--out")
     if out.exists() and not force:

@@ -59,6 +59,7 @@ RIG_PARAM = typer.Option(
 )
 SUPPLY = typer.Option(
     None,
+    "--supply",
     help="Supply pressure of the simulated rig, MPa gauge, whatever the model's pressure "
     "unit (default 0.2; the same as --rig-param supply_gauge_mpa).",
 )

@@ -5,12 +5,16 @@ from __future__ import annotations
 import signal
 import threading
 from pathlib import Path
-from typing import Any
+from types import FrameType
+from typing import TYPE_CHECKING, Any
 
 import typer
 
 from softbend.cli import _common
 from softbend.cli import control_options as opt
+
+if TYPE_CHECKING:
+    from softbend.control.setup import ControlSetup
 
 _LOG_FORMATS = ("csv", "parquet")
 #: What an earlier result in --out may hold (it is replaced as a whole).
@@ -38,24 +42,28 @@ def run_cmd(
     ),
     reference: str = opt.REFERENCE,
     controller: str = opt.CONTROLLER,
-    settings: list[str] = opt.SET,
+    assignments: list[str] = opt.SET,
     design: str = opt.DESIGN,
     model: Path = opt.MODEL,
     plant: str = opt.PLANT,
-    duration: float = typer.Option(
+    duration_s: float = typer.Option(
         10.0,
+        "--duration",
         help="Run time, s: in (0, 86400] and at most SOFTBEND_MAX_LOOP_TICKS ticks (default "
         "10 000 000: 10 000 s at the default 1 ms tick), each logged in memory.",
     ),
-    period: float = typer.Option(
-        None, help="Loop tick (controller, valves), s (default: the config's period_s, 0.001)."
-    ),
-    sensor_period: float = typer.Option(
+    period_s: float = typer.Option(
         None,
+        "--period",
+        help="Loop tick (controller, valves), s (default: the config's period_s, 0.001).",
+    ),
+    sensor_period_s: float = typer.Option(
+        None,
+        "--sensor-period",
         help="Pressure reading period, s (default: the config's sensor_period_s, 0.01: 100 Hz).",
     ),
-    supply: float = opt.SUPPLY,
-    rig_params: list[str] = opt.RIG_PARAM,
+    supply_mpa: float = opt.SUPPLY,
+    rig_assignments: list[str] = opt.RIG_PARAM,
     seed: int = typer.Option(0, help="Seed of a simulated rig's sensor and camera noise."),
     log_format: str = typer.Option("csv", help="Tick log format: csv (streamed) or parquet."),
     strict: bool = opt.STRICT,
@@ -93,7 +101,6 @@ def run_cmd(
     from softbend.control.runs import plan_loop
     from softbend.reports import control_figures
 
-    command = "softbend control run"
     check_choice(log_format, "log_format", _LOG_FORMATS)
     log_name = f"ticks.{log_format}"
     _common.check_output_dir(out, "--out", files=(log_name, "run.json", "run.png"))
@@ -103,9 +110,9 @@ def run_cmd(
     with _common.library_progress():  # an FEM plant's sweep, if any
         plan = plan_loop(
             rig=rig, config=config, reference=reference, controller=controller,
-            assignments=settings or (), design=design, model=model, plant=plant,
-            duration_s=duration, period_s=period, sensor_period_s=sensor_period,
-            supply_mpa=supply, rig_assignments=rig_params or (), seed=seed, command=command,
+            assignments=assignments or (), design=design, model=model, plant=plant,
+            duration_s=duration_s, period_s=period_s, sensor_period_s=sensor_period_s,
+            supply_mpa=supply_mpa, rig_assignments=rig_assignments or (), seed=seed,
             strict=strict,
         )  # fmt: skip
     done = [0]
@@ -163,7 +170,7 @@ def metric_rows(metrics: dict[str, Any], undefined: dict[str, str]) -> list[list
     ]
 
 
-def model_lines(setup: Any) -> tuple[str, list[list[Any]]]:
+def model_lines(setup: ControlSetup) -> tuple[str, list[list[Any]]]:
     """What a run's table says of its models: a note for the title and rows naming them.
 
     Nothing for the shipped MLP against a named plant (paper B's runs); one row when
@@ -190,7 +197,7 @@ def terminate_as_interrupt() -> Any:
     if threading.current_thread() is not threading.main_thread():
         return None
 
-    def interrupt(signum: int, frame: Any) -> None:
+    def interrupt(signum: int, frame: FrameType | None) -> None:
         raise KeyboardInterrupt
 
     return signal.signal(signal.SIGTERM, interrupt)

@@ -7,7 +7,7 @@
 - :mod:`softbend.control.experiments`: references, the loop and its metrics.
 
 Named extension points (:class:`softbend.registry.Registry`): :data:`CONTROLLERS`
-(controller factories, :mod:`softbend.control.factory`), :data:`PLANTS` (θ(p)
+(controller classes, :mod:`softbend.control.factory`), :data:`PLANTS` (θ(p)
 of the actuator, :mod:`softbend.control.plants`) and :data:`RIGS` (what the loop
 runs on, :mod:`softbend.control.rigs`). The names below are imported on first
 use, so ``import softbend.control`` stays light.
@@ -23,11 +23,12 @@ from softbend._lazy import export as _export
 _EXPORTS: dict[str, str] = {
     "CONTROLLERS": "factory",
     "DEFAULT_CONTROLLER": "factory",
-    "ControllerModel": "factory",
+    "ControllerModel": "controllers",
     "build_controller": "factory",
     "controller_parameters": "factory",
     "make_controller": "factory",
     "BangBang": "controllers",
+    "BangBangClosed": "controllers",
     "Controller": "controllers",
     "PressurePI": "controllers",
     "PressureRelay": "controllers",

@@ -2,37 +2,36 @@
 
 A controller class or :class:`~softbend.control.rig.RigParams` declares the
 range of each numeric parameter once (:func:`softbend.parameters.declare_ranges`);
-the registered factories and the settings of the simulated rig reuse those
-declarations (:func:`ranges_of`), and the constructors check their arguments
-against the same ones (:func:`check_declared`): one source of truth for
-``--set``, ``--rig-param``, a rig TOML and Python.
+the registry checks the values given by name against them
+(:func:`softbend.parameters.check_parameters`), and the constructors check their
+arguments against the same ones (:func:`check_declared`), in the wording of
+:mod:`softbend._validation`: one source of truth for ``--set``, ``--rig-param``,
+a rig TOML and Python.
 """
 
 from __future__ import annotations
 
 import math
 import numbers
-from collections.abc import Callable
-from typing import Any
 
-from softbend.parameters import Range, declared_ranges
+from softbend._validation import must_be
+from softbend.errors import InputError
+from softbend.parameters import Range
 
-__all__ = ["check_declared", "ranges_of"]
+__all__ = ["check_declared"]
 
 
 def check_declared(
-    value: Any, name: str, owner: str, declared: Range, *, integer: bool = False
-) -> Any:
+    value: object, name: str, declared: Range, *, integer: bool = False
+) -> float | int:
     """``value`` as a float (an int with ``integer``) when it lies in ``declared``.
 
     Parameters
     ----------
-    value : Any
+    value : object
         The value given.
     name : str
-        Its name, for the message (with its unit, e.g. ``"valve_delay_s"``).
-    owner : str
-        What it belongs to, for the message (``"RigParams"``).
+        Its key (with its unit, e.g. ``"valve_delay_s"``).
     declared : Range
         The declared range.
     integer : bool, default False
@@ -40,29 +39,16 @@ def check_declared(
 
     Raises
     ------
-    ValueError
-        One line naming the parameter, its range and the value: not a number
+    InputError
+        ``name: must be a number in [low, high] unit; got value``: not a number
         (a boolean is not one), not finite, or out of the range.
     """
     kind = "an integer" if integer else "a number"
-    message = (
-        f"The '{name}' of {owner} must be {kind} in {declared.describe()}. Got {value!r} instead."
-    )
+    error = InputError(must_be(f"{kind} in {declared.describe()}", value), key=name)
     wanted = numbers.Integral if integer else numbers.Real
     if isinstance(value, bool) or not isinstance(value, wanted):
-        raise ValueError(message)
-    number = int(value) if integer and isinstance(value, numbers.Integral) else float(value)
+        raise error
+    number = int(value) if integer and isinstance(value, numbers.Integral) else float(value)  # type: ignore[arg-type]
     if not (integer or math.isfinite(number)) or not declared.contains(number):
-        raise ValueError(message)
+        raise error
     return number
-
-
-def ranges_of(entry: Callable[..., Any], **names: str) -> dict[str, Range]:
-    """The declared ranges of ``entry``'s parameters under other names.
-
-    ``ranges_of(BangBang, deadzone="deadzone_fraction")`` is
-    ``{"deadzone": <the Range of BangBang's deadzone_fraction>}``: a factory
-    declares the ranges of the class it builds (:func:`declare_ranges`).
-    """
-    declared = declared_ranges(entry)
-    return {mine: declared[theirs] for mine, theirs in names.items()}

@@ -13,7 +13,7 @@ run is known from its duration and its step before anything runs. One function,
    the default 1 ms);
 3. the memory the run needs (its steps times the bytes logged per step, plus the
    interpreter and its libraries), against the memory the machine has left:
-   a run that would not fit is refused with one line naming the options,
+   a run that would not fit is refused with one line naming the duration,
    instead of ending in a ``MemoryError`` after minutes of work.
 
 The bytes per step were measured (``tracemalloc``, 1 000 000 steps) on the whole
@@ -27,6 +27,7 @@ import math
 from dataclasses import dataclass
 
 from softbend._validation import check_range
+from softbend.errors import InputError, keyed
 from softbend.limits import check_limit
 
 __all__ = [
@@ -75,12 +76,8 @@ def check_run_size(
     bytes_per_tick: int,
     *,
     what: str = "A run",
-    owner: str = "check_run_size",
-    duration_name: str = "duration_s",
-    step_name: str = "step_s",
     unit: str = "ticks",
     step_word: str | None = None,
-    name_options: bool = True,
     available_bytes: int | None = -1,
 ) -> RunSize:
     """Refuse, before it starts, a run too long for the limits or the memory.
@@ -96,19 +93,10 @@ def check_run_size(
         :data:`LOOP_BYTES_PER_TICK`).
     what : str
         The run, for messages (``"A simulated run"``).
-    owner : str
-        The command or function asking, for messages about a bad duration or step.
-    duration_name, step_name : str
-        The options or arguments that set the duration and the step, for
-        messages (``"--duration"``, ``"--rig-param step_s"``).
     unit : str
         What a logged row is called in messages (``"rig steps"``, ``"ticks"``).
     step_word : str, optional
         What the step is called in messages (default: ``unit`` in the singular).
-    name_options : bool, default True
-        Name ``duration_name`` and ``step_name`` after the values in messages
-        (``"of 20 s (--duration)"``); False for a library call that gave them as
-        arguments.
     available_bytes : int, optional
         The memory the run may use; default (-1): what the machine has left
         (:func:`softbend.identification.resources.available_memory_bytes`);
@@ -121,23 +109,23 @@ def check_run_size(
 
     Raises
     ------
-    ValueError
-        A duration or step out of range, or a run whose estimated memory exceeds
-        ``available_bytes`` (one line naming the options).
+    InputError
+        A duration or step out of range (key ``duration_s``, ``step_s``), or a
+        run whose estimated memory exceeds ``available_bytes`` (key ``duration_s``:
+        the one to shorten).
     LimitError
-        More rows than the ``loop_ticks`` limit (``SOFTBEND_MAX_LOOP_TICKS``).
+        More rows than the ``loop_ticks`` limit (``SOFTBEND_MAX_LOOP_TICKS``); key
+        ``duration_s``.
     """
     duration = check_range(
-        duration_s, duration_name, low=0.0, high=MAX_DURATION_S, high_inclusive=True
+        duration_s, "duration_s", low=0.0, high=MAX_DURATION_S, high_inclusive=True
     )
-    step = check_range(step_s, step_name, low=0.0)
+    step = check_range(step_s, "step_s", low=0.0)
     word = unit.removesuffix("s") if step_word is None else step_word
-    said = (
-        f"{what} of {duration:g} s{f' ({duration_name})' if name_options else ''} at a {word} "
-        f"of {step:g} s{f' ({step_name})' if name_options else ''}"
-    )
+    said = f"{what} of {duration:g} s at a {word} of {step:g} s"
     ratio = duration / step
-    check_limit("loop_ticks", round(ratio) if math.isfinite(ratio) else ratio, said)
+    with keyed("duration_s"):
+        check_limit("loop_ticks", round(ratio) if math.isfinite(ratio) else ratio, said)
     ticks = max(1, round(ratio))
     need = BASE_BYTES + ticks * int(bytes_per_tick)
     if available_bytes == -1:
@@ -145,9 +133,10 @@ def check_run_size(
 
         available_bytes = available_memory_bytes()
     if available_bytes is not None and need > available_bytes:
-        raise ValueError(
+        raise InputError(
             f"{said} logs {ticks:,} {unit}: about {need / _GIB:.1f} GiB of memory, more than "
-            f"the {available_bytes / _GIB:.1f} GiB this machine has left; shorten "
-            f"{duration_name} or lengthen {step_name}."
+            f"the {available_bytes / _GIB:.1f} GiB this machine has left; shorten the run "
+            f"or lengthen its {word}",
+            key="duration_s",
         )
     return RunSize(ticks=ticks, memory_bytes=need)

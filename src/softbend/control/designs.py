@@ -23,14 +23,13 @@ import numpy as np
 
 from softbend.actuators import SFRBA, Actuator
 from softbend.design import SFRBADesign
+from softbend.errors import InputError, keyed
 
 __all__ = [
     "DEFAULT_DESIGN",
     "ModelDesign",
     "actuator_of_design",
     "control_design",
-    "design_label",
-    "mpa_to_model",
 ]
 
 #: The actuator of paper B's control experiments (l, r, t, b, phi, lc in mm and degrees).
@@ -87,21 +86,10 @@ def actuator_of_design(design: SFRBADesign | ModelDesign) -> Actuator:
     return design.actuator if isinstance(design, ModelDesign) else SFRBA
 
 
-def mpa_to_model(design: SFRBADesign | ModelDesign) -> float:
-    """Factor from MPa to the pressure unit of the model of ``design`` (1 for paper B's)."""
-    return design.pressure_scale if isinstance(design, ModelDesign) else 1.0
-
-
-def design_label(design: SFRBADesign | ModelDesign) -> str:
-    """The design as a run's record names it: ``100,6,2,2,5,8`` or ``A=1, B=2 mm, ...``."""
-    return str(design)
-
-
 def control_design(
     design: str | SFRBADesign | ModelDesign | Sequence[float] | None,
     actuator: Actuator,
     *,
-    field: str = "--design",
     source: str = "the model",
 ) -> SFRBADesign | ModelDesign:
     """``design`` as a design of ``actuator``, checked against its description.
@@ -116,16 +104,14 @@ def control_design(
         default design.
     actuator : Actuator
         The description of the controller's model.
-    field : str
-        The option the design came from, for messages.
     source : str
         What the description belongs to (``"the model m.json"``), for messages.
 
     Raises
     ------
-    ValueError
+    InputError
         A design that is not one of ``actuator`` (the message names its parameters),
-        or none given for an actuator other than paper B's.
+        or none given for an actuator other than paper B's; its key is ``design``.
     """
     if actuator == SFRBA:
         if design is None:
@@ -136,27 +122,32 @@ def control_design(
             return SFRBADesign.from_sequence(design.codes.tolist())
         if isinstance(design, str):
             if "=" in design:
-                codes = actuator.parse_design(design, field=field)
+                with keyed("design"):
+                    codes = actuator.parse_design(design)
                 return SFRBADesign.from_sequence(codes.tolist())
             return SFRBADesign.parse(design)
         return SFRBADesign.from_sequence([float(v) for v in design])
     if design is None:
-        raise ValueError(
-            f"The '{field}' must be given for {source}, of the actuator {actuator.name} "
-            f"({', '.join(actuator.names)}): {actuator.design_hint()}."
+        raise InputError(
+            f"must be given for {source}, of the actuator {actuator.name} "
+            f"({', '.join(actuator.names)}): {actuator.design_hint()}",
+            key="design",
         )
     if isinstance(design, SFRBADesign):
-        raise ValueError(
-            f"The '{field}' is a design of paper B's actuator, but {source} is of the actuator "
-            f"{actuator.name}; give {actuator.design_hint()}."
+        raise InputError(
+            f"is a design of paper B's actuator, but {source} is of the actuator "
+            f"{actuator.name}; give {actuator.design_hint()}",
+            key="design",
         )
     if isinstance(design, ModelDesign):
         if design.actuator.names != actuator.names:
-            raise ValueError(
-                f"The '{field}' is a design of the actuator {design.actuator.name}, but "
-                f"{source} is of {actuator.name} ({', '.join(actuator.names)})."
+            raise InputError(
+                f"is a design of the actuator {design.actuator.name}, but "
+                f"{source} is of {actuator.name} ({', '.join(actuator.names)})",
+                key="design",
             )
         return ModelDesign(actuator, design.codes)
     if isinstance(design, str):
-        return ModelDesign(actuator, actuator.parse_design(design, field=field))
+        with keyed("design"):
+            return ModelDesign(actuator, actuator.parse_design(design))
     return ModelDesign(actuator, np.asarray(design, dtype=float))

@@ -22,11 +22,16 @@ import math
 import time
 from array import array
 from dataclasses import dataclass, field, replace
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
-from softbend._validation import check_range
+from softbend._validation import check_range, interval_text, must_be
+from softbend.errors import InputError
+
+if TYPE_CHECKING:
+    from softbend.control.controllers import Controller
+    from softbend.control.rig import SimulatedRig
 
 __all__ = [
     "ControlRun",
@@ -69,10 +74,17 @@ class Reference:
 _USAGE = "step:AMP[:T0_S], square:AMP:PERIOD_S[:LOW] or triangle:FREQ_HZ:AMP[:LOW]"
 
 
-def parse_reference(spec: str) -> Reference:
-    """Parse a reference spec (see the module doc); errors name the field and its allowed values."""
+def parse_reference(reference: str) -> Reference:
+    """Parse a reference spec (see the module doc); errors name the field and its allowed values.
+
+    Raises
+    ------
+    InputError
+        Key ``reference``; the message names the value at fault (``amplitude_deg``, ...).
+    """
+    spec = reference
     if not isinstance(spec, str) or ":" not in spec:
-        raise ValueError(f"The 'reference' must be one of {_USAGE}. Got {spec!r} instead.")
+        raise InputError(must_be(f"one of {_USAGE}", spec), key="reference")
     kind, *parts = spec.strip().split(":")
     kind = kind.strip().lower()
     names = {
@@ -81,18 +93,18 @@ def parse_reference(spec: str) -> Reference:
         "triangle": (("freq_hz", "amplitude_deg", "low_deg"), 2),
     }
     if kind not in names:
-        raise ValueError(
-            f"The 'reference' kind must be one of 'step', 'square', 'triangle' ({_USAGE}). "
-            f"Got {kind!r} instead."
+        raise InputError(
+            f"kind must be one of 'step', 'square', 'triangle' ({_USAGE}); got {kind!r}",
+            key="reference",
         )
     fields_, required = names[kind]
     if not required <= len(parts) <= len(fields_):
-        raise ValueError(
-            f"The 'reference' {kind} takes {required}–{len(fields_)} values "
-            f"({':'.join(f.upper() for f in fields_)}). Got {len(parts)} in {spec!r} instead."
+        raise InputError(
+            f"{kind} takes {required}–{len(fields_)} values "
+            f"({':'.join(f.upper() for f in fields_)}); got {len(parts)} in {spec!r}",
+            key="reference",
         )
     values: dict[str, float] = {}
-    owner = f"reference {kind}"
     bounds = {
         "amplitude_deg": (0.0, 720.0, False),
         "low_deg": (0.0, 720.0, True),
@@ -101,24 +113,23 @@ def parse_reference(spec: str) -> Reference:
         "freq_hz": (0.0, 50.0, False),
     }
     for name, text in zip(fields_, parts, strict=False):
-        try:
-            number = float(text)
-        except ValueError:
-            low, high, inclusive = bounds[name]
-            bracket = "[" if inclusive else "("
-            raise ValueError(
-                f"The '{name}' of {owner} must be a number in {bracket}{low:g}, {high:g}]. "
-                f"Got {text!r} instead."
-            ) from None
         low, high, inclusive = bounds[name]
-        values[name] = check_range(
-            number, name, low=low, high=high, low_inclusive=inclusive, high_inclusive=True
-        )
+        interval = interval_text(low, high, low_inclusive=inclusive, high_inclusive=True)
+        try:
+            values[name] = check_range(
+                float(text), name, low=low, high=high, low_inclusive=inclusive, high_inclusive=True
+            )
+        except (ValueError, InputError):
+            raise InputError(
+                f"{name} of the {kind} {must_be(f'a number in {interval}', text)}",
+                key="reference",
+            ) from None
     low = values.get("low_deg", 0.0)
     if low >= values["amplitude_deg"]:
-        raise ValueError(
-            f"The 'low_deg' of {owner} must be below its 'amplitude_deg'. "
-            f"Got low_deg={low:g} and amplitude_deg={values['amplitude_deg']:g} instead."
+        raise InputError(
+            f"low_deg of the {kind} must be below its amplitude_deg; got low_deg={low:g} and "
+            f"amplitude_deg={values['amplitude_deg']:g}",
+            key="reference",
         )
     if kind == "step":
         return Reference(
@@ -215,8 +226,8 @@ def _bucket_extreme(values: np.ndarray, width: int, largest: bool) -> np.ndarray
 
 
 def simulate(
-    rig: Any,
-    controller: Any,
+    rig: SimulatedRig,
+    controller: Controller,
     reference: Reference | str,
     duration_s: float,
     *,
@@ -240,10 +251,8 @@ def simulate(
     ref = parse_reference(reference) if isinstance(reference, str) else reference
     h = rig.step_s
     n = check_run_size(
-        duration_s, h, SIMULATE_BYTES_PER_STEP, what="A simulated run", owner="simulate",
-        duration_name="duration_s", step_name="the rig's step_s", unit="rig steps",
-        name_options=False,
-    ).ticks  # fmt: skip
+        duration_s, h, SIMULATE_BYTES_PER_STEP, what="A simulated run", unit="rig steps"
+    ).ticks
     sensor_every = max(1, round(check_range(sensor_period_s, "sensor_period_s", low=0.0) / h))
     # The log is kept in preallocated arrays of machine numbers (8 bytes a value, 1 a
     # valve state), not lists of Python floats (32): a long run's memory is known in

@@ -19,9 +19,10 @@ from __future__ import annotations
 import hashlib
 import json
 import os
+from collections.abc import Callable
 from dataclasses import dataclass
 from pathlib import Path
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
@@ -29,6 +30,9 @@ from softbend._io import json_text, write_text_atomic
 from softbend._progress import report
 from softbend.control.rig import AngleTable, cavity_compliance_mm3_per_mpa
 from softbend.design import SFRBADesign
+
+if TYPE_CHECKING:
+    from softbend.fem.options import FEMOptions
 
 __all__ = ["FEMCurve", "cache_dir", "fem_curve"]
 
@@ -111,13 +115,17 @@ class FEMCurve:
         return curve
 
 
-def _key(design: SFRBADesign, options: Any) -> str:
+def _key(design: SFRBADesign, options: FEMOptions) -> str:
     described = json_text({"design": design.as_dict(), "options": options.to_dict()}, indent=None)
     return hashlib.sha256(described.encode()).hexdigest()[:16]
 
 
 def fem_curve(
-    design: SFRBADesign, options: Any = None, *, progress: Any = None, cache: bool = True
+    design: SFRBADesign,
+    options: FEMOptions | None = None,
+    *,
+    progress: Callable[[float, float, float], None] | None = None,
+    cache: bool = True,
 ) -> FEMCurve:
     """The FEM sweep of ``design`` up to 0.5 MPa: from the cache, else solved and kept.
 

@@ -44,18 +44,23 @@ import gc
 import math
 import os
 from array import array
+from collections.abc import Callable
 from dataclasses import dataclass, field
 from pathlib import Path
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
 from softbend._io import atomic_file
-from softbend._validation import check_int, check_range
+from softbend._validation import check_int, check_range, must_be
 from softbend.control.budget import LOOP_BYTES_PER_TICK, check_run_size
 from softbend.control.experiments import ControlRun, Reference, parse_reference, run_metrics
 from softbend.control.rigconfig import SafetyLimits
-from softbend.errors import RigError
+from softbend.errors import InputError, RigError
+
+if TYPE_CHECKING:
+    from softbend.control.controllers import Controller
+    from softbend.control.rig import Rig
 
 __all__ = ["COLUMNS", "LoopRun", "run_loop"]
 
@@ -246,7 +251,7 @@ class _Log:
         return frame
 
 
-def _cell(value: Any) -> str:
+def _cell(value: object) -> str:
     if isinstance(value, bool):
         return "1" if value else "0"
     if isinstance(value, float):
@@ -256,8 +261,8 @@ def _cell(value: Any) -> str:
 
 
 def run_loop(
-    rig: Any,
-    controller: Any,
+    rig: Rig,
+    controller: Controller,
     reference: Reference | str,
     duration_s: float,
     *,
@@ -266,7 +271,7 @@ def run_loop(
     limits: SafetyLimits | None = None,
     log_path: str | os.PathLike[str] | None = None,
     flush_every: int = 1000,
-    progress: Any = None,
+    progress: Callable[[int, int], None] | None = None,
 ) -> LoopRun:
     """Run ``controller`` on ``rig`` at a fixed period for ``duration_s``, safely.
 
@@ -316,16 +321,13 @@ def run_loop(
         low_inclusive=True, high_inclusive=True,
     )  # fmt: skip
     n = check_run_size(
-        duration_s, period, LOOP_BYTES_PER_TICK, what="A run", owner="run_loop",
-        duration_name="duration_s", step_name="period_s", step_word="period", name_options=False,
-    ).ticks  # fmt: skip
+        duration_s, period, LOOP_BYTES_PER_TICK, what="A run", step_word="period"
+    ).ticks
     flush = check_int(flush_every, "flush_every", low=1)
     limits = SafetyLimits() if limits is None else limits
     path = None if log_path is None else Path(log_path)
     if path is not None and path.suffix.lower() not in (".csv", ".parquet"):
-        raise ValueError(
-            f"The 'log_path' of run_loop must end in .csv or .parquet. Got {str(path)!r} instead."
-        )
+        raise InputError(must_be("a file ending in .csv or .parquet", str(path)), key="log_path")
     sensor_every = max(1, round(sensor / period))
     log = _Log(path, flush)
     controller.reset()
@@ -454,9 +456,9 @@ def _row(
     actual: float,
     reading: float,
     ref: Reference,
-    controller: Any,
+    controller: Controller,
     state: tuple[bool, bool],
-    rig: Any,
+    rig: Rig,
     status: str,
 ) -> tuple:
     theta_r = float(ref.values(np.array([target]))[0])

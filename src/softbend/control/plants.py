@@ -23,14 +23,21 @@ from __future__ import annotations
 
 from collections.abc import Callable
 from pathlib import Path
-from typing import Any, cast
+from typing import TYPE_CHECKING, cast
 
 import numpy as np
 
 from softbend.control.designs import ModelDesign, actuator_of_design, control_design
 from softbend.control.rig import AngleTable
 from softbend.design import SFRBADesign
+from softbend.errors import InputError
 from softbend.registry import Registry, UnknownNameError
+
+if TYPE_CHECKING:
+    import pandas as pd
+
+    from softbend.surrogates.persistence import SavedSurrogate
+    from softbend.transfer.measurements import Measurements
 
 __all__ = [
     "PAPER_B_PLANTS",
@@ -61,38 +68,38 @@ def plant_file(name: str) -> Path | None:
     return path if path.suffix.lower() in (".json", ".csv") and path.is_file() else None
 
 
-def check_plant(name: str, *, field: str = "plant") -> str:
-    """``name`` if it names a plant: a name of :data:`PLANTS` or a plant file.
+def check_plant(plant: str) -> str:
+    """``plant`` if it names a plant: a name of :data:`PLANTS` or a plant file.
 
     Raises
     ------
     UnknownNameError
         Neither (the message lists the names and says a file may be given).
     """
-    if plant_file(name) is None:
+    if plant_file(plant) is None:
         try:
-            PLANTS.check(name, field=field)
+            PLANTS.check(plant)
         except UnknownNameError as exc:
             raise UnknownNameError(
-                f"{exc} A plant may also be the path of a saved surrogate (.json) or of "
-                "measurements (.csv)."
+                f"{exc.detail} A plant may also be the path of a saved surrogate (.json) or of "
+                "measurements (.csv).",
+                key="plant",
             ) from None
-    return name
+    return plant
 
 
 def plant_table(
-    name: str,
+    plant: str,
     design: SFRBADesign | ModelDesign,
     model_table: AngleTable,
     *,
-    field: str = "plant_table",
     pmax_mpa: float = 0.5,
 ) -> AngleTable:
-    """The plant ``name`` of ``design``: a name of :data:`PLANTS`, or a plant file.
+    """The plant ``plant`` of ``design``: a name of :data:`PLANTS`, or a plant file.
 
     Parameters
     ----------
-    name : str
+    plant : str
         A name of :data:`PLANTS` (``model_table`` for "surrogate"), the path of a
         saved surrogate (``.json``: its θ(p) for ``design``) or of a measurements
         CSV (``.csv``: the design's loading readings, smoothed as
@@ -104,22 +111,21 @@ def plant_table(
         that takes such a design; ``fem``, ``lab`` and a CSV are refused).
     model_table : AngleTable
         θ(p) of the controllers' own model.
-    field : str
-        Where ``name`` came from, for the message (``"--plant"``).
     pmax_mpa : float, default 0.5
         The top of a saved surrogate's table, MPa gauge.
     """
-    path = plant_file(name)
+    path = plant_file(plant)
     if isinstance(design, ModelDesign) and (
-        name in PAPER_B_PLANTS or (path is not None and path.suffix.lower() == ".csv")
+        plant in PAPER_B_PLANTS or (path is not None and path.suffix.lower() == ".csv")
     ):
-        raise ValueError(
-            f"The plant {name!r} (in {field}) is of paper B's actuator only; the design "
+        raise InputError(
+            f"{plant!r} is of paper B's actuator only; the design "
             f"{design} is of the actuator {design.actuator.name}: use the plant 'surrogate' "
-            "(the controller's model) or a saved surrogate .json of that actuator."
+            "(the controller's model) or a saved surrogate .json of that actuator",
+            key="plant",
         )
     if path is None:
-        factory = PLANTS.get(check_plant(name, field=field), field=field)
+        factory = PLANTS.get(check_plant(plant))
         # paper B's plants were refused above for another actuator's design; a registered
         # one receives the design the controller's model takes
         return factory(cast(SFRBADesign, design), model_table)
@@ -127,7 +133,7 @@ def plant_table(
         from softbend.surrogates.persistence import load_surrogate
 
         saved = load_surrogate(path)
-        own = control_design(design, saved.actuator, field="design", source=f"the plant {path}")
+        own = control_design(design, saved.actuator, source=f"the plant {path}")
         return AngleTable.from_surrogate(saved.model, own, pmax_mpa=pmax_mpa)
     from softbend.transfer.measurements import load_measurements
 
@@ -164,7 +170,7 @@ def fem_plant(design: SFRBADesign, model_table: AngleTable) -> AngleTable:
 
 
 def support_warnings(
-    saved: Any,
+    saved: SavedSurrogate,
     design: SFRBADesign | ModelDesign,
     up_to_mpa: float,
     *,
@@ -208,7 +214,7 @@ def support_warnings(
     if not isinstance(record, dict):
         return None, None, None
     actuator = getattr(saved, "actuator", actuator_of_design(design))
-    own = control_design(design, actuator, field="design", source=role)
+    own = control_design(design, actuator, source=role)
     with using_features(actuator.features):
         support = Support.from_dict(record)
     if isinstance(own, SFRBADesign):
@@ -257,7 +263,10 @@ def shipped_angle_table(
 
 
 def fem_angle_table(
-    design: SFRBADesign, pmax_mpa: float = 0.5, points: int = 501, data: Any = None
+    design: SFRBADesign,
+    pmax_mpa: float = 0.5,
+    points: int = 501,
+    data: pd.DataFrame | None = None,
 ) -> AngleTable:
     """θ(p) of ``design`` from its FEM sweep in the shipped Table 1 dataset: a plant unlike the MLP.
 
@@ -289,9 +298,10 @@ def fem_angle_table(
         allowed = "; ".join(
             f"{k} in {', '.join(f'{v:g}' for v in vals)}" for k, vals in levels.items()
         )
-        raise ValueError(
-            f"The design {design} is not in the FEM dataset (Table 1: {allowed}); use a "
-            "surrogate plant for it."
+        raise InputError(
+            f"{design} is not in the FEM dataset (Table 1: {allowed}); use a surrogate plant "
+            "for it",
+            key="design",
         )
     p = rows["pressure_mpa"].to_numpy(dtype=float)
     a = rows["angle_deg"].to_numpy(dtype=float)
@@ -312,7 +322,7 @@ def lab_angle_table(
     design: SFRBADesign,
     pmax_mpa: float = 0.5,
     points: int = 501,
-    measurements: Any = None,
+    measurements: Measurements | None = None,
     degree: int = 3,
     source: str = "the virtual lab",
 ) -> AngleTable:
@@ -349,10 +359,10 @@ def lab_angle_table(
     if len(rows) <= degree:
         designs = data[columns].drop_duplicates().to_numpy()
         known = ", ".join(",".join(f"{v:g}" for v in row) for row in designs)
-        raise ValueError(
-            f"The design {design} has no measured loading curve in {source} (fewer than "
-            f"{degree + 1} readings; measured designs: {known}); use the 'surrogate' or 'fem' "
-            "plant for it."
+        raise InputError(
+            f"has no measured loading curve in {source} (fewer than {degree + 1} readings; "
+            f"measured designs: {known}); use the 'surrogate' or 'fem' plant for {design}",
+            key="design",
         )
     p = rows["pressure_mpa"].to_numpy(dtype=float)
     coef = np.polynomial.polynomial.polyfit(p, rows["angle_deg"].to_numpy(dtype=float), degree)

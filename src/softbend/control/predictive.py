@@ -25,11 +25,11 @@ but decides, at every call (the loop's 1 ms tick), on a *prediction*:
   A valve that is open is closed as soon as ``p_δ`` reaches ``p*`` (less half
   of one tick's change, so the closing error is centred); with the valves shut,
   the inlet (outlet) opens when ``p* − p_δ`` is above (below minus) the
-  ``deadband_mpa``. Over the prediction horizon this is the time-optimal pulse
+  ``deadband``. Over the prediction horizon this is the time-optimal pulse
   to ``p*`` with at most one switch on and one off per move, which is what the
   cost ``|θ(p) − θr|`` with a price on switching asks of two on/off valves.
 - **Preview.** The controller sees θr only now; on a ramp it extrapolates it by
-  ``preview_s`` (default: the valve delay plus the angle's time constant, the
+  ``preview`` (default: the valve delay plus the angle's time constant, the
   delay of a ramp through both) from the slope of the reference over its last
   calls, so the pressure leads as it must. A jump (a step or square edge) is
   not extrapolated.
@@ -44,7 +44,7 @@ from __future__ import annotations
 
 import math
 from bisect import bisect_left
-from typing import Any
+from collections.abc import Callable
 
 from softbend.control._ranges import check_declared
 from softbend.control.controllers import (
@@ -52,11 +52,13 @@ from softbend.control.controllers import (
     _FILL,
     _VENT,
     PRESSURE_BAND_RANGE,
+    ControllerModel,
     ValveCommand,
     _PressureTarget,
 )
 from softbend.control.rig import (
     GAS_CONSTANT_J_KG_K,
+    AngleTable,
     RigParams,
     chamber_pressure_rate_pa_s,
     iso6358_mass_flow_kg_s,
@@ -161,7 +163,12 @@ def curve_step_s(params: RigParams) -> float:
 
 
 def _integrate(
-    start_pa: float, stop_pa: float, inlet: bool, rate: Any, h: float, atm: float
+    start_pa: float,
+    stop_pa: float,
+    inlet: bool,
+    rate: Callable[[float, bool], float],
+    h: float,
+    atm: float,
 ) -> tuple[list[float], list[float]]:
     """RK4 from ``start_pa`` until ``stop_pa`` is passed; (times s, gauge MPa), every 5th step."""
     t, p = 0.0, start_pa
@@ -196,75 +203,75 @@ def _interp(xs: list[float], ys: list[float], x: float) -> float:
 
 
 @declare_ranges(
-    deadband_mpa=PRESSURE_BAND_RANGE,
+    deadband=PRESSURE_BAND_RANGE,
     observer_gain=Range(
         0.0, 1.0, "",
         "weight of a new sample against the prediction: 0 would ignore the sensor, 1 trusts "
         "each sample alone",
         low_inclusive=False,
     ),
-    preview_s=Range(
+    preview=Range(
         0.0, 2.0, "s",
         "how far a ramping reference is extrapolated: at most the longest valve delay (1 s) "
         "plus the longest angle lag (1 s) of the simulated rig",
     ),
-    tick_s=Range(
+    tick=Range(
         1e-5, 0.1, "s",
         "the period the controller is called at: from the rig's finest step (1e-5 s) to "
         "0.1 s, beyond which a pulse cannot be timed within a move",
     ),
 )  # fmt: skip
 class PredictivePulse(_PressureTarget):
-    """Model-predictive pulses of the valves toward ``p* = θ⁻¹(θr)`` (see the module doc).
+    """Model-predictive pulses of the valves toward θ⁻¹(θr), timed by a model of the pneumatics.
+
+    See the module's documentation.
 
     Parameters
     ----------
-    angle_table : AngleTable
-        θ(p) of the controlled actuator (the surrogate), inverted on its rising branch.
+    angle_table : ControllerModel or AngleTable
+        θ(p) of the controlled actuator (the surrogate), inverted on its rising
+        branch; a :class:`~softbend.control.controllers.ControllerModel` gives
+        its ``rig`` as ``params`` too.
     params : RigParams, optional
         The rig model (default :class:`RigParams`); its ``valve_delay_s`` is the
         prediction horizon.
-    deadband_mpa : float, default 0.002
-        Four times the default sensor noise: no pulse for a smaller error (on a
-        ramp, the size of the pulses: a trade of tracking error for switches;
-        on the default rig 0.0015 gives triangle MAPE 2.3 % with 302 switches,
-        0.002 2.85 % with 224).
+    deadband : float, default 0.002
+        Pressure error without a pulse, MPa: four times the default sensor
+        noise (on a ramp, the size of the pulses: a trade of tracking error for
+        switches; on the default rig 0.0015 gives triangle MAPE 2.3 % with 302
+        switches, 0.002 2.85 % with 224).
     observer_gain : float, default 0.3
         Weight of a new sample against the prediction, in (0, 1].
-    preview_s : float, optional
+    preview : float, optional
         How far a ramping reference is extrapolated, s (default
-        ``valve_delay_s + angle_time_constant_s`` of ``params``).
-    tick_s : float, default 0.001
+        ``valve_delay_s + angle_time_constant_s`` of ``params``; recorded as null).
+    tick : float, default 0.001
         The period the controller is called at (the loop's tick), s.
     """
 
     def __init__(
         self,
-        angle_table: Any,
+        angle_table: ControllerModel | AngleTable,
         params: RigParams | None = None,
         *,
-        deadband_mpa: float = 0.002,
+        deadband: float = 0.002,
         observer_gain: float = 0.3,
-        preview_s: float | None = None,
-        tick_s: float = 0.001,
+        preview: float | None = None,
+        tick: float = 0.001,
     ) -> None:
-        owner = "PredictivePulse"
-        super().__init__(angle_table, owner)
+        if params is None and isinstance(angle_table, ControllerModel):
+            params = angle_table.rig
+        super().__init__(angle_table)
         self.params = RigParams() if params is None else params
         ranges = declared_ranges(PredictivePulse)
-        self.deadband_mpa = check_declared(
-            deadband_mpa, "deadband_mpa", owner, ranges["deadband_mpa"]
-        )
-        self.observer_gain = check_declared(
-            observer_gain, "observer_gain", owner, ranges["observer_gain"]
-        )
-        self.tick_s = check_declared(tick_s, "tick_s", owner, ranges["tick_s"])
+        self.deadband = check_declared(deadband, "deadband", ranges["deadband"])
+        self.observer_gain = check_declared(observer_gain, "observer_gain", ranges["observer_gain"])
+        self.tick = check_declared(tick, "tick", ranges["tick"])
         self.delay_s = self.params.valve_delay_s
         default_preview = self.delay_s + self.params.angle_time_constant_s
-        self.preview_s = check_declared(
-            default_preview if preview_s is None else preview_s,
-            "preview_s", owner, ranges["preview_s"],
-        )  # fmt: skip
+        self.preview = check_declared(
+            default_preview if preview is None else preview, "preview", ranges["preview"]
+        )
         self.curves = PneumaticCurves(self.params)
         self.reset()
 
@@ -295,7 +302,7 @@ class PredictivePulse(_PressureTarget):
         return after(p, t1 - t0, state), state
 
     def _preview(self, reference_deg: float, t_s: float) -> float:
-        """The reference's change over ``preview_s`` on a ramp; 0 after a jump or at rest."""
+        """The reference's change over ``preview`` on a ramp; 0 after a jump or at rest."""
         dt = t_s - self._prev_ref_t
         if dt > 0.0:
             change = reference_deg - self._prev_ref
@@ -305,7 +312,7 @@ class PredictivePulse(_PressureTarget):
             self._prev_ref, self._prev_ref_t = reference_deg, t_s
         elif self._prev_ref != self._prev_ref:
             self._prev_ref, self._prev_ref_t = reference_deg, t_s
-        return self._slope * self.preview_s
+        return self._slope * self.preview
 
     def step(self, measurement_mpa: float, reference_deg: float, t_s: float) -> ValveCommand:
         # retire the commands that have acted
@@ -327,18 +334,18 @@ class PredictivePulse(_PressureTarget):
         ahead, _ = self._propagate(self._estimate, t_s, t_s + self.delay_s)
         command = self._command
         if command is _FILL:
-            gain = self.curves.after(ahead, self.tick_s, _FILL) - ahead
+            gain = self.curves.after(ahead, self.tick, _FILL) - ahead
             if ahead + 0.5 * gain >= target:
                 command = _CLOSED
         elif command is _VENT:
-            loss = ahead - self.curves.after(ahead, self.tick_s, _VENT)
+            loss = ahead - self.curves.after(ahead, self.tick, _VENT)
             if ahead - 0.5 * loss <= target:
                 command = _CLOSED
         if command is _CLOSED:
             error = target - ahead
-            if error > self.deadband_mpa:
+            if error > self.deadband:
                 command = _FILL
-            elif error < -self.deadband_mpa:
+            elif error < -self.deadband:
                 command = _VENT
         if command is not self._command:
             self._command = command

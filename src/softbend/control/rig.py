@@ -44,15 +44,21 @@ import random
 from bisect import bisect_right
 from collections.abc import Callable
 from dataclasses import dataclass, fields, replace
-from typing import Any, Protocol, runtime_checkable
+from typing import TYPE_CHECKING, Any, Protocol, runtime_checkable
 
 import numpy as np
+from numpy.typing import ArrayLike
 
 from softbend._validation import check_int, check_range
 from softbend.control._ranges import check_declared
 from softbend.design import SFRBADesign
 from softbend.parameters import Range, declare_ranges
 from softbend.plausibility import RANGES as PLAUSIBLE
+
+if TYPE_CHECKING:
+    from softbend.control.designs import ModelDesign
+    from softbend.models import BendingModel, SweepResult
+    from softbend.surrogates.protocol import Surrogate
 
 __all__ = [
     "ANR_DENSITY_KG_M3",
@@ -151,7 +157,7 @@ def chamber_pressure_rate_pa_s(
 
 
 def cavity_compliance_mm3_per_mpa(
-    pressures_mpa: Any, volume_rates_mm3_per_mpa: Any, up_to_mpa: float
+    pressures_mpa: ArrayLike, volume_rates_mm3_per_mpa: ArrayLike, up_to_mpa: float
 ) -> float:
     """The slope k of ``V(p) ≈ V0 + k·p`` fitted to an FEM sweep's cavity volume, mm³/MPa.
 
@@ -176,8 +182,6 @@ def cavity_compliance_mm3_per_mpa(
     q, v = p[inside], volume[inside]
     return float(np.dot(q, v) / np.dot(q, q))
 
-
-_OWNER = "RigParams"
 
 #: The range of each field of :class:`RigParams` (declared on it; ``--rig-param``, a rig
 #: TOML's [simulation] table and RigParams itself are held to them).
@@ -300,13 +304,14 @@ class RigParams:
     def __post_init__(self) -> None:
         for f in fields(self):
             value = check_declared(
-                getattr(self, f.name), f.name, _OWNER, RIG_RANGES[f.name],
-                integer=f.name == "sensor_bits",
+                getattr(self, f.name), f.name, RIG_RANGES[f.name], integer=f.name == "sensor_bits",
             )  # fmt: skip
             object.__setattr__(self, f.name, value)
 
     @classmethod
-    def from_fem_sweep(cls, result: Any, *, tubing_mm3: float = 2000.0, **kwargs: Any) -> RigParams:
+    def from_fem_sweep(
+        cls, result: SweepResult, *, tubing_mm3: float = 2000.0, **kwargs: Any
+    ) -> RigParams:
         """Parameters whose chamber is the FEM's: ``V0`` of the design, ``dV/dp`` of its sweep.
 
         ``result`` is a :class:`softbend.models.SweepResult` of the FEM (its
@@ -332,7 +337,7 @@ class RigParams:
         cls, design: SFRBADesign, *, tubing_mm3: float = 2000.0, **kwargs: Any
     ) -> RigParams:
         """Parameters with ``volume_mm3`` = ½·π·r²·l of ``design`` plus ``tubing_mm3``."""
-        tubing = check_declared(tubing_mm3, "tubing_mm3", "RigParams.for_design", TUBING_RANGE)
+        tubing = check_declared(tubing_mm3, "tubing_mm3", TUBING_RANGE)
         volume = design.cavity_volume_mm3 + tubing
         declared = RIG_RANGES["volume_mm3"]
         if not declared.contains(volume):
@@ -408,7 +413,11 @@ class AngleTable:
 
     @classmethod
     def from_surrogate(
-        cls, model: Any, design: Any, pmax_mpa: float = 0.5, points: int = 501
+        cls,
+        model: Surrogate,
+        design: SFRBADesign | ModelDesign,
+        pmax_mpa: float = 0.5,
+        points: int = 501,
     ) -> AngleTable:
         """Tabulate a fitted surrogate (``.predict`` on the rows ``design.feature_rows(p)``).
 
@@ -423,7 +432,7 @@ class AngleTable:
 
     @classmethod
     def from_bending_model(
-        cls, model: Any, design: SFRBADesign, pmax_mpa: float = 0.5, points: int = 101
+        cls, model: BendingModel, design: SFRBADesign, pmax_mpa: float = 0.5, points: int = 101
     ) -> AngleTable:
         """Tabulate a :class:`softbend.models.BendingModel` by one sweep (converged at every p)."""
         p = np.round(np.linspace(0.0, pmax_mpa, points), 12)

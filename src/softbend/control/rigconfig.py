@@ -74,15 +74,16 @@ import datetime
 import inspect
 import math
 import re
-from collections.abc import Mapping
+from collections.abc import Iterator, Mapping
+from contextlib import contextmanager
 from dataclasses import dataclass, field, fields
 from pathlib import Path
 from typing import Any
 
 from softbend._io import read_input_text
 from softbend._tomltext import parse_toml
-from softbend._validation import check_choice, check_int, check_range, short_repr
-from softbend.errors import DatasetError
+from softbend._validation import check_choice, check_int, check_range, must_be, short_repr
+from softbend.errors import DatasetError, InputError, SoftbendError, keyed
 from softbend.plausibility import RANGES, implausible_index
 
 __all__ = [
@@ -98,8 +99,6 @@ __all__ = [
     "rig_config_template",
     "simulation_settings_entry",
 ]
-
-_OWNER = "rig config"
 
 #: The tubing volume between the inlet valve and the actuator, mm³ (:meth:`RigParams.for_design`).
 DEFAULT_TUBING_MM3 = 2000.0
@@ -121,34 +120,28 @@ class ConnectionConfig:
     retries: int = 0
 
     def __post_init__(self) -> None:
-        owner = f"[connection] of the {_OWNER}"
         check_choice(self.transport, "transport", ("tcp", "rtu"))
         check_choice(self.parity, "parity", ("N", "E", "O"))
         check_choice(self.stopbits, "stopbits", (1, 2))
-        check_int(self.port, "port", low=0)
-        if self.port > 65535:
-            raise ValueError(
-                f"The 'port' of {owner} must be an integer in [0, 65535]. "
-                f"Got {self.port!r} instead."
-            )
+        _check_integer(self.port, "port", 0xFFFF)
         check_int(self.baudrate, "baudrate", low=1)
         check_int(self.retries, "retries", low=0)
-        device = check_int(self.device_id, "device_id", low=0)
-        if device > 247:
-            raise ValueError(
-                f"The 'device_id' of {owner} must be an integer in [0, 247]. "
-                f"Got {self.device_id!r} instead."
-            )
+        _check_integer(self.device_id, "device_id", 247)
         check_range(self.timeout_s, "timeout_s", low=0.0, high=10.0, high_inclusive=True)
         if self.transport == "tcp" and not (isinstance(self.host, str) and self.host.strip()):
-            raise ValueError(
-                f"The 'host' of {owner} must name the rig (e.g. '192.168.0.10') when transport "
-                f"is 'tcp'. Got {self.host!r} instead."
+            raise InputError(
+                must_be(
+                    "the rig's address (e.g. '192.168.0.10') when transport is 'tcp'", self.host
+                ),
+                key="host",
             )
         if self.transport == "rtu" and not self.serial_port:
-            raise ValueError(
-                f"The 'serial_port' of {owner} must name a serial device (e.g. "
-                "'/dev/ttyUSB0') when transport is 'rtu'. Got nothing instead."
+            raise InputError(
+                must_be(
+                    "a serial device (e.g. '/dev/ttyUSB0') when transport is 'rtu'",
+                    self.serial_port,
+                ),
+                key="serial_port",
             )
 
     @property
@@ -172,26 +165,27 @@ class RegisterConfig:
     section: str = field(default="pressure", compare=False)
 
     def __post_init__(self) -> None:
-        owner = f"[{self.section}] of the {_OWNER}"
         check_choice(self.table, "table", ("input", "holding"))
-        _check_address(self.address, "address", owner)
+        _check_integer(self.address, "address", 0xFFFF)
         if self.counter_address is not None:
-            _check_address(self.counter_address, "counter_address", owner)
+            _check_integer(self.counter_address, "counter_address", 0xFFFF)
             if self.counter_address == self.address:
-                raise ValueError(
-                    f"The 'counter_address' of {owner} must differ from its 'address' "
-                    f"({self.address}). Got {self.counter_address} instead."
+                raise InputError(
+                    must_be(
+                        f"another register than the address ({self.address})", self.counter_address
+                    ),
+                    key="counter_address",
                 )
         if not isinstance(self.signed, bool):
-            raise ValueError(
-                f"The 'signed' of {owner} must be true or false. Got {self.signed!r} instead."
-            )
-        if isinstance(self.scale, bool) or not isinstance(self.scale, int | float):
-            raise ValueError(f"The 'scale' of {owner} must be a number. Got {self.scale!r}.")
-        if not math.isfinite(self.scale) or self.scale == 0.0:
-            raise ValueError(
-                f"The 'scale' of {owner} must be a finite non-zero number. Got {self.scale!r}."
-            )
+            raise InputError(must_be("true or false", self.signed), key="signed")
+        scale = self.scale
+        if (
+            isinstance(scale, bool)
+            or not isinstance(scale, int | float)
+            or not math.isfinite(scale)
+            or scale == 0.0
+        ):
+            raise InputError(must_be("a finite non-zero number", scale), key="scale")
         check_range(self.offset, "offset", low=-1e9, high=1e9)
 
     def decode(self, count: int) -> float:
@@ -216,13 +210,12 @@ class ValveConfig:
     outlet_coil: int = 1
 
     def __post_init__(self) -> None:
-        owner = f"[valves] of the {_OWNER}"
-        _check_address(self.inlet_coil, "inlet_coil", owner)
-        _check_address(self.outlet_coil, "outlet_coil", owner)
+        _check_integer(self.inlet_coil, "inlet_coil", 0xFFFF)
+        _check_integer(self.outlet_coil, "outlet_coil", 0xFFFF)
         if self.inlet_coil == self.outlet_coil:
-            raise ValueError(
-                f"The 'outlet_coil' of {owner} must differ from its 'inlet_coil' "
-                f"({self.inlet_coil}). Got {self.outlet_coil} instead."
+            raise InputError(
+                must_be(f"another coil than the inlet_coil ({self.inlet_coil})", self.outlet_coil),
+                key="outlet_coil",
             )
 
 
@@ -249,15 +242,15 @@ class SafetyLimits:
     max_missed_reads: int = 3
 
     def __post_init__(self) -> None:
-        owner = f"[safety] of the {_OWNER}"
         check_range(self.max_pressure_mpa, "max_pressure_mpa", low=0.0, high=10.0)
         check_range(self.valid_min_mpa, "valid_min_mpa", low=-10.0, high=10.0)
         check_range(self.valid_max_mpa, "valid_max_mpa", low=-10.0, high=10.0)
         if not self.valid_min_mpa < self.max_pressure_mpa < self.valid_max_mpa:
-            raise ValueError(
-                f"The limits of {owner} must satisfy valid_min_mpa < max_pressure_mpa < "
-                f"valid_max_mpa. Got {self.valid_min_mpa:g}, {self.max_pressure_mpa:g}, "
-                f"{self.valid_max_mpa:g} instead."
+            raise InputError(
+                f"must lie between valid_min_mpa and valid_max_mpa (valid_min_mpa < "
+                f"max_pressure_mpa < valid_max_mpa); got {self.valid_min_mpa:g}, "
+                f"{self.max_pressure_mpa:g}, {self.valid_max_mpa:g}",
+                key="max_pressure_mpa",
             )
         check_range(self.stale_after_s, "stale_after_s", low=0.0, high=60.0)
         check_int(self.max_missed_reads, "max_missed_reads", low=1)
@@ -282,10 +275,10 @@ class ControllerConfig:
     def __post_init__(self) -> None:
         from softbend.control.factory import CONTROLLERS, controller_parameters
 
-        where = f"[controller] of the {_OWNER}"
-        CONTROLLERS.check(self.name, field=f"the 'name' of {where}")
+        with keyed("name"):
+            CONTROLLERS.check(self.name)
         given = dict(self.params)
-        checked = controller_parameters(self.name, given, field=where)
+        checked = controller_parameters(self.name, given)
         object.__setattr__(self, "params", tuple((k, checked[k]) for k in given))
 
     def as_dict(self) -> dict[str, Any]:
@@ -317,28 +310,28 @@ class RigConfig:
 
     def __post_init__(self) -> None:
         given = dict(self.simulation)
-        checked = check_simulation_settings(given, f"[simulation] of the {_OWNER}")
+        checked = check_simulation_settings(given)
         object.__setattr__(self, "simulation", tuple((k, checked[k]) for k in given))
         check_range(self.period_s, "period_s", low=0.0, high=1.0, high_inclusive=True)
         check_range(
             self.sensor_period_s, "sensor_period_s", low=self.period_s, high=10.0,
             low_inclusive=True, high_inclusive=True,
         )  # fmt: skip
-        used = {(self.pressure.table, self.pressure.address): "[pressure] address"}
+        used = {(self.pressure.table, self.pressure.address): "pressure.address"}
         others = []
         if self.pressure.counter_address is not None:
             others.append(
-                ((self.pressure.table, self.pressure.counter_address), "[pressure] counter_address")
+                ((self.pressure.table, self.pressure.counter_address), "pressure.counter_address")
             )
         if self.angle is not None:
-            others.append(((self.angle.table, self.angle.address), "[angle] address"))
-        for key, name in others:
-            if key in used:
-                raise ValueError(
-                    f"The {name} of the {_OWNER} must not share {key[0]} register {key[1]} "
-                    f"with the {used[key]}."
+            others.append(((self.angle.table, self.angle.address), "angle.address"))
+        for register, name in others:
+            if register in used:
+                raise InputError(
+                    f"must not share {register[0]} register {register[1]} with {used[register]}",
+                    key=name,
                 )
-            used[key] = name
+            used[register] = name
 
     @classmethod
     def from_dict(
@@ -358,77 +351,91 @@ class RigConfig:
         Raises
         ------
         DatasetError
-            One line naming ``source`` (and the line, when ``text`` is given), the
-            section and the key: an unknown section or key, a section that is not
-            a table, a missing required key (``address`` and ``scale`` of
-            [pressure] and of [angle]), a value of the wrong type (a string for a
-            number, a float for an integer, a boolean for a number, ...), or a value
-            out of range, not finite or not a plausible gauge pressure (the
-            [safety] pressures, :mod:`softbend.plausibility`).
+            One line naming ``source`` (and the line, when ``text`` is given) and
+            the key at fault as its TOML path (``connection.port``; its ``key``):
+            an unknown section or key, a section that is not a table, a missing
+            required key (``address`` and ``scale`` of [pressure] and of [angle]),
+            a value of the wrong type (a string for a number, a float for an
+            integer, a boolean for a number, ...), or a value out of range, not
+            finite or not a plausible gauge pressure (the [safety] pressures,
+            :mod:`softbend.plausibility`).
         """
         try:
             return cls._from_checked(data)
-        except (_FieldError, ValueError) as exc:
-            line = _line_of(text, *_field_of(exc)) if text is not None else None
-            where = f"{source}, line {line}" if line is not None else source
-            message = " ".join(str(exc).split())
-            raise DatasetError(f"{where}: {message}") from None
+        except SoftbendError as exc:
+            section, _, key = (exc.key or "").strip("[]").partition(".")
+            line = _line_of(text, section, key) if text is not None and section else None
+            message = " ".join(exc.detail.split())
+            raise DatasetError(message, key=exc.key, file=source, line=line) from None
 
     @classmethod
-    def _from_checked(cls, data: Any) -> RigConfig:
+    def _from_checked(cls, data: object) -> RigConfig:
         sections = set(_SECTIONS) | {"loop", "controller", "simulation"}
-        _check_keys(data, sections, "the rig config", "section")
-        if "pressure" not in data:
-            raise ValueError(
-                "The rig config must have a [pressure] section (table, address, scale, ...)."
+        if not isinstance(data, dict):
+            raise InputError(must_be("a table of keys", data))
+        unknown = sorted(set(data) - sections)
+        if unknown:
+            raise InputError(
+                f"is not a section of a rig config; allowed: {', '.join(sorted(sections))}",
+                key=f"[{unknown[0]}]",
             )
+        if "pressure" not in data:
+            raise InputError("must have a [pressure] section (table, address, scale, ...)")
         for name in (*_SECTIONS, "loop"):
             if name in data:
-                _check_table(name, data[name])
+                with _in_section(name):
+                    _check_table(name, data[name])
 
         def build(name: str, extra: dict[str, Any] | None = None) -> Any:
-            return _SECTIONS[name](**data.get(name, {}), **(extra or {}))
+            with _in_section(name):
+                return _SECTIONS[name](**data.get(name, {}), **(extra or {}))
 
         loop = data.get("loop", {})
-        config = cls(
-            connection=build("connection"),
-            pressure=build("pressure", {"section": "pressure"}),
-            angle=build("angle", {"section": "angle"}) if "angle" in data else None,
-            valves=build("valves"),
-            safety=build("safety"),
-            period_s=loop.get("period_s", 0.001),
-            sensor_period_s=loop.get("sensor_period_s", 0.01),
-            controller=_controller(data["controller"]) if "controller" in data else None,
-            simulation=_simulation(data["simulation"]) if "simulation" in data else (),
-        )
+        parts = {
+            "connection": build("connection"),
+            "pressure": build("pressure", {"section": "pressure"}),
+            "angle": build("angle", {"section": "angle"}) if "angle" in data else None,
+            "valves": build("valves"),
+            "safety": build("safety"),
+        }
+        with _in_section("controller"):
+            controller = _controller(data["controller"]) if "controller" in data else None
+        with _in_section("simulation"):
+            simulation = _simulation(data["simulation"]) if "simulation" in data else ()
+        with _in_section("loop"):
+            config = cls(
+                **parts,
+                period_s=loop.get("period_s", 0.001),
+                sensor_period_s=loop.get("sensor_period_s", 0.01),
+                controller=controller,
+                simulation=simulation,
+            )
         for name, keys in _REQUIRED.items():
             missing = [key for key in keys if name in data and key not in data[name]]
             if missing:
                 given = ", ".join(map(repr, data[name]))
-                raise _FieldError(
-                    f"The [{name}] of the {_OWNER} must give {', '.join(map(repr, missing))} "
-                    f"(no default fits every sensor). Got {f'only {given}' if given else 'none'}.",
-                    name,
-                    None,
+                raise InputError(
+                    f"must give {', '.join(map(repr, missing))} (no default fits every "
+                    f"sensor); got {f'only {given}' if given else 'none'}",
+                    key=f"[{name}]",
                 )
         for key in _PRESSURE_KEYS:
             value = data.get("safety", {}).get(key)
             if value is not None and implausible_index([value], "pressure_mpa") is not None:
                 bounds = RANGES["pressure_mpa"]
-                raise _FieldError(
-                    f"The '{key}' of [safety] of the {_OWNER} must be a plausible "
-                    f"{bounds.label} ({bounds.low:g} to {bounds.high:g} {bounds.unit}). "
-                    f"Got {value!r} instead.",
-                    "safety",
-                    key,
+                requirement = (
+                    f"a plausible {bounds.label} ({bounds.low:g} to {bounds.high:g} {bounds.unit})"
                 )
+                raise InputError(must_be(requirement, value), key=f"safety.{key}")
         return config
 
     def to_toml(self) -> str:
         """The config as TOML text that :func:`load_rig_config` reads back to an equal config."""
         lines: list[str] = []
 
-        def section(name: str, obj: Any) -> None:
+        def section(
+            name: str, obj: ConnectionConfig | RegisterConfig | ValveConfig | SafetyLimits
+        ) -> None:
             lines.append(f"[{name}]")
             for f in fields(obj):
                 value = getattr(obj, f.name)
@@ -533,41 +540,23 @@ _KINDS: dict[str, str] = {"str": "a string", "int": "an integer", "float": "a nu
 _KINDS.update({"bool": "true or false", "int | None": "an integer"})
 
 
-def _controller(table: Any) -> ControllerConfig:
-    """The [controller] table: a string ``name`` and scalar parameters (one _FieldError)."""
-    from softbend.parameters import ParameterValueError, UnknownParameterError
-
-    owner = f"[controller] of the {_OWNER}"
+def _controller(table: object) -> ControllerConfig:
+    """The [controller] table: a string ``name`` and scalar parameters."""
     if not isinstance(table, dict):
-        raise _FieldError(
-            f"The {owner} must be a table ([controller] followed by its keys). "
-            f"Got {short_repr(table)} ({_toml_type(table)}) instead.",
-            None,
-            "controller",
-        )
+        raise InputError(_not_a_table("controller", table))
     if "name" not in table:
         given = ", ".join(map(repr, table))
-        raise _FieldError(
-            f"The {owner} must give 'name' (a controller, e.g. \"bang-bang\"). "
-            f"Got {f'only {given}' if given else 'none'}.",
-            "controller",
-            None,
+        raise InputError(
+            "must give 'name' (a controller, e.g. \"bang-bang\"); "
+            f"got {f'only {given}' if given else 'none'}"
         )
     name = table["name"]
     if not isinstance(name, str):
-        raise _FieldError(
-            f"The 'name' of {owner} must be a string. "
-            f"Got {short_repr(name)} ({_toml_type(name)}) instead.",
-            "controller",
-            "name",
+        raise InputError(
+            f"must be a string; got {short_repr(name)} ({_toml_type(name)})", key="name"
         )
     params = {k: v for k, v in table.items() if k != "name"}
-    try:
-        return ControllerConfig(name, tuple(params.items()))
-    except (UnknownParameterError, ParameterValueError) as exc:
-        raise _FieldError(str(exc), "controller", exc.key) from None
-    except ValueError as exc:
-        raise _FieldError(str(exc), "controller", "name") from None
+    return ControllerConfig(name, tuple(params.items()))
 
 
 def _settings_signature() -> inspect.Signature:
@@ -582,7 +571,7 @@ def _settings_signature() -> inspect.Signature:
     )
 
 
-def simulation_settings_entry(**settings: Any) -> None:
+def simulation_settings_entry(**settings: object) -> None:
     """The settings of a simulated rig, as a signature that ``check_parameters`` reads.
 
     Its declared ranges are those of :class:`~softbend.control.rig.RigParams`
@@ -603,7 +592,7 @@ _declare_settings()
 
 
 def check_simulation_settings(
-    values: Mapping[str, Any], field: str, *, from_text: bool = False
+    values: Mapping[str, object], *, from_text: bool = False
 ) -> dict[str, Any]:
     """Settings of a simulated rig (the [simulation] table, ``--rig-param``), checked.
 
@@ -622,38 +611,41 @@ def check_simulation_settings(
     """
     from softbend.parameters import check_parameters
 
-    return check_parameters(
-        simulation_settings_entry, values, owner="the simulated rig", field=field,
-        from_text=from_text,
-    )  # fmt: skip
+    return check_parameters(simulation_settings_entry, values, from_text=from_text)
 
 
-def _simulation(table: Any) -> tuple[tuple[str, Any], ...]:
-    """The [simulation] table: settings of the simulated rig, checked (one _FieldError)."""
-    from softbend.parameters import ParameterValueError, UnknownParameterError
-
-    owner = f"[simulation] of the {_OWNER}"
+def _simulation(table: object) -> tuple[tuple[str, Any], ...]:
+    """The [simulation] table: settings of the simulated rig, checked."""
     if not isinstance(table, dict):
-        raise _FieldError(
-            f"The {owner} must be a table ([simulation] followed by its keys). "
-            f"Got {short_repr(table)} ({_toml_type(table)}) instead.",
-            None,
-            "simulation",
-        )
-    try:
-        checked = check_simulation_settings(table, owner)
-    except (UnknownParameterError, ParameterValueError) as exc:
-        raise _FieldError(str(exc), "simulation", exc.key) from None
+        raise InputError(_not_a_table("simulation", table))
+    checked = check_simulation_settings(table)
     return tuple((k, checked[k]) for k in table)
 
 
-class _FieldError(ValueError):
-    """A bad section or key of a rig config, with where it is (for the line)."""
+@contextmanager
+def _in_section(name: str) -> Iterator[None]:
+    """Key an error raised about the section ``name`` by its TOML path.
 
-    def __init__(self, message: str, section: str | None, key: str | None) -> None:
-        super().__init__(message)
-        self.section = section
-        self.key = key
+    ``[name]`` for the section itself, ``name.key`` for one of its keys: never
+    the name of a command-line option.
+    """
+    try:
+        yield
+    except SoftbendError as error:
+        if error.key is None:
+            error.key = f"[{name}]"
+        elif "." not in error.key:
+            error.key = f"{name}.{error.key}"
+        raise
+    except ValueError as error:  # a check outside softbend's vocabulary
+        raise InputError(" ".join(str(error).split()), key=f"[{name}]") from None
+
+
+def _not_a_table(name: str, value: object) -> str:
+    return (
+        f"must be a table ([{name}] followed by its keys); got {short_repr(value)} "
+        f"({_toml_type(value)})"
+    )
 
 
 def _section_kinds(name: str) -> dict[str, str]:
@@ -663,7 +655,7 @@ def _section_kinds(name: str) -> dict[str, str]:
     return {f.name: str(f.type) for f in fields(_SECTIONS[name]) if f.name != "section"}
 
 
-def _toml_type(value: Any) -> str:
+def _toml_type(value: object) -> str:
     if isinstance(value, bool):
         return "a boolean"
     if isinstance(value, int):
@@ -681,7 +673,7 @@ def _toml_type(value: Any) -> str:
     return type(value).__name__
 
 
-def _has_kind(value: Any, kind: str) -> bool:
+def _has_kind(value: object, kind: str) -> bool:
     if kind == "str":
         return isinstance(value, str)
     if kind == "bool":
@@ -691,59 +683,33 @@ def _has_kind(value: Any, kind: str) -> bool:
     return type(value) in (int, float)  # a number: TOML integers and floats, not booleans
 
 
-def _check_table(name: str, table: Any) -> None:
-    """Unknown keys and wrong TOML types of the section ``name``: one :class:`_FieldError`."""
-    owner = f"[{name}] of the {_OWNER}"
+def _check_table(name: str, table: object) -> None:
+    """Unknown keys and wrong TOML types of the section ``name``."""
     if not isinstance(table, dict):
-        raise _FieldError(
-            f"The {owner} must be a table ([{name}] followed by its keys). "
-            f"Got {short_repr(table)} ({_toml_type(table)}) instead.",
-            None,
-            name,
-        )
+        raise InputError(_not_a_table(name, table))
     kinds = _section_kinds(name)
-    try:
-        _check_keys(table, set(kinds), owner, "key")
-    except ValueError as exc:
-        unknown = sorted(set(table) - set(kinds))
-        raise _FieldError(str(exc), name, unknown[0]) from None
+    unknown = sorted(set(table) - set(kinds))
+    if unknown:
+        raise InputError(
+            f"is not a key of [{name}]; allowed: {', '.join(sorted(kinds))}", key=unknown[0]
+        )
     for key, value in table.items():
         kind = kinds[key]
         if not _has_kind(value, kind):
-            raise _FieldError(
-                f"The '{key}' of {owner} must be {_KINDS[kind]}. "
-                f"Got {short_repr(value)} ({_toml_type(value)}) instead.",
-                name,
-                key,
+            raise InputError(
+                f"must be {_KINDS[kind]}; got {short_repr(value)} ({_toml_type(value)})", key=key
             )
-
-
-_KEY_MESSAGE = re.compile(r"The '(?P<key>\w+)' of \[(?P<section>\w+)\]")
-_SECTION_MESSAGE = re.compile(r"The \[(?P<section>\w+)\] (?P<key>\w+) of")
-_UNKNOWN_SECTION = re.compile(r"The section '(?P<key>[^']+)' of the rig config")
-
-
-def _field_of(exc: Exception) -> tuple[str | None, str | None]:
-    """The (section, key) a rig-config error is about, for its line."""
-    if isinstance(exc, _FieldError):
-        return exc.section, exc.key
-    text = str(exc)
-    for pattern in (_KEY_MESSAGE, _SECTION_MESSAGE):
-        match = pattern.search(text)
-        if match:
-            return match["section"], match["key"]
-    match = _UNKNOWN_SECTION.search(text)
-    return (None, match["key"]) if match else (None, None)
 
 
 _HEADER = re.compile(r"\[\s*([A-Za-z0-9_-]+)\s*\]")
 _ASSIGN = re.compile(r"(?:([A-Za-z0-9_-]+)\s*\.\s*)?\"?([A-Za-z0-9_-]+)\"?\s*=")
 
 
-def _line_of(text: str, section: str | None, key: str | None) -> int | None:
-    """The line of ``key`` in ``section`` of a TOML text (else of the section), or None."""
-    if section is None and key is None:
-        return None
+def _line_of(text: str, section: str, key: str) -> int | None:
+    """The line of ``key`` in ``section`` of a TOML text (else of the section), or None.
+
+    ``key`` empty: the line of the section (its header, or a top-level key of that name).
+    """
     current: str | None = None
     header = None
     for number, line in enumerate(text.splitlines(), start=1):
@@ -751,43 +717,28 @@ def _line_of(text: str, section: str | None, key: str | None) -> int | None:
         match = _HEADER.match(stripped)
         if match:
             current = match.group(1)
-            if section is not None and current == section and header is None:
+            if current == section and header is None:
                 header = number
-            if section is None and current == key:
-                return number
             continue
         match = _ASSIGN.match(stripped)
         if match is None:
             continue
         table = match.group(1) if match.group(1) and current is None else current
-        if table == section and match.group(2) == key:
+        if key and table == section and match.group(2) == key:
             return number
-        if section is None and current is None and match.group(2) == key:
+        if not key and current is None and match.group(2) == section:
             return number
     return header
 
 
-def _check_address(value: Any, name: str, owner: str) -> int:
-    address = check_int(value, name, low=0)
-    if address > 0xFFFF:
-        raise ValueError(
-            f"The '{name}' of {owner} must be an integer in [0, 65535]. Got {value!r} instead."
-        )
-    return address
+def _check_integer(value: object, key: str, high: int) -> int:
+    """``value`` if it is an integer in [0, high] (a register address, a port), else raise."""
+    if isinstance(value, bool) or not isinstance(value, int) or not 0 <= value <= high:
+        raise InputError(must_be(f"an integer in [0, {high}]", value), key=key)
+    return value
 
 
-def _check_keys(data: Any, allowed: set[str], owner: str, what: str) -> None:
-    if not isinstance(data, dict):
-        raise ValueError(f"The {owner} must be a table of keys. Got {data!r} instead.")
-    unknown = sorted(set(data) - allowed)
-    if unknown:
-        raise ValueError(
-            f"The {what} {unknown[0]!r} of {owner} is not known; allowed: "
-            f"{', '.join(sorted(allowed))}."
-        )
-
-
-def _toml_value(value: Any) -> str:
+def _toml_value(value: object) -> str:
     if isinstance(value, bool):
         return "true" if value else "false"
     if isinstance(value, str):

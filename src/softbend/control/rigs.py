@@ -23,7 +23,7 @@ import inspect
 from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 from softbend.control.designs import ModelDesign
 from softbend.control.rig import AngleTable, Rig, RigParams, SimulatedRig
@@ -34,8 +34,13 @@ from softbend.control.rigconfig import (
     simulation_settings_entry,
 )
 from softbend.design import SFRBADesign
+from softbend.errors import InputError, keyed
 from softbend.parameters import declared_ranges, parse_assignments
 from softbend.registry import Registry
+
+if TYPE_CHECKING:
+    from softbend.control.modbus import ModbusRig
+    from softbend.control.realtime import WallClockRig
 
 __all__ = [
     "DEFAULT_RIG",
@@ -76,8 +81,6 @@ class RigSetup:
         Pneumatics of a simulated rig (default :class:`RigParams`).
     seed : int, default 0
         Seed of a simulated rig's sensor and camera noise.
-    command : str
-        The command asking, for messages.
     """
 
     config: RigConfig = field(default_factory=RigConfig)
@@ -85,32 +88,31 @@ class RigSetup:
     plant_table: AngleTable | None = None
     params: RigParams | None = None
     seed: int = 0
-    command: str = "make_rig"
 
 
 def sim_rig(setup: RigSetup) -> SimulatedRig:
     """The simulated rig in simulated time (the loop's sleeps integrate the model)."""
     if setup.plant_table is None:
-        raise ValueError(
-            f"The simulated rig of {setup.command} needs the actuator's θ(p) (plant_table). "
-            "Got none."
+        raise InputError(
+            "must be given for a simulated rig (the actuator's θ(p))", key="plant_table"
         )
     return SimulatedRig(setup.plant_table, setup.params, seed=setup.seed)
 
 
-def sim_realtime_rig(setup: RigSetup) -> Any:
+def sim_realtime_rig(setup: RigSetup) -> WallClockRig:
     """The simulated rig kept in step with the wall clock (a rehearsal of the real timing)."""
     from softbend.control.realtime import WallClockRig
 
     return WallClockRig(sim_rig(setup))
 
 
-def modbus_rig(setup: RigSetup) -> Any:
+def modbus_rig(setup: RigSetup) -> ModbusRig:
     """A Modbus rig from the TOML's connection and register map, connected and probed."""
     if setup.config_path is None:
-        raise ValueError(
-            f"The '--config' of {setup.command} must name a rig TOML file with --rig "
-            "modbus (write a template with 'softbend control rig-config --out rig.toml')."
+        raise InputError(
+            "must name a rig TOML file for the rig modbus (write a template with "
+            "'softbend control rig-config --out rig.toml')",
+            key="config",
         )
     from softbend.control.modbus import ModbusRig
 
@@ -122,13 +124,13 @@ RIGS.register("sim-realtime", sim_realtime_rig)
 RIGS.register("modbus", modbus_rig)
 
 
-def make_rig(name: str, setup: RigSetup, *, field: str = "make_rig") -> Rig:
+def make_rig(name: str, setup: RigSetup) -> Rig:
     """The rig ``name`` (one of :data:`RIGS`) built from ``setup``.
 
     An unknown name raises :class:`~softbend.registry.UnknownNameError` listing the
-    known ones (``field`` names where it came from, e.g. ``"--rig"``).
+    known ones.
     """
-    return RIGS.get(name, field=field)(setup)
+    return RIGS.get(name)(setup)
 
 
 #: Rigs that are hardware: the parameters of a simulated rig mean nothing to them.
@@ -181,30 +183,25 @@ def rig_parameter_catalog() -> list[dict[str, Any]]:
 
 
 def rig_settings(
-    assignments: Sequence[str] | None = (),
-    values: Mapping[str, Any] | None = None,
+    rig_assignments: Sequence[str] | None = (),
+    values: Mapping[str, object] | None = None,
     *,
     supply_mpa: float | None = None,
-    field: str = "--rig-param",
-    table_field: str = "[simulation] of the rig config",
-    supply_field: str = "--supply",
 ) -> dict[str, Any]:
     """The settings of a simulated rig that differ from the defaults, checked.
 
     Parameters
     ----------
-    assignments : sequence of str, optional
-        ``NAME=VALUE`` text (``--rig-param``), read by the kind of each name:
-        a field of :class:`~softbend.control.rig.RigParams` or ``tubing_mm3``
+    rig_assignments : sequence of str, optional
+        ``NAME=VALUE`` text, read by the kind of each name: a field of
+        :class:`~softbend.control.rig.RigParams` or ``tubing_mm3``
         (:data:`RIG_SETTINGS`).
     values : mapping, optional
         Data values of the same names (a rig TOML's [simulation] table);
-        ``assignments`` override them.
+        ``rig_assignments`` override them.
     supply_mpa : float, optional
-        The supply pressure given on its own (``--supply``), MPa gauge: the same as
+        The supply pressure given on its own, MPa gauge: the same as
         ``supply_gauge_mpa``; it overrides ``values`` too.
-    field, table_field, supply_field : str
-        Where the assignments, the values and the supply came from, for messages.
 
     Returns
     -------
@@ -218,39 +215,45 @@ def rig_settings(
         An unknown name; the message lists the known names.
     ParameterValueError
         A value of the wrong kind, or out of the range that RigParams allows.
-    ValueError
+    InputError
         An assignment that is not ``NAME=VALUE`` or gives a name twice, a
         ``supply_mpa`` that differs from ``supply_gauge_mpa`` of the assignments,
-        or both ``volume_mm3`` and ``tubing_mm3``.
+        or both ``volume_mm3`` and ``tubing_mm3``. The key of each error is the
+        parameter the value came by (``rig_assignments``, ``values``, ``supply_mpa``).
         (Whether the supply is a plausible gauge pressure is for
         :func:`~softbend.control.setup.check_supply`.)
     """
-    table = check_simulation_settings(values or {}, table_field, from_text=False)
-    given = check_simulation_settings(parse_assignments(assignments, field), field, from_text=True)
+    with keyed("values"):
+        table = check_simulation_settings(values or {}, from_text=False)
+    with keyed("rig_assignments"):
+        texts = parse_assignments(rig_assignments)
+    with keyed("rig_assignments"):
+        given = check_simulation_settings(texts, from_text=True)
     if supply_mpa is not None:
-        supply = check_simulation_settings(
-            {"supply_gauge_mpa": supply_mpa}, supply_field, from_text=False
-        )
+        with keyed("supply_mpa"):
+            supply = check_simulation_settings({"supply_gauge_mpa": supply_mpa}, from_text=False)
         other = given.get("supply_gauge_mpa", supply["supply_gauge_mpa"])
         if other != supply["supply_gauge_mpa"]:
-            raise ValueError(
-                f"The '{supply_field}' and '{field} supply_gauge_mpa' are the same setting, "
-                f"the supply pressure (MPa gauge): give one, or the same value. Got "
-                f"{supply_mpa!r} and {other!r} instead."
+            raise InputError(
+                "must equal the rig setting supply_gauge_mpa (the same supply pressure, MPa "
+                f"gauge: give one, or the same value); got {supply_mpa!r} and {other!r}",
+                key="supply_mpa",
             )
         given.update(supply)
     merged = {**table, **given}
     if "volume_mm3" in merged and "tubing_mm3" in merged:
-        raise ValueError(
-            f"The 'volume_mm3' (the whole chamber) and 'tubing_mm3' (added to the design's "
-            f"cavity) of the simulated rig (in {field} or the {table_field}) both set the "
-            "chamber volume: give one. Got both instead."
+        raise InputError(
+            "volume_mm3 (the whole chamber) and tubing_mm3 (added to the design's cavity) "
+            "both set the chamber volume of the simulated rig: give one; got both",
+            key="rig_assignments" if {"volume_mm3", "tubing_mm3"} & set(given) else "values",
         )
     return merged
 
 
 def rig_params_for(
-    design: SFRBADesign | ModelDesign, settings: Mapping[str, Any] | None = None, **defaults: Any
+    design: SFRBADesign | ModelDesign,
+    settings: Mapping[str, Any] | None = None,
+    **defaults: float,
 ) -> RigParams:
     """The simulated rig of ``design`` with ``settings`` (:func:`rig_settings`) applied.
 
@@ -295,7 +298,7 @@ def _rig_of_actuator(design: ModelDesign, chosen: dict[str, Any], tubing: float)
                 "volume_mm3=V, the air volume at 0 MPa gauge with the tubing, in mm³ (or "
                 "volume_mm3 in the [simulation] table of the rig config)."
             )
-        tubing = check_declared(tubing, "tubing_mm3", "the simulated rig", TUBING_RANGE)
+        tubing = check_declared(tubing, "tubing_mm3", TUBING_RANGE)
         volume = actuator.chamber_volume_mm3 + tubing
         declared = RIG_RANGES["volume_mm3"]
         if not declared.contains(volume):

@@ -18,13 +18,14 @@ import warnings
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
-from softbend._validation import check_range
+from softbend._validation import check_range, must_be
 from softbend.control.budget import LOOP_BYTES_PER_TICK, SIMULATE_BYTES_PER_STEP, check_run_size
 from softbend.control.experiments import ControlRun, Reference, parse_reference
+from softbend.control.rig import Rig
 from softbend.control.rigconfig import RigConfig, load_rig_config
 from softbend.control.rigs import (
     DEFAULT_RIG,
@@ -40,6 +41,11 @@ from softbend.control.setup import (
     check_supply,
     prepare_control,
 )
+from softbend.errors import InputError, keyed
+
+if TYPE_CHECKING:
+    from softbend.control.loop import LoopRun
+    from softbend.control.modbus_server import SimulatedModbusServer
 
 __all__ = [
     "LoopPlan",
@@ -72,7 +78,6 @@ def simulate_control(
     supply_mpa: float | None = None,
     rig_assignments: Sequence[str] = (),
     seed: int = 0,
-    command: str = "simulate_control",
     strict: bool = False,
 ) -> Simulation:
     """Run a controller on the simulated rig of ``design`` and score it (synthetic).
@@ -94,16 +99,14 @@ def simulate_control(
     from softbend.control.rig import RigParams, SimulatedRig
 
     ref = parse_reference(reference)
-    simulated = _rig_settings(rig_assignments, {}, supply_mpa, command)
-    duration_name, step_name = _option_names(command, "step_s")
+    simulated = _rig_settings(rig_assignments, {}, supply_mpa)
     check_run_size(
         duration_s, simulated.get("step_s", RigParams.step_s), SIMULATE_BYTES_PER_STEP,
-        what="A simulated run", owner=command, duration_name=duration_name,
-        step_name=step_name, unit="rig steps",
+        what="A simulated run", unit="rig steps",
     )  # fmt: skip
     setup = prepare_control(
         controller=controller, assignments=assignments, design=design, model=model,
-        plant=plant, rig_settings=simulated, command=command, strict=strict,
+        plant=plant, rig_settings=simulated, strict=strict,
     )  # fmt: skip
     rig = SimulatedRig(setup.plant_table, setup.rig_params, seed=seed)
     run = simulate(rig, setup.controller, ref, duration_s, seed=seed)
@@ -137,7 +140,7 @@ def simulate_control(
 class LoopResult:
     """A loop run: the :class:`~softbend.control.loop.LoopRun` and its summary (``run.json``)."""
 
-    loop: Any = field(repr=False)
+    loop: LoopRun = field(repr=False)
     summary: dict[str, Any]
 
     def control_run(self) -> ControlRun:
@@ -177,16 +180,16 @@ class LoopPlan:
         """Ticks of the loop."""
         return max(1, round(self.duration_s / self.period_s))
 
-    def make_rig(self) -> Any:
+    def make_rig(self) -> Rig:
         """The rig of the run, built (a hardware rig connected) by its factory."""
-        return make_rig(self.rig, self.rig_setup, field="--rig")
+        return make_rig(self.rig, self.rig_setup)
 
     def run(
         self,
         log_path: Path | None = None,
         progress: Callable[[int, int], None] | None = None,
         *,
-        device: Any = None,
+        device: Rig | None = None,
     ) -> LoopResult:
         """Run the loop on ``device`` (default: :meth:`make_rig`), logging every tick to
         ``log_path``; the rig is closed at the end, whatever happens."""
@@ -210,14 +213,14 @@ class LoopPlan:
         return LoopResult(loop=result, summary=self._summary(device, result, reached, beyond))
 
     @staticmethod
-    def _reached(result: Any) -> float:
+    def _reached(result: LoopRun) -> float:
         """The largest pressure read in the run, MPa (0 when no reading was logged)."""
         measured = result.control_run().measured_mpa
         finite = measured[np.isfinite(measured)]
         return float(finite.max()) if finite.size else 0.0
 
     def _summary(
-        self, device: Any, result: Any, reached: float, beyond: str | None
+        self, device: Rig, result: LoopRun, reached: float, beyond: str | None
     ) -> dict[str, Any]:
         from softbend.control.experiments import summary_metrics
 
@@ -275,7 +278,6 @@ def plan_loop(
     supply_mpa: float | None = None,
     rig_assignments: Sequence[str] = (),
     seed: int = 0,
-    command: str = "plan_loop",
     strict: bool = False,
 ) -> LoopPlan:
     """Check a loop run and build its controller; the rig is built by :meth:`LoopPlan.run`.
@@ -301,37 +303,35 @@ def plan_loop(
     others
         As :func:`simulate_control`.
     """
-    RIGS.check(rig, field="--rig")
+    with keyed("rig"):
+        RIGS.check(rig)
     if rig in HARDWARE_RIGS and rig_assignments:
-        raise ValueError(
-            f"The '--rig-param' of {command} sets the simulated rig; --rig {rig} is hardware "
-            "(its pneumatics are what they are): drop --rig-param, or use --rig sim or "
-            f"sim-realtime. Got {list(rig_assignments)!r} instead."
+        raise InputError(
+            f"set the simulated rig, but the rig {rig} is hardware (its pneumatics are what "
+            f"they are): drop them, or use the rig sim or sim-realtime; got "
+            f"{list(rig_assignments)!r}",
+            key="rig_assignments",
         )
     ref = parse_reference(reference)
     settings = load_rig_config(config) if config is not None else RigConfig()
     tick = settings.period_s if period_s is None else period_s
     sensor = settings.sensor_period_s if sensor_period_s is None else sensor_period_s
     table = dict(settings.simulation) if rig not in HARDWARE_RIGS else {}
-    simulated = _rig_settings(rig_assignments, table, supply_mpa, command)
-    check_range(tick, "period", low=0.0, high=1.0, high_inclusive=True)
+    simulated = _rig_settings(rig_assignments, table, supply_mpa)
+    check_range(tick, "period_s", low=0.0, high=1.0, high_inclusive=True)
     check_range(
-        sensor, "sensor_period", low=tick, high=10.0,
+        sensor, "sensor_period_s", low=tick, high=10.0,
         low_inclusive=True, high_inclusive=True,
     )  # fmt: skip
-    duration_name, step_name = _option_names(command, "period_s")
-    check_run_size(
-        duration_s, tick, LOOP_BYTES_PER_TICK, what="A loop run", owner=command,
-        duration_name=duration_name, step_name=step_name, unit="ticks",
-    )  # fmt: skip
+    check_run_size(duration_s, tick, LOOP_BYTES_PER_TICK, what="A loop run", unit="ticks")
     setup = prepare_control(
         controller=controller, assignments=assignments, config=settings.controller,
-        design=design, model=model, plant=plant, rig_settings=simulated, command=command,
+        design=design, model=model, plant=plant, rig_settings=simulated,
         strict=strict, simulated=rig not in HARDWARE_RIGS,
     )  # fmt: skip
     rig_setup = RigSetup(
         config=settings, config_path=None if config is None else Path(config),
-        plant_table=setup.plant_table, params=setup.rig_params, seed=seed, command=command,
+        plant_table=setup.plant_table, params=setup.rig_params, seed=seed,
     )  # fmt: skip
     return LoopPlan(
         setup=setup, rig=rig, rig_setup=rig_setup, reference_spec=reference, reference=ref,
@@ -350,8 +350,7 @@ def simulated_server(
     supply_mpa: float | None = None,
     rig_assignments: Sequence[str] = (),
     seed: int = 0,
-    command: str = "simulated_server",
-) -> Any:
+) -> SimulatedModbusServer:
     """The simulated rig of ``design`` behind a Modbus TCP server (not started).
 
     The register map is the ``config``'s (default: the built-in map); ``port``
@@ -365,37 +364,25 @@ def simulated_server(
     settings = load_rig_config(config) if config is not None else RigConfig()
     listen = port if port is not None else (settings.connection.port if config else 5020)
     if not host.strip():
-        raise ValueError(
-            f"The '--host' of {command} must be an address to listen on "
-            "(e.g. 127.0.0.1 or 0.0.0.0). Got an empty string instead."
+        raise InputError(
+            must_be("an address to listen on (e.g. 127.0.0.1 or 0.0.0.0)", host), key="host"
         )
     if not 0 <= listen <= 65535:
-        raise ValueError(
-            f"The '--port' of {command} must be an integer in [0, 65535]. Got {listen} instead."
-        )
+        raise InputError(must_be("an integer in [0, 65535]", listen), key="port")
     table = dict(settings.simulation)
-    simulated = _rig_settings(rig_assignments, table, supply_mpa, command)
-    setup = prepare_control(
-        design=design, model=model, plant=plant, rig_settings=simulated, command=command
-    )
+    simulated = _rig_settings(rig_assignments, table, supply_mpa)
+    setup = prepare_control(design=design, model=model, plant=plant, rig_settings=simulated)
     rig = SimulatedRig(setup.plant_table, setup.rig_params, seed=seed)
     return SimulatedModbusServer(rig, settings, host=host, port=listen)
 
 
-def _option_names(command: str, step: str) -> tuple[str, str]:
-    """What the duration and the step are called in messages: options on the command line."""
-    if not command.startswith("softbend "):
-        return "duration_s", step
-    return "--duration", "--rig-param step_s" if step == "step_s" else "--period"
-
-
 def _rig_settings(
-    assignments: Sequence[str], table: dict[str, Any], supply_mpa: float | None, command: str
+    rig_assignments: Sequence[str], table: dict[str, Any], supply_mpa: float | None
 ) -> dict[str, Any]:
-    """The simulated rig's settings: ``--supply`` checked as a gauge pressure first."""
+    """The simulated rig's settings: ``supply_mpa`` checked as a gauge pressure first."""
     if supply_mpa is not None:
-        check_supply(supply_mpa, command)
-    return rig_settings(assignments, table, supply_mpa=supply_mpa)
+        check_supply(supply_mpa)
+    return rig_settings(rig_assignments, table, supply_mpa=supply_mpa)
 
 
 def _percentiles_ms(values: list[float]) -> dict[str, float]:

@@ -26,23 +26,21 @@ import warnings
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 from softbend.actuators import SFRBA, Actuator
-from softbend.control.controllers import Controller
+from softbend.control.controllers import Controller, ControllerModel
 from softbend.control.designs import DEFAULT_DESIGN, ModelDesign, control_design
-from softbend.control.factory import (
-    CONTROLLERS,
-    DEFAULT_CONTROLLER,
-    ControllerModel,
-    build_controller,
-    controller_parameters,
-)
+from softbend.control.factory import CONTROLLERS, DEFAULT_CONTROLLER, controller_parameters
 from softbend.control.plants import check_plant, in_table1, plant_table
 from softbend.control.rig import AngleTable, RigParams
 from softbend.control.rigconfig import ControllerConfig
 from softbend.design import SFRBADesign
-from softbend.parameters import parse_assignments
+from softbend.errors import InputError, keyed
+from softbend.parameters import effective_parameters, parse_assignments
+
+if TYPE_CHECKING:
+    from softbend.surrogates.persistence import SavedSurrogate
 
 __all__ = [
     "DEFAULT_DESIGN",
@@ -53,8 +51,6 @@ __all__ = [
     "prepare_control",
     "resolve_controller",
 ]
-
-_TOML = "[controller] of the rig config"
 
 
 @dataclass(frozen=True)
@@ -145,73 +141,74 @@ class ControlSetup:
         return out
 
 
-def check_supply(supply_mpa: float, command: str, field: str = "--supply") -> float:
-    """A supply pressure that is a positive, plausible gauge pressure (MPa), else ValueError.
-
-    ``field`` names the option (or setting) that gave it, for the message.
-    """
+def check_supply(supply_mpa: float) -> float:
+    """A supply pressure that is a positive, plausible gauge pressure (MPa), else InputError."""
+    from softbend._validation import must_be
     from softbend.plausibility import RANGES
 
     high = RANGES["pressure_mpa"].high
     if isinstance(supply_mpa, bool) or not 0.0 < supply_mpa <= high:
-        raise ValueError(
-            f"The '{field}' of {command} must be a gauge pressure in (0, {high:g}] MPa "
-            f"({high:g} MPa bursts any silicone actuator; a value in kPa must be divided by "
-            f"1000). Got {supply_mpa!r} instead."
+        requirement = (
+            f"a gauge pressure in (0, {high:g}] MPa ({high:g} MPa bursts any silicone "
+            "actuator; a value in kPa must be divided by 1000)"
         )
+        raise InputError(must_be(requirement, supply_mpa), key="supply_mpa")
     return float(supply_mpa)
 
 
 def resolve_controller(
-    name: str | None = None,
+    controller: str | None = None,
     assignments: Sequence[str] = (),
     config: ControllerConfig | None = None,
-) -> tuple[str, dict[str, Any], dict[str, Any]]:
-    """The controller's name, its parameters as used, and those given (with their origin).
+) -> tuple[str, dict[str, Any]]:
+    """The controller's name and its parameters as used.
 
     Parameters
     ----------
-    name : str, optional
-        The controller asked for (``--controller``); default: the ``config``'s, else
+    controller : str, optional
+        The controller asked for; default: the ``config``'s, else
         :data:`~softbend.control.factory.DEFAULT_CONTROLLER`.
     assignments : sequence of str
-        ``NAME=VALUE`` text (``--set``), parsed by each parameter's kind; it overrides
-        the ``config``'s values.
+        ``NAME=VALUE`` text of its parameters, parsed by each parameter's kind
+        and checked; it overrides the ``config``'s values.
     config : ControllerConfig, optional
-        A rig TOML's [controller] table; its parameters apply when it names the same
-        controller as ``name`` (or ``name`` is not given); for another controller
-        they are left out, with a warning.
+        A rig TOML's [controller] table (checked when it was read); its
+        parameters apply when it names the same controller as ``controller`` (or
+        ``controller`` is not given); for another controller they are left out,
+        with a warning.
 
     Returns
     -------
     name : str
     params : dict
-        Every public parameter (defaults filled in).
-    given : dict
-        ``{"--set": {...}, "[controller] of the rig config": {...}}``, the values given.
+        Every public parameter: the value given (``assignments`` over the
+        ``config``'s), else its default.
 
     Raises
     ------
     UnknownNameError
         An unknown controller or parameter; the message lists the known names.
     ParameterValueError
-        A ``--set`` value that is not of the parameter's kind.
+        An ``assignments`` value that is not of the parameter's kind or out of its range.
     """
-    chosen = name if name is not None else (config.name if config else DEFAULT_CONTROLLER)
-    CONTROLLERS.check(chosen, field="--controller" if name is not None else _TOML)
-    texts = parse_assignments(assignments, "--set")
-    typed = controller_parameters(chosen, texts, field="--set", from_text=True)
+    chosen = controller if controller is not None else (config.name if config else None)
+    chosen = DEFAULT_CONTROLLER if chosen is None else chosen
+    with keyed("controller"):
+        entry = CONTROLLERS.get(chosen)
+    with keyed("assignments"):
+        texts = parse_assignments(assignments)
+    with keyed("assignments"):
+        typed = controller_parameters(chosen, texts, from_text=True)
     from_set = {k: typed[k] for k in texts}
     from_toml = config.as_dict() if config is not None and config.name == chosen else {}
     if config is not None and config.name != chosen and config.as_dict():
         warnings.warn(
-            f"The {_TOML} sets parameters of {config.name!r}, but --controller is {chosen!r}: "
-            f"they are not used ({chosen!r} runs with its defaults and --set).",
+            f"The [controller] of the rig config sets parameters of {config.name!r}, but "
+            f"--controller is {chosen!r}: they are not used ({chosen!r} runs with its "
+            "defaults and --set).",
             stacklevel=2,
         )
-    given = {origin: v for origin, v in (("--set", from_set), (_TOML, from_toml)) if v}
-    params = controller_parameters(chosen, {**from_toml, **from_set})
-    return chosen, params, given
+    return chosen, effective_parameters(entry, {**from_toml, **from_set})
 
 
 def model_of_run(model: str | Path | None, plant: str) -> tuple[Path | None, str]:
@@ -241,7 +238,6 @@ def prepare_control(
     model: str | Path | None = None,
     plant: str = "surrogate",
     supply_mpa: float = 0.2,
-    command: str = "prepare_control",
     strict: bool = False,
     rig_settings: Mapping[str, Any] | None = None,
     simulated: bool = True,
@@ -271,8 +267,6 @@ def prepare_control(
         Supply pressure of the simulated rig, MPa gauge (``supply_gauge_mpa`` of
         ``rig_settings``, when given, replaces it: :func:`~softbend.control.rigs.rig_settings`
         refuses the two when they differ).
-    command : str
-        The command asking, for messages.
     strict : bool, default False
         Refuse a design outside the training ranges of the controller's model,
         and a controller model or plant surrogate whose θ(p) of the design up
@@ -301,19 +295,23 @@ def prepare_control(
     from softbend.control.rigs import rig_settings as check_rig_settings
     from softbend.transfer.base import load_base_saved, shipped_base_path
 
-    name, params, given = resolve_controller(controller, assignments, config)
-    check_plant(plant, field="--plant")
-    settings = check_rig_settings(values=rig_settings, table_field=f"rig_settings of {command}")
-    supply_field = "--supply" if "supply_gauge_mpa" not in settings else "supply_gauge_mpa"
-    supply_mpa = settings.get("supply_gauge_mpa", supply_mpa)
-    check_supply(supply_mpa, command, supply_field)
+    name, params = resolve_controller(controller, assignments, config)
+    with keyed("plant"):
+        check_plant(plant)
+    with keyed("rig_settings"):
+        settings = check_rig_settings(values=rig_settings)
+    if "supply_gauge_mpa" in settings:  # held by rig_settings to the same (0, 2] MPa
+        supply_mpa = settings["supply_gauge_mpa"]
+    else:
+        supply_mpa = check_supply(supply_mpa)
     chosen = {**settings, "supply_gauge_mpa": supply_mpa}
     model_path, model_from = model_of_run(model, plant)
     saved = load_base_saved(model_path)
     label = str(model_path) if model_path is not None else str(shipped_base_path())
     source = "the shipped MLP" if model_path is None else f"the model {model_path}"
     actuator = saved.actuator
-    actuator_design = control_design(design, actuator, field="--design", source=source)
+    with keyed("design"):
+        actuator_design = control_design(design, actuator, source=source)
     plant_path = _plant_model(plant)
     shared = (
         plant_path is not None and model_path is not None and _same_file(plant_path, model_path)
@@ -344,11 +342,11 @@ def prepare_control(
     controller_model = ControllerModel.from_surrogate(
         surrogate, actuator_design, rig, pmax_mpa=pmax
     )
-    actuator_table = plant_table(
-        plant, actuator_design, controller_model.angle_table, field="--plant", pmax_mpa=pmax
-    )
-    origin = " and ".join(given) or "make_controller"
-    built = build_controller(name, controller_model, _flat(given), field=origin)
+    with keyed("plant"):
+        actuator_table = plant_table(
+            plant, actuator_design, controller_model.angle_table, pmax_mpa=pmax
+        )
+    built = CONTROLLERS.get(name)(controller_model, **params)  # checked by resolve_controller
     return ControlSetup(
         design=actuator_design,
         rig_params=rig,
@@ -427,7 +425,7 @@ def _design_check(
 
 
 def _support_check(
-    saved: Any,
+    saved: SavedSurrogate,
     model: Path | None,
     plant: Path | None,
     shared: bool,
@@ -485,11 +483,3 @@ def beyond_support(setup: ControlSetup, max_pressure_mpa: float) -> str | None:
         f"were trained to near the design {setup.design}: the angles above it are "
         "extrapolated (--strict refuses such a run)."
     )
-
-
-def _flat(given: Mapping[str, Mapping[str, Any]]) -> dict[str, Any]:
-    """The given values, ``--set`` over the TOML's."""
-    merged: dict[str, Any] = {}
-    for origin in reversed(list(given)):
-        merged.update(given[origin])
-    return merged

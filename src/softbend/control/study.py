@@ -14,15 +14,20 @@ from __future__ import annotations
 
 from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass, field
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import pandas as pd
 
+from softbend.control.controllers import ControllerModel
 from softbend.control.experiments import ControlRun, run_metrics, simulate
-from softbend.control.factory import ControllerModel, build_controller, controller_parameters
+from softbend.control.factory import CONTROLLERS, controller_parameters
 from softbend.control.rig import AngleTable, RigParams, SimulatedRig
 from softbend.design import SFRBADesign
+from softbend.errors import InputError, keyed
 from softbend.references import CONTROL_RESULTS, values
+
+if TYPE_CHECKING:
+    from softbend.surrogates.protocol import Surrogate
 
 __all__ = [
     "PAPER_B_CONTROL",
@@ -71,7 +76,7 @@ class ControlStudy:
 
 
 def control_study(
-    model: Any,
+    model: Surrogate,
     design: SFRBADesign,
     *,
     plant_table: AngleTable | None = None,
@@ -107,7 +112,7 @@ def control_study(
         ``progress(done_runs, total_runs)``.
     controller_params : mapping, optional
         ``{controller: {parameter: value}}``: public parameters of some of the
-        ``controllers`` (see their factories, e.g. ``{"bang-bang": {"deadzone": 0.02}}``);
+        ``controllers`` (see their classes, e.g. ``{"bang-bang": {"deadzone": 0.02}}``);
         the others keep their defaults.
 
     Raises
@@ -115,17 +120,18 @@ def control_study(
     UnknownNameError
         An unknown controller or parameter; the message lists the known names.
     """
+    with keyed("controllers"):
+        for name in controllers:
+            CONTROLLERS.check(name)
     given = dict(controller_params or {})
     for name in given:
         if name not in controllers:
-            raise ValueError(
-                f"The 'controller_params' of control_study name {name!r}, which is not one "
-                f"of its controllers ({', '.join(controllers)})."
+            raise InputError(
+                f"name {name!r}, which is not one of the controllers ({', '.join(controllers)})",
+                key="controller_params",
             )
-    used = {
-        name: controller_parameters(name, given.get(name), field="control_study")
-        for name in controllers
-    }
+    with keyed("controller_params"):
+        used = {name: controller_parameters(name, given.get(name)) for name in controllers}
     params = RigParams.for_design(design) if params is None else params
     controller_model = ControllerModel.from_surrogate(model, design, params)
     actuator = controller_model.angle_table if plant_table is None else plant_table
@@ -133,9 +139,7 @@ def control_study(
     total = len(controllers) * len(references)
     for name in controllers:
         for spec in references:
-            controller = build_controller(
-                name, controller_model, given.get(name), field="control_study"
-            )
+            controller = CONTROLLERS.get(name)(controller_model, **used[name])
             run = simulate(SimulatedRig(actuator, params, seed=seed), controller, spec, duration_s)
             runs[(name, spec)] = run
             rows.append({"controller": name, "reference": spec, **run_metrics(run)})
