@@ -109,9 +109,9 @@ def test_defaults_and_the_record_of_a_run():
 
 def test_assignments():
     assert parse_assignments(["a=1", " b = x "]) == {"a": "1", "b": "x"}
-    with pytest.raises(ValueError, match=r"^items: must be NAME=VALUE"):
+    with pytest.raises(ValueError, match=r"^an assignment must be NAME=VALUE"):
         parse_assignments(["a"])
-    with pytest.raises(ValueError, match=r"^items: gives the parameter 'a' twice"):
+    with pytest.raises(ValueError, match=r"^the parameter .a. is given twice"):
         parse_assignments(["a=1", "a=2"])
 
 

@@ -272,7 +272,7 @@ def parse_assignments(
     Raises
     ------
     InputError
-        With the key ``items`` (a caller re-keys it with
+        Without a key (the caller names its option with
         :func:`softbend.errors.keyed`): an item without ``=``, with an empty
         name, or a name given twice.
     """
@@ -281,12 +281,11 @@ def parse_assignments(
         name, sep, text = str(item).partition("=")
         name = name.strip()
         if not sep or not name:
-            raise InputError(must_be("NAME=VALUE (e.g. epochs=500)", item), key="items")
+            raise InputError("an assignment " + must_be("NAME=VALUE (e.g. epochs=500)", item))
         if name in values:
             raise InputError(
-                f"gives the parameter {name!r} twice ({values[name]!r} and "
-                f"{text.strip()!r}); give it once",
-                key="items",
+                f"the parameter {name!r} is given twice ({values[name]!r} and "
+                f"{text.strip()!r}); give it once"
             )
         values[name] = text.strip()
     return values

@@ -106,7 +106,7 @@ def test_volume_and_tubing_together_are_refused():
 
 
 def test_a_name_given_twice_is_refused():
-    with pytest.raises(ValueError, match=r"^rig_assignments: items: gives the parameter .* twice"):
+    with pytest.raises(ValueError, match=r"^rig_assignments: the parameter .* is given twice"):
         rig_settings(["valve_delay_s=0.01", "valve_delay_s=0.02"])
 
 
