@@ -40,10 +40,10 @@ def _zero_scale(state):
 @pytest.mark.parametrize(
     ("change", "needle"),
     [
-        (_nan_coefficient, "state key 'coef_'"),
-        (_zero_scale, "state key 'x_scale_'"),
-        (lambda s: s.update(y_scale_=0.0), "state key 'y_scale_'"),
-        (lambda s: s.update(y_scale_="12.5"), "state key 'y_scale_'"),
+        (_nan_coefficient, "state.coef_: must"),
+        (_zero_scale, "state.x_scale_: must"),
+        (lambda s: s.update(y_scale_=0.0), "state.y_scale_: must"),
+        (lambda s: s.update(y_scale_="12.5"), "state.y_scale_: must"),
         (lambda s: s.pop("coef_"), "coef_ missing"),
         (lambda s: s.update(predict="boom"), "unknown state key(s) 'predict'"),
     ],

@@ -54,20 +54,23 @@ def test_train_writes_models_tables_figures_and_predicts(small_campaign, tmp_pat
 @pytest.mark.parametrize(
     ("extra", "needle"),
     [
-        (["--models", "plr,svm"], "surrogate family 'svm' (in models); known: plr, xgb, mlp."),
-        (["--models", " , "], "'models' must name at least one surrogate family"),
-        (["--grid", "huge"], "'grid'"),
-        (["--device", "tpu"], "'device'"),
+        (
+            ["--models", "plr,svm"],
+            "--models: Unknown surrogate family 'svm'; known: plr, xgb, mlp.",
+        ),
+        (["--models", " , "], "--models: must be at least one surrogate family name"),
+        (["--grid", "huge"], "--grid: must be one of"),
+        (["--device", "tpu"], "--device: must be one of"),
         (["--folds", "1"], "folds"),
         (
             ["--workers", "0"],
-            "The '--workers' of softbend train must be an integer in [1, inf). Got 0",
+            "--workers: must be an integer in [1, inf); got 0",
         ),
-        (["--workers", "-1"], "'--workers' of softbend train must be an integer in [1, inf)"),
-        (["--halving-rungs", "0"], "'--halving-rungs' of softbend train must be an integer"),
-        (["--plr-patience", "0"], "'--plr-patience' of softbend train must be an integer"),
+        (["--workers", "-1"], "--workers: must be an integer in [1, inf)"),
+        (["--halving-rungs", "0"], "--halving-rungs: must be an integer"),
+        (["--plr-patience", "0"], "--plr-patience: must be an integer"),
         (["--halving-rungs", "3"], "needs 'halving'"),
-        (["--halving", "3", "--halving-rungs", "40"], "'rungs' of halving_rungs must be at most"),
+        (["--halving", "3", "--halving-rungs", "40"], "--halving-rungs: rungs: must be at most"),
     ],
 )
 def test_train_bad_input_is_one_line_exit_2(small_campaign, tmp_path, capsys, extra, needle):
@@ -86,12 +89,12 @@ def test_train_missing_database(tmp_path, capsys):
     ("design", "pressure", "needle"),
     [
         ("100,6,2,2,5", "0.1", "6 values"),
-        ("100,6,2,2,5,x", "0.1", "'lc_mm' must be a number"),
+        ("100,6,2,2,5,x", "0.1", "--design: lc_mm must be a number"),
         ("100,6,-2,2,5,8", "0.1", "t_mm"),
         ("l_mm=100,r_mm=6", "0.1", "lacks t_mm, b_mm, phi_deg, lc_mm"),
         ("n_chambers=10", "0.1", "not a design parameter"),
-        ("100,6,2,2,5,8", "0.1,abc", "'--pressures'"),
-        ("100,6,2,2,5,8", "-0.1", "'--pressures'"),
+        ("100,6,2,2,5,8", "0.1,abc", "--pressures: must be comma-separated numbers"),
+        ("100,6,2,2,5,8", "-0.1", "--pressures: must be finite and >= 0"),
     ],
 )
 def test_predict_bad_input(small_base_file, capsys, design, pressure, needle):

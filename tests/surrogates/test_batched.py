@@ -364,7 +364,7 @@ def test_memory_estimate_grows_with_models_and_guard_names_the_remedy():
     assert estimate_pass_bytes(10, 7, 65, 65, 1024, 24000, itemsize=8) > small
     X, y = _smooth_data()
     budget_mb = estimate_pass_bytes(2, 7, 8, 7, 32, 96) / 1024**2
-    with pytest.raises(ValueError, match=r"'max_models_per_pass' of train_mlp_grid to 2 or fewer"):
+    with pytest.raises(ValueError, match=r"max_models_per_pass: .*set it to 2 or fewer"):
         train_mlp_grid(
             X, y, _uneven_splits(len(y)), CONFIGS, epochs=1, batch_size=32, max_memory_mb=budget_mb
         )
@@ -384,20 +384,20 @@ def test_memory_estimate_grows_with_models_and_guard_names_the_remedy():
 @pytest.mark.parametrize(
     "kwargs, match",
     [
-        ({"hidden_sizes": [(0, 5)]}, "'hidden_sizes' of train_mlp_grid must be a pair"),
-        ({"hidden_sizes": [(5,)]}, "'hidden_sizes' of train_mlp_grid must be a pair"),
-        ({"hidden_sizes": []}, "'hidden_sizes' of train_mlp_grid must be a non-empty"),
-        ({"batch_size": 0}, r"'batch_size' of train_mlp_grid must be an integer in \[1, inf\)"),
-        ({"epochs": 2.5}, "'epochs' of train_mlp_grid"),
-        ({"learning_rate": -1.0}, "'learning_rate' of train_mlp_grid"),
-        ({"seed": -1}, "'seed' of train_mlp_grid"),
-        ({"device": "tpu"}, "'device' of train_mlp_grid must be one of 'auto', 'cpu', 'cuda'"),
-        ({"dtype": torch.float16}, "'dtype' of train_mlp_grid"),
-        ({"max_models_per_pass": 0}, "'max_models_per_pass' of train_mlp_grid"),
-        ({"progress": 3}, "'progress' of train_mlp_grid"),
-        ({"splits": []}, "'splits' of train_mlp_grid must be a non-empty list"),
+        ({"hidden_sizes": [(0, 5)]}, "hidden_sizes: must be a pair"),
+        ({"hidden_sizes": [(5,)]}, "hidden_sizes: must be a pair"),
+        ({"hidden_sizes": []}, "hidden_sizes: must be a non-empty"),
+        ({"batch_size": 0}, r"batch_size: must be an integer in \[1, inf\)"),
+        ({"epochs": 2.5}, "epochs: must be"),
+        ({"learning_rate": -1.0}, "learning_rate: must be"),
+        ({"seed": -1}, "seed: must be"),
+        ({"device": "tpu"}, "device: must be one of 'auto', 'cpu', 'cuda'"),
+        ({"dtype": torch.float16}, "dtype: must be"),
+        ({"max_models_per_pass": 0}, "max_models_per_pass: must be"),
+        ({"progress": 3}, "progress: must be"),
+        ({"splits": []}, "splits: must be a non-empty list"),
         ({"splits": [(np.arange(3), np.array([200]))]}, "val indices of split 0"),
-        ({"splits": [(np.array([], dtype=int), np.arange(3))]}, "Split 0 has no training row"),
+        ({"splits": [(np.array([], dtype=int), np.arange(3))]}, "split 0 with no training row"),
         ({"splits": [(np.array([0.5]), np.arange(3))]}, "train indices of split 0"),
     ],
 )
@@ -415,11 +415,11 @@ def test_bad_data_raises():
     split = [(rows, rows[:0])]
     X_nan = X.copy()
     X_nan[4, 2] = np.nan
-    with pytest.raises(ValueError, match="'X' of train_mlp_grid must be finite"):
+    with pytest.raises(ValueError, match="X: must be finite"):
         train_mlp_grid(X_nan, y, split, [(3, 3)], epochs=1)
-    with pytest.raises(ValueError, match=r"'y' of train_mlp_grid must have shape \(30,\)"):
+    with pytest.raises(ValueError, match=r"y: must have shape \(30,\)"):
         train_mlp_grid(X, y[:-1], split, [(3, 3)], epochs=1)
-    with pytest.raises(ValueError, match="'X' of train_mlp_grid must be a non-empty 2-D"):
+    with pytest.raises(ValueError, match="X: must be a non-empty 2-D"):
         train_mlp_grid(X[:, 0], y, split, [(3, 3)], epochs=1)
 
 
@@ -428,7 +428,9 @@ def test_cuda_is_refused_clearly_without_a_gpu_and_matches_cpu_with_one():
     rows = np.arange(60)
     args = (X, y, [(rows[:40], rows[40:])], [(5, 4)])
     if not torch.cuda.is_available():
-        with pytest.raises(ValueError, match="'device' of train_mlp_grid is 'cuda'"):
+        with pytest.raises(
+            ValueError, match="device: must be 'auto' or 'cpu' without a usable GPU"
+        ):
             train_mlp_grid(*args, epochs=1, device="cuda")
         pytest.skip("CUDA not available: GPU equivalence not checked")
     # the device shuffle draws the same orders on both; the GPU path graphs its epochs

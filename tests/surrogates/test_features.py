@@ -70,10 +70,10 @@ def test_hash_is_stable_and_sensitive():
 
 
 def test_check_features_accepts_one_sample_and_names_bad_input():
-    assert check_features(np.ones(7), "f").shape == (1, 7)
-    with pytest.raises(ValueError, match="7 columns"):
-        check_features(np.ones((3, 6)), "f")
+    assert check_features(np.ones(7)).shape == (1, 7)
+    with pytest.raises(ValueError, match="X: must have 7 columns"):
+        check_features(np.ones((3, 6)))
     x = np.ones((2, 7))
     x[1, 6] = np.nan
     with pytest.raises(ValueError, match="'pressure_mpa' of row 1"):
-        check_features(x, "f")
+        check_features(x)

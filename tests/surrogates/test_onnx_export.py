@@ -166,11 +166,11 @@ def test_bad_inputs_are_refused(fitted, tmp_path):
     with pytest.raises(FileNotFoundError):
         onnx_predict(tmp_path / "absent.onnx", np.ones((2, 7)))
     for opset in (12, "17", True, 10**6):
-        with pytest.raises(ValueError, match="'opset' of to_onnx"):
+        with pytest.raises(ValueError, match="opset: must be None or an integer"):
             to_onnx(model, opset=opset)
-    with pytest.raises(ValueError, match=r"'opset' of to_onnx.*\[13, "):
+    with pytest.raises(ValueError, match=r"opset: must be .*\[13, "):
         to_onnx(fitted["xgb"], opset=99)
-    with pytest.raises(ValueError, match="'model' of to_onnx must be one of"):
+    with pytest.raises(ValueError, match="model: must be one of"):
         to_onnx(LinearRegression().fit(np.ones((3, 7)), np.ones(3)))
     with pytest.raises(NotFittedError):
         to_onnx(PolynomialRegressor())

@@ -3,10 +3,14 @@
 from __future__ import annotations
 
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 import typer
 
 from softbend.cli import _common
+
+if TYPE_CHECKING:
+    from softbend.surrogates.features import TrainingData
 
 
 def train(
@@ -108,11 +112,11 @@ def train(
     from softbend.surrogates.workflow import train_into
 
     if workers is not None:
-        check_int(workers, "--workers", low=1)
+        check_int(workers, "workers", low=1)
     if halving_rungs is not None:
-        check_int(halving_rungs, "--halving-rungs", low=1)
+        check_int(halving_rungs, "halving_rungs", low=1)
     if plr_patience is not None:
-        check_int(plr_patience, "--plr-patience", low=1)
+        check_int(plr_patience, "plr_patience", low=1)
     if epochs is not None:
         check_limit("epochs", epochs, "--epochs")
     source = _training_source(
@@ -166,7 +170,7 @@ def _training_source(
     pressure_unit: str | None,
     angle_column: str,
     actuator: str | None,
-) -> object:
+) -> Path | TrainingData:
     """The campaign path, or a table's training data (checked before anything runs)."""
     from softbend.surrogates.tables import TABLE_SUFFIXES
 

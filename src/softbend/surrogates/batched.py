@@ -54,8 +54,8 @@ import numpy as np
 from numpy.typing import ArrayLike
 
 from softbend._torch import require_torch
-from softbend._validation import check_choice, check_int, check_range
-from softbend.errors import ConvergenceError
+from softbend._validation import check_choice, check_int, check_range, must_be
+from softbend.errors import ConvergenceError, InputError
 from softbend.limits import check_limit
 from softbend.surrogates.batched_checks import (
     check_data,
@@ -387,9 +387,7 @@ def train_mlp_grid(
     device = resolve_device(device)
     dtype = check_dtype(dtype)
     if progress is not None and not callable(progress):
-        raise ValueError(
-            f"The 'progress' of {_OWNER} must be a callable or None. Got {progress!r} instead."
-        )
+        raise InputError(f"must be a callable or None; got {progress!r}", key="progress")
     if max_models_per_pass is not None:
         max_models_per_pass = check_int(max_models_per_pass, "max_models_per_pass", low=1)
     if max_memory_mb is not None:
@@ -401,13 +399,11 @@ def train_mlp_grid(
         shuffle = "device" if device == "cuda" else "host"
     for name, flag in (("tf32", tf32), ("compile_step", compile_step)):
         if not isinstance(flag, bool):
-            raise ValueError(f"The '{name}' of {_OWNER} must be True or False. Got {flag!r}.")
+            raise InputError(must_be("True or False", flag), key=name)
     if cuda_graph is None:
         cuda_graph = device == "cuda" and shuffle == "device"
     elif not isinstance(cuda_graph, bool):
-        raise ValueError(
-            f"The 'cuda_graph' of {_OWNER} must be True, False or None. Got {cuda_graph!r}."
-        )
+        raise InputError(must_be("True, False or None", cuda_graph), key="cuda_graph")
 
     jobs = [
         _Job(c, s, h1, h2, train, val)
@@ -438,7 +434,6 @@ def train_mlp_grid(
         dtype=dtype,
         max_models_per_pass=max_models_per_pass,
         max_memory_mb=max_memory_mb,
-        owner=_OWNER,
     )
     X_dev = torch.tensor(X, dtype=torch.float64, device=device)
     y_dev = torch.tensor(y, dtype=torch.float64, device=device)

@@ -12,6 +12,7 @@ import os
 from typing import TYPE_CHECKING
 
 from softbend._torch import require_torch
+from softbend.errors import InputError
 
 if TYPE_CHECKING:
     import torch
@@ -93,9 +94,8 @@ def models_per_pass(
     dtype: torch.dtype,
     max_models_per_pass: int | None,
     max_memory_mb: float | None,
-    owner: str = "train_mlp_grid",
 ) -> int:
-    """Models one pass of ``owner`` trains at once, checked against the memory allowed.
+    """Models one pass trains at once, checked against the memory allowed.
 
     Parameters
     ----------
@@ -111,8 +111,6 @@ def models_per_pass(
         Upper bound asked for (None: all models at once).
     max_memory_mb : float or None
         Memory a pass may use, MB; None: 80 % of :func:`available_bytes`.
-    owner : str
-        Name of the calling function, for the error message.
 
     Returns
     -------
@@ -121,9 +119,9 @@ def models_per_pass(
 
     Raises
     ------
-    ValueError
-        If that many models would not fit, naming the largest
-        ``max_models_per_pass`` that would (or that even one does not fit).
+    softbend.errors.InputError
+        Key ``max_models_per_pass``: that many models would not fit; the message
+        names the largest number that would (or that even one does not fit).
     """
     per_pass = n_models if max_models_per_pass is None else min(max_models_per_pass, n_models)
     itemsize = torch.empty((), dtype=dtype).element_size()
@@ -137,13 +135,14 @@ def models_per_pass(
     if need(per_pass) > budget:
         fitting = [k for k in range(per_pass, 0, -1) if need(k) <= budget][:1]
         hint = (
-            f"set 'max_models_per_pass' of {owner} to {fitting[0]} or fewer"
+            f"set it to {fitting[0]} or fewer"
             if fitting
             else "even one model does not fit: lower 'batch_size'"
         )
-        raise ValueError(
-            f"Training {per_pass} MLPs at once needs about {need(per_pass) / 1024**2:.3g} MB "
-            f"on {device}, more than the {budget / 1024**2:.3g} MB allowed; {hint} "
-            f"(train fewer configurations at a time)."
+        raise InputError(
+            f"must leave a pass within the memory allowed: training {per_pass} MLPs at once "
+            f"needs about {need(per_pass) / 1024**2:.3g} MB on {device}, more than the "
+            f"{budget / 1024**2:.3g} MB allowed; {hint} (train fewer configurations at a time)",
+            key="max_models_per_pass",
         )
     return per_pass

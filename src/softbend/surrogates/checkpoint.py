@@ -53,7 +53,7 @@ def checkpoint_path(out_dir: str | os.PathLike[str]) -> Path:
     return out.with_name(f".{out.name}.train-checkpoint.jsonl")
 
 
-def _plain(value: Any) -> Any:
+def _plain(value: object) -> Any:
     """JSON fallback for NumPy scalars and arrays."""
     if isinstance(value, np.generic):
         return value.item()
@@ -62,7 +62,7 @@ def _plain(value: Any) -> Any:
     raise TypeError(f"{type(value).__name__} is not JSON-serializable")
 
 
-def _canonical(value: Any) -> Any:
+def _canonical(value: object) -> Any:
     """``value`` as it reads back from JSON (tuples become lists, NumPy scalars numbers)."""
     return json.loads(json.dumps(value, default=_plain, sort_keys=True))
 

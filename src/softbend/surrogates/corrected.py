@@ -34,6 +34,8 @@ from numpy.typing import ArrayLike
 from scipy.stats import norm
 
 from softbend._validation import check_range
+from softbend.errors import InputError
+from softbend.surrogates.protocol import Surrogate
 
 __all__ = [
     "AffineCorrected",
@@ -45,12 +47,10 @@ __all__ = [
 ]
 
 
-def _rows(X: ArrayLike, n_features: int, owner: str) -> np.ndarray:
+def _rows(X: ArrayLike, n_features: int) -> np.ndarray:
     rows = np.asarray(X, dtype=np.float64)
     if rows.ndim != 2 or rows.shape[1] != n_features:
-        raise ValueError(
-            f"The 'X' of {owner} must have shape (n, {n_features}). Got {rows.shape} instead."
-        )
+        raise InputError(f"must have shape (n, {n_features}); got {rows.shape}", key="X")
     return rows
 
 
@@ -61,7 +61,7 @@ def scaled_pressure_rows(X: ArrayLike, scale: float) -> np.ndarray:
     return rows
 
 
-def _half_width(level: float, std: np.ndarray | float, owner: str) -> np.ndarray | float:
+def _half_width(level: float, std: np.ndarray | float) -> np.ndarray | float:
     """Half the central interval of probability ``level`` of a Gaussian of ``std``."""
     level = check_range(level, "level", low=0.0, high=1.0)
     return norm.ppf(0.5 + level / 2) * std
@@ -83,7 +83,7 @@ class AffineCorrected:
         interval's width.
     """
 
-    def __init__(self, base: Any, scale: float, offset: float, residual_std: float) -> None:
+    def __init__(self, base: Surrogate, scale: float, offset: float, residual_std: float) -> None:
         self.base = base
         self.scale_ = float(scale)
         self.offset_ = float(offset)
@@ -92,12 +92,12 @@ class AffineCorrected:
 
     def predict(self, X: ArrayLike) -> np.ndarray:
         """Corrected angle, degrees."""
-        rows = _rows(X, self.n_features_in_, type(self).__name__)
+        rows = _rows(X, self.n_features_in_)
         return self.scale_ * np.asarray(self.base.predict(rows), dtype=np.float64) + self.offset_
 
     def predict_interval(self, X: ArrayLike, level: float = 0.9) -> tuple[np.ndarray, np.ndarray]:
         """Central interval of probability ``level`` (Gaussian residuals), degrees."""
-        half = _half_width(level, self.residual_std_, type(self).__name__)
+        half = _half_width(level, self.residual_std_)
         mean = self.predict(X)
         return mean - half, mean + half
 
@@ -117,7 +117,7 @@ class PressureScaled:
         interval's width.
     """
 
-    def __init__(self, base: Any, scale: float, residual_std: float) -> None:
+    def __init__(self, base: Surrogate, scale: float, residual_std: float) -> None:
         self.base = base
         self.scale_ = check_range(scale, "scale", low=0.0)
         self.residual_std_ = float(residual_std)
@@ -125,12 +125,12 @@ class PressureScaled:
 
     def predict(self, X: ArrayLike) -> np.ndarray:
         """The base's angle at the scaled pressure, degrees."""
-        rows = scaled_pressure_rows(_rows(X, self.n_features_in_, type(self).__name__), self.scale_)
+        rows = scaled_pressure_rows(_rows(X, self.n_features_in_), self.scale_)
         return np.asarray(self.base.predict(rows), dtype=np.float64)
 
     def predict_interval(self, X: ArrayLike, level: float = 0.9) -> tuple[np.ndarray, np.ndarray]:
         """Central interval of probability ``level`` (Gaussian residuals), degrees."""
-        half = _half_width(level, self.residual_std_, type(self).__name__)
+        half = _half_width(level, self.residual_std_)
         mean = self.predict(X)
         return mean - half, mean + half
 
@@ -175,7 +175,7 @@ class GPCorrected:
 
     def __init__(
         self,
-        base: Any,
+        base: Surrogate,
         z_mean: ArrayLike,
         z_scale: ArrayLike,
         kernel_theta: ArrayLike,
@@ -208,14 +208,14 @@ class GPCorrected:
         self, X: ArrayLike, return_std: bool = False
     ) -> np.ndarray | tuple[np.ndarray, np.ndarray]:
         """Corrected angle, degrees (and the predictive standard deviation, degrees)."""
-        theta, z = self._inputs(_rows(X, self.n_features_in_, type(self).__name__))
+        theta, z = self._inputs(_rows(X, self.n_features_in_))
         mean, std = self.gp_.predict(z, return_std=True)
         return (theta + mean, std) if return_std else theta + mean
 
     def predict_interval(self, X: ArrayLike, level: float = 0.9) -> tuple[np.ndarray, np.ndarray]:
         """Central interval of probability ``level`` for a new reading, degrees."""
         mean, std = self.predict(X, return_std=True)
-        half = _half_width(level, std, type(self).__name__)
+        half = _half_width(level, std)
         return mean - half, mean + half
 
 
@@ -231,18 +231,16 @@ class MeanEnsemble:
         (>= 0); added in quadrature to the spread for the interval.
     """
 
-    def __init__(self, members: list[Any], residual_std: float) -> None:
+    def __init__(self, members: list[Surrogate], residual_std: float) -> None:
         if len(members) < 2:
-            raise ValueError(
-                f"The 'members' of MeanEnsemble must be 2 or more surrogates. Got {len(members)}."
-            )
+            raise InputError(f"must be 2 or more surrogates; got {len(members)}", key="members")
         self.members_ = list(members)
         self.residual_std_ = float(residual_std)
         self.n_features_in_ = int(members[0].n_features_in_)
 
     def spread(self, X: ArrayLike) -> tuple[np.ndarray, np.ndarray]:
         """The members' mean and sample standard deviation, degrees."""
-        rows = _rows(X, self.n_features_in_, type(self).__name__)
+        rows = _rows(X, self.n_features_in_)
         predictions = np.array([m.predict(rows) for m in self.members_], dtype=np.float64)
         return predictions.mean(axis=0), predictions.std(axis=0, ddof=1)
 
@@ -253,5 +251,5 @@ class MeanEnsemble:
     def predict_interval(self, X: ArrayLike, level: float = 0.9) -> tuple[np.ndarray, np.ndarray]:
         """Central interval of probability ``level`` (spread and noise, Gaussian), degrees."""
         mean, spread = self.spread(X)
-        half = _half_width(level, np.sqrt(spread**2 + self.residual_std_**2), type(self).__name__)
+        half = _half_width(level, np.sqrt(spread**2 + self.residual_std_**2))
         return mean - half, mean + half

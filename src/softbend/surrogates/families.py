@@ -42,14 +42,22 @@ import importlib
 import sys
 from collections.abc import Callable, Iterator, Mapping, Sequence
 from dataclasses import dataclass, field
-from typing import Any, Protocol
+from typing import TYPE_CHECKING, Any, Protocol, cast
 
 from softbend._extras import require
-from softbend._validation import check_choice
+from softbend._validation import check_choice, must_be
+from softbend.errors import InputError, keyed
 from softbend.references import SURROGATE_TRAINING
 from softbend.registry import Registry
+from softbend.surrogates.protocol import Surrogate
 from softbend.surrogates.schema import MLP_SCHEMA, POLYNOMIAL_SCHEMA, XGBOOST_SCHEMA, Schema
 from softbend.surrogates.xgboost_codec import XGBoostCodec
+
+if TYPE_CHECKING:
+    from xgboost import XGBRegressor
+
+    from softbend.surrogates.mlp import NormalizedMLPRegressor
+    from softbend.surrogates.polynomial import PolynomialRegressor
 
 __all__ = [
     "FAMILIES",
@@ -106,21 +114,24 @@ class Codec(Protocol):
     a new estimator after its schema's rule accepted it.
     """
 
-    def is_fitted(self, model: Any) -> bool:
-        """Whether ``model`` is fitted (and can be saved)."""
+    def is_fitted(self, model: object) -> bool:
+        """Whether ``model`` (an instance of the family's class) is fitted (and can be saved)."""
         ...
 
-    def params(self, model: Any) -> dict[str, Any]:
+    def params(self, model: Surrogate) -> dict[str, Any]:
         """The parameters to write, as strict JSON."""
         ...
 
-    def state(self, model: Any) -> dict[str, Any]:
+    def state(self, model: Surrogate) -> dict[str, Any]:
         """The fitted state to write, as strict JSON (checked on load by the schema)."""
         ...
 
-    def restore(self, cls: type, params: dict[str, Any], state: dict[str, Any], path: str) -> Any:
+    def restore(
+        self, cls: type, params: dict[str, Any], state: dict[str, Any], path: str
+    ) -> Surrogate:
         """The fitted estimator of ``params`` (as read) and ``state`` (checked), or a
-        :class:`~softbend.errors.SchemaError` naming ``path``."""
+        :class:`~softbend.errors.SchemaError` keyed by the field at fault
+        (``params.missing``); the loader names the file ``path``."""
         ...
 
 
@@ -157,7 +168,7 @@ class Storage:
     extra: str | None = None
     codec: Codec | None = None
 
-    def holds(self, model: Any) -> bool:
+    def holds(self, model: object) -> bool:
         """Whether ``model`` is an instance of exactly this class (no import)."""
         cls = getattr(sys.modules.get(self.module), self.class_name, None)
         return cls is not None and type(model) is cls
@@ -203,23 +214,26 @@ class Family:
     onnx: Callable[[Any, int | None], Any] | None = field(default=None, compare=False)
 
     def __post_init__(self) -> None:
-        owner = f"the surrogate family {self.name!r}"
+        family = f"of the surrogate family {self.name!r}"
         if not isinstance(self.title, str) or not self.title.strip():
-            raise ValueError(f"The 'title' of {owner} must be a non-empty string.")
+            raise InputError(must_be(f"a non-empty string {family}", self.title), key="title")
         if not callable(self.make):
-            raise ValueError(f"The 'make' of {owner} must be callable (params, settings).")
+            raise InputError(
+                f"must be callable (params, settings) {family}; got {self.make!r}", key="make"
+            )
         grids = dict(self.grids) if isinstance(self.grids, Mapping) else {}
         for grid_name in GRID_NAMES:
             configs = grids.get(grid_name)
             if not isinstance(configs, Sequence) or isinstance(configs, str) or not configs:
-                raise ValueError(
-                    f"The 'grids' of {owner} must give one or more configurations for each "
-                    f"grid {', '.join(GRID_NAMES)}. Got {grid_name!r}: {configs!r}."
+                raise InputError(
+                    f"must give one or more configurations {family} for each grid "
+                    f"{', '.join(GRID_NAMES)}; got {grid_name!r}: {configs!r}",
+                    key="grids",
                 )
             if not all(isinstance(c, Mapping) for c in configs):
-                raise ValueError(
-                    f"The 'grids' of {owner} must hold dicts of parameters. "
-                    f"Got {configs!r} for {grid_name!r}."
+                raise InputError(
+                    f"must hold dicts of parameters {family}; got {configs!r} for {grid_name!r}",
+                    key="grids",
                 )
         object.__setattr__(self, "grids", {k: tuple(dict(c) for c in v) for k, v in grids.items()})
 
@@ -234,10 +248,10 @@ class _FamilyRegistry(Registry[Family]):
 
     def register(self, name: str, entry: Family, *, replace: bool = False) -> Family:
         if not isinstance(entry, Family) or entry.name != name:
-            raise ValueError(
-                f"A surrogate family must be a Family registered under its own name. "
-                f"Got {type(entry).__name__} named {getattr(entry, 'name', None)!r} "
-                f"for {name!r}."
+            raise InputError(
+                f"must be a Family registered under its own name; got {type(entry).__name__} "
+                f"named {getattr(entry, 'name', None)!r} for {name!r}",
+                key="entry",
             )
         return super().register(name, entry, replace=replace)
 
@@ -246,33 +260,33 @@ class _FamilyRegistry(Registry[Family]):
 FAMILIES: Registry[Family] = _FamilyRegistry("surrogate family")
 
 
-def family_names(models: str | Sequence[str], *, field: str = "models") -> tuple[str, ...]:
+def family_names(models: str | Sequence[str]) -> tuple[str, ...]:
     """The families named by ``models``, each checked, without repeats, in order.
 
     Parameters
     ----------
     models : str or sequence of str
         Names, or one comma-separated text of names (``"plr,mlp"``).
-    field : str
-        The option or argument they came from, for the messages.
 
     Raises
     ------
     softbend.registry.UnknownNameError
-        For a name no family has, listing the known ones.
-    ValueError
-        For no name at all.
+        For a name no family has, listing the known ones (key ``models``).
+    softbend.errors.InputError
+        For no name at all (key ``models``).
     """
+    given = models
     if isinstance(models, str):
         models = models.split(",")
     names = [m.strip() if isinstance(m, str) else m for m in models]
     names = [m for m in names if m != ""]
     if not names:
-        raise ValueError(
-            f"The '{field}' must name at least one surrogate family "
-            f"(known: {', '.join(FAMILIES.names())})."
+        known = ", ".join(FAMILIES.names())
+        raise InputError(
+            must_be(f"at least one surrogate family name (known: {known})", given), key="models"
         )
-    return tuple(dict.fromkeys(FAMILIES.check(name, field=field) for name in names))
+    with keyed("models"):
+        return tuple(dict.fromkeys(FAMILIES.check(name) for name in names))
 
 
 def legacy_kinds() -> dict[str, str]:
@@ -334,22 +348,22 @@ def _make_mlp(params: dict[str, Any], settings: FitSettings) -> Any:
     )
 
 
-def _plr_onnx(model: Any, opset: int | None) -> Any:
+def _plr_onnx(model: Surrogate, opset: int | None) -> Any:
     from softbend.surrogates.onnx_graphs import polynomial_graph
 
-    return polynomial_graph(model, opset)
+    return polynomial_graph(cast("PolynomialRegressor", model), opset)
 
 
-def _xgb_onnx(model: Any, opset: int | None) -> Any:
+def _xgb_onnx(model: Surrogate, opset: int | None) -> Any:
     from softbend.surrogates.onnx_graphs import xgboost_graph
 
-    return xgboost_graph(model, opset)
+    return xgboost_graph(cast("XGBRegressor", model), opset)
 
 
-def _mlp_onnx(model: Any, opset: int | None) -> Any:
+def _mlp_onnx(model: Surrogate, opset: int | None) -> Any:
     from softbend.surrogates.onnx_graphs import mlp_graph
 
-    return mlp_graph(model, opset)
+    return mlp_graph(cast("NormalizedMLPRegressor", model), opset)
 
 
 _INPUT_STATE = ("n_features_in_", "x_mean_", "x_scale_", "y_mean_", "y_scale_")

@@ -20,7 +20,7 @@ import numpy as np
 from numpy.typing import ArrayLike
 
 from softbend.design import FEATURES as DESIGN_FEATURES
-from softbend.errors import DatasetError
+from softbend.errors import DatasetError, InputError
 
 if TYPE_CHECKING:  # a table only for training: predicting needs no pandas
     import pandas as pd
@@ -185,8 +185,8 @@ def training_data(
     )
 
 
-def check_features(X: ArrayLike, owner: str) -> np.ndarray:
-    """``X`` as a finite float64 array of shape (n, 7), or one clear ``ValueError``.
+def check_features(X: ArrayLike) -> np.ndarray:
+    """``X`` as a finite float64 array of shape (n, 7), or one :class:`InputError` (key ``X``).
 
     A single sample may be given as a 1-D array of length 7.
     """
@@ -195,16 +195,16 @@ def check_features(X: ArrayLike, owner: str) -> np.ndarray:
     if array.ndim == 1:
         array = array[None, :]
     if array.ndim != 2 or array.shape[1] != len(features):
-        raise ValueError(
-            f"The 'X' of {owner} must have {len(features)} columns "
-            f"({', '.join(features)}). Got shape {np.shape(X)} instead."
+        raise InputError(
+            f"must have {len(features)} columns ({', '.join(features)}); got shape {np.shape(X)}",
+            key="X",
         )
     bad = ~np.isfinite(array)
     if bad.any():
         row, col = np.argwhere(bad)[0]
-        raise ValueError(
-            f"The 'X' of {owner} must be finite. Got {array[row, col]} in column "
-            f"'{features[col]}' of row {row}."
+        raise InputError(
+            f"must be finite; got {array[row, col]} in column '{features[col]}' of row {row}",
+            key="X",
         )
     return array
 
@@ -215,7 +215,7 @@ def training_ranges(X: ArrayLike) -> dict[str, list[float]]:
     Saved with a model (``metadata["training_ranges"]``) so that a prediction
     outside them can be flagged (:func:`outside_training_ranges`).
     """
-    array = check_features(X, "training_ranges")
+    array = check_features(X)
     return {
         name: [float(array[:, j].min()), float(array[:, j].max())]
         for j, name in enumerate(model_features())
@@ -232,7 +232,7 @@ def outside_training_ranges(ranges: dict[str, list[float]], X: ArrayLike) -> lis
     X : array_like of shape (n, 7)
         Rows to predict.
     """
-    array = check_features(X, "outside_training_ranges")
+    array = check_features(X)
     out = []
     for j, name in enumerate(model_features()):
         if name not in ranges:

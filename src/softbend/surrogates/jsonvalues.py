@@ -15,24 +15,31 @@ an equal object of the same type (the format is that of
 from __future__ import annotations
 
 from pathlib import Path
-from typing import Any
+from typing import Any, Protocol, cast
 
 import numpy as np
 
 from softbend._validation import short_repr
+from softbend.errors import InputError
 from softbend.surrogates.schema import tag_float, untag_float
 
 __all__ = ["decode", "encode", "encode_params", "plain_json"]
 
 
-def _tagged(nested: Any) -> Any:
+class _Estimator(Protocol):
+    """A scikit-learn style estimator: its constructor parameters by name."""
+
+    def get_params(self, deep: bool = True) -> dict[str, Any]: ...
+
+
+def _tagged(nested: object) -> Any:
     """A nested list of an array's elements with its NaN and infinities as tags."""
     if isinstance(nested, list):
         return [_tagged(v) for v in nested]
     return tag_float(nested) if isinstance(nested, float) else nested
 
 
-def encode(value: Any, where: str) -> Any:
+def encode(value: object, where: str) -> Any:
     """Strict-JSON form of ``value`` that :func:`decode` turns back into an equal object.
 
     Parameters
@@ -74,14 +81,14 @@ def encode(value: Any, where: str) -> Any:
     raise TypeError(f"{where}: values of type {type(value).__name__} cannot be saved")
 
 
-def _untagged(nested: Any) -> Any:
+def _untagged(nested: object) -> Any:
     """A nested list of an array's elements with its tags of non-finite floats as floats."""
     if isinstance(nested, list):
         return [_untagged(v) for v in nested]
     return untag_float(nested)
 
 
-def _dtype(name: Any) -> np.dtype:
+def _dtype(name: object) -> np.dtype:
     """The NumPy dtype ``name`` of a saved array or scalar: a bool, integer or float one."""
     dtype = np.dtype(name) if isinstance(name, str) else None
     if dtype is None or dtype.kind not in "biuf":
@@ -89,7 +96,7 @@ def _dtype(name: Any) -> np.dtype:
     return dtype
 
 
-def decode(value: Any) -> Any:
+def decode(value: object) -> Any:
     """The object :func:`encode` wrote (raises KeyError, TypeError, ValueError, RuleError)."""
     if isinstance(value, list):
         return [decode(v) for v in value]
@@ -112,28 +119,29 @@ def decode(value: Any) -> Any:
     return {k: decode(v) for k, v in value.items()}
 
 
-def encode_params(model: Any) -> dict[str, Any]:
+def encode_params(model: object) -> dict[str, Any]:
     """The encoded ``get_params(deep=False)`` of an estimator.
 
     Raises
     ------
-    ValueError
-        A parameter JSON cannot hold, naming it and the estimator's class.
+    softbend.errors.InputError
+        Key ``model``: a parameter JSON cannot hold, naming it and the estimator's class.
     """
     params = {}
-    for key, value in model.get_params(deep=False).items():
+    for key, value in cast(_Estimator, model).get_params(deep=False).items():
         try:
             params[key] = encode(value, key)
         except TypeError:
-            raise ValueError(
-                f"The parameter '{key}' of {type(model).__name__} must be JSON-serializable to "
-                f"save the model (None, numbers, strings, arrays, lists, tuples, dicts). "
-                f"Got {type(value).__name__} instead."
+            raise InputError(
+                "must have JSON-serializable parameters to be saved (None, numbers, strings, "
+                f"arrays, lists, tuples, dicts); got {type(value).__name__} for the parameter "
+                f"'{key}' of {type(model).__name__}",
+                key="model",
             ) from None
     return params
 
 
-def plain_json(value: Any) -> Any:
+def plain_json(value: object) -> Any:
     """``json.dumps`` fallback for caller metadata: NumPy numbers and arrays as Python ones."""
     if isinstance(value, np.generic | np.ndarray):
         return value.tolist()

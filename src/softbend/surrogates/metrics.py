@@ -16,6 +16,7 @@ import numpy as np
 from numpy.typing import ArrayLike
 
 from softbend.metrics import r2, rmse, thresholded_mape
+from softbend.surrogates.protocol import Surrogate
 
 #: Default smallest ``|θ|`` (degrees) included in the MAPE.
 MAPE_THRESHOLD_DEG = 1.0
@@ -64,7 +65,7 @@ def _median_time(call: Callable[[], Any], *, repeats: int, number: int) -> float
 
 
 def inference_time(
-    model: Any, X: ArrayLike, *, batch: int = 10_000, repeats: int = 5, seed: int = 0
+    model: Surrogate, X: ArrayLike, *, batch: int = 10_000, repeats: int = 5, seed: int = 0
 ) -> dict[str, float]:
     """Inference time of a fitted surrogate for one sample and for a batch.
 

@@ -23,7 +23,8 @@ from numpy.typing import ArrayLike
 from sklearn.base import BaseEstimator, RegressorMixin
 from sklearn.utils.validation import check_is_fitted, validate_data
 
-from softbend._validation import check_int, check_range
+from softbend._validation import check_int, check_range, must_be
+from softbend.errors import InputError
 from softbend.surrogates.features import FEATURES
 from softbend.surrogates.mlp_core import check_hidden_pair, mlp_forward, resolve_device
 
@@ -32,17 +33,16 @@ if TYPE_CHECKING:
 
 __all__ = ["NormalizedMLPRegressor", "mlp_forward"]
 
-_OWNER = "NormalizedMLPRegressor"
-
 
 def _check_finite_x(X: np.ndarray, method: str) -> None:
     bad = ~np.isfinite(X)
     if bad.any():
         row, col = (int(i) for i in np.argwhere(bad)[0])
         column = FEATURES[col] if X.shape[1] == len(FEATURES) else f"column {col}"
-        raise ValueError(
-            f"The 'X' of {_OWNER}.{method} must be finite (no NaN or inf). "
-            f"Got {X[row, col]} in '{column}' of row {row}."
+        raise InputError(
+            f"must be finite (no NaN or inf) in {method}; got {X[row, col]} in '{column}' "
+            f"of row {row}",
+            key="X",
         )
 
 
@@ -55,9 +55,9 @@ def _check_finite_y(y: ArrayLike) -> None:
     bad = ~np.isfinite(values)
     if bad.any():
         first = int(np.flatnonzero(bad.ravel())[0])
-        raise ValueError(
-            f"The 'y' of {_OWNER}.fit must be finite (no NaN or inf). "
-            f"Got {values.ravel()[first]} at position {first}."
+        raise InputError(
+            f"must be finite (no NaN or inf); got {values.ravel()[first]} at position {first}",
+            key="y",
         )
 
 
@@ -149,12 +149,12 @@ class NormalizedMLPRegressor(RegressorMixin, BaseEstimator):
         ConvergenceError
             If training produced non-finite weights.
         """
-        hidden = check_hidden_pair(self.hidden_sizes, "hidden_sizes", _OWNER)
+        hidden = check_hidden_pair(self.hidden_sizes)
         epochs = check_int(self.epochs, "epochs", low=1)
         batch_size = check_int(self.batch_size, "batch_size", low=1)
         learning_rate = check_range(self.learning_rate, "learning_rate", low=0.0, high=math.inf)
         seed = check_int(self.seed, "seed", low=0)
-        device = resolve_device(self.device, _OWNER)
+        device = resolve_device(self.device)
         # PyTorch only for training: loading and predicting stay NumPy
         from softbend.surrogates.batched import train_mlp_grid
 
@@ -295,19 +295,19 @@ class NormalizedMLPRegressor(RegressorMixin, BaseEstimator):
                 (1,),
             ]
         if not ok:
-            raise ValueError(
-                f"The arrays of {_OWNER}.from_arrays must have shapes x_mean (d,), "
-                f"x_scale (d,), coefs (d, h1), (h1, h2), (h2, 1), intercepts (h1,), (h2,), "
-                f"(1,). Got x_mean {mean.shape}, x_scale {scale.shape}, coefs "
-                f"{[c.shape for c in weights]}, intercepts {[b.shape for b in biases]}."
+            raise InputError(
+                "x_mean, x_scale, coefs and intercepts must have shapes (d,), (d,), "
+                "[(d, h1), (h1, h2), (h2, 1)] and [(h1,), (h2,), (1,)]; got "
+                f"{mean.shape}, {scale.shape}, {[c.shape for c in weights]} and "
+                f"{[b.shape for b in biases]}"
             )
         values = [mean, scale, np.array([y_mean, y_scale], dtype=np.float64)]
         if not all(np.all(np.isfinite(v)) for v in [*values, *weights, *biases]):
-            raise ValueError(f"The arrays of {_OWNER}.from_arrays must be finite.")
+            raise InputError("the arrays of from_arrays must be finite; got NaN or inf")
         if np.any(scale <= 0) or not y_scale > 0:
-            raise ValueError(
-                f"The 'x_scale' and 'y_scale' of {_OWNER}.from_arrays must be > 0. "
-                f"Got x_scale {scale.tolist()}, y_scale {y_scale!r} instead."
+            raise InputError(
+                f"x_scale and y_scale must be > 0; got x_scale {scale.tolist()}, "
+                f"y_scale {y_scale!r}"
             )
         estimator = cls(hidden_sizes=(int(h1), int(h2)), **params)
         estimator._set_fitted(
@@ -370,18 +370,12 @@ class NormalizedMLPRegressor(RegressorMixin, BaseEstimator):
         def predict_one(x: ArrayLike) -> float:
             x = asarray(x, dtype=np.float64)
             if x.shape != shape:
-                raise ValueError(
-                    f"The 'x' of {_OWNER}.predictor must have shape {shape}. "
-                    f"Got shape {x.shape} instead."
-                )
+                raise InputError(f"must have shape {shape}; got shape {x.shape}", key="x")
             h = tanh(dot(x, W1f) + b1f)
             h = tanh(dot(h, W2c) + b2)
             value = float(dot(h, w3)) + offset
             if not isfinite(value) or not isfinite(float(dot(x, x))):
-                raise ValueError(
-                    f"The 'x' of {_OWNER}.predictor must be finite (no NaN or inf). "
-                    f"Got {x.tolist()} instead."
-                )
+                raise InputError(must_be("finite (no NaN or inf)", x.tolist()), key="x")
             return value
 
         return predict_one

@@ -17,7 +17,8 @@ from typing import Any, cast
 
 import numpy as np
 
-from softbend._validation import check_choice
+from softbend._validation import check_choice, must_be
+from softbend.errors import InputError
 
 __all__ = [
     "check_hidden_pair",
@@ -64,31 +65,35 @@ def mlp_forward(
     return y_mean + y_scale * (a @ coefs[2] + intercepts[2])[:, 0]
 
 
-def check_hidden_pair(value: object, name: str, owner: str) -> tuple[int, int]:
-    message = (
-        f"The '{name}' of {owner} must be a pair of positive integers (h1, h2). "
-        f"Got {value!r} instead."
-    )
+def check_hidden_pair(value: object) -> tuple[int, int]:
+    """``value`` as a pair of positive integers (h1, h2), the sizes of the two hidden layers.
+
+    Raises
+    ------
+    softbend.errors.InputError
+        Key ``hidden_sizes``: anything else.
+    """
+    error = InputError(must_be("a pair of positive integers (h1, h2)", value), key="hidden_sizes")
     try:
         pair: tuple[Any, ...] = tuple(value)  # type: ignore[arg-type]
     except TypeError:
-        raise ValueError(message) from None
+        raise error from None
     if len(pair) != 2 or not all(
         isinstance(h, Integral) and not isinstance(h, bool) and cast(int, h) >= 1 for h in pair
     ):
-        raise ValueError(message)
+        raise error
     return int(pair[0]), int(pair[1])
 
 
-def resolve_device(device: object, owner: str = "train_mlp_grid") -> str:
+def resolve_device(device: object, owner: str | None = None) -> str:
     """The torch device a ``device`` parameter means: ``"cpu"`` or ``"cuda"``.
 
     Parameters
     ----------
     device : {"auto", "cpu", "cuda"}
         ``"auto"`` is ``"cuda"`` when :func:`torch.cuda.is_available`, else ``"cpu"``.
-    owner : str
-        Name used in the error message.
+    owner : str, optional
+        Unused; accepted while callers still pass it.
 
     Returns
     -------
@@ -97,9 +102,10 @@ def resolve_device(device: object, owner: str = "train_mlp_grid") -> str:
 
     Raises
     ------
-    ValueError
-        For another value, or ``"cuda"`` without a usable GPU.
+    softbend.errors.InputError
+        Key ``device``: another value, or ``"cuda"`` without a usable GPU.
     """
+    del owner  # transitional: softbend.transfer.finetune still passes it
     check_choice(device, "device", ("auto", "cpu", "cuda"))
     # PyTorch only here (training): a fitted model predicts with NumPy alone
     from softbend._torch import require_torch
@@ -108,9 +114,10 @@ def resolve_device(device: object, owner: str = "train_mlp_grid") -> str:
     if device == "auto":
         return "cuda" if torch.cuda.is_available() else "cpu"
     if device == "cuda" and not torch.cuda.is_available():
-        raise ValueError(
-            f"The 'device' of {owner} is 'cuda' but torch.cuda.is_available() is False "
-            f"(torch {torch.__version__}); use 'auto' or 'cpu'."
+        raise InputError(
+            f"must be 'auto' or 'cpu' without a usable GPU (torch.cuda.is_available() is False, "
+            f"torch {torch.__version__}); got 'cuda'",
+            key="device",
         )
     return str(device)
 

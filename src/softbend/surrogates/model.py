@@ -13,14 +13,15 @@ import os
 import time
 from dataclasses import dataclass, field
 from pathlib import Path
-from typing import Any
 
 from numpy.typing import ArrayLike
 
 from softbend.analytical import tip_position_mm
 from softbend.campaign.backends import BACKENDS, register_backend
 from softbend.design import SFRBADesign
+from softbend.errors import InputError
 from softbend.models import SweepResult, check_pressures_mpa
+from softbend.surrogates.protocol import Surrogate
 
 __all__ = ["SurrogateModel"]
 
@@ -46,15 +47,16 @@ class SurrogateModel:
     >>> model.sweep(design, default_pressures_mpa(0.2)).angle_deg  # doctest: +SKIP
     """
 
-    estimator: Any
+    estimator: Surrogate
     source: str = ""
     name: str = field(default="surrogate", init=False)
 
     def __post_init__(self) -> None:
         if not callable(getattr(self.estimator, "predict", None)):
-            raise ValueError(
-                "The 'estimator' of SurrogateModel must be a fitted regressor with a "
-                f"'predict' method. Got {type(self.estimator).__name__} instead."
+            raise InputError(
+                "must be a fitted regressor with a 'predict' method; got "
+                f"{type(self.estimator).__name__}",
+                key="estimator",
             )
 
     @classmethod
@@ -78,7 +80,7 @@ class SurrogateModel:
         solver that failed would.
         """
         start = time.perf_counter()
-        grid = check_pressures_mpa(pressures_mpa, "SurrogateModel.sweep")
+        grid = check_pressures_mpa(pressures_mpa)
         angle = self.estimator.predict(design.feature_rows(grid))
         tip_x, tip_z = tip_position_mm(design, angle)
         return SweepResult.from_angles(

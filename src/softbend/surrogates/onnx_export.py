@@ -23,7 +23,6 @@ from __future__ import annotations
 import json
 import os
 from pathlib import Path
-from typing import Any
 
 import numpy as np
 from numpy.typing import ArrayLike
@@ -31,15 +30,17 @@ from numpy.typing import ArrayLike
 from softbend import __version__
 from softbend._extras import require
 from softbend._io import write_bytes_atomic
+from softbend.errors import InputError
 from softbend.surrogates.families import FAMILIES
 from softbend.surrogates.features import TARGET, check_features, model_features
 from softbend.surrogates.onnx_graphs import DEFAULT_OPSET, helper, onnx
 from softbend.surrogates.persistence import COMPOSITE_KINDS, check_fitted_surrogate
+from softbend.surrogates.protocol import Surrogate
 
 __all__ = ["DEFAULT_OPSET", "onnx_predict", "save_onnx", "to_onnx"]
 
 
-def to_onnx(model: Any, *, opset: int | None = None) -> onnx.ModelProto:
+def to_onnx(model: Surrogate, *, opset: int | None = None) -> onnx.ModelProto:
     """Export a fitted surrogate as an ONNX model.
 
     Parameters
@@ -68,15 +69,15 @@ def to_onnx(model: Any, *, opset: int | None = None) -> onnx.ModelProto:
     sklearn.exceptions.NotFittedError
         If the model is not fitted.
     """
-    kind = check_fitted_surrogate(model, "to_onnx")
+    kind = check_fitted_surrogate(model)
     export = None if kind in COMPOSITE_KINDS else FAMILIES.get(kind).onnx
     if export is None:
         exporting = [name for name, family in FAMILIES.items() if family.onnx is not None]
         hint = "; export its base instead" if kind in COMPOSITE_KINDS else ""
-        raise ValueError(
-            f"The 'model' of to_onnx must be a surrogate of a family with an ONNX export "
-            f"({', '.join(exporting)}). Got a {kind} surrogate ({type(model).__name__}), "
-            f"which has no ONNX export{hint}."
+        raise InputError(
+            f"must be a surrogate of a family with an ONNX export ({', '.join(exporting)}); "
+            f"got a {kind} surrogate ({type(model).__name__}), which has no ONNX export{hint}",
+            key="model",
         )
     from softbend.surrogates.persistence import current_units
 
@@ -106,9 +107,8 @@ def _as_bytes(model: onnx.ModelProto | bytes | str | os.PathLike[str]) -> bytes:
         if not path.is_file():
             raise FileNotFoundError(f"No ONNX model at {path}.")
         return path.read_bytes()
-    raise ValueError(
-        "The 'model' of onnx_predict must be an onnx.ModelProto, bytes or a path. "
-        f"Got {type(model).__name__} instead."
+    raise InputError(
+        f"must be an onnx.ModelProto, bytes or a path; got {type(model).__name__}", key="model"
     )
 
 
@@ -142,20 +142,19 @@ def onnx_predict(
         ``X`` of the wrong shape or not finite, or a ``model`` of another type.
     """
     onnxruntime = require("onnxruntime", "ONNX prediction (onnx_predict)")
-    X = check_features(X, "onnx_predict")
+    X = check_features(X)
     session = onnxruntime.InferenceSession(_as_bytes(model), providers=["CPUExecutionProvider"])
     (source,) = session.get_inputs()
     dtype = _NUMPY_OF_ONNX.get(source.type)
     if dtype is None:
-        raise ValueError(
-            "The 'model' of onnx_predict must take a double or float tensor. "
-            f"Got an input of type {source.type} instead."
+        raise InputError(
+            f"must take a double or float tensor; got an input of type {source.type}", key="model"
         )
     (result,) = session.run([session.get_outputs()[0].name], {source.name: X.astype(dtype)})
     return np.asarray(result, dtype=np.float64).reshape(X.shape[0])
 
 
-def save_onnx(model: Any, path: str | os.PathLike[str], *, opset: int | None = None) -> Path:
+def save_onnx(model: Surrogate, path: str | os.PathLike[str], *, opset: int | None = None) -> Path:
     """Export a fitted surrogate with :func:`to_onnx` and write it to ``path`` atomically.
 
     Parameters

@@ -15,16 +15,24 @@ adds the metadata and checks the model. The families of
 from __future__ import annotations
 
 import copy
-from typing import TYPE_CHECKING, Any
+from typing import TYPE_CHECKING
 
 import numpy as np
 from numpy.typing import ArrayLike
 
 from softbend._extras import require
+from softbend._validation import interval_text, must_be
+from softbend.errors import InputError
 from softbend.surrogates.features import TARGET
 
 if TYPE_CHECKING:
     import onnx
+    from xgboost import XGBRegressor
+
+    from softbend.surrogates.mlp import NormalizedMLPRegressor
+    from softbend.surrogates.polynomial import PolynomialRegressor
+
+    _Standardized = PolynomialRegressor | NormalizedMLPRegressor
 else:
     onnx = require("onnx", "ONNX export (softbend.surrogates.onnx_export)")
 TensorProto, helper, numpy_helper = onnx.TensorProto, onnx.helper, onnx.numpy_helper
@@ -41,15 +49,14 @@ _INPUT = "x"
 _OUTPUT = TARGET
 
 
-def check_opset(opset: Any, highest: int, owner: str) -> int:
-    """``opset``, or the default (at most ``highest``) for None; else a ValueError."""
+def check_opset(opset: object, highest: int) -> int:
+    """``opset``, or the default (at most ``highest``) for None; else an
+    :class:`~softbend.errors.InputError` (key ``opset``)."""
     if opset is None:
         return min(DEFAULT_OPSET, highest)
     if isinstance(opset, bool) or not isinstance(opset, int) or not _MIN_OPSET <= opset <= highest:
-        raise ValueError(
-            f"The 'opset' of {owner} must be None or an integer in [{_MIN_OPSET}, {highest}]. "
-            f"Got {opset!r} instead."
-        )
+        interval = interval_text(_MIN_OPSET, highest, low_inclusive=True, high_inclusive=True)
+        raise InputError(must_be(f"None or an integer in {interval}", opset), key="opset")
     return opset
 
 
@@ -57,7 +64,7 @@ def _const(name: str, value: ArrayLike, dtype: type = np.float64) -> onnx.Tensor
     return numpy_helper.from_array(np.ascontiguousarray(value, dtype=dtype), name)
 
 
-def _standardize(model: Any) -> tuple[list[onnx.NodeProto], list[onnx.TensorProto]]:
+def _standardize(model: _Standardized) -> tuple[list[onnx.NodeProto], list[onnx.TensorProto]]:
     """Nodes computing z = (x − x_mean_)/x_scale_ into ``"z"``."""
     nodes = [
         helper.make_node("Sub", [_INPUT, "x_mean"], ["x_centred"]),
@@ -66,7 +73,9 @@ def _standardize(model: Any) -> tuple[list[onnx.NodeProto], list[onnx.TensorProt
     return nodes, [_const("x_mean", model.x_mean_), _const("x_scale", model.x_scale_)]
 
 
-def _rescale(model: Any, source: str) -> tuple[list[onnx.NodeProto], list[onnx.TensorProto]]:
+def _rescale(
+    model: _Standardized, source: str
+) -> tuple[list[onnx.NodeProto], list[onnx.TensorProto]]:
     """Nodes computing angle_deg = y_mean_ + y_scale_ · source."""
     nodes = [
         helper.make_node("Mul", [source, "y_scale"], ["y_scaled"]),
@@ -75,7 +84,7 @@ def _rescale(model: Any, source: str) -> tuple[list[onnx.NodeProto], list[onnx.T
     return nodes, [_const("y_scale", model.y_scale_), _const("y_mean", model.y_mean_)]
 
 
-def _polynomial_body(model: Any, opset: int) -> tuple[list, list]:
+def _polynomial_body(model: PolynomialRegressor, opset: int) -> tuple[list, list]:
     powers = np.asarray(model.powers_, dtype=np.float64)
     nodes = [
         helper.make_node("Unsqueeze", ["z", "axis_1"], ["z_rows"]),  # [N, 1, d]
@@ -98,7 +107,7 @@ def _polynomial_body(model: Any, opset: int) -> tuple[list, list]:
     return nodes, constants
 
 
-def _mlp_body(model: Any) -> tuple[list, list]:
+def _mlp_body(model: NormalizedMLPRegressor) -> tuple[list, list]:
     coefs = [np.asarray(w, dtype=np.float64) for w in model.coefs_]
     intercepts = [np.asarray(b, dtype=np.float64).ravel() for b in model.intercepts_]
     nodes, constants, source = [], [], "z"
@@ -119,7 +128,9 @@ def _mlp_body(model: Any) -> tuple[list, list]:
     return nodes, constants
 
 
-def _double_graph(model: Any, name: str, body: tuple[list, list], opset: int) -> onnx.ModelProto:
+def _double_graph(
+    model: _Standardized, name: str, body: tuple[list, list], opset: int
+) -> onnx.ModelProto:
     """Standardize, ``body`` (into ``"y_std"``), rescale: the graph ``softbend_<name>``."""
     d = int(model.n_features_in_)
     first, first_consts = _standardize(model)
@@ -138,7 +149,7 @@ def _double_graph(model: Any, name: str, body: tuple[list, list], opset: int) ->
     )
 
 
-def polynomial_graph(model: Any, opset: int | None = None) -> onnx.ModelProto:
+def polynomial_graph(model: PolynomialRegressor, opset: int | None = None) -> onnx.ModelProto:
     """The graph of a fitted ``PolynomialRegressor`` (double precision).
 
     It raises the standardized inputs z[:, None, :] to the exponent table
@@ -147,17 +158,17 @@ def polynomial_graph(model: Any, opset: int | None = None) -> onnx.ModelProto:
     (``MatMul``) and rescales. Its peak memory is N·T·7 doubles (degree 4: 18 kB
     per sample), so evaluate very large batches in chunks.
     """
-    opset = check_opset(opset, onnx.defs.onnx_opset_version(), "to_onnx")
+    opset = check_opset(opset, onnx.defs.onnx_opset_version())
     return _double_graph(model, "plr", _polynomial_body(model, opset), opset)
 
 
-def mlp_graph(model: Any, opset: int | None = None) -> onnx.ModelProto:
+def mlp_graph(model: NormalizedMLPRegressor, opset: int | None = None) -> onnx.ModelProto:
     """The graph of a fitted ``NormalizedMLPRegressor``: MatMul/Add/Tanh twice, then linear."""
-    opset = check_opset(opset, onnx.defs.onnx_opset_version(), "to_onnx")
+    opset = check_opset(opset, onnx.defs.onnx_opset_version())
     return _double_graph(model, "mlp", _mlp_body(model), opset)
 
 
-def xgboost_graph(model: Any, opset: int | None = None) -> onnx.ModelProto:
+def xgboost_graph(model: XGBRegressor, opset: int | None = None) -> onnx.ModelProto:
     """The graph of a fitted ``xgboost.XGBRegressor``: a float32 ``TreeEnsembleRegressor``.
 
     Converted by :func:`onnxmltools.convert_xgboost` (XGBoost evaluates its trees
@@ -168,7 +179,7 @@ def xgboost_graph(model: Any, opset: int | None = None) -> onnx.ModelProto:
     from onnxmltools.convert.common._topology import get_maximum_opset_supported
     from onnxmltools.convert.common.data_types import FloatTensorType
 
-    opset = check_opset(opset, get_maximum_opset_supported(), "to_onnx (xgb)")
+    opset = check_opset(opset, get_maximum_opset_supported())
     if model.get_booster().feature_names is not None:
         # Fitted on a DataFrame: onnxmltools only reads the default names f0, f1, ...
         booster = model.get_booster().copy()

@@ -72,15 +72,15 @@ from contextvars import ContextVar
 from dataclasses import dataclass, field
 from datetime import UTC, datetime
 from pathlib import Path
-from typing import Any
+from typing import TYPE_CHECKING, Any, cast
 
 import numpy as np
 
 from softbend import __version__
 from softbend._io import json_safe, write_text_atomic
-from softbend._validation import short_repr
+from softbend._validation import must_be, short_repr
 from softbend.actuators import SFRBA, Actuator
-from softbend.errors import SchemaError
+from softbend.errors import InputError, SchemaError, SoftbendError, keyed
 from softbend.limits import check_limit, limit
 from softbend.plausibility import RANGES, implausible_index
 from softbend.surrogates.families import FAMILIES, Family, legacy_kinds
@@ -95,7 +95,11 @@ from softbend.surrogates.features import (
 from softbend.surrogates.jsonvalues import encode as _encode
 from softbend.surrogates.jsonvalues import encode_params
 from softbend.surrogates.jsonvalues import plain_json as _plain_json
-from softbend.surrogates.schema import COMPOSITE_SCHEMAS, QUANTITIES, Rule, RuleError
+from softbend.surrogates.protocol import Surrogate
+from softbend.surrogates.schema import COMPOSITE_SCHEMAS, QUANTITIES, Rule
+
+if TYPE_CHECKING:
+    from softbend.surrogates.corrected import MeanEnsemble
 
 logger = logging.getLogger(__name__)
 
@@ -225,7 +229,7 @@ class SavedSurrogate:
         When the file was written, ISO 8601 in UTC.
     """
 
-    model: Any
+    model: Surrogate
     kind: str
     metadata: dict[str, Any] = field(default_factory=dict)
     softbend_version: str = ""
@@ -239,10 +243,13 @@ class SavedSurrogate:
 
 def _stored(kind: str) -> Family:
     """The family ``kind`` if it can be saved (a family with a storage)."""
-    family = FAMILIES.get(kind, field="kind")
+    with keyed("kind"):
+        family = FAMILIES.get(kind)
     if family.storage is None:
-        raise ValueError(
-            f"The surrogate family {kind!r} declares no storage: it cannot be saved or loaded."
+        raise InputError(
+            f"must be a family with a storage; the surrogate family {kind!r} declares none: "
+            "it cannot be saved or loaded",
+            key="kind",
         )
     return family
 
@@ -266,7 +273,7 @@ def _allowed() -> str:
     return ", ".join(f"{cls} ({kind!r})" for cls, kind in classes)
 
 
-def kind_of(model: Any) -> str:
+def kind_of(model: object) -> str:
     """The kind of a surrogate: its family's name (``"plr"``, ...) or its composite kind.
 
     Only the exact classes count (a subclass could change what ``params`` and
@@ -286,8 +293,8 @@ def kind_of(model: Any) -> str:
 
     Raises
     ------
-    ValueError
-        For any other type, naming the allowed ones.
+    softbend.errors.InputError
+        For any other type (key ``model``), naming the allowed ones.
     """
     for name, family in FAMILIES.items():
         if family.storage is not None and family.storage.holds(model):
@@ -296,20 +303,16 @@ def kind_of(model: Any) -> str:
         cls = getattr(sys.modules.get(module), name, None)
         if cls is not None and type(model) is cls:
             return kind
-    raise ValueError(
-        f"The 'model' of kind_of must be one of {_allowed()}. Got {type(model).__name__} instead."
-    )
+    raise InputError(f"must be one of {_allowed()}; got {type(model).__name__}", key="model")
 
 
-def check_fitted_surrogate(model: Any, owner: str) -> str:
+def check_fitted_surrogate(model: object) -> str:
     """Return the kind of a fitted surrogate on the 7 inputs, or raise a clear error.
 
     Parameters
     ----------
     model : estimator
         The surrogate to check.
-    owner : str
-        Name of the calling function, used in the messages.
 
     Returns
     -------
@@ -318,18 +321,13 @@ def check_fitted_surrogate(model: Any, owner: str) -> str:
 
     Raises
     ------
-    ValueError
-        Unknown model type, or a model fitted on other than the 7 :data:`FEATURES`.
+    softbend.errors.InputError
+        Unknown model type, or a model fitted on other than the 7 :data:`FEATURES`
+        (key ``model``).
     sklearn.exceptions.NotFittedError
         If the model is not fitted (a ``ValueError`` too).
     """
-    try:
-        kind = kind_of(model)
-    except ValueError:
-        raise ValueError(
-            f"The 'model' of {owner} must be one of {_allowed()}. "
-            f"Got {type(model).__name__} instead."
-        ) from None
+    kind = kind_of(model)
     name = type(model).__name__
     if kind in COMPOSITE_KINDS:
         fitted = True  # built from fitted surrogates, each checked when saved
@@ -344,19 +342,23 @@ def check_fitted_surrogate(model: Any, owner: str) -> str:
     if not fitted:
         from sklearn.exceptions import NotFittedError  # only here: loading needs no sklearn
 
-        raise NotFittedError(f"This {name} instance is not fitted yet. Call 'fit' before {owner}.")
-    n_features = int(model.n_features_in_)
+        raise NotFittedError(
+            f"This {name} instance is not fitted yet. Call 'fit' before saving or exporting it."
+        )
+    n_features = int(cast(Surrogate, model).n_features_in_)
     features = model_features()
     if n_features != len(features):
-        raise ValueError(
-            f"The 'model' of {owner} must be fitted on the {len(features)} surrogate inputs "
-            f"({', '.join(features)}). Got a {name} with n_features_in_ = {n_features} instead."
+        raise InputError(
+            f"must be fitted on the {len(features)} surrogate inputs ({', '.join(features)}); "
+            f"got a {name} with n_features_in_ = {n_features}",
+            key="model",
         )
     names = getattr(model, "feature_names_in_", None)
     if names is not None and [str(n) for n in names] != list(features):
-        raise ValueError(
-            f"The 'model' of {owner} must be fitted on the columns {', '.join(features)} in "
-            f"this order. Got a {name} fitted on {', '.join(map(str, names))} instead."
+        raise InputError(
+            f"must be fitted on the columns {', '.join(features)} in this order; "
+            f"got a {name} fitted on {', '.join(map(str, names))}",
+            key="model",
         )
     return kind
 
@@ -364,14 +366,14 @@ def check_fitted_surrogate(model: Any, owner: str) -> str:
 # --- save --------------------------------------------------------------------------------------
 
 
-def _params(model: Any, kind: str) -> dict[str, Any]:
+def _params(model: Surrogate, kind: str) -> dict[str, Any]:
     storage = FAMILIES.get(kind).storage
     assert storage is not None  # kind_of names only families with a storage
     codec = storage.codec
     return codec.params(model) if codec is not None else encode_params(model)
 
 
-def _document(model: Any, kind: str, depth: int = 0) -> dict[str, Any]:
+def _document(model: Surrogate, kind: str, depth: int = 0) -> dict[str, Any]:
     """The saved form of a checked model, without ``metadata``."""
     return {
         "format": FORMAT,
@@ -387,27 +389,28 @@ def _document(model: Any, kind: str, depth: int = 0) -> dict[str, Any]:
     }
 
 
-def _inner(model: Any, depth: int) -> dict[str, Any]:
+def _inner(model: Surrogate, depth: int) -> dict[str, Any]:
     """An inner surrogate of a composite as a whole document (empty metadata)."""
     if depth >= _MAX_DEPTH:
-        raise ValueError(
-            f"save_surrogate nests surrogates at most {_MAX_DEPTH} deep; this model nests deeper."
+        raise InputError(
+            f"must nest surrogates at most {_MAX_DEPTH} deep; got a model nesting deeper",
+            key="model",
         )
-    kind = check_fitted_surrogate(model, "save_surrogate")
+    kind = check_fitted_surrogate(model)
     return {**_document(model, kind, depth + 1), "metadata": {}}
 
 
-def _composite_state(model: Any, kind: str, depth: int) -> dict[str, Any]:
+def _composite_state(model: Surrogate, kind: str, depth: int) -> dict[str, Any]:
     state: dict[str, Any]
     if kind == "ensemble":
-        state = {"members": [_inner(m, depth) for m in model.members_]}
+        state = {"members": [_inner(m, depth) for m in cast("MeanEnsemble", model).members_]}
     else:
-        state = {"base": _inner(model.base, depth)}
+        state = {"base": _inner(getattr(model, "base"), depth)}  # noqa: B009 (a composite's)
     names = [key for key in _COMPOSITE_STATE[kind] if key not in ("base", "members")]
     return state | {key: _encode(getattr(model, key), key) for key in names}
 
 
-def _state(model: Any, kind: str, depth: int = 0) -> dict[str, Any]:
+def _state(model: Surrogate, kind: str, depth: int = 0) -> dict[str, Any]:
     if kind in COMPOSITE_KINDS:
         return _composite_state(model, kind, depth)
     storage = FAMILIES.get(kind).storage
@@ -421,16 +424,17 @@ def _state(model: Any, kind: str, depth: int = 0) -> dict[str, Any]:
             state[key] = _encode(getattr(model, key), key)
         except TypeError as err:
             if key in storage.required_state:
-                raise ValueError(
-                    f"The fitted attribute '{key}' of {type(model).__name__} cannot be saved: "
-                    f"{err}."
+                raise InputError(
+                    f"must hold fitted attributes JSON can hold; its '{key}' "
+                    f"({type(model).__name__}) cannot be saved: {err}",
+                    key="model",
                 ) from None
             logger.debug("save_surrogate leaves out %s: %s", key, err)
     return state
 
 
 def save_surrogate(
-    model: Any, path: str | os.PathLike[str], *, metadata: dict[str, Any] | None = None
+    model: Surrogate, path: str | os.PathLike[str], *, metadata: dict[str, Any] | None = None
 ) -> Path:
     """Write a fitted surrogate to one JSON file (atomically) and return its path.
 
@@ -457,9 +461,10 @@ def save_surrogate(
 
     Raises
     ------
-    ValueError
+    softbend.errors.InputError
         Unknown model type (naming the allowed kinds), a model fitted on other than
-        7 features, a parameter or ``metadata`` that JSON cannot hold.
+        7 features, a parameter (key ``model``) or ``metadata`` (key ``metadata``)
+        that JSON cannot hold.
     sklearn.exceptions.NotFittedError
         If the model is not fitted.
     """
@@ -468,23 +473,25 @@ def save_surrogate(
     try:
         actuator = actuator_of(metadata)
     except ValueError as err:
-        raise ValueError(f"The metadata 'actuator' of save_surrogate is not valid: {err}") from None
+        raise InputError(
+            f"must hold a valid 'actuator' description; got one that is not: {err}",
+            key="metadata",
+        ) from None
     with describing(actuator):
         return _save(model, Path(path), metadata)
 
 
-def _save(model: Any, path: Path, metadata: dict[str, Any]) -> Path:
-    kind = check_fitted_surrogate(model, "save_surrogate")
+def _save(model: Surrogate, path: Path, metadata: dict[str, Any]) -> Path:
+    kind = check_fitted_surrogate(model)
     if not isinstance(metadata, dict) or not all(isinstance(k, str) for k in metadata):
-        raise ValueError(
-            "The 'metadata' of save_surrogate must be a dict with string keys. "
-            f"Got {type(metadata).__name__} instead."
+        raise InputError(
+            f"must be a dict with string keys; got {type(metadata).__name__}", key="metadata"
         )
     try:  # strict JSON: NaN and infinities become null
         metadata_json = json.dumps(json_safe(metadata), default=_plain_json, allow_nan=False)
     except (TypeError, ValueError, RecursionError) as err:
-        raise ValueError(
-            f"The 'metadata' of save_surrogate must be JSON-serializable. Got an error: {err}."
+        raise InputError(
+            f"must be JSON-serializable; got an error: {err}", key="metadata"
         ) from None
     document = _document(model, kind)
     # One top-level key per line: the header stays readable, big arrays stay on one line.
@@ -500,7 +507,7 @@ def _save(model: Any, path: Path, metadata: dict[str, Any]) -> Path:
 # --- load --------------------------------------------------------------------------------------
 
 
-def _depth(value: Any) -> int:
+def _depth(value: object) -> int:
     """How deep JSON objects and arrays nest in ``value`` (a number 0, ``[]`` 1), iteratively."""
     deepest, stack = 0, [(value, 1)] if isinstance(value, dict | list) else []
     while stack:
@@ -511,53 +518,74 @@ def _depth(value: Any) -> int:
     return deepest
 
 
+@contextmanager
+def _in_file(path: Path | str) -> Iterator[None]:
+    """Name ``path`` as the file of any :class:`SchemaError` raised inside."""
+    try:
+        yield
+    except SchemaError as error:
+        if error.file is None:
+            error.file = str(path)
+        raise
+
+
+@contextmanager
+def _within(field_path: str) -> Iterator[None]:
+    """Put the keys of the errors of an inner surrogate under its field (``state.base``)."""
+    try:
+        yield
+    except SchemaError as error:
+        error.key = field_path if error.key is None else f"{field_path}.{error.key}"
+        raise
+
+
 def _read_document(path: Path) -> dict[str, Any]:
     if not path.is_file():
         raise FileNotFoundError(f"No saved surrogate at {path}.")
     try:
         document = json.loads(path.read_text(encoding="utf-8"))
     except (ValueError, UnicodeDecodeError) as err:  # JSONDecodeError, a 5000-digit number
-        raise SchemaError(f"{path} is not a softbend surrogate: not valid JSON ({err}).") from None
+        raise SchemaError(
+            f"not a softbend surrogate: not valid JSON ({err})", file=str(path)
+        ) from None
     except RecursionError:  # the parser recurses once per level
         raise SchemaError(
-            f"{path} is not a softbend surrogate: its JSON nests too deeply to be read (a "
-            f"softbend surrogate nests at most {limit('nesting')} levels, the limit "
-            "SOFTBEND_MAX_NESTING)."
+            "not a softbend surrogate: its JSON nests too deeply to be read (a softbend "
+            f"surrogate nests at most {limit('nesting')} levels, the limit SOFTBEND_MAX_NESTING)",
+            file=str(path),
         ) from None
     check_limit("nesting", _depth(document), f"The JSON nesting of {path}")
-    return _checked_document(document, str(path))
+    with _in_file(path):
+        return _checked_document(document)
 
 
-def _checked_document(document: Any, path: str) -> dict[str, Any]:
-    """``document`` if its header is that of a softbend surrogate (``path`` names it)."""
+def _checked_document(document: object) -> dict[str, Any]:
+    """``document`` if its header is that of a softbend surrogate, else a :class:`SchemaError`
+    keyed by the header field at fault (the caller names the file)."""
     if not isinstance(document, dict) or document.get("format") != FORMAT:
         found = document.get("format") if isinstance(document, dict) else type(document).__name__
         shown = repr(found) if isinstance(found, str | None) else short_repr(found)
-        raise SchemaError(
-            f"{path} is not a softbend surrogate: format {shown}, expected {FORMAT!r}."
-        )
+        raise SchemaError(f"not a softbend surrogate: format {shown}, expected {FORMAT!r}")
     version = document.get("schema_version")
     if isinstance(version, bool) or not isinstance(version, int) or version < 1:
-        shown = repr(version) if isinstance(version, str | None) else short_repr(version)
         raise SchemaError(
-            f"{path} has an invalid schema_version {shown}; expected an integer "
-            f"from 1 to {SCHEMA_VERSION}."
+            must_be(f"an integer from 1 to {SCHEMA_VERSION} (invalid schema_version)", version),
+            key="schema_version",
         )
     if version > SCHEMA_VERSION:
         raise SchemaError(
-            f"{path} has schema version {version}, newer than this softbend ({__version__}) "
-            f"reads (up to {SCHEMA_VERSION}). Upgrade softbend to load it."
+            f"{version} is newer than this softbend ({__version__}) reads (up to "
+            f"{SCHEMA_VERSION}); upgrade softbend to load it",
+            key="schema_version",
         )
     missing = [key for key in _HEADER_KEYS if key not in document]
     if missing:
-        raise SchemaError(
-            f"{path} is an incomplete softbend surrogate: key(s) {', '.join(missing)} missing."
-        )
+        raise SchemaError(f"an incomplete softbend surrogate: key(s) {', '.join(missing)} missing")
     unknown = [key for key in document if key not in ("format", "schema_version", *_HEADER_KEYS)]
     if unknown:
         raise SchemaError(
-            f"{path}: unknown key(s) {', '.join(map(repr, unknown))} in a softbend surrogate; "
-            f"allowed keys: format, schema_version, {', '.join(_HEADER_KEYS)}."
+            f"unknown key(s) {', '.join(map(repr, unknown))} in a softbend surrogate; "
+            f"allowed keys: format, schema_version, {', '.join(_HEADER_KEYS)}"
         )
     kind = document["kind"]
     if version == 1 and isinstance(kind, str):  # migration: version 1 named two kinds otherwise
@@ -565,24 +593,26 @@ def _checked_document(document: Any, path: str) -> dict[str, Any]:
     if not isinstance(kind, str) or kind not in saved_kinds():
         shown = repr(kind) if isinstance(kind, str) else short_repr(kind)
         raise SchemaError(
-            f"{path} holds an unknown surrogate kind {shown}; "
-            f"expected one of {', '.join(map(repr, saved_kinds()))}."
+            f"must be one of {', '.join(map(repr, saved_kinds()))}; "
+            f"got the unknown surrogate kind {shown}",
+            key="kind",
         )
     for key in ("params", "state", "metadata", "units"):
         if not isinstance(document[key], dict):
-            raise SchemaError(f"{path}: '{key}' must be a JSON object.")
+            raise SchemaError(must_be("a JSON object", document[key]), key=key)
     if "actuator" in document["metadata"]:
         try:
             actuator = actuator_of(document["metadata"])
         except ValueError as err:
-            raise SchemaError(f"{path}: metadata key 'actuator' is not valid: {err}") from None
+            raise SchemaError(f"is not valid: {err}", key="metadata.actuator") from None
         features, units = list(actuator.features), model_units(actuator)
     else:  # paper B's, or an inner model of the composite being read
         features, units = list(model_features()), dict(_UNITS.get())
     if document["features"] != features or document["target"] != TARGET:
         raise SchemaError(
-            f"{path} maps {short_repr(document['features'])} -> {short_repr(document['target'])}"
-            f"; its actuator's surrogates map {features} -> {TARGET!r}."
+            f"maps {short_repr(document['features'])} -> {short_repr(document['target'])}"
+            f"; its actuator's surrogates map {features} -> {TARGET!r}",
+            key="features",
         )
     if document["units"] != units:
         wrong = next(
@@ -591,37 +621,36 @@ def _checked_document(document: Any, path: str) -> dict[str, Any]:
         )
         got = short_repr(document["units"].get(wrong)) if wrong in document["units"] else "none"
         raise SchemaError(
-            f"{path}: 'units' must be {json.dumps(units)} (the units every softbend surrogate "
-            f"maps); got {got} for {wrong!r}."
+            f"must be {json.dumps(units)} (the units every softbend surrogate maps); "
+            f"got {got} for {wrong!r}",
+            key="units",
         )
     for key in ("softbend_version", "created_utc"):
         if not isinstance(document[key], str):
-            raise SchemaError(f"{path}: '{key}' must be a string; got {short_repr(document[key])}.")
+            raise SchemaError(must_be("a string", document[key]), key=key)
     return document
 
 
 def _validated(
-    values: dict[str, Any], rules: dict[str, Rule], path: Path | str, kind: str, section: str
+    values: dict[str, Any], rules: dict[str, Rule], kind: str, section: str
 ) -> dict[str, Any]:
-    """``values`` decoded by their rules; a key without a rule or a broken rule raises."""
+    """``values`` decoded by their rules; a key without a rule or a broken rule raises
+    (keyed ``section.key``)."""
     unknown = [key for key in values if key not in rules]
     if unknown:
         raise SchemaError(
-            f"{path}: unknown {section} key(s) {', '.join(map(repr, unknown))} for the {kind} "
-            f"surrogate; allowed keys: {', '.join(rules)}."
+            f"unknown {section} key(s) {', '.join(map(repr, unknown))} for the {kind} "
+            f"surrogate; allowed keys: {', '.join(rules)}",
+            key=section,
         )
     decoded = {}
     for key, value in values.items():
-        try:
+        with _within(f"{section}.{key}"):
             decoded[key] = rules[key](value)
-        except RuleError as err:
-            raise SchemaError(
-                f"{path}: {section} key '{key}' of the {kind} surrogate {err}."
-            ) from None
     return decoded
 
 
-def _check_training_ranges(metadata: dict[str, Any], path: Path) -> None:
+def _check_training_ranges(metadata: dict[str, Any]) -> None:
     """Refuse ``metadata["training_ranges"]`` unless one plausible ``[low, high]`` per input.
 
     A range that is not two finite numbers (a NaN low end) would silently stop the
@@ -630,12 +659,12 @@ def _check_training_ranges(metadata: dict[str, Any], path: Path) -> None:
     if "training_ranges" not in metadata:
         return
     ranges = metadata["training_ranges"]
-    where = f"{path}: metadata key 'training_ranges'"
+    key = "metadata.training_ranges"
     features = model_features()
     if not isinstance(ranges, dict):
         raise SchemaError(
-            f"{where} must be an object of [low, high] per input ({', '.join(features)}); "
-            f"got {short_repr(ranges)}."
+            must_be(f"an object of [low, high] per input ({', '.join(features)})", ranges),
+            key=key,
         )
     unknown = [name for name in ranges if name not in features]
     missing = [name for name in features if name not in ranges]
@@ -646,7 +675,7 @@ def _check_training_ranges(metadata: dict[str, Any], path: Path) -> None:
             else f"no range for {', '.join(missing)}"
         )
         raise SchemaError(
-            f"{where} must give [low, high] for each input {', '.join(features)}; got {found}."
+            f"must give [low, high] for each input {', '.join(features)}; got {found}", key=key
         )
     if not is_paper_b():  # another actuator: its own units, no plausible range known here
         for name, pair in ranges.items():
@@ -657,8 +686,8 @@ def _check_training_ranges(metadata: dict[str, Any], path: Path) -> None:
                 and pair[0] <= pair[1]
             ):
                 raise SchemaError(
-                    f"{where}, field '{name}' must be [low, high]: two finite numbers with "
-                    f"low <= high; got {short_repr(pair)}."
+                    must_be("[low, high]: two finite numbers with low <= high", pair),
+                    key=f"{key}.{name}",
                 )
         return
     for name, pair in ranges.items():
@@ -676,13 +705,16 @@ def _check_training_ranges(metadata: dict[str, Any], path: Path) -> None:
             or values[0] > values[1]
         ):
             raise SchemaError(
-                f"{where}, field '{name}' must be [low, high]: two finite numbers with "
-                f"low <= high, from {bounds.low:g} to {bounds.high:g} {UNITS[name]} "
-                f"(a plausible {bounds.label}); got {short_repr(pair)}."
+                must_be(
+                    f"[low, high]: two finite numbers with low <= high, from {bounds.low:g} to "
+                    f"{bounds.high:g} {UNITS[name]} (a plausible {bounds.label})",
+                    pair,
+                ),
+                key=f"{key}.{name}",
             )
 
 
-def _check_support(metadata: dict[str, Any], path: Path) -> None:
+def _check_support(metadata: dict[str, Any]) -> None:
     """Refuse ``metadata["support"]`` unless a :class:`~softbend.surrogates.support.Support` record.
 
     A broken support would silently stop the check of
@@ -695,116 +727,117 @@ def _check_support(metadata: dict[str, Any], path: Path) -> None:
 
     try:
         Support.from_dict(metadata["support"])
-    except ValueError as err:
+    except ValueError as err:  # an InputError keyed by the record's field, if one is at fault
+        field_key = getattr(err, "key", None)
+        detail = err.detail if isinstance(err, SoftbendError) else str(err)
         raise SchemaError(
-            f"{path}: metadata key 'support' (each training design's largest pressure and the "
-            f"largest angle) {err}."
+            f"{detail} (the training support: each training design's largest pressure and "
+            "the largest angle)",
+            key="metadata.support" + (f".{field_key}" if field_key else ""),
         ) from None
 
 
-def _restore_inner(value: Any, path: str, key: str, depth: int) -> Any:
-    where = f"{path}, state key '{key}'"
-    if depth >= _MAX_DEPTH:
-        raise SchemaError(f"{where}: surrogates nest at most {_MAX_DEPTH} deep.")
-    return _restore(_checked_document(value, where), where, depth + 1)
+def _restore_inner(value: object, path: Path | str, key: str, depth: int) -> Surrogate:
+    with _within(f"state.{key}"):
+        if depth >= _MAX_DEPTH:
+            raise SchemaError(f"surrogates nest at most {_MAX_DEPTH} deep")
+        return _restore(_checked_document(value), path, depth + 1)
 
 
-def _restore_composite(document: dict[str, Any], path: str, depth: int) -> Any:
+def _restore_composite(document: dict[str, Any], path: Path | str, depth: int) -> Surrogate:
     """A composite's inner surrogates restored (and validated) first, then the composite."""
     kind = document["kind"]
     if document["params"]:
-        got = short_repr(document["params"])
-        raise SchemaError(f"{path}: the {kind} surrogate takes no params; got {got}.")
-    state = _validated(document["state"], COMPOSITE_SCHEMAS[kind].state, path, kind, "state")
-    try:
-        COMPOSITE_SCHEMAS[kind].check(state)
-    except RuleError as err:
-        raise SchemaError(f"{path}: the {kind} surrogate's {err}.") from None
+        raise SchemaError(
+            must_be(f"empty: the {kind} surrogate takes no params", document["params"]),
+            key="params",
+        )
+    state = _validated(document["state"], COMPOSITE_SCHEMAS[kind].state, kind, "state")
+    COMPOSITE_SCHEMAS[kind].check(state)
     cls = _class_of(kind)
     if kind == "ensemble":
         members = [
             _restore_inner(m, path, f"members[{i}]", depth) for i, m in enumerate(state["members"])
         ]
-        return cls(members, state["residual_std_"])
+        return cast(Surrogate, cls(members, state["residual_std_"]))
     base = _restore_inner(state["base"], path, "base", depth)
     if kind == "affine-corrected":
-        return cls(base, state["scale_"], state["offset_"], state["residual_std_"])
+        return cast(Surrogate, cls(base, state["scale_"], state["offset_"], state["residual_std_"]))
     if kind == "pressure-scaled":
-        return cls(base, state["scale_"], state["residual_std_"])
+        return cast(Surrogate, cls(base, state["scale_"], state["residual_std_"]))
     try:
-        return cls(
-            base,
-            *(state[k] for k in ("z_mean_", "z_scale_", "kernel_theta_", "inputs_", "targets_")),
+        return cast(
+            Surrogate,
+            cls(
+                base,
+                *(
+                    state[k]
+                    for k in ("z_mean_", "z_scale_", "kernel_theta_", "inputs_", "targets_")
+                ),
+            ),
         )
     except (ValueError, np.linalg.LinAlgError) as err:  # a kernel matrix that is not positive
-        raise SchemaError(f"{path}: cannot rebuild the {kind} surrogate ({err}).") from None
+        raise SchemaError(f"cannot rebuild the {kind} surrogate ({err})") from None
 
 
-def _check_required(document: dict[str, Any], path: Path | str, required: tuple[str, ...]) -> None:
+def _check_required(document: dict[str, Any], required: tuple[str, ...]) -> None:
     missing = [key for key in required if key not in document["state"]]
     if missing:
         raise SchemaError(
-            f"{path} is an incomplete softbend surrogate: state key(s) "
-            f"{', '.join(missing)} missing for kind {document['kind']!r}."
+            f"an incomplete softbend surrogate: state key(s) {', '.join(missing)} missing for "
+            f"kind {document['kind']!r}",
+            key="state",
         )
 
 
-def _family_state(document: dict[str, Any], path: Path | str) -> dict[str, Any]:
+def _family_state(document: dict[str, Any]) -> dict[str, Any]:
     """A family's state, every value validated by its schema (rules across keys included)."""
     kind = document["kind"]
     storage = _stored(kind).storage
     assert storage is not None  # _stored refuses a family without a storage
-    _check_required(document, path, storage.required_state)
+    _check_required(document, storage.required_state)
     schema = storage.schema
-    state = _validated(document["state"], schema.state, path, kind, "state")
-    try:
-        schema.check(state)
-    except RuleError as err:
-        raise SchemaError(f"{path}: the {kind} surrogate's {err}.") from None
+    state = _validated(document["state"], schema.state, kind, "state")
+    schema.check(state)
     return state
 
 
-def _check_against(
-    kind: str, params: dict[str, Any], state: dict[str, Any], path: Path | str
-) -> None:
+def _check_against(kind: str, params: dict[str, Any], state: dict[str, Any]) -> None:
     """The declared sizes (defaults included) against the arrays, and the 7 inputs."""
     storage = _stored(kind).storage
     assert storage is not None  # _stored refuses a family without a storage
-    try:
-        storage.schema.against(params, state)
-    except RuleError as err:
-        raise SchemaError(f"{path}: the {kind} surrogate's {err}.") from None
+    storage.schema.against(params, state)
     n_features = state.get("n_features_in_")
     features = model_features()
     if isinstance(n_features, bool) or n_features != len(features):
         raise SchemaError(
-            f"{path}: the {kind} surrogate must take the {len(features)} inputs "
-            f"{', '.join(features)}; its state gives n_features_in_ {short_repr(n_features)}."
+            f"must be {len(features)}: the {kind} surrogate must take the inputs "
+            f"{', '.join(features)}; got {short_repr(n_features)}",
+            key="state.n_features_in_",
         )
 
 
-def _restore(document: dict[str, Any], path: Path | str, depth: int = 0) -> Any:
+def _restore(document: dict[str, Any], path: Path | str, depth: int = 0) -> Surrogate:
     """The model of a document, every params and state value validated by its kind's schema."""
     kind = document["kind"]
     if kind in COMPOSITE_KINDS:
-        _check_required(document, path, _COMPOSITE_STATE[kind])
-        return _restore_composite(document, str(path), depth)
+        _check_required(document, _COMPOSITE_STATE[kind])
+        return _restore_composite(document, path, depth)
     storage = _stored(kind).storage
     assert storage is not None  # _stored refuses a family without a storage
-    state = _family_state(document, path)
+    state = _family_state(document)
     cls = _class_of(kind)
     if storage.codec is not None:
         return storage.codec.restore(cls, document["params"], state, str(path))
-    model = cls(**_validated(document["params"], storage.schema.params or {}, path, kind, "params"))
+    model = cls(**_validated(document["params"], storage.schema.params or {}, kind, "params"))
     for key, value in state.items():  # keys of the schema only
         setattr(model, key, value)
     _check_against(
         kind,
         model.get_params(deep=False),
         {**state, "n_features_in_": getattr(model, "n_features_in_", None)},
-        path,
     )
-    return model
+    return cast(Surrogate, model)
 
 
 def load_surrogate(path: str | os.PathLike[str]) -> SavedSurrogate:
@@ -842,9 +875,9 @@ def load_surrogate(path: str | os.PathLike[str]) -> SavedSurrogate:
     """
     path = Path(path)
     document = _read_document(path)
-    with describing(actuator_of(document["metadata"])):
-        _check_training_ranges(document["metadata"], path)
-        _check_support(document["metadata"], path)
+    with describing(actuator_of(document["metadata"])), _in_file(path):
+        _check_training_ranges(document["metadata"])
+        _check_support(document["metadata"])
         return _saved_surrogate(document, path)
 
 
@@ -854,8 +887,8 @@ def _saved_surrogate(document: dict[str, Any], path: Path) -> SavedSurrogate:
         model = _restore(document, path)
     except RecursionError:  # only with SOFTBEND_MAX_NESTING raised far above its default
         raise SchemaError(
-            f"{path}: the surrogate nests too deeply to be rebuilt; lower SOFTBEND_MAX_NESTING "
-            f"(now {limit('nesting')}) to have it refused on reading."
+            "the surrogate nests too deeply to be rebuilt; lower SOFTBEND_MAX_NESTING "
+            f"(now {limit('nesting')}) to have it refused on reading"
         ) from None
     return SavedSurrogate(
         model=model,
@@ -923,15 +956,15 @@ def load_state(path: str | os.PathLike[str], kinds: tuple[str, ...]) -> SavedSta
     """
     path = Path(path)
     document = _read_document(path)
-    with describing(actuator_of(document["metadata"])):
+    with describing(actuator_of(document["metadata"])), _in_file(path):
         return _load_state(document, path, kinds)
 
 
 def _load_state(
     document: dict[str, Any], path: Path, kinds: tuple[str, ...]
 ) -> SavedState | SavedSurrogate:
-    _check_training_ranges(document["metadata"], path)
-    _check_support(document["metadata"], path)
+    _check_training_ranges(document["metadata"])
+    _check_support(document["metadata"])
     kind = document["kind"]
     storage = None if kind in COMPOSITE_KINDS else _stored(kind).storage
     if (
@@ -942,8 +975,8 @@ def _load_state(
         and set(storage.schema.params) <= set(document["params"])
         and "feature_names_in_" not in document["state"]
     ):
-        state = _family_state(document, path)
-        params = _validated(document["params"], storage.schema.params, path, kind, "params")
-        _check_against(kind, params, state, path)
+        state = _family_state(document)
+        params = _validated(document["params"], storage.schema.params, kind, "params")
+        _check_against(kind, params, state)
         return SavedState(kind=kind, params=params, state=state, metadata=document["metadata"])
     return _saved_surrogate(document, path)

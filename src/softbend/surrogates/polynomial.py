@@ -31,7 +31,7 @@ from sklearn.base import BaseEstimator, RegressorMixin
 from sklearn.utils.validation import check_is_fitted, validate_data
 
 from softbend._validation import check_int, check_range
-from softbend.errors import ConvergenceError
+from softbend.errors import ConvergenceError, InputError
 
 logger = logging.getLogger(__name__)
 
@@ -125,9 +125,10 @@ def _check_finite(values: np.ndarray, name: str) -> None:
         position = (
             f"column {where[1]} of row {where[0]}" if values.ndim == 2 else f"position {where[0]}"
         )
-        raise ValueError(
-            f"The '{name}' of {_OWNER} must be finite (no NaN or inf). "
-            f"Got {values[tuple(where)]} in {position} ({int(bad.sum())} non-finite values)."
+        raise InputError(
+            f"must be finite (no NaN or inf); got {values[tuple(where)]} in {position} "
+            f"({int(bad.sum())} non-finite values)",
+            key=name,
         )
 
 
@@ -147,13 +148,13 @@ class _Plan:
 def _plan(powers: np.ndarray) -> _Plan:
     """Evaluation plan for any exponent table closed under removing one factor."""
     powers = np.ascontiguousarray(powers, dtype=np.int64)
-    message = (
-        f"The 'powers_' of {_OWNER} must be a 2-D table of non-negative exponents with one "
-        "constant row and, with every monomial, the monomial with one factor fewer. "
-        "Got an incomplete exponent table instead."
+    incomplete = InputError(
+        "must be a 2-D table of non-negative exponents with one constant row and, with "
+        "every monomial, the monomial with one factor fewer; got an incomplete exponent table",
+        key="powers_",
     )
     if powers.ndim != 2 or powers.min(initial=0) < 0:
-        raise ValueError(message)
+        raise incomplete
     terms, d = powers.shape
     totals = powers.sum(axis=1)
     nonconstant = np.flatnonzero(totals > 0)
@@ -164,7 +165,7 @@ def _plan(powers: np.ndarray) -> _Plan:
     index = {row.tobytes(): k for k, row in enumerate(powers)}
     parents = np.array([index.get(row.tobytes(), -1) for row in parent_powers], dtype=np.int64)
     if np.count_nonzero(totals == 0) != 1 or len(index) != terms or np.any(parents < 0):
-        raise ValueError(message)
+        raise incomplete
     parent_of = np.zeros(terms, dtype=np.int64)
     feature_of = np.zeros(terms, dtype=np.int64)
     parent_of[nonconstant] = parents
@@ -298,12 +299,12 @@ class PolynomialRegressor(RegressorMixin, BaseEstimator):
         fits = [k for k in range(1, degree) if system_memory_mb(n_features, k, chunk_rows) <= limit]
         largest = f"the largest degree that fits is {fits[-1]}" if fits else "no degree fits"
         terms = n_terms(n_features, degree)
-        raise ValueError(
-            f"The 'degree' of {_OWNER} must fit in max_memory_mb={limit:g} with "
-            f"{n_features} features and chunk_rows={chunk_rows} ({largest}). Got {degree!r} "
-            f"instead: {terms} terms need {8.0 * terms**2 / _BYTES_PER_MB:.0f} MB for the "
-            f"{terms} x {terms} normal matrix plus {8.0 * terms * chunk_rows / _BYTES_PER_MB:.0f}"
-            f" MB per chunk = {needed:.0f} MB."
+        raise InputError(
+            f"must fit in max_memory_mb={limit:g} with {n_features} features and "
+            f"chunk_rows={chunk_rows} ({largest}); got {degree!r}: {terms} terms need "
+            f"{8.0 * terms**2 / _BYTES_PER_MB:.0f} MB for the {terms} x {terms} normal matrix "
+            f"plus {8.0 * terms * chunk_rows / _BYTES_PER_MB:.0f} MB per chunk = {needed:.0f} MB",
+            key="degree",
         )
 
     def fit(self, X: ArrayLike, y: ArrayLike) -> PolynomialRegressor:
@@ -462,10 +463,7 @@ class PolynomialRegressor(RegressorMixin, BaseEstimator):
         def predict_one(x: ArrayLike) -> float:
             z = np.asarray(x, dtype=np.float64)
             if z.shape != shape:
-                raise ValueError(
-                    f"The 'x' of {_OWNER}.predictor() must have shape {shape}. "
-                    f"Got shape {z.shape} instead."
-                )
+                raise InputError(f"must have shape {shape}; got shape {z.shape}", key="x")
             table = np.empty(table_shape)
             table[:, 0] = 1.0
             table[:, 1:] = ((z - mean) * inv_scale)[:, None]

@@ -9,10 +9,11 @@ from typing import Any
 import numpy as np
 from numpy.typing import ArrayLike
 
+from softbend._validation import must_be
 from softbend.actuators import SFRBA, Actuator
 from softbend.design import SFRBADesign
-from softbend.errors import SchemaError
-from softbend.models import check_pressures_mpa
+from softbend.errors import InputError, SchemaError, keyed
+from softbend.surrogates.protocol import Surrogate
 
 __all__ = [
     "INTERVAL_LEVEL",
@@ -121,7 +122,7 @@ class Prediction:
         return payload
 
 
-def calibrated_interval(record: Any, angles: np.ndarray) -> tuple[np.ndarray, np.ndarray] | None:
+def calibrated_interval(record: object, angles: np.ndarray) -> tuple[np.ndarray, np.ndarray] | None:
     """The calibrated 90 % interval a refined model records (``transfer refine``), if any.
 
     The record is the ``interval`` metadata of :mod:`softbend.transfer.conformal`:
@@ -137,22 +138,21 @@ def calibrated_interval(record: Any, angles: np.ndarray) -> tuple[np.ndarray, np
     return np.minimum(np.maximum(angles - half, floor), angles), angles + half
 
 
-def parse_pressures(text: str, name: str = "pressure") -> list[float]:
+def parse_pressures(text: str) -> list[float]:
     """Pressures from comma-separated text such as ``"0.05,0.1"`` (in the model's unit).
 
     Raises
     ------
-    ValueError
-        Text that is not comma-separated numbers, or holds none, naming ``name``.
+    softbend.errors.InputError
+        Text that is not comma-separated numbers, or holds none (no key: the
+        caller names the input, :func:`~softbend.errors.keyed`).
     """
     try:
         values = [float(v) for v in text.split(",") if v.strip()]
     except ValueError:
-        raise ValueError(
-            f"The '{name}' must be comma-separated numbers, e.g. 0.05,0.1. Got {text!r} instead."
-        ) from None
+        raise InputError(must_be("comma-separated numbers, e.g. 0.05,0.1", text)) from None
     if not values:
-        raise ValueError(f"The '{name}' must hold at least one number. Got {text!r} instead.")
+        raise InputError(must_be("at least one number", text))
     return values
 
 
@@ -162,7 +162,6 @@ def predict_text(
     pressures: str,
     *,
     strict: bool = False,
-    field: str = "--pressures",
 ) -> Prediction:
     """:func:`predict_angles` of a design and pressures given as text (as on a command line).
 
@@ -178,16 +177,29 @@ def predict_text(
         (:func:`parse_pressures`; MPa for paper B's actuator).
     strict : bool
         As :func:`predict_angles`.
-    field : str, default "--pressures"
-        The option the pressures came from, named in messages.
+
+    Raises
+    ------
+    softbend.errors.InputError
+        As :func:`predict_angles`; pressures that are not numbers, negative or
+        not finite are keyed ``pressures``.
     """
-    return predict_angles(
-        path,
-        design,
-        parse_pressures(pressures, field),
-        strict=strict,
-        field=field,
-    )
+    with keyed("pressures"):
+        values = parse_pressures(pressures)
+    _check_pressures(values, key="pressures")
+    return predict_angles(path, design, values, strict=strict)
+
+
+def _check_pressures(
+    pressures_mpa: ArrayLike, unit: str = "", *, key: str = "pressures_mpa"
+) -> np.ndarray:
+    """The pressures as a flat float array if non-empty, finite and >= 0 (in ``unit``), else
+    an :class:`~softbend.errors.InputError` keyed ``key``."""
+    pressures = np.asarray(pressures_mpa, dtype=float).ravel()
+    if pressures.size == 0 or not np.all(np.isfinite(pressures)) or np.any(pressures < 0):
+        requirement = f"finite and >= 0 {unit}".rstrip()
+        raise InputError(must_be(requirement, np.asarray(pressures_mpa).tolist()), key=key)
+    return pressures
 
 
 def predict_angles(
@@ -196,7 +208,6 @@ def predict_angles(
     pressures_mpa: ArrayLike,
     *,
     strict: bool = False,
-    field: str = "pressure",
 ) -> Prediction:
     """Load a saved surrogate and predict ``design``'s angle at each pressure.
 
@@ -216,13 +227,12 @@ def predict_angles(
         Refuse inputs outside the model's training ranges, and predictions
         beyond its training data's support (:mod:`softbend.surrogates.support`),
         instead of flagging them; refuse models that record neither.
-    field : str, default "pressure"
-        The name of the pressures in messages (``"--pressures"`` from the command line).
 
     Raises
     ------
     ValueError
-        Bad pressures, or with ``strict`` an extrapolation (naming the inputs
+        Bad pressures (an :class:`~softbend.errors.InputError`, key
+        ``pressures_mpa``), or with ``strict`` an extrapolation (naming the inputs
         or the support left);
         without ``strict``, an extrapolation where the model predicts a NaN or
         infinite angle (naming the file and the inputs).
@@ -239,15 +249,11 @@ def predict_angles(
     saved = load_state(path, ("mlp",))
     actuator = saved.actuator
     unit = actuator.pressure_unit
-    pressures = np.asarray(pressures_mpa, dtype=float).ravel()
-    if pressures.size == 0 or not np.all(np.isfinite(pressures)) or np.any(pressures < 0):
-        raise ValueError(
-            f"The '{field}' must be finite and >= 0 {unit}. "
-            f"Got {np.asarray(pressures_mpa).tolist()!r} instead."
-        )
-    check_pressures_mpa(np.unique(pressures) * actuator.to_mpa, "predict_angles", field)
+    pressures = _check_pressures(pressures_mpa, unit)
     design = _design_of(design, actuator, path)
-    model: Any = _MLPArrays(saved.state) if isinstance(saved, SavedState) else saved.model
+    model: Surrogate | _MLPArrays = (
+        _MLPArrays(saved.state) if isinstance(saved, SavedState) else saved.model
+    )
     codes = design.as_array() if isinstance(design, SFRBADesign) else design
     rows = np.empty((pressures.size, codes.size + 1))
     rows[:, :-1] = codes
@@ -274,8 +280,9 @@ def predict_angles(
     with np.errstate(all="ignore"):  # an overflow is reported below, naming the file
         angles = np.asarray(model.predict(rows), dtype=float)
         interval = None
-        if callable(getattr(model, "predict_interval", None)):
-            low, high = model.predict_interval(rows, INTERVAL_LEVEL)
+        predict_interval = getattr(model, "predict_interval", None)
+        if callable(predict_interval):
+            low, high = predict_interval(rows, INTERVAL_LEVEL)
             interval = (np.asarray(low, dtype=float), np.asarray(high, dtype=float))
     _check_finite(path, saved.kind, pressures, angles, "angle", outside, unit)
     with using_features(actuator.features):
@@ -335,7 +342,7 @@ def _design_of(
 
 
 def _support_check(
-    record: Any, rows: np.ndarray, angles: np.ndarray
+    record: object, rows: np.ndarray, angles: np.ndarray
 ) -> tuple[list[str], np.ndarray | None]:
     """The phrases and per-row mask of :class:`~softbend.surrogates.support.Support`;
     ``([], None)`` when the model records no support (checked on load)."""

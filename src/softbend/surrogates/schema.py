@@ -27,12 +27,13 @@ import json
 import math
 from collections.abc import Callable
 from dataclasses import dataclass
-from typing import Any
+from typing import Any, cast
 
 import numpy as np
 
-from softbend._validation import short_repr
+from softbend._validation import interval_text, must_be, short_repr
 from softbend.design import FEATURE_QUANTITIES
+from softbend.errors import SchemaError
 from softbend.plausibility import RANGES, implausible_index
 from softbend.surrogates.features import FEATURES, TARGET, is_paper_b, model_features
 
@@ -66,11 +67,16 @@ _NON_FINITE = {"nan": math.nan, "inf": math.inf, "-inf": -math.inf}
 QUANTITIES: dict[str, str] = {**FEATURE_QUANTITIES, TARGET: "angle_deg"}
 
 
-class RuleError(Exception):
-    """A value breaks its rule; the message says how (the caller names the file and the key)."""
+class RuleError(SchemaError):
+    """A value breaks its rule.
+
+    The message is the predicate (``must be ...; got ...``). A rule of one value
+    leaves ``key`` unset (the loader sets the value's field path, ``state.coef_``,
+    and the file); a rule across keys names the field at fault itself.
+    """
 
 
-Rule = Callable[[Any], Any]
+Rule = Callable[[object], Any]
 
 
 def tag_float(value: float) -> Any:
@@ -80,7 +86,7 @@ def tag_float(value: float) -> Any:
     return {FLOAT_TAG: "nan" if math.isnan(value) else ("inf" if value > 0 else "-inf")}
 
 
-def untag_float(value: Any) -> Any:
+def untag_float(value: object) -> Any:
     """The float a :func:`tag_float` object stands for; any other value unchanged.
 
     Raises
@@ -92,8 +98,7 @@ def untag_float(value: Any) -> Any:
         text = value[FLOAT_TAG]
         if set(value) != {FLOAT_TAG} or not isinstance(text, str) or text not in _NON_FINITE:
             raise RuleError(
-                f'must be {{"{FLOAT_TAG}": "nan" | "inf" | "-inf"}} to stand for a non-finite '
-                f"number; got {short_repr(value)}"
+                must_be(f'{{"{FLOAT_TAG}": "nan" | "inf" | "-inf"}} for a non-finite number', value)
             )
         return _NON_FINITE[text]
     return value
@@ -103,11 +108,11 @@ _FLOAT = "float64"
 _INT = "int64"
 
 
-def _is_real(value: Any) -> bool:
+def _is_real(value: object) -> bool:
     return type(value) in (int, float)  # not bool
 
 
-def _scalar(value: Any, dtype: str, what: str) -> Any:
+def _scalar(value: object, dtype: str, what: str) -> Any:
     """A plain JSON number, or a ``{"__scalar__", "dtype"}`` of ``dtype``, decoded."""
     ok = _is_real if dtype == _FLOAT else (lambda v: type(v) is int)
     if dtype == _FLOAT:
@@ -116,22 +121,23 @@ def _scalar(value: Any, dtype: str, what: str) -> Any:
         if dtype != _FLOAT:
             return value
         try:
-            return float(value)
+            return float(cast(float, value))  # an int or a float: ok() checked
         except OverflowError:  # an integer beyond float64
-            raise RuleError(f"must be {what} within {dtype}; got {short_repr(value)}") from None
+            raise RuleError(must_be(f"{what} within {dtype}", value)) from None
     if isinstance(value, dict) and set(value) == {"__scalar__", "dtype"}:
         inner = untag_float(value["__scalar__"]) if dtype == _FLOAT else value["__scalar__"]
         if value["dtype"] == dtype and ok(inner):
             try:
                 return np.dtype(dtype).type(inner)
             except OverflowError:
-                raise RuleError(f"must be {what} within {dtype}; got {short_repr(value)}") from None
-        raise RuleError(f"must be {what} of dtype {dtype}; got {short_repr(value)}")
-    raise RuleError(f"must be {what}; got {short_repr(value)}")
+                raise RuleError(must_be(f"{what} within {dtype}", value)) from None
+        raise RuleError(must_be(f"{what} of dtype {dtype}", value))
+    raise RuleError(must_be(what, value))
 
 
 def _bounds(low: float | None, strict: bool) -> str:
-    return "" if low is None else f" {'>' if strict else '>='} {low:g}"
+    """`` in (0, inf)`` for a lower bound (``strict``: exclusive), else nothing."""
+    return "" if low is None else f" in {interval_text(low, math.inf, low_inclusive=not strict)}"
 
 
 def real(*, low: float | None = None, strict: bool = False, finite: bool = True) -> Rule:
@@ -147,14 +153,16 @@ def real(*, low: float | None = None, strict: bool = False, finite: bool = True)
         Refuse infinities (NaN is always refused).
     """
     what = ("a finite number" if finite else "a number") + _bounds(low, strict)
+    if not finite:
+        what += " or inf" if low is not None else ", inf or -inf"
 
-    def rule(value: Any) -> Any:
+    def rule(value: object) -> Any:
         decoded = _scalar(value, _FLOAT, what)
         x = float(decoded)
         if (finite and not math.isfinite(x)) or math.isnan(x):
-            raise RuleError(f"must be {what}; got {x}")
+            raise RuleError(must_be(what, x))
         if low is not None and not (x > low if strict else x >= low):
-            raise RuleError(f"must be {what}; got {x:g}")
+            raise RuleError(must_be(what, x))
         return decoded
 
     return rule
@@ -162,12 +170,12 @@ def real(*, low: float | None = None, strict: bool = False, finite: bool = True)
 
 def integer(low: int = 0) -> Rule:
     """An integer (a plain JSON one, not a bool, or an int64 ``__scalar__``) >= ``low``."""
-    what = f"an integer >= {low}"
+    what = f"an integer in {interval_text(low, math.inf, low_inclusive=True)}"
 
-    def rule(value: Any) -> Any:
+    def rule(value: object) -> Any:
         decoded = _scalar(value, _INT, what)
         if int(decoded) < low:
-            raise RuleError(f"must be {what}; got {int(decoded)}")
+            raise RuleError(must_be(what, int(decoded)))
         return decoded
 
     return rule
@@ -177,7 +185,7 @@ def string(choices: tuple[str, ...] | None = None) -> Rule:
     """A string, one of ``choices`` if given."""
     what = "a string" if choices is None else f"one of {', '.join(map(repr, choices))}"
 
-    def rule(value: Any) -> Any:
+    def rule(value: object) -> Any:
         decoded = value
         if (
             isinstance(value, dict)
@@ -187,34 +195,37 @@ def string(choices: tuple[str, ...] | None = None) -> Rule:
         ):
             decoded = np.str_(value["__scalar__"])
         if not isinstance(decoded, str) or (choices is not None and decoded not in choices):
-            raise RuleError(f"must be {what}; got {short_repr(value)}")
+            raise RuleError(must_be(what, value))
         return decoded
 
     return rule
 
 
-def boolean(value: Any) -> bool:
+def boolean(value: object) -> bool:
     """The rule of a ``true`` or ``false`` (not a number)."""
     if not isinstance(value, bool):
-        raise RuleError(f"must be true or false; got {short_repr(value)}")
+        raise RuleError(must_be("true or false", value))
     return value
 
 
 def optional(rule: Rule) -> Rule:
     """``null`` (None), or a value of ``rule``."""
 
-    def either(value: Any) -> Any:
+    def either(value: object) -> Any:
         if value is None:
             return None
         try:
             return rule(value)
         except RuleError as err:
-            raise RuleError(f"{err} (or null)") from None
+            detail = err.detail
+            if detail.startswith("must be "):
+                raise RuleError(f"must be null or {detail[len('must be ') :]}") from None
+            raise RuleError(f"{detail} (or be null)") from None
 
     return either
 
 
-def _leaves(nested: Any, shape: list[int]) -> list[Any]:
+def _leaves(nested: object, shape: list[int]) -> list[Any]:
     """The elements of a nested list of ``shape``, in order; raise if it has another shape."""
     items = [nested]
     for depth, size in enumerate(shape):
@@ -245,11 +256,10 @@ def array(dtype: str, ndim: int, *, low: float | None = None, strict: bool = Fal
     element = {_FLOAT: "finite numbers", _INT: "integers", "str": "strings"}[dtype]
     what = f"a {ndim}-D {dtype} array"
 
-    def rule(value: Any) -> np.ndarray:
+    def rule(value: object) -> np.ndarray:
         if not (isinstance(value, dict) and set(value) == {"__ndarray__", "dtype", "shape"}):
             raise RuleError(
-                f"must be {what} ({{'__ndarray__': ..., 'dtype': ..., 'shape': ...}}); "
-                f"got {short_repr(value)}"
+                must_be(f"{what} ({{'__ndarray__': ..., 'dtype': ..., 'shape': ...}})", value)
             )
         if value["dtype"] != dtype:
             raise RuleError(f"must be {what}; got dtype {short_repr(value['dtype'])}")
@@ -292,7 +302,7 @@ def _arrays(count: int, ndim: int) -> Rule:
     """A list of ``count`` float64 arrays of ``ndim`` dimensions."""
     item = array(_FLOAT, ndim)
 
-    def rule(value: Any) -> list[np.ndarray]:
+    def rule(value: object) -> list[np.ndarray]:
         if not isinstance(value, list) or len(value) != count:
             found = f"{len(value)} items" if isinstance(value, list) else short_repr(value)
             raise RuleError(f"must be a list of {count} {ndim}-D float64 arrays; got {found}")
@@ -301,40 +311,40 @@ def _arrays(count: int, ndim: int) -> Rule:
             try:
                 arrays.append(item(entry))
             except RuleError as err:
-                raise RuleError(f"item {i} {err}") from None
+                raise RuleError(f"item {i} {err.detail}") from None
         return arrays
 
     return rule
 
 
-def _numbers(value: Any) -> list[float]:
+def _numbers(value: object) -> list[float]:
     """A list of numbers (a diagnostic such as a loss curve: NaN and inf allowed)."""
     if isinstance(value, list):
         value = [untag_float(v) for v in value]
     if not isinstance(value, list) or not all(_is_real(v) for v in value):
-        raise RuleError(f"must be a list of numbers; got {short_repr(value)}")
+        raise RuleError(must_be("a list of numbers", value))
     return [float(v) for v in value]
 
 
-def _int_pair(value: Any) -> Any:
+def _int_pair(value: object) -> Any:
     """Two integers >= 1, as a tuple (``{"__tuple__": [...]}``) or a list."""
     items = (
         value.get("__tuple__") if isinstance(value, dict) and set(value) == {"__tuple__"} else value
     )
     if not isinstance(items, list) or len(items) != 2:
-        raise RuleError(f"must be two integers >= 1; got {short_repr(value)}")
+        raise RuleError(must_be("two integers in [1, inf)", value))
     pair = [integer(1)(v) for v in items]
     return tuple(pair) if items is not value else pair
 
 
-def _booster(value: Any) -> str:
+def _booster(value: object) -> str:
     """XGBoost's JSON model as text: an object with a ``learner``, finite numbers only."""
 
     def refuse(constant: str) -> None:
         raise RuleError(f"must hold only finite numbers; got {constant}")
 
     if not isinstance(value, str):
-        raise RuleError(f"must be XGBoost's JSON model as a string; got {short_repr(value)}")
+        raise RuleError(must_be("XGBoost's JSON model as a string", value))
     try:
         model = json.loads(value, parse_constant=refuse)
     except json.JSONDecodeError as err:
@@ -364,17 +374,17 @@ def _check_inputs(state: dict[str, Any]) -> None:
     d = len(features)
     if int(state["n_features_in_"]) != d:
         raise RuleError(
-            f"state key 'n_features_in_' must be {d} (the inputs {', '.join(features)}); "
-            f"got {state['n_features_in_']}"
+            f"must be {d} (the inputs {', '.join(features)}); got {state['n_features_in_']}",
+            key="state.n_features_in_",
         )
     for key in ("x_mean_", "x_scale_"):
         if state[key].shape != (d,):
-            raise RuleError(f"state key '{key}' must have shape ({d},); got {state[key].shape}")
+            raise RuleError(f"must have shape ({d},); got {state[key].shape}", key=f"state.{key}")
     names = state.get("feature_names_in_")
     if names is not None and [str(n) for n in names] != list(features):
         raise RuleError(
-            f"state key 'feature_names_in_' must be {', '.join(features)}; "
-            f"got {', '.join(map(str, names))}"
+            f"must be {', '.join(features)}; got {', '.join(map(str, names))}",
+            key="state.feature_names_in_",
         )
 
 
@@ -384,12 +394,12 @@ def _check_polynomial(state: dict[str, Any]) -> None:
     d = len(model_features())
     if powers.shape[0] < 1 or powers.shape[1] != d:
         raise RuleError(
-            f"state key 'powers_' must have shape (n_terms >= 1, {d}); got {powers.shape}"
+            f"must have shape (n_terms >= 1, {d}); got {powers.shape}", key="state.powers_"
         )
     if coef.shape != (powers.shape[0],):
         raise RuleError(
-            f"state key 'coef_' must have shape ({powers.shape[0]},) (one per row of "
-            f"'powers_'); got {coef.shape}"
+            f"must have shape ({powers.shape[0]},) (one per row of 'powers_'); got {coef.shape}",
+            key="state.coef_",
         )
     from softbend.surrogates.polynomial import _plan
 
@@ -397,8 +407,9 @@ def _check_polynomial(state: dict[str, Any]) -> None:
         _plan(powers)
     except ValueError:
         raise RuleError(
-            "state key 'powers_' must be a complete exponent table (one constant row and, "
-            "with every monomial, the monomial with one factor fewer)"
+            "must be a complete exponent table (one constant row and, "
+            "with every monomial, the monomial with one factor fewer)",
+            key="state.powers_",
         ) from None
 
 
@@ -409,13 +420,15 @@ def _check_mlp(state: dict[str, Any]) -> None:
     expected = [(d, h1), (h1, h2), (h2, 1)]
     if [c.shape for c in coefs] != expected or 0 in (h1, h2):
         raise RuleError(
-            f"state key 'coefs_' must have the chained shapes (d, h1), (h1, h2), (h2, 1) with "
-            f"d = {d}, h1, h2 >= 1; got {', '.join(str(c.shape) for c in coefs)}"
+            f"must have the chained shapes (d, h1), (h1, h2), (h2, 1) with "
+            f"d = {d}, h1, h2 >= 1; got {', '.join(str(c.shape) for c in coefs)}",
+            key="state.coefs_",
         )
     if [b.shape for b in intercepts] != [(h1,), (h2,), (1,)]:
         raise RuleError(
-            f"state key 'intercepts_' must have the shapes ({h1},), ({h2},), (1,) of the "
-            f"layers of 'coefs_'; got {', '.join(str(b.shape) for b in intercepts)}"
+            f"must have the shapes ({h1},), ({h2},), (1,) of the "
+            f"layers of 'coefs_'; got {', '.join(str(b.shape) for b in intercepts)}",
+            key="state.intercepts_",
         )
 
 
@@ -424,17 +437,17 @@ def no_check(state: dict[str, Any]) -> None:
     return None
 
 
-def _document(value: Any) -> Any:
+def _document(value: object) -> Any:
     """An inner surrogate: a JSON object (its own header and schema are checked on restore)."""
     if not isinstance(value, dict):
-        raise RuleError(f"must be a saved surrogate (a JSON object); got {short_repr(value)}")
+        raise RuleError(must_be("a saved surrogate (a JSON object)", value))
     return value
 
 
-def _documents(value: Any) -> Any:
+def _documents(value: object) -> Any:
     """Two or more inner surrogates."""
     if not isinstance(value, list) or len(value) < 2:
-        raise RuleError(f"must be a list of 2 or more saved surrogates; got {short_repr(value)}")
+        raise RuleError(must_be("a list of 2 or more saved surrogates", value))
     return [_document(v) for v in value]
 
 
@@ -449,8 +462,9 @@ def _check_angle(state: dict[str, Any], key: str, what: str, *, spread: bool = F
     low = 0.0 if spread else bounds.low
     if not low <= value <= bounds.high:
         raise RuleError(
-            f"state key '{key}' must be {what} from {low:g} to {bounds.high:g} degrees "
-            f"(plausible {bounds.label}s); got {value:g}"
+            f"must be {what} from {low:g} to {bounds.high:g} degrees "
+            f"(plausible {bounds.label}s); got {value:g}",
+            key=f"state.{key}",
         )
 
 
@@ -492,19 +506,20 @@ def _check_gp(state: dict[str, Any]) -> None:
     d = len(gp_inputs)  # the inputs and the base's angle
     for key in ("z_mean_", "z_scale_"):
         if state[key].shape != (d,):
-            raise RuleError(f"state key '{key}' must have shape ({d},); got {state[key].shape}")
+            raise RuleError(f"must have shape ({d},); got {state[key].shape}", key=f"state.{key}")
     if state["kernel_theta_"].shape != (d + 2,):
         raise RuleError(
-            f"state key 'kernel_theta_' must have shape ({d + 2},) (constant, {d} length "
-            f"scales, noise); got {state['kernel_theta_'].shape}"
+            f"must have shape ({d + 2},) (constant, {d} length "
+            f"scales, noise); got {state['kernel_theta_'].shape}",
+            key="state.kernel_theta_",
         )
     inputs, targets = state["inputs_"], state["targets_"]
     if inputs.ndim != 2 or inputs.shape[1] != d or inputs.shape[0] < 1:
-        raise RuleError(f"state key 'inputs_' must have shape (n >= 1, {d}); got {inputs.shape}")
+        raise RuleError(f"must have shape (n >= 1, {d}); got {inputs.shape}", key="state.inputs_")
     if targets.shape != (inputs.shape[0],):
         raise RuleError(
-            f"state key 'targets_' must have shape ({inputs.shape[0]},) (one per row of "
-            f"'inputs_'); got {targets.shape}"
+            f"must have shape ({inputs.shape[0]},) (one per row of 'inputs_'); got {targets.shape}",
+            key="state.targets_",
         )
     width = RANGES["kernel_width"]
     with np.errstate(over="ignore", under="ignore"):
@@ -512,11 +527,12 @@ def _check_gp(state: dict[str, Any]) -> None:
     bad = implausible_index(hyper, "kernel_width")
     if bad is not None:
         raise RuleError(
-            f"state key 'kernel_theta_' must hold the logarithms of the kernel's constant, "
+            f"must hold the logarithms of the kernel's constant, "
             f"length scales and noise, each within {width.low:g} to {width.high:g} "
             f"(log {math.log(width.low):.4g} to {math.log(width.high):.4g}); got "
             f"{_gp_hyperparameters()[bad]} {hyper[bad]:g} (log {state['kernel_theta_'][bad]:g}) "
-            f"at index {bad}"
+            f"at index {bad}",
+            key="state.kernel_theta_",
         )
     # paper B's inputs have plausible ranges; another actuator's only its angle
     named = (*FEATURES, TARGET) if is_paper_b() else (TARGET,)
@@ -530,29 +546,33 @@ def _check_gp(state: dict[str, Any]) -> None:
         unit = f" {bounds.unit}" if bounds.unit else ""
         if not bounds.low <= mean <= bounds.high:
             raise RuleError(
-                f"state key 'z_mean_' must hold plausible means of the GP's inputs; got "
+                f"must hold plausible means of the GP's inputs; got "
                 f"{mean:g} for {name} at index {j} (allowed {bounds.low:g} to "
-                f"{bounds.high:g}{unit})"
+                f"{bounds.high:g}{unit})",
+                key="state.z_mean_",
             )
         if scale > bounds.high - bounds.low:
             raise RuleError(
-                f"state key 'z_scale_' must hold plausible standard deviations of the GP's "
+                f"must hold plausible standard deviations of the GP's "
                 f"inputs; got {scale:g} for {name} at index {j} (allowed up to "
-                f"{bounds.high - bounds.low:g}{unit}, the width of its range)"
+                f"{bounds.high - bounds.low:g}{unit}, the width of its range)",
+                key="state.z_scale_",
             )
     outside = np.abs(inputs) > width.high
     if outside.any():
         row, col = (int(i) for i in np.argwhere(outside)[0])
         raise RuleError(
-            f"state key 'inputs_' must hold standardized values of magnitude at most "
-            f"{width.high:g}; got {inputs[row, col]:g} at ({row}, {col})"
+            f"must hold standardized values of magnitude at most "
+            f"{width.high:g}; got {inputs[row, col]:g} at ({row}, {col})",
+            key="state.inputs_",
         )
     bad = implausible_index(targets, "angle_deg")
     if bad is not None:
         bounds = RANGES["angle_deg"]
         raise RuleError(
-            f"state key 'targets_' must hold the base's errors, plausible angles from "
-            f"{bounds.low:g} to {bounds.high:g} degrees; got {targets[bad]:g} at index {bad}"
+            f"must hold the base's errors, plausible angles from "
+            f"{bounds.low:g} to {bounds.high:g} degrees; got {targets[bad]:g} at index {bad}",
+            key="state.targets_",
         )
 
 
@@ -562,8 +582,9 @@ def _check_mlp_sizes(params: dict[str, Any], state: dict[str, Any]) -> None:
     actual = (state["coefs_"][0].shape[1], state["coefs_"][1].shape[1])
     if tuple(int(h) for h in declared) != actual:
         raise RuleError(
-            f"params key 'hidden_sizes' must be the layer sizes of 'coefs_', {list(actual)}; "
-            f"got {short_repr(list(declared))}"
+            f"must be the layer sizes of 'coefs_', {list(actual)}; "
+            f"got {short_repr(list(declared))}",
+            key="params.hidden_sizes",
         )
 
 
@@ -573,13 +594,13 @@ def _check_polynomial_degree(params: dict[str, Any], state: dict[str, Any]) -> N
     highest = int(powers.sum(axis=1).max())
     if int(params["degree"]) != highest:
         raise RuleError(
-            f"params key 'degree' must be the highest total degree of 'powers_', {highest}; "
-            f"got {params['degree']}"
+            f"must be the highest total degree of 'powers_', {highest}; got {params['degree']}",
+            key="params.degree",
         )
     if "rank_" in state and int(state["rank_"]) > powers.shape[0]:
         raise RuleError(
-            f"state key 'rank_' must be at most the number of terms, {powers.shape[0]}; "
-            f"got {state['rank_']}"
+            f"must be at most the number of terms, {powers.shape[0]}; got {state['rank_']}",
+            key="state.rank_",
         )
 
 

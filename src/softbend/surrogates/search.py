@@ -57,7 +57,8 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 import pandas as pd
 
-from softbend._validation import check_choice, check_int, check_range
+from softbend._validation import check_choice, check_int, check_range, must_be
+from softbend.errors import InputError, keyed
 from softbend.references import SURROGATE_TRAINING
 from softbend.surrogates.families import (
     FAMILIES,
@@ -108,7 +109,9 @@ def grid(name: str, model: str) -> list[dict[str, Any]]:
         An unknown grid; :class:`~softbend.registry.UnknownNameError` an unknown family.
     """
     check_choice(name, "grid", GRID_NAMES)
-    return FAMILIES.get(model, field="model").configs(name)
+    with keyed("model"):
+        family = FAMILIES.get(model)
+    return family.configs(name)
 
 
 def describe(params: dict[str, Any]) -> str:
@@ -274,7 +277,7 @@ def _mlp_precision(model: str, device: str, tf32: bool) -> AbstractContextManage
     from softbend.surrogates.batched import tf32_matmul
     from softbend.surrogates.mlp_core import resolve_device
 
-    return tf32_matmul(resolve_device(device, "surrogate search"), True)
+    return tf32_matmul(resolve_device(device), True)
 
 
 def _make(
@@ -282,7 +285,9 @@ def _make(
 ) -> Any:
     """A new, unfitted estimator of the family ``model`` in the configuration ``params``."""
     settings = FitSettings(seed=seed, n_jobs=n_jobs, device=device, epochs=epochs)
-    return FAMILIES.get(model, field="models").make(dict(params), settings)
+    with keyed("models"):
+        family = FAMILIES.get(model)
+    return family.make(dict(params), settings)
 
 
 def _fold_scores(
@@ -421,11 +426,11 @@ def halving_rungs(
         rungs = check_int(rungs, "rungs", low=1)
         most = _most_rungs(n_configs, epochs, eta)
         if rungs > most:
-            raise ValueError(
-                f"The 'rungs' of halving_rungs must be at most {most} for {n_configs} "
-                f"configurations, {epochs} epochs and factor {eta} (the first rung trains at "
-                f"least one epoch, the one before the last races at least two "
-                f"configurations). Got {rungs} instead."
+            raise InputError(
+                f"must be at most {most} for {n_configs} configurations, {epochs} epochs and "
+                f"factor {eta} (the first rung trains at least one epoch, the one before the "
+                f"last races at least two configurations); got {rungs}",
+                key="rungs",
             )
     out = []
     kept = n_configs
@@ -668,8 +673,7 @@ def search(
     SearchResult
         With ``resumed``, the configuration-folds loaded from ``checkpoint``.
     """
-    owner = "surrogate search"
-    models = list(family_names(models, field="models"))
+    models = list(family_names(models))
     check_choice(grid_name, "grid", GRID_NAMES)
     check_choice(device, "device", ("auto", "cpu", "cuda"))
     epochs = (
@@ -679,15 +683,15 @@ def search(
     )
     check_choice(cv, "cv", CV_PROTOCOLS)
     if not isinstance(tf32, bool):
-        raise ValueError(f"The 'tf32' of {owner} must be True or False. Got {tf32!r}.")
+        raise InputError(must_be("True or False", tf32), key="tf32")
     if halving is not None:
         halving = check_int(halving, "halving", low=2)
     n_rungs = None if halving_rungs is None else check_int(halving_rungs, "halving_rungs", low=1)
     patience = None if plr_patience is None else check_int(plr_patience, "plr_patience", low=1)
     if n_rungs is not None and halving is None:
-        raise ValueError(
-            f"The 'halving_rungs' of {owner} needs 'halving' (the factor, e.g. 3). "
-            f"Got halving_rungs={n_rungs} without it."
+        raise InputError(
+            f"needs 'halving' (the factor, e.g. 3); got halving_rungs={n_rungs} without it",
+            key="halving_rungs",
         )
     splits = (
         grouped_splits(data.groups, folds, seed)
@@ -698,10 +702,12 @@ def search(
     families: dict[str, FamilyResult] = {}
     param_grid = dict(param_grid or {})
     for name in param_grid:
-        FAMILIES.check(name, field="param_grid")
+        with keyed("param_grid"):
+            FAMILIES.check(name)
     plan = {model: list(param_grid.get(model) or grid(grid_name, model)) for model in models}
     if halving is not None and "mlp" in plan:
-        _halving_rungs(len(plan["mlp"]), epochs, halving, n_rungs)  # bad rungs: before any fit
+        with keyed("halving_rungs"):  # bad rungs: before any fit
+            _halving_rungs(len(plan["mlp"]), epochs, halving, n_rungs)
     if checkpoint is not None:
         checkpoint.start(
             search_fingerprint(
@@ -890,7 +896,7 @@ def search_fingerprint(
         fingerprint["mlp"] = {
             "epochs": epochs,
             "halving": halving,
-            "device": resolve_device(device, "surrogate search"),
+            "device": resolve_device(device),
         }
         if halving and n_rungs is not None:  # (absent: older checkpoints stay valid)
             fingerprint["mlp"]["halving_rungs"] = n_rungs

@@ -34,7 +34,9 @@ from typing import Any
 import numpy as np
 from numpy.typing import ArrayLike
 
+from softbend._validation import must_be
 from softbend.design import PARAMETERS
+from softbend.errors import InputError
 
 __all__ = ["ANGLE_TOLERANCE", "NEIGHBOURS", "RULE", "Support", "support_from_rows"]
 
@@ -82,25 +84,22 @@ class Support:
         pmax = np.asarray(self.max_pressure_mpa, dtype=np.float64).ravel()
         d = len(self.parameters)
         if designs.ndim != 2 or designs.shape[1] != d or designs.shape[0] == 0:
-            raise ValueError(
-                f"The 'designs' of Support must have shape (n, {d}) with n >= 1. "
-                f"Got shape {designs.shape} instead."
+            raise InputError(
+                f"must have shape (n, {d}) with n >= 1; got shape {designs.shape}", key="designs"
             )
         if pmax.shape != (designs.shape[0],):
-            raise ValueError(
-                f"The 'max_pressure_mpa' of Support must hold one pressure per design "
-                f"({designs.shape[0]}). Got {pmax.size} instead."
+            raise InputError(
+                f"must hold one pressure per design ({designs.shape[0]}); got {pmax.size}",
+                key="max_pressure_mpa",
             )
         if not (np.isfinite(designs).all() and np.isfinite(pmax).all() and (pmax >= 0).all()):
-            raise ValueError(
-                "The 'designs' and 'max_pressure_mpa' of Support must be finite, the "
-                "pressures >= 0 MPa."
+            raise InputError(
+                "the designs and max_pressure_mpa must be finite, the pressures >= 0 MPa"
             )
         object.__setattr__(self, "parameters", tuple(self.parameters))
         if not (math.isfinite(self.max_angle_deg) and self.max_angle_deg > 0):
-            raise ValueError(
-                f"The 'max_angle_deg' of Support must be a finite angle > 0 degrees. "
-                f"Got {self.max_angle_deg!r} instead."
+            raise InputError(
+                must_be("a finite angle > 0 degrees", self.max_angle_deg), key="max_angle_deg"
             )
         object.__setattr__(self, "designs", designs)
         object.__setattr__(self, "max_pressure_mpa", pmax)
@@ -198,34 +197,40 @@ class Support:
         return out
 
     @classmethod
-    def from_dict(cls, data: Any) -> Support:
+    def from_dict(cls, data: object) -> Support:
         """The support a :meth:`to_dict` record describes.
 
         Raises
         ------
-        ValueError
+        softbend.errors.InputError
             A record that is not one (missing keys, other parameters, wrong shapes,
-            non-finite numbers), naming what is wrong.
+            non-finite numbers), naming what is wrong (keyed by the record's field
+            where one is at fault).
         """
         if not isinstance(data, dict):
-            raise ValueError(f"must be an object; got {type(data).__name__}")
+            raise InputError(f"must be an object; got {type(data).__name__}")
         missing = [k for k in ("designs", "max_pressure_mpa", "max_angle_deg") if k not in data]
         if missing:
-            raise ValueError(f"lacks {', '.join(missing)}")
+            raise InputError(
+                f"must give designs, max_pressure_mpa and max_angle_deg; lacks {', '.join(missing)}"
+            )
         from softbend.surrogates.features import model_features
 
         expected = list(model_features()[:-1])
         if data.get("parameters", list(PARAMETERS)) != expected:
-            raise ValueError(f"must list the parameters {', '.join(expected)}")
+            raise InputError(
+                must_be(f"the parameters {', '.join(expected)}", data.get("parameters")),
+                key="parameters",
+            )
         unit = data.get("pressure_unit", "MPa")
         if not isinstance(unit, str):
-            raise ValueError("must give the pressure unit as text")
+            raise InputError(must_be("the pressure unit as text", unit), key="pressure_unit")
         try:
             designs = np.asarray(data["designs"], dtype=np.float64)
             pmax = np.asarray(data["max_pressure_mpa"], dtype=np.float64)
             angle = float(data["max_angle_deg"])
         except (TypeError, ValueError):
-            raise ValueError("must hold numbers only") from None
+            raise InputError("must hold numbers only") from None
         return cls(designs, pmax, angle, tuple(expected), unit)
 
 
@@ -245,9 +250,9 @@ def support_from_rows(
     angles = np.asarray(y, dtype=np.float64).ravel()
     d = len(parameters)
     if rows.ndim != 2 or rows.shape[1] != d + 1 or rows.shape[0] != angles.size:
-        raise ValueError(
-            f"The 'X' and 'y' of support_from_rows must be rows of {d + 1} inputs "
-            f"and one angle per row. Got shapes {rows.shape} and {angles.shape} instead."
+        raise InputError(
+            f"X and y must be rows of {d + 1} inputs and one angle per row; got shapes "
+            f"{rows.shape} and {angles.shape}"
         )
     unique, inverse = np.unique(rows[:, :d], axis=0, return_inverse=True)
     pmax = np.zeros(unique.shape[0])

@@ -24,7 +24,7 @@ from __future__ import annotations
 import os
 from collections.abc import Callable, Sequence
 from pathlib import Path
-from typing import TYPE_CHECKING, Any
+from typing import TYPE_CHECKING, Any, TypeAlias
 
 import numpy as np
 import pandas as pd
@@ -38,6 +38,9 @@ from softbend.surrogates.search import MODEL_NAMES, Progress, SearchResult, desc
 if TYPE_CHECKING:
     from softbend.surrogates.checkpoint import SearchCheckpoint
 
+#: What surrogates are trained from: a campaign database, its samples table, or prepared data.
+Source: TypeAlias = TrainingData | pd.DataFrame | str | os.PathLike[str]
+
 #: Paper B §4.1 (Fig. 5): best configuration of each family, 5-fold CV on its FEM data
 #: (:data:`softbend.references.SURROGATES`).
 PAPER_B_FIG5: dict[str, dict[str, Any]] = values(SURROGATES)
@@ -48,7 +51,7 @@ def _paper_b(name: str) -> dict[str, Any]:
     return dict(PAPER_B_FIG5.get(name) or {})
 
 
-def _load_data(source: Any) -> TrainingData:
+def _load_data(source: Source) -> TrainingData:
     if isinstance(source, TrainingData):
         return source
     if isinstance(source, pd.DataFrame):
@@ -62,7 +65,7 @@ def _load_data(source: Any) -> TrainingData:
 
 
 def train_surrogates(
-    source: Any,
+    source: Source,
     out_dir: str | os.PathLike[str],
     *,
     models: str | Sequence[str] = MODEL_NAMES,
@@ -204,7 +207,7 @@ def train_surrogates(
 
 
 def train_into(
-    source: Any,
+    source: Source,
     out_dir: str | os.PathLike[str],
     *,
     models: str | Sequence[str] = MODEL_NAMES,
@@ -253,7 +256,7 @@ def train_into(
     from softbend._io import staged_dir
     from softbend.surrogates.checkpoint import SearchCheckpoint, checkpoint_path
 
-    names = family_names(models, field="models")
+    names = family_names(models)
     out = Path(out_dir)
     checkpoint = SearchCheckpoint(checkpoint_path(out), on_resume=on_resume, on_discard=on_discard)
     with checkpoint:

@@ -12,20 +12,24 @@ from __future__ import annotations
 
 import math
 import warnings
-from typing import Any
+from typing import TYPE_CHECKING, Any, cast
 
 import numpy as np
 
-from softbend._validation import short_repr
+from softbend._validation import must_be
 from softbend.errors import SchemaError
 from softbend.surrogates.features import FEATURES
 from softbend.surrogates.jsonvalues import decode, encode_params
+from softbend.surrogates.protocol import Surrogate
 from softbend.surrogates.schema import RuleError, tag_float
+
+if TYPE_CHECKING:
+    from xgboost import XGBRegressor
 
 __all__ = ["XGBoostCodec"]
 
 
-def _params(params: dict[str, Any], cls: type, path: str) -> tuple[dict[str, Any], set[str]]:
+def _params(params: dict[str, Any], cls: type) -> tuple[dict[str, Any], set[str]]:
     """Decoded XGBoost parameters and the names of the standard ones."""
     standard = set(cls().get_params(deep=False))
     unknown = [
@@ -36,14 +40,15 @@ def _params(params: dict[str, Any], cls: type, path: str) -> tuple[dict[str, Any
     ]
     if unknown:
         raise SchemaError(
-            f"{path}: unknown params key(s) {', '.join(map(repr, unknown))} for the xgb "
+            f"unknown params key(s) {', '.join(map(repr, unknown))} for the xgb "
             f"surrogate; allowed keys: {', '.join(sorted(standard))} and XGBoost's extra "
-            "booster parameters."
+            "booster parameters",
+            key="params",
         )
     try:
         decoded = {key: decode(value) for key, value in params.items()}
     except (KeyError, TypeError, ValueError, AttributeError, RuleError) as err:
-        raise SchemaError(f"{path}: params of the xgb surrogate cannot be read ({err}).") from None
+        raise SchemaError(f"cannot be read ({err})", key="params") from None
     if "missing" in decoded:  # null: XGBoost's default NaN (how the codec writes it)
         missing = decoded["missing"]
         if missing is None:
@@ -52,8 +57,8 @@ def _params(params: dict[str, Any], cls: type, path: str) -> tuple[dict[str, Any
             missing, int | float | np.integer | np.floating
         ):
             raise SchemaError(
-                f"{path}: params key 'missing' of the xgb surrogate must be a number or "
-                f"null (NaN, XGBoost's default); got {short_repr(params['missing'])}."
+                must_be("a number or null (NaN, XGBoost's default)", params["missing"]),
+                key="params.missing",
             )
     return decoded, standard
 
@@ -61,31 +66,34 @@ def _params(params: dict[str, Any], cls: type, path: str) -> tuple[dict[str, Any
 class XGBoostCodec:
     """The :class:`~softbend.surrogates.families.Codec` of ``xgboost.XGBRegressor``."""
 
-    def is_fitted(self, model: Any) -> bool:
+    def is_fitted(self, model: object) -> bool:
         """Whether the regressor holds a trained booster."""
-        return bool(model.__sklearn_is_fitted__())
+        return bool(cast("XGBRegressor", model).__sklearn_is_fitted__())
 
-    def params(self, model: Any) -> dict[str, Any]:
+    def params(self, model: Surrogate) -> dict[str, Any]:
         """The estimator's parameters, XGBoost's default ``missing`` (NaN) as ``null``."""
         params = encode_params(model)
         if params.get("missing") == tag_float(math.nan):
             params["missing"] = None  # read back as NaN
         return params
 
-    def state(self, model: Any) -> dict[str, Any]:
+    def state(self, model: Surrogate) -> dict[str, Any]:
         """``{"booster": XGBoost's JSON model as text}``."""
-        return {"booster": bytes(model.get_booster().save_raw("json")).decode("utf-8")}
+        booster = cast("XGBRegressor", model).get_booster()
+        return {"booster": bytes(booster.save_raw("json")).decode("utf-8")}
 
-    def restore(self, cls: type, params: dict[str, Any], state: dict[str, Any], path: str) -> Any:
+    def restore(
+        self, cls: type, params: dict[str, Any], state: dict[str, Any], path: str
+    ) -> Surrogate:
         """The regressor of ``params`` (as saved) with the checked ``booster`` loaded.
 
         Raises
         ------
         softbend.errors.SchemaError
             A parameter XGBoost does not know or refuses, a booster it cannot load or
-            one that predicts a non-finite angle, naming ``path``.
+            one that predicts a non-finite angle (the file ``path``).
         """
-        decoded, standard = _params(params, cls, path)
+        decoded, standard = _params(params, cls)
         try:
             model = cls(**decoded)
             model.load_model(bytearray(state["booster"].encode("utf-8")))
@@ -101,10 +109,12 @@ class XGBoostCodec:
                 probe = np.asarray(model.predict(np.zeros((1, len(FEATURES)))), dtype=np.float64)
         except Exception as err:  # xgboost.core.XGBoostError, a parameter XGBoost refuses, ...
             reason = (str(err).strip().splitlines() or [type(err).__name__])[0]  # no stack trace
-            raise SchemaError(f"{path}: cannot rebuild the xgb surrogate ({reason}).") from None
+            raise SchemaError(f"cannot rebuild the xgb surrogate ({reason})", file=path) from None
         if not np.isfinite(probe).all():
             raise SchemaError(
-                f"{path}: the xgb surrogate's booster predicts {probe.ravel()[0]} (its "
-                "base_score or a leaf value is not a finite number)."
+                f"must predict finite angles; the booster predicts {probe.ravel()[0]} (its "
+                "base_score or a leaf value is not a finite number)",
+                key="state.booster",
+                file=path,
             )
-        return model
+        return cast(Surrogate, model)
