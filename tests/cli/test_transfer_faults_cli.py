@@ -66,7 +66,8 @@ def test_lab_measure_refuses_a_billion_cycles_at_once(tmp_path, capsys):
     assert main([*argv, "--out", str(out)]) == 2
     assert time.perf_counter() - start < 5.0
     line = one_error_line(capsys)
-    assert "--cycles is 1,000,000,000 cycles" in line and "limit of 1,000" in line
+    assert line.startswith("softbend: error: --cycles: ") and "1,000,000,000 cycles" in line
+    assert "limit of 1,000" in line
     assert "SOFTBEND_MAX_CYCLES" in line
     assert _listing(tmp_path) == []
 
@@ -83,8 +84,8 @@ def test_lab_measure_a_max_angle_below_the_first_step_is_one_line(tmp_path, caps
     argv = ["lab", "measure", "--plant", "analytical", "--max-angle", "0.01", "--out", str(out)]
     assert main(argv) == 2
     line = one_error_line(capsys)
-    assert "The '--max-angle' of softbend lab measure (0.01°) stops actuator" in line
-    assert "Raise --max-angle or lower --pstep." in line
+    assert "softbend: error: --max-angle: (0.01°) stops actuator" in line
+    assert "raise it, or lower the pressure step" in line
     assert "max_angle_deg" not in line and "VirtualLab" not in line
     assert _listing(tmp_path) == []
 
@@ -235,7 +236,7 @@ def test_refine_an_absurd_angle_is_one_line_and_no_model(
     argv = ["transfer", "refine", str(small_base_file), str(bad), "--out", str(out)]
     assert main([*argv, "--strategy", "scale-offset"]) == 2
     line = one_error_line(capsys)  # no overflow warnings before it
-    assert f"{bad}, line {line_number}, column 'angle_deg': 1e+300" in line
+    assert f"{bad}:{line_number}:8: angle_deg: 1e+300" in line
     assert "-3600 to 3600" in line
     assert not out.exists()
 
@@ -246,7 +247,7 @@ def test_refine_a_bad_metadata_header_is_one_line(lab_csv, tmp_path, capsys, sma
     bad.write_text(text)
     argv = ["transfer", "refine", str(small_base_file), str(bad), "--out", str(tmp_path / "m.json")]
     assert main([*argv, "--strategy", "scale-offset"]) == 2
-    assert f"{bad}, line 2: the metadata 'synthetic' must be" in one_error_line(capsys)
+    assert f"{bad}:2: synthetic: must be 'true' or 'false'" in one_error_line(capsys)
 
 
 def test_refine_on_a_full_disk_names_the_option_and_keeps_the_old_model(

@@ -126,11 +126,11 @@ def test_bad_input_is_refused():
     model = BaseMeanResidual(base).fit(X, y)
     with pytest.raises(ValueError, match="NaN"):
         model.predict(bad)
-    with pytest.raises(ValueError, match="at least 2 readings"):
+    with pytest.raises(ValueError, match=r"^X: must hold at least 2 readings"):
         BaseMeanResidual(base).fit(X[:1], y[:1])
-    with pytest.raises(ValueError, match="'base' of BaseMeanResidual"):
+    with pytest.raises(ValueError, match=r"^base: must be a fitted surrogate"):
         BaseMeanResidual(None).fit(X, y)
-    with pytest.raises(ValueError, match="must have the 7 columns"):
+    with pytest.raises(ValueError, match=r"^X: must have the 7 columns"):
         BaseMeanResidual(base).fit(X[:, :-1], y)
 
 

@@ -1,9 +1,10 @@
 """A strategy defined outside softbend: one ``register`` call, then every command knows it.
 
-The toy below lives in this file only; registering it is the whole change. The
-command line then fits it (``transfer refine --strategy toy --set ...``),
-scores it (``transfer loco``), lists it (``transfer strategies``) and records
-its parameters, with no edit of softbend's files.
+The toy below lives in this file only: one class that declares the range of its
+parameter beside it, and one ``register`` line. The command line then fits it
+(``transfer refine --strategy toy --set ...``), holds ``--set`` to the declared
+range, scores it (``transfer loco``), lists it with its range (``transfer
+strategies``) and records its parameters, with no edit of softbend's files.
 """
 
 from __future__ import annotations
@@ -15,6 +16,7 @@ import pytest
 from sklearn.base import BaseEstimator, RegressorMixin
 
 from softbend.cli import main
+from softbend.parameters import Range, declare_ranges
 from softbend.surrogates.corrected import AffineCorrected
 from softbend.surrogates.persistence import save_surrogate
 from softbend.transfer import STRATEGIES
@@ -22,6 +24,7 @@ from softbend.transfer import STRATEGIES
 DESIGN = "100,6,2,2,5,8"
 
 
+@declare_ranges(share=Range(0, 1, "of the mean error", "0 keeps the base; 1 removes its error"))
 class ShiftedBase(RegressorMixin, BaseEstimator):
     """The base plus a share of its mean error on the readings (a toy strategy)."""
 
@@ -103,6 +106,7 @@ def test_a_registered_strategy_is_scored_listed_and_its_parameters_recorded(
     assert main(["transfer", "strategies", "--json"]) == 0
     listed = {r["name"]: r for r in json.loads(capsys.readouterr().out)}
     assert listed["toy"]["parameters"] == {"share": 1.0} and listed["toy"]["learns"]
+    assert listed["toy"]["ranges"] == {"share": "[0, 1] of the mean error"}
     assert listed["toy"]["summary"].startswith("The base plus a share")
     assert main(["transfer", "strategies"]) == 0
     assert "toy" in capsys.readouterr().out
@@ -115,12 +119,17 @@ def test_a_misspelt_parameter_or_an_unknown_strategy_is_one_line_listing_the_kno
     argv = ["transfer", "refine", str(base), str(lab), "--out", str(tmp_path / "m.json")]
     assert main([*argv, "--strategy", toy, "--set", "shar=0.5"]) == 2
     line = _error_line(capsys)
-    assert "Unknown parameter 'shar' of transfer strategy 'toy' (in --set); known: share." in line
+    assert line == "softbend: error: --set: shar: is not a parameter; known: share"
     assert main([*argv, "--strategy", toy, "--set", "share=half"]) == 2
-    assert "'share'" in _error_line(capsys)
+    line = _error_line(capsys)
+    assert line.startswith("softbend: error: --set: share: must be a number")
+    assert main([*argv, "--strategy", toy, "--set", "share=2"]) == 2
+    line = _error_line(capsys)
+    assert line == "softbend: error: --set: share: must be in [0, 1] of the mean error; got '2'"
     assert main([*argv, "--strategy", "tyo"]) == 2
     line = _error_line(capsys)
-    assert "Unknown transfer strategy 'tyo'" in line and "refined" in line and "toy" in line
+    assert line.lower().startswith("softbend: error: --strategy: unknown transfer strategy 'tyo'")
+    assert "refined" in line and "toy" in line
     assert not (tmp_path / "m.json").exists()
 
 
@@ -131,5 +140,6 @@ def test_an_unregistered_strategy_is_unknown_again(files, tmp_path, capsys):
     assert main([*argv, "--strategy", "toy"]) == 2
     line = _error_line(capsys)
     assert (
-        "Unknown transfer strategy 'toy'" in line and "known: fem-only, base-mean-residual" in line
+        "unknown transfer strategy 'toy'" in line.lower()
+        and "known: fem-only, base-mean-residual" in line
     )

@@ -50,7 +50,7 @@ def test_cpu_is_the_auto_path_without_a_gpu(base, monkeypatch):
 
 def test_unknown_device_is_one_line(base):
     X, y = _rows(base, n=5)
-    with pytest.raises(ValueError, match="'device' of fine_tune_many must be one of"):
+    with pytest.raises(ValueError, match=r"^device: must be one of 'auto', 'cpu', 'cuda'"):
         fine_tune_many(base, X, y, np.ones((1, y.size)), epochs=2, device="tpu")
 
 

@@ -76,7 +76,9 @@ def test_loco_refuses_the_analytical_baseline_for_another_actuator(lab):
     base, readings = lab
     saved = load_surrogate(base)
     data = load_actuator_measurements(readings, saved.actuator)
-    with pytest.raises(ValueError, match="paper B's actuator only"):
+    with pytest.raises(
+        ValueError, match=r"^strategies: 'analytical' models paper B's actuator only"
+    ):
         leave_one_configuration_out(data, saved.model, ["analytical"], learning_curve=False)
 
 
@@ -126,4 +128,6 @@ def test_a_readings_file_with_another_column_is_one_line(lab, tmp_path, capsys):
     assert code == 2
     err = capsys.readouterr().err.strip().splitlines()
     assert len(err) == 1
-    assert "lacks the column(s) wall_mm" in err[0] and "has column(s) wall the model" in err[0]
+    assert (
+        "lacks the column(s) wall_mm" in err[0] and "has column(s) wall the measurement" in err[0]
+    )

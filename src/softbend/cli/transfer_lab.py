@@ -1,9 +1,10 @@
 """``softbend lab``: the virtual lab's labelled-synthetic measurements of paper B's actuators.
 
 Every setting is checked before the lab runs, and a message names the option
-typed (``--pmax``), not the library's field. Options that contradict each other
-(``--material`` gives the silicone whole, so ``--elastomer`` and
-``--elastomer-max-stretch`` would be dropped) are refused, naming both. The CSV
+typed (``--pmax``), not the library's field (:mod:`softbend.cli._options`).
+Options that contradict each other (``--material`` gives the silicone whole, so
+``--elastomer`` and ``--elastomer-max-stretch`` would be dropped) are refused,
+naming both. The CSV
 and its figure are written together through temporary files beside them: a run
 that fails, or is stopped by Ctrl-C or SIGTERM, leaves both as they were and no
 temporary file.
@@ -16,34 +17,16 @@ import threading
 from collections.abc import Iterator
 from contextlib import contextmanager
 from pathlib import Path
-from typing import TYPE_CHECKING, Any
+from types import FrameType
+from typing import TYPE_CHECKING
 
 import typer
 
 from softbend.cli import _common
+from softbend.errors import InputError, SoftbendError
 
 if TYPE_CHECKING:
     from softbend.design import SFRBADesign
-
-_COMMAND = "softbend lab measure"
-
-#: The option that sets each setting of :class:`~softbend.transfer.lab.VirtualLab`.
-OPTIONS: dict[str, str] = {
-    "actuators": "--design",
-    "plant": "--plant",
-    "elastomer": "--elastomer",
-    "elastomer_max_stretch": "--elastomer-max-stretch",
-    "material": "--material",
-    "fabrication_error_mm": "--fabrication-error",
-    "hysteresis": "--hysteresis",
-    "camera_noise_deg": "--camera-noise",
-    "pmax_mpa": "--pmax",
-    "pressure_step_mpa": "--pstep",
-    "max_angle_deg": "--max-angle",
-    "unloading": "--unloading",
-    "cycles": "--cycles",
-    "seed": "--seed",
-}
 
 #: Options that ``--material`` makes pointless: the silicone is given whole.
 _MATERIAL_REPLACES: dict[str, str] = {
@@ -70,7 +53,7 @@ def _terminate_as_interrupt() -> Iterator[None]:
         yield
         return
 
-    def interrupt(signum: int, frame: Any) -> None:
+    def interrupt(signum: int, frame: FrameType | None) -> None:
         raise KeyboardInterrupt
 
     previous = signal.signal(signal.SIGTERM, interrupt)
@@ -93,7 +76,7 @@ def measure(
     ctx: typer.Context,
     out: Path = typer.Option(..., "--out", "-o", help="CSV file to write the measurements to."),
     plant: str = typer.Option(
-        "fem", help="Model of the actuators as built: a lab plant (fem or analytical)."
+        "fem", help="Model of the actuators as built: a lab model (fem or analytical)."
     ),
     seed: int = typer.Option(0, help="Seed of the fabrication errors and the camera noise."),
     fabrication_error: float = typer.Option(
@@ -145,7 +128,6 @@ def measure(
         softbend lab measure --out own.csv --design 130,7,2.5,3,10,9 --material fit.json
     """
     from softbend._io import atomic_files
-    from softbend.limits import check_limit
     from softbend.reports.transfer_figures import lab_measurements
     from softbend.transfer.lab import LAB_ACTUATORS, VirtualLab
     from softbend.transfer.measurements import format_measurements
@@ -157,7 +139,6 @@ def measure(
                     f"The '--material' gives the lab's silicone whole, so the '{option}' "
                     f"would not be used; give one of '--material' and '{option}'."
                 )
-    check_limit("cycles", cycles, "--cycles")
     out = Path(out)
     figure = out.with_suffix(".png")
     if out.suffix.lower() == ".png":
@@ -168,9 +149,7 @@ def measure(
     _common.check_output_file(out, "--out", kind="csv")
     _common.check_output_file(figure, "--out", kind="png")
     actuators = tuple(_design(text) for text in designs) if designs else LAB_ACTUATORS
-    lab = VirtualLab.from_options(
-        OPTIONS,
-        _COMMAND,
+    lab = VirtualLab(
         actuators=actuators,
         plant=plant,
         seed=seed,
@@ -237,4 +216,5 @@ def _design(text: str) -> SFRBADesign:
     try:
         return SFRBADesign.parse(text)
     except ValueError as exc:
-        raise ValueError(f"The '--design' {text!r} is not a design: {exc}") from None
+        detail = exc.detail if isinstance(exc, SoftbendError) else str(exc)
+        raise InputError(f"{text!r} is not a design: {detail}", key="designs") from None

@@ -3,14 +3,16 @@
 from __future__ import annotations
 
 from pathlib import Path
-from typing import TYPE_CHECKING, Any
+from typing import TYPE_CHECKING
 
 import typer
 
 from softbend.cli import _common
 
 if TYPE_CHECKING:
+    from softbend.transfer.actuator_measurements import ActuatorMeasurements
     from softbend.transfer.loco import LocoResult
+    from softbend.transfer.measurements import Measurements
 
 #: The files 'transfer loco' writes into its '--out' folder.
 LOCO_FILES: tuple[str, ...] = (
@@ -90,7 +92,6 @@ def loco(
     from softbend.transfer.base import load_base_saved
     from softbend.transfer.loco import (
         DEFAULT_STRATEGIES,
-        check_calibration,
         leave_one_configuration_out,
         strategy_options,
     )
@@ -109,19 +110,11 @@ def loco(
         else [n.strip() for n in strategies.split(",") if n.strip()]
     )
     options = strategy_options(names, _common.parse_assignments(settings or ()))
-    data: Any = (
+    data: Measurements | ActuatorMeasurements = (
         load_measurements_files(measurements, force=force)
         if paper_b
         else load_actuator_measurements(measurements, actuator, force=force)
     )
-    if calibrate:  # before the base is read and any strategy fitted
-        check_calibration(
-            data.actuator_ids,
-            names,
-            field="--calibrate",
-            data_field="MEASUREMENTS",
-            owner="softbend transfer loco",
-        )
     model = saved.model
     with _common.library_progress(enabled=not as_json) as progress:
         result = leave_one_configuration_out(
@@ -135,7 +128,7 @@ def loco(
             options=options,
             progress=lambda done, total, name: progress("fitting strategies", done, total),
         )
-    result.settings["measurement_files"] = files_record(measurements, data)
+    result.settings["measurement_files"] = files_record(measurements, data)  # type: ignore[arg-type]
     synthetic = bool(data.synthetic.any())  # the figure flags any synthetic reading
     with (
         _common.output_errors(out, "--out"),

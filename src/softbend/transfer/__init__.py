@@ -24,7 +24,7 @@ _EXPORTS = {
     "shipped_base_path": "base",
     "train_base_mlp": "base",
     "LAB_ACTUATORS": "lab",
-    "PLANTS": "lab",
+    "LAB_MODELS": "lab",
     "VirtualLab": "lab",
     "actuator_id": "lab",
     "shipped_measurements": "lab",

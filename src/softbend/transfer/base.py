@@ -14,13 +14,19 @@ import os
 from collections.abc import Callable
 from importlib import resources
 from pathlib import Path
-from typing import Any, cast
+from typing import TYPE_CHECKING, Any, cast
 
 import numpy as np
 
 from softbend.design import FEATURES
 from softbend.errors import DatasetError
 from softbend.references import SURROGATE_TRAINING
+
+if TYPE_CHECKING:
+    import pandas as pd
+
+    from softbend.surrogates.mlp import NormalizedMLPRegressor
+    from softbend.surrogates.persistence import SavedSurrogate
 
 __all__ = [
     "BASE_HIDDEN_SIZES",
@@ -44,7 +50,7 @@ def shipped_base_path() -> Path:
     return Path(str(resources.files("softbend") / "data" / "transfer" / _SHIPPED))
 
 
-def fem_rows(samples: Any = None) -> np.ndarray:
+def fem_rows(samples: pd.DataFrame | None = None) -> np.ndarray:
     """The converged rows of :data:`FEATURES` of FEM samples (default: the shipped dataset)."""
     from softbend.datasets import table1_fem
 
@@ -54,13 +60,13 @@ def fem_rows(samples: Any = None) -> np.ndarray:
 
 
 def train_base_mlp(
-    samples: Any = None,
+    samples: pd.DataFrame | None = None,
     *,
     hidden_sizes: tuple[int, int] = BASE_HIDDEN_SIZES,
     epochs: int = 1000,
     seed: int = 0,
     progress: Callable[[int, int], object] | None = None,
-) -> Any:
+) -> NormalizedMLPRegressor:
     """Train paper B's MLP on FEM samples.
 
     Parameters
@@ -109,7 +115,9 @@ def train_base_mlp(
     return NormalizedMLPRegressor.from_grid(grid, 0, 0)
 
 
-def base_metadata(model: Any, *, epochs: int, seed: int, command: str) -> dict[str, Any]:
+def base_metadata(
+    model: NormalizedMLPRegressor, *, epochs: int, seed: int, command: str
+) -> dict[str, Any]:
     """The record saved with a base MLP that :func:`train_base_mlp` trained on the shipped data.
 
     Parameters
@@ -168,7 +176,7 @@ def load_base(path: str | os.PathLike[str] | None = None) -> Any:
     return load_base_saved(path).model
 
 
-def load_base_saved(path: str | os.PathLike[str] | None = None) -> Any:
+def load_base_saved(path: str | os.PathLike[str] | None = None) -> SavedSurrogate:
     """:func:`load_base`, with the file's record: a :class:`~softbend.surrogates.SavedSurrogate`.
 
     Raises

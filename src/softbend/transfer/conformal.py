@@ -49,6 +49,7 @@ import numpy as np
 from numpy.typing import ArrayLike
 
 from softbend._validation import check_range
+from softbend.surrogates.protocol import Surrogate
 
 __all__ = [
     "Calibrated",
@@ -254,7 +255,7 @@ class Calibrated:
     calibration : Calibration
     """
 
-    def __init__(self, model: Any, calibration: Calibration) -> None:
+    def __init__(self, model: Surrogate, calibration: Calibration) -> None:
         self.model = model
         self.calibration = calibration
 

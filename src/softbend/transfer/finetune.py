@@ -17,15 +17,18 @@ loop never waits for the host.
 
 from __future__ import annotations
 
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 from numpy.typing import ArrayLike
 
 from softbend._progress import every, report
 from softbend._validation import check_int, check_range
-from softbend.errors import ConvergenceError
+from softbend.errors import ConvergenceError, InputError
 from softbend.limits import check_limit
+
+if TYPE_CHECKING:
+    from softbend.surrogates.mlp import NormalizedMLPRegressor
 
 __all__ = ["FINE_TUNE_THREADS", "check_mlp", "fine_tune_many", "fine_tune_mlp", "row_weights"]
 
@@ -38,16 +41,17 @@ __all__ = ["FINE_TUNE_THREADS", "check_mlp", "fine_tune_many", "fine_tune_mlp", 
 FINE_TUNE_THREADS = 2
 
 
-def check_mlp(base: Any, owner: str) -> Any:
-    """``base`` if it is a fitted NormalizedMLPRegressor, else one ``ValueError`` naming it."""
+def check_mlp(base: object) -> NormalizedMLPRegressor:
+    """``base`` if it is a fitted NormalizedMLPRegressor, else :class:`InputError` keyed base."""
     from sklearn.utils.validation import check_is_fitted
 
     from softbend.surrogates.mlp import NormalizedMLPRegressor
 
     if not isinstance(base, NormalizedMLPRegressor):
-        raise ValueError(
-            f"The 'base' of {owner} must be a fitted NormalizedMLPRegressor (an 'mlp' "
-            f"surrogate): its weights are trained further. Got {type(base).__name__} instead."
+        raise InputError(
+            "must be a fitted NormalizedMLPRegressor (an 'mlp' surrogate): its weights are "
+            f"trained further; got {type(base).__name__}",
+            key="base",
         )
     check_is_fitted(base)
     return base
@@ -59,7 +63,7 @@ def row_weights(row_sets: list[np.ndarray], n_rows: int) -> np.ndarray:
 
 
 def fine_tune_many(
-    base: Any | list[Any],
+    base: NormalizedMLPRegressor | list[NormalizedMLPRegressor],
     X: ArrayLike,
     y: ArrayLike,
     weights: ArrayLike,
@@ -67,7 +71,7 @@ def fine_tune_many(
     epochs: int = 1000,
     learning_rate: float = 6e-4,
     device: str = "auto",
-) -> list[Any]:
+) -> list[NormalizedMLPRegressor]:
     """Train K copies of a fitted MLP further, full batch, each on its own weighted rows.
 
     Parameters
@@ -101,43 +105,39 @@ def fine_tune_many(
     from softbend._torch import require_torch
     from softbend.surrogates.mlp import NormalizedMLPRegressor
 
-    owner = "fine_tune_many"
     torch = require_torch("refining the MLP surrogate")
     from softbend.surrogates.mlp_core import resolve_device
 
-    device = resolve_device(device, owner)
-    starts = [check_mlp(b, owner) for b in (base if isinstance(base, list) else [base])]
-    base = starts[0]
+    device = resolve_device(device)
+    starts = [check_mlp(b) for b in (base if isinstance(base, list) else [base])]
+    first = starts[0]
     epochs = check_int(epochs, "epochs", low=1)
-    check_limit("epochs", epochs, f"The 'epochs' of {owner}")
+    check_limit("epochs", epochs, "epochs")
     learning_rate = check_range(learning_rate, "learning_rate", low=0.0)
     X = np.asarray(X, dtype=np.float64)
     y = np.asarray(y, dtype=np.float64).ravel()
     w = np.asarray(weights, dtype=np.float64)
-    d = base.n_features_in_
+    d = first.n_features_in_
     if X.ndim != 2 or X.shape[1] != d or X.shape[0] != y.size or y.size == 0:
-        raise ValueError(
-            f"The 'X' and 'y' of {owner} must have shapes (n, {d}) and (n,) with n >= 1. "
-            f"Got {X.shape} and {y.shape} instead."
+        raise InputError(
+            f"must have shape (n, {d}) and y shape (n,), n >= 1; got {X.shape} and {y.shape}",
+            key="X",
         )
     if not (np.isfinite(X).all() and np.isfinite(y).all()):
-        raise ValueError(f"The 'X' and 'y' of {owner} must be finite (no NaN or inf).")
+        raise InputError("must be finite (no NaN or inf), and so must y", key="X")
     if w.ndim != 2 or w.shape[1] != y.size:
-        raise ValueError(
-            f"The 'weights' of {owner} must have shape (K, {y.size}). Got {w.shape} instead."
-        )
+        raise InputError(f"must have shape (K, {y.size}); got {w.shape}", key="weights")
     if not np.isfinite(w).all() or (w < 0).any() or (w.sum(axis=1) <= 0).any():
-        raise ValueError(
-            f"The 'weights' of {owner} must be finite, >= 0, with a positive sum per variant."
-        )
+        raise InputError("must be finite, >= 0, with a positive sum per variant", key="weights")
     k = w.shape[0]
     if len(starts) == 1:
         starts = starts * k
     shapes = {tuple(c.shape for c in m.coefs_) for m in starts}
     if len(starts) != k or len(shapes) != 1:
-        raise ValueError(
-            f"The 'base' of {owner} must be one MLP or {k} MLPs of one architecture. "
-            f"Got {len(starts)} with layer shapes {sorted(shapes)}."
+        raise InputError(
+            f"must be one MLP or {k} MLPs of one architecture; got {len(starts)} with layer "
+            f"shapes {sorted(shapes)}",
+            key="base",
         )
     x_mean = np.array([m.x_mean_ for m in starts])[:, None, :]
     x_scale = np.array([m.x_scale_ for m in starts])[:, None, :]
@@ -179,7 +179,7 @@ def fine_tune_many(
     coefs = [p.detach().cpu().numpy() for p in weights_]
     intercepts = [p.detach().cpu().numpy()[:, 0, :] for p in biases]
     if not all(np.isfinite(a).all() for a in (*coefs, *intercepts)):
-        raise ConvergenceError(f"{owner} produced non-finite weights; lower the learning_rate")
+        raise ConvergenceError("the refit produced non-finite weights; lower the learning_rate")
     return [
         NormalizedMLPRegressor.from_arrays(
             x_mean=starts[i].x_mean_,
@@ -200,14 +200,14 @@ def fine_tune_many(
 
 
 def fine_tune_mlp(
-    base: Any,
+    base: NormalizedMLPRegressor,
     X: ArrayLike,
     y: ArrayLike,
     *,
     epochs: int = 1000,
     learning_rate: float = 6e-4,
     device: str = "auto",
-) -> Any:
+) -> NormalizedMLPRegressor:
     """Train every layer of a fitted MLP further on new rows (full batch), scaling kept.
 
     :func:`fine_tune_many` with one variant holding every row once. Paper B's

@@ -27,7 +27,7 @@ is synthetic and lists the gap's parameters in its header.
 
 from __future__ import annotations
 
-from collections.abc import Callable, Mapping
+from collections.abc import Callable, Iterable, Mapping
 from dataclasses import asdict, dataclass, field, replace
 from pathlib import Path
 from typing import Any
@@ -35,50 +35,50 @@ from typing import Any
 import numpy as np
 import pandas as pd
 
-from softbend._validation import check_choice, check_int, check_range
+from softbend._validation import check_choice, check_int, check_range, must_be
 from softbend.design import PAPER_B_FIG7_DESIGNS, PARAMETERS, SFRBADesign
-from softbend.errors import ConvergenceError
+from softbend.errors import ConvergenceError, InputError, keyed
 from softbend.limits import check_limit
 from softbend.materials.fit import fit_model
 from softbend.materials.models import Yeoh
 from softbend.materials.presets import DRAGON_SKIN_30, Material
 from softbend.materials.tensile import load_shipped, shipped_tensile_tests
 from softbend.models import BendingModel, default_pressures_mpa
+from softbend.parameters import Range
 from softbend.references import FEM_VALIDATION
 from softbend.registry import Registry
 from softbend.transfer.measurements import Measurements
 
 __all__ = [
     "LAB_ACTUATORS",
-    "PLANTS",
+    "LAB_MODELS",
     "VirtualLab",
     "actuator_id",
     "shipped_measurements",
     "shipped_measurements_path",
 ]
 
-_OWNER = "VirtualLab"
-
 #: The seven actuators of paper B Fig. 7 (:data:`softbend.design.PAPER_B_FIG7_DESIGNS`).
 LAB_ACTUATORS: tuple[SFRBADesign, ...] = PAPER_B_FIG7_DESIGNS
 
 
-def _fem_plant(elastomer: Material) -> BendingModel:
+def _fem_model(elastomer: Material) -> BendingModel:
     from softbend.fem import FEMModel, FEMOptions
 
     return FEMModel(FEMOptions(elastomer=elastomer))
 
 
-def _analytical_plant(elastomer: Material) -> BendingModel:
+def _analytical_model(elastomer: Material) -> BendingModel:
     from softbend.analytical import AnalyticalModel
 
     return AnalyticalModel(material=elastomer)
 
 
-#: Models that can play the lab's actuators: ``factory(elastomer) -> BendingModel``.
-PLANTS: Registry[Callable[[Material], BendingModel]] = Registry("lab plant")
-PLANTS.register("fem", _fem_plant)
-PLANTS.register("analytical", _analytical_plant)
+#: Bending models that can play the lab's actuators: ``factory(elastomer) -> BendingModel``.
+#: The lab's ``plant`` setting (``softbend lab measure --plant``) names one.
+LAB_MODELS: Registry[Callable[[Material], BendingModel]] = Registry("lab model")
+LAB_MODELS.register("fem", _fem_model)
+LAB_MODELS.register("analytical", _analytical_model)
 
 
 def actuator_id(design: SFRBADesign) -> str:
@@ -89,93 +89,78 @@ def actuator_id(design: SFRBADesign) -> str:
 #: CSV column of each design parameter (the measurement files' names).
 _COLUMNS = dict(zip(PARAMETERS, ("l", "r", "t", "b", "phi", "lc"), strict=True))
 
-#: The interval of each numeric setting: ``(low, high, low_inclusive, high_inclusive)``.
-_BOUNDS: dict[str, tuple[float, float, bool, bool]] = {
-    "elastomer_max_stretch": (1.0, 50.0, False, False),
-    "fabrication_error_mm": (0.0, 1.0, True, False),
-    "hysteresis": (0.0, 0.25, True, False),
-    "pressure_step_mpa": (0.0, 0.1, False, True),
-    "pmax_mpa": (0.0, 1.0, False, True),
-    "camera_noise_deg": (0.0, 90.0, True, True),
-    "max_angle_deg": (0.0, 300.0, False, True),
+#: The range of each numeric setting.
+_BOUNDS: dict[str, Range] = {
+    "elastomer_max_stretch": Range(1.0, 50.0, low_inclusive=False, high_inclusive=False),
+    "fabrication_error_mm": Range(0.0, 1.0, "mm", high_inclusive=False),
+    "hysteresis": Range(0.0, 0.25, high_inclusive=False),
+    "pressure_step_mpa": Range(0.0, 0.1, "MPa", low_inclusive=False),
+    "pmax_mpa": Range(0.0, 1.0, "MPa", low_inclusive=False),
+    "camera_noise_deg": Range(0.0, 90.0, "deg"),
+    "max_angle_deg": Range(0.0, 300.0, "deg", low_inclusive=False),
 }
 
 
-def _checked_settings(
-    settings: Mapping[str, Any], names: Mapping[str, str], owner: str
-) -> dict[str, Any]:
-    """The settings of a :class:`VirtualLab`, checked; messages name each as ``names`` does.
+def _checked_settings(settings: Mapping[str, object]) -> dict[str, Any]:
+    """The settings of a :class:`VirtualLab` given, checked; an error is keyed by the setting.
 
-    ``names`` maps a setting to what the caller calls it (a command line's
-    ``{"pmax_mpa": "--pmax"}``); a setting it leaves out is named as it is.
     Only the settings given are checked (the lab's own defaults need none).
     """
-
-    def name(key: str) -> str:
-        return names.get(key, key)
-
-    out = dict(settings)
+    out: dict[str, Any] = dict(settings)
     if "actuators" in settings:
-        actuators = settings["actuators"]
-        try:
-            actuators = tuple(actuators)
-        except TypeError:
-            actuators = ()
+        given = settings["actuators"]
+        actuators = tuple(given) if isinstance(given, Iterable) else ()
         if not actuators or not all(isinstance(a, SFRBADesign) for a in actuators):
-            raise ValueError(
-                f"The '{name('actuators')}' of {owner} must be a non-empty sequence of "
-                f"SFRBADesign. Got {settings['actuators']!r} instead."
-            )
+            raise InputError(must_be("a non-empty sequence of SFRBADesign", given), key="actuators")
         ids = [actuator_id(a) for a in actuators]
         repeated = sorted({i for i in ids if ids.count(i) > 1})
         if repeated:
-            raise ValueError(
-                f"The '{name('actuators')}' of {owner} must be distinct designs. Got "
-                f"{', '.join(repeated)} more than once."
+            raise InputError(
+                f"must be distinct designs; got {', '.join(repeated)} more than once",
+                key="actuators",
             )
         out["actuators"] = actuators
     if "plant" in settings:
-        PLANTS.check(settings["plant"], field=name("plant"))
+        with keyed("plant"):
+            LAB_MODELS.check(settings["plant"])
     if "elastomer" in settings:
-        check_choice(settings["elastomer"], name("elastomer"), shipped_tensile_tests())
-    for key, (low, high, low_inclusive, high_inclusive) in _BOUNDS.items():
+        check_choice(settings["elastomer"], "elastomer", shipped_tensile_tests())
+    for key, bounds in _BOUNDS.items():
         if key in settings:
             out[key] = check_range(
                 settings[key],
-                name(key),
-                low=low,
-                high=high,
-                low_inclusive=low_inclusive,
-                high_inclusive=high_inclusive,
+                key,
+                low=bounds.low,
+                high=bounds.high,
+                low_inclusive=bounds.low_inclusive,
+                high_inclusive=bounds.high_inclusive,
             )
     if "unloading" in settings and not isinstance(settings["unloading"], bool):
-        raise ValueError(
-            f"The '{name('unloading')}' of {owner} must be True or False. "
-            f"Got {settings['unloading']!r} instead."
-        )
+        raise InputError(must_be("True or False", settings["unloading"]), key="unloading")
     if "cycles" in settings:
-        out["cycles"] = check_int(settings["cycles"], name("cycles"), low=1)
-        check_limit("cycles", out["cycles"], f"The '{name('cycles')}' of {owner}")
+        cycles = out["cycles"] = check_int(settings["cycles"], "cycles", low=1)
+        with keyed("cycles"):
+            check_limit("cycles", cycles, "the count")
     if "seed" in settings:
-        out["seed"] = check_int(settings["seed"], name("seed"), low=0)
+        out["seed"] = check_int(settings["seed"], "seed", low=0)
     if settings.get("material") is not None:
         from softbend.materials.choice import material_from_spec
 
         for key in ("elastomer", "elastomer_max_stretch"):
             if key in settings and settings[key] != getattr(VirtualLab, key):
-                raise ValueError(
-                    f"The '{name('material')}' of {owner} gives the lab's silicone whole, so "
-                    f"the '{name(key)}' ({settings[key]!r}) would not be used; give one of "
-                    f"'{name('material')}' and '{name(key)}'."
+                raise InputError(
+                    f"gives the lab's silicone whole, so {key} ({settings[key]!r}) would not "
+                    f"be used; give one of material and {key}",
+                    key="material",
                 )
-        out["_material"] = material_from_spec(str(settings["material"]), field=name("material"))
+        with keyed("material"):
+            out["_material"] = material_from_spec(str(settings["material"]))
     if "pmax_mpa" in out or "pressure_step_mpa" in out:
-        default_pressures_mpa(  # a whole number of steps
-            out.get("pmax_mpa", VirtualLab.pmax_mpa),
-            out.get("pressure_step_mpa", VirtualLab.pressure_step_mpa),
-            names=(name("pmax_mpa"), name("pressure_step_mpa")),
-            owner=owner,
-        )
+        with keyed("pmax_mpa"):  # a whole number of steps
+            default_pressures_mpa(
+                out.get("pmax_mpa", VirtualLab.pmax_mpa),
+                out.get("pressure_step_mpa", VirtualLab.pressure_step_mpa),
+            )
     return out
 
 
@@ -188,7 +173,7 @@ class VirtualLab:
     actuators : tuple of SFRBADesign
         Nominal designs measured, default :data:`LAB_ACTUATORS` (paper B Fig. 7).
     plant : str
-        Model of the actuators as built, a name of :data:`PLANTS`: the 3D FEM
+        Model of the actuators as built, a name of :data:`LAB_MODELS`: the 3D FEM
         (``"fem"``, default) or the analytical model (``"analytical"``: seconds
         instead of minutes, for checks).
     elastomer : str
@@ -228,9 +213,9 @@ class VirtualLab:
 
     Raises
     ------
-    ValueError
-        A setting out of its range, naming it; :class:`~softbend.errors.LimitError`
-        for ``cycles`` over its limit.
+    InputError
+        A setting out of its range, keyed by its name;
+        :class:`~softbend.errors.LimitError` for ``cycles`` over its limit.
     """
 
     actuators: tuple[SFRBADesign, ...] = LAB_ACTUATORS
@@ -248,9 +233,6 @@ class VirtualLab:
     cycles: int = 1
     seed: int = 0
     _material: Material | None = field(default=None, init=False, repr=False, compare=False)
-    _names: tuple[dict[str, str], str] | None = field(
-        default=None, init=False, repr=False, compare=False
-    )
 
     def __post_init__(self) -> None:
         settings = {
@@ -266,42 +248,9 @@ class VirtualLab:
                 "seed",
             )
         }
-        # A bad material spec is refused here, naming 'material'; a good one is kept.
-        for key, value in _checked_settings(settings, {}, _OWNER).items():
+        # A bad material spec is refused here, keyed 'material'; a good one is kept.
+        for key, value in _checked_settings(settings).items():
             object.__setattr__(self, key, value)
-
-    @classmethod
-    def from_options(cls, names: Mapping[str, str], owner: str, **settings: Any) -> VirtualLab:
-        """A lab whose messages name its settings as the caller does (a command line's options).
-
-        Parameters
-        ----------
-        names : mapping of str to str
-            What the caller calls each setting (``{"pmax_mpa": "--pmax"}``); a
-            setting left out is named as it is.
-        owner : str
-            Who asks, for messages (``"softbend lab measure"``).
-        **settings
-            The settings of :class:`VirtualLab`.
-
-        Raises
-        ------
-        ValueError
-            As :class:`VirtualLab`, naming the setting as ``names`` does; so do
-            the errors of :meth:`measure` about a setting (``max_angle_deg``).
-        """
-        _checked_settings(settings, names, owner)
-        lab = cls(**settings)
-        object.__setattr__(lab, "_names", (dict(names), owner))
-        return lab
-
-    def _named(self, key: str) -> str:
-        """A setting as the messages name it (see :meth:`from_options`)."""
-        return (self._names or ({}, _OWNER))[0].get(key, key)
-
-    @property
-    def _owner(self) -> str:
-        return (self._names or ({}, _OWNER))[1]
 
     # -- the gap -----------------------------------------------------------------
 
@@ -311,7 +260,8 @@ class VirtualLab:
         if self._material is None and self.material is not None:
             from softbend.materials.choice import material_from_spec
 
-            chosen = material_from_spec(str(self.material), field="material")
+            with keyed("material"):
+                chosen = material_from_spec(str(self.material))
             object.__setattr__(self, "_material", chosen)
         if self._material is None:
             test = load_shipped(self.elastomer)
@@ -347,7 +297,9 @@ class VirtualLab:
 
     def plant_model(self) -> BendingModel:
         """The bending model of the actuators as built, with the lab's elastomer."""
-        return PLANTS.get(self.plant, field="plant")(self.elastomer_material())
+        with keyed("plant"):
+            factory = LAB_MODELS.get(self.plant)
+        return factory(self.elastomer_material())
 
     def metadata(self) -> dict[str, str]:
         """Header lines of the lab's files: synthetic, the gap's parameters, the material."""
@@ -355,7 +307,7 @@ class VirtualLab:
         values = {
             k: v
             for k, v in asdict(self).items()
-            if k not in ("actuators", "_material", "_names")
+            if k not in ("actuators", "_material")
             # the material given whole replaces the shipped test's fit
             and not (k == "material" and v is None)
             and not (k.startswith("elastomer") and self.material is not None)
@@ -406,8 +358,8 @@ class VirtualLab:
         ------
         ConvergenceError
             The model stopped before an actuator's second pressure step.
-        ValueError
-            ``max_angle_deg`` stops an actuator before its second reading.
+        InputError
+            Key ``max_angle_deg``: it stops an actuator before its second reading.
         """
         model = self.plant_model() if model is None else model
         grid = default_pressures_mpa(self.pmax_mpa, self.pressure_step_mpa)
@@ -428,12 +380,11 @@ class VirtualLab:
                     pressure_mpa=float(reached.max(initial=0.0)),
                 )
             if pressures.size < 2:
-                max_angle, step = self._named("max_angle_deg"), self._named("pressure_step_mpa")
-                raise ValueError(
-                    f"The '{max_angle}' of {self._owner} ({self.max_angle_deg:g}°) stops "
-                    f"actuator {actuator_id(nominal)} before its second reading: it bends "
-                    f"{float(angle[1]):.4g}° at {float(reached[1]):g} MPa. Raise {max_angle} "
-                    f"or lower {step}."
+                raise InputError(
+                    f"({self.max_angle_deg:g}°) stops actuator {actuator_id(nominal)} before "
+                    f"its second reading: it bends {float(angle[1]):.4g}° at "
+                    f"{float(reached[1]):g} MPa; raise it, or lower the pressure step",
+                    key="max_angle_deg",
                 )
             frames.extend(self._readings(nominal, pressures, elastic, noise_rng))
             if progress is not None:

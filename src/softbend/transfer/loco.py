@@ -32,8 +32,10 @@ import pandas as pd
 
 from softbend._io import json_text, write_text_atomic
 from softbend._validation import check_int, check_range
+from softbend.errors import InputError, keyed
 from softbend.metrics import rmse, thresholded_mape
 from softbend.registry import UnknownNameError
+from softbend.surrogates.protocol import Surrogate
 from softbend.transfer.actuator_measurements import ActuatorMeasurements
 from softbend.transfer.conformal import Calibration, angle_floor, calibrate
 from softbend.transfer.measurements import Measurements
@@ -66,8 +68,6 @@ _SLOW = ("experimental", "refined-ensemble")
 #: The strategy every other is judged against (``rmse_vs_baseline_pct`` of the summary): the
 #: base plus the mean residual of the training actuators as a function of pressure alone.
 BASELINE_STRATEGY = "base-mean-residual"
-
-_OWNER = "leave_one_configuration_out"
 
 #: Actuators the nested calibration needs: the held-out one, and at least two others,
 #: each predicted by a model fitted without it and without the held-out one.
@@ -167,7 +167,11 @@ class LocoResult:
 
 
 def _score(
-    strategy: str, held_out: str, y: np.ndarray, pred: np.ndarray, interval: Any
+    strategy: str,
+    held_out: str,
+    y: np.ndarray,
+    pred: np.ndarray,
+    interval: tuple[np.ndarray, np.ndarray] | None,
 ) -> dict[str, Any]:
     ok = np.isfinite(pred)
     row: dict[str, Any] = {
@@ -193,7 +197,7 @@ def _score(
 
 def _fit_all(
     name: str,
-    base: Any,
+    base: Surrogate | None,
     options: dict[str, Any],
     seed: int,
     X: np.ndarray,
@@ -214,7 +218,7 @@ def _fit_all(
 
 def leave_one_configuration_out(
     measurements: Measurements | ActuatorMeasurements,
-    base: Any,
+    base: Surrogate | None,
     strategies: Sequence[str] = DEFAULT_STRATEGIES,
     *,
     level: float = 0.9,
@@ -267,23 +271,25 @@ def leave_one_configuration_out(
 
     Raises
     ------
-    ValueError
-        Bad input; among them ``calibrated`` with too few actuators or only
-        the slowest strategies (:func:`check_calibration`).
+    InputError
+        Bad input, keyed by the parameter; among them ``calibrated`` with too
+        few actuators or only the slowest strategies (:func:`check_calibration`).
     """
     if not isinstance(measurements, Measurements | ActuatorMeasurements):
-        raise ValueError(
-            f"The 'measurements' of {_OWNER} must be Measurements (see load_measurements) or "
-            f"ActuatorMeasurements. Got {type(measurements).__name__} instead."
+        raise InputError(
+            "must be Measurements (see load_measurements) or ActuatorMeasurements; got "
+            f"{type(measurements).__name__}",
+            key="measurements",
         )
     from softbend.actuators import SFRBA
     from softbend.surrogates.persistence import describing
 
     actuator = getattr(measurements, "actuator", SFRBA)  # paper B's Measurements: SFRBA
     if actuator != SFRBA and "analytical" in strategies:
-        raise ValueError(
-            f"The 'analytical' strategy models paper B's actuator only; the measurements "
-            f"are of {actuator.name}. Leave it out of the strategies."
+        raise InputError(
+            f"'analytical' models paper B's actuator only; the measurements are of "
+            f"{actuator.name}: leave it out",
+            key="strategies",
         )
     with describing(actuator):  # the strategies check the inputs of this actuator
         result = _leave_one_out(
@@ -306,8 +312,8 @@ def leave_one_configuration_out(
 
 
 def _leave_one_out(
-    measurements: Any,
-    base: Any,
+    measurements: Measurements | ActuatorMeasurements,
+    base: Surrogate | None,
     strategies: Sequence[str],
     *,
     level: float,
@@ -321,25 +327,21 @@ def _leave_one_out(
     """:func:`leave_one_configuration_out` once the measurements' kind is known."""
     names = tuple(strategies)
     if not names:
-        raise ValueError(
-            f"The 'strategies' of {_OWNER} must name at least one of {', '.join(STRATEGIES)}."
-        )
-    for name in names:
-        STRATEGIES.check(name, field="strategies")
+        raise InputError(f"must name at least one of {', '.join(STRATEGIES)}", key="strategies")
+    with keyed("strategies"):
+        for name in names:
+            STRATEGIES.check(name)
     if len(set(names)) != len(names):
-        raise ValueError(f"The 'strategies' of {_OWNER} must be distinct. Got {list(names)}.")
+        raise InputError(f"must be distinct; got {list(names)}", key="strategies")
     level = check_range(level, "level", low=0.0, high=1.0)
     seed = check_int(seed, "seed", low=0)
-    options = {
-        name: check_parameters(name, STRATEGIES.get(name, field="options"), values)
-        for name, values in dict(options or {}).items()
-    }
+    with keyed("options"):
+        options = {
+            name: check_parameters(STRATEGIES.get(name), values)
+            for name, values in dict(options or {}).items()
+        }
     ids = measurements.actuator_ids
-    if len(ids) < 2:
-        raise ValueError(
-            f"The 'measurements' of {_OWNER} must cover at least 2 actuators. "
-            f"Got {len(ids)} ({', '.join(ids)}) instead."
-        )
+    _check_two_actuators(ids)
     if calibrated:
         check_calibration(ids, names)
     X, y, groups = measurements.features, measurements.angle_deg, measurements.groups
@@ -440,8 +442,9 @@ def _leave_one_out(
                     "mape_pct": row["mape_pct"],
                 }
             )
-    if hasattr(base, "loss_curve_") and hasattr(base, "y_scale_") and "fem-only" in names:
-        loss_curves["fem-only"] = np.asarray(base.loss_curve_) * base.y_scale_**2
+    base_curve, y_scale = getattr(base, "loss_curve_", None), getattr(base, "y_scale_", None)
+    if base_curve is not None and y_scale is not None and "fem-only" in names:
+        loss_curves["fem-only"] = np.asarray(base_curve) * y_scale**2
 
     per_actuator = pd.DataFrame(scores)
     return LocoResult(
@@ -481,14 +484,16 @@ def _leave_one_out(
     )
 
 
-def check_calibration(
-    actuators: Sequence[str],
-    strategies: Sequence[str],
-    *,
-    field: str = "calibrated",
-    data_field: str = "measurements",
-    owner: str = _OWNER,
-) -> None:
+def _check_two_actuators(ids: Sequence[str]) -> None:
+    """Refuse measurements of fewer than 2 actuators (key ``measurements``)."""
+    if len(ids) < 2:
+        raise InputError(
+            f"must cover at least 2 actuators; got {len(ids)} ({', '.join(ids)})",
+            key="measurements",
+        )
+
+
+def check_calibration(actuators: Sequence[str], strategies: Sequence[str]) -> None:
     """Refuse a nested calibration that :func:`leave_one_configuration_out` cannot make.
 
     The calibrated interval of a held-out actuator comes from the leave-one-out
@@ -503,34 +508,32 @@ def check_calibration(
         The measured actuators.
     strategies : sequence of str
         The strategies to score.
-    field, data_field, owner : str
-        The option, the measurements and the caller named in messages
-        (``"--calibrate"``, ``"MEASUREMENTS"``, ``"softbend transfer loco"``).
 
     Raises
     ------
-    ValueError
-        Fewer than :data:`MIN_CALIBRATION_ACTUATORS` actuators, or no strategy
+    InputError
+        Key ``calibrated`` (the parameter of :func:`leave_one_configuration_out`):
+        fewer than :data:`MIN_CALIBRATION_ACTUATORS` actuators, or no strategy
         that is calibrated.
     """
     if len(actuators) < MIN_CALIBRATION_ACTUATORS:
-        raise ValueError(
-            f"The '{field}' of {owner} needs the {data_field} of at least "
-            f"{MIN_CALIBRATION_ACTUATORS} actuators (the held-out one and two others, each "
-            "predicted by a model fitted without it, to calibrate its interval on). "
-            f"Got {len(actuators)} ({'; '.join(actuators)}) instead."
+        raise InputError(
+            f"needs measurements of at least {MIN_CALIBRATION_ACTUATORS} actuators (the "
+            "held-out one and two others, each predicted by a model fitted without it, to "
+            f"calibrate its interval on); got {len(actuators)} ({'; '.join(actuators)})",
+            key="calibrated",
         )
     if all(name in _SLOW for name in strategies):
-        raise ValueError(
-            f"The '{field}' of {owner} calibrates strategies other than "
-            f"{' and '.join(_SLOW)} (their training would dominate the time). "
-            f"Got only {', '.join(strategies)} instead."
+        raise InputError(
+            f"calibrates strategies other than {' and '.join(_SLOW)} (their training would "
+            f"dominate the time); got only {', '.join(strategies)}",
+            key="calibrated",
         )
 
 
 def held_out_residuals(
-    measurements: Measurements,
-    base: Any,
+    measurements: Measurements | ActuatorMeasurements,
+    base: Surrogate | None,
     strategy: str,
     *,
     seed: int = 0,
@@ -560,15 +563,12 @@ def held_out_residuals(
     dict of str to ndarray
         Actuator id → ``|prediction − reading|`` on its readings, degrees.
     """
-    owner = "held_out_residuals"
-    STRATEGIES.check(strategy, field="strategy")
+    with keyed("strategy"):
+        cls = STRATEGIES.get(strategy)
     ids = measurements.actuator_ids
-    if len(ids) < 2:
-        raise ValueError(
-            f"The 'measurements' of {owner} must cover at least 2 actuators. "
-            f"Got {len(ids)} ({', '.join(ids)}) instead."
-        )
-    values = check_parameters(strategy, STRATEGIES.get(strategy), dict(options or {}))
+    _check_two_actuators(ids)
+    with keyed("options"):
+        values = check_parameters(cls, dict(options or {}))
     X, y, groups = measurements.features, measurements.angle_deg, measurements.groups
     tests = [np.flatnonzero(groups == a) for a in ids]
     trains = [np.flatnonzero(groups != a) for a in ids]
@@ -673,7 +673,7 @@ def _summarize(
 
 
 def strategy_options(
-    strategies: Sequence[str], settings: Mapping[str, str], *, field: str = "--set"
+    strategies: Sequence[str], settings: Mapping[str, str]
 ) -> dict[str, dict[str, Any]]:
     """Text settings of a run of several strategies as the ``options`` of the run.
 
@@ -684,8 +684,6 @@ def strategy_options(
     settings : mapping of str to str
         ``{"refined.epochs": "500"}`` sets a parameter of one strategy;
         ``{"epochs": "500"}`` sets it on every strategy of the run that takes it.
-    field : str, default "--set"
-        Where the settings came from, named in messages.
 
     Returns
     -------
@@ -695,29 +693,31 @@ def strategy_options(
     Raises
     ------
     UnknownNameError
-        A strategy that is not registered, a parameter it does not take, or a
-        parameter no strategy of the run takes (the known ones listed).
+        A strategy that is not registered (key ``strategies``), or in
+        ``settings`` (key ``settings``) a strategy that is not, a parameter it
+        does not take, or a parameter no strategy of the run takes (the known
+        ones listed).
     ValueError
-        A value that is not of the parameter's kind.
+        Key ``settings``: a value that is not of the parameter's kind or out of its range.
     """
-    names = [STRATEGIES.check(name, field="strategies") for name in strategies]
+    with keyed("strategies"):
+        names = [STRATEGIES.check(name) for name in strategies]
     options: dict[str, dict[str, Any]] = {}
-    for key, text in settings.items():
-        target, dot, parameter = key.rpartition(".")
-        if dot:
-            STRATEGIES.check(target, field=field)
-            targets = [target]
-        else:
-            targets = [n for n in names if parameter in strategy_parameters(n)]
-            if not targets:
-                known = sorted({p for n in names for p in strategy_parameters(n)})
-                raise UnknownNameError(
-                    f"Unknown parameter {parameter!r} (in {field}): no strategy of the run "
-                    f"({', '.join(names)}) takes it; known: {', '.join(known) or 'none'}."
-                )
-        for name in targets:
-            value = check_parameters(
-                name, STRATEGIES.get(name), {parameter: text}, field=field, from_text=True
-            )
-            options.setdefault(name, {}).update(value)
+    with keyed("settings"):
+        for key, text in settings.items():
+            target, dot, parameter = key.rpartition(".")
+            if dot:
+                targets = [STRATEGIES.check(target)]
+            else:
+                targets = [n for n in names if parameter in strategy_parameters(n)]
+                if not targets:
+                    known = sorted({p for n in names for p in strategy_parameters(n)})
+                    raise UnknownNameError(
+                        f"is not a parameter of any strategy of the run ({', '.join(names)}); "
+                        f"known: {', '.join(known) or 'none'}",
+                        key=parameter,
+                    )
+            for name in targets:
+                value = check_parameters(STRATEGIES.get(name), {parameter: text}, from_text=True)
+                options.setdefault(name, {}).update(value)
     return options

@@ -83,10 +83,6 @@ def item_count(cls: type, name: str) -> int | None:
     return len([part for part in found.group(1).split(",") if part.strip()])
 
 
-def _owner(name: str) -> str:
-    return f"transfer strategy {name!r}"
-
-
 def _count_words(cls: type, key: str, count: int) -> str:
     """``"2 integers separated by commas, each in [1, 1024] units"``."""
     declared = _parameters.declared_ranges(cls).get(key)
@@ -108,54 +104,26 @@ def describe_range(cls: type, key: str) -> str | None:
     return _count_words(cls, key, count) if count is not None else declared.describe()
 
 
-def _check_one(
-    name: str, cls: type, key: str, value: Any, *, field: str, from_text: bool
-) -> dict[str, Any]:
+def _check_one(cls: type, key: str, value: object, *, from_text: bool) -> dict[str, Any]:
     """One parameter checked by :func:`softbend.parameters.check_parameters`, and its count."""
-    owner = _owner(name)
     count = item_count(cls, key)
     try:
         checked = _parameters.check_parameters(
-            cls,
-            {key: value},
-            owner=owner,
-            field=field,
-            from_text=from_text,
-            skip=FILLED,
-            keyword_only=False,
-            hints=_HINTS,
+            cls, {key: value}, from_text=from_text, skip=FILLED, keyword_only=False, hints=_HINTS
         )
-    except OverflowError:  # an integer too large to compare with a float bound
-        if count is not None:
-            must, shown = _count_words(cls, key, count), _items(value)
-        else:
-            declared = _parameters.declared_ranges(cls).get(key)
-            must = declared.requirement() if declared is not None else "a smaller number"
-            shown = str(value).strip()
-            shown = shown if len(shown) <= 40 else f"a number of {len(shown)} characters"
-        raise _parameters.ParameterValueError(
-            f"The parameter {key!r} of {owner} (in {field}) must be {must}. Got {shown} instead.",
-            key,
-        ) from None
     except _parameters.ParameterValueError:
         if count is None:
             raise
-        raise _parameters.ParameterValueError(
-            f"The parameter {key!r} of {owner} (in {field}) must be "
-            f"{_count_words(cls, key, count)}. Got {_items(value)} instead.",
-            key,
-        ) from None
+        checked = {}
     result = checked.get(key)
-    if count is not None and isinstance(result, tuple) and len(result) != count:
+    if count is not None and not (isinstance(result, tuple) and len(result) == count):
         raise _parameters.ParameterValueError(
-            f"The parameter {key!r} of {owner} (in {field}) must be "
-            f"{_count_words(cls, key, count)}. Got {_items(value)} instead.",
-            key,
+            f"must be {_count_words(cls, key, count)}; got {_items(value)}", key
         )
     return checked
 
 
-def _items(value: Any) -> str:
+def _items(value: object) -> str:
     """A value given for a tuple parameter, with its number of items: ``'0,0' (2 values)``."""
     if isinstance(value, str):
         n = len(value.split(","))
@@ -168,28 +136,21 @@ def _items(value: Any) -> str:
 
 
 def check_parameters(
-    name: str,
-    cls: type,
-    values: Mapping[str, Any] | None,
-    *,
-    field: str = "options",
-    from_text: bool = False,
+    cls: type, values: Mapping[str, object] | None, *, from_text: bool = False
 ) -> dict[str, Any]:
-    """``values`` checked against the parameters of strategy ``name`` (class ``cls``).
+    """``values`` checked against the parameters of the strategy class ``cls``.
 
     :func:`softbend.parameters.check_parameters` on the constructor of ``cls``,
-    less :data:`FILLED`.
+    less :data:`FILLED`. An error's key is the parameter's name; a caller that
+    hands on its own parameter re-keys it (:func:`softbend.errors.keyed`:
+    ``settings``, ``options``), and the parameter's name moves into the message.
 
     Parameters
     ----------
-    name : str
-        The strategy's registered name, for messages.
     cls : type
         The strategy class.
     values : mapping, optional
         ``{parameter: value}``; text values when ``from_text``.
-    field : str, default "options"
-        Where the values came from (``"--set"``), named in messages.
     from_text : bool, default False
         Read each value from text by the kind of the parameter.
 
@@ -211,24 +172,21 @@ def check_parameters(
     """
     checked: dict[str, Any] = {}
     for key, value in (values or {}).items():
-        checked.update(_check_one(name, cls, key, value, field=field, from_text=from_text))
+        checked.update(_check_one(cls, key, value, from_text=from_text))
     return checked
 
 
-def check_estimator(name: str, estimator: Any, *, field: str | None = None) -> dict[str, Any]:
+def check_estimator(estimator: object) -> dict[str, Any]:
     """The ranged parameters of a strategy object, checked as :func:`check_parameters` does.
 
     For a strategy built directly (``RefinedMLP(base, learning_rate=...)``) or
-    changed by ``set_params``: its fit calls this before any work.
+    changed by ``set_params``: its fit calls this before any work. An error's
+    key is the parameter's name, as the constructor calls it.
 
     Parameters
     ----------
-    name : str
-        The strategy's registered name (its class name if it has none), for messages.
     estimator : object
         The strategy object; every parameter of its class with a declared range is read.
-    field : str, optional
-        Where the values came from, for messages; default ``"<Class> parameters"``.
 
     Returns
     -------
@@ -242,10 +200,10 @@ def check_estimator(name: str, estimator: Any, *, field: str | None = None) -> d
         for key in _parameters.declared_ranges(cls)
         if key in known and key not in FILLED and hasattr(estimator, key)
     }
-    return check_parameters(name, cls, values, field=field or f"{cls.__name__} parameters")
+    return check_parameters(cls, values)
 
 
-def recorded_parameters(estimator: Any) -> dict[str, Any]:
+def recorded_parameters(estimator: object) -> dict[str, Any]:
     """Every parameter of a strategy object, ``seed`` included, as it will run (for a record).
 
     The base surrogate is left out (the record names its file); a value that is

@@ -19,13 +19,18 @@ trained further from the mapped start (the ``scaled-refined`` strategy).
 
 from __future__ import annotations
 
-from typing import Any
+from typing import TYPE_CHECKING
 
 import numpy as np
 from numpy.typing import ArrayLike
 from scipy.optimize import minimize_scalar
 
+from softbend.errors import InputError
 from softbend.surrogates.corrected import scaled_pressure_rows
+from softbend.surrogates.protocol import Surrogate
+
+if TYPE_CHECKING:
+    from softbend.surrogates.mlp import NormalizedMLPRegressor
 
 __all__ = ["SCALE_BOUNDS", "fit_pressure_scale", "scale_mlp_pressure"]
 
@@ -33,7 +38,7 @@ __all__ = ["SCALE_BOUNDS", "fit_pressure_scale", "scale_mlp_pressure"]
 SCALE_BOUNDS: tuple[float, float] = (0.25, 4.0)
 
 
-def fit_pressure_scale(base: Any, X: ArrayLike, y: ArrayLike, *, owner: str) -> float:
+def fit_pressure_scale(base: Surrogate, X: ArrayLike, y: ArrayLike) -> float:
     """The ``s`` that minimises ``Σ (base(design, s·p) − θ)²`` over the rows.
 
     Parameters
@@ -44,8 +49,6 @@ def fit_pressure_scale(base: Any, X: ArrayLike, y: ArrayLike, *, owner: str) -> 
         Measured designs and pressures (mm, deg, MPa), finite.
     y : array_like of shape (n,)
         Measured angles, degrees.
-    owner : str
-        Name of the caller, for the error message.
 
     Returns
     -------
@@ -54,17 +57,19 @@ def fit_pressure_scale(base: Any, X: ArrayLike, y: ArrayLike, *, owner: str) -> 
 
     Raises
     ------
-    ValueError
-        If no row has a positive pressure (the scale is then undetermined), or
-        the best scale lies on a bound of :data:`SCALE_BOUNDS` (the measured
-        actuators are not this model's actuator made softer or stiffer).
+    InputError
+        Key ``X``: no row has a positive pressure (the scale is then
+        undetermined), or the best scale lies on a bound of :data:`SCALE_BOUNDS`
+        (the measured actuators are not this model's actuator made softer or
+        stiffer); key ``base``: the base predicts no finite angle at any scale.
     """
     rows = np.asarray(X, dtype=np.float64)
     angles = np.asarray(y, dtype=np.float64)
     if not np.any(rows[:, -1] > 0.0):
-        raise ValueError(
-            f"The measurements of {owner} must include a pressure above 0 MPa: the pressure "
-            "scale is fitted on pressurized readings."
+        raise InputError(
+            "must include a pressure above 0 MPa: the pressure scale is fitted on "
+            "pressurized readings",
+            key="X",
         )
     low, high = SCALE_BOUNDS
 
@@ -81,18 +86,19 @@ def fit_pressure_scale(base: Any, X: ArrayLike, y: ArrayLike, *, owner: str) -> 
     grid = np.linspace(np.log(low), np.log(high), 41)
     losses = np.array([loss(float(np.exp(g))) for g in grid])
     if not np.isfinite(losses).any():
-        raise ValueError(
-            f"The base of {owner} predicts no finite angle at the measured pressures for any "
-            f"pressure scale in {low:g}–{high:g}."
+        raise InputError(
+            "predicts no finite angle at the measured pressures for any pressure scale in "
+            f"{low:g}–{high:g}",
+            key="base",
         )
     best = int(np.argmin(losses))
     if best in (0, grid.size - 1):
-        raise ValueError(
-            f"The pressure scale of {owner} lies on its bound "
-            f"({float(np.exp(grid[best])):.3g}, allowed {low:g}–{high:g}): the measured "
-            "actuators do not behave like the base's actuator with a softer or stiffer "
-            "elastomer. Check the units of the pressure column (MPa) and that the base is a "
-            "surrogate of the same actuator family."
+        raise InputError(
+            f"gives a pressure scale on its bound ({float(np.exp(grid[best])):.3g}, allowed "
+            f"{low:g}–{high:g}): the measured actuators do not behave like the base's actuator "
+            "with a softer or stiffer elastomer. Check the units of the pressure column (MPa) "
+            "and that the base is a surrogate of the same actuator family",
+            key="X",
         )
     found = minimize_scalar(
         lambda log_s: loss(float(np.exp(log_s))),
@@ -103,7 +109,7 @@ def fit_pressure_scale(base: Any, X: ArrayLike, y: ArrayLike, *, owner: str) -> 
     return float(np.exp(found.x))
 
 
-def scale_mlp_pressure(model: Any, scale: float) -> Any:
+def scale_mlp_pressure(model: NormalizedMLPRegressor, scale: float) -> NormalizedMLPRegressor:
     """A copy of a normalized MLP that answers ``model(design, scale·p)`` exactly.
 
     The network standardizes its inputs as ``(x − mean)/scale_x``; asking it at

@@ -30,14 +30,19 @@ from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
 import numpy as np
+from numpy.typing import ArrayLike
 
-from softbend.errors import ConvergenceError
+from softbend.errors import ConvergenceError, InputError, keyed
+from softbend.surrogates.protocol import Surrogate
 from softbend.transfer.conformal import Calibration, angle_floor, calibrate
 from softbend.transfer.parameters import check_parameters, recorded_parameters, takes
 from softbend.transfer.strategies import STRATEGIES, fit_strategy, learns
 
 if TYPE_CHECKING:
     from softbend.actuators import Actuator
+    from softbend.surrogates.persistence import SavedSurrogate
+    from softbend.transfer.actuator_measurements import ActuatorMeasurements
+    from softbend.transfer.measurements import Measurements
 
 __all__ = ["Refinement", "refinable_strategies", "refine_surrogate"]
 
@@ -77,7 +82,7 @@ class Refinement:
     metadata: dict[str, Any]
     calibration: Calibration | None = None
 
-    def predict_interval(self, X: Any, level: float = 0.9) -> tuple[np.ndarray, np.ndarray]:
+    def predict_interval(self, X: ArrayLike, level: float = 0.9) -> tuple[np.ndarray, np.ndarray]:
         """The calibrated interval at the rows ``X``, degrees (``level``: the calibration's).
 
         Raises
@@ -102,7 +107,7 @@ class Refinement:
         return save_surrogate(self.strategy.model_, path, metadata=json_safe(self.metadata))
 
 
-def _merged_ranges(own: dict[str, list[float]], base: Any) -> dict[str, list[float]]:
+def _merged_ranges(own: dict[str, list[float]], base: object) -> dict[str, list[float]]:
     """The ranges of the measurements widened by those the base was trained on."""
     if not isinstance(base, dict):
         return own
@@ -121,7 +126,7 @@ def _check_finite_predictions(strategy: str, predicted: np.ndarray, features: np
         )
 
 
-def _check_finite_figures(strategy: str, figures: Mapping[str, Any]) -> None:
+def _check_finite_figures(strategy: str, figures: Mapping[str, float | None]) -> None:
     """Raise :class:`ConvergenceError` naming the first figure of the record that is not finite."""
     for name, value in figures.items():
         if value is not None and not np.isfinite(float(value)):
@@ -139,8 +144,7 @@ def refine_surrogate(
     *,
     seed: int = 0,
     settings: Mapping[str, str] | None = None,
-    options: Mapping[str, Any] | None = None,
-    field: str = "--set",
+    options: Mapping[str, object] | None = None,
     calibrated: bool = True,
     force: bool = False,
 ) -> Refinement:
@@ -164,8 +168,6 @@ def refine_surrogate(
         kind of each parameter's default.
     options : mapping, optional
         Parameters of the strategy as values (``{"epochs": 500}``).
-    field : str, default "--set"
-        Where ``settings`` came from, named in messages.
     calibrated : bool, default True
         Also calibrate the 90 % interval over actuators (one more fit per
         actuator; at least 2 actuators). A ``UserWarning`` when there are too
@@ -182,10 +184,12 @@ def refine_surrogate(
     Raises
     ------
     UnknownNameError
-        An unknown strategy or parameter (the known ones listed).
+        An unknown strategy or parameter (the known ones listed), keyed
+        ``strategy``, ``settings`` or ``options``.
     ValueError
-        A strategy that learns nothing (a baseline), a parameter value of the
-        wrong kind, bad measurements or a fit that cannot be made.
+        A strategy that learns nothing (a baseline, key ``strategy``), a
+        parameter value of the wrong kind (key ``settings`` or ``options``),
+        bad measurements or a fit that cannot be made.
     FileNotFoundError, SchemaError
         A missing or unreadable input.
     ConvergenceError
@@ -197,20 +201,22 @@ def refine_surrogate(
     from softbend.transfer.actuator_measurements import load_actuator_measurements
     from softbend.transfer.measurements import load_measurements_files
 
-    cls = STRATEGIES.get(strategy, field="strategy")
+    with keyed("strategy"):
+        cls = STRATEGIES.get(strategy)
     if not learns(strategy):
-        raise ValueError(
-            f"The transfer strategy {strategy!r} learns nothing from the measurements, so it "
-            f"has no model to save; known strategies that do: {', '.join(refinable_strategies())}."
+        raise InputError(
+            f"{strategy!r} learns nothing from the measurements, so it has no model to save; "
+            f"known strategies that do: {', '.join(refinable_strategies())}",
+            key="strategy",
         )
-    values = {
-        **check_parameters(strategy, cls, settings, field=field, from_text=True),
-        **check_parameters(strategy, cls, options),
-    }
+    with keyed("settings"):
+        from_text = check_parameters(cls, settings, from_text=True)
+    with keyed("options"):
+        values = {**from_text, **check_parameters(cls, options)}
     files = [measurements] if isinstance(measurements, str | os.PathLike) else list(measurements)
     start = load_surrogate(base)
     actuator = start.actuator
-    data: Any
+    data: Measurements | ActuatorMeasurements
     if actuator == SFRBA:
         data = load_measurements_files(files, force=force)
     else:  # another actuator's plain CSV: its own columns and units
@@ -231,8 +237,8 @@ def refine_surrogate(
 
 def _refine(
     strategy: str,
-    start: Any,
-    data: Any,
+    start: SavedSurrogate,
+    data: Measurements | ActuatorMeasurements,
     files: list[str | os.PathLike[str]],
     base: str | os.PathLike[str],
     actuator: Actuator,
@@ -246,7 +252,7 @@ def _refine(
     from softbend.surrogates.support import Support, support_from_rows
     from softbend.transfer.measurements import files_record, synthetic_label
 
-    cls = STRATEGIES.get(strategy, field="strategy")
+    cls = STRATEGIES.get(strategy)
     model = fit_strategy(strategy, start.model, data, seed=seed, **values)
     ranges = training_ranges(data.features)
     support = support_from_rows(
@@ -268,10 +274,10 @@ def _refine(
         "parameters": recorded_parameters(model),
         "base": str(base),
         "measurements": str(files[0]) if len(files) == 1 else [str(f) for f in files],
-        "measurement_files": files_record(files, data),
+        "measurement_files": files_record(files, data),  # type: ignore[arg-type]
         "n_measurements": len(data),
         "actuators": list(data.actuator_ids),
-        "synthetic_measurements": synthetic_label(data),
+        "synthetic_measurements": synthetic_label(data),  # type: ignore[arg-type]
         "training_rmse_deg": float(np.sqrt(np.mean(residual**2))),
         "training_ranges": ranges,
         "support": support.to_dict(),
@@ -298,7 +304,11 @@ def _refine(
 
 
 def _calibrate(
-    data: Any, base: Any, strategy: str, seed: int, values: dict[str, Any]
+    data: Measurements | ActuatorMeasurements,
+    base: Surrogate,
+    strategy: str,
+    seed: int,
+    values: dict[str, Any],
 ) -> Calibration | None:
     """The 90 % calibration over the actuators of ``data``; warns when they are too few."""
     from softbend.surrogates.predict import INTERVAL_LEVEL

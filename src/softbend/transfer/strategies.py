@@ -53,7 +53,8 @@ from __future__ import annotations
 
 import math
 import warnings
-from typing import Any, ClassVar, Literal, overload
+from collections.abc import Sequence
+from typing import TYPE_CHECKING, Any, ClassVar, Literal, overload
 
 import numpy as np
 from numpy.typing import ArrayLike
@@ -65,7 +66,8 @@ from sklearn.utils.validation import check_is_fitted, validate_data
 
 from softbend._validation import check_int, check_range
 from softbend.design import SFRBADesign
-from softbend.errors import ConvergenceError
+from softbend.errors import ConvergenceError, InputError, keyed
+from softbend.models import BendingModel
 from softbend.parameters import Range, declare_ranges, declared_ranges
 from softbend.plausibility import RANGES as PLAUSIBLE
 from softbend.plausibility import check_plausible
@@ -79,6 +81,7 @@ from softbend.surrogates.corrected import (
     scaled_pressure_rows,
 )
 from softbend.surrogates.features import is_paper_b, model_features
+from softbend.surrogates.protocol import Surrogate
 from softbend.transfer.finetune import check_mlp, fine_tune_many, row_weights
 from softbend.transfer.parameters import (
     check_estimator,
@@ -88,6 +91,11 @@ from softbend.transfer.parameters import (
     takes,
 )
 from softbend.transfer.pressure_map import fit_pressure_scale, scale_mlp_pressure
+
+if TYPE_CHECKING:
+    from softbend.surrogates.mlp import NormalizedMLPRegressor
+    from softbend.transfer.actuator_measurements import ActuatorMeasurements
+    from softbend.transfer.measurements import Measurements
 
 __all__ = [
     "BUILTIN_STRATEGIES",
@@ -148,7 +156,9 @@ def _registered_name(cls: type) -> str:
     return next((name for name, entry in STRATEGIES.items() if entry is cls), cls.__name__)
 
 
-def _check_trained(strategy: str, model: Any, X: np.ndarray, learning_rate: float) -> None:
+def _check_trained(
+    strategy: str, model: NormalizedMLPRegressor, X: np.ndarray, learning_rate: float
+) -> None:
     """Raise :class:`ConvergenceError` if a trained network diverged.
 
     Diverged: a non-finite training loss, or a non-finite angle or one no
@@ -176,50 +186,57 @@ def _check_trained(strategy: str, model: Any, X: np.ndarray, learning_rate: floa
     )
 
 
-def _check_base(base: Any, owner: str) -> Any:
+def _check_base(base: object) -> Surrogate:
+    """``base`` if it predicts, else :class:`InputError` keyed ``base``."""
     if not callable(getattr(base, "predict", None)):
-        raise ValueError(
-            f"The 'base' of {owner} must be a fitted surrogate with a 'predict' method. "
-            f"Got {type(base).__name__} instead."
+        raise InputError(
+            f"must be a fitted surrogate with a 'predict' method; got {type(base).__name__}",
+            key="base",
         )
-    return base
+    return base  # type: ignore[return-value]
 
 
-def _check_same(estimators: list, names: tuple[str, ...], owner: str) -> None:
+def _check_same(estimators: Sequence[object], names: tuple[str, ...]) -> None:
+    """Refuse estimators of one batch (``fit_batch``) that differ in one of ``names``."""
     first = estimators[0]
     for estimator in estimators[1:]:
         for name in names:
-            if getattr(estimator, name) is not getattr(first, name) and getattr(
-                estimator, name
-            ) != getattr(first, name):
-                raise ValueError(
-                    f"The estimators of {owner}.fit_batch must share '{name}'. "
-                    f"Got {getattr(first, name)!r} and {getattr(estimator, name)!r}."
+            mine, theirs = getattr(estimator, name), getattr(first, name)
+            if mine is not theirs and mine != theirs:
+                raise InputError(
+                    f"must share {name!r}; got {theirs!r} and {mine!r}", key="estimators"
                 )
-
-
-def _check_level(level: float, owner: str) -> float:
-    return check_range(level, "level", low=0.0, high=1.0)
 
 
 def _row(index: int) -> str:
     return f"row {index}"
 
 
-def _base_angles(base: Any, X: np.ndarray, strategy: str) -> np.ndarray:
-    """The base's angles at the rows, degrees; one error naming ``strategy`` if not finite."""
+def _base_angles(base: Surrogate, X: np.ndarray, strategy: str) -> np.ndarray:
+    """The base's angles at the rows, degrees; one error (key ``base``) if not finite."""
     theta = np.asarray(base.predict(X), dtype=np.float64)
     bad = np.flatnonzero(~np.isfinite(theta))
     if bad.size:
-        raise ValueError(
-            f"The base of the '{strategy}' strategy predicts a non-finite angle at "
-            f"{bad.size} of the {theta.size} measured rows (first: row {int(bad[0])}, "
-            f"{', '.join(f'{v:g}' for v in X[bad[0]])}); it cannot be corrected there"
+        raise InputError(
+            f"predicts a non-finite angle at {bad.size} of the {theta.size} measured rows "
+            f"(first: row {int(bad[0])}, {', '.join(f'{v:g}' for v in X[bad[0]])}); the "
+            f"'{strategy}' strategy cannot correct it there",
+            key="base",
         )
     return theta
 
 
-def _check_finite_fit(strategy: str, **parameters: Any) -> None:
+def _check_readings(strategy: str, y: np.ndarray, least: int, fits: str) -> None:
+    """Refuse fewer than ``least`` readings (key ``X``) for a strategy that fits ``fits``."""
+    if y.size < least:
+        raise InputError(
+            f"must hold at least {least} readings: the '{strategy}' strategy fits {fits}; "
+            f"got {y.size}",
+            key="X",
+        )
+
+
+def _check_finite_fit(strategy: str, **parameters: ArrayLike) -> None:
     """Raise :class:`ConvergenceError` naming ``strategy`` if a fitted parameter is not finite.
 
     A fit that overflowed (absurd angles, a base that answers with huge numbers)
@@ -249,9 +266,10 @@ class _Strategy(RegressorMixin, BaseEstimator):
         owner = f"{type(self).__name__}.fit"
         features = model_features()
         if X_arr.shape[1] != len(features):
-            raise ValueError(
-                f"The 'X' of {owner} must have the {len(features)} columns "
-                f"{', '.join(features)}. Got {X_arr.shape[1]} columns instead."
+            raise InputError(
+                f"must have the {len(features)} columns {', '.join(features)}; got "
+                f"{X_arr.shape[1]} columns",
+                key="X",
             )
         if is_paper_b(features):  # another actuator's pressure is in its own unit
             check_plausible(
@@ -266,7 +284,7 @@ class _Strategy(RegressorMixin, BaseEstimator):
 
     def _check_parameters(self) -> None:
         """Hold the parameters to their declared ranges (a strategy built directly)."""
-        check_estimator(_registered_name(type(self)), self)
+        check_estimator(self)
 
 
 class _Corrected(_Strategy):
@@ -284,7 +302,7 @@ class _Corrected(_Strategy):
         noise term (residual-gp), the members' spread and the residual noise
         (refined-ensemble).
         """
-        level = _check_level(level, type(self).__name__)
+        level = check_range(level, "level", low=0.0, high=1.0)
         return self.model_.predict_interval(self._check_rows(X), level)
 
 
@@ -293,19 +311,19 @@ class BaseOnly(_Strategy):
 
     learns: ClassVar[bool] = False
 
-    def __init__(self, base: Any = None) -> None:
+    def __init__(self, base: Surrogate | None = None) -> None:
         self.base = base
 
     def fit(self, X: ArrayLike, y: ArrayLike) -> BaseOnly:
         """Check the data; nothing is learned from it."""
-        _check_base(self.base, type(self).__name__)
+        _check_base(self.base)
         self._check_fit_data(X, y)
         self.fitted_ = True
         return self
 
     def predict(self, X: ArrayLike) -> np.ndarray:
         """The base's angle, degrees."""
-        return np.asarray(self.base.predict(self._check_rows(X)), dtype=np.float64)
+        return np.asarray(_check_base(self.base).predict(self._check_rows(X)), dtype=np.float64)
 
 
 @declare_ranges(
@@ -372,23 +390,19 @@ class BaseMeanResidual(_Strategy):
 
     learns: ClassVar[bool] = False
 
-    def __init__(self, base: Any = None, *, n_bins: int = 8) -> None:
+    def __init__(self, base: Surrogate | None = None, *, n_bins: int = 8) -> None:
         self.base = base
         self.n_bins = n_bins
 
     def fit(self, X: ArrayLike, y: ArrayLike) -> BaseMeanResidual:
         """Fit ``r(p)`` to the residuals ``y − base(X)`` of the rows."""
         self._check_parameters()
-        _check_base(self.base, type(self).__name__)
-        n_bins = check_int(self.n_bins, "n_bins", low=1)
+        base = _check_base(self.base)
+        n_bins = int(self.n_bins)
         X, y = self._check_fit_data(X, y)
-        if y.size < 2:
-            raise ValueError(
-                "The 'base-mean-residual' strategy fits the mean residual and the spread of the "
-                f"readings around it: it needs at least 2 readings. Got {y.size}."
-            )
+        _check_readings("base-mean-residual", y, 2, "the mean residual and the spread around it")
         with np.errstate(over="ignore", invalid="ignore"):  # checked below
-            residual = y - _base_angles(self.base, X, "base-mean-residual")
+            residual = y - _base_angles(base, X, "base-mean-residual")
         pressure = X[:, -1]
         band = _pressure_bands(pressure, n_bins)
         _, actuator = np.unique(X[:, :-1], axis=0, return_inverse=True)
@@ -421,11 +435,12 @@ class BaseMeanResidual(_Strategy):
     def predict(self, X: ArrayLike) -> np.ndarray:
         """The base's angle plus the mean residual at the row's pressure, degrees."""
         X = self._check_rows(X)
-        return np.asarray(self.base.predict(X), dtype=np.float64) + self._residual(X[:, -1])
+        base = _check_base(self.base)
+        return np.asarray(base.predict(X), dtype=np.float64) + self._residual(X[:, -1])
 
     def predict_interval(self, X: ArrayLike, level: float = 0.9) -> tuple[np.ndarray, np.ndarray]:
         """Central interval of probability ``level`` for a new reading (Gaussian), degrees."""
-        level = _check_level(level, type(self).__name__)
+        level = check_range(level, "level", low=0.0, high=1.0)
         mean = self.predict(X)
         half = float(norm.ppf(0.5 + level / 2)) * self.residual_std_
         return mean - half, mean + half
@@ -484,12 +499,13 @@ class AnalyticalBaseline(_Strategy):
 
     learns: ClassVar[bool] = False
 
-    def __init__(self, model: Any = None) -> None:
+    def __init__(self, model: BendingModel | None = None) -> None:
         self.model = model
 
     def fit(self, X: ArrayLike, y: ArrayLike) -> AnalyticalBaseline:
         """Check the data; nothing is learned from it."""
         self._check_fit_data(X, y)
+        self.model_: BendingModel
         if self.model is None:
             from softbend.analytical import AnalyticalModel
 
@@ -497,9 +513,9 @@ class AnalyticalBaseline(_Strategy):
         elif callable(getattr(self.model, "sweep", None)):
             self.model_ = self.model
         else:
-            raise ValueError(
-                f"The 'model' of the '{_registered_name(type(self))}' strategy must be a bending "
-                f"model with a 'sweep' method (from Python). Got {self.model!r} instead."
+            raise InputError(
+                f"must be a bending model with a 'sweep' method (from Python); got {self.model!r}",
+                key="model",
             )
         return self
 
@@ -552,7 +568,7 @@ class RefinedMLP(_Strategy):
 
     def __init__(
         self,
-        base: Any = None,
+        base: Surrogate | None = None,
         *,
         epochs: int = 1000,
         learning_rate: float = 6e-4,
@@ -583,10 +599,10 @@ class RefinedMLP(_Strategy):
         first = estimators[0]
         for estimator in estimators:
             estimator._check_parameters()
-        check_mlp(first.base, cls.__name__)
-        _check_same(estimators, ("base", "epochs", "learning_rate", "device"), cls.__name__)
+        base = check_mlp(first.base)
+        _check_same(estimators, ("base", "epochs", "learning_rate", "device"))
         models = fine_tune_many(
-            cls._starts(first.base, X, y, row_sets),
+            cls._starts(base, X, y, row_sets),
             X,
             y,
             row_weights(row_sets, len(y)),
@@ -602,11 +618,13 @@ class RefinedMLP(_Strategy):
         return estimators
 
     @classmethod
-    def _starts(cls, base: Any, X: np.ndarray, y: np.ndarray, row_sets: list) -> Any:
+    def _starts(
+        cls, base: NormalizedMLPRegressor, X: np.ndarray, y: np.ndarray, row_sets: list
+    ) -> NormalizedMLPRegressor | list[NormalizedMLPRegressor]:
         """Where training starts: the base itself, for every row set."""
         return base
 
-    def _set(self, model: Any, X: np.ndarray) -> None:
+    def _set(self, model: NormalizedMLPRegressor, X: np.ndarray) -> None:
         self.model_ = model
         self.loss_curve_ = np.asarray(model.loss_curve_) * model.y_scale_**2
         self.n_features_in_ = X.shape[1]
@@ -692,9 +710,7 @@ class ExperimentalMLP(_Strategy):
         first = estimators[0]
         for estimator in estimators:
             estimator._check_parameters()
-        _check_same(
-            estimators, ("hidden_sizes", "epochs", "learning_rate", "device", "seed"), cls.__name__
-        )
+        _check_same(estimators, ("hidden_sizes", "epochs", "learning_rate", "device", "seed"))
         h1, h2 = (int(h) for h in first.hidden_sizes)
         starts = []
         for k, rows in enumerate(row_sets):
@@ -744,27 +760,24 @@ class ScaleOffset(_Corrected):
     with the residual standard deviation of the fit.
     """
 
-    def __init__(self, base: Any = None) -> None:
+    def __init__(self, base: Surrogate | None = None) -> None:
         self.base = base
 
     def fit(self, X: ArrayLike, y: ArrayLike) -> ScaleOffset:
         """Fit ``a`` and ``c`` on the rows."""
-        _check_base(self.base, type(self).__name__)
+        base = _check_base(self.base)
         X, y = self._check_fit_data(X, y)
-        if y.size < 3:
-            raise ValueError(
-                "The 'scale-offset' strategy fits two numbers and the spread of the readings "
-                f"around them: it needs at least 3 readings. Got {y.size}."
-            )
-        theta = _base_angles(self.base, X, "scale-offset")
+        _check_readings("scale-offset", y, 3, "two numbers and the spread around them")
+        theta = _base_angles(base, X, "scale-offset")
         A = np.column_stack([theta, np.ones_like(theta)])
         with np.errstate(over="ignore", invalid="ignore"):  # checked below
             (self.scale_, self.offset_), _, rank, _ = np.linalg.lstsq(A, y, rcond=None)
         if rank < 2:
-            raise ValueError(
-                "The 'scale-offset' strategy cannot tell its scale from its offset: the base "
-                f"predicts the same angle ({theta[0]:g}°) at every reading. Measure at more "
-                "than one pressure."
+            raise InputError(
+                "must hold readings at more than one pressure: the 'scale-offset' strategy "
+                "cannot tell its scale from its offset where the base predicts the same angle "
+                f"({theta[0]:g}°) at every reading",
+                key="X",
             )
         with np.errstate(over="ignore", invalid="ignore"):  # checked below
             dof = max(y.size - 2, 1)
@@ -777,7 +790,7 @@ class ScaleOffset(_Corrected):
             offset=self.offset_,
             residual_std=self.residual_std_,
         )
-        self.model_ = AffineCorrected(self.base, self.scale_, self.offset_, self.residual_std_)
+        self.model_ = AffineCorrected(base, self.scale_, self.offset_, self.residual_std_)
         return self
 
 
@@ -798,24 +811,20 @@ class PressureScale(_Corrected):
         Residual standard deviation on the training rows, degrees.
     """
 
-    def __init__(self, base: Any = None) -> None:
+    def __init__(self, base: Surrogate | None = None) -> None:
         self.base = base
 
     def fit(self, X: ArrayLike, y: ArrayLike) -> PressureScale:
         """Fit ``s`` by least squares on the rows."""
-        _check_base(self.base, type(self).__name__)
+        base = _check_base(self.base)
         X, y = self._check_fit_data(X, y)
-        if y.size < 2:
-            raise ValueError(
-                "The 'pressure-scale' strategy fits one number and the spread of the readings "
-                f"around it: it needs at least 2 readings. Got {y.size}."
-            )
-        self.scale_ = fit_pressure_scale(self.base, X, y, owner=type(self).__name__)
-        residual = np.asarray(self.base.predict(scaled_pressure_rows(X, self.scale_))) - y
+        _check_readings("pressure-scale", y, 2, "one number and the spread around it")
+        self.scale_ = fit_pressure_scale(base, X, y)
+        residual = np.asarray(base.predict(scaled_pressure_rows(X, self.scale_))) - y
         with np.errstate(over="ignore", invalid="ignore"):  # checked below
             self.residual_std_ = float(np.sqrt(np.sum(residual**2) / max(y.size - 1, 1)))
         _check_finite_fit("pressure-scale", scale=self.scale_, residual_std=self.residual_std_)
-        self.model_ = PressureScaled(self.base, self.scale_, self.residual_std_)
+        self.model_ = PressureScaled(base, self.scale_, self.residual_std_)
         return self
 
 
@@ -847,17 +856,19 @@ class ScaledRefinedMLP(RefinedMLP):
     """
 
     @classmethod
-    def _starts(cls, base: Any, X: np.ndarray, y: np.ndarray, row_sets: list) -> list[Any]:
+    def _starts(
+        cls, base: NormalizedMLPRegressor, X: np.ndarray, y: np.ndarray, row_sets: list
+    ) -> list[NormalizedMLPRegressor]:
         """The base mapped with the pressure scale fitted on each row set."""
         return [
-            scale_mlp_pressure(base, fit_pressure_scale(base, X[rows], y[rows], owner=cls.__name__))
+            scale_mlp_pressure(base, fit_pressure_scale(base, X[rows], y[rows]))
             for rows in row_sets
         ]
 
-    def _set(self, model: Any, X: np.ndarray) -> None:
+    def _set(self, model: NormalizedMLPRegressor, X: np.ndarray) -> None:
         super()._set(model, X)
         # Refinement keeps the start's input standardization, which holds s.
-        self.pressure_scale_ = float(self.base.x_scale_[-1] / model.x_scale_[-1])
+        self.pressure_scale_ = float(check_mlp(self.base).x_scale_[-1] / model.x_scale_[-1])
 
 
 @declare_ranges(
@@ -888,7 +899,9 @@ class ResidualGP(_Corrected):
         Seed of the restarts.
     """
 
-    def __init__(self, base: Any = None, *, n_restarts: int = 3, seed: int = 0) -> None:
+    def __init__(
+        self, base: Surrogate | None = None, *, n_restarts: int = 3, seed: int = 0
+    ) -> None:
         self.base = base
         self.n_restarts = n_restarts
         self.seed = seed
@@ -896,10 +909,9 @@ class ResidualGP(_Corrected):
     def fit(self, X: ArrayLike, y: ArrayLike) -> ResidualGP:
         """Fit the GP to ``y − base(X)``."""
         self._check_parameters()
-        _check_base(self.base, type(self).__name__)
-        n_restarts = check_int(self.n_restarts, "n_restarts", low=0)
+        base = _check_base(self.base)
         X, y = self._check_fit_data(X, y)
-        theta = _base_angles(self.base, X, "residual-gp")
+        theta = _base_angles(base, X, "residual-gp")
         Z = np.column_stack([X, theta])
         with np.errstate(over="ignore", invalid="ignore"):  # checked below
             z_mean = Z.mean(axis=0)
@@ -914,11 +926,11 @@ class ResidualGP(_Corrected):
             gp = GaussianProcessRegressor(
                 kernel=gp_kernel(Z.shape[1]),
                 normalize_y=True,
-                n_restarts_optimizer=n_restarts,
+                n_restarts_optimizer=int(self.n_restarts),
                 random_state=self.seed,
             ).fit(inputs, y - theta)
         # The chosen hyperparameters, fixed: the model saves and reloads as it predicts here.
-        self.model_ = GPCorrected(self.base, z_mean, z_scale, gp.kernel_.theta, inputs, y - theta)
+        self.model_ = GPCorrected(base, z_mean, z_scale, gp.kernel_.theta, inputs, y - theta)
         self.z_mean_, self.z_scale_, self.gp_ = z_mean, z_scale, self.model_.gp_
         with np.errstate(all="ignore"):  # checked below
             mean, std = self.gp_.predict(inputs, return_std=True)
@@ -983,7 +995,7 @@ class RefinedEnsemble(_Corrected):
 
     def __init__(
         self,
-        base: Any = None,
+        base: Surrogate | None = None,
         *,
         n_members: int = 5,
         epochs: int = 1000,
@@ -1005,7 +1017,7 @@ class RefinedEnsemble(_Corrected):
 
     def _draws(self, X: np.ndarray, rows: np.ndarray) -> list[np.ndarray]:
         """The members' rows: a seeded draw, with replacement, of the actuators in ``rows``."""
-        n_members = check_int(self.n_members, "n_members", low=2)
+        n_members = int(self.n_members)
         _, group = np.unique(X[rows, :-1], axis=0, return_inverse=True)
         group = group.ravel()
         n_groups = int(group.max()) + 1
@@ -1024,16 +1036,14 @@ class RefinedEnsemble(_Corrected):
         first = estimators[0]
         for estimator in estimators:
             estimator._check_parameters()
-        check_mlp(first.base, cls.__name__)
-        _check_same(
-            estimators, ("base", "epochs", "learning_rate", "device", "n_members"), cls.__name__
-        )
+        base = check_mlp(first.base)
+        _check_same(estimators, ("base", "epochs", "learning_rate", "device", "n_members"))
         draws = [
             est._draws(X, np.asarray(rows)) for est, rows in zip(estimators, row_sets, strict=True)
         ]
         flat = [d for member_rows in draws for d in member_rows]
         models = fine_tune_many(
-            first.base,
+            base,
             X,
             y,
             row_weights(flat, len(y)),
@@ -1052,7 +1062,7 @@ class RefinedEnsemble(_Corrected):
             with np.errstate(over="ignore", invalid="ignore"):  # checked below
                 estimator.residual_std_ = float(np.sqrt(np.mean((mean - y[rows]) ** 2)))
             _check_finite_fit("refined-ensemble", residual_std=estimator.residual_std_)
-            estimator.model_ = MeanEnsemble(members, estimator.residual_std_)
+            estimator.model_ = MeanEnsemble(list[Surrogate](members), estimator.residual_std_)
         return estimators
 
 
@@ -1083,12 +1093,14 @@ def strategy_parameters(name: str) -> dict[str, Any]:
     UnknownNameError
         An unknown name (listing :data:`STRATEGIES`).
     """
-    return parameter_defaults(STRATEGIES.get(name, field="strategy"))
+    with keyed("name"):
+        return parameter_defaults(STRATEGIES.get(name))
 
 
 def learns(name: str) -> bool:
     """Whether strategy ``name`` learns a model from the measurements (a baseline does not)."""
-    return bool(getattr(STRATEGIES.get(name, field="strategy"), "learns", True))
+    with keyed("name"):
+        return bool(getattr(STRATEGIES.get(name), "learns", True))
 
 
 def describe_strategies() -> list[dict[str, Any]]:
@@ -1124,7 +1136,9 @@ def describe_strategies() -> list[dict[str, Any]]:
     return rows
 
 
-def make_strategy(name: str, base: Any = None, *, seed: int = 0, **options: Any) -> Any:
+def make_strategy(
+    name: str, base: Surrogate | None = None, *, seed: int = 0, **options: object
+) -> Any:
     """A fresh, unfitted strategy by name.
 
     Parameters
@@ -1143,14 +1157,17 @@ def make_strategy(name: str, base: Any = None, *, seed: int = 0, **options: Any)
     Raises
     ------
     UnknownNameError
-        An unknown name (listing :data:`STRATEGIES`), or a parameter the strategy
-        does not take (listing those it takes).
+        An unknown name (key ``name``, listing :data:`STRATEGIES`), or a
+        parameter the strategy does not take (key ``options``, listing those it takes).
     ValueError
-        A value of the wrong kind or outside its declared range
-        (:class:`~softbend.parameters.ParameterValueError`), or a negative seed.
+        A value of the wrong kind or outside its declared range (key
+        ``options``: :class:`~softbend.parameters.ParameterValueError`), or a
+        negative seed (key ``seed``).
     """
-    cls = STRATEGIES.get(name, field="strategy")
-    options = check_parameters(name, cls, options)
+    with keyed("name"):
+        cls = STRATEGIES.get(name)
+    with keyed("options"):
+        options = check_parameters(cls, options)
     if takes(cls, "seed"):
         seed = check_int(seed, "seed", low=0)
     filled = {"base": base, "seed": seed}
@@ -1159,12 +1176,12 @@ def make_strategy(name: str, base: Any = None, *, seed: int = 0, **options: Any)
 
 def fit_strategy(
     name: str,
-    base: Any,
-    measurements: Any,
+    base: Surrogate | None,
+    measurements: Measurements | ActuatorMeasurements,
     *,
     seed: int = 0,
     epochs: int | None = None,
-    **options: Any,
+    **options: object,
 ) -> _Strategy:
     """:func:`make_strategy` fitted on all of ``measurements`` (a :class:`Measurements`).
 
@@ -1172,11 +1189,11 @@ def fit_strategy(
     """
     if epochs is not None:
         options["epochs"] = epochs
-    strategy = make_strategy(name, base, seed=seed, **options)
+    strategy: _Strategy = make_strategy(name, base, seed=seed, **options)
     strategy.fit(measurements.features, measurements.angle_deg)
     return strategy
 
 
-def has_interval(estimator: Any) -> bool:
+def has_interval(estimator: object) -> bool:
     """Whether the strategy gives prediction intervals."""
     return callable(getattr(estimator, "predict_interval", None))
