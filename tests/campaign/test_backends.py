@@ -30,7 +30,7 @@ def test_registry_names_the_allowed_backends():
     assert backends.BACKENDS.names()[:3] == ("analytical", "fem", "fault-injection")
     with pytest.raises(
         ValueError,
-        match=r"Unknown campaign backend 'abaqus' \(in backend\); known: analytical, fem, ",
+        match=r"^backend: Unknown campaign backend 'abaqus'; known: analytical, fem, ",
     ):
         get_backend("abaqus")
     with pytest.raises(ValueError, match="options of backend 'analytical' are invalid"):
@@ -49,7 +49,7 @@ def test_register_backend_plugs_in_a_model_and_refuses_silent_replacement():
     with pytest.raises(ValueError, match="already registered"):
         register_backend("analytical", AnalyticalModel)
     assert AnalyticalBackend is AnalyticalModel  # the earlier name still works
-    with pytest.raises(ValueError, match="'factory'"):
+    with pytest.raises(ValueError, match=r"^factory: must be callable"):
         register_backend("x", 3)
     with pytest.raises(ValueError, match="lower-case"):
         register_backend("My Model", AnalyticalModel)
@@ -58,9 +58,11 @@ def test_register_backend_plugs_in_a_model_and_refuses_silent_replacement():
 def test_backend_for_run_builds_public_backends_with_what_the_command_line_gives():
     assert backends.public_backends()[:2] == ("analytical", "fem")
     assert isinstance(backends.backend_for_run("analytical", compiled=True), AnalyticalModel)
-    with pytest.raises(ValueError, match=r"'fault-injection' \(in --backend\); known: analytical"):
-        backends.backend_for_run("fault-injection", field="--backend")
-    with pytest.raises(ValueError, match="'model' of backend_for_run must be given with"):
+    with pytest.raises(
+        ValueError, match=r"^backend: Unknown .*'fault-injection'.*; known: analytical"
+    ):
+        backends.backend_for_run("fault-injection")
+    with pytest.raises(ValueError, match=r"^model: must be given with"):
         backends.backend_for_run("analytical", model="m.json")
     register_backend("from-file", lambda path: AnalyticalModel())
     try:
@@ -113,9 +115,9 @@ def test_analytical_backend_options():
     assert get_backend("analytical", material="dragon-skin-30").material.name == "Dragon Skin 30"
     with pytest.raises(ValueError, match="Unknown material preset 'rubber'; known: dragon-skin"):
         get_backend("analytical", material="rubber")
-    with pytest.raises(ValueError, match="'material' of AnalyticalModel"):
+    with pytest.raises(ValueError, match=r"^material: must be"):
         AnalyticalModel(material=3.0)
-    with pytest.raises(ValueError, match="'max_angle_deg'"):
+    with pytest.raises(ValueError, match=r"^max_angle_deg: must be a number in"):
         AnalyticalModel(max_angle_deg=0.0)
     limited = AnalyticalModel(max_angle_deg=90.0).sweep(DESIGN, default_pressures_mpa())
     assert not limited.converged[-1] and np.nanmax(limited.angle_deg) <= 90.0
@@ -134,7 +136,7 @@ def test_fault_injection_fails_chosen_designs_and_delegates_the_rest():
     np.testing.assert_array_equal(
         backend.sweep(other, grid).angle_deg, AnalyticalModel().sweep(other, grid).angle_deg
     )
-    with pytest.raises(ValueError, match="'delay_s'"):
+    with pytest.raises(ValueError, match=r"^delay_s: must be a number in"):
         get_backend("fault-injection", delay_s=-1)
-    with pytest.raises(ValueError, match="'inner'"):
+    with pytest.raises(ValueError, match=r"^inner: must be another backend"):
         get_backend("fault-injection", inner="fault-injection")

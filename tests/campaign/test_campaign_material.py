@@ -95,6 +95,7 @@ def test_the_cli_material_reaches_the_solve_and_the_store(tmp_path, solves, fit_
 def test_what_is_sent_to_workers_keeps_the_material(fit_file):
     material = material_from_spec(f"{fit_file}#neo-hookean")
     fem = backend_for_run("fem", material=f"{fit_file}#neo-hookean")
+    assert backend_for_run("fem", material=material) == fem
     back = pickle.loads(pickle.dumps(fem))
     assert back == fem and back.options.elastomer == material
     faulty = get_backend("fault-injection", inner="fem")
@@ -127,7 +128,7 @@ def test_a_material_reaches_worker_processes(tmp_path, designs, grid):
 
 
 def test_a_backend_without_a_material_refuses_one(tmp_path, capsys):
-    with pytest.raises(ValueError, match=r"'material' of run_campaign applies to a backend"):
+    with pytest.raises(ValueError, match=r"^material: applies to a backend that takes a material"):
         run_campaign(
             tmp_path / "c.duckdb",
             _two_designs(),
@@ -142,8 +143,8 @@ def test_a_backend_without_a_material_refuses_one(tmp_path, capsys):
     assert main(args) == 2
     err = capsys.readouterr().err.strip().splitlines()
     assert err == [
-        "softbend: error: The '--material' of softbend campaign run applies to a backend that "
-        "takes a material (analytical, fem). Got --backend surrogate instead."
+        "softbend: error: --material: applies to a backend that takes a material "
+        "(analytical, fem); got backend 'surrogate'"
     ]
     assert not db.exists()
 
@@ -161,7 +162,7 @@ def test_a_bad_material_is_one_line_before_anything_is_written(
 ):
     spec = spec.format(fit=fit_file)
     with pytest.raises(error, match=needle):
-        backend_for_run("fem", material=spec, material_field="--material")
+        backend_for_run("fem", material=spec)
     db = tmp_path / "c.duckdb"
     assert main(["campaign", "run", str(db), "--backend", "fem", *CLI_RUN, "--material", spec]) == 2
     err = capsys.readouterr().err.strip().splitlines()

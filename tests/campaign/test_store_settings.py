@@ -100,7 +100,9 @@ def test_a_resume_with_other_settings_is_refused(
         _fem(db, **second)
     message = str(caught.value)
     assert all(needle in message for needle in needles), message
-    assert "a new database" in message and "accept_new_settings=True" in message
+    assert message.startswith(
+        f"accept_new_settings: must be set to resume the campaign '{db}'"
+    ) and ("a new database" in message)
     with CampaignStore(db, read_only=True) as store:
         assert len(store.runs()) == 1  # nothing of the refused run was recorded
 
@@ -141,9 +143,12 @@ def test_the_cli_refuses_another_material_in_one_line_and_accepts_on_request(
     other = ["campaign", "run", str(db), *CLI_RUN, "--material", f"{fit_file}#neo-hookean"]
     assert main(other) == 2
     err = capsys.readouterr().err.strip().splitlines()
-    assert len(err) == 1 and err[0].startswith("softbend: error: The settings of this run")
+    assert len(err) == 1
+    assert err[0].startswith(
+        f"softbend: error: --accept-new-settings: must be set to resume the campaign '{db}'"
+    )
     assert "material.model.model is 'yeoh' there, 'neo-hookean' here" in err[0]
-    assert "a new DB" in err[0] and "--accept-new-settings" in err[0]
+    assert "or write to a new database" in err[0]
     assert main([*other, "--accept-new-settings", "--json"]) == 0
     assert json.loads(capsys.readouterr().out)["n_skipped_done"] == 3
 

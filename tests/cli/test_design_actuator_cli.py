@@ -106,17 +106,17 @@ def test_a_spec_file_names_the_model_s_parameters(model, tmp_path, capsys):
 @pytest.mark.parametrize(
     ("extra", "needles"),
     [
-        (["--range", "wall=1:2"], ["'--range' names 'wall'", "n_chambers, wall_mm, layer"]),
-        (["--fix", "chambers=8"], ["'--fix' names 'chambers'", "n_chambers, wall_mm, layer"]),
-        (["--range", "wall_mm=2:1"], ["'--range' of 'wall_mm'", "LOW <= HIGH"]),
-        (["--range", "wall_mm=0.1:2"], ["'--range' of 'wall_mm'", "[0.5, 3] mm"]),
-        (["--range", "n_chambers=6.5:9"], ["'--range' of 'n_chambers'", "not a whole number"]),
-        (["--fix", "n_chambers=7.5"], ["'--fix' value of 'n_chambers'", "not a whole number"]),
-        (["--fix", "layer=wood"], ["'--fix' value of 'layer'", "fabric, paper"]),
-        (["--range", "layer=0:1"], ["'--range'", "categorical parameter 'layer'"]),
-        (["--resolution", "n_chambers=0.5"], ["'--resolution' of 'n_chambers'", "whole"]),
-        (["--minimize", "volume"], ["'--minimize'", "n_chambers, wall_mm, pressure"]),
-        (["--minimize", "l"], ["'--minimize'", "Got 'l'"]),
+        (["--range", "wall=1:2"], ["--range: names 'wall'", "n_chambers, wall_mm, layer"]),
+        (["--fix", "chambers=8"], ["--fix: names 'chambers'", "n_chambers, wall_mm, layer"]),
+        (["--range", "wall_mm=2:1"], ["--range: wall_mm: ", "LOW <= HIGH"]),
+        (["--range", "wall_mm=0.1:2"], ["--range: wall_mm: 0.1 leaves", "[0.5, 3] mm"]),
+        (["--range", "n_chambers=6.5:9"], ["--range: n_chambers: 6.5 is", "not a whole number"]),
+        (["--fix", "n_chambers=7.5"], ["--fix: n_chambers: 7.5 is", "not a whole number"]),
+        (["--fix", "layer=wood"], ["--fix: layer: must be one of", "fabric, paper"]),
+        (["--range", "layer=0:1"], ["--range: ", "categorical parameter 'layer'"]),
+        (["--resolution", "n_chambers=0.5"], ["--resolution: n_chambers (0.5)", "whole"]),
+        (["--minimize", "volume"], ["--minimize: ", "n_chambers, wall_mm, pressure"]),
+        (["--minimize", "l"], ["--minimize: ", 'got "l"']),
     ],
 )
 def test_bad_input_is_one_line_exit_2(model, tmp_path, capsys, extra, needles):
@@ -135,4 +135,4 @@ def test_a_pressure_is_read_in_the_model_s_unit(model, tmp_path, capsys):
             "-o", str(tmp_path / "x")]  # fmt: skip
     assert main(args) == 2
     line = capsys.readouterr().err.strip()
-    assert "(0, 1000] kPa" in line and "Got 3000" in line
+    assert "--at: " in line and "(0, 1000] kPa" in line and "got 3000" in line

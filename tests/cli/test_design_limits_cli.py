@@ -117,7 +117,7 @@ def test_a_bad_spec_name_writes_nothing_anywhere(model, tmp_path, capsys, names,
     args = ["design", "find", "--model", str(model), "--spec", str(spec), "--out", str(out)]
     assert main(args) == 2
     line = _error(capsys)
-    assert needle in line and f"[[spec]] {number} 'name' of --spec {spec}" in line
+    assert needle in line and f"[[spec]] {number}" in line and str(spec) in line
     assert _tree(tmp_path) == before
 
 
@@ -190,7 +190,7 @@ def test_a_bad_spec_file_is_one_line_naming_the_file_and_key(
     args = ["design", "find", "--model", str(model), "--spec", str(spec), "--out", str(out)]
     assert main(args) == 2
     line = _error(capsys)
-    assert f"--spec {spec}" in line
+    assert str(spec) in line
     for needle in needles:
         assert needle in line, line
     assert not out.exists()
@@ -204,21 +204,21 @@ def test_a_bad_spec_file_is_one_line_naming_the_file_and_key(
     [
         (["--resolution", "1e-9"], ["designs", "--resolution", "20,000,000"]),
         (["--resolution", "l=1e-9", "--range", "l=100:160"], ["l 60,000,000,001 at 1e-09 mm"]),
-        (["--resolution", "inf"], ["'--resolution'", "finite"]),
-        (["--top", "1000000000"], ["'--top'", "[1, 1000]"]),
-        (["--top", "0"], ["'--top'", "[1, 1000]"]),
-        (["--resolution", "l=0", "--top", "26"], ["(l: step 0) lists at most 25", "--top"]),
-        (["--tolerance", "0"], ["'--tolerance'", "(0, 90] deg"]),
-        (["--tolerance", "nan"], ["'--tolerance'"]),
-        (["--tolerance", "1000"], ["'--tolerance'"]),
-        (["--margin", "3"], ["'--margin'", "[0, 3)"]),
-        (["--margin", "-1"], ["'--margin'"]),
-        (["--verify", "101"], ["'--verify'", "[0, 100]"]),
-        (["--verify", "-1"], ["'--verify'"]),
-        (["--verify", "1", "--workers", "0"], ["'--workers'", "[1, 4096]"]),
-        (["--verify", "1", "--workers", "100000"], ["'--workers'", "[1, 4096]"]),
-        (["--range", "t=0:1", "--allow-extrapolation"], ["'--range' of 't'", "(0, 50] mm"]),
-        (["--fix", "phi=90", "--allow-extrapolation"], ["'--fix' value of 'phi'", "[0, 60] deg"]),
+        (["--resolution", "inf"], ["--resolution: ", "finite"]),
+        (["--top", "1000000000"], ["--top: ", "[1, 1000]"]),
+        (["--top", "0"], ["--top: ", "[1, 1000]"]),
+        (["--resolution", "l=0", "--top", "26"], ["--top: must be at most 25", "(l: step 0"]),
+        (["--tolerance", "0"], ["--tolerance: ", "(0, 90] deg"]),
+        (["--tolerance", "nan"], ["--tolerance: "]),
+        (["--tolerance", "1000"], ["--tolerance: "]),
+        (["--margin", "3"], ["--margin: ", "[0, 3)"]),
+        (["--margin", "-1"], ["--margin: "]),
+        (["--verify", "101"], ["--verify: ", "[0, 100]"]),
+        (["--verify", "-1"], ["--verify: "]),
+        (["--verify", "1", "--workers", "0"], ["--workers: ", "[1, 4096]"]),
+        (["--verify", "1", "--workers", "100000"], ["--workers: ", "[1, 4096]"]),
+        (["--range", "t=0:1", "--allow-extrapolation"], ["--range: t: leaves", "(0, 50] mm"]),
+        (["--fix", "phi=90", "--allow-extrapolation"], ["--fix: phi: leaves", "[0, 60] deg"]),
     ],
 )
 def test_a_number_out_of_its_range_is_refused_before_the_search(
@@ -235,16 +235,16 @@ def test_a_number_out_of_its_range_is_refused_before_the_search(
 @pytest.mark.parametrize(
     ("target", "needles"),
     [
-        (["--curve", "0.05:40,0.05:50"], ["'--curve' gives 0.05 MPa twice", "each pressure once"]),
-        (["--curve", "0:40,0.05:50"], ["'--curve' point '0:40'", "(0, 1] MPa"]),
-        (["--curve", "nan:40,0.05:50"], ["'--curve' point 'nan:40'"]),
-        (["--curve", "0.05:40,0.1:400"], ["'--curve' point '0.1:400'", "(0, 360] deg"]),
+        (["--curve", "0.05:40,0.05:50"], ["--curve: gives 0.05 MPa twice", "each pressure once"]),
+        (["--curve", "0:40,0.05:50"], ["--curve: point '0:40'", "(0, 1] MPa"]),
+        (["--curve", "nan:40,0.05:50"], ["--curve: point 'nan:40'"]),
+        (["--curve", "0.05:40,0.1:400"], ["--curve: point '0.1:400'", "(0, 360] deg"]),
         (["--curve", ",".join(f"{0.01 * i:.2f}:{i}" for i in range(1, 60))], ["2 to 50 points"]),
-        (["--curve", "0.05:40,0.1:90", "--angle", "10"], ["'--angle' has no meaning"]),
-        (["--angle", "400", "--at", "0.08"], ["'--angle'", "(0, 360] deg"]),
-        (["--angle", "90", "--at", "inf"], ["'--at'", "MPa"]),
-        (["--angle", "90", "--max-pressure", "-1"], ["'--max-pressure'", "(0, 1] MPa"]),
-        (["--max-angle-at", "2"], ["'--max-angle-at'", "kPa"]),
+        (["--curve", "0.05:40,0.1:90", "--angle", "10"], ["--angle: has no meaning"]),
+        (["--angle", "400", "--at", "0.08"], ["--angle: ", "(0, 360] deg"]),
+        (["--angle", "90", "--at", "inf"], ["--at: ", "MPa"]),
+        (["--angle", "90", "--max-pressure", "-1"], ["--max-pressure: ", "(0, 1] MPa"]),
+        (["--max-angle-at", "2"], ["--max-angle-at: ", "kPa"]),
     ],
 )
 def test_a_bad_target_is_refused_before_the_search(
@@ -278,7 +278,7 @@ def test_the_material_is_resolved_before_the_search(model, tmp_path, capsys, no_
     for material, needle in (
         ("nope", "Unknown material preset 'nope'"),
         (str(not_json), "not valid JSON"),
-        (f"{negative}#yeoh", "'c10_mpa' of Yeoh"),
+        (f"{negative}#yeoh", "c10_mpa"),
     ):
         assert main([*base, "--verify", "1", "--material", material]) == 2
         assert needle in _error(capsys)
@@ -292,7 +292,7 @@ def test_the_material_is_resolved_before_the_search(model, tmp_path, capsys, no_
 def test_a_verification_option_without_verify_is_refused(model, tmp_path, capsys, no_search, extra):
     args = ["design", "find", "--model", str(model), *TARGET, "-o", str(tmp_path / "x"), *extra]
     assert main(args) == 2
-    assert f"'{extra[0]}' applies to the verification; give --verify N" in _error(capsys)
+    assert f"{extra[0]}: applies to the verification; give --verify N" in _error(capsys)
 
 
 # -- 5. options that the spec file gives ------------------------------------------------------
@@ -322,7 +322,7 @@ def test_an_option_the_spec_file_gives_is_refused_beside_it(
     args = ["design", "find", "--model", str(model), "--spec", str(spec), "-o", str(tmp_path / "x")]
     assert main([*args, *extra]) == 2
     line = _error(capsys)
-    assert f"'{flag}' cannot be used with --spec: the spec file gives each spec's {what}" in line
+    assert f"{flag}: cannot be used with --spec: the spec file gives each spec's {what}" in line
 
 
 # -- 6. the verification's temporary campaign after a kill ------------------------------------

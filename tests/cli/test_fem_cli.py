@@ -10,13 +10,13 @@ from .conftest import one_error_line
 @pytest.mark.parametrize(
     ("args", "needle"),
     [
-        (["--design", "100,6,-2,2,5,10"], "'t_mm' of SFRBADesign must be a number in (0, 50]"),
+        (["--design", "100,6,-2,2,5,10"], "t_mm: must be a number in (0, 50]"),
         (["--design", "100,6,2"], "A design needs 6 values"),
-        (["--maxh", "0"], "'maxh_mm' of FEMOptions"),
-        (["--gravity", "up"], "'gravity' of FEMOptions must be one of"),
-        (["--pmax", "nan"], "'--pmax' of softbend fem run"),
-        (["--pmax", "0.1", "--pstep", "0.03"], "'--pmax' of softbend fem run must be a whole"),
-        (["--shapes", "0"], "'--shapes' must be an integer in [1, inf)"),
+        (["--maxh", "0"], "--maxh: must be a number in (0, 20]"),
+        (["--gravity", "up"], "--gravity: must be one of"),
+        (["--pmax", "nan"], "--pmax: must be a number in"),
+        (["--pmax", "0.1", "--pstep", "0.03"], "whole number of steps of 0.03 MPa"),
+        (["--shapes", "0"], "--shapes: must be an integer in [1, inf)"),
     ],
 )
 def test_fem_run_bad_input_is_one_line_and_exit_2(tmp_path, capsys, args, needle):
@@ -26,7 +26,7 @@ def test_fem_run_bad_input_is_one_line_and_exit_2(tmp_path, capsys, args, needle
 
 def test_mesh_study_bad_sizes_exit_2(capsys):
     assert main(["fem", "mesh-study", "--maxh", "4,x"]) == 2
-    assert "'--maxh' must be comma-separated numbers" in one_error_line(capsys)
+    assert "--maxh: must be comma-separated numbers" in one_error_line(capsys)
 
 
 def test_fem_run_writes_the_sweep_figures_and_vtk(tmp_path, capsys):
@@ -65,7 +65,7 @@ def test_maxh_has_one_rule_in_run_and_mesh_study(tmp_path, monkeypatch, capsys):
 
     import softbend.fem.sweep as sweep
 
-    message = "The 'maxh_mm' of FEMOptions must be a number in (0, 20]. Got 20.5 instead."
+    message = "--maxh: must be a number in (0, 20]; got 20.5"
     for argv in (
         ["fem", "run", "--out", str(tmp_path / "o"), "--maxh", "20.5"],
         ["fem", "mesh-study", "--maxh", "4,20.5"],

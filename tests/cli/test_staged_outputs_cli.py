@@ -700,7 +700,7 @@ def test_run_reproduce_refuses_a_folder_of_other_files(tmp_path, fake_reproduce)
     out = tmp_path / "mine"
     out.mkdir()
     (out / "data.csv").write_text("keep me\n")
-    with pytest.raises(ValueError, match="'out_dir' of run_reproduce must be a new or empty"):
+    with pytest.raises(ValueError, match=r"^out_dir: must be a new or empty"):
         run_reproduce(out)
     assert (out / "data.csv").read_text() == "keep me\n"
     assert os.listdir(tmp_path) == ["mine"]

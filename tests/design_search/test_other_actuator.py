@@ -180,7 +180,7 @@ def test_ranges_fixes_and_steps_by_the_description(constrained):
     }
     assert steps == {"n_chambers": 1.0, "wall_mm": 0.2}
     for args, needle in [
-        ((["wall=1"],), "'--fix' names 'wall', which is not a design parameter"),
+        ((["wall=1"],), "fixes: names 'wall', which is not a design parameter"),
         (((), ["wall_mm=2:1"]), "finite LOW <= HIGH"),
         (((), ["wall_mm=0.2:2"]), "0.2 leaves the range [0.5, 3] mm"),
         (((), ["n_chambers=6.5:9"]), "6.5 is not a whole number"),

@@ -42,7 +42,8 @@ def test_a_grid_too_large_is_refused_at_once_naming_the_resolution():
         searched_ranges(spec, TRAINED)
     assert time.perf_counter() - started < 1.0
     message = str(caught.value)
-    assert "--resolution" in message and f"{MAX_DESIGNS:,}" in message
+    assert message.startswith("steps: ") and f"{MAX_DESIGNS:,}" in message
+    assert "coarsen the resolution" in message
     assert "l 60,000,000,001 at 1e-09 mm" in message
     ranges, total = searched_ranges(Specification(AT_90), TRAINED)
     assert total == grid_size(ranges) == 121 * 9 * 5 * 5 * 11 * 9
@@ -75,11 +76,13 @@ def test_a_design_out_of_its_limits_is_refused_before_the_search():
 def test_top_has_a_declared_range(linear_model):
     assert (TOP.low, TOP.high) == (1, 1000) and TOP.why
     for bad in (0, 1001, 10**9, True):
-        with pytest.raises(ValueError, match=r"'top' of find_designs must be an integer in"):
+        with pytest.raises(ValueError, match=r"^top: must be an integer in"):
             find_designs(linear_model, Specification(AT_90), top=bad)
     # Each candidate of a continuous search is polished on its own: a shorter list.
     continuous = Specification(AT_90, {"l": ParameterRange(100.0, 160.0, 0.0)})
-    with pytest.raises(ValueError, match=r"continuous parameter \(l: step 0\) lists at most 25"):
+    with pytest.raises(
+        ValueError, match=r"^top: must be at most 25 with a continuous parameter \(l: step 0"
+    ):
         find_designs(linear_model, continuous, top=26)
 
 

@@ -10,21 +10,21 @@ from softbend.fem.geometry import actuator_geometry, mesh_actuator
 @pytest.mark.parametrize(
     ("field", "value", "needle"),
     [
-        ("maxh_mm", -1.0, "'maxh_mm' of FEMOptions must be a number in (0, 20]"),
-        ("maxh_mm", float("nan"), "'maxh_mm' of FEMOptions"),
-        ("order", 1, "'order' of FEMOptions must be one of 2, 3"),
-        ("fiber_law", "rope", "'fiber_law' of FEMOptions must be one of 'tension-compression'"),
-        ("gravity", "down", "'gravity' of FEMOptions must be one of 'bending', 'against'"),
-        ("output", "all", "'output' of FEMOptions must be one of 'interpolate', 'solve'"),
-        ("max_angle_deg", 400.0, "'max_angle_deg' of FEMOptions must be a number in (0, 340]"),
-        ("max_stretch", 0.9, "'max_stretch' of FEMOptions must be a number in (1, 50]"),
+        ("maxh_mm", -1.0, "maxh_mm: must be a number in (0, 20]"),
+        ("maxh_mm", float("nan"), "maxh_mm: "),
+        ("order", 1, "order: must be one of 2, 3"),
+        ("fiber_law", "rope", "fiber_law: must be one of 'tension-compression'"),
+        ("gravity", "down", "gravity: must be one of 'bending', 'against'"),
+        ("output", "all", "output: must be one of 'interpolate', 'solve'"),
+        ("max_angle_deg", 400.0, "max_angle_deg: must be a number in (0, 340]"),
+        ("max_stretch", 0.9, "max_stretch: must be a number in (1, 50]"),
         (
             "predictor_error_mm",
             0.0,
-            "'predictor_error_mm' of FEMOptions must be a number in (0, 10]",
+            "predictor_error_mm: must be a number in (0, 10]",
         ),
-        ("base_cap_mm", 0.0, "'base_cap_mm' of FEMOptions"),
-        ("elastomer", "silicone", "'elastomer' of FEMOptions must be a Material"),
+        ("base_cap_mm", 0.0, "base_cap_mm: "),
+        ("elastomer", "silicone", "elastomer: must be a Material"),
     ],
 )
 def test_bad_options_name_the_field(field, value, needle):
@@ -34,19 +34,19 @@ def test_bad_options_name_the_field(field, value, needle):
 
 
 def test_step_bounds_are_ordered():
-    with pytest.raises(ValueError, match="'initial_step_mpa' of FEMOptions"):
+    with pytest.raises(ValueError, match="initial_step_mpa: "):
         FEMOptions(initial_step_mpa=0.1, max_step_mpa=0.05)
     with pytest.raises(ValueError, match="unknown"):
         FEMOptions().replace(mesh=3)
 
 
 def test_impossible_geometry_is_refused_by_the_design():
-    with pytest.raises(ValueError, match="'t_mm' of SFRBADesign must be a number in \\(0, 50\\]"):
+    with pytest.raises(ValueError, match=r"t_mm.*\(0, 50\]"):
         SFRBADesign(100, 6, -2, 2, 5, 10)
 
 
 def test_a_mesh_too_fine_to_afford_is_refused_before_meshing():
-    with pytest.raises(ValueError, match="'maxh_mm' of the FEM mesh must give at most"):
+    with pytest.raises(ValueError, match=r"^maxh_mm: must give at most"):
         mesh_actuator(SFRBADesign(160, 10, 4, 4, 5, 12), maxh_mm=0.05)
 
 

@@ -168,5 +168,5 @@ def test_file_names_are_in_mpa(pressure, name):
 
 @pytest.mark.parametrize("pressure", [-0.1, float("nan"), float("inf")])
 def test_a_bad_pressure_in_the_file_name_is_one_value_error(pressure):
-    with pytest.raises(ValueError, match=r"'pressure_mpa' of vtk_file_name must be a number"):
+    with pytest.raises(ValueError, match=r"^pressure_mpa: must be a number"):
         vtk_file_name(pressure)

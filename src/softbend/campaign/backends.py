@@ -34,16 +34,16 @@ import inspect
 import logging
 import os
 import time
-from collections.abc import Callable, Mapping
+from collections.abc import Callable, Iterable, Mapping
 from dataclasses import dataclass, field
-from typing import Any, cast
+from typing import TYPE_CHECKING, Any, NamedTuple, cast
 
 import numpy as np
 
-from softbend._validation import check_range
+from softbend._validation import check_range, must_be, short_repr
 from softbend.analytical import AnalyticalModel
 from softbend.design import SFRBADesign
-from softbend.errors import ConvergenceError, SoftbendError
+from softbend.errors import ConvergenceError, InputError, SoftbendError, keyed
 from softbend.materials.presets import Material
 from softbend.models import (
     DEFAULT_PMAX_MPA,
@@ -55,6 +55,9 @@ from softbend.models import (
 )
 from softbend.registry import Registry
 
+if TYPE_CHECKING:
+    from softbend.fem.options import FEMOptions
+
 __all__ = [
     "BACKENDS",
     "DEFAULT_PMAX_MPA",
@@ -64,6 +67,8 @@ __all__ = [
     "Backend",
     "BendingModel",
     "FaultInjectionBackend",
+    "MaterialGiven",
+    "ResolvedMaterial",
     "SweepResult",
     "available_backends",
     "backend_for_run",
@@ -97,30 +102,36 @@ def _import_fem() -> Any:
 
 
 def _make_fem(
-    options: Any = None, *, compiled: bool = False, material: Any = None, **fem_options: Any
+    options: FEMOptions | None = None,
+    *,
+    compiled: bool = False,
+    material: MaterialGiven | None = None,
+    **fem_options: object,
 ) -> BendingModel:
     fem = _import_fem()
     if material is not None:
         if "elastomer" in fem_options:
-            raise ValueError(
-                "The elastomer of the 'fem' backend must be given either as 'material' or as "
-                f"'elastomer', not both. Got material={material!r}."
+            raise InputError(
+                f"must be given either as material or as elastomer, not both; got {material!r}",
+                key="material",
             )
         if options is None:
-            fem_options["elastomer"] = resolve_material(material)[0]
+            fem_options["elastomer"] = resolve_material(material).material
         else:
-            options = options.replace(elastomer=resolve_material(material)[0])
+            options = options.replace(elastomer=resolve_material(material).material)
     if fem_options:
         if options is not None:
-            raise ValueError(
-                "The options of the 'fem' backend must be given either as 'options' or as "
-                f"keywords, not both. Got options={options!r} and {sorted(fem_options)}."
+            raise InputError(
+                "must be given either as options or as keywords, not both; got options and "
+                f"{sorted(fem_options)}",
+                key="options",
             )
         make_options = getattr(fem, "FEMOptions", None)
         if make_options is None:
-            raise ValueError(
-                "The 'fem' backend takes its settings as options=<object>; this softbend.fem "
-                f"has no FEMOptions to build them from keywords {sorted(fem_options)}."
+            raise InputError(
+                "must be given as options=<object>: this softbend.fem has no FEMOptions to "
+                f"build them from keywords {sorted(fem_options)}",
+                key="options",
             )
         options = make_options(**fem_options)
     return fem.FEMModel(options=options, compiled=compiled)
@@ -191,14 +202,11 @@ def _make_fault_injection(
     inner: str = "analytical",
     inner_options: Mapping[str, Any] | None = None,
     delay_s: float = 0.0,
-    fail_design_ids: Any = (),
-    crash_design_ids: Any = (),
+    fail_design_ids: str | Iterable[object] = (),
+    crash_design_ids: str | Iterable[object] = (),
 ) -> FaultInjectionBackend:
     if inner == "fault-injection":
-        raise ValueError(
-            "The 'inner' of the 'fault-injection' backend must be another backend. "
-            "Got 'fault-injection' instead."
-        )
+        raise InputError(must_be("another backend", inner), key="inner")
     delay = check_range(
         delay_s,
         "delay_s",
@@ -215,7 +223,7 @@ def _make_fault_injection(
     )
 
 
-def _id_set(ids: Any) -> frozenset[str]:
+def _id_set(ids: str | Iterable[object]) -> frozenset[str]:
     if isinstance(ids, str):
         ids = [ids]
     return frozenset(str(i) for i in ids)
@@ -252,7 +260,7 @@ def register_backend(name: str, factory: Callable[..., Backend], *, replace: boo
         spaces, or a name already registered (without ``replace``).
     """
     if not callable(factory):
-        raise ValueError(f"The 'factory' of register_backend must be callable. Got {factory!r}.")
+        raise InputError(must_be("callable", factory), key="factory")
     BACKENDS.register(name, factory, replace=replace)
 
 
@@ -266,7 +274,7 @@ def public_backends() -> tuple[str, ...]:
     return tuple(name for name in BACKENDS if name not in INTERNAL_BACKENDS)
 
 
-def get_backend(name: str, **options: Any) -> Backend:
+def get_backend(name: str, **options: object) -> Backend:
     """Build the backend registered as ``name`` with ``options``.
 
     Raises
@@ -279,7 +287,8 @@ def get_backend(name: str, **options: Any) -> Backend:
         If the backend's implementation is not installed (``"fem"`` without
         ``softbend.fem``).
     """
-    factory = BACKENDS.get(name, field="backend")
+    with keyed("backend"):
+        factory = BACKENDS.get(name)
     try:
         inspect.signature(factory).bind(**options)
     except TypeError as exc:
@@ -298,13 +307,8 @@ def backend_for_run(
     *,
     model: str | os.PathLike[str] | None = None,
     compiled: bool = False,
-    material: str | os.PathLike[str] | Material | None = None,
+    material: MaterialGiven | None = None,
     maxh_mm: float | None = None,
-    field: str = "backend",
-    model_field: str = "model",
-    material_field: str = "material",
-    maxh_field: str = "maxh_mm",
-    owner: str = "backend_for_run",
 ) -> Backend:
     """The backend a command line names, built with what the command line gives it.
 
@@ -317,107 +321,122 @@ def backend_for_run(
         e.g. ``"surrogate"``); required for such a backend, refused for others.
     compiled : bool, default False
         Passed to a backend whose factory takes it (``"fem"``: compile the energy).
-    material : str, path or Material, optional
-        The elastomer of a backend that takes one (:func:`takes_material`): a
-        preset name or ``fit.json[#model]``, as
-        :func:`~softbend.materials.choice.material_from_spec`; refused for others.
-        Default: the backend's own (Dragon Skin 30).
+    material : str, path, Material or ResolvedMaterial, optional
+        The elastomer of a backend that takes one (:func:`takes_material`), as
+        :func:`resolve_material` reads it; refused for others. Default: the
+        backend's own (Dragon Skin 30).
     maxh_mm : float, optional
         Largest element size of the ``"fem"`` backend, mm (> 0); refused for others.
         Default: the FEM's own (:class:`~softbend.fem.FEMOptions`).
-    field, model_field, material_field, maxh_field, owner : str
-        The options and the command named in messages (``"--backend"``,
-        ``"--model"``, ``"--material"``, ``"softbend campaign run"``).
 
     Raises
     ------
     UnknownNameError
-        A name that is not a public backend (the public ones listed).
-    ValueError
-        A file given to a backend that reads none, or none to one that does; a
-        material given to a backend that takes none.
+        Keyed ``backend``: a name that is not a public backend (the public ones listed).
+    InputError
+        Keyed ``model``: a file given to a backend that reads none, or none to
+        one that does; keyed ``material``: a material given to a backend that
+        takes none; keyed ``maxh_mm``: a mesh size of another backend than the
+        FEM's, or one not above 0.
     UnknownNameError, SchemaError
-        A material that is neither a preset nor a readable ``fit.json``.
+        Keyed ``material``: neither a preset nor a readable ``fit.json``.
     """
     public = Registry[Callable[..., Backend]](BACKENDS.kind)
     for known in public_backends():
         public.register(known, BACKENDS.get(known))
-    takes = inspect.signature(public.get(name, field=field)).parameters
+    with keyed("backend"):
+        takes = inspect.signature(public.get(name)).parameters
     if material is not None and "material" not in takes:
-        raise ValueError(_no_material(material_field, owner, f"{field} {name}"))
+        raise _no_material(f"backend {name!r}")
     if ("path" in takes) != (model is not None):
         from_file = [n for n in public if "path" in inspect.signature(public.get(n)).parameters]
-        shown = f"{field} {' or '.join(from_file)}" if from_file else "none is registered"
-        raise ValueError(
-            f"The '{model_field}' of {owner} must be given with a backend read from a saved "
-            f"file ({shown}), and only then. Got {field} {name} and {model_field} {model} instead."
+        shown = f"backend {' or '.join(from_file)}" if from_file else "none is registered"
+        raise InputError(
+            f"must be given with a backend read from a saved file ({shown}), and only "
+            f"then; got backend {name!r} and model {short_repr(model)}",
+            key="model",
         )
-    options: dict[str, Any] = {"path": model} if model is not None else {}
+    options: dict[str, object] = {"path": model} if model is not None else {}
     if material is not None:
-        options["material"] = resolve_material(material, field=material_field)[0]
+        options["material"] = resolve_material(material).material
     if "compiled" in takes:
         options["compiled"] = compiled
     if maxh_mm is not None:
         if name != "fem":
-            raise ValueError(
-                f"The '{maxh_field}' of {owner} is the mesh size of the 'fem' backend. Got "
-                f"{field} {name}, which has no mesh."
+            raise InputError(
+                f"is the mesh size of the 'fem' backend; got backend {name!r}, which has no mesh",
+                key="maxh_mm",
             )
         if isinstance(maxh_mm, bool) or not (isinstance(maxh_mm, int | float) and maxh_mm > 0):
-            raise ValueError(
-                f"The '{maxh_field}' of {owner} must be a size > 0 mm. Got {maxh_mm!r} instead."
-            )
+            raise InputError(must_be("a size > 0 mm", maxh_mm), key="maxh_mm")
         options["maxh_mm"] = float(maxh_mm)
     return get_backend(name, **options)
 
 
 def takes_material(name: str) -> bool:
     """Whether the backend registered as ``name`` takes an elastomer (a ``material`` option)."""
-    return "material" in inspect.signature(BACKENDS.get(name, field="backend")).parameters
+    with keyed("backend"):
+        return "material" in inspect.signature(BACKENDS.get(name)).parameters
 
 
-def _no_material(field: str, owner: str, given: str) -> str:
+def _no_material(given: str) -> InputError:
     takers = [n for n in public_backends() if takes_material(n)]
-    return (
-        f"The '{field}' of {owner} applies to a backend that takes a material "
-        f"({', '.join(takers)}). Got {given} instead."
+    return InputError(
+        f"applies to a backend that takes a material ({', '.join(takers)}); got {given}",
+        key="material",
     )
 
 
-def resolve_material(
-    material: str | os.PathLike[str] | Material, *, field: str = "material"
-) -> tuple[Material, dict[str, str] | None]:
+class ResolvedMaterial(NamedTuple):
+    """A material read once, and what named it."""
+
+    material: Material
+    #: :func:`~softbend.materials.choice.material_spec_record` of a spec (the
+    #: spec, and a fit's file and SHA-256); None for a Material object.
+    given: dict[str, str] | None = None
+
+
+#: What names a material: a preset name, ``fit.json[#model]``, or the material itself.
+MaterialGiven = str | os.PathLike[str] | Material | ResolvedMaterial
+
+
+def resolve_material(material: MaterialGiven) -> ResolvedMaterial:
     """The material ``material`` names, and what named it (None for a Material object).
 
     Parameters
     ----------
-    material : str, path or Material
+    material : str, path, Material or ResolvedMaterial
         A preset name, ``fit.json[#model]`` (as
-        :func:`~softbend.materials.choice.material_from_spec`) or a material.
-    field : str
-        Where it came from, named in messages.
+        :func:`~softbend.materials.choice.material_from_spec`), a material, or
+        one already resolved (returned as it is: a spec is read once).
 
     Returns
     -------
-    (Material, dict or None)
+    ResolvedMaterial
         The material, and :func:`~softbend.materials.choice.material_spec_record`
         of a spec (the spec, and a fit's file and SHA-256).
+
+    Raises
+    ------
+    InputError, UnknownNameError, SchemaError
+        Keyed ``material``: not a spec of a material.
     """
+    if isinstance(material, ResolvedMaterial):
+        return material
     if isinstance(material, Material):
-        return material, None
+        return ResolvedMaterial(material)
     from softbend.materials.choice import material_from_spec, material_spec_record
 
     if not isinstance(material, str | os.PathLike):
-        raise ValueError(
-            f"The '{field}' must be a preset name, the path of a fit.json or a Material. "
-            f"Got {material!r} instead."
+        raise InputError(
+            must_be("a preset name, the path of a fit.json or a Material", material),
+            key="material",
         )
-    return material_from_spec(material, field=field), material_spec_record(material)
+    with keyed("material"):
+        return ResolvedMaterial(material_from_spec(material), material_spec_record(material))
 
 
-def with_material(
-    backend: Backend, material: Material, *, field: str = "material", owner: str = "with_material"
-) -> Backend:
+def with_material(backend: Backend, material: Material) -> Backend:
     """``backend`` with ``material`` as its elastomer.
 
     The FEM's :class:`~softbend.fem.FEMOptions` get it as their ``elastomer``;
@@ -427,8 +446,8 @@ def with_material(
 
     Raises
     ------
-    ValueError
-        A backend that takes no material.
+    InputError
+        Keyed ``material``: a backend that takes no material.
     """
     from softbend.campaign.settings import fem_options_of
 
@@ -445,6 +464,5 @@ def with_material(
         return cast(Backend, dataclasses.replace(target, material=material))
     inner = getattr(backend, "inner", None)
     if "inner" in names and isinstance(inner, Backend):
-        inner = with_material(inner, material, field=field, owner=owner)
-        return cast(Backend, dataclasses.replace(target, inner=inner))
-    raise ValueError(_no_material(field, owner, f"backend {backend.name!r}"))
+        return cast(Backend, dataclasses.replace(target, inner=with_material(inner, material)))
+    raise _no_material(f"backend {backend.name!r}")

@@ -40,13 +40,16 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 
 from softbend._extras import require
+from softbend._validation import must_be
 from softbend.campaign.backends import Backend, SweepResult
 from softbend.campaign.schema import first_line
 from softbend.design import SFRBADesign
-from softbend.errors import SoftbendError
+from softbend.errors import InputError, SoftbendError, keyed
 from softbend.limits import check_file_size
 
 if TYPE_CHECKING:
+    from distributed import Client
+
     from softbend.campaign.store import CampaignStore
 
 __all__ = [
@@ -67,7 +70,6 @@ logger = logging.getLogger(__name__)
 #: run, designs handed to workers and not yet back, designs this run has to do.
 ProgressCallback = Callable[[int, int, int, int], None]
 
-_OWNER = "run_campaign"
 _ADDRESS = re.compile(
     r"^(?P<protocol>tcp|tls)://(?P<host>\[[0-9A-Fa-f:.]+\]|[A-Za-z0-9._-]+):(?P<port>\d{1,5})$"
 )
@@ -223,7 +225,7 @@ def _run_isolated(
     backend: Backend,
     suspects: deque[SFRBADesign],
     pressures: np.ndarray,
-    context: Any,
+    context: multiprocessing.context.BaseContext,
     recorder: Recorder,
 ) -> None:
     """Run each design that was in flight when a worker died alone, in its own process.
@@ -336,7 +338,7 @@ def parse_scheduler_address(scheduler: str) -> str:
     Raises
     ------
     ValueError
-        Naming ``--scheduler``, the expected form and the value received.
+        Keyed ``scheduler``: the expected form and the value received.
     FileNotFoundError
         The scheduler file does not exist.
     LimitError
@@ -347,9 +349,12 @@ def parse_scheduler_address(scheduler: str) -> str:
         text = _scheduler_file_address(Path(text))
     match = _ADDRESS.match(text)
     if match is None or not 1 <= int(match["port"]) <= 65535:
-        raise ValueError(
-            f"The 'scheduler' (--scheduler) of {_OWNER} must be an address of the form "
-            f"tcp://HOST:PORT (PORT 1-65535) or a Dask scheduler file. Got {scheduler!r} instead."
+        raise InputError(
+            must_be(
+                "an address of the form tcp://HOST:PORT (PORT 1-65535) or a Dask scheduler file",
+                scheduler,
+            ),
+            key="scheduler",
         )
     return text
 
@@ -360,21 +365,20 @@ _JSON_KINDS = {list: "array", str: "string", int: "number", float: "number", boo
 def _scheduler_file_address(path: Path) -> str:
     """The ``address`` of a Dask scheduler file, checked: a JSON object with a string there."""
     if not path.is_file():
-        raise FileNotFoundError(f"No Dask scheduler file at {str(path)!r} (--scheduler).")
-    check_file_size(path, f"The Dask scheduler file {path} (--scheduler)")
+        raise FileNotFoundError(f"No Dask scheduler file at {str(path)!r}.")
+    with keyed("scheduler"):
+        check_file_size(path, f"The Dask scheduler file {path}")
     try:
         payload = json.loads(path.read_bytes())
     except (ValueError, RecursionError) as exc:  # not JSON, not UTF-8, nested too deeply
         reason = "nested too deeply" if isinstance(exc, RecursionError) else first_line(exc)
-        raise ValueError(
-            f"The Dask scheduler file {str(path)!r} (--scheduler) must be JSON with an "
-            f"'address'. Got a file that is not JSON ({reason}) instead."
+        raise InputError(
+            f"must be a Dask scheduler file, JSON with an 'address'; got a file that is not "
+            f"JSON ({reason})",
+            file=str(path),
         ) from None
     except OSError as exc:
-        raise ValueError(
-            f"The Dask scheduler file {str(path)!r} (--scheduler) cannot be read: "
-            f"{exc.strerror or exc}."
-        ) from None
+        raise InputError(f"cannot be read: {exc.strerror or exc}", file=str(path)) from None
     address = payload.get("address") if isinstance(payload, dict) else None
     if not isinstance(address, str):
         if not isinstance(payload, dict):
@@ -383,9 +387,10 @@ def _scheduler_file_address(path: Path) -> str:
             found = f"'address' {address!r}"
         else:
             found = "no 'address'"
-        raise ValueError(
-            f"The Dask scheduler file {str(path)!r} (--scheduler) must be a JSON object with "
-            f"an 'address' string (tcp://HOST:PORT). Got {found[:200]} instead."
+        raise InputError(
+            f"must be a Dask scheduler file, a JSON object with an 'address' string "
+            f"(tcp://HOST:PORT); got {found[:200]}",
+            file=str(path),
         )
     return address
 
@@ -401,8 +406,9 @@ def _probe(address: str, timeout_s: float) -> None:
     except OSError as exc:
         reason = exc.strerror or type(exc).__name__
         raise SoftbendError(
-            f"Cannot reach the Dask scheduler at {address} ({reason}); start it with "
-            "'dask scheduler' or check --scheduler."
+            f"cannot reach the Dask scheduler at {address} ({reason}); start it with "
+            "'dask scheduler' or check the address",
+            key="scheduler",
         ) from None
 
 
@@ -430,9 +436,10 @@ def _in_thread(work: Callable[[], Any], deadline_s: float) -> tuple[bool, Any, A
 
 def _not_dask(address: str, why: str) -> SoftbendError:
     return SoftbendError(
-        f"The '--scheduler' {address} did not answer as a Dask scheduler ({why}); give the "
-        "address the scheduler prints as 'Scheduler at: tcp://HOST:PORT' (port 8786 by "
-        "default), not its dashboard or another service."
+        f"{address} did not answer as a Dask scheduler ({why}); give the address the "
+        "scheduler prints as 'Scheduler at: tcp://HOST:PORT' (port 8786 by default), not its "
+        "dashboard or another service",
+        key="scheduler",
     )
 
 
@@ -465,8 +472,9 @@ def _identify(address: str, timeout_s: float) -> None:
     finished, reply, error = _in_thread(run, timeout_s + 5.0)
     if not finished or isinstance(error, asyncio.TimeoutError | TimeoutError):
         raise SoftbendError(
-            f"The '--scheduler' {address} did not answer within {timeout_s:g} s: something "
-            "listens there but does not speak Dask's protocol; check --scheduler."
+            f"{address} did not answer within {timeout_s:g} s: something listens there but "
+            "does not speak Dask's protocol; check the address",
+            key="scheduler",
         )
     if error is not None:
         if isinstance(error, MemoryError):
@@ -488,7 +496,7 @@ def _closing_client(Client: type) -> type:
     """
 
     class ClosingClient(Client):  # type: ignore[misc, valid-type]
-        def start(self, **kwargs: Any) -> None:
+        def start(self, **kwargs: object) -> None:
             try:
                 super().start(**kwargs)
             except BaseException:
@@ -501,7 +509,7 @@ def _closing_client(Client: type) -> type:
     return ClosingClient
 
 
-def connect(address: str, timeout_s: float) -> Any:
+def connect(address: str, timeout_s: float) -> Client:
     """A Dask client of the scheduler at ``address``, or one line within the deadline.
 
     Every wait has a deadline: something that accepts TCP but is not a Dask
@@ -510,7 +518,7 @@ def connect(address: str, timeout_s: float) -> Any:
     the client is made in a helper thread that is given up after ``timeout_s``
     (plus a grace of 5 s).
     """
-    Client = require("distributed", "A campaign on a Dask cluster (--scheduler)").Client
+    Client = require("distributed", "A campaign on a Dask cluster").Client
 
     _probe(address, timeout_s)
     _identify(address, timeout_s)
@@ -520,13 +528,15 @@ def connect(address: str, timeout_s: float) -> Any:
     )
     if not finished:
         raise SoftbendError(
-            f"The Dask scheduler at {address} did not answer within {timeout_s:g} s: something "
-            "listens there but does not speak Dask's protocol; check --scheduler."
+            f"the Dask scheduler at {address} did not answer within {timeout_s:g} s: something "
+            "listens there but does not speak Dask's protocol; check the address",
+            key="scheduler",
         )
     if error is not None:
         raise SoftbendError(
-            f"Cannot connect to the Dask scheduler at {address}: {type(error).__name__}: "
-            f"{first_line(error)}"
+            f"cannot connect to the Dask scheduler at {address}: {type(error).__name__}: "
+            f"{first_line(error)}",
+            key="scheduler",
         ) from None
     try:
         client.wait_for_workers(1, timeout=timeout_s)
@@ -543,7 +553,7 @@ def run_dask(
     backend: Backend,
     chunks: deque[list[SFRBADesign]],
     pressures: np.ndarray,
-    client: Any,
+    client: Client,
     recorder: Recorder,
 ) -> None:
     """Sweep the chunks on the Dask cluster of ``client``; pending tasks are cancelled on exit."""

@@ -20,9 +20,10 @@ from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
-from softbend._validation import check_range
+from softbend._validation import check_range, must_be
 from softbend.campaign.backends import Backend, get_backend
 from softbend.design import SFRBADesign
+from softbend.errors import InputError
 
 if TYPE_CHECKING:
     from softbend.campaign.store import CampaignStore
@@ -39,7 +40,6 @@ __all__ = [
 
 logger = logging.getLogger(__name__)
 
-_OWNER = "run_campaign"
 # Largest batch sent to a worker in one task when the backend states no preference.
 _MAX_AUTO_CHUNK = 16
 
@@ -86,22 +86,18 @@ def check_designs(designs: Iterable[SFRBADesign]) -> list[SFRBADesign]:
     try:
         items = list(designs)
     except TypeError:
-        raise ValueError(
-            f"The 'designs' of {_OWNER} must be an iterable of SFRBADesign. "
-            f"Got {designs!r} instead."
-        ) from None
+        raise InputError(must_be("an iterable of SFRBADesign", designs), key="designs") from None
     if not items:
-        raise ValueError(f"The 'designs' of {_OWNER} must not be empty. Got 0 designs.")
+        raise InputError("must not be empty; got 0 designs", key="designs")
     for i, design in enumerate(items):
         if not isinstance(design, SFRBADesign):
-            raise ValueError(
-                f"The 'designs' of {_OWNER} must all be SFRBADesign. "
-                f"Got {design!r} at position {i} instead."
+            raise InputError(
+                f"must all be SFRBADesign; got {design!r} at position {i}", key="designs"
             )
     ids = [d.design_id for d in items]
     if len(set(ids)) != len(ids):
-        raise ValueError(
-            f"The 'designs' of {_OWNER} must be unique. Got {len(ids) - len(set(ids))} duplicates."
+        raise InputError(
+            f"must be unique; got {len(ids) - len(set(ids))} duplicates", key="designs"
         )
     return items
 
@@ -117,14 +113,14 @@ def resolve_backend(backend: str | Backend, options: dict[str, Any] | None) -> B
     if isinstance(backend, str):
         return get_backend(backend, **dict(options or {}))
     if not isinstance(backend, Backend):
-        raise ValueError(
-            f"The 'backend' of {_OWNER} must be a backend name or an object with 'name' and "
-            f"'sweep'. Got {backend!r} instead."
+        raise InputError(
+            must_be("a backend name or an object with 'name' and 'sweep'", backend),
+            key="backend",
         )
     if options:
-        raise ValueError(
-            f"The 'backend_options' of {_OWNER} apply to a backend name only. "
-            f"Got {sorted(options)} with a backend object."
+        raise InputError(
+            f"apply to a backend name only; got {sorted(options)} with a backend object",
+            key="backend_options",
         )
     return backend
 

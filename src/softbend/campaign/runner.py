@@ -48,14 +48,16 @@ import time
 from collections.abc import Iterable
 from dataclasses import asdict, dataclass, field
 from pathlib import Path
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 from numpy.typing import ArrayLike
 
 from softbend import __version__
+from softbend._validation import must_be
 from softbend.campaign.backends import (
     Backend,
+    MaterialGiven,
     check_pressures_mpa,
     default_pressures_mpa,
     resolve_material,
@@ -82,13 +84,14 @@ from softbend.campaign.planning import (
 from softbend.campaign.settings import backend_settings, fem_options_of
 from softbend.campaign.store import CampaignStore
 from softbend.design import SFRBADesign
-from softbend.materials.presets import Material
+from softbend.errors import InputError
+
+if TYPE_CHECKING:
+    from distributed import Client
 
 __all__ = ["CampaignSummary", "count_designs_to_run", "parse_scheduler_address", "run_campaign"]
 
 logger = logging.getLogger(__name__)
-
-_OWNER = "run_campaign"
 
 
 @dataclass(frozen=True)
@@ -168,7 +171,7 @@ def run_campaign(
     progress: ProgressCallback | None = None,
     chunk_size: int | None = None,
     connect_timeout_s: float = 5.0,
-    material: str | os.PathLike[str] | Material | None = None,
+    material: MaterialGiven | None = None,
     accept_new_settings: bool = False,
 ) -> CampaignSummary:
     """Sweep every design not yet done and record each in the campaign database.
@@ -206,11 +209,13 @@ def run_campaign(
         most 16.
     connect_timeout_s : float
         Time allowed to reach the Dask scheduler and find a worker, s, in (0, 600].
-    material : str, path or Material, optional
+    material : str, path, Material or ResolvedMaterial, optional
         Elastomer of a backend that takes one (``"fem"``, ``"analytical"``): a
         preset name, ``fit.json[#model]`` (as
-        :func:`~softbend.materials.choice.material_from_spec`) or a material; it
-        reaches every sweep, in every worker. Default: the backend's own.
+        :func:`~softbend.materials.choice.material_from_spec`), a material, or
+        one :func:`~softbend.campaign.backends.resolve_material` read (a spec is
+        read once); it reaches every sweep, in every worker and is recorded
+        with what named it. Default: the backend's own.
     accept_new_settings : bool
         Resume even if the backend's settings (mesh size and other FEM options,
         material, see :mod:`~softbend.campaign.settings`) differ from those the
@@ -243,22 +248,20 @@ def run_campaign(
     backend_obj = resolve_backend(backend, backend_options)
     given = None
     if material is not None:
-        elastomer, given = resolve_material(material)
-        backend_obj = with_material(backend_obj, elastomer, owner=_OWNER)
+        chosen = resolve_material(material)
+        backend_obj, given = with_material(backend_obj, chosen.material), chosen.given
     design_list = check_designs(designs)
     fem_options = fem_options_of(backend_obj)
     if fem_options is not None:
         # The FEM's own rule on the mesh size, for every design before any is swept:
         # a mesh size too fine for them would otherwise fail each design in turn.
         fem_options.check_mesh(design_list)
-    grid = check_pressures_mpa(
-        default_pressures_mpa() if pressures_mpa is None else pressures_mpa, _OWNER
-    )
+    grid = check_pressures_mpa(default_pressures_mpa() if pressures_mpa is None else pressures_mpa)
     settings = backend_settings(backend_obj, grid, material_given=given)
     workers, chunk_size, timeout_s = check_run_options(workers, chunk_size, connect_timeout_s)
     address = parse_scheduler_address(scheduler) if scheduler is not None else None
     if progress is not None and not callable(progress):
-        raise ValueError(f"The 'progress' of {_OWNER} must be callable. Got {progress!r} instead.")
+        raise InputError(must_be("callable", progress), key="progress")
     space = getattr(designs, "name", None)
 
     # Connect first: an unreachable cluster fails before the database is touched.
@@ -331,7 +334,7 @@ def _execute(
     plan: RunPlan,
     backend: Backend,
     grid: np.ndarray,
-    client: Any,
+    client: Client | None,
     chunk_size: int | None,
     recorder: Recorder,
 ) -> int | None:

@@ -46,10 +46,13 @@ from collections.abc import Iterator
 from contextlib import contextmanager
 from datetime import UTC, datetime
 from pathlib import Path
-from typing import Any
+from typing import TYPE_CHECKING
 
 from softbend.design import PARAMETERS
 from softbend.errors import SchemaError, SoftbendError
+
+if TYPE_CHECKING:
+    from duckdb import DuckDBPyConnection
 
 __all__ = [
     "DESIGN_COLUMNS",
@@ -176,7 +179,7 @@ def utc_now() -> datetime:
 
 
 @contextmanager
-def transaction(con: Any) -> Iterator[None]:
+def transaction(con: DuckDBPyConnection) -> Iterator[None]:
     """Run the body in one transaction of the DuckDB connection ``con``.
 
     Committed when the body returns, rolled back when it raises (anything,
@@ -197,7 +200,7 @@ def transaction(con: Any) -> Iterator[None]:
 # -- creating a database or checking an existing one -------------------------------
 
 
-def ensure_schema(con: Any, path: Path, *, read_only: bool) -> None:
+def ensure_schema(con: DuckDBPyConnection, path: Path, *, read_only: bool) -> None:
     """Create the tables of a new campaign database, or check those of an existing one.
 
     Parameters
@@ -255,7 +258,7 @@ def ensure_schema(con: Any, path: Path, *, read_only: bool) -> None:
         )
 
 
-def _create(con: Any, path: Path) -> None:
+def _create(con: DuckDBPyConnection, path: Path) -> None:
     with transaction(con):
         for statement in _DDL:
             con.execute(statement)
@@ -268,7 +271,7 @@ def _create(con: Any, path: Path) -> None:
     logger.info("created campaign database %s (schema %d)", path, SCHEMA_VERSION)
 
 
-def check_complete(con: Any, path: Path) -> None:
+def check_complete(con: DuckDBPyConnection, path: Path) -> None:
     """Raise unless the file holds every block of the database, each one readable.
 
     DuckDB reads a block only when a query needs it, so a truncated or partly
@@ -279,9 +282,11 @@ def check_complete(con: Any, path: Path) -> None:
     A DuckDB error raised here is turned into one line by the caller.
     """
     size = path.stat().st_size
-    block_size, total, free = con.execute(
+    row = con.execute(
         "SELECT block_size, total_blocks, free_blocks FROM pragma_database_size()"
     ).fetchone()
+    assert row is not None  # the pragma answers one row for the open database
+    block_size, total, free = row
     needed = _DUCKDB_HEADER_BYTES + block_size * (total - free)
     if size < needed:
         raise unreadable(path, f"truncated: {size} bytes, its blocks in use need {needed}")

@@ -25,12 +25,17 @@ import math
 import os
 from collections.abc import Mapping
 from pathlib import Path
-from typing import Any
+from typing import TYPE_CHECKING, Any, cast
 
 import numpy as np
 
 from softbend.errors import SoftbendError
-from softbend.materials.presets import DRAGON_SKIN_30, Material
+from softbend.materials.models import HyperelasticModel
+from softbend.materials.presets import DRAGON_SKIN_30, LinearElastic, Material
+
+if TYPE_CHECKING:
+    from softbend.campaign.backends import Backend
+    from softbend.fem.options import FEMOptions
 
 __all__ = [
     "SETTINGS_VERSION",
@@ -71,7 +76,10 @@ class UncheckedSettingsWarning(UserWarning):
 
 
 class SettingsMismatchError(SoftbendError, ValueError):
-    """A campaign resumed (or merged) with settings other than those it recorded.
+    """A campaign resumed with settings other than those it recorded.
+
+    Keyed ``accept_new_settings`` (what lets such a run go on); the message
+    names the database and each differing setting.
 
     Parameters
     ----------
@@ -79,32 +87,19 @@ class SettingsMismatchError(SoftbendError, ValueError):
         The campaign database.
     differences : list of (name, recorded, given)
         As :func:`settings_differences`.
-    new : str
-        What to use instead, named in the message (``"a new database"``).
-    accept : str
-        How to accept the change, named in the message.
     """
 
     def __init__(
-        self,
-        path: str | os.PathLike[str],
-        differences: list[tuple[str, Any, Any]],
-        *,
-        new: str = "a new database",
-        accept: str = "accept_new_settings=True",
+        self, path: str | os.PathLike[str], differences: list[tuple[str, Any, Any]]
     ) -> None:
         self.path = Path(path)
         self.differences = differences
         super().__init__(
-            f"The settings of this run differ from those recorded in the campaign "
-            f"{str(self.path)!r}: {describe_differences(differences)}. Resume with the "
-            f"recorded settings, write to {new}, or pass {accept} to mix both settings in "
-            "one campaign."
+            f"must be set to resume the campaign {str(self.path)!r} with settings other than "
+            f"those it recorded: {describe_differences(differences)}; or resume with the "
+            "recorded settings, or write to a new database",
+            key="accept_new_settings",
         )
-
-    def with_names(self, *, new: str, accept: str) -> SettingsMismatchError:
-        """The same error naming a command line's ``new`` target and ``accept`` option."""
-        return SettingsMismatchError(self.path, self.differences, new=new, accept=accept)
 
 
 def describe_differences(
@@ -118,7 +113,7 @@ def describe_differences(
     return shown + more
 
 
-def _show(value: Any) -> str:
+def _show(value: object) -> str:
     if value is _MISSING:
         return "not recorded"
     if isinstance(value, float):
@@ -128,17 +123,19 @@ def _show(value: Any) -> str:
     return json.dumps(value, default=str)
 
 
-def fem_options_of(backend: Any) -> Any:
+def fem_options_of(backend: object) -> FEMOptions | None:
     """The :class:`~softbend.fem.FEMOptions` of an FEM backend (defaults for None), else None."""
     if getattr(backend, "name", None) != "fem" or not hasattr(backend, "options"):
         return None
     from softbend.fem.options import FEMOptions
 
-    options = backend.options
-    return FEMOptions() if options is None else options
+    options = getattr(backend, "options", None)
+    return FEMOptions() if options is None else cast(FEMOptions, options)
 
 
-def _material_record(material: Any, given: Mapping[str, str] | None) -> dict[str, Any]:
+def _material_record(
+    material: Material | HyperelasticModel | LinearElastic, given: Mapping[str, str] | None
+) -> dict[str, Any]:
     """A material (or a bare constitutive model) as settings, with what named it."""
     record = material.to_dict() if isinstance(material, Material) else {"model": material.to_dict()}
     if given:
@@ -146,7 +143,7 @@ def _material_record(material: Any, given: Mapping[str, str] | None) -> dict[str
     return record
 
 
-def _plain_fields(backend: Any) -> dict[str, Any]:
+def _plain_fields(backend: object) -> dict[str, Any]:
     """A dataclass backend's options that are plain values (numbers, text, None)."""
     if not dataclasses.is_dataclass(backend):
         return {}
@@ -159,7 +156,7 @@ def _plain_fields(backend: Any) -> dict[str, Any]:
 
 
 def backend_settings(
-    backend: Any, pressures_mpa: np.ndarray, *, material_given: Mapping[str, str] | None = None
+    backend: Backend, pressures_mpa: np.ndarray, *, material_given: Mapping[str, str] | None = None
 ) -> dict[str, Any]:
     """The settings of ``backend`` that change a campaign's numbers, as JSON-ready data.
 
@@ -195,7 +192,7 @@ def backend_settings(
         },
     }
     inner = getattr(backend, "inner", None)
-    described = inner if inner is not None and hasattr(inner, "sweep") else backend
+    described: Any = inner if inner is not None and hasattr(inner, "sweep") else backend
     if described is not backend:
         settings["inner_backend"] = str(described.name)
     fem = fem_options_of(described)
@@ -215,11 +212,13 @@ def backend_settings(
     return json.loads(json.dumps(settings, default=str))
 
 
-def _fields(backend: Any) -> tuple[dataclasses.Field[Any], ...]:
-    return dataclasses.fields(backend) if dataclasses.is_dataclass(backend) else ()
+def _fields(backend: object) -> tuple[dataclasses.Field[Any], ...]:
+    if dataclasses.is_dataclass(backend):
+        return dataclasses.fields(backend)
+    return ()
 
 
-def _flatten(value: Any, prefix: str = "") -> dict[str, Any]:
+def _flatten(value: object, prefix: str = "") -> dict[str, Any]:
     if isinstance(value, Mapping) and value:
         out: dict[str, Any] = {}
         for key, item in value.items():
@@ -234,7 +233,7 @@ def _compared(name: str) -> bool:
     return not any(name == u or name.startswith(u + ".") for u in UNCOMPARED)
 
 
-def _same(a: Any, b: Any) -> bool:
+def _same(a: object, b: object) -> bool:
     if isinstance(a, float) and isinstance(b, float) and math.isnan(a) and math.isnan(b):
         return True
     return bool(a == b)

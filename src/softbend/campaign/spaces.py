@@ -24,7 +24,9 @@ from dataclasses import dataclass, replace
 from pathlib import Path
 from typing import Literal, cast
 
+from softbend._validation import must_be
 from softbend.design import DESIGN_LIMITS, PARAMETERS, TABLE1_LEVELS, DesignSpace
+from softbend.errors import InputError, keyed
 from softbend.limits import check_count_text, check_limit
 
 __all__ = [
@@ -80,25 +82,19 @@ class SpaceSpec:
     n_designs: int
     ranges: tuple[tuple[str, float, float], ...] = ()
 
-    def with_ranges(
-        self,
-        ranges: dict[str, tuple[float, float]],
-        *,
-        option: str = "ranges",
-        owner: str = "SpaceSpec.with_ranges",
-    ) -> SpaceSpec:
+    def with_ranges(self, ranges: dict[str, tuple[float, float]]) -> SpaceSpec:
         """The same space sampled over ``ranges`` (from :func:`parse_ranges`).
 
         Raises
         ------
-        ValueError
-            Naming ``option`` of ``owner``: only the sampled spaces (``lhs:N``, ``sobol:N``)
-            take ranges.
+        InputError
+            Keyed ``ranges``: only the sampled spaces (``lhs:N``, ``sobol:N``) take ranges.
         """
         if self.kind not in ("lhs", "sobol"):
-            raise ValueError(
-                f"The '{option}' of {owner} applies to the sampled spaces lhs:N and sobol:N, "
-                f"not to {self.text!r}, whose designs are paper B's Table 1 levels."
+            raise InputError(
+                f"applies to the sampled spaces lhs:N and sobol:N, not to {self.text!r}, "
+                "whose designs are paper B's Table 1 levels",
+                key="ranges",
             )
         ordered = tuple((p, *ranges[p]) for p in _SHORT if p in ranges)
         return replace(self, ranges=ordered)
@@ -123,9 +119,7 @@ class SpaceSpec:
 _RECORDED = 1e-6
 
 
-def parse_ranges(
-    texts: Sequence[str], *, option: str = "ranges", owner: str = "parse_ranges"
-) -> dict[str, tuple[float, float]]:
+def parse_ranges(ranges: Sequence[str]) -> dict[str, tuple[float, float]]:
     """``{parameter: (low, high)}`` from ``NAME=LOW:HIGH`` texts (``l=60:90``).
 
     ``NAME`` is one of ``l, r, t, b, phi, lc``; ``LOW < HIGH`` in mm (degrees for
@@ -134,11 +128,11 @@ def parse_ranges(
 
     Raises
     ------
-    ValueError
-        Naming ``option`` of ``owner``, the allowed form and values, and the text received.
+    InputError
+        Keyed ``ranges``: the allowed form and values, and the text received.
     """
     out: dict[str, tuple[float, float]] = {}
-    for text in texts:
+    for text in ranges:
         match = re.fullmatch(r"\s*([a-z]+)\s*=\s*([^:]+):(.+)", str(text))
         name = match[1] if match else None
         try:
@@ -146,47 +140,51 @@ def parse_ranges(
         except ValueError:
             low, high = math.nan, math.nan
         if name not in DESIGN_LIMITS or not (math.isfinite(low) and math.isfinite(high)):
-            raise ValueError(
-                f"The '{option}' of {owner} must be NAME=LOW:HIGH with NAME one of "
-                f"{', '.join(_SHORT)} and LOW, HIGH numbers (mm; degrees for phi). "
-                f"Got {text!r} instead."
+            raise InputError(
+                must_be(
+                    f"NAME=LOW:HIGH with NAME one of {', '.join(_SHORT)} and LOW, HIGH numbers "
+                    "(mm; degrees for phi)",
+                    text,
+                ),
+                key="ranges",
             )
         least, most, closed = DESIGN_LIMITS[name]
+        unit = "deg" if name == "phi" else "mm"
         if not (least <= low if closed else least < low) or not low < high <= most:
             opening = "[" if closed else "("
-            unit = "deg" if name == "phi" else "mm"
             bound = f"{opening}{least:g}, {most:g}] {unit}"
-            raise ValueError(
-                f"The '{option}' of {owner} must give {name} a range LOW < HIGH within {bound}. "
-                f"Got {text!r} instead."
+            raise InputError(
+                must_be(f"a range of {name} LOW < HIGH within {bound}", text), key="ranges"
             )
-        unit = "deg" if name == "phi" else "mm"
         if (
             high - low < _RECORDED
             or round(low, 6) == round(high, 6)
             or (not closed and round(low, 6) <= least)
         ):
             start = "" if closed else f" from at least {_RECORDED:g} {unit}"
-            raise ValueError(
-                f"The '{option}' of {owner} must give {name} a range at least {_RECORDED:g} "
-                f"{unit} wide{start} (designs are sampled to {_RECORDED:g} {unit}). "
-                f"Got {text!r} instead."
+            raise InputError(
+                must_be(
+                    f"a range of {name} at least {_RECORDED:g} {unit} wide{start} (designs are "
+                    f"sampled to {_RECORDED:g} {unit})",
+                    text,
+                ),
+                key="ranges",
             )
         if name in out:
-            raise ValueError(f"The '{option}' of {owner} gives {name} twice. Got {text!r} again.")
+            raise InputError(f"gives {name} twice; got {text!r} again", key="ranges")
         out[name] = (low, high)
     t_high = out.get("t", (0.0, max(TABLE1_LEVELS["t_mm"])))[1]
     r_low = out.get("r", (min(TABLE1_LEVELS["r_mm"]), 0.0))[0]
     if t_high >= r_low:
-        raise ValueError(
-            f"The '{option}' of {owner} must keep the wall thinner than the radius in every "
-            f"design: t's high must be below r's low. Got t up to {t_high:g} mm and r from "
-            f"{r_low:g} mm instead."
+        raise InputError(
+            "must keep the wall thinner than the radius in every design: t's high must be "
+            f"below r's low; got t up to {t_high:g} mm and r from {r_low:g} mm",
+            key="ranges",
         )
     return out
 
 
-def parse_space(text: str, *, option: str = "space", owner: str = "parse_space") -> SpaceSpec:
+def parse_space(space: str) -> SpaceSpec:
     """Read ``table1``, ``corners``, ``lhs:N`` or ``sobol:N`` (lower case, ``N >= 1``).
 
     The number of designs is known from the text alone and checked against the
@@ -195,45 +193,42 @@ def parse_space(text: str, *, option: str = "space", owner: str = "parse_space")
 
     Raises
     ------
-    ValueError
-        Naming ``option`` of ``owner``, the accepted forms and the text received.
+    InputError
+        Keyed ``space``: the accepted forms and the text received.
     LimitError
-        The space has more designs than the ``designs`` limit (``SOFTBEND_MAX_DESIGNS``).
+        Keyed ``space``: the space has more designs than the ``designs`` limit
+        (``SOFTBEND_MAX_DESIGNS``).
     """
+    text = space
     match = re.fullmatch(r"(table1|corners)|(lhs|sobol):([0-9]+)", str(text))
     digits = None if match is None or match[3] is None else match[3].lstrip("0")
     if match is None or digits == "":
-        raise ValueError(
-            f"The '{option}' of {owner} must be one of {SPACE_FORMS} (lower case, N >= 1). "
-            f"Got {text!r} instead."
-        )
+        raise InputError(must_be(f"one of {SPACE_FORMS} (lower case, N >= 1)", text), key="space")
     shown = text if len(text) <= 40 else f"{text[:30]}...({len(text)} characters)"
-    what = f"The '{option}' {shown}"
-    if match[1] == "table1":
-        spec = SpaceSpec(text, "table1", math.prod(len(v) for v in TABLE1_LEVELS.values()))
-    elif match[1] == "corners":
-        spec = SpaceSpec(text, "corners", 2 ** len(TABLE1_LEVELS))
-    else:
-        assert digits is not None  # the lhs:N / sobol:N branch always has digits
-        spec = SpaceSpec(text, match[2], check_count_text("designs", digits, what))
-    check_limit("designs", spec.n_designs, what)
+    what = shown
+    with keyed("space"):
+        if match[1] == "table1":
+            spec = SpaceSpec(text, "table1", math.prod(len(v) for v in TABLE1_LEVELS.values()))
+        elif match[1] == "corners":
+            spec = SpaceSpec(text, "corners", 2 ** len(TABLE1_LEVELS))
+        else:
+            assert digits is not None  # the lhs:N / sobol:N branch always has digits
+            spec = SpaceSpec(text, match[2], check_count_text("designs", digits, what))
+        check_limit("designs", spec.n_designs, what)
     return spec
 
 
-def parse_shard(text: str, *, option: str = "shard", owner: str = "parse_shard") -> tuple[int, int]:
+def parse_shard(shard: str) -> tuple[int, int]:
     """``(K, N)`` from ``K/N``: shard K (0-based) of N, every N-th design from the K-th.
 
     Raises
     ------
-    ValueError
-        Naming ``option`` of ``owner``, unless ``N >= 1`` and ``K`` in ``0..N-1``.
+    InputError
+        Keyed ``shard``, unless ``N >= 1`` and ``K`` in ``0..N-1``.
     """
-    match = re.fullmatch(r"\s*(\d+)\s*/\s*(\d+)\s*", str(text))
+    match = re.fullmatch(r"\s*(\d+)\s*/\s*(\d+)\s*", str(shard))
     if match is None or int(match[2]) < 1 or int(match[1]) >= int(match[2]):
-        raise ValueError(
-            f"The '{option}' of {owner} must be K/N with N >= 1 and K in 0..N-1 "
-            f"(e.g. 0/8). Got {text!r} instead."
-        )
+        raise InputError(must_be("K/N with N >= 1 and K in 0..N-1 (e.g. 0/8)", shard), key="shard")
     return int(match[1]), int(match[2])
 
 
@@ -328,9 +323,6 @@ def check_footprint(
     db: str | os.PathLike[str],
     *,
     allow_large: bool = False,
-    option: str = "space",
-    owner: str = "check_footprint",
-    allow_flag: str = "allow_large=True",
 ) -> None:
     """Refuse a campaign that does not fit, or that is large and not ``allow_large``.
 
@@ -342,9 +334,9 @@ def check_footprint(
 
     Raises
     ------
-    ValueError
-        Naming ``option`` of ``owner`` and the estimate (and ``allow_flag``, the
-        way the caller passes ``allow_large``).
+    InputError
+        Keyed ``space`` (the space sets the campaign's size) for one that does
+        not fit, keyed ``allow_large`` for a large one; both with the estimate.
     """
     db = Path(db)
     used = db.stat().st_size if db.is_file() else 0
@@ -354,17 +346,17 @@ def check_footprint(
     if short_of_memory or short_of_disk:
         have_memory = "unknown" if memory is None else _size(memory)
         have_disk = "unknown" if disk is None else _size(disk + used)
-        raise ValueError(
-            f"The '{option}' of {owner} must give a campaign that fits this machine. Got "
-            f"{footprint.designs()}, which need "
-            f"about {_size(footprint.memory_bytes)} of memory ({have_memory} available) and "
-            f"{_size(footprint.disk_bytes)} of disk ({have_disk} free for {db})."
+        raise InputError(
+            f"must give a campaign that fits this machine; got {footprint.designs()}, which "
+            f"need about {_size(footprint.memory_bytes)} of memory ({have_memory} available) "
+            f"and {_size(footprint.disk_bytes)} of disk ({have_disk} free for {db})",
+            key="space",
         )
     if not allow_large and (
         footprint.memory_bytes > MEMORY_LIMIT_BYTES or footprint.disk_bytes > DISK_LIMIT_BYTES
     ):
-        raise ValueError(
-            f"The '{option}' of {owner} gives a large campaign, {footprint.describe()} "
-            f"(more than {_size(MEMORY_LIMIT_BYTES)} of memory or "
-            f"{_size(DISK_LIMIT_BYTES)} of disk): pass {allow_flag} to run it."
+        raise InputError(
+            f"must be set to run a large campaign, {footprint.describe()} (more than "
+            f"{_size(MEMORY_LIMIT_BYTES)} of memory or {_size(DISK_LIMIT_BYTES)} of disk)",
+            key="allow_large",
         )

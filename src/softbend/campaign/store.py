@@ -62,6 +62,7 @@ from softbend.models import SweepResult, check_pressures_mpa
 
 if TYPE_CHECKING:
     import pandas as pd
+    from duckdb import DuckDBPyConnection
 
 __all__ = ["SCHEMA_VERSION", "CampaignStore", "load_designs", "load_samples", "merge_campaigns"]
 
@@ -257,7 +258,7 @@ class CampaignStore:
                 isinstance(v, int | float) and not isinstance(v, bool) for v in values
             ):
                 raise ValueError("not a JSON list of numbers")
-            return check_pressures_mpa(np.asarray(values, dtype=float), "CampaignStore")
+            return check_pressures_mpa(np.asarray(values, dtype=float))
         except (ValueError, RecursionError) as exc:
             reason = "nested too deeply" if isinstance(exc, RecursionError) else first_line(exc)
             raise SchemaError(
@@ -340,7 +341,7 @@ class CampaignStore:
             Other settings than the recorded ones, not accepted; it names each
             differing setting with both values.
         """
-        grid = check_pressures_mpa(pressures_mpa, "CampaignStore.bind")
+        grid = check_pressures_mpa(pressures_mpa)
         stored_backend, stored_grid = self.backend, self.pressures_mpa
         if stored_backend is not None and stored_backend != backend:
             raise ValueError(
@@ -999,7 +1000,7 @@ def _has_log(path: Path) -> bool:
         return False
 
 
-def _close_quietly(con: Any) -> None:
+def _close_quietly(con: DuckDBPyConnection) -> None:
     """Close a DuckDB connection that is being given up; its own error is not the news."""
     try:
         con.close()

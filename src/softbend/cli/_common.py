@@ -4,7 +4,7 @@ Gathered here for the command modules (``from softbend.cli import _common``);
 each part lives in its own module: :mod:`~softbend.cli._console` (consoles,
 one-line errors, JSON, tables), :mod:`~softbend.cli._progress` (progress on
 stderr) and :mod:`~softbend.cli._outputs` (outputs checked before any work, OS
-errors as one line). :func:`parse_assignments` reads repeated ``--set NAME=VALUE``;
+errors as one line). :func:`parse_assignments` reads a repeated ``--set NAME=VALUE``;
 :data:`DESIGN_HELP` is the help of every ``--design`` option.
 """
 
@@ -34,7 +34,7 @@ from softbend.cli._outputs import (
     output_errors,
 )
 from softbend.cli._progress import library_progress, phase_progress, progress_bar
-from softbend.errors import SoftbendError
+from softbend.errors import SoftbendError, keyed
 
 __all__ = [
     "DESIGN_HELP",
@@ -66,11 +66,13 @@ __all__ = [
 DESIGN_HELP = "Actuator l,r,t,b,phi,lc (mm, mm, mm, mm, deg, mm)."
 
 
-def parse_assignments(texts: Sequence[str], option: str = "--set") -> dict[str, str]:
-    """``NAME=VALUE`` texts (a repeated option) as names and value texts.
+def parse_assignments(texts: Sequence[str]) -> dict[str, str]:
+    """The ``NAME=VALUE`` texts of a repeated ``--set`` as names and value texts.
 
-    :func:`softbend.parameters.parse_assignments`; ``option`` names the option in messages.
+    :func:`softbend.parameters.parse_assignments`, its errors keyed ``settings``
+    (the key the command line names ``--set``).
     """
     from softbend.parameters import parse_assignments as parse
 
-    return parse(texts, option)
+    with keyed("settings"):
+        return parse(texts)

@@ -64,7 +64,7 @@ def warning_line(message: str) -> None:
     err_console.print(f"softbend: warning: {text}", markup=False, highlight=False, soft_wrap=True)
 
 
-def print_json(payload: Any) -> None:
+def print_json(payload: object) -> None:
     """Print ``payload`` as JSON on stdout (NaN and inf become null)."""
     print(json_text(payload))
 

@@ -36,7 +36,7 @@ def progress_bar(
 
         state = {"done": 0, "tenth": -1, "start": time.monotonic()}
 
-        def advance_plain(n: int = 1, **fields: Any) -> None:
+        def advance_plain(n: int = 1, **fields: object) -> None:
             state["done"] += n
             done = state["done"]
             tenth = 10 if total <= 0 else min(10, (10 * done) // total)
@@ -66,7 +66,7 @@ def progress_bar(
     with Progress(*columns, console=err_console, disable=not enabled, transient=False) as bar:
         task = bar.add_task(description, total=total, info="")
 
-        def advance(n: int = 1, **fields: Any) -> None:
+        def advance(n: int = 1, **fields: object) -> None:
             info = "  ".join(f"{k} {v}" for k, v in fields.items())
             bar.update(task, advance=n, info=info)
 

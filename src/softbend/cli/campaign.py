@@ -32,7 +32,7 @@ def parse_space(spec: str, seed: int = 0) -> DesignSpace:
     """The designs of a ``--space`` text (see :data:`SPACE_FORMS`), sampled with ``seed``."""
     from softbend.campaign.spaces import parse_space as parse
 
-    return parse(spec, option="--space", owner="softbend campaign run").build(seed)
+    return parse(spec).build(seed)
 
 
 @app.command("merge")
@@ -174,8 +174,8 @@ def export(
 
     if format is None:
         format = "csv" if out.suffix.lower() == ".csv" else "parquet"
-    check_choice(format, "--format", ("parquet", "csv"))
-    check_choice(table, "--table", ("samples", "designs"))
+    check_choice(format, "format", ("parquet", "csv"))
+    check_choice(table, "table", ("samples", "designs"))
     _common.check_output_file(out, "--out", inputs=(db,), kind=format)
     with CampaignStore(db, read_only=True) as store, _common.output_errors(out, "--out"):
         path = store.export(out, format=format, table=table)
@@ -215,11 +215,7 @@ def dataset(
 
     if not db.is_file():
         raise missing_database(db)
-    planned = (
-        parse_space(space, option="--space", owner="softbend campaign dataset").n_designs
-        if space is not None
-        else None
-    )
+    planned = parse_space(space).n_designs if space is not None else None
     written = (SAMPLES_FILE, DESIGNS_FILE, PROVENANCE_FILE)
     _common.check_output_dir(out, "--out", inputs=(db,), files=written)
     # write_dataset reads and checks the whole campaign before it writes anything

@@ -13,7 +13,6 @@ from softbend.cli import _common
 if TYPE_CHECKING:
     from softbend.campaign.runner import CampaignSummary
 
-_OWNER = "softbend campaign run"
 #: The design spaces of --space (softbend.campaign.spaces.SPACE_FORMS, not imported at start).
 SPACE_FORMS = "table1, corners, lhs:N or sobol:N"
 
@@ -112,13 +111,17 @@ def run(
         softbend campaign run table1.duckdb --backend analytical --space table1
         softbend campaign run own.duckdb --space sobol:256 --range l=60:90 --range t=1:2
     """
-    from softbend.campaign.backends import backend_for_run, default_pressures_mpa
+    from softbend._validation import check_int
+    from softbend.campaign.backends import (
+        backend_for_run,
+        default_pressures_mpa,
+        resolve_material,
+    )
     from softbend.campaign.runner import (
         count_designs_to_run,
         parse_scheduler_address,
         run_campaign,
     )
-    from softbend.campaign.settings import SettingsMismatchError
     from softbend.campaign.spaces import (
         campaign_footprint,
         check_footprint,
@@ -128,26 +131,16 @@ def run(
     )
 
     _common.check_output_file(db, "DB", inputs=(model,) if model is not None else ())
-    spec = parse_space(space, option="--space", owner=_OWNER)
+    spec = parse_space(space)
     if ranges:
-        given = parse_ranges(ranges, option="--range", owner=_OWNER)
-        spec = spec.with_ranges(given, option="--range", owner=_OWNER)
-    if seed < 0:
-        raise ValueError(f"The '--seed' of {_OWNER} must be an integer >= 0. Got {seed} instead.")
-    shard_of = parse_shard(shard, option="--shard", owner=_OWNER) if shard is not None else None
-    pressures = default_pressures_mpa(pmax, pstep, names=("--pmax", "--pstep"), owner=_OWNER)
+        spec = spec.with_ranges(parse_ranges(ranges))
+    check_int(seed, "seed")
+    shard_of = parse_shard(shard) if shard is not None else None
+    pressures = default_pressures_mpa(pmax, pstep)
     with_surrogates()
+    chosen = resolve_material(material) if material is not None else None  # read once
     backend_obj = backend_for_run(
-        backend,
-        model=model,
-        compiled=compile_energy,
-        material=material,
-        maxh_mm=maxh,
-        field="--backend",
-        model_field="--model",
-        material_field="--material",
-        maxh_field="--maxh",
-        owner=_OWNER,
+        backend, model=model, compiled=compile_energy, material=chosen, maxh_mm=maxh
     )
     if scheduler is not None:
         parse_scheduler_address(scheduler)
@@ -157,9 +150,6 @@ def run(
         campaign_footprint(spec.n_designs, len(pressures), n_stored=n_stored),
         db,
         allow_large=allow_large,
-        option="--space",
-        owner=_OWNER,
-        allow_flag="--allow-large",
     )
     designs = spec.build(seed)
     if shard_of is not None:
@@ -201,11 +191,9 @@ def run(
                 progress=progress,
                 chunk_size=chunk_size,
                 connect_timeout_s=connect_timeout,
-                material=material,
+                material=chosen,
                 accept_new_settings=accept_new_settings,
             )
-        except SettingsMismatchError as exc:
-            raise exc.with_names(new="a new DB", accept="--accept-new-settings") from None
         except OSError as exc:
             # A failed write of the database (a full disk) names it: one line naming DB.
             # The designs recorded before stay in it; re-running the command resumes.

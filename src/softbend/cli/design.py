@@ -19,12 +19,18 @@ removes if this one is killed.
 from __future__ import annotations
 
 from pathlib import Path
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import typer
 
+from softbend._validation import check_choice, must_be
 from softbend.cli import _common
+from softbend.errors import InputError, SoftbendError
 from softbend.parameters import Range
+
+if TYPE_CHECKING:
+    from softbend.campaign.backends import ResolvedMaterial
+    from softbend.design_search.search import SearchResult
 
 #: How many of the best candidates ``--verify`` sweeps.
 VERIFY = Range(0, 100, "designs", "each is a sweep of the FEM, minutes long")
@@ -32,28 +38,24 @@ VERIFY = Range(0, 100, "designs", "each is a sweep of the FEM, minutes long")
 #: The processes of the verification (``--workers``).
 WORKERS = Range(1, 4096, "processes", "the bound of a campaign's local workers")
 
-#: Options a spec file gives itself, and what of each spec they set.
-_SPEC_GIVES: dict[str, tuple[str, str]] = {
-    "angle": ("--angle", "target"),
-    "at": ("--at", "target"),
-    "max_pressure": ("--max-pressure", "target"),
-    "max_angle_at": ("--max-angle-at", "target"),
-    "curve": ("--curve", "target"),
-    "tolerance": ("--tolerance", "tolerance"),
-    "margin": ("--margin", "margin"),
-    "minimize": ("--minimize", "objectives"),
-    "maximize": ("--maximize", "objectives"),
-    "fix": ("--fix", "ranges (fix, range)"),
-    "ranges": ("--range", "ranges (fix, range)"),
-    "resolution": ("--resolution", "resolution"),
+#: Options a spec file gives itself (by parameter), and what of each spec they set.
+_SPEC_GIVES: dict[str, str] = {
+    "angle": "target",
+    "at": "target",
+    "max_pressure": "target",
+    "max_angle_at": "target",
+    "curve": "target",
+    "tolerance": "tolerance",
+    "margin": "margin",
+    "minimize": "objectives",
+    "maximize": "objectives",
+    "fix": "ranges (fix, range)",
+    "ranges": "ranges (fix, range)",
+    "resolution": "resolution",
 }
 
-#: Options of the verification alone.
-_VERIFY_OPTIONS: dict[str, str] = {
-    "backend": "--backend",
-    "workers": "--workers",
-    "material": "--material",
-}
+#: Options of the verification alone (by parameter).
+_VERIFY_OPTIONS: tuple[str, ...] = ("backend", "workers", "material")
 
 
 def _typed(ctx: typer.Context, parameter: str) -> bool:
@@ -62,57 +64,53 @@ def _typed(ctx: typer.Context, parameter: str) -> bool:
     return getattr(source, "name", None) in ("COMMANDLINE", "ENVIRONMENT")
 
 
-def _check_count(value: int, option: str, allowed: Range) -> None:
-    """Refuse an integer option outside ``allowed``, naming it, the range and why."""
+def _check_count(value: int, key: str, allowed: Range) -> None:
+    """Refuse an integer option outside ``allowed`` (keyed ``key``), with the range and why."""
     if not allowed.contains(value):
-        raise ValueError(
-            f"The '{option}' must be an integer in {allowed.describe()} ({allowed.why}). "
-            f"Got {value} instead."
+        raise InputError(
+            must_be(f"an integer in {allowed.describe()} ({allowed.why})", value), key=key
         )
 
 
 def _verification(
     ctx: typer.Context, verify: int, backend: str, workers: int | None, material: str | None
-) -> Any:
-    """Check the options of ``--verify`` and resolve ``--material`` once; the material
+) -> ResolvedMaterial | None:
+    """Check the options of ``--verify`` and read ``--material`` once; the material
     (None: the backend's own).
 
     Raises
     ------
-    ValueError
+    InputError
         A verification option without ``--verify``, a backend that is not public
         or takes no material, ``--workers`` outside :data:`WORKERS`.
     SoftbendError
         A material that is not a preset nor a valid ``fit.json`` (as ``fem run``).
     """
-    _check_count(verify, "--verify", VERIFY)
+    _check_count(verify, "verify", VERIFY)
     if not verify:
-        given = [flag for name, flag in _VERIFY_OPTIONS.items() if _typed(ctx, name)]
+        given = [name for name in _VERIFY_OPTIONS if _typed(ctx, name)]
         if given:
-            raise ValueError(
-                f"The '{given[0]}' applies to the verification; give --verify N "
-                "(the best N candidates swept), or leave it out."
+            raise InputError(
+                "applies to the verification; give --verify N (the best N candidates "
+                "swept), or leave it out",
+                key=given[0],
             )
         return None
     from softbend.campaign.backends import public_backends, resolve_material, takes_material
 
-    if backend not in public_backends():
-        raise ValueError(
-            f"The '--backend' must be one of {', '.join(public_backends())}. "
-            f"Got {backend!r} instead."
-        )
+    check_choice(backend, "backend", public_backends())
     if workers is not None:
-        _check_count(workers, "--workers", WORKERS)
+        _check_count(workers, "workers", WORKERS)
     if material is None:
         return None
     if not takes_material(backend):
         takers = [n for n in public_backends() if takes_material(n)]
-        raise ValueError(
-            f"The '--material' applies to a backend that takes a material "
-            f"({', '.join(takers)}). Got --backend {backend}."
+        raise InputError(
+            f"applies to a backend that takes a material ({', '.join(takers)}); "
+            f"got --backend {backend}",
+            key="material",
         )
-    elastomer, _ = resolve_material(material, field="--material")
-    return elastomer
+    return resolve_material(material)
 
 
 app = typer.Typer(
@@ -238,11 +236,10 @@ def find(
     """
     from softbend._io import staged_dir
     from softbend.design_search import spec as specs
-    from softbend.design_search.search import TOP, find_designs, searched_ranges
+    from softbend.design_search.search import TOP, LoadedModel, find_designs, searched_ranges
     from softbend.design_search.space import space_of
     from softbend.design_search.verify import verify_candidates, verify_skipped
     from softbend.reports.design_outputs import FILES, write_search
-    from softbend.surrogates.predict import load_predictor
     from softbend.transfer.base import shipped_base_path
 
     out = Path(out)
@@ -252,21 +249,20 @@ def find(
     _common.check_replaceable_dir(
         out, "--out", "design find", inputs=inputs, files=None, marker="search.json"
     )
-    _check_count(top, "--top", TOP)
+    _check_count(top, "top", TOP)
     elastomer = _verification(ctx, verify, backend, workers, material)
-    predictor, saved = load_predictor(model_path)  # its actuator names the parameters
-    space = space_of(saved.actuator)
+    loaded = LoadedModel.load(model_path)  # read once; its actuator names the parameters
+    space = space_of(loaded.actuator)
     actuator = None if space.paper_b else space.actuator
     if spec is not None:
-        for name, (flag, what) in _SPEC_GIVES.items():
+        for name, what in _SPEC_GIVES.items():
             if _typed(ctx, name):
-                raise ValueError(
-                    f"The '{flag}' cannot be used with --spec: the spec file gives each "
-                    f"spec's {what}."
+                raise InputError(
+                    f"cannot be used with --spec: the spec file gives each spec's {what}",
+                    key=name,
                 )
         chosen = specs.load_specifications(
             spec,
-            what=f"--spec {spec}",
             reserved=sorted({"search.json", *FILES}),
             actuator=actuator,
         )
@@ -276,20 +272,22 @@ def find(
             curve=curve, tolerance=tolerance, unit=space.pressure_unit,
         )  # fmt: skip
         if not 0 <= margin < tolerance:
-            raise ValueError(
-                f"The '--margin' must lie in [0, {tolerance:g}) degrees (below --tolerance, "
-                f"the miss the surrogate's own error may take). Got {margin!r} instead."
+            raise InputError(
+                must_be(
+                    f"in [0, {tolerance:g}) degrees (below --tolerance, the miss the "
+                    "surrogate's own error may take)",
+                    margin,
+                ),
+                key="margin",
             )
         numbers = [s for s in resolution or () if "=" not in s]
         if len(numbers) > 1:
-            raise ValueError(
-                f"The '--resolution' number is given {len(numbers)} times; give it once."
-            )
+            raise InputError(f"gives a number {len(numbers)} times; give it once", key="resolution")
         try:
             every = float(numbers[0]) if numbers else None
         except ValueError:
-            raise ValueError(
-                f"The '--resolution' must be a number or NAME=STEP. Got {numbers[0]!r} instead."
+            raise InputError(
+                must_be("a number or NAME=STEP", numbers[0]), key="resolution"
             ) from None
         given, steps = specs.build_ranges(
             fix or (),
@@ -300,25 +298,19 @@ def find(
         )
         objectives = specs.parse_objectives(minimize or (), maximize or (), space)
         chosen = [specs.Specification(target, given, objectives, "spec", steps, margin, actuator)]
-    training = saved.metadata.get("training_ranges")
-    hint = (
-        "coarsen --resolution or narrow the ranges (--range, --fix)"
-        if spec is None
-        else "coarsen its 'resolution' or narrow its ranges ('range', 'fix')"
-    )
+    training = loaded.metadata.get("training_ranges")
     for number, one in enumerate(chosen, start=1):  # every grid counted before any is built
         try:
-            searched_ranges(
-                one, training, allow_extrapolation=allow_extrapolation, hint=hint, top=top
-            )
+            searched_ranges(one, training, allow_extrapolation=allow_extrapolation, top=top)
         except ValueError as exc:
             if spec is None:
                 raise
-            raise ValueError(f"--spec {spec}, [[spec]] {number} ({one.name!r}): {exc}") from None
+            said = exc.detail if isinstance(exc, SoftbendError) else str(exc)
+            raise InputError(f"[[spec]] {number} ({one.name!r}): {said}", file=str(spec)) from None
     with _common.library_progress(enabled=not as_json):
         results = [
             find_designs(
-                model_path,
+                loaded,
                 one,
                 top=top,
                 allow_extrapolation=allow_extrapolation,
@@ -347,7 +339,7 @@ def find(
         payload = [r.to_dict() for r in results]
         for result in results:
             folder = stage / result.spec.name if len(results) > 1 else stage
-            write_search(result, predictor, folder)
+            write_search(result, loaded.predictor, folder)
         if len(results) > 1:  # the record of them all, and the folder's marker
             (stage / "search.json").write_text(
                 _common.json_text({"specs": payload}) + "\n", encoding="utf-8"
@@ -366,10 +358,7 @@ def find(
     _common.console.print(f"{', '.join(FILES)} written to {out}")
 
 
-def _print_result(result: object) -> None:
-    from softbend.design_search.search import SearchResult
-
-    assert isinstance(result, SearchResult)
+def _print_result(result: SearchResult) -> None:
     spec = result.spec
     design = "l,r,t,b,φ,lc" if spec.space.paper_b else "design"
     columns = ["#", design, "θ (°)", "miss (°)"]

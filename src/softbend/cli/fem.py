@@ -3,11 +3,16 @@
 from __future__ import annotations
 
 from pathlib import Path
-from typing import Annotated
+from typing import TYPE_CHECKING, Annotated
 
 import typer
 
+from softbend._validation import must_be
 from softbend.cli import _common
+from softbend.errors import InputError, keyed
+
+if TYPE_CHECKING:
+    from softbend.fem import FEMOptions
 
 app = typer.Typer(
     help="Nonlinear 3D finite-element model of the actuator.\n\n"
@@ -48,12 +53,15 @@ MaterialOption = Annotated[
 ]
 
 
-def _options(maxh: float, gravity: str, material: str = "dragon-skin-30", **extra):
+def _options(
+    maxh: float, gravity: str, material: str = "dragon-skin-30", output: str = "interpolate"
+) -> FEMOptions:
     from softbend.fem import FEMOptions
     from softbend.materials.choice import material_from_spec
 
-    elastomer = material_from_spec(material)
-    return FEMOptions(maxh_mm=maxh, gravity=gravity, elastomer=elastomer, **extra)
+    with keyed("material"):
+        elastomer = material_from_spec(material)
+    return FEMOptions(maxh_mm=maxh, gravity=gravity, elastomer=elastomer, output=output)
 
 
 @app.command("run")
@@ -103,19 +111,17 @@ def run(
         softbend fem run --design 100,6,2,2,5,10 --pmax 0.2 --out fem
     """
     from softbend._io import staged_dir, write_text_atomic
+    from softbend._validation import check_int
     from softbend.design import SFRBADesign
     from softbend.fem.stats import fem_stats
     from softbend.models import default_pressures_mpa
     from softbend.reports.fem_figures import sweep_with_files
 
     actuator = SFRBADesign.parse(design)
-    pressures = default_pressures_mpa(
-        pmax, pstep, names=("--pmax", "--pstep"), owner="softbend fem run"
-    )
+    pressures = default_pressures_mpa(pmax, pstep)
     options = _options(maxh, gravity, material, output="solve" if solve_every else "interpolate")
     options.check_mesh(actuator)  # before NGSolve loads: a too fine --maxh is one line at once
-    if shapes < 1:
-        raise ValueError(f"The '--shapes' must be an integer in [1, inf). Got {shapes} instead.")
+    check_int(shapes, "shapes", low=1)
     out = Path(out)
     _common.check_output_dir(out, "--out", files=RUN_FILES[:-1])
     _common.check_replaceable_dir(out, "--out", "fem run", files=RUN_FILES, marker=SWEEP_JSON)
@@ -216,8 +222,8 @@ def mesh_study(
     from softbend.fem.verification import mesh_study as study
 
     actuator = SFRBADesign.parse(design)
-    sizes = _floats(maxh, "--maxh")
-    grid = _floats(pressures, "--pressures")
+    sizes = _floats(maxh, "maxh")
+    grid = _floats(pressures, "pressures")
     with _common.progress_bar("mesh sizes", len(sizes), enabled=not json_output) as advance:
         rows = study(
             actuator, sizes, grid, _options(4.0, gravity, material), progress=lambda d, n: advance()
@@ -250,13 +256,12 @@ def mesh_study(
     )
 
 
-def _floats(text: str, name: str) -> list[float]:
+def _floats(text: str, key: str) -> list[float]:
+    """The comma-separated numbers of ``text`` (at least one), errors keyed ``key``."""
     try:
         values = [float(v) for v in text.split(",") if v.strip()]
     except ValueError:
-        raise ValueError(
-            f"The '{name}' must be comma-separated numbers. Got {text!r} instead."
-        ) from None
+        raise InputError(must_be("comma-separated numbers", text), key=key) from None
     if not values:
-        raise ValueError(f"The '{name}' must hold at least one number. Got {text!r} instead.")
+        raise InputError(must_be("at least one number", text), key=key)
     return values

@@ -33,10 +33,11 @@ import os
 import time
 from collections.abc import Callable, Mapping
 from dataclasses import dataclass, field
-from typing import Any
+from typing import TYPE_CHECKING, Any, Protocol
 
 import numpy as np
 
+from softbend._validation import must_be
 from softbend.design import SFRBADesign
 from softbend.design_search.space import ActuatorDesign, SearchSpace, pressure_key, space_of
 from softbend.design_search.spec import (
@@ -45,7 +46,13 @@ from softbend.design_search.spec import (
     ParameterRange,
     Specification,
 )
+from softbend.errors import InputError
 from softbend.parameters import Range
+
+if TYPE_CHECKING:
+    from softbend.actuators import Actuator
+    from softbend.surrogates.persistence import SavedState, SavedSurrogate
+    from softbend.surrogates.support import Support
 
 __all__ = [
     "CONTINUOUS_POINTS",
@@ -53,6 +60,8 @@ __all__ = [
     "TOP",
     "TOP_CONTINUOUS",
     "Candidate",
+    "LoadedModel",
+    "Predictor",
     "SearchResult",
     "elastomer_volume_mm3",
     "find_designs",
@@ -361,7 +370,6 @@ def searched_ranges(
     training_ranges: Mapping[str, Any] | None,
     *,
     allow_extrapolation: bool = False,
-    hint: str = "coarsen --resolution or narrow the ranges (--range, --fix)",
     top: int | None = None,
 ) -> tuple[dict[str, ParameterRange], int]:
     """Every parameter's range a search of ``spec`` scores, and the designs of its grid.
@@ -376,8 +384,6 @@ def searched_ranges(
         The model's training ranges (``metadata["training_ranges"]``).
     allow_extrapolation : bool, default False
         As :func:`find_designs`.
-    hint : str
-        What to change when the grid is too large, as the caller's input names it.
     top : int, optional
         The candidates to list, held to :data:`TOP_CONTINUOUS` when a parameter
         is searched continuously.
@@ -416,9 +422,11 @@ def searched_ranges(
             for n, r in ranges.items()
             if not r.fixed
         )
-        raise ValueError(
+        raise InputError(
             f"The ranges and steps hold {shown} designs ({counts}), more than the "
-            f"{MAX_DESIGNS:,} one search scores; {hint}."
+            f"{MAX_DESIGNS:,} one search scores; coarsen the resolution or narrow the ranges "
+            "(range, fix)",
+            key="steps",
         )
     t, r = (ranges["t"], ranges["r"]) if space.paper_b else (None, None)
     if t is not None and r is not None and t.low >= r.high:
@@ -428,10 +436,13 @@ def searched_ranges(
         )
     continuous = [n for n, one in ranges.items() if not one.fixed and one.step == 0]
     if continuous and top is not None and not TOP_CONTINUOUS.contains(top):
-        raise ValueError(
-            f"A search with a continuous parameter ({', '.join(continuous)}: step 0) lists "
-            f"at most {TOP_CONTINUOUS.high:g} candidates (--top; {TOP_CONTINUOUS.why}). "
-            f"Got {top}."
+        raise InputError(
+            must_be(
+                f"at most {TOP_CONTINUOUS.high:g} with a continuous parameter "
+                f"({', '.join(continuous)}: step 0; {TOP_CONTINUOUS.why})",
+                top,
+            ),
+            key="top",
         )
     return ranges, total
 
@@ -555,8 +566,54 @@ def _designs_at(axes: list[np.ndarray], flat: np.ndarray) -> np.ndarray:
     return np.column_stack([a[i] for a, i in zip(axes, index, strict=True)])
 
 
+class Predictor(Protocol):
+    """What a search asks of a model: the angles (deg) of rows of its inputs.
+
+    :func:`~softbend.surrogates.predict.load_predictor` gives one; an MLP's also
+    has ``predict32`` (float32, for screening) and a model with intervals
+    ``predict_interval``.
+    """
+
+    def predict(self, X: np.ndarray) -> np.ndarray:
+        """Angles (deg) of the rows ``X`` (the model's inputs, pressure last)."""
+        ...
+
+
+@dataclass(frozen=True)
+class LoadedModel:
+    """A saved surrogate read once: its file, its fastest predictor and its record.
+
+    :meth:`load` reads it; :func:`find_designs` takes one (or a path, read then),
+    so that a command that searches several specifications and draws the
+    answers reads the file once.
+    """
+
+    path: str
+    predictor: Predictor
+    saved: SavedState | SavedSurrogate
+
+    @classmethod
+    def load(cls, path: str | os.PathLike[str]) -> LoadedModel:
+        """Read the saved surrogate at ``path``, as
+        :func:`~softbend.surrogates.predict.load_predictor`."""
+        from softbend.surrogates.predict import load_predictor
+
+        predictor, saved = load_predictor(path)
+        return cls(os.fspath(path), predictor, saved)
+
+    @property
+    def actuator(self) -> Actuator:
+        """The description of the actuator the model was trained on."""
+        return self.saved.actuator
+
+    @property
+    def metadata(self) -> dict[str, Any]:
+        """The file's metadata (training ranges, support, interval)."""
+        return self.saved.metadata
+
+
 def find_designs(
-    model: str | os.PathLike[str],
+    model: str | os.PathLike[str] | LoadedModel,
     spec: Specification,
     *,
     top: int = 10,
@@ -568,9 +625,9 @@ def find_designs(
 
     Parameters
     ----------
-    model : path
+    model : path or LoadedModel
         A saved surrogate (:func:`softbend.surrogates.save_surrogate`, a refined
-        one of ``softbend transfer refine`` included).
+        one of ``softbend transfer refine`` included), or one read already.
     spec : Specification
     top : int, default 10
         Candidates returned, >= 1.
@@ -603,21 +660,15 @@ def find_designs(
     for another actuator, the designs that break a constraint of its description.
     """
     from softbend.surrogates.persistence import describing
-    from softbend.surrogates.predict import load_predictor
 
     if isinstance(top, bool) or not isinstance(top, int) or not TOP.contains(top):
-        raise ValueError(
-            f"The 'top' of find_designs must be an integer in {TOP.describe()} ({TOP.why}). "
-            f"Got {top!r} instead."
-        )
+        raise InputError(must_be(f"an integer in {TOP.describe()} ({TOP.why})", top), key="top")
     start = time.perf_counter()
-    predictor, saved = load_predictor(model)
-    _check_actuator(spec, saved.actuator, model)
-    with describing(saved.actuator):
+    loaded = model if isinstance(model, LoadedModel) else LoadedModel.load(model)
+    _check_actuator(spec, loaded)
+    with describing(loaded.actuator):
         return _find(
-            model,
-            predictor,
-            saved.metadata,
+            loaded,
             spec,
             top=top,
             allow_extrapolation=allow_extrapolation,
@@ -627,24 +678,22 @@ def find_designs(
         )
 
 
-def _check_actuator(spec: Specification, actuator: Any, model: Any) -> None:
+def _check_actuator(spec: Specification, model: LoadedModel) -> None:
     """Refuse a specification of another actuator than the model's, naming both."""
-    space = spec.space
+    space, actuator = spec.space, model.actuator
     if space == space_of(actuator):
         return
     mine = "paper B's actuator" if space.paper_b else f"the actuator {space.actuator.name}"
     raise ValueError(
         f"The specification {spec.name!r} names the parameters of {mine} "
-        f"({space.listing()}), but the model {model} is of the actuator {actuator.name} "
+        f"({space.listing()}), but the model {model.path} is of the actuator {actuator.name} "
         f"({', '.join(actuator.names)}); give the specification that actuator "
         "(Specification(..., actuator=...), as the model records it)."
     )
 
 
 def _find(
-    model: Any,
-    predictor: Any,
-    metadata: Mapping[str, Any],
+    model: LoadedModel,
     spec: Specification,
     *,
     top: int,
@@ -658,6 +707,7 @@ def _find(
     from softbend.surrogates.features import outside_training_ranges
     from softbend.surrogates.support import Support
 
+    predictor, metadata = model.predictor, model.metadata
     space = spec.space
     training = metadata.get("training_ranges")
     ranges, total = searched_ranges(
@@ -770,7 +820,7 @@ def _find(
         n_meeting=int(meeting.size),
         n_passed_over=passed_over,
         front=front,
-        model=str(model),
+        model=model.path,
         seconds=time.perf_counter() - start,
     )
 
@@ -884,8 +934,8 @@ def _outside_mask(
     designs: np.ndarray,
     scores: Mapping[str, np.ndarray],
     spec: Specification,
-    training: Any,
-    support: Any,
+    training: object,
+    support: Support | None,
 ) -> np.ndarray:
     """Which rows :func:`_flags` would flag, for a batch at once (the same comparisons)."""
     n = designs.shape[0]
@@ -914,8 +964,8 @@ def _flags(
     design: np.ndarray,
     scores: Mapping[str, float],
     spec: Specification,
-    training: Any,
-    support: Any,
+    training: object,
+    support: Support | None,
     outside: Callable[[dict[str, list[float]], np.ndarray], list[str]],
 ) -> list[str]:
     """Why a design's answer lies outside the model's training data (empty inside)."""
@@ -931,7 +981,7 @@ def _flags(
 
 
 def _interval_of(
-    predictor: Any, metadata: Mapping[str, Any]
+    predictor: Predictor, metadata: Mapping[str, Any]
 ) -> Callable[[np.ndarray, Mapping[str, float]], tuple[float, float] | None]:
     """The 90 % interval of a candidate's angle: the calibrated one a refined model
     records, else the model's own, else None."""

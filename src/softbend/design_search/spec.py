@@ -39,14 +39,15 @@ import os
 import reprlib
 from collections.abc import Collection, Mapping, Sequence
 from dataclasses import dataclass, field
-from typing import Any
+from typing import Any, TypeGuard
 
 from softbend._names import output_name
 from softbend._tomltext import read_toml
+from softbend._validation import must_be
 from softbend.actuators import PRESSURE_UNITS, Actuator, ActuatorError
 from softbend.design import DESIGN_LIMITS, PARAMETERS
 from softbend.design_search.space import PAPER_B, SearchSpace, aligned, space_of
-from softbend.errors import DatasetError
+from softbend.errors import DatasetError, InputError, keyed
 from softbend.parameters import Range
 
 __all__ = [
@@ -263,8 +264,8 @@ class Target:
                     raise ValueError(
                         f"A point of a 'curve' target must be (pressure, angle). Got {point!r}."
                     )
-                _check_pressure(point[0], "a point's pressure", unit=self.unit)
-                _check_angle(point[1], "a point's angle")
+                _check_pressure(point[0], "points", self.unit, "a point's pressure ")
+                _check_angle(point[1], "points", "a point's angle ")
             pressures = [float(p) for p, _ in points]
             twice = sorted({p for p in pressures if pressures.count(p) > 1})
             if twice:
@@ -276,9 +277,9 @@ class Target:
                 self, "points", tuple(sorted((float(p), float(a)) for p, a in points))
             )
             return
-        _check_pressure(self.pressure_mpa, "pressure", unit=self.unit)
+        _check_pressure(self.pressure_mpa, "pressure_mpa", self.unit)
         if self.kind != "max_angle":
-            _check_angle(self.angle_deg, "angle")
+            _check_angle(self.angle_deg, "angle_deg")
 
     @property
     def pressures_mpa(self) -> tuple[float, ...]:
@@ -484,9 +485,10 @@ class Specification:
             given = self.ranges.get(name)
             if given is None:
                 if trained is None:
-                    raise ValueError(
-                        f"The parameter {name!r} needs a range (--range {name}=LOW:HIGH or "
-                        f"--fix {name}=VALUE): the model records no training ranges."
+                    raise InputError(
+                        f"must give the parameter {name!r} a range ({name}=LOW:HIGH, or fix "
+                        f"{name}=VALUE): the model records no training ranges",
+                        key="ranges",
                     )
                 given = ParameterRange(trained[0], trained[1], float(self.steps[name]))
             for end in (given.low, given.high):
@@ -500,11 +502,12 @@ class Specification:
                 given.low < trained[0] - 1e-9 or given.high > trained[1] + 1e-9
             )
             if outside and trained is not None and not allow_extrapolation:
-                raise ValueError(
-                    f"The range of {name!r} ({given.low:g}:{given.high:g} "
-                    f"{UNITS[name]}) leaves the model's training range "
-                    f"[{trained[0]:g}, {trained[1]:g}]; narrow it, or pass "
-                    "--allow-extrapolation (the answers outside are then flagged)."
+                raise InputError(
+                    f"must be set for the range of {name!r} ({given.low:g}:{given.high:g} "
+                    f"{UNITS[name]}), which leaves the model's training range "
+                    f"[{trained[0]:g}, {trained[1]:g}] (the answers outside are then "
+                    "flagged); or narrow the range",
+                    key="allow_extrapolation",
                 )
             if not given.fixed and given.step > 0 and given.count() < 1:
                 raise ValueError(f"The range of {name!r} holds no value on its step.")
@@ -534,18 +537,21 @@ class Specification:
                 if trained is not None:
                     low, high = max(low, trained[0]), min(high, trained[1])
                 if not (math.isfinite(low) and math.isfinite(high)):
-                    raise ValueError(
-                        f"The parameter {name!r} needs a range (--range {name}=LOW:HIGH or "
-                        f"--fix {name}=VALUE): the model records no training range of it and "
-                        f"the actuator {space.actuator.name} declares none."
+                    raise InputError(
+                        f"must give the parameter {name!r} a range ({name}=LOW:HIGH, or fix "
+                        f"{name}=VALUE): the model records no training range of it and the "
+                        f"actuator {space.actuator.name} declares none",
+                        key="ranges",
                     )
                 if p.kind != "continuous":
                     low, high = float(math.ceil(low - 1e-9)), float(math.floor(high + 1e-9))
                 if low > high:
-                    raise ValueError(
-                        f"The model's training range of {name!r} does not meet the range "
+                    raise InputError(
+                        f"must give {name!r} a range ({name}=LOW:HIGH, or fix {name}=VALUE): "
+                        f"the model's training range of it does not meet the range "
                         f"[{p.low:g}, {p.high:g}]{unit} the actuator {space.actuator.name} "
-                        f"describes; give it one (--range {name}=LOW:HIGH or --fix {name}=VALUE)."
+                        "describes",
+                        key="ranges",
                     )
                 given = ParameterRange(low, high, float(self.steps[name]))
             else:
@@ -561,10 +567,12 @@ class Specification:
                     given.low < trained[0] - 1e-9 or given.high > trained[1] + 1e-9
                 )
                 if outside and trained is not None and not allow_extrapolation:
-                    raise ValueError(
-                        f"The range of {name!r} ({given.low:g}:{given.high:g}{unit}) leaves the "
-                        f"model's training range [{trained[0]:g}, {trained[1]:g}]; narrow it, or "
-                        "pass --allow-extrapolation (the answers outside are then flagged)."
+                    raise InputError(
+                        f"must be set for the range of {name!r} ({given.low:g}:{given.high:g}"
+                        f"{unit}), which leaves the model's training range [{trained[0]:g}, "
+                        f"{trained[1]:g}] (the answers outside are then flagged); or narrow the "
+                        "range",
+                        key="allow_extrapolation",
                     )
             out[name] = self._on_step(name, given, unit)
         return out
@@ -633,85 +641,73 @@ def pressure_range(unit: str = "MPa") -> Range:
     return Range(0.0, high, unit, "a gauge pressure of at most 1 MPa", low_inclusive=False)
 
 
-def _check_pressure(value: Any, what: str, where: str = "The target's ", unit: str = "MPa") -> None:
+def _check_pressure(value: object, key: str | None, unit: str = "MPa", subject: str = "") -> None:
+    """Refuse a value that is not a gauge pressure of :func:`pressure_range` (keyed ``key``;
+    ``subject`` names a part of it, ``"point '0.1:40' "``)."""
     if isinstance(value, bool) or not isinstance(value, int | float) or not math.isfinite(value):
-        raise ValueError(f"{where}{what} must be a number of {unit}. Got {value!r} instead.")
+        raise InputError(subject + must_be(f"a number of {unit}", value), key=key)
     allowed = pressure_range(unit)
     if not allowed.contains(value):
         hint = (
-            "; a value in kPa? (0.08 MPa = 80 kPa)"
+            " (a value in kPa? 0.08 MPa = 80 kPa)"
             if unit == "MPa" and value > PRESSURE.high
-            else "."
+            else ""
         )
-        raise ValueError(
-            f"{where}{what} must be a gauge pressure in {allowed.describe()}. Got {value:g}{hint}"
+        raise InputError(
+            subject + must_be(f"a gauge pressure in {allowed.describe()}", value) + hint, key=key
         )
 
 
-def _check_angle(value: Any, what: str, where: str = "The target's ") -> None:
+def _check_angle(value: object, key: str | None, subject: str = "") -> None:
+    """Refuse a value that is not an angle of :data:`ANGLE` (keyed ``key``)."""
     if isinstance(value, bool) or not isinstance(value, int | float) or not math.isfinite(value):
-        raise ValueError(f"{where}{what} must be a number of degrees. Got {value!r}.")
+        raise InputError(subject + must_be("a number of degrees", value), key=key)
     if not ANGLE.contains(value):
-        raise ValueError(
-            f"{where}{what} must lie in {ANGLE.describe()} ({ANGLE.why}). Got {value:g}."
-        )
+        raise InputError(subject + must_be(f"in {ANGLE.describe()} ({ANGLE.why})", value), key=key)
 
 
-def parse_assignment(text: str, field_name: str = "--fix") -> tuple[str, float]:
+def parse_assignment(text: str) -> tuple[str, float]:
     """``("phi", 10.0)`` from ``"phi=10"`` (or ``"phi_deg=10"``); one clear line for
-    anything else. Paper B's parameters; :func:`parse_value` reads another actuator's."""
+    anything else (keyed by the parameter where one is named). Paper B's parameters;
+    :func:`parse_value` reads another actuator's."""
     name, sep, value = text.partition("=")
     name = PAPER_B.canonical(name.strip()) or name.strip()
     if not sep or name not in NAMES:
-        raise ValueError(
-            f"The '{field_name}' must be NAME=VALUE with NAME among {', '.join(NAMES)}. "
-            f"Got {text!r} instead."
-        )
+        raise InputError(must_be(f"NAME=VALUE with NAME among {', '.join(NAMES)}", text))
     try:
         number = float(value)
     except ValueError:
-        raise ValueError(
-            f"The '{field_name}' value of {name!r} must be a number ({UNITS[name]}). "
-            f"Got {value!r} instead."
-        ) from None
+        raise InputError(must_be(f"a number ({UNITS[name]})", value), key=name) from None
     if not math.isfinite(number):
-        raise ValueError(f"The '{field_name}' value of {name!r} must be finite. Got {value!r}.")
+        raise InputError(must_be("finite", value), key=name)
     return name, number
 
 
-def parse_range(text: str, field_name: str = "--range") -> tuple[str, float, float]:
-    """``("t", 3.0, 4.0)`` from ``"t=3:4"``; one clear line for anything else. Paper B's
-    parameters; :func:`parse_span` reads another actuator's."""
+def parse_range(text: str) -> tuple[str, float, float]:
+    """``("t", 3.0, 4.0)`` from ``"t=3:4"``; one clear line for anything else (keyed
+    by the parameter where one is named). Paper B's parameters; :func:`parse_span` reads
+    another actuator's."""
     name, sep, value = text.partition("=")
     name = PAPER_B.canonical(name.strip()) or name.strip()
     low, colon, high = value.partition(":")
     if not sep or name not in NAMES or not colon:
-        raise ValueError(
-            f"The '{field_name}' must be NAME=LOW:HIGH with NAME among {', '.join(NAMES)}. "
-            f"Got {text!r} instead."
-        )
+        raise InputError(must_be(f"NAME=LOW:HIGH with NAME among {', '.join(NAMES)}", text))
     try:
         a, b = float(low), float(high)
     except ValueError:
-        raise ValueError(
-            f"The '{field_name}' ends of {name!r} must be numbers ({UNITS[name]}). "
-            f"Got {value!r} instead."
-        ) from None
+        raise InputError(must_be(f"LOW:HIGH, numbers ({UNITS[name]})", value), key=name) from None
     if not (math.isfinite(a) and math.isfinite(b)) or a > b:
-        raise ValueError(
-            f"The '{field_name}' of {name!r} must have finite LOW <= HIGH. Got {value!r}."
-        )
+        raise InputError(must_be("finite LOW <= HIGH", value), key=name)
     return name, a, b
 
 
-def _named(space: SearchSpace, name: str, field_name: str, text: str) -> str:
-    """The parameter ``name`` of ``space``, or one line naming it and listing them."""
+def _named(space: SearchSpace, name: str, text: str) -> str:
+    """The parameter ``name`` of ``space``, or one line listing them."""
     key = space.canonical(name)
     if key is None:
-        raise ValueError(
-            f"The '{field_name}' names {name!r}, which is not a design parameter of the "
-            f"model's actuator {space.actuator.name}; its parameters are {space.listing()}. "
-            f"Got {text!r}."
+        raise InputError(
+            f"names {name!r}, which is not a design parameter of the model's actuator "
+            f"{space.actuator.name}; its parameters are {space.listing()}; got {text!r}",
         )
     return key
 
@@ -721,42 +717,42 @@ def _unit_of(space: SearchSpace, name: str) -> str:
     return f" {unit}" if unit else ""
 
 
-def parse_value(space: SearchSpace, text: Any, field_name: str = "--fix") -> tuple[str, float]:
+def parse_value(space: SearchSpace, text: object) -> tuple[str, float]:
     """``("layer", 1.0)`` from ``"layer=paper"``: a parameter of another actuator and the code
-    of its value (a level's index), checked against its description; one line otherwise."""
+    of its value (a level's index), checked against its description; one line (keyed
+    by the parameter where one is named) otherwise."""
     name, sep, value = str(text).partition("=")
     name, value = name.strip(), value.strip()
     if not sep or not name:
-        raise ValueError(
-            f"The '{field_name}' must be NAME=VALUE with NAME among {space.listing()}. "
-            f"Got {text!r} instead."
-        )
-    key = _named(space, name, field_name, str(text))
-    return key, _code_of(space, key, value, f"The '{field_name}' value of {key!r}")
+        raise InputError(must_be(f"NAME=VALUE with NAME among {space.listing()}", text))
+    key = _named(space, name, str(text))
+    return key, _code_of(space, key, value)
 
 
-def _code_of(space: SearchSpace, key: str, value: Any, what: str) -> float:
-    """The code of ``value`` (a level, a whole number, a number) for ``key``, checked."""
+def _code_of(space: SearchSpace, key: str, value: object) -> float:
+    """The code of ``value`` (a level, a whole number, a number) for ``key``, checked.
+
+    Raises
+    ------
+    InputError
+        Keyed ``key`` (``layer: must be one of its levels ...``).
+    """
     p = space.parameter(key)
     if p.kind == "categorical":
         try:
             code = p.encode(value)
         except ActuatorError:
-            raise ValueError(
-                f"{what} must be one of its levels {', '.join(map(str, p.levels or ()))}. "
-                f"Got {value!r} instead."
-            ) from None
+            levels = ", ".join(map(str, p.levels or ()))
+            raise InputError(must_be(f"one of its levels {levels}", value), key=key) from None
         return code
     if isinstance(value, bool):
         value = "true" if value else "false"
     try:
-        code = float(value)
+        code = float(value)  # type: ignore[arg-type]  # anything float() reads; else refused
     except (TypeError, ValueError, OverflowError):
         unit = space.unit(key)
         kind = "a whole number" if p.kind == "integer" else "a number"
-        raise ValueError(
-            f"{what} must be {kind}{f' ({unit})' if unit else ''}. Got {value!r} instead."
-        ) from None
+        raise InputError(must_be(kind + (f" ({unit})" if unit else ""), value), key=key) from None
     problem = space.value_problem(key, code)
     if problem is None and p.kind == "continuous" and p.resolution is not None:
         ratio = code / p.resolution
@@ -766,46 +762,38 @@ def _code_of(space: SearchSpace, key: str, value: Any, what: str) -> float:
                 f"the actuator {space.actuator.name} declares"
             )
     if problem is not None:
-        raise ValueError(f"{what} ({value}) {problem}.")
+        raise InputError(f"{value} {problem}", key=key)
     return code
 
 
-def parse_span(
-    space: SearchSpace, text: str, field_name: str = "--range"
-) -> tuple[str, float, float]:
+def parse_span(space: SearchSpace, text: str) -> tuple[str, float, float]:
     """``("wall_mm", 1.0, 2.0)`` from ``"wall_mm=1:2"``: a range of another actuator's
     parameter inside its description (whole ends for an integer one); a categorical one
-    is refused (fix one level, or leave it out for every level)."""
+    is refused (fix one level, or leave it out for every level). Errors are keyed by the
+    parameter where one is named."""
     name, sep, value = text.partition("=")
     low, colon, high = value.partition(":")
     if not sep or not colon or not name.strip():
-        raise ValueError(
-            f"The '{field_name}' must be NAME=LOW:HIGH with NAME among {space.listing()}. "
-            f"Got {text!r} instead."
-        )
-    key = _named(space, name.strip(), field_name, text)
+        raise InputError(must_be(f"NAME=LOW:HIGH with NAME among {space.listing()}", text))
+    key = _named(space, name.strip(), text)
     p = space.parameter(key)
     if p.kind == "categorical":
         levels = list(map(str, p.levels or ()))
-        raise ValueError(
-            f"The '{field_name}' cannot span the categorical parameter {key!r}: fix one level "
-            f"(--fix {key}={levels[0]}) or leave it out to search every level "
-            f"({', '.join(levels)})."
+        raise InputError(
+            f"cannot span the categorical parameter {key!r}: fix one level "
+            f"({key}={levels[0]}) or leave it out to search every level ({', '.join(levels)})",
+            key=key,
         )
     try:
         a, b = float(low), float(high)
     except ValueError:
-        raise ValueError(
-            f"The '{field_name}' ends of {key!r} must be numbers. Got {value!r} instead."
-        ) from None
+        raise InputError(must_be("LOW:HIGH, numbers", value), key=key) from None
     if not (math.isfinite(a) and math.isfinite(b)) or a > b:
-        raise ValueError(
-            f"The '{field_name}' of {key!r} must have finite LOW <= HIGH. Got {value!r}."
-        )
+        raise InputError(must_be("finite LOW <= HIGH", value), key=key)
     for end in (a, b):
         problem = space.value_problem(key, end)
         if problem is not None:
-            raise ValueError(f"The '{field_name}' of {key!r} ({value}): {end:g} {problem}.")
+            raise InputError(f"{end:g} {problem}; got {value!r}", key=key)
     return key, a, b
 
 
@@ -823,10 +811,9 @@ def parse_objectives(
                 if name:
                     name = space.canonical(name) or name
                     if name not in allowed:
-                        option = "--minimize" if sense == "min" else "--maximize"
-                        raise ValueError(
-                            f"The '{option}' must name objectives among "
-                            f"{', '.join(allowed)}. Got {name!r} instead."
+                        raise InputError(
+                            must_be(f"objectives among {', '.join(allowed)}", name),
+                            key="minimize" if sense == "min" else "maximize",
                         )
                     unit = None if space.paper_b else allowed[name]
                     out.append(Objective(name, sense, unit))
@@ -860,32 +847,40 @@ def build_ranges(
     if space is not None and not space.paper_b:
         return _build_other(space, fixes, ranges, steps, step)
     if step is not None and not STEP.contains(step):
-        raise ValueError(
-            f"The '--resolution' must be a finite number >= 0 (mm and deg; {STEP.why}). "
-            f"Got {step!r} instead."
+        raise InputError(
+            must_be(f"a finite number >= 0 (mm and deg; {STEP.why})", step), key="step"
         )
     per_step = dict(DEFAULT_STEPS) if step is None else dict.fromkeys(NAMES, float(step))
     for text in steps:
-        name, value = parse_assignment(text, "--resolution")
-        per_step[name] = value
-    for name, value in per_step.items():
+        with keyed("steps"):
+            name, value = parse_assignment(text)
         if value < 0:
-            raise ValueError(f"The '--resolution' of {name!r} must be >= 0. Got {value:g}.")
-    out: dict[str, ParameterRange] = {}
+            raise InputError(f"{name} {must_be('>= 0', value)}", key="steps")
+        per_step[name] = value
     given: list[tuple[str, ParameterRange]] = []
     for text in fixes:
-        name, value = parse_assignment(text, "--fix")
-        _check_design_value(name, (value,), f"The '--fix' value of {name!r}", text)
+        with keyed("fixes"):
+            name, value = parse_assignment(text)
+            _check_design_values(name, (value,), text)
         given.append((name, ParameterRange(value, value, 0.0)))
     for text in ranges:
-        name, low, high = parse_range(text)
-        _check_design_value(name, (low, high), f"The '--range' of {name!r}", text)
+        with keyed("ranges"):
+            name, low, high = parse_range(text)
+            _check_design_values(name, (low, high), text)
         given.append((name, ParameterRange(low, high, per_step[name])))
+    return _once(given), per_step
+
+
+def _once(given: Sequence[tuple[str, ParameterRange]]) -> dict[str, ParameterRange]:
+    """The ranges by parameter, each given once (by ``fixes`` or ``ranges``)."""
+    out: dict[str, ParameterRange] = {}
     for name, chosen in given:
         if name in out:
-            raise ValueError(f"The parameter {name!r} is given twice (--fix or --range).")
+            raise InputError(
+                f"{name!r} is given twice (fixed or ranged); give it once", key="ranges"
+            )
         out[name] = chosen
-    return out, per_step
+    return out
 
 
 def _build_other(
@@ -897,9 +892,11 @@ def _build_other(
 ) -> tuple[dict[str, ParameterRange], dict[str, float]]:
     """:func:`build_ranges` for another actuator than paper B's."""
     if step is not None and not STEP.contains(step):
-        raise ValueError(
-            f"The '--resolution' must be a finite number >= 0 (in each continuous "
-            f"parameter's unit; {STEP.why}). Got {step!r} instead."
+        raise InputError(
+            must_be(
+                f"a finite number >= 0 (in each continuous parameter's unit; {STEP.why})", step
+            ),
+            key="step",
         )
     per_step = {n: space.default_step(n) for n in space.names}
     if step is not None:
@@ -907,56 +904,50 @@ def _build_other(
             if space.kind(name) == "continuous":
                 problem = space.step_problem(name, float(step))
                 if problem is not None:
-                    raise ValueError(f"The '--resolution' {step:g} of {name!r} {problem}.")
+                    raise InputError(f"{step:g} of {name!r} {problem}", key="step")
                 per_step[name] = float(step)
     for text in steps:
         name, sep, value = text.partition("=")
         if not sep:
-            raise ValueError(
-                f"The '--resolution' must be a number or NAME=STEP with NAME among "
-                f"{space.listing()}. Got {text!r} instead."
+            raise InputError(
+                must_be(f"a number or NAME=STEP with NAME among {space.listing()}", text),
+                key="steps",
             )
-        key = _named(space, name.strip(), "--resolution", text)
+        with keyed("steps"):
+            key = _named(space, name.strip(), text)
         try:
             number = float(value)
         except ValueError:
-            raise ValueError(
-                f"The '--resolution' of {key!r} must be a number. Got {value!r} instead."
-            ) from None
+            raise InputError(f"{key} {must_be('a number', value)}", key="steps") from None
         if not STEP.contains(number):
-            raise ValueError(
-                f"The '--resolution' of {key!r} must be a finite number >= 0. Got {value!r}."
-            )
+            raise InputError(f"{key} {must_be('a finite number >= 0', value)}", key="steps")
         problem = space.step_problem(key, number)
         if problem is not None:
-            raise ValueError(f"The '--resolution' of {key!r} ({value.strip()}) {problem}.")
+            raise InputError(f"{key} ({value.strip()}) {problem}", key="steps")
         per_step[key] = number
-    out: dict[str, ParameterRange] = {}
     given: list[tuple[str, ParameterRange]] = []
     for text in fixes:
-        key, code = parse_value(space, text, "--fix")
+        with keyed("fixes"):
+            key, code = parse_value(space, text)
         given.append((key, ParameterRange(code, code, 0.0)))
     for text in ranges:
-        key, low, high = parse_span(space, text, "--range")
+        with keyed("ranges"):
+            key, low, high = parse_span(space, text)
         given.append((key, ParameterRange(low, high, per_step[key])))
-    for name, chosen in given:
-        if name in out:
-            raise ValueError(f"The parameter {name!r} is given twice (--fix or --range).")
-        out[name] = chosen
-    return out, {n: v for n, v in per_step.items() if space.kind(n) != "categorical"}
+    return _once(given), {n: v for n, v in per_step.items() if space.kind(n) != "categorical"}
 
 
-def _check_design_value(name: str, values: Sequence[float], field: str, given: str) -> None:
+def _check_design_values(name: str, values: Sequence[float], text: str) -> None:
+    """Refuse a value (of ``text``) that a design's parameter ``name`` cannot take."""
     for value in values:
         problem = _design_value_problem(name, value)
         if problem is not None:
-            raise ValueError(f"{field} {problem}. Got {given!r} instead.")
+            raise InputError(f"{problem}; got {text!r}", key=name)
 
 
 def load_specifications(
     path: str | os.PathLike[str],
     *,
-    what: str | None = None,
     reserved: Collection[str] = (),
     actuator: Actuator | None = None,
 ) -> list[Specification]:
@@ -1003,8 +994,6 @@ def load_specifications(
     ----------
     path : path
         The TOML file.
-    what : str, optional
-        The file as messages name it (default: the path), e.g. ``"--spec specs.toml"``.
     reserved : collection of str
         Names the caller writes beside the specs' folders (``search.json``).
     actuator : Actuator, optional
@@ -1025,7 +1014,7 @@ def load_specifications(
         specification: one line naming the file, the ``[[spec]]`` number, the
         key, what was expected and what was found.
     """
-    source = str(os.fspath(path)) if what is None else what
+    source = str(os.fspath(path))
     data = read_toml(path, source, DatasetError)
     others = sorted(k for k in data if k != "spec")
     if others:
@@ -1052,11 +1041,9 @@ def load_specifications(
             raise DatasetError(f"{where}: expected a table; found {_found(table)}.")
         spec = _SpecTable(table, where, space_of(actuator)).specification(f"spec{i}")
         try:
-            output_name(
-                spec.name, f"[[spec]] {i} 'name' of {source}", reserved=reserved, taken=names
-            )
-        except ValueError as exc:
-            raise DatasetError(str(exc)) from None
+            output_name(spec.name, reserved=reserved, taken=names)
+        except InputError as exc:
+            raise DatasetError(f"{where} 'name': {exc.detail}") from None
         names.append(spec.name)
         specs.append(spec)
     return specs
@@ -1091,7 +1078,7 @@ _SHORT.maxlevel = 3
 _SHORT.maxlong = 40
 
 
-def _found(value: Any) -> str:
+def _found(value: object) -> str:
     """A value of a TOML file, short, with its kind."""
     if isinstance(value, bool):
         return f"{'true' if value else 'false'} (a boolean)"
@@ -1106,7 +1093,7 @@ def _found(value: Any) -> str:
     return f"{type(value).__name__} {_SHORT.repr(value)}"
 
 
-def _is_number(value: Any) -> bool:
+def _is_number(value: object) -> TypeGuard[int | float]:
     """Whether ``value`` is a number of a TOML file a float can hold."""
     if isinstance(value, bool) or not isinstance(value, int | float):
         return False
@@ -1125,11 +1112,11 @@ class _SpecTable:
         self.where = where
         self.space = space
 
-    def fail(self, key: str, expected: str, found: Any) -> DatasetError:
+    def fail(self, key: str, expected: str, found: object) -> DatasetError:
         """The error of ``key``: what was expected and what was found."""
         return DatasetError(f"{self.where} '{key}': expected {expected}; found {_found(found)}.")
 
-    def number(self, key: str, allowed: Range, what: str, value: Any = None) -> float:
+    def number(self, key: str, allowed: Range, what: str, value: object = None) -> float:
         """The number at ``key`` (or ``value``) in ``allowed``."""
         value = self.table[key] if value is None else value
         expected = f"{what} in {allowed.describe()}" + (f" ({allowed.why})" if allowed.why else "")
@@ -1158,15 +1145,15 @@ class _SpecTable:
             out[name] = v
         return out
 
-    def design_number(self, key: str, name: str, value: Any) -> float:
+    def design_number(self, key: str, name: str, value: object) -> float:
         """``value`` as a value of the parameter ``name`` of a design (its code)."""
         if not self.space.paper_b:
             if self.space.kind(name) != "categorical" and not _is_number(value):
                 raise self.fail(f"{key}.{name}", "a number", value)
             try:
-                return _code_of(self.space, name, value, "it")
-            except ValueError as exc:
-                raise DatasetError(f"{self.where} '{key}.{name}': {exc}") from None
+                return _code_of(self.space, name, value)
+            except InputError as exc:
+                raise DatasetError(f"{self.where} '{key}.{name}': {exc.detail}") from None
         low, high, low_inclusive = DESIGN_LIMITS[name]
         allowed = Range(low, high, UNITS[name], "the values a design may take", low_inclusive)
         return self.number(f"{key}.{name}", allowed, "a number", value)
@@ -1382,61 +1369,56 @@ def target_from_options(
     given = [
         name
         for name, value in (
-            ("--at", at),
-            ("--max-pressure", max_pressure),
-            ("--max-angle-at", max_angle_at),
-            ("--curve", curve),
+            ("at", at),
+            ("max_pressure", max_pressure),
+            ("max_angle_at", max_angle_at),
+            ("curve", curve),
         )
         if value is not None
     ]
     if len(given) != 1:
-        raise ValueError(
-            "The target must be one of --angle A --at P, --angle A --max-pressure P, "
-            f"--max-angle-at P or --curve P:A,P:A,... Got {', '.join(given) or 'none'}."
+        raise InputError(
+            "The target must be one of angle A at P, angle A max_pressure P, max_angle_at P "
+            f"or curve P:A,P:A,...; got {', '.join(given) or 'none'}",
+            key=given[1] if given else None,
         )
     if not (_is_number(tolerance) and TOLERANCE.contains(tolerance)):
-        raise ValueError(
-            f"The '--tolerance' must lie in {TOLERANCE.describe()} ({TOLERANCE.why}). "
-            f"Got {tolerance!r} instead."
+        raise InputError(
+            must_be(f"in {TOLERANCE.describe()} ({TOLERANCE.why})", tolerance), key="tolerance"
         )
-    for option, value in (
-        ("--at", at),
-        ("--max-pressure", max_pressure),
-        ("--max-angle-at", max_angle_at),
-    ):
+    for key, value in (("at", at), ("max_pressure", max_pressure), ("max_angle_at", max_angle_at)):
         if value is not None:
-            _check_pressure(value, "", f"The '{option}'", unit)
+            _check_pressure(value, key, unit)
     if angle is not None:
-        _check_angle(angle, "", "The '--angle'")
+        _check_angle(angle, "angle")
     if curve is not None:
         if angle is not None:
-            raise ValueError(
-                "The '--angle' has no meaning with --curve (the curve gives its angles); "
-                "leave it out."
+            raise InputError(
+                "has no meaning with curve (the curve gives its angles); leave it out", key="angle"
             )
-        return Target(
-            "curve", tolerance_deg=tolerance, points=_curve_points(curve, unit), unit=unit
-        )
+        with keyed("curve"):
+            points = _curve_points(curve, unit)
+        return Target("curve", tolerance_deg=tolerance, points=points, unit=unit)
     if max_angle_at is not None:
         if angle is not None:
-            raise ValueError("The '--angle' has no meaning with --max-angle-at; leave it out.")
+            raise InputError("has no meaning with max_angle_at; leave it out", key="angle")
         return Target("max_angle", pressure_mpa=max_angle_at, tolerance_deg=tolerance, unit=unit)
     if angle is None:
-        raise ValueError(f"The target {given[0]} needs '--angle' (degrees).")
+        raise InputError(f"is needed with {given[0]} (degrees)", key="angle")
     kind, pressure = ("angle_at", at) if at is not None else ("pressure_for", max_pressure)
-    assert pressure is not None  # exactly one of --at and --max-pressure, checked above
+    assert pressure is not None  # exactly one of at and max_pressure, checked above
     return Target(
         kind, angle_deg=angle, pressure_mpa=float(pressure), tolerance_deg=tolerance, unit=unit
     )
 
 
 def _curve_points(text: str, unit: str = "MPa") -> tuple[tuple[float, float], ...]:
-    """The points of ``--curve P:ANGLE,...``: each pressure once, each number in its range."""
+    """The points of ``P:ANGLE,...``: each pressure once, each number in its range."""
     items = [x.strip() for x in text.split(",") if x.strip()]
     if not CURVE_POINTS.contains(len(items)):
-        raise ValueError(
-            f"The '--curve' must give {CURVE_POINTS.low:g} to {CURVE_POINTS.high:g} points "
-            f"PRESSURE:ANGLE ({CURVE_POINTS.why}). Got {len(items):,}."
+        raise InputError(
+            f"must give {CURVE_POINTS.low:g} to {CURVE_POINTS.high:g} points PRESSURE:ANGLE "
+            f"({CURVE_POINTS.why}); got {len(items):,}",
         )
     points: list[tuple[float, float]] = []
     seen: dict[float, str] = {}
@@ -1445,18 +1427,18 @@ def _curve_points(text: str, unit: str = "MPa") -> tuple[tuple[float, float], ..
         try:
             pressure, angle = float(p), float(a)
         except ValueError:
-            raise ValueError(
-                f"The '--curve' must be PRESSURE:ANGLE pairs ({unit}:deg), e.g. "
-                f"{'0.05:40,0.1:95' if unit == 'MPa' else '10:40,20:95'}. Got {item!r} instead."
+            example = "0.05:40,0.1:95" if unit == "MPa" else "10:40,20:95"
+            raise InputError(
+                must_be(f"PRESSURE:ANGLE pairs ({unit}:deg), e.g. {example}", item)
             ) from None
         if not colon:
-            raise ValueError(f"The '--curve' point {item!r} lacks ':ANGLE'.")
-        _check_pressure(pressure, f" point {item!r}", "The '--curve'", unit)
-        _check_angle(angle, f" point {item!r}", "The '--curve'")
+            raise InputError(f"point {item!r} lacks ':ANGLE'")
+        _check_pressure(pressure, None, unit, f"point {item!r}: ")
+        _check_angle(angle, None, f"point {item!r}: ")
         if pressure in seen:
-            raise ValueError(
-                f"The '--curve' gives {pressure:g} {unit} twice ({seen[pressure]!r} and {item!r}); "
-                "a curve gives each pressure once (one angle at each)."
+            raise InputError(
+                f"gives {pressure:g} {unit} twice ({seen[pressure]!r} and {item!r}); a curve "
+                "gives each pressure once (one angle at each)",
             )
         seen[pressure] = item
         points.append((pressure, angle))

@@ -22,11 +22,15 @@ import math
 import os
 from collections.abc import Sequence
 from pathlib import Path
-from typing import Any
+from typing import TYPE_CHECKING
 
 import numpy as np
 
+from softbend._validation import check_int
 from softbend.design_search.search import Candidate, SearchResult
+
+if TYPE_CHECKING:
+    from softbend.campaign.backends import MaterialGiven
 
 __all__ = ["fem_angle_at", "verify_candidates", "verify_skipped"]
 
@@ -102,7 +106,7 @@ def verify_candidates(
     backend: str = "fem",
     workers: int | None = None,
     scheduler: str | None = None,
-    material: Any = None,
+    material: MaterialGiven | None = None,
     scratch_dir: str | os.PathLike[str] | None = None,
 ) -> list[Candidate]:
     """Sweep the best ``k`` candidates of ``result`` and set their FEM figures in place.
@@ -123,8 +127,8 @@ def verify_candidates(
         Local processes (default: as :func:`softbend.campaign.run_campaign`).
     scheduler : str, optional
         A Dask scheduler address to run the sweeps on.
-    material : str or Material, optional
-        The elastomer of the backend (``--material``).
+    material : str, path, Material or ResolvedMaterial, optional
+        The elastomer of the backend, as :func:`~softbend.campaign.run_campaign` takes it.
     scratch_dir : path, optional
         The folder the temporary folder of the sweeps is made in (default: the
         system's). A command passes the staging folder of its output, so that a
@@ -148,8 +152,7 @@ def verify_candidates(
     from softbend._progress import report
     from softbend.campaign import load_samples, run_campaign
 
-    if isinstance(k, bool) or not isinstance(k, int) or k < 1:
-        raise ValueError(f"The 'k' of verify_candidates must be an integer >= 1. Got {k!r}.")
+    check_int(k, "k", low=1)
     skipped = verify_skipped(result, backend)
     if skipped is not None:
         result.verify_skipped = skipped

@@ -32,11 +32,14 @@ import shutil
 import sys
 import threading
 from dataclasses import dataclass
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 from softbend.fem._ngsolve import require_ngsolve
 from softbend.fem.mechanics import fiber_energy, membrane_energy, solid_energy, volume_flux
 from softbend.fem.options import FEMOptions
+
+if TYPE_CHECKING:
+    from ngsolve import FESpace
 
 require_ngsolve()  # NGSolve after PyTorch, or one line naming softbend[fem]
 
@@ -112,7 +115,7 @@ def compiler_available() -> bool:
     return shutil.which("ngscxx") is not None and shutil.which("c++") is not None
 
 
-def energy_terms(fes: Any, options: FEMOptions) -> EnergyTerms:
+def energy_terms(fes: FESpace, options: FEMOptions) -> EnergyTerms:
     """The energy terms for a model on ``fes`` (a 3D ``VectorH1`` space).
 
     Interpreted terms of its own unless :func:`use_compiled` is on; then this
@@ -132,7 +135,7 @@ def energy_terms(fes: Any, options: FEMOptions) -> EnergyTerms:
     return cache[key]
 
 
-def _key(fes: Any, options: FEMOptions) -> str:
+def _key(fes: FESpace, options: FEMOptions) -> str:
     import json
 
     parts = {
@@ -146,7 +149,7 @@ def _key(fes: Any, options: FEMOptions) -> str:
     return json.dumps(parts, sort_keys=True, default=str)
 
 
-def _build(fes: Any, options: FEMOptions, *, compile_code: bool) -> EnergyTerms:
+def _build(fes: FESpace, options: FEMOptions, *, compile_code: bool) -> EnergyTerms:
     import ngsolve as ngs
     from ngsolve import CoefficientFunction as CF  # noqa: N817
     from ngsolve import Cross, Grad, Id, Norm, specialcf

@@ -10,6 +10,8 @@ from pathlib import Path
 import numpy as np
 
 from softbend._io import write_text_atomic
+from softbend._validation import must_be
+from softbend.errors import InputError
 from softbend.fem._ngsolve import require_ngsolve
 from softbend.fem.actuator import ActuatorModel
 from softbend.models import SweepResult
@@ -76,10 +78,7 @@ def vtk_file_name(pressure_mpa: float) -> str:
     """
     p = float(pressure_mpa)
     if not math.isfinite(p) or p < 0.0:
-        raise ValueError(
-            f"The 'pressure_mpa' of vtk_file_name must be a number in [0, inf). "
-            f"Got {pressure_mpa!r} instead."
-        )
+        raise InputError(must_be("a number in [0, inf)", pressure_mpa), key="pressure_mpa")
     digits = next((d for d in range(3, 7) if abs(round(p, d) - p) <= 1e-12), 6)
     return f"shape_p{p:.{digits}f}MPa.vtu"
 

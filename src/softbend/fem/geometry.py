@@ -17,7 +17,7 @@ from dataclasses import dataclass
 from typing import Any
 
 from softbend.design import SFRBADesign
-from softbend.errors import SoftbendError
+from softbend.errors import InputError, SoftbendError
 from softbend.fem._ngsolve import require_ngsolve
 
 __all__ = [
@@ -222,9 +222,9 @@ def check_mesh_size(
 
     Raises
     ------
-    ValueError
-        A design's estimated mesh exceeds :data:`MAX_ELEMENTS`; the message
-        names the design with the most elements, as the FEM would.
+    InputError
+        Keyed ``maxh_mm``: a design's estimated mesh exceeds :data:`MAX_ELEMENTS`;
+        the message names the design with the most elements, as the FEM would.
     """
     items = [designs] if isinstance(designs, SFRBADesign) else list(designs)
     if not items:
@@ -232,8 +232,8 @@ def check_mesh_size(
     estimates = [estimated_elements(d, maxh_mm, base_cap_mm) for d in items]
     largest = max(range(len(items)), key=estimates.__getitem__)
     if estimates[largest] > MAX_ELEMENTS:
-        raise ValueError(
-            f"The 'maxh_mm' of the FEM mesh must give at most {MAX_ELEMENTS} elements for "
-            f"design {items[largest]}. Got {maxh_mm:g} mm (about {estimates[largest]:.0f} "
-            "elements) instead."
+        raise InputError(
+            f"must give at most {MAX_ELEMENTS} elements for design {items[largest]}; got "
+            f"{maxh_mm:g} mm (about {estimates[largest]:.0f} elements)",
+            key="maxh_mm",
         )

@@ -23,9 +23,14 @@ from __future__ import annotations
 
 import math
 from collections.abc import Sequence
-from typing import Any
+from typing import TYPE_CHECKING
 
+from softbend._validation import must_be
+from softbend.errors import InputError
 from softbend.materials.models import HyperelasticModel
+
+if TYPE_CHECKING:
+    from ngsolve import CoefficientFunction
 
 __all__ = [
     "FIBER_LAWS",
@@ -40,7 +45,9 @@ __all__ = [
 FIBER_LAWS: tuple[str, ...] = ("tension-compression", "tension-only")
 
 
-def solid_energy(F: Any, model: HyperelasticModel, bulk_modulus_mpa: float) -> Any:
+def solid_energy(
+    F: CoefficientFunction, model: HyperelasticModel, bulk_modulus_mpa: float
+) -> CoefficientFunction:
     """Nearly incompressible solid: ``W(Ī1) + K/2 (J − 1)²``, MPa.
 
     The isochoric split ``Ī1 = J^(−2/3) tr(FᵀF)`` makes the deviatoric response
@@ -67,11 +74,11 @@ def solid_energy(F: Any, model: HyperelasticModel, bulk_modulus_mpa: float) -> A
 
 
 def membrane_energy(
-    Fs: Any,
-    tangents: Sequence[Any],
+    Fs: CoefficientFunction,
+    tangents: Sequence[CoefficientFunction],
     model: HyperelasticModel,
     thickness_mm: float,
-) -> Any:
+) -> CoefficientFunction:
     """Incompressible hyperelastic membrane bonded to a face, N/mm (energy per area).
 
     With ``C_s`` the 2×2 metric of the deformed face in the orthonormal reference
@@ -100,13 +107,13 @@ def membrane_energy(
 
 
 def fiber_energy(
-    Fs: Any,
-    direction: Any,
+    Fs: CoefficientFunction,
+    direction: CoefficientFunction,
     stiffness_n_per_mm: float,
     law: str = "tension-compression",
     *,
     smoothing: float = 0.01,
-) -> Any:
+) -> CoefficientFunction:
     """One family of fibers smeared over a face, N/mm (energy per reference area).
 
     A fiber along the unit reference direction ``a`` stretches by
@@ -140,13 +147,15 @@ def fiber_energy(
     if law == "tension-only":
         positive = 0.5 * (strain + sqrt(strain * strain + smoothing * smoothing))
         return 0.5 * stiffness_n_per_mm * positive * positive
-    raise ValueError(
-        f"The 'fiber_law' must be one of {', '.join(repr(v) for v in FIBER_LAWS)}. "
-        f"Got {law!r} instead."
-    )
+    raise InputError(must_be(f"one of {', '.join(repr(v) for v in FIBER_LAWS)}", law), key="law")
 
 
-def volume_flux(position: Any, Fs: Any, normal: Any, axes: Sequence[int]) -> Any:
+def volume_flux(
+    position: CoefficientFunction,
+    Fs: CoefficientFunction,
+    normal: CoefficientFunction,
+    axes: Sequence[int],
+) -> CoefficientFunction:
     """Integrand of the enclosed volume: ``w(x)·n da`` per reference area, mm.
 
     By the divergence theorem the volume enclosed by a closed surface is
@@ -172,7 +181,7 @@ def volume_flux(position: Any, Fs: Any, normal: Any, axes: Sequence[int]) -> Any
     from ngsolve import Cof
 
     if not axes:
-        raise ValueError("The 'axes' of volume_flux must name at least one of 0, 1, 2.")
+        raise InputError(must_be("at least one of 0, 1, 2", list(axes)), key="axes")
     nda = Cof(Fs) * normal
     return sum(position[i] * nda[i] for i in axes) / float(len(axes))
 

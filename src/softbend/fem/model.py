@@ -7,6 +7,7 @@ from dataclasses import dataclass, field
 from numpy.typing import ArrayLike
 
 from softbend.design import SFRBADesign
+from softbend.errors import InputError
 from softbend.fem.energy import use_compiled
 from softbend.fem.options import FEMOptions
 from softbend.fem.sweep import simulate
@@ -46,9 +47,8 @@ class FEMModel:
 
     def __post_init__(self) -> None:
         if self.options is not None and not isinstance(self.options, FEMOptions):
-            raise ValueError(
-                "The 'options' of FEMModel must be FEMOptions or None. "
-                f"Got {type(self.options).__name__} instead."
+            raise InputError(
+                f"must be FEMOptions or None; got {type(self.options).__name__}", key="options"
             )
 
     def sweep(self, design: SFRBADesign, pressures_mpa: ArrayLike) -> SweepResult:

@@ -37,11 +37,14 @@ import math
 import time
 from collections.abc import Callable
 from dataclasses import dataclass, field
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
 from softbend.errors import ConvergenceError
+
+if TYPE_CHECKING:
+    from ngsolve import BaseVector
 
 __all__ = ["EnergySolver", "NewtonReport"]
 
@@ -164,7 +167,7 @@ class EnergySolver:
     def _load_scale(self) -> float:
         return 1.0 if self.load_factor is None else float(self.load_factor.Get())
 
-    def energy(self, vec: Any = None) -> float:
+    def energy(self, vec: BaseVector | None = None) -> float:
         """Total potential energy at ``vec`` (default: the current state), mJ."""
         vec = self.gfu.vec if vec is None else vec
         self._prepare()
@@ -173,7 +176,7 @@ class EnergySolver:
             value -= self._load_scale() * float(self.load.InnerProduct(vec))
         return value
 
-    def residual(self, out: Any = None) -> Any:
+    def residual(self, out: BaseVector | None = None) -> BaseVector:
         """Gradient of the energy at the current state (N); fixed dofs are not masked."""
         out = self._res if out is None else out
         start = time.perf_counter()
@@ -184,7 +187,7 @@ class EnergySolver:
         self.timings.residual_s += time.perf_counter() - start
         return out
 
-    def _norm(self, vec: Any) -> float:
+    def _norm(self, vec: BaseVector) -> float:
         values = vec.FV().NumPy()
         return float(math.sqrt(float((values[self._mask] ** 2).sum())))
 
@@ -204,7 +207,7 @@ class EnergySolver:
         self.timings.factorizations += 1
         return self._inverse
 
-    def solve_tangent(self, rhs: Any, out: Any) -> Any:
+    def solve_tangent(self, rhs: BaseVector, out: BaseVector) -> BaseVector:
         """``out = K⁻¹ rhs`` with the last factorised Hessian."""
         start = time.perf_counter()
         out.data = self._inverse * rhs

@@ -6,8 +6,9 @@ from collections.abc import Iterable
 from dataclasses import asdict, dataclass, field, fields
 from typing import Any, cast
 
-from softbend._validation import check_choice, check_int, check_range
+from softbend._validation import check_choice, check_int, check_range, must_be
 from softbend.design import SFRBADesign
+from softbend.errors import InputError
 from softbend.fem.geometry import check_mesh_size
 from softbend.fem.mechanics import FIBER_LAWS
 from softbend.materials.models import HyperelasticModel
@@ -161,8 +162,6 @@ class FEMOptions:
     extra: dict[str, Any] = field(default_factory=dict, repr=False, compare=False)
 
     def __post_init__(self) -> None:
-        owner = "FEMOptions"
-
         def number(name: str, low: float, high: float, low_inclusive: bool = False) -> None:
             value = check_range(
                 getattr(self, name),
@@ -175,9 +174,7 @@ class FEMOptions:
             object.__setattr__(self, name, value)
 
         number("maxh_mm", 0.0, 20.0)
-        order = check_int(self.order, "order", low=1)
-        if order not in (2, 3):
-            raise ValueError(f"The 'order' of {owner} must be one of 2, 3. Got {order!r} instead.")
+        check_choice(check_int(self.order, "order", low=1), "order", (2, 3))
         number("base_cap_mm", 0.0, 50.0)
         number("bulk_ratio", 10.0, 1e5, low_inclusive=True)
         for name in ("elastomer", "layer"):
@@ -185,14 +182,12 @@ class FEMOptions:
             if not isinstance(material, Material) or not isinstance(
                 material.model, HyperelasticModel
             ):
-                raise ValueError(
-                    f"The '{name}' of {owner} must be a Material with a hyperelastic model. "
-                    f"Got {material!r} instead."
+                raise InputError(
+                    must_be("a Material with a hyperelastic model", material), key=name
                 )
         if not isinstance(self.fiber, Material) or not isinstance(self.fiber.model, LinearElastic):
-            raise ValueError(
-                f"The 'fiber' of {owner} must be a Material with a LinearElastic model. "
-                f"Got {self.fiber!r} instead."
+            raise InputError(
+                must_be("a Material with a LinearElastic model", self.fiber), key="fiber"
             )
         number("layer_thickness_mm", 0.0, 10.0)
         number("fiber_radius_mm", 0.0, 5.0)
@@ -243,7 +238,7 @@ class FEMOptions:
         """
         check_mesh_size(designs, self.maxh_mm, base_cap_mm=self.base_cap_mm)
 
-    def replace(self, **changes: Any) -> FEMOptions:
+    def replace(self, **changes: object) -> FEMOptions:
         """A copy with ``changes`` applied (validated again)."""
         values = {f.name: getattr(self, f.name) for f in fields(self)}
         unknown = sorted(set(changes) - set(values))

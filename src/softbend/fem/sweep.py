@@ -42,8 +42,9 @@ from typing import cast
 import numpy as np
 from numpy.typing import ArrayLike
 
+from softbend._validation import must_be
 from softbend.design import SFRBADesign
-from softbend.errors import ConvergenceError
+from softbend.errors import ConvergenceError, InputError
 from softbend.fem._ngsolve import require_ngsolve
 from softbend.fem.actuator import ActuatorModel
 from softbend.fem.options import FEMOptions
@@ -427,14 +428,12 @@ def run_sweep(
     """
     from ngsolve import SetNumThreads, TaskManager
 
-    grid = check_pressures_mpa(pressures_mpa, "simulate")
+    grid = check_pressures_mpa(pressures_mpa)
     options = options or FEMOptions()
     if not isinstance(options, FEMOptions):
-        raise ValueError(f"The 'options' of simulate must be FEMOptions. Got {options!r} instead.")
+        raise InputError(must_be("FEMOptions", options), key="options")
     if not isinstance(design, SFRBADesign):
-        raise ValueError(
-            f"The 'design' of simulate must be an SFRBADesign. Got {design!r} instead."
-        )
+        raise InputError(must_be("an SFRBADesign", design), key="design")
     started = time.perf_counter()
     SetNumThreads(options.threads)
     with TaskManager():

@@ -19,16 +19,21 @@ from __future__ import annotations
 import math
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass
-from typing import Any
+from typing import TYPE_CHECKING
 
 import numpy as np
 
 from softbend.design import SFRBADesign
-from softbend.errors import ConvergenceError
+from softbend.errors import ConvergenceError, InputError
 from softbend.fem._ngsolve import require_ngsolve
 from softbend.fem.mechanics import solid_energy, volume_flux
 from softbend.fem.newton import EnergySolver
 from softbend.materials.models import NeoHookean
+
+if TYPE_CHECKING:
+    from ngsolve import BilinearForm, FESpace, GridFunction
+
+    from softbend.fem.options import FEMOptions
 
 require_ngsolve()  # NGSolve after PyTorch, or one line naming softbend[fem]
 
@@ -72,7 +77,7 @@ def tube_closed_form_pressure(
     return shear_modulus_mpa * (math.log(la / lb) + 0.5 * (lb**-2 - la**-2))
 
 
-def _ramp_solver(form: Any, gfu: Any, fes: Any) -> EnergySolver:
+def _ramp_solver(form: BilinearForm, gfu: GridFunction, fes: FESpace) -> EnergySolver:
     """Newton for :func:`_ramp`: every increment starts from the last state, not a
     prediction, so the first iteration may cut the residual less than tenfold and
     the sweep's early give-up rule stays off (as for the sweep's gravity ramp)."""
@@ -297,7 +302,7 @@ def mesh_study(
     design: SFRBADesign,
     maxh_mm: Sequence[float],
     pressures_mpa: Sequence[float],
-    options: Any = None,
+    options: FEMOptions | None = None,
     *,
     progress: Callable[[int, int], None] | None = None,
 ) -> list[MeshStudyRow]:
@@ -315,7 +320,7 @@ def mesh_study(
     options = options or FEMOptions()
     sizes = [options.replace(maxh_mm=h).maxh_mm for h in maxh_mm]  # FEMOptions' rule
     if not sizes:
-        raise ValueError("The 'maxh_mm' of mesh_study must hold at least one size.")
+        raise InputError("must hold at least one size; got none", key="maxh_mm")
     rows = []
     for i, h in enumerate(sizes):
         result = simulate(design, pressures_mpa, options.replace(maxh_mm=h, output="solve"))

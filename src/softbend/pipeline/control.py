@@ -19,6 +19,7 @@ from softbend.pipeline import Progress
 
 if TYPE_CHECKING:  # pragma: no cover
     from softbend.control.study import ControlStudy
+    from softbend.surrogates.protocol import Surrogate
 
 __all__ = ["CONTROL_DESIGN", "Control", "run_control"]
 
@@ -58,7 +59,7 @@ class Control:
     summary: dict[str, Any]
 
 
-def _refined(base: Any, seed: int, epochs: int | None) -> Any:
+def _refined(base: Surrogate, seed: int, epochs: int | None) -> Surrogate:
     """The shipped MLP refined on all the shipped lab readings (``transfer refine``)."""
     from softbend.transfer.lab import shipped_measurements
     from softbend.transfer.strategies import fit_strategy

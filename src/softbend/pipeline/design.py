@@ -13,7 +13,7 @@ import time
 from dataclasses import dataclass
 from typing import Any
 
-from softbend.design_search.search import SearchResult
+from softbend.design_search.search import LoadedModel, SearchResult
 from softbend.design_search.spec import (
     Objective,
     ParameterRange,
@@ -52,10 +52,12 @@ SPECIFICATIONS: tuple[Specification, ...] = (
 @dataclass(frozen=True)
 class Design:
     """What :func:`run_design` found: per specification its search result (the verified
-    candidates carry the FEM's figures), and headline figures."""
+    candidates carry the FEM's figures), headline figures, and the model searched (read
+    once, for the figures drawn from it)."""
 
     results: list[SearchResult]
     summary: dict[str, Any]
+    model: LoadedModel
 
 
 def run_design(
@@ -82,7 +84,7 @@ def run_design(
     from softbend.design_search.verify import verify_candidates
     from softbend.transfer.base import shipped_base_path
 
-    model = shipped_base_path()
+    model = LoadedModel.load(shipped_base_path())  # read once for every specification
     results, rows = [], []
     for spec in specifications:
         start = time.perf_counter()
@@ -106,4 +108,4 @@ def run_design(
             }
         )
     summary = {"backend": backend, "verify": verify, "specifications": rows}
-    return Design(results, summary)
+    return Design(results, summary, model)

@@ -14,6 +14,10 @@ from softbend.pipeline import Progress
 from softbend.references import FEM_VALIDATION
 
 if TYPE_CHECKING:  # pragma: no cover
+    from numpy.typing import ArrayLike
+
+    from softbend.design import SFRBADesign
+    from softbend.fem.options import FEMOptions
     from softbend.materials import FitResult, TensileTest
     from softbend.models import SweepResult
 
@@ -55,9 +59,9 @@ class FEMSweep:
 
 
 def sweep_with_shapes(
-    design: Any,
-    pressures_mpa: Any,
-    options: Any,
+    design: SFRBADesign,
+    pressures_mpa: ArrayLike,
+    options: FEMOptions | None,
     out_dir: str | Path,
     *,
     shape_pressures_mpa: Sequence[float] | int,
@@ -165,7 +169,7 @@ def run_fig2(
     out_dir: Path,
     progress: Progress | None = None,
     *,
-    options: Any = None,
+    options: FEMOptions | None = None,
     pmax_mpa: float = FIG2_PMAX_MPA,
 ) -> Fig2:
     """Fit the shipped Dragon Skin 30 test and sweep the Fig. 2 design with the FEM.

@@ -81,7 +81,7 @@ class FEMData:
 
 
 def _surrogates(
-    samples: Any,
+    samples: pd.DataFrame,
     folder: Path,
     seed: int,
     progress: Progress | None,

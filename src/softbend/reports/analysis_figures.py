@@ -22,6 +22,8 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
+from softbend.errors import InputError
+
 if TYPE_CHECKING:
     import pandas as pd
 
@@ -107,10 +109,7 @@ def correlation_heatmap(corr: pd.DataFrame, path: str | Path, *, title: str | No
     """
     values = np.asarray(corr.to_numpy(), dtype=float)
     if values.ndim != 2 or values.shape[0] != values.shape[1]:
-        raise ValueError(
-            f"The 'corr' of correlation_heatmap must be a square matrix. Got shape "
-            f"{values.shape} instead."
-        )
+        raise InputError(f"must be a square matrix; got shape {values.shape}", key="corr")
     rows = [column_label(str(c)) for c in corr.index]
     cols = [column_label(str(c)) for c in corr.columns]
     k = len(cols)

@@ -5,15 +5,21 @@ Matplotlib is imported inside the functions (Agg canvas, no pyplot state).
 
 from __future__ import annotations
 
+from collections.abc import Iterable
 from pathlib import Path
-from typing import Any
+from typing import TYPE_CHECKING
+
+if TYPE_CHECKING:
+    from matplotlib.axes import Axes
+
+    from softbend.control.experiments import ControlRun
 
 __all__ = ["run_figure", "runs_figure"]
 
 _DPI = 120
 
 
-def _panels(axes: Any, run: Any, *, legend: bool = True) -> None:
+def _panels(axes: Iterable[Axes], run: ControlRun, *, legend: bool = True) -> None:
     top, valves, pressure = axes
     top.plot(run.t_s, run.reference_deg, "k--", lw=1, label="reference θr")
     top.plot(run.t_s, run.camera_deg, lw=1.2, label="true angle θe (camera)")
@@ -33,7 +39,7 @@ def _panels(axes: Any, run: Any, *, legend: bool = True) -> None:
         pressure.legend(loc="upper right", fontsize=7)
 
 
-def run_figure(run: Any, path: str | Path, title: str) -> Path:
+def run_figure(run: ControlRun, path: str | Path, title: str) -> Path:
     """One run: reference, true and predicted angle; valve states; pressure (true, sensor)."""
     from matplotlib.figure import Figure
 
@@ -46,7 +52,7 @@ def run_figure(run: Any, path: str | Path, title: str) -> Path:
     return Path(path)
 
 
-def runs_figure(runs: dict[str, Any], path: str | Path, title: str) -> Path:
+def runs_figure(runs: dict[str, ControlRun], path: str | Path, title: str) -> Path:
     """Several runs side by side (one column each, titled by their keys)."""
     from matplotlib.figure import Figure
 

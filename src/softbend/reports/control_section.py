@@ -13,16 +13,19 @@ from __future__ import annotations
 import math
 import time
 from pathlib import Path
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 from softbend.pipeline import Progress
 from softbend.pipeline.control import CONTROL_DESIGN, Control
 from softbend.reports.html import Report
 
+if TYPE_CHECKING:
+    import pandas as pd
+
 __all__ = ["CONTROL_DESIGN", "add_control", "add_section"]
 
 
-def _cell(metrics: Any, controller: str, reference: str, name: str) -> float | str:
+def _cell(metrics: pd.DataFrame, controller: str, reference: str, name: str) -> float | str:
     rows = metrics[(metrics["controller"] == controller) & (metrics["reference"] == reference)]
     value = float(rows[name].iloc[0]) if len(rows) and name in rows else math.nan
     return "" if value != value else value

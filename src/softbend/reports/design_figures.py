@@ -4,23 +4,26 @@ from __future__ import annotations
 
 import math
 from pathlib import Path
-from typing import Any
+from typing import TYPE_CHECKING
 
 import numpy as np
 
-from softbend.design_search.spec import OBJECTIVES
+from softbend.design_search.spec import OBJECTIVES, Objective
+
+if TYPE_CHECKING:
+    from softbend.design_search.search import Predictor, SearchResult
 
 __all__ = ["curves_figure", "front_figure"]
 
 _DPI = 120
 
 
-def _label(objective: Any) -> str:
+def _label(objective: Objective) -> str:
     unit = OBJECTIVES[objective.name] if objective.unit is None else objective.unit
     return f"{objective.name} ({unit})" if unit else objective.name
 
 
-def front_figure(result: Any, path: str | Path) -> Path:
+def front_figure(result: SearchResult, path: str | Path) -> Path:
     """The trade-off of the designs that meet the target, and the candidates' FEM check.
 
     Left: with two objectives or more, the Pareto front of the first two (every
@@ -81,7 +84,9 @@ def front_figure(result: Any, path: str | Path) -> Path:
     return Path(path)
 
 
-def curves_figure(result: Any, predictor: Any, path: str | Path, *, count: int = 5) -> Path:
+def curves_figure(
+    result: SearchResult, predictor: Predictor, path: str | Path, *, count: int = 5
+) -> Path:
     """θ(p) of the best ``count`` candidates: the surrogate's line, the FEM's points if verified,
     and the target."""
     from matplotlib.figure import Figure

@@ -15,7 +15,7 @@ from pathlib import Path
 from typing import Any
 
 from softbend.design import SFRBADesign
-from softbend.design_search.search import SearchResult
+from softbend.design_search.search import Predictor, SearchResult
 from softbend.design_search.space import pressure_key
 from softbend.design_search.spec import NAMES, UNITS
 
@@ -60,7 +60,7 @@ def candidate_rows(result: SearchResult) -> list[dict[str, Any]]:
     return rows
 
 
-def write_search(result: SearchResult, predictor: Any, folder: str | Path) -> dict[str, str]:
+def write_search(result: SearchResult, predictor: Predictor, folder: str | Path) -> dict[str, str]:
     """Write :data:`FILES` into ``folder`` (created); returns name → path.
 
     ``candidates.csv`` and ``search.json`` hold every candidate; ``front.png``

@@ -9,11 +9,15 @@ from __future__ import annotations
 
 import math
 import time
+from collections.abc import Iterable
 from pathlib import Path
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 from softbend.pipeline import Progress
 from softbend.reports.html import Report
+
+if TYPE_CHECKING:
+    from softbend.design_search.spec import Specification
 
 __all__ = ["add_section"]
 
@@ -25,7 +29,7 @@ def add_section(
     *,
     verify: int = 1,
     backend: str = "fem",
-    specifications: Any = None,
+    specifications: Iterable[Specification] | None = None,
 ) -> dict[str, Any]:
     """Append the design-search section to ``report``; return the headline figures.
 
@@ -52,12 +56,9 @@ def add_section(
         specifications=SPECIFICATIONS if specifications is None else tuple(specifications),
     )
     from softbend.reports.design_outputs import write_search
-    from softbend.surrogates.predict import load_predictor
-    from softbend.transfer.base import shipped_base_path
 
-    predictor, _ = load_predictor(shipped_base_path())
     files = {
-        r.spec.name: write_search(r, predictor, Path(out_dir) / "design" / r.spec.name)
+        r.spec.name: write_search(r, design.model.predictor, Path(out_dir) / "design" / r.spec.name)
         for r in design.results
     }
     section = report.section("Design to a specification (softbend design find)")

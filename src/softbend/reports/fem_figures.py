@@ -5,13 +5,19 @@ from __future__ import annotations
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
 from softbend.fem.stats import fem_stats
 from softbend.models import SweepResult
 from softbend.reports.analysis_figures import _figure, _save
+
+if TYPE_CHECKING:
+    from numpy.typing import ArrayLike
+
+    from softbend.design import SFRBADesign
+    from softbend.fem.options import FEMOptions
 
 __all__ = ["FEMSweepFiles", "angle_pressure_curve", "deformed_shapes", "sweep_with_files"]
 
@@ -108,9 +114,9 @@ class FEMSweepFiles:
 
 
 def sweep_with_files(
-    design: Any,
-    pressures_mpa: Any,
-    options: Any,
+    design: SFRBADesign,
+    pressures_mpa: ArrayLike,
+    options: FEMOptions | None,
     out_dir: str | Path,
     *,
     shape_pressures_mpa: Sequence[float] | int,

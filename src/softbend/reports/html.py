@@ -15,9 +15,12 @@ import os
 import re
 from dataclasses import dataclass, field
 from pathlib import Path
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 from softbend._io import write_text_atomic
+
+if TYPE_CHECKING:
+    import pandas as pd
 
 __all__ = ["Link", "Report", "Section", "human_numbers", "slug", "write_text_atomic"]
 
@@ -73,7 +76,7 @@ class Link:
     href: str
 
 
-def _format_cell(value: Any) -> str:
+def _format_cell(value: object) -> str:
     if isinstance(value, Link):
         return f'<a href="{html.escape(value.href)}">{html.escape(value.text)}</a>'
     if isinstance(value, bool):
@@ -111,7 +114,7 @@ class Section:
         )
         return self
 
-    def frame(self, df: Any, *, caption: str = "", index: bool = False) -> Section:
+    def frame(self, df: pd.DataFrame, *, caption: str = "", index: bool = False) -> Section:
         """Add a pandas DataFrame as a table."""
         frame = df.reset_index() if index else df
         return self.table(

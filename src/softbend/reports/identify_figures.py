@@ -3,7 +3,11 @@
 from __future__ import annotations
 
 from pathlib import Path
-from typing import Any
+from typing import TYPE_CHECKING
+
+if TYPE_CHECKING:
+    from softbend.identification.selection import Selection
+    from softbend.identification.timeseries import TimeSeriesSet
 
 import numpy as np
 
@@ -13,7 +17,7 @@ _DPI = 120
 _COLORS = {"arx": "C0", "poly2": "C2", "gg-svr": "C3"}
 
 
-def selection_figure(selection: Any, path: str | Path) -> Path:
+def selection_figure(selection: Selection, path: str | Path) -> Path:
     """Each candidate's cross-validated free-run NRMSE (bars, by family), its one-step NRMSE
     (dots) and, with validation experiments, its validation free-run NRMSE (crosses)."""
     from matplotlib.figure import Figure
@@ -48,7 +52,12 @@ def selection_figure(selection: Any, path: str | Path) -> Path:
 
 
 def freerun_overlays(
-    data: Any, outputs: dict[str, np.ndarray], path: str | Path, *, title: str, count: int = 6
+    data: TimeSeriesSet,
+    outputs: dict[str, np.ndarray],
+    path: str | Path,
+    *,
+    title: str,
+    count: int = 6,
 ) -> Path:
     """Measured and free-run outputs of up to ``count`` held-out experiments (rows) per
     output (columns)."""

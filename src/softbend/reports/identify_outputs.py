@@ -4,7 +4,11 @@ from __future__ import annotations
 
 import csv
 from pathlib import Path
-from typing import Any
+from typing import TYPE_CHECKING, Any
+
+if TYPE_CHECKING:
+    from softbend.identification.selection import Selection
+    from softbend.identification.timeseries import TimeSeriesSet
 
 __all__ = ["FILES", "write_identification"]
 
@@ -19,7 +23,9 @@ FILES: tuple[str, ...] = (
 )
 
 
-def write_identification(selection: Any, data: Any, folder: str | Path) -> dict[str, str]:
+def write_identification(
+    selection: Selection, data: TimeSeriesSet, folder: str | Path
+) -> dict[str, str]:
     """Write :data:`FILES` into ``folder`` (created) and return name → path.
 
     ``holdout_freerun.csv`` has ``experiment``, the time column and, per output,

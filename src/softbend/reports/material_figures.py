@@ -18,6 +18,7 @@ from typing import TYPE_CHECKING
 import numpy as np
 
 from softbend._validation import check_choice
+from softbend.errors import InputError
 from softbend.reports.analysis_figures import _figure, _save
 
 if TYPE_CHECKING:
@@ -84,9 +85,7 @@ def fit_figure(
     check_choice(x_axis, "x_axis", ("stretch", "strain"))
     fits = list(results.values()) if isinstance(results, Mapping) else list(results)
     if not fits:
-        raise ValueError(
-            "The 'results' of fit_figure must hold at least one fit. Got none instead."
-        )
+        raise InputError("must hold at least one fit; got none", key="results")
     shift = 1.0 if x_axis == "stretch" else 0.0
     stretch = test.stretch
     stress = test.engineering_stress_mpa

@@ -7,9 +7,10 @@ from typing import TYPE_CHECKING, Any
 
 from softbend.references import CURLING_ACTUATOR
 from softbend.reports import curling_figures
-from softbend.reports.html import Report
+from softbend.reports.html import Report, Section
 
 if TYPE_CHECKING:  # pragma: no cover
+    from softbend.identification.selection import Selection
     from softbend.identification.study import IdentificationResult
 
 
@@ -114,7 +115,9 @@ def add_section(
         _add_selection(section, selections, result, root)
 
 
-def _add_selection(section: Any, selections: dict[str, Any], result: Any, root: Path) -> None:
+def _add_selection(
+    section: Section, selections: dict[str, Selection], result: IdentificationResult, root: Path
+) -> None:
     """The models chosen by held-out free-run error, beside paper A's setting."""
     from softbend.identification.timeseries import from_experiments
     from softbend.reports.identify_outputs import write_identification

@@ -18,7 +18,7 @@ if TYPE_CHECKING:  # pragma: no cover
     import pandas as pd
 
     from softbend.analysis import RegressionReport
-    from softbend.reports.html import Report
+    from softbend.reports.html import Report, Section
 
 #: Paper B §3.3 (FEM data, 972 designs): standardized loadings, R², F and MAPE
 #: (:data:`softbend.references.LINEAR_MODEL`).
@@ -139,7 +139,7 @@ def surrogate_cells(name: str, model: dict[str, Any]) -> list[Any]:
     return [title, *(model[k] for k in keys), *(model[k] for k in timing)]
 
 
-def add_regression_tables(section: Any, regression: Any, data: str = "") -> None:
+def add_regression_tables(section: Section, regression: RegressionReport, data: str = "") -> None:
     """The loadings and the fit of paper B's linear model beside paper B's, as two tables.
 
     ``data`` names the data in the captions and the column (e.g. ``"FEM"``).

@@ -8,11 +8,14 @@ from __future__ import annotations
 import time
 from collections.abc import Callable
 from pathlib import Path
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 from softbend.pipeline.paper_b_fem import FIG2_DESIGN, FIG2_PMAX_MPA, Fig2
 from softbend.references import MATERIALS
 from softbend.reports.html import Report
+
+if TYPE_CHECKING:
+    from softbend.fem.options import FEMOptions
 
 __all__ = ["FIG2_DESIGN", "FIG2_PMAX_MPA", "add_fig2", "add_section"]
 
@@ -79,7 +82,7 @@ def add_section(
     out_dir: Path,
     progress: Callable[[str, int, int], None] | None = None,
     *,
-    options: Any = None,
+    options: FEMOptions | None = None,
     pmax_mpa: float = FIG2_PMAX_MPA,
 ) -> dict[str, Any]:
     """Fit the shipped Dragon Skin 30 test, sweep the Fig. 2 design, add both to ``report``.

@@ -42,15 +42,19 @@ import shutil
 import time
 from datetime import UTC, datetime
 from pathlib import Path
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 from softbend import __version__
 from softbend._io import json_text, staged_dir, stale_staging, write_text_atomic
 from softbend._validation import check_range
 from softbend.design import DesignSpace
+from softbend.errors import InputError
 from softbend.pipeline import Progress
 from softbend.references import FEM_DATASET
 from softbend.reports.html import Report
+
+if TYPE_CHECKING:
+    from softbend.fem.options import FEMOptions
 
 logger = logging.getLogger(__name__)
 
@@ -156,7 +160,7 @@ def run_reproduce(
     workers: int | None = None,
     progress: Progress | None = None,
     design_space: DesignSpace | None = None,
-    fem_options: Any = None,
+    fem_options: FEMOptions | None = None,
     fem_pmax_mpa: float | None = None,
     fem_dataset: str | Path | None = None,
     fem_dataset_epochs: int | None = None,
@@ -263,7 +267,7 @@ def _run_into(
     workers: int | None,
     progress: Progress | None,
     design_space: DesignSpace | None,
-    fem_options: Any,
+    fem_options: FEMOptions | None,
     fem_pmax_mpa: float | None,
     fem_dataset: str | Path | None,
     fem_dataset_epochs: int | None,
@@ -365,7 +369,8 @@ def _run_into(
 
 
 def _renamed(value: Any, staged: str, final: str) -> Any:
-    """``value`` with every path under ``staged`` (text or ``Path``) named under ``final``."""
+    """``value`` (a JSON-ready record) with every path under ``staged`` (text or ``Path``)
+    named under ``final``."""
     if isinstance(value, dict):
         return {key: _renamed(item, staged, final) for key, item in value.items()}
     if isinstance(value, list | tuple):
@@ -380,19 +385,17 @@ def _renamed(value: Any, staged: str, final: str) -> Any:
 def _check_replaceable(out_dir: Path) -> None:
     """Refuse an ``out_dir`` whose files replacing it as a whole would lose."""
     if out_dir.exists() and not out_dir.is_dir():
-        raise ValueError(
-            f"The 'out_dir' of run_reproduce must be a folder. Got the file {out_dir}."
-        )
+        raise InputError(f"must be a folder; got the file {out_dir}", key="out_dir")
     if not out_dir.is_dir():
         return
     entries = sorted(p.name for p in out_dir.iterdir())
     others = [name for name in entries if name not in ENTRIES]
     if others or (entries and MARKER not in entries):
         shown = ", ".join((others or entries)[:3])
-        raise ValueError(
-            f"The 'out_dir' of run_reproduce must be a new or empty folder or an earlier "
-            f"report's (with {MARKER}); it is replaced as a whole. Got {out_dir}, which holds "
-            f"other files ({shown}), instead."
+        raise InputError(
+            f"must be a new or empty folder or an earlier report's (with {MARKER}); it is "
+            f"replaced as a whole; got {out_dir}, which holds other files ({shown})",
+            key="out_dir",
         )
 
 

@@ -45,7 +45,7 @@ def _get(summary: Mapping[str, Any], *path: str) -> Any:
     return value
 
 
-def _number(value: Any, fmt: Callable[[float], str]) -> str:
+def _number(value: float | str | None, fmt: Callable[[float], str]) -> str:
     """``fmt(value)``, or why there is no number (never "nan")."""
     if value is None:
         return "not computed in this run"
