@@ -47,7 +47,6 @@ _DEVICES = {"con", "prn", "aux", "nul"} | {f"{p}{i}" for p in ("com", "lpt") for
 
 def output_name(
     name: object,
-    field: str | None = None,  # transitional: ignored, removed once callers pass no option names
     *,
     reserved: Collection[str] = (),
     taken: Collection[str] = (),
@@ -130,7 +129,6 @@ def _problem(name: str) -> str | None:
 
 def check_output_names(
     names: Iterable[object],
-    field: str | None = None,  # transitional: ignored, removed once callers pass no option names
     *,
     reserved: Collection[str] = (),
 ) -> list[str]:

@@ -83,8 +83,6 @@ class ActuatorError(SoftbendError, ValueError):
 
 def pressure_to_mpa(
     unit: str,
-    *,
-    field: str | None = None,  # transitional: ignored, removed once callers pass no option names
 ) -> float:
     """The factor from ``unit`` (kPa, MPa, bar or psi; case as written) to MPa.
 
@@ -504,9 +502,6 @@ class Actuator:
     def parse_design(
         self,
         text: str,
-        *,
-        field: str
-        | None = None,  # transitional: ignored, removed once callers pass no option names
     ) -> np.ndarray:
         """A design from text: ``A=1,B=2,...`` by name, or the values in column order.
 
@@ -570,9 +565,6 @@ class Actuator:
     def design_codes(
         self,
         values: Mapping[str, Any],
-        *,
-        field: str
-        | None = None,  # transitional: ignored, removed once callers pass no option names
     ) -> np.ndarray:
         """Model-input codes of one design given by name, checked (errors keyed ``design``)."""
         with keyed("design"):
@@ -784,8 +776,6 @@ def load_actuator(path: str | os.PathLike[str]) -> Actuator:
 
 def actuator_from(
     text: str,
-    *,
-    field: str | None = None,  # transitional: ignored, removed once callers pass no option names
 ) -> Actuator:
     """A registered description by name, or one read from a ``.json`` file."""
     if text.lower().endswith(".json"):
@@ -799,8 +789,6 @@ ACTUATORS: Registry[Actuator] = Registry("actuator")
 
 def get_actuator(
     name: str,
-    *,
-    field: str | None = None,  # transitional: ignored, removed once callers pass no option names
 ) -> Actuator:
     """The registered description ``name`` (one error, keyed ``actuator``, listing the names)."""
     with keyed("actuator"):

@@ -96,7 +96,6 @@ def default_pressures_mpa(
 
 def check_pressures_mpa(
     pressures_mpa: ArrayLike,
-    owner: str | None = None,  # transitional: ignored; callers outside this module still pass it
     key: str = "pressures_mpa",
 ) -> np.ndarray:
     """Validate a sweep grid: 1-D, finite, >= 0 MPa and strictly increasing.

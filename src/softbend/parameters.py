@@ -260,7 +260,6 @@ def effective_parameters(
 
 def parse_assignments(
     items: Sequence[str] | None,
-    field: str | None = None,  # transitional: ignored, removed once callers pass no option names
 ) -> dict[str, str]:
     """``["NAME=VALUE", ...]`` as ``{name: text}`` (the values are read later, by kind).
 
@@ -360,8 +359,6 @@ def check_parameters(
     entry: Callable[..., Any],
     values: Mapping[str, Any] | None,
     *,
-    owner: str | None = None,  # transitional: ignored, removed once callers pass no option names
-    field: str | None = None,  # transitional: ignored, removed once callers pass no option names
     from_text: bool = False,
     skip: Collection[str] = (),
     keyword_only: bool = True,

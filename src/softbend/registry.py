@@ -85,9 +85,6 @@ class Registry(Generic[T]):
     def check(
         self,
         name: object,
-        *,
-        field: str
-        | None = None,  # transitional: ignored, removed once callers pass no option names
     ) -> str:
         """Return ``name`` if registered, else raise :class:`UnknownNameError`.
 
@@ -111,9 +108,6 @@ class Registry(Generic[T]):
     def get(
         self,
         name: object,
-        *,
-        field: str
-        | None = None,  # transitional: ignored, removed once callers pass no option names
     ) -> T:
         """The entry registered as ``name``; an unknown name raises :class:`UnknownNameError`."""
         return self._entries[self.check(name)]

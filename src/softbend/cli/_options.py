@@ -11,7 +11,6 @@ general or for one command.
 from __future__ import annotations
 
 from collections.abc import Sequence
-
 from typing import Any
 
 import typer
@@ -21,14 +20,8 @@ from softbend.errors import SoftbendError
 __all__ = ["ALIASES", "error_text", "option_for"]
 
 #: Library key -> command-line parameter name, where they differ. A key may be
-#: given for one command only as ``"command path:key"`` (``"campaign run:ranges"``).
+#: given for one command only as ``"command path:key"`` (``"design find:fixes"``).
 ALIASES: dict[str, str] = {
-    "ranges": "range",
-    "settings": "set",
-    "controller_parameters": "set",
-    "rig_parameters": "rig_param",
-    "campaign run:ranges": "ranges",
-    "design find:ranges": "ranges",
     "design find:fixes": "fix",
     "design find:steps": "resolution",
     "design find:step": "resolution",
@@ -46,8 +39,6 @@ ALIASES: dict[str, str] = {
     "transfer refine:X": "measurements",
     "transfer loco:X": "measurements",
     "transfer loco:calibrated": "calibrate",
-    "transfer refine:settings": "settings",
-    "transfer loco:settings": "settings",
     "analyze:mape_threshold": "mape_threshold_deg",
     "analyze:samples": "db",
     "curling simulate:n_samples": "samples",

@@ -95,7 +95,7 @@ def identify(
         time=time,
     )
     held = _names(validate_on, "validate_on") if validate_on is not None else None
-    check_holdout(series, held, label="'--validate-on'")
+    check_holdout(series, held)
     check_signals(series, held)  # a constant or huge output: refused before any fit
     # every candidate's regressor must fit in every experiment (the longest lags: 3)
     check_experiments_for_lags(series, max(c.build(10).max_lag for c in default_candidates(seed)))

@@ -401,8 +401,6 @@ def check_experiments_for_lags(data: TimeSeriesSet, max_lag: int) -> None:
 def check_holdout(
     data: TimeSeriesSet,
     validate_on: str | Sequence[str] | None,
-    *,
-    label: str | None = None,  # transitional: ignored, removed once callers pass no option names
 ) -> None:
     """Check that experiments can be held out for validation and the rest selected on.
 

@@ -85,15 +85,13 @@ def check_hidden_pair(value: object) -> tuple[int, int]:
     return int(pair[0]), int(pair[1])
 
 
-def resolve_device(device: object, owner: str | None = None) -> str:
+def resolve_device(device: object) -> str:
     """The torch device a ``device`` parameter means: ``"cpu"`` or ``"cuda"``.
 
     Parameters
     ----------
     device : {"auto", "cpu", "cuda"}
         ``"auto"`` is ``"cuda"`` when :func:`torch.cuda.is_available`, else ``"cpu"``.
-    owner : str, optional
-        Unused; accepted while callers still pass it.
 
     Returns
     -------
@@ -105,7 +103,6 @@ def resolve_device(device: object, owner: str | None = None) -> str:
     softbend.errors.InputError
         Key ``device``: another value, or ``"cuda"`` without a usable GPU.
     """
-    del owner  # transitional: softbend.transfer.finetune still passes it
     check_choice(device, "device", ("auto", "cpu", "cuda"))
     # PyTorch only here (training): a fitted model predicts with NumPy alone
     from softbend._torch import require_torch
