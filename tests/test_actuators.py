@@ -69,7 +69,7 @@ def test_psi_is_the_pound_per_square_inch():
 @pytest.mark.parametrize("unit", ["kpa", "Pa", "atm", ""])
 def test_an_unknown_pressure_unit_is_one_error_naming_the_four(unit):
     with pytest.raises(ActuatorError, match="kPa, MPa, bar, psi"):
-        pressure_to_mpa(unit, field="--pressure-unit")
+        pressure_to_mpa(unit)
 
 
 def test_design_by_name_encodes_levels_and_checks_kinds():

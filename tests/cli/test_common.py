@@ -150,7 +150,7 @@ def test_parse_assignments_reads_name_value_pairs_once_each():
     for bad, needle in ((["epochs"], "^settings: .*NAME=VALUE"), (["=3"], "NAME=VALUE")):
         with pytest.raises(ValueError, match=needle):
             _common.parse_assignments(bad)
-    with pytest.raises(ValueError, match=r"^settings: .*'epochs' twice"):
+    with pytest.raises(ValueError, match=r"^settings: the parameter .epochs. is given twice"):
         _common.parse_assignments(["epochs=1", "epochs=2"])
 
 

@@ -87,5 +87,5 @@ def test_maxh_has_one_rule_in_run_and_mesh_study(tmp_path, monkeypatch, capsys):
 @pytest.mark.parametrize("design", ["100,6,7,2,5,10", "100,1,50,2,5,10"])
 def test_a_wall_thicker_than_the_radius_is_refused_before_solving(tmp_path, capsys, design):
     assert main(["fem", "run", "--design", design, "--out", str(tmp_path / "o")]) == 2
-    assert "'t_mm' of SFRBADesign must be less than its 'r_mm'" in one_error_line(capsys)
+    assert "--design: t_mm: must be less than r_mm" in one_error_line(capsys)
     assert not (tmp_path / "o").exists()

@@ -5,12 +5,18 @@ from __future__ import annotations
 import csv
 import json
 
+import numpy as np
 import pytest
 
 from softbend.cli import main
 from softbend.identification.arm import arm_experiments
+from softbend.identification.data import save_experiments
 from softbend.identification.multi import load_multi_narx
+from softbend.identification.synthetic import synthetic_dataset
+from softbend.identification.timeseries import Series, TimeSeriesSet
 from softbend.identification.timeseries_io import save_timeseries
+
+from .conftest import one_error_line
 
 ARGS = ["--inputs", "p1_kpa,p2_kpa,p3_kpa", "--outputs", "x_mm,y_mm",
         "--experiment", "experiment", "--time", "time_s"]  # fmt: skip
@@ -87,3 +93,165 @@ def test_an_experiment_shorter_than_the_lags_is_one_line(recording, tmp_path, ca
     assert main(["identify", str(path), *ARGS, "--out", str(tmp_path / "x")]) == 2
     err = capsys.readouterr().err.strip().splitlines()
     assert len(err) == 1 and "stub" in err[0], err
+
+
+# --- ``softbend identify`` and ``softbend curling identify`` refuse bad input before any work ---
+#
+# Every numeric option is held to its declared range (softbend.identification.ranges),
+# and data whose figures could not be finite (a constant output, values whose squares
+# overflow) are refused up front: one ``softbend: error:`` line, exit 2, no fit, no
+# output folder.
+
+
+ARGS_BIG = ["--inputs", "u", "--outputs", "y,z", "--experiment", "experiment", "--time", "t"]
+
+
+@pytest.fixture
+def no_fit(monkeypatch):
+    """Any model fit fails the test: the refusal must come before the first one."""
+    from softbend.identification.multi import MultiNARX
+    from softbend.identification.narx import NARXRegressor
+
+    def fit(self, *args, **kwargs):
+        raise AssertionError("a model was fitted before the input was checked")
+
+    monkeypatch.setattr(MultiNARX, "fit", fit)
+    monkeypatch.setattr(NARXRegressor, "fit", fit)
+
+
+def _recording(path, z_of=None):
+    """Four experiments a, b, c, d of 40 samples: input u, outputs y and z."""
+    rng = np.random.default_rng(0)
+    experiments = []
+    for k, name in enumerate("abcd"):
+        u = rng.normal(size=40)
+        y = np.cumsum(u) * 0.1
+        z = z_of(k, y) if z_of is not None else y**2
+        experiments.append(Series(name, np.arange(40.0), u, np.column_stack([y, z])))
+    return save_timeseries(TimeSeriesSet(("u",), ("y", "z"), tuple(experiments), "t"), path)
+
+
+# ------------------------------------------------------------------ softbend identify
+@pytest.mark.parametrize(
+    ("option", "value", "said"),
+    [
+        ("--seed", "-1", r"--seed: must be an integer in [0, 4294967295]; got -1"),
+        ("--folds", "1", r"--folds: must be an integer in [2, 1000]; got 1"),
+        ("--folds", "99999999999999999999", "; got 99999999999999999999"),
+        ("--max-memory-mb", "nan", r"--max-memory-mb: must be a number in (0, 1e+09]"),
+        ("--max-memory-mb", "-1", r"--max-memory-mb: must be a number in (0, 1e+09]"),
+    ],
+)
+def test_identify_options_out_of_range(tmp_path, capsys, no_fit, option, value, said):
+    out = tmp_path / "out"
+    missing = tmp_path / "nowhere.csv"  # the option is refused before the data are looked at
+    assert main(["identify", str(missing), *ARGS_BIG, option, value, "--out", str(out)]) == 2
+    line = one_error_line(capsys)
+    assert said in line, line
+    assert "expected non-negative integer" not in line and not out.exists()
+
+
+@pytest.mark.parametrize(
+    ("held", "said"),
+    [
+        ("a,a", "--validate-on: must name each experiment once; got 'a' more than once"),
+        ("a,zz", "--validate-on: must name experiments of the data (a, b, c, d); got 'zz'"),
+        ("a,b,c", "--validate-on: must leave at least 2 of the 4 experiments to train on"),
+    ],
+)
+def test_identify_validate_on_is_checked_before_any_fit(tmp_path, capsys, no_fit, held, said):
+    path = _recording(tmp_path / "rec.csv")
+    out = tmp_path / "out"
+    assert main(["identify", str(path), *ARGS_BIG, "--validate-on", held, "--out", str(out)]) == 2
+    assert said in one_error_line(capsys)
+    assert not out.exists()
+
+
+@pytest.mark.parametrize(
+    ("z_of", "extra", "said"),
+    [
+        (
+            lambda k, y: np.full_like(y, 2.5),
+            [],
+            "The output column 'z' is constant over the training experiments (every sample 2.5)",
+        ),
+        (lambda k, y: 1e301 * y, [], "The output column 'z' of experiment 'a'"),
+        # constant where it is trained on: its validation experiment varying does not help
+        (
+            lambda k, y: np.full_like(y, 2.5) if k < 3 else y,
+            ["--validate-on", "d"],
+            "'z' is constant over the training experiments",
+        ),
+    ],
+    ids=["constant", "1e301", "constant-in-training"],
+)
+def test_identify_refuses_an_output_whose_figures_could_not_be_finite(
+    tmp_path, capsys, no_fit, z_of, extra, said
+):
+    path = _recording(tmp_path / "rec.csv", z_of)
+    out = tmp_path / "out"
+    assert main(["identify", str(path), *ARGS_BIG, *extra, "--out", str(out)]) == 2
+    line = one_error_line(capsys)
+    assert said in line and "nan" not in line.lower(), line
+    assert not out.exists()
+
+
+# ---------------------------------------------------------- softbend curling identify
+@pytest.mark.parametrize(
+    ("option", "value", "said"),
+    [
+        (
+            "--input-lags",
+            "1000000000",
+            "--input-lags: must be an integer in [1, 50]; got 1000000000",
+        ),
+        (
+            "--output-lags",
+            "99999999999999999999",
+            "--output-lags: must be an integer in [1, 50]; got 99999999999999999999",
+        ),
+        ("--output-lags", "0", "--output-lags: must be an integer in [1, 50]; got 0"),
+        ("--C", "1e300", "--C: must be a number in (0, 10000]; got 1e+300"),
+        ("--C", "0", "--C: must be a number in (0, 10000]; got 0.0"),
+        ("--epsilon", "nan", "--epsilon: must be a number in [0, 10]; got nan"),
+        ("--epsilon", "-0.1", "--epsilon: must be a number in [0, 10]; got -0.1"),
+        ("--max-memory-mb", "inf", "--max-memory-mb: must be a number in (0, 1e+09]"),
+    ],
+)
+def test_curling_identify_options_out_of_range(tmp_path, capsys, no_fit, option, value, said):
+    out = tmp_path / "out"
+    missing = tmp_path / "nowhere"  # the option is refused before the data are looked at
+    assert main(["curling", "identify", str(missing), option, value, "--out", str(out)]) == 2
+    line = one_error_line(capsys)
+    assert said in line, line
+    assert "Maximum allowed size" not in line and not out.exists()
+
+
+def test_curling_identify_refuses_lags_the_shortest_experiment_cannot_hold(
+    tmp_path, capsys, no_fit
+):
+    data = synthetic_dataset(n_experiments=2, n_samples=16, seed=1)
+    folder = tmp_path / "exp"
+    save_experiments([e for group in data.values() for e in group], folder)
+    out = tmp_path / "out"
+    assert main(["curling", "identify", str(folder), "--output-lags", "20", "-o", str(out)]) == 2
+    line = one_error_line(capsys)
+    assert "--output-lags: must be an integer in [1, 12] for these experiments" in line
+    assert "16 sample(s)" in line and "; got 20" in line and not out.exists()
+
+
+def test_curling_identify_refuses_an_experiment_with_a_constant_output(tmp_path, capsys, no_fit):
+    from softbend.identification.data import Experiment
+
+    data = synthetic_dataset(n_experiments=2, n_samples=64, seed=1)
+    experiments = [e for group in data.values() for e in group]
+    first = experiments[0]
+    n = first.n_samples
+    still = Experiment("still", first.time_s, np.full(n, 5.0), np.zeros(n), np.zeros(n))
+    folder = tmp_path / "exp"
+    save_experiments([*experiments, still], folder)
+    out = tmp_path / "out"
+    assert main(["curling", "identify", str(folder), "-o", str(out)]) == 2
+    line = one_error_line(capsys)
+    assert "Experiment 'still' has a constant rho (every sample 0)" in line
+    assert not out.exists()

@@ -100,7 +100,7 @@ def test_text_values_are_parsed_by_kind():
     assert parse_assignments(["a=1", " b = x "]) == {"a": "1", "b": "x"}
     with pytest.raises(ValueError, match="must be NAME=VALUE"):
         parse_assignments(["deadzone"])
-    with pytest.raises(ValueError, match="'deadzone' twice"):
+    with pytest.raises(ValueError, match="'deadzone' is given twice"):
         parse_assignments(["deadzone=1", "deadzone=2"])
 
 

@@ -40,7 +40,7 @@ MAX_LAG = max(c.build(10).max_lag for c in CANDIDATES)
 
 #: Cells that break naive numerics, put now and then into a column.
 SPECIAL = ["nan", "inf", "-inf", "1e301", "-1e308", "1e100", "1e-300", "5e-324", "-0", "", "abc"]
-#: Scales of a column: ordinary, tiny, huge (beyond 1e100 they must be refused).
+#: Scales of a column: ordinary, tiny, huge (beyond 1e50 they must be refused).
 SCALES = [1.0] * 5 + [1e-200, 1e-90, 1e-20, 1e20, 1e90, 1e150, 1e300]
 
 
@@ -127,7 +127,7 @@ def test_any_table_gives_finite_figures_or_one_clean_error(tmp_path, fuzz_counte
         with warnings.catch_warnings():
             warnings.simplefilter("error", RuntimeWarning)  # no numpy warning either
             series = load_timeseries(path, inputs, outputs, experiment="run", time="t")
-            check_holdout(series, held, label="'--validate-on'")
+            check_holdout(series, held)
             check_signals(series, held)
             check_experiments_for_lags(series, MAX_LAG)
             selection = select_model(

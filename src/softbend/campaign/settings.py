@@ -34,8 +34,8 @@ from softbend.materials.models import HyperelasticModel
 from softbend.materials.presets import DRAGON_SKIN_30, LinearElastic, Material
 
 if TYPE_CHECKING:
-    from softbend.campaign.backends import Backend
     from softbend.fem.options import FEMOptions
+    from softbend.models import BendingModel
 
 __all__ = [
     "SETTINGS_VERSION",
@@ -156,13 +156,16 @@ def _plain_fields(backend: object) -> dict[str, Any]:
 
 
 def backend_settings(
-    backend: Backend, pressures_mpa: np.ndarray, *, material_given: Mapping[str, str] | None = None
+    backend: BendingModel,
+    pressures_mpa: np.ndarray,
+    *,
+    material_given: Mapping[str, str] | None = None,
 ) -> dict[str, Any]:
     """The settings of ``backend`` that change a campaign's numbers, as JSON-ready data.
 
     Parameters
     ----------
-    backend : Backend
+    backend : BendingModel
         The campaign's backend. For the FEM its :class:`~softbend.fem.FEMOptions`
         (but the threads) are recorded; for a dataclass backend its plain options
         (``max_angle_deg`` of the analytical model); a wrapper with an ``inner``

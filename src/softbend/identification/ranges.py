@@ -28,9 +28,9 @@ seed                [0, 2³² − 1]      the usual range of a random seed
 folds               [2, 1000]         folds of whole experiments; more than the
                                       experiments are cut to their number
 ``max_memory_mb``   (0, 1e9] MiB      about 1 PB, beyond any machine
-input and output    [−1e100, 1e100]   squares and sums of squares of 10⁷ samples
-values                                stay far below the largest double (1.8e308):
-                                      no standardization overflows
+input and output    [−1e50, 1e50]     fourth powers (a polynomial NARX squares its
+values                                regressors, least squares squares them again)
+                                      of 10⁷ samples stay below the largest double
 output range        ≥ 1e-100          an output must vary (its NRMSE is over its
                                       range), by enough that the squares of its
                                       deviations are normal doubles (> 2.2e-308)
@@ -93,10 +93,11 @@ FOLDS_RANGE = Range(
 MAX_MEMORY_MB_RANGE = Range(
     0, 1e9, "MiB", why="about 1 PB, beyond any machine", low_inclusive=False
 )
-#: The largest magnitude of an input or output value: squares and sums of squares of
-#: 10^7 samples of it stay far below the largest double (1.8e308), so no
-#: standardization or error overflows.
-MAX_ABS_VALUE = 1e100
+#: The largest magnitude of an input or output value: a polynomial NARX squares its
+#: regressors and least squares squares them again, and sums of those fourth powers
+#: over 10^7 samples stay far below the largest double (1.8e308), so no fit,
+#: standardization or error overflows (at 1e100 a quadratic model's one-step error did).
+MAX_ABS_VALUE = 1e50
 #: The smallest range of an output over the training experiments: the NRMSE is over
 #: the range, and the squares of smaller deviations would leave the normal doubles.
 MIN_OUTPUT_RANGE = 1e-100

@@ -281,7 +281,7 @@ def select_model(
         experiment, ``folds`` or ``seed`` out of range (all before any fit).
     DatasetError
         Signals :func:`~softbend.identification.timeseries_io.check_signals`
-        refuses (a value beyond ±1e100, a constant output), or training folds
+        refuses (a value beyond ±1e50, a constant output), or training folds
         with fewer than :data:`MIN_KERNEL_ROWS` regressor rows for a kernel
         candidate (all before any fit).
     ConvergenceError

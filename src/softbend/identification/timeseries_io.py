@@ -462,7 +462,7 @@ def check_signals(data: TimeSeriesSet, validate_on: str | Sequence[str] | None =
     """Refuse, before any fit, signals whose identification figures could not be finite.
 
     Every input and output value must lie within ±:data:`~softbend.identification.ranges.
-    MAX_ABS_VALUE` (1e100: the squares of larger values overflow the standardization),
+    MAX_ABS_VALUE` (1e50: the fourth powers of larger values overflow a polynomial fit),
     and every output must vary over the training experiments (those not in
     ``validate_on``) by at least :data:`~softbend.identification.ranges.MIN_OUTPUT_RANGE`:
     the error of a model is over its output's range (NRMSE), undefined for a
@@ -495,7 +495,7 @@ def check_signals(data: TimeSeriesSet, validate_on: str | Sequence[str] | None =
                 raise DatasetError(
                     f"The {kind} column '{names[column]}' of experiment {e.name!r}{source} "
                     f"holds {float(values[row, column])!r} at sample {row}: values must lie "
-                    f"within ±{MAX_ABS_VALUE:g} (the squares of larger ones overflow); "
+                    f"within ±{MAX_ABS_VALUE:g} (larger ones overflow a polynomial fit); "
                     "rescale the column (e.g. a larger unit)."
                 )
     train = [e for e in data.experiments if e.name not in held] or list(data.experiments)
