@@ -1,12 +1,13 @@
 # Two entry points that work on a fresh machine with Python 3.11:
 #   make run   - set up .venv and run the main job (softbend reproduce) end to end
-#   make test  - set up .venv and run the test suite (fast subset; `make test-all` adds slow cases)
+#   make test-full - set up .venv and run the test suite that CI runs (all but the slow physics)
+#   make test  - the quick loop between edits (about 5 minutes on 2 cores; `make test-all`: every test)
 PYTHON ?= python3
 VENV ?= .venv
 BIN := $(VENV)/bin
 OUT ?= results/reproduce
 
-.PHONY: setup run test test-all lint typecheck docs bench clean
+.PHONY: setup run test test-full test-all lint typecheck docs bench clean
 
 $(BIN)/.softbend-installed: pyproject.toml
 	$(PYTHON) -m venv $(VENV)
@@ -20,7 +21,12 @@ run: setup
 	$(BIN)/softbend reproduce --out $(OUT)
 	@echo "report: $(OUT)/index.html; documentation: docs/index.md (make docs builds docs/_build/html)"
 
+# The quick loop: units and one end-to-end case per stage (tests/thorough.txt lists the rest).
 test: setup
+	$(BIN)/python -m pytest -q -m "not slow and not thorough"
+
+# What CI runs: every test but the slow physics cases.
+test-full: setup
 	$(BIN)/python -m pytest -q -m "not slow"
 
 test-all: setup

@@ -15,6 +15,28 @@ def pytest_configure(config):
     os.environ["SOFTBEND_CACHE_DIR"] = tempfile.mkdtemp(prefix="softbend-test-cache-")
 
 
+def _thorough() -> frozenset[str]:
+    """``path::function`` of the tests outside the quick loop (tests/thorough.txt)."""
+    from pathlib import Path
+
+    listing = Path(__file__).with_name("thorough.txt").read_text(encoding="utf-8")
+    return frozenset(
+        line.strip() for line in listing.splitlines() if line.strip() and not line.startswith("#")
+    )
+
+
+def pytest_collection_modifyitems(config, items):
+    """Mark ``thorough`` what tests/thorough.txt lists (every case of a function, or a file)."""
+    from pathlib import Path
+
+    listed = _thorough()
+    root = Path(config.rootpath)
+    for item in items:
+        path = Path(item.path).relative_to(root).as_posix()
+        if path in listed or f"{path}::{item.originalname}" in listed:
+            item.add_marker(pytest.mark.thorough)
+
+
 @pytest.fixture(scope="session")
 def small_campaign(tmp_path_factory):
     """80 space-filling designs swept by the analytical model, 0-0.2 MPa (880 samples)."""

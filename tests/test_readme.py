@@ -5,7 +5,7 @@ The quick variant appends options to a command (a later option wins in the comma
 that the tour runs in about a minute: a coarser mesh, fewer designs, epochs and folds, an
 analytical check instead of the FEM's. :data:`QUICK` holds them by command. A command of the
 README that :data:`QUICK` does not know fails the test, so each new command gets a decision.
-``make run`` and ``make test``, the README's two commands, are what CI and the pipeline tests
+``make run`` and ``make test-full``, the README's two commands, are what CI and the pipeline tests
 run; they are not run again here.
 """
 
