@@ -39,6 +39,10 @@ def material_from_spec(
 ) -> Material:
     """The material ``spec`` names: a preset, or a model of a ``materials fit`` file.
 
+    An error about the name is keyed ``spec`` (a caller that hands its own
+    parameter on names it with :func:`softbend.errors.keyed`); an error in the
+    file names the file and the entry.
+
     Parameters
     ----------
     spec : str or path-like
@@ -59,10 +63,6 @@ def material_from_spec(
     SchemaError
         The file is not a valid ``fit.json`` (as :func:`~softbend.materials.fit.load_fit_json`),
         names an unknown model after ``#``, or has no model with a finite R².
-
-    An error about the name is keyed ``spec`` (a caller that hands its own
-    parameter on names it with :func:`softbend.errors.keyed`); an error in the
-    file names the file and the entry.
     """
     text = os.fspath(spec)
     path_text, _, model_name = text.partition("#")
