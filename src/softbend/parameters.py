@@ -77,34 +77,12 @@ class UnknownParameterError(UnknownNameError):
     ``str(error)`` puts the key in front.
     """
 
-    def __init__(
-        self,
-        message: str,
-        key: str | None = None,
-        *,
-        file: str | None = None,
-        line: int | None = None,
-        column: int | None = None,
-    ) -> None:
-        super().__init__(message, key=key, file=file, line=line, column=column)
-
 
 class ParameterValueError(SoftbendError, ValueError):
     """A parameter value of the wrong kind; ``key`` is the parameter's name.
 
     The message is the predicate (``must be an integer; got 2.5``).
     """
-
-    def __init__(
-        self,
-        message: str,
-        key: str | None = None,
-        *,
-        file: str | None = None,
-        line: int | None = None,
-        column: int | None = None,
-    ) -> None:
-        super().__init__(message, key=key, file=file, line=line, column=column)
 
 
 def _bound(value: float) -> str:
@@ -404,15 +382,17 @@ def check_parameters(
         if key not in known and not open_ended:
             hint = f" ({hints[key]})" if hints and key in hints else ""
             raise UnknownParameterError(
-                f"is not a parameter{hint}; known: {', '.join(known) or 'none'}", key
+                f"is not a parameter{hint}; known: {', '.join(known) or 'none'}", key=key
             )
         kind = _kind(known[key]) if key in known else "any"
         try:
             result = _from_text(str(value), kind) if from_text else _typed(value, kind)
         except (ValueError, OverflowError):  # an integer too large for a float is no number
-            raise ParameterValueError(f"must be {_WORDS[kind]}; got {_shown(value)}", key) from None
+            raise ParameterValueError(
+                f"must be {_WORDS[kind]}; got {_shown(value)}", key=key
+            ) from None
         if isinstance(result, float) and not math.isfinite(result):
-            raise ParameterValueError(f"must be a finite number; got {_shown(value)}", key)
+            raise ParameterValueError(f"must be a finite number; got {_shown(value)}", key=key)
         if key == "epochs" and kind == "int":
             with keyed(key):
                 check_limit("epochs", result, "the value")
@@ -420,6 +400,6 @@ def check_parameters(
         if declared is not None and not declared.contains(result):
             shown = _shown(",".join(map(str, result))) if isinstance(result, tuple) else None
             shown = shown.strip("'") if shown is not None else _shown(value)
-            raise ParameterValueError(f"must be {declared.requirement()}; got {shown}", key)
+            raise ParameterValueError(f"must be {declared.requirement()}; got {shown}", key=key)
         checked[key] = result
     return checked

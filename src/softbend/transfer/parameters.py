@@ -118,7 +118,7 @@ def _check_one(cls: type, key: str, value: object, *, from_text: bool) -> dict[s
     result = checked.get(key)
     if count is not None and not (isinstance(result, tuple) and len(result) == count):
         raise _parameters.ParameterValueError(
-            f"must be {_count_words(cls, key, count)}; got {_items(value)}", key
+            f"must be {_count_words(cls, key, count)}; got {_items(value)}", key=key
         )
     return checked
 
