@@ -47,6 +47,12 @@ def test_identify_writes_the_selection_the_model_and_the_held_out_runs(recording
     assert {r["experiment"] for r in rows} == set(validation)
     model, metadata = load_multi_narx(out / "model.json")
     assert metadata["inputs"] == ["p1_kpa", "p2_kpa", "p3_kpa"] and model.n_outputs_ == 2
+    # the chosen model read physically: one step reading per (input, output) pair
+    pairs = {(r["input"], r["output"]) for r in payload["dynamics"]}
+    assert pairs == {(p, o) for p in ("p1_kpa", "p2_kpa", "p3_kpa") for o in ("x_mm", "y_mm")}
+    assert {r["gain_unit"] for r in payload["dynamics"]} == {"mm/kPa"}
+    assert metadata["dynamics"] == payload["dynamics"] and metadata["time_unit_s"] == 1.0
+    assert metadata["sample_period"] == pytest.approx(np.median(np.diff(data.experiments[0].time)))
     for name in ("selection.csv", "selection.png", "freerun.png"):
         assert (out / name).is_file()
 

@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import math
 from pathlib import Path
 
 import typer
@@ -48,7 +49,12 @@ def identify(
     free-run error wins, whatever the family, and the output says when a linear
     model is the best. Every output's regressor holds the lags of every output.
     Writes the selection table, the model, the held-out free runs
-    (holdout_freerun.csv) and their figures into --out.
+    (holdout_freerun.csv) and their figures into --out, and reads the chosen
+    model physically: from the operating point (the inputs' training means)
+    each input steps by one training standard deviation, and each output's
+    gain, time constant (63.2 %) and dead time (2 %) are printed and recorded
+    in model.json ("dynamics"). 'softbend predict MODEL.json --input CSV' runs
+    the model on a new input series.
 
     Example:
 
@@ -110,6 +116,7 @@ def identify(
         return
     _print_selection(selection)
     _common.console.print(selection.verdict())
+    _print_dynamics(selection)
     _common.console.print(f"{', '.join(FILES)} written to {out}")
 
 
@@ -136,3 +143,43 @@ def _print_selection(selection: object) -> None:
         f"{len(selection.train)} training experiments"
     )
     _common.print_table(title, columns, rows)
+
+
+def _time_text(value: float | None, reading: object, selection: object) -> str:
+    """A time of a step reading in s when the unit is known, else in samples."""
+    from softbend.identification.dynamics import StepReading
+    from softbend.identification.selection import Selection
+
+    assert isinstance(reading, StepReading) and isinstance(selection, Selection)
+    if value is None:
+        return f"— ({reading.note})"
+    if reading.time_unit_s is not None:
+        return f"{value * reading.time_unit_s:.3g} s"
+    samples = value / selection.sample_period
+    return f"{samples:.3g} sample{'' if samples == 1 else 's'}"
+
+
+def _print_dynamics(selection: object) -> None:
+    """The chosen model's step readings: gain, time constant, delay per input → output."""
+    from softbend.identification.selection import Selection
+
+    assert isinstance(selection, Selection)
+    if not selection.dynamics:
+        return
+    rows = []
+    for r in selection.dynamics:
+        defined = math.isfinite(r.gain)
+        gain = f"{r.gain:.4g} {r.gain_unit}".rstrip() if defined else f"— ({r.note})"
+        rows.append(
+            [
+                f"{r.input} → {r.output}",
+                gain,
+                _time_text(r.time_constant, r, selection),
+                _time_text(r.delay, r, selection),
+            ]
+        )
+    title = (
+        f"{selection.best} read physically: each input stepped by one training standard "
+        "deviation from its training mean"
+    )
+    _common.print_table(title, ["input → output", "gain", "τ (63.2 %)", "delay (2 %)"], rows)

@@ -14,6 +14,13 @@ from softbend._lazy import export as _export
 if TYPE_CHECKING:
     from softbend.identification.arm import SoftArm, arm_experiments
     from softbend.identification.data import Experiment, load_experiments, save_experiments
+    from softbend.identification.dynamics import (
+        IdentifiedModel,
+        StepReading,
+        is_identified_model,
+        load_identified,
+        step_readings,
+    )
     from softbend.identification.kernels import (
         estimate_gg_shape,
         estimate_kernel_shape,
@@ -38,6 +45,11 @@ _EXPORTS = {
     "Experiment": "data",
     "load_experiments": "data",
     "save_experiments": "data",
+    "IdentifiedModel": "dynamics",
+    "StepReading": "dynamics",
+    "is_identified_model": "dynamics",
+    "load_identified": "dynamics",
+    "step_readings": "dynamics",
     "CurlingActuator": "synthetic",
     "synthetic_dataset": "synthetic",
     "check_identify_memory": "resources",
@@ -59,11 +71,13 @@ __all__ = [
     "CurlingActuator",
     "Experiment",
     "GeneralizedGaussianSVR",
+    "IdentifiedModel",
     "MultiNARX",
     "NARXRegressor",
     "Selection",
     "Series",
     "SoftArm",
+    "StepReading",
     "TimeSeriesSet",
     "arm_experiments",
     "check_identify_memory",
@@ -71,13 +85,16 @@ __all__ = [
     "estimate_kernel_shape",
     "from_experiments",
     "generalized_gaussian_kernel",
+    "is_identified_model",
     "load_experiments",
+    "load_identified",
     "load_multi_narx",
     "load_timeseries",
     "save_experiments",
     "save_multi_narx",
     "save_timeseries",
     "select_model",
+    "step_readings",
     "synthetic_dataset",
 ]
 

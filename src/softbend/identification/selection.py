@@ -20,7 +20,10 @@ third again on ``max_rows``. The model chosen is the lowest cross-validated
 free-run error among all of them, whichever family wins; when it is a linear
 ARX, :meth:`Selection.verdict` says so plainly. With ``validate_on``, those
 experiments are never seen by the selection; every candidate, refitted on all
-the training experiments, is run free on them too.
+the training experiments, is run free on them too. The chosen model is then
+read physically (:attr:`Selection.dynamics`): the gain, time constant and dead
+time of every output's response to a step of every input
+(:func:`~softbend.identification.dynamics.step_readings`).
 """
 
 from __future__ import annotations
@@ -35,6 +38,12 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 
 from softbend.errors import ConvergenceError, DatasetError, InputError
+from softbend.identification.dynamics import (
+    StepReading,
+    identified_model,
+    seconds_per_unit,
+    step_readings,
+)
 from softbend.identification.kernels import ShapeClippedWarning
 from softbend.identification.multi import MultiNARX, nrmse
 from softbend.identification.ranges import FOLDS_RANGE, SEED_RANGE, check_integer
@@ -171,6 +180,13 @@ class Selection:
     cv_outputs : dict of str to ndarray
         Each training experiment's free run by the chosen candidate fitted without
         its fold (the cross-validation's held-out runs).
+    time_name : str
+        The data's time column (``"sample"`` for the sample index).
+    sample_period : float
+        The data's median sampling interval, in the time column's unit.
+    dynamics : list of StepReading
+        The chosen model's gain, time constant and delay of every (input,
+        output) pair (:func:`~softbend.identification.dynamics.step_readings`).
     """
 
     table: Any
@@ -184,6 +200,14 @@ class Selection:
     validation_outputs: dict[str, np.ndarray]
     seconds: float
     cv_outputs: dict[str, np.ndarray] = field(default_factory=dict)
+    time_name: str = "sample"
+    sample_period: float = 1.0
+    dynamics: list[StepReading] = field(default_factory=list)
+
+    @property
+    def time_unit_s(self) -> float | None:
+        """Seconds per unit of the time column (None when unknown or the sample index)."""
+        return seconds_per_unit(self.time_name)
 
     @property
     def holdout_outputs(self) -> dict[str, np.ndarray]:
@@ -238,6 +262,10 @@ class Selection:
             "train": list(self.train),
             "validation": list(self.validation),
             "output_ranges": self.ranges.tolist(),
+            "time": self.time_name,
+            "sample_period": self.sample_period,
+            "time_unit_s": self.time_unit_s,
+            "dynamics": [r.to_dict() for r in self.dynamics],
             "table": self.table.to_dict(orient="records"),
             "seconds": self.seconds,
         }
@@ -412,6 +440,7 @@ def select_model(
     columns = ["candidate", "family", "na", "nb", "settings", "rows", "rung", "cv_freerun_nrmse"]
     columns += ["cv_onestep_nrmse", "validation_freerun_nrmse", "fit_s"]
     _check_finite(table, validated=bool(held))
+    identified = identified_model(fitted[best.name], data)
     return Selection(
         table=table[columns],
         best=best.name,
@@ -424,6 +453,9 @@ def select_model(
         validation_outputs=validation_outputs,
         seconds=time.perf_counter() - start,
         cv_outputs=cv_runs[best.name],
+        time_name=identified.time_name,
+        sample_period=identified.sample_period,
+        dynamics=step_readings(identified),
     )
 
 

@@ -30,7 +30,10 @@ def write_identification(
 
     ``holdout_freerun.csv`` has ``experiment``, the time column and, per output,
     ``<name>_measured`` and ``<name>_simulated``: the selected model run free on
-    each held-out experiment (:attr:`Selection.holdout_outputs`).
+    each held-out experiment (:attr:`Selection.holdout_outputs`). ``model.json``'s
+    metadata records the time column, its median sampling interval and unit, and
+    the model's step readings (gain, time constant, delay per input and output),
+    which :func:`softbend.identification.dynamics.load_identified` reads back.
     """
     from softbend._io import json_text
     from softbend.identification.multi import save_multi_narx
@@ -51,6 +54,10 @@ def write_identification(
             "train": list(selection.train),
             "validation": list(selection.validation),
             "verdict": selection.verdict(),
+            "time": selection.time_name,
+            "sample_period": selection.sample_period,
+            "time_unit_s": selection.time_unit_s,
+            "dynamics": record["dynamics"],
         },
     )
     held = selection.holdout_outputs
