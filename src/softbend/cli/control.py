@@ -47,6 +47,7 @@ def simulate_cmd(
     ),
     supply_mpa: float = opt.SUPPLY,
     rig_assignments: list[str] = opt.RIG_PARAM,
+    rig_from: Path = opt.RIG_FROM,
     seed: int = typer.Option(0, help="Seed of the sensor and camera noise."),
     strict: bool = opt.STRICT,
     as_json: bool = typer.Option(False, "--json", help="Print the metrics as JSON."),
@@ -63,7 +64,14 @@ def simulate_cmd(
     parameters (NAME=VALUE pairs), its pressures are converted from the rig's MPa
     (--supply, --rig-param and the scores stay in MPa), and the chamber is its
     description's (else --rig-param volume_mm3). A design outside the model's
-    training ranges is a warning naming the parameter; --strict refuses it.
+    training ranges is a warning naming the parameter, and the table's row
+    "design in the model's training data" and design_supported in metrics.json
+    say so; --strict refuses it. A model of 'softbend identify' (one pressure
+    input, an angle output, a time column in s or ms) may play the plant: its
+    dynamics replace θ(p) and the angle lag, and without --model its
+    steady-state θ(p) is the controller's (such a plant has no --design).
+    --rig-from such a model sets the rig's angle_time_constant_s and
+    valve_delay_s from its step reading; --rig-param values win.
     A score the run does not define (an angle that did not settle within the
     run, a run without a rising edge) is null in metrics.json and --json, with
     the reason under undefined_metrics, and 'null (the reason)' in the table;
@@ -92,10 +100,10 @@ def simulate_cmd(
                 reference=reference, controller=controller, assignments=assignments or (),
                 design=design, model=model, plant=plant, duration_s=duration_s,
                 supply_mpa=supply_mpa, rig_assignments=rig_assignments or (), seed=seed,
-                strict=strict,
+                strict=strict, rig_from=rig_from,
             )  # fmt: skip
         payload = dict(result.summary)
-        name, actuator = payload["controller"], payload["design"]
+        name, actuator = payload["controller"], control_run.actuator_of(payload)
         with (
             _common.output_errors(out, "--out"),
             staged_dir(out) as stage,
@@ -114,6 +122,7 @@ def simulate_cmd(
         _common.print_json(payload)
         return
     note, named = control_run.model_lines(result.setup)
+    named += control_run.rig_from_rows(payload.get("rig_from"))
     _common.print_table(
         f"{name} on {actuator}, {reference}: simulated rig (SYNTHETIC){note}",
         ["metric", "value"],
@@ -202,6 +211,7 @@ def serve_cmd(
     plant: str = opt.PLANT,
     supply_mpa: float = opt.SUPPLY,
     rig_assignments: list[str] = opt.RIG_PARAM,
+    rig_from: Path = opt.RIG_FROM,
     seed: int = typer.Option(0, help="Seed of the sensor and camera noise."),
     duration_s: float = typer.Option(
         0.0, "--duration", help="Serve for this long, s (0: until Ctrl-C)."
@@ -222,7 +232,6 @@ def serve_cmd(
     import time
 
     from softbend._validation import check_range
-    from softbend.control.designs import DEFAULT_DESIGN
     from softbend.control.runs import simulated_server
 
     duration = check_range(duration_s, "duration_s", low=0.0, low_inclusive=True)
@@ -230,12 +239,13 @@ def serve_cmd(
         server = simulated_server(
             config=config, host=host, port=port, design=design, model=model, plant=plant,
             supply_mpa=supply_mpa, rig_assignments=rig_assignments or (), seed=seed,
+            rig_from=rig_from,
         )  # fmt: skip
     previous = control_run.terminate_as_interrupt()  # `kill` stops it as Ctrl-C does
     try:
         server.start()
         _common.console.print(
-            f"simulated rig {design or DEFAULT_DESIGN} serving on "
+            f"simulated rig {_served(design, plant)} serving on "
             f"{server.config.connection.where} "
             f"({'Ctrl-C to stop' if duration == 0 else f'for {duration:g} s'})"
         )
@@ -290,6 +300,16 @@ def rig_config_cmd(
     with _common.output_errors(out, "--out"):
         write_text_atomic(out, text)
     _common.console.print(f"rig config written to {out}")
+
+
+def _served(design: str | None, plant: str) -> str:
+    """What ``control serve`` says it simulates: the design, or an identified plant."""
+    from softbend.control.designs import DEFAULT_DESIGN
+    from softbend.control.identified_plant import is_identified_plant
+
+    if design is None and is_identified_plant(plant):
+        return f"of the identified model {plant}"
+    return design or DEFAULT_DESIGN
 
 
 __all__ = ["app"]

@@ -42,7 +42,9 @@ PLANT = typer.Option(
     "FEM sweep), lab (its virtual-lab readings: model mismatch), or a file of your own "
     "actuator: a saved surrogate .json (e.g. from 'softbend transfer refine'; also the "
     "controller's model unless --model is given) or a measurements .csv (its loading "
-    "readings, smoothed). fem, lab and .csv are paper B's actuator's only.",
+    "readings, smoothed), or a model of 'softbend identify' (DIR/model.json: one pressure "
+    "input, an angle output; its dynamics replace θ(p) and the angle lag). fem, lab and .csv "
+    "are paper B's actuator's only.",
 )
 RIG_PARAM = typer.Option(
     None,
@@ -56,6 +58,13 @@ RIG_PARAM = typer.Option(
     "description's chamber_volume_mm3 plus tubing_mm3, growing by its "
     "volume_growth_mm3_per_mpa (else rigid, with a warning): without a described volume, "
     "give volume_mm3 (measured, tubing included) or the run is refused.",
+)
+RIG_FROM = typer.Option(
+    None,
+    "--rig-from",
+    help="A model of 'softbend identify' (DIR/model.json: a pressure input, an angle output) "
+    "whose step reading sets the simulated rig's angle_time_constant_s (its time constant) "
+    "and valve_delay_s (its delay); --rig-param values win.",
 )
 SUPPLY = typer.Option(
     None,

@@ -64,6 +64,7 @@ def run_cmd(
     ),
     supply_mpa: float = opt.SUPPLY,
     rig_assignments: list[str] = opt.RIG_PARAM,
+    rig_from: Path = opt.RIG_FROM,
     seed: int = typer.Option(0, help="Seed of a simulated rig's sensor and camera noise."),
     log_format: str = typer.Option("csv", help="Tick log format: csv (streamed) or parquet."),
     strict: bool = opt.STRICT,
@@ -113,7 +114,7 @@ def run_cmd(
             assignments=assignments or (), design=design, model=model, plant=plant,
             duration_s=duration_s, period_s=period_s, sensor_period_s=sensor_period_s,
             supply_mpa=supply_mpa, rig_assignments=rig_assignments or (), seed=seed,
-            strict=strict,
+            strict=strict, rig_from=rig_from,
         )  # fmt: skip
     done = [0]
 
@@ -132,7 +133,7 @@ def run_cmd(
             with _common.progress_bar("control loop", plan.ticks, enabled=not as_json) as advance:
                 result = plan.run(stage / log_name, progress=report, device=device)
             payload = dict(result.summary)
-            name, actuator = payload["controller"], payload["design"]
+            name, actuator = payload["controller"], actuator_of(payload)
             text = _common.json_text(payload) + "\n"
             (stage / "run.json").write_text(text, encoding="utf-8")
             title = (
@@ -148,6 +149,7 @@ def run_cmd(
         _common.print_json(payload)
     else:
         note, named = model_lines(plan.setup)
+        named += rig_from_rows(payload.get("rig_from"))
         rows = named + metric_rows(payload["metrics"], payload["undefined_metrics"])
         rows += [[k, v] for k, v in payload["jitter"].items()]
         _common.print_table(
@@ -173,19 +175,49 @@ def metric_rows(metrics: dict[str, Any], undefined: dict[str, str]) -> list[list
 def model_lines(setup: ControlSetup) -> tuple[str, list[list[Any]]]:
     """What a run's table says of its models: a note for the title and rows naming them.
 
-    Nothing for the shipped MLP against a named plant (paper B's runs); one row when
-    the plant is the controller's model; a row each otherwise, and the title's note
-    "model mismatch" when a saved surrogate plays the plant and the controller uses another.
+    Nothing for the shipped MLP against a named plant (paper B's runs) with a design
+    inside its training ranges; one row when the plant is the controller's model; a
+    row each otherwise, and the title's note "model mismatch" when a saved model
+    plays the plant and the controller uses another. An identified plant is named
+    by its description; the row "design in the model's training data" says whether
+    the design lies in the training ranges of the controller's model (as the
+    summary's ``design_supported`` and the warning do).
     """
     from softbend.control.plants import plant_file
 
     plant, model = setup.plant, setup.model_path
+    support = setup.design_support_text()
+    design_row = [[DESIGN_ROW, support]] if support is not None else []
+    if setup.identified is not None:
+        rows = [["plant", setup.identified.describe()]]
+        if not setup.has_design:
+            top = setup.model.angle_table.pmax_mpa
+            return "", [*rows, ["controller's model", f"its steady-state θ(p), 0–{top:g} MPa"]]
+        return "; model mismatch", [*rows, ["controller's model", model], *design_row]
     if setup.model_from == "shipped" and plant_file(plant) is None:
-        return "", []
+        return "", design_row if setup.design_supported is False else []
     if setup.plant_is_model:
-        return "", [["plant and controller's model", model]]
-    rows = [["plant", plant], ["controller's model", model]]
+        return "", [["plant and controller's model", model], *design_row]
+    rows = [["plant", plant], ["controller's model", model], *design_row]
     return ("; model mismatch" if setup.mismatch else ""), rows
+
+
+def actuator_of(payload: dict[str, Any]) -> str:
+    """What a run's title calls the actuator: its design, else the identified plant."""
+    design = payload.get("design")
+    return str(design) if design is not None else "the identified actuator"
+
+
+def rig_from_rows(origin: dict[str, Any] | None) -> list[list[Any]]:
+    """The row of a run's table naming the rig settings of an identified model (--rig-from)."""
+    if not origin or not origin.get("used"):
+        return []
+    values = ", ".join(f"{name} {origin[name]:.3g} s" for name in origin["used"])
+    return [["rig from", f"{origin['file']}: {values}"]]
+
+
+#: The row of a run's table that says whether the design is in its model's training data.
+DESIGN_ROW = "design in the model's training data"
 
 
 def terminate_as_interrupt() -> Any:
@@ -203,4 +235,12 @@ def terminate_as_interrupt() -> Any:
     return signal.signal(signal.SIGTERM, interrupt)
 
 
-__all__ = ["metric_rows", "model_lines", "run_cmd", "terminate_as_interrupt"]
+__all__ = [
+    "DESIGN_ROW",
+    "actuator_of",
+    "metric_rows",
+    "model_lines",
+    "rig_from_rows",
+    "run_cmd",
+    "terminate_as_interrupt",
+]

@@ -13,6 +13,10 @@ surrogate (``model.json``, e.g. the one ``softbend transfer refine`` wrote for
 it) or a measurements CSV (``readings.csv``: its loading readings of the
 design, smoothed), as ``--plant model.json`` or ``--plant readings.csv``.
 
+A model of ``softbend identify`` (a pressure input, an angle output) plays the
+plant by its dynamics instead of a θ(p) table
+(:mod:`softbend.control.identified_plant`; :func:`plant_table` does not take it).
+
 A saved surrogate of any actuator plays the plant of its design
 (:class:`~softbend.control.designs.ModelDesign`): its θ(p) is tabulated in MPa,
 the rig's unit, from the model's own pressure unit. ``fem``, ``lab`` and a
@@ -81,8 +85,8 @@ def check_plant(plant: str) -> str:
             PLANTS.check(plant)
         except UnknownNameError as exc:
             raise UnknownNameError(
-                f"{exc.detail} A plant may also be the path of a saved surrogate (.json) or of "
-                "measurements (.csv).",
+                f"{exc.detail} A plant may also be the path of a saved surrogate (.json), of a "
+                "model of 'softbend identify' (.json) or of measurements (.csv).",
                 key="plant",
             ) from None
     return plant

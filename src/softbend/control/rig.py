@@ -26,7 +26,9 @@ own (every one a field of :class:`RigParams`, with its unit in its name):
   (:func:`cavity_compliance_mm3_per_mpa`, :meth:`RigParams.from_fem_sweep`; the
   cavity grows 2.7-fold by 0.18 MPa);
   isothermal (polytropic exponent 1.0) unless set;
-- the angle follows the quasi-static θ(p) through a first-order lag of 30 ms;
+- the angle follows the quasi-static θ(p) through a first-order lag of 30 ms
+  (or, given an :class:`AngleDynamics`, a dynamic model such as an identified
+  one: :mod:`softbend.control.identified_plant`);
 - the pressure sensor has 0.5 kPa Gaussian noise and 12-bit quantisation over
   0–0.5 MPa gauge; the camera runs at 240 fps, no latency, 0.2° noise.
 
@@ -66,6 +68,7 @@ __all__ = [
     "GAS_CONSTANT_J_KG_K",
     "RIG_RANGES",
     "TUBING_RANGE",
+    "AngleDynamics",
     "AngleTable",
     "Rig",
     "RigParams",
@@ -476,6 +479,23 @@ class AngleTable:
 
 
 @runtime_checkable
+class AngleDynamics(Protocol):
+    """A dynamic model of the angle that replaces θ(p) and its first-order lag in the rig.
+
+    :class:`SimulatedRig` calls :meth:`reset` at its own reset (the angle at
+    rest, degrees) and :meth:`advance` after every integration step with the
+    true gauge pressure at its end (MPa) and the step (s); it returns the true
+    angle then, degrees. One object serves one rig at a time (it holds the state).
+    :class:`softbend.control.identified_plant.NARXAngle` is one: an identified
+    NARX model stepped at its sample period.
+    """
+
+    def reset(self) -> float: ...
+
+    def advance(self, pressure_mpa: float, dt_s: float) -> float: ...
+
+
+@runtime_checkable
 class Rig(Protocol):
     """What the fixed-period loop (:func:`softbend.control.loop.run_loop`) needs from a rig.
 
@@ -519,6 +539,10 @@ class SimulatedRig:
     params : RigParams, optional
     seed : int
         Seed of the sensor and camera noise.
+    dynamics : AngleDynamics, optional
+        A dynamic model of the angle (an identified model): when given, the true
+        angle is its output for the chamber pressure, and ``angle_map`` and
+        ``angle_time_constant_s`` are not used for it.
 
     Attributes (state, SI inside): ``t_s``, ``p_pa`` (absolute), ``angle_deg``
     (true), ``inlet_open``, ``outlet_open`` (actual valve states), ``air_used_kg``
@@ -529,14 +553,25 @@ class SimulatedRig:
     where = "simulated"
 
     def __init__(
-        self, angle_map: Callable[[float], float], params: RigParams | None = None, *, seed: int = 0
+        self,
+        angle_map: Callable[[float], float],
+        params: RigParams | None = None,
+        *,
+        seed: int = 0,
+        dynamics: AngleDynamics | None = None,
     ) -> None:
         if not callable(angle_map):
             raise ValueError(
                 f"The 'angle_map' of SimulatedRig must be callable. Got {angle_map!r} instead."
             )
+        if dynamics is not None and not isinstance(dynamics, AngleDynamics):
+            raise ValueError(
+                "The 'dynamics' of SimulatedRig must have reset() and advance(pressure_mpa, "
+                f"dt_s). Got {dynamics!r} instead."
+            )
         self.params = RigParams() if params is None else params
         self.angle_map = angle_map
+        self.dynamics = dynamics
         self.step_s = self.params.step_s
         self.seed = check_int(seed, "seed", low=0)
         self._derive()
@@ -570,7 +605,10 @@ class SimulatedRig:
         self.t_s = 0.0
         self._i = 0
         self.p_pa = self._patm
-        self.angle_deg = float(self.angle_map(0.0))
+        if self.dynamics is None:
+            self.angle_deg = float(self.angle_map(0.0))
+        else:
+            self.angle_deg = float(self.dynamics.reset())
         self.inlet_open = False
         self.outlet_open = False
         self._pending: list[tuple[int, bool, bool]] = []
@@ -627,6 +665,7 @@ class SimulatedRig:
         v0, k, n = self._v0, self._k, self._n
         nrt = n * self._rt
         sqrt = math.sqrt
+        dynamics = self.dynamics
         for _ in range(steps):
             pending = self._pending
             while pending and pending[0][0] <= self._i:
@@ -662,8 +701,11 @@ class SimulatedRig:
                 p = min(max(p + 0.5 * h * (rate0 + rate), lo), hi)
                 self.air_used_kg += 0.5 * h * (flow0 + qin)
                 self.p_pa = p
-            target = angle_map((p - lo) * 1e-6)
-            self.angle_deg += lag * (target - self.angle_deg)
+            if dynamics is None:
+                target = angle_map((p - lo) * 1e-6)
+                self.angle_deg += lag * (target - self.angle_deg)
+            else:
+                self.angle_deg = dynamics.advance((p - lo) * 1e-6, h)
             self._i += 1
             self.t_s = self._i * h
             if self.t_s >= self._next_frame - 1e-12:

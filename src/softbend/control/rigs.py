@@ -26,7 +26,7 @@ from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
 from softbend.control.designs import ModelDesign
-from softbend.control.rig import AngleTable, Rig, RigParams, SimulatedRig
+from softbend.control.rig import AngleDynamics, AngleTable, Rig, RigParams, SimulatedRig
 from softbend.control.rigconfig import (
     DEFAULT_TUBING_MM3,
     RigConfig,
@@ -81,6 +81,9 @@ class RigSetup:
         Pneumatics of a simulated rig (default :class:`RigParams`).
     seed : int, default 0
         Seed of a simulated rig's sensor and camera noise.
+    dynamics : AngleDynamics, optional
+        A dynamic model of a simulated actuator's angle (an identified model) that
+        replaces ``plant_table`` and the angle lag (:class:`~softbend.control.rig.SimulatedRig`).
     """
 
     config: RigConfig = field(default_factory=RigConfig)
@@ -88,6 +91,7 @@ class RigSetup:
     plant_table: AngleTable | None = None
     params: RigParams | None = None
     seed: int = 0
+    dynamics: AngleDynamics | None = None
 
 
 def sim_rig(setup: RigSetup) -> SimulatedRig:
@@ -96,7 +100,7 @@ def sim_rig(setup: RigSetup) -> SimulatedRig:
         raise InputError(
             "must be given for a simulated rig (the actuator's θ(p))", key="plant_table"
         )
-    return SimulatedRig(setup.plant_table, setup.params, seed=setup.seed)
+    return SimulatedRig(setup.plant_table, setup.params, seed=setup.seed, dynamics=setup.dynamics)
 
 
 def sim_realtime_rig(setup: RigSetup) -> WallClockRig:

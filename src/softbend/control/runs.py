@@ -79,6 +79,7 @@ def simulate_control(
     rig_assignments: Sequence[str] = (),
     seed: int = 0,
     strict: bool = False,
+    rig_from: str | Path | None = None,
 ) -> Simulation:
     """Run a controller on the simulated rig of ``design`` and score it (synthetic).
 
@@ -93,13 +94,18 @@ def simulate_control(
     that reaches a pressure past what the models were trained to near the
     design warns (:func:`~softbend.control.setup.beyond_support`) and says so in
     the summary's ``support``; with ``strict`` the run is refused before it starts
-    when the supply lies past it.
+    when the supply lies past it. ``rig_from``, a model saved by ``softbend
+    identify``, sets the rig's ``angle_time_constant_s`` and ``valve_delay_s``
+    from its step reading (:func:`~softbend.control.identified_plant.rig_settings_from`;
+    ``rig_assignments`` win); the summary's ``rig_from`` says where they came from.
+    ``plant`` may be such a model too: its dynamics then play the actuator
+    (:mod:`softbend.control.identified_plant`).
     """
     from softbend.control.experiments import run_metrics, simulate, summary_metrics
     from softbend.control.rig import RigParams, SimulatedRig
 
     ref = parse_reference(reference)
-    simulated = _rig_settings(rig_assignments, {}, supply_mpa)
+    simulated, origin = _rig_settings(rig_assignments, {}, supply_mpa, rig_from)
     check_run_size(
         duration_s, simulated.get("step_s", RigParams.step_s), SIMULATE_BYTES_PER_STEP,
         what="A simulated run", unit="rig steps",
@@ -108,7 +114,9 @@ def simulate_control(
         controller=controller, assignments=assignments, design=design, model=model,
         plant=plant, rig_settings=simulated, strict=strict,
     )  # fmt: skip
-    rig = SimulatedRig(setup.plant_table, setup.rig_params, seed=seed)
+    rig = SimulatedRig(
+        setup.plant_table, setup.rig_params, seed=seed, dynamics=setup.plant_dynamics()
+    )
     run = simulate(rig, setup.controller, ref, duration_s, seed=seed)
     reached = float(np.max(run.pressure_mpa))
     beyond = beyond_support(setup, reached)
@@ -124,6 +132,7 @@ def simulate_control(
         "seed": seed,
         "rig": setup.rig_params.as_dict(),
         "rig_settings": dict(setup.rig_settings),
+        **({"rig_from": origin} if origin is not None else {}),
         "metrics": metrics,
         "undefined_metrics": undefined,
         "support": {
@@ -174,6 +183,7 @@ class LoopPlan:
     period_s: float
     sensor_period_s: float
     seed: int
+    rig_from: dict[str, Any] | None = None
 
     @property
     def ticks(self) -> int:
@@ -249,6 +259,7 @@ class LoopPlan:
             "rig_config": self.rig_setup.config.to_toml(),
             "rig_params": self.setup.rig_params.as_dict() if synthetic else None,
             "rig_settings": dict(self.setup.rig_settings) if synthetic else None,
+            **({"rig_from": self.rig_from} if self.rig_from is not None else {}),
             "support": {
                 "supported_mpa": self.setup.supported_mpa,
                 "max_pressure_mpa": reached,
@@ -279,6 +290,7 @@ def plan_loop(
     rig_assignments: Sequence[str] = (),
     seed: int = 0,
     strict: bool = False,
+    rig_from: str | Path | None = None,
 ) -> LoopPlan:
     """Check a loop run and build its controller; the rig is built by :meth:`LoopPlan.run`.
 
@@ -305,6 +317,12 @@ def plan_loop(
     """
     with keyed("rig"):
         RIGS.check(rig)
+    if rig in HARDWARE_RIGS and rig_from is not None:
+        raise InputError(
+            f"sets the simulated rig, but the rig {rig} is hardware (its pneumatics are what "
+            f"they are): drop it, or use the rig sim or sim-realtime; got {str(rig_from)!r}",
+            key="rig_from",
+        )
     if rig in HARDWARE_RIGS and rig_assignments:
         raise InputError(
             f"set the simulated rig, but the rig {rig} is hardware (its pneumatics are what "
@@ -317,7 +335,7 @@ def plan_loop(
     tick = settings.period_s if period_s is None else period_s
     sensor = settings.sensor_period_s if sensor_period_s is None else sensor_period_s
     table = dict(settings.simulation) if rig not in HARDWARE_RIGS else {}
-    simulated = _rig_settings(rig_assignments, table, supply_mpa)
+    simulated, origin = _rig_settings(rig_assignments, table, supply_mpa, rig_from)
     check_range(tick, "period_s", low=0.0, high=1.0, high_inclusive=True)
     check_range(
         sensor, "sensor_period_s", low=tick, high=10.0,
@@ -332,10 +350,12 @@ def plan_loop(
     rig_setup = RigSetup(
         config=settings, config_path=None if config is None else Path(config),
         plant_table=setup.plant_table, params=setup.rig_params, seed=seed,
+        dynamics=setup.plant_dynamics(),
     )  # fmt: skip
     return LoopPlan(
         setup=setup, rig=rig, rig_setup=rig_setup, reference_spec=reference, reference=ref,
         duration_s=duration_s, period_s=tick, sensor_period_s=sensor, seed=seed,
+        rig_from=origin,
     )  # fmt: skip
 
 
@@ -350,13 +370,15 @@ def simulated_server(
     supply_mpa: float | None = None,
     rig_assignments: Sequence[str] = (),
     seed: int = 0,
+    rig_from: str | Path | None = None,
 ) -> SimulatedModbusServer:
     """The simulated rig of ``design`` behind a Modbus TCP server (not started).
 
     The register map is the ``config``'s (default: the built-in map); ``port``
     defaults to the config's, else 5020. The rig's parameters are the config's
     [simulation] table with ``rig_assignments`` (``--rig-param NAME=VALUE``) and
-    ``supply_mpa`` over it (:func:`~softbend.control.rigs.rig_settings`).
+    ``supply_mpa`` over it (:func:`~softbend.control.rigs.rig_settings`), and the
+    lag and delay of ``rig_from`` (an identified model) under them.
     """
     from softbend.control.modbus_server import SimulatedModbusServer
     from softbend.control.rig import SimulatedRig
@@ -370,19 +392,37 @@ def simulated_server(
     if not 0 <= listen <= 65535:
         raise InputError(must_be("an integer in [0, 65535]", listen), key="port")
     table = dict(settings.simulation)
-    simulated = _rig_settings(rig_assignments, table, supply_mpa)
+    simulated, _ = _rig_settings(rig_assignments, table, supply_mpa, rig_from)
     setup = prepare_control(design=design, model=model, plant=plant, rig_settings=simulated)
-    rig = SimulatedRig(setup.plant_table, setup.rig_params, seed=seed)
+    rig = SimulatedRig(
+        setup.plant_table, setup.rig_params, seed=seed, dynamics=setup.plant_dynamics()
+    )
     return SimulatedModbusServer(rig, settings, host=host, port=listen)
 
 
 def _rig_settings(
-    rig_assignments: Sequence[str], table: dict[str, Any], supply_mpa: float | None
-) -> dict[str, Any]:
-    """The simulated rig's settings: ``supply_mpa`` checked as a gauge pressure first."""
+    rig_assignments: Sequence[str],
+    table: dict[str, Any],
+    supply_mpa: float | None,
+    rig_from: str | Path | None = None,
+) -> tuple[dict[str, Any], dict[str, Any] | None]:
+    """The simulated rig's settings, and where those of ``rig_from`` came from (else None).
+
+    ``supply_mpa`` is checked as a gauge pressure first; the settings given
+    (``rig_assignments``, ``table``) win over those of ``rig_from``.
+    """
     if supply_mpa is not None:
         check_supply(supply_mpa)
-    return rig_settings(rig_assignments, table, supply_mpa=supply_mpa)
+    given = rig_settings(rig_assignments, table, supply_mpa=supply_mpa)
+    if rig_from is None:
+        return given, None
+    from softbend.control.identified_plant import rig_settings_from
+
+    derived, record = rig_settings_from(rig_from)
+    used = {k: v for k, v in derived.items() if k not in given}
+    record["used"] = sorted(used)
+    record["overridden"] = sorted(set(derived) - set(used))
+    return {**used, **given}, record
 
 
 def _percentiles_ms(values: list[float]) -> dict[str, float]:

@@ -18,6 +18,13 @@ else :data:`~softbend.control.factory.DEFAULT_CONTROLLER` with its defaults;
 parameters are :class:`~softbend.control.rig.RigParams` of the design with the
 settings of :func:`~softbend.control.rigs.rig_settings` applied
 (:func:`~softbend.control.rigs.rig_params_for`).
+
+A model of ``softbend identify`` may play the plant
+(:mod:`~softbend.control.identified_plant`): its dynamics replace the rig's
+θ(p) and angle lag. Without ``model`` it is also the controllers' model (its
+steady-state θ(p)); such a plant has no design, so ``design`` is refused, and
+the rig's chamber is that of paper B's default design unless ``volume_mm3`` is
+set.
 """
 
 from __future__ import annotations
@@ -40,6 +47,8 @@ from softbend.errors import InputError, keyed
 from softbend.parameters import effective_parameters, parse_assignments
 
 if TYPE_CHECKING:
+    from softbend.control.identified_plant import IdentifiedPlant
+    from softbend.control.rig import AngleDynamics
     from softbend.surrogates.persistence import SavedSurrogate
 
 __all__ = [
@@ -92,6 +101,13 @@ class ControlSetup:
         The description of the controller's model (paper B's, or the model's own).
     design_notes : list of str
         Where the design leaves the training ranges of the controller's model.
+    design_outside : list of str
+        The parameters of the design outside those ranges, one phrase each
+        (``"l_mm 8 outside [100, 160]"``).
+    identified : IdentifiedPlant, optional
+        The identified dynamic model that plays the actuator (``plant`` its file);
+        ``plant_table`` is then its steady-state θ(p) and :meth:`plant_dynamics`
+        its dynamics.
     """
 
     design: SFRBADesign | ModelDesign
@@ -109,10 +125,34 @@ class ControlSetup:
     model_from: str = "shipped"
     actuator: Actuator = SFRBA
     design_notes: list[str] = field(default_factory=list)
+    design_outside: list[str] = field(default_factory=list)
+    identified: IdentifiedPlant | None = field(default=None, repr=False)
+
+    def plant_dynamics(self) -> AngleDynamics | None:
+        """A fresh dynamic model of the plant's angle for a rig, else None (θ(p) and a lag)."""
+        return None if self.identified is None else self.identified.dynamics()
+
+    @property
+    def has_design(self) -> bool:
+        """Whether the run has a design (not so for an identified plant without --model)."""
+        return not (self.identified is not None and self.model_from == "plant")
+
+    @property
+    def design_supported(self) -> bool | None:
+        """Whether the design lies in the training ranges of the controller's model
+        (None when the run has no design)."""
+        return not self.design_outside if self.has_design else None
+
+    def design_support_text(self) -> str | None:
+        """``"yes"`` or ``"no (l_mm 8 outside [100, 160])"``; None without a design."""
+        supported = self.design_supported
+        if supported is None:
+            return None
+        return "yes" if supported else f"no ({'; '.join(self.design_outside)})"
 
     @property
     def mismatch(self) -> bool:
-        """Whether the plant is a saved surrogate other than the controller's model."""
+        """Whether the plant is a saved model other than the controller's model."""
         return _plant_model(self.plant) is not None and not self.plant_is_model
 
     @property
@@ -132,8 +172,12 @@ class ControlSetup:
             "plant": self.plant,
             "model": self.model_path,
             "model_from": self.model_from,
-            "design": str(self.design),
+            "design": str(self.design) if self.has_design else None,
+            "design_supported": self.design_supported,
+            "design_outside": list(self.design_outside),
         }
+        if self.identified is not None:
+            out["plant_description"] = self.identified.describe()
         if isinstance(self.design, ModelDesign):
             out["actuator"] = self.actuator.name
             out["design_parameters"] = self.design.as_record()
@@ -260,9 +304,11 @@ def prepare_control(
     plant : str
         The actuator's θ(p): a name of :data:`~softbend.control.plants.PLANTS`, or a
         saved surrogate ``.json`` / measurements ``.csv`` of the lab's own actuator
-        (:func:`~softbend.control.plants.plant_table`). A saved surrogate and
-        ``model`` must describe the same design parameters (their pressure units
-        may differ).
+        (:func:`~softbend.control.plants.plant_table`), or a model of ``softbend
+        identify`` (``.json``) whose dynamics play the actuator (one pressure input,
+        an angle output, a known time unit; else an InputError keyed ``plant``). A
+        saved surrogate and ``model`` must describe the same design parameters
+        (their pressure units may differ).
     supply_mpa : float, default 0.2
         Supply pressure of the simulated rig, MPa gauge (``supply_gauge_mpa`` of
         ``rig_settings``, when given, replaces it: :func:`~softbend.control.rigs.rig_settings`
@@ -305,6 +351,9 @@ def prepare_control(
     else:
         supply_mpa = check_supply(supply_mpa)
     chosen = {**settings, "supply_gauge_mpa": supply_mpa}
+    identified = _identified_plant(plant)
+    if identified is not None and model is None:
+        return _identified_setup(identified, name, params, design, settings, chosen, supply_mpa)
     model_path, model_from = model_of_run(model, plant)
     saved = load_base_saved(model_path)
     label = str(model_path) if model_path is not None else str(shipped_base_path())
@@ -312,7 +361,7 @@ def prepare_control(
     actuator = saved.actuator
     with keyed("design"):
         actuator_design = control_design(design, actuator, source=source)
-    plant_path = _plant_model(plant)
+    plant_path = _plant_model(plant) if identified is None else None
     shared = (
         plant_path is not None and model_path is not None and _same_file(plant_path, model_path)
     )
@@ -333,7 +382,7 @@ def prepare_control(
         compliance = fem_curve(actuator_design).compliance_mm3_per_mpa(supply_mpa)
         rig = rig_params_for(actuator_design, chosen, compliance_mm3_per_mpa=compliance)
     surrogate = saved.model
-    design_notes = _design_check(model_path, label, actuator_design, strict)
+    design_notes, outside = _design_check(model_path, label, actuator_design, strict)
     supported, notes = _support_check(
         saved, model_path, plant_path, shared, actuator_design, supply_mpa, strict
     )
@@ -342,10 +391,13 @@ def prepare_control(
     controller_model = ControllerModel.from_surrogate(
         surrogate, actuator_design, rig, pmax_mpa=pmax
     )
-    with keyed("plant"):
-        actuator_table = plant_table(
-            plant, actuator_design, controller_model.angle_table, pmax_mpa=pmax
-        )
+    if identified is None:
+        with keyed("plant"):
+            actuator_table = plant_table(
+                plant, actuator_design, controller_model.angle_table, pmax_mpa=pmax
+            )
+    else:  # the rig steps its dynamics; its steady state is the plant's θ(p) on record
+        actuator_table = identified.angle_table(supply_mpa, check=False)
     built = CONTROLLERS.get(name)(controller_model, **params)  # checked by resolve_controller
     return ControlSetup(
         design=actuator_design,
@@ -363,11 +415,70 @@ def prepare_control(
         model_from=model_from,
         actuator=actuator,
         design_notes=design_notes,
+        design_outside=outside,
+        identified=identified,
+    )
+
+
+def _identified_plant(plant: str) -> IdentifiedPlant | None:
+    """The plant as an identified dynamic model (checked to play the actuator), else None."""
+    from softbend.control.identified_plant import identified_plant, is_identified_plant
+    from softbend.control.plants import plant_file
+
+    path = plant_file(plant)
+    if path is None or not is_identified_plant(path):
+        return None
+    with keyed("plant"):
+        return identified_plant(path)
+
+
+def _identified_setup(
+    identified: IdentifiedPlant,
+    name: str,
+    params: dict[str, Any],
+    design: str | SFRBADesign | ModelDesign | None,
+    settings: dict[str, Any],
+    chosen: dict[str, Any],
+    supply_mpa: float,
+) -> ControlSetup:
+    """An identified plant that is also the controller's model: its steady-state θ(p).
+
+    Such a plant has no design: a ``design`` is refused (it would be for the
+    controller's model of ``--model``). The rig's chamber is paper B's default
+    design's unless ``volume_mm3`` is set.
+    """
+    from softbend.control.rigs import rig_params_for
+
+    if design is not None:
+        raise InputError(
+            "must not be given with an identified --plant and no --model: the identified "
+            f"model {identified.path} is of one actuator, with no design parameters (give "
+            "--model, a saved surrogate, for a controller's model of a design)",
+            key="design",
+        )
+    rig = rig_params_for(SFRBADesign.parse(DEFAULT_DESIGN), chosen)
+    with keyed("plant"):
+        table = identified.angle_table(supply_mpa)
+    controller_model = ControllerModel(table, table, rig)
+    built = CONTROLLERS.get(name)(controller_model, **params)  # checked by resolve_controller
+    return ControlSetup(
+        design=SFRBADesign.parse(DEFAULT_DESIGN),
+        rig_params=rig,
+        plant=str(identified.path),
+        plant_table=table,
+        model=controller_model,
+        controller_name=name,
+        controller_params=params,
+        controller=built,
+        rig_settings=dict(settings),
+        model_path=str(identified.path),
+        model_from="plant",
+        identified=identified,
     )
 
 
 def _plant_model(plant: str) -> Path | None:
-    """The plant as a saved surrogate's file, else None."""
+    """The plant as a saved model's file (a surrogate or an identified model), else None."""
     from softbend.control.plants import plant_file
 
     path = plant_file(plant)
@@ -401,9 +512,12 @@ def _design_check(
     label: str,
     design: SFRBADesign | ModelDesign,
     strict: bool,
-) -> list[str]:
-    """Where ``design`` leaves the training ranges of the controller's model: a warning each
-    (naming the model and the parameters), or with ``strict`` a refusal."""
+) -> tuple[list[str], list[str]]:
+    """Where ``design`` leaves the training ranges of the controller's model: a warning
+    (naming the model and the parameters), or with ``strict`` a refusal.
+
+    Returns the note (none when the design lies inside) and the phrases, one per
+    parameter outside (``"l_mm 8 outside [100, 160]"``)."""
     from softbend.surrogates.predict import predict_angles
     from softbend.transfer.base import shipped_base_path
 
@@ -413,7 +527,7 @@ def _design_check(
     names = set(design.actuator.names if isinstance(design, ModelDesign) else SFRBA.names)
     phrases = [phrase for phrase in outside if phrase.split(" ", 1)[0] in names]
     if not phrases:
-        return []
+        return [], []
     note = (
         f"The design {design} lies outside the training ranges of the controller's model "
         f"{label}: {'; '.join(phrases)}; its θ(p) there is an extrapolation"
@@ -421,7 +535,7 @@ def _design_check(
     if strict:
         raise ValueError(f"The design must lie in its model's training data (--strict): {note}.")
     warnings.warn(f"{note} (--strict refuses it).", UserWarning, stacklevel=3)
-    return [note]
+    return [note], phrases
 
 
 def _support_check(
