@@ -20,21 +20,25 @@ with a prediction interval for a new reading:
                        interval of the fit's residual standard deviation
 =====================  =========================================================
 
-The Gaussian process is scikit-learn's. It is stored as its fitted
-log-hyperparameters and training set and rebuilt with them fixed, which gives
-back the same predictions.
+The Gaussian process is scikit-learn's kernel and regression. It is stored as its
+fitted log-hyperparameters and training set and rebuilt with them fixed, which
+gives back the same predictions; it predicts with
+:class:`~softbend.surrogates.gp_core.FixedGP` (NumPy alone, the same numbers to
+about 1e-12), so a saved correction loads and predicts without scikit-learn or
+SciPy.
 """
 
 from __future__ import annotations
 
+from statistics import NormalDist
 from typing import Any
 
 import numpy as np
 from numpy.typing import ArrayLike
-from scipy.stats import norm
 
 from softbend._validation import check_range
 from softbend.errors import InputError
+from softbend.surrogates.gp_core import FixedGP
 from softbend.surrogates.protocol import Surrogate
 
 __all__ = [
@@ -64,7 +68,9 @@ def scaled_pressure_rows(X: ArrayLike, scale: float) -> np.ndarray:
 def _half_width(level: float, std: np.ndarray | float) -> np.ndarray | float:
     """Half the central interval of probability ``level`` of a Gaussian of ``std``."""
     level = check_range(level, "level", low=0.0, high=1.0)
-    return norm.ppf(0.5 + level / 2) * std
+    if level == 1.0:
+        return np.inf * np.ones_like(std) if isinstance(std, np.ndarray) else np.inf
+    return NormalDist().inv_cdf(0.5 + level / 2) * std
 
 
 class AffineCorrected:
@@ -154,9 +160,11 @@ class GPCorrected:
 
     ``z`` is the rows with the base's angle appended, standardized by
     ``z_mean`` and ``z_scale`` (so an error that grows with the angle is a
-    smooth function of one input). The GP (scikit-learn's, ``normalize_y``)
-    has the kernel :func:`gp_kernel` fixed at ``kernel_theta``; it is fitted
-    here, on ``inputs`` and ``targets``, without optimizing it again.
+    smooth function of one input). The GP (scikit-learn's regression with
+    ``normalize_y``) has the kernel :func:`gp_kernel` fixed at ``kernel_theta``;
+    it is fitted here, on ``inputs`` and ``targets``, without optimizing it
+    again, and predicts with :class:`~softbend.surrogates.gp_core.FixedGP`
+    (NumPy alone; ``gp_`` builds scikit-learn's on first use).
 
     Parameters
     ----------
@@ -182,23 +190,32 @@ class GPCorrected:
         inputs: ArrayLike,
         targets: ArrayLike,
     ) -> None:
-        from sklearn.gaussian_process import GaussianProcessRegressor
-
         self.base = base
         self.z_mean_ = np.asarray(z_mean, dtype=np.float64)
         self.z_scale_ = np.asarray(z_scale, dtype=np.float64)
         self.inputs_ = np.asarray(inputs, dtype=np.float64)
         self.targets_ = np.asarray(targets, dtype=np.float64)
-        kernel = gp_kernel(self.inputs_.shape[1])
-        kernel.theta = np.asarray(kernel_theta, dtype=np.float64)
-        self.gp_ = GaussianProcessRegressor(kernel=kernel, normalize_y=True, optimizer=None)
-        self.gp_.fit(self.inputs_, self.targets_)
+        self._gp = FixedGP(kernel_theta, self.inputs_, self.targets_)
+        self._sklearn_gp: Any = None
         self.n_features_in_ = int(base.n_features_in_)
 
     @property
     def kernel_theta_(self) -> np.ndarray:
         """The kernel's log-hyperparameters (constant, length scales, noise)."""
-        return self.gp_.kernel_.theta
+        return self._gp.theta
+
+    @property
+    def gp_(self) -> Any:
+        """scikit-learn's ``GaussianProcessRegressor`` fitted with the kernel fixed (built on
+        first use; the predictions are :class:`~softbend.surrogates.gp_core.FixedGP`'s)."""
+        if self._sklearn_gp is None:
+            from sklearn.gaussian_process import GaussianProcessRegressor
+
+            kernel = gp_kernel(self.inputs_.shape[1])
+            kernel.theta = self._gp.theta
+            gp = GaussianProcessRegressor(kernel=kernel, normalize_y=True, optimizer=None)
+            self._sklearn_gp = gp.fit(self.inputs_, self.targets_)
+        return self._sklearn_gp
 
     def _inputs(self, rows: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         theta = np.asarray(self.base.predict(rows), dtype=np.float64)
@@ -209,7 +226,7 @@ class GPCorrected:
     ) -> np.ndarray | tuple[np.ndarray, np.ndarray]:
         """Corrected angle, degrees (and the predictive standard deviation, degrees)."""
         theta, z = self._inputs(_rows(X, self.n_features_in_))
-        mean, std = self.gp_.predict(z, return_std=True)
+        mean, std = self._gp.predict(z)
         return (theta + mean, std) if return_std else theta + mean
 
     def predict_interval(self, X: ArrayLike, level: float = 0.9) -> tuple[np.ndarray, np.ndarray]:

@@ -66,7 +66,7 @@ import logging
 import math
 import os
 import sys
-from collections.abc import Iterator
+from collections.abc import Callable, Iterator, Mapping
 from contextlib import contextmanager
 from contextvars import ContextVar
 from dataclasses import dataclass, field
@@ -111,6 +111,7 @@ __all__ = [
     "SavedSurrogate",
     "check_fitted_surrogate",
     "kind_of",
+    "load_light",
     "load_state",
     "load_surrogate",
     "save_surrogate",
@@ -825,7 +826,14 @@ def _restore(document: dict[str, Any], path: Path | str, depth: int = 0) -> Surr
         return _restore_composite(document, path, depth)
     storage = _stored(kind).storage
     assert storage is not None  # _stored refuses a family without a storage
+    builder = (_BUILDERS.get() or {}).get(kind)
+    if builder is not None and _arrays_suffice(document):
+        return cast(Surrogate, builder(_saved_state(document)))
     state = _family_state(document)
+    if builder is not None and storage.codec is not None:  # the builder may decline: None
+        light = builder(SavedState(kind, document["params"], state, document["metadata"]))
+        if light is not None:
+            return cast(Surrogate, light)
     cls = _class_of(kind)
     if storage.codec is not None:
         return storage.codec.restore(cls, document["params"], state, str(path))
@@ -960,23 +968,83 @@ def load_state(path: str | os.PathLike[str], kinds: tuple[str, ...]) -> SavedSta
         return _load_state(document, path, kinds)
 
 
+def _arrays_suffice(document: dict[str, Any]) -> bool:
+    """Whether a family's file gives everything its prediction needs without its estimator:
+    no codec, every constructor parameter, and no ``feature_names_in_`` (checked by the
+    estimator on each prediction)."""
+    kind = document["kind"]
+    storage = None if kind in COMPOSITE_KINDS else _stored(kind).storage
+    return (
+        storage is not None
+        and storage.codec is None
+        and storage.schema.params is not None
+        and set(storage.schema.params) <= set(document["params"])
+        and "feature_names_in_" not in document["state"]
+    )
+
+
+def _saved_state(document: dict[str, Any]) -> SavedState:
+    """A family's document validated as :func:`load_surrogate` does, its estimator not built."""
+    kind = document["kind"]
+    storage = _stored(kind).storage
+    assert storage is not None and storage.schema.params is not None  # _arrays_suffice
+    state = _family_state(document)
+    params = _validated(document["params"], storage.schema.params, kind, "params")
+    _check_against(kind, params, state)
+    return SavedState(kind=kind, params=params, state=state, metadata=document["metadata"])
+
+
 def _load_state(
     document: dict[str, Any], path: Path, kinds: tuple[str, ...]
 ) -> SavedState | SavedSurrogate:
     _check_training_ranges(document["metadata"])
     _check_support(document["metadata"])
-    kind = document["kind"]
-    storage = None if kind in COMPOSITE_KINDS else _stored(kind).storage
-    if (
-        kind in kinds
-        and storage is not None
-        and storage.codec is None
-        and storage.schema.params is not None
-        and set(storage.schema.params) <= set(document["params"])
-        and "feature_names_in_" not in document["state"]
-    ):
-        state = _family_state(document)
-        params = _validated(document["params"], storage.schema.params, kind, "params")
-        _check_against(kind, params, state)
-        return SavedState(kind=kind, params=params, state=state, metadata=document["metadata"])
+    if document["kind"] in kinds and _arrays_suffice(document):
+        return _saved_state(document)
     return _saved_surrogate(document, path)
+
+
+#: Family → how :func:`load_light` builds its predictor from its validated arrays.
+_BUILDERS: ContextVar[Mapping[str, Callable[[SavedState], Any]] | None] = ContextVar(
+    "softbend_light_builders", default=None
+)
+
+
+def load_light(
+    path: str | os.PathLike[str], builders: Mapping[str, Callable[[SavedState], Any]]
+) -> SavedSurrogate:
+    """:func:`load_surrogate`, with the families in ``builders`` built from their arrays.
+
+    Every family surrogate in the file (the file's own, or one inside a composite:
+    the base of a correction, the members of an ensemble) whose kind is in
+    ``builders`` and whose arrays suffice (as for :func:`load_state`) is validated by
+    the same rules and then built by ``builders[kind](saved_state)`` instead of its
+    estimator, so its class and what it imports (scikit-learn, PyTorch) stay
+    unloaded. A family with its own codec (XGBoost) is offered its state checked by
+    its schema (``params`` as written); the builder returns None to have the
+    estimator built instead. The composites are built as by :func:`load_surrogate`.
+
+    Parameters
+    ----------
+    path : str or os.PathLike
+        The JSON file.
+    builders : mapping of str to callable
+        Family name → a callable taking a :class:`SavedState` and returning an
+        object with ``predict(rows)`` (degrees) and ``n_features_in_``.
+
+    Returns
+    -------
+    SavedSurrogate
+        As :func:`load_surrogate`; its ``model`` (or a composite's inner models) may
+        be a builder's predictor.
+
+    Raises
+    ------
+    FileNotFoundError, softbend.errors.SchemaError, softbend.errors.LimitError
+        As :func:`load_surrogate`.
+    """
+    token = _BUILDERS.set(dict(builders))
+    try:
+        return load_surrogate(path)
+    finally:
+        _BUILDERS.reset(token)

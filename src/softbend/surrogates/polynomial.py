@@ -20,7 +20,6 @@ import itertools
 import logging
 import math
 from collections.abc import Callable
-from dataclasses import dataclass
 
 import numpy as np
 from numpy.typing import ArrayLike
@@ -32,6 +31,10 @@ from sklearn.utils.validation import check_is_fitted, validate_data
 
 from softbend._validation import check_int, check_range
 from softbend.errors import ConvergenceError, InputError
+from softbend.surrogates.polynomial_core import Plan as _Plan
+from softbend.surrogates.polynomial_core import design_t as _design_t
+from softbend.surrogates.polynomial_core import plan as _plan
+from softbend.surrogates.polynomial_core import polynomial_predict
 
 logger = logging.getLogger(__name__)
 
@@ -130,66 +133,6 @@ def _check_finite(values: np.ndarray, name: str) -> None:
             f"({int(bad.sum())} non-finite values)",
             key=name,
         )
-
-
-@dataclass(frozen=True)
-class _Plan:
-    """How to build every monomial as (a lower monomial) × (one feature).
-
-    ``levels[k] = (rows, parents, features)``: the monomials of total degree
-    k + 1, each the product of the monomial ``parents[i]`` and feature
-    ``features[i]``. Evaluating all T terms costs T multiplications per sample.
-    """
-
-    powers: np.ndarray
-    levels: tuple[tuple[np.ndarray | slice, np.ndarray, np.ndarray], ...]
-
-
-def _plan(powers: np.ndarray) -> _Plan:
-    """Evaluation plan for any exponent table closed under removing one factor."""
-    powers = np.ascontiguousarray(powers, dtype=np.int64)
-    incomplete = InputError(
-        "must be a 2-D table of non-negative exponents with one constant row and, with "
-        "every monomial, the monomial with one factor fewer; got an incomplete exponent table",
-        key="powers_",
-    )
-    if powers.ndim != 2 or powers.min(initial=0) < 0:
-        raise incomplete
-    terms, d = powers.shape
-    totals = powers.sum(axis=1)
-    nonconstant = np.flatnonzero(totals > 0)
-    # The factor removed is the last feature with a nonzero exponent.
-    last = d - 1 - np.argmax(powers[nonconstant, ::-1] > 0, axis=1)
-    parent_powers = powers[nonconstant].copy()
-    parent_powers[np.arange(nonconstant.size), last] -= 1
-    index = {row.tobytes(): k for k, row in enumerate(powers)}
-    parents = np.array([index.get(row.tobytes(), -1) for row in parent_powers], dtype=np.int64)
-    if np.count_nonzero(totals == 0) != 1 or len(index) != terms or np.any(parents < 0):
-        raise incomplete
-    parent_of = np.zeros(terms, dtype=np.int64)
-    feature_of = np.zeros(terms, dtype=np.int64)
-    parent_of[nonconstant] = parents
-    feature_of[nonconstant] = last
-    levels = []
-    for total in range(1, int(totals.max(initial=0)) + 1):
-        rows = np.flatnonzero(totals == total)
-        parents_k, features_k = parent_of[rows], feature_of[rows]
-        where: np.ndarray | slice = rows
-        if rows.size and rows[-1] - rows[0] + 1 == rows.size:
-            where = slice(int(rows[0]), int(rows[-1]) + 1)  # graded order: write in place
-        levels.append((where, parents_k, features_k))
-    return _Plan(powers=powers, levels=tuple(levels))
-
-
-def _design_t(plan: _Plan, Zt: np.ndarray, constant_row: int, out: np.ndarray) -> np.ndarray:
-    """Transposed design matrix Φᵀ (T, m) of the standardized rows ``Zt`` (d, m)."""
-    out[constant_row] = 1.0
-    for rows, parents, features in plan.levels:
-        if isinstance(rows, slice):
-            np.multiply(out[parents], Zt[features], out=out[rows])
-        else:
-            out[rows] = out[parents] * Zt[features]
-    return out
 
 
 def _symmetrize_from_lower(G: np.ndarray) -> None:
@@ -418,19 +361,16 @@ class PolynomialRegressor(RegressorMixin, BaseEstimator):
         check_is_fitted(self)
         X_arr = validate_data(self, X, reset=False, dtype=np.float64, ensure_all_finite=False)
         _check_finite(X_arr, "X")
-        plan = self._current_plan()
-        coef = np.asarray(self.coef_, dtype=np.float64)
-        constant_row = int(np.flatnonzero(plan.powers.sum(axis=1) == 0)[0])
-        chunk_rows = max(1, min(int(self.chunk_rows), X_arr.shape[0]))
-        buffer = np.empty(coef.size * chunk_rows)
-        out = np.empty(X_arr.shape[0])
-        for start in range(0, X_arr.shape[0], chunk_rows):
-            stop = min(start + chunk_rows, X_arr.shape[0])
-            Zt = np.ascontiguousarray(((X_arr[start:stop] - self.x_mean_) / self.x_scale_).T)
-            rows = buffer[: coef.size * (stop - start)].reshape(coef.size, stop - start)
-            Phi_t = _design_t(plan, Zt, constant_row, rows)
-            out[start:stop] = coef @ Phi_t
-        return self.y_mean_ + self.y_scale_ * out
+        return polynomial_predict(
+            X_arr,
+            self._current_plan(),
+            np.asarray(self.coef_, dtype=np.float64),
+            self.x_mean_,
+            self.x_scale_,
+            self.y_mean_,
+            self.y_scale_,
+            self.chunk_rows,
+        )
 
     def predictor(self) -> Callable[[ArrayLike], float]:
         """A fast one-sample evaluator for control loops (plain NumPy, no validation).

@@ -13,7 +13,6 @@ from softbend._validation import must_be
 from softbend.actuators import SFRBA, Actuator
 from softbend.design import SFRBADesign
 from softbend.errors import InputError, SchemaError, keyed
-from softbend.surrogates.protocol import Surrogate
 
 __all__ = [
     "INTERVAL_LEVEL",
@@ -243,17 +242,14 @@ def predict_angles(
         non-finite number is never returned.
     """
     from softbend.surrogates.features import outside_training_ranges, using_features
-    from softbend.surrogates.persistence import SavedState, load_state
 
-    # an MLP predicts from its arrays (NumPy only); any other kind through its estimator
-    saved = load_state(path, ("mlp",))
+    # an MLP or a polynomial (alone or inside a composite) predicts from its arrays (NumPy
+    # only); any other kind through its estimator
+    model, saved = load_predictor(path)
     actuator = saved.actuator
     unit = actuator.pressure_unit
     pressures = _check_pressures(pressures_mpa, unit)
     design = _design_of(design, actuator, path)
-    model: Surrogate | _MLPArrays = (
-        _MLPArrays(saved.state) if isinstance(saved, SavedState) else saved.model
-    )
     codes = design.as_array() if isinstance(design, SFRBADesign) else design
     rows = np.empty((pressures.size, codes.size + 1))
     rows[:, :-1] = codes
@@ -362,21 +358,74 @@ def load_predictor(path: str | os.PathLike[str]) -> tuple[Any, Any]:
     predictor : object
         ``.predict(rows)`` of float rows of the 7 inputs (mm, deg, MPa) in degrees:
         for an MLP its NumPy forward pass (no estimator, no scikit-learn; also
-        ``.predict32`` in float32, for screening millions of rows), else the
-        estimator itself.
-    saved : SavedState or SavedSurrogate
-        ``.kind`` and ``.metadata`` of the file.
+        ``.predict32`` in float32, for screening millions of rows), for a
+        polynomial its NumPy evaluation, for XGBoost's plain regression its trees
+        walked in NumPy (:mod:`softbend.surrogates.xgboost_core`), for a composite
+        the composite over such predictors (a GP correction computes in NumPy
+        too), else the estimator itself.
+    saved : SavedSurrogate
+        ``.kind``, ``.metadata`` and ``.actuator`` of the file.
 
     Raises
     ------
     FileNotFoundError, softbend.errors.SchemaError
         As :func:`softbend.surrogates.load_surrogate`.
     """
-    from softbend.surrogates.persistence import SavedState, load_state
+    from softbend.surrogates.persistence import load_light
 
-    saved = load_state(path, ("mlp",))
-    model: Any = _MLPArrays(saved.state) if isinstance(saved, SavedState) else saved.model
-    return model, saved
+    saved = load_light(
+        path, {"mlp": _MLPArrays.of, "plr": _PolynomialArrays.of, "xgb": _xgboost_trees}
+    )
+    return saved.model, saved
+
+
+def _xgboost_trees(saved: Any) -> Any:
+    """A saved XGBoost model's trees in NumPy, or None where XGBoost itself must predict."""
+    from softbend.surrogates.features import model_features
+    from softbend.surrogates.xgboost_core import booster_trees
+
+    booster = saved.state.get("booster")
+    if not isinstance(booster, str):
+        return None
+    return booster_trees(booster, saved.params, len(model_features()))
+
+
+class _PolynomialArrays:
+    """The prediction of a saved polynomial from its validated arrays (no SciPy, no sklearn).
+
+    The same evaluation as :meth:`PolynomialRegressor.predict
+    <softbend.surrogates.polynomial.PolynomialRegressor.predict>`, so the same angles bit for
+    bit (rows are not validated: the caller passes finite float rows).
+    """
+
+    def __init__(self, state: dict[str, Any], chunk_rows: int) -> None:
+        from softbend.surrogates.polynomial_core import plan
+
+        self.state = state
+        self.chunk_rows = int(chunk_rows)
+        self.plan = plan(state["powers_"])
+        self.n_features_in_ = int(state["n_features_in_"])
+
+    @classmethod
+    def of(cls, saved: Any) -> _PolynomialArrays:
+        """The predictor of a :class:`~softbend.surrogates.persistence.SavedState`."""
+        return cls(saved.state, saved.params["chunk_rows"])
+
+    def predict(self, rows: np.ndarray) -> np.ndarray:
+        """Angles (deg) of finite float rows of the 7 inputs (mm, deg, MPa)."""
+        from softbend.surrogates.polynomial_core import polynomial_predict
+
+        s = self.state
+        return polynomial_predict(
+            np.asarray(rows, dtype=np.float64),
+            self.plan,
+            np.asarray(s["coef_"], dtype=np.float64),
+            s["x_mean_"],
+            s["x_scale_"],
+            s["y_mean_"],
+            s["y_scale_"],
+            self.chunk_rows,
+        )
 
 
 class _MLPArrays:
@@ -388,6 +437,12 @@ class _MLPArrays:
 
     def __init__(self, state: dict[str, Any]) -> None:
         self.state = state
+        self.n_features_in_ = int(state["n_features_in_"])
+
+    @classmethod
+    def of(cls, saved: Any) -> _MLPArrays:
+        """The predictor of a :class:`~softbend.surrogates.persistence.SavedState`."""
+        return cls(saved.state)
 
     def predict(self, rows: np.ndarray) -> np.ndarray:
         """Angles (deg) of finite float rows of the 7 inputs (mm, deg, MPa)."""

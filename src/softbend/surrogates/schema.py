@@ -401,7 +401,7 @@ def _check_polynomial(state: dict[str, Any]) -> None:
             f"must have shape ({powers.shape[0]},) (one per row of 'powers_'); got {coef.shape}",
             key="state.coef_",
         )
-    from softbend.surrogates.polynomial import _plan
+    from softbend.surrogates.polynomial_core import plan as _plan
 
     try:
         _plan(powers)
