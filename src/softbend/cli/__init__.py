@@ -5,13 +5,19 @@ function and prints. :func:`main` runs the app in-process and returns the exit
 code, so tests call ``main([...])`` directly.
 
 Exit codes: 0 success, 1 unexpected failure, 2 bad input (usage errors and any
-:class:`softbend.errors.SoftbendError` or ``ValueError``), printed as one line.
+:class:`softbend.errors.SoftbendError` or ``ValueError``), printed as one line,
+130 interrupted (Ctrl-C): one line, naming where the finished work is kept when
+the same command resumes from it (:func:`resume_path`).
 """
 
 from __future__ import annotations
 
+import functools
+import os
 import sys
-from collections.abc import Sequence
+from collections.abc import Callable, Iterator, Sequence
+from pathlib import Path
+from typing import Any
 
 import typer
 
@@ -70,15 +76,120 @@ def _root(
     _common.configure_logging(verbose)
 
 
+#: Exit code of a command stopped by Ctrl-C (128 + SIGINT, as a shell reports it).
+INTERRUPTED = 130
+
+
+def _option(args: Sequence[str], *names: str) -> str | None:
+    """The value of the last of the options ``names`` in ``args`` (``--out X``, ``--out=X``)."""
+    value = None
+    for i, arg in enumerate(args):
+        for name in names:
+            if arg == name and i + 1 < len(args):
+                value = args[i + 1]
+            elif name.startswith("--") and arg.startswith(name + "="):
+                value = arg[len(name) + 1 :]
+    return value
+
+
+def _positionals(args: Sequence[str]) -> list[str]:
+    """The words of ``args`` that are not options (nor, roughly, their values)."""
+    return [a for a in args if not a.startswith("-")]
+
+
+def resume_path(args: Sequence[str]) -> Path | None:
+    """Where a resumable command keeps its finished work, if it exists, else None.
+
+    ``softbend train`` keeps every finished configuration-fold in a checkpoint
+    beside ``--out``; ``softbend campaign run`` records every finished design in its
+    database; ``softbend reproduce`` keeps its campaign database beside ``--out``.
+    Each resumes when the same command is run again.
+    """
+    words = _positionals(args)
+    path: Path | None = None
+    if words[:1] == ["train"]:
+        out = _option(args, "--out", "-o")
+        if out is not None:
+            path = Path(os.path.abspath(out))
+            path = path.with_name(f".{path.name}.train-checkpoint.jsonl")
+    elif words[:2] == ["campaign", "run"] and len(words) > 2:
+        path = Path(words[2])
+    elif words[:1] == ["reproduce"]:
+        out = Path(_option(args, "--out", "-o") or "results/reproduce")
+        path = out.with_name(f".{out.name}.resume")
+        if not path.exists():
+            path = out / "paper_b" / "campaign.duckdb" if out.is_dir() else None
+    return path if path is not None and path.exists() else None
+
+
+def interrupted_line(args: Sequence[str]) -> str:
+    """The one line printed when Ctrl-C stops the command ``args``."""
+    kept = resume_path(args)
+    if kept is None:
+        return "softbend: interrupted"
+    return f"softbend: interrupted; finished work is kept in {kept}: the same command resumes"
+
+
+#: Whether Ctrl-C reached :func:`main` through a command (set by :func:`_noting_interrupts`).
+_CTRL_C = {"seen": False}
+
+
+def _noting_interrupts(callback: Callable[..., Any]) -> Callable[..., Any]:
+    """``callback`` noting a Ctrl-C it lets through (typer turns it into exit code 130).
+
+    A command that handles Ctrl-C itself (says what it kept, exits 130) lets none
+    through, so :func:`main` adds no second line.
+    """
+
+    @functools.wraps(callback)
+    def run(*args: Any, **kwargs: Any) -> Any:
+        try:
+            return callback(*args, **kwargs)
+        except KeyboardInterrupt:
+            _CTRL_C["seen"] = True
+            raise
+
+    run._softbend_noting = True  # type: ignore[attr-defined]
+    return run
+
+
+def _commands(typer_app: typer.Typer) -> Iterator[Any]:
+    """Every registered command of ``typer_app`` and its sub-apps."""
+    yield from typer_app.registered_commands
+    for group in typer_app.registered_groups:
+        if group.typer_instance is not None:
+            yield from _commands(group.typer_instance)
+
+
+def _note_interrupts() -> None:
+    for command in _commands(app):
+        callback = command.callback
+        if callback is not None and not getattr(callback, "_softbend_noting", False):
+            command.callback = _noting_interrupts(callback)
+
+
+def _interrupted(args: Sequence[str]) -> int:
+    _common.err_console.print(interrupted_line(args), markup=False, highlight=False, soft_wrap=True)
+    return INTERRUPTED
+
+
 def main(argv: Sequence[str] | None = None) -> int:
     """Run the CLI with ``argv`` (default: ``sys.argv[1:]``) and return the exit code."""
     args = list(sys.argv[1:] if argv is None else argv)
+    _note_interrupts()
+    _CTRL_C["seen"] = False
     try:
         with _common.warnings_as_lines():
             result = app(args=args, prog_name="softbend", standalone_mode=False)
+    except KeyboardInterrupt:
+        return _interrupted(args)
     except typer.Exit as exc:
+        if isinstance(exc.__cause__, KeyboardInterrupt):  # typer's word for Ctrl-C
+            return _interrupted(args)
         return int(exc.exit_code)
-    except typer.Abort:
+    except typer.Abort as exc:
+        if isinstance(exc.__context__, KeyboardInterrupt):  # click's word for Ctrl-C
+            return _interrupted(args)
         _common.error_line("aborted")
         return 1
     except typer.TyperException as exc:  # usage errors: unknown option, bad value
@@ -100,6 +211,8 @@ def main(argv: Sequence[str] | None = None) -> int:
     except OSError as exc:  # last resort: an OS error no command named an option for
         _common.error_line(_common.os_error_message(exc))
         return 1
+    if result == INTERRUPTED and _CTRL_C["seen"]:  # typer returns Ctrl-C as exit code 130
+        return _interrupted(args)
     return int(result) if isinstance(result, int) else 0
 
 

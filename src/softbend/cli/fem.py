@@ -12,6 +12,8 @@ from softbend.cli import _common
 from softbend.errors import InputError, keyed
 
 if TYPE_CHECKING:
+    import numpy as np
+
     from softbend.fem import FEMOptions
 
 app = typer.Typer(
@@ -64,6 +66,15 @@ def _options(
     return FEMOptions(maxh_mm=maxh, gravity=gravity, elastomer=elastomer, output=output)
 
 
+def steps_reached(grid: np.ndarray, pressure_mpa: float) -> int:
+    """How many pressures of the sweep's sorted ``grid`` (MPa) a sweep at ``pressure_mpa``
+    has reached: the unit of ``fem run``'s progress (a load step may be cut into sub-steps,
+    which count when they reach the next pressure of the grid)."""
+    import numpy as np
+
+    return int(np.searchsorted(grid, pressure_mpa * (1 + 1e-9) + 1e-12, side="right"))
+
+
 @app.command("run")
 def run(
     design: DesignOption = "100,6,2,2,5,10",
@@ -110,6 +121,8 @@ def run(
     \b
         softbend fem run --design 100,6,2,2,5,10 --pmax 0.2 --out fem
     """
+    import numpy as np
+
     from softbend._io import staged_dir, write_text_atomic
     from softbend._validation import check_int
     from softbend.design import SFRBADesign
@@ -125,19 +138,19 @@ def run(
     out = Path(out)
     _common.check_output_dir(out, "--out", files=RUN_FILES[:-1])
     _common.check_replaceable_dir(out, "--out", "fem run", files=RUN_FILES, marker=SWEEP_JSON)
-    scale = 1000
+    grid = np.sort(np.asarray(pressures, dtype=float))
     with (
         _common.output_errors(out, "--out"),
         staged_dir(out) as stage,
         _common.as_written(stage, out),
     ):
         with _common.progress_bar(
-            "FEM sweep (pressure x 1000 / pmax)", scale, enabled=not json_output
+            "FEM sweep (pressure steps)", int(grid.size), enabled=not json_output
         ) as advance:
             state = {"done": 0}
 
             def on_step(pressure: float, angle: float, target: float) -> None:
-                done = round(scale * pressure / target) if target > 0 else scale
+                done = steps_reached(grid, pressure)
                 advance(
                     max(done - state["done"], 0), p=f"{pressure:.4f} MPa", angle=f"{angle:.1f}°"
                 )

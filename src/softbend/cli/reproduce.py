@@ -45,7 +45,8 @@ def reproduce(
     out = Path(out)
     _common.check_output_dir(out, "--out")
     _common.check_replaceable_dir(out, "--out", "reproduce", files=ENTRIES, marker=MARKER)
-    with _common.phase_progress(enabled=not as_json) as progress:
+    # library_progress: the steps deep inside (a refit's epochs) are heard too
+    with _common.library_progress(enabled=not as_json) as progress:
         summary = run_reproduce(
             out,
             seed=seed,

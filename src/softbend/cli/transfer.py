@@ -44,13 +44,17 @@ def base(
     \b
         softbend transfer base --out base.json --epochs 1000
     """
-    from softbend._io import json_safe
+    from softbend._validation import check_int
     from softbend.limits import check_limit
+
+    check_int(epochs, "epochs", low=1)
+    check_limit("epochs", epochs, "--epochs")
+    _common.check_output_file(out, "--out", kind="json")
+    # heavy (PyTorch, scikit-learn: seconds): after the arguments' checks
+    from softbend._io import json_safe
     from softbend.surrogates.persistence import save_surrogate
     from softbend.transfer.base import BASE_HIDDEN_SIZES, base_metadata, train_base_mlp
 
-    check_limit("epochs", epochs, "--epochs")
-    _common.check_output_file(out, "--out", kind="json")
     with _common.progress_bar("training the FEM MLP (epochs)", epochs) as advance:
         state = {"done": 0}
 
@@ -118,7 +122,6 @@ def refine(
         softbend transfer refine base.json lab.csv bench.csv --out refined.json
     """
     from softbend.limits import check_limit
-    from softbend.transfer.refine import refine_surrogate
 
     values = _common.parse_assignments(settings or ())
     if epochs is not None:
@@ -128,7 +131,10 @@ def refine(
             )
         check_limit("epochs", epochs, "--epochs")
         values["epochs"] = str(epochs)
+    _check_inputs(base, measurements)
     _common.check_output_file(out, "--out", inputs=(base, *measurements), kind="json")
+    from softbend.transfer.refine import refine_surrogate  # heavy: after the arguments' checks
+
     with _common.library_progress():  # the refit's epochs, then the calibration's
         result = refine_surrogate(
             base, measurements, strategy, seed=seed, settings=values, force=force
@@ -148,6 +154,16 @@ def refine(
         f"actuators written to {path} (training RMSE {meta['training_rmse_deg']:.3g}°"
         f"{calibration}); use it with 'softbend predict {path}'"
     )
+
+
+def _check_inputs(base: Path, measurements: list[Path]) -> None:
+    """Refuse a missing base model or measurements file before the strategies are imported
+    (scikit-learn, PyTorch: seconds)."""
+    if not base.is_file():
+        raise FileNotFoundError(f"No saved surrogate at {base}.")
+    for path in measurements:
+        if not path.is_file():
+            raise FileNotFoundError(f"No measurements file at {path}.")
 
 
 @app.command("strategies")

@@ -184,12 +184,14 @@ def run_fig2(
 
     start = time.perf_counter()
     folder = Path(out_dir) / "paper_b_fem"
+    phase = "paper B: FEM sweep (kPa)"
+    total = round(1000 * pmax_mpa)
+    if progress is not None:  # the material fits and the mesh come first (seconds)
+        progress(phase, 0, total)
     test = load_shipped("dragon-skin-30")
     fits = fit_models(test)
     design = SFRBADesign.parse(FIG2_DESIGN)
     pressures = default_pressures_mpa(pmax_mpa)
-    phase = "paper B: FEM sweep (kPa)"
-    total = round(1000 * pmax_mpa)
 
     def on_step(pressure: float, _angle: float, _target: float) -> None:
         if progress is not None:

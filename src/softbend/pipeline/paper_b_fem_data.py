@@ -93,10 +93,17 @@ def _surrogates(
     from softbend.surrogates.search import MODEL_NAMES, search
     from softbend.surrogates.workflow import train_surrogates
 
+    families = MODEL_NAMES if models is None else tuple(models)
+    # after the last family's grouped search: the refits on all designs and the export
+    after = "paper B FEM data: surrogates, refit on all designs and export (stages)"
+
     def on_progress(protocol: str) -> Progress:
         def forward(phase: str, done: int, total: int) -> None:
             if progress is not None:
                 progress(f"paper B FEM data: surrogates ({protocol} CV), {phase}", done, total)
+                last = protocol == "grouped" and families and phase.startswith(f"{families[-1]}:")
+                if last and done >= total:
+                    progress(after, 0, 1)
 
         return forward
 
@@ -104,12 +111,14 @@ def _surrogates(
     result, grouped = train_surrogates(
         data,
         folder,
-        models=MODEL_NAMES if models is None else tuple(models),
+        models=families,
         grid_name="quick",
         seed=seed,
         epochs=epochs,
         progress=on_progress("grouped"),
     )
+    if progress is not None:
+        progress(after, 1, 1)
     started = time.perf_counter()
     chosen = {name: [dict(fam.params)] for name, fam in result.families.items()}
     shuffled = search(

@@ -245,7 +245,8 @@ def parity_plot(report: RegressionReport, path: str | Path) -> Path:
     ax.set_ylabel(f"Fitted {label}")
     ax.set_title(f"Multiple linear regression: R² = {report.r2:.4f}, F = {report.f_value:.4g}")
     markerscale = max(1.0, 12.0 / marker_size)
-    ax.legend(loc="upper left", fontsize=8, framealpha=0.9, markerscale=markerscale)
+    if ax.get_legend_handles_labels()[0]:  # no legend without a label
+        ax.legend(loc="upper left", fontsize=8, framealpha=0.9, markerscale=markerscale)
     ax.grid(alpha=0.3)
     return _save(fig, path)
 

@@ -62,7 +62,8 @@ def tip_positions(experiments: Mapping[str, Sequence[Experiment]], path: Path) -
         ax.set_xlabel("tip x (mm)")
         ax.set_ylabel("tip y (mm)")
         ax.set_title(_SIGN_TITLES.get(sign, sign))
-        ax.legend(loc="best", fontsize=8)
+        if ax.get_legend_handles_labels()[0]:  # no legend without a label
+            ax.legend(loc="best", fontsize=8)
         fig.colorbar(points, ax=ax, label="pressure (kPa)")
     fig.suptitle("Measured tip positions (paper A Fig. 5)" + _suffix(experiments))
     return _save(fig, path)
@@ -90,7 +91,8 @@ def output_vs_pressure(
         ax.set_ylabel(_LABELS[output])
         ax.set_title(_SIGN_TITLES.get(sign, sign))
         ax.grid(alpha=0.3)
-        ax.legend(fontsize=7, markerscale=4, ncol=2)
+        if ax.get_legend_handles_labels()[0]:  # no legend without a label
+            ax.legend(fontsize=7, markerscale=4, ncol=2)
     name = "bending grade ρ" if output == "rho" else "arc length L"
     fig.suptitle(
         f"Calculated {name} against pressure (paper A Fig. {number})" + _suffix(experiments)
@@ -146,7 +148,8 @@ def identified_vs_measured(result: IdentificationResult, output: str, path: Path
         ax.set_xlabel("time, experiments one after another (s)")
         ax.set_ylabel(_LABELS[output])
         ax.grid(alpha=0.3)
-        ax.legend(loc="upper right", fontsize=8)
+        if ax.get_legend_handles_labels()[0]:  # no legend without a label
+            ax.legend(loc="upper right", fontsize=8)
     name = "bending grade ρ" if output == "rho" else "arc length L"
     fig.suptitle(
         f"Identified {name}, leave-one-experiment-out (paper A Fig. {number})"

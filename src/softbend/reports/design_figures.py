@@ -58,7 +58,8 @@ def front_figure(result: SearchResult, path: str | Path) -> Path:
     left.set_title(f"{spec.name}: {result.n_meeting:,} of {result.n_designs:,} designs meet it",
                    fontsize=9)  # fmt: skip
     left.grid(True, alpha=0.3)
-    left.legend(fontsize=7)
+    if left.get_legend_handles_labels()[0]:  # no legend without a label
+        left.legend(fontsize=7)
     ranks = np.arange(1, len(candidates) + 1)
     right.plot(ranks, [c.angle_deg for c in candidates], "o", label="surrogate")
     fem = [c.fem_angle_deg if c.fem_angle_deg is not None else math.nan for c in candidates]
@@ -78,7 +79,8 @@ def front_figure(result: SearchResult, path: str | Path) -> Path:
     right.set_xticks(ranks)
     right.set_title(target.describe(), fontsize=9)
     right.grid(True, alpha=0.3)
-    right.legend(fontsize=7)
+    if right.get_legend_handles_labels()[0]:  # no legend without a label
+        right.legend(fontsize=7)
     fig.tight_layout()
     fig.savefig(path, dpi=_DPI)
     return Path(path)
@@ -127,7 +129,8 @@ def curves_figure(
         f"{spec.name}: surrogate (lines)" + (", FEM (circles)" if verified else ""), fontsize=9
     )
     ax.grid(True, alpha=0.3)
-    ax.legend(fontsize=7)
+    if ax.get_legend_handles_labels()[0]:  # no legend without a label
+        ax.legend(fontsize=7)
     fig.tight_layout()
     fig.savefig(path, dpi=_DPI)
     return Path(path)

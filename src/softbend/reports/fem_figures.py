@@ -56,7 +56,8 @@ def angle_pressure_curve(
     ax.set_ylabel("bending angle θ (°)")
     ax.set_title(f"Design (l, r, t, b, φ, lc) = ({result.design})", fontsize=10)
     ax.grid(alpha=0.3)
-    ax.legend(fontsize=8)
+    if ax.get_legend_handles_labels()[0]:  # no legend without a label
+        ax.legend(fontsize=8)
     return _save(fig, path)
 
 
@@ -86,7 +87,8 @@ def deformed_shapes(
     ax.invert_yaxis()
     ax.set_title(title or "Deformed actuator, bending plane", fontsize=10)
     ax.grid(alpha=0.3)
-    ax.legend(fontsize=8, loc="best")
+    if ax.get_legend_handles_labels()[0]:  # no legend without a label
+        ax.legend(fontsize=8, loc="best")
     return _save(fig, path)
 
 

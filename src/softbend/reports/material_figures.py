@@ -147,6 +147,7 @@ def fit_figure(
         f"{test.material}: uniaxial tension, hyperelastic fits\n{_source_line(test)}",
         fontsize=10,
     )
-    ax.legend(loc="upper left", fontsize=8, framealpha=0.9)
+    if ax.get_legend_handles_labels()[0]:  # no legend without a label
+        ax.legend(loc="upper left", fontsize=8, framealpha=0.9)
     ax.grid(alpha=0.3)
     return _save(fig, path)

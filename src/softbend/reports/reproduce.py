@@ -147,9 +147,14 @@ def _paper_b_surrogates(
 
     start = time.perf_counter()
     trained = train_campaign_surrogates(out_dir, seed=seed, progress=progress)
+    phase = "paper B: surrogates, figures (Fig. 5)"
+    if progress is not None:
+        progress(phase, 0, 1)
     drawn = training_figures(trained.search, out_dir / "paper_b" / "surrogates")
     training = {**trained.training, "files": {**trained.training["files"], **drawn}}
     paper_b.add_surrogate_section(report, training, root=out_dir)
+    if progress is not None:
+        progress(phase, 1, 1)
     return {**trained.summary, "seconds": time.perf_counter() - start}
 
 

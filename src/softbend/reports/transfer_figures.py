@@ -78,7 +78,8 @@ def loss_curves(result: LocoResult, path: Path) -> Path:
     ax.set_ylabel("training MSE (deg²)")
     ax.set_title("Training loss on all measured actuators (cf. paper B Fig. 6)", fontsize=10)
     if ax.get_legend_handles_labels()[0]:
-        ax.legend(fontsize=7)
+        if ax.get_legend_handles_labels()[0]:  # no legend without a label
+            ax.legend(fontsize=7)
     else:  # no strategy of this run trains a network (a base without a loss curve)
         ax.text(
             0.5,
@@ -151,7 +152,8 @@ def actuator_panels(result: LocoResult, path: Path, *, synthetic: bool = True) -
         ax.set_xlabel(f"pressure ({punit})")
         ax.set_ylabel("bending angle (°)")
         ax.grid(True, alpha=0.3)
-        ax.legend(fontsize=6, loc="upper left")
+        if ax.get_legend_handles_labels()[0]:  # no legend without a label
+            ax.legend(fontsize=6, loc="upper left")
     for ax in axes[len(ids) :]:
         ax.set_visible(False)
     kind = "virtual-lab (synthetic) measurements" if synthetic else "measurements"
@@ -192,7 +194,8 @@ def learning_curve(result: LocoResult, path: Path) -> Path:
     ax.set_ylabel("mean held-out RMSE (°)")
     ax.set_title("Learning curve: how many prototypes to measure", fontsize=10)
     ax.grid(True, alpha=0.3)
-    ax.legend(fontsize=7)
+    if ax.get_legend_handles_labels()[0]:  # no legend without a label
+        ax.legend(fontsize=7)
     fig.tight_layout()
     fig.savefig(path, dpi=_DPI)
     return path
@@ -242,7 +245,8 @@ def lab_measurements(measurements: Measurements, path: Path) -> Path:
         )
         fig.text(0.01, 0.01, f"reality gap: {gap}", fontsize=7)
     ax.grid(True, alpha=0.3)
-    ax.legend(title="actuator (l,r,t,b,φ,lc)", fontsize=7, title_fontsize=7)
+    if ax.get_legend_handles_labels()[0]:  # no legend without a label
+        ax.legend(title="actuator (l,r,t,b,φ,lc)", fontsize=7, title_fontsize=7)
     fig.tight_layout(rect=(0, 0.03, 1, 1))
     fig.savefig(path, dpi=_DPI)
     return path
