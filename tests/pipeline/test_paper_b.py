@@ -72,4 +72,8 @@ def test_surrogates_fit_the_campaign_and_are_saved(campaign):
     assert trained.training["files"]["plr_model"] == str(folder / "models" / "plr.json")
     assert set(trained.search.families) == set(models)
     assert phases.all_finished()
+    # the refits and the export after the last search are a phase of their own, last
+    names = list(phases.last)
+    assert names[-1] == "paper B: surrogates, refit on all designs and export (stages)"
+    assert names[-2].startswith("paper B: surrogates, plr:")
     assert pictures(folder) == []

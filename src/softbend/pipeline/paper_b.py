@@ -146,20 +146,28 @@ def train_campaign_surrogates(
     from softbend.surrogates.workflow import train_surrogates
 
     folder = Path(out_dir) / "paper_b"
+    families = MODEL_NAMES if models is None else tuple(models)
+    # after the last family's search: the refits on all designs, the timings, the saved
+    # models and their ONNX export (minutes on a CPU), told as a phase of its own
+    after = "paper B: surrogates, refit on all designs and export (stages)"
 
     def on_progress(phase: str, done: int, total: int) -> None:
         if progress is not None:
             progress(f"paper B: surrogates, {phase}", done, total)
+            if families and phase.startswith(f"{families[-1]}:") and done >= total:
+                progress(after, 0, 1)
 
     start = time.perf_counter()
     result, training = train_surrogates(
         folder / "campaign.duckdb",
         folder / "surrogates",
-        models=MODEL_NAMES if models is None else tuple(models),
+        models=families,
         grid_name="quick",
         seed=seed,
         progress=on_progress,
     )
+    if progress is not None:
+        progress(after, 1, 1)
     summary = {
         "seconds": time.perf_counter() - start,
         "best_by_mape": training["best_by_mape"],
