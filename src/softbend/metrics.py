@@ -17,6 +17,8 @@ simulation of ρ or L, bending angles):
 ``thresholded_mape``      mean absolute percentage error over the samples with
                           \|y\| at least a threshold (bending angles near 0°
                           are left out and counted)
+``mape_floor``            the default threshold of a bending angle's MAPE:
+                          max(5°, 5 % of the largest \|θ\|)
 ========================  =====================================================
 
 Rules that hold for all of them:
@@ -45,7 +47,10 @@ from softbend._validation import check_finite_array, check_range
 from softbend.errors import InputError
 
 __all__ = [
+    "MAPE_FLOOR_DEG",
+    "MAPE_FLOOR_SHARE",
     "fit_percent",
+    "mape_floor",
     "nrmse",
     "r2",
     "regression_metrics",
@@ -255,3 +260,49 @@ def thresholded_mape(
         return math.nan, n_excluded
     mape = 100.0 * float(np.mean(np.abs(pred[keep] - obs[keep]) / np.abs(obs[keep])))
     return mape, n_excluded
+
+
+#: Smallest floor of a bending angle's MAPE, degrees (:func:`mape_floor`).
+MAPE_FLOOR_DEG = 5.0
+#: Share of the largest ``|θ|`` below which a reading is left out of the MAPE (:func:`mape_floor`).
+MAPE_FLOOR_SHARE = 0.05
+
+
+def mape_floor(
+    observed: ArrayLike, *, minimum: float = MAPE_FLOOR_DEG, share: float = MAPE_FLOOR_SHARE
+) -> float:
+    """Default threshold of a bending angle's MAPE: ``max(minimum, share · max|observed|)``.
+
+    A percentage error divides by the reading, so readings near zero dominate a
+    mean of them: a model 2° off on a 3° reading at low pressure is 67 % wrong
+    there and the mean over a table then says nothing about the fit (a table of
+    30 designs gave mean MAPEs of hundreds of percent that way). Readings below
+    the floor are left out of the MAPE (and counted); RMSE, R² and the maximum
+    error still use every reading. The two parts:
+
+    - 5°: an FEM sweep's or a bench's error of a fraction of a degree (sensor
+      resolution, the solver's tolerance) is at most about 10 % of it;
+    - 5 % of the largest ``|θ|``: a surrogate's error is about a fixed share of
+      the range it was trained on, so readings in the lowest 5 % of the range
+      carry percentage errors of 20 times that share; for an actuator bending to
+      300° this floor is 15°.
+
+    Parameters
+    ----------
+    observed : array_like
+        Measured or simulated angles, degrees (finite).
+    minimum : float, default 5.0
+        Floor in degrees, >= 0.
+    share : float, default 0.05
+        Share of the largest ``|observed|``, in [0, 1].
+
+    Returns
+    -------
+    float
+        The floor, degrees: pass it as ``threshold`` to :func:`thresholded_mape`.
+    """
+    minimum = check_range(minimum, "minimum", low=0.0, low_inclusive=True)
+    share = check_range(share, "share", low=0.0, low_inclusive=True, high=1.0, high_inclusive=True)
+    obs = check_finite_array(observed, "observed").ravel()
+    largest = float(np.max(np.abs(obs))) if obs.size else 0.0
+    return max(minimum, share * largest)

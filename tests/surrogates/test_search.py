@@ -370,3 +370,34 @@ def test_tf32_is_recorded_checked_and_changes_nothing_on_the_cpu(small_data):
     np.testing.assert_array_equal(plain.families["mlp"].oof_pred, tf32.families["mlp"].oof_pred)
     with pytest.raises(ValueError, match="tf32: must be True or False"):
         search(small_data, device="cpu", tf32="yes", **kwargs)
+
+
+def test_the_small_grid_changes_the_mlp_alone():
+    from softbend.surrogates.search import MLP_EPOCHS, SMALL_DATA_MLP_GRID
+
+    for family in ("plr", "xgb"):
+        assert grid("small", family) == grid("quick", family)
+    small = [c["hidden_sizes"] for c in grid("small", "mlp")]
+    assert small == [c["hidden_sizes"] for c in SMALL_DATA_MLP_GRID]
+    # smaller than paper B's pick, trained longer than the quick grid
+    assert all(a * b < 63 * 65 for a, b in small) and MLP_EPOCHS["small"] > MLP_EPOCHS["quick"]
+
+
+def test_search_records_the_mape_floor_of_the_data(searched, small_data):
+    # a campaign of paper B's actuator: paper B's MAPE, only the 0 MPa readings left out
+    assert searched.settings["mape_floor_deg"] == 1.0
+    plr = searched.families["plr"].cv
+    assert plr["mape_floor_deg"] == 1.0
+    assert plr["n_mape_used"] == int((np.abs(small_data.y) >= 1.0).sum())
+    floored = search(small_data, models=["plr"], param_grid=SMALL_GRID, mape_threshold_deg=30.0)
+    cv = floored.families["plr"].cv
+    assert cv["n_mape_used"] == int((np.abs(small_data.y) >= 30.0).sum()) < plr["n_mape_used"]
+    assert cv["rmse_deg"] == plr["rmse_deg"]  # the floor is the MAPE's alone
+    with pytest.raises(ValueError, match=r"^mape_threshold_deg: "):
+        search(small_data, models=["plr"], mape_threshold_deg=-1.0)
+
+
+def test_mlp_configurations_trained_together_share_one_learning_rate(small_data):
+    rates = [{"hidden_sizes": (4, 4), "learning_rate": r} for r in (1e-3, 2e-3)]
+    with pytest.raises(ValueError, match=r"^param_grid: must be one learning_rate"):
+        search(small_data, models=["mlp"], param_grid={"mlp": rates}, epochs=2)

@@ -12,7 +12,12 @@ from softbend.design import DesignSpace
 from softbend.models import default_pressures_mpa
 from softbend.reports.surrogate_figures import training_figures
 from softbend.surrogates.persistence import load_surrogate
-from softbend.surrogates.workflow import PAPER_B_FIG5, train_surrogates
+from softbend.surrogates.workflow import (
+    PAPER_B_FIG5,
+    best_family,
+    small_data_advice,
+    train_surrogates,
+)
 
 
 @pytest.fixture(scope="module")
@@ -46,3 +51,39 @@ def test_the_workflow_saves_models_and_tables_and_draws_nothing(samples, tmp_pat
 def test_a_missing_database_is_a_clear_error(tmp_path):
     with pytest.raises(FileNotFoundError, match=r"nope\.duckdb"):
         train_surrogates(tmp_path / "nope.duckdb", tmp_path / "out")
+
+
+class _Scored:
+    def __init__(self, **cv):
+        self.cv = cv
+
+
+def test_the_best_family_follows_the_metric_asked_for():
+    # The newcomer's case: XGBoost's MAPE is lower, its RMSE nearly three times the polynomial's.
+    families = {
+        "plr": _Scored(rmse_deg=5.4, mape_pct=12.0, r2=0.99),
+        "xgb": _Scored(rmse_deg=14.5, mape_pct=9.0, r2=0.95),
+        "mlp": _Scored(rmse_deg=6.0, mape_pct=float("nan"), r2=0.995),
+    }
+    assert best_family(families) == "plr"  # RMSE by default
+    assert best_family(families, "mape") == "xgb"  # an undefined MAPE is no candidate
+    assert best_family(families, "r2") == "mlp"
+    assert best_family({"mlp": families["mlp"]}, "mape") is None
+    with pytest.raises(ValueError, match=r"^select_by: .*got .mae."):
+        best_family(families, "mae")
+
+
+def test_small_tables_get_the_small_grid_and_one_line_of_advice(samples, tmp_path):
+    lines = []
+    result, summary = train_surrogates(
+        samples, tmp_path, models=["plr"], grid_name=None, export_onnx=False, advise=lines.append
+    )
+    assert result.settings["grid"] == "small" and len(lines) == 1
+    assert lines[0].startswith("30 designs: fewer than 100") and summary["advice"] == lines[0]
+    assert summary["best"] == "plr" and summary["selected_by"] == "rmse"
+    # paper B's actuator keeps paper B's MAPE (only the 0 MPa readings left out)
+    plr = summary["models"]["plr"]
+    assert summary["mape_floor_deg"] == plr["mape_floor_deg"] == 1.0
+    assert plr["n_mape_used"] == int((abs(result.data.y) >= 1.0).sum()) < result.data.n_samples
+    assert small_data_advice(100, None) is None
+    assert "--grid quick was asked for" in small_data_advice(99, "quick")

@@ -131,3 +131,24 @@ def test_a_readings_file_with_another_column_is_one_line(lab, tmp_path, capsys):
     assert (
         "lacks the column(s) wall_mm" in err[0] and "has column(s) wall the measurement" in err[0]
     )
+
+
+def test_loco_mape_leaves_out_the_readings_below_the_floor(lab):
+    from softbend.metrics import mape_floor, thresholded_mape
+
+    base, readings = lab
+    saved = load_surrogate(base)
+    data = load_actuator_measurements(readings, saved.actuator)
+    result = leave_one_configuration_out(data, saved.model, ["fem-only"], learning_curve=False)
+    floor = result.settings["mape_floor_deg"]
+    assert floor == mape_floor(data.angle_deg) >= 5.0
+    predictions = result.predictions
+    for _, row in result.per_actuator.iterrows():
+        part = predictions[predictions["actuator_id"] == row["actuator_id"]]
+        expected, left_out = thresholded_mape(
+            part["angle_deg"], part["predicted_deg"], threshold=floor
+        )
+        assert row["mape_pct"] == pytest.approx(expected)
+        assert row["n_mape_used"] == len(part) - left_out < len(part)  # the 0 kPa readings
+    summary = result.summary.set_index("strategy")
+    assert summary.loc["fem-only", "n_mape_used"] == result.per_actuator["n_mape_used"].sum()

@@ -47,7 +47,16 @@ def train(
         "plr,xgb,mlp",
         help="Comma-separated surrogate families: plr, xgb, mlp (paper B's) or any registered.",
     ),
-    grid: str = typer.Option("quick", help="Hyperparameter grid: quick or paper."),
+    grid: str | None = typer.Option(
+        None,
+        help="Hyperparameter grid: quick, paper (paper B's) or small (the MLP's small-data "
+        "networks; default below 100 designs, quick from 100).",
+    ),
+    select_by: str = typer.Option(
+        "rmse",
+        "--select-by",
+        help="The cross-validated metric that names the best family: rmse (degrees), mape or r2.",
+    ),
     folds: int = typer.Option(5, help="Design-grouped cross-validation folds."),
     seed: int = typer.Option(0, help="Seed of the folds, XGBoost and the MLP."),
     device: str = typer.Option("auto", help="MLP device: auto, cpu or cuda."),
@@ -55,7 +64,8 @@ def train(
         False, "--tf32", help="On a CUDA device, TF32 matrix products for the MLP (faster)."
     ),
     epochs: int | None = typer.Option(
-        None, help="MLP epochs (default: 200 quick grid, 1000 paper grid as paper B)."
+        None,
+        help="MLP epochs (default: 200 quick grid, 1000 paper grid as paper B, 1000 small grid).",
     ),
     workers: int | None = typer.Option(
         None, "--workers", help="XGBoost threads, >= 1 (default: all cores)."
@@ -86,6 +96,11 @@ def train(
     Grid-searches each surrogate family with design-grouped K-fold
     cross-validation, refits the best configuration on all designs, then saves
     the models and draws the figures (paper B, Figure 5) into the folder --out.
+    The best family is the one of the lowest held-out RMSE (--select-by). MAPE
+    leaves out the readings below a floor, max(5°, 5 % of the largest angle)
+    (1° for paper B's actuator, as paper B), which the table names. A table of
+    fewer than 100 designs is a warning and searches the small-data MLP grid
+    unless --grid is given.
 
     TABLE is a softbend campaign (paper B's actuator), or any actuator's
     simulation table: a CSV or Parquet file whose columns --design-columns,
@@ -106,11 +121,15 @@ def train(
         softbend train sims.csv --design-columns n_chambers,wall_mm \\
             --pressure-column p_kpa --pressure-unit kPa --out pneunet
     """
-    from softbend._validation import check_int
+    from softbend._validation import check_choice, check_int
     from softbend.limits import check_limit
     from softbend.reports.surrogate_figures import training_figures
-    from softbend.surrogates.workflow import train_into
+    from softbend.surrogates.search import SEARCH_GRIDS
+    from softbend.surrogates.workflow import SELECT_BY, train_into
 
+    check_choice(select_by, "select_by", tuple(SELECT_BY))
+    if grid is not None:
+        check_choice(grid, "grid", SEARCH_GRIDS)
     if workers is not None:
         check_int(workers, "workers", low=1)
     if halving_rungs is not None:
@@ -143,6 +162,8 @@ def train(
             on_resume=None if as_json else resuming,
             on_discard=_common.warning_line,
             grid_name=grid,
+            select_by=select_by,
+            advise=_common.warning_line,
             folds=folds,
             seed=seed,
             device=device,
@@ -198,10 +219,22 @@ def _training_source(
     )
 
 
+def _mape_cell(value: float | None) -> str:
+    """A MAPE as the table shows it: a dash where it is undefined (no reading above the floor)."""
+    if value is None or value != value:  # None or NaN
+        return "—"
+    return f"{value:.3f}"
+
+
 def print_summary(summary: dict) -> None:
     """The per-family table, beside paper B's figures for paper B's actuator (a dash for a
-    family it lacks); another actuator's table names it and leaves paper B out."""
+    family it lacks); another actuator's table names it and leaves paper B out. The MAPE
+    column names its floor; a line below names the best family and the metric that chose
+    it."""
+    from softbend.surrogates.metrics import mape_text
+
     paper_b = "actuator" not in summary
+    floor = summary.get("mape_floor_deg", summary.get("settings", {}).get("mape_threshold_deg"))
     rows = []
     for name, m in summary["models"].items():
         paper = m["paper_b"]
@@ -214,7 +247,7 @@ def print_summary(summary: dict) -> None:
                 m["params"],
                 f"{m['r2']:.6f}",
                 f"{m['rmse_deg']:.3f}",
-                f"{m['mape_pct']:.3f}",
+                _mape_cell(m["mape_pct"]),
                 f"{m['max_abs_error_deg']:.2f}",
                 f"{m['inference_single_us']:.1f}",
                 f"{m['inference_batch_ms']:.2f}",
@@ -233,7 +266,7 @@ def print_summary(summary: dict) -> None:
             "best configuration",
             "R²",
             "RMSE °",
-            "MAPE %",
+            "MAPE %" if floor is None else mape_text(floor),
             "max |e| °",
             "1 sample µs",
             "10k batch ms",
@@ -241,18 +274,26 @@ def print_summary(summary: dict) -> None:
         ],
         rows,
     )
+    best = summary.get("best")
+    if best is not None:
+        metric = {"rmse": "RMSE", "mape": "MAPE", "r2": "R²"}.get(summary["selected_by"], "")
+        _common.console.print(f"best by held-out {metric}: {best}", highlight=False)
 
 
 def predict(
-    model: Path = typer.Argument(..., help="A model saved by 'softbend train' (models/*.json)."),
-    design: str = typer.Option(
+    model: Path = typer.Argument(
         ...,
+        help="A model saved by 'softbend train' (models/*.json), or the model.json of "
+        "'softbend identify'.",
+    ),
+    design: str = typer.Option(
+        None,
         help="The design by the model's parameter names, NAME=VALUE,... (a categorical "
         "parameter by its level), or the values in the model's column order; for paper B's "
         "actuator l,r,t,b,phi,lc (mm, mm, mm, mm, deg, mm).",
     ),
     pressures: str = typer.Option(
-        ...,
+        None,
         help="Comma-separated gauge pressures in the model's pressure unit (MPa for paper "
         "B's actuator; such as 0.05,0.1).",
     ),
@@ -260,8 +301,28 @@ def predict(
         False, "--strict", help="Refuse a design or pressure outside the model's training data."
     ),
     as_json: bool = typer.Option(False, "--json", help="Print the predictions as JSON."),
+    series: Path = typer.Option(
+        None,
+        "--input",
+        help="For a model of 'softbend identify': a CSV of its input columns (optionally its "
+        "time and output columns: the outputs' first samples then start the run, and its "
+        "error is reported); the model runs free on it.",
+    ),
+    out: Path = typer.Option(
+        None,
+        "--out",
+        "-o",
+        help="With --input: a CSV of the time, the inputs and the simulated outputs.",
+    ),
 ) -> None:
-    """Predict the bending angle of a design at the given pressures.
+    """Predict a design's angles, or an identified model's free run.
+
+    With a surrogate of 'softbend train', --design and --pressures give the
+    bending angle of the design at each pressure. With the model.json of
+    'softbend identify', --input gives a CSV of its input series: the model runs
+    free on it (from the measured outputs' first samples when the CSV has them,
+    else from rest), and the outputs are summarized (with their free-run NRMSE
+    when measured), written with --out or printed with --json.
 
     A design or pressure outside the ranges the model was trained on, a pressure
     past what the training designs nearest to this one were swept to, or an angle
@@ -276,7 +337,15 @@ def predict(
             --pressures 0.05,0.1,0.17
         softbend predict pneunet/models/plr.json \\
             --design n_chambers=10,n_layers=2,wall_mm=2,height_mm=12 --pressures 20,40
+        softbend predict arm-model/model.json --input steps.csv --out steps-run.csv
     """
+    from softbend.cli.predict_series import is_series_model, predict_series, surrogate_options
+
+    if is_series_model(model):
+        predict_series(model, series=series, out=out, as_json=as_json, design=design,
+                       pressures=pressures, strict=strict)  # fmt: skip
+        return
+    design, pressures = surrogate_options(model, design, pressures, series, out)
     from softbend.surrogates.predict import INTERVAL_LEVEL, predict_text
 
     result = predict_text(model, design, pressures, strict=strict)

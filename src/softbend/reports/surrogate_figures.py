@@ -23,6 +23,14 @@ if TYPE_CHECKING:
 _DPI = 150
 
 
+def _mape_label(cv: dict[str, float]) -> str:
+    """``MAPE 1.23 % (|θ| ≥ 5°)``, or that it is undefined (no reading above the floor)."""
+    floor = cv.get("mape_floor_deg")
+    over = "" if floor is None else f" (|θ| ≥ {floor:.3g}°)"
+    mape = cv["mape_pct"]
+    return f"MAPE {mape:.2f} %{over}" if np.isfinite(mape) else f"MAPE undefined{over}"
+
+
 def parity_and_errors(result: SearchResult, path: Path) -> Path:
     """Paper B Fig. 5: parity plot and error histogram for each family's best model.
 
@@ -49,7 +57,7 @@ def parity_and_errors(result: SearchResult, path: Path) -> Path:
         ax_parity.set_title(
             f"{FAMILIES.get(name).title} ({describe(fam.params)})\n"
             f"R² {fam.cv['r2']:.6f}, RMSE {fam.cv['rmse_deg']:.2f}°, "
-            f"MAPE {fam.cv['mape_pct']:.2f} %",
+            f"{_mape_label(fam.cv)}",
             fontsize=9,
         )
         ax_parity.legend(loc="upper left", fontsize=8)

@@ -13,6 +13,14 @@ into ``out_dir``:
 - ``summary.csv`` — the best of each family beside paper B's figures (empty for
   a family paper B does not have).
 
+The summary names the best family by cross-validated RMSE (°) unless told
+another metric (``select_by``: ``rmse``, ``mape`` or ``r2``; :data:`SELECT_BY`):
+a MAPE weighs the readings near its floor most and can prefer a model several
+times further off in degrees. ``best_by_mape`` stays, reported beside. On a
+table of fewer than :data:`~softbend.surrogates.search.SMALL_DATA_DESIGNS`
+designs the search uses the ``small`` grid unless a grid is named, and says so
+(``advice``).
+
 It draws nothing: :func:`softbend.reports.surrogate_figures.training_figures`
 draws paper B Fig. 5 and the MLP's loss from what it returns.
 :func:`train_into` is what ``softbend train`` runs: the same, into a folder that
@@ -30,10 +38,18 @@ import numpy as np
 import pandas as pd
 
 from softbend._io import write_text_atomic
+from softbend._validation import check_choice
 from softbend.references import SURROGATES, values
 from softbend.surrogates.families import FAMILIES, family_names
 from softbend.surrogates.features import TrainingData, training_data
-from softbend.surrogates.search import MODEL_NAMES, Progress, SearchResult, describe, search
+from softbend.surrogates.search import (
+    MODEL_NAMES,
+    SMALL_DATA_DESIGNS,
+    Progress,
+    SearchResult,
+    describe,
+    search,
+)
 
 if TYPE_CHECKING:
     from softbend.surrogates.checkpoint import SearchCheckpoint
@@ -44,6 +60,79 @@ Source: TypeAlias = TrainingData | pd.DataFrame | str | os.PathLike[str]
 #: Paper B §4.1 (Fig. 5): best configuration of each family, 5-fold CV on its FEM data
 #: (:data:`softbend.references.SURROGATES`).
 PAPER_B_FIG5: dict[str, dict[str, Any]] = values(SURROGATES)
+
+
+#: Metrics the best family may be chosen by: (key of the CV scores, True if higher is better).
+SELECT_BY: dict[str, tuple[str, bool]] = {
+    "rmse": ("rmse_deg", False),
+    "mape": ("mape_pct", False),
+    "r2": ("r2", True),
+}
+
+
+def best_family(families: dict[str, Any], select_by: str = "rmse") -> str | None:
+    """The family whose pooled cross-validated ``select_by`` score is best.
+
+    Parameters
+    ----------
+    families : dict
+        ``{name: FamilyResult}`` (anything with a ``cv`` dict of scores).
+    select_by : {"rmse", "mape", "r2"}
+        Lowest RMSE (°), lowest MAPE (%) or highest R². A family whose score is
+        undefined (NaN: no reading above the MAPE floor) is no candidate.
+
+    Returns
+    -------
+    str or None
+        The family's name; None when no family has a defined score.
+    """
+    check_choice(select_by, "select_by", tuple(SELECT_BY))
+    key, higher = SELECT_BY[select_by]
+    scored = {
+        name: float(fam.cv[key]) for name, fam in families.items() if np.isfinite(fam.cv[key])
+    }
+    if not scored:
+        return None
+    pick = max if higher else min
+    return pick(scored, key=scored.__getitem__)
+
+
+def small_data_advice(n_designs: int, grid_name: str | None) -> str | None:
+    """One line for a table of fewer than :data:`SMALL_DATA_DESIGNS` designs, else None.
+
+    ``grid_name`` is the grid the caller named (None: none).
+    """
+    if n_designs >= SMALL_DATA_DESIGNS:
+        return None
+    grid = (
+        "the MLP searches the small-data grid (networks of 16 and 32 units, 1000 epochs; "
+        "--grid quick for paper B's network)"
+        if grid_name is None
+        else f"--grid {grid_name} was asked for (the small-data grid is the default here)"
+    )
+    return (
+        f"{n_designs} designs: fewer than {SMALL_DATA_DESIGNS}, so the held-out scores vary "
+        f"from fold to fold and a flexible model can fit noise; {grid}. Compare the families "
+        "by RMSE and add designs where the held-out error is largest."
+    )
+
+
+def _telling(advise: Callable[[str], None] | None, line: str | None) -> Callable[[], None] | None:
+    """``advise(line)`` as a call of no arguments; None when there is nothing to tell."""
+    if advise is None or line is None:
+        return None
+    return lambda: advise(line)
+
+
+def _mape_entry(cv: dict[str, float]) -> dict[str, Any]:
+    """The MAPE fields of a summary entry: null and a reason when it is undefined."""
+    floor = float(cv["mape_floor_deg"])
+    used = int(cv["n_mape_used"])
+    entry: dict[str, Any] = {"mape_floor_deg": floor, "n_mape_used": used}
+    if not np.isfinite(cv["mape_pct"]):
+        entry["mape_pct"] = None
+        entry["mape_undefined"] = f"no reading has |angle| >= {floor:g} deg (the MAPE floor)"
+    return entry
 
 
 def _paper_b(name: str) -> dict[str, Any]:
@@ -69,7 +158,7 @@ def train_surrogates(
     out_dir: str | os.PathLike[str],
     *,
     models: str | Sequence[str] = MODEL_NAMES,
-    grid_name: str = "quick",
+    grid_name: str | None = "quick",
     folds: int = 5,
     seed: int = 0,
     device: str = "auto",
@@ -77,6 +166,8 @@ def train_surrogates(
     epochs: int | None = None,
     export_onnx: bool = True,
     progress: Progress | None = None,
+    select_by: str = "rmse",
+    advise: Callable[[str], None] | None = None,
     cv: str = "grouped",
     halving: int | None = None,
     halving_rungs: int | None = None,
@@ -94,7 +185,9 @@ def train_surrogates(
         Output folder (created).
     models, grid_name, folds, seed, device, n_jobs, epochs, progress
         As :func:`softbend.surrogates.search.search` (``models``: registered family
-        names, or one comma-separated text of them).
+        names, or one comma-separated text of them). ``grid_name`` None: ``small``
+        for fewer than :data:`~softbend.surrogates.search.SMALL_DATA_DESIGNS`
+        designs, else ``quick``.
     export_onnx : bool
         Also write and check ``models/<model>.onnx`` (default True) for the families
         that have an ONNX export.
@@ -108,21 +201,35 @@ def train_surrogates(
     tf32 : bool
         TF32 matrix products for the MLP on a CUDA device (see
         :func:`softbend.surrogates.search.search`).
+    select_by : {"rmse", "mape", "r2"}
+        The cross-validated metric that names the best family (default RMSE).
+    advise : callable, optional
+        Told :func:`small_data_advice`'s line, once the settings are checked and
+        before the first fit, for a table of
+        fewer than :data:`~softbend.surrogates.search.SMALL_DATA_DESIGNS` designs.
 
     Returns
     -------
     result : SearchResult
     summary : dict
         JSON-friendly headline figures, per family and paper B's beside them
-        (``paper_b``, empty for a family paper B does not have), the files
-        written, and ``resumed_config_folds`` (folds loaded from ``checkpoint``).
+        (``paper_b``, empty for a family paper B does not have; the MAPE with
+        its floor ``mape_floor_deg`` and ``n_mape_used``, null with
+        ``mape_undefined`` when no reading reaches the floor), ``best`` and
+        ``selected_by``, ``best_by_mape``, ``advice`` (None for 100 designs or
+        more), the files written, and ``resumed_config_folds`` (folds loaded
+        from ``checkpoint``).
     """
     from softbend.actuators import SFRBA
     from softbend.surrogates.features import training_ranges
     from softbend.surrogates.persistence import describing, save_surrogate
     from softbend.surrogates.support import support_from_rows
 
+    check_choice(select_by, "select_by", tuple(SELECT_BY))
     data = _load_data(source)
+    advice = small_data_advice(data.n_groups, grid_name)
+    if grid_name is None:
+        grid_name = "small" if advice is not None else "quick"
     actuator = data.actuator or SFRBA
     with describing(actuator):  # every check and file names this actuator
         paper_b = actuator == SFRBA
@@ -142,6 +249,7 @@ def train_surrogates(
             plr_patience=plr_patience,
             checkpoint=checkpoint,
             tf32=tf32,
+            on_start=_telling(advise, advice),
         )
         out = Path(out_dir)
         (out / "models").mkdir(parents=True, exist_ok=True)
@@ -168,6 +276,7 @@ def train_surrogates(
             entry: dict[str, Any] = {
                 "params": describe(fam.params),
                 **{k: float(v) for k, v in fam.cv.items()},
+                **_mape_entry(fam.cv),
                 **{f"inference_{k}": v for k, v in fam.timing.items()},
                 "fit_s": fam.fit_s,
                 "search_s": fam.search_s,
@@ -194,12 +303,15 @@ def train_surrogates(
         write_text_atomic(out / "summary.csv", summary_table.to_csv(index=False))
         files["cv_results"] = str(cv_path)
         files["summary"] = str(out / "summary.csv")
-        best = min(result.families, key=lambda m: result.families[m].cv["mape_pct"], default=None)
         summary = {
             **({} if paper_b else {"actuator": actuator.to_dict()}),
             "settings": result.settings,
             "models": families,
-            "best_by_mape": best,
+            "best": best_family(result.families, select_by),
+            "selected_by": select_by,
+            "best_by_mape": best_family(result.families, "mape"),
+            "mape_floor_deg": result.settings["mape_floor_deg"],
+            "advice": advice,
             "resumed_config_folds": result.resumed,
             "files": files,
         }

@@ -1,8 +1,7 @@
 """Leave-one-configuration-out evaluation of the refinement strategies (paper B Fig. 7).
 
 For every measured actuator, every strategy is fitted on the measurements of the
-other actuators and scored on the held-out one: RMSE, MAPE (the 0 MPa points
-included, as paper B; only exact zeros are left out), largest error, and for
+other actuators and scored on the held-out one: RMSE, MAPE, largest error, and for
 strategies with intervals the share of held-out readings inside the interval.
 Every strategy (but the two slowest) also gets a calibrated interval
 (:mod:`softbend.transfer.conformal`), nested: the held-out actuator's interval
@@ -10,6 +9,14 @@ is calibrated on the leave-one-out errors of the other actuators, each from a
 model fitted without it and without the held-out one, as a lab with those
 actuators alone would have calibrated it. A learning curve repeats this with
 1, 2, ... of the other actuators measured.
+
+The MAPE of paper B's actuator keeps paper B's definition (the 0 MPa points
+included; only exact zeros left out), to compare with paper B Fig. 7 (6.45 %).
+Any other actuator's leaves out the readings below
+:func:`softbend.metrics.mape_floor` of all its measured angles, max(5°, 5 % of
+the largest), as ``softbend train`` does: near 0° a percentage says nothing.
+The floor is ``mape_floor_deg`` of the settings, and each row counts the
+readings it used (``n_mape_used``).
 
 Every strategy's mean RMSE is also stated relative to the baseline's,
 ``base-mean-residual`` (:data:`BASELINE_STRATEGY`: the base plus the training
@@ -33,7 +40,7 @@ import pandas as pd
 from softbend._io import json_text, write_text_atomic
 from softbend._validation import check_int, check_range
 from softbend.errors import InputError, keyed
-from softbend.metrics import rmse, thresholded_mape
+from softbend.metrics import mape_floor, rmse, thresholded_mape
 from softbend.registry import UnknownNameError
 from softbend.surrogates.protocol import Surrogate
 from softbend.transfer.actuator_measurements import ActuatorMeasurements
@@ -82,8 +89,10 @@ class LocoResult:
     ----------
     per_actuator : DataFrame
         One row per (strategy, held-out actuator): ``n_points``, ``rmse_deg``,
-        ``mape_pct``, ``max_error_deg``, ``coverage`` (share inside the interval,
-        NaN without one), ``calibrated_coverage`` and ``calibrated_width_deg``
+        ``mape_pct`` (over the readings at or above the settings'
+        ``mape_floor_deg``; NaN when none is), ``n_mape_used``, ``max_error_deg``,
+        ``coverage`` (share inside the interval, NaN without one),
+        ``calibrated_coverage`` and ``calibrated_width_deg``
         (share inside, and mean width in degrees, of the calibrated interval,
         calibrated without the held-out actuator; NaN when not calibrated),
         ``calibration_half_width_deg``, ``calibration_guaranteed``, ``fit_s``.
@@ -172,6 +181,7 @@ def _score(
     y: np.ndarray,
     pred: np.ndarray,
     interval: tuple[np.ndarray, np.ndarray] | None,
+    floor: float = 0.0,
 ) -> dict[str, Any]:
     ok = np.isfinite(pred)
     row: dict[str, Any] = {
@@ -183,10 +193,11 @@ def _score(
     if ok.any():
         err = pred[ok] - y[ok]
         row["rmse_deg"] = rmse(y[ok], pred[ok])
-        row["mape_pct"] = thresholded_mape(y[ok], pred[ok], threshold=0.0)[0]
+        row["mape_pct"], left_out = thresholded_mape(y[ok], pred[ok], threshold=floor)
+        row["n_mape_used"] = int(ok.sum()) - left_out
         row["max_error_deg"] = float(np.max(np.abs(err)))
     else:
-        row.update(rmse_deg=np.nan, mape_pct=np.nan, max_error_deg=np.nan)
+        row.update(rmse_deg=np.nan, mape_pct=np.nan, n_mape_used=0, max_error_deg=np.nan)
     if interval is not None:
         lo, hi = interval
         row["coverage"] = float(np.mean((y >= lo) & (y <= hi)))
@@ -291,6 +302,8 @@ def leave_one_configuration_out(
             f"{actuator.name}: leave it out",
             key="strategies",
         )
+    # Paper B's actuator: paper B's MAPE (only exact zeros left out); any other: the floor.
+    floor = 0.0 if actuator == SFRBA else mape_floor(measurements.angle_deg)
     with describing(actuator):  # the strategies check the inputs of this actuator
         result = _leave_one_out(
             measurements,
@@ -303,6 +316,7 @@ def leave_one_configuration_out(
             seed=seed,
             options=options,
             progress=progress,
+            floor=floor,
         )
     if actuator != SFRBA:
         result.settings["actuator"] = actuator.to_dict()
@@ -323,8 +337,12 @@ def _leave_one_out(
     seed: int,
     options: dict[str, dict[str, Any]] | None,
     progress: Callable[[int, int, str], None] | None,
+    floor: float = 0.0,
 ) -> LocoResult:
-    """:func:`leave_one_configuration_out` once the measurements' kind is known."""
+    """:func:`leave_one_configuration_out` once the measurements' kind is known.
+
+    ``floor``: the smallest ``|θ|`` in the MAPE, degrees.
+    """
     names = tuple(strategies)
     if not names:
         raise InputError(f"must name at least one of {', '.join(STRATEGIES)}", key="strategies")
@@ -419,7 +437,7 @@ def _leave_one_out(
             continue
         if kind == "nested":
             continue
-        row = _score(name, held_out, y[test], out["pred"], out["interval"])
+        row = _score(name, held_out, y[test], out["pred"], out["interval"], floor)
         if kind == "loco":
             row["fit_s"] = out["fit_s"]
             cal = _calibration(nested.get((name, held_out)), level, y[train], fallback)
@@ -478,6 +496,7 @@ def _leave_one_out(
             },
             "calibrated": list(nested_names),
             "baseline": BASELINE_STRATEGY if BASELINE_STRATEGY in names else None,
+            "mape_floor_deg": floor,
             "fits": len(tasks),
             "wall_time_s": time.perf_counter() - start,
         },
@@ -646,6 +665,7 @@ def _summarize(
                 "rmse_deg_mean": mean_rmse,
                 "rmse_vs_baseline_pct": np.nan,
                 "mape_pct": float(part["mape_pct"].mean()),
+                "n_mape_used": int(part["n_mape_used"].sum()),
                 "max_error_deg": float(part["max_error_deg"].max()),
                 "coverage": float(
                     (part["coverage"] * part["n_points"]).sum() / part["n_points"].sum()
