@@ -43,6 +43,8 @@ typecheck: setup
 # The documentation site (Sphinx + MyST) into docs/_build/html, warnings as errors. The generated
 # pages are written first: the command-line reference, the performance page (from the benchmarks'
 # JSON in benchmarks/results/), the names-and-ranges page (from the declarations in the code) and, after a `make run`, the validation page from its summary.json.
+# Each generated page holds only what a rerun repeats (the validation page leaves off the run's
+# dates and wall time), so `make docs` leaves the tracked pages unchanged unless a figure changed.
 docs: setup
 	$(BIN)/python docs/gen_cli_reference.py
 	$(BIN)/python docs/gen_performance.py

@@ -7,6 +7,10 @@ The summary is checked before anything is written: a file that is missing, not
 JSON, or not the summary ``softbend reproduce`` writes (a section missing, a
 value of the wrong type) is one line naming the file and what is wrong, exit
 code 2, and docs/validation.md is left as it was. The page is replaced whole.
+
+The page holds what a rerun repeats: the figures and the run's setting, not its
+dates and wall time (:data:`VOLATILE`), so that `make docs` after a fresh
+`make run` leaves the tracked page unchanged unless a figure changed.
 """
 
 from __future__ import annotations
@@ -27,6 +31,17 @@ SECTIONS = ("paper_a", "paper_b", "paper_b_fem_data", "transfer", "control", "de
 
 #: Every key the summary must have: the sections, the run's provenance and what was reduced.
 REQUIRED = (*SECTIONS, "provenance", "reduced_settings")
+
+#: Provenance that differs from one run to the next of the same code on the same machine: left
+#: off the page, so that `make docs` after a fresh `make run` leaves the tracked page as it was
+#: unless a figure changed. The run's report (index.html) keeps them.
+VOLATILE = ("started (UTC)", "finished (UTC)", "wall time")
+
+#: The page's last line: where the left-off provenance is.
+NOTE = (
+    "The run's start, end and wall time are in its report (`results/reproduce/index.html`), "
+    "not on this page: it changes only when a figure or the run's setting does."
+)
 
 #: JSON kinds by name, for the checks below.
 _OBJECT, _LIST, _TEXT, _NUMBER, _NULL = "an object", "a list", "a string", "a number", "null"
@@ -149,6 +164,15 @@ def check_summary(data: Any) -> dict[str, Any]:
     return data
 
 
+def page_text(summary: dict[str, Any]) -> str:
+    """The validation page of a checked summary: its figures and the provenance that a rerun
+    of the same code on the same machine repeats (:data:`VOLATILE` left off)."""
+    from softbend.reports.summary_section import validation_markdown
+
+    provenance = {k: v for k, v in summary["provenance"].items() if k not in VOLATILE}
+    return validation_markdown({**summary, "provenance": provenance}) + "\n" + NOTE + "\n"
+
+
 def main(argv: Sequence[str] | None = None) -> int:
     """Check the summary, then write the page; the exit code (2: a summary that is not one)."""
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
@@ -165,10 +189,9 @@ def main(argv: Sequence[str] | None = None) -> int:
         print(exc, file=sys.stderr)
         return 2
     from softbend._io import write_text_atomic
-    from softbend.reports.summary_section import validation_markdown
 
     try:
-        write_text_atomic(args.out, validation_markdown(summary))  # whole, or as it was
+        write_text_atomic(args.out, page_text(summary))  # whole, or as it was
     except OSError as exc:
         print(f"{args.out}: cannot be written ({exc.strerror or exc}).", file=sys.stderr)
         return 1

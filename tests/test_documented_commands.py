@@ -2,7 +2,9 @@
 
 The commands are read from the ```bash blocks (continuation lines joined, comments dropped);
 each is resolved in the command tree of ``softbend`` and each ``--option`` must be one of that
-command's. A renamed command or option breaks this test, not a reader's first try.
+command's. A renamed command or option breaks this test, not a reader's first try. A line
+pasted twice into a continued command, or an option line left after a command has ended, breaks
+it too: the shell would run it as a command of its own.
 """
 
 from __future__ import annotations
@@ -16,7 +18,7 @@ import typer
 
 from softbend.cli import app
 
-from .doc_commands import softbend_commands
+from .doc_commands import broken_continuations, softbend_commands
 
 ROOT = Path(__file__).resolve().parents[1]
 PAGES = [ROOT / "README.md", *sorted((ROOT / "docs").glob("*.md"))]
@@ -67,3 +69,32 @@ def test_a_renamed_command_or_option_is_caught():
 def test_a_documented_command_exists_with_its_options(page, line, command):
     problem = _problem(command)
     assert problem is None, f"{page}:{line}: {problem}"
+
+
+def test_a_line_pasted_twice_is_caught(tmp_path):
+    page = tmp_path / "page.md"
+    page.write_text(
+        "```bash\n"
+        "softbend identify arm.csv --inputs p1 \\\n"
+        "    --outputs x --out m/          # the model\n"
+        "    --outputs x --out m/          # the model\n"
+        "softbend fem run --design 100,6,2,2,5,8 \\\n"
+        "    --pmax 0.1 \\\n"
+        "    --pmax 0.1 \\\n"
+        "    -o fem/\n"
+        "softbend predict m.json --pressures 0.1\n"
+        "    --design 100,6,2,2,5,8\n"
+        "MY_SPACE=(--space corners\n"
+        "          --range l=60:100)\n"
+        "```\n"
+        "```text\n"
+        "    --pmax 0.1\n"
+        "    --pmax 0.1\n"
+        "```\n"
+    )
+    assert [line for line, _ in broken_continuations(page)] == [4, 7, 10]
+
+
+@pytest.mark.parametrize("page", PAGES, ids=lambda p: p.name)
+def test_no_command_block_has_a_line_pasted_twice(page):
+    assert broken_continuations(page) == [], f"{page.name}: a line that breaks a copy-paste"

@@ -1,8 +1,9 @@
 """The README's tour runs: every ``softbend …`` command of its bash blocks, in order, in a quick
-variant, in a fresh folder.
+variant, in a fresh folder; and its first line makes ``softbend`` a command of a new shell.
 
-The quick variant appends options to a command (a later option wins in the command line) so
-that the tour runs in about a minute: a coarser mesh, fewer designs, epochs and folds, an
+The README's tour is already in quick settings (a coarse FEM mesh, the analytical lab, no MLP);
+the test's variant appends options to a command (a later option wins in the command line) so
+that the tour runs in about a minute: a coarser mesh still, fewer designs and folds, an
 analytical check instead of the FEM's. :data:`QUICK` holds them by command. A command of the
 README that :data:`QUICK` does not know fails the test, so each new command gets a decision.
 ``make run`` and ``make test-full``, the README's two commands, are what CI and the pipeline tests
@@ -13,9 +14,12 @@ from __future__ import annotations
 
 import os
 import shlex
+import shutil
 import subprocess
 import sys
 from pathlib import Path
+
+import pytest
 
 from .doc_commands import softbend_commands
 
@@ -27,7 +31,7 @@ QUICK: dict[str, tuple[str, ...]] = {
     "fem run": ("--maxh", "12", "--pmax", "0.04", "--pstep", "0.02", "--shapes", "2"),
     "campaign run": ("--space", "corners", "--pmax", "0.1", "--pstep", "0.01"),
     "analyze": (),
-    "train": ("--models", "plr,mlp", "--folds", "2", "--epochs", "3", "--no-onnx"),
+    "train": ("--folds", "2", "--no-onnx"),
     "predict": (),
     "design find": ("--verify", "1", "--backend", "analytical"),
     "lab measure": ("--plant", "analytical"),
@@ -65,6 +69,48 @@ def test_the_tour_shows_the_lab_s_path():
 def test_every_readme_command_has_a_quick_variant():
     unknown = sorted({_path(c) for c in COMMANDS} - set(QUICK))
     assert not unknown, f"add the README's {unknown} to QUICK (with the options that make it quick)"
+
+
+def _tour() -> list[str]:
+    """The lines of the tour's bash block (the first after its heading)."""
+    text = (ROOT / "README.md").read_text(encoding="utf-8")
+    after = text[text.index("## A five-minute tour") :]
+    return after.split("```bash\n", 1)[1].split("```", 1)[0].splitlines()
+
+
+def test_the_tour_opens_with_the_line_that_puts_softbend_on_path():
+    lines = [line for line in _tour() if line.strip() and not line.startswith("#")]
+    assert lines[0].split("#")[0].strip() == "source .venv/bin/activate"
+    assert all(line.lstrip().startswith(("softbend ", "-")) for line in lines[1:]), lines
+
+
+def test_the_first_line_makes_softbend_a_command_of_a_new_shell(tmp_path):
+    """In a shell whose PATH has no softbend, the tour's first line finds .venv's."""
+    bash = shutil.which("bash")
+    venv = Path(sys.prefix)
+    if bash is None or not (venv / "bin" / "activate").is_file():
+        pytest.skip("needs bash and a virtual environment with bin/activate")
+    (tmp_path / ".venv").symlink_to(venv, target_is_directory=True)
+    plain = os.pathsep.join(
+        p for p in os.environ["PATH"].split(os.pathsep) if not (Path(p) / "softbend").exists()
+    )
+    env = {**os.environ, "PATH": plain or "/usr/bin:/bin"}
+    env.pop("VIRTUAL_ENV", None)
+    missing = subprocess.run(
+        [bash, "-c", "command -v softbend"], cwd=tmp_path, env=env, capture_output=True, text=True
+    )
+    assert missing.returncode != 0  # as a new user's shell after make run
+    first = _tour()[0].split("#")[0].strip()
+    found = subprocess.run(
+        [bash, "-c", f"{first} && command -v softbend"],
+        cwd=tmp_path,
+        env=env,
+        capture_output=True,
+        text=True,
+        timeout=120,
+    )
+    assert found.returncode == 0, found.stderr
+    assert Path(found.stdout.strip()).samefile(venv / "bin" / "softbend")
 
 
 def _tree(root: Path) -> dict[str, tuple[int, int]]:
@@ -119,6 +165,6 @@ def test_the_tour_runs_in_its_quick_variant(tmp_path):
         changed = {p for p, v in after.items() if before.get(p) != v} | (set(before) - set(after))
         assert not _outside(changed, _outputs(words)), f"{shown} wrote outside its outputs"
     # The tour's files are where the README says they are.
-    for name in ("mat/fit.json", "table1.duckdb", "surrogates/models/mlp.json", "refined.json"):
+    for name in ("mat/fit.json", "corners.duckdb", "surrogates/models/xgb.json", "refined.json"):
         assert (tmp_path / name).exists(), name
     assert (tmp_path / "ctl").is_dir() and (tmp_path / "ident").is_dir()

@@ -63,6 +63,47 @@ def test_no_design_meets_it_is_a_warning_with_the_closest(model, tmp_path, capsy
     )
 
 
+@pytest.fixture(scope="module")
+def short_model(tmp_path_factory):
+    """θ = 10·p·l, the 160 mm designs swept to 0.05 MPa only."""
+    from tests.design_search.conftest import save_model
+
+    return save_model(
+        tmp_path_factory.mktemp("cli") / "short.json",
+        swept_to=lambda design: 0.05 if design[0] == 160.0 else 0.5,
+    )
+
+
+def _largest_at_008(short_model, out, *extra):
+    args = ["design", "find", "--model", str(short_model), "--max-angle-at", "0.08", *FIXED,
+            "--top", "3", "-o", str(out), *extra]  # fmt: skip
+    assert main(args) == 0
+
+
+def test_a_design_outside_the_training_data_is_said_as_predict_says_it(
+    short_model, tmp_path, capsys
+):
+    # Paper B's 160 mm designs were swept to 0.05 MPa: at 0.08 MPa the largest angle (1.28°/mm)
+    # is an extrapolation, passed over by default and flagged when allowed.
+    _largest_at_008(short_model, tmp_path / "inside", "--json")
+    captured = capsys.readouterr()
+    inside = json.loads(captured.out)["candidates"]
+    assert all(c["supported"] is True and c["flags"] == [] for c in inside)
+    assert inside[0]["design"]["l"] < 160.0 and "not trained there" not in captured.err
+    _largest_at_008(short_model, tmp_path / "outside", "--json", "--allow-extrapolation")
+    captured = capsys.readouterr()
+    outside = json.loads(captured.out)["candidates"]
+    assert outside[0]["design"]["l"] == 160.0
+    assert outside[0]["supported"] is False and outside[0]["flags"]
+    assert [c["supported"] for c in outside] == [not c["flags"] for c in outside]
+    assert "#1" in captured.err and "was not trained there" in captured.err
+    _largest_at_008(short_model, tmp_path / "table", "--allow-extrapolation")
+    captured = capsys.readouterr()
+    assert "trained there" in captured.out
+    rows = [line for line in captured.out.splitlines() if "160" in line and "0.08" not in line]
+    assert rows and rows[0].rstrip(" │|").endswith("no"), captured.out
+
+
 @pytest.mark.parametrize(
     ("extra", "needle"),
     [

@@ -205,7 +205,9 @@ def find(
     those that meet the target within --tolerance are ranked by the
     objectives (several: the Pareto front), each listed design more than one
     step from a better one (--neighbours lists them all). Answers outside the model's
-    training data are passed over unless --allow-extrapolation. With --verify N
+    training data are passed over unless --allow-extrapolation (which lists them
+    with a "no" in the table's "trained there" column, "supported": false in the
+    JSON and a warning on stderr, as softbend predict does). With --verify N
     the best N are swept by the FEM and set beside the surrogate.
 
     Every input is checked before a design is scored: each number against its
@@ -348,6 +350,9 @@ def find(
         line = result.message()
         if line is not None:
             _common.warning_line(line)
+        line = _extrapolated(result, model_path, len(results) > 1)
+        if line is not None:
+            _common.warning_line(line)
     if skipped is not None:
         _common.warning_line(f"--verify skipped: {skipped}; the answers are the surrogate's.")
     if as_json:
@@ -358,6 +363,21 @@ def find(
     _common.console.print(f"{', '.join(FILES)} written to {out}")
 
 
+def _extrapolated(result: SearchResult, model: Path, named: bool) -> str | None:
+    """One line naming the listed designs outside the model's training data (only kept with
+    --allow-extrapolation), as ``softbend predict`` warns; None when every one is inside."""
+    outside = [(rank, c) for rank, c in enumerate(result.candidates, start=1) if not c.supported]
+    if not outside:
+        return None
+    ranks = ", ".join(f"#{rank}" for rank, _ in outside)
+    first = outside[0][1].flags[0]
+    where = f"{result.spec.name}: " if named else ""
+    return (
+        f"{where}{ranks} of {len(result.candidates)} listed: {model} was not trained there "
+        f"({first}); their angles are extrapolations (kept by --allow-extrapolation)."
+    )
+
+
 def _print_result(result: SearchResult) -> None:
     spec = result.spec
     design = "l,r,t,b,φ,lc" if spec.space.paper_b else "design"
@@ -366,6 +386,7 @@ def _print_result(result: SearchResult) -> None:
     verified = any(c.fem_meets is not None for c in result.candidates)
     if verified:
         columns += ["FEM θ (°)", "FEM ok"]
+    columns.append("trained there")
     rows = []
     for rank, c in enumerate(result.candidates, start=1):
         row = [str(rank), str(c.design), f"{c.angle_deg:.2f}", f"{c.error_deg:.2f}"]
@@ -373,6 +394,7 @@ def _print_result(result: SearchResult) -> None:
         if verified:
             fem = "" if c.fem_angle_deg is None else f"{c.fem_angle_deg:.2f}"
             row += [fem, "" if c.fem_meets is None else ("yes" if c.fem_meets else "NO")]
+        row.append("yes" if c.supported else "no")
         rows.append(row)
     title = (
         f"{spec.name}: {spec.target.describe()} — {result.n_meeting:,} of "

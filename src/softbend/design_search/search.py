@@ -154,9 +154,16 @@ class Candidate:
     fem_curve: tuple[np.ndarray, np.ndarray] | None = field(default=None, repr=False)
     pressure_unit: str = "MPa"
 
+    @property
+    def supported(self) -> bool:
+        """Whether the answer lies inside the model's training data (no flag), as
+        ``softbend predict`` says "trained there"."""
+        return not self.flags
+
     def to_dict(self) -> dict[str, Any]:
         """JSON-friendly: the design by named parameters (mm, deg; another actuator's in its
-        units, levels by name) and every figure (the pressure keyed by its unit)."""
+        units, levels by name), every figure (the pressure keyed by its unit), the ``flags``
+        and ``supported`` (no flag: inside the model's training data)."""
         if isinstance(self.design, SFRBADesign):
             design = dict(zip(NAMES, (float(v) for v in self.design.as_array()), strict=True))
         else:
@@ -169,6 +176,7 @@ class Candidate:
             "meets": self.meets,
             "objectives": dict(self.objectives),
             "flags": list(self.flags),
+            "supported": self.supported,
         }
         if self.interval_deg is not None:
             out["interval_deg"] = list(self.interval_deg)
