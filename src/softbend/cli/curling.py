@@ -194,28 +194,37 @@ def identify(
         softbend curling identify experiments --out identification
     """
     from softbend.identification.data import experiment_files, load_experiments
+    from softbend.identification.ranges import (
+        C_RANGE,
+        EPSILON_RANGE,
+        LAGS_RANGE,
+        MAX_MEMORY_MB_RANGE,
+        check_integer,
+        check_number,
+    )
 
+    # every numeric option within its declared range (softbend.identification.ranges),
+    # before anything is read: lags of 10**9 would allocate GiB before the first fit
+    check_number(c, C_RANGE, "C")
+    check_number(epsilon, EPSILON_RANGE, "epsilon")
+    check_integer(output_lags, LAGS_RANGE, "output_lags")
+    check_integer(input_lags, LAGS_RANGE, "input_lags")
+    if max_memory_mb is not None:
+        check_number(max_memory_mb, MAX_MEMORY_MB_RANGE, "max_memory_mb")
     if not Path(data).exists():  # one line naming it, before the fitting's imports (seconds)
         experiment_files(data)
 
     from softbend._io import staged_dir
-    from softbend.identification.ranges import MAX_MEMORY_MB_RANGE, check_number
     from softbend.identification.resources import check_identify_memory
     from softbend.identification.study import (
         IdentificationConfig,
         check_experiments,
-        check_settings,
         n_fits,
     )
     from softbend.identification.study import identify as run_identify
     from softbend.reports.identify_outputs import write_identification
     from softbend.reports.paper_a import write_identification_outputs
 
-    # every numeric option within its declared range (softbend.identification.ranges),
-    # before anything is read: lags of 10**9 would allocate GiB before the first fit
-    check_settings(C=c, epsilon=epsilon, output_lags=output_lags, input_lags=input_lags)
-    if max_memory_mb is not None:
-        check_number(max_memory_mb, MAX_MEMORY_MB_RANGE, "max_memory_mb")
     choices: dict[str, Any] = {"kernel": kernel, "moments_of": moments_of}  # checked there
     config = IdentificationConfig(
         C=c, epsilon=epsilon, output_lags=output_lags, input_lags=input_lags, **choices
