@@ -87,3 +87,5 @@ def test_small_tables_get_the_small_grid_and_one_line_of_advice(samples, tmp_pat
     assert plr["n_mape_used"] == int((abs(result.data.y) >= 1.0).sum()) < result.data.n_samples
     assert small_data_advice(100, None) is None
     assert "--grid quick was asked for" in small_data_advice(99, "quick")
+    # without the MLP, no word of its grid
+    assert "grid" not in small_data_advice(99, None, mlp=False)

@@ -97,10 +97,11 @@ def best_family(families: dict[str, Any], select_by: str = "rmse") -> str | None
     return pick(scored, key=scored.__getitem__)
 
 
-def small_data_advice(n_designs: int, grid_name: str | None) -> str | None:
+def small_data_advice(n_designs: int, grid_name: str | None, *, mlp: bool = True) -> str | None:
     """One line for a table of fewer than :data:`SMALL_DATA_DESIGNS` designs, else None.
 
-    ``grid_name`` is the grid the caller named (None: none).
+    ``grid_name`` is the grid the caller named (None: none); ``mlp`` whether the
+    MLP is among the families trained (the grid is said only then).
     """
     if n_designs >= SMALL_DATA_DESIGNS:
         return None
@@ -110,9 +111,10 @@ def small_data_advice(n_designs: int, grid_name: str | None) -> str | None:
         if grid_name is None
         else f"--grid {grid_name} was asked for (the small-data grid is the default here)"
     )
+    said = f"; {grid}" if mlp else ""
     return (
         f"{n_designs} designs: fewer than {SMALL_DATA_DESIGNS}, so the held-out scores vary "
-        f"from fold to fold and a flexible model can fit noise; {grid}. Compare the families "
+        f"from fold to fold and a flexible model can fit noise{said}. Compare the families "
         "by RMSE and add designs where the held-out error is largest."
     )
 
@@ -227,7 +229,8 @@ def train_surrogates(
 
     check_choice(select_by, "select_by", tuple(SELECT_BY))
     data = _load_data(source)
-    advice = small_data_advice(data.n_groups, grid_name)
+    names = [m.strip() for m in models.split(",")] if isinstance(models, str) else list(models)
+    advice = small_data_advice(data.n_groups, grid_name, mlp="mlp" in names)
     if grid_name is None:
         grid_name = "small" if advice is not None else "quick"
     actuator = data.actuator or SFRBA
