@@ -115,10 +115,10 @@ def resume_path(args: Sequence[str]) -> Path | None:
     elif words[:2] == ["campaign", "run"] and len(words) > 2:
         path = Path(words[2])
     elif words[:1] == ["reproduce"]:
-        out = Path(_option(args, "--out", "-o") or "results/reproduce")
-        path = out.with_name(f".{out.name}.resume")
+        folder = Path(_option(args, "--out", "-o") or "results/reproduce")
+        path = folder.with_name(f".{folder.name}.resume")
         if not path.exists():
-            path = out / "paper_b" / "campaign.duckdb" if out.is_dir() else None
+            path = folder / "paper_b" / "campaign.duckdb" if folder.is_dir() else None
     return path if path is not None and path.exists() else None
 
 

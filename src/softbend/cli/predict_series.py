@@ -52,8 +52,8 @@ def surrogate_options(
     for key, value in (("series", series), ("out", out)):
         if value is not None:
             raise InputError(f"is for {_IDENTIFY}; {model} is not one{why}", key=key)
-    for key, value in (("design", design), ("pressures", pressures)):
-        if value is None:
+    for key, text in (("design", design), ("pressures", pressures)):
+        if text is None:
             raise InputError(
                 f"is required to predict with a surrogate ({model}); an identified model "
                 "takes --input instead",

@@ -389,7 +389,7 @@ def step_readings(identified: IdentifiedModel) -> list[StepReading]:
         u1[i] += du
         trajectory, status = _hold(model, u1, start, before=u0)
         for j, output in enumerate(identified.output_names):
-            common = {
+            common: dict[str, Any] = {
                 "input": name,
                 "output": output,
                 "time_unit_s": identified.time_unit_s,
