@@ -9,6 +9,7 @@ reads no file (the commands' own --help).
 
 from __future__ import annotations
 
+import copy
 import importlib.util
 import json
 import sys
@@ -299,3 +300,60 @@ def test_a_missing_results_folder_is_refused_not_an_empty_page(tmp_path, capsys)
 def test_the_cli_reference_generator_reads_no_input():
     text = (ROOT / "docs" / "gen_cli_reference.py").read_text()
     assert "open(" not in text and "read_text" not in text and "sys.argv" not in text
+
+
+# make docs after a fresh make run leaves docs/validation.md as it was: two runs of the same
+# code differ in their dates and wall time only, which the page leaves off.
+
+#: A run's summary as ``softbend reproduce`` writes it (the figures the page reads).
+RUN = {
+    "paper_a": {},
+    "paper_b": {"r2": 0.84181, "f_value": 68146.3, "mape_pct": 133.55},
+    "paper_b_fem_data": {"r2": 0.83593, "f_value": 37817.9, "mape_pct": 48.93},
+    "transfer": {"best": "refined", "summary": {"refined": {"rmse_deg": 7.6, "mape_pct": 7.05}}},
+    "control": {"rig": [{"controller": "bang-bang", "reference": "square:90:4", "mape_pct": 7.17}]},
+    "design": {"specifications": []},
+    "reduced_settings": [],
+    "provenance": {
+        "command": "softbend reproduce --out results/reproduce",
+        "softbend": "0.1.0",
+        "seed": 0,
+        "started (UTC)": "2026-11-26 13:25:58",
+        "finished (UTC)": "2026-11-26 13:32:44",
+        "wall time": "406 s",
+    },
+    "seconds": 406.0,
+}
+
+
+def _rerun(**changes: object) -> dict:
+    """The same run again: other dates and wall time, and ``changes`` to its figures."""
+    again = copy.deepcopy(RUN)
+    again["provenance"].update(
+        {"started (UTC)": "2026-11-28 02:00:01", "finished (UTC)": "2026-11-28 02:07:30"}
+    )
+    again["provenance"]["wall time"] = "449 s"
+    again["seconds"] = 449.3
+    for section, figures in changes.items():
+        again[section] = {**again[section], **figures}
+    return again
+
+
+def test_a_rerun_makes_the_same_page():
+    page = gen_validation.page_text(gen_validation.check_summary(copy.deepcopy(RUN)))
+    assert gen_validation.page_text(_rerun()) == page
+    assert "2026-11-26" not in page and "406 s" not in page
+    assert "| seed | 0 |" in page and "| 0.84181 |" in page  # the setting and the figures stay
+    assert page.rstrip().endswith(gen_validation.NOTE)
+
+
+def test_a_changed_figure_changes_the_page():
+    page = gen_validation.page_text(RUN)
+    assert gen_validation.page_text(_rerun(paper_b={"r2": 0.84182})) != page
+
+
+def test_the_tracked_page_has_no_run_s_dates():
+    tracked = (ROOT / "docs" / "validation.md").read_text(encoding="utf-8")
+    for key in gen_validation.VOLATILE:
+        assert f"| {key} |" not in tracked, key
+    assert tracked.rstrip().endswith(gen_validation.NOTE)

@@ -71,8 +71,8 @@ def test_input_in_kpa_is_converted(tmp_path, fopdt):
 
 @pytest.mark.parametrize(
     ("name", "unit", "scale"),
-    [("p_mpa", "mpa", 1.0), ("P_KPA", "kpa", 1e3), ("p_bar", "bar", 10.0),
-     ("p_pa", "pa", 1e6), ("p_psi", "psi", 145.0377)],
+    [("p_mpa", "MPa", 1.0), ("P_KPA", "kPa", 1e3), ("p_bar", "bar", 10.0),
+     ("p_pa", "Pa", 1e6), ("p_psi", "psi", 145.0377)],
 )  # fmt: skip
 def test_pressure_units(name, unit, scale):
     got = pressure_unit(name)

@@ -30,6 +30,7 @@ from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
+from softbend.actuators import PRESSURE_UNITS
 from softbend.control.rig import RIG_RANGES, AngleTable
 from softbend.errors import InputError
 
@@ -37,7 +38,7 @@ if TYPE_CHECKING:
     from softbend.identification.dynamics import IdentifiedModel
 
 __all__ = [
-    "PRESSURE_UNITS",
+    "MPA_PER_UNIT",
     "IdentifiedPlant",
     "NARXAngle",
     "angle_output",
@@ -47,14 +48,9 @@ __all__ = [
     "rig_settings_from",
 ]
 
-#: Units of a pressure column by the end of its name: units per MPa.
-PRESSURE_UNITS: dict[str, float] = {
-    "_mpa": 1.0,
-    "_kpa": 1e3,
-    "_bar": 10.0,
-    "_psi": 1e6 / 6894.757293168,
-    "_pa": 1e6,
-}
+#: MPa per unit of a pressure column, by the unit its name ends with: an actuator
+#: description's units, and pascal, which a recording may use.
+MPA_PER_UNIT: dict[str, float] = {**PRESSURE_UNITS, "Pa": 1e-6}
 
 #: Grid points of the steady-state θ(p) of an identified plant.
 STEADY_POINTS = 41
@@ -73,11 +69,10 @@ RIG_FROM_FIELDS: dict[str, str] = {
 
 def pressure_unit(name: str) -> tuple[str, float] | None:
     """The unit of a pressure column by its name's end, and its units per MPa, else None."""
-    lower = name.strip().lower()
-    for suffix, scale in PRESSURE_UNITS.items():
-        if lower.endswith(suffix):
-            return suffix[1:], scale
-    return None
+    from softbend.identification.dynamics import unit_from_name
+
+    unit = unit_from_name(name.strip())
+    return (unit, 1.0 / MPA_PER_UNIT[unit]) if unit in MPA_PER_UNIT else None
 
 
 def _is_angle(name: str) -> bool:
@@ -188,7 +183,7 @@ class IdentifiedPlant:
         Its file.
     identified : IdentifiedModel
     input_unit : str
-        The unit of its pressure input (``mpa``, ``kpa``, ``bar``, ``pa``, ``psi``).
+        The unit of its pressure input (``MPa``, ``kPa``, ``bar``, ``psi``, ``Pa``).
     input_scale : float
         Units of its input per MPa.
     angle_index : int
@@ -311,7 +306,7 @@ def identified_plant(path: str | Path, *, role: str = "--plant") -> IdentifiedPl
     if len(inputs) != 1 or units[0] is None:
         raise InputError(
             "must have exactly one input, a pressure whose column name gives its unit (ending "
-            f"in {', '.join(PRESSURE_UNITS)}) to play the actuator; {source} has the inputs "
+            f"in {', '.join('_' + u.lower() for u in MPA_PER_UNIT)}) to play the actuator; {source} has the inputs "
             f"{', '.join(inputs)}",
             key="plant",
         )
