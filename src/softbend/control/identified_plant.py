@@ -55,8 +55,6 @@ MPA_PER_UNIT: dict[str, float] = {**PRESSURE_UNITS, "Pa": 1e-6}
 #: Grid points of the steady-state θ(p) of an identified plant.
 STEADY_POINTS = 41
 
-_SETTLE_CHUNK = 500  # samples of each free run between checks that it settled
-
 #: A fall of the steady-state θ(p) by more than this share of its rise is reported.
 MONOTONE_TOLERANCE = 0.02
 
@@ -223,31 +221,11 @@ class IdentifiedPlant:
     def steady_angles_deg(self, pressures_mpa: np.ndarray) -> np.ndarray:
         """The angle each gauge pressure (MPa) held settles to, degrees.
 
-        As :meth:`~softbend.identification.dynamics.IdentifiedModel.steady_state`
-        (started at the training outputs' means, held until no output moves by
-        more than 1e-7 of its standard deviation over half a chunk, at most
-        ``MAX_SETTLE_STEPS`` samples), every pressure run as one experiment of a
-        single free run.
+        :meth:`~softbend.identification.dynamics.IdentifiedModel.steady_states` of the
+        pressures in the model's input unit.
         """
-        from softbend.identification.dynamics import MAX_SETTLE_STEPS
-
-        model = self.identified.model
-        u = np.asarray(pressures_mpa, dtype=float).reshape(-1) * self.input_scale
-        g, lag, m = u.size, model.max_lag, model.n_outputs_
-        rows = np.tile(model.y_mean_, (g, lag, 1))
-        n = _SETTLE_CHUNK + lag
-        U = np.repeat(u, n)[:, None]
-        groups = np.repeat(np.arange(g), n)
-        for _ in range(max(1, MAX_SETTLE_STEPS // _SETTLE_CHUNK)):
-            Y = np.empty((g, n, m))
-            Y[:, :lag] = rows
-            Y[:, lag:] = rows[:, -1:]
-            out = model.simulate(U, Y.reshape(g * n, m), groups).reshape(g, n, m)
-            rows = out[:, -lag:]
-            change = np.ptp(out[:, -_SETTLE_CHUNK // 2 :], axis=1) / model.y_std_
-            if np.all(change <= 1e-7):
-                break
-        return rows[:, -1, self.angle_index].copy()
+        u = np.asarray(pressures_mpa, dtype=float).reshape(-1, 1) * self.input_scale
+        return self.identified.steady_states(u)[:, self.angle_index].copy()
 
     def angle_table(
         self, pmax_mpa: float, points: int = STEADY_POINTS, *, check: bool = True
@@ -304,10 +282,10 @@ def identified_plant(path: str | Path, *, role: str = "--plant") -> IdentifiedPl
     inputs = list(identified.input_names)
     units = [pressure_unit(name) for name in inputs]
     if len(inputs) != 1 or units[0] is None:
+        suffixes = ", ".join("_" + unit.lower() for unit in MPA_PER_UNIT)
         raise InputError(
             "must have exactly one input, a pressure whose column name gives its unit (ending "
-            f"in {', '.join('_' + u.lower() for u in MPA_PER_UNIT)}) to play the actuator; {source} has the inputs "
-            f"{', '.join(inputs)}",
+            f"in {suffixes}) to play the actuator; {source} has the inputs {', '.join(inputs)}",
             key="plant",
         )
     if identified.sample_period_s is None:

@@ -226,10 +226,7 @@ class IdentifiedModel:
         Returns
         -------
         ndarray, shape (m,)
-            The settled outputs: started at the training outputs' means, the input
-            is held for at most :data:`MAX_SETTLE_STEPS` samples, until no output
-            moves by more than 1e-7 of its training standard deviation over 250
-            samples (the last outputs reached when they never settle).
+            As one row of :meth:`steady_states`.
         """
         u = check_finite_array(inputs, "inputs").ravel()
         if u.size != len(self.input_names):
@@ -238,9 +235,42 @@ class IdentifiedModel:
                         f"{u.size}"),
                 key="inputs",
             )  # fmt: skip
-        rest = np.tile(self.model.y_mean_, (self.max_lag, 1))
-        trajectory, _ = _hold(self.model, u, rest)
-        return trajectory[-1].copy()
+        return self.steady_states(u[None, :])[0]
+
+    def steady_states(self, inputs: ArrayLike) -> np.ndarray:
+        """The outputs settled at under each row of ``inputs`` held, all run together.
+
+        Parameters
+        ----------
+        inputs : array_like, shape (g, k)
+            One row of input values per steady state, in :attr:`input_names` order.
+
+        Returns
+        -------
+        ndarray, shape (g, m)
+            Started at the training outputs' means, each row's input is held for
+            at most :data:`MAX_SETTLE_STEPS` samples, until no output of any row
+            moves by more than 1e-7 of its training standard deviation over the
+            last half of a chunk (the last outputs reached when they never settle).
+        """
+        model = self.model
+        u = check_finite_array(inputs, "inputs")
+        u = u.reshape(-1, len(self.input_names))
+        g, lag, m = u.shape[0], model.max_lag, model.n_outputs_
+        rows = np.tile(model.y_mean_, (g, lag, 1))
+        n = _CHUNK + lag
+        U = np.repeat(u, n, axis=0)
+        groups = np.repeat(np.arange(g), n)
+        for _ in range(max(1, MAX_SETTLE_STEPS // _CHUNK)):
+            Y = np.empty((g, n, m))
+            Y[:, :lag] = rows
+            Y[:, lag:] = rows[:, -1:]
+            out = model.simulate(U, Y.reshape(g * n, m), groups).reshape(g, n, m)
+            rows = out[:, -lag:]
+            change = np.ptp(out[:, -_CHUNK // 2 :], axis=1) / model.y_std_
+            if np.all(change <= _SETTLED):
+                break
+        return rows[:, -1].copy()
 
 
 def _hold(
