@@ -72,8 +72,9 @@ def test_surrogates_fit_the_campaign_and_are_saved(campaign):
     assert trained.training["files"]["plr_model"] == str(folder / "models" / "plr.json")
     assert set(trained.search.families) == set(models)
     assert phases.all_finished()
-    # the refits and the export after the last search are a phase of their own, last
+    # each family's refit on all designs is a phase of its own; saving and the export,
+    # after the last refit, are the last phase
     names = list(phases.last)
-    assert names[-1] == "paper B: surrogates, refit on all designs and export (stages)"
-    assert names[-2].startswith("paper B: surrogates, plr:")
+    assert names[-1] == "paper B: surrogates, save and export (stages)"
+    assert names[-2] == "paper B: surrogates, plr: refit on all designs"
     assert pictures(folder) == []

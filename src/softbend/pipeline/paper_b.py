@@ -147,14 +147,14 @@ def train_campaign_surrogates(
 
     folder = Path(out_dir) / "paper_b"
     families = MODEL_NAMES if models is None else tuple(models)
-    # after the last family's search: the refits on all designs, the timings, the saved
-    # models and their ONNX export (minutes on a CPU), told as a phase of its own
-    after = "paper B: surrogates, refit on all designs and export (stages)"
+    # after the last family's refit on all designs (each refit is a phase of the search):
+    # the saved models and their ONNX export, told as a phase of their own
+    after = "paper B: surrogates, save and export (stages)"
 
     def on_progress(phase: str, done: int, total: int) -> None:
         if progress is not None:
             progress(f"paper B: surrogates, {phase}", done, total)
-            if families and phase.startswith(f"{families[-1]}:") and done >= total:
+            if families and phase.startswith(f"{families[-1]}: refit on all designs") and done >= total:
                 progress(after, 0, 1)
 
     start = time.perf_counter()

@@ -94,14 +94,14 @@ def _surrogates(
     from softbend.surrogates.workflow import train_surrogates
 
     families = MODEL_NAMES if models is None else tuple(models)
-    # after the last family's grouped search: the refits on all designs and the export
-    after = "paper B FEM data: surrogates, refit on all designs and export (stages)"
+    # after the last family's refit on all designs: the saved models and their export
+    after = "paper B FEM data: surrogates, save and export (stages)"
 
     def on_progress(protocol: str) -> Progress:
         def forward(phase: str, done: int, total: int) -> None:
             if progress is not None:
                 progress(f"paper B FEM data: surrogates ({protocol} CV), {phase}", done, total)
-                last = protocol == "grouped" and families and phase.startswith(f"{families[-1]}:")
+                last = protocol == "grouped" and families and phase.startswith(f"{families[-1]}: refit on all designs")
                 if last and done >= total:
                     progress(after, 0, 1)
 

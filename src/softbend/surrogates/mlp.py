@@ -127,7 +127,13 @@ class NormalizedMLPRegressor(RegressorMixin, BaseEstimator):
         self.seed = seed
         self.device = device
 
-    def fit(self, X: ArrayLike, y: ArrayLike) -> NormalizedMLPRegressor:
+    def fit(
+        self,
+        X: ArrayLike,
+        y: ArrayLike,
+        *,
+        progress: Callable[[int, int], object] | None = None,
+    ) -> NormalizedMLPRegressor:
         """Train the network on all rows.
 
         Parameters
@@ -136,6 +142,8 @@ class NormalizedMLPRegressor(RegressorMixin, BaseEstimator):
             Inputs, finite (softbend: columns :data:`FEATURES`, mm/deg/MPa).
         y : array_like of shape (n_samples,)
             Bending angle, degrees, finite.
+        progress : callable, optional
+            ``progress(epochs_done, epochs)`` as training goes.
 
         Returns
         -------
@@ -174,6 +182,7 @@ class NormalizedMLPRegressor(RegressorMixin, BaseEstimator):
             learning_rate=learning_rate,
             seed=seed,
             device=device,
+            progress=progress,
         )
         fitted = result.models[0]
         self._set_fitted(

@@ -909,7 +909,7 @@ def search(
             final, timing, fit_s = None, {"single_us": math.nan, "batch_ms": math.nan}, 0.0
             if refit:
                 start = time.perf_counter()
-                final = make(params).fit(data.X, data.y)
+                final = _refit(make(params), data, f"{model}: refit on all designs", progress)
                 fit_s = time.perf_counter() - start
                 timing = inference_time(final, data.X, seed=seed)
             families[model] = FamilyResult(
@@ -949,6 +949,26 @@ def search(
         settings=settings,
         resumed=resumed,
     )
+
+
+def _refit(estimator: Any, data: TrainingData, phase: str, progress: Progress | None) -> Any:
+    """``estimator`` fitted on every row, told as its own phase: the MLP counts its
+    training epochs, every other family counts one fit."""
+    from softbend.surrogates.mlp import NormalizedMLPRegressor
+
+    if progress is None:
+        return estimator.fit(data.X, data.y)
+    if isinstance(estimator, NormalizedMLPRegressor):
+        epochs_phase = f"{phase}, training epochs"
+
+        def on_epoch(done: int, total: int) -> None:
+            progress(epochs_phase, done, total)
+
+        return estimator.fit(data.X, data.y, progress=on_epoch)
+    progress(phase, 0, 1)
+    fitted = estimator.fit(data.X, data.y)
+    progress(phase, 1, 1)
+    return fitted
 
 
 def search_fingerprint(
