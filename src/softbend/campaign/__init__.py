@@ -9,6 +9,9 @@
   (mesh, FEM options, material) and checks on resume;
 * :mod:`~softbend.campaign.spaces` — design spaces and shards named by text, and
   the memory and disk a campaign over one needs;
+* :mod:`~softbend.campaign.families` and :mod:`~softbend.campaign.family_spaces` —
+  campaigns over another FEM actuator family than paper B's (``--family``): its
+  FEM sweep as a backend, what its database records, and its design spaces;
 * :mod:`~softbend.campaign.runner` — :func:`run_campaign`: plans a run
   (:mod:`~softbend.campaign.planning`: resume, the designs left, the executor) and
   runs it (:mod:`~softbend.campaign.executors`: serial, local processes or a Dask
@@ -45,6 +48,11 @@ _EXPORTS = {
     "count_designs_to_run": "runner",
     "parse_scheduler_address": "runner",
     "run_campaign": "runner",
+    "FamilyBackend": "families",
+    "campaign_actuator": "families",
+    "family_backend": "families",
+    "FamilySpace": "family_spaces",
+    "parse_family_space": "family_spaces",
     "SPACE_FORMS": "spaces",
     "SpaceSpec": "spaces",
     "campaign_footprint": "spaces",

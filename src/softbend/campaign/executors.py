@@ -35,15 +35,15 @@ from concurrent.futures import FIRST_COMPLETED, ProcessPoolExecutor, wait
 from concurrent.futures.process import BrokenProcessPool
 from dataclasses import dataclass
 from pathlib import Path
-from typing import TYPE_CHECKING, Any
+from typing import TYPE_CHECKING, Any, cast
 
 import numpy as np
 
 from softbend._extras import require
 from softbend._validation import must_be
 from softbend.campaign.backends import Backend, SweepResult
+from softbend.campaign.families import CampaignDesign
 from softbend.campaign.schema import first_line
-from softbend.design import SFRBADesign
 from softbend.errors import InputError, SoftbendError, keyed
 from softbend.limits import check_file_size
 
@@ -86,7 +86,7 @@ _MAX_POOL_RESTARTS = 3
 class Outcome:
     """One design's sweep, as sent back by a worker."""
 
-    design: SFRBADesign
+    design: CampaignDesign
     result: SweepResult | None
     error: str | None
     wall_time_s: float
@@ -97,10 +97,11 @@ def _error_text(exc: BaseException) -> str:
     return f"{type(exc).__name__}: {message}" if message else type(exc).__name__
 
 
-def _sweep_one(backend: Backend, design: SFRBADesign, pressures_mpa: np.ndarray) -> Outcome:
+def _sweep_one(backend: Backend, design: CampaignDesign, pressures_mpa: np.ndarray) -> Outcome:
     start = time.perf_counter()
     try:
-        result = backend.sweep(design, pressures_mpa)
+        # A family's backend sweeps its FamilyDesign; the protocol names paper B's design.
+        result = backend.sweep(cast(Any, design), pressures_mpa)
         if not isinstance(result, SweepResult):
             raise SoftbendError(
                 f"backend {backend.name!r} returned {type(result).__name__}, not a SweepResult"
@@ -116,13 +117,13 @@ def _sweep_one(backend: Backend, design: SFRBADesign, pressures_mpa: np.ndarray)
 
 
 def sweep_chunk(
-    backend: Backend, designs: Sequence[SFRBADesign], pressures_mpa: np.ndarray
+    backend: Backend, designs: Sequence[CampaignDesign], pressures_mpa: np.ndarray
 ) -> list[Outcome]:
     """Worker task: sweep each design of the chunk independently."""
     return [_sweep_one(backend, design, pressures_mpa) for design in designs]
 
 
-def _lost_chunk(designs: Sequence[SFRBADesign], exc: BaseException) -> list[Outcome]:
+def _lost_chunk(designs: Sequence[CampaignDesign], exc: BaseException) -> list[Outcome]:
     text = _error_text(exc)
     if isinstance(exc, BrokenProcessPool):
         text = (
@@ -202,7 +203,7 @@ class Recorder:
 
 
 def run_serial(
-    backend: Backend, todo: Sequence[SFRBADesign], pressures: np.ndarray, recorder: Recorder
+    backend: Backend, todo: Sequence[CampaignDesign], pressures: np.ndarray, recorder: Recorder
 ) -> None:
     """Sweep the designs one after another in this process."""
     for design in todo:
@@ -223,7 +224,7 @@ def _mp_context() -> multiprocessing.context.BaseContext:
 
 def _run_isolated(
     backend: Backend,
-    suspects: deque[SFRBADesign],
+    suspects: deque[CampaignDesign],
     pressures: np.ndarray,
     context: multiprocessing.context.BaseContext,
     recorder: Recorder,
@@ -259,7 +260,7 @@ def _run_isolated(
 
 def run_local(
     backend: Backend,
-    chunks: deque[list[SFRBADesign]],
+    chunks: deque[list[CampaignDesign]],
     pressures: np.ndarray,
     workers: int,
     recorder: Recorder,
@@ -274,13 +275,13 @@ def run_local(
     """
     context = _mp_context()
     restarts = 0
-    suspects: deque[SFRBADesign] = deque()
+    suspects: deque[CampaignDesign] = deque()
     while chunks or suspects:
         _run_isolated(backend, suspects, pressures, context, recorder)
         if not chunks:
             break
         pool = ProcessPoolExecutor(max_workers=workers, mp_context=context)
-        pending: dict[Any, list[SFRBADesign]] = {}
+        pending: dict[Any, list[CampaignDesign]] = {}
         broken = False
         clean = False
         try:
@@ -551,7 +552,7 @@ def connect(address: str, timeout_s: float) -> Client:
 
 def run_dask(
     backend: Backend,
-    chunks: deque[list[SFRBADesign]],
+    chunks: deque[list[CampaignDesign]],
     pressures: np.ndarray,
     client: Client,
     recorder: Recorder,
@@ -560,7 +561,7 @@ def run_dask(
     from distributed import as_completed
 
     n_threads = max(1, sum(client.nthreads().values()))
-    pending: dict[Any, list[SFRBADesign]] = {}
+    pending: dict[Any, list[CampaignDesign]] = {}
 
     def submit() -> Any:
         chunk = chunks.popleft()

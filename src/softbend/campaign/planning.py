@@ -22,8 +22,10 @@ import numpy as np
 
 from softbend._validation import check_range, must_be
 from softbend.campaign.backends import Backend, get_backend
+from softbend.campaign.families import DEFAULT_FAMILY, CampaignDesign
 from softbend.design import SFRBADesign
 from softbend.errors import InputError
+from softbend.fem.families import FamilyDesign
 
 if TYPE_CHECKING:
     from softbend.campaign.store import CampaignStore
@@ -34,6 +36,7 @@ __all__ = [
     "check_designs",
     "check_run_options",
     "chunks",
+    "design_family",
     "plan_run",
     "resolve_backend",
 ]
@@ -50,7 +53,7 @@ class RunPlan:
 
     Attributes
     ----------
-    todo : list of SFRBADesign
+    todo : list of SFRBADesign or FamilyDesign
         The designs to sweep, in the order asked for.
     n_skipped_done : int
         Designs already done in the database (not re-run).
@@ -63,7 +66,7 @@ class RunPlan:
         when the designs run in local processes.
     """
 
-    todo: list[SFRBADesign]
+    todo: list[CampaignDesign]
     n_skipped_done: int
     n_skipped_failed: int
     executor: str
@@ -73,15 +76,18 @@ class RunPlan:
 # -- the arguments -------------------------------------------------------------------
 
 
-def check_designs(designs: Iterable[SFRBADesign]) -> list[SFRBADesign]:
+def check_designs(designs: Iterable[CampaignDesign]) -> list[CampaignDesign]:
     """The designs as a list: non-empty, all :class:`SFRBADesign`, no two alike.
+
+    Designs of another FEM family (:class:`~softbend.fem.families.FamilyDesign`)
+    are accepted too, all of one family.
 
     Raises
     ------
     ValueError
-        Not an iterable of designs, empty, or with duplicates.
+        Not an iterable of designs, empty, of two families, or with duplicates.
     """
-    if isinstance(designs, SFRBADesign):
+    if isinstance(designs, SFRBADesign | FamilyDesign):
         designs = [designs]
     try:
         items = list(designs)
@@ -89,10 +95,18 @@ def check_designs(designs: Iterable[SFRBADesign]) -> list[SFRBADesign]:
         raise InputError(must_be("an iterable of SFRBADesign", designs), key="designs") from None
     if not items:
         raise InputError("must not be empty; got 0 designs", key="designs")
+    family = None
     for i, design in enumerate(items):
-        if not isinstance(design, SFRBADesign):
+        if not isinstance(design, SFRBADesign | FamilyDesign):
             raise InputError(
                 f"must all be SFRBADesign; got {design!r} at position {i}", key="designs"
+            )
+        family = design_family(design) if family is None else family
+        if design_family(design) != family:
+            raise InputError(
+                f"must all be of one family; got a design of {design_family(design)!r} at "
+                f"position {i} after designs of {family!r}",
+                key="designs",
             )
     ids = [d.design_id for d in items]
     if len(set(ids)) != len(ids):
@@ -100,6 +114,21 @@ def check_designs(designs: Iterable[SFRBADesign]) -> list[SFRBADesign]:
             f"must be unique; got {len(ids) - len(set(ids))} duplicates", key="designs"
         )
     return items
+
+
+def design_family(design: object) -> str:
+    """The FEM family of a design: its ``family`` (FamilyDesign), ``"sfrba"`` for paper B's.
+
+    Raises
+    ------
+    InputError
+        Keyed ``designs``: neither an SFRBADesign nor a FamilyDesign.
+    """
+    if isinstance(design, FamilyDesign):
+        return design.family
+    if isinstance(design, SFRBADesign):
+        return DEFAULT_FAMILY
+    raise InputError(must_be("SFRBADesign or FamilyDesign objects", design), key="designs")
 
 
 def resolve_backend(backend: str | Backend, options: dict[str, Any] | None) -> Backend:
@@ -165,7 +194,7 @@ def plan_run(
     store: CampaignStore,
     backend: str,
     pressures_mpa: np.ndarray,
-    designs: Sequence[SFRBADesign],
+    designs: Sequence[CampaignDesign],
     *,
     space: str | None,
     retry_failed: bool,
@@ -184,7 +213,7 @@ def plan_run(
         Backend name.
     pressures_mpa : numpy.ndarray
         Checked sweep grid, MPa.
-    designs : sequence of SFRBADesign
+    designs : sequence of SFRBADesign or FamilyDesign
         The designs asked for (checked by :func:`check_designs`).
     space : str, optional
         Label of the design space, stored for reports.
@@ -265,6 +294,6 @@ def auto_chunk_size(backend: Backend, n_designs: int, n_slots: int) -> int:
     return max(1, min(_MAX_AUTO_CHUNK, math.ceil(n_designs / (8 * max(1, n_slots)))))
 
 
-def chunks(designs: Sequence[SFRBADesign], size: int) -> deque[list[SFRBADesign]]:
+def chunks(designs: Sequence[CampaignDesign], size: int) -> deque[list[CampaignDesign]]:
     """The designs cut into consecutive tasks of ``size`` designs (the last may be shorter)."""
     return deque(list(designs[i : i + size]) for i in range(0, len(designs), size))

@@ -48,7 +48,7 @@ import time
 from collections.abc import Iterable
 from dataclasses import asdict, dataclass, field
 from pathlib import Path
-from typing import TYPE_CHECKING, Any
+from typing import TYPE_CHECKING, Any, cast
 
 import numpy as np
 from numpy.typing import ArrayLike
@@ -72,12 +72,20 @@ from softbend.campaign.executors import (
     run_local,
     run_serial,
 )
+from softbend.campaign.families import (
+    DEFAULT_FAMILY,
+    CampaignDesign,
+    FamilyBackend,
+    FamilySchema,
+    family_backend,
+)
 from softbend.campaign.planning import (
     RunPlan,
     auto_chunk_size,
     check_designs,
     check_run_options,
     chunks,
+    design_family,
     plan_run,
     resolve_backend,
 )
@@ -160,7 +168,7 @@ class CampaignSummary:
 
 def run_campaign(
     db_path: str | os.PathLike[str],
-    designs: Iterable[SFRBADesign],
+    designs: Iterable[CampaignDesign],
     *,
     backend: str | Backend = "analytical",
     backend_options: dict[str, Any] | None = None,
@@ -180,18 +188,25 @@ def run_campaign(
     ----------
     db_path : str or os.PathLike
         DuckDB file of the campaign; created if missing, resumed if present.
-    designs : iterable of SFRBADesign
-        The designs (e.g. a :class:`~softbend.design.DesignSpace`), non-empty and
-        unique.
+    designs : iterable of SFRBADesign or FamilyDesign
+        The designs (e.g. a :class:`~softbend.design.DesignSpace`, or a
+        :class:`~softbend.campaign.family_spaces.FamilySpace` of another FEM
+        family), non-empty, unique and of one family. A database keeps the
+        family of its first run (paper B's ``"sfrba"`` unless another's designs
+        created it); another is refused.
     backend : str or Backend
         Registered backend name (``"analytical"``, ``"fem"``, ...) or a backend
         object. A database keeps the backend of its first run; another is refused.
+        For another family's designs: ``"fem"`` (the family's own FEM sweep,
+        :class:`~softbend.campaign.families.FamilyBackend`, with
+        ``backend_options`` ``maxh_mm`` at most) or a backend object that sweeps them.
     backend_options : dict, optional
         Keyword options of the named backend.
     pressures_mpa : array_like, optional
         Sweep grid, MPa: 1-D, >= 0, strictly increasing. Default
         :func:`~softbend.campaign.backends.default_pressures_mpa` (0–0.5 MPa,
-        step 0.005). A database keeps the grid of its first run.
+        step 0.005; for another family's designs 0 to its ``pmax_mpa`` by its
+        ``pstep_mpa``). A database keeps the grid of its first run.
     workers : int, optional
         Local worker processes; default ``os.cpu_count()``. 0 or 1 runs serially
         in this process. Ignored with ``scheduler``.
@@ -245,18 +260,24 @@ def run_campaign(
         or has no workers, or local workers keep dying.
     """
     start = time.perf_counter()
-    backend_obj = resolve_backend(backend, backend_options)
+    design_list = check_designs(designs)
+    family = design_family(design_list[0])
+    if family != DEFAULT_FAMILY:
+        backend_obj = _family_backend(family, backend, backend_options)
+    else:
+        backend_obj = resolve_backend(backend, backend_options)
     given = None
     if material is not None:
         chosen = resolve_material(material)
         backend_obj, given = with_material(backend_obj, chosen.material), chosen.given
-    design_list = check_designs(designs)
     fem_options = fem_options_of(backend_obj)
-    if fem_options is not None:
+    if fem_options is not None and family == DEFAULT_FAMILY:
         # The FEM's own rule on the mesh size, for every design before any is swept:
         # a mesh size too fine for them would otherwise fail each design in turn.
-        fem_options.check_mesh(design_list)
-    grid = check_pressures_mpa(default_pressures_mpa() if pressures_mpa is None else pressures_mpa)
+        fem_options.check_mesh(cast(list[SFRBADesign], design_list))
+    if pressures_mpa is None:
+        pressures_mpa = _default_pressures(family)
+    grid = check_pressures_mpa(pressures_mpa)
     settings = backend_settings(backend_obj, grid, material_given=given)
     workers, chunk_size, timeout_s = check_run_options(workers, chunk_size, connect_timeout_s)
     address = parse_scheduler_address(scheduler) if scheduler is not None else None
@@ -267,7 +288,7 @@ def run_campaign(
     # Connect first: an unreachable cluster fails before the database is touched.
     client = connect(address, timeout_s) if address is not None else None
     try:
-        with CampaignStore(db_path) as store:
+        with CampaignStore(db_path, family=FamilySchema.of(family)) as store:
             plan = plan_run(
                 store,
                 backend_obj.name,
@@ -313,8 +334,54 @@ def run_campaign(
     return summary
 
 
+def _default_pressures(family: str) -> np.ndarray:
+    """The default grid: 0–0.5 MPa by 0.005 MPa, or the family's own (its pmax and pstep)."""
+    if family == DEFAULT_FAMILY:
+        return default_pressures_mpa()
+    from softbend.fem.families import get_family
+
+    fem_family = get_family(family)
+    return default_pressures_mpa(fem_family.pmax_mpa, fem_family.pstep_mpa)
+
+
+def _family_backend(family: str, backend: str | Backend, options: dict[str, Any] | None) -> Backend:
+    """The backend sweeping the designs of ``family`` (not paper B's).
+
+    ``"fem"`` is the family's own FEM sweep with ``options`` ``maxh_mm`` (mm) at
+    most; a backend object is taken as given (a :class:`FamilyBackend` must be of
+    ``family``). Paper B's models (``"analytical"``, paper B's FEM) are refused.
+    """
+    from softbend.fem.families import get_family
+
+    if isinstance(backend, FamilyBackend):
+        if backend.family.name != family:
+            raise InputError(
+                f"must sweep the designs' family {family!r}; got the FEM of the "
+                f"{backend.family.name!r} family",
+                key="backend",
+            )
+        return resolve_backend(backend, options)
+    if backend == "fem":
+        options = dict(options or {})
+        unknown = sorted(set(options) - {"maxh_mm"})
+        if unknown:
+            raise InputError(
+                f"must be maxh_mm alone for the FEM of the {family!r} family; got {unknown}",
+                key="backend_options",
+            )
+        return family_backend(get_family(family), maxh_mm=options.get("maxh_mm"))
+    if isinstance(backend, str) or getattr(backend, "name", None) in ("analytical", "fem"):
+        shown = backend if isinstance(backend, str) else backend.name
+        raise InputError(
+            f"must be 'fem' for designs of the {family!r} family (its own FEM sweep); got "
+            f"{shown!r}, a model of paper B's actuator",
+            key="backend",
+        )
+    return resolve_backend(backend, options)
+
+
 def count_designs_to_run(
-    db: str | os.PathLike[str], designs: Iterable[SFRBADesign], retry_failed: bool = True
+    db: str | os.PathLike[str], designs: Iterable[CampaignDesign], retry_failed: bool = True
 ) -> int:
     """How many of ``designs`` a run on ``db`` will sweep (all of them for a new database).
 

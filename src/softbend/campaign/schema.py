@@ -10,9 +10,13 @@ Tables (schema version :data:`SCHEMA_VERSION`):
     mesh size, FEM options and material among them, see
     :mod:`softbend.campaign.settings`; set by the first run, checked by later
     ones, absent in databases of older softbend versions), ``runs`` (JSON list
-    of each run's record), ``space`` and ``n_designs_planned`` (of the latest run).
+    of each run's record), ``space`` and ``n_designs_planned`` (of the latest run);
+    a campaign of an FEM family other than paper B's also ``family`` (its name)
+    and ``actuator`` (its :meth:`~softbend.actuators.Actuator.to_dict` as JSON),
+    set on creation (see :mod:`softbend.campaign.families`).
 ``designs``
-    One row per attempted design: its parameters (``l_mm`` ... ``lc_mm``),
+    One row per attempted design: its parameters (``l_mm`` ... ``lc_mm``; those
+    of its family, in its units, for another family's campaign),
     ``status`` ``'done'`` or ``'failed'``, ``error`` (``"ExceptionType: message"``
     for failed designs), ``wall_time_s``, ``n_samples`` (rows in ``samples``,
     including the final non-converged pressure), ``max_pressure_mpa`` and
@@ -39,6 +43,7 @@ writes live in :mod:`softbend.campaign.store`.
 from __future__ import annotations
 
 import errno
+import json
 import logging
 import os
 import re
@@ -48,6 +53,7 @@ from datetime import UTC, datetime
 from pathlib import Path
 from typing import TYPE_CHECKING
 
+from softbend.campaign.families import FamilySchema
 from softbend.design import PARAMETERS
 from softbend.errors import SchemaError, SoftbendError
 
@@ -60,11 +66,15 @@ __all__ = [
     "SCHEMA_VERSION",
     "check_complete",
     "check_duckdb_file",
+    "design_columns",
     "ensure_schema",
     "first_line",
     "missing_database",
     "not_a_database",
     "open_error",
+    "quoted",
+    "read_family",
+    "sample_columns",
     "softbend_version",
     "transaction",
     "unreadable",
@@ -107,6 +117,22 @@ DESIGN_COLUMNS: tuple[str, ...] = (
     "finished_at",
     "stats",
 )
+
+
+def design_columns(parameters: tuple[str, ...] = tuple(PARAMETERS)) -> tuple[str, ...]:
+    """Columns of the ``designs`` table of a campaign whose designs have ``parameters``."""
+    return ("design_id", *parameters, *DESIGN_COLUMNS[1 + len(PARAMETERS) :])
+
+
+def sample_columns(parameters: tuple[str, ...] = tuple(PARAMETERS)) -> tuple[str, ...]:
+    """Columns of the samples (joined with the designs) of a campaign of ``parameters``."""
+    return ("design_id", *parameters, *SAMPLE_COLUMNS[1 + len(PARAMETERS) :])
+
+
+def quoted(name: str) -> str:
+    """A column name as a quoted SQL identifier."""
+    return '"{}"'.format(name.replace('"', '""'))
+
 
 _DDL = (
     """
@@ -200,7 +226,9 @@ def transaction(con: DuckDBPyConnection) -> Iterator[None]:
 # -- creating a database or checking an existing one -------------------------------
 
 
-def ensure_schema(con: DuckDBPyConnection, path: Path, *, read_only: bool) -> None:
+def ensure_schema(
+    con: DuckDBPyConnection, path: Path, *, read_only: bool, family: FamilySchema | None = None
+) -> None:
     """Create the tables of a new campaign database, or check those of an existing one.
 
     Parameters
@@ -212,6 +240,10 @@ def ensure_schema(con: DuckDBPyConnection, path: Path, *, read_only: bool) -> No
     read_only : bool
         The connection is read-only: a file without tables is refused rather
         than created.
+    family : FamilySchema, optional
+        The family of a new database's designs (default paper B's); its
+        ``designs`` table gets the family's parameter columns and its ``meta``
+        table the family's name and actuator.
 
     Raises
     ------
@@ -233,7 +265,7 @@ def ensure_schema(con: DuckDBPyConnection, path: Path, *, read_only: bool) -> No
                 f"{str(path)!r} is not a softbend campaign database "
                 f"(no 'meta' table; found {found}; {_WHAT_A_CAMPAIGN_IS})."
             )
-        _create(con, path)
+        _create(con, path, family or FamilySchema.paper_b())
         return
     meta = dict(con.execute("SELECT key, value FROM meta").fetchall())
     version_text = meta.get("schema_version")
@@ -258,9 +290,12 @@ def ensure_schema(con: DuckDBPyConnection, path: Path, *, read_only: bool) -> No
         )
 
 
-def _create(con: DuckDBPyConnection, path: Path) -> None:
+def _create(con: DuckDBPyConnection, path: Path, family: FamilySchema) -> None:
+    paper_b = family.name == FamilySchema.paper_b().name
     with transaction(con):
         for statement in _DDL:
+            if not paper_b and "designs (" in statement:
+                statement = _family_ddl(statement, family.parameters)
             con.execute(statement)
         for key, value in (
             ("schema_version", str(SCHEMA_VERSION)),
@@ -268,7 +303,62 @@ def _create(con: DuckDBPyConnection, path: Path) -> None:
             ("created_at", utc_now().isoformat(timespec="seconds") + "Z"),
         ):
             con.execute("INSERT INTO meta VALUES (?, ?)", [key, value])
+        if not paper_b:
+            con.execute("INSERT INTO meta VALUES ('family', ?)", [family.name])
+            actuator = json.dumps(family.actuator, sort_keys=True)
+            con.execute("INSERT INTO meta VALUES ('actuator', ?)", [actuator])
     logger.info("created campaign database %s (schema %d)", path, SCHEMA_VERSION)
+
+
+def _family_ddl(statement: str, parameters: tuple[str, ...]) -> str:
+    """The ``designs`` table's definition with ``parameters`` in place of paper B's."""
+    own = "".join(f"{quoted(name)} DOUBLE NOT NULL,\n        " for name in parameters)
+    start = statement.index("l_mm DOUBLE")
+    end = statement.index("status VARCHAR")
+    return statement[:start] + own + statement[end:]
+
+
+def read_family(con: DuckDBPyConnection, path: Path) -> FamilySchema:
+    """The family of an open campaign database: paper B's where its ``meta`` names none.
+
+    The parameter columns are read from the ``designs`` table itself (those
+    between ``design_id`` and ``status``).
+
+    Raises
+    ------
+    SchemaError
+        A damaged ``actuator`` entry (not a JSON object) or a ``designs`` table
+        without ``design_id`` and ``status``.
+    """
+    meta = dict(
+        con.execute("SELECT key, value FROM meta WHERE key IN ('family', 'actuator')").fetchall()
+    )
+    columns = [
+        row[0]
+        for row in con.execute(
+            "SELECT column_name FROM information_schema.columns WHERE table_schema = 'main' "
+            "AND table_name = 'designs' ORDER BY ordinal_position"
+        ).fetchall()
+    ]
+    if "design_id" not in columns or "status" not in columns:
+        raise SchemaError(
+            f"The campaign database {str(path)!r} has a damaged 'designs' table (no design_id "
+            "or status column)."
+        )
+    parameters = tuple(columns[columns.index("design_id") + 1 : columns.index("status")])
+    name = meta.get("family", FamilySchema.paper_b().name)
+    actuator = None
+    if "actuator" in meta:
+        try:
+            actuator = json.loads(meta["actuator"])
+        except (ValueError, RecursionError):
+            actuator = None
+        if not isinstance(actuator, dict):
+            raise SchemaError(
+                f"The campaign database {str(path)!r} has a damaged 'actuator' in its 'meta' "
+                f"table: it must be a JSON object. Got {meta['actuator'][:80]!r}."
+            )
+    return FamilySchema(name, parameters, actuator)
 
 
 def check_complete(con: DuckDBPyConnection, path: Path) -> None:

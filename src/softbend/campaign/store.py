@@ -34,55 +34,69 @@ import numpy as np
 
 from softbend._io import new_file_mode
 from softbend._validation import check_choice
+from softbend.campaign.families import DEFAULT_FAMILY, CampaignDesign, FamilySchema
+from softbend.campaign.schema import SAMPLE_COLUMNS as SAMPLE_COLUMNS
 from softbend.campaign.schema import (
-    DESIGN_COLUMNS,
     SCHEMA_VERSION,
     check_complete,
     check_duckdb_file,
+    design_columns,
     ensure_schema,
     first_line,
     missing_database,
     open_error,
+    quoted,
+    read_family,
     softbend_version,
     transaction,
     unreadable,
     utc_now,
     write_error,
 )
-from softbend.campaign.schema import SAMPLE_COLUMNS as SAMPLE_COLUMNS
 from softbend.campaign.settings import (
     SettingsMismatchError,
     UncheckedSettingsWarning,
     describe_differences,
     settings_differences,
 )
-from softbend.design import PARAMETERS, SFRBADesign
+from softbend.design import SFRBADesign
 from softbend.errors import SchemaError, SoftbendError
+from softbend.fem.families import FamilyDesign
 from softbend.models import SweepResult, check_pressures_mpa
 
 if TYPE_CHECKING:
     import pandas as pd
     from duckdb import DuckDBPyConnection
 
+    from softbend.fem.families import FEMFamily
+
 __all__ = ["SCHEMA_VERSION", "CampaignStore", "load_designs", "load_samples", "merge_campaigns"]
 
 logger = logging.getLogger(__name__)
 
-_INSERT_DESIGN = (
-    f"INSERT INTO designs ({', '.join(DESIGN_COLUMNS)}) "
-    f"VALUES ({', '.join('?' for _ in DESIGN_COLUMNS)})"
-)
 # One statement for all samples of a design: parallel lists unnested row-wise.
 _INSERT_SAMPLES = (
     "INSERT INTO samples SELECT ?, unnest(?::DOUBLE[]), unnest(?::DOUBLE[]), "
     "unnest(?::DOUBLE[]), unnest(?::DOUBLE[]), unnest(?::BOOLEAN[]), unnest(?::INTEGER[])"
 )
-_SAMPLES_QUERY = (
-    f"SELECT s.design_id, {', '.join('d.' + p for p in PARAMETERS)}, s.pressure_mpa, "
-    "s.angle_deg, s.tip_x_mm, s.tip_z_mm, s.converged "
-    "FROM samples s JOIN designs d USING (design_id) "
-    "ORDER BY s.design_id, s.pressure_mpa"
-)
+
+
+def _insert_design(columns: tuple[str, ...]) -> str:
+    """The statement inserting one ``designs`` row of ``columns``."""
+    return (
+        f"INSERT INTO designs ({', '.join(map(quoted, columns))}) "
+        f"VALUES ({', '.join('?' for _ in columns)})"
+    )
+
+
+def _samples_query(parameters: tuple[str, ...]) -> str:
+    """The samples joined with the designs' ``parameters``, by design and pressure."""
+    return (
+        f"SELECT s.design_id, {', '.join('d.' + quoted(p) for p in parameters)}, "
+        "s.pressure_mpa, s.angle_deg, s.tip_x_mm, s.tip_z_mm, s.converged "
+        "FROM samples s JOIN designs d USING (design_id) "
+        "ORDER BY s.design_id, s.pressure_mpa"
+    )
 
 
 def _nullable(values: np.ndarray) -> list[float | None]:
@@ -104,6 +118,11 @@ class CampaignStore:
         ``read_only``).
     read_only : bool
         Open an existing database for reading only (status, export, analysis).
+    family : FEMFamily, FamilySchema or str, optional
+        The FEM actuator family of the campaign's designs
+        (:mod:`softbend.campaign.families`). A new database is created for it
+        (default paper B's, ``"sfrba"``); an existing one must hold it. None
+        opens an existing database of any family.
 
     Raises
     ------
@@ -116,6 +135,8 @@ class CampaignStore:
         :data:`SCHEMA_VERSION`, or ``path`` is a folder; one line naming the file.
     SoftbendError
         The file is locked by another process (a running campaign).
+    ValueError
+        ``family`` given and the existing database holds another family's designs.
     OSError
         A new file could not be written (a full disk): it names the file, and
         nothing of it is left. Any later write that fails the same way (recording
@@ -129,8 +150,16 @@ class CampaignStore:
     campaign writes to it.
     """
 
-    def __init__(self, path: str | os.PathLike[str], *, read_only: bool = False) -> None:
+    def __init__(
+        self,
+        path: str | os.PathLike[str],
+        *,
+        read_only: bool = False,
+        family: FEMFamily | FamilySchema | str | None = None,
+    ) -> None:
         import duckdb
+
+        wanted = family if isinstance(family, FamilySchema | None) else FamilySchema.of(family)
 
         self.path = Path(path)
         self.read_only = bool(read_only)
@@ -159,7 +188,16 @@ class CampaignStore:
             self._con.execute("SET enable_progress_bar = false")
             if existed:
                 check_complete(self._con, self.path)
-            ensure_schema(self._con, self.path, read_only=self.read_only)
+            ensure_schema(self._con, self.path, read_only=self.read_only, family=wanted)
+            self._family = read_family(self._con, self.path)
+            if wanted is not None and wanted.name != self._family.name:
+                raise ValueError(
+                    f"The campaign in {str(self.path)!r} holds designs of the "
+                    f"{self._family.name!r} family. Got family {wanted.name!r} instead; use a "
+                    "new database for another family."
+                )
+            self._design_columns = design_columns(self._family.parameters)
+            self._insert_design = _insert_design(self._design_columns)
             self._load_binding()
             self._recorded: set[str] = {
                 row[0] for row in self._con.execute("SELECT design_id FROM designs").fetchall()
@@ -279,6 +317,21 @@ class CampaignStore:
                 f"The campaign database {str(self.path)!r} has a damaged {key!r} in its 'meta' "
                 f"table: it must be an integer. Got {text[:80]!r}."
             ) from None
+
+    @property
+    def family(self) -> str:
+        """The FEM actuator family of the campaign's designs (``"sfrba"`` if none recorded)."""
+        return self._family.name
+
+    @property
+    def family_schema(self) -> FamilySchema:
+        """The family, its parameter columns and its recorded actuator description."""
+        return self._family
+
+    @property
+    def parameters(self) -> tuple[str, ...]:
+        """The design parameters' columns of the ``designs`` table, in order."""
+        return self._family.parameters
 
     @property
     def backend(self) -> str | None:
@@ -448,6 +501,7 @@ class CampaignStore:
             raise ValueError(f"A campaign cannot be merged into itself: {str(source_path)!r}.")
         with CampaignStore(source_path, read_only=True) as other:
             backend, grid, settings = other.backend, other.pressures_mpa, other.settings
+            _check_same_family((self.family, self.path), (other.family, source_path))
             their_runs = other.runs()
             theirs = {
                 row[0]: row[1]
@@ -502,7 +556,7 @@ class CampaignStore:
                 self._con.execute(
                     "DELETE FROM designs WHERE design_id IN (SELECT * FROM merge_ids)"
                 )
-                columns = ", ".join(DESIGN_COLUMNS)
+                columns = ", ".join(map(quoted, self._design_columns))
                 self._con.execute(
                     f"INSERT INTO designs ({columns}) SELECT {columns} FROM merge_src.designs "
                     "WHERE design_id IN (SELECT * FROM merge_ids)"
@@ -539,6 +593,7 @@ class CampaignStore:
         backend = self._backend_name(backend)
         self._check_on_grid(result)
         design = result.design
+        self._check_family(design)
         stats = json.dumps(result.stats, default=str) if result.stats else None
         row = [
             design.design_id,
@@ -559,7 +614,7 @@ class CampaignStore:
         ]
         with self._writing(), transaction(self._con):
             self._delete(design.design_id)
-            self._con.execute(_INSERT_DESIGN, row)
+            self._con.execute(self._insert_design, row)
             if len(result.pressure_mpa):
                 self._con.execute(
                     _INSERT_SAMPLES,
@@ -577,7 +632,7 @@ class CampaignStore:
 
     def record_failure(
         self,
-        design: SFRBADesign,
+        design: CampaignDesign,
         error_text: str,
         wall_time_s: float,
         *,
@@ -587,8 +642,8 @@ class CampaignStore:
 
         Parameters
         ----------
-        design : SFRBADesign
-            The design.
+        design : SFRBADesign or FamilyDesign
+            The design, of the campaign's family.
         error_text : str
             Why it failed, conventionally ``"ExceptionType: message"``.
         wall_time_s : float
@@ -596,11 +651,12 @@ class CampaignStore:
         backend : str, optional
             Backend name; default the campaign's.
         """
-        if not isinstance(design, SFRBADesign):
+        if not isinstance(design, SFRBADesign | FamilyDesign):
             raise ValueError(
-                f"The 'design' of CampaignStore.record_failure must be an SFRBADesign. "
-                f"Got {design!r} instead."
+                f"The 'design' of CampaignStore.record_failure must be an SFRBADesign or a "
+                f"FamilyDesign. Got {design!r} instead."
             )
+        self._check_family(design)
         backend = self._backend_name(backend)
         wall = float(wall_time_s)
         row = [
@@ -622,8 +678,21 @@ class CampaignStore:
         ]
         with self._writing(), transaction(self._con):
             self._delete(design.design_id)
-            self._con.execute(_INSERT_DESIGN, row)
+            self._con.execute(self._insert_design, row)
         self._recorded.add(design.design_id)
+
+    def _check_family(self, design: Any) -> None:
+        """Refuse a design of another family than the campaign's (its columns differ)."""
+        family = getattr(design, "family", DEFAULT_FAMILY)
+        if not isinstance(family, str):
+            family = DEFAULT_FAMILY
+        names = tuple(design.as_dict())
+        if family != self.family or names != self.parameters:
+            raise ValueError(
+                f"The designs of the campaign in {str(self.path)!r} are of the {self.family!r} "
+                f"family ({', '.join(self.parameters)}). Got a design of {family!r} "
+                f"({', '.join(names)}) instead."
+            )
 
     def _delete(self, design_id: str) -> None:
         # Only when something is there: a DELETE costs as much as the insert.
@@ -676,7 +745,9 @@ class CampaignStore:
         ``done``, ``failed``, ``samples``, ``converged_samples``,
         ``sweep_time_s_total``, ``sweep_time_s_mean`` (over done designs),
         ``max_angle_deg``, ``last_finished_at`` and ``failures`` (up to
-        ``max_failures`` ``{"design_id", "design", "error"}`` entries).
+        ``max_failures`` ``{"design_id", "design", "error"}`` entries); a
+        campaign of another family than paper B's also ``family``, and
+        ``parameters`` (the columns of ``design``).
         """
         meta = self.meta()
         grid = self.pressures_mpa
@@ -694,14 +765,17 @@ class CampaignStore:
         assert counts is not None and sample_counts is not None
         done, failed, wall_total, wall_mean, max_angle, last = counts
         n_samples, n_converged = sample_counts
+        n_parameters = len(self.parameters)
         failures = self._con.execute(
-            f"SELECT design_id, {', '.join(PARAMETERS)}, error FROM designs "
+            f"SELECT design_id, {', '.join(map(quoted, self.parameters))}, error FROM designs "
             "WHERE status = 'failed' ORDER BY finished_at, design_id LIMIT ?",
             [int(max_failures)],
         ).fetchall()
         planned = self._meta_int("n_designs_planned")
+        family = {} if self.family == DEFAULT_FAMILY else {"family": self.family}
         return {
             "path": str(self.path),
+            **family,
             "schema_version": int(meta["schema_version"]),
             "softbend_version": meta.get("softbend_version"),
             "created_at": meta.get("created_at"),
@@ -721,13 +795,14 @@ class CampaignStore:
             "sweep_time_s_mean": None if wall_mean is None else float(wall_mean),
             "max_angle_deg": None if max_angle is None else float(max_angle),
             "last_finished_at": None if last is None else last.isoformat(timespec="seconds") + "Z",
+            **({"parameters": list(self.parameters)} if family else {}),
             "failures": [
                 {
                     "design_id": row[0],
                     # Formatted from the stored values, not rebuilt: a database of an
                     # older softbend may hold a design today's rules refuse (t >= r).
-                    "design": ",".join(f"{float(v):g}" for v in row[1:7]),
-                    "error": row[7],
+                    "design": ",".join(f"{float(v):g}" for v in row[1 : 1 + n_parameters]),
+                    "error": row[1 + n_parameters],
                 }
                 for row in failures
             ],
@@ -740,19 +815,20 @@ class CampaignStore:
         -------
         pandas.DataFrame
             Columns ``design_id, l_mm, r_mm, t_mm, b_mm, phi_deg, lc_mm,
-            pressure_mpa, angle_deg, tip_x_mm, tip_z_mm, converged``, sorted by
-            design and pressure. The last pressure of a truncated sweep has
-            ``converged`` False and NaN angle and tip: filter on ``converged`` to
-            get training data.
+            pressure_mpa, angle_deg, tip_x_mm, tip_z_mm, converged`` (the
+            family's parameters in place of paper B's ``l_mm`` ... ``lc_mm``
+            in a campaign of another family), sorted by design and pressure.
+            The last pressure of a truncated sweep has ``converged`` False and
+            NaN angle and tip: filter on ``converged`` to get training data.
         """
-        frame = self._con.execute(_SAMPLES_QUERY).df()
+        frame = self._con.execute(_samples_query(self.parameters)).df()
         frame["converged"] = frame["converged"].astype(bool)
         return frame
 
     def load_designs(self) -> pd.DataFrame:
         """The ``designs`` table (done and failed), sorted by ``design_id``."""
         return self._con.execute(
-            f"SELECT {', '.join(DESIGN_COLUMNS)} FROM designs ORDER BY design_id"
+            f"SELECT {', '.join(map(quoted, self._design_columns))} FROM designs ORDER BY design_id"
         ).df()
 
     def export(
@@ -798,9 +874,10 @@ class CampaignStore:
                 f"The folder of the export file {str(target)!r} does not exist."
             )
         query = (
-            _SAMPLES_QUERY
+            _samples_query(self.parameters)
             if table == "samples"
-            else f"SELECT {', '.join(DESIGN_COLUMNS)} FROM designs ORDER BY design_id"
+            else f"SELECT {', '.join(map(quoted, self._design_columns))} FROM designs "
+            "ORDER BY design_id"
         )
         tmp = target.with_name(f".{target.name}.{uuid.uuid4().hex}.tmp")
         try:
@@ -879,6 +956,9 @@ def merge_campaigns(
     held = CampaignStore(target, read_only=True) if target.exists() else None
     try:
         reference = None
+        family: tuple[FamilySchema, Path] | None = None
+        if held is not None:
+            family = (held.family_schema, target)
         recorded: tuple[dict[str, Any], Path] | None = None
         unchecked: list[Path] = []  # databases of an older softbend, without settings
         if held is not None and held.backend is not None:
@@ -890,6 +970,9 @@ def merge_campaigns(
         for source in paths:
             with CampaignStore(source, read_only=True) as other:
                 backend, grid, settings = other.backend, other.pressures_mpa, other.settings
+                if family is None:
+                    family = (other.family_schema, source)
+                _check_same_family((family[0].name, family[1]), (other.family, source))
             if backend is None or grid is None:
                 continue  # a shard that never ran: nothing to merge
             if reference is None:
@@ -912,7 +995,7 @@ def merge_campaigns(
             )
         with warnings.catch_warnings():  # said above, naming the databases given
             warnings.simplefilter("ignore", UncheckedSettingsWarning)
-            return _merge_staged(target, paths, held)
+            return _merge_staged(target, paths, held, None if family is None else family[0])
     finally:
         if held is not None:
             held.close()
@@ -940,6 +1023,17 @@ def _check_same_campaign(
         )
 
 
+def _check_same_family(first: tuple[str, Path], other: tuple[str, Path]) -> None:
+    """Refuse ``other`` unless it holds the family of ``first``; each is ``(family, path)``."""
+    (family, path), (other_family, other_path) = first, other
+    if other_family != family:
+        raise ValueError(
+            f"The campaign in {str(other_path)!r} holds designs of the {other_family!r} family, "
+            f"that in {str(path)!r} of the {family!r} family; only campaigns of one family "
+            "merge. Nothing was merged."
+        )
+
+
 def _check_same_settings(
     first: tuple[dict[str, Any], Path], other: tuple[dict[str, Any], Path]
 ) -> None:
@@ -958,15 +1052,18 @@ def _check_same_settings(
 
 
 def _merge_staged(
-    target: Path, sources: list[Path], held: CampaignStore | None
+    target: Path, sources: list[Path], held: CampaignStore | None, family: FamilySchema | None
 ) -> list[dict[str, Any]]:
-    """Merge ``sources`` into a copy of ``target`` beside it, then move it into place."""
+    """Merge ``sources`` into a copy of ``target`` beside it, then move it into place.
+
+    A new ``target`` is created for ``family`` (that of the sources; paper B's if None).
+    """
     staging = target.with_name(f".{target.name}.{uuid.uuid4().hex}.tmp")
     try:
         if held is not None:
             shutil.copyfile(target, staging)
             os.chmod(staging, new_file_mode(target))
-        store = CampaignStore(staging)
+        store = CampaignStore(staging, family=family)
         try:
             with store._writing(target):
                 counts = [store.merge(source) for source in sources]

@@ -122,6 +122,7 @@ def status(
         f"campaign {summary['path']}",
         ["quantity", "value"],
         [
+            *([["family", summary["family"]]] if "family" in summary else []),
             ["backend", summary["backend"] or "-"],
             ["material", (settings.get("material") or {}).get("name", "-")],
             ["mesh size maxh (mm)", "-" if maxh is None else maxh],
@@ -145,9 +146,17 @@ def status(
     if summary["failures"]:
         _common.print_table(
             "failed designs",
-            ["design (l,r,t,b,phi,lc)", "error"],
+            [_design_header(summary), "error"],
             [[f["design"], one_line(f["error"])] for f in summary["failures"]],
         )
+
+
+def _design_header(summary: dict[str, object]) -> str:
+    """``design (l,r,t,b,phi,lc)``, or the parameters of another family's campaign."""
+    parameters = summary.get("parameters")
+    if isinstance(parameters, list):
+        return f"design ({','.join(map(str, parameters))})"
+    return "design (l,r,t,b,phi,lc)"
 
 
 @app.command("export")

@@ -4,17 +4,22 @@ from __future__ import annotations
 
 from contextlib import ExitStack
 from pathlib import Path
-from typing import TYPE_CHECKING
+from typing import TYPE_CHECKING, Any
 
 import typer
 
 from softbend.cli import _common
 
 if TYPE_CHECKING:
+    from softbend.campaign.backends import Backend, ResolvedMaterial
     from softbend.campaign.runner import CampaignSummary
+    from softbend.fem.families import FEMFamily
 
 #: The design spaces of --space (softbend.campaign.spaces.SPACE_FORMS, not imported at start).
 SPACE_FORMS = "table1, corners, lhs:N or sobol:N"
+
+#: Those of another family than paper B's (softbend.campaign.family_spaces.FAMILY_SPACE_FORMS).
+FAMILY_SPACE_FORMS = "lhs:N, sobol:N, grid or grid:K"
 
 
 def one_line(text: str) -> str:
@@ -29,19 +34,31 @@ def with_surrogates() -> None:
 
 def run(
     db: Path = typer.Argument(..., help="Campaign database (DuckDB); created or resumed."),
-    backend: str = typer.Option(
-        "analytical",
-        help="Sweep model, a campaign backend: analytical, fem or surrogate (with --model).",
+    family: str = typer.Option(
+        "sfrba",
+        help="FEM actuator family of the designs: sfrba (paper B's actuator) or another "
+        "registered family (pneunet), swept with its own FEM over the ranges of its "
+        "description.",
+    ),
+    backend: str | None = typer.Option(
+        None,
+        help="Sweep model, a campaign backend: analytical, fem or surrogate (with --model); "
+        "default analytical, and fem (the only one) for another --family than sfrba.",
     ),
     model: Path | None = typer.Option(
         None, help="A surrogate saved by 'softbend train' (models/*.json), for --backend surrogate."
     ),
-    space: str = typer.Option("table1", help=f"Designs: {SPACE_FORMS}."),
+    space: str | None = typer.Option(
+        None,
+        help=f"Designs: {SPACE_FORMS} (default table1); for another --family "
+        f"{FAMILY_SPACE_FORMS} over its ranges (grid: 3 levels a parameter, grid:K: K), "
+        "required.",
+    ),
     ranges: list[str] = typer.Option(
         None,
         "--range",
         help="Range of one parameter of an lhs/sobol space, NAME=LOW:HIGH in mm or deg "
-        "(repeatable; the others keep paper B's Table 1 ranges).",
+        "(repeatable; the others keep paper B's Table 1 ranges, or the family's).",
     ),
     seed: int = typer.Option(0, help="Seed of the lhs/sobol sampler."),
     shard: str | None = typer.Option(
@@ -49,8 +66,12 @@ def run(
         help="Only shard K/N of the space (every N-th design from the K-th, K in 0..N-1); "
         "merge the shards' databases with 'softbend campaign merge'.",
     ),
-    pmax: float = typer.Option(0.5, help="Largest pressure of the sweep's grid, MPa."),
-    pstep: float = typer.Option(0.005, help="Pressure step of the sweep's grid, MPa."),
+    pmax: float | None = typer.Option(
+        None, help="Largest pressure of the sweep's grid, MPa (default 0.5; the family's)."
+    ),
+    pstep: float | None = typer.Option(
+        None, help="Pressure step of the sweep's grid, MPa (default 0.005; the family's)."
+    ),
     workers: int | None = typer.Option(
         None, help="Local worker processes (default: all cores; 0 or 1: serial)."
     ),
@@ -78,7 +99,8 @@ def run(
         "see benchmarks/bench_fem.py).",
     ),
     maxh: float | None = typer.Option(
-        None, help="Largest element size of --backend fem, mm (default: the FEM's, 5)."
+        None,
+        help="Largest element size of --backend fem, mm (default: the FEM's, 5; the family's).",
     ),
     material: str | None = typer.Option(
         None,
@@ -105,11 +127,18 @@ def run(
     and the first reason. A --maxh too fine for a design of --space is
     refused before any work (the FEM's limit on the elements of a mesh).
 
+    With --family other than sfrba the designs are those of that FEM actuator
+    family, drawn over the ranges of its description (integers whole, lengths
+    to their resolution; designs breaking its constraints are drawn again for
+    lhs/sobol and left out of a grid, and counted), swept with its own FEM up
+    to its pressure; DB records the family and refuses designs of another.
+
     Example:
 
     \b
         softbend campaign run table1.duckdb --backend analytical --space table1
         softbend campaign run own.duckdb --space sobol:256 --range l=60:90 --range t=1:2
+        softbend campaign run pneunet.duckdb --family pneunet --space sobol:256
     """
     from softbend._validation import check_int
     from softbend.campaign.backends import (
@@ -131,17 +160,37 @@ def run(
     )
 
     _common.check_output_file(db, "DB", inputs=(model,) if model is not None else ())
-    spec = parse_space(space)
-    if ranges:
-        spec = spec.with_ranges(parse_ranges(ranges))
+    fem_family = _fem_family(family)
+    spec: Any
+    if fem_family is None:
+        spec = parse_space("table1" if space is None else space)
+        if ranges:
+            spec = spec.with_ranges(parse_ranges(ranges))
+    else:
+        spec = _family_space(fem_family, space, ranges)
     check_int(seed, "seed")
     shard_of = parse_shard(shard) if shard is not None else None
-    pressures = default_pressures_mpa(pmax, pstep)
+    if fem_family is None:
+        pressures = default_pressures_mpa(
+            0.5 if pmax is None else pmax, 0.005 if pstep is None else pstep
+        )
+    else:
+        pressures = default_pressures_mpa(
+            fem_family.pmax_mpa if pmax is None else pmax,
+            fem_family.pstep_mpa if pstep is None else pstep,
+        )
     with_surrogates()
     chosen = resolve_material(material) if material is not None else None  # read once
-    backend_obj = backend_for_run(
-        backend, model=model, compiled=compile_energy, material=chosen, maxh_mm=maxh
-    )
+    if fem_family is None:
+        backend_obj = backend_for_run(
+            "analytical" if backend is None else backend,
+            model=model,
+            compiled=compile_energy,
+            material=chosen,
+            maxh_mm=maxh,
+        )
+    else:
+        backend_obj = _family_backend(fem_family, backend, model, chosen, maxh)
     if scheduler is not None:
         parse_scheduler_address(scheduler)
     k, count = shard_of or (0, 1)
@@ -152,6 +201,11 @@ def run(
         allow_large=allow_large,
     )
     designs = spec.build(seed)
+    rejected = getattr(designs, "describe_rejected", lambda: "")()
+    if rejected and not json_output:
+        _common.err_console.print(
+            f"{designs.name}: {len(designs)} designs; {rejected}", highlight=False, soft_wrap=True
+        )
     if shard_of is not None:
         designs = designs.shard(*shard_of)
     n_todo = count_designs_to_run(db, designs, retry_failed)
@@ -202,13 +256,17 @@ def run(
             with _common.output_errors(db, "DB"):
                 raise
     if json_output:
-        _common.print_json({"space": designs.name, **summary.as_dict()})
+        extra: dict[str, Any] = {}
+        if fem_family is not None:
+            extra = {"family": fem_family.name, "rejected": dict(designs.rejected)}
+        _common.print_json({"space": designs.name, **extra, **summary.as_dict()})
         _exit_if_all_failed(summary, db)
         return
     _common.print_table(
         f"campaign {summary.db_path}",
         ["quantity", "value"],
         [
+            *([] if fem_family is None else [["family", fem_family.name]]),
             ["backend", summary.backend],
             ["space", f"{designs.name} ({summary.n_designs} designs)"],
             ["executor", summary.executor],
@@ -223,12 +281,73 @@ def run(
     )
     if summary.failures:
         by_id = {design.design_id: str(design) for design in designs}
+        header = "design (l,r,t,b,phi,lc)" if fem_family is None else "design"
         _common.print_table(
             "failed designs",
-            ["design (l,r,t,b,phi,lc)", "error"],
+            [header, "error"],
             [[by_id.get(i, i), one_line(e)] for i, e in summary.failures[:20]],
         )
     _exit_if_all_failed(summary, db)
+
+
+def _fem_family(name: str) -> FEMFamily | None:
+    """The FEM family ``name`` of ``--family``; None for paper B's (the campaigns of before).
+
+    An unknown name is one error keyed ``family`` that lists the known families.
+    """
+    from softbend.errors import keyed
+    from softbend.fem.families import get_family
+
+    with keyed("family"):
+        fem_family = get_family(name)
+    return None if fem_family.name == "sfrba" else fem_family
+
+
+def _family_space(fem_family: FEMFamily, space: str | None, ranges: list[str] | None) -> Any:
+    """The checked ``--space`` (and ``--range``) of another family than paper B's."""
+    from softbend.campaign.family_spaces import parse_family_ranges, parse_family_space
+    from softbend.errors import InputError
+
+    if space is None:
+        raise InputError(
+            f"must be given for the {fem_family.name} family: one of {FAMILY_SPACE_FORMS} "
+            "over the ranges of its description",
+            key="space",
+        )
+    spec = parse_family_space(space, fem_family)
+    if ranges:
+        spec = spec.with_ranges(parse_family_ranges(ranges, fem_family))
+    return spec
+
+
+def _family_backend(
+    fem_family: FEMFamily,
+    backend: str | None,
+    model: Path | None,
+    chosen: ResolvedMaterial | None,
+    maxh: float | None,
+) -> Backend:
+    """The FEM sweep of ``fem_family`` with ``--maxh`` and ``--material`` (checked)."""
+    from softbend.campaign.families import family_backend
+    from softbend.errors import InputError
+
+    if backend not in (None, "fem"):
+        raise InputError(
+            f"must be fem for the {fem_family.name} family (its own FEM sweep); got {backend!r}",
+            key="backend",
+        )
+    if model is not None:
+        raise InputError(
+            f"applies to --backend surrogate of paper B's actuator; the {fem_family.name} "
+            f"family runs its FEM; got {str(model)!r}",
+            key="model",
+        )
+    if maxh is not None and (
+        isinstance(maxh, bool) or not (isinstance(maxh, int | float) and maxh > 0)
+    ):
+        raise InputError(f"must be a size > 0 mm; got {maxh!r}", key="maxh_mm")
+    material = None if chosen is None else chosen.material
+    return family_backend(fem_family, maxh_mm=maxh, material=material)
 
 
 def _exit_if_all_failed(summary: CampaignSummary, db: Path) -> None:

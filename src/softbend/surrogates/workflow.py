@@ -147,12 +147,23 @@ def _load_data(source: Source) -> TrainingData:
         return source
     if isinstance(source, pd.DataFrame):
         return training_data(source)
+    from softbend.campaign.families import campaign_actuator
     from softbend.campaign.store import load_samples
 
     path = Path(os.fspath(source))
     if not path.exists():
         raise FileNotFoundError(f"Campaign database {str(path)!r} does not exist.")
-    return training_data(load_samples(path))
+    samples = load_samples(path)
+    # A campaign of another FEM family than paper B's trains on its own design
+    # columns and actuator, recorded in the database; paper B's records none.
+    actuator = campaign_actuator(path)
+    if actuator is None:
+        return training_data(samples)
+    if actuator.pressure_column != "pressure_mpa":
+        samples[actuator.pressure_column] = samples["pressure_mpa"] / actuator.to_mpa
+    if actuator.angle_column != "angle_deg":
+        samples[actuator.angle_column] = samples["angle_deg"]
+    return training_data(samples, actuator=actuator)
 
 
 def train_surrogates(
