@@ -834,3 +834,11 @@ def _register_paper_b() -> Actuator:
 
 #: Paper B's actuator: the description of every campaign and shipped model.
 SFRBA: Actuator = _register_paper_b()
+
+
+def _register_fem_families() -> None:
+    """Register the descriptions of the FEM's other actuator families (the PneuNet)."""
+    import softbend.fem.families  # noqa: F401  (its families register their descriptions)
+
+
+_register_fem_families()

@@ -24,7 +24,7 @@ from __future__ import annotations
 
 from collections.abc import Mapping
 from dataclasses import dataclass, field
-from typing import Any, Protocol, runtime_checkable
+from typing import TYPE_CHECKING, Any, Protocol, runtime_checkable
 
 import numpy as np
 from numpy.typing import ArrayLike
@@ -32,6 +32,9 @@ from numpy.typing import ArrayLike
 from softbend._validation import check_range, must_be
 from softbend.design import SFRBADesign
 from softbend.errors import InputError
+
+if TYPE_CHECKING:
+    from softbend.fem.families import FamilyDesign
 
 __all__ = [
     "DEFAULT_PMAX_MPA",
@@ -148,8 +151,9 @@ class SweepResult:
 
     Parameters
     ----------
-    design : SFRBADesign
-        The design swept.
+    design : SFRBADesign or FamilyDesign
+        The design swept (paper B's actuator, or a design of another FEM
+        family, :class:`softbend.fem.families.FamilyDesign`).
     pressure_mpa : array_like
         Gauge pressures applied, MPa, strictly increasing.
     angle_deg : array_like
@@ -177,7 +181,7 @@ class SweepResult:
         non-converged entry is not the last one.
     """
 
-    design: SFRBADesign
+    design: SFRBADesign | FamilyDesign
     pressure_mpa: np.ndarray
     angle_deg: np.ndarray
     tip_x_mm: np.ndarray
@@ -189,8 +193,10 @@ class SweepResult:
     stats: dict[str, Any] = field(default_factory=dict)
 
     def __post_init__(self) -> None:
-        if not isinstance(self.design, SFRBADesign):
-            raise InputError(must_be("an SFRBADesign", self.design), key="design")
+        from softbend.fem.families import FamilyDesign
+
+        if not isinstance(self.design, SFRBADesign | FamilyDesign):
+            raise InputError(must_be("an SFRBADesign or a FamilyDesign", self.design), key="design")
         arrays = {
             "pressure_mpa": float,
             "angle_deg": float,

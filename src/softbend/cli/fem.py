@@ -15,11 +15,13 @@ if TYPE_CHECKING:
     import numpy as np
 
     from softbend.fem import FEMOptions
+    from softbend.fem.families import FEMFamily
 
 app = typer.Typer(
     help="Nonlinear 3D finite-element model of the actuator.\n\n"
-    "The fiber-reinforced bending actuator of paper B: pressure sweeps of one "
-    "design and the mesh-convergence study.",
+    "The fiber-reinforced bending actuator of paper B (--family sfrba, the default) "
+    "or a PneuNet (--family pneunet): pressure sweeps of one design and the "
+    "mesh-convergence study.",
     no_args_is_help=True,
 )
 
@@ -30,27 +32,48 @@ SWEEP_JSON = "sweep.json"
 #: Everything ``fem run`` writes into its ``--out`` folder (the last: the folder of VTK files).
 RUN_FILES: tuple[str, ...] = ("sweep.csv", SWEEP_JSON, "angle_pressure.png", "shapes.png", "vtk")
 
+#: Paper B's reference design, what ``--design`` sweeps for ``--family sfrba`` when not given.
+SFRBA_DESIGN = "100,6,2,2,5,10"
+
 DesignOption = Annotated[
-    str,
-    typer.Option("--design", help=_common.DESIGN_HELP),
+    str | None,
+    typer.Option(
+        "--design",
+        help=_common.DESIGN_HELP
+        + " For another --family: NAME=VALUE pairs separated by commas (n_chambers=6,wall_mm=1.5); "
+        "parameters left out take the family's reference values (default: the reference).",
+    ),
 ]
-MaxhOption = Annotated[float, typer.Option("--maxh", help="Largest element size, mm.")]
-GravityOption = Annotated[
+FamilyOption = Annotated[
     str,
+    typer.Option(
+        "--family",
+        help="FEM actuator family: sfrba (paper B's fiber-reinforced actuator) or pneunet "
+        "(a row of chambers on a strain-limiting layer).",
+    ),
+]
+MaxhOption = Annotated[
+    float | None,
+    typer.Option("--maxh", help="Largest element size, mm (default: the family's, sfrba 5)."),
+]
+GravityOption = Annotated[
+    str | None,
     typer.Option(
         "--gravity",
         help="Direction of gravity: bending (towards the strain-limiting layer, as paper B's "
-        "experiments), against (the opposite), axial (base to tip) or none.",
+        "experiments), against (the opposite), axial (base to tip) or none (default: the "
+        "family's, sfrba bending, pneunet none).",
     ),
 ]
 
 
 MaterialOption = Annotated[
-    str,
+    str | None,
     typer.Option(
         "--material",
         help="Elastomer: a preset (dragon-skin-30) or the fit.json of 'softbend materials fit', "
-        "optionally with its model after # (fit.json#yeoh; default the best fit).",
+        "optionally with its model after # (fit.json#yeoh; default the best fit). Default: "
+        "the family's (sfrba dragon-skin-30, pneunet Elastosil M4601).",
     ),
 ]
 
@@ -66,6 +89,26 @@ def _options(
     return FEMOptions(maxh_mm=maxh, gravity=gravity, elastomer=elastomer, output=output)
 
 
+def _family_options(
+    family: FEMFamily,
+    maxh: float | None,
+    gravity: str | None,
+    material: str | None,
+    output: str = "interpolate",
+) -> FEMOptions:
+    """The options of a family other than paper B's, from its defaults and the given flags."""
+    from softbend.materials.choice import material_from_spec
+
+    changes: dict[str, object] = {"maxh_mm": family.maxh_mm if maxh is None else maxh}
+    if gravity is not None:
+        changes["gravity"] = gravity
+    if material is not None:
+        with keyed("material"):
+            changes["elastomer"] = material_from_spec(material)
+    changes["output"] = output
+    return family.options(**changes)
+
+
 def steps_reached(grid: np.ndarray, pressure_mpa: float) -> int:
     """How many pressures of the sweep's sorted ``grid`` (MPa) a sweep at ``pressure_mpa``
     has reached: the unit of ``fem run``'s progress (a load step may be cut into sub-steps,
@@ -77,13 +120,21 @@ def steps_reached(grid: np.ndarray, pressure_mpa: float) -> int:
 
 @app.command("run")
 def run(
-    design: DesignOption = "100,6,2,2,5,10",
+    design: DesignOption = None,
+    family: FamilyOption = "sfrba",
     pmax: Annotated[
-        float, typer.Option("--pmax", help="Largest pressure of the sweep's grid, MPa.")
-    ] = 0.2,
+        float | None,
+        typer.Option(
+            "--pmax", help="Largest pressure of the sweep's grid, MPa (default: the family's)."
+        ),
+    ] = None,
     pstep: Annotated[
-        float, typer.Option("--pstep", help="Pressure step of the sweep's grid (outputs), MPa.")
-    ] = 0.005,
+        float | None,
+        typer.Option(
+            "--pstep",
+            help="Pressure step of the sweep's grid (outputs), MPa (default: the family's).",
+        ),
+    ] = None,
     out: Annotated[
         Path,
         typer.Option(
@@ -93,9 +144,9 @@ def run(
             "or empty folder, or an earlier result of this command).",
         ),
     ] = Path("results/fem"),
-    maxh: MaxhOption = 5.0,
-    gravity: GravityOption = "bending",
-    material: MaterialOption = "dragon-skin-30",
+    maxh: MaxhOption = None,
+    gravity: GravityOption = None,
+    material: MaterialOption = None,
     shapes: Annotated[int, typer.Option("--shapes", help="Deformed shapes drawn and saved.")] = 5,
     solve_every: Annotated[
         bool,
@@ -116,24 +167,47 @@ def run(
     fails leaves the previous results as they were and a rerun never mixes two
     runs. An existing --out may hold only what this command writes.
 
+    With --family pneunet: a PneuNet, --design NAME=VALUE pairs (the reference
+    PneuNet without); the sweep also stops where neighbouring chamber walls
+    touch (the reason names the pressure). Its folder holds sweep.csv,
+    sweep.json, angle_pressure.png and vtk/ (no shapes.png); --json adds the
+    cavity volume of every converged step.
+
     Example:
 
     \b
         softbend fem run --design 100,6,2,2,5,10 --pmax 0.2 --out fem
+        softbend fem run --family pneunet --design n_chambers=6,wall_mm=1.5 --out pneunet
     """
     import numpy as np
 
     from softbend._io import staged_dir, write_text_atomic
     from softbend._validation import check_int
     from softbend.design import SFRBADesign
+    from softbend.fem.families import get_family
     from softbend.fem.stats import fem_stats
     from softbend.models import default_pressures_mpa
-    from softbend.reports.fem_figures import sweep_with_files
+    from softbend.reports.fem_figures import family_sweep_with_files, sweep_with_files
 
-    actuator = SFRBADesign.parse(design)
+    with keyed("family"):
+        chosen = get_family(family)
+    paper_b = chosen.name == "sfrba"
+    output = "solve" if solve_every else "interpolate"
+    if paper_b:
+        actuator = SFRBADesign.parse(design or SFRBA_DESIGN)
+        options = _options(
+            5.0 if maxh is None else maxh,
+            gravity or "bending",
+            material or "dragon-skin-30",
+            output=output,
+        )
+    else:
+        actuator = chosen.parse(design)
+        options = _family_options(chosen, maxh, gravity, material, output)
+    pmax = chosen.pmax_mpa if pmax is None else pmax
+    pstep = chosen.pstep_mpa if pstep is None else pstep
     pressures = default_pressures_mpa(pmax, pstep)
-    options = _options(maxh, gravity, material, output="solve" if solve_every else "interpolate")
-    options.check_mesh(actuator)  # before NGSolve loads: a too fine --maxh is one line at once
+    chosen.check_mesh(actuator, options)  # before NGSolve loads: a too fine --maxh is one line
     check_int(shapes, "shapes", low=1)
     out = Path(out)
     _common.check_output_dir(out, "--out", files=RUN_FILES[:-1])
@@ -156,18 +230,31 @@ def run(
                 )
                 state["done"] = max(done, state["done"])
 
-            sweep = sweep_with_files(
-                actuator,
-                pressures,
-                options,
-                stage,
-                shape_pressures_mpa=shapes,
-                vtk=True,
-                progress=on_step,
-            )
+            if paper_b:
+                sweep = sweep_with_files(
+                    actuator,
+                    pressures,
+                    options,
+                    stage,
+                    shape_pressures_mpa=shapes,
+                    vtk=True,
+                    progress=on_step,
+                )
+            else:
+                sweep = family_sweep_with_files(
+                    chosen,
+                    actuator,
+                    pressures,
+                    options,
+                    stage,
+                    shape_pressures_mpa=shapes,
+                    vtk=True,
+                    progress=on_step,
+                )
         result = sweep.result
         stats = fem_stats(result)
         summary = {
+            **({} if paper_b else {"family": chosen.name}),
             "design": str(actuator),
             "stop_reason": stats["stop_reason"],
             "max_pressure_mpa": result.max_pressure_mpa,
@@ -182,6 +269,11 @@ def run(
             {**summary, "pressure_mpa": result.pressure_mpa, "angle_deg": result.angle_deg}
         )
         return
+    title = (
+        f"FEM sweep of ({actuator})" if paper_b else f"FEM sweep of the {chosen.name} ({actuator})"
+    )
+    # Paper B: a row every 0.02 MPa; another family: about ten rows over its sweep.
+    every = max(1, round(0.02 / pstep)) if paper_b else max(1, len(result.pressure_mpa) // 10)
     rows = [
         [f"{p:.3f}", f"{a:.2f}", f"{x:.1f}", f"{z:.1f}", int(i)]
         for p, a, x, z, i in zip(
@@ -192,10 +284,10 @@ def run(
             result.newton_iterations,
             strict=True,
         )
-        if round(p / pstep) % max(1, round(0.02 / pstep)) == 0
+        if round(p / pstep) % every == 0
     ]
     _common.print_table(
-        f"FEM sweep of ({actuator})",
+        title,
         ["pressure MPa", "angle °", "tip x mm", "tip z mm", "Newton its"],
         rows,
     )
@@ -210,15 +302,26 @@ def run(
 
 @app.command("mesh-study")
 def mesh_study(
-    design: DesignOption = "100,6,2,2,5,10",
+    design: DesignOption = None,
+    family: FamilyOption = "sfrba",
     maxh: Annotated[
-        str, typer.Option("--maxh", help="Comma-separated element sizes, mm, coarse to fine.")
-    ] = "6,5,4,3",
+        str | None,
+        typer.Option(
+            "--maxh",
+            help="Comma-separated element sizes, mm, coarse to fine (default sfrba 6,5,4,3; "
+            "pneunet 3,2.5,2).",
+        ),
+    ] = None,
     pressures: Annotated[
-        str, typer.Option("--pressures", help="Comma-separated pressures, MPa.")
-    ] = "0,0.05,0.1",
-    gravity: GravityOption = "bending",
-    material: MaterialOption = "dragon-skin-30",
+        str | None,
+        typer.Option(
+            "--pressures",
+            help="Comma-separated pressures, MPa (default sfrba 0,0.05,0.1; pneunet "
+            "0,0.002,0.004,0.006: below the reference's touching walls).",
+        ),
+    ] = None,
+    gravity: GravityOption = None,
+    material: MaterialOption = None,
     json_output: Annotated[bool, typer.Option("--json", help="Print the table as JSON.")] = False,
 ) -> None:
     """Bending angle at --pressures for each element size.
@@ -232,15 +335,30 @@ def mesh_study(
         softbend fem mesh-study --maxh 6,5,4,3 --pressures 0,0.05,0.1
     """
     from softbend.design import SFRBADesign
+    from softbend.fem.families import get_family
     from softbend.fem.verification import mesh_study as study
 
-    actuator = SFRBADesign.parse(design)
-    sizes = _floats(maxh, "maxh")
-    grid = _floats(pressures, "pressures")
+    with keyed("family"):
+        chosen = get_family(family)
+    default_maxh, default_pressures = _MESH_STUDY_DEFAULTS.get(
+        chosen.name,
+        (
+            f"{1.5 * chosen.maxh_mm:g},{chosen.maxh_mm:g},{0.75 * chosen.maxh_mm:g}",
+            f"0,{chosen.pmax_mpa / 2:g},{chosen.pmax_mpa:g}",
+        ),
+    )
+    sizes = _floats(maxh or default_maxh, "maxh")
+    grid = _floats(pressures or default_pressures, "pressures")
+    if chosen.name == "sfrba":
+        actuator = SFRBADesign.parse(design or SFRBA_DESIGN)
+        options = _options(4.0, gravity or "bending", material or "dragon-skin-30")
+    else:
+        actuator = chosen.parse(design)
+        options = _family_options(chosen, None, gravity, material)
+    for h in sizes:  # a too fine size is one line before any sweep
+        chosen.check_mesh(actuator, options.replace(maxh_mm=h))
     with _common.progress_bar("mesh sizes", len(sizes), enabled=not json_output) as advance:
-        rows = study(
-            actuator, sizes, grid, _options(4.0, gravity, material), progress=lambda d, n: advance()
-        )
+        rows = study(actuator, sizes, grid, options, progress=lambda d, n: advance())
     table = []
     for i, row in enumerate(rows):
         change = (
@@ -267,6 +385,14 @@ def mesh_study(
             for r in table
         ],
     )
+
+
+#: ``fem mesh-study``'s default sizes and pressures by family (others: 1.5, 1 and 0.75
+#: times the family's maxh; 0, half and all of its pmax).
+_MESH_STUDY_DEFAULTS: dict[str, tuple[str, str]] = {
+    "sfrba": ("6,5,4,3", "0,0.05,0.1"),
+    "pneunet": ("3,2.5,2", "0,0.002,0.004,0.006"),
+}
 
 
 def _floats(text: str, key: str) -> list[float]:

@@ -7,6 +7,12 @@ minimisation) → ``sweep`` (load stepping, :func:`simulate`) → ``model``
 (:class:`FEMModel`, the FEM as a :class:`~softbend.models.BendingModel`);
 ``verification`` holds the closed-form cases solved with the same core.
 
+The FEM simulates more than one kind of actuator: :mod:`softbend.fem.families`
+registers them (:func:`get_family`, ``--family``). Paper B's actuator above is
+``"sfrba"``; the PneuNet (``"pneunet"``, :mod:`softbend.fem.pneunet`) reuses the
+energy terms and the load stepping with its own geometry and readout
+(:class:`PneuNetModel`, :func:`run_pneunet_sweep`).
+
 Names are imported lazily, so ``import softbend.fem`` is light and the
 pure-Python parts work without NGSolve: :class:`FEMOptions`, the typed solver
 statistics :class:`FEMStats` (:func:`fem_stats`) and the dimensions of
@@ -24,14 +30,23 @@ from softbend._lazy import export as _export
 
 if TYPE_CHECKING:
     from softbend.fem.energy import use_compiled
+    from softbend.fem.families import FEM_FAMILIES, FamilyDesign, FEMFamily, get_family
     from softbend.fem.geometry import ActuatorGeometry
     from softbend.fem.model import FEMModel
     from softbend.fem.options import GRAVITY_DIRECTIONS, OUTPUT_MODES, FEMOptions
+    from softbend.fem.pneunet.model import PneuNetModel
+    from softbend.fem.pneunet.sweep import run_pneunet_sweep
     from softbend.fem.stats import FEMStats, FEMTimings, fem_stats
     from softbend.fem.sweep import simulate
 
 #: Public name → submodule that defines it.
 _EXPORTS = {
+    "FEM_FAMILIES": "families",
+    "FEMFamily": "families",
+    "FamilyDesign": "families",
+    "PneuNetModel": "softbend.fem.pneunet.model",
+    "get_family": "families",
+    "run_pneunet_sweep": "softbend.fem.pneunet.sweep",
     "ActuatorGeometry": "geometry",
     "FEMModel": "model",
     "FEMOptions": "options",
@@ -45,14 +60,20 @@ _EXPORTS = {
 }
 
 __all__ = [
+    "FEM_FAMILIES",
     "GRAVITY_DIRECTIONS",
     "OUTPUT_MODES",
     "ActuatorGeometry",
+    "FEMFamily",
     "FEMModel",
     "FEMOptions",
     "FEMStats",
     "FEMTimings",
+    "FamilyDesign",
+    "PneuNetModel",
     "fem_stats",
+    "get_family",
+    "run_pneunet_sweep",
     "simulate",
     "use_compiled",
 ]

@@ -6,6 +6,7 @@ import math
 import os
 from dataclasses import dataclass, field
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 import numpy as np
 
@@ -15,6 +16,9 @@ from softbend.errors import InputError
 from softbend.fem._ngsolve import require_ngsolve
 from softbend.fem.actuator import ActuatorModel
 from softbend.models import SweepResult
+
+if TYPE_CHECKING:
+    from softbend.fem.pneunet.model import PneuNetModel
 
 require_ngsolve()  # NGSolve after PyTorch, or one line naming softbend[fem]
 
@@ -114,16 +118,17 @@ class VTKGrid:
 
 
 def actuator_grid(
-    model: ActuatorModel, *, pressure_mpa: float | None = None, mirror: bool = True
+    model: ActuatorModel | PneuNetModel, *, pressure_mpa: float | None = None, mirror: bool = True
 ) -> VTKGrid:
     """The current state of ``model`` as a grid of shared nodes, the whole actuator by default.
 
-    The model is the half ``y ≥ 0``; with ``mirror`` its reflection about the
-    symmetry plane ``y = 0`` (``y → −y``, ``u_y → −u_y``) completes it, the
-    nodes on the plane kept once. Cells are quadratic tetrahedra (VTK type 24)
-    where the displacement is of order 2 or more (the edge nodes take the
-    exact value of the displacement at the edge midpoints; for order 3 that is a
-    sample of the cubic field), linear ones (type 10) for order 1.
+    The model (paper B's actuator or a PneuNet) is the half ``y ≥ 0``; with
+    ``mirror`` its reflection about the symmetry plane ``y = 0`` (``y → −y``,
+    ``u_y → −u_y``) completes it, the nodes on the plane kept once. Cells are
+    quadratic tetrahedra (VTK type 24) where the displacement is of order 2 or
+    more (the edge nodes take the exact value of the displacement at the edge
+    midpoints; for order 3 that is a sample of the cubic field), linear ones
+    (type 10) for order 1.
 
     Fields:
 
@@ -137,7 +142,7 @@ def actuator_grid(
 
     Parameters
     ----------
-    model : ActuatorModel
+    model : ActuatorModel or PneuNetModel
         Its displacement ``gfu`` is the state written.
     pressure_mpa : float, optional
         Cavity pressure of the state, MPa (the state a sweep restores does not
@@ -279,7 +284,7 @@ def vtu_text(grid: VTKGrid) -> str:
 
 
 def write_vtk(
-    model: ActuatorModel,
+    model: ActuatorModel | PneuNetModel,
     path: str | os.PathLike[str],
     *,
     pressure_mpa: float | None = None,
@@ -295,7 +300,7 @@ def write_vtk(
 
     Parameters
     ----------
-    model : ActuatorModel
+    model : ActuatorModel or PneuNetModel
     path : path
         File to write (its folder is created).
     pressure_mpa : float, optional

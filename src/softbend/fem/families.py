@@ -125,6 +125,10 @@ class FEMFamily:
         ``default_options(**overrides) -> FEMOptions``: the family's modelling
         defaults (strain-limiting layer, gravity, ...); plain :class:`FEMOptions`
         when absent.
+    mesh_check : callable, optional
+        ``mesh_check(design, options)``: refuse, before NGSolve loads, a
+        ``maxh_mm`` that would mesh ``design`` with too many elements (one
+        :class:`~softbend.errors.InputError` keyed ``maxh_mm``); no check when absent.
     """
 
     name: str
@@ -137,6 +141,7 @@ class FEMFamily:
     make_design: Callable[[dict[str, float]], Any]
     sweep: Callable[..., tuple[SweepResult, Any, Any]]
     default_options: Callable[..., FEMOptions] | None = None
+    mesh_check: Callable[[Any, FEMOptions], None] | None = None
 
     @property
     def names(self) -> tuple[str, ...]:
@@ -177,6 +182,11 @@ class FEMFamily:
         from softbend.fem.options import FEMOptions
 
         return FEMOptions(**overrides)
+
+    def check_mesh(self, design: Any, options: FEMOptions) -> None:
+        """Refuse ``options.maxh_mm`` if it meshes ``design`` too finely (see ``mesh_check``)."""
+        if self.mesh_check is not None:
+            self.mesh_check(design, options)
 
     def simulate(
         self,
@@ -236,6 +246,10 @@ def _sfrba_sweep(
     return run_sweep(design, pressures_mpa, options, **kwargs)
 
 
+def _sfrba_mesh_check(design: Any, options: FEMOptions) -> None:
+    options.check_mesh(design)
+
+
 def _register_paper_b() -> FEMFamily:
     from softbend.actuators import SFRBA
 
@@ -256,9 +270,15 @@ def _register_paper_b() -> FEMFamily:
         maxh_mm=5.0,
         make_design=_sfrba_design,
         sweep=_sfrba_sweep,
+        mesh_check=_sfrba_mesh_check,
     )
     return FEM_FAMILIES.register(family.name, family)
 
 
 #: Paper B's fiber-reinforced actuator, the first family.
 SFRBA_FAMILY: FEMFamily = _register_paper_b()
+
+
+# The built-in families beyond paper B's register themselves on import (pure
+# Python: their sweeps import NGSolve when they run).
+import softbend.fem.pneunet.description  # noqa: E402, F401

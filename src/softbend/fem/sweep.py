@@ -17,7 +17,10 @@
 
 The sweep ends at the last requested pressure, when the angle passes
 ``max_angle_deg`` (the actuator has curled round; outputs above it are not
-reported), when the largest stretch in the elastomer passes ``max_stretch``
+reported), when the model itself says so after a converged step (a model with a
+``stop_after_step(pressure)`` method: the PneuNet's neighbouring chamber walls
+touching, :class:`~softbend.fem.pneunet.model.PneuNetModel`; outputs stop at the
+pressure it names), when the largest stretch in the elastomer passes ``max_stretch``
 (outside the material model; outputs stop at the step before), or when a step
 shorter than ``min_step_mpa`` still does not converge — then the first requested
 pressure beyond the last converged state is reported with ``converged=False``.
@@ -37,7 +40,7 @@ import math
 import time
 from collections.abc import Callable
 from dataclasses import dataclass, field
-from typing import cast
+from typing import TYPE_CHECKING, Any, cast
 
 import numpy as np
 from numpy.typing import ArrayLike
@@ -51,9 +54,17 @@ from softbend.fem.options import FEMOptions
 from softbend.fem.stats import FEMStats, FEMTimings
 from softbend.models import SweepResult, check_pressures_mpa
 
+if TYPE_CHECKING:
+    from typing import TypeAlias
+
+    from softbend.fem.pneunet.model import PneuNetModel
+
+    #: A model the load stepping drives (the interface of :class:`ActuatorModel`).
+    SweepModel: TypeAlias = ActuatorModel | PneuNetModel
+
 require_ngsolve()  # NGSolve after PyTorch, or one line naming softbend[fem]
 
-__all__ = ["Step", "StepHistory", "run_sweep", "simulate"]
+__all__ = ["Step", "StepHistory", "run_model_sweep", "run_sweep", "simulate"]
 
 logger = logging.getLogger(__name__)
 
@@ -77,6 +88,7 @@ class Step:
     max_stretch: float = float("nan")
     state: np.ndarray | None = field(default=None, repr=False)
     volume_rate: float = float("nan")  # dV/dp of the cavity, mm³/MPa
+    volume_mm3: float = float("nan")  # the cavity's volume (both halves), mm³
 
 
 @dataclass
@@ -125,7 +137,7 @@ class StepHistory:
 
 
 def _record(
-    model: ActuatorModel, pressure: float, iterations: int, keep_state: bool
+    model: SweepModel, pressure: float, iterations: int, keep_state: bool
 ) -> tuple[Step, np.ndarray]:
     """The converged state at ``pressure`` as a :class:`Step`, and its tangent ``du/dp``."""
     values = model.measure().as_array()
@@ -134,10 +146,11 @@ def _record(
     stretch, _ = model.max_stretch()
     state = model.state() if keep_state else None
     rate = model.cavity_volume_rate(tangent)
-    return Step(pressure, values, slopes, iterations, stretch, state, rate), tangent
+    volume = model.cavity_volume_mm3()
+    return Step(pressure, values, slopes, iterations, stretch, state, rate, volume), tangent
 
 
-def _apply_gravity(model: ActuatorModel) -> int:
+def _apply_gravity(model: SweepModel) -> int:
     """Ramp gravity in fractions with extrapolated starts; returns the Newton iterations.
 
     The weight is followed like the pressure: from 1/4 of it, doubling the
@@ -161,7 +174,7 @@ def _apply_gravity(model: ActuatorModel) -> int:
             setattr(solver, name, value)
 
 
-def _gravity_tangent(model: ActuatorModel) -> np.ndarray:
+def _gravity_tangent(model: SweepModel) -> np.ndarray:
     """``du/dg`` at the current state, g the fraction of gravity applied (mm).
 
     The weight is a dead load ``g·f``, so ``∂r/∂g = −f`` and ``K du/dg = f``.
@@ -174,7 +187,7 @@ def _gravity_tangent(model: ActuatorModel) -> np.ndarray:
     return np.array(out.FV().NumPy(), copy=True)
 
 
-def _gravity_fractions(model: ActuatorModel) -> int:
+def _gravity_fractions(model: SweepModel) -> int:
     options = model.options
     solver = model.solver
     if options.gravity == "none" or options.gravity_mm_s2 == 0.0:
@@ -241,7 +254,7 @@ def _predict(
 
 
 def run_steps(
-    model: ActuatorModel,
+    model: SweepModel,
     pmax_mpa: float,
     *,
     landing_mpa: np.ndarray | None = None,
@@ -302,10 +315,23 @@ def run_steps(
             continue
         previous = (pressure, start, tangent)
         pressure = target
+        logger.debug(
+            "step %d at %.6g MPa: %d Newton iterations, residual %.3g N (force scale %.3g N)",
+            len(history.steps),
+            pressure,
+            report.iterations,
+            report.residual,
+            model.force_scale_n(pressure),
+        )
         step, tangent = _record(model, pressure, report.iterations, keep_states)
         history.steps.append(step)
         if progress is not None:
             progress(pressure, float(step.values[0]), pmax_mpa)
+        stop_after_step = getattr(model, "stop_after_step", None)
+        found = stop_after_step(pressure) if stop_after_step is not None else None
+        if found is not None:
+            history.stop_reason, history.valid_up_to_mpa = found
+            break
         if step.max_stretch > options.max_stretch:
             _, site = model.stretch_site()
             history.stop_reason = (
@@ -426,18 +452,39 @@ def run_sweep(
     With ``keep_states=True`` every step keeps its displacement vector, so the
     deformed shapes can be drawn or exported (``model.set_state(step.state)``).
     """
-    from ngsolve import SetNumThreads, TaskManager
-
-    grid = check_pressures_mpa(pressures_mpa)
     options = options or FEMOptions()
     if not isinstance(options, FEMOptions):
         raise InputError(must_be("FEMOptions", options), key="options")
     if not isinstance(design, SFRBADesign):
         raise InputError(must_be("an SFRBADesign", design), key="design")
+    result, model, history = run_model_sweep(
+        ActuatorModel, design, pressures_mpa, options, progress=progress, keep_states=keep_states
+    )
+    return result, cast(ActuatorModel, model), history
+
+
+def run_model_sweep(
+    build: Callable[[Any, FEMOptions], SweepModel],
+    design: Any,
+    pressures_mpa: ArrayLike,
+    options: FEMOptions,
+    *,
+    progress: ProgressCallback | None = None,
+    keep_states: bool = False,
+) -> tuple[SweepResult, SweepModel, StepHistory]:
+    """The sweep of the model ``build(design, options)`` (any FEM family's model).
+
+    The load stepping of :func:`run_sweep` on the model the family builds
+    (one with the interface of :class:`ActuatorModel`); ``design`` and
+    ``options`` are checked by the caller.
+    """
+    from ngsolve import SetNumThreads, TaskManager
+
+    grid = check_pressures_mpa(pressures_mpa)
     started = time.perf_counter()
     SetNumThreads(options.threads)
     with TaskManager():
-        model = ActuatorModel(design, options)
+        model = build(design, options)
         built = time.perf_counter()
         landing = grid if options.output == "solve" else None
         history = run_steps(
@@ -447,7 +494,7 @@ def run_sweep(
 
 
 def _to_result(
-    model: ActuatorModel, grid: np.ndarray, history: StepHistory, started: float, built: float
+    model: SweepModel, grid: np.ndarray, history: StepHistory, started: float, built: float
 ) -> SweepResult:
     options = model.options
     p_steps = history.pressures
@@ -483,7 +530,7 @@ def _to_result(
     timings = cast(FEMTimings, model.solver.timings.as_dict())
     wall = time.perf_counter() - started
     stats: FEMStats = {
-        "model": "3D FEM, NGSolve, half model, quadratic tetrahedra",
+        "model": getattr(model, "description", "3D FEM, NGSolve, half model, quadratic tetrahedra"),
         "stop_reason": history.stop_reason,
         "steps_mpa": [float(s.pressure_mpa) for s in history.steps],
         "step_angles_deg": [float(s.values[0]) for s in history.steps],
@@ -496,7 +543,9 @@ def _to_result(
         "timings": timings,
         "options": options.to_dict(),
         "options_sha256": options.digest(),
-        "fiber_spacing_mm": model.fiber_spacing_mm(),
+        "fiber_spacing_mm": (
+            model.fiber_spacing_mm() if isinstance(model, ActuatorModel) else float("nan")
+        ),
     }
     if history.failure:
         stats["failure"] = history.failure

@@ -26,6 +26,7 @@ import numpy as np
 from softbend.design import SFRBADesign
 from softbend.errors import ConvergenceError, InputError
 from softbend.fem._ngsolve import require_ngsolve
+from softbend.fem.families import FamilyDesign
 from softbend.fem.mechanics import solid_energy, volume_flux
 from softbend.fem.newton import EnergySolver
 from softbend.materials.models import NeoHookean
@@ -34,6 +35,7 @@ if TYPE_CHECKING:
     from ngsolve import BilinearForm, FESpace, GridFunction
 
     from softbend.fem.options import FEMOptions
+    from softbend.models import SweepResult
 
 require_ngsolve()  # NGSolve after PyTorch, or one line naming softbend[fem]
 
@@ -299,7 +301,7 @@ class MeshStudyRow:
 
 
 def mesh_study(
-    design: SFRBADesign,
+    design: SFRBADesign | FamilyDesign,
     maxh_mm: Sequence[float],
     pressures_mpa: Sequence[float],
     options: FEMOptions | None = None,
@@ -308,22 +310,38 @@ def mesh_study(
 ) -> list[MeshStudyRow]:
     """Bending angle at ``pressures_mpa`` for each element size in ``maxh_mm``.
 
-    Each size runs :func:`softbend.fem.simulate` over ``pressures_mpa`` with
+    Each size runs the sweep of the design's FEM family
+    (:func:`softbend.fem.simulate` for paper B's actuator, the family's
+    :attr:`~softbend.fem.families.FEMFamily.sweep` for a
+    :class:`~softbend.fem.families.FamilyDesign`) over ``pressures_mpa`` with
     ``output="solve"`` (every pressure a Newton solve), so only the mesh
     differs. The relative change between consecutive rows is the convergence
-    measure.
+    measure. ``options`` None: the family's defaults.
     """
+    from softbend.fem.families import get_family
     from softbend.fem.options import FEMOptions
     from softbend.fem.stats import fem_stats
     from softbend.fem.sweep import simulate
 
-    options = options or FEMOptions()
+    run: Callable[[FEMOptions], SweepResult]
+    if isinstance(design, FamilyDesign):
+        family = get_family(design.family)
+        options = options or family.options()
+
+        def run(opts: FEMOptions) -> SweepResult:
+            return family.sweep(design, pressures_mpa, opts)[0]
+    else:
+        options = options or FEMOptions()
+
+        def run(opts: FEMOptions) -> SweepResult:
+            return simulate(design, pressures_mpa, opts)
+
     sizes = [options.replace(maxh_mm=h).maxh_mm for h in maxh_mm]  # FEMOptions' rule
     if not sizes:
         raise InputError("must hold at least one size; got none", key="maxh_mm")
     rows = []
     for i, h in enumerate(sizes):
-        result = simulate(design, pressures_mpa, options.replace(maxh_mm=h, output="solve"))
+        result = run(options.replace(maxh_mm=h, output="solve"))
         angles = [float(a) for a in result.angle_deg]
         angles += [math.nan] * (len(pressures_mpa) - len(angles))
         stats = fem_stats(result)

@@ -17,9 +17,16 @@ if TYPE_CHECKING:
     from numpy.typing import ArrayLike
 
     from softbend.design import SFRBADesign
+    from softbend.fem.families import FEMFamily
     from softbend.fem.options import FEMOptions
 
-__all__ = ["FEMSweepFiles", "angle_pressure_curve", "deformed_shapes", "sweep_with_files"]
+__all__ = [
+    "FEMSweepFiles",
+    "angle_pressure_curve",
+    "deformed_shapes",
+    "family_sweep_with_files",
+    "sweep_with_files",
+]
 
 
 def angle_pressure_curve(
@@ -27,8 +34,12 @@ def angle_pressure_curve(
     path: str | Path,
     *,
     analytical: SweepResult | None = None,
+    title: str | None = None,
 ) -> Path:
-    """Bending angle against pressure; the converged steps marked, the analytical model dashed."""
+    """Bending angle against pressure; the converged steps marked, the analytical model dashed.
+
+    ``title``: the figure's title (default: paper B's design tuple).
+    """
     fig, ax = _figure((6.0, 4.2))
     ok = result.converged
     ax.plot(result.pressure_mpa[ok], result.angle_deg[ok], color="C0", label="FEM (outputs)")
@@ -54,7 +65,7 @@ def angle_pressure_curve(
         )
     ax.set_xlabel("pressure (MPa)")
     ax.set_ylabel("bending angle θ (°)")
-    ax.set_title(f"Design (l, r, t, b, φ, lc) = ({result.design})", fontsize=10)
+    ax.set_title(title or f"Design (l, r, t, b, φ, lc) = ({result.design})", fontsize=10)
     ax.grid(alpha=0.3)
     if ax.get_legend_handles_labels()[0]:  # no legend without a label
         ax.legend(fontsize=8)
@@ -178,4 +189,74 @@ def sweep_with_files(
         files["vtk"] = sweep.files["vtk"]
     return FEMSweepFiles(
         sweep.result, sweep.analytical, sweep.shape_pressures_mpa, sweep.steps, files
+    )
+
+
+def family_sweep_with_files(
+    family: FEMFamily,
+    design: Any,
+    pressures_mpa: ArrayLike,
+    options: FEMOptions,
+    out_dir: str | Path,
+    *,
+    shape_pressures_mpa: int,
+    vtk: bool = True,
+    progress: Callable[[float, float, float], None] | None = None,
+) -> FEMSweepFiles:
+    """Sweep one design of an FEM family other than paper B's and write its files.
+
+    Writes ``sweep.csv`` (pressure, angle, tip, converged, Newton iterations),
+    ``angle_pressure.png`` and with ``vtk`` the whole actuator (the half model
+    mirrored) at ``shape_pressures_mpa`` converged steps evenly spaced from 0 to
+    the last reported pressure as ``vtk/shape_p<MPa>MPa.vtu``. There is no analytical model to
+    compare with: ``analytical`` is the FEM sweep itself.
+
+    Parameters
+    ----------
+    family : FEMFamily
+        The family (:func:`softbend.fem.families.get_family`).
+    design
+        A checked design of the family.
+    pressures_mpa : array_like
+        Output pressures, MPa, increasing.
+    options : FEMOptions
+    out_dir : path
+        Folder of the files (created).
+    shape_pressures_mpa : int
+        How many shapes to export.
+    vtk : bool
+        Export the shapes as VTK.
+    progress : callable, optional
+        ``progress(pressure_mpa, angle_deg, target_mpa)`` after each load step.
+    """
+    from softbend.fem.export import vtk_file_name, write_sweep_csv, write_vtk
+
+    out = Path(out_dir)
+    out.mkdir(parents=True, exist_ok=True)
+    result, model, history = family.sweep(
+        design, pressures_mpa, options, progress=progress, keep_states=True
+    )
+    files: dict[str, Any] = {"csv": write_sweep_csv(result, out / "sweep.csv")}
+    files["curve"] = angle_pressure_curve(
+        result, out / "angle_pressure.png", title=f"{family.title}\n({design})"
+    )
+    last = float(result.pressure_mpa[result.converged][-1]) if result.converged.any() else 0.0
+    # The converged steps inside the reported range (not a step past touching walls).
+    inside = [step for step in history.steps if step.pressure_mpa <= last + 1e-12]
+    at = np.array([step.pressure_mpa for step in inside])
+    picked = {int(np.abs(at - q).argmin()) for q in np.linspace(0.0, last, shape_pressures_mpa)}
+    chosen_steps = [inside[i] for i in sorted(picked)]
+    if vtk:
+        vtk_files = []
+        for chosen in chosen_steps:
+            model.set_state(chosen.state)
+            p = float(chosen.pressure_mpa)
+            vtk_files.append(write_vtk(model, out / "vtk" / vtk_file_name(p), pressure_mpa=p))
+        files["vtk"] = vtk_files
+    return FEMSweepFiles(
+        result,
+        result,
+        [float(s.pressure_mpa) for s in chosen_steps],
+        len(history.steps) - 1,
+        files,
     )

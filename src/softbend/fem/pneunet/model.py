@@ -1,0 +1,308 @@
+"""The finite-element model of one PneuNet: its energy, state, measurements and touching walls.
+
+:class:`PneuNetModel` meshes the half PneuNet of a design and assembles
+
+    Π(u) = ∫ W_solid dV + ∫_bottom W_layer dA − p·V_cavities(u) − ∫ ρ g·u dV
+
+over quadratic displacements, the fixed face ``x = 0`` clamped and ``u_y = 0``
+on the symmetry plane: the elastomer and strain-limiting membrane terms of
+paper B's model (:mod:`softbend.fem.energy`), no fibers. It has the interface
+the load stepping of :mod:`softbend.fem.sweep` uses (that of
+:class:`~softbend.fem.actuator.ActuatorModel`) and the same measurement frame:
+``x`` along the undeformed axis from the fixed face, ``z`` normal to the
+strain-limiting layer towards the side the actuator bends to; the bending
+angle is ``arc length / radius`` of the least-squares arc
+(:func:`softbend.kinematics.fit_arc`) through the strain-limiting layer on the
+symmetry plane over the chambered part.
+
+Walls that touch
+----------------
+As a PneuNet bends, the expanding walls of neighbouring chambers bulge into the
+gap between them and meet. This model does not model that contact: the sweep
+stops at first touch, with the pressure recorded and the reason "neighbouring
+chamber walls touch at X kPa" (:meth:`PneuNetModel.stop_after_step`). Why:
+contact turns the smooth energy minimisation into a constrained one whose
+active set changes from step to step (a penalty or Nitsche term adds a
+non-smooth Hessian, the difficulty paper B's tension-only fibers showed), the
+contacting walls need a finer mesh than the bending does, and past first touch
+the actuator's curve depends on friction and on the wall surfaces, which the
+published setups do not give. A campaign's designs are compared on the curve
+before contact; the touch pressure is itself a design output. The gap is
+measured after every converged step between pairs of points at the same
+``(y, z)`` on the two facing wall faces across each gap
+(:meth:`~softbend.fem.pneunet.geometry.PneuNetGeometry.facing_walls`): the
+deformed distance between them, signed by the deformed axial direction of the
+base between the chambers (negative once the walls overlap). The touch pressure
+is where the smallest gap reaches zero, interpolated linearly between the two
+steps around it; outputs are reported up to it.
+"""
+
+from __future__ import annotations
+
+import logging
+import math
+from typing import Any
+
+import numpy as np
+
+from softbend.fem._ngsolve import require_ngsolve
+from softbend.fem.actuator import Measurement
+from softbend.fem.energy import energy_terms
+from softbend.fem.families import FamilyDesign
+from softbend.fem.newton import EnergySolver
+from softbend.fem.options import FEMOptions
+from softbend.fem.pneunet.geometry import mesh_pneunet
+from softbend.kinematics import fit_arc
+
+require_ngsolve()  # NGSolve after PyTorch, or one line naming softbend[fem]
+
+__all__ = ["PneuNetModel"]
+
+logger = logging.getLogger(__name__)
+
+
+class PneuNetModel:
+    """Mesh, energy and state of the FEM model of a PneuNet design.
+
+    Parameters
+    ----------
+    design : FamilyDesign
+        A design of the ``"pneunet"`` family.
+    options : FEMOptions
+        ``base_cap_mm`` is the length of the inlet block at the fixed end;
+        the fiber options are not used.
+    """
+
+    #: What :func:`softbend.fem.sweep.run_sweep` records as the model in the stats.
+    description = "3D FEM, NGSolve, half PneuNet, quadratic tetrahedra"
+
+    def __init__(self, design: FamilyDesign, options: FEMOptions) -> None:
+        import ngsolve as ngs
+
+        self.design = design
+        self.options = options
+        ngs.ngsglobals.msg_level = 0
+        self.mesh, self.geometry = mesh_pneunet(
+            design, maxh_mm=options.maxh_mm, order=options.order, end_mm=options.base_cap_mm
+        )
+        self.fes = ngs.VectorH1(
+            self.mesh,
+            order=options.order,
+            dirichletx="base",
+            dirichlety="base|symmetry",
+            dirichletz="base",
+        )
+        self.gfu = ngs.GridFunction(self.fes)
+        self.pressure = ngs.Parameter(0.0)
+        self.gravity_factor = ngs.Parameter(0.0)
+        self.form, self.volume_form, self.weight_vector = self._assemble_energy()
+        self.solver = EnergySolver(
+            self.form,
+            self.gfu,
+            self.fes.FreeDofs(),
+            rtol=options.rtol,
+            max_iterations=options.max_iterations,
+            load=self.weight_vector,
+            load_factor=self.gravity_factor,
+            prepare=self._bind,
+        )
+        start, end = self.geometry.chambers_mm
+        self._backbone_x = np.linspace(start, end, options.backbone_points)
+        self._backbone_points = self.mesh(
+            self._backbone_x, np.zeros_like(self._backbone_x), np.zeros_like(self._backbone_x)
+        )
+        self._tip_point = self.mesh(self.geometry.length_mm, 0.0, 0.0)
+        one = ngs.CoefficientFunction(1.0)
+        self._cavity_area = ngs.Integrate(one, self.mesh, definedon=self.mesh.Boundaries("cavity"))
+        self._bottom_area = ngs.Integrate(one, self.mesh, definedon=self.mesh.Boundaries("bottom"))
+        self._weight_n = self._total_weight_n()
+        rule = ngs.IntegrationRule(points=[(0.25, 0.25, 0.25)], weights=[1.0 / 6.0])
+        self._check_points = self.mesh.MapToAllElements(rule, ngs.VOL)
+        self._check_xyz = np.asarray(
+            ngs.CoefficientFunction((ngs.x, ngs.y, ngs.z))(self._check_points)
+        )
+        self._deformation = ngs.Id(3) + ngs.Grad(self.gfu)
+        self._walls = [
+            (a, b, self._points(a), self._points(b)) for a, b in self.geometry.facing_walls()
+        ]
+        self._gaps: list[tuple[float, float]] = []  # (pressure MPa, smallest gap mm)
+
+    def _points(self, xyz: np.ndarray) -> Any:
+        return self.mesh(xyz[:, 0], xyz[:, 1], xyz[:, 2])
+
+    # -- energy --------------------------------------------------------------------------
+    def _gravity_vector(self) -> tuple[float, float, float]:
+        g = self.options.gravity_mm_s2
+        return {
+            "bending": (0.0, 0.0, -g),
+            "against": (0.0, 0.0, g),
+            "axial": (g, 0.0, 0.0),
+            "none": (0.0, 0.0, 0.0),
+        }[self.options.gravity]
+
+    def _total_weight_n(self) -> float:
+        o = self.options
+        mass = o.elastomer.density_t_per_mm3 * self.geometry.half_volume_mm3
+        mass += o.layer.density_t_per_mm3 * o.layer_thickness_mm * self._bottom_area
+        return mass * o.gravity_mm_s2
+
+    def _assemble_energy(self) -> tuple[Any, Any, Any]:
+        import ngsolve as ngs
+        from ngsolve import CoefficientFunction as CF  # noqa: N817
+        from ngsolve import ds, dx
+
+        o = self.options
+        self.terms = terms = energy_terms(self.fes, o)
+        self._bind()
+        form = ngs.BilinearForm(self.fes, symmetric=True, symmetric_storage=True)
+        form += ngs.Variation(terms.solid * dx)
+        form += ngs.Variation(terms.layer * ds("bottom"))
+        form += ngs.Variation(terms.pressure_work * ds("cavity"))
+        volume = ngs.BilinearForm(self.fes, symmetric=True)
+        volume += ngs.Variation(terms.flux * ds("cavity"))
+        v = self.fes.TestFunction()
+        g = CF(self._gravity_vector())
+        weight = ngs.LinearForm(self.fes)
+        weight += o.elastomer.density_t_per_mm3 * ngs.InnerProduct(g, v) * dx
+        layer_mass = o.layer.density_t_per_mm3 * o.layer_thickness_mm
+        weight += layer_mass * ngs.InnerProduct(g, v.Trace()) * ds("bottom")
+        weight.Assemble()
+        return form, volume, weight.vec
+
+    def _bind(self) -> None:
+        """This model's pressure into the (possibly shared) energy terms; no fibers."""
+        self.terms.bind(self.pressure.Get(), 0.0, 0.0)
+
+    # -- loads and state -----------------------------------------------------------------
+    @property
+    def ndof(self) -> int:
+        """Free degrees of freedom."""
+        return int(sum(self.fes.FreeDofs()))
+
+    @property
+    def n_elements(self) -> int:
+        """Tetrahedra of the half model."""
+        return int(self.mesh.ne)
+
+    def set_load(self, pressure_mpa: float, gravity_factor: float = 1.0) -> None:
+        """Set the cavity pressure (MPa) and the fraction of gravity applied."""
+        self.pressure.Set(float(pressure_mpa))
+        self.gravity_factor.Set(float(gravity_factor))
+        self._bind()
+
+    def force_scale_n(self, pressure_mpa: float) -> float:
+        """Load size for the Newton tolerance: pressure on the half cavities + weight, N."""
+        return abs(pressure_mpa) * self._cavity_area + self._weight_n
+
+    def state(self) -> np.ndarray:
+        """A copy of the displacement vector."""
+        return np.array(self.gfu.vec.FV().NumPy(), copy=True)
+
+    def set_state(self, values: np.ndarray) -> None:
+        """Overwrite the displacement vector."""
+        self.gfu.vec.FV().NumPy()[:] = values
+
+    def pressure_tangent(self, *, refactorize: bool = True) -> np.ndarray:
+        """``du/dp`` at the current (converged) state, mm/MPa (as the actuator model's)."""
+        rhs = self.gfu.vec.CreateVector()
+        self.volume_form.Apply(self.gfu.vec, rhs)
+        out = self.gfu.vec.CreateVector()
+        if refactorize or not self.solver.has_factorization:
+            self.solver.factorize()
+        self.solver.solve_tangent(rhs, out)
+        return -np.array(out.FV().NumPy(), copy=True)
+
+    def cavity_volume_rate(self, tangent: np.ndarray) -> float:
+        """``dV/dp`` of all the cavities (both halves) along ``tangent = du/dp``, mm³/MPa."""
+        gradient = self.gfu.vec.CreateVector()
+        self.volume_form.Apply(self.gfu.vec, gradient)
+        free = self.solver.free_mask
+        return -2.0 * float(np.dot(gradient.FV().NumPy()[free], tangent[free]))
+
+    def cavity_volume_mm3(self) -> float:
+        """Deformed volume of all the cavities (both halves), mm³."""
+        return -2.0 * float(self.volume_form.Energy(self.gfu.vec))
+
+    # -- measurements --------------------------------------------------------------------
+    def backbone_mm(self) -> np.ndarray:
+        """Deformed strain-limiting layer on the symmetry plane, shape (n, 2): columns x, z."""
+        values = np.asarray(self.gfu(self._backbone_points))
+        return np.column_stack([self._backbone_x + values[:, 0], -values[:, 2]])
+
+    def measure(self) -> Measurement:
+        """Bending angle (arc fit of the backbone, degrees) and tip position (mm)."""
+        fit = fit_arc(self.backbone_mm())
+        tip = self.gfu(self._tip_point)
+        return Measurement(
+            angle_deg=float(fit.angle_deg),
+            tip_x_mm=float(self.geometry.length_mm + tip[0]),
+            tip_z_mm=float(-tip[2]),
+        )
+
+    def measure_derivative(self, tangent: np.ndarray, step_mpa: float = 1e-5) -> np.ndarray:
+        """``d(angle, tip x, tip z)/dp`` along ``tangent = du/dp`` by central differences."""
+        base = self.state()
+        self.set_state(base + step_mpa * tangent)
+        plus = self.measure().as_array()
+        self.set_state(base - step_mpa * tangent)
+        minus = self.measure().as_array()
+        self.set_state(base)
+        return (plus - minus) / (2.0 * step_mpa)
+
+    def max_stretch(self) -> tuple[float, np.ndarray]:
+        """Largest principal stretch at the element centroids and where it is (x, y, z mm)."""
+        F = np.asarray(self._deformation(self._check_points)).reshape(-1, 3, 3)
+        C = np.einsum("nki,nkj->nij", F, F)
+        largest = np.linalg.eigvalsh(C)[:, -1]
+        k = int(np.argmax(largest))
+        return float(math.sqrt(largest[k])), self._check_xyz[k].copy()
+
+    def stretch_site(self) -> tuple[float, str]:
+        """Largest principal stretch and where it is, e.g. ``"chamber 3 at x = 24 mm"``."""
+        stretch, where = self.max_stretch()
+        return stretch, f"{self.region_of(float(where[0]))} at x = {where[0]:.0f} mm"
+
+    def region_of(self, x_mm: float) -> str:
+        """Name of the part of the PneuNet at axial position ``x_mm``."""
+        if x_mm < self.geometry.end_mm:
+            return "inlet block"
+        for i in range(self.geometry.n):
+            x0, x1 = self.geometry.chamber_x_mm(i)
+            if x0 <= x_mm <= x1:
+                return f"chamber {i + 1}"
+        return "base between chambers"
+
+    # -- walls that touch ----------------------------------------------------------------
+    def wall_gap_mm(self) -> float:
+        """Smallest deformed gap between the facing walls of neighbouring chambers, mm.
+
+        Negative once they overlap; ``inf`` for a single chamber (see the module docstring).
+        """
+        smallest = math.inf
+        for back_xyz, front_xyz, back, front in self._walls:
+            a = back_xyz + np.asarray(self.gfu(back))
+            b = front_xyz + np.asarray(self.gfu(front))
+            # The deformed axial direction at the base between the two chambers.
+            axis = b[0] - a[0]
+            axis = axis / np.linalg.norm(axis)
+            d = b - a
+            signed = np.sign(d @ axis) * np.linalg.norm(d, axis=1)
+            smallest = min(smallest, float(signed.min()))
+        return smallest
+
+    def stop_after_step(self, pressure_mpa: float) -> tuple[str, float] | None:
+        """After a converged step: the reason to stop and the last valid pressure, or None.
+
+        Stops when neighbouring chamber walls touch; the touch pressure is
+        interpolated between the last two steps' gaps (MPa).
+        """
+        gap = self.wall_gap_mm()
+        previous = self._gaps[-1] if self._gaps else None
+        self._gaps.append((pressure_mpa, gap))
+        if gap > 0.0:
+            return None
+        touch = pressure_mpa
+        if previous is not None and previous[1] > 0.0:
+            p0, g0 = previous
+            touch = p0 + (pressure_mpa - p0) * g0 / (g0 - gap)
+        return f"neighbouring chamber walls touch at {touch * 1000:.2f} kPa", touch

@@ -1,0 +1,74 @@
+"""``softbend fem run|mesh-study --family pneunet``: the PneuNet through the same commands."""
+
+import json
+
+import pytest
+
+from softbend.cli import main
+
+from .conftest import one_error_line
+
+
+@pytest.mark.parametrize(
+    ("design", "needle"),
+    [
+        ("n_chambers=0", "n_chambers: must be a whole number of chambers >= 1; got 0"),
+        ("gap_mm=0", "gap_mm: must be > 0 mm; got 0"),
+        ("wall_mm=5", "wall_mm: must be < chamber_length_mm / 2 = 4 mm"),
+        ("outer_wall_mm=16", "outer_wall_mm: must be < chamber_width_mm / 2"),
+        ("chambers=4", "--design: chambers is not a parameter of the pneunet family"),
+        ("wall_mm", "--design: must be NAME=VALUE pairs"),
+    ],
+)
+def test_a_bad_pneunet_design_is_one_line_naming_the_parameter(tmp_path, capsys, design, needle):
+    args = ["fem", "run", "--family", "pneunet", "--design", design, "--out", str(tmp_path)]
+    assert main(args) == 2
+    assert needle in one_error_line(capsys)
+
+
+def test_an_unknown_family_and_a_tiny_mesh_are_one_line(tmp_path, capsys):
+    assert main(["fem", "run", "--family", "pneunets", "--out", str(tmp_path)]) == 2
+    assert "--family: Unknown FEM actuator family 'pneunets'" in one_error_line(capsys)
+    args = ["fem", "mesh-study", "--family", "pneunet", "--maxh", "3,0.1"]
+    assert main(args) == 2
+    assert "--maxh: must give at most" in one_error_line(capsys)
+
+
+def test_fem_run_pneunet_json_prints_pressures_and_angles_and_writes_vtk(tmp_path, capsys):
+    out = tmp_path / "run"
+    code = main(
+        [
+            "fem",
+            "run",
+            "--family",
+            "pneunet",
+            "--design",
+            "n_chambers=3,chamber_height_mm=12",
+            "--pmax",
+            "0.004",
+            "--pstep",
+            "0.002",
+            "--maxh",
+            "3",
+            "--shapes",
+            "2",
+            "--out",
+            str(out),
+            "--json",
+        ]
+    )
+    assert code == 0
+    payload = json.loads(capsys.readouterr().out)
+    assert payload["family"] == "pneunet" and payload["design"].startswith("n_chambers=3,")
+    assert "chamber_height_mm=12," in payload["design"]
+    assert payload["pressure_mpa"] == [0.0, 0.002, 0.004]
+    assert payload["angle_deg"][0] == pytest.approx(0.0, abs=1e-9)
+    assert payload["angle_deg"][2] > payload["angle_deg"][1] > 0.0
+    assert payload["stats"]["step_volume_mm3"][-1] > payload["stats"]["step_volume_mm3"][0]
+    lines = (out / "sweep.csv").read_text().splitlines()
+    assert len(lines) == 4
+    assert (out / "angle_pressure.png").stat().st_size > 1000
+    vtks = sorted(p.name for p in (out / "vtk").glob("*.vtu"))
+    assert vtks[0] == "shape_p0.000MPa.vtu" and len(vtks) == 2
+    text = (out / "vtk" / vtks[-1]).read_text()
+    assert 'Name="model_half"' in text and "displacement" in text
