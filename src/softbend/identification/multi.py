@@ -18,7 +18,11 @@ The static maps are one of :data:`STRUCTURES`:
 - ``gg-svr``: paper A's generalized-Gaussian kernel SVR
   (:class:`~softbend.identification.svr.GeneralizedGaussianSVR`; ``shape=2``
   is the Gaussian RBF kernel), fitted on at most ``max_rows`` evenly spaced
-  regressor rows (a kernel fit grows with the square of the rows).
+  regressor rows (a kernel fit grows with the square of the rows);
+- ``arx-sim``, ``poly2-sim``, ``nn-sim``: the linear and degree-2 maps, and a
+  small neural map, started from the one-step fit and fitted by their free-run
+  error, optionally behind a first-order filter on every input whose time
+  constant is estimated with the map (:mod:`softbend.identification.simfit`).
 
 Signals are standardized per signal (each output's mean and standard
 deviation from the training data, shared by its lags), so ``epsilon`` of an
@@ -30,6 +34,7 @@ that diverges saturates there instead of overflowing, and its error shows it.
 from __future__ import annotations
 
 import json
+import math
 import os
 from collections.abc import Mapping, Sequence
 from pathlib import Path
@@ -42,11 +47,19 @@ from softbend._validation import check_choice, check_finite_array, check_int, mu
 from softbend.errors import InputError, SchemaError, SoftbendError
 from softbend.identification.narx import _row_index, _segments
 from softbend.identification.persistence import svr_from_state, svr_state
+from softbend.identification.simfit import Start, refine
+from softbend.identification.simmaps import (
+    SIM_FAMILIES,
+    NeuralMap,
+    check_sim_params,
+    filter_inputs,
+)
 from softbend.identification.svr import GeneralizedGaussianSVR
 
 __all__ = [
     "FREE_RUN_MARGIN",
     "STRUCTURES",
+    "TAU_GRID",
     "MultiNARX",
     "load_multi_narx",
     "save_multi_narx",
@@ -54,12 +67,18 @@ __all__ = [
 
 #: The static maps a :class:`MultiNARX` may use (its ``family``; not the surrogate
 #: families of :data:`softbend.surrogates.FAMILIES`).
-STRUCTURES: tuple[str, ...] = ("arx", "poly2", "gg-svr")
+STRUCTURES: tuple[str, ...] = ("arx", "poly2", "gg-svr", *SIM_FAMILIES)
 
 #: A free run stays within the training range widened by this many ranges per side.
 FREE_RUN_MARGIN = 1.0
 
+#: Input time constants (samples) whose one-step fits are run free when ``tau_init`` is None.
+TAU_GRID: tuple[float, ...] = (0.25, 0.5, 1.0, 2.0, 4.0, 8.0, 16.0)
+
 _FORMAT = "softbend-multi-narx"
+_SCORE_ROWS = 200
+_SEARCH_ROWS = 10_000
+_GOLDEN_STEPS = 5
 _SCHEMA = 1
 _RIDGE = 1e-8
 
@@ -104,7 +123,7 @@ class MultiNARX:
 
     Parameters
     ----------
-    family : {"arx", "poly2", "gg-svr"}, default "arx"
+    family : {"arx", "poly2", "gg-svr", "arx-sim", "poly2-sim", "nn-sim"}, default "arx"
         The static map of each output (module docstring).
     output_lags : int, default 2
         na ≥ 1: past samples of every output in the regressor.
@@ -113,7 +132,11 @@ class MultiNARX:
     params : dict, optional
         Parameters of the static map: for ``gg-svr`` those of
         :class:`~softbend.identification.svr.GeneralizedGaussianSVR` (``C``,
-        ``epsilon``, ``shape``, ...; default paper A's C = 100, ε = 0.1).
+        ``epsilon``, ``shape``, ...; default paper A's C = 100, ε = 0.1); for
+        the ``-sim`` families the settings of
+        :func:`~softbend.identification.simmaps.check_sim_params` (``steps``,
+        ``epochs``, ``window``, ``batch``, ``lr``, ``filter``, ``tau_init`` in
+        samples, ``hidden``, ``pretrain``, ``seed``).
     max_rows : int, default 4000
         Regressor rows a ``gg-svr`` map is fitted on (evenly spaced; all when fewer).
 
@@ -125,6 +148,9 @@ class MultiNARX:
         Standardization of the outputs and inputs.
     y_low_, y_high_ : ndarray
         The bounds of a free run (training range widened by :data:`FREE_RUN_MARGIN`).
+    input_tau_ : ndarray or None
+        The time constant of each input's first-order filter, in samples (None:
+        no filter); :meth:`input_time_constants_s` in seconds.
     n_outputs_, n_inputs_, max_lag_ : int
     """
 
@@ -141,6 +167,8 @@ class MultiNARX:
         check_int(output_lags, "output_lags", low=1)
         check_int(input_lags, "input_lags", low=1)
         check_int(max_rows, "max_rows", low=10)
+        if family in SIM_FAMILIES:
+            check_sim_params(dict(params or {}), family)
         self.family = family
         self.output_lags = output_lags
         self.input_lags = input_lags
@@ -157,12 +185,38 @@ class MultiNARX:
         settings = ", ".join(f"{k}={v:g}" if isinstance(v, float) else f"{k}={v}"
                              for k, v in sorted(self.params.items()))  # fmt: skip
         text = f"{self.family} na={self.output_lags} nb={self.input_lags}"
-        return f"{text} ({settings})" if settings else text
+        text = f"{text} ({settings})" if settings else text
+        tau = getattr(self, "input_tau_", None)
+        if tau is not None:
+            text += f", input tau = {', '.join(f'{t:.3g}' for t in tau)} samples"
+        return text
+
+    def input_time_constants_s(self, sample_period_s: float | None) -> list[float] | None:
+        """Each input filter's time constant in seconds (None without a filter).
+
+        Parameters
+        ----------
+        sample_period_s : float or None
+            The sampling interval, s; None (unknown) gives the time constants in samples.
+        """
+        tau = getattr(self, "input_tau_", None)
+        if tau is None:
+            return None
+        scale = 1.0 if sample_period_s is None else float(sample_period_s)
+        return [float(t) * scale for t in tau]
+
+    def _inputs_standard(self, U: np.ndarray, segments: Any) -> np.ndarray:
+        """Standardized inputs, through the input filters when the model has them."""
+        Us = (U - self.u_mean_) / self.u_std_
+        tau = getattr(self, "input_tau_", None)
+        if tau is None:
+            return Us
+        return filter_inputs(Us, segments.starts, segments.lengths, tau)
 
     def _map(self) -> _Ridge | GeneralizedGaussianSVR:
-        if self.family == "arx":
+        if self.family in ("arx", "arx-sim", "nn-sim"):
             return _Ridge(1)
-        if self.family == "poly2":
+        if self.family in ("poly2", "poly2-sim"):
             return _Ridge(2)
         return GeneralizedGaussianSVR(**{"C": 100.0, "epsilon": 0.1, **self.params})
 
@@ -196,16 +250,115 @@ class MultiNARX:
         self.y_low_ = low - FREE_RUN_MARGIN * span
         self.y_high_ = high + FREE_RUN_MARGIN * span
         Us, Ys = (U - self.u_mean_) / self.u_std_, (Y - self.y_mean_) / self.y_std_
-        index = _row_index(segments, lag)
-        Phi = self._regressors(Us, Ys, index)
-        target = Ys[index]
-        if self.family == "gg-svr" and index.size > self.max_rows:
-            keep = np.unique(np.linspace(0, index.size - 1, self.max_rows).round().astype(int))
-            Phi, target = Phi[keep], target[keep]
-        self.estimators_ = [self._map().fit(Phi, target[:, j]) for j in range(Y.shape[1])]
+        sim = self.family in SIM_FAMILIES
+        settings = check_sim_params(self.params, self.family) if sim else None
+        self.input_tau_ = None
         self.n_inputs_, self.n_outputs_ = U.shape[1], Y.shape[1]
+        if settings is not None and settings["filter"]:
+            tau = settings["tau_init"]
+            tau = self._search_tau(U, Y, Ys, segments) if tau is None else float(tau)
+            self.input_tau_ = np.full(U.shape[1], tau)
+        Phi, target = self._fit_one_step(U, Ys, segments)
         self.n_train_rows_ = int(Phi.shape[0])
+        if settings is not None:
+            self._refine(settings, Us, Ys, segments, Phi, target)
         return self
+
+    def _fit_one_step(
+        self, U: np.ndarray, Ys: np.ndarray, segments: Any, rows: int | None = None
+    ) -> tuple[np.ndarray, np.ndarray]:
+        """The maps fitted one step ahead (least squares or SVR); returns their rows and targets.
+
+        ``rows``: at most that many regressor rows (evenly spaced); a ``gg-svr``'s ``max_rows``.
+        """
+        index = _row_index(segments, self.max_lag)
+        Phi = self._regressors(self._inputs_standard(U, segments), Ys, index)
+        target = Ys[index]
+        rows = self.max_rows if self.family == "gg-svr" else rows
+        if rows is not None and index.size > rows:
+            keep = np.unique(np.linspace(0, index.size - 1, rows).round().astype(int))
+            Phi, target = Phi[keep], target[keep]
+        self.estimators_ = [self._map().fit(Phi, target[:, j]) for j in range(Ys.shape[1])]
+        return Phi, target
+
+    def _search_tau(self, U: np.ndarray, Y: np.ndarray, Ys: np.ndarray, segments: Any) -> float:
+        """The input time constant (samples, one for all inputs) whose one-step fit runs free best.
+
+        Scored on :data:`TAU_GRID`, then by a golden-section search in log τ between the
+        best point's neighbours; each one-step fit on at most ``_SEARCH_ROWS`` rows.
+        """
+        k = U.shape[1]
+
+        def score(tau: float) -> float:
+            self.input_tau_ = np.full(k, tau)
+            self._fit_one_step(U, Ys, segments, rows=_SEARCH_ROWS)
+            return self._start_score(U, Y, segments)
+
+        scores = [score(t) for t in TAU_GRID]
+        i = int(np.argmin(scores))
+        best, best_score = TAU_GRID[i], scores[i]
+        # golden-section search in log τ between the best point's neighbours
+        a = math.log(TAU_GRID[max(i - 1, 0)])
+        b = math.log(TAU_GRID[min(i + 1, len(TAU_GRID) - 1)])
+        ratio = (math.sqrt(5.0) - 1.0) / 2.0
+        c, d = b - ratio * (b - a), a + ratio * (b - a)
+        fc, fd = score(math.exp(c)), score(math.exp(d))
+        for _ in range(_GOLDEN_STEPS):
+            if fc < fd:
+                b, d, fd = d, c, fc
+                c = b - ratio * (b - a)
+                fc = score(math.exp(c))
+            else:
+                a, c, fc = c, d, fd
+                d = a + ratio * (b - a)
+                fd = score(math.exp(d))
+        for x, f in ((c, fc), (d, fd)):
+            if f < best_score:
+                best, best_score = math.exp(x), f
+        return best
+
+    def _start_score(self, U: np.ndarray, Y: np.ndarray, segments: Any) -> float:
+        """Mean squared free-run error (standardized) over each experiment's first samples."""
+        counts = np.minimum(segments.lengths, _SCORE_ROWS)
+        starts = segments.starts
+        rows = np.concatenate([np.arange(s, s + c) for s, c in zip(starts, counts, strict=True)])
+        labels = np.repeat(np.arange(len(counts)), counts)
+        simulated = self.simulate(U[rows], Y[rows], labels)
+        return float(np.mean(((simulated - Y[rows]) / self.y_std_) ** 2))
+
+    def _refine(
+        self,
+        settings: dict[str, Any],
+        Us: np.ndarray,
+        Ys: np.ndarray,
+        segments: Any,
+        Phi: np.ndarray,
+        target: np.ndarray,
+    ) -> None:
+        """Replace the one-step maps by their simulation-error refinement."""
+        ridges = self.estimators_
+        start = Start(
+            degree=ridges[0].degree,
+            coef=np.column_stack([r.coef_ for r in ridges]),
+            intercept=np.array([r.intercept_ for r in ridges]),
+        )
+        bounds = ((self.y_low_ - self.y_mean_) / self.y_std_,
+                  (self.y_high_ - self.y_mean_) / self.y_std_)  # fmt: skip
+        refined = refine(
+            self.family, settings, Us, Ys, (segments.starts, segments.lengths),
+            (self.output_lags, self.input_lags), bounds, start, self.input_tau_,
+            (Phi, target) if self.family == "nn-sim" else None,
+        )  # fmt: skip
+        if refined.neural is not None:
+            self.estimators_ = refined.neural
+        else:
+            self.estimators_ = [
+                _Ridge.from_state({"degree": start.degree, "coef": refined.coef[:, j],
+                                   "intercept": refined.intercept[j]})
+                for j in range(refined.coef.shape[1])
+            ]  # fmt: skip
+        self.input_tau_ = refined.tau
+        self.sim_steps_ = refined.steps_run
 
     def _arrays(
         self, inputs: ArrayLike, outputs: ArrayLike, outputs_key: str = "Y"
@@ -238,9 +391,10 @@ class MultiNARX:
         """Each output at t from the measured past (NaN for the initial conditions)."""
         U, Y = self._arrays(U, Y)
         self._check_fitted(U)
-        Us, Ys = (U - self.u_mean_) / self.u_std_, (Y - self.y_mean_) / self.y_std_
+        segments = _segments(groups, U.shape[0], self.max_lag)
+        Us, Ys = self._inputs_standard(U, segments), (Y - self.y_mean_) / self.y_std_
         out = np.full(Y.shape, np.nan)
-        index = _row_index(_segments(groups, U.shape[0], self.max_lag), self.max_lag)
+        index = _row_index(segments, self.max_lag)
         Phi = self._regressors(Us, Ys, index)
         out[index] = np.column_stack([e.predict(Phi) for e in self.estimators_])
         return out * self.y_std_ + self.y_mean_
@@ -269,7 +423,7 @@ class MultiNARX:
         self._check_fitted(U)
         lag = self.max_lag
         segments = _segments(groups, U.shape[0], lag)
-        Us = (U - self.u_mean_) / self.u_std_
+        Us = self._inputs_standard(U, segments)
         Ys = (Y0 - self.y_mean_) / self.y_std_
         low = (self.y_low_ - self.y_mean_) / self.y_std_
         high = (self.y_high_ - self.y_mean_) / self.y_std_
@@ -295,6 +449,7 @@ class MultiNARX:
             svr_state(e) if isinstance(e, GeneralizedGaussianSVR) else e.state()
             for e in self.estimators_
         ]
+        tau = getattr(self, "input_tau_", None)
         return {
             "format": _FORMAT,
             "schema_version": _SCHEMA,
@@ -312,6 +467,7 @@ class MultiNARX:
                 for name in ("u_mean", "u_std", "y_mean", "y_std", "y_low", "y_high")
             },
             "maps": maps,
+            **({} if tau is None else {"input_tau": tau.tolist()}),
         }
 
     @classmethod
@@ -354,10 +510,22 @@ class MultiNARX:
             maps = data["maps"]
             if not isinstance(maps, list) or len(maps) != model.n_outputs_:
                 raise SchemaError(f"must hold one map per output ({model.n_outputs_})", key="maps")
+            d = model.output_lags * model.n_outputs_ + model.input_lags * model.n_inputs_
             model.estimators_ = [
-                svr_from_state(m) if model.family == "gg-svr" else _Ridge.from_state(m)
+                svr_from_state(m) if model.family == "gg-svr"
+                else NeuralMap.from_state(m, d) if model.family == "nn-sim"
+                else _Ridge.from_state(m)
                 for m in maps
-            ]
+            ]  # fmt: skip
+            model.input_tau_ = None
+            if data.get("input_tau") is not None:
+                tau = np.asarray(data["input_tau"], dtype=np.float64)
+                if tau.shape != (model.n_inputs_,) or not (np.isfinite(tau) & (tau >= 0)).all():
+                    raise SchemaError(
+                        f"must hold {model.n_inputs_} finite non-negative numbers",
+                        key="input_tau",
+                    )
+                model.input_tau_ = tau
         except SoftbendError as err:
             raise SchemaError(err.detail, key=err.key) from None
         except KeyError as err:
