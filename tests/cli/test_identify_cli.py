@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import csv
 import json
+import re
 
 import numpy as np
 import pytest
@@ -38,13 +39,32 @@ def test_identify_writes_the_selection_the_model_and_the_held_out_runs(recording
     payload = json.loads(capsys.readouterr().out)
     assert payload["validation"] == validation and len(payload["train"]) == 4
     families = {row["family"] for row in payload["table"]}
-    assert families == {"arx", "poly2", "gg-svr"}
+    assert families == {"arx", "poly2", "gg-svr", "poly2-sim", "nn-sim"}
     assert payload["best"] in {row["candidate"] for row in payload["table"]}
     with open(out / "holdout_freerun.csv", encoding="utf-8") as handle:
         rows = list(csv.DictReader(handle))
-    assert list(rows[0]) == ["experiment", "time_s", "x_mm_measured", "x_mm_simulated",
-                             "y_mm_measured", "y_mm_simulated"]  # fmt: skip
+    ends = ("measured", "simulated", "low", "high")
+    columns = [f"{name}_{end}" for name in ("x_mm", "y_mm") for end in ends]
+    assert list(rows[0]) == ["experiment", "time_s", *columns]
     assert {r["experiment"] for r in rows} == set(validation)
+    # the 90 % band: the free run plus the CV residuals' 5 % and 95 % quantiles, no width
+    # over the initial conditions, its coverage the measured samples inside it
+    band, lag = payload["band"], load_multi_narx(out / "model.json")[0].max_lag
+    assert band["level"] == 0.9 and band["coverage_on"] == "validation experiments"
+    given = np.array([r["experiment"] != rows[max(i - lag, 0)]["experiment"] or i < lag
+                      for i, r in enumerate(rows)])  # fmt: skip
+    assert band["coverage_samples"] == len(rows) - given.sum() == len(rows) - lag * len(validation)
+    for j, name in enumerate(("x_mm", "y_mm")):
+        low, high, simulated, measured = (
+            np.array([float(r[f"{name}_{end}"]) for r in rows])
+            for end in ("low", "high", "simulated", "measured")
+        )
+        np.testing.assert_allclose(low[~given] - simulated[~given], band["low"][j], atol=1e-9)
+        np.testing.assert_allclose(high[~given] - simulated[~given], band["high"][j], atol=1e-9)
+        np.testing.assert_array_equal(high[given], low[given])
+        inside = (measured >= low) & (measured <= high)
+        assert inside[~given].mean() == pytest.approx(band["coverage"][j])
+    assert payload["peak_memory_mib"] > 0 and payload["total_seconds"] >= payload["seconds"]
     model, metadata = load_multi_narx(out / "model.json")
     assert metadata["inputs"] == ["p1_kpa", "p2_kpa", "p3_kpa"] and model.n_outputs_ == 2
     # the chosen model read physically: one step reading per (input, output) pair
@@ -52,9 +72,52 @@ def test_identify_writes_the_selection_the_model_and_the_held_out_runs(recording
     assert pairs == {(p, o) for p in ("p1_kpa", "p2_kpa", "p3_kpa") for o in ("x_mm", "y_mm")}
     assert {r["gain_unit"] for r in payload["dynamics"]} == {"mm/kPa"}
     assert metadata["dynamics"] == payload["dynamics"] and metadata["time_unit_s"] == 1.0
+    assert metadata["band"] == payload["band"]
     assert metadata["sample_period"] == pytest.approx(np.median(np.diff(data.experiments[0].time)))
     for name in ("selection.csv", "selection.png", "freerun.png"):
         assert (out / name).is_file()
+
+
+def test_without_validation_the_band_is_checked_fold_by_fold_and_drawn(
+    recording, tmp_path, capsys, monkeypatch
+):
+    from softbend.identification import selection as selection_module
+    from softbend.reports import identify_figures
+
+    every = selection_module.default_candidates
+    monkeypatch.setattr(  # the linear ARX models only: the band, not the search, is tested here
+        selection_module,
+        "default_candidates",
+        lambda seed=0, **kw: [c for c in every(seed) if c.family == "arx"],
+    )
+    drawn = {}
+    overlays = identify_figures.freerun_overlays
+
+    def spy(data, outputs, path, **kwargs):
+        drawn.update(kwargs, outputs=outputs)
+        return overlays(data, outputs, path, **kwargs)
+
+    monkeypatch.setattr(identify_figures, "freerun_overlays", spy)
+    path, data = recording
+    out = tmp_path / "model"
+    assert main(["identify", str(path), *ARGS, "--folds", "3", "--out", str(out)]) == 0
+    text = capsys.readouterr().out
+    said = re.search(r"90 % free-run band covers (\d+) % of held-out samples "
+                     r"\(cross-validation folds; x_mm (\d+) %, y_mm (\d+) %", text)  # fmt: skip
+    assert said is not None, text
+    record = json.loads((out / "selection.json").read_text())
+    band = record["band"]
+    assert band["coverage_on"] == "cross-validation folds"
+    assert int(said[1]) == round(100 * band["coverage_mean"])
+    assert record["peak_memory_mib"] > 0 and record["seconds"] > 0
+    said = r"[\d,]+ rows identified in \d+ s \(selection \d+ s, CPU \d+ s\), peak memory"
+    assert re.search(said, text), text
+    # every held-out run is drawn with its band, the level in the legend
+    assert set(drawn["bands"]) == set(drawn["outputs"]) == set(data.names)
+    assert drawn["band_label"].startswith("90 % band")
+    for low, high in drawn["bands"].values():
+        width = (high - low)[-1]
+        np.testing.assert_allclose(width, np.subtract(band["high"], band["low"]), rtol=1e-12)
 
 
 @pytest.mark.parametrize(

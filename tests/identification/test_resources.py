@@ -8,6 +8,7 @@ from softbend.identification.resources import (
     available_memory_bytes,
     check_identify_memory,
     estimate_identify_memory,
+    peak_memory_mib,
 )
 from softbend.identification.synthetic import synthetic_dataset
 
@@ -75,3 +76,18 @@ def test_curling_identify_refuses_data_too_big_for_its_memory_limit(folder, tmp_
     err = capsys.readouterr().err.strip()
     assert "would need about" in err and "--max-memory-mb" in err
     assert not (out / "metrics.csv").exists()
+
+
+def test_the_peak_memory_is_the_kernels_high_water_mark():
+    import sys
+    from pathlib import Path
+
+    if not sys.platform.startswith("linux"):
+        pytest.skip("/proc/self/status is Linux's")
+    status = Path("/proc/self/status").read_text().splitlines()
+    rss, hwm = (
+        int(next(line for line in status if line.startswith(key)).split()[1]) / 1024
+        for key in ("VmRSS:", "VmHWM:")
+    )
+    peak = peak_memory_mib()
+    assert peak is not None and rss <= peak + 1 and peak == pytest.approx(hwm, abs=2)

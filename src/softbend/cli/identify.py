@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import math
 from pathlib import Path
+from time import perf_counter, process_time
 
 import typer
 
@@ -53,7 +54,11 @@ def identify(
     model physically: from the operating point (the inputs' training means)
     each input steps by one training standard deviation, and each output's
     gain, time constant (63.2 %) and dead time (2 %) are printed and recorded
-    in model.json ("dynamics"). 'softbend predict MODEL.json --input CSV' runs
+    in model.json ("dynamics"). A 90 % band around the free run, from the
+    cross-validation residuals of the chosen model, is written beside it
+    (<output>_low, <output>_high), shaded in freerun.png and checked on
+    held-out samples; the time taken and the peak memory are printed and
+    recorded in selection.json. 'softbend predict MODEL.json --input CSV' runs
     the model on a new input series.
 
     Example:
@@ -91,8 +96,14 @@ def identify(
     _common.check_replaceable_dir(
         out, "--out", "identify", inputs=(data,), files=FILES, marker="selection.json"
     )
+    began, cpu_began = perf_counter(), process_time()
     experiment_files(data)  # a missing path or a folder without CSV: refused first
-    check_identify_memory(data, max_memory_mb=max_memory_mb)
+    need = check_identify_memory(data, max_memory_mb=max_memory_mb)
+    if not as_json and need.csv_bytes >= 4 * 2**20:  # long enough to be worth a line
+        _common.err_console.print(
+            f"reading {need.csv_bytes / 2**20:.1f} MiB of CSV (about {need.rows:,} samples)",
+            highlight=False,
+        )
     series = load_timeseries(
         data,
         _names(inputs, "inputs"),
@@ -107,17 +118,49 @@ def identify(
     check_experiments_for_lags(series, max(c.build(10).max_lag for c in default_candidates(seed)))
     with _common.library_progress(enabled=not as_json):
         selection = select_model(series, validate_on=held, folds=folds, seed=seed)
-    with _common.output_errors(out, "--out"), staged_dir(out) as stage:
+    with (
+        _common.library_progress(enabled=not as_json),
+        _common.output_errors(out, "--out"),
+        staged_dir(out) as stage,
+    ):
         write_identification(selection, series, stage)
+    seconds, cpu = perf_counter() - began, process_time() - cpu_began
     if as_json:
         _common.print_json(
-            {**selection.to_dict(), "files": {name: str(out / name) for name in FILES}}
+            {
+                **selection.to_dict(),
+                "total_seconds": seconds,
+                "total_cpu_seconds": cpu,
+                "files": {name: str(out / name) for name in FILES},
+            }
         )
         return
     _print_selection(selection)
     _common.console.print(selection.verdict())
+    if selection.band is not None:
+        _common.console.print(selection.band.summary())
     _print_dynamics(selection)
+    _common.console.print(
+        _cost_line(selection, seconds, cpu, sum(e.n_samples for e in series.experiments))
+    )
     _common.console.print(f"{', '.join(FILES)} written to {out}")
+
+
+def _cost_line(selection: object, seconds: float, cpu: float, rows: int) -> str:
+    """What the identification took: wall and CPU time, the selection's share, peak memory,
+    cores (on a shared machine the wall time grows with the load, the CPU time much less)."""
+    import os
+
+    from softbend.identification.selection import Selection
+
+    assert isinstance(selection, Selection)
+    peak = selection.peak_memory_mib
+    memory = "" if peak is None else f", peak memory {peak:,.0f} MiB"
+    cores = len(os.sched_getaffinity(0)) if hasattr(os, "sched_getaffinity") else os.cpu_count()
+    return (
+        f"{rows:,} rows identified in {seconds:.0f} s (selection {selection.seconds:.0f} s, "
+        f"CPU {cpu:.0f} s){memory}, {cores} cores."
+    )
 
 
 def _print_selection(selection: object) -> None:

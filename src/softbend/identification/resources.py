@@ -41,6 +41,7 @@ __all__ = [
     "available_memory_bytes",
     "check_identify_memory",
     "estimate_identify_memory",
+    "peak_memory_mib",
 ]
 
 MIB = 2**20
@@ -167,6 +168,23 @@ def available_memory_bytes() -> int | None:
         if limit is not None and usage is not None and limit < 2**60:
             candidates.append(max(0, limit - usage))
     return min(candidates) if candidates else None
+
+
+def peak_memory_mib() -> float | None:
+    """The peak resident memory of this process so far, MiB (None where it cannot be told).
+
+    ``getrusage``'s ``ru_maxrss``: KiB on Linux, bytes on macOS; Windows has no
+    :mod:`resource` module.
+    """
+    try:
+        import resource
+    except ImportError:  # Windows
+        return None
+    import sys
+
+    peak = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss
+    scale = 1 if sys.platform == "darwin" else 1024
+    return peak * scale / MIB if peak > 0 else None
 
 
 def check_identify_memory(

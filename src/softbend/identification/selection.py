@@ -24,6 +24,16 @@ the training experiments, is run free on them too. The chosen model is then
 read physically (:attr:`Selection.dynamics`): the gain, time constant and dead
 time of every output's response to a step of every input
 (:func:`~softbend.identification.dynamics.step_readings`).
+
+How far the chosen model's free run may stray is read from the same held-out
+runs: :attr:`Selection.band` is a 90 % band of the cross-validation free-run
+residuals of the chosen candidate (:mod:`softbend.identification.band`), and
+its coverage is checked on samples it was not estimated from — the validation
+experiments, or without them each fold against the band of the other folds.
+Every phase longer than a moment reports its progress
+(:func:`softbend._progress.report`); the selection's wall time and the
+process's peak memory are recorded (:attr:`Selection.seconds`,
+:attr:`Selection.peak_memory_mib`, :attr:`Selection.cpu_seconds`).
 """
 
 from __future__ import annotations
@@ -32,12 +42,20 @@ import math
 import time
 import warnings
 from collections.abc import Callable, Sequence
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
 from softbend.errors import ConvergenceError, DatasetError, InputError
+from softbend.identification.band import (
+    BAND_LEVEL,
+    FreeRunBand,
+    coverage,
+    estimate_band,
+    fold_coverage,
+    free_run_residuals,
+)
 from softbend.identification.dynamics import (
     StepReading,
     identified_model,
@@ -47,6 +65,7 @@ from softbend.identification.dynamics import (
 from softbend.identification.kernels import ShapeClippedWarning
 from softbend.identification.multi import MultiNARX, nrmse
 from softbend.identification.ranges import FOLDS_RANGE, SEED_RANGE, check_integer
+from softbend.identification.resources import peak_memory_mib
 from softbend.identification.timeseries import TimeSeriesSet
 from softbend.identification.timeseries_io import check_signals
 from softbend.parameters import Range
@@ -75,7 +94,8 @@ _N_KERNEL_RANGE = Range(0, 1000, "candidates", why="each costs a cross-validatio
 
 @dataclass(frozen=True)
 class Candidate:
-    """One model to try: a family, its lags and its map's parameters."""
+    """One model to try: a family (:data:`~softbend.identification.multi.STRUCTURES`), its
+    lags and its map's parameters."""
 
     name: str
     family: str
@@ -100,7 +120,12 @@ class Candidate:
 
 
 def default_candidates(seed: int = 0, n_kernel: int = 6) -> list[Candidate]:
-    """The baselines and ``n_kernel`` seeded kernel candidates (module docstring).
+    """The baselines, the simulation-error models and ``n_kernel`` seeded kernel candidates.
+
+    The simulation-error models (:mod:`~softbend.identification.simfit`, each
+    started from its one-step fit and seeded by ``seed``) are a degree-2
+    polynomial with an input filter and a neural NARX, both with lags 2 and 3;
+    the rest as the module docstring says.
 
     Parameters
     ----------
@@ -115,6 +140,11 @@ def default_candidates(seed: int = 0, n_kernel: int = 6) -> list[Candidate]:
     out = [Candidate(f"arx-{na}-{nb}", "arx", na, nb) for na, nb in lags]
     out += [Candidate(f"poly2-{na}-{nb}", "poly2", na, nb) for na, nb in lags if na + nb <= 4]
     out.append(Candidate("paper-a", "gg-svr", 2, 2, {"C": 100.0, "epsilon": 0.1}))
+    # fitted by simulation error, from the one-step fit (softbend.identification.simfit)
+    out += [
+        Candidate("poly2-sim-2-3-filter", "poly2-sim", 2, 3, {"filter": True, "seed": seed}),
+        Candidate("nn-sim-2-3", "nn-sim", 2, 3, {"seed": seed}),
+    ]
     rng = np.random.default_rng([seed, 32])
     kernel_lags = [(1, 1), (2, 1), (2, 2), (3, 2)]
     for i in range(n_kernel):
@@ -177,6 +207,7 @@ class Selection:
     validation_outputs : dict of str to ndarray
         Each validation experiment's free run by the chosen model (n, m).
     seconds : float
+        Wall time of the selection, s.
     cv_outputs : dict of str to ndarray
         Each training experiment's free run by the chosen candidate fitted without
         its fold (the cross-validation's held-out runs).
@@ -187,6 +218,16 @@ class Selection:
     dynamics : list of StepReading
         The chosen model's gain, time constant and delay of every (input,
         output) pair (:func:`~softbend.identification.dynamics.step_readings`).
+    band : FreeRunBand, optional
+        The band around the chosen model's free run from its cross-validation
+        residuals, in the outputs' units, with its coverage on held-out samples
+        (:mod:`softbend.identification.band`).
+    peak_memory_mib : float, optional
+        The process's peak resident memory at the end of the selection, MiB
+        (None where the platform cannot tell).
+    cpu_seconds : float, optional
+        CPU time of the process's threads during the selection, s (beside the
+        wall time, which grows with the load of a shared machine).
     """
 
     table: Any
@@ -203,6 +244,9 @@ class Selection:
     time_name: str = "sample"
     sample_period: float = 1.0
     dynamics: list[StepReading] = field(default_factory=list)
+    band: FreeRunBand | None = None
+    peak_memory_mib: float | None = None
+    cpu_seconds: float | None = None
 
     @property
     def time_unit_s(self) -> float | None:
@@ -267,7 +311,10 @@ class Selection:
             "time_unit_s": self.time_unit_s,
             "dynamics": [r.to_dict() for r in self.dynamics],
             "table": self.table.to_dict(orient="records"),
+            "band": None if self.band is None else self.band.to_dict(),
             "seconds": self.seconds,
+            "peak_memory_mib": self.peak_memory_mib,
+            "cpu_seconds": self.cpu_seconds,
         }
 
 
@@ -319,7 +366,7 @@ def select_model(
 
     from softbend._progress import report
 
-    start = time.perf_counter()
+    start, cpu_start = time.perf_counter(), time.process_time()
     held = tuple(validate_on or ())
     unknown = [n for n in held if n not in data.names]
     if unknown:
@@ -360,13 +407,23 @@ def select_model(
     cheap = [c for c in chosen if c.family != "gg-svr" or c.baseline]
     raced = [c for c in chosen if c.family == "gg-svr" and not c.baseline]
     survivors = max(1, math.ceil(len(raced) / 3)) if raced else 0
-    total = folds * (len(cheap) + len(raced) + survivors) + (len(cheap) + survivors) * bool(held)
+    cv_total = folds * (len(cheap) + len(raced) + survivors)
+    total = cv_total + (len(cheap) + survivors) * bool(held)
+    cv_phase = f"cross-validating {len(chosen)} candidates on {folds} folds (fits)"
+    final_phase = (
+        f"refitting {len(cheap) + survivors} candidates, free runs of the validation experiments"
+        if held
+        else "refitting the chosen candidate"
+    )
     done = 0
 
     def tick() -> None:
         nonlocal done
         done += 1
-        report("selecting a model (fits)", done, total)
+        if done <= cv_total:
+            report(cv_phase, done, cv_total)
+        else:
+            report(final_phase, done - cv_total, total - cv_total)
         if progress is not None:
             progress(done, total)
 
@@ -413,6 +470,8 @@ def select_model(
         final = [c for c in chosen if rows_by_name[c.name]["rung"] != "first"]
         best = min(final, key=lambda c: rows_by_name[c.name]["cv_freerun_nrmse"])
 
+        if not held:
+            report(final_phase, 0, 1)
         U, Y, groups = train.stacked()
         validation_outputs: dict[str, np.ndarray] = {}
         fitted: dict[str, MultiNARX] = {}
@@ -440,7 +499,21 @@ def select_model(
     columns = ["candidate", "family", "na", "nb", "settings", "rows", "rung", "cv_freerun_nrmse"]
     columns += ["cv_onestep_nrmse", "validation_freerun_nrmse", "fit_s"]
     _check_finite(table, validated=bool(held))
+    if not held:
+        report(final_phase, 1, 1)
+    band = _band(
+        data,
+        train_names,
+        held,
+        cv_runs[best.name],
+        validation_outputs,
+        fold_of,
+        fitted[best.name].max_lag,
+    )
+    report("reading the chosen model's step responses", 0, 1)
     identified = identified_model(fitted[best.name], data)
+    dynamics = step_readings(identified)
+    report("reading the chosen model's step responses", 1, 1)
     return Selection(
         table=table[columns],
         best=best.name,
@@ -452,10 +525,48 @@ def select_model(
         ranges=ranges,
         validation_outputs=validation_outputs,
         seconds=time.perf_counter() - start,
+        peak_memory_mib=peak_memory_mib(),
+        cpu_seconds=time.process_time() - cpu_start,
         cv_outputs=cv_runs[best.name],
         time_name=identified.time_name,
         sample_period=identified.sample_period,
-        dynamics=step_readings(identified),
+        dynamics=dynamics,
+        band=band,
+    )
+
+
+def _band(
+    data: TimeSeriesSet,
+    train_names: Sequence[str],
+    held: Sequence[str],
+    cv_outputs: dict[str, np.ndarray],
+    validation_outputs: dict[str, np.ndarray],
+    fold_of: dict[str, int],
+    lag: int,
+) -> FreeRunBand:
+    """The chosen model's band from its cross-validation runs, its coverage checked on the
+    validation experiments, else on each fold against the band of the other folds."""
+    outputs = {e.name: e.outputs for e in data.experiments}
+
+    def residuals(names: Sequence[str], runs: dict[str, np.ndarray]) -> np.ndarray:
+        return free_run_residuals([outputs[n] for n in names], [runs[n] for n in names], start=lag)
+
+    band = estimate_band(residuals(train_names, cv_outputs), data.output_names, level=BAND_LEVEL)
+    if held:
+        checked = residuals(held, validation_outputs)
+        covered, samples, on = coverage(band, checked), len(checked), "validation experiments"
+    else:
+        by_fold = [
+            residuals([n for n in train_names if fold_of[n] == k], cv_outputs)
+            for k in sorted(set(fold_of.values()))
+        ]
+        covered, samples = fold_coverage(by_fold, data.output_names, level=BAND_LEVEL)
+        on = "cross-validation folds"
+    return replace(
+        band,
+        coverage=tuple(float(c) for c in covered),
+        coverage_on=on,
+        coverage_samples=int(samples),
     )
 
 

@@ -58,9 +58,12 @@ def freerun_overlays(
     *,
     title: str,
     count: int = 6,
+    bands: dict[str, tuple[np.ndarray, np.ndarray]] | None = None,
+    band_label: str = "band",
 ) -> Path:
     """Measured and free-run outputs of up to ``count`` held-out experiments (rows) per
-    output (columns)."""
+    output (columns), the free run's band (``bands``: experiment → ``(low, high)``,
+    each shaped like its run) shaded behind it and named ``band_label`` in the legend."""
     from matplotlib.figure import Figure
 
     shown = [e for e in data.experiments if e.name in outputs][:count]
@@ -71,6 +74,11 @@ def freerun_overlays(
         simulated = outputs[e.name]
         for j, name in enumerate(data.output_names):
             ax = axes[i, j]
+            if bands and e.name in bands:
+                low, high = bands[e.name]
+                ax.fill_between(
+                    e.time, low[:, j], high[:, j], color="C3", alpha=0.2, lw=0, label=band_label
+                )
             ax.plot(e.time, e.outputs[:, j], color="0.3", lw=0.8, label="measured")
             ax.plot(e.time, simulated[:, j], color="C3", lw=0.8, label="free run")
             ax.set_title(f"{e.name}: {name}", fontsize=8)
