@@ -182,17 +182,25 @@ def test_paper_b_default_rig_is_the_lag(table):
         assert rig.angle_deg == angle
 
 
-def test_narx_angle_steps_as_the_model_runs_free(tmp_path):
-    """Sampled every period, the rig's stepping equals the model's own free run (poly2)."""
+@pytest.mark.parametrize(
+    ("family", "params"),
+    [("poly2", {}), ("poly2-sim", {"filter": True, "steps": 10, "tau_init": 4.0})],
+    ids=["poly2", "poly2-sim-filter"],
+)
+def test_narx_angle_steps_as_the_model_runs_free(tmp_path, family, params):
+    """Sampled every period, the rig's stepping equals the model's own free run, the learned
+    input filter included."""
     from softbend.identification.dynamics import load_identified
     from softbend.identification.multi import MultiNARX, save_multi_narx
 
     rng = np.random.default_rng(1)
     p = np.repeat(rng.uniform(0.0, 0.2, 40), 25)
     angle = fopdt_series(p) ** 1.2 / 10.0  # a bend that stiffens: not linear in p
-    model = MultiNARX("poly2", output_lags=2, input_lags=3).fit(p[:, None], angle[:, None])
+    model = MultiNARX(family, output_lags=2, input_lags=3, params=params)
+    model.fit(p[:, None], angle[:, None])
+    assert (getattr(model, "input_tau_", None) is not None) == bool(params)
     metadata = {"inputs": ["p_kpa"], "outputs": ["angle_deg"], "time": "t_ms", "sample_period": 10}
-    path = save_multi_narx(model, tmp_path / "poly2.json", metadata=metadata)
+    path = save_multi_narx(model, tmp_path / f"{family}.json", metadata=metadata)
     plant = identified_plant(path)
     assert plant.sample_period_s == pytest.approx(0.01) and plant.input_scale == 1000.0
     dynamics = plant.dynamics()

@@ -45,8 +45,10 @@ def identify(
     """A NARX model of any time series, chosen by its free run.
 
     Linear ARX and degree-2 polynomial NARX models (several lags), paper A's
-    GG-SVR setting and a seeded search of kernel models are cross-validated on
-    whole held-out experiments, each run free from its first samples; the lowest
+    GG-SVR setting, a seeded search of kernel models, and a polynomial (with a
+    learned first-order lag on each input) and a small neural NARX fitted by
+    their free-run error over the training runs are cross-validated on whole
+    held-out experiments, each run free from its first samples; the lowest
     free-run error wins, whatever the family, and the output says when a linear
     model is the best. Every output's regressor holds the lags of every output.
     Writes the selection table, the model, the held-out free runs
@@ -226,3 +228,8 @@ def _print_dynamics(selection: object) -> None:
         "deviation from its training mean"
     )
     _common.print_table(title, ["input → output", "gain", "τ (63.2 %)", "delay (2 %)"], rows)
+    filters = selection.input_filters
+    if filters is not None:
+        values, unit = filters
+        text = ", ".join(f"{name} {value:.3g} {unit}" for name, value in values.items())
+        _common.console.print(f"Input filters learned with the model (first-order lag τ): {text}.")

@@ -131,6 +131,10 @@ class NARXAngle:
         self._y_mean, self._y_std = model.y_mean_, model.y_std_
         self._low = (model.y_low_ - model.y_mean_) / model.y_std_
         self._high = (model.y_high_ - model.y_mean_) / model.y_std_
+        # a learned first-order lag on the (standardized) input, as the model's free run
+        # applies it: u_f(t) = a·u_f(t−1) + (1−a)·u(t), a = exp(−1/τ), τ in samples
+        tau = getattr(model, "input_tau_", None)
+        self._lag = 0.0 if tau is None or float(tau[0]) <= 0 else math.exp(-1.0 / float(tau[0]))
         self.reset()
 
     def reset(self) -> float:
@@ -139,7 +143,9 @@ class NARXAngle:
         rest = (self._rest - self._y_mean) / self._y_std
         # newest first: y(t−1) … y(t−na) and u(t−1) … u(t−nb+1), standardized
         self._ys = [rest.copy() for _ in range(model.output_lags)]
-        self._us = [(0.0 - self._u_mean) / self._u_std] * (model.input_lags - 1)
+        at_rest = (0.0 - self._u_mean) / self._u_std
+        self._us = [at_rest] * (model.input_lags - 1)
+        self._filtered = at_rest  # the input filter's state, settled at rest
         self._t = 0.0
         self._samples = 0
         self.angle_deg = float(self._rest[self._index])
@@ -148,6 +154,8 @@ class NARXAngle:
     def _step(self, u: float) -> None:
         """One sample of the model: φ(t) = [y(t−1), …, y(t−na), u(t), …, u(t−nb+1)]."""
         us = (u - self._u_mean) / self._u_std
+        if self._lag:
+            us = self._filtered = self._lag * self._filtered + (1.0 - self._lag) * us
         phi = np.concatenate([*self._ys, [us, *self._us]])[None, :]
         with np.errstate(all="ignore"):
             new = np.array([float(e.predict(phi)[0]) for e in self._model.estimators_])

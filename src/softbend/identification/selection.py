@@ -254,6 +254,22 @@ class Selection:
         return seconds_per_unit(self.time_name)
 
     @property
+    def input_filters(self) -> tuple[dict[str, float], str] | None:
+        """The chosen model's learned input filters: each input's time constant and the unit
+        (``"s"`` when the time column's unit is known, else ``"samples"``); None without."""
+        tau = getattr(self.model, "input_tau_", None)
+        if tau is None:
+            return None
+        unit_s = self.time_unit_s
+        scale, unit = (
+            (1.0, "samples") if unit_s is None else (float(self.sample_period) * unit_s, "s")
+        )
+        if unit_s is None and self.time_name != "sample":
+            scale, unit = float(self.sample_period), self.time_name
+        values = {name: float(t) * scale for name, t in zip(self.input_names, tau, strict=True)}
+        return values, unit
+
+    @property
     def holdout_outputs(self) -> dict[str, np.ndarray]:
         """The chosen model's free runs of held-out experiments: the validation experiments
         (fitted on all training ones), else each training experiment run by the model of
@@ -310,6 +326,9 @@ class Selection:
             "sample_period": self.sample_period,
             "time_unit_s": self.time_unit_s,
             "dynamics": [r.to_dict() for r in self.dynamics],
+            "input_filters": None
+            if self.input_filters is None
+            else dict(zip(("time_constants", "unit"), self.input_filters, strict=True)),
             "table": self.table.to_dict(orient="records"),
             "band": None if self.band is None else self.band.to_dict(),
             "seconds": self.seconds,
