@@ -31,11 +31,11 @@ def _cells(line: str) -> list[str]:
 
 #: Lines the page shows that the run must print (the figures a reader compares with).
 FIGURES = [
-    "pressure_mpa → angle_deg   1313 deg/MPa   0.054 s      0 s",
-    "angle_deg  6.948   73.58    71.7           0.0007",
-    "plant                identified model ident/model.json (poly2 na=2 nb=2), sample period "
-    "0.01 s",
-    "rig from             ident/model.json: angle_time_constant_s 0.054 s, valve_delay_s 0 s",
+    "pressure_mpa → angle_deg   1310 deg/MPa   0.0544 s     0 s",
+    "angle_deg  6.962    73.5   71.67           0.0004",
+    "plant                identified model ident/model.json (poly2-sim na=2 nb=3 (filter=True, "
+    "seed=0), input tau = 3.67 samples), sample period 0.01 s",
+    "rig from             ident/model.json: angle_time_constant_s 0.0544 s, valve_delay_s 0 s",
 ]
 
 
