@@ -55,7 +55,8 @@ class FEMStats(TypedDict):
         What was solved ("3D FEM, NGSolve, half model, quadratic tetrahedra").
     stop_reason : str
         Why the sweep ended ("reached the last pressure", "bending angle above …",
-        "stretch … above …", "inflation instability above …", "no convergence above …").
+        "stretch … above …", "inflation instability above …", "no convergence above …",
+        and for the PneuNet "neighbouring chamber walls touch at … kPa").
     steps_mpa : list of float
         Pressure of every converged load step, MPa, from 0 (the gravity state).
     step_angles_deg : list of float
@@ -79,7 +80,10 @@ class FEMStats(TypedDict):
     options_sha256 : str
         :meth:`softbend.fem.FEMOptions.digest` of those options.
     fiber_spacing_mm : float
-        Distance between neighbouring fibers of one family, mm.
+        Distance between neighbouring fibers of one family, mm (NaN for an actuator
+        without fibers).
+    step_volume_mm3 : list of float, optional
+        Volume of the whole cavity at each step, mm³ (the PneuNet's sweeps).
     failure : str, optional
         The solver's last error, present only when the sweep stopped on one.
     """
@@ -98,6 +102,7 @@ class FEMStats(TypedDict):
     options: dict[str, Any]
     options_sha256: str
     fiber_spacing_mm: float
+    step_volume_mm3: NotRequired[list[float]]
     failure: NotRequired[str]
 
 
