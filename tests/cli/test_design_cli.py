@@ -419,7 +419,12 @@ def test_the_material_is_resolved_before_the_search(
 
 @pytest.mark.parametrize(
     "extra",
-    [["--workers", "2"], ["--material", "dragon-skin-30"], ["--backend", "analytical"]],
+    [
+        ["--workers", "2"],
+        ["--material", "dragon-skin-30"],
+        ["--backend", "analytical"],
+        ["--replace-stopped"],
+    ],
 )
 def test_a_verification_option_without_verify_is_refused(
     model_big, tmp_path, capsys, no_search, extra

@@ -3,8 +3,11 @@
 The search names the model's own parameters (its recorded actuator
 description): paper B's ``l, r, t, b, phi, lc``, or another actuator's
 (``--fix layer=paper --range wall_mm=1:2 --minimize n_chambers``), with
-pressures in the model's pressure unit; ``--verify`` sweeps only an actuator
-the FEM models and otherwise says so in one line.
+pressures in the model's pressure unit; ``--verify`` sweeps an actuator with
+the FEM of its family (paper B's, or the ``fem_family`` its description names,
+such as the PneuNet) and otherwise says so in one line; a sweep that stops
+before the pressure checked (walls touching, no convergence) is shown as
+stopped, with the FEM's reason.
 
 Everything is checked before a design is scored: the output folder, every
 number against its declared range (:data:`VERIFY`, :data:`WORKERS`,
@@ -55,7 +58,7 @@ _SPEC_GIVES: dict[str, str] = {
 }
 
 #: Options of the verification alone (by parameter).
-_VERIFY_OPTIONS: tuple[str, ...] = ("backend", "workers", "material")
+_VERIFY_OPTIONS: tuple[str, ...] = ("backend", "workers", "material", "replace_stopped")
 
 
 def _typed(ctx: typer.Context, parameter: str) -> bool:
@@ -185,14 +188,22 @@ def find(
     ),
     verify: int = typer.Option(
         0,
-        help="Sweep the best N (at most 100) with --backend and compare (paper B's actuator; "
-        "another is not verified, and the output says so).",
+        help="Sweep the best N (at most 100) with --backend and compare (paper B's actuator, "
+        "or another with the FEM of the family its description names; one that names none "
+        "is not verified, and the output says so).",
     ),
     backend: str = typer.Option("fem", help="Backend of the verification: fem or analytical."),
     workers: int = typer.Option(
         None, help="Processes of the verification, 1 to 4096 (default: all cores)."
     ),
     material: str = typer.Option(None, help="Elastomer of the verification (as fem run)."),
+    replace_stopped: bool = typer.Option(
+        False,
+        "--replace-stopped",
+        help="Replace a verified candidate whose FEM sweep stops before the pressure "
+        "(chamber walls touch, no convergence) by the next listed one, until N reach it "
+        "or the --top list ends.",
+    ),
     allow_extrapolation: bool = typer.Option(
         False, "--allow-extrapolation", help="Search outside the training data, answers flagged."
     ),
@@ -225,8 +236,13 @@ def find(
     --fix names one, a continuous one on its declared resolution, else on a
     round step of about a hundredth of its range), designs breaking the
     description's constraints left out, pressures in the model's unit.
-    --verify checks only an actuator the FEM models; for another it says so (a
-    warning, and "verify_skipped" in search.json).
+    --verify sweeps another actuator with the FEM of the family its description
+    names (such as pneunet; --backend fem); a sweep that stops before the
+    pressure checked (chamber walls touching, no convergence) is "stopped", with
+    the FEM's reason, not an angle; --replace-stopped then verifies the next
+    listed design instead, until N reach the pressure. An actuator that names
+    no FEM family is not verified, and the output says so (a warning, and
+    "verify_skipped" in search.json).
 
     Example:
 
@@ -240,7 +256,7 @@ def find(
     from softbend.design_search import spec as specs
     from softbend.design_search.search import TOP, LoadedModel, find_designs, searched_ranges
     from softbend.design_search.space import space_of
-    from softbend.design_search.verify import verify_candidates, verify_skipped
+    from softbend.design_search.verify import verify_candidates, verify_family, verify_skipped
     from softbend.reports.design_outputs import FILES, write_search
     from softbend.transfer.base import shipped_base_path
 
@@ -255,6 +271,8 @@ def find(
     elastomer = _verification(ctx, verify, backend, workers, material)
     loaded = LoadedModel.load(model_path)  # read once; its actuator names the parameters
     space = space_of(loaded.actuator)
+    if verify and space.verifiable:  # a family that cannot sweep its designs: before any search
+        verify_family(space)
     actuator = None if space.paper_b else space.actuator
     if spec is not None:
         for name, what in _SPEC_GIVES.items():
@@ -337,6 +355,7 @@ def find(
                             workers=workers,
                             material=elastomer,
                             scratch_dir=stage,
+                            replace_stopped=replace_stopped,
                         )
         payload = [r.to_dict() for r in results]
         for result in results:
@@ -386,6 +405,7 @@ def _print_result(result: SearchResult) -> None:
     verified = any(c.fem_meets is not None for c in result.candidates)
     if verified:
         columns += ["FEM θ (°)", "FEM ok"]
+    stops: list[str] = []
     columns.append("trained there")
     rows = []
     for rank, c in enumerate(result.candidates, start=1):
@@ -393,6 +413,9 @@ def _print_result(result: SearchResult) -> None:
         row += [f"{c.objectives[o.name]:.4g}" for o in spec.objectives if o.name != "error"]
         if verified:
             fem = "" if c.fem_angle_deg is None else f"{c.fem_angle_deg:.2f}"
+            if c.fem_stop is not None:
+                fem = "stopped"
+                stops.append(f"#{rank}: {c.fem_stop}")
             row += [fem, "" if c.fem_meets is None else ("yes" if c.fem_meets else "NO")]
         row.append("yes" if c.supported else "no")
         rows.append(row)
@@ -400,4 +423,11 @@ def _print_result(result: SearchResult) -> None:
         f"{spec.name}: {spec.target.describe()} — {result.n_meeting:,} of "
         f"{result.n_designs:,} designs meet it ({result.seconds:.1f} s)"
     )
+    by = result.verified_by
+    if verified and by is not None:
+        title += f"; verified by the {by['backend']} backend, FEM family {by['family']}"
     _common.print_table(title, columns, rows)
+    if stops:
+        _common.console.print(
+            "FEM sweeps stopped before the pressure checked (no angle): " + "; ".join(stops)
+        )

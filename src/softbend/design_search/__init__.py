@@ -10,7 +10,10 @@ and sets the FEM's angle beside the surrogate's.
 The parameters are those of the model's actuator
 (:class:`~softbend.design_search.space.SearchSpace`): paper B's six by their
 short names, or another description's own (``Specification(...,
-actuator=saved.actuator)``); only paper B's actuator is verified by the FEM.
+actuator=saved.actuator)``). Paper B's actuator is verified by its FEM,
+another by the FEM of the family its description names (``fem_family``, such as
+the PneuNet); a sweep that stops before the pressure checked (walls touching)
+is reported with the FEM's stop reason, not as an angle.
 """
 
 from __future__ import annotations
@@ -33,6 +36,7 @@ _EXPORTS: dict[str, str] = {
     "load_specifications": "spec",
     "space_of": "space",
     "verify_candidates": "verify",
+    "verify_family": "verify",
 }
 
 __all__ = sorted(_EXPORTS)

@@ -138,6 +138,11 @@ class Candidate:
         The FEM's converged sweep, pressures (MPa) and angles (degrees).
     pressure_unit : str
         Unit of ``pressure_mpa`` (the model's pressure unit).
+    fem_stop : str or None
+        Why the FEM gave no angle, once verified: the sweep stopped before the
+        pressure checked (its stop reason, such as neighbouring chamber walls
+        touching), failed, or the FEM family refused the design; None when the
+        sweep reached every pressure checked.
     """
 
     design: SFRBADesign | ActuatorDesign
@@ -153,6 +158,7 @@ class Candidate:
     fem_meets: bool | None = None
     fem_curve: tuple[np.ndarray, np.ndarray] | None = field(default=None, repr=False)
     pressure_unit: str = "MPa"
+    fem_stop: str | None = None
 
     @property
     def supported(self) -> bool:
@@ -184,6 +190,7 @@ class Candidate:
             out["fem_angle_deg"] = self.fem_angle_deg
             out["fem_error_deg"] = self.fem_error_deg
             out["fem_meets"] = self.fem_meets
+            out["fem_stop_reason"] = self.fem_stop
         return out
 
 
@@ -213,6 +220,10 @@ class SearchResult:
         Time of the search (not of any verification), s.
     verify_skipped : str, optional
         Why ``--verify`` checked nothing (the FEM does not model the actuator).
+    verified_by : dict, optional
+        What verified the candidates, once verified: ``backend`` (``"fem"``,
+        ``"analytical"``), ``family`` (the FEM family, ``"sfrba"`` for paper B's
+        actuator) and ``designs`` (how many were swept).
     """
 
     spec: Specification
@@ -226,6 +237,7 @@ class SearchResult:
     model: str
     seconds: float
     verify_skipped: str | None = None
+    verified_by: dict[str, Any] | None = None
 
     def message(self) -> str | None:
         """One line when no design meets the target: the closest, and by how much it misses."""
@@ -254,7 +266,10 @@ class SearchResult:
         their unit (a categorical one its levels searched), the pressures are
         keyed by their unit (``pressure_kpa``), and ``actuator`` and
         ``pressure_unit`` say whose they are; a skipped ``--verify`` adds
-        ``verified`` (null) and ``verify_skipped`` (why).
+        ``verified`` (null) and ``verify_skipped`` (why), a verification
+        ``verified`` (its backend, FEM family and number of designs, and each
+        verified candidate its ``fem_stop_reason``, null where the sweep
+        reached the pressure).
         """
         space = self.spec.space
         target = self.spec.target
@@ -288,6 +303,8 @@ class SearchResult:
         if self.verify_skipped is not None:
             out["verified"] = None
             out["verify_skipped"] = self.verify_skipped
+        elif self.verified_by is not None:
+            out["verified"] = dict(self.verified_by)
         return out
 
 

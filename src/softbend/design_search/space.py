@@ -17,7 +17,8 @@ on (:attr:`SavedSurrogate.actuator <softbend.surrogates.persistence.SavedSurroga
   constraints
   (:meth:`~softbend.actuators.Actuator.constraints_met`) decide which designs
   are actuators, and its pressure unit is the unit of every pressure of the
-  search.
+  search; a description that names an FEM family (``fem_family``) is verified
+  by that family's FEM.
 
 :class:`ActuatorDesign` is one design of such an actuator, by its codes.
 """
@@ -157,8 +158,12 @@ class SearchSpace:
 
     @property
     def verifiable(self) -> bool:
-        """Whether the FEM simulates this actuator (``--verify``)."""
-        return self.paper_b and self.actuator.fem_family == "sfrba"
+        """Whether the actuator names an FEM family (``--verify``): paper B's ``"sfrba"``,
+        or another registered in :data:`~softbend.fem.families.FEM_FAMILIES` (checked when
+        it is verified, :func:`~softbend.design_search.verify.verify_family`)."""
+        if self.paper_b:
+            return self.actuator.fem_family == "sfrba"
+        return self.actuator.fem_family is not None
 
     def parameter(self, name: str) -> DesignParameter:
         """The description of the parameter ``name`` (a name of :attr:`names`)."""
