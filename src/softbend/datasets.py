@@ -18,7 +18,9 @@ columns and dtypes of :data:`SAMPLE_COLUMN_KINDS` or :data:`DESIGN_COLUMN_KINDS`
 or with a physically implausible value is a
 :class:`~softbend.errors.DatasetError` naming the file and the field, never a
 wrong table. :func:`write_dataset` makes such a folder from a campaign database
-(``softbend campaign dataset DB --out DIR``).
+(``softbend campaign dataset DB --out DIR``); a campaign of another FEM family
+than paper B's (``softbend campaign run --family NAME``) makes a dataset of that
+family, read by :mod:`softbend.family_datasets`.
 """
 
 from __future__ import annotations
@@ -28,6 +30,7 @@ import json
 import math
 import os
 import re
+from collections.abc import Callable, Sequence
 from datetime import UTC, datetime
 from importlib import resources
 from pathlib import Path
@@ -144,6 +147,7 @@ _STOP_KINDS = (
     ("stretch ", "stretch limit"),
     ("inflation instability", "inflation instability"),
     ("no convergence", "no convergence"),
+    ("neighbouring chamber walls touch", "walls touch"),
 )
 _REGION = re.compile(r"(proximal cap|distal cap|chamber wall)")
 
@@ -300,8 +304,18 @@ def _dtype_kind(series: pd.Series) -> str:
     return str(dtype)
 
 
-def _check_table(table: pd.DataFrame, path: Path, kinds: dict[str, str], name: str) -> None:
-    """Raise :class:`DatasetError` naming ``path`` and the columns of another name or dtype."""
+def _check_table(
+    table: pd.DataFrame,
+    path: Path,
+    kinds: dict[str, str],
+    name: str,
+    quantities: dict[str, str] | None = None,
+) -> None:
+    """Raise :class:`DatasetError` naming ``path`` and the columns of another name or dtype.
+
+    ``quantities`` maps the physical columns to their quantity of
+    :data:`softbend.plausibility.RANGES` (default paper B's for the table ``name``).
+    """
     missing = [column for column in kinds if column not in table.columns]
     if missing:
         raise DatasetError(
@@ -318,7 +332,8 @@ def _check_table(table: pd.DataFrame, path: Path, kinds: dict[str, str], name: s
         raise DatasetError(
             f"The dataset file {str(path)!r} has column(s) of another type: {', '.join(wrong)}."
         )
-    for column, quantity in _COLUMN_QUANTITIES[name].items():
+    checked = _COLUMN_QUANTITIES[name] if quantities is None else quantities
+    for column, quantity in checked.items():
         values = table[column].to_numpy(dtype="float64", na_value=math.nan)
         row = implausible_index(values, quantity)
         if row is not None:
@@ -332,9 +347,18 @@ def _check_table(table: pd.DataFrame, path: Path, kinds: dict[str, str], name: s
 
 
 def _read(folder: Path, name: str) -> pd.DataFrame:
+    table = _read_file(folder, name, verify_dataset(folder))
+    if name == SAMPLES_FILE:
+        _check_table(table, folder / name, SAMPLE_COLUMN_KINDS, "samples")
+    elif name == DESIGNS_FILE:
+        _check_table(table, folder / name, DESIGN_COLUMN_KINDS, "designs")
+    return table
+
+
+def _read_file(folder: Path, name: str, provenance: dict[str, Any]) -> pd.DataFrame:
+    """The Parquet table ``name`` of a verified dataset folder (its columns not yet checked)."""
     import pandas as pd
 
-    provenance = verify_dataset(folder)
     if name not in provenance["files"]:
         raise DatasetError(f"The dataset {str(folder)!r} has no {name!r} in its provenance.")
     path = folder / name
@@ -344,10 +368,6 @@ def _read(folder: Path, name: str) -> pd.DataFrame:
         raise DatasetError(
             f"The dataset file {str(path)!r} is not a Parquet table ({exc})."
         ) from None
-    if name == SAMPLES_FILE:
-        _check_table(table, path, SAMPLE_COLUMN_KINDS, "samples")
-    elif name == DESIGNS_FILE:
-        _check_table(table, path, DESIGN_COLUMN_KINDS, "designs")
     return table
 
 
@@ -385,7 +405,8 @@ def table1_fem_designs(folder: str | os.PathLike[str] | None = None) -> pd.DataF
 
     Columns: ``design_id``, the six parameters, then :data:`DESIGN_STAT_COLUMNS`
     (``stop_kind`` one of "last pressure", "angle limit", "stretch limit",
-    "inflation instability", "no convergence"; ``stop_region`` the part of the
+    "inflation instability", "no convergence" ("walls touch" for a PneuNet's
+    dataset, :mod:`softbend.family_datasets`); ``stop_region`` the part of the
     actuator a stretch or instability stop names, else empty; times in s).
     Checked as :func:`table1_fem` is, the columns against :data:`DESIGN_COLUMN_KINDS`.
     """
@@ -411,17 +432,23 @@ def _stop_region(reason: str, kind: str) -> str:
     return match[1] if match and kind in ("stretch limit", "inflation instability") else ""
 
 
-def _design_table(designs: pd.DataFrame) -> pd.DataFrame:
+def _design_table(
+    designs: pd.DataFrame,
+    parameters: Sequence[str] = tuple(PARAMETERS),
+    region: Callable[[str, str], str] = _stop_region,
+) -> pd.DataFrame:
     """The campaign's designs table with its JSON stats unpacked into columns.
 
     The stats are an FEM sweep's (:class:`~softbend.fem.stats.FEMStats`); a key
-    that another backend does not record reads as empty or zero.
+    that another backend does not record reads as empty or zero. ``parameters``
+    are the design columns (paper B's by default) and ``region(reason, kind)``
+    the part of the actuator a stop reason names.
     """
     stats = [
         cast("FEMStats", json.loads(s) if isinstance(s, str) and s else {})
         for s in designs["stats"]
     ]
-    out = designs[["design_id", *PARAMETERS]].copy()
+    out = designs[["design_id", *parameters]].copy()
     out["status"] = designs["status"]
     out["error"] = designs["error"].fillna("")
     out["n_samples"] = designs["n_samples"].astype("int32")
@@ -429,14 +456,7 @@ def _design_table(designs: pd.DataFrame) -> pd.DataFrame:
     out["max_angle_deg"] = designs["max_angle_deg"]
     reasons = [s.get("stop_reason", "") for s in stats]
     out["stop_kind"] = [_stop_kind(r) for r in reasons]
-    out["stop_region"] = [
-        (
-            m[1]
-            if (m := _REGION.search(r)) and k in ("stretch limit", "inflation instability")
-            else ""
-        )
-        for r, k in zip(reasons, out["stop_kind"], strict=True)
-    ]
+    out["stop_region"] = [region(r, k) for r, k in zip(reasons, out["stop_kind"], strict=True)]
     out["stop_reason"] = reasons
     out["wall_time_s"] = designs["wall_time_s"]
     out["newton_iterations_total"] = designs["newton_iterations_total"].astype("Int64")
@@ -480,16 +500,23 @@ def write_dataset(
     Returns
     -------
     dict
-        The provenance record written.
+        The provenance record written. A campaign of another FEM family than
+        paper B's is written with its family's columns
+        (:func:`softbend.family_datasets.family_column_kinds`), its values
+        checked against the family's actuator, and its provenance also records
+        ``family`` (the name) and ``actuator`` (the description,
+        :meth:`~softbend.actuators.Actuator.to_dict`).
 
     Raises
     ------
     DatasetError
-        If the campaign has no run or no design yet, or ``out_dir`` holds other
-        files than a dataset's.
+        If the campaign has no run or no design yet, ``out_dir`` holds other
+        files than a dataset's, or a family's value lies outside its actuator's
+        range (naming the column).
     """
     from softbend import __version__
     from softbend._io import staged_dir
+    from softbend.campaign.families import DEFAULT_FAMILY
     from softbend.campaign.store import CampaignStore
 
     out = Path(out_dir)
@@ -508,12 +535,20 @@ def write_dataset(
         runs = store.runs()
         backend = store.backend
         grid = store.pressures_mpa
+        schema = store.family_schema
     if backend is None or grid is None or len(grid) == 0 or designs.empty:
         raise DatasetError(
             f"The campaign database {db_path} holds no finished run (backend, pressure grid "
             "and designs): run 'softbend campaign run' on it before writing a dataset."
         )
-    table = _design_table(designs)
+    if schema.name == DEFAULT_FAMILY:  # paper B's: the table of every dataset before families
+        dataset_name, family = _TABLE1_FEM, {}
+        table = _design_table(designs)
+    else:
+        from softbend.family_datasets import family_tables
+
+        actuator, table = family_tables(schema, samples, designs, db_path)
+        dataset_name, family = schema.name, {"family": schema.name, "actuator": actuator.to_dict()}
     stats = [_stats_record(s, db_path) for s in designs["stats"] if isinstance(s, str) and s]
     options = {json.dumps(s.get("options"), sort_keys=True) for s in stats if "options" in s}
     files: dict[str, dict[str, Any]] = {}
@@ -523,8 +558,9 @@ def write_dataset(
             files[name] = {"bytes": (stage / name).stat().st_size, "sha256": _sha256(stage / name)}
         done = table[table["status"] == "done"]
         provenance = {
-            "name": "table1_fem",
+            "name": dataset_name,
             "description": description,
+            **family,
             "command": command,
             "backend": backend,
             "pressures_mpa": {

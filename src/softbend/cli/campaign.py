@@ -203,28 +203,36 @@ def dataset(
     ),
     description: str = typer.Option("", help="What the data are, one paragraph."),
     space: str | None = typer.Option(
-        None, help=f"The campaign's whole design space, {SPACE_FORMS}: its size is recorded."
+        None,
+        help=f"The campaign's whole design space, {SPACE_FORMS} (for another family than "
+        "sfrba lhs:N, sobol:N, grid or grid:K): its size is recorded.",
     ),
     json_output: bool = typer.Option(False, "--json", help="Print the provenance as JSON."),
 ) -> None:
     """Write a campaign as a verified dataset with its provenance.
 
     Writes the samples and the designs as Parquet and a provenance file (the
-    command, the counts and each file's SHA-256) into the folder --out.
+    command, the counts and each file's SHA-256) into the folder --out. The
+    campaign of another FEM family than paper B's (campaign run --family) is
+    written with its family's design columns, checked against its actuator's
+    ranges, and its provenance records the family and the actuator
+    description: a folder named after the family beside softbend's table1_fem
+    is a shipped dataset of that family.
 
     Example:
 
     \b
         softbend campaign dataset table1.duckdb --out data \\
             --command "softbend campaign run table1.duckdb --space table1"
+        softbend campaign dataset pneunet.duckdb --out pneunet --space lhs:200 \\
+            --command "softbend campaign run pneunet.duckdb --family pneunet --space lhs:200"
     """
     from softbend.campaign.schema import missing_database
-    from softbend.campaign.spaces import parse_space
     from softbend.datasets import DESIGNS_FILE, PROVENANCE_FILE, SAMPLES_FILE, write_dataset
 
     if not db.is_file():
         raise missing_database(db)
-    planned = parse_space(space).n_designs if space is not None else None
+    planned = _planned_designs(db, space) if space is not None else None
     written = (SAMPLES_FILE, DESIGNS_FILE, PROVENANCE_FILE)
     _common.check_output_dir(out, "--out", inputs=(db,), files=written)
     # write_dataset reads and checks the whole campaign before it writes anything
@@ -240,6 +248,7 @@ def dataset(
         f"dataset {out}",
         ["quantity", "value"],
         [
+            *([["family", provenance["family"]]] if "family" in provenance else []),
             [
                 "designs done / failed (of planned)",
                 f"{designs['done']} / {designs['failed']} (of {designs['planned']})",
@@ -253,3 +262,31 @@ def dataset(
             ["files", ", ".join(f"{k} ({v['bytes']} B)" for k, v in provenance["files"].items())],
         ],
     )
+
+
+def _planned_designs(db: Path, space: str) -> int:
+    """The number of designs of ``--space`` for the family of the campaign ``db``.
+
+    Paper B's forms are read before the database (a space over the designs limit
+    is refused first); another family's (``grid``, ``grid:K``) once it names the family.
+    """
+    from softbend.campaign import CampaignStore
+    from softbend.campaign.families import DEFAULT_FAMILY
+    from softbend.campaign.spaces import parse_space
+    from softbend.errors import InputError
+
+    try:
+        planned, refused = parse_space(space).n_designs, None
+    except InputError as exc:
+        planned, refused = None, exc
+    with CampaignStore(db, read_only=True) as store:
+        family = store.family
+    if family == DEFAULT_FAMILY:
+        if refused is not None:
+            raise refused
+        assert planned is not None
+        return planned
+    from softbend.campaign.family_spaces import parse_family_space
+    from softbend.fem.families import get_family
+
+    return parse_family_space(space, get_family(family)).n_designs

@@ -17,8 +17,10 @@ def train(
     db: Path = typer.Argument(
         ...,
         metavar="TABLE",
-        help="What to learn from: a campaign database (DuckDB), or a simulation table "
-        "(CSV or Parquet, one row per design and pressure) described by --design-columns.",
+        help="What to learn from: a campaign database (DuckDB), a dataset folder of "
+        "'softbend campaign dataset' or the name of a shipped one (table1_fem, or a family "
+        "such as pneunet), or a simulation table (CSV or Parquet, one row per design and "
+        "pressure) described by --design-columns.",
     ),
     out: Path = typer.Option(..., "--out", "-o", help="Folder for models, tables and figures."),
     design_columns: str | None = typer.Option(
@@ -102,7 +104,9 @@ def train(
     fewer than 100 designs is a warning and searches the small-data MLP grid
     unless --grid is given.
 
-    TABLE is a softbend campaign (paper B's actuator), or any actuator's
+    TABLE is a softbend campaign (of paper B's actuator or another FEM family),
+    a verified dataset (a folder of 'softbend campaign dataset', or the name of
+    one softbend ships: table1_fem, or a family's name), or any actuator's
     simulation table: a CSV or Parquet file whose columns --design-columns,
     --pressure-column (in --pressure-unit) and --angle-column (degrees) name.
     Integer columns stay integer parameters and text columns categorical ones;
@@ -192,11 +196,22 @@ def _training_source(
     angle_column: str,
     actuator: str | None,
 ) -> Path | TrainingData:
-    """The campaign path, or a table's training data (checked before anything runs)."""
+    """The campaign path, or a dataset's or table's training data (checked before anything runs)."""
+    from softbend.family_datasets import is_dataset_name
+    from softbend.surrogates.features import dataset_training_data
     from softbend.surrogates.tables import TABLE_SUFFIXES
 
     described = actuator is not None
     table_options = (design_columns, pressure_column, pressure_unit)
+    if db.is_dir() or (not db.exists() and is_dataset_name(str(db))):
+        if any(v is not None for v in table_options) or described or angle_column != "angle_deg":
+            raise typer.BadParameter(
+                f"{db} is a dataset (its own columns and actuator); --design-columns, "
+                "--pressure-column, --pressure-unit, --angle-column and --actuator describe "
+                "a CSV or Parquet table.",
+                param_hint="TABLE",
+            )
+        return dataset_training_data(db)
     if db.suffix.lower() not in TABLE_SUFFIXES:
         if any(v is not None for v in table_options) or described or angle_column != "angle_deg":
             raise typer.BadParameter(

@@ -10,6 +10,7 @@ with the design ids as CV groups so that a sweep never spans two folds.
 from __future__ import annotations
 
 import hashlib
+import os
 from collections.abc import Iterator, Sequence
 from contextlib import contextmanager
 from contextvars import ContextVar
@@ -183,6 +184,27 @@ def training_data(
         n_dropped=int((~keep).sum()),
         actuator=actuator,
     )
+
+
+def dataset_training_data(source: str | os.PathLike[str]) -> TrainingData:
+    """Inputs, target and CV groups of a verified dataset, by folder or shipped name.
+
+    ``source`` is a folder of ``softbend campaign dataset`` or the name of a
+    dataset softbend ships (``"table1_fem"``, a family's name), read by
+    :func:`softbend.family_datasets.dataset_samples`. Table 1's gives paper B's
+    :data:`FEATURES`; another family's its parameters and pressure (in its
+    actuator's unit) with the recorded actuator.
+    """
+    from softbend.family_datasets import dataset_samples
+
+    samples, actuator = dataset_samples(source)
+    if actuator is None:
+        return training_data(samples)
+    if actuator.pressure_column != "pressure_mpa":
+        samples[actuator.pressure_column] = samples["pressure_mpa"] / actuator.to_mpa
+    if actuator.angle_column != "angle_deg":
+        samples[actuator.angle_column] = samples["angle_deg"]
+    return training_data(samples, actuator=actuator)
 
 
 def check_features(X: ArrayLike) -> np.ndarray:
