@@ -28,7 +28,7 @@ def small_space() -> DesignSpace:
 def stand_in_fem_dataset(folder: Path) -> Path:
     """A small dataset in the shipped format (analytical sweeps of 15 designs: fast, same table)."""
     from softbend.campaign import run_campaign
-    from softbend.datasets import write_dataset
+    from softbend.dataset_writing import write_dataset
 
     db = folder / "stand_in.duckdb"
     run_campaign(db, DesignSpace.sample(15, seed=4), backend="analytical", workers=0)

@@ -10,6 +10,7 @@ import pytest
 
 from softbend.campaign import load_samples, run_campaign
 from softbend.campaign.backends import default_pressures_mpa
+from softbend.dataset_writing import write_dataset
 from softbend.datasets import (
     DESIGN_COLUMN_KINDS,
     DESIGN_STAT_COLUMNS,
@@ -18,7 +19,6 @@ from softbend.datasets import (
     table1_fem_designs,
     table1_fem_provenance,
     verify_dataset,
-    write_dataset,
 )
 from softbend.design import PARAMETERS, DesignSpace
 from softbend.errors import DatasetError
@@ -295,14 +295,14 @@ def test_the_shipped_dataset_passes_every_check():
 def test_a_write_that_fails_half_way_leaves_the_previous_dataset_whole(
     campaign, dataset, monkeypatch
 ):
-    import softbend.datasets as datasets
+    import softbend.dataset_writing as writing
 
     before = {p.name: p.read_bytes() for p in dataset.iterdir()}
 
     def full_disk(path, text):
         raise OSError(28, "No space left on device", str(path))
 
-    monkeypatch.setattr(datasets, "write_text_atomic", full_disk)  # the provenance, last
+    monkeypatch.setattr(writing, "write_text_atomic", full_disk)  # the provenance, last
     with pytest.raises(OSError, match="No space left"):
         write_dataset(campaign, dataset, command="again")
     assert {p.name: p.read_bytes() for p in dataset.iterdir()} == before

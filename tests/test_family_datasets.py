@@ -21,7 +21,8 @@ from softbend.actuators import Actuator, DesignParameter
 from softbend.campaign import CampaignStore, load_samples, run_campaign
 from softbend.campaign.family_spaces import parse_family_space
 from softbend.cli import main
-from softbend.datasets import DESIGN_STAT_COLUMNS, _stop_kind, table1_fem, write_dataset
+from softbend.dataset_writing import write_dataset
+from softbend.datasets import DESIGN_STAT_COLUMNS, _stop_kind, table1_fem
 from softbend.errors import DatasetError, InputError
 from softbend.family_datasets import (
     family_dataset,

@@ -40,7 +40,7 @@ STAGES: tuple[tuple[str, ...], ...] = (
     ("models",),
     ("analytical", "fem"),
     ("campaign",),
-    ("datasets", "analysis"),
+    ("datasets", "family_datasets", "dataset_writing", "analysis"),
     ("surrogates",),
     ("identification",),
     ("transfer", "control", "design_search"),

@@ -17,10 +17,10 @@ digits}``), a missing, truncated or altered file, or a table without the
 columns and dtypes of :data:`SAMPLE_COLUMN_KINDS` or :data:`DESIGN_COLUMN_KINDS`
 or with a physically implausible value is a
 :class:`~softbend.errors.DatasetError` naming the file and the field, never a
-wrong table. :func:`write_dataset` makes such a folder from a campaign database
-(``softbend campaign dataset DB --out DIR``); a campaign of another FEM family
-than paper B's (``softbend campaign run --family NAME``) makes a dataset of that
-family, read by :mod:`softbend.family_datasets`.
+wrong table. :func:`softbend.dataset_writing.write_dataset` makes such a folder
+from a campaign database (``softbend campaign dataset DB --out DIR``); a campaign
+of another FEM family than paper B's (``softbend campaign run --family NAME``)
+makes a dataset of that family, read by :mod:`softbend.family_datasets`.
 """
 
 from __future__ import annotations
@@ -31,12 +31,10 @@ import math
 import os
 import re
 from collections.abc import Callable, Sequence
-from datetime import UTC, datetime
 from importlib import resources
 from pathlib import Path
 from typing import TYPE_CHECKING, Any, cast
 
-from softbend._io import json_text, write_text_atomic
 from softbend._validation import short_repr
 from softbend.design import FEATURE_QUANTITIES, PARAMETERS
 from softbend.errors import DatasetError
@@ -56,7 +54,6 @@ __all__ = [
     "table1_fem_designs",
     "table1_fem_provenance",
     "verify_dataset",
-    "write_dataset",
 ]
 
 SAMPLES_FILE = "samples.parquet"
@@ -377,8 +374,8 @@ def table1_fem(folder: str | os.PathLike[str] | None = None) -> pd.DataFrame:
     Parameters
     ----------
     folder : path, optional
-        A dataset folder made by :func:`write_dataset`; default: the one shipped
-        in the package.
+        A dataset folder made by :func:`~softbend.dataset_writing.write_dataset`;
+        default: the one shipped in the package.
 
     Returns
     -------
@@ -468,141 +465,3 @@ def _design_table(
     out["options_sha256"] = [s.get("options_sha256", "") for s in stats]
     out["finished_at"] = designs["finished_at"]
     return out.reset_index(drop=True)
-
-
-def write_dataset(
-    db_path: str | os.PathLike[str],
-    out_dir: str | os.PathLike[str],
-    *,
-    command: str,
-    description: str = "",
-    planned: int | None = None,
-) -> dict[str, Any]:
-    """Write a campaign database as a verified dataset folder (Parquet + provenance).
-
-    Parameters
-    ----------
-    db_path : path
-        Campaign database (see :class:`softbend.campaign.CampaignStore`).
-    out_dir : path
-        Folder of the dataset (created). It is written beside its place and
-        swapped in whole when complete (:func:`softbend._io.staged_dir`), so a
-        reader, or a run that fails half-way, sees the old dataset or the new one;
-        an existing folder may hold only a dataset's three files.
-    command : str
-        The command that produced the campaign, recorded for reproduction.
-    description : str
-        One paragraph saying what the data are.
-    planned : int, optional
-        Designs of the whole campaign; recorded so that a dataset written from
-        part of it (some shards) says so.
-
-    Returns
-    -------
-    dict
-        The provenance record written. A campaign of another FEM family than
-        paper B's is written with its family's columns
-        (:func:`softbend.family_datasets.family_column_kinds`), its values
-        checked against the family's actuator, and its provenance also records
-        ``family`` (the name) and ``actuator`` (the description,
-        :meth:`~softbend.actuators.Actuator.to_dict`).
-
-    Raises
-    ------
-    DatasetError
-        If the campaign has no run or no design yet, ``out_dir`` holds other
-        files than a dataset's, or a family's value lies outside its actuator's
-        range (naming the column).
-    """
-    from softbend import __version__
-    from softbend._io import staged_dir
-    from softbend.campaign.families import DEFAULT_FAMILY
-    from softbend.campaign.store import CampaignStore
-
-    out = Path(out_dir)
-    if out.is_dir():
-        others = sorted(p.name for p in out.iterdir() if p.name not in _DATASET_FILES)
-        if others:
-            raise DatasetError(
-                f"The dataset folder {out} holds other files than a dataset's "
-                f"({', '.join(others[:3])}{' …' if len(others) > 3 else ''}); it is replaced "
-                "as a whole: choose a new or empty folder."
-            )
-    with CampaignStore(db_path, read_only=True) as store:
-        samples = store.load_samples()
-        designs = store.load_designs()
-        status = store.status_summary()
-        runs = store.runs()
-        backend = store.backend
-        grid = store.pressures_mpa
-        schema = store.family_schema
-    if backend is None or grid is None or len(grid) == 0 or designs.empty:
-        raise DatasetError(
-            f"The campaign database {db_path} holds no finished run (backend, pressure grid "
-            "and designs): run 'softbend campaign run' on it before writing a dataset."
-        )
-    if schema.name == DEFAULT_FAMILY:  # paper B's: the table of every dataset before families
-        dataset_name, family = _TABLE1_FEM, {}
-        table = _design_table(designs)
-    else:
-        from softbend.family_datasets import family_tables
-
-        actuator, table = family_tables(schema, samples, designs, db_path)
-        dataset_name, family = schema.name, {"family": schema.name, "actuator": actuator.to_dict()}
-    stats = [_stats_record(s, db_path) for s in designs["stats"] if isinstance(s, str) and s]
-    options = {json.dumps(s.get("options"), sort_keys=True) for s in stats if "options" in s}
-    files: dict[str, dict[str, Any]] = {}
-    with staged_dir(out) as stage:
-        for name, frame in ((SAMPLES_FILE, samples), (DESIGNS_FILE, table)):
-            frame.to_parquet(stage / name, compression="zstd", index=False)
-            files[name] = {"bytes": (stage / name).stat().st_size, "sha256": _sha256(stage / name)}
-        done = table[table["status"] == "done"]
-        provenance = {
-            "name": dataset_name,
-            "description": description,
-            **family,
-            "command": command,
-            "backend": backend,
-            "pressures_mpa": {
-                "first": float(grid[0]),
-                "last": float(grid[-1]),
-                "count": len(grid),
-            },
-            "designs": {
-                "planned": int(planned) if planned is not None else len(table),
-                "recorded": len(table),
-                "done": int(status["done"]),
-                "failed": int(status["failed"]),
-                "by_stop_kind": {
-                    str(k): int(v) for k, v in done["stop_kind"].value_counts().items()
-                },
-            },
-            "samples": {"rows": len(samples), "converged": int(samples["converged"].sum())},
-            "cpu_time_s": float(done["wall_time_s"].sum()),
-            "cpu_time_note": "sum of the sweeps' wall times, each sweep on one thread",
-            "softbend_versions": sorted(set(table["softbend_version"])),
-            "options_sha256": sorted(set(table["options_sha256"]) - {""}),
-            "options": [json.loads(o) for o in sorted(options)],
-            "campaign_runs": runs,
-            "first_design_at": str(table["finished_at"].min()),
-            "last_design_at": str(table["finished_at"].max()),
-            "written_at": datetime.now(UTC).isoformat(timespec="seconds"),
-            "written_by": f"softbend {__version__}",
-            "files": files,
-        }
-        write_text_atomic(stage / PROVENANCE_FILE, json_text(provenance) + "\n")
-    return provenance
-
-
-def _stats_record(text: str, db_path: str | os.PathLike[str]) -> dict[str, Any]:
-    """One design's stored solver statistics (JSON object text), checked."""
-    try:
-        record = json.loads(text)
-    except (ValueError, RecursionError):
-        record = None
-    if not isinstance(record, dict):
-        raise DatasetError(
-            f"The campaign database {db_path} holds a design whose solver statistics are "
-            "not a JSON object; the database is damaged."
-        )
-    return record

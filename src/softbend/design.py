@@ -8,6 +8,9 @@ thickness ``b`` carrying the strain-limiting layer, double-helix fibers wound at
 
 ``DesignSpace.table1()`` is paper B Table 1 (972 designs); ``DesignSpace.sample``
 draws space-filling designs (Latin hypercube or Sobol) over the same ranges.
+:class:`FamilyDesign` holds a design of another FEM actuator family (the
+PneuNet) as named values; its family checks them
+(:mod:`softbend.fem.families`).
 """
 
 from __future__ import annotations
@@ -16,7 +19,7 @@ import hashlib
 import itertools
 import math
 from collections.abc import Iterator, Mapping, Sequence
-from dataclasses import asdict, dataclass
+from dataclasses import asdict, dataclass, field
 from typing import Literal
 
 import numpy as np
@@ -330,3 +333,50 @@ class DesignSpace:
 TABLE1_LEVELS: dict[str, tuple[float, ...]] = {
     name: DESIGN_SPACE[name].value for name in PARAMETERS
 }
+
+
+@dataclass(frozen=True)
+class FamilyDesign:
+    """One design of a FEM family other than paper B's: named values, in the family's order.
+
+    Parameters
+    ----------
+    family : str
+        The family's registry name (``"pneunet"``).
+    values : mapping of str to float
+        Every design parameter of the family, in its units (see the family's
+        :attr:`FEMFamily.actuator`). Check values with :meth:`FEMFamily.design`,
+        which builds designs; this class only holds them.
+    """
+
+    family: str
+    values: Mapping[str, float] = field(default_factory=dict)
+
+    def __post_init__(self) -> None:
+        object.__setattr__(self, "values", {k: float(v) for k, v in dict(self.values).items()})
+
+    def __hash__(self) -> int:
+        return hash((self.family, tuple(self.values.items())))
+
+    def __getattr__(self, name: str) -> float:
+        values = self.__dict__.get("values", {})
+        if name in values:
+            return values[name]
+        raise AttributeError(name)
+
+    @property
+    def design_id(self) -> str:
+        """Stable 16-hex-digit identifier: a SHA-1 of the family and its values rounded to 1e-6."""
+        canonical = self.family + ":" + ",".join(f"{k}={v:.6f}" for k, v in self.values.items())
+        return hashlib.sha1(canonical.encode()).hexdigest()[:16]
+
+    def as_dict(self) -> dict[str, float]:
+        """Parameters as an ordered ``{name: value}`` mapping."""
+        return dict(self.values)
+
+    def as_array(self) -> np.ndarray:
+        """Parameters as a float array in the family's order."""
+        return np.array(list(self.values.values()), dtype=float)
+
+    def __str__(self) -> str:
+        return ", ".join(f"{k}={v:g}" for k, v in self.values.items())

@@ -34,7 +34,7 @@ from softbend.design import SFRBADesign
 from softbend.errors import InputError
 
 if TYPE_CHECKING:
-    from softbend.fem.families import FamilyDesign
+    from softbend.design import FamilyDesign
 
 __all__ = [
     "DEFAULT_PMAX_MPA",
@@ -153,7 +153,7 @@ class SweepResult:
     ----------
     design : SFRBADesign or FamilyDesign
         The design swept (paper B's actuator, or a design of another FEM
-        family, :class:`softbend.fem.families.FamilyDesign`).
+        family, :class:`softbend.design.FamilyDesign`).
     pressure_mpa : array_like
         Gauge pressures applied, MPa, strictly increasing.
     angle_deg : array_like
@@ -193,7 +193,7 @@ class SweepResult:
     stats: dict[str, Any] = field(default_factory=dict)
 
     def __post_init__(self) -> None:
-        from softbend.fem.families import FamilyDesign
+        from softbend.design import FamilyDesign
 
         if not isinstance(self.design, SFRBADesign | FamilyDesign):
             raise InputError(must_be("an SFRBADesign or a FamilyDesign", self.design), key="design")

@@ -49,7 +49,7 @@ _EXPORTS = {
     "parse_scheduler_address": "runner",
     "run_campaign": "runner",
     "FamilyBackend": "families",
-    "campaign_actuator": "families",
+    "campaign_actuator": "store",
     "family_backend": "families",
     "FamilySpace": "family_spaces",
     "parse_family_space": "family_spaces",

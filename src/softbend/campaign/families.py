@@ -9,23 +9,19 @@ sweep (:class:`FamilyBackend`), and its database records the family's name and
 actuator description (:class:`FamilySchema`): the ``designs`` table then has the
 family's parameter columns, named and in the units of its
 :class:`~softbend.actuators.Actuator`, and ``softbend train`` reads the
-description back (:func:`campaign_actuator`).
+description back (:func:`softbend.campaign.store.campaign_actuator`).
 """
 
 from __future__ import annotations
 
-import json
-import os
 from dataclasses import dataclass, field
 from typing import TYPE_CHECKING, Any, NamedTuple, TypeAlias
 
-from softbend.design import PARAMETERS, SFRBADesign
-from softbend.fem.families import FamilyDesign
+from softbend.design import PARAMETERS, FamilyDesign, SFRBADesign
 
 if TYPE_CHECKING:
     import numpy as np
 
-    from softbend.actuators import Actuator
     from softbend.fem.families import FEMFamily
     from softbend.fem.options import FEMOptions
     from softbend.models import SweepResult
@@ -35,7 +31,6 @@ __all__ = [
     "CampaignDesign",
     "FamilyBackend",
     "FamilySchema",
-    "campaign_actuator",
     "family_backend",
 ]
 
@@ -119,23 +114,3 @@ def family_backend(
     if material is not None:
         overrides["elastomer"] = material
     return FamilyBackend(family, family.options(**overrides))
-
-
-def campaign_actuator(db: str | os.PathLike[str]) -> Actuator | None:
-    """The actuator of the campaign database ``db``; None for paper B's (no family recorded).
-
-    The description recorded with the family is read back; a database that
-    names a family but no description takes the registered family's.
-    """
-    from softbend.actuators import Actuator
-    from softbend.campaign.store import CampaignStore
-
-    with CampaignStore(db, read_only=True) as store:
-        schema = store.family_schema
-    if schema.name == DEFAULT_FAMILY:
-        return None
-    if schema.actuator is not None:
-        return Actuator.from_dict(json.loads(json.dumps(schema.actuator)))
-    from softbend.fem.families import get_family
-
-    return get_family(schema.name).actuator

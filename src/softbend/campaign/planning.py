@@ -23,9 +23,8 @@ import numpy as np
 from softbend._validation import check_range, must_be
 from softbend.campaign.backends import Backend, get_backend
 from softbend.campaign.families import DEFAULT_FAMILY, CampaignDesign
-from softbend.design import SFRBADesign
+from softbend.design import FamilyDesign, SFRBADesign
 from softbend.errors import InputError
-from softbend.fem.families import FamilyDesign
 
 if TYPE_CHECKING:
     from softbend.campaign.store import CampaignStore

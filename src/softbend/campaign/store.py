@@ -59,18 +59,25 @@ from softbend.campaign.settings import (
     describe_differences,
     settings_differences,
 )
-from softbend.design import SFRBADesign
+from softbend.design import FamilyDesign, SFRBADesign
 from softbend.errors import SchemaError, SoftbendError
-from softbend.fem.families import FamilyDesign
 from softbend.models import SweepResult, check_pressures_mpa
 
 if TYPE_CHECKING:
     import pandas as pd
     from duckdb import DuckDBPyConnection
 
+    from softbend.actuators import Actuator
     from softbend.fem.families import FEMFamily
 
-__all__ = ["SCHEMA_VERSION", "CampaignStore", "load_designs", "load_samples", "merge_campaigns"]
+__all__ = [
+    "SCHEMA_VERSION",
+    "CampaignStore",
+    "campaign_actuator",
+    "load_designs",
+    "load_samples",
+    "merge_campaigns",
+]
 
 logger = logging.getLogger(__name__)
 
@@ -1137,3 +1144,22 @@ def load_designs(db_path: str | os.PathLike[str]) -> pd.DataFrame:
     """Designs table of the campaign database at ``db_path`` (done and failed)."""
     with CampaignStore(db_path, read_only=True) as store:
         return store.load_designs()
+
+
+def campaign_actuator(db: str | os.PathLike[str]) -> Actuator | None:
+    """The actuator of the campaign database ``db``; None for paper B's (no family recorded).
+
+    The description recorded with the family is read back; a database that
+    names a family but no description takes the registered family's.
+    """
+    from softbend.actuators import Actuator
+
+    with CampaignStore(db, read_only=True) as store:
+        schema = store.family_schema
+    if schema.name == DEFAULT_FAMILY:
+        return None
+    if schema.actuator is not None:
+        return Actuator.from_dict(json.loads(json.dumps(schema.actuator)))
+    from softbend.fem.families import get_family
+
+    return get_family(schema.name).actuator

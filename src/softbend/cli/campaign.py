@@ -228,7 +228,8 @@ def dataset(
             --command "softbend campaign run pneunet.duckdb --family pneunet --space lhs:200"
     """
     from softbend.campaign.schema import missing_database
-    from softbend.datasets import DESIGNS_FILE, PROVENANCE_FILE, SAMPLES_FILE, write_dataset
+    from softbend.dataset_writing import write_dataset
+    from softbend.datasets import DESIGNS_FILE, PROVENANCE_FILE, SAMPLES_FILE
 
     if not db.is_file():
         raise missing_database(db)

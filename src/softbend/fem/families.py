@@ -17,18 +17,17 @@ NGSolve (a family's sweep imports it when it runs).
 
 from __future__ import annotations
 
-import hashlib
 import math
 from collections.abc import Callable, Mapping
-from dataclasses import dataclass, field
+from dataclasses import dataclass
 from typing import TYPE_CHECKING, Any
 
 from softbend._validation import must_be
+from softbend.design import FamilyDesign
 from softbend.errors import InputError
 from softbend.registry import Registry
 
 if TYPE_CHECKING:
-    import numpy as np
     from numpy.typing import ArrayLike
 
     from softbend.actuators import Actuator
@@ -42,55 +41,6 @@ __all__ = [
     "get_family",
     "parse_assignments",
 ]
-
-
-@dataclass(frozen=True)
-class FamilyDesign:
-    """One design of a FEM family other than paper B's: named values, in the family's order.
-
-    Parameters
-    ----------
-    family : str
-        The family's registry name (``"pneunet"``).
-    values : mapping of str to float
-        Every design parameter of the family, in its units (see the family's
-        :attr:`FEMFamily.actuator`). Check values with :meth:`FEMFamily.design`,
-        which builds designs; this class only holds them.
-    """
-
-    family: str
-    values: Mapping[str, float] = field(default_factory=dict)
-
-    def __post_init__(self) -> None:
-        object.__setattr__(self, "values", {k: float(v) for k, v in dict(self.values).items()})
-
-    def __hash__(self) -> int:
-        return hash((self.family, tuple(self.values.items())))
-
-    def __getattr__(self, name: str) -> float:
-        values = self.__dict__.get("values", {})
-        if name in values:
-            return values[name]
-        raise AttributeError(name)
-
-    @property
-    def design_id(self) -> str:
-        """Stable 16-hex-digit identifier: a SHA-1 of the family and its values rounded to 1e-6."""
-        canonical = self.family + ":" + ",".join(f"{k}={v:.6f}" for k, v in self.values.items())
-        return hashlib.sha1(canonical.encode()).hexdigest()[:16]
-
-    def as_dict(self) -> dict[str, float]:
-        """Parameters as an ordered ``{name: value}`` mapping."""
-        return dict(self.values)
-
-    def as_array(self) -> np.ndarray:
-        """Parameters as a float array in the family's order."""
-        import numpy as np
-
-        return np.array(list(self.values.values()), dtype=float)
-
-    def __str__(self) -> str:
-        return ", ".join(f"{k}={v:g}" for k, v in self.values.items())
 
 
 @dataclass(frozen=True)
@@ -279,6 +229,40 @@ def _register_paper_b() -> FEMFamily:
 SFRBA_FAMILY: FEMFamily = _register_paper_b()
 
 
-# The built-in families beyond paper B's register themselves on import (pure
-# Python: their sweeps import NGSolve when they run).
-import softbend.fem.pneunet.description  # noqa: E402, F401
+def _pneunet_sweep(
+    design: Any, pressures_mpa: ArrayLike, options: FEMOptions | None = None, **kwargs: Any
+) -> tuple[SweepResult, Any, Any]:
+    from softbend.fem.pneunet.description import pneunet_options
+    from softbend.fem.pneunet.sweep import run_pneunet_sweep
+
+    return run_pneunet_sweep(design, pressures_mpa, options or pneunet_options(), **kwargs)
+
+
+def _pneunet_mesh_check(design: Any, options: FEMOptions) -> None:
+    from softbend.fem.pneunet.geometry import check_pneunet_mesh
+
+    check_pneunet_mesh(design, options.maxh_mm, options.base_cap_mm)
+
+
+def _register_pneunet() -> FEMFamily:
+    from softbend.actuators import PNEUNET
+    from softbend.fem.pneunet import description as pneunet
+
+    family = FEMFamily(
+        name="pneunet",
+        title=PNEUNET.title,
+        actuator=PNEUNET,
+        reference=pneunet.REFERENCE,
+        pmax_mpa=0.05,
+        pstep_mpa=0.001,
+        maxh_mm=pneunet.PNEUNET_MAXH_MM,
+        make_design=pneunet.make_pneunet_design,
+        sweep=_pneunet_sweep,
+        default_options=pneunet.pneunet_options,
+        mesh_check=_pneunet_mesh_check,
+    )
+    return FEM_FAMILIES.register(family.name, family)
+
+
+#: The PneuNet (:mod:`softbend.fem.pneunet`), the second family (``--family pneunet``).
+PNEUNET_FAMILY: FEMFamily = _register_pneunet()

@@ -23,10 +23,9 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
-from softbend.design import SFRBADesign
+from softbend.design import FamilyDesign, SFRBADesign
 from softbend.errors import ConvergenceError, InputError
 from softbend.fem._ngsolve import require_ngsolve
-from softbend.fem.families import FamilyDesign
 from softbend.fem.mechanics import solid_energy, volume_flux
 from softbend.fem.newton import EnergySolver
 from softbend.materials.models import NeoHookean

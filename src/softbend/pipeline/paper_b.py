@@ -154,7 +154,11 @@ def train_campaign_surrogates(
     def on_progress(phase: str, done: int, total: int) -> None:
         if progress is not None:
             progress(f"paper B: surrogates, {phase}", done, total)
-            if families and phase.startswith(f"{families[-1]}: refit on all designs") and done >= total:
+            if (
+                families
+                and phase.startswith(f"{families[-1]}: refit on all designs")
+                and done >= total
+            ):
                 progress(after, 0, 1)
 
     start = time.perf_counter()

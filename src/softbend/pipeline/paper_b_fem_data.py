@@ -101,7 +101,11 @@ def _surrogates(
         def forward(phase: str, done: int, total: int) -> None:
             if progress is not None:
                 progress(f"paper B FEM data: surrogates ({protocol} CV), {phase}", done, total)
-                last = protocol == "grouped" and families and phase.startswith(f"{families[-1]}: refit on all designs")
+                last = (
+                    protocol == "grouped"
+                    and families
+                    and phase.startswith(f"{families[-1]}: refit on all designs")
+                )
                 if last and done >= total:
                     progress(after, 0, 1)
 

@@ -147,8 +147,7 @@ def _load_data(source: Source) -> TrainingData:
         return source
     if isinstance(source, pd.DataFrame):
         return training_data(source)
-    from softbend.campaign.families import campaign_actuator
-    from softbend.campaign.store import load_samples
+    from softbend.campaign.store import campaign_actuator, load_samples
 
     path = Path(os.fspath(source))
     if not path.exists():

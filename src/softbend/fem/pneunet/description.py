@@ -25,7 +25,7 @@ as the side walls (2 mm instead of 4 mm: one outer-wall parameter). Its
 bending curve is to be compared with the fast PneuNet of Mosadegh et al. 2014
 (their bending angle against pressure), read off the figure.
 
-The design space (:data:`PNEUNET` ranges): 3–8 chambers 5–12 mm long,
+The design space (:data:`~softbend.actuators.PNEUNET` ranges): 3–8 chambers 5–12 mm long,
 10–20 mm wide and 8–25 mm tall, expanding walls 0.8–2.5 mm, outer walls
 1.5–3 mm (with 1 mm outer walls the largest corner, eight 25 × 20 × 12 mm
 chambers, stopped converging near 6 kPa at 80° after 270 s of step cutting),
@@ -36,23 +36,20 @@ from __future__ import annotations
 
 from typing import TYPE_CHECKING, Any
 
-from softbend.actuators import ACTUATORS, Actuator, DesignParameter
+from softbend.actuators import PNEUNET
+from softbend.design import FamilyDesign
 from softbend.errors import InputError
-from softbend.fem.families import FEM_FAMILIES, FamilyDesign, FEMFamily
 from softbend.materials.models import NeoHookean, Yeoh
 from softbend.materials.presets import G_PER_CM3_TO_T_PER_MM3, Material
 
 if TYPE_CHECKING:
-    from numpy.typing import ArrayLike
-
     from softbend.fem.options import FEMOptions
-    from softbend.models import SweepResult
 
 __all__ = [
     "ELASTOSIL_M4601",
     "PAPER_LAYER",
     "PNEUNET",
-    "PNEUNET_FAMILY",
+    "PNEUNET_MAXH_MM",
     "REFERENCE",
     "cavity_volume_mm3",
     "length_mm",
@@ -95,79 +92,6 @@ REFERENCE: dict[str, float] = {
     "base_mm": 2.0,
 }
 
-_PARAMETERS = (
-    DesignParameter(
-        "n_chambers", "", 3, 8, kind="integer", description="number of chambers in the row"
-    ),
-    DesignParameter(
-        "chamber_length_mm",
-        "mm",
-        5.0,
-        12.0,
-        resolution=0.1,
-        description="outer length of one chamber along the actuator, walls included",
-    ),
-    DesignParameter(
-        "chamber_width_mm",
-        "mm",
-        10.0,
-        20.0,
-        resolution=0.1,
-        description="outer width of a chamber across the actuator (and of the base)",
-    ),
-    DesignParameter(
-        "chamber_height_mm",
-        "mm",
-        8.0,
-        25.0,
-        resolution=0.1,
-        description="outer height of a chamber above the base",
-    ),
-    DesignParameter(
-        "wall_mm",
-        "mm",
-        0.8,
-        2.5,
-        resolution=0.1,
-        description="thickness of the expanding walls facing the neighbouring chambers",
-    ),
-    DesignParameter(
-        "outer_wall_mm",
-        "mm",
-        1.5,
-        3.0,
-        resolution=0.1,
-        description="thickness of the side walls and the roof of a chamber",
-    ),
-    DesignParameter(
-        "gap_mm", "mm", 1.0, 5.0, resolution=0.1, description="gap between neighbouring chambers"
-    ),
-    DesignParameter(
-        "base_mm",
-        "mm",
-        1.0,
-        4.0,
-        resolution=0.1,
-        description="thickness of the base under the chambers, strain-limiting layer below",
-    ),
-)
-
-#: The PneuNet's description for the learning pipeline (registered as ``"pneunet"``).
-PNEUNET: Actuator = Actuator(
-    name="pneunet",
-    title="PneuNet: a row of inflatable chambers on a strain-limiting layer",
-    parameters=_PARAMETERS,
-    pressure_column="pressure_mpa",
-    pressure_unit="MPa",
-    angle_column="angle_deg",
-    constraints=(
-        "2 * wall_mm < chamber_length_mm",
-        "2 * outer_wall_mm < chamber_width_mm",
-        "outer_wall_mm < chamber_height_mm",
-    ),
-    fem_family="pneunet",
-)
-
 
 def _refuse(name: str, requirement: str, value: float) -> InputError:
     return InputError(f"must be {requirement}; got {value:g}", key=name)
@@ -177,7 +101,7 @@ def make_pneunet_design(values: dict[str, float]) -> FamilyDesign:
     """The checked PneuNet design of ``values`` (every parameter named, in mm).
 
     Only what makes the geometry impossible is refused: a design outside the
-    ranges of :data:`PNEUNET` (the campaign's design space) is still a solid.
+    ranges of :data:`~softbend.actuators.PNEUNET` (the campaign's design space) is still a solid.
 
     Raises
     ------
@@ -269,39 +193,5 @@ def pneunet_options(**overrides: Any) -> FEMOptions:
     return FEMOptions(**values)
 
 
-def _sweep(
-    design: Any, pressures_mpa: ArrayLike, options: FEMOptions | None = None, **kwargs: Any
-) -> tuple[SweepResult, Any, Any]:
-    from softbend.fem.pneunet.sweep import run_pneunet_sweep
-
-    return run_pneunet_sweep(design, pressures_mpa, options or pneunet_options(), **kwargs)
-
-
-def _mesh_check(design: FamilyDesign, options: FEMOptions) -> None:
-    from softbend.fem.pneunet.geometry import check_pneunet_mesh
-
-    check_pneunet_mesh(design, options.maxh_mm, options.base_cap_mm)
-
-
 #: Default largest element size of the PneuNet's mesh, mm.
 PNEUNET_MAXH_MM = 3.0
-
-#: The PneuNet as an FEM family (``--family pneunet``).
-PNEUNET_FAMILY = FEMFamily(
-    name="pneunet",
-    title=PNEUNET.title,
-    actuator=PNEUNET,
-    reference=REFERENCE,
-    pmax_mpa=0.05,
-    pstep_mpa=0.001,
-    maxh_mm=PNEUNET_MAXH_MM,
-    make_design=make_pneunet_design,
-    sweep=_sweep,
-    default_options=pneunet_options,
-    mesh_check=_mesh_check,
-)
-
-if PNEUNET.name not in ACTUATORS:
-    ACTUATORS.register(PNEUNET.name, PNEUNET)
-if PNEUNET_FAMILY.name not in FEM_FAMILIES:
-    FEM_FAMILIES.register(PNEUNET_FAMILY.name, PNEUNET_FAMILY)

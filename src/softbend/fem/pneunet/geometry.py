@@ -25,9 +25,9 @@ from typing import Any
 
 import numpy as np
 
+from softbend.design import FamilyDesign
 from softbend.errors import InputError, SoftbendError
 from softbend.fem._ngsolve import require_ngsolve
-from softbend.fem.families import FamilyDesign
 from softbend.fem.geometry import MAX_ELEMENTS
 from softbend.fem.pneunet.description import cavity_volume_mm3, length_mm
 

@@ -45,10 +45,10 @@ from typing import Any
 
 import numpy as np
 
+from softbend.design import FamilyDesign
 from softbend.fem._ngsolve import require_ngsolve
 from softbend.fem.actuator import Measurement
 from softbend.fem.energy import energy_terms
-from softbend.fem.families import FamilyDesign
 from softbend.fem.newton import EnergySolver
 from softbend.fem.options import FEMOptions
 from softbend.fem.pneunet.geometry import mesh_pneunet

@@ -15,9 +15,9 @@ from collections.abc import Callable
 from numpy.typing import ArrayLike
 
 from softbend._validation import must_be
+from softbend.design import FamilyDesign
 from softbend.errors import InputError
 from softbend.fem._ngsolve import require_ngsolve
-from softbend.fem.families import FamilyDesign
 from softbend.fem.options import FEMOptions
 from softbend.fem.pneunet.model import PneuNetModel
 from softbend.fem.sweep import StepHistory, run_model_sweep
