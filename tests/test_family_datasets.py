@@ -384,3 +384,27 @@ def test_train_takes_a_dataset_folder_or_a_shipped_name(dataset, tmp_path, monke
     argv = ["train", str(dataset), "--out", str(tmp_path / "c"), "--design-columns", "n_cells"]
     assert main(argv) == 2
     assert "is a dataset" in one_error_line(capsys)
+
+
+def test_the_shipped_pneunet_dataset_verifies_and_spans_its_described_space():
+    """data/pneunet: at least 200 swept designs, each inside the PneuNet's ranges and
+    constraints, every sweep from 0 kPa, angles growing with pressure on average."""
+    from softbend.actuators import PNEUNET
+    from softbend.family_datasets import family_dataset_designs, family_dataset_provenance
+
+    provenance = family_dataset_provenance("pneunet")
+    designs = family_dataset_designs("pneunet")
+    samples = family_dataset("pneunet")
+    assert provenance["family"] == "pneunet" and provenance["designs"]["done"] >= 200
+    assert (designs["status"] == "done").sum() >= 200
+    for p in PNEUNET.parameters:
+        assert designs[p.name].between(p.low, p.high).all(), p.name
+    PNEUNET.check_designs(designs[list(PNEUNET.names)].to_numpy())  # the constraints
+    first = samples.groupby("design_id")["pressure_mpa"].min()
+    assert (first == 0.0).all()
+    slopes = samples[samples["converged"]].groupby("design_id")[["pressure_mpa", "angle_deg"]]
+    rising = slopes.apply(
+        lambda g: g["angle_deg"].corr(g["pressure_mpa"]) > 0 if len(g) > 2 else True
+    )
+    assert rising.mean() > 0.95
+    assert set(designs["stop_kind"]) <= {"walls touch", "last pressure", "no convergence"}
