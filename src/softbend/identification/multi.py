@@ -278,7 +278,9 @@ class MultiNARX:
         if rows is not None and index.size > rows:
             keep = np.unique(np.linspace(0, index.size - 1, rows).round().astype(int))
             Phi, target = Phi[keep], target[keep]
-        self.estimators_ = [self._map().fit(Phi, target[:, j]) for j in range(Ys.shape[1])]
+        self.estimators_: list[Any] = [
+            self._map().fit(Phi, target[:, j]) for j in range(Ys.shape[1])
+        ]
         return Phi, target
 
     def _search_tau(self, U: np.ndarray, Y: np.ndarray, Ys: np.ndarray, segments: Any) -> float:

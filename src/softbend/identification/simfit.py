@@ -220,6 +220,7 @@ def _pretrain(trainer: _Trainer, Phi: np.ndarray, target: np.ndarray, steps: int
         Phi, target = Phi[keep], target[keep]
     X = torch.tensor(Phi, dtype=torch.float64)
     T = torch.tensor(target, dtype=torch.float64)
+    assert trainer.hidden is not None  # the neural map has its hidden layer
     optimizer = torch.optim.Adam([*trainer.hidden, trainer.coef, trainer.intercept], lr=0.01)
     for _ in range(steps):
         optimizer.zero_grad()
@@ -301,7 +302,9 @@ def _refine(
     with torch.no_grad():
         best_loss = start_loss = float(trainer.run(monitor))
     best, stale, steps_run = trainer.snapshot(), 0, 0
-    groups = [{"params": [p for p in trainer.params if p is not trainer.theta]}]
+    groups: list[dict[str, Any]] = [
+        {"params": [p for p in trainer.params if p is not trainer.theta]}
+    ]
     if trainer.theta is not None:  # a time constant moves by samples, not by fractions
         groups.append({"params": [trainer.theta], "lr": _TAU_LR})
     optimizer = torch.optim.Adam(groups, lr=settings["lr"])
