@@ -56,7 +56,8 @@ def test_an_fem_sweep_records_exactly_the_keys_and_types_of_femstats(result):
     _check_typeddict(result.stats, FEMStats, "stats")
     assert set(result.stats["timings"]) == set(FEMTimings.__required_keys__)
     assert "failure" not in result.stats  # only when the sweep stopped on an error
-    assert FEMStats.__optional_keys__ == {"failure"}
+    assert "step_volume_mm3" not in result.stats  # the PneuNet's sweeps record it
+    assert FEMStats.__optional_keys__ == {"failure", "step_volume_mm3"}
 
 
 def test_fem_stats_is_the_same_dictionary_read_by_key(result):

@@ -106,7 +106,7 @@ def train(
 
     TABLE is a softbend campaign (of paper B's actuator or another FEM family),
     a verified dataset (a folder of 'softbend campaign dataset', or the name of
-    one softbend ships: table1_fem, or a family's name), or any actuator's
+    a shipped one: table1_fem, or a family's name such as pneunet), or any actuator's
     simulation table: a CSV or Parquet file whose columns --design-columns,
     --pressure-column (in --pressure-unit) and --angle-column (degrees) name.
     Integer columns stay integer parameters and text columns categorical ones;
