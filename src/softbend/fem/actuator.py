@@ -39,7 +39,7 @@ from softbend.kinematics import fit_arc
 
 require_ngsolve()  # NGSolve after PyTorch, or one line naming softbend[fem]
 
-__all__ = ["ActuatorModel", "Measurement"]
+__all__ = ["ActuatorModel", "Measurement", "ModelState"]
 
 logger = logging.getLogger(__name__)
 
@@ -56,7 +56,146 @@ class Measurement:
         return np.array([self.angle_deg, self.tip_x_mm, self.tip_z_mm])
 
 
-class ActuatorModel:
+class ModelState:
+    """Loads, state and measurements shared by the FEM models of every family.
+
+    A model class that mixes this in sets ``mesh``, ``fes``, ``gfu``, ``pressure``,
+    ``gravity_factor``, ``options``, ``solver``, ``volume_form``, ``_bind``,
+    ``_cavity_area``, ``_weight_n``, the backbone and tip points, the stretch check
+    points and ``region_of``.
+    """
+
+    mesh: Any
+    fes: Any
+    gfu: Any
+    pressure: Any
+    gravity_factor: Any
+    options: FEMOptions
+    solver: EnergySolver
+    volume_form: Any
+    geometry: Any
+    _cavity_area: float
+    _weight_n: float
+    _tip_point: Any
+    _check_points: Any
+    _check_xyz: np.ndarray
+    _deformation: Any
+
+    def _bind(self) -> None:
+        raise NotImplementedError
+
+    def backbone_mm(self) -> np.ndarray:
+        """Deformed backbone in the measurement frame, shape (n, 2): columns x, z."""
+        raise NotImplementedError
+
+    def region_of(self, x_mm: float) -> str:
+        """Name of the part of the actuator at axial position ``x_mm``."""
+        raise NotImplementedError
+
+    def _gravity_vector(self) -> tuple[float, float, float]:
+        g = self.options.gravity_mm_s2
+        return {
+            "bending": (0.0, 0.0, -g),
+            "against": (0.0, 0.0, g),
+            "axial": (g, 0.0, 0.0),
+            "none": (0.0, 0.0, 0.0),
+        }[self.options.gravity]
+
+    @property
+    def ndof(self) -> int:
+        """Free degrees of freedom."""
+        return int(sum(self.fes.FreeDofs()))
+
+    @property
+    def n_elements(self) -> int:
+        """Tetrahedra of the half model."""
+        return int(self.mesh.ne)
+
+    def set_load(self, pressure_mpa: float, gravity_factor: float = 1.0) -> None:
+        """Set the cavity pressure (MPa) and the fraction of gravity applied."""
+        self.pressure.Set(float(pressure_mpa))
+        self.gravity_factor.Set(float(gravity_factor))
+        self._bind()
+
+    def force_scale_n(self, pressure_mpa: float) -> float:
+        """Load size for the Newton tolerance: pressure resultant on the half cavity + weight, N."""
+        return abs(pressure_mpa) * self._cavity_area + self._weight_n
+
+    def state(self) -> np.ndarray:
+        """A copy of the displacement vector."""
+        return np.array(self.gfu.vec.FV().NumPy(), copy=True)
+
+    def set_state(self, values: np.ndarray) -> None:
+        """Overwrite the displacement vector."""
+        self.gfu.vec.FV().NumPy()[:] = values
+
+    def pressure_tangent(self, *, refactorize: bool = True) -> np.ndarray:
+        """``du/dp`` at the current (converged) state, mm/MPa.
+
+        From ``K du/dp = −∂r/∂p`` with ``∂r/∂p = −∂V/∂u`` (the load is ``−p·V``).
+        With ``refactorize=False`` the Hessian factorised by the last Newton
+        iteration is used (one Newton update away from the converged state,
+        where the residual was already small), which saves a factorisation.
+        """
+        rhs = self.gfu.vec.CreateVector()
+        self.volume_form.Apply(self.gfu.vec, rhs)  # ∂(−V)/∂u = ∂r/∂p
+        out = self.gfu.vec.CreateVector()
+        if refactorize or not self.solver.has_factorization:
+            self.solver.factorize()
+        self.solver.solve_tangent(rhs, out)
+        return -np.array(out.FV().NumPy(), copy=True)
+
+    def cavity_volume_rate(self, tangent: np.ndarray) -> float:
+        """``dV/dp`` of the whole cavity along ``tangent = du/dp``, mm³/MPa."""
+        gradient = self.gfu.vec.CreateVector()
+        self.volume_form.Apply(self.gfu.vec, gradient)  # ∂(−V_half)/∂u
+        free = self.solver.free_mask
+        return -2.0 * float(np.dot(gradient.FV().NumPy()[free], tangent[free]))
+
+    def cavity_volume_mm3(self) -> float:
+        """Deformed volume of the whole cavity (both halves), mm³."""
+        return -2.0 * float(self.volume_form.Energy(self.gfu.vec))
+
+    def measure(self) -> Measurement:
+        """Bending angle (arc fit of the backbone, degrees) and tip position (mm)."""
+        fit = fit_arc(self.backbone_mm())
+        tip = self.gfu(self._tip_point)
+        return Measurement(
+            angle_deg=float(fit.angle_deg),
+            tip_x_mm=float(self.geometry.length_mm + tip[0]),
+            tip_z_mm=float(-tip[2]),
+        )
+
+    def max_stretch(self) -> tuple[float, np.ndarray]:
+        """Largest principal stretch in the elastomer and where it is (undeformed x, y, z mm).
+
+        Checked at the centroid of every tetrahedron, so the singular peak at a
+        sharp inner corner (where the chamber meets a cap) is not what counts:
+        the value follows the deformation of whole elements.
+        """
+        F = np.asarray(self._deformation(self._check_points)).reshape(-1, 3, 3)
+        C = np.einsum("nki,nkj->nij", F, F)
+        largest = np.linalg.eigvalsh(C)[:, -1]
+        k = int(np.argmax(largest))
+        return float(math.sqrt(largest[k])), self._check_xyz[k].copy()
+
+    def stretch_site(self) -> tuple[float, str]:
+        """Largest principal stretch and where it is, e.g. ``"distal cap at x = 104 mm"``."""
+        stretch, where = self.max_stretch()
+        return stretch, f"{self.region_of(float(where[0]))} at x = {where[0]:.0f} mm"
+
+    def measure_derivative(self, tangent: np.ndarray, step_mpa: float = 1e-5) -> np.ndarray:
+        """``d(angle, tip x, tip z)/dp`` along ``tangent = du/dp`` by central differences."""
+        base = self.state()
+        self.set_state(base + step_mpa * tangent)
+        plus = self.measure().as_array()
+        self.set_state(base - step_mpa * tangent)
+        minus = self.measure().as_array()
+        self.set_state(base)
+        return (plus - minus) / (2.0 * step_mpa)
+
+
+class ActuatorModel(ModelState):
     """Mesh, energy and state of the FEM model of ``design``.
 
     Parameters
@@ -95,7 +234,8 @@ class ActuatorModel:
             load_factor=self.gravity_factor,
             prepare=self._bind,
         )
-        self._backbone_x = np.linspace(*self.geometry.chamber_mm, options.backbone_points)
+        start, end = self.geometry.chamber_mm
+        self._backbone_x = np.linspace(start, end, options.backbone_points)
         self._backbone_points = [self.mesh(float(x), 0.0, 0.0) for x in self._backbone_x]
         self._tip_point = self.mesh(self.geometry.length_mm, 0.0, 0.0)
         self._cavity_area = ngs.Integrate(
@@ -124,15 +264,6 @@ class ActuatorModel:
         return helix_stiffness_n_per_mm(
             self.options.fiber_model.e_mpa, self.options.fiber_radius_mm, self.fiber_spacing_mm()
         )
-
-    def _gravity_vector(self) -> tuple[float, float, float]:
-        g = self.options.gravity_mm_s2
-        return {
-            "bending": (0.0, 0.0, -g),
-            "against": (0.0, 0.0, g),
-            "axial": (g, 0.0, 0.0),
-            "none": (0.0, 0.0, 0.0),
-        }[self.options.gravity]
 
     def _layer_and_fiber_mass_per_area(self) -> tuple[float, float]:
         o = self.options
@@ -190,61 +321,6 @@ class ActuatorModel:
         self.terms.bind(self.pressure.Get(), self.design.phi_deg, self._fiber_stiffness)
 
     # -- loads and state -----------------------------------------------------------------
-    @property
-    def ndof(self) -> int:
-        """Free degrees of freedom."""
-        return int(sum(self.fes.FreeDofs()))
-
-    @property
-    def n_elements(self) -> int:
-        """Tetrahedra of the half model."""
-        return int(self.mesh.ne)
-
-    def set_load(self, pressure_mpa: float, gravity_factor: float = 1.0) -> None:
-        """Set the cavity pressure (MPa) and the fraction of gravity applied."""
-        self.pressure.Set(float(pressure_mpa))
-        self.gravity_factor.Set(float(gravity_factor))
-        self._bind()
-
-    def force_scale_n(self, pressure_mpa: float) -> float:
-        """Load size for the Newton tolerance: pressure resultant on the half cavity + weight, N."""
-        return abs(pressure_mpa) * self._cavity_area + self._weight_n
-
-    def state(self) -> np.ndarray:
-        """A copy of the displacement vector."""
-        return np.array(self.gfu.vec.FV().NumPy(), copy=True)
-
-    def set_state(self, values: np.ndarray) -> None:
-        """Overwrite the displacement vector."""
-        self.gfu.vec.FV().NumPy()[:] = values
-
-    def pressure_tangent(self, *, refactorize: bool = True) -> np.ndarray:
-        """``du/dp`` at the current (converged) state, mm/MPa.
-
-        From ``K du/dp = −∂r/∂p`` with ``∂r/∂p = −∂V/∂u`` (the load is ``−p·V``).
-        With ``refactorize=False`` the Hessian factorised by the last Newton
-        iteration is used (one Newton update away from the converged state,
-        where the residual was already small), which saves a factorisation.
-        """
-        rhs = self.gfu.vec.CreateVector()
-        self.volume_form.Apply(self.gfu.vec, rhs)  # ∂(−V)/∂u = ∂r/∂p
-        out = self.gfu.vec.CreateVector()
-        if refactorize or not self.solver.has_factorization:
-            self.solver.factorize()
-        self.solver.solve_tangent(rhs, out)
-        return -np.array(out.FV().NumPy(), copy=True)
-
-    def cavity_volume_rate(self, tangent: np.ndarray) -> float:
-        """``dV/dp`` of the whole cavity along ``tangent = du/dp``, mm³/MPa."""
-        gradient = self.gfu.vec.CreateVector()
-        self.volume_form.Apply(self.gfu.vec, gradient)  # ∂(−V_half)/∂u
-        free = self.solver.free_mask
-        return -2.0 * float(np.dot(gradient.FV().NumPy()[free], tangent[free]))
-
-    def cavity_volume_mm3(self) -> float:
-        """Deformed volume of the whole cavity (both halves), mm³."""
-        return -2.0 * float(self.volume_form.Energy(self.gfu.vec))
-
     # -- measurements --------------------------------------------------------------------
     def backbone_mm(self) -> np.ndarray:
         """Deformed backbone in the measurement frame, shape (n, 2): columns x, z."""
@@ -252,34 +328,6 @@ class ActuatorModel:
         x = self._backbone_x + values[:, 0]
         z = -values[:, 2]
         return np.column_stack([x, z])
-
-    def measure(self) -> Measurement:
-        """Bending angle (arc fit of the backbone, degrees) and tip position (mm)."""
-        fit = fit_arc(self.backbone_mm())
-        tip = self.gfu(self._tip_point)
-        return Measurement(
-            angle_deg=float(fit.angle_deg),
-            tip_x_mm=float(self.geometry.length_mm + tip[0]),
-            tip_z_mm=float(-tip[2]),
-        )
-
-    def max_stretch(self) -> tuple[float, np.ndarray]:
-        """Largest principal stretch in the elastomer and where it is (undeformed x, y, z mm).
-
-        Checked at the centroid of every tetrahedron, so the singular peak at a
-        sharp inner corner (where the chamber meets a cap) is not what counts:
-        the value follows the deformation of whole elements.
-        """
-        F = np.asarray(self._deformation(self._check_points)).reshape(-1, 3, 3)
-        C = np.einsum("nki,nkj->nij", F, F)
-        largest = np.linalg.eigvalsh(C)[:, -1]
-        k = int(np.argmax(largest))
-        return float(math.sqrt(largest[k])), self._check_xyz[k].copy()
-
-    def stretch_site(self) -> tuple[float, str]:
-        """Largest principal stretch and where it is, e.g. ``"distal cap at x = 104 mm"``."""
-        stretch, where = self.max_stretch()
-        return stretch, f"{self.region_of(float(where[0]))} at x = {where[0]:.0f} mm"
 
     def region_of(self, x_mm: float) -> str:
         """Name of the part of the actuator at axial position ``x_mm``."""
@@ -289,13 +337,3 @@ class ActuatorModel:
         if x_mm > end:
             return "distal cap"
         return "chamber wall"
-
-    def measure_derivative(self, tangent: np.ndarray, step_mpa: float = 1e-5) -> np.ndarray:
-        """``d(angle, tip x, tip z)/dp`` along ``tangent = du/dp`` by central differences."""
-        base = self.state()
-        self.set_state(base + step_mpa * tangent)
-        plus = self.measure().as_array()
-        self.set_state(base - step_mpa * tangent)
-        minus = self.measure().as_array()
-        self.set_state(base)
-        return (plus - minus) / (2.0 * step_mpa)

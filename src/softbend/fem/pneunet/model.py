@@ -47,12 +47,11 @@ import numpy as np
 
 from softbend.design import FamilyDesign
 from softbend.fem._ngsolve import require_ngsolve
-from softbend.fem.actuator import Measurement
+from softbend.fem.actuator import ModelState
 from softbend.fem.energy import energy_terms
 from softbend.fem.newton import EnergySolver
 from softbend.fem.options import FEMOptions
 from softbend.fem.pneunet.geometry import mesh_pneunet
-from softbend.kinematics import fit_arc
 
 require_ngsolve()  # NGSolve after PyTorch, or one line naming softbend[fem]
 
@@ -61,7 +60,7 @@ __all__ = ["PneuNetModel"]
 logger = logging.getLogger(__name__)
 
 
-class PneuNetModel:
+class PneuNetModel(ModelState):
     """Mesh, energy and state of the FEM model of a PneuNet design.
 
     Parameters
@@ -131,15 +130,6 @@ class PneuNetModel:
         return self.mesh(xyz[:, 0], xyz[:, 1], xyz[:, 2])
 
     # -- energy --------------------------------------------------------------------------
-    def _gravity_vector(self) -> tuple[float, float, float]:
-        g = self.options.gravity_mm_s2
-        return {
-            "bending": (0.0, 0.0, -g),
-            "against": (0.0, 0.0, g),
-            "axial": (g, 0.0, 0.0),
-            "none": (0.0, 0.0, 0.0),
-        }[self.options.gravity]
-
     def _total_weight_n(self) -> float:
         o = self.options
         mass = o.elastomer.density_t_per_mm3 * self.geometry.half_volume_mm3
@@ -174,93 +164,11 @@ class PneuNetModel:
         self.terms.bind(self.pressure.Get(), 0.0, 0.0)
 
     # -- loads and state -----------------------------------------------------------------
-    @property
-    def ndof(self) -> int:
-        """Free degrees of freedom."""
-        return int(sum(self.fes.FreeDofs()))
-
-    @property
-    def n_elements(self) -> int:
-        """Tetrahedra of the half model."""
-        return int(self.mesh.ne)
-
-    def set_load(self, pressure_mpa: float, gravity_factor: float = 1.0) -> None:
-        """Set the cavity pressure (MPa) and the fraction of gravity applied."""
-        self.pressure.Set(float(pressure_mpa))
-        self.gravity_factor.Set(float(gravity_factor))
-        self._bind()
-
-    def force_scale_n(self, pressure_mpa: float) -> float:
-        """Load size for the Newton tolerance: pressure on the half cavities + weight, N."""
-        return abs(pressure_mpa) * self._cavity_area + self._weight_n
-
-    def state(self) -> np.ndarray:
-        """A copy of the displacement vector."""
-        return np.array(self.gfu.vec.FV().NumPy(), copy=True)
-
-    def set_state(self, values: np.ndarray) -> None:
-        """Overwrite the displacement vector."""
-        self.gfu.vec.FV().NumPy()[:] = values
-
-    def pressure_tangent(self, *, refactorize: bool = True) -> np.ndarray:
-        """``du/dp`` at the current (converged) state, mm/MPa (as the actuator model's)."""
-        rhs = self.gfu.vec.CreateVector()
-        self.volume_form.Apply(self.gfu.vec, rhs)
-        out = self.gfu.vec.CreateVector()
-        if refactorize or not self.solver.has_factorization:
-            self.solver.factorize()
-        self.solver.solve_tangent(rhs, out)
-        return -np.array(out.FV().NumPy(), copy=True)
-
-    def cavity_volume_rate(self, tangent: np.ndarray) -> float:
-        """``dV/dp`` of all the cavities (both halves) along ``tangent = du/dp``, mm³/MPa."""
-        gradient = self.gfu.vec.CreateVector()
-        self.volume_form.Apply(self.gfu.vec, gradient)
-        free = self.solver.free_mask
-        return -2.0 * float(np.dot(gradient.FV().NumPy()[free], tangent[free]))
-
-    def cavity_volume_mm3(self) -> float:
-        """Deformed volume of all the cavities (both halves), mm³."""
-        return -2.0 * float(self.volume_form.Energy(self.gfu.vec))
-
     # -- measurements --------------------------------------------------------------------
     def backbone_mm(self) -> np.ndarray:
         """Deformed strain-limiting layer on the symmetry plane, shape (n, 2): columns x, z."""
         values = np.asarray(self.gfu(self._backbone_points))
         return np.column_stack([self._backbone_x + values[:, 0], -values[:, 2]])
-
-    def measure(self) -> Measurement:
-        """Bending angle (arc fit of the backbone, degrees) and tip position (mm)."""
-        fit = fit_arc(self.backbone_mm())
-        tip = self.gfu(self._tip_point)
-        return Measurement(
-            angle_deg=float(fit.angle_deg),
-            tip_x_mm=float(self.geometry.length_mm + tip[0]),
-            tip_z_mm=float(-tip[2]),
-        )
-
-    def measure_derivative(self, tangent: np.ndarray, step_mpa: float = 1e-5) -> np.ndarray:
-        """``d(angle, tip x, tip z)/dp`` along ``tangent = du/dp`` by central differences."""
-        base = self.state()
-        self.set_state(base + step_mpa * tangent)
-        plus = self.measure().as_array()
-        self.set_state(base - step_mpa * tangent)
-        minus = self.measure().as_array()
-        self.set_state(base)
-        return (plus - minus) / (2.0 * step_mpa)
-
-    def max_stretch(self) -> tuple[float, np.ndarray]:
-        """Largest principal stretch at the element centroids and where it is (x, y, z mm)."""
-        F = np.asarray(self._deformation(self._check_points)).reshape(-1, 3, 3)
-        C = np.einsum("nki,nkj->nij", F, F)
-        largest = np.linalg.eigvalsh(C)[:, -1]
-        k = int(np.argmax(largest))
-        return float(math.sqrt(largest[k])), self._check_xyz[k].copy()
-
-    def stretch_site(self) -> tuple[float, str]:
-        """Largest principal stretch and where it is, e.g. ``"chamber 3 at x = 24 mm"``."""
-        stretch, where = self.max_stretch()
-        return stretch, f"{self.region_of(float(where[0]))} at x = {where[0]:.0f} mm"
 
     def region_of(self, x_mm: float) -> str:
         """Name of the part of the PneuNet at axial position ``x_mm``."""
