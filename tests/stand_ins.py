@@ -2,12 +2,21 @@
 
 from __future__ import annotations
 
+from collections.abc import Callable, Iterator, Mapping
+from collections.abc import Set as AbstractSet
+from contextlib import contextmanager
+from dataclasses import dataclass
 from pathlib import Path
+from typing import Any
 
 import numpy as np
 import pandas as pd
 
-from softbend.design import DesignSpace
+from softbend.actuators import Actuator, DesignParameter
+from softbend.design import DesignSpace, FamilyDesign
+from softbend.errors import ConvergenceError, InputError
+from softbend.fem.families import FEM_FAMILIES, FEMFamily
+from softbend.models import SweepResult
 
 
 def small_space() -> DesignSpace:
@@ -111,3 +120,189 @@ def actuator_table(designs: int = 24, seed: int = 0) -> pd.DataFrame:
                 }
             )
     return pd.DataFrame(rows)
+
+
+# --- a stand-in FEM family: a closed-form sweep behind softbend.fem.families ----------------
+
+
+#: The design parameters of a stand-in family of cells: a count and two lengths (mm).
+CELL_PARAMETERS = (
+    DesignParameter("n_cells", "", 2, 5, kind="integer"),
+    DesignParameter("width_mm", "mm", 1.0, 3.0, resolution=0.1),
+    DesignParameter("height_mm", "mm", 2.0, 6.0, resolution=0.5),
+)
+#: Its constraint between the two lengths, and its reference design.
+CELL_CONSTRAINTS = ("width_mm < height_mm - 0.5",)
+CELL_REFERENCE = {"n_cells": 3, "width_mm": 2.0, "height_mm": 4.0}
+
+
+@dataclass(frozen=True)
+class StandInDesigns:
+    """A stand-in family's ``make_design``: designs with 5 cells cap one value.
+
+    ``cap = (name, limit)`` refuses a design with ``n_cells == 5`` and
+    ``values[name] > limit + slack`` (mm), as a family refuses walls too thick
+    for its chambers; ``cap`` None accepts every design.
+    """
+
+    family: str
+    cap: tuple[str, float] | None = None
+    slack: float = 0.0
+
+    def __call__(self, values: dict[str, float]) -> FamilyDesign:
+        if self.cap is not None:
+            name, limit = self.cap
+            if values["n_cells"] == 5 and values[name] > limit + self.slack:
+                raise InputError(f"must be at most {limit:g} mm with 5 cells", key=name)
+        return FamilyDesign(self.family, values)
+
+
+@dataclass(frozen=True)
+class ClosedFormSweep:
+    """A stand-in family's sweep: ``angle = k_deg_per_mpa · p · (sum of the design's values)``.
+
+    Parameters
+    ----------
+    k_deg_per_mpa : float
+        The closed form's factor, degrees per MPa per unit of the summed values.
+    touch_mpa : callable, optional
+        ``touch_mpa(values[touch_parameter])``: the pressure, MPa, where
+        neighbouring walls touch; the sweep keeps the pressures up to it and
+        records the stop ``"neighbouring walls touch at X kPa"`` when it falls
+        before the last pressure (``"reached the last pressure"`` otherwise).
+        A function of an importable module, so the sweep pickles to workers.
+    touch_parameter : str
+        The design value ``touch_mpa`` takes.
+    stop_reasons : mapping of int to str, optional
+        The recorded stop reason of a design with each number of cells.
+    failing : set of str
+        Design ids whose sweep raises ConvergenceError (a solver that does not converge).
+    solver_record : bool
+        Record what a solver would: tip at x = 40 mm and z = -p, 2 Newton
+        iterations a step, 0.5 s, a mesh of 7 elements, and the stats of every
+        load step, one rejected step, 300 degrees of freedom and an options
+        hash; False records zeros, 1 iteration, 0 s and a mesh of 1.
+    """
+
+    k_deg_per_mpa: float
+    touch_mpa: Callable[[float], float] | None = None
+    touch_parameter: str = "width_mm"
+    stop_reasons: Mapping[int, str] | None = None
+    failing: AbstractSet[str] = frozenset()
+    solver_record: bool = False
+
+    def __call__(
+        self, design, pressures_mpa, options=None, *, progress=None, keep_states=False
+    ) -> tuple[SweepResult, None, None]:
+        if design.design_id in self.failing:
+            raise ConvergenceError("stand-in does not converge", pressure_mpa=0.0)
+        p = np.asarray(pressures_mpa, dtype=float)
+        stats: dict = {}
+        if self.touch_mpa is not None:
+            touch = self.touch_mpa(design.values[self.touch_parameter])
+            p = p[p <= touch]
+            stats["stop_reason"] = (
+                f"neighbouring walls touch at {touch * 1000:.2f} kPa"
+                if touch < float(np.max(pressures_mpa))
+                else "reached the last pressure"
+            )
+        if self.stop_reasons is not None:
+            stats["stop_reason"] = self.stop_reasons[round(design.values["n_cells"])]
+        angle = self.k_deg_per_mpa * p * sum(design.values.values())
+        if self.solver_record:
+            stats.update(steps_mpa=p.tolist(), rejected_steps=1, ndof=300, options_sha256="ab" * 32)
+            record = dict(
+                tip_x_mm=np.full_like(p, 40.0),
+                tip_z_mm=-p,
+                newton_iterations=np.full(len(p), 2),
+                wall_time_s=0.5,
+                mesh_size=7,
+            )
+        else:
+            record = dict(
+                tip_x_mm=np.zeros_like(p),
+                tip_z_mm=np.zeros_like(p),
+                newton_iterations=np.ones(len(p), dtype=int),
+                wall_time_s=0.0,
+                mesh_size=1,
+            )
+        result = SweepResult(
+            design=design,
+            pressure_mpa=p,
+            angle_deg=angle,
+            converged=np.ones(len(p), dtype=bool),
+            stats=stats,
+            **record,
+        )
+        return result, None, None
+
+
+def stand_in_family(
+    name: str,
+    parameters: tuple[DesignParameter, ...],
+    k_deg_per_mpa: float,
+    *,
+    title: str = "stand-in actuator with a closed-form sweep",
+    actuator_title: str = "stand-in actuator",
+    reference: Mapping[str, float],
+    pmax_mpa: float,
+    pstep_mpa: float,
+    maxh_mm: float = 2.0,
+    cap: tuple[str, float] | None = None,
+    cap_slack: float = 0.0,
+    touch_mpa: Callable[[float], float] | None = None,
+    stop_reasons: Mapping[int, str] | None = None,
+    failing: AbstractSet[str] = frozenset(),
+    solver_record: bool = False,
+    **actuator: Any,
+) -> FEMFamily:
+    """An FEM family ``name`` whose sweep is :class:`ClosedFormSweep` (no NGSolve).
+
+    Parameters
+    ----------
+    name : str
+        The family's name, also its actuator's and its designs' family.
+    parameters : tuple of DesignParameter
+        The actuator's design parameters (one of them ``n_cells``).
+    k_deg_per_mpa : float
+        The closed form's factor, degrees per MPa (see :class:`ClosedFormSweep`).
+    title, reference, pmax_mpa, pstep_mpa, maxh_mm
+        As :class:`~softbend.fem.families.FEMFamily` (MPa, mm).
+    actuator_title : str
+        The title of the family's :class:`~softbend.actuators.Actuator`.
+    cap, cap_slack
+        The design a family refuses (see :class:`StandInDesigns`), mm.
+    touch_mpa, stop_reasons, failing, solver_record
+        As :class:`ClosedFormSweep`.
+    **actuator
+        Further fields of the actuator (``constraints``, ``pressure_unit``, ...).
+    """
+    return FEMFamily(
+        name=name,
+        title=title,
+        actuator=Actuator(
+            name=name, title=actuator_title, parameters=parameters, fem_family=name, **actuator
+        ),
+        reference=reference,
+        pmax_mpa=pmax_mpa,
+        pstep_mpa=pstep_mpa,
+        maxh_mm=maxh_mm,
+        make_design=StandInDesigns(name, cap, cap_slack),
+        sweep=ClosedFormSweep(
+            k_deg_per_mpa,
+            touch_mpa=touch_mpa,
+            stop_reasons=stop_reasons,
+            failing=failing,
+            solver_record=solver_record,
+        ),
+    )
+
+
+@contextmanager
+def registered_family(family: FEMFamily) -> Iterator[FEMFamily]:
+    """``family`` registered in ``FEM_FAMILIES`` (replacing one of its name), removed after."""
+    FEM_FAMILIES.register(family.name, family, replace=True)
+    try:
+        yield family
+    finally:
+        FEM_FAMILIES.unregister(family.name)

@@ -17,7 +17,6 @@ import numpy as np
 import pandas as pd
 import pytest
 
-from softbend.actuators import Actuator, DesignParameter
 from softbend.campaign import CampaignStore, load_samples, run_campaign
 from softbend.campaign.family_spaces import parse_family_space
 from softbend.cli import main
@@ -32,11 +31,16 @@ from softbend.family_datasets import (
     family_stop_region,
     shipped_families,
 )
-from softbend.fem.families import FEM_FAMILIES, FamilyDesign, FEMFamily
-from softbend.models import SweepResult
 from softbend.surrogates.features import dataset_training_data
 
 from .cli.conftest import one_error_line
+from .stand_ins import (
+    CELL_CONSTRAINTS,
+    CELL_PARAMETERS,
+    CELL_REFERENCE,
+    registered_family,
+    stand_in_family,
+)
 
 K_DEG_PER_MPA = 10.0
 NAMES = ("n_cells", "width_mm", "height_mm")
@@ -51,65 +55,26 @@ KINDS = {2: "last pressure", 3: "walls touch", 4: "stretch limit", 5: "inflation
 REGIONS = {2: "", 3: "", 4: "chamber 2", 5: "chamber 4"}
 
 
-def _make_design(values: dict[str, float]) -> FamilyDesign:
-    return FamilyDesign("standin", values)
-
-
-def _sweep(design, pressures_mpa, options=None, *, progress=None, keep_states=False):
-    p = np.asarray(pressures_mpa, dtype=float)
-    angle = K_DEG_PER_MPA * p * sum(design.values.values())
-    result = SweepResult(
-        design=design,
-        pressure_mpa=p,
-        angle_deg=angle,
-        tip_x_mm=np.full_like(p, 40.0),
-        tip_z_mm=-p,
-        converged=np.ones(len(p), dtype=bool),
-        newton_iterations=np.full(len(p), 2),
-        wall_time_s=0.5,
-        mesh_size=7,
-        stats={
-            "stop_reason": REASONS[round(design.values["n_cells"])],
-            "steps_mpa": p.tolist(),
-            "rejected_steps": 1,
-            "ndof": 300,
-            "options_sha256": "ab" * 32,
-        },
-    )
-    return result, None, None
-
-
-STANDIN = FEMFamily(
-    name="standin",
-    title="stand-in actuator with a closed-form sweep",
-    actuator=Actuator(
-        name="standin",
-        title="stand-in actuator",
-        parameters=(
-            DesignParameter("n_cells", "", 2, 5, kind="integer"),
-            DesignParameter("width_mm", "mm", 1.0, 3.0, resolution=0.1),
-            DesignParameter("height_mm", "mm", 2.0, 6.0, resolution=0.5),
-        ),
-        pressure_column="p_kpa",
-        pressure_unit="kPa",
-        constraints=("width_mm < height_mm - 0.5",),
-        fem_family="standin",
-    ),
-    reference={"n_cells": 3, "width_mm": 2.0, "height_mm": 4.0},
+STANDIN = stand_in_family(
+    "standin",
+    CELL_PARAMETERS,
+    K_DEG_PER_MPA,
+    pressure_column="p_kpa",
+    pressure_unit="kPa",
+    constraints=CELL_CONSTRAINTS,
+    reference=CELL_REFERENCE,
     pmax_mpa=0.04,
     pstep_mpa=0.01,
-    maxh_mm=2.0,
-    make_design=_make_design,
-    sweep=_sweep,
+    stop_reasons=REASONS,
+    solver_record=True,  # 300 dofs, 5 load steps, 1 rejected, a mesh of 7, 0.5 s a sweep
 )
 
 
 @pytest.fixture(autouse=True)
 def standin():
     """The stand-in family, registered for the test and removed after it."""
-    FEM_FAMILIES.register("standin", STANDIN, replace=True)
-    yield STANDIN
-    FEM_FAMILIES.unregister("standin")
+    with registered_family(STANDIN) as family:
+        yield family
 
 
 @pytest.fixture

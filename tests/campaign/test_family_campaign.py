@@ -16,80 +16,48 @@ import numpy as np
 import pandas as pd
 import pytest
 
-from softbend.actuators import Actuator, DesignParameter
 from softbend.campaign import CampaignStore, load_samples, run_campaign
 from softbend.campaign.families import FamilyBackend, family_backend
 from softbend.campaign.family_spaces import parse_family_ranges, parse_family_space
 from softbend.campaign.store import campaign_actuator
 from softbend.cli import main
 from softbend.design import SFRBADesign
-from softbend.errors import ConvergenceError, InputError
-from softbend.fem.families import FEM_FAMILIES, FamilyDesign, FEMFamily
-from softbend.models import SweepResult
+from softbend.errors import InputError
+from softbend.fem.families import FamilyDesign
 
 from ..cli.conftest import one_error_line
+from ..stand_ins import (
+    CELL_CONSTRAINTS,
+    CELL_PARAMETERS,
+    CELL_REFERENCE,
+    registered_family,
+    stand_in_family,
+)
 
 K_DEG_PER_MPA = 10.0
 NAMES = ("n_cells", "width_mm", "height_mm")
 #: Design ids whose stand-in sweep raises (a solver that does not converge).
 FAILING: set[str] = set()
 
-
-def _make_design(values: dict[str, float]) -> FamilyDesign:
-    if values["n_cells"] == 5 and values["height_mm"] > 5.5:
-        raise InputError("must be at most 5.5 mm with 5 cells", key="height_mm")
-    return FamilyDesign("standin", values)
-
-
-def _sweep(design, pressures_mpa, options=None, *, progress=None, keep_states=False):
-    if design.design_id in FAILING:
-        raise ConvergenceError("stand-in does not converge", pressure_mpa=0.0)
-    p = np.asarray(pressures_mpa, dtype=float)
-    angle = K_DEG_PER_MPA * p * sum(design.values.values())
-    result = SweepResult(
-        design=design,
-        pressure_mpa=p,
-        angle_deg=angle,
-        tip_x_mm=np.zeros_like(p),
-        tip_z_mm=np.zeros_like(p),
-        converged=np.ones(len(p), dtype=bool),
-        newton_iterations=np.ones(len(p), dtype=int),
-        wall_time_s=0.0,
-        mesh_size=1,
-    )
-    return result, None, None
-
-
-STANDIN = FEMFamily(
-    name="standin",
-    title="stand-in actuator with a closed-form sweep",
-    actuator=Actuator(
-        name="standin",
-        title="stand-in actuator",
-        parameters=(
-            DesignParameter("n_cells", "", 2, 5, kind="integer"),
-            DesignParameter("width_mm", "mm", 1.0, 3.0, resolution=0.1),
-            DesignParameter("height_mm", "mm", 2.0, 6.0, resolution=0.5),
-        ),
-        constraints=("width_mm < height_mm - 0.5",),
-        fem_family="standin",
-    ),
-    reference={"n_cells": 3, "width_mm": 2.0, "height_mm": 4.0},
+STANDIN = stand_in_family(
+    "standin",
+    CELL_PARAMETERS,
+    K_DEG_PER_MPA,
+    constraints=CELL_CONSTRAINTS,
+    reference=CELL_REFERENCE,
     pmax_mpa=0.04,
     pstep_mpa=0.01,
-    maxh_mm=2.0,
-    make_design=_make_design,
-    sweep=_sweep,
+    cap=("height_mm", 5.5),  # refused: more than 5.5 mm high with 5 cells
+    failing=FAILING,
 )
 
 
 @pytest.fixture(autouse=True)
 def standin():
     """The stand-in family, registered for the test and removed after it."""
-    FEM_FAMILIES.register("standin", STANDIN, replace=True)
     FAILING.clear()
-    yield STANDIN
-    FEM_FAMILIES.unregister("standin")
+    with registered_family(STANDIN) as family:
+        yield family
     FAILING.clear()
 
 

@@ -10,6 +10,7 @@ as a surrogate trained on the swept range does not know where a sweep would stop
 
 from __future__ import annotations
 
+import dataclasses
 import itertools
 import json
 import math
@@ -18,23 +19,20 @@ import numpy as np
 import pandas as pd
 import pytest
 
-from softbend.actuators import Actuator, DesignParameter
+from softbend.actuators import Actuator
 from softbend.cli import main
 from softbend.design_search.search import find_designs
 from softbend.design_search.spec import Specification, Target
 from softbend.design_search.verify import verify_candidates, verify_family, verify_skipped
 from softbend.errors import InputError
-from softbend.fem.families import FEM_FAMILIES, FamilyDesign, FEMFamily
-from softbend.models import SweepResult
+from softbend.fem.families import FEM_FAMILIES
 from softbend.surrogates.persistence import load_surrogate
 
 from ..cli.conftest import one_error_line
+from ..stand_ins import CELL_PARAMETERS, registered_family, stand_in_family
 
 K_DEG_PER_MPA = 1000.0
-PARAMETERS = (
-    DesignParameter("n_cells", "", 2, 5, kind="integer"),
-    DesignParameter("width_mm", "mm", 1.0, 3.0, resolution=0.1),
-)
+PARAMETERS = CELL_PARAMETERS[:2]  # n_cells, width_mm
 
 
 def touch_mpa(width_mm: float) -> float:
@@ -47,47 +45,18 @@ def fem_angle(n: float, width_mm: float, p_mpa: float) -> float:
     return K_DEG_PER_MPA * p_mpa * (n + width_mm)
 
 
-def _make_design(values: dict[str, float]) -> FamilyDesign:
-    if values["n_cells"] == 5 and values["width_mm"] > 2.5 + 1e-9:
-        raise InputError("must be at most 2.5 mm with 5 cells", key="width_mm")
-    return FamilyDesign("touchy", values)
-
-
-def _sweep(design, pressures_mpa, options=None, *, progress=None, keep_states=False):
-    p = np.asarray(pressures_mpa, dtype=float)
-    touch = touch_mpa(design.values["width_mm"])
-    p = p[p <= touch]
-    reason = (
-        f"neighbouring walls touch at {touch * 1000:.2f} kPa"
-        if touch < float(np.max(pressures_mpa))
-        else "reached the last pressure"
-    )
-    angle = K_DEG_PER_MPA * p * (design.values["n_cells"] + design.values["width_mm"])
-    result = SweepResult(
-        design=design,
-        pressure_mpa=p,
-        angle_deg=angle,
-        tip_x_mm=np.zeros_like(p),
-        tip_z_mm=np.zeros_like(p),
-        converged=np.ones(len(p), dtype=bool),
-        newton_iterations=np.ones(len(p), dtype=int),
-        wall_time_s=0.0,
-        mesh_size=1,
-        stats={"stop_reason": reason},
-    )
-    return result, None, None
-
-
-TOUCHY = FEMFamily(
-    name="touchy",
+TOUCHY = stand_in_family(
+    "touchy",
+    PARAMETERS,
+    K_DEG_PER_MPA,
     title="stand-in actuator whose walls touch",
-    actuator=Actuator(name="touchy", title="stand-in", parameters=PARAMETERS, fem_family="touchy"),
+    actuator_title="stand-in",
     reference={"n_cells": 3, "width_mm": 2.0},
     pmax_mpa=0.05,
     pstep_mpa=0.001,
-    maxh_mm=2.0,
-    make_design=_make_design,
-    sweep=_sweep,
+    cap=("width_mm", 2.5),  # refused: wider than 2.5 mm with 5 cells
+    cap_slack=1e-9,
+    touch_mpa=touch_mpa,
 )
 
 
@@ -127,9 +96,8 @@ def _train(folder, actuator: Actuator):
 @pytest.fixture(autouse=True)
 def touchy():
     """The stand-in family, registered for the test and removed after it."""
-    FEM_FAMILIES.register("touchy", TOUCHY, replace=True)
-    yield TOUCHY
-    FEM_FAMILIES.unregister("touchy")
+    with registered_family(TOUCHY) as family:
+        yield family
 
 
 @pytest.fixture(scope="module")
@@ -214,16 +182,11 @@ def test_a_family_no_softbend_simulates_is_one_clear_error(unknown_family_model,
 
 
 def test_a_family_of_other_parameters_is_refused(model):
-    other = FEMFamily(
-        name="touchy",
+    other = dataclasses.replace(
+        TOUCHY,
         title="stand-in with other parameters",
         actuator=Actuator(name="touchy", title="other", parameters=PARAMETERS[::-1]),
         reference={"width_mm": 2.0, "n_cells": 3},
-        pmax_mpa=0.05,
-        pstep_mpa=0.001,
-        maxh_mm=2.0,
-        make_design=_make_design,
-        sweep=_sweep,
     )
     FEM_FAMILIES.register("touchy", other, replace=True)
     space = _spec(model, 80.0, 20.0).space
