@@ -45,7 +45,8 @@ Modelling choices, stated once:
 Modules: :mod:`~softbend.analysis.samples` (default columns, cleaning),
 :mod:`~softbend.analysis.correlation`, :mod:`~softbend.analysis.ols` (z-scored
 least squares and its tests), :mod:`~softbend.analysis.regression` (the report)
-and :mod:`~softbend.analysis.campaign_analysis`. Names are imported lazily, so
+and :mod:`~softbend.analysis.campaign_analysis`; :mod:`~softbend.analysis.effects`
+reads a design space's main effects (group means per parameter). Names are imported lazily, so
 ``import softbend.analysis`` stays light (pandas is loaded by the first name used).
 """
 
@@ -58,6 +59,7 @@ from softbend._lazy import export as _export
 if TYPE_CHECKING:
     from softbend.analysis.campaign_analysis import CampaignAnalysis, analyze_samples
     from softbend.analysis.correlation import correlation_matrix
+    from softbend.analysis.effects import MainEffects, angle_at_pressure, main_effects
     from softbend.analysis.ols import significance_stars
     from softbend.analysis.regression import (
         ConstantFeatureWarning,
@@ -72,6 +74,9 @@ _EXPORTS = {
     "DEFAULT_FEATURES": "softbend.analysis.samples",
     "DEFAULT_TARGET": "softbend.analysis.samples",
     "CampaignAnalysis": "softbend.analysis.campaign_analysis",
+    "MainEffects": "softbend.analysis.effects",
+    "angle_at_pressure": "softbend.analysis.effects",
+    "main_effects": "softbend.analysis.effects",
     "ConstantFeatureWarning": "softbend.analysis.regression",
     "RegressionReport": "softbend.analysis.regression",
     "analyze_samples": "softbend.analysis.campaign_analysis",
@@ -86,9 +91,12 @@ __all__ = [
     "DEFAULT_TARGET",
     "CampaignAnalysis",
     "ConstantFeatureWarning",
+    "MainEffects",
     "RegressionReport",
     "analyze_samples",
+    "angle_at_pressure",
     "correlation_matrix",
+    "main_effects",
     "significance_stars",
     "standardized_regression",
     "thresholded_mape",
