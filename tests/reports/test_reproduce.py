@@ -26,6 +26,9 @@ QUICK_DESIGN = {
     ),
 }
 
+#: The PneuNet section in seconds: the default mesh alone, no FEM check of the design.
+QUICK_PNEUNET = {"mesh_sizes_mm": (3.0,), "verify": 0}
+
 #: Transfer learning in seconds: few epochs, one ensemble pair, no GP restarts.
 QUICK_TRANSFER = {
     "experimental": {"epochs": 50},
@@ -61,6 +64,7 @@ def first_run(tmp_path_factory, fem_dataset):
         transfer_options=QUICK_TRANSFER,
         control_options={"duration_s": 1.5, "refine_epochs": 20},
         design_options=QUICK_DESIGN,
+        pneunet_options=QUICK_PNEUNET,
     )
     return out, summary, phases
 
@@ -93,6 +97,9 @@ def test_report_has_both_papers_and_their_files(first_run):
         "paper_b_fem/fig4b_loadings_fem.png",
         "paper_b_fem/surrogates/fig5_parity_errors.png",
         "paper_b_fem/surrogates/models/mlp.json",
+        "pneunet/reference_curves.png",
+        "pneunet/main_effects.png",
+        "pneunet/design/curves.png",
     ):
         assert (out / name).is_file(), name
         assert name in html or not name.endswith(".png"), name
@@ -172,6 +179,7 @@ def test_second_run_resumes_the_campaign(first_run, fem_dataset):
         transfer_options=QUICK_TRANSFER,
         control_options={"duration_s": 1.5, "refine_epochs": 20},
         design_options=QUICK_DESIGN,
+        pneunet_options=QUICK_PNEUNET,
     )
     b = again["paper_b"]
     assert b["run_now"] == 0 and b["resumed_done"] == 8

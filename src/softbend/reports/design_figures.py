@@ -86,6 +86,10 @@ def front_figure(result: SearchResult, path: str | Path) -> Path:
     return Path(path)
 
 
+#: A design's label longer than this is drawn as its values (names in the legend's title).
+_LABEL_CHARS = 48
+
+
 def curves_figure(
     result: SearchResult, predictor: Predictor, path: str | Path, *, count: int = 5
 ) -> Path:
@@ -102,10 +106,20 @@ def curves_figure(
     p = np.linspace(0.0, top, 121)
     fig = Figure(figsize=(7, 4.5))
     ax = fig.subplots()
-    for i, c in enumerate(result.candidates[:count]):
+    shown = result.candidates[:count]
+    names = list(shown[0].design.as_dict()) if shown else []
+    long = any(len(str(c.design)) > _LABEL_CHARS for c in shown)
+    for i, c in enumerate(shown):
         color = f"C{i}"
         rows = c.design.feature_rows(p)
-        ax.plot(p, predictor.predict(rows), color=color, lw=1.2, label=f"{i + 1}: {c.design}")
+        said = (
+            ", ".join(
+                f"{v:g}" if isinstance(v, float) else str(v) for v in c.design.as_dict().values()
+            )
+            if long
+            else str(c.design)
+        )
+        ax.plot(p, predictor.predict(rows), color=color, lw=1.2, label=f"{i + 1}: {said}")
         if c.fem_curve is not None:
             ax.plot(*c.fem_curve, "o", ms=3, color=color, mfc="none")
     if target.kind == "curve":
@@ -130,7 +144,9 @@ def curves_figure(
     )
     ax.grid(True, alpha=0.3)
     if ax.get_legend_handles_labels()[0]:  # no legend without a label
-        ax.legend(fontsize=7)
+        # a long design is its values, the names once in the legend's title
+        title = "rank: " + ", ".join(names) if long else None
+        ax.legend(fontsize=7, title=title, title_fontsize=6)
     fig.tight_layout()
     fig.savefig(path, dpi=_DPI)
     return Path(path)

@@ -15,6 +15,9 @@ softbend can reproduce, and the data, models and figures beside it:
   mismatched plant (Figs. 8 and 9).
 - ``design/``: three design specifications answered on the shipped FEM surrogate,
   the best design of each swept by the FEM.
+- ``pneunet/``: the second FEM family: the reference PneuNet's θ(p) and V(p), its
+  mesh convergence, the main effects of the shipped PneuNet dataset, and a design
+  search on a surrogate of it, the best design swept by the FEM.
 
 Each section's computation is in :mod:`softbend.pipeline` (one module per
 section, returning its results); this module and the section modules of
@@ -70,6 +73,7 @@ ENTRIES: tuple[str, ...] = (
     "transfer",
     "control",
     "design",
+    "pneunet",
 )
 
 #: The file every finished report folder has (written last).
@@ -172,6 +176,7 @@ def run_reproduce(
     transfer_options: dict[str, dict[str, Any]] | None = None,
     control_options: dict[str, Any] | None = None,
     design_options: dict[str, Any] | None = None,
+    pneunet_options: dict[str, Any] | None = None,
     command: str | None = None,
 ) -> dict[str, Any]:
     """Run every reproducible section and write ``out_dir/index.html``.
@@ -209,6 +214,9 @@ def run_reproduce(
         (:func:`softbend.reports.design_section.add_section`, e.g.
         ``{"backend": "analytical"}`` for a quick run); default: the best design of
         each specification verified by the FEM.
+    pneunet_options : dict, optional
+        Options of the PneuNet section (:func:`softbend.reports.pneunet_section.add_section`,
+        e.g. ``{"mesh_sizes_mm": (3.0,), "verify": 0}`` for a quick run).
     command : str, optional
         The command line that started the run, shown in the report's provenance.
 
@@ -256,6 +264,7 @@ def run_reproduce(
                 transfer_options=transfer_options,
                 control_options=control_options,
                 design_options=design_options,
+                pneunet_options=pneunet_options,
                 command=command,
             )
         except BaseException:
@@ -279,6 +288,7 @@ def _run_into(
     transfer_options: dict[str, dict[str, Any]] | None,
     control_options: dict[str, Any] | None,
     design_options: dict[str, Any] | None,
+    pneunet_options: dict[str, Any] | None,
     command: str | None,
 ) -> dict[str, Any]:
     """Every section of :func:`run_reproduce` written into ``stage``, paths named under ``final``.
@@ -328,6 +338,11 @@ def _run_into(
     summary["design"] = design_section.add_section(
         report, out_dir, progress, **(design_options or {})
     )
+    from softbend.reports import pneunet_section
+
+    summary["pneunet"] = pneunet_section.add_section(
+        report, out_dir, progress, seed=seed, **(pneunet_options or {})
+    )
     from softbend.reports.summary_section import add_summary
 
     reduced = [
@@ -341,6 +356,7 @@ def _run_into(
             ("other transfer settings", transfer_options),
             ("other control settings", control_options),
             ("other design settings", design_options),
+            ("other PneuNet settings", pneunet_options),
         )
         if value is not None
     ]

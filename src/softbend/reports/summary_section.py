@@ -33,6 +33,7 @@ _SECTIONS = {
     "transfer": "Paper B — transfer learning",
     "control": "Paper B — closed-loop control",
     "design": "Design to a specification",
+    "pneunet": "A second actuator: the PneuNet",
 }
 
 
@@ -72,6 +73,10 @@ def _pct(v: float) -> str:
 
 def _deg(v: float) -> str:
     return f"{v:.2f}°"
+
+
+def _kpa(v: float) -> str:
+    return f"{v * 1e3:g} kPa"
 
 
 def _f_value(v: float) -> str:
@@ -186,6 +191,31 @@ def headline_rows(summary: Mapping[str, Any]) -> list[tuple[str, str, str, str]]
                 _number(best_design.get("angle_deg"), _deg) + " / " + _number(fem, _deg),
                 "— (beyond the papers)",
                 "design",
+            )
+        )
+    pneunet = _get(summary, "pneunet") or {}
+    if pneunet:
+        sizes = pneunet.get("mesh_sizes_mm") or []
+        rows.append(
+            (
+                f"PneuNet reference: angle at {_number(pneunet.get('mesh_pressure_mpa'), _kpa)}, "
+                f"change from {sizes[0] if sizes else '?'} mm to "
+                f"{sizes[-1] if sizes else '?'} mm elements",
+                _number(pneunet.get("mesh_change_deg"), _deg),
+                "— (beyond the papers)",
+                "pneunet",
+            )
+        )
+        best_design = pneunet.get("best") or {}
+        rows.append(
+            (
+                f"PneuNet design find, {pneunet.get('target')}: best design's angle, "
+                "surrogate / FEM",
+                _number(best_design.get("angle_deg"), _deg)
+                + " / "
+                + _number(best_design.get("fem_angle_deg"), _deg),
+                "— (beyond the papers)",
+                "pneunet",
             )
         )
     return rows

@@ -22,8 +22,9 @@ of the PneuNet demonstration of GIBBON (Moerman, J. Open Source Softw. 3 (2018)
 height 25, expanding wall 1.2, gap 2.5, side wall 2, base 1 mm plus 1 mm of
 elastomer around the paper (``base_mm`` = 2). One change: the roof is as thick
 as the side walls (2 mm instead of 4 mm: one outer-wall parameter). Its
-bending curve is to be compared with the fast PneuNet of Mosadegh et al. 2014
-(their bending angle against pressure), read off the figure.
+bending curve is not yet set beside a published one: the fast PneuNet of
+Mosadegh et al. 2014 gives its bending angle against pressure as a figure
+only, and softbend ships no values read off it.
 
 The design space (:data:`~softbend.actuators.PNEUNET` ranges): 3–8 chambers 5–12 mm long,
 10–20 mm wide and 8–25 mm tall, expanding walls 0.8–2.5 mm, outer walls

@@ -1,0 +1,253 @@
+"""The PneuNet section: the second FEM family from its reference to a checked design.
+
+:func:`run_pneunet` computes, for the report,
+
+1. the FEM sweep of the reference PneuNet (:data:`softbend.fem.pneunet.description.REFERENCE`):
+   its bending angle and cavity volume at every converged step, to the first touch
+   of neighbouring chamber walls;
+2. the mesh convergence of the reference at :data:`MESH_PRESSURES_MPA` (the
+   largest below its touch on every mesh of :data:`MESH_SIZES_MM`);
+3. the main effects of the shipped PneuNet dataset's design space
+   (:func:`softbend.analysis.main_effects`) on three responses: the angle at
+   :data:`EFFECT_PRESSURE_MPA`, the largest angle before the sweep stopped and
+   the pressure it stopped at;
+4. a design search on a surrogate trained on that dataset (:data:`SPECIFICATION`),
+   its best designs swept by the FEM until one reaches the specified pressure.
+"""
+
+from __future__ import annotations
+
+import time
+from dataclasses import dataclass
+from pathlib import Path
+from typing import TYPE_CHECKING, Any
+
+import numpy as np
+
+from softbend.pipeline import Progress
+
+if TYPE_CHECKING:
+    import pandas as pd
+
+    from softbend.analysis.effects import MainEffects
+    from softbend.design_search.search import LoadedModel, SearchResult
+    from softbend.fem.verification import MeshStudyRow
+    from softbend.models import SweepResult
+
+__all__ = [
+    "EFFECT_PRESSURE_MPA",
+    "MESH_PRESSURES_MPA",
+    "MESH_SIZES_MM",
+    "SPECIFICATION_STEPS",
+    "PneuNetSection",
+    "run_pneunet",
+]
+
+#: Element sizes of the mesh study, mm (3 mm: the family's default).
+MESH_SIZES_MM: tuple[float, ...] = (3.0, 2.5, 2.0)
+#: Pressures of the mesh study, MPa: the reference touches at 6–7 kPa on these meshes.
+MESH_PRESSURES_MPA: tuple[float, ...] = (0.002, 0.004)
+#: Pressure of the main effects' angle, MPa (227 of the 256 shipped designs reach it).
+EFFECT_PRESSURE_MPA = 0.005
+#: The search's target: 30° at 20 kPa.
+TARGET_ANGLE_DEG, TARGET_PRESSURE_MPA = 30.0, 0.02
+#: The search grid's step per parameter (803 520 designs over the dataset's ranges).
+SPECIFICATION_STEPS: dict[str, float] = {
+    "n_chambers": 1.0,
+    "chamber_length_mm": 1.0,
+    "chamber_width_mm": 2.0,
+    "chamber_height_mm": 2.0,
+    "wall_mm": 0.5,
+    "outer_wall_mm": 0.5,
+    "gap_mm": 1.0,
+    "base_mm": 1.0,
+}
+
+
+@dataclass(frozen=True)
+class PneuNetSection:
+    """What :func:`run_pneunet` computed (see the module's list).
+
+    Attributes
+    ----------
+    design : FamilyDesign
+        The reference PneuNet.
+    sweep : SweepResult
+        Its FEM sweep.
+    step_pressure_mpa, step_angle_deg, step_volume_mm3 : ndarray
+        Its converged steps' pressures (MPa), bending angles (degrees) and cavity
+        volumes (both halves, mm³), to the first touch of neighbouring walls: a
+        step past it is replaced by the values at the touch, linear between the
+        last two steps.
+    mesh : list of MeshStudyRow
+    designs : DataFrame
+        The shipped dataset's designs (one row each, with the responses).
+    effects : MainEffects
+    search : SearchResult
+        The design search, its verified candidates carrying the FEM's angles.
+    model : LoadedModel
+        The surrogate searched (``out_dir/pneunet/surrogate/models/plr.json``).
+    training : dict
+        The surrogate's cross-validated figures (``model``, ``params``, ``r2``, ``rmse_deg``).
+    summary : dict
+        Headline figures for ``summary.json``.
+    """
+
+    design: Any
+    sweep: SweepResult
+    step_pressure_mpa: np.ndarray
+    step_angle_deg: np.ndarray
+    step_volume_mm3: np.ndarray
+    mesh: list[MeshStudyRow]
+    designs: pd.DataFrame
+    effects: MainEffects
+    search: SearchResult
+    model: LoadedModel
+    training: dict[str, Any]
+    summary: dict[str, Any]
+
+
+def _reference_sweep(
+    progress: Progress | None,
+) -> tuple[Any, SweepResult, np.ndarray, np.ndarray, np.ndarray]:
+    from softbend.fem.families import get_family
+
+    family = get_family("pneunet")
+    design = family.design()
+    pressures = np.round(np.arange(0.0, family.pmax_mpa + 1e-12, family.pstep_mpa), 6)
+    phase = "PneuNet: FEM sweep of the reference, kPa"
+
+    def told(pressure_mpa: float, angle_deg: float, pmax_mpa: float) -> None:
+        if progress is not None:
+            progress(phase, round(pressure_mpa * 1e3), round(pmax_mpa * 1e3))
+
+    result, _, history = family.sweep(design, pressures, family.options(), progress=told)
+    if progress is not None:  # done, at the touch or the last pressure
+        progress(phase, round(family.pmax_mpa * 1e3), round(family.pmax_mpa * 1e3))
+    p = np.array([s.pressure_mpa for s in history.steps])
+    a = np.array([s.values[0] for s in history.steps])
+    v = np.array(result.stats["step_volume_mm3"])
+    limit = history.valid_up_to_mpa
+    if limit is not None and limit < p[-1]:  # past the touch: cut there, interpolated
+        keep = p < limit - 1e-12
+        a = np.append(a[keep], np.interp(limit, p, a))
+        v = np.append(v[keep], np.interp(limit, p, v))
+        p = np.append(p[keep], limit)
+    return design, result, p, a, v
+
+
+def _effects(designs: pd.DataFrame, samples: pd.DataFrame) -> MainEffects:
+    from softbend.actuators import PNEUNET
+    from softbend.analysis.effects import angle_at_pressure, main_effects
+
+    angle = angle_at_pressure(samples, EFFECT_PRESSURE_MPA)
+    responses = {
+        f"angle at {EFFECT_PRESSURE_MPA * 1e3:g} kPa (°)": angle,
+        "largest angle (°)": designs["max_angle_deg"],
+        "stop pressure (kPa)": designs["max_pressure_mpa"] * 1e3,
+    }
+    return main_effects(designs, [p.name for p in PNEUNET.parameters], responses)
+
+
+def _search(
+    out_dir: Path, seed: int, verify: int, progress: Progress | None
+) -> tuple[SearchResult, LoadedModel, dict[str, Any]]:
+    from softbend._progress import listening
+    from softbend.actuators import PNEUNET
+    from softbend.design_search.search import LoadedModel, find_designs
+    from softbend.design_search.spec import Specification, Target
+    from softbend.design_search.verify import verify_candidates
+    from softbend.surrogates.features import dataset_training_data
+    from softbend.surrogates.workflow import train_into
+
+    folder = out_dir / "pneunet" / "surrogate"
+    _, summary = train_into(
+        dataset_training_data("pneunet"),
+        folder,
+        models="plr",
+        seed=seed,
+        export_onnx=False,
+        plr_patience=1,  # degree 4 loses to 2: degree 6 (minutes) is not tried
+        progress=progress,
+    )
+    model = LoadedModel.load(folder / "models" / "plr.json")
+    spec = Specification(
+        Target("angle_at", angle_deg=TARGET_ANGLE_DEG, pressure_mpa=TARGET_PRESSURE_MPA),
+        name="pneunet-30-at-20kPa",
+        steps=SPECIFICATION_STEPS,
+        actuator=PNEUNET,
+    )
+    with listening(progress):
+        result = find_designs(model, spec, top=5)
+        if verify and result.candidates:
+            verify_candidates(
+                result, verify, backend="fem", workers=1, scratch_dir=folder, replace_stopped=True
+            )
+    cv = summary["models"]["plr"]
+    return (
+        result,
+        model,
+        {"model": "plr", "params": cv["params"], "r2": cv["r2"], "rmse_deg": cv["rmse_deg"]},
+    )
+
+
+def run_pneunet(
+    out_dir: Path,
+    *,
+    seed: int = 0,
+    progress: Progress | None = None,
+    mesh_sizes_mm: tuple[float, ...] = MESH_SIZES_MM,
+    verify: int = 1,
+) -> PneuNetSection:
+    """Compute the PneuNet section of the report (see the module's list).
+
+    Parameters
+    ----------
+    out_dir : Path
+        The report's folder; the surrogate is written into ``out_dir/pneunet/surrogate``.
+    seed : int
+        Seed of the surrogate's folds.
+    progress : callable, optional
+        ``progress(phase, done, total)``.
+    mesh_sizes_mm : tuple of float
+        Element sizes of the mesh study, mm, coarsest first (one size for a quick run).
+    verify : int, default 1
+        Designs the FEM verifies (0: none, for a quick run); a sweep that stops
+        before the target's pressure is replaced by the next design's.
+    """
+    from softbend.family_datasets import family_dataset, family_dataset_designs
+    from softbend.fem.verification import mesh_study
+
+    start = time.perf_counter()
+    design, sweep, p, a, v = _reference_sweep(progress)
+    phase = "PneuNet: mesh study of the reference"
+    mesh = mesh_study(
+        design,
+        mesh_sizes_mm,
+        MESH_PRESSURES_MPA,
+        progress=None if progress is None else lambda d, n: progress(phase, d, n),
+    )
+    designs = family_dataset_designs("pneunet").set_index("design_id")
+    effects = _effects(designs, family_dataset("pneunet"))
+    search, model, training = _search(Path(out_dir), seed, verify, progress)
+    best = next((c for c in search.candidates if c.fem_angle_deg is not None), None)
+    finest = mesh[-1].angles_deg[-1]
+    summary = {
+        "reference": str(design),
+        "stop_reason": sweep.stats["stop_reason"],
+        "touch_pressure_mpa": float(p[-1]),
+        "touch_angle_deg": float(a[-1]),
+        "mesh_sizes_mm": list(mesh_sizes_mm),
+        "mesh_pressure_mpa": MESH_PRESSURES_MPA[-1],
+        "mesh_angles_deg": [r.angles_deg[-1] for r in mesh],
+        "mesh_change_deg": float(abs(mesh[0].angles_deg[-1] - finest)),
+        "surrogate": training,
+        "target": search.spec.target.describe(),
+        "designs_searched": search.n_designs,
+        "verify": verify,
+        "best": None if best is None else best.to_dict(),
+        "seconds": time.perf_counter() - start,
+    }
+    return PneuNetSection(
+        design, sweep, p, a, v, mesh, designs, effects, search, model, training, summary
+    )
