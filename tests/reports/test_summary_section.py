@@ -65,3 +65,21 @@ def test_the_validation_page_carries_the_run_s_provenance_and_every_row():
     assert len([line for line in page.splitlines() if line.startswith("| Paper")]) == len(
         headline_rows(SUMMARY)
     ) - sum(figure.startswith("  ") for figure, *_ in headline_rows(SUMMARY))
+
+
+def test_the_pneunet_rows_give_the_mesh_change_and_the_fem_check_of_the_design():
+    summary = {
+        "pneunet": {
+            "mesh_sizes_mm": [3.0, 2.5, 2.0],
+            "mesh_pressure_mpa": 0.004,
+            "mesh_change_deg": 0.566,
+            "target": "30° ± 3° at 0.02 MPa",
+            "best": {"angle_deg": 30.0, "fem_angle_deg": None},  # a quick run: not swept
+        }
+    }
+    rows = {figure: ours for figure, ours, _, _ in headline_rows(summary)}
+    assert rows["PneuNet reference: angle at 4 kPa, change from 3 mm to 2 mm elements"] == "0.57°"
+    checked = rows[
+        "PneuNet design find, 30° ± 3° at 0.02 MPa: best design's angle, surrogate / FEM"
+    ]
+    assert checked == "30.00° / not computed in this run"

@@ -75,6 +75,10 @@ def _deg(v: float) -> str:
     return f"{v:.2f}°"
 
 
+def _sizes(sizes: list[float]) -> str:
+    return f"{sizes[0]:g} mm" if sizes else "? mm"
+
+
 def _kpa(v: float) -> str:
     return f"{v * 1e3:g} kPa"
 
@@ -199,8 +203,7 @@ def headline_rows(summary: Mapping[str, Any]) -> list[tuple[str, str, str, str]]
         rows.append(
             (
                 f"PneuNet reference: angle at {_number(pneunet.get('mesh_pressure_mpa'), _kpa)}, "
-                f"change from {sizes[0] if sizes else '?'} mm to "
-                f"{sizes[-1] if sizes else '?'} mm elements",
+                f"change from {_sizes(sizes[:1])} to {_sizes(sizes[-1:])} elements",
                 _number(pneunet.get("mesh_change_deg"), _deg),
                 "— (beyond the papers)",
                 "pneunet",
