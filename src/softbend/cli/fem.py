@@ -179,6 +179,8 @@ def run(
         softbend fem run --design 100,6,2,2,5,10 --pmax 0.2 --out fem
         softbend fem run --family pneunet --design n_chambers=6,wall_mm=1.5 --out pneunet
     """
+    from functools import partial
+
     import numpy as np
 
     from softbend._io import staged_dir, write_text_atomic
@@ -230,27 +232,16 @@ def run(
                 )
                 state["done"] = max(done, state["done"])
 
-            if paper_b:
-                sweep = sweep_with_files(
-                    actuator,
-                    pressures,
-                    options,
-                    stage,
-                    shape_pressures_mpa=shapes,
-                    vtk=True,
-                    progress=on_step,
-                )
-            else:
-                sweep = family_sweep_with_files(
-                    chosen,
-                    actuator,
-                    pressures,
-                    options,
-                    stage,
-                    shape_pressures_mpa=shapes,
-                    vtk=True,
-                    progress=on_step,
-                )
+            with_files = sweep_with_files if paper_b else partial(family_sweep_with_files, chosen)
+            sweep = with_files(
+                actuator,
+                pressures,
+                options,
+                stage,
+                shape_pressures_mpa=shapes,
+                vtk=True,
+                progress=on_step,
+            )
         result = sweep.result
         stats = fem_stats(result)
         summary = {

@@ -59,10 +59,11 @@ class Measurement:
 class ModelState:
     """Loads, state and measurements shared by the FEM models of every family.
 
-    A model class that mixes this in sets ``mesh``, ``fes``, ``gfu``, ``pressure``,
-    ``gravity_factor``, ``options``, ``solver``, ``volume_form``, ``_bind``,
-    ``_cavity_area``, ``_weight_n``, the backbone and tip points, the stretch check
-    points and ``region_of``.
+    A model class that mixes this in sets ``design`` and ``options``, calls
+    :meth:`_set_up` (which builds the mesh, space, state, loads, energy, solver,
+    tip point, cavity area and stretch check points from its ``_mesh`` and
+    ``_assemble_energy``), then sets ``_weight_n`` and the backbone points; it
+    defines ``_bind``, ``backbone_mm`` and ``region_of``.
     """
 
     mesh: Any
@@ -80,9 +81,107 @@ class ModelState:
     _check_points: Any
     _check_xyz: np.ndarray
     _deformation: Any
+    terms: Any
+
+    def _mesh(self) -> tuple[Any, Any]:
+        """The model's mesh and geometry (``options`` set)."""
+        raise NotImplementedError
+
+    def _assemble_energy(self) -> tuple[Any, Any, Any]:
+        """The energy form, the volume form and the weight vector."""
+        raise NotImplementedError
 
     def _bind(self) -> None:
         raise NotImplementedError
+
+    def _energy_forms(self, fiber_mass_per_area: float | None) -> tuple[Any, Any, Any]:
+        """The energy form, the volume form and the weight vector of paper B's energy.
+
+        The elastomer, strain-limiting layer (``bottom``) and cavity pressure
+        terms of :func:`~softbend.fem.energy.energy_terms`, and its fiber term
+        on ``outer|bottom`` unless ``fiber_mass_per_area`` is None. Sets and
+        binds (:meth:`_bind`) ``terms``.
+
+        Parameters
+        ----------
+        fiber_mass_per_area : float or None
+            Mass of the fibers per area of ``outer|bottom``, t/mm²; None: no fibers.
+        """
+        import ngsolve as ngs
+        from ngsolve import CoefficientFunction as CF  # noqa: N817
+        from ngsolve import ds, dx
+
+        o = self.options
+        self.terms = terms = energy_terms(self.fes, o)
+        self._bind()
+        # Only the lower triangle of the Hessian is stored: sparse Cholesky needs
+        # no more, and assembly writes half the entries (about a tenth faster).
+        form = ngs.BilinearForm(self.fes, symmetric=True, symmetric_storage=True)
+        form += ngs.Variation(terms.solid * dx)
+        form += ngs.Variation(terms.layer * ds("bottom"))
+        if fiber_mass_per_area is not None:
+            form += ngs.Variation(terms.fiber * ds("outer|bottom"))
+        form += ngs.Variation(terms.pressure_work * ds("cavity"))
+        volume = ngs.BilinearForm(self.fes, symmetric=True)
+        volume += ngs.Variation(terms.flux * ds("cavity"))
+
+        # Gravity is a dead load (its potential −ρ g·u is linear in u): assembled
+        # once as a force vector and scaled by the gravity factor, instead of
+        # being differentiated twice at every Newton iteration.
+        v = self.fes.TestFunction()
+        g = CF(self._gravity_vector())
+        layer_mass = o.layer.density_t_per_mm3 * o.layer_thickness_mm
+        weight = ngs.LinearForm(self.fes)
+        weight += o.elastomer.density_t_per_mm3 * ngs.InnerProduct(g, v) * dx
+        weight += layer_mass * ngs.InnerProduct(g, v.Trace()) * ds("bottom")
+        if fiber_mass_per_area is not None:
+            weight += fiber_mass_per_area * ngs.InnerProduct(g, v.Trace()) * ds("outer|bottom")
+        weight.Assemble()
+        return form, volume, weight.vec
+
+    def _set_up(self) -> None:
+        """Mesh the model and build its space, state, loads, energy, solver and check points.
+
+        The half model is clamped on the face ``base`` (all three components)
+        and held at ``u_y = 0`` on ``symmetry``; the pressure and the gravity
+        factor start at 0.
+        """
+        import ngsolve as ngs
+
+        options = self.options
+        ngs.ngsglobals.msg_level = 0
+        self.mesh, self.geometry = self._mesh()
+        self.fes = ngs.VectorH1(
+            self.mesh,
+            order=options.order,
+            dirichletx="base",
+            dirichlety="base|symmetry",
+            dirichletz="base",
+        )
+        self.gfu = ngs.GridFunction(self.fes)
+        self.pressure = ngs.Parameter(0.0)
+        self.gravity_factor = ngs.Parameter(0.0)
+        self.form, self.volume_form, self.weight_vector = self._assemble_energy()
+        self.solver = EnergySolver(
+            self.form,
+            self.gfu,
+            self.fes.FreeDofs(),
+            rtol=options.rtol,
+            max_iterations=options.max_iterations,
+            load=self.weight_vector,
+            load_factor=self.gravity_factor,
+            prepare=self._bind,
+        )
+        self._tip_point = self.mesh(self.geometry.length_mm, 0.0, 0.0)
+        self._cavity_area = ngs.Integrate(
+            ngs.CoefficientFunction(1.0), self.mesh, definedon=self.mesh.Boundaries("cavity")
+        )
+        # The centroid of every tetrahedron: where the stretch is checked.
+        rule = ngs.IntegrationRule(points=[(0.25, 0.25, 0.25)], weights=[1.0 / 6.0])
+        self._check_points = self.mesh.MapToAllElements(rule, ngs.VOL)
+        centroids = ngs.CoefficientFunction((ngs.x, ngs.y, ngs.z))(self._check_points)
+        self._check_xyz = np.asarray(centroids)
+        self._deformation = ngs.Id(3) + ngs.Grad(self.gfu)
 
     def backbone_mm(self) -> np.ndarray:
         """Deformed backbone in the measurement frame, shape (n, 2): columns x, z."""
@@ -205,49 +304,19 @@ class ActuatorModel(ModelState):
     """
 
     def __init__(self, design: SFRBADesign, options: FEMOptions | None = None) -> None:
-        import ngsolve as ngs
-
         self.design = design
         self.options = options = options or FEMOptions()
-        ngs.ngsglobals.msg_level = 0
-        self.mesh, self.geometry = mesh_actuator(
-            design, maxh_mm=options.maxh_mm, order=options.order, base_cap_mm=options.base_cap_mm
-        )
-        self.fes = ngs.VectorH1(
-            self.mesh,
-            order=options.order,
-            dirichletx="base",
-            dirichlety="base|symmetry",
-            dirichletz="base",
-        )
-        self.gfu = ngs.GridFunction(self.fes)
-        self.pressure = ngs.Parameter(0.0)
-        self.gravity_factor = ngs.Parameter(0.0)
-        self.form, self.volume_form, self.weight_vector = self._assemble_energy()
-        self.solver = EnergySolver(
-            self.form,
-            self.gfu,
-            self.fes.FreeDofs(),
-            rtol=options.rtol,
-            max_iterations=options.max_iterations,
-            load=self.weight_vector,
-            load_factor=self.gravity_factor,
-            prepare=self._bind,
-        )
+        self._set_up()
         start, end = self.geometry.chamber_mm
         self._backbone_x = np.linspace(start, end, options.backbone_points)
         self._backbone_points = [self.mesh(float(x), 0.0, 0.0) for x in self._backbone_x]
-        self._tip_point = self.mesh(self.geometry.length_mm, 0.0, 0.0)
-        self._cavity_area = ngs.Integrate(
-            ngs.CoefficientFunction(1.0), self.mesh, definedon=self.mesh.Boundaries("cavity")
-        )
         self._weight_n = self._total_weight_n()
-        # The centroid of every tetrahedron: where the stretch is checked.
-        rule = ngs.IntegrationRule(points=[(0.25, 0.25, 0.25)], weights=[1.0 / 6.0])
-        self._check_points = self.mesh.MapToAllElements(rule, ngs.VOL)
-        centroids = ngs.CoefficientFunction((ngs.x, ngs.y, ngs.z))(self._check_points)
-        self._check_xyz = np.asarray(centroids)
-        self._deformation = ngs.Id(3) + ngs.Grad(self.gfu)
+
+    def _mesh(self) -> tuple[Any, Any]:
+        o = self.options
+        return mesh_actuator(
+            self.design, maxh_mm=o.maxh_mm, order=o.order, base_cap_mm=o.base_cap_mm
+        )
 
     # -- energy --------------------------------------------------------------------------
     def fiber_spacing_mm(self) -> float:
@@ -284,37 +353,9 @@ class ActuatorModel(ModelState):
         return mass * o.gravity_mm_s2
 
     def _assemble_energy(self) -> tuple[Any, Any, Any]:
-        """The hyperelastic and pressure energy, the volume form and the weight vector."""
-        import ngsolve as ngs
-        from ngsolve import CoefficientFunction as CF  # noqa: N817
-        from ngsolve import ds, dx
-
-        o = self.options
-        self.terms = terms = energy_terms(self.fes, o)
+        """The hyperelastic, fiber and pressure energy, the volume form and the weight vector."""
         self._fiber_stiffness = self.fiber_stiffness_n_per_mm()
-        self._bind()
-        # Only the lower triangle of the Hessian is stored: sparse Cholesky needs
-        # no more, and assembly writes half the entries (about a tenth faster).
-        form = ngs.BilinearForm(self.fes, symmetric=True, symmetric_storage=True)
-        form += ngs.Variation(terms.solid * dx)
-        form += ngs.Variation(terms.layer * ds("bottom"))
-        form += ngs.Variation(terms.fiber * ds("outer|bottom"))
-        form += ngs.Variation(terms.pressure_work * ds("cavity"))
-        volume = ngs.BilinearForm(self.fes, symmetric=True)
-        volume += ngs.Variation(terms.flux * ds("cavity"))
-
-        # Gravity is a dead load (its potential −ρ g·u is linear in u): assembled
-        # once as a force vector and scaled by the gravity factor, instead of
-        # being differentiated twice at every Newton iteration.
-        v = self.fes.TestFunction()
-        g = CF(self._gravity_vector())
-        layer_mass, fiber_mass = self._layer_and_fiber_mass_per_area()
-        weight = ngs.LinearForm(self.fes)
-        weight += o.elastomer.density_t_per_mm3 * ngs.InnerProduct(g, v) * dx
-        weight += layer_mass * ngs.InnerProduct(g, v.Trace()) * ds("bottom")
-        weight += fiber_mass * ngs.InnerProduct(g, v.Trace()) * ds("outer|bottom")
-        weight.Assemble()
-        return form, volume, weight.vec
+        return self._energy_forms(fiber_mass_per_area=self._layer_and_fiber_mass_per_area()[1])
 
     def _bind(self) -> None:
         """This model's pressure and fiber values into the (possibly shared) energy terms."""

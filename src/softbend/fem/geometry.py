@@ -23,9 +23,13 @@ from softbend.fem._ngsolve import require_ngsolve
 __all__ = [
     "ActuatorGeometry",
     "actuator_geometry",
+    "check_element_count",
     "check_mesh_size",
+    "curved_mesh",
     "estimated_elements",
     "mesh_actuator",
+    "name_faces",
+    "tetrahedra_in_volume",
 ]
 
 #: Largest number of tetrahedra a mesh may have (guards against a tiny maxh).
@@ -108,14 +112,41 @@ def actuator_geometry(design: SFRBADesign, base_cap_mm: float) -> tuple[Any, Act
     cavity = Cylinder(Pnt(x0, 0, b), X, r, x1 - x0) * Box(Pnt(x0, 0, b), Pnt(x1, r, b + r))
     cavity.faces.name = "cavity"
     solid = body - cavity
-    tol = 1e-7 * length
+    name_faces(solid, length, tip=True, what=f"the actuator geometry of design {design}")
+    return solid, info
+
+
+def name_faces(solid: Any, length_mm: float, *, tip: bool, what: str) -> None:
+    """Name the faces of a half model (its ``cavity`` faces named) for the physics.
+
+    By where a face's centre lies: ``x = 0`` is ``base``, with ``tip`` the face
+    ``x = length_mm`` is ``tip``, ``y = 0`` is ``symmetry``, ``z = 0`` is
+    ``bottom``; every other face is ``outer``.
+
+    Parameters
+    ----------
+    solid : netgen.occ.TopoDS_Shape
+        The half model, ``0 ≤ x ≤ length_mm``, ``y ≥ 0``, ``z ≥ 0``; renamed in place.
+    length_mm : float
+        Its length along ``x``, mm.
+    tip : bool
+        Whether the face ``x = length_mm`` is named ``tip`` (else ``outer``).
+    what : str
+        The geometry, for the error message.
+
+    Raises
+    ------
+    SoftbendError
+        If the names found are not the expected ones (a netgen behaviour change).
+    """
+    tol = 1e-7 * length_mm
     for face in solid.faces:
         if face.name == "cavity":
             continue
         c = face.center
         if abs(c.x) < tol:
             face.name = "base"
-        elif abs(c.x - length) < tol:
+        elif tip and abs(c.x - length_mm) < tol:
             face.name = "tip"
         elif abs(c.y) < tol:
             face.name = "symmetry"
@@ -124,13 +155,11 @@ def actuator_geometry(design: SFRBADesign, base_cap_mm: float) -> tuple[Any, Act
         else:
             face.name = "outer"
     names = {f.name for f in solid.faces}
-    expected = {"base", "tip", "symmetry", "bottom", "outer", "cavity"}
+    expected = {"base", "symmetry", "bottom", "outer", "cavity"} | ({"tip"} if tip else set())
     if names != expected:  # pragma: no cover - a netgen behaviour change
         raise SoftbendError(
-            f"the actuator geometry of design {design} has faces {sorted(map(str, names))}, "
-            f"expected {sorted(expected)}"
+            f"{what} has faces {sorted(map(str, names))}, expected {sorted(expected)}"
         )
-    return solid, info
 
 
 def mesh_actuator(
@@ -160,19 +189,44 @@ def mesh_actuator(
     SoftbendError
         If netgen fails to mesh the geometry.
     """
+    require_ngsolve()
+    check_mesh_size(design, maxh_mm, base_cap_mm)
+    shape, info = actuator_geometry(design, base_cap_mm)
+    return curved_mesh(shape, maxh_mm, order, f"design {design} with maxh_mm={maxh_mm:g}"), info
+
+
+def curved_mesh(shape: Any, h_mm: float, order: int, what: str) -> Any:
+    """Tetrahedral mesh of ``shape``, elements at most ``h_mm``, curved to ``order``.
+
+    Parameters
+    ----------
+    shape : netgen.occ.TopoDS_Shape
+        The solid, faces named.
+    h_mm : float
+        Largest element size, mm.
+    order : int
+        Geometric order of the curved elements.
+    what : str
+        What is meshed, for the error message.
+
+    Returns
+    -------
+    ngsolve.Mesh
+
+    Raises
+    ------
+    SoftbendError
+        If netgen fails to mesh the geometry.
+    """
     ngsolve = require_ngsolve()
     from netgen.occ import OCCGeometry
 
-    check_mesh_size(design, maxh_mm, base_cap_mm)
-    shape, info = actuator_geometry(design, base_cap_mm)
     try:
-        mesh = ngsolve.Mesh(OCCGeometry(shape).GenerateMesh(maxh=maxh_mm))
+        mesh = ngsolve.Mesh(OCCGeometry(shape).GenerateMesh(maxh=h_mm))
     except Exception as exc:  # netgen raises its own exception types
-        raise SoftbendError(
-            f"netgen could not mesh design {design} with maxh_mm={maxh_mm:g}: {exc}"
-        ) from exc
+        raise SoftbendError(f"netgen could not mesh {what}: {exc}") from exc
     mesh.Curve(order)
-    return mesh, info
+    return mesh
 
 
 def estimated_elements(design: SFRBADesign, maxh_mm: float, base_cap_mm: float = 3.0) -> float:
@@ -196,8 +250,27 @@ def estimated_elements(design: SFRBADesign, maxh_mm: float, base_cap_mm: float =
     float
         The estimated number of elements.
     """
-    volume = ActuatorGeometry(design, base_cap_mm).half_volume_mm3
-    return 6.0 * volume / (maxh_mm**3 / (6.0 * math.sqrt(2.0)))
+    return tetrahedra_in_volume(ActuatorGeometry(design, base_cap_mm).half_volume_mm3, maxh_mm)
+
+
+def tetrahedra_in_volume(volume_mm3: float, h_mm: float) -> float:
+    """Six times ``volume_mm3`` over the volume of a regular tetrahedron of edge ``h_mm``.
+
+    The element count the FEM's meshes are estimated by before meshing.
+
+    Parameters
+    ----------
+    volume_mm3 : float
+        The meshed volume, mm³.
+    h_mm : float
+        Element size, mm (> 0).
+
+    Returns
+    -------
+    float
+        The estimated number of elements.
+    """
+    return 6.0 * volume_mm3 / (h_mm**3 / (6.0 * math.sqrt(2.0)))
 
 
 def check_mesh_size(
@@ -231,9 +304,29 @@ def check_mesh_size(
         return
     estimates = [estimated_elements(d, maxh_mm, base_cap_mm) for d in items]
     largest = max(range(len(items)), key=estimates.__getitem__)
-    if estimates[largest] > MAX_ELEMENTS:
+    check_element_count(estimates[largest], items[largest], maxh_mm)
+
+
+def check_element_count(estimate: float, design: object, maxh_mm: float) -> None:
+    """Refuse a mesh of about ``estimate`` elements above :data:`MAX_ELEMENTS`.
+
+    Parameters
+    ----------
+    estimate : float
+        The estimated number of elements of the mesh of ``design``.
+    design : object
+        The design, named in the message.
+    maxh_mm : float
+        The element size asked for, mm.
+
+    Raises
+    ------
+    InputError
+        Keyed ``maxh_mm``, naming the design, the size and the estimate.
+    """
+    if estimate > MAX_ELEMENTS:
         raise InputError(
-            f"must give at most {MAX_ELEMENTS} elements for design {items[largest]}; got "
-            f"{maxh_mm:g} mm (about {estimates[largest]:.0f} elements)",
+            f"must give at most {MAX_ELEMENTS} elements for design {design}; got "
+            f"{maxh_mm:g} mm (about {estimate:.0f} elements)",
             key="maxh_mm",
         )

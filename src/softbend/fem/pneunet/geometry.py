@@ -19,16 +19,14 @@ strain-limiting layer), ``cavity`` (pressure) and ``outer`` (the rest).
 
 from __future__ import annotations
 
-import math
 from dataclasses import dataclass
 from typing import Any
 
 import numpy as np
 
 from softbend.design import FamilyDesign
-from softbend.errors import InputError, SoftbendError
 from softbend.fem._ngsolve import require_ngsolve
-from softbend.fem.geometry import MAX_ELEMENTS
+from softbend.fem.geometry import check_element_count, curved_mesh, name_faces, tetrahedra_in_volume
 from softbend.fem.pneunet.description import cavity_volume_mm3, length_mm
 
 __all__ = [
@@ -153,26 +151,7 @@ def pneunet_solid(design: FamilyDesign, end_mm: float) -> tuple[Any, PneuNetGeom
     cavity = Glue(cavities) if len(cavities) > 1 else cavities[0]
     cavity.faces.name = "cavity"
     solid = body - cavity
-    tol = 1e-7 * info.length_mm
-    for face in solid.faces:
-        if face.name == "cavity":
-            continue
-        c = face.center
-        if abs(c.x) < tol:
-            face.name = "base"
-        elif abs(c.y) < tol:
-            face.name = "symmetry"
-        elif abs(c.z) < tol:
-            face.name = "bottom"
-        else:
-            face.name = "outer"
-    names = {f.name for f in solid.faces}
-    expected = {"base", "symmetry", "bottom", "outer", "cavity"}
-    if names != expected:  # pragma: no cover - a netgen behaviour change
-        raise SoftbendError(
-            f"the PneuNet geometry of design {design} has faces {sorted(map(str, names))}, "
-            f"expected {sorted(expected)}"
-        )
+    name_faces(solid, info.length_mm, tip=False, what=f"the PneuNet geometry of design {design}")
     return solid, info
 
 
@@ -200,9 +179,8 @@ def estimated_pneunet_elements(design: FamilyDesign, maxh_mm: float, end_mm: flo
     upper bound where ``maxh_mm`` is below the walls' thickness, the case it
     guards (the reference at 3 mm: estimate 6 800, mesh 1 345).
     """
-    h = element_size_mm(design, maxh_mm)
     volume = PneuNetGeometry(design, end_mm).half_volume_mm3
-    return 6.0 * volume / (h**3 / (6.0 * math.sqrt(2.0)))
+    return tetrahedra_in_volume(volume, element_size_mm(design, maxh_mm))
 
 
 def check_pneunet_mesh(design: FamilyDesign, maxh_mm: float, end_mm: float) -> None:
@@ -214,13 +192,7 @@ def check_pneunet_mesh(design: FamilyDesign, maxh_mm: float, end_mm: float) -> N
         Keyed ``maxh_mm``: the estimate of :func:`estimated_pneunet_elements`
         exceeds :data:`softbend.fem.geometry.MAX_ELEMENTS`.
     """
-    estimate = estimated_pneunet_elements(design, maxh_mm, end_mm)
-    if estimate > MAX_ELEMENTS:
-        raise InputError(
-            f"must give at most {MAX_ELEMENTS} elements for design {design}; got "
-            f"{maxh_mm:g} mm (about {estimate:.0f} elements)",
-            key="maxh_mm",
-        )
+    check_element_count(estimated_pneunet_elements(design, maxh_mm, end_mm), design, maxh_mm)
 
 
 def mesh_pneunet(
@@ -235,16 +207,9 @@ def mesh_pneunet(
     SoftbendError
         If netgen fails to mesh the geometry.
     """
-    ngsolve = require_ngsolve()
-    from netgen.occ import OCCGeometry
-
+    require_ngsolve()
     check_pneunet_mesh(design, maxh_mm, end_mm)
     shape, info = pneunet_solid(design, end_mm)
-    try:
-        mesh = ngsolve.Mesh(OCCGeometry(shape).GenerateMesh(maxh=element_size_mm(design, maxh_mm)))
-    except Exception as exc:  # netgen raises its own exception types
-        raise SoftbendError(
-            f"netgen could not mesh the PneuNet {design} with maxh_mm={maxh_mm:g}: {exc}"
-        ) from exc
-    mesh.Curve(order)
-    return mesh, info
+    h = element_size_mm(design, maxh_mm)
+    what = f"the PneuNet {design} with maxh_mm={maxh_mm:g}"
+    return curved_mesh(shape, h, order, what), info

@@ -48,8 +48,6 @@ import numpy as np
 from softbend.design import FamilyDesign
 from softbend.fem._ngsolve import require_ngsolve
 from softbend.fem.actuator import ModelState
-from softbend.fem.energy import energy_terms
-from softbend.fem.newton import EnergySolver
 from softbend.fem.options import FEMOptions
 from softbend.fem.pneunet.geometry import mesh_pneunet
 
@@ -80,51 +78,24 @@ class PneuNetModel(ModelState):
 
         self.design = design
         self.options = options
-        ngs.ngsglobals.msg_level = 0
-        self.mesh, self.geometry = mesh_pneunet(
-            design, maxh_mm=options.maxh_mm, order=options.order, end_mm=options.base_cap_mm
-        )
-        self.fes = ngs.VectorH1(
-            self.mesh,
-            order=options.order,
-            dirichletx="base",
-            dirichlety="base|symmetry",
-            dirichletz="base",
-        )
-        self.gfu = ngs.GridFunction(self.fes)
-        self.pressure = ngs.Parameter(0.0)
-        self.gravity_factor = ngs.Parameter(0.0)
-        self.form, self.volume_form, self.weight_vector = self._assemble_energy()
-        self.solver = EnergySolver(
-            self.form,
-            self.gfu,
-            self.fes.FreeDofs(),
-            rtol=options.rtol,
-            max_iterations=options.max_iterations,
-            load=self.weight_vector,
-            load_factor=self.gravity_factor,
-            prepare=self._bind,
-        )
+        self._set_up()
         start, end = self.geometry.chambers_mm
         self._backbone_x = np.linspace(start, end, options.backbone_points)
         self._backbone_points = self.mesh(
             self._backbone_x, np.zeros_like(self._backbone_x), np.zeros_like(self._backbone_x)
         )
-        self._tip_point = self.mesh(self.geometry.length_mm, 0.0, 0.0)
-        one = ngs.CoefficientFunction(1.0)
-        self._cavity_area = ngs.Integrate(one, self.mesh, definedon=self.mesh.Boundaries("cavity"))
-        self._bottom_area = ngs.Integrate(one, self.mesh, definedon=self.mesh.Boundaries("bottom"))
-        self._weight_n = self._total_weight_n()
-        rule = ngs.IntegrationRule(points=[(0.25, 0.25, 0.25)], weights=[1.0 / 6.0])
-        self._check_points = self.mesh.MapToAllElements(rule, ngs.VOL)
-        self._check_xyz = np.asarray(
-            ngs.CoefficientFunction((ngs.x, ngs.y, ngs.z))(self._check_points)
+        self._bottom_area = ngs.Integrate(
+            ngs.CoefficientFunction(1.0), self.mesh, definedon=self.mesh.Boundaries("bottom")
         )
-        self._deformation = ngs.Id(3) + ngs.Grad(self.gfu)
+        self._weight_n = self._total_weight_n()
         self._walls = [
             (a, b, self._points(a), self._points(b)) for a, b in self.geometry.facing_walls()
         ]
         self._gaps: list[tuple[float, float]] = []  # (pressure MPa, smallest gap mm)
+
+    def _mesh(self) -> tuple[Any, Any]:
+        o = self.options
+        return mesh_pneunet(self.design, maxh_mm=o.maxh_mm, order=o.order, end_mm=o.base_cap_mm)
 
     def _points(self, xyz: np.ndarray) -> Any:
         return self.mesh(xyz[:, 0], xyz[:, 1], xyz[:, 2])
@@ -137,27 +108,8 @@ class PneuNetModel(ModelState):
         return mass * o.gravity_mm_s2
 
     def _assemble_energy(self) -> tuple[Any, Any, Any]:
-        import ngsolve as ngs
-        from ngsolve import CoefficientFunction as CF  # noqa: N817
-        from ngsolve import ds, dx
-
-        o = self.options
-        self.terms = terms = energy_terms(self.fes, o)
-        self._bind()
-        form = ngs.BilinearForm(self.fes, symmetric=True, symmetric_storage=True)
-        form += ngs.Variation(terms.solid * dx)
-        form += ngs.Variation(terms.layer * ds("bottom"))
-        form += ngs.Variation(terms.pressure_work * ds("cavity"))
-        volume = ngs.BilinearForm(self.fes, symmetric=True)
-        volume += ngs.Variation(terms.flux * ds("cavity"))
-        v = self.fes.TestFunction()
-        g = CF(self._gravity_vector())
-        weight = ngs.LinearForm(self.fes)
-        weight += o.elastomer.density_t_per_mm3 * ngs.InnerProduct(g, v) * dx
-        layer_mass = o.layer.density_t_per_mm3 * o.layer_thickness_mm
-        weight += layer_mass * ngs.InnerProduct(g, v.Trace()) * ds("bottom")
-        weight.Assemble()
-        return form, volume, weight.vec
+        """The hyperelastic and pressure energy, the volume form and the weight vector."""
+        return self._energy_forms(fiber_mass_per_area=None)
 
     def _bind(self) -> None:
         """This model's pressure into the (possibly shared) energy terms; no fibers."""
