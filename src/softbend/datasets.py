@@ -63,43 +63,8 @@ PROVENANCE_FILE = "provenance.json"
 _DATASET_FILES = (SAMPLES_FILE, DESIGNS_FILE, PROVENANCE_FILE)
 _TABLE1_FEM = "table1_fem"
 
-#: Columns of the designs table besides the design parameters.
-DESIGN_STAT_COLUMNS: tuple[str, ...] = (
-    "status",
-    "error",
-    "n_samples",
-    "max_pressure_mpa",
-    "max_angle_deg",
-    "stop_kind",
-    "stop_region",
-    "stop_reason",
-    "wall_time_s",
-    "newton_iterations_total",
-    "load_steps",
-    "rejected_steps",
-    "ndof",
-    "mesh_size",
-    "softbend_version",
-    "options_sha256",
-    "finished_at",
-)
-
-#: Columns of the samples table (:func:`table1_fem`) and the kind of dtype of each:
-#: "string", "float" (any real dtype: float or integer), "integer", "bool" or "datetime".
-SAMPLE_COLUMN_KINDS: dict[str, str] = {
-    "design_id": "string",
-    **dict.fromkeys(PARAMETERS, "float"),
-    "pressure_mpa": "float",
-    "angle_deg": "float",
-    "tip_x_mm": "float",
-    "tip_z_mm": "float",
-    "converged": "bool",
-}
-
-#: Columns of the designs table (:func:`table1_fem_designs`) and the kind of dtype of each.
-DESIGN_COLUMN_KINDS: dict[str, str] = {
-    "design_id": "string",
-    **dict.fromkeys(PARAMETERS, "float"),
+#: The kind of dtype of each column of the designs table besides the design parameters.
+_DESIGN_STAT_KINDS: dict[str, str] = {
     "status": "string",
     "error": "string",
     "n_samples": "integer",
@@ -119,20 +84,58 @@ DESIGN_COLUMN_KINDS: dict[str, str] = {
     "finished_at": "datetime",
 }
 
-#: The quantity of :data:`softbend.plausibility.RANGES` of each physical column.
-_COLUMN_QUANTITIES: dict[str, dict[str, str]] = {
+#: Columns of the designs table besides the design parameters.
+DESIGN_STAT_COLUMNS: tuple[str, ...] = tuple(_DESIGN_STAT_KINDS)
+
+
+def _column_kinds(parameters: Sequence[str]) -> tuple[dict[str, str], dict[str, str]]:
+    """The columns of a samples and a designs table of ``parameters`` and their dtype kinds.
+
+    Samples: ``design_id``, the parameters (each "float"), ``pressure_mpa`` (MPa),
+    ``angle_deg`` (deg), ``tip_x_mm``, ``tip_z_mm`` (mm), ``converged``. Designs:
+    ``design_id``, the parameters, then :data:`DESIGN_STAT_COLUMNS`.
+    """
+    kinds = dict.fromkeys(parameters, "float")
+    samples = {
+        "design_id": "string",
+        **kinds,
+        "pressure_mpa": "float",
+        "angle_deg": "float",
+        "tip_x_mm": "float",
+        "tip_z_mm": "float",
+        "converged": "bool",
+    }
+    return samples, {"design_id": "string", **kinds, **_DESIGN_STAT_KINDS}
+
+
+#: Columns of the samples table (:func:`table1_fem`) and the kind of dtype of each:
+#: "string", "float" (any real dtype: float or integer), "integer", "bool" or "datetime".
+SAMPLE_COLUMN_KINDS: dict[str, str] = _column_kinds(PARAMETERS)[0]
+
+#: Columns of the designs table (:func:`table1_fem_designs`) and the kind of dtype of each.
+DESIGN_COLUMN_KINDS: dict[str, str] = _column_kinds(PARAMETERS)[1]
+
+#: The quantity of :data:`softbend.plausibility.RANGES` of each physical column
+#: besides the design parameters, in any family's samples and designs tables.
+_MEASURED_QUANTITIES: dict[str, dict[str, str]] = {
     "samples": {
-        **FEATURE_QUANTITIES,
+        "pressure_mpa": "pressure_mpa",
         "angle_deg": "angle_deg",
         "tip_x_mm": "coordinate_mm",
         "tip_z_mm": "coordinate_mm",
     },
     "designs": {
-        **{name: FEATURE_QUANTITIES[name] for name in PARAMETERS},
         "max_pressure_mpa": "pressure_mpa",
         "max_angle_deg": "angle_deg",
         "wall_time_s": "time_s",
     },
+}
+
+#: The quantity of :data:`softbend.plausibility.RANGES` of each physical column
+#: of paper B's tables: its design parameters, then :data:`_MEASURED_QUANTITIES`.
+_COLUMN_QUANTITIES: dict[str, dict[str, str]] = {
+    table: {**{name: FEATURE_QUANTITIES[name] for name in PARAMETERS}, **measured}
+    for table, measured in _MEASURED_QUANTITIES.items()
 }
 
 _HEX64 = re.compile(r"[0-9a-fA-F]{64}")

@@ -39,12 +39,12 @@ import numpy as np
 
 from softbend._validation import must_be
 from softbend.datasets import (
-    DESIGN_COLUMN_KINDS,
-    DESIGN_STAT_COLUMNS,
+    _MEASURED_QUANTITIES,
     DESIGNS_FILE,
     PROVENANCE_FILE,
     SAMPLES_FILE,
     _check_table,
+    _column_kinds,
     _design_table,
     _read_file,
     _shipped,
@@ -77,22 +77,6 @@ __all__ = [
 _PAPER_B = "sfrba"
 TABLE1_FOLDER = "table1_fem"
 
-#: The quantity of :data:`softbend.plausibility.RANGES` of each physical column
-#: besides the design parameters (those are checked against the actuator's ranges).
-_QUANTITIES: dict[str, dict[str, str]] = {
-    "samples": {
-        "pressure_mpa": "pressure_mpa",
-        "angle_deg": "angle_deg",
-        "tip_x_mm": "coordinate_mm",
-        "tip_z_mm": "coordinate_mm",
-    },
-    "designs": {
-        "max_pressure_mpa": "pressure_mpa",
-        "max_angle_deg": "angle_deg",
-        "wall_time_s": "time_s",
-    },
-}
-
 #: Where a stretch or instability stop is: "… in the chamber 3 at x = 24 mm …"
 #: or "…: the chamber 3 at x = 24 mm balloons".
 _SITE = re.compile(r"(?:in the|: the) (.+?) at x = ")
@@ -113,22 +97,7 @@ def family_column_kinds(actuator: Actuator) -> tuple[dict[str, str], dict[str, s
         Designs: ``design_id``, the parameters, then
         :data:`~softbend.datasets.DESIGN_STAT_COLUMNS`.
     """
-    parameters = dict.fromkeys(actuator.names, "float")
-    samples = {
-        "design_id": "string",
-        **parameters,
-        "pressure_mpa": "float",
-        "angle_deg": "float",
-        "tip_x_mm": "float",
-        "tip_z_mm": "float",
-        "converged": "bool",
-    }
-    designs = {
-        "design_id": "string",
-        **parameters,
-        **{column: DESIGN_COLUMN_KINDS[column] for column in DESIGN_STAT_COLUMNS},
-    }
-    return samples, designs
+    return _column_kinds(actuator.names)
 
 
 def family_stop_region(reason: str, kind: str) -> str:
@@ -173,7 +142,8 @@ def _check_family_table(table: pd.DataFrame, path: Path, actuator: Actuator, nam
     """Check a family's ``name`` table ("samples" or "designs") read from ``path``."""
     samples, designs = family_column_kinds(actuator)
     kinds = samples if name == "samples" else designs
-    _check_table(table, path, kinds, name, quantities=_QUANTITIES[name])
+    # the design parameters are checked against the actuator's ranges, not RANGES
+    _check_table(table, path, kinds, name, quantities=_MEASURED_QUANTITIES[name])
     _check_parameters(table, f"The dataset file {str(path)!r}", actuator)
 
 

@@ -272,28 +272,23 @@ def refine(
     threads = torch.get_num_threads()
     torch.set_num_threads(1)
     try:
-        return _refine(
-            torch, family, settings, Us, Ys, segments, lags, bounds, start, tau, one_step
+        starts, lengths = (np.asarray(s, dtype=np.int64) for s in segments)
+        trainer = _Trainer(
+            torch, family, settings, Us, Ys, starts, lengths, lags, bounds, start, tau
         )
+        return _refine(trainer, settings, int(lengths.sum()), one_step)
     finally:
         torch.set_num_threads(threads)
 
 
 def _refine(
-    torch: Any,
-    family: str,
+    trainer: _Trainer,
     settings: dict[str, Any],
-    Us: np.ndarray,
-    Ys: np.ndarray,
-    segments: tuple[np.ndarray, np.ndarray],
-    lags: tuple[int, int],
-    bounds: tuple[np.ndarray, np.ndarray],
-    start: Start,
-    tau: np.ndarray | None,
+    n_rows: int,
     one_step: tuple[np.ndarray, np.ndarray] | None,
 ) -> Refined:
-    starts, lengths = (np.asarray(s, dtype=np.int64) for s in segments)
-    trainer = _Trainer(torch, family, settings, Us, Ys, starts, lengths, lags, bounds, start, tau)
+    """:func:`refine` on a built trainer; ``n_rows``: the training rows, for the budget."""
+    torch = trainer.torch
     torch.manual_seed(settings["seed"])
     if trainer.hidden is not None and one_step is not None:
         _pretrain(trainer, one_step[0], one_step[1], settings["pretrain"])
@@ -310,7 +305,7 @@ def _refine(
     optimizer = torch.optim.Adam(groups, lr=settings["lr"])
     # at most `epochs` passes over the training rows: a short recording gets fewer updates
     per_step = settings["batch"] * (trainer.length - trainer.lag)
-    budget = min(settings["steps"], math.ceil(settings["epochs"] * int(lengths.sum()) / per_step))
+    budget = min(settings["steps"], math.ceil(settings["epochs"] * n_rows / per_step))
     for step in range(1, budget + 1):
         optimizer.zero_grad()
         loss = trainer.run(trainer.draw(rng, settings["batch"]))

@@ -197,7 +197,17 @@ def dataset_training_data(source: str | os.PathLike[str]) -> TrainingData:
     """
     from softbend.family_datasets import dataset_samples
 
-    samples, actuator = dataset_samples(source)
+    return family_training_data(*dataset_samples(source))
+
+
+def family_training_data(samples: pd.DataFrame, actuator: Actuator | None) -> TrainingData:
+    """Inputs, target and CV groups of a family's samples table (paper B's for None).
+
+    The table has :func:`softbend.campaign.load_samples`'s columns, pressure in
+    MPa (``pressure_mpa``) and angle in deg (``angle_deg``); the actuator's own
+    pressure and angle columns (pressure in its unit) are added to it in place
+    when they are named otherwise, then :func:`training_data` reads them.
+    """
     if actuator is None:
         return training_data(samples)
     if actuator.pressure_column != "pressure_mpa":

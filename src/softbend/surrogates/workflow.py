@@ -41,7 +41,7 @@ from softbend._io import write_text_atomic
 from softbend._validation import check_choice
 from softbend.references import SURROGATES, values
 from softbend.surrogates.families import FAMILIES, family_names
-from softbend.surrogates.features import TrainingData, training_data
+from softbend.surrogates.features import TrainingData, family_training_data, training_data
 from softbend.surrogates.search import (
     MODEL_NAMES,
     SMALL_DATA_DESIGNS,
@@ -155,14 +155,7 @@ def _load_data(source: Source) -> TrainingData:
     samples = load_samples(path)
     # A campaign of another FEM family than paper B's trains on its own design
     # columns and actuator, recorded in the database; paper B's records none.
-    actuator = campaign_actuator(path)
-    if actuator is None:
-        return training_data(samples)
-    if actuator.pressure_column != "pressure_mpa":
-        samples[actuator.pressure_column] = samples["pressure_mpa"] / actuator.to_mpa
-    if actuator.angle_column != "angle_deg":
-        samples[actuator.angle_column] = samples["angle_deg"]
-    return training_data(samples, actuator=actuator)
+    return family_training_data(samples, campaign_actuator(path))
 
 
 def train_surrogates(
