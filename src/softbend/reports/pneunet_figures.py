@@ -17,14 +17,15 @@ if TYPE_CHECKING:
 __all__ = ["main_effects_figure", "reference_curves"]
 
 
-def _figure(rows: int, cols: int, size: tuple[float, float], **kwargs: object):
-    """A figure of ``rows`` × ``cols`` axes, drawn by the Agg canvas outside pyplot."""
+def _figure(rows: int, cols: int, size: tuple[float, float], *, share_rows: bool = False):
+    """A figure of ``rows`` × ``cols`` axes (the y axis shared along each row if asked),
+    drawn by the Agg canvas outside pyplot."""
     from matplotlib.backends.backend_agg import FigureCanvasAgg
     from matplotlib.figure import Figure
 
     fig = Figure(figsize=size, layout="constrained")
     FigureCanvasAgg(fig)
-    return fig, fig.subplots(rows, cols, squeeze=False, **kwargs)
+    return fig, fig.subplots(rows, cols, squeeze=False, sharey="row" if share_rows else False)
 
 
 def reference_curves(
@@ -76,7 +77,10 @@ def main_effects_figure(effects: MainEffects, path: str | Path, *, title: str = 
     parameters = list(effects.effects.index)
     responses = list(effects.effects.columns)
     fig, axes = _figure(
-        len(responses), len(parameters), (1.9 * len(parameters), 2.0 * len(responses)), sharey="row"
+        len(responses),
+        len(parameters),
+        (1.9 * len(parameters), 2.0 * len(responses)),
+        share_rows=True,
     )
     for i, response in enumerate(responses):
         rows = table[table["response"] == response]
