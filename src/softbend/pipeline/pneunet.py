@@ -10,8 +10,9 @@
 3. the main effects of the shipped PneuNet dataset's design space
    (:func:`softbend.analysis.main_effects`) on three responses: the angle at
    :data:`EFFECT_PRESSURE_MPA`, the largest angle before the sweep stopped and
-   the pressure it stopped at;
-4. a design search on a surrogate trained on that dataset (:data:`SPECIFICATION`),
+   the pressure it reached (the touch, the last pressure, or where Newton stopped);
+4. a design search on a surrogate trained on that dataset (30° at 20 kPa on the
+   grid of :data:`SPECIFICATION_STEPS`),
    its best designs swept by the FEM until one reaches the specified pressure.
 """
 
@@ -144,7 +145,7 @@ def _effects(designs: pd.DataFrame, samples: pd.DataFrame) -> MainEffects:
     responses = {
         f"angle at {EFFECT_PRESSURE_MPA * 1e3:g} kPa (°)": angle,
         "largest angle (°)": designs["max_angle_deg"],
-        "stop pressure (kPa)": designs["max_pressure_mpa"] * 1e3,
+        "pressure reached (kPa)": designs["max_pressure_mpa"] * 1e3,
     }
     return main_effects(designs, [p.name for p in PNEUNET.parameters], responses)
 
