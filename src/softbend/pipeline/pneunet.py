@@ -78,8 +78,9 @@ class PneuNetSection:
     step_pressure_mpa, step_angle_deg, step_volume_mm3 : ndarray
         Its converged steps' pressures (MPa), bending angles (degrees) and cavity
         volumes (both halves, mm³), to the first touch of neighbouring walls: a
-        step past it is replaced by the values at the touch, linear between the
-        last two steps.
+        step past it is replaced by the values at the touch (the angle cubic
+        Hermite between the last two steps, as the sweep's outputs; the volume
+        linear).
     mesh : list of MeshStudyRow
     designs : DataFrame
         The shipped dataset's designs (one row each, with the responses).
@@ -129,9 +130,10 @@ def _reference_sweep(
     a = np.array([s.values[0] for s in history.steps])
     v = np.array(result.stats["step_volume_mm3"])
     limit = history.valid_up_to_mpa
-    if limit is not None and limit < p[-1]:  # past the touch: cut there, interpolated
+    if limit is not None and limit < p[-1]:  # past the touch: cut there
         keep = p < limit - 1e-12
-        a = np.append(a[keep], np.interp(limit, p, a))
+        # the angle as the sweep's own outputs (cubic Hermite), the volume linear
+        a = np.append(a[keep], history.interpolate(np.array([limit]))[0, 0])
         v = np.append(v[keep], np.interp(limit, p, v))
         p = np.append(p[keep], limit)
     return design, result, p, a, v
