@@ -306,3 +306,19 @@ def registered_family(family: FEMFamily) -> Iterator[FEMFamily]:
         yield family
     finally:
         FEM_FAMILIES.unregister(family.name)
+
+
+def check_closed_form_samples(samples: pd.DataFrame, names, k_deg_per_mpa: float, rows: int):
+    """Assert a stand-in family's samples: the campaign's columns, the closed-form angle
+    ``k · p · (sum of the design's values)`` and ``rows`` rows."""
+    assert list(samples.columns) == [
+        "design_id",
+        *names,
+        "pressure_mpa",
+        "angle_deg",
+        "tip_x_mm",
+        "tip_z_mm",
+        "converged",
+    ]
+    expected = k_deg_per_mpa * samples["pressure_mpa"] * samples[list(names)].sum(axis=1)
+    assert np.allclose(samples["angle_deg"], expected) and len(samples) == rows

@@ -38,6 +38,7 @@ from .stand_ins import (
     CELL_CONSTRAINTS,
     CELL_PARAMETERS,
     CELL_REFERENCE,
+    check_closed_form_samples,
     registered_family,
     stand_in_family,
 )
@@ -128,17 +129,7 @@ def test_the_cli_writes_a_family_dataset_that_loads_back_the_campaign(tmp_path, 
 
     samples = family_dataset("standin", out)
     pd.testing.assert_frame_equal(samples, load_samples(db))
-    assert list(samples.columns) == [
-        "design_id",
-        *NAMES,
-        "pressure_mpa",
-        "angle_deg",
-        "tip_x_mm",
-        "tip_z_mm",
-        "converged",
-    ]
-    expected = K_DEG_PER_MPA * samples["pressure_mpa"] * samples[list(NAMES)].sum(axis=1)
-    assert np.allclose(samples["angle_deg"], expected) and len(samples) == 12 * 5
+    check_closed_form_samples(samples, NAMES, K_DEG_PER_MPA, 12 * 5)
 
     designs = family_dataset_designs("standin", out)
     assert list(designs.columns) == ["design_id", *NAMES, *DESIGN_STAT_COLUMNS]

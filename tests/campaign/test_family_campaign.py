@@ -30,6 +30,7 @@ from ..stand_ins import (
     CELL_CONSTRAINTS,
     CELL_PARAMETERS,
     CELL_REFERENCE,
+    check_closed_form_samples,
     registered_family,
     stand_in_family,
 )
@@ -176,17 +177,7 @@ def test_run_resume_export_and_train_reader_over_the_cli(tmp_path, capsys):
     samples_file = tmp_path / "samples.parquet"
     assert main(["campaign", "export", str(db), "--out", str(samples_file)]) == 0
     samples = pd.read_parquet(samples_file)
-    assert list(samples.columns) == [
-        "design_id",
-        *NAMES,
-        "pressure_mpa",
-        "angle_deg",
-        "tip_x_mm",
-        "tip_z_mm",
-        "converged",
-    ]
-    expected = K_DEG_PER_MPA * samples["pressure_mpa"] * samples[list(NAMES)].sum(axis=1)
-    assert np.allclose(samples["angle_deg"], expected) and len(samples) == 12 * 5
+    check_closed_form_samples(samples, NAMES, K_DEG_PER_MPA, 12 * 5)
     capsys.readouterr()
     assert main(["campaign", "status", str(db), "--json"]) == 0
     status = json.loads(capsys.readouterr().out)
