@@ -31,6 +31,7 @@ STAGES: tuple[tuple[str, ...], ...] = (
         "_validation",
         "errors",
         "limits",
+        "units",
     ),
     ("registry", "references", "parameters"),
     ("plausibility", "tables"),

@@ -1,0 +1,120 @@
+"""Pressure and angle units: conversion factors, a column's unit from its name, values with units.
+
+One place for what a unit means, used by every reader of tables, measurements and command
+options: ``PRESSURE_UNITS`` (factor to MPa), :func:`column_unit` (the unit a column's name
+ends with, ``pressure_psi`` → ``psi``), :func:`check_column_unit` (a declared unit that
+disagrees with the column's name is refused, naming both) and :func:`parse_pressure`
+(``"20psi"``, ``"138 kPa"`` or a bare number in a default unit).
+"""
+
+from __future__ import annotations
+
+import math
+import re
+
+from softbend.errors import InputError
+
+__all__ = [
+    "ANGLE_UNITS",
+    "PRESSURE_UNITS",
+    "check_column_unit",
+    "column_unit",
+    "convert_pressure",
+    "parse_pressure",
+]
+
+#: Factor from each pressure unit to MPa. Pa is read (a recording may use it); the four
+#: units an actuator is described in are kPa, MPa, bar and psi.
+PRESSURE_UNITS: dict[str, float] = {
+    "Pa": 1e-6,
+    "kPa": 1e-3,
+    "MPa": 1.0,
+    "bar": 0.1,
+    "psi": 6.894757293168e-3,
+}
+
+#: Angle units, by their spelling in a column's name.
+ANGLE_UNITS: dict[str, str] = {"deg": "deg", "rad": "rad"}
+
+_SUFFIX: dict[str, str] = {u.lower(): u for u in PRESSURE_UNITS} | ANGLE_UNITS
+
+_VALUE = re.compile(r"^\s*([-+]?(?:\d+\.?\d*|\.\d+)(?:[eE][-+]?\d+)?)\s*([A-Za-z]*)\s*$")
+
+
+def column_unit(name: str) -> str:
+    """The pressure or angle unit a column's name ends with, in its canonical spelling, or ``""``.
+
+    Only the part after the last underscore counts, in any case: ``pressure_psi`` → ``psi``,
+    ``p_KPA`` → ``kPa``, ``angle_deg`` → ``deg``, ``pressure`` → ``""``.
+    """
+    if "_" not in name:
+        return ""
+    return _SUFFIX.get(name.rsplit("_", 1)[-1].strip().lower(), "")
+
+
+def check_column_unit(column: str, unit: str, option: str) -> None:
+    """Refuse a declared ``unit`` that disagrees with the unit ``column``'s name carries.
+
+    Parameters
+    ----------
+    column
+        The column's name, as in the file (``pressure_psi``).
+    unit
+        The unit declared for it (by ``option`` or a description), any case.
+    option
+        What declared the unit, named in the error (``--pressure-unit``).
+
+    Raises
+    ------
+    InputError
+        When the name carries a unit (see :func:`column_unit`) other than ``unit``.
+    """
+    named = column_unit(column)
+    if named and named.lower() != str(unit).strip().lower():
+        raise InputError(
+            f"The column '{column}' is named in {named}, but {option} says {unit}; "
+            f"give {option} {named} or rename the column."
+        )
+
+
+def convert_pressure(value: float, from_unit: str, to_unit: str) -> float:
+    """``value`` in ``from_unit`` expressed in ``to_unit`` (both keys of :data:`PRESSURE_UNITS`)."""
+    return value * PRESSURE_UNITS[_pressure_unit(from_unit)] / PRESSURE_UNITS[_pressure_unit(to_unit)]
+
+
+def parse_pressure(text: str | float, unit: str, option: str) -> float:
+    """A pressure given on the command line, in ``unit``.
+
+    ``text`` is a number in ``unit`` (``"20"``) or a number with a unit suffix
+    (``"20psi"``, ``"138 kPa"``, ``"0.1MPa"``, ``"1.5bar"``; any case), converted to ``unit``.
+
+    Raises
+    ------
+    InputError
+        Naming ``option``, for text that is not a finite number with an optional unit, or an
+        unknown unit (listing the allowed ones).
+    """
+    target = _pressure_unit(unit)
+    if isinstance(text, int | float) and not isinstance(text, bool):
+        value, given = float(text), target
+    else:
+        match = _VALUE.match(str(text))
+        if match is None:
+            raise InputError(
+                f"{option} must be a pressure: a number, optionally with a unit "
+                f"({', '.join(PRESSURE_UNITS)}), e.g. 20{target}; got {text!r}."
+            )
+        value = float(match.group(1))
+        given = target if not match.group(2) else _pressure_unit(match.group(2), option)
+    if not math.isfinite(value):
+        raise InputError(f"{option} must be a finite pressure; got {text!r}.")
+    return convert_pressure(value, given, target)
+
+
+def _pressure_unit(unit: str, option: str = "unit") -> str:
+    found = {u.lower(): u for u in PRESSURE_UNITS}.get(str(unit).strip().lower())
+    if found is None:
+        raise InputError(
+            f"{option}: unknown pressure unit {unit!r}; allowed: {', '.join(PRESSURE_UNITS)}."
+        )
+    return found

@@ -1,0 +1,40 @@
+"""Units: a column's unit from its name, declared units checked against it, pressures with units."""
+
+import math
+
+import pytest
+
+from softbend.errors import InputError
+from softbend.units import check_column_unit, column_unit, convert_pressure, parse_pressure
+
+
+@pytest.mark.parametrize(
+    ("name", "unit"),
+    [("pressure_psi", "psi"), ("p_KPA", "kPa"), ("p_mpa", "MPa"), ("p_bar", "bar"),
+     ("p_pa", "Pa"), ("angle_deg", "deg"), ("theta_rad", "rad"), ("pressure", ""),
+     ("wall_mm", "")],
+)  # fmt: skip
+def test_column_unit_reads_the_last_suffix(name, unit):
+    assert column_unit(name) == unit
+
+
+def test_a_declared_unit_that_disagrees_with_the_name_is_refused_naming_both():
+    with pytest.raises(InputError, match=r"pressure_psi.*psi.*--pressure-unit says kPa"):
+        check_column_unit("pressure_psi", "kPa", "--pressure-unit")
+    check_column_unit("pressure_psi", "PSI", "--pressure-unit")  # same unit, any case
+    check_column_unit("pressure", "kPa", "--pressure-unit")  # the name says nothing
+
+
+def test_pressures_parse_with_and_without_a_unit():
+    assert parse_pressure("20", "psi", "--at") == 20.0
+    assert parse_pressure(20, "psi", "--at") == 20.0
+    assert math.isclose(parse_pressure("20psi", "kPa", "--at"), 137.895, rel_tol=1e-5)
+    assert math.isclose(parse_pressure("138 kPa", "MPa", "--at"), 0.138)
+    assert math.isclose(parse_pressure("1.5BAR", "kPa", "--at"), 150.0)
+    assert math.isclose(convert_pressure(1.0, "MPa", "Pa"), 1e6)
+
+
+@pytest.mark.parametrize("text", ["", "psi", "20 furlongs", "1e999", "nan", "20psi30"])
+def test_bad_pressures_name_the_option(text):
+    with pytest.raises(InputError, match="--supply"):
+        parse_pressure(text, "kPa", "--supply")
