@@ -79,7 +79,8 @@ def check_column_unit(column: str, unit: str, option: str) -> None:
 
 def convert_pressure(value: float, from_unit: str, to_unit: str) -> float:
     """``value`` in ``from_unit`` expressed in ``to_unit`` (both keys of :data:`PRESSURE_UNITS`)."""
-    return value * PRESSURE_UNITS[_pressure_unit(from_unit)] / PRESSURE_UNITS[_pressure_unit(to_unit)]
+    factor = PRESSURE_UNITS[_pressure_unit(from_unit)] / PRESSURE_UNITS[_pressure_unit(to_unit)]
+    return value * factor
 
 
 def parse_pressure(text: str | float, unit: str, option: str) -> float:
