@@ -59,31 +59,6 @@ def test_text_is_utf8_and_the_folder_is_created(tmp_path):
         pass
 
 
-def test_staging_folders_of_dead_processes_are_removed_by_the_next_run(tmp_path):
-    import subprocess
-    import sys
-
-    from softbend._io import staged_dir
-
-    out = tmp_path / "models"
-    child = subprocess.run([sys.executable, "-c", "import os; print(os.getpid())"],
-                           capture_output=True, text=True, check=True)  # fmt: skip
-    dead_pid = int(child.stdout)  # a process that has exited
-    stale = tmp_path / f".models.{dead_pid}-abc123.new"
-    stale.mkdir()
-    (stale / "half.json").write_text("{")
-    mine = tmp_path / f".models.{os.getpid()}-live.new"  # a run of a live process
-    mine.mkdir()
-    unrelated = tmp_path / ".other.1-x.new"
-    unrelated.mkdir()
-    with staged_dir(out) as staging:
-        (staging / "model.json").write_text("{}")
-        assert staging.name.startswith(f".models.{os.getpid()}-")
-    assert not stale.exists()
-    assert mine.exists() and unrelated.exists()
-    assert (out / "model.json").exists()
-
-
 def test_json_text_is_strict_json_with_nan_as_null():
     import json
 

@@ -22,6 +22,7 @@ STAGES: tuple[tuple[str, ...], ...] = (
         "__init__",
         "_extras",
         "_io",
+        "_outdir",
         "_jsontext",
         "_lazy",
         "_names",

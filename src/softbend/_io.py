@@ -13,13 +13,10 @@ project through it.
 
 from __future__ import annotations
 
-import glob
 import json
 import math
 import os
-import shutil
 import stat
-import sys
 import tempfile
 from collections.abc import Iterator
 from contextlib import contextmanager
@@ -35,9 +32,6 @@ __all__ = [
     "new_file_mode",
     "read_header_csv",
     "read_input_text",
-    "remove_stale_staging",
-    "staged_dir",
-    "stale_staging",
     "write_bytes_atomic",
     "write_text_atomic",
 ]
@@ -269,101 +263,6 @@ def write_bytes_atomic(path: str | os.PathLike[str], data: bytes) -> Path:
     with atomic_file(path, "wb") as handle:
         handle.write(data)
     return Path(path)
-
-
-@contextmanager
-def staged_dir(path: str | os.PathLike[str]) -> Iterator[Path]:
-    """Yield a fresh folder beside ``path`` that replaces ``path`` when the block ends.
-
-    Everything is written into the staging folder; only when the block finishes
-    is the old ``path`` (if any) moved aside, the staging folder renamed to
-    ``path`` and the old one removed. If the block raises (or the process is
-    killed), ``path`` is untouched and the staging folder is removed (or left as
-    a hidden ``.NAME.PID-*.new`` folder, which the next run beside ``path``
-    removes once process PID is gone), so ``path`` is never a mix of an old and
-    a new run. On Linux the swap is one atomic ``renameat2(RENAME_EXCHANGE)``;
-    elsewhere it is two renames, and a kill between them leaves the old folder as
-    ``.NAME.old-PID`` beside a missing ``path``.
-    """
-    path = Path(path)
-    path.parent.mkdir(parents=True, exist_ok=True)
-    remove_stale_staging(path)
-    staging = Path(
-        tempfile.mkdtemp(dir=path.parent, prefix=f".{path.name}.{os.getpid()}-", suffix=".new")
-    )
-    os.chmod(staging, 0o777 & ~_umask())
-    try:
-        yield staging
-    except BaseException:
-        shutil.rmtree(staging, ignore_errors=True)
-        raise
-    if path.exists() and _exchange(staging, path):
-        shutil.rmtree(staging, ignore_errors=True)  # now holds the old folder
-        return
-    old = None
-    if path.exists():
-        old = path.with_name(f".{path.name}.old-{os.getpid()}")
-        os.replace(path, old)
-    os.replace(staging, path)
-    if old is not None:
-        shutil.rmtree(old, ignore_errors=True)
-
-
-def remove_stale_staging(path: str | os.PathLike[str]) -> list[Path]:
-    """Remove the staging folders of :func:`staged_dir` left beside ``path`` by dead processes.
-
-    A folder ``.NAME.PID-*.new`` is removed when no process PID exists; one of a
-    live process (a run still going, or an unrelated process that reuses the
-    PID) is kept. Returns the folders removed.
-    """
-    removed = []
-    for folder in stale_staging(path):
-        shutil.rmtree(folder, ignore_errors=True)
-        removed.append(folder)
-    return removed
-
-
-def stale_staging(path: str | os.PathLike[str]) -> list[Path]:
-    """The staging folders of :func:`staged_dir` beside ``path`` whose process is gone.
-
-    The folders ``.NAME.PID-*.new`` that :func:`remove_stale_staging` removes,
-    left in place: what a run killed before its swap had written, for a caller
-    that resumes from it first.
-    """
-    path = Path(path)
-    found = []
-    for folder in sorted(path.parent.glob(f".{glob.escape(path.name)}.*-*.new")):
-        pid_text = folder.name[len(path.name) + 2 :].split("-", 1)[0]
-        if not pid_text.isdigit() or not folder.is_dir() or _alive(int(pid_text)):
-            continue
-        found.append(folder)
-    return found
-
-
-def _alive(pid: int) -> bool:
-    try:
-        os.kill(pid, 0)
-    except (ProcessLookupError, OverflowError):  # no such process (or no such PID at all)
-        return False
-    except PermissionError:  # someone else's process
-        return True
-    return True
-
-
-def _exchange(a: Path, b: Path) -> bool:
-    """Swap two paths atomically (Linux ``renameat2(RENAME_EXCHANGE)``); False if unsupported."""
-    if not sys.platform.startswith("linux"):
-        return False
-    import ctypes
-
-    try:
-        libc = ctypes.CDLL(None, use_errno=True)
-        renameat2 = libc.renameat2
-    except (OSError, AttributeError):
-        return False
-    at_fdcwd, rename_exchange = -100, 2
-    result = renameat2(at_fdcwd, os.fsencode(a), at_fdcwd, os.fsencode(b), rename_exchange)
-    return result == 0
 
 
 def json_safe(value: Any) -> Any:

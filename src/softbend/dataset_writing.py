@@ -16,7 +16,6 @@ from typing import Any
 
 from softbend._io import json_text, write_text_atomic
 from softbend.datasets import (
-    _DATASET_FILES,
     _TABLE1_FEM,
     DESIGNS_FILE,
     PROVENANCE_FILE,
@@ -46,9 +45,10 @@ def write_dataset(
         Campaign database (see :class:`softbend.campaign.CampaignStore`).
     out_dir : path
         Folder of the dataset (created). It is written beside its place and
-        swapped in whole when complete (:func:`softbend._io.staged_dir`), so a
+        swapped in whole when complete (:func:`softbend._outdir.staged_dir`), so a
         reader, or a run that fails half-way, sees the old dataset or the new one;
-        an existing folder may hold only a dataset's three files.
+        an existing folder may hold only an earlier dataset
+        (:func:`softbend._outdir.check_replaceable`).
     command : str
         The command that produced the campaign, recorded for reproduction.
     description : str
@@ -75,19 +75,12 @@ def write_dataset(
         range (naming the column).
     """
     from softbend import __version__
-    from softbend._io import staged_dir
+    from softbend._outdir import check_replaceable, staged_dir
     from softbend.campaign.families import DEFAULT_FAMILY
     from softbend.campaign.store import CampaignStore
 
     out = Path(out_dir)
-    if out.is_dir():
-        others = sorted(p.name for p in out.iterdir() if p.name not in _DATASET_FILES)
-        if others:
-            raise DatasetError(
-                f"The dataset folder {out} holds other files than a dataset's "
-                f"({', '.join(others[:3])}{' …' if len(others) > 3 else ''}); it is replaced "
-                "as a whole: choose a new or empty folder."
-            )
+    check_replaceable(out, "campaign dataset", key="out_dir")
     with CampaignStore(db_path, read_only=True) as store:
         samples = store.load_samples()
         designs = store.load_designs()
@@ -110,7 +103,7 @@ def write_dataset(
     stats = [_stats_record(s, db_path) for s in designs["stats"] if isinstance(s, str) and s]
     options = {json.dumps(s.get("options"), sort_keys=True) for s in stats if "options" in s}
     files: dict[str, dict[str, Any]] = {}
-    with staged_dir(out) as stage:
+    with staged_dir(out, "campaign dataset") as stage:
         for name, frame in ((SAMPLES_FILE, samples), (DESIGNS_FILE, table)):
             frame.to_parquet(stage / name, compression="zstd", index=False)
             files[name] = {"bytes": (stage / name).stat().st_size, "sha256": _sha256(stage / name)}

@@ -24,6 +24,7 @@ import numpy as np
 import pandas as pd
 import pytest
 
+from softbend._outdir import MANIFEST
 from softbend.cli import main
 
 from .conftest import one_error_line
@@ -42,6 +43,14 @@ def _tree(folder: Path) -> dict[str, bytes | None]:
 def _staging(out: Path) -> list[str]:
     """The staging folders left beside ``out``."""
     return sorted(p.name for p in out.parent.glob(f".{out.name}.*.new"))
+
+
+def _unfinished_manifest(folder: Path, command: str) -> None:
+    """The manifest a run of ``command`` writes first into its staging folder (PID in the name)."""
+    pid = int(folder.name.split(".")[2].split("-")[0])
+    manifest = {"format": "softbend-output-manifest", "version": 1, "command": command,
+                "pid": pid, "complete": False, "entries": {}}  # fmt: skip
+    (folder / MANIFEST).write_text(json.dumps(manifest))
 
 
 def _full_disk(*args: object, **kwargs: object) -> None:
@@ -379,6 +388,7 @@ def test_fem_rerun_keeps_no_file_of_the_previous_run(tmp_path, capsys, fake_fem)
     assert [p.name for p in (out / "vtk").iterdir()] == ["shape_p0.000MPa.vtu"]
     assert json.loads((out / "sweep.json").read_text())["design"].startswith("120")
     assert sorted(p.name for p in out.iterdir()) == [
+        MANIFEST,
         "angle_pressure.png",
         "shapes.png",
         "sweep.csv",
@@ -422,7 +432,7 @@ def test_simulate_on_a_full_disk_leaves_the_previous_experiments(tmp_path, capsy
     out = tmp_path / "sim"
     assert main(_simulate(out, "--experiments", "6")) == 0
     before = _tree(out)
-    assert len(before) == 12
+    assert len(before) == 13  # the twelve experiments and the manifest
     lines = data._header_lines
     calls = []
 
@@ -447,9 +457,9 @@ def test_simulate_on_a_full_disk_leaves_the_previous_experiments(tmp_path, capsy
 def test_simulate_rerun_leaves_no_experiment_of_the_previous_run(tmp_path, capsys):
     out = tmp_path / "sim"
     assert main(_simulate(out, "--experiments", "6")) == 0
-    assert len(list(out.iterdir())) == 12
+    assert len(list(out.iterdir())) == 13
     assert main(_simulate(out, "--experiments", "1", "--seed", "1")) == 0
-    assert sorted(p.name for p in out.iterdir()) == ["negative-01.csv", "positive-01.csv"]
+    assert sorted(p.name for p in out.iterdir()) == [MANIFEST, "negative-01.csv", "positive-01.csv"]
 
 
 def test_simulate_prints_the_final_paths(tmp_path, capsys):
@@ -491,7 +501,7 @@ def test_simulate_killed_midway_leaves_the_previous_experiments(tmp_path):
     assert len(_staging(out)) == 1  # what the killed run had written, beside --out
     assert main(_simulate(out, "--experiments", "1", "--seed", "2")) == 0
     assert _staging(out) == []  # removed by the next run
-    assert sorted(p.name for p in out.iterdir()) == ["negative-01.csv", "positive-01.csv"]
+    assert sorted(p.name for p in out.iterdir()) == [MANIFEST, "negative-01.csv", "positive-01.csv"]
 
 
 def test_simulate_replaces_its_own_earlier_experiments_only(tmp_path, capsys):
@@ -592,7 +602,7 @@ def test_analyze_on_a_full_disk_leaves_the_previous_results(tmp_path, capsys, mo
     out = tmp_path / "analysis"
     assert main(["analyze", str(fake_db), "--out", str(out), "--json"]) == 0
     before = _tree(out)
-    assert len(before) == 5
+    assert len(before) == 6  # five files and the manifest
     monkeypatch.setattr(figures, "parity_plot", _full_disk)
     capsys.readouterr()
     assert main(["analyze", str(fake_db), "--out", str(out), "--mape-threshold-deg", "5"]) == 2
@@ -666,6 +676,7 @@ def test_reproduce_killed_resumes_the_campaign_and_removes_the_stage(
     (stale / "paper_b" / "campaign.duckdb").write_text("8\n")
     (stale / "paper_a").mkdir()
     (stale / "paper_a" / "result.txt").write_text("seed 1\n")
+    _unfinished_manifest(stale, "reproduce")  # what every staging folder starts with
     assert _tree(out) == before  # --out never saw the killed run
     assert main(_reproduce(out, 1)) == 0
     assert fake_reproduce["campaigns"] == [0, 8]  # resumed where the killed run was
@@ -700,7 +711,7 @@ def test_run_reproduce_refuses_a_folder_of_other_files(tmp_path, fake_reproduce)
     out = tmp_path / "mine"
     out.mkdir()
     (out / "data.csv").write_text("keep me\n")
-    with pytest.raises(ValueError, match=r"^out_dir: must be a new or empty"):
+    with pytest.raises(ValueError, match=r"^out_dir: .*mine is replaced as a whole .*\(data.csv\)"):
         run_reproduce(out)
     assert (out / "data.csv").read_text() == "keep me\n"
     assert os.listdir(tmp_path) == ["mine"]

@@ -21,7 +21,7 @@ from typing import Any
 
 import typer
 
-from softbend.cli import _common, _options
+from softbend.cli import _common, _options, _outputs
 
 app = typer.Typer(
     name="softbend",
@@ -153,19 +153,22 @@ def _noting_interrupts(callback: Callable[..., Any]) -> Callable[..., Any]:
     return run
 
 
-def _commands(typer_app: typer.Typer) -> Iterator[Any]:
-    """Every registered command of ``typer_app`` and its sub-apps."""
-    yield from typer_app.registered_commands
+def _commands(typer_app: typer.Typer, prefix: str = "") -> Iterator[tuple[str, Any]]:
+    """Every registered command of ``typer_app`` and its sub-apps, with its name (``fem run``)."""
+    for command in typer_app.registered_commands:
+        callback = command.callback
+        name = command.name or (callback.__name__.replace("_", "-") if callback else "")
+        yield f"{prefix}{name}", command
     for group in typer_app.registered_groups:
         if group.typer_instance is not None:
-            yield from _commands(group.typer_instance)
+            yield from _commands(group.typer_instance, f"{prefix}{group.name} ")
 
 
 def _note_interrupts() -> None:
-    for command in _commands(app):
+    for name, command in _commands(app):
         callback = command.callback
         if callback is not None and not getattr(callback, "_softbend_noting", False):
-            command.callback = _noting_interrupts(callback)
+            command.callback = _noting_interrupts(_outputs.running_as(name, callback))
 
 
 def _interrupted(args: Sequence[str]) -> int:

@@ -2,10 +2,13 @@
 
 from __future__ import annotations
 
+import functools
 import os
-from collections.abc import Iterator
+from collections.abc import Callable, Iterator
 from contextlib import contextmanager
+from contextvars import ContextVar
 from pathlib import Path
+from typing import Any
 
 from softbend.errors import SoftbendError
 
@@ -18,6 +21,7 @@ __all__ = [
     "file_kind",
     "os_error_message",
     "output_errors",
+    "running_as",
 ]
 
 
@@ -41,6 +45,7 @@ _REPLACEABLE: dict[str, set[str]] = {
     "png": {"PNG"},
     "csv": {"text"},
     "json": {"text"},
+    "model": {"softbend model"},
     "text": {"text"},
 }
 
@@ -65,6 +70,18 @@ def file_kind(path: Path) -> str:
         if exc.start < len(head) - 3:  # not just a character cut at 4096 bytes
             return "binary"
     return "text"
+
+
+def _is_softbend_model(path: Path) -> bool:
+    """Whether a JSON file is a model softbend saved (its ``format`` names softbend's)."""
+    import json
+
+    try:
+        with open(path, encoding="utf-8") as handle:
+            document = json.load(handle)
+    except (OSError, ValueError):
+        return False
+    return isinstance(document, dict) and str(document.get("format", "")).startswith("softbend-")
 
 
 def _same(a: Path, b: Path) -> bool:
@@ -92,7 +109,8 @@ def check_output_file(
 
     Refused: a folder; one of the command's ``inputs`` (the same file under any
     name); an existing file of another kind than ``kind`` (a key of
-    :data:`_REPLACEABLE`: an export never replaces a database); a file whose
+    :data:`_REPLACEABLE`: an export never replaces a database, a saved model only
+    replaces a model softbend saved); a file whose
     folder cannot be created or written.
     """
     path = Path(path)
@@ -103,6 +121,8 @@ def check_output_file(
             raise ValueError(f"The '{option}' {path} is also an input; choose another file.")
     if kind is not None and path.is_file():
         found = file_kind(path)
+        if found == "text" and kind == "model" and _is_softbend_model(path):
+            found = "softbend model"
         if found != "empty" and found not in _REPLACEABLE[kind]:
             raise ValueError(
                 f"The '{option}' must be a new file or a {kind} file to replace. "
@@ -144,43 +164,108 @@ def check_output_dir(
 
 
 def check_replaceable_dir(
-    path: Path,
-    option: str,
-    command: str,
-    *,
-    inputs: tuple[Path, ...] = (),
-    files: tuple[str, ...] | None = None,
-    marker: str | None = None,
+    path: Path, option: str, command: str | None = None, *, inputs: tuple[Path, ...] = ()
 ) -> None:
-    """Refuse an existing output folder that replacing it as a whole would lose data from.
+    """Refuse, before any work, an output folder that replacing it as a whole would lose from.
 
-    A command that builds its folder beside ``path`` and swaps it in (``staged_dir``)
-    deletes whatever the old folder held. Refused, before any work: a folder that
-    holds one of the command's ``inputs``; a folder with entries other than
-    ``files`` (the names the command writes); a non-empty folder without
-    ``marker`` (a file every earlier result of the command has).
+    The one rule of :mod:`softbend._outdir` for every command that writes a folder:
+    an existing ``path`` is replaced only when it is empty or holds nothing but an
+    earlier result of the same command (listed in its manifest, unchanged). Refused
+    with one line: the current folder or one above it; a folder with other entries
+    (naming them); a folder that holds one of the command's inputs. The inputs are
+    ``inputs`` and every file or folder named by an option or argument of the running
+    command (so an ``--actuator`` read from inside ``--out`` is refused too).
     """
-    path = Path(path)
-    if not path.is_dir():
-        return
-    folder = Path(os.path.abspath(path))
-    for source in inputs:  # (a missing input is reported by its reader)
-        if Path(source).exists() and folder in Path(os.path.abspath(source)).parents:
+    from softbend._outdir import check_replaceable, replaceable_target
+    from softbend.errors import InputError
+
+    try:
+        target = replaceable_target(path)
+    except InputError as exc:
+        raise ValueError(f"The '{option}' {exc.detail}") from None
+    for name, source in (*_named_inputs(option), *((None, Path(p)) for p in inputs)):
+        if not Path(source).exists():  # (a missing input is reported by its reader)
+            continue
+        found = Path(os.path.realpath(source))
+        if found == target or target in found.parents:
+            given = f"the '{name}' {source}" if name else f"the input {source}"
             raise ValueError(
-                f"The '{option}' {path} holds the input {source}, and the folder is replaced "
-                "as a whole by the new results; choose another folder."
+                f"The '{option}' {path} holds {given}, and the folder is replaced as a whole "
+                "by the new results; move the input or choose another folder."
             )
-    entries = sorted(p.name for p in path.iterdir())
-    others = [name for name in entries if files is not None and name not in files]
-    if marker is not None and entries and marker not in entries:
-        others = others or entries
-    if others:
-        shown = ", ".join(others[:3]) + (f" and {len(others) - 3} more" if len(others) > 3 else "")
-        raise ValueError(
-            f"The '{option}' {path} is replaced as a whole by the results of '{command}', but "
-            f"it holds other files ({shown}); choose a new or empty folder, or one of its "
-            "earlier results."
-        )
+    try:
+        check_replaceable(path, command)
+    except InputError as exc:
+        raise ValueError(f"The '{option}' {exc.detail}") from None
+
+
+#: The command line's running command: its parameters' labels (``--actuator``, ``DB``) and
+#: values, set by :func:`running_as` for the paths :func:`check_replaceable_dir` refuses.
+_ARGUMENTS: ContextVar[tuple[tuple[str, object], ...]] = ContextVar("arguments", default=())
+
+
+def running_as(command: str, callback: Callable[..., Any]) -> Callable[..., Any]:
+    """``callback``, a command's function, run as the command ``command`` (``"fem run"``).
+
+    While it runs, output folders are written as that command's
+    (:func:`softbend._outdir.running`) and its arguments are known to
+    :func:`check_replaceable_dir`, which refuses an input read from inside ``--out``.
+    """
+    from softbend._outdir import running
+
+    labels = _labels(callback)
+
+    @functools.wraps(callback)
+    def run(*args: Any, **kwargs: Any) -> Any:
+        arguments = tuple((labels.get(k, k), v) for k, v in kwargs.items())
+        token = _ARGUMENTS.set(arguments)
+        try:
+            with running(command):
+                return callback(*args, **kwargs)
+        finally:
+            _ARGUMENTS.reset(token)
+
+    return run
+
+
+def _labels(callback: Callable[..., Any]) -> dict[str, str]:
+    """Each parameter of a command's function as a user types it: ``--actuator``, or ``DB``."""
+    import inspect
+    import typing
+
+    try:
+        hints = typing.get_type_hints(callback, include_extras=True)
+    except Exception:  # an annotation that does not resolve: the defaults still name options
+        hints = {}
+    labels = {}
+    for name, parameter in inspect.signature(callback).parameters.items():
+        found = [parameter.default, *getattr(hints.get(name), "__metadata__", ())]
+        decls = [d for info in found for d in (getattr(info, "param_decls", None) or ())]
+        long = [d for d in decls if isinstance(d, str) and d.startswith("--")]
+        labels[name] = long[0] if long else f"--{name.replace('_', '-')}"
+        if any(type(info).__name__ == "ArgumentInfo" for info in found):
+            labels[name] = name.upper()
+    return labels
+
+
+def _named_inputs(option: str) -> list[tuple[str, Path]]:
+    """Every existing path an option or argument of the running command names, but ``option``."""
+    found = []
+    for label, value in _ARGUMENTS.get():
+        if label == option:
+            continue
+        values = value if isinstance(value, list | tuple) else [value]
+        for item in values:
+            if isinstance(item, str | os.PathLike) and str(item) and _exists(item):
+                found.append((label, Path(item)))
+    return found
+
+
+def _exists(item: str | os.PathLike[str]) -> bool:
+    try:
+        return os.path.lexists(item)
+    except (OSError, ValueError):  # a name too long, a NUL byte: not a path
+        return False
 
 
 def _concerns(exc: OSError, path: Path) -> bool:

@@ -63,7 +63,8 @@ def analyze(
     \b
         softbend analyze table1.duckdb --out analysis
     """
-    from softbend._io import staged_dir, write_text_atomic
+    from softbend._io import write_text_atomic
+    from softbend._outdir import staged_dir
     from softbend.analysis import analyze_samples
     from softbend.errors import DatasetError
     from softbend.reports.analysis_figures import campaign_analysis_figures
@@ -74,9 +75,7 @@ def analyze(
         raise DatasetError(f"Campaign database {str(db)!r} is a folder, not a DuckDB file.")
     out = Path(out)
     _common.check_output_dir(out, "--out", inputs=(db,), files=FILES)
-    _common.check_replaceable_dir(
-        out, "--out", "analyze", inputs=(db,), files=FILES, marker=COEFFICIENTS_CSV
-    )
+    _common.check_replaceable_dir(out, "--out", inputs=(db,))
 
     from softbend.campaign.store import load_samples
 

@@ -236,6 +236,7 @@ def dataset(
     planned = _planned_designs(db, space) if space is not None else None
     written = (SAMPLES_FILE, DESIGNS_FILE, PROVENANCE_FILE)
     _common.check_output_dir(out, "--out", inputs=(db,), files=written)
+    _common.check_replaceable_dir(out, "--out", inputs=(db,))
     # write_dataset reads and checks the whole campaign before it writes anything
     with _common.output_errors(out, "--out"):
         provenance = write_dataset(

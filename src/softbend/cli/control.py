@@ -87,12 +87,12 @@ def simulate_cmd(
     """
     import signal
 
-    from softbend._io import staged_dir
+    from softbend._outdir import staged_dir
     from softbend.control.runs import simulate_control
     from softbend.reports import control_figures
 
     _common.check_output_dir(out, "--out", files=_FILES)
-    _common.check_replaceable_dir(out, "--out", "control simulate", files=_FILES, marker=_FILES[1])
+    _common.check_replaceable_dir(out, "--out")
     previous = control_run.terminate_as_interrupt()  # `kill`: staged results removed
     try:
         with _common.library_progress(enabled=not as_json):  # an FEM plant's sweep, if any

@@ -17,8 +17,6 @@ if TYPE_CHECKING:
     from softbend.control.setup import ControlSetup
 
 _LOG_FORMATS = ("csv", "parquet")
-#: What an earlier result in --out may hold (it is replaced as a whole).
-_REPLACEABLE = ("ticks.csv", "ticks.parquet", "ticks.csv.partial", "run.json", "run.png")
 
 
 def run_cmd(
@@ -97,7 +95,7 @@ def run_cmd(
     \b
         softbend control run --out loop --config rig.toml --set deadzone=0.02
     """
-    from softbend._io import staged_dir
+    from softbend._outdir import staged_dir
     from softbend._validation import check_choice
     from softbend.control.runs import plan_loop
     from softbend.reports import control_figures
@@ -105,9 +103,7 @@ def run_cmd(
     check_choice(log_format, "log_format", _LOG_FORMATS)
     log_name = f"ticks.{log_format}"
     _common.check_output_dir(out, "--out", files=(log_name, "run.json", "run.png"))
-    _common.check_replaceable_dir(
-        out, "--out", "control run", files=_REPLACEABLE, marker="run.json"
-    )
+    _common.check_replaceable_dir(out, "--out")
     with _common.library_progress():  # an FEM plant's sweep, if any
         plan = plan_loop(
             rig=rig, config=config, reference=reference, controller=controller,

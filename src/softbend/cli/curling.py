@@ -2,7 +2,6 @@
 
 from __future__ import annotations
 
-import re
 from pathlib import Path
 from typing import Any
 
@@ -49,16 +48,14 @@ def simulate(
     \b
         softbend curling simulate --out experiments --experiments 6
     """
-    from softbend._io import staged_dir
+    from softbend._outdir import staged_dir
     from softbend.identification.data import save_experiments
     from softbend.identification.synthetic import check_synthetic_size, synthetic_dataset
 
     check_synthetic_size(samples, dt)
     out = Path(out)
     _common.check_output_dir(out, "--out")
-    _common.check_replaceable_dir(
-        out, "--out", "curling simulate", files=_simulated_files(out), marker=None
-    )
+    _common.check_replaceable_dir(out, "--out")
     choice: Any = excitation  # one of EXCITATIONS: synthetic_dataset checks it
     dataset = synthetic_dataset(
         n_experiments=experiments, n_samples=samples, dt_s=dt, seed=seed, excitation=choice
@@ -114,32 +111,6 @@ IDENTIFY_FILES: tuple[str, ...] = (
     "selection_positive",
     "selection_negative",
 )
-
-#: The name of an experiment file of ``curling simulate``: ``positive-01.csv``, …
-_SIMULATED_NAME = re.compile(r"(positive|negative)-[0-9]{2,}\.csv")
-
-
-def _simulated_files(folder: Path) -> tuple[str, ...]:
-    """The files in ``folder`` that ``curling simulate`` wrote: its names, labelled synthetic.
-
-    A file counts when its name is one the command gives and its header
-    comments, before the column header, say ``# synthetic: true``; the rest of
-    the folder (a measurement of the same name included) is the user's.
-    """
-    if not folder.is_dir():
-        return ()
-    own = []
-    for path in folder.iterdir():
-        if not (_SIMULATED_NAME.fullmatch(path.name) and path.is_file()):
-            continue
-        try:
-            with open(path, encoding="utf-8", errors="replace") as handle:
-                head = [handle.readline().strip() for _ in range(8)]
-        except OSError:
-            continue
-        if "# synthetic: true" in head:
-            own.append(path.name)
-    return tuple(own)
 
 
 @app.command("identify")
@@ -214,7 +185,7 @@ def identify(
     if not Path(data).exists():  # one line naming it, before the fitting's imports (seconds)
         experiment_files(data)
 
-    from softbend._io import staged_dir
+    from softbend._outdir import staged_dir
     from softbend.identification.resources import check_identify_memory
     from softbend.identification.study import (
         IdentificationConfig,
@@ -233,9 +204,7 @@ def identify(
     inputs = (data, *csvs)
     out = Path(out)
     _common.check_output_dir(out, "--out", inputs=inputs, files=("metrics.csv", "summary.csv"))
-    _common.check_replaceable_dir(
-        out, "--out", "curling identify", inputs=inputs, files=IDENTIFY_FILES, marker="metrics.csv"
-    )
+    _common.check_replaceable_dir(out, "--out", inputs=inputs)
     experiment_files(data)  # missing data and files over the size limit: refused first
     need = check_identify_memory(data, max_memory_mb=max_memory_mb)
     if not as_json and need.csv_bytes >= 4 * 2**20:  # long enough to be worth a line

@@ -252,7 +252,7 @@ def find(
         softbend design find --model pneunet.json --angle 90 --at 30 \\
             --minimize n_chambers --fix layer=paper --range wall_mm=1:2 --out design
     """
-    from softbend._io import staged_dir
+    from softbend._outdir import staged_dir
     from softbend.design_search import spec as specs
     from softbend.design_search.search import TOP, LoadedModel, find_designs, searched_ranges
     from softbend.design_search.space import space_of
@@ -264,9 +264,7 @@ def find(
     model_path = shipped_base_path() if model is None else Path(model)
     inputs = tuple(p for p in (model, spec) if p is not None)
     _common.check_output_dir(out, "--out", inputs=inputs)
-    _common.check_replaceable_dir(
-        out, "--out", "design find", inputs=inputs, files=None, marker="search.json"
-    )
+    _common.check_replaceable_dir(out, "--out", inputs=inputs)
     _check_count(top, "top", TOP)
     elastomer = _verification(ctx, verify, backend, workers, material)
     loaded = LoadedModel.load(model_path)  # read once; its actuator names the parameters

@@ -183,7 +183,8 @@ def run(
 
     import numpy as np
 
-    from softbend._io import staged_dir, write_text_atomic
+    from softbend._io import write_text_atomic
+    from softbend._outdir import staged_dir
     from softbend._validation import check_int
     from softbend.design import SFRBADesign
     from softbend.fem.families import get_family
@@ -213,7 +214,7 @@ def run(
     check_int(shapes, "shapes", low=1)
     out = Path(out)
     _common.check_output_dir(out, "--out", files=RUN_FILES[:-1])
-    _common.check_replaceable_dir(out, "--out", "fem run", files=RUN_FILES, marker=SWEEP_JSON)
+    _common.check_replaceable_dir(out, "--out")
     grid = np.sort(np.asarray(pressures, dtype=float))
     with (
         _common.output_errors(out, "--out"),

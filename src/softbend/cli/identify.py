@@ -69,7 +69,7 @@ def identify(
         softbend identify arm/ --inputs p1_kpa,p2_kpa,p3_kpa --outputs x_mm,y_mm \\
             --time time_s --validate-on val01,val02 --out arm-model
     """
-    from softbend._io import staged_dir
+    from softbend._outdir import staged_dir
     from softbend.identification.data import experiment_files
     from softbend.identification.ranges import (
         FOLDS_RANGE,
@@ -95,9 +95,7 @@ def identify(
     if max_memory_mb is not None:
         check_number(max_memory_mb, MAX_MEMORY_MB_RANGE, "max_memory_mb")
     _common.check_output_dir(out, "--out", inputs=(data,))
-    _common.check_replaceable_dir(
-        out, "--out", "identify", inputs=(data,), files=FILES, marker="selection.json"
-    )
+    _common.check_replaceable_dir(out, "--out", inputs=(data,))
     began, cpu_began = perf_counter(), process_time()
     experiment_files(data)  # a missing path or a folder without CSV: refused first
     need = check_identify_memory(data, max_memory_mb=max_memory_mb)

@@ -147,9 +147,7 @@ def train(
     )
     _common.check_output_dir(out, "--out", inputs=(db,))
     # the folder is swapped whole: nothing but an earlier result of this command may be lost
-    _common.check_replaceable_dir(
-        out, "--out", "softbend train", inputs=(db,), marker="cv_results.csv"
-    )
+    _common.check_replaceable_dir(out, "--out", inputs=(db,))
 
     def resuming(line: str) -> None:
         _common.err_console.print(line, highlight=False, soft_wrap=True)

@@ -49,7 +49,7 @@ def base(
 
     check_int(epochs, "epochs", low=1)
     check_limit("epochs", epochs, "--epochs")
-    _common.check_output_file(out, "--out", kind="json")
+    _common.check_output_file(out, "--out", kind="model")
     # heavy (PyTorch, scikit-learn: seconds): after the arguments' checks
     from softbend._io import json_safe
     from softbend.surrogates.persistence import save_surrogate
@@ -132,7 +132,7 @@ def refine(
         check_limit("epochs", epochs, "--epochs")
         values["epochs"] = str(epochs)
     _check_inputs(base, measurements)
-    _common.check_output_file(out, "--out", inputs=(base, *measurements), kind="json")
+    _common.check_output_file(out, "--out", inputs=(base, *measurements), kind="model")
     from softbend.transfer.refine import refine_surrogate  # heavy: after the arguments' checks
 
     with _common.library_progress():  # the refit's epochs, then the calibration's

@@ -85,7 +85,7 @@ def loco(
             --strategies refined,scale-offset --set epochs=500
         softbend transfer loco lab.csv bench.csv --out loco
     """
-    from softbend._io import staged_dir
+    from softbend._outdir import staged_dir
     from softbend.actuators import SFRBA
     from softbend.reports import transfer_figures
     from softbend.transfer.actuator_measurements import load_actuator_measurements
@@ -100,7 +100,7 @@ def loco(
     out = Path(out)
     inputs = tuple(measurements) if base is None else (*measurements, base)
     _common.check_output_dir(out, "--out", inputs=inputs, files=LOCO_FILES)
-    _common.check_replaceable_dir(out, "--out", "transfer loco", inputs=inputs, files=LOCO_FILES)
+    _common.check_replaceable_dir(out, "--out", inputs=inputs)
     saved = load_base_saved(base)
     actuator = saved.actuator
     paper_b = actuator == SFRBA

@@ -24,7 +24,7 @@ section, returning its results); this module and the section modules of
 :mod:`softbend.reports` draw those results and write the HTML.
 
 The folder is written as a whole: every section writes into a staging folder
-beside ``out_dir`` (:func:`softbend._io.staged_dir`), swapped in once
+beside ``out_dir`` (:func:`softbend._outdir.staged_dir`), swapped in once
 ``summary.json`` is written, so ``out_dir`` holds one run, never a mix of two,
 and a run that fails or is killed leaves the previous report as it was. The one
 thing carried over is the campaign database, so that the campaign resumes: the
@@ -48,10 +48,10 @@ from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
 from softbend import __version__
-from softbend._io import json_text, staged_dir, stale_staging, write_text_atomic
+from softbend._io import json_text, write_text_atomic
+from softbend._outdir import check_replaceable, staged_dir, stale_staging
 from softbend._validation import check_range
 from softbend.design import DesignSpace
-from softbend.errors import InputError
 from softbend.pipeline import Progress
 from softbend.references import FEM_DATASET
 from softbend.reports.html import Report
@@ -61,20 +61,7 @@ if TYPE_CHECKING:
 
 logger = logging.getLogger(__name__)
 
-__all__ = ["ENTRIES", "MARKER", "Progress", "run_reproduce"]
-
-#: Everything :func:`run_reproduce` writes into its folder, which it replaces as a whole.
-ENTRIES: tuple[str, ...] = (
-    "index.html",
-    "summary.json",
-    "paper_a",
-    "paper_b",
-    "paper_b_fem",
-    "transfer",
-    "control",
-    "design",
-    "pneunet",
-)
+__all__ = ["MARKER", "Progress", "run_reproduce"]
 
 #: The file every finished report folder has (written last).
 MARKER = "summary.json"
@@ -245,9 +232,9 @@ def run_reproduce(
             )
         )
     out_dir = Path(out_dir)
-    _check_replaceable(out_dir)
+    check_replaceable(out_dir, "reproduce", key="out_dir")
     _rescue_interrupted(out_dir)
-    with staged_dir(out_dir) as stage:
+    with staged_dir(out_dir, "reproduce") as stage:
         _seed_campaign(stage, out_dir)
         try:
             summary = _run_into(
@@ -403,23 +390,6 @@ def _renamed(value: Any, staged: str, final: str) -> Any:
     return value
 
 
-def _check_replaceable(out_dir: Path) -> None:
-    """Refuse an ``out_dir`` whose files replacing it as a whole would lose."""
-    if out_dir.exists() and not out_dir.is_dir():
-        raise InputError(f"must be a folder; got the file {out_dir}", key="out_dir")
-    if not out_dir.is_dir():
-        return
-    entries = sorted(p.name for p in out_dir.iterdir())
-    others = [name for name in entries if name not in ENTRIES]
-    if others or (entries and MARKER not in entries):
-        shown = ", ".join((others or entries)[:3])
-        raise InputError(
-            f"must be a new or empty folder or an earlier report's (with {MARKER}); it is "
-            f"replaced as a whole; got {out_dir}, which holds other files ({shown})",
-            key="out_dir",
-        )
-
-
 def _campaign_time(folder: Path) -> float:
     """When the campaign database under ``folder`` last changed (-inf: there is none)."""
     if not (folder / _CAMPAIGN).is_file():
@@ -447,7 +417,7 @@ def _rescue_interrupted(out_dir: Path) -> None:
     """Keep the campaign database of a killed run for this one, before its folder is removed.
 
     A run killed before its swap leaves its staging folder beside ``out_dir``
-    (removed by :func:`~softbend._io.staged_dir`); a database there newer than
+    (removed by :func:`~softbend._outdir.staged_dir`); a database there newer than
     the one kept aside (and than ``out_dir``'s) moves to :func:`_resume_dir`.
     """
     kept = _resume_dir(out_dir)

@@ -371,14 +371,14 @@ def train_into(
     softbend.registry.UnknownNameError
         An unknown family, before anything is written.
     """
-    from softbend._io import staged_dir
+    from softbend._outdir import staged_dir
     from softbend.surrogates.checkpoint import SearchCheckpoint, checkpoint_path
 
     names = family_names(models)
     out = Path(out_dir)
     checkpoint = SearchCheckpoint(checkpoint_path(out), on_resume=on_resume, on_discard=on_discard)
     with checkpoint:
-        with staged_dir(out) as stage:
+        with staged_dir(out, "train") as stage:
             result, summary = train_surrogates(
                 source, stage, models=names, checkpoint=checkpoint, **options
             )

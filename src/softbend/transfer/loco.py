@@ -145,7 +145,7 @@ class LocoResult:
 
         Each file is written whole (temporary file, then rename); ``loco.json`` is
         strict JSON (NaN as null). The command line writes the folder as a whole
-        (:func:`softbend._io.staged_dir`).
+        (:func:`softbend._outdir.staged_dir`).
         """
         folder = Path(out)
         folder.mkdir(parents=True, exist_ok=True)
