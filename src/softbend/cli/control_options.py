@@ -6,7 +6,9 @@ import typer
 
 REFERENCE = typer.Option(
     "step:90",
-    help="step:AMP[:T0_S], square:AMP:PERIOD_S[:LOW] or triangle:FREQ_HZ:AMP[:LOW] (degrees).",
+    help="step:AMP[:T0_S], square:AMP:PERIOD_S[:LOW], triangle:FREQ_HZ:AMP[:LOW] or "
+    "sine:AMP:PERIOD_S[:OFFSET] (angles in degrees, times in s): the square, triangle and sine "
+    "swing between LOW or OFFSET (default 0) at t = 0 and AMP.",
 )
 CONTROLLER = typer.Option(
     None,
