@@ -332,6 +332,16 @@ def test_identify_refuses_an_output_whose_figures_could_not_be_finite(
     assert not out.exists()
 
 
+def test_one_recording_with_a_constant_input_is_one_line(tmp_path, capsys, no_fit):
+    path = tmp_path / "rec.csv"
+    path.write_text("u,p_kpa,y\n" + "".join(f"{i % 7},101.325,{i % 5}\n" for i in range(200)))
+    out = tmp_path / "out"
+    args = ["identify", str(path), "--inputs", "u,p_kpa", "--outputs", "y", "--out", str(out)]
+    assert main(args) == 2
+    assert "The input column 'p_kpa' is constant" in one_error_line(capsys)
+    assert not out.exists()
+
+
 def test_identify_refuses_a_constant_input_naming_the_column(tmp_path, capsys, no_fit):
     rng = np.random.default_rng(0)
     experiments = []

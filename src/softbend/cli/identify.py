@@ -132,11 +132,12 @@ def identify(
     if len(series.experiments) == 1:  # one recording: segments of it, or a refusal
         split = _split_one_recording(series, experiment, held, folds)
         series, held = split.data, list(split.validation)
-        _common.err_console.print(split.summary(), highlight=False)  # also with --json
     check_holdout(series, held)
     check_signals(series, held)  # a constant or huge output: refused before any fit
     # every candidate's regressor must fit in every experiment (the longest lags: 3)
     check_experiments_for_lags(series, max(c.build(10).max_lag for c in default_candidates(seed)))
+    if split is not None:  # said once the data passed its checks (an error stays one line)
+        _common.err_console.print(split.summary(), highlight=False)  # also with --json
     with _common.library_progress(enabled=not as_json):
         selection = select_model(series, validate_on=held, folds=folds, seed=seed)
     if split is not None:
