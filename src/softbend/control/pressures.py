@@ -40,13 +40,13 @@ def run_pressure_unit(model: str | Path | None, plant: str) -> str:
         model file that cannot be read (as the run itself would say).
     """
     from softbend.control.identified_plant import identified_plant, is_identified_plant
-    from softbend.control.plants import check_plant
-    from softbend.control.setup import _plant_model
+    from softbend.control.plants import check_plant, plant_file
     from softbend.surrogates.persistence import load_surrogate
 
     with keyed("plant"):
         check_plant(plant)
-        path = _plant_model(plant)
+        path = plant_file(plant)
+        path = path if path is not None and path.suffix.lower() == ".json" else None
         if path is not None and is_identified_plant(path):
             return identified_plant(path).input_unit
         if path is not None:
