@@ -66,6 +66,57 @@ def test_bad_rig_parameters_exit_2_with_one_line(tmp_path, capsys, args, needles
     assert not (tmp_path / "o").exists()
 
 
+@pytest.mark.parametrize(
+    ("args", "needles"),
+    [
+        (
+            ["--rig-param", "supply_gauge_mpa=400psi"],
+            ["--rig-param: supply_gauge_mpa: must be in (0, 2] MPa", "(given as '400psi')"],
+        ),
+        (
+            ["--rig-param", "sensor_noise_mpa=1bars"],
+            ["--rig-param: sensor_noise_mpa: unknown pressure unit 'bars'; allowed: Pa, kPa"],
+        ),
+        (["--rig-param", "tubing_mm3=5kPa"], ["--rig-param: tubing_mm3: must be a number"]),
+        (
+            ["--supply", "20bars"],
+            ["--supply: must be a pressure: a number, optionally with a unit (Pa, kPa, MPa"],
+        ),
+        (
+            ["--supply", "400psi"],
+            ["--supply: must be a gauge pressure in (0, 2] MPa", "got 400psi (2.7579 MPa)"],
+        ),
+        (
+            ["--supply", "20psi", "--rig-param", "supply_gauge_mpa=0.2"],
+            ["--supply: must equal the rig setting supply_gauge_mpa"],
+        ),
+    ],
+)
+def test_bad_pressures_with_units_exit_2_with_one_line(tmp_path, capsys, args, needles):
+    assert _simulate(tmp_path / "o", *args) == 2
+    line = one_error_line(capsys)
+    for needle in needles:
+        assert needle in line, line
+    assert not (tmp_path / "o").exists()
+
+
+@pytest.mark.parametrize(
+    ("args", "supply_mpa", "noise_mpa"),
+    [
+        (["--supply", "20psi"], 20 * 6.894757293168e-3, 0.0005),
+        (["--supply", "200kPa", "--rig-param", "supply_gauge_mpa=0.2"], 0.2, 0.0005),
+        (["--rig-param", "supply_gauge_mpa=3bar", "--rig-param", "sensor_noise_mpa=1kPa"],
+         0.3, 0.001),
+        (["--supply", "0.15"], 0.15, 0.0005),  # paper B's model is in MPa: a bare number too
+    ],
+)  # fmt: skip
+def test_supply_and_rig_pressures_take_a_unit(tmp_path, capsys, args, supply_mpa, noise_mpa):
+    assert _simulate(tmp_path / "o", *args, "--json") == 0
+    rig = json.loads(capsys.readouterr().out)["rig"]
+    assert rig["supply_gauge_mpa"] == pytest.approx(supply_mpa, rel=1e-12)
+    assert rig["sensor_noise_mpa"] == pytest.approx(noise_mpa, rel=1e-12)
+
+
 def test_the_same_supply_twice_is_accepted(tmp_path, capsys):
     args = ["--supply", "0.25", "--rig-param", "supply_gauge_mpa=0.25", "--json"]
     assert _simulate(tmp_path / "o", *args) == 0

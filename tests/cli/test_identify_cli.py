@@ -142,13 +142,75 @@ def test_bad_input_is_one_line_exit_2(recording, tmp_path, capsys, extra, edit, 
     assert len(err) == 1 and needle in err[0], err
 
 
-def test_one_experiment_only_has_nothing_to_hold_out(recording, tmp_path, capsys):
+def test_an_experiment_column_of_one_experiment_names_the_option(recording, tmp_path, capsys):
     _, data = recording
     one = tmp_path / "one.csv"
     save_timeseries(data.subset(data.names[:1]), one)
     assert main(["identify", str(one), *ARGS, "--out", str(tmp_path / "x")]) == 2
-    err = capsys.readouterr().err.strip().splitlines()
-    assert len(err) == 1 and "hold" in err[0]
+    line = one_error_line(capsys)
+    assert "--experiment: the column 'experiment' names one experiment" in line, line
+    assert "nothing to hold out" in line and "--validate-on" not in line, line
+
+
+def _arx_only(monkeypatch):
+    """The linear ARX candidates only: the split, not the search, is tested here."""
+    from softbend.identification import selection as selection_module
+
+    every = selection_module.default_candidates
+    monkeypatch.setattr(
+        selection_module,
+        "default_candidates",
+        lambda seed=0, **kw: [c for c in every(seed) if c.family == "arx"],
+    )
+
+
+def test_one_recording_is_split_into_segments_and_says_which_samples_went_where(
+    tmp_path, capsys, monkeypatch
+):
+    _arx_only(monkeypatch)
+    rng = np.random.default_rng(3)
+    u = rng.normal(size=200)
+    y = np.convolve(u, [0.0, 0.5, 0.25], mode="full")[:200]
+    path = tmp_path / "rec.csv"
+    rows = np.column_stack([0.02 * np.arange(200), u, y]).tolist()
+    path.write_text("t,u,y\n" + "".join(",".join(map(repr, row)) + "\n" for row in rows))
+    out = tmp_path / "out"
+    args = ["identify", str(path), "--inputs", "u", "--outputs", "y", "--time", "t"]
+    assert main([*args, "--out", str(out)]) == 0
+    err = capsys.readouterr().err
+    said = ("One recording ('rec', 200 samples, no experiment column): split into 5 contiguous "
+            "segments; selection on samples 0–159 (4 segments, one cross-validation fold each), "
+            "validation on samples 160–199 (the last segment).")  # fmt: skip
+    assert said in err, err
+    record = json.loads((out / "selection.json").read_text())
+    assert record["validation"] == ["rec[160:200]"] and len(record["train"]) == 4
+    segments = record["split"]["segments"]
+    assert [(s["first_sample"], s["last_sample"], s["role"]) for s in segments] == [
+        (0, 39, "selection"), (40, 79, "selection"), (80, 119, "selection"),
+        (120, 159, "selection"), (160, 199, "validation"),
+    ]  # fmt: skip
+
+
+@pytest.mark.parametrize(
+    ("samples", "extra", "said"),
+    [
+        (60, [], "--experiment: not given, and the data is one recording 'rec'"),
+        (200, ["--validate-on", "rec"], "--validate-on: names experiments, but the data is one "
+                                        "recording ('rec', no --experiment column)"),
+    ],
+    ids=["too-short", "validate-on"],
+)  # fmt: skip
+def test_one_recording_that_cannot_be_split_names_the_option(
+    tmp_path, capsys, no_fit, samples, extra, said
+):
+    path = tmp_path / "rec.csv"
+    path.write_text("u,y\n" + "".join(f"{i % 7},{i % 5}\n" for i in range(samples)))
+    out = tmp_path / "out"
+    args = ["identify", str(path), "--inputs", "u", "--outputs", "y", *extra]
+    assert main([*args, "--out", str(out)]) == 2
+    line = one_error_line(capsys)
+    assert said in line, line
+    assert not out.exists()
 
 
 def test_an_experiment_shorter_than_the_lags_is_one_line(recording, tmp_path, capsys):
@@ -251,8 +313,13 @@ def test_identify_validate_on_is_checked_before_any_fit(tmp_path, capsys, no_fit
             ["--validate-on", "d"],
             "'z' is constant over the training experiments",
         ),
+        (
+            lambda k, y: np.full_like(y, 2.5) + 1e-12 * (y > 0),
+            [],
+            "The output column 'z' is near-constant over the training experiments",
+        ),
     ],
-    ids=["constant", "1e301", "constant-in-training"],
+    ids=["constant", "1e301", "constant-in-training", "near-constant"],
 )
 def test_identify_refuses_an_output_whose_figures_could_not_be_finite(
     tmp_path, capsys, no_fit, z_of, extra, said
@@ -263,6 +330,34 @@ def test_identify_refuses_an_output_whose_figures_could_not_be_finite(
     line = one_error_line(capsys)
     assert said in line and "nan" not in line.lower(), line
     assert not out.exists()
+
+
+def test_one_recording_with_a_constant_input_is_one_line(tmp_path, capsys, no_fit):
+    path = tmp_path / "rec.csv"
+    path.write_text("u,p_kpa,y\n" + "".join(f"{i % 7},101.325,{i % 5}\n" for i in range(200)))
+    out = tmp_path / "out"
+    args = ["identify", str(path), "--inputs", "u,p_kpa", "--outputs", "y", "--out", str(out)]
+    assert main(args) == 2
+    assert "The input column 'p_kpa' is constant" in one_error_line(capsys)
+    assert not out.exists()
+
+
+def test_identify_refuses_a_constant_input_naming_the_column(tmp_path, capsys, no_fit):
+    rng = np.random.default_rng(0)
+    experiments = []
+    for name in "abcd":
+        u = rng.normal(size=40)
+        y = np.cumsum(u) * 0.1
+        still = np.full(40, 101.325)
+        experiments.append(Series(name, np.arange(40.0), np.column_stack([u, still]), y))
+    path = tmp_path / "rec.csv"
+    save_timeseries(TimeSeriesSet(("u", "p_kpa"), ("y",), tuple(experiments), "t"), path)
+    out = tmp_path / "out"
+    args = ["identify", str(path), "--inputs", "u,p_kpa", "--outputs", "y"]
+    assert main([*args, "--experiment", "experiment", "--out", str(out)]) == 2
+    line = one_error_line(capsys)
+    assert "The input column 'p_kpa' is constant over the training experiments" in line, line
+    assert "leave it out of the inputs" in line and not out.exists()
 
 
 # ---------------------------------------------------------- softbend curling identify

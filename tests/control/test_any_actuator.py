@@ -22,8 +22,9 @@ from softbend.design import SFRBADesign
 
 #: A design inside the training data, given by name.
 DESIGN = "n_chambers=10,wall_mm=2,height_mm=10,layer=paper"
-#: The rig's supply for the actuator (60 kPa: past the 50 kPa it was swept to).
-SUPPLY = "0.06"
+#: The rig's supply for the actuator (60 kPa: past the 50 kPa it was swept to), with its
+#: unit: a bare number would be in the unit of the plant (kPa or MPa).
+SUPPLY = "60kPa"
 SHIPPED_MLP = "src/softbend/data/transfer/table1_fem_mlp.json"
 
 
@@ -138,6 +139,35 @@ def test_the_rig_converts_the_models_pressure_unit(models):
     a, b = runs["kPa"].run.frame(), runs["MPa"].run.frame()
     np.testing.assert_allclose(a["angle_deg"], b["angle_deg"], atol=1e-6)
     assert runs["MPa"].summary["model_pressure_unit"] == "MPa"
+
+
+@pytest.mark.parametrize(
+    ("unit", "role", "supply"),
+    [
+        ("kPa", "--plant", "60"),  # a bare number in the plant's unit
+        ("kPa", "--model", "60"),  # ... or the controller's model's, the plant its own
+        ("MPa", "--plant", "0.06"),
+        ("MPa", "--plant", "60kPa"),  # a unit wins
+        ("kPa", "--plant", "8.70226psi"),
+    ],
+)
+def test_a_bare_supply_is_in_the_models_pressure_unit(models, tmp_path, capsys, unit, role, supply):
+    args = ["control", "simulate", "--design", DESIGN, role, str(models[unit]),
+            "--supply", supply, "--rig-param", "volume_mm3=14000", "--duration", "0.3",
+            "--reference", "step:40"]  # fmt: skip
+    assert main([*args, "--json", "-o", str(tmp_path / "a")]) == 0
+    payload = json.loads(capsys.readouterr().out)
+    assert payload["rig"]["supply_gauge_mpa"] == pytest.approx(0.06, rel=1e-5)
+    assert payload["model_pressure_unit"] == unit
+
+
+def test_a_bare_supply_past_the_plausible_names_the_models_unit(models, tmp_path, capsys):
+    args = ["control", "simulate", "--design", DESIGN, "--plant", str(models["kPa"]),
+            "--supply", "5000", "-o", str(tmp_path / "a")]  # fmt: skip
+    assert main(args) == 2
+    err = capsys.readouterr().err.strip().splitlines()
+    assert len(err) == 1 and "--supply: must be a gauge pressure in (0, 2] MPa" in err[0], err
+    assert "got 5000 kPa (5 MPa)" in err[0], err
 
 
 def test_the_plant_alone_is_the_controllers_model_too(models, tmp_path, capsys):

@@ -20,6 +20,15 @@ def test_bad_reference_is_one_line(capsys):
     assert "--reference: amplitude_deg of the step must be" in capsys.readouterr().err
 
 
+@pytest.mark.parametrize("command", ["simulate", "run"])
+def test_a_bad_sine_reference_is_one_line_with_the_expected_form(tmp_path, capsys, command):
+    out = tmp_path / "o"
+    assert main(["control", command, "--out", str(out), "--reference", "sine:60:4:x"]) == 2
+    err = capsys.readouterr().err.strip().splitlines()
+    assert len(err) == 1 and err[0].startswith("softbend: error: --reference: offset_deg of"), err
+    assert "(sine:AMP:PERIOD_S[:OFFSET])" in err[0] and not out.exists()
+
+
 @pytest.mark.parametrize("controller", ["bang-bang", "pressure-pi"])
 def test_simulate_writes_run(tmp_path, capsys, controller):
     out = tmp_path / "run"
@@ -100,3 +109,15 @@ def test_run_on_the_simulated_rig_writes_its_log(tmp_path, capsys):
     payload = json.loads(capsys.readouterr().out)
     assert payload["completed"] and payload["rig"] == "sim"
     assert (out / "ticks.parquet").is_file() and (out / "run.png").is_file()
+
+
+def test_simulate_tracks_a_sine_reference_scored_by_its_delay(tmp_path, capsys):
+    out = tmp_path / "run"
+    args = ["control", "simulate", "--reference", "sine:60:1:10", "--duration", "1.5"]
+    assert main([*args, "--out", str(out), "--json"]) == 0
+    payload = json.loads(capsys.readouterr().out)
+    assert payload["reference"] == "sine:60:1:10"
+    assert payload["metrics"]["delay_s"] is not None and "rising_edges" not in payload["metrics"]
+    lines = (out / "run.csv").read_text().splitlines()
+    references = [float(line.split(",")[1]) for line in lines[1:]]
+    assert min(references) == pytest.approx(10) and max(references) == pytest.approx(60, abs=0.1)

@@ -21,6 +21,15 @@ def test_parse_references():
     assert tri.values(np.array([0.0, 1.25, 2.5, 5.0])) == pytest.approx([0, 45, 90, 0])
 
 
+def test_a_sine_swings_from_its_offset_at_rest_to_its_amplitude_at_half_a_period():
+    sine = parse_reference("sine:60:4:20")
+    t = np.array([0.0, 1.0, 2.0, 3.0, 4.0, 0.5])
+    expected = [20, 40, 60, 40, 20, 20 + 40 * (1 - np.cos(np.pi / 4)) / 2]
+    assert sine.values(t) == pytest.approx(expected)
+    assert str(sine) == "sine:60:4:20" and sine.kind == "sine"
+    assert parse_reference("sine:30:2").values(np.array([0.0, 1.0])) == pytest.approx([0, 30])
+
+
 @pytest.mark.parametrize(
     ("spec", "message"),
     [
@@ -31,6 +40,15 @@ def test_parse_references():
         ("square:90", "reference: square takes 2–3 values"),
         ("triangle:0:90", "reference: freq_hz of the triangle must be a number in \\(0, 50\\]"),
         ("square:90:2:95", "reference: low_deg of the square must be below its amplitude_deg"),
+        ("sine:60", r"reference: sine takes 2–3 values \(sine:AMP:PERIOD_S\[:OFFSET\]\)"),
+        (
+            "sine:60:x",
+            r"period_s of the sine must be a number in \(0, 3600\]; got \"x\" "
+            r"\(sine:AMP:PERIOD_S\[:OFFSET\]\)",
+        ),
+        ("sine:60:4:70", "reference: offset_deg of the sine must be below its amplitude_deg"),
+        ("sine:60:4:-1", r"offset_deg of the sine must be a number in \[0, 720\]"),
+        ("cos:60:4", "reference: kind must be one of 'step', 'square', 'triangle', 'sine'"),
     ],
 )
 def test_parse_reference_errors_name_the_field(spec, message):

@@ -383,6 +383,36 @@ def test_check_signals_refuses_a_constant_output_naming_the_column():
         check_signals(_one_output([0, 1e-200, 0], [0, 0, 0]))
 
 
+def test_check_signals_refuses_a_constant_input_naming_the_column():
+    check_signals(_one_output([1, 2, 3], [3, 2, 1]))  # a varying input: fine
+    with pytest.raises(DatasetError, match=r"input column 'u' is constant .*every sample 5\.0.*"
+                       r"gain or time constant"):  # fmt: skip
+        check_signals(_one_output([1, 2, 3], [3, 2, 1], inputs=np.array([5.0, 5.0, 5.0])))
+
+
+@pytest.mark.parametrize("kind", ["input", "output"])
+@pytest.mark.parametrize(
+    ("relative", "refused"), [(5e-10, True), (9e-10, True), (1.1e-9, False), (1e-6, False)]
+)
+def test_check_signals_near_constant_is_a_range_within_1e_9_of_the_magnitude(
+    kind, relative, refused
+):
+    """101.325 up to rounding is refused; a range just above 1e-9 of it is a signal."""
+    wobble = 101.325 * (1 + relative * np.array([0.0, 1.0, 0.5, 0.0, 1.0]))
+    varying = np.array([0.0, 1.0, 2.0, 1.0, 0.0])
+    if kind == "input":
+        data = _one_output(varying, varying, inputs=wobble)
+    else:
+        data = _one_output(wobble, wobble, inputs=varying)
+    if refused:
+        with pytest.raises(DatasetError, match=rf"The {kind} column '[uy]' is near-constant "
+                           r"over the training experiments: it varies by only .* around "
+                           r"101\.325.*leave it out"):  # fmt: skip
+            check_signals(data)
+    else:
+        check_signals(data)
+
+
 def test_check_signals_refuses_values_whose_squares_overflow():
     with pytest.raises(DatasetError, match=r"output column 'y' of experiment 'e1' \(f1\.csv\) "
                        r"holds 1e\+301 at sample 2.*within ±1e\+50"):  # fmt: skip

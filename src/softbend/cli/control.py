@@ -45,7 +45,7 @@ def simulate_cmd(
         help="Simulated time, s: in (0, 86400] and at most SOFTBEND_MAX_LOOP_TICKS rig steps "
         "(default 10 000 000: 10 000 s at the default step_s of 1 ms), each logged in memory.",
     ),
-    supply_mpa: float = opt.SUPPLY,
+    supply_mpa: str = opt.SUPPLY,
     rig_assignments: list[str] = opt.RIG_PARAM,
     rig_from: Path = opt.RIG_FROM,
     seed: int = typer.Option(0, help="Seed of the sensor and camera noise."),
@@ -62,7 +62,9 @@ def simulate_cmd(
     --model with another --plant .json is a deliberate mismatch, and the table
     names both. A model of any actuator may be used: --design names its
     parameters (NAME=VALUE pairs), its pressures are converted from the rig's MPa
-    (--supply, --rig-param and the scores stay in MPa), and the chamber is its
+    (a bare --supply is in the model's pressure unit, a --rig-param pressure in
+    MPa as its name says, both take a unit such as 20psi; the scores stay in
+    MPa), and the chamber is its
     description's (else --rig-param volume_mm3). A design outside the model's
     training ranges is a warning naming the parameter, and the table's row
     "design in the model's training data" and design_supported in metrics.json
@@ -88,6 +90,7 @@ def simulate_cmd(
     import signal
 
     from softbend._outdir import staged_dir
+    from softbend.control.pressures import run_supply_mpa
     from softbend.control.runs import simulate_control
     from softbend.reports import control_figures
 
@@ -99,7 +102,8 @@ def simulate_cmd(
             result = simulate_control(
                 reference=reference, controller=controller, assignments=assignments or (),
                 design=design, model=model, plant=plant, duration_s=duration_s,
-                supply_mpa=supply_mpa, rig_assignments=rig_assignments or (), seed=seed,
+                supply_mpa=run_supply_mpa(supply_mpa, model, plant),
+                rig_assignments=rig_assignments or (), seed=seed,
                 strict=strict, rig_from=rig_from,
             )  # fmt: skip
         payload = dict(result.summary)
@@ -209,7 +213,7 @@ def serve_cmd(
     design: str = opt.DESIGN,
     model: Path = opt.MODEL,
     plant: str = opt.PLANT,
-    supply_mpa: float = opt.SUPPLY,
+    supply_mpa: str = opt.SUPPLY,
     rig_assignments: list[str] = opt.RIG_PARAM,
     rig_from: Path = opt.RIG_FROM,
     seed: int = typer.Option(0, help="Seed of the sensor and camera noise."),
@@ -232,14 +236,15 @@ def serve_cmd(
     import time
 
     from softbend._validation import check_range
+    from softbend.control.pressures import run_supply_mpa
     from softbend.control.runs import simulated_server
 
     duration = check_range(duration_s, "duration_s", low=0.0, low_inclusive=True)
     with _common.library_progress():  # an FEM plant's sweep, if any
         server = simulated_server(
             config=config, host=host, port=port, design=design, model=model, plant=plant,
-            supply_mpa=supply_mpa, rig_assignments=rig_assignments or (), seed=seed,
-            rig_from=rig_from,
+            supply_mpa=run_supply_mpa(supply_mpa, model, plant),
+            rig_assignments=rig_assignments or (), seed=seed, rig_from=rig_from,
         )  # fmt: skip
     previous = control_run.terminate_as_interrupt()  # `kill` stops it as Ctrl-C does
     try:

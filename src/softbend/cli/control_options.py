@@ -6,7 +6,9 @@ import typer
 
 REFERENCE = typer.Option(
     "step:90",
-    help="step:AMP[:T0_S], square:AMP:PERIOD_S[:LOW] or triangle:FREQ_HZ:AMP[:LOW] (degrees).",
+    help="step:AMP[:T0_S], square:AMP:PERIOD_S[:LOW], triangle:FREQ_HZ:AMP[:LOW] or "
+    "sine:AMP:PERIOD_S[:OFFSET] (angles in degrees, times in s): the square, triangle and sine "
+    "swing between LOW or OFFSET (default 0) at t = 0 and AMP.",
 )
 CONTROLLER = typer.Option(
     None,
@@ -53,7 +55,9 @@ RIG_PARAM = typer.Option(
     help="A parameter of the simulated rig NAME=VALUE, repeatable: valves "
     "(inlet_conductance_m3_s_pa, outlet_conductance_m3_s_pa, critical_ratio, valve_delay_s), "
     "tubing_mm3, supply_gauge_mpa, sensor (sensor_noise_mpa, sensor_bits, sensor_range_mpa), "
-    "camera_noise_deg and more (the command 'control rig-parameters' lists them all). The "
+    "camera_noise_deg and more (the command 'control rig-parameters' lists them all). A "
+    "pressure (a name ending in _mpa) is a bare number in MPa, as its name says, or takes a "
+    "unit: supply_gauge_mpa=20psi, sensor_noise_mpa=0.5kPa. The "
     "chamber is paper B's design's cavity plus tubing_mm3; another actuator's is its "
     "description's chamber_volume_mm3 plus tubing_mm3, growing by its "
     "volume_growth_mm3_per_mpa (else rigid, with a warning): without a described volume, "
@@ -69,8 +73,10 @@ RIG_FROM = typer.Option(
 SUPPLY = typer.Option(
     None,
     "--supply",
-    help="Supply pressure of the simulated rig, MPa gauge, whatever the model's pressure "
-    "unit (default 0.2; the same as --rig-param supply_gauge_mpa).",
+    help="Supply pressure of the simulated rig, gauge: a number with a unit (20psi, 138kPa, "
+    "0.2MPa, 2bar), or a bare number in the pressure unit of the plant when it is a saved "
+    "model (else of --model; else MPa, as paper B's) (default 0.2 MPa; the same as "
+    "--rig-param supply_gauge_mpa).",
 )
 STRICT = typer.Option(
     False,

@@ -60,7 +60,7 @@ def run_cmd(
         "--sensor-period",
         help="Pressure reading period, s (default: the config's sensor_period_s, 0.01: 100 Hz).",
     ),
-    supply_mpa: float = opt.SUPPLY,
+    supply_mpa: str = opt.SUPPLY,
     rig_assignments: list[str] = opt.RIG_PARAM,
     rig_from: Path = opt.RIG_FROM,
     seed: int = typer.Option(0, help="Seed of a simulated rig's sensor and camera noise."),
@@ -97,6 +97,7 @@ def run_cmd(
     """
     from softbend._outdir import staged_dir
     from softbend._validation import check_choice
+    from softbend.control.pressures import run_supply_mpa
     from softbend.control.runs import plan_loop
     from softbend.reports import control_figures
 
@@ -109,7 +110,8 @@ def run_cmd(
             rig=rig, config=config, reference=reference, controller=controller,
             assignments=assignments or (), design=design, model=model, plant=plant,
             duration_s=duration_s, period_s=period_s, sensor_period_s=sensor_period_s,
-            supply_mpa=supply_mpa, rig_assignments=rig_assignments or (), seed=seed,
+            supply_mpa=run_supply_mpa(supply_mpa, model, plant),
+            rig_assignments=rig_assignments or (), seed=seed,
             strict=strict, rig_from=rig_from,
         )  # fmt: skip
     done = [0]

@@ -3,14 +3,20 @@
 from __future__ import annotations
 
 import math
+from dataclasses import replace
 from pathlib import Path
 from time import perf_counter, process_time
+from typing import TYPE_CHECKING
 
 import typer
 
 from softbend._validation import must_be
 from softbend.cli import _common
 from softbend.errors import InputError
+
+if TYPE_CHECKING:
+    from softbend.identification.segments import RecordingSplit
+    from softbend.identification.timeseries import TimeSeriesSet
 
 
 def _names(text: str | None, key: str) -> list[str]:
@@ -28,7 +34,10 @@ def identify(
     inputs: str = typer.Option(..., help="Comma-separated input columns (e.g. p1,p2,p3)."),
     outputs: str = typer.Option(..., help="Comma-separated output columns (e.g. x,y)."),
     experiment: str = typer.Option(
-        None, help="Column that splits a file into experiments (contiguous runs)."
+        None,
+        help="Column that splits a file into experiments (contiguous runs). Without it, "
+        "one recording is split into contiguous segments: the last for validation, the "
+        "others one cross-validation fold each.",
     ),
     time: str = typer.Option(None, help="Time column (default: the sample index)."),
     validate_on: str = typer.Option(
@@ -62,6 +71,11 @@ def identify(
     held-out samples; the time taken and the peak memory are printed and
     recorded in selection.json. 'softbend predict MODEL.json --input CSV' runs
     the model on a new input series.
+
+    Without --experiment, one recording is split into contiguous segments (the
+    last for validation, the others one fold each), said on stderr and recorded
+    in selection.json ("split"). A constant or near-constant input or output is
+    refused, naming the column.
 
     Example:
 
@@ -112,12 +126,20 @@ def identify(
         time=time,
     )
     held = _names(validate_on, "validate_on") if validate_on is not None else None
+    split = None
+    if len(series.experiments) == 1:  # one recording: segments of it, or a refusal
+        split = _split_one_recording(series, experiment, held, folds)
+        series, held = split.data, list(split.validation)
     check_holdout(series, held)
     check_signals(series, held)  # a constant or huge output: refused before any fit
     # every candidate's regressor must fit in every experiment (the longest lags: 3)
     check_experiments_for_lags(series, max(c.build(10).max_lag for c in default_candidates(seed)))
+    if split is not None:  # said once the data passed its checks (an error stays one line)
+        _common.err_console.print(split.summary(), highlight=False)  # also with --json
     with _common.library_progress(enabled=not as_json):
         selection = select_model(series, validate_on=held, folds=folds, seed=seed)
+    if split is not None:
+        selection = replace(selection, split=split.to_dict())
     with (
         _common.library_progress(enabled=not as_json),
         _common.output_errors(out, "--out"),
@@ -144,6 +166,31 @@ def identify(
         _cost_line(selection, seconds, cpu, sum(e.n_samples for e in series.experiments))
     )
     _common.console.print(f"{', '.join(FILES)} written to {out}")
+
+
+def _split_one_recording(
+    series: TimeSeriesSet, experiment: str | None, held: list[str] | None, folds: int
+) -> RecordingSplit:
+    """The segments of a set of one recording (see softbend.identification.segments), or a
+    refusal naming the option that made it one experiment or that names experiments."""
+    from softbend.identification.segments import split_recording
+
+    (only,) = series.names
+    if experiment is not None:
+        raise InputError(
+            f"the column {experiment!r} names one experiment ({only!r}): nothing to hold out "
+            "for validation; name a column with at least two experiments, or leave "
+            "--experiment out to split the recording into contiguous segments",
+            key="experiment",
+        )
+    if held is not None:
+        raise InputError(
+            f"names experiments, but the data is one recording ({only!r}, no --experiment "
+            "column); leave --validate-on out to split it into contiguous segments for "
+            "selection and validation, or give --experiment",
+            key="validate_on",
+        )
+    return split_recording(series, folds)
 
 
 def _cost_line(selection: object, seconds: float, cpu: float, rows: int) -> str:

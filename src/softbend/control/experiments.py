@@ -6,7 +6,11 @@ References are parsed from short specs:
 - ``square:AMP:PERIOD_S[:LOW]``: ``LOW`` (default 0°) for the first half of each
   period, ``AMP`` for the second, starting at t = 0;
 - ``triangle:FREQ_HZ:AMP[:LOW]``: a triangle between ``LOW`` (default 0°) at t = 0
-  and ``AMP`` at half a period.
+  and ``AMP`` at half a period;
+- ``sine:AMP:PERIOD_S[:OFFSET]``: a sine between ``OFFSET`` (default 0°) at t = 0 and
+  ``AMP`` at half a period, ``OFFSET + (AMP − OFFSET)·(1 − cos 2πt/PERIOD_S)/2``: like the
+  square and the triangle it spans ``OFFSET``..``AMP`` (an actuator bends one way, so no
+  negative angle), and it starts at rest with zero slope.
 
 :func:`simulate` runs a controller on a :class:`~softbend.control.rig.SimulatedRig`
 and records every rig step; :func:`run_metrics` scores it on the camera angle
@@ -47,7 +51,8 @@ __all__ = [
 
 @dataclass(frozen=True)
 class Reference:
-    """A reference angle θr(t), degrees; ``kind`` is ``step``, ``square`` or ``triangle``."""
+    """A reference angle θr(t), degrees; ``kind`` is ``step``, ``square``, ``triangle`` or
+    ``sine``; ``low_deg`` is the square's and triangle's LOW and the sine's OFFSET."""
 
     kind: str
     amplitude_deg: float
@@ -65,13 +70,41 @@ class Reference:
         if self.kind == "square":
             return np.where(phase < 0.5, self.low_deg, self.amplitude_deg)
         span = self.amplitude_deg - self.low_deg
+        if self.kind == "sine":
+            return self.low_deg + span * 0.5 * (1.0 - np.cos(2.0 * np.pi * phase))
         return self.low_deg + span * (1.0 - np.abs(2.0 * phase - 1.0))
 
     def __str__(self) -> str:
         return self.spec or self.kind
 
 
-_USAGE = "step:AMP[:T0_S], square:AMP:PERIOD_S[:LOW] or triangle:FREQ_HZ:AMP[:LOW]"
+#: Each kind of reference: its fields (as named in errors) and how many are required.
+_KINDS: dict[str, tuple[tuple[str, ...], int]] = {
+    "step": (("amplitude_deg", "t0_s"), 1),
+    "square": (("amplitude_deg", "period_s", "low_deg"), 2),
+    "triangle": (("freq_hz", "amplitude_deg", "low_deg"), 2),
+    "sine": (("amplitude_deg", "period_s", "offset_deg"), 2),
+}
+#: How each field is written in a spec.
+_SPELLED = {
+    "amplitude_deg": "AMP",
+    "t0_s": "T0_S",
+    "period_s": "PERIOD_S",
+    "low_deg": "LOW",
+    "freq_hz": "FREQ_HZ",
+    "offset_deg": "OFFSET",
+}
+
+
+def _form(kind: str) -> str:
+    """The spec of ``kind`` (``square:AMP:PERIOD_S[:LOW]``)."""
+    fields_, required = _KINDS[kind]
+    words = [_SPELLED[f] for f in fields_]
+    optional = "".join(f"[:{w}" for w in words[required:]) + "]" * (len(words) - required)
+    return ":".join([kind, *words[:required]]) + optional
+
+
+_USAGE = ", ".join(_form(k) for k in list(_KINDS)[:-1]) + f" or {_form(list(_KINDS)[-1])}"
 
 
 def parse_reference(reference: str) -> Reference:
@@ -87,27 +120,23 @@ def parse_reference(reference: str) -> Reference:
         raise InputError(must_be(f"one of {_USAGE}", spec), key="reference")
     kind, *parts = spec.strip().split(":")
     kind = kind.strip().lower()
-    names = {
-        "step": (("amplitude_deg", "t0_s"), 1),
-        "square": (("amplitude_deg", "period_s", "low_deg"), 2),
-        "triangle": (("freq_hz", "amplitude_deg", "low_deg"), 2),
-    }
-    if kind not in names:
+    if kind not in _KINDS:
         raise InputError(
-            f"kind must be one of 'step', 'square', 'triangle' ({_USAGE}); got {kind!r}",
+            f"kind must be one of {', '.join(map(repr, _KINDS))} ({_USAGE}); got {kind!r}",
             key="reference",
         )
-    fields_, required = names[kind]
+    fields_, required = _KINDS[kind]
     if not required <= len(parts) <= len(fields_):
         raise InputError(
-            f"{kind} takes {required}–{len(fields_)} values "
-            f"({':'.join(f.upper() for f in fields_)}); got {len(parts)} in {spec!r}",
+            f"{kind} takes {required}–{len(fields_)} values ({_form(kind)}); "
+            f"got {len(parts)} in {spec!r}",
             key="reference",
         )
     values: dict[str, float] = {}
     bounds = {
         "amplitude_deg": (0.0, 720.0, False),
         "low_deg": (0.0, 720.0, True),
+        "offset_deg": (0.0, 720.0, True),
         "t0_s": (0.0, 3600.0, True),
         "period_s": (0.0, 3600.0, False),
         "freq_hz": (0.0, 50.0, False),
@@ -121,22 +150,23 @@ def parse_reference(reference: str) -> Reference:
             )
         except (ValueError, InputError):
             raise InputError(
-                f"{name} of the {kind} {must_be(f'a number in {interval}', text)}",
+                f"{name} of the {kind} {must_be(f'a number in {interval}', text)} ({_form(kind)})",
                 key="reference",
             ) from None
-    low = values.get("low_deg", 0.0)
+    low_name = "offset_deg" if kind == "sine" else "low_deg"
+    low = values.get(low_name, 0.0)
     if low >= values["amplitude_deg"]:
         raise InputError(
-            f"low_deg of the {kind} must be below its amplitude_deg; got low_deg={low:g} and "
-            f"amplitude_deg={values['amplitude_deg']:g}",
+            f"{low_name} of the {kind} must be below its amplitude_deg; got {low_name}={low:g} "
+            f"and amplitude_deg={values['amplitude_deg']:g} ({_form(kind)})",
             key="reference",
         )
     if kind == "step":
         return Reference(
             "step", values["amplitude_deg"], start_s=values.get("t0_s", 0.5), spec=spec
         )
-    if kind == "square":
-        return Reference("square", values["amplitude_deg"], values["period_s"], low, spec=spec)
+    if kind in ("square", "sine"):
+        return Reference(kind, values["amplitude_deg"], values["period_s"], low, spec=spec)
     return Reference("triangle", values["amplitude_deg"], 1.0 / values["freq_hz"], low, spec=spec)
 
 
@@ -435,7 +465,7 @@ def run_metrics(
       out of the mean and counted in ``unsettled_edges``), ``overshoot_pct`` (of
       the jump); means over edges (an edge with fewer than 10 samples after it is
       left out);
-    - for triangles ``delay_s`` by cross-correlation of θe with θr (and
+    - for triangles and sines ``delay_s`` by cross-correlation of θe with θr (and
       ``predicted_delay_s`` for θp);
     - ``switches`` (valve state changes), ``air_used_kg``, ``realtime_factor``.
 
@@ -470,7 +500,7 @@ def run_metrics(
     if math.isnan(out["air_used_kg"]):
         why["air_used_kg"] = "the rig does not measure the air it uses"
     kind = run.reference.kind if run.reference is not None else "step"
-    if kind == "triangle":
+    if kind in ("triangle", "sine"):
         finite = np.isfinite(y)
         out["delay_s"] = cross_correlation_delay_s(t[finite], r[finite], y[finite])
         pf = np.isfinite(run.predicted_deg)

@@ -20,6 +20,8 @@ actuator's chamber from its description or a measured ``volume_mm3``);
 from __future__ import annotations
 
 import inspect
+import math
+import re
 from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -34,7 +36,7 @@ from softbend.control.rigconfig import (
     simulation_settings_entry,
 )
 from softbend.design import SFRBADesign
-from softbend.errors import InputError, keyed
+from softbend.errors import InputError, SoftbendError, keyed
 from softbend.parameters import declared_ranges, parse_assignments
 from softbend.registry import Registry
 
@@ -51,6 +53,7 @@ __all__ = [
     "RigSetup",
     "make_rig",
     "modbus_rig",
+    "pressures_in_mpa",
     "rig_parameter_catalog",
     "rig_params_for",
     "rig_settings",
@@ -199,7 +202,8 @@ def rig_settings(
     rig_assignments : sequence of str, optional
         ``NAME=VALUE`` text, read by the kind of each name: a field of
         :class:`~softbend.control.rig.RigParams` or ``tubing_mm3``
-        (:data:`RIG_SETTINGS`).
+        (:data:`RIG_SETTINGS`). A pressure (a setting in MPa, ``supply_gauge_mpa``)
+        may carry a unit suffix, ``20psi`` or ``138kPa`` (:func:`pressures_in_mpa`).
     values : mapping, optional
         Data values of the same names (a rig TOML's [simulation] table);
         ``rig_assignments`` override them.
@@ -230,14 +234,19 @@ def rig_settings(
     with keyed("values"):
         table = check_simulation_settings(values or {}, from_text=False)
     with keyed("rig_assignments"):
-        texts = parse_assignments(rig_assignments)
-    with keyed("rig_assignments"):
-        given = check_simulation_settings(texts, from_text=True)
+        typed = parse_assignments(rig_assignments)
+        texts = pressures_in_mpa(typed)
+        try:
+            given = check_simulation_settings(texts, from_text=True)
+        except SoftbendError as error:  # a converted pressure: name it as it was typed
+            if error.key in texts and texts[error.key] != typed[error.key]:
+                error.args = (f"{error.detail} (given as {typed[error.key]!r})",)
+            raise
     if supply_mpa is not None:
         with keyed("supply_mpa"):
             supply = check_simulation_settings({"supply_gauge_mpa": supply_mpa}, from_text=False)
         other = given.get("supply_gauge_mpa", supply["supply_gauge_mpa"])
-        if other != supply["supply_gauge_mpa"]:
+        if not math.isclose(other, supply["supply_gauge_mpa"], rel_tol=1e-12):
             raise InputError(
                 "must equal the rig setting supply_gauge_mpa (the same supply pressure, MPa "
                 f"gauge: give one, or the same value); got {supply_mpa!r} and {other!r}",
@@ -252,6 +261,37 @@ def rig_settings(
             key="rig_assignments" if {"volume_mm3", "tubing_mm3"} & set(given) else "values",
         )
     return merged
+
+
+#: A number followed by a unit (``20psi``, ``1.5e2 kPa``): what :func:`pressures_in_mpa` reads.
+_WITH_UNIT = re.compile(r"^\s*[-+]?(?:\d+\.?\d*|\.\d+)(?:[eE][-+]?\d+)?\s*[A-Za-z]+\s*$")
+
+
+def pressures_in_mpa(texts: Mapping[str, str]) -> dict[str, str]:
+    """``{name: text}`` of rig settings with every pressure given with a unit in MPa.
+
+    A pressure is a setting whose declared range is in MPa (``supply_gauge_mpa``,
+    ``atmosphere_mpa``, ``sensor_noise_mpa``, ``sensor_range_mpa``); its name says
+    MPa, so a bare number is MPa, and a number with a unit suffix (``20psi``,
+    ``138 kPa``) is converted (:func:`softbend.units.parse_pressure`). Other text
+    is left to the settings' own checks.
+
+    Raises
+    ------
+    InputError
+        A pressure with an unknown unit (the message names the setting and lists
+        the units).
+    """
+    from softbend.control.rig import RIG_RANGES
+    from softbend.units import parse_pressure
+
+    out = dict(texts)
+    for name, text in texts.items():
+        known = RIG_RANGES.get(name)
+        if known is None or known.unit != "MPa" or not _WITH_UNIT.match(text):
+            continue
+        out[name] = repr(parse_pressure(text, "MPa", name))
+    return out
 
 
 def rig_params_for(

@@ -185,8 +185,12 @@ class ControlSetup:
         return out
 
 
-def check_supply(supply_mpa: float) -> float:
-    """A supply pressure that is a positive, plausible gauge pressure (MPa), else InputError."""
+def check_supply(supply_mpa: float, given: str | None = None) -> float:
+    """A supply pressure that is a positive, plausible gauge pressure (MPa), else InputError.
+
+    ``given``, when the value was typed otherwise (``"20 psi (0.138 MPa)"``), is what the
+    message says was got.
+    """
     from softbend._validation import must_be
     from softbend.plausibility import RANGES
 
@@ -194,8 +198,10 @@ def check_supply(supply_mpa: float) -> float:
     if isinstance(supply_mpa, bool) or not 0.0 < supply_mpa <= high:
         requirement = (
             f"a gauge pressure in (0, {high:g}] MPa ({high:g} MPa bursts any silicone "
-            "actuator; a value in kPa must be divided by 1000)"
+            "actuator; a value in another unit takes its suffix, e.g. 200kPa)"
         )
+        if given is not None:
+            raise InputError(f"must be {requirement}; got {given}", key="supply_mpa")
         raise InputError(must_be(requirement, supply_mpa), key="supply_mpa")
     return float(supply_mpa)
 

@@ -53,6 +53,7 @@ __all__ = [
     "MAX_ABS_VALUE",
     "MAX_MEMORY_MB_RANGE",
     "MIN_OUTPUT_RANGE",
+    "NEAR_CONSTANT_RTOL",
     "SEED_RANGE",
     "check_integer",
     "check_lags_fit",
@@ -101,6 +102,10 @@ MAX_ABS_VALUE = 1e50
 #: The smallest range of an output over the training experiments: the NRMSE is over
 #: the range, and the squares of smaller deviations would leave the normal doubles.
 MIN_OUTPUT_RANGE = 1e-100
+#: A signal whose range over the training experiments is at most this fraction of its
+#: largest magnitude is a constant up to rounding (101.325 written as 101.32500000000001):
+#: near-constant, refused as a constant is.
+NEAR_CONSTANT_RTOL = 1e-9
 
 #: Integers with more digits than this are shown by their length in a message.
 _SHOWN_DIGITS = 40

@@ -228,6 +228,10 @@ class Selection:
     cpu_seconds : float, optional
         CPU time of the process's threads during the selection, s (beside the
         wall time, which grows with the load of a shared machine).
+    split : dict, optional
+        Where the experiments came from when they are segments of one recording
+        (:meth:`~softbend.identification.segments.RecordingSplit.to_dict`: each
+        segment's sample range and role); None for experiments of their own.
     """
 
     table: Any
@@ -247,6 +251,7 @@ class Selection:
     band: FreeRunBand | None = None
     peak_memory_mib: float | None = None
     cpu_seconds: float | None = None
+    split: dict[str, Any] | None = None
 
     @property
     def time_unit_s(self) -> float | None:
@@ -334,6 +339,7 @@ class Selection:
             "seconds": self.seconds,
             "peak_memory_mib": self.peak_memory_mib,
             "cpu_seconds": self.cpu_seconds,
+            "split": self.split,
         }
 
 

@@ -38,7 +38,7 @@ from softbend._io import atomic_file
 from softbend._validation import check_int, must_be
 from softbend.errors import DatasetError, InputError
 from softbend.identification.data import experiment_files
-from softbend.identification.ranges import MAX_ABS_VALUE, MIN_OUTPUT_RANGE
+from softbend.identification.ranges import MAX_ABS_VALUE, MIN_OUTPUT_RANGE, NEAR_CONSTANT_RTOL
 from softbend.identification.timeseries import Series, TimeSeriesSet
 from softbend.tables import Column, Table, TableFormat, read_table
 
@@ -459,21 +459,25 @@ def check_holdout(
 
 
 def check_signals(data: TimeSeriesSet, validate_on: str | Sequence[str] | None = None) -> None:
-    """Refuse, before any fit, signals whose identification figures could not be finite.
+    """Refuse, before any fit, signals whose identification figures could not be finite or
+    would be made up.
 
     Every input and output value must lie within ±:data:`~softbend.identification.ranges.
-    MAX_ABS_VALUE` (1e50: the fourth powers of larger values overflow a polynomial fit),
-    and every output must vary over the training experiments (those not in
-    ``validate_on``) by at least :data:`~softbend.identification.ranges.MIN_OUTPUT_RANGE`:
-    the error of a model is over its output's range (NRMSE), undefined for a
-    constant output.
+    MAX_ABS_VALUE` (1e50: the fourth powers of larger values overflow a polynomial fit).
+    No input or output may be constant or near-constant over the training experiments
+    (those not in ``validate_on``): a column is near-constant when its range (max − min)
+    is at most :data:`~softbend.identification.ranges.NEAR_CONSTANT_RTOL` (1e-9) times its
+    largest magnitude, a constant up to rounding. A model has nothing to learn from such
+    an output (its error over its range, the NRMSE, is undefined), and the gain and time
+    constant of such an input would be made up. Every output must also vary by at least
+    :data:`~softbend.identification.ranges.MIN_OUTPUT_RANGE` to be standardized.
 
     Parameters
     ----------
     data : TimeSeriesSet
         The experiments (finite, as every :class:`Series` is).
     validate_on : str or sequence of str, optional
-        The validation experiments, left out of the outputs' ranges.
+        The validation experiments, left out of the signals' ranges.
 
     Raises
     ------
@@ -499,17 +503,38 @@ def check_signals(data: TimeSeriesSet, validate_on: str | Sequence[str] | None =
                     "rescale the column (e.g. a larger unit)."
                 )
     train = [e for e in data.experiments if e.name not in held] or list(data.experiments)
-    outputs = np.vstack([e.outputs for e in train])
-    spans = np.ptp(outputs, axis=0)
-    for column, name in enumerate(data.output_names):
+    for kind, names, attribute in (
+        ("input", data.input_names, "inputs"),
+        ("output", data.output_names, "outputs"),
+    ):
+        _check_varies(kind, names, np.vstack([getattr(e, attribute) for e in train]))
+
+
+def _check_varies(kind: str, names: Sequence[str], values: np.ndarray) -> None:
+    """Refuse a constant or near-constant column of ``values`` (samples × columns)."""
+    spans = np.ptp(values, axis=0)
+    scales = np.max(np.abs(values), axis=0)
+    why = (
+        "a model of it has nothing to learn and its error over its range (NRMSE) is undefined"
+        if kind == "output"
+        else "a model cannot learn its effect, and a gain or time constant read from it "
+        "would be made up"
+    )
+    for column, name in enumerate(names):
         if spans[column] == 0:
             raise DatasetError(
-                f"The output column '{name}' is constant over the training experiments "
-                f"(every sample {float(outputs[0, column])!r}): a model of it has nothing to "
-                "learn and its error over its range (NRMSE) is undefined; leave it out of "
-                "the outputs."
+                f"The {kind} column '{name}' is constant over the training experiments "
+                f"(every sample {float(values[0, column])!r}): {why}; leave it out of "
+                f"the {kind}s."
             )
-        if spans[column] < MIN_OUTPUT_RANGE:
+        if spans[column] <= NEAR_CONSTANT_RTOL * scales[column]:
+            raise DatasetError(
+                f"The {kind} column '{name}' is near-constant over the training experiments: "
+                f"it varies by only {float(spans[column]):.3g} around "
+                f"{float(values[0, column]):.6g}, at most {NEAR_CONSTANT_RTOL:g} of its "
+                f"magnitude (a constant up to rounding): {why}; leave it out of the {kind}s."
+            )
+        if kind == "output" and spans[column] < MIN_OUTPUT_RANGE:
             raise DatasetError(
                 f"The output column '{name}' varies by only {float(spans[column])!r} over the "
                 f"training experiments, less than {MIN_OUTPUT_RANGE:g}: too little to "
