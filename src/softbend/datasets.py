@@ -59,8 +59,6 @@ __all__ = [
 SAMPLES_FILE = "samples.parquet"
 DESIGNS_FILE = "designs.parquet"
 PROVENANCE_FILE = "provenance.json"
-#: The files of a dataset folder.
-_DATASET_FILES = (SAMPLES_FILE, DESIGNS_FILE, PROVENANCE_FILE)
 _TABLE1_FEM = "table1_fem"
 
 #: The kind of dtype of each column of the designs table besides the design parameters.
