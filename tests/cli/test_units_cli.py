@@ -90,3 +90,79 @@ def test_an_actuator_description_whose_column_names_another_unit_is_refused(tmp_
     path.write_text(json.dumps(described))
     assert main(["train", str(table), "--actuator", str(path), "--out", str(tmp_path / "o")]) == 2
     assert "angle_column: 'angle_rad' is named in radians" in one_error_line(capsys)
+
+
+# ------------------------------------------------ measured pressures against the base's range
+def test_pressures_far_past_the_base_s_range_are_refused_with_both_ranges(base, tmp_path, capsys):
+    bench = readings(tmp_path / "bench.csv", scale=7.0)  # 0-350 "kPa" for a 0-50 kPa model
+    for command in (
+        ["transfer", "loco", str(bench), "--base", str(base)],
+        ["transfer", "refine", str(base), str(bench), "--strategy", "scale-offset"],
+    ):
+        out = tmp_path / "out.json"
+        assert main([*command, "--out", str(out)]) == 2
+        line = one_error_line(capsys)
+        assert line.startswith("softbend: error: MEASUREMENTS: the pressures reach 350 kPa")
+        assert "span 0–350 kPa; the base model was trained on 0–50 kPa" in line
+        assert "'P1' in " in line and "--force" in line
+        assert not out.exists()
+
+
+def test_force_uses_pressures_past_the_range_and_records_it(base, tmp_path, capsys):
+    bench = readings(tmp_path / "bench.csv", scale=7.0)
+    argv = ["transfer", "loco", str(bench), "--base", str(base), "--out", str(tmp_path / "l")]
+    argv += ["--strategies", "fem-only,scale-offset", "--no-learning-curve", "--json", "--force"]
+    assert main(argv) == 0
+    captured = capsys.readouterr()
+    forced = json.loads(captured.out)["settings"]["forced"]
+    assert forced == {
+        "pressure": {
+            "measured_range": [0.0, 350.0],
+            "trained_range": [0.0, 50.0],
+            "unit": "kPa",
+            "forced": True,
+        }
+    }
+    assert "softbend: warning: measurements: the pressures reach 350 kPa" in captured.err
+    assert json.loads((tmp_path / "l" / "loco.json").read_text())["settings"]["forced"] == forced
+    model = tmp_path / "m.json"
+    argv = ["transfer", "refine", str(base), str(bench), "--out", str(model), "--force"]
+    assert main([*argv, "--strategy", "scale-offset"]) == 0
+    assert json.loads(model.read_text())["metadata"]["forced"] == forced
+
+
+def test_kpa_numbers_in_a_psi_column_say_what_they_look_like(tmp_path, capsys):
+    from softbend.surrogates.tables import table_training_data
+    from softbend.surrogates.workflow import train_surrogates
+
+    sims = tmp_path / "sims.csv"
+    table = actuator_table(designs=12)
+    table["p_psi"] = table.pop("p_kpa") / 6.894757  # 0-7.25 psi
+    table.to_csv(sims, index=False)
+    data = table_training_data(
+        sims, design_columns=ACTUATOR_COLUMNS, pressure_column="p_psi", pressure_unit="psi"
+    )
+    train_surrogates(data, tmp_path / "m", models="plr", grid_name="quick", folds=3)
+    bench = readings(tmp_path / "bench.csv")  # kPa numbers in the psi column
+    bench.write_text(bench.read_text().replace("p_kpa", "p_psi"))
+    argv = ["transfer", "loco", str(bench), "--base", str(tmp_path / "m/models/plr.json")]
+    assert main([*argv, "--out", str(tmp_path / "l")]) == 2
+    line = one_error_line(capsys)
+    assert "trained on 0–7.252 psi" in line and "they look like kPa" in line
+
+
+# ------------------------------------------------------------- radians next to the prediction
+def test_a_stiff_actuator_is_not_taken_for_radians(base, tmp_path, capsys):
+    stiff = readings(tmp_path / "stiff.csv", stiff=0.15)  # 6.0° at the top, a tenth of the model
+    argv = ["transfer", "loco", str(stiff), "--base", str(base), "--out", str(tmp_path / "l")]
+    assert main([*argv, "--strategies", "fem-only,scale-offset", "--no-learning-curve"]) == 0
+    assert "radians" not in capsys.readouterr().err
+
+
+def test_angles_in_radians_next_to_the_prediction_are_refused(base, tmp_path, capsys):
+    bench = readings(tmp_path / "bench.csv", stiff=1 / 57.2958)
+    argv = ["transfer", "loco", str(bench), "--base", str(base), "--out", str(tmp_path / "l")]
+    assert main(argv) == 2
+    line = one_error_line(capsys)
+    assert "bench.csv: angle_deg: the actuator 'P1' reaches only 0.70" in line
+    assert "look like radians" in line and "--force" in line

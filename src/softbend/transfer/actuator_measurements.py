@@ -17,10 +17,9 @@ degrees. Nothing else: a file that lacks a design column, or names one the
 model does not have, is one error naming both. The ``# key: value`` header
 lines are optional (``synthetic: true`` marks simulated readings). Every design
 must lie in the model's description (ranges, kinds, constraints); an actuator
-has one design; pressures are finite and >= 0; angles finite, and refused when
-they look like radians (no ``|angle|`` above a full turn in radians while the
-pressure reaches past a tenth of the file's largest — pass ``force`` to read
-them as given).
+has one design; pressures are finite and >= 0; angles finite (whether they are
+in radians depends on the actuator: :mod:`softbend.transfer.against_base` compares
+them with the base model's prediction).
 
 :class:`ActuatorMeasurements` offers what transfer learning reads from paper
 B's :class:`~softbend.transfer.measurements.Measurements`: ``features`` (the
@@ -30,9 +29,7 @@ model's inputs), ``angle_deg``, ``groups``, ``actuator_ids``, ``subset``,
 
 from __future__ import annotations
 
-import math
 import os
-import warnings
 from collections.abc import Iterable, Mapping, Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -53,7 +50,6 @@ __all__ = [
 
 #: The column naming the built actuator of each reading.
 ACTUATOR_COLUMN = "actuator"
-_RADIAN_MAX = 2.0 * math.pi * 1.05
 
 
 @dataclass(frozen=True, eq=False)
@@ -174,7 +170,7 @@ def measurement_format(actuator: Actuator) -> TableFormat:
     )
 
 
-def _read_one(path: Path, actuator: Actuator, force: bool) -> tuple[pd.DataFrame, dict[str, str]]:
+def _read_one(path: Path, actuator: Actuator) -> tuple[pd.DataFrame, dict[str, str]]:
     try:
         table = read_table(path, measurement_format(actuator))
     except DatasetError as error:
@@ -211,7 +207,6 @@ def _read_one(path: Path, actuator: Actuator, force: bool) -> tuple[pd.DataFrame
     frame[actuator.pressure_column] = raw[actuator.pressure_column]
     frame["angle_deg"] = raw[actuator.angle_column]
     frame["direction"] = "loading"  # a plain file records the loading branch
-    pressure = frame[actuator.pressure_column].to_numpy()
     met = actuator.constraints_met(frame[list(actuator.names)].to_numpy())
     if not met.all():
         pos = int(np.argmin(met))
@@ -219,27 +214,12 @@ def _read_one(path: Path, actuator: Actuator, force: bool) -> tuple[pd.DataFrame
             actuator.check_designs(frame[list(actuator.names)].to_numpy()[pos])
         except ActuatorError as err:
             raise ActuatorError(err.detail, file=table.file, line=int(table.lines[pos])) from None
-    angles = np.abs(frame["angle_deg"].to_numpy())
-    if angles.max() <= _RADIAN_MAX and pressure.max() > 0:
-        message = (
-            f"the angles reach only {angles.max():.4g} over the whole file; they look like "
-            "radians: multiply by 180/π (57.2958) for degrees"
-        )
-        angle, file = actuator.angle_column, table.file
-        if not force:
-            raise ActuatorError(
-                message + " (or read them as given with --force)", key=angle, file=file
-            )
-        warning = ActuatorError(message, key=angle, file=file)
-        warnings.warn(f"{warning}; read as given (force).", UserWarning, stacklevel=3)
     return frame, table.header
 
 
 def load_actuator_measurements(
     paths: str | os.PathLike[str] | Sequence[str | os.PathLike[str]],
     actuator: Actuator,
-    *,
-    force: bool = False,
 ) -> ActuatorMeasurements:
     """Read one or more plain measurement CSV files of ``actuator`` (module docstring).
 
@@ -256,7 +236,7 @@ def load_actuator_measurements(
     frames, provenance, shared = [], [], None
     for item in files:
         path = Path(item)
-        frame, metadata = _read_one(path, actuator, force)
+        frame, metadata = _read_one(path, actuator)
         frames.append(frame)
         flag = metadata.get("synthetic", "false").strip().lower() == "true"
         provenance.append(
