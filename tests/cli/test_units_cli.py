@@ -166,3 +166,43 @@ def test_angles_in_radians_next_to_the_prediction_are_refused(base, tmp_path, ca
     line = one_error_line(capsys)
     assert "bench.csv: angle_deg: the actuator 'P1' reaches only 0.70" in line
     assert "look like radians" in line and "--force" in line
+
+
+# ------------------------------------------- pressures asked of a model outside its range
+DESIGN = "n_chambers=10,wall_mm=2,height_mm=12,layer=fabric"
+
+
+def test_predict_names_the_pressures_outside_the_trained_range(base, capsys):
+    argv = ["predict", str(base), "--design", DESIGN, "--pressures", "10,90,345", "--json"]
+    assert main(argv) == 0
+    captured = capsys.readouterr()
+    assert json.loads(captured.out)["outside_pressure_range"] == {
+        "pressures": [90.0, 345.0],
+        "trained_range": [0.0, 50.0],
+        "unit": "kPa",
+    }
+    assert "softbend: warning: --pressures 90, 345 kPa: outside the pressures " in captured.err
+    assert "trained on (0–50 kPa)" in captured.err
+    assert main([*argv[:-2], "10,40", "--json"]) == 0
+    assert json.loads(capsys.readouterr().out)["outside_pressure_range"] is None
+
+
+def test_design_find_at_outside_the_range_says_so_and_takes_a_unit(base, tmp_path, capsys):
+    argv = ["design", "find", "--model", str(base), "--angle", "60", "--json"]
+    assert main([*argv, "--at", "103.4", "--out", str(tmp_path / "a")]) == 0
+    captured = capsys.readouterr()
+    record = json.loads(captured.out)
+    assert record["outside_pressure_range"] == {
+        "pressures": [103.4],
+        "trained_range": [0.0, 50.0],
+        "unit": "kPa",
+    }
+    assert "103.4 kPa lies outside the pressures the model was trained on (0–50 kPa)" in (
+        captured.err
+    )
+    assert main([*argv, "--at", "7psi", "--out", str(tmp_path / "b")]) == 0  # 48.26 kPa
+    record = json.loads(capsys.readouterr().out)
+    assert record["spec"]["pressure_kpa"] == pytest.approx(48.263, abs=1e-3)
+    assert record["outside_pressure_range"] is None and record["feasible"]
+    assert main([*argv, "--at", "20 furlongs", "--out", str(tmp_path / "c")]) == 2
+    assert "--at: unknown pressure unit 'furlongs'" in one_error_line(capsys)

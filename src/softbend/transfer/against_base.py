@@ -117,18 +117,11 @@ def load_for_base(
 def trained_pressure_range(saved: SavedSurrogate) -> tuple[float, float] | None:
     """The pressures ``saved`` was trained on, in its actuator's unit, or None if unrecorded.
 
-    Its ``training_ranges`` of the pressure column, else 0 to the largest pressure of its
-    support (``metadata["support"]``).
+    :func:`softbend.surrogates.support.trained_pressure_range` of its metadata.
     """
-    column = saved.actuator.pressure_column
-    ranges = saved.metadata.get("training_ranges")
-    if isinstance(ranges, dict) and column in ranges:
-        low, high = (float(v) for v in ranges[column])
-        return low, high
-    support = saved.metadata.get("support")
-    if isinstance(support, dict) and support.get("max_pressure_mpa"):
-        return 0.0, float(np.max(np.asarray(support["max_pressure_mpa"], dtype=np.float64)))
-    return None
+    from softbend.surrogates.support import trained_pressure_range as recorded
+
+    return recorded(saved.metadata, saved.actuator.pressure_column)
 
 
 def _where(data: Measurements | ActuatorMeasurements, row: int) -> str:
