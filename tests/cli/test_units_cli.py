@@ -206,3 +206,38 @@ def test_design_find_at_outside_the_range_says_so_and_takes_a_unit(base, tmp_pat
     assert record["outside_pressure_range"] is None and record["feasible"]
     assert main([*argv, "--at", "20 furlongs", "--out", str(tmp_path / "c")]) == 2
     assert "--at: unknown pressure unit 'furlongs'" in one_error_line(capsys)
+
+
+# ----------------------------------------------------- one file per actuator, named by its file
+def test_files_without_an_id_column_are_one_actuator_each_named_by_the_file(base, tmp_path, capsys):
+    files = [
+        readings(tmp_path / f"{name}.csv", ids=False, actuators={name: design})
+        for name, design in BUILT.items()
+    ]
+    argv = ["transfer", "loco", *map(str, files), "--base", str(base), "--json"]
+    argv += ["--out", str(tmp_path / "l"), "--strategies", "fem-only,scale-offset"]
+    assert main([*argv, "--no-learning-curve"]) == 0
+    assert json.loads(capsys.readouterr().out)["settings"]["actuators"] == ["P1", "P2"]
+
+
+def test_actuator_id_is_an_id_column_and_a_missing_column_names_both(base, tmp_path, capsys):
+    bench = readings(tmp_path / "bench.csv")
+    bench.write_text(bench.read_text().replace("actuator,", "actuator_id,", 1))
+    argv = ["transfer", "refine", str(base), str(bench), "--strategy", "scale-offset"]
+    assert main([*argv, "--out", str(tmp_path / "m.json")]) == 0
+    meta = json.loads((tmp_path / "m.json").read_text())["metadata"]
+    assert meta["actuators"] == ["P1", "P2"]
+    capsys.readouterr()
+    bench.write_text(bench.read_text().replace("actuator_id,n_chambers,", "actuator_id,", 1))
+    assert main([*argv, "--out", str(tmp_path / "n.json")]) == 2
+    line = one_error_line(capsys)
+    assert "lacks the column(s) n_chambers" in line and "(optional: actuator, actuator_id)" in line
+
+
+def test_one_file_without_ids_holding_two_designs_says_how_to_name_them(base, tmp_path, capsys):
+    bench = readings(tmp_path / "bench.csv", ids=False)
+    argv = ["transfer", "loco", str(bench), "--base", str(base), "--out", str(tmp_path / "l")]
+    assert main(argv) == 2
+    line = one_error_line(capsys)
+    assert "the actuator 'bench' has two designs" in line
+    assert "a file without an actuator or actuator_id column is one actuator" in line

@@ -10,11 +10,13 @@ writes one row per reading::
     A1,10,2,2.0,12,0,0.4
     A1,10,2,2.0,12,20,41.8
 
-Columns: ``actuator`` (the id of the built actuator), the model's design
-columns (its :class:`~softbend.actuators.Actuator` parameters, categorical
-ones by level), its pressure column in its unit and its angle column, in
-degrees. Nothing else: a file that lacks a design column, or names one the
-model does not have, is one error naming both. The ``# key: value`` header
+Columns: ``actuator`` or ``actuator_id`` (the id of the built actuator), the
+model's design columns (its :class:`~softbend.actuators.Actuator` parameters,
+categorical ones by level), its pressure column in its unit and its angle column,
+in degrees. A file without an id column is one actuator, named by the file's stem
+(``A1.csv`` holds the readings of ``A1``), as labs keep one file per actuator.
+Nothing else: a file that lacks a design column, or names one the model does not
+have, is one error naming both. The ``# key: value`` header
 lines are optional (``synthetic: true`` marks simulated readings). Every design
 must lie in the model's description (ranges, kinds, constraints); an actuator
 has one design; pressures are finite and >= 0; angles finite (whether they are
@@ -39,7 +41,7 @@ import pandas as pd
 
 from softbend.actuators import Actuator, ActuatorError
 from softbend.errors import DatasetError
-from softbend.tables import Column, TableFormat, read_table
+from softbend.tables import Column, Table, TableFormat, read_table
 
 __all__ = [
     "ACTUATOR_COLUMN",
@@ -50,6 +52,9 @@ __all__ = [
 
 #: The column naming the built actuator of each reading.
 ACTUATOR_COLUMN = "actuator"
+#: The names the id column may have: a file gives one of them, or none (one actuator, the
+#: file's stem).
+ID_COLUMNS: tuple[str, ...] = (ACTUATOR_COLUMN, "actuator_id")
 
 
 @dataclass(frozen=True, eq=False)
@@ -152,15 +157,15 @@ class ActuatorMeasurements:
 def measurement_format(actuator: Actuator) -> TableFormat:
     """The plain measurement CSV of ``actuator``, as :mod:`softbend.tables` reads it.
 
-    The id column, the design columns (read as text: a categorical parameter
-    gives its level), the pressure column (>= 0, the actuator's unit) and the
-    angle column (degrees); any ``# key: value`` line without spaces in its key
-    is kept.
+    The optional id column (``actuator`` or ``actuator_id``), the design columns
+    (read as text: a categorical parameter gives its level), the pressure column
+    (>= 0, the actuator's unit) and the angle column (degrees); any ``# key: value``
+    line without spaces in its key is kept.
     """
     return TableFormat(
         name=f"measurement file of the actuator {actuator.name}",
         columns=(
-            Column(ACTUATOR_COLUMN, kind="text"),
+            *(Column(name, kind="text", required=False) for name in ID_COLUMNS),
             *(Column(p.name, p.unit, kind="text") for p in actuator.parameters),
             Column(actuator.pressure_column, actuator.pressure_unit, low=0.0),
             Column(actuator.angle_column, "deg"),
@@ -170,7 +175,25 @@ def measurement_format(actuator: Actuator) -> TableFormat:
     )
 
 
-def _read_one(path: Path, actuator: Actuator) -> tuple[pd.DataFrame, dict[str, str]]:
+def _ids(table: Table, path: Path) -> pd.Series:
+    """Each reading's actuator: its id column (``actuator`` or ``actuator_id``), or, in a
+    file with neither, the file's stem (the file is one actuator)."""
+    given = [name for name in ID_COLUMNS if name in table.frame.columns]
+    if len(given) > 1:
+        raise ActuatorError(
+            f"names the actuators twice, by the columns {' and '.join(given)}; keep one",
+            key=given[1],
+            file=table.file,
+            line=table.header_line,
+            column=table.positions[given[1]],
+        )
+    if given:
+        return table.frame[given[0]].astype(object)
+    return pd.Series([path.stem] * len(table.frame), dtype=object)
+
+
+def _read_one(path: Path, actuator: Actuator) -> tuple[pd.DataFrame, dict[str, str], bool]:
+    """One file's readings, its ``# key: value`` lines, and whether its file names its actuator."""
     try:
         table = read_table(path, measurement_format(actuator))
     except DatasetError as error:
@@ -180,7 +203,7 @@ def _read_one(path: Path, actuator: Actuator) -> tuple[pd.DataFrame, dict[str, s
             error.detail, key=error.key, file=error.file, line=error.line, column=error.column
         ) from None
     raw = table.frame
-    frame = pd.DataFrame({"actuator_id": raw[ACTUATOR_COLUMN]})
+    frame = pd.DataFrame({"actuator_id": _ids(table, path)})
     for parameter in actuator.parameters:
         column = table.positions[parameter.name]
         codes = []
@@ -214,7 +237,7 @@ def _read_one(path: Path, actuator: Actuator) -> tuple[pd.DataFrame, dict[str, s
             actuator.check_designs(frame[list(actuator.names)].to_numpy()[pos])
         except ActuatorError as err:
             raise ActuatorError(err.detail, file=table.file, line=int(table.lines[pos])) from None
-    return frame, table.header
+    return frame, table.header, not any(name in raw.columns for name in ID_COLUMNS)
 
 
 def load_actuator_measurements(
@@ -234,10 +257,13 @@ def load_actuator_measurements(
     """
     files = [paths] if isinstance(paths, str | os.PathLike) else list(paths)
     frames, provenance, shared = [], [], None
+    by_file: set[str] = set()  # actuators named by their file (no id column)
     for item in files:
         path = Path(item)
-        frame, metadata = _read_one(path, actuator)
+        frame, metadata, named_by_file = _read_one(path, actuator)
         frames.append(frame)
+        if named_by_file:
+            by_file.add(path.stem)
         flag = metadata.get("synthetic", "false").strip().lower() == "true"
         provenance.append(
             pd.DataFrame(
@@ -257,9 +283,15 @@ def load_actuator_measurements(
     designs = frame.groupby("actuator_id", sort=False)[list(actuator.names)].nunique()
     twice = designs.index[(designs > 1).any(axis=1)].tolist()
     if twice:
+        hint = (
+            f" (a file without an {' or '.join(ID_COLUMNS)} column is one actuator, named by "
+            "the file: add one of those columns to a file of several)"
+            if twice[0] in by_file
+            else ""
+        )
         raise ActuatorError(
             f"the actuator {twice[0]!r} has two designs in {', '.join(map(str, files))}; "
-            "each built actuator has one (give the others their own ids)",
+            f"each built actuator has one (give the others their own ids){hint}",
             key=ACTUATOR_COLUMN,
         )
     return ActuatorMeasurements(
