@@ -109,3 +109,11 @@ def test_missing_and_empty_files(tmp_path):
         load_actuator_measurements(tmp_path / "none.csv", ACTUATOR)
     with pytest.raises(DatasetError, match="followed by 0 data row"):
         load_actuator_measurements(write(tmp_path, []), ACTUATOR)
+
+
+def test_both_id_columns_at_once_are_refused_naming_both(tmp_path):
+    header = "actuator,actuator_id,n_folds,wall_mm,skin,p_kpa,angle_deg"
+    path = write(tmp_path, ["A1,A1,5,1.0,latex,0,0.5"], header=header)
+    match = r"lab\.csv:1:2: actuator_id: .*by the columns actuator and actuator_id"
+    with pytest.raises(ActuatorError, match=match):
+        load_actuator_measurements(path, ACTUATOR)
