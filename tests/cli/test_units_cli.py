@@ -151,6 +151,18 @@ def test_kpa_numbers_in_a_psi_column_say_what_they_look_like(tmp_path, capsys):
     assert "trained on 0–7.252 psi" in line and "they look like kPa" in line
 
 
+def test_mpa_numbers_in_a_kpa_column_are_refused_as_too_small(base, tmp_path, capsys):
+    bench = readings(tmp_path / "bench.csv", scale=1e-3)  # 0-0.05 "kPa" for a 0-50 kPa model
+    argv = ["transfer", "loco", str(bench), "--base", str(base), "--out", str(tmp_path / "l")]
+    assert main(argv) == 2
+    line = one_error_line(capsys)
+    assert "the pressures reach only 0.05 kPa" in line and "1/1000 of the top" in line
+    assert "trained on 0–50 kPa; they look like MPa" in line
+    low = readings(tmp_path / "low.csv", scale=0.08)  # a lab that measured low pressures only
+    argv = ["transfer", "loco", str(low), "--base", str(base), "--out", str(tmp_path / "m")]
+    assert main([*argv, "--strategies", "fem-only,scale-offset", "--no-learning-curve"]) == 0
+
+
 # ------------------------------------------------------------- radians next to the prediction
 def test_a_stiff_actuator_is_not_taken_for_radians(base, tmp_path, capsys):
     stiff = readings(tmp_path / "stiff.csv", stiff=0.15)  # 6.0° at the top, a tenth of the model

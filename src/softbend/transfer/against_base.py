@@ -8,9 +8,12 @@ strategy is fitted, checks two slips of units against the model itself:
 - **Pressures** (:func:`check_pressures`): the measured pressures must stay within
   :data:`PRESSURE_MARGIN` (1.5) times the top of the pressure range the base was
   trained on (``metadata["training_ranges"]``, else its support), and be >= 0. Beyond,
-  the column is most likely in another unit (kPa left in a psi column is 6.9 times
-  too large, MPa in a kPa column 1000 times too small the other way round): the error
-  gives both ranges in the model's unit and the unit the numbers look like, if one fits.
+  the column is most likely in another unit (kPa numbers left in a psi column are 6.9
+  times too large): the error gives both ranges in the model's unit and the unit the
+  numbers look like, if one fits. A top :data:`SMALL_RATIO` (20) or more times below
+  the trained top is refused too when the factor is that between two units (MPa
+  numbers in a kPa column are 1000 times too small); a lab that measured only low
+  pressures, by no such factor, passes.
 - **Radians** (:func:`check_angles`): an actuator whose measured angles are about
   57.3 (180/π) times smaller than the base predicts at the same design and pressures
   was measured in radians. A stiff actuator that truly bends little bends little in
@@ -50,6 +53,9 @@ __all__ = [
 
 #: Measured pressures may reach this many times the top of the base's trained range.
 PRESSURE_MARGIN = 1.5
+#: Measured pressures whose top is this many times below the trained top, by the factor
+#: between two units (1000: MPa numbers in a kPa column), are refused too.
+SMALL_RATIO = 20.0
 #: Degrees per radian: a curve measured in radians is this much smaller than in degrees.
 DEGREES_PER_RADIAN = 180.0 / math.pi
 #: The radians rule's factors: measured at most 1/10 of the prediction, and the measured
@@ -147,7 +153,8 @@ def _looks_like(ratio: float, unit: str) -> str:
 def check_pressures(
     data: Measurements | ActuatorMeasurements, saved: SavedSurrogate, *, force: bool = False
 ) -> dict[str, Any] | None:
-    """Refuse measured pressures past :data:`PRESSURE_MARGIN` times the base's trained top.
+    """Refuse measured pressures past :data:`PRESSURE_MARGIN` times the base's trained top (or
+    negative, or below it by the factor between two units).
 
     Parameters
     ----------
@@ -169,7 +176,9 @@ def check_pressures(
     ------
     DatasetError
         Key ``measurements``: both ranges in the model's unit, the reading at fault
-        (actuator and file) and the unit the numbers look like, unless ``force``.
+        (actuator and file) and the unit the numbers look like, unless ``force``; also
+        for a top :data:`SMALL_RATIO` times below the trained one by a factor between
+        two units (see the module docstring).
     """
     trained = trained_pressure_range(saved)
     if trained is None or len(data) == 0:
@@ -178,26 +187,31 @@ def check_pressures(
     unit = actuator.pressure_unit
     pressure = data.frame[actuator.pressure_column].to_numpy(dtype=np.float64)
     low, high = float(pressure.min()), float(pressure.max())
-    limit = PRESSURE_MARGIN * trained[1]
-    if low >= 0 and high <= limit:
+    ratio = high / trained[1] if trained[1] > 0 else math.inf
+    other = _looks_like(ratio, unit) if 0 < ratio < math.inf else ""
+    too_small = ratio <= 1 / SMALL_RATIO and other != ""
+    if low >= 0 and ratio <= PRESSURE_MARGIN and not too_small:
         return None
-    row = int(np.argmax(pressure)) if high > limit else int(np.argmin(pressure))
+    row = int(np.argmin(pressure)) if low < 0 else int(np.argmax(pressure))
     shown = f"{pressure[row]:g} {unit}"
     ranges = (
         f"the measured pressures span {low:.4g}–{high:.4g} {unit}; the base model was trained on "
         f"{trained[0]:.4g}–{trained[1]:.4g} {unit}"
     )
+    check = f"Check the unit of the column {actuator.pressure_column} (the model takes {unit})"
     if low < 0:
         text = f"a negative pressure ({shown}, {_where(data, row)}): {ranges}"
+    elif too_small:
+        text = (
+            f"the pressures reach only {shown} ({_where(data, row)}), 1/{1 / ratio:.4g} of the "
+            f"top of the base model's range: {ranges}; they look like {other}. {check}"
+        )
     else:
-        ratio = high / trained[1] if trained[1] > 0 else math.inf
-        other = _looks_like(ratio, unit) if math.isfinite(ratio) else ""
         hint = f"; they look like {other}" if other else ""
         text = (
             f"the pressures reach {shown} ({_where(data, row)}), {ratio:.3g}× the top of the "
             f"base model's range and more than the {PRESSURE_MARGIN:g}× allowed: {ranges}"
-            f"{hint}. Check the unit of the column {actuator.pressure_column} (the model "
-            f"takes {unit})"
+            f"{hint}. {check}"
         )
     if not force:
         raise DatasetError(f"{text}, or pass force=True (--force) to use them", key="measurements")
