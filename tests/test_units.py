@@ -38,3 +38,13 @@ def test_pressures_parse_with_and_without_a_unit():
 def test_bad_pressures_name_the_option(text):
     with pytest.raises(InputError, match="--supply"):
         parse_pressure(text, "kPa", "--supply")
+
+
+def test_a_keyed_check_carries_the_key_and_says_the_predicate():
+    with pytest.raises(InputError) as caught:
+        check_column_unit("pressure_psi", "kPa", "pressure_unit", key="pressure_unit")
+    assert caught.value.key == "pressure_unit"
+    assert str(caught.value) == (
+        "pressure_unit: is kPa, but the column 'pressure_psi' is named in psi; give psi or "
+        "rename the column"
+    )

@@ -406,9 +406,10 @@ class Actuator:
     pressure_column : str
         Name of the gauge-pressure input (``"pressure_mpa"``, ``"p_kpa"``).
     pressure_unit : {"kPa", "MPa", "bar", "psi"}
-        Unit of the pressure column.
+        Unit of the pressure column; a column whose name ends in a unit
+        (``p_psi``) must be in that one.
     angle_column : str
-        Name of the bending-angle column, degrees.
+        Name of the bending-angle column, degrees (a name ending ``_rad`` is refused).
     constraints : tuple of str
         Comparisons between parameters that every design meets
         (``"t_mm < r_mm"``), in the parameters' units and codes.
@@ -451,6 +452,7 @@ class Actuator:
             )
         with keyed("pressure_unit"):
             pressure_to_mpa(self.pressure_unit)
+        _check_column_units(self.pressure_column, self.pressure_unit, self.angle_column)
         for key in ("chamber_volume_mm3", "volume_growth_mm3_per_mpa"):
             value = getattr(self, key)
             if value is not None and not (math.isfinite(value) and value >= 0):
@@ -736,6 +738,28 @@ class Actuator:
             pressure_column=pressure_column,
             pressure_unit=pressure_unit,
             angle_column=angle_column,
+        )
+
+
+def _check_column_units(pressure_column: str, pressure_unit: str, angle_column: str) -> None:
+    """Refuse a pressure or angle column whose name carries a unit other than the declared one.
+
+    ``pressure_psi`` declared in kPa is refused naming both (key ``pressure_unit``), and an
+    angle column named in radians (``angle_rad``) is refused (key ``angle_column``): softbend
+    learns angles in degrees. :func:`softbend.units.check_column_unit` reads the names.
+    """
+    from softbend.errors import InputError
+    from softbend.units import check_column_unit, column_unit
+
+    try:
+        check_column_unit(pressure_column, pressure_unit, "pressure_unit", key="pressure_unit")
+    except InputError as err:
+        raise ActuatorError(err.detail, key=err.key) from None
+    if column_unit(angle_column) == "rad":
+        raise ActuatorError(
+            f"{angle_column!r} is named in radians; softbend learns angles in degrees: "
+            "multiply by 180/π (57.2958) and name the column e.g. angle_deg",
+            key="angle_column",
         )
 
 

@@ -52,7 +52,7 @@ def column_unit(name: str) -> str:
     return _SUFFIX.get(name.rsplit("_", 1)[-1].strip().lower(), "")
 
 
-def check_column_unit(column: str, unit: str, option: str) -> None:
+def check_column_unit(column: str, unit: str, option: str, *, key: str | None = None) -> None:
     """Refuse a declared ``unit`` that disagrees with the unit ``column``'s name carries.
 
     Parameters
@@ -63,6 +63,10 @@ def check_column_unit(column: str, unit: str, option: str) -> None:
         The unit declared for it (by ``option`` or a description), any case.
     option
         What declared the unit, named in the error (``--pressure-unit``).
+    key
+        The library key of what declared the unit (``pressure_unit``): given, the error
+        carries it (the command line names its option, a file its field) and the message
+        is the predicate ("is kPa, but the column 'pressure_psi' is named in psi; ...").
 
     Raises
     ------
@@ -70,11 +74,18 @@ def check_column_unit(column: str, unit: str, option: str) -> None:
         When the name carries a unit (see :func:`column_unit`) other than ``unit``.
     """
     named = column_unit(column)
-    if named and named.lower() != str(unit).strip().lower():
+    if not named or named.lower() == str(unit).strip().lower():
+        return
+    if key is not None:
         raise InputError(
-            f"The column '{column}' is named in {named}, but {option} says {unit}; "
-            f"give {option} {named} or rename the column."
+            f"is {unit}, but the column '{column}' is named in {named}; give {named} or "
+            "rename the column",
+            key=key,
         )
+    raise InputError(
+        f"The column '{column}' is named in {named}, but {option} says {unit}; "
+        f"give {option} {named} or rename the column."
+    )
 
 
 def convert_pressure(value: float, from_unit: str, to_unit: str) -> float:

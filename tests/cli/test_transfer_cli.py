@@ -442,7 +442,7 @@ def test_radians_are_one_line_exit_2_and_force_reads_them_with_a_warning(
     ):
         assert main([*command, "--out", str(tmp_path / "o")]) == 2
         line = one_error_line(capsys)
-        assert "bench.csv:3:8: angle_deg: " in line
+        assert "bench.csv: angle_deg: the actuator '130,7,2.5,3,10,9' reaches only 0.8" in line
         assert "look like radians" in line and "--force" in line
     model = tmp_path / "forced.json"
     args = [str(small_base_file), str(lab_csv), str(bench), "--out", str(model)]

@@ -90,7 +90,6 @@ def test_several_files_join(tmp_path):
             r"lab\.csv:2:1: actuator: must be non-empty text; got an empty cell",
         ),
         (HEADER, ["A1,5,1.0,latex,0,0", "A1,6,1.0,latex,10,20"], "two designs"),
-        (HEADER, ["A1,5,1.0,latex,0,0", "A1,5,1.0,latex,40,0.9"], "radians"),
     ],
 )
 def test_bad_files_are_one_error_naming_the_column(tmp_path, header, lines, match):
@@ -98,10 +97,10 @@ def test_bad_files_are_one_error_naming_the_column(tmp_path, header, lines, matc
         load_actuator_measurements(write(tmp_path, lines, header=header), ACTUATOR)
 
 
-def test_force_reads_small_angles_as_given(tmp_path):
+def test_small_angles_are_read_as_given(tmp_path):
+    # whether they are radians depends on the actuator: transfer.against_base judges
     path = write(tmp_path, ["A1,5,1.0,latex,0,0", "A1,5,1.0,latex,40,0.9"])
-    with pytest.warns(UserWarning, match="radians"):
-        data = load_actuator_measurements(path, ACTUATOR, force=True)
+    data = load_actuator_measurements(path, ACTUATOR)
     assert data.angle_deg[-1] == pytest.approx(0.9)
 
 
@@ -110,3 +109,11 @@ def test_missing_and_empty_files(tmp_path):
         load_actuator_measurements(tmp_path / "none.csv", ACTUATOR)
     with pytest.raises(DatasetError, match="followed by 0 data row"):
         load_actuator_measurements(write(tmp_path, []), ACTUATOR)
+
+
+def test_both_id_columns_at_once_are_refused_naming_both(tmp_path):
+    header = "actuator,actuator_id,n_folds,wall_mm,skin,p_kpa,angle_deg"
+    path = write(tmp_path, ["A1,A1,5,1.0,latex,0,0.5"], header=header)
+    match = r"lab\.csv:1:2: actuator_id: .*by the columns actuator and actuator_id"
+    with pytest.raises(ActuatorError, match=match):
+        load_actuator_measurements(path, ACTUATOR)

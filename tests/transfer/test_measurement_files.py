@@ -9,7 +9,6 @@ import pytest
 
 from softbend.errors import DatasetError
 from softbend.transfer.measurements import (
-    RADIAN_ANGLE_MAX,
     Measurements,
     files_record,
     load_measurements,
@@ -119,35 +118,18 @@ def test_files_record_has_each_files_digest_and_flag(tmp_path):
 
 
 KPA = "l,r,t,b,phi,lc,pressure_mpa,angle_deg\n100,6,2,2,5,8,0,0\n100,6,2,2,5,8,50,30\n"
-RADIANS = "l,r,t,b,phi,lc,pressure_mpa,angle_deg\n100,6,2,2,5,8,0,0\n100,6,2,2,5,8,0.1,0.9\n"
 
 
-def test_kpa_in_the_mpa_column_is_caught_even_with_force(tmp_path):
-    # Above 2 MPa no strategy or surrogate accepts a pressure: force cannot help.
+def test_kpa_in_the_mpa_column_is_caught_by_the_reader(tmp_path):
+    # Above 2 MPa no strategy or surrogate accepts a pressure: no option can help.
     path = _write(tmp_path, "kpa.csv", KPA)
-    for force in (False, True):
-        with pytest.raises(DatasetError, match=r"kpa\.csv:3:7: pressure_mpa: .*looks like kPa"):
-            load_measurements_files([_write(tmp_path, "ok.csv", BENCH), path], force=force)
+    with pytest.raises(DatasetError, match=r"kpa\.csv:3:7: pressure_mpa: .*looks like kPa"):
+        load_measurements_files([_write(tmp_path, "ok.csv", BENCH), path])
 
 
-def test_radians_in_the_degree_column_are_caught_and_force_reads_them(tmp_path):
-    path = _write(tmp_path, "rad.csv", RADIANS)
-    with pytest.raises(DatasetError, match=r"rad\.csv:3:8: angle_deg: .*radians"):
-        load_measurements(path)
-    with pytest.warns(UserWarning, match="radians"):
-        data = load_measurements_files([path], force=True)
-    assert data.angle_deg.tolist() == [0.0, 0.9]
-
-
-@pytest.mark.parametrize(
-    ("pressure", "angle"),
-    [
-        (0.05, 0.9),  # at 0.05 MPa a small angle may be real
-        (0.1, RADIAN_ANGLE_MAX + 0.1),  # beyond a turn in radians: degrees
-        (0.1, 30.0),
-    ],
-)
-def test_the_radian_rule_lets_plausible_degrees_pass(tmp_path, pressure, angle):
+@pytest.mark.parametrize(("pressure", "angle"), [(0.05, 0.9), (0.1, 0.9), (0.1, 30.0)])
+def test_the_reader_reads_small_angles_as_given(tmp_path, pressure, angle):
+    # whether they are radians depends on the actuator: transfer.against_base judges
     text = f"l,r,t,b,phi,lc,pressure_mpa,angle_deg\n100,6,2,2,5,8,{pressure},{angle}\n"
     data = load_measurements(_write(tmp_path, "deg.csv", text))
     assert np.isclose(data.angle_deg[0], angle)

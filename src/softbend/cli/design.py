@@ -137,16 +137,17 @@ def find(
         None, help="A TOML file of [[spec]] tables, one folder of results per spec."
     ),
     angle: float = typer.Option(None, help="Target angle, deg (with --at or --max-pressure)."),
-    at: float = typer.Option(
-        None, help="Pressure the target angle is read at, in the model's pressure unit (MPa)."
-    ),
-    max_pressure: float = typer.Option(
+    at: str = typer.Option(
         None,
-        help="Reach --angle at no more than this pressure, in the model's pressure unit "
-        "(then --minimize pressure).",
+        help="Pressure the target angle is read at: a number in the model's pressure unit "
+        "(MPa for paper B's actuator) or with a unit (20psi, 138kPa, 0.1MPa, 1.5bar).",
     ),
-    max_angle_at: float = typer.Option(
-        None, help="Bend as far as possible at this pressure, in the model's pressure unit."
+    max_pressure: str = typer.Option(
+        None,
+        help="Reach --angle at no more than this pressure, as --at (then --minimize pressure).",
+    ),
+    max_angle_at: str = typer.Option(
+        None, help="Bend as far as possible at this pressure, as --at."
     ),
     curve: str = typer.Option(
         None,
@@ -285,9 +286,12 @@ def find(
             actuator=actuator,
         )
     else:
+        unit = space.pressure_unit
         target = specs.target_from_options(
-            angle=angle, at=at, max_pressure=max_pressure, max_angle_at=max_angle_at,
-            curve=curve, tolerance=tolerance, unit=space.pressure_unit,
+            angle=angle, at=_pressure(at, unit, "--at"),
+            max_pressure=_pressure(max_pressure, unit, "--max-pressure"),
+            max_angle_at=_pressure(max_angle_at, unit, "--max-angle-at"),
+            curve=curve, tolerance=tolerance, unit=unit,
         )  # fmt: skip
         if not 0 <= margin < tolerance:
             raise InputError(
@@ -364,7 +368,9 @@ def find(
                 _common.json_text({"specs": payload}) + "\n", encoding="utf-8"
             )
     for result in results:
-        line = result.message()
+        line = result.message()  # none meets the target (and the pressures outside, if any)
+        if line is None and result.outside_pressures:
+            line = f"{result.pressure_warning()}."
         if line is not None:
             _common.warning_line(line)
         line = _extrapolated(result, model_path, len(results) > 1)
@@ -378,6 +384,21 @@ def find(
     for result in results:
         _print_result(result)
     _common.console.print(f"{', '.join(FILES)} written to {out}")
+
+
+def _pressure(text: str | None, unit: str, option: str) -> float | None:
+    """A pressure option in the model's ``unit``: a number, or one with a unit (``20psi``).
+
+    A bare number (``inf`` too) is returned as given, for the target's own range check.
+    """
+    from softbend.units import parse_pressure
+
+    if text is None:
+        return None
+    try:
+        return float(text)
+    except ValueError:
+        return parse_pressure(text, unit, option)
 
 
 def _extrapolated(result: SearchResult, model: Path, named: bool) -> str | None:

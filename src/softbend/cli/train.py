@@ -362,6 +362,9 @@ def predict(
     from softbend.surrogates.predict import INTERVAL_LEVEL, predict_text
 
     result = predict_text(model, design, pressures, strict=strict)
+    outside = result.pressure_warning()
+    if outside is not None:
+        _common.warning_line(f"--pressures {outside}.")
     if result.extrapolated:
         _common.warning_line(
             f"{model} was not trained there: {'; '.join(result.extrapolated)}; the "

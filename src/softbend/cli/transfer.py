@@ -100,7 +100,9 @@ def refine(
     force: bool = typer.Option(
         False,
         "--force",
-        help="Read angles that look like radians as degrees, as given (with a warning).",
+        help="Use pressures past the base model's range (1.5x its top) and angles that look "
+        "like radians next to its prediction as given (with a warning; recorded in the model "
+        "file).",
     ),
 ) -> None:
     """Fit a strategy on measurements and save it.

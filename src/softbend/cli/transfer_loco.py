@@ -10,9 +10,7 @@ import typer
 from softbend.cli import _common
 
 if TYPE_CHECKING:
-    from softbend.transfer.actuator_measurements import ActuatorMeasurements
     from softbend.transfer.loco import LocoResult
-    from softbend.transfer.measurements import Measurements
 
 #: The files 'transfer loco' writes into its '--out' folder.
 LOCO_FILES: tuple[str, ...] = (
@@ -66,7 +64,8 @@ def loco(
     force: bool = typer.Option(
         False,
         "--force",
-        help="Read angles that look like radians as degrees, as given (with a warning).",
+        help="Use pressures past the base model's range (1.5x its top) and angles that look "
+        "like radians next to its prediction as given (with a warning; recorded in loco.json).",
     ),
 ) -> None:
     """Score every strategy on held-out actuators.
@@ -88,14 +87,14 @@ def loco(
     from softbend._outdir import staged_dir
     from softbend.actuators import SFRBA
     from softbend.reports import transfer_figures
-    from softbend.transfer.actuator_measurements import load_actuator_measurements
+    from softbend.transfer.against_base import load_for_base
     from softbend.transfer.base import load_base_saved
     from softbend.transfer.loco import (
         DEFAULT_STRATEGIES,
         leave_one_configuration_out,
         strategy_options,
     )
-    from softbend.transfer.measurements import files_record, load_measurements_files
+    from softbend.transfer.measurements import files_record
 
     out = Path(out)
     inputs = tuple(measurements) if base is None else (*measurements, base)
@@ -110,11 +109,7 @@ def loco(
         else [n.strip() for n in strategies.split(",") if n.strip()]
     )
     options = strategy_options(names, _common.parse_assignments(settings or ()))
-    data: Measurements | ActuatorMeasurements = (
-        load_measurements_files(measurements, force=force)
-        if paper_b
-        else load_actuator_measurements(measurements, actuator, force=force)
-    )
+    data, forced = load_for_base(measurements, saved, force=force)  # before any fit
     model = saved.model
     with _common.library_progress(enabled=not as_json) as progress:
         result = leave_one_configuration_out(
@@ -129,6 +124,8 @@ def loco(
             progress=lambda done, total, name: progress("fitting strategies", done, total),
         )
     result.settings["measurement_files"] = files_record(measurements, data)  # type: ignore[arg-type]
+    if forced:
+        result.settings["forced"] = forced
     synthetic = bool(data.synthetic.any())  # the figure flags any synthetic reading
     with (
         _common.output_errors(out, "--out"),

@@ -224,6 +224,9 @@ class SearchResult:
         What verified the candidates, once verified: ``backend`` (``"fem"``,
         ``"analytical"``), ``family`` (the FEM family, ``"sfrba"`` for paper B's
         actuator) and ``designs`` (how many were swept).
+    pressure_range : (float, float), optional
+        The pressures the model was trained on, in the target's unit
+        (:func:`softbend.surrogates.support.trained_pressure_range`); None if unrecorded.
     """
 
     spec: Specification
@@ -238,11 +241,41 @@ class SearchResult:
     seconds: float
     verify_skipped: str | None = None
     verified_by: dict[str, Any] | None = None
+    pressure_range: tuple[float, float] | None = None
+
+    @property
+    def outside_pressures(self) -> list[float]:
+        """The target's pressures outside :attr:`pressure_range` (its unit)."""
+        if self.pressure_range is None:
+            return []
+        low, high = self.pressure_range
+        return [float(p) for p in self.spec.target.pressures_mpa if p < low or p > high]
+
+    def pressure_warning(self) -> str | None:
+        """The target's pressures outside the model's trained range, and the range; else None."""
+        outside = self.outside_pressures
+        if not outside or self.pressure_range is None:
+            return None
+        from softbend.surrogates.support import pressures_text
+
+        unit = self.spec.target.unit
+        low, high = self.pressure_range
+        return (
+            f"{pressures_text(outside, unit)} lies outside the pressures the model was trained "
+            f"on ({low:.4g}–{high:.4g} {unit}): its angles there are extrapolations"
+        )
 
     def message(self) -> str | None:
-        """One line when no design meets the target: the closest, and by how much it misses."""
+        """One line when no design meets the target: the closest, and by how much it misses;
+        and the target's pressures outside the model's trained range, if any."""
         if self.feasible:
             return None
+        line = self._miss()
+        outside = self.pressure_warning()
+        return line if outside is None else f"{line[:-1]}; {outside}."
+
+    def _miss(self) -> str:
+        """What :meth:`message` says of the designs: none meets the target, or the closest."""
         space = self.spec.space
         if not self.candidates and self.n_designs == 0 and space.actuator.constraints:
             return (
@@ -269,7 +302,9 @@ class SearchResult:
         ``verified`` (null) and ``verify_skipped`` (why), a verification
         ``verified`` (its backend, FEM family and number of designs, and each
         verified candidate its ``fem_stop_reason``, null where the sweep
-        reached the pressure).
+        reached the pressure). ``outside_pressure_range`` lists the target's
+        pressures outside the model's trained range, with the range and its unit
+        (null when all lie inside or the model records none).
         """
         space = self.spec.space
         target = self.spec.target
@@ -299,6 +334,15 @@ class SearchResult:
                 "search_s": self.seconds,
                 "candidates": [c.to_dict() for c in self.candidates],
             }
+        )
+        out["outside_pressure_range"] = (
+            {
+                "pressures": self.outside_pressures,
+                "trained_range": list(self.pressure_range),
+                "unit": target.unit,
+            }
+            if self.outside_pressures and self.pressure_range is not None
+            else None
         )
         if self.verify_skipped is not None:
             out["verified"] = None
@@ -730,7 +774,7 @@ def _find(
     """:func:`find_designs` once the model is loaded (within its actuator's inputs)."""
     from softbend._progress import report
     from softbend.surrogates.features import outside_training_ranges
-    from softbend.surrogates.support import Support
+    from softbend.surrogates.support import Support, trained_pressure_range
 
     predictor, metadata = model.predictor, model.metadata
     space = spec.space
@@ -847,6 +891,7 @@ def _find(
         front=front,
         model=model.path,
         seconds=time.perf_counter() - start,
+        pressure_range=trained_pressure_range(metadata, spec.space.actuator.pressure_column),
     )
 
 

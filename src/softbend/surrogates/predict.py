@@ -13,6 +13,7 @@ from softbend._validation import must_be
 from softbend.actuators import SFRBA, Actuator
 from softbend.design import SFRBADesign
 from softbend.errors import InputError, SchemaError, keyed
+from softbend.surrogates.support import pressures_text, trained_pressure_range
 
 __all__ = [
     "INTERVAL_LEVEL",
@@ -65,6 +66,9 @@ class Prediction:
         The model file.
     actuator : Actuator
         The description the model was trained with.
+    pressure_range : (float, float) or None
+        The pressures the model was trained on, in its pressure unit
+        (:func:`softbend.surrogates.support.trained_pressure_range`); None if unrecorded.
     """
 
     kind: str
@@ -78,6 +82,27 @@ class Prediction:
     beyond_support: list[str] = field(default_factory=list)
     supported: np.ndarray | None = None
     actuator: Actuator = SFRBA
+    pressure_range: tuple[float, float] | None = None
+
+    @property
+    def outside_pressures(self) -> list[float]:
+        """The pressures asked for outside :attr:`pressure_range`, in the order asked."""
+        if self.pressure_range is None:
+            return []
+        low, high = self.pressure_range
+        return [float(p) for p in self.pressure_mpa if p < low or p > high]
+
+    def pressure_warning(self) -> str | None:
+        """The pressures outside the trained range and the range, in words; else None."""
+        outside = self.outside_pressures
+        if not outside or self.pressure_range is None:
+            return None
+        unit = self.actuator.pressure_unit
+        low, high = self.pressure_range
+        return (
+            f"{pressures_text(outside, unit)}: outside the pressures {self.source} was "
+            f"trained on ({low:.4g}–{high:.4g} {unit}); the angles there are extrapolations"
+        )
 
     @property
     def design_codes(self) -> np.ndarray:
@@ -102,7 +127,9 @@ class Prediction:
         """JSON-friendly form: model, kind, design (mm, deg), pressures (MPa), angles (deg),
         the inputs outside the training ranges, the ways the predictions leave the
         training data's support and, per pressure, whether each lies in it (null
-        when the model records no support), and the interval's level and ends if any."""
+        when the model records no support), the pressures outside the trained pressure
+        range with the range and its unit (``outside_pressure_range``, null when all
+        lie inside or the model records none), and the interval's level and ends if any."""
         payload: dict[str, Any] = {
             "model": self.source,
             "kind": self.kind,
@@ -113,6 +140,13 @@ class Prediction:
             "outside_training_ranges": list(self.outside_training_ranges),
             "beyond_training_support": list(self.beyond_support),
             "supported": None if self.supported is None else self.supported.tolist(),
+            "outside_pressure_range": None
+            if not self.outside_pressures or self.pressure_range is None
+            else {
+                "pressures": self.outside_pressures,
+                "trained_range": list(self.pressure_range),
+                "unit": self.actuator.pressure_unit,
+            },
         }
         if self.interval_deg is not None:
             payload["interval_level"] = INTERVAL_LEVEL
@@ -314,6 +348,7 @@ def predict_angles(
         beyond,
         supported,
         actuator,
+        trained_pressure_range(saved.metadata, actuator.pressure_column),
     )
 
 

@@ -28,6 +28,7 @@ supported pressure.
 from __future__ import annotations
 
 import math
+from collections.abc import Mapping, Sequence
 from dataclasses import dataclass
 from typing import Any
 
@@ -38,7 +39,15 @@ from softbend._validation import must_be
 from softbend.design import PARAMETERS
 from softbend.errors import InputError
 
-__all__ = ["ANGLE_TOLERANCE", "NEIGHBOURS", "RULE", "Support", "support_from_rows"]
+__all__ = [
+    "ANGLE_TOLERANCE",
+    "NEIGHBOURS",
+    "RULE",
+    "Support",
+    "pressures_text",
+    "support_from_rows",
+    "trained_pressure_range",
+]
 
 #: Training designs whose swept pressure is interpolated to a new design.
 NEIGHBOURS = 12
@@ -265,3 +274,36 @@ def support_from_rows(
         tuple(parameters),
         pressure_unit,
     )
+
+
+def trained_pressure_range(
+    metadata: Mapping[str, Any], pressure_column: str
+) -> tuple[float, float] | None:
+    """The pressures a saved model was trained on, in its pressure unit, or None if unrecorded.
+
+    Parameters
+    ----------
+    metadata : mapping
+        The model file's metadata.
+    pressure_column : str
+        Its actuator's pressure input (``pressure_mpa``, ``p_kpa``).
+
+    Returns
+    -------
+    (low, high) or None
+        The ``training_ranges`` of ``pressure_column``, else 0 to the largest pressure of
+        the ``support`` (each training design's largest); None when the file records neither.
+    """
+    ranges = metadata.get("training_ranges")
+    if isinstance(ranges, Mapping) and pressure_column in ranges:
+        low, high = (float(v) for v in ranges[pressure_column])
+        return low, high
+    support = metadata.get("support")
+    if isinstance(support, Mapping) and support.get("max_pressure_mpa"):
+        return 0.0, float(np.max(np.asarray(support["max_pressure_mpa"], dtype=np.float64)))
+    return None
+
+
+def pressures_text(pressures: Sequence[float], unit: str) -> str:
+    """``"90, 345 kPa"``: pressures as a message shows them, in ``unit``."""
+    return f"{', '.join(f'{p:.4g}' for p in pressures)} {unit}"

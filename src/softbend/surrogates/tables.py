@@ -39,6 +39,7 @@ from softbend.limits import check_file_size
 from softbend.surrogates.features import GROUP, TrainingData, data_hash
 from softbend.tables import Column, TableFormat, check_columns
 from softbend.tables import read_table as read_csv_table
+from softbend.units import check_column_unit
 
 if TYPE_CHECKING:
     import pandas as pd
@@ -155,6 +156,10 @@ def table_training_data(
         A missing column (naming it and the table's columns), a unit not one of
         the four, a design outside ``actuator``'s description, radians; the key
         is the parameter at fault (``design_columns``, ``pressure_unit``, ...).
+    softbend.errors.InputError
+        A pressure column whose name carries a unit other than the one given
+        (``pressure_psi`` in kPa; :func:`softbend.units.check_column_unit`), key
+        ``pressure_unit``.
     softbend.errors.DatasetError
         An unreadable file, no usable row, or a pressure or angle column that
         is not numbers or a negative pressure (:func:`softbend.tables.check_columns`).
@@ -210,6 +215,7 @@ def table_training_data(
     _check_present(frame, designs, "design_columns", str(source))
     _check_present(frame, [pressure_column], "pressure_column", str(source))
     _check_present(frame, [angle_column], "angle_column", str(source))
+    check_column_unit(pressure_column, unit, "pressure_unit", key="pressure_unit")
     check_columns(
         frame,
         TableFormat(

@@ -10,17 +10,18 @@ writes one row per reading::
     A1,10,2,2.0,12,0,0.4
     A1,10,2,2.0,12,20,41.8
 
-Columns: ``actuator`` (the id of the built actuator), the model's design
-columns (its :class:`~softbend.actuators.Actuator` parameters, categorical
-ones by level), its pressure column in its unit and its angle column, in
-degrees. Nothing else: a file that lacks a design column, or names one the
-model does not have, is one error naming both. The ``# key: value`` header
+Columns: ``actuator`` or ``actuator_id`` (the id of the built actuator), the
+model's design columns (its :class:`~softbend.actuators.Actuator` parameters,
+categorical ones by level), its pressure column in its unit and its angle column,
+in degrees. A file without an id column is one actuator, named by the file's stem
+(``A1.csv`` holds the readings of ``A1``), as labs keep one file per actuator.
+Nothing else: a file that lacks a design column, or names one the model does not
+have, is one error naming both. The ``# key: value`` header
 lines are optional (``synthetic: true`` marks simulated readings). Every design
 must lie in the model's description (ranges, kinds, constraints); an actuator
-has one design; pressures are finite and >= 0; angles finite, and refused when
-they look like radians (no ``|angle|`` above a full turn in radians while the
-pressure reaches past a tenth of the file's largest — pass ``force`` to read
-them as given).
+has one design; pressures are finite and >= 0; angles finite (whether they are
+in radians depends on the actuator: :mod:`softbend.transfer.against_base` compares
+them with the base model's prediction).
 
 :class:`ActuatorMeasurements` offers what transfer learning reads from paper
 B's :class:`~softbend.transfer.measurements.Measurements`: ``features`` (the
@@ -30,9 +31,7 @@ model's inputs), ``angle_deg``, ``groups``, ``actuator_ids``, ``subset``,
 
 from __future__ import annotations
 
-import math
 import os
-import warnings
 from collections.abc import Iterable, Mapping, Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -42,7 +41,7 @@ import pandas as pd
 
 from softbend.actuators import Actuator, ActuatorError
 from softbend.errors import DatasetError
-from softbend.tables import Column, TableFormat, read_table
+from softbend.tables import Column, Table, TableFormat, read_table
 
 __all__ = [
     "ACTUATOR_COLUMN",
@@ -53,7 +52,9 @@ __all__ = [
 
 #: The column naming the built actuator of each reading.
 ACTUATOR_COLUMN = "actuator"
-_RADIAN_MAX = 2.0 * math.pi * 1.05
+#: The names the id column may have: a file gives one of them, or none (one actuator, the
+#: file's stem).
+ID_COLUMNS: tuple[str, ...] = (ACTUATOR_COLUMN, "actuator_id")
 
 
 @dataclass(frozen=True, eq=False)
@@ -156,15 +157,15 @@ class ActuatorMeasurements:
 def measurement_format(actuator: Actuator) -> TableFormat:
     """The plain measurement CSV of ``actuator``, as :mod:`softbend.tables` reads it.
 
-    The id column, the design columns (read as text: a categorical parameter
-    gives its level), the pressure column (>= 0, the actuator's unit) and the
-    angle column (degrees); any ``# key: value`` line without spaces in its key
-    is kept.
+    The optional id column (``actuator`` or ``actuator_id``), the design columns
+    (read as text: a categorical parameter gives its level), the pressure column
+    (>= 0, the actuator's unit) and the angle column (degrees); any ``# key: value``
+    line without spaces in its key is kept.
     """
     return TableFormat(
         name=f"measurement file of the actuator {actuator.name}",
         columns=(
-            Column(ACTUATOR_COLUMN, kind="text"),
+            *(Column(name, kind="text", required=False) for name in ID_COLUMNS),
             *(Column(p.name, p.unit, kind="text") for p in actuator.parameters),
             Column(actuator.pressure_column, actuator.pressure_unit, low=0.0),
             Column(actuator.angle_column, "deg"),
@@ -174,7 +175,25 @@ def measurement_format(actuator: Actuator) -> TableFormat:
     )
 
 
-def _read_one(path: Path, actuator: Actuator, force: bool) -> tuple[pd.DataFrame, dict[str, str]]:
+def _ids(table: Table, path: Path) -> pd.Series:
+    """Each reading's actuator: its id column (``actuator`` or ``actuator_id``), or, in a
+    file with neither, the file's stem (the file is one actuator)."""
+    given = [name for name in ID_COLUMNS if name in table.frame.columns]
+    if len(given) > 1:
+        raise ActuatorError(
+            f"names the actuators twice, by the columns {' and '.join(given)}; keep one",
+            key=given[1],
+            file=table.file,
+            line=table.header_line,
+            column=table.positions[given[1]],
+        )
+    if given:
+        return table.frame[given[0]].astype(object)
+    return pd.Series([path.stem] * len(table.frame), dtype=object)
+
+
+def _read_one(path: Path, actuator: Actuator) -> tuple[pd.DataFrame, dict[str, str], bool]:
+    """One file's readings, its ``# key: value`` lines, and whether its file names its actuator."""
     try:
         table = read_table(path, measurement_format(actuator))
     except DatasetError as error:
@@ -184,7 +203,7 @@ def _read_one(path: Path, actuator: Actuator, force: bool) -> tuple[pd.DataFrame
             error.detail, key=error.key, file=error.file, line=error.line, column=error.column
         ) from None
     raw = table.frame
-    frame = pd.DataFrame({"actuator_id": raw[ACTUATOR_COLUMN]})
+    frame = pd.DataFrame({"actuator_id": _ids(table, path)})
     for parameter in actuator.parameters:
         column = table.positions[parameter.name]
         codes = []
@@ -211,7 +230,6 @@ def _read_one(path: Path, actuator: Actuator, force: bool) -> tuple[pd.DataFrame
     frame[actuator.pressure_column] = raw[actuator.pressure_column]
     frame["angle_deg"] = raw[actuator.angle_column]
     frame["direction"] = "loading"  # a plain file records the loading branch
-    pressure = frame[actuator.pressure_column].to_numpy()
     met = actuator.constraints_met(frame[list(actuator.names)].to_numpy())
     if not met.all():
         pos = int(np.argmin(met))
@@ -219,27 +237,12 @@ def _read_one(path: Path, actuator: Actuator, force: bool) -> tuple[pd.DataFrame
             actuator.check_designs(frame[list(actuator.names)].to_numpy()[pos])
         except ActuatorError as err:
             raise ActuatorError(err.detail, file=table.file, line=int(table.lines[pos])) from None
-    angles = np.abs(frame["angle_deg"].to_numpy())
-    if angles.max() <= _RADIAN_MAX and pressure.max() > 0:
-        message = (
-            f"the angles reach only {angles.max():.4g} over the whole file; they look like "
-            "radians: multiply by 180/π (57.2958) for degrees"
-        )
-        angle, file = actuator.angle_column, table.file
-        if not force:
-            raise ActuatorError(
-                message + " (or read them as given with --force)", key=angle, file=file
-            )
-        warning = ActuatorError(message, key=angle, file=file)
-        warnings.warn(f"{warning}; read as given (force).", UserWarning, stacklevel=3)
-    return frame, table.header
+    return frame, table.header, not any(name in raw.columns for name in ID_COLUMNS)
 
 
 def load_actuator_measurements(
     paths: str | os.PathLike[str] | Sequence[str | os.PathLike[str]],
     actuator: Actuator,
-    *,
-    force: bool = False,
 ) -> ActuatorMeasurements:
     """Read one or more plain measurement CSV files of ``actuator`` (module docstring).
 
@@ -254,10 +257,13 @@ def load_actuator_measurements(
     """
     files = [paths] if isinstance(paths, str | os.PathLike) else list(paths)
     frames, provenance, shared = [], [], None
+    by_file: set[str] = set()  # actuators named by their file (no id column)
     for item in files:
         path = Path(item)
-        frame, metadata = _read_one(path, actuator, force)
+        frame, metadata, named_by_file = _read_one(path, actuator)
         frames.append(frame)
+        if named_by_file:
+            by_file.add(path.stem)
         flag = metadata.get("synthetic", "false").strip().lower() == "true"
         provenance.append(
             pd.DataFrame(
@@ -277,9 +283,15 @@ def load_actuator_measurements(
     designs = frame.groupby("actuator_id", sort=False)[list(actuator.names)].nunique()
     twice = designs.index[(designs > 1).any(axis=1)].tolist()
     if twice:
+        hint = (
+            f" (a file without an {' or '.join(ID_COLUMNS)} column is one actuator, named by "
+            "the file: add one of those columns to a file of several)"
+            if twice[0] in by_file
+            else ""
+        )
         raise ActuatorError(
             f"the actuator {twice[0]!r} has two designs in {', '.join(map(str, files))}; "
-            "each built actuator has one (give the others their own ids)",
+            f"each built actuator has one (give the others their own ids){hint}",
             key=ACTUATOR_COLUMN,
         )
     return ActuatorMeasurements(

@@ -45,17 +45,13 @@ A file is read only if it is within the limits of :mod:`softbend.limits`
 
 Units
 -----
-Two slips of a hand-written file are caught as errors naming the file, the line
-and the column. A ``pressure_mpa`` column written in kPa has a value above
-2 MPa, the plausible limit: the error says it looks like kPa (divide by 1000).
-This one is not overridable: no strategy or surrogate accepts a pressure above
-2 MPa. An ``angle_deg`` column written in radians: when the file's pressures
-reach above :data:`RADIAN_PRESSURE_MPA` (0.05 MPa, where the actuators of
-paper B already bend tens of degrees, paper B Fig. 7) and yet no ``|angle|``
-exceeds :data:`RADIAN_ANGLE_MAX` (2π·1.05 ≈ 6.6, a full turn in radians with
-5 % margin), the angles are taken for radians. A very stiff actuator may truly
-bend so little: ``force=True`` (``--force`` on the command line) then reads
-the angles as degrees, as given, with a warning.
+A ``pressure_mpa`` column written in kPa is caught as an error naming the file, the
+line and the column: it has a value above 2 MPa, the plausible limit, and the error
+says it looks like kPa (divide by 1000). This one is not overridable: no strategy or
+surrogate accepts a pressure above 2 MPa. Whether the angles are in radians, or the
+pressures in another unit within that limit, depends on the actuator: where the
+readings meet a base model, :mod:`softbend.transfer.against_base` compares them with
+the model's own range and prediction.
 
 Several files
 -------------
@@ -76,7 +72,6 @@ import logging
 import math
 import numbers
 import os
-import warnings
 from collections.abc import Callable, Iterable, Mapping, Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -123,12 +118,6 @@ _FORMAT_LINE = "softbend measurements CSV v1"
 #: Columns of :attr:`Measurements.provenance` every table has, before the other
 #: metadata keys of the files: the file, its ``synthetic`` flag and its ``date``.
 PROVENANCE_COLUMNS: tuple[str, ...] = ("source", "synthetic", "date")
-#: Pressure (MPa) above which the angles of a file must exceed
-#: :data:`RADIAN_ANGLE_MAX` somewhere, or they look like radians.
-RADIAN_PRESSURE_MPA = 0.05
-#: The largest ``|angle|`` of a file in radians that the radian rule suspects: a
-#: full turn with 5 % margin (2π·1.05).
-RADIAN_ANGLE_MAX = 2.0 * math.pi * 1.05
 _MAX_CYCLE = 2**53  # the largest integer a float64 holds exactly
 
 #: Plausible range of each numeric column: a quantity of
@@ -820,43 +809,13 @@ class Measurements:
 
 
 # --------------------------------------------------------------------- loading
-def _check_angle_unit(frame: pd.DataFrame, table: Table, force: bool) -> None:
-    """Raise (or, with ``force``, warn) when the file's angles look like radians.
-
-    The rule of the module docstring (Units): the pressures reach above
-    :data:`RADIAN_PRESSURE_MPA` and no ``|angle|`` exceeds :data:`RADIAN_ANGLE_MAX`.
-    The line named is that of the reading at the highest pressure.
-    """
-    pressure = frame["pressure_mpa"].to_numpy(dtype=np.float64)
-    angle = np.abs(frame["angle_deg"].to_numpy(dtype=np.float64))
-    if pressure.max() <= RADIAN_PRESSURE_MPA or angle.max() > RADIAN_ANGLE_MAX:
-        return
-    pos = int(np.argmax(pressure))
-    text = (
-        f"the angles reach only {angle.max():.4g} while the pressure reaches "
-        f"{pressure[pos]:g} MPa; they look like radians: multiply by 180/π (57.2958) for degrees"
-    )
-    error = table.error(text, row=pos, column="angle_deg")
-    if not force:
-        raise table.error(
-            f"{text}, or pass force=True (--force) to read them as degrees",
-            row=pos,
-            column="angle_deg",
-        )
-    warnings.warn(f"{error}; read as degrees as given (force).", UserWarning, stacklevel=3)
-
-
-def load_measurements(path: str | os.PathLike[str], *, force: bool = False) -> Measurements:
+def load_measurements(path: str | os.PathLike[str]) -> Measurements:
     """Read measurements from a CSV file in the format of this module.
 
     Parameters
     ----------
     path : str or path-like
         The CSV file.
-    force : bool, default False
-        Read an ``angle_deg`` column that looks like radians as degrees, as
-        given, with a warning (:class:`UserWarning`), instead of raising
-        (module docstring, Units).
 
     Returns
     -------
@@ -873,8 +832,7 @@ def load_measurements(path: str | os.PathLike[str], *, force: bool = False) -> M
         the wrong number of cells or a cell CSV cannot read, no data rows, a
         metadata key given twice, unknown or with a malformed value, an
         implausible number (:mod:`softbend.plausibility`; a pressure above
-        2 MPa is said to look like kPa), angles that look like radians (unless
-        ``force``), or any cell check of :class:`Measurements`.
+        2 MPa is said to look like kPa), or any cell check of :class:`Measurements`.
     LimitError
         The file is larger than the ``file_mib`` limit or has more data rows
         than the ``csv_rows`` limit (:mod:`softbend.limits`); checked before the
@@ -883,7 +841,6 @@ def load_measurements(path: str | os.PathLike[str], *, force: bool = False) -> M
     source = Path(path)
     table = read_table(source, MEASUREMENT_FORMAT)
     frame, _ = _normalize(table.frame, _Rows(str(source), table=table))
-    _check_angle_unit(frame, table, force)
     metadata = table.header
     measurements = Measurements(frame, metadata=metadata, source=str(source))
     logger.debug(
@@ -896,7 +853,7 @@ def load_measurements(path: str | os.PathLike[str], *, force: bool = False) -> M
 
 
 def load_measurements_files(
-    paths: str | os.PathLike[str] | Sequence[str | os.PathLike[str]], *, force: bool = False
+    paths: str | os.PathLike[str] | Sequence[str | os.PathLike[str]],
 ) -> Measurements:
     """Read measurements from one or more CSV files and join their readings, in file order.
 
@@ -905,8 +862,6 @@ def load_measurements_files(
     paths : path or sequence of paths
         The CSV files (:func:`load_measurements`); one path reads as
         :func:`load_measurements` does.
-    force : bool, default False
-        As for :func:`load_measurements`, for every file.
 
     Returns
     -------
@@ -930,7 +885,7 @@ def load_measurements_files(
     if not items:
         raise DatasetError("No measurement file given; at least one CSV file is required.")
     if len(items) == 1:
-        return load_measurements(items[0], force=force)
+        return load_measurements(items[0])
     seen: dict[Path, str] = {}
     for item in items:
         key = Path(item).resolve()
@@ -940,7 +895,7 @@ def load_measurements_files(
                 "give each file once."
             )
         seen[key] = str(item)
-    parts = [load_measurements(item, force=force) for item in items]
+    parts = [load_measurements(item) for item in items]
     owner: dict[str, tuple[SFRBADesign, str]] = {}
     for part in parts:
         for actuator in part.actuator_ids:

@@ -174,8 +174,9 @@ def refine_surrogate(
         few for the rule's guarantee (:func:`softbend.transfer.conformal.min_actuators`)
         or too few to calibrate at all.
     force : bool, default False
-        Read angles that look like radians as degrees, as given, with a
-        warning (:mod:`softbend.transfer.measurements`, Units).
+        Use measured pressures past the base's trained range and angles that
+        look like radians as given, with a warning, and record them in the
+        model's ``metadata["forced"]`` (:mod:`softbend.transfer.against_base`).
 
     Returns
     -------
@@ -189,17 +190,16 @@ def refine_surrogate(
     ValueError
         A strategy that learns nothing (a baseline, key ``strategy``), a
         parameter value of the wrong kind (key ``settings`` or ``options``),
-        bad measurements or a fit that cannot be made.
+        bad measurements (pressures past the base's range, radians: unless
+        ``force``) or a fit that cannot be made.
     FileNotFoundError, SchemaError
         A missing or unreadable input.
     ConvergenceError
         A refit that diverged, or whose predictions on the readings, training
         error, final loss or calibrated half-width is not finite.
     """
-    from softbend.actuators import SFRBA
     from softbend.surrogates.persistence import describing, load_surrogate
-    from softbend.transfer.actuator_measurements import load_actuator_measurements
-    from softbend.transfer.measurements import load_measurements_files
+    from softbend.transfer.against_base import load_for_base
 
     with keyed("strategy"):
         cls = STRATEGIES.get(strategy)
@@ -216,13 +216,9 @@ def refine_surrogate(
     files = [measurements] if isinstance(measurements, str | os.PathLike) else list(measurements)
     start = load_surrogate(base)
     actuator = start.actuator
-    data: Measurements | ActuatorMeasurements
-    if actuator == SFRBA:
-        data = load_measurements_files(files, force=force)
-    else:  # another actuator's plain CSV: its own columns and units
-        data = load_actuator_measurements(files, actuator, force=force)
+    data, forced = load_for_base(files, start, force=force)  # before any fit
     with describing(actuator):
-        return _refine(
+        refinement = _refine(
             strategy,
             start,
             data,
@@ -233,6 +229,9 @@ def refine_surrogate(
             values=values,
             calibrated=calibrated,
         )
+    if forced:
+        refinement.metadata["forced"] = forced
+    return refinement
 
 
 def _refine(
