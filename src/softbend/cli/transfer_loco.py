@@ -96,6 +96,7 @@ def loco(
         strategy_options,
     )
     from softbend.transfer.measurements import files_record, load_measurements_files
+    from softbend.transfer.strategies import applicable_strategies, check_applicable
 
     out = Path(out)
     inputs = tuple(measurements) if base is None else (*measurements, base)
@@ -104,12 +105,13 @@ def loco(
     saved = load_base_saved(base)
     actuator = saved.actuator
     paper_b = actuator == SFRBA
-    names = (
-        [n for n in DEFAULT_STRATEGIES if paper_b or n != "analytical"]
-        if strategies.strip() == "all"
-        else [n.strip() for n in strategies.split(",") if n.strip()]
-    )
+    left_out: dict[str, str] = {}
+    if strategies.strip() == "all":  # those that apply to the base, the others said
+        names, left_out = applicable_strategies(DEFAULT_STRATEGIES, saved.model, actuator)
+    else:
+        names = [n.strip() for n in strategies.split(",") if n.strip()]
     options = strategy_options(names, _common.parse_assignments(settings or ()))
+    check_applicable(names, saved.model, actuator, key="strategies")  # before any work
     data: Measurements | ActuatorMeasurements = (
         load_measurements_files(measurements, force=force)
         if paper_b
@@ -129,6 +131,7 @@ def loco(
             progress=lambda done, total, name: progress("fitting strategies", done, total),
         )
     result.settings["measurement_files"] = files_record(measurements, data)  # type: ignore[arg-type]
+    result.settings["left_out"] = left_out
     synthetic = bool(data.synthetic.any())  # the figure flags any synthetic reading
     with (
         _common.output_errors(out, "--out"),
@@ -147,11 +150,38 @@ def loco(
                 transfer_figures.learning_curve(result, stage / "learning_curve.png")
             )
     files = {key: str(out / Path(value).name) for key, value in written.items()}
+    if left_out:  # said once the run has succeeded: an error stays the one line
+        _common.warning_line(left_out_line(left_out))
+    failed = result.settings.get("failed", [])
+    if failed:
+        _common.warning_line(failed_line(failed))
     if as_json:
         _common.print_json({**result.to_dict(), "files": files, "synthetic": synthetic})
         return
     print_loco_summary(result)
     _common.console.print(f"tables and figures written to {out}")
+
+
+def left_out_line(left_out: dict[str, str]) -> str:
+    """The one line saying which strategies of 'all' were left out for the base, and why."""
+    reasons: dict[str, list[str]] = {}
+    for name, reason in left_out.items():
+        reasons.setdefault(reason, []).append(name)
+    parts = [f"{', '.join(names)} ({reason})" for reason, names in reasons.items()]
+    return (
+        "--strategies all runs the strategies that apply to the base; left out: "
+        + "; ".join(parts)
+        + " (recorded in loco.json, settings.left_out)"
+    )
+
+
+def failed_line(failed: list[dict[str, str]]) -> str:
+    """The one line listing the (strategy, held-out actuator) fits that failed."""
+    pairs = ", ".join(f"{f['strategy']} on held-out {f['actuator_id']}" for f in failed)
+    return (
+        f"{len(failed)} fit(s) failed and are left out of the means: {pairs}; each reason is "
+        "in per_actuator.csv (column 'error') and loco.json"
+    )
 
 
 def print_loco_summary(result: LocoResult) -> None:
