@@ -691,17 +691,19 @@ class RefinedMLP(_Strategy):
         base = check_mlp(first.base)
         _check_same(estimators, ("base", "epochs", "learning_rate", "device"))
         starts = cls._starts(base, X, y, row_sets)
-        live = []
+        live: list[int] = []
+        ready: list[NormalizedMLPRegressor] = []
         for i, start in enumerate(starts):
             if isinstance(start, Exception):
                 _fit_failed(estimators[i], start, keep_going)
             else:
                 live.append(i)
+                ready.append(start)
         if not live:
             return estimators
         try:
             models = fine_tune_many(
-                [starts[i] for i in live],
+                ready,
                 X,
                 y,
                 row_weights([row_sets[i] for i in live], len(y)),
