@@ -178,6 +178,30 @@ def test_a_fit_that_fails_on_one_held_out_actuator_is_reported_and_the_rest_writ
     assert "scale-offset on held-out P1, pressure-scale on held-out P1" in line
 
 
+def test_a_learning_curve_fit_that_fails_is_reported_in_its_table(plr_lab, tmp_path, capsys):
+    base, readings, _ = plr_lab
+    three = tmp_path / "three.csv"  # P1 and P2 over their pressures, P3 at rest only
+    lines = [line for line in readings.read_text().splitlines() if not line.startswith("P3,")]
+    three.write_text("\n".join([*lines, _reading("P3", 0.0), _reading("P3", 0.0)]) + "\n")
+    out = tmp_path / "o"
+    code = main(
+        [
+            *("transfer", "loco", str(three), "--base", str(base), "--out", str(out)),
+            *("--strategies", "scale-offset"),
+        ]
+    )
+    captured = capsys.readouterr()
+    assert code == 0, captured.err
+    with open(out / "learning_curve.csv", newline="") as table:
+        rows = list(csv.DictReader(table))
+    failed = [r for r in rows if r["error"]]
+    assert failed and all(r["rmse_deg"] == "" and r["n_actuators"] == "1" for r in failed)
+    assert "must hold at least 3 readings" in failed[0]["error"]
+    assert all(r["rmse_deg"] for r in rows if not r["error"])
+    (line,) = _warnings(captured.err)
+    assert f"{len(failed)} fit(s) of the learning curve or the calibration failed" in line
+
+
 def test_a_batched_network_fit_that_fails_on_one_held_out_actuator_leaves_the_others(
     tmp_path, capsys, small_base_file
 ):

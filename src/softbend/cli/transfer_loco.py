@@ -152,9 +152,9 @@ def loco(
     files = {key: str(out / Path(value).name) for key, value in written.items()}
     if left_out:  # said once the run has succeeded: an error stays the one line
         _common.warning_line(left_out_line(left_out))
-    failed = result.settings.get("failed", [])
-    if failed:
-        _common.warning_line(failed_line(failed))
+    failed, others = result.settings.get("failed", []), result.settings.get("failed_other_fits", 0)
+    if failed or others:
+        _common.warning_line(failed_line(failed, others))
     if as_json:
         _common.print_json({**result.to_dict(), "files": files, "synthetic": synthetic})
         return
@@ -175,13 +175,24 @@ def left_out_line(left_out: dict[str, str]) -> str:
     )
 
 
-def failed_line(failed: list[dict[str, str]]) -> str:
-    """The one line listing the (strategy, held-out actuator) fits that failed."""
+def failed_line(failed: list[dict[str, str]], others: int = 0) -> str:
+    """The one line listing the (strategy, held-out actuator) fits that failed.
+
+    ``others``: how many fits of the learning curve and the nested calibration failed.
+    """
     pairs = ", ".join(f"{f['strategy']} on held-out {f['actuator_id']}" for f in failed)
-    return (
-        f"{len(failed)} fit(s) failed and are left out of the means: {pairs}; each reason is "
-        "in per_actuator.csv (column 'error') and loco.json"
-    )
+    parts = []
+    if failed:
+        parts.append(
+            f"{len(failed)} fit(s) failed and are left out of the means: {pairs}; each reason "
+            "is in per_actuator.csv (column 'error') and loco.json"
+        )
+    if others:
+        parts.append(
+            f"{others} fit(s) of the learning curve or the calibration failed (learning_curve.csv, "
+            "column 'error'; loco.json, settings.failed_other_fits)"
+        )
+    return "; ".join(parts)
 
 
 def print_loco_summary(result: LocoResult) -> None:

@@ -122,8 +122,9 @@ class LocoResult:
         interval strategies, ``cal_lo_deg``/``cal_hi_deg`` for the calibrated
         interval).
     learning_curve : DataFrame
-        ``strategy, n_actuators, held_out, rmse_deg, mape_pct``: fitted on the
-        first ``n`` of the other actuators in a seeded order.
+        ``strategy, n_actuators, held_out, rmse_deg, mape_pct, error``: fitted on
+        the first ``n`` of the other actuators in a seeded order (``error``: why
+        a fit failed, its scores NaN; None when it did not).
     loss_curves : dict of str to ndarray
         Training MSE per epoch (deg²) of the MLP strategies fitted on all
         actuators (paper B Fig. 6).
@@ -536,6 +537,7 @@ def _leave_one_out(
                     "held_out": held_out,
                     "rmse_deg": row["rmse_deg"],
                     "mape_pct": row["mape_pct"],
+                    "error": row["error"],
                 }
             )
     base_curve, y_scale = getattr(base, "loss_curve_", None), getattr(base, "y_scale_", None)
@@ -548,7 +550,8 @@ def _leave_one_out(
         summary=_summarize(per_actuator, names, calibrated=calibrated),
         predictions=pd.concat(predictions, ignore_index=True),
         learning_curve=pd.DataFrame(
-            curve, columns=["strategy", "n_actuators", "held_out", "rmse_deg", "mape_pct"]
+            curve,
+            columns=["strategy", "n_actuators", "held_out", "rmse_deg", "mape_pct", "error"],
         )
         .sort_values(["strategy", "n_actuators", "held_out"], kind="stable")
         .reset_index(drop=True),
@@ -741,7 +744,7 @@ def _coverage_reason(name: str, calibrated: bool, coverage: float) -> str | None
         )
     return (
         "not calibrated on every held-out actuator: the leave-one-out errors of an "
-        "actuator were not finite"
+        "actuator were not finite, or a fit without it failed"
     )
 
 
