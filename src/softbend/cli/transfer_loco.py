@@ -198,7 +198,9 @@ def failed_line(failed: list[dict[str, str]], others: int = 0) -> str:
 def print_loco_summary(result: LocoResult) -> None:
     """The per-strategy table beside paper B's refined MLP (paper B §4.3, Fig. 7).
 
-    The "vs baseline" column is each strategy's mean RMSE relative to the
+    A strategy that could not be fitted without some held-out actuators says
+    how many ("pressure-scale (1 failed)"): its means are over the others. The
+    "vs baseline" column is each strategy's mean RMSE relative to the
     baseline's (:data:`~softbend.transfer.loco.BASELINE_STRATEGY`, the base plus
     the mean residual against pressure): −23 % is 23 % lower. A dash when the
     baseline is not in the run.
@@ -226,6 +228,11 @@ def print_loco_summary(result: LocoResult) -> None:
             return "—"
         return f"{change:+.0f} %".replace("-", "\u2212")
 
+    def _strategy_cell(r: pd.Series) -> str:
+        """The strategy, and how many held-out actuators it could not be fitted without."""
+        failed = int(r.get("n_failed", 0))
+        return f"{r['strategy']} ({failed} failed)" if failed else str(r["strategy"])
+
     def _mape_cell(r: pd.Series) -> str | float:
         """The mean MAPE, or a dash where no held-out reading reached the floor."""
         mape = float(r["mape_pct"])
@@ -238,7 +245,7 @@ def print_loco_summary(result: LocoResult) -> None:
     for _, r in result.summary.iterrows():
         rows.append(
             [
-                r["strategy"],
+                _strategy_cell(r),
                 float(r["rmse_deg"]),
                 _baseline_cell(r),
                 _mape_cell(r),
