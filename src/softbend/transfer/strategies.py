@@ -46,7 +46,12 @@ constructor's ``base`` and ``seed``, if it takes them, are filled by the library
 its other parameters, with defaults, are the ones a user sets
 (:mod:`softbend.transfer.parameters`: ``--set NAME=VALUE``). ``fit(X, y)`` sets
 ``model_``, the surrogate that ``softbend transfer refine`` saves; a class whose
-``learns`` is False (a baseline) has nothing to save.
+``learns`` is False (a baseline) has nothing to save. A class method
+``refusal(base, actuator)`` says why the strategy cannot start from a base (the
+network strategies need an ``mlp``; ``analytical``, paper B's actuator), or None
+when it can: the default runs leave such a strategy out and say why
+(:func:`applicable_strategies`), and a run that names it is refused before any
+work (:func:`check_applicable`). A class without one takes any base.
 """
 
 from __future__ import annotations
