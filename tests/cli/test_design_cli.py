@@ -10,6 +10,7 @@ from pathlib import Path
 
 import pytest
 
+from softbend._outdir import write_manifest
 from softbend.cli import main
 
 FIXED = ["--fix", "r=8", "--fix", "t=3", "--fix", "b=3", "--fix", "phi=10", "--fix", "lc=10"]
@@ -228,6 +229,7 @@ def test_a_bad_spec_name_writes_nothing_anywhere(
     out = tmp_path / "out"
     out.mkdir()
     (out / "search.json").write_text('{"specs": []}\n')  # an earlier result, kept as it is
+    write_manifest(out, "design find", complete=True)
     names = [str(tmp_path / "abs" / "x") if n == "ABSOLUTE" else n for n in names]
     spec = folder / "specs.toml"
     spec.write_text("".join(_table(n) for n in names), encoding="utf-8")

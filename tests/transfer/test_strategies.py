@@ -53,7 +53,10 @@ def test_unknown_strategy_lists_the_allowed_ones():
 
 
 def test_refining_needs_an_mlp_base(quick_measurements):
-    with pytest.raises(ValueError, match=r"^base: must be a fitted NormalizedMLPRegressor"):
+    with pytest.raises(
+        ValueError,
+        match=r"^base: must be a fitted mlp surrogate: .*; got a model of no saved family$",
+    ):
         RefinedMLP(ScaleOffset()).fit(quick_measurements.features, quick_measurements.angle_deg)
 
 
@@ -204,7 +207,8 @@ def test_an_absurd_angle_is_refused_before_fitting(small_base, rows, name):
         with pytest.raises(DatasetError) as error:
             model.fit(X, y)
     message = str(error.value)
-    assert "row 5, column 'y': 1e+300 is not a plausible bending angle" in message
+    assert "row 5, column 'angle_deg': 1e+300 is not a plausible bending angle" in message
+    assert f"the '{name}' strategy's training readings" in message and ".fit" not in message
     assert "-3600 to 3600" in message
 
 
@@ -214,7 +218,8 @@ def test_an_absurd_pressure_is_refused_before_fitting(small_base, rows):
     X[3, -1] = 250.0  # kPa
     with pytest.raises(
         DatasetError,
-        match=r"ScaleOffset.fit, row 3, column 'pressure_mpa': 250 is not a plausible.*kPa",
+        match=r"^the 'scale-offset' strategy's training readings, row 3, column 'pressure_mpa': "
+        r"250 is not a plausible.*kPa",
     ):
         ScaleOffset(small_base).fit(X, y)
 

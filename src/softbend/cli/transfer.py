@@ -82,9 +82,10 @@ def refine(
         help="Measurements CSV file(s); several are joined, each keeping its provenance.",
     ),
     out: Path = typer.Option(..., "--out", "-o", help="File for the refined model (JSON)."),
-    strategy: str = typer.Option(
-        "refined",
-        help="A strategy that learns from the measurements (see 'softbend transfer strategies').",
+    strategy: str | None = typer.Option(
+        None,
+        help="A strategy that learns from the measurements (see 'softbend transfer "
+        "strategies'). Default: 'refined' for an mlp base, else 'scale-offset'.",
     ),
     settings: list[str] | None = typer.Option(
         None,
@@ -106,6 +107,11 @@ def refine(
     ),
 ) -> None:
     """Fit a strategy on measurements and save it.
+
+    Without --strategy, the base's own default: paper B's refined MLP for an mlp base,
+    scale-offset (the base frozen, corrected linearly) for any other, said on stderr. A
+    strategy that cannot start from the base is refused before any work, naming those that
+    can.
 
     The strategy learns from all the MEASUREMENTS (one or more CSV files, joined; the
     model file records each file with its SHA-256); the model is saved like the other
@@ -144,6 +150,12 @@ def refine(
     with _common.output_errors(out, "--out"):
         path = result.save(out)
     meta = result.metadata
+    strategy = str(meta["strategy"])
+    for name, reason in meta.get("strategy_left_out", {}).items():
+        _common.warning_line(
+            f"--strategy not given: '{name}' {reason}; fitted '{strategy}' instead "
+            "(recorded in the model file, strategy_left_out)"
+        )
     interval = meta.get("interval")
     calibration = (
         f"; calibrated {interval['level']:.0%} interval ±{interval['half_width_deg']:.3g}° "

@@ -85,7 +85,6 @@ def loco(
         softbend transfer loco lab.csv bench.csv --out loco
     """
     from softbend._outdir import staged_dir
-    from softbend.actuators import SFRBA
     from softbend.reports import transfer_figures
     from softbend.transfer.against_base import load_for_base
     from softbend.transfer.base import load_base_saved
@@ -95,6 +94,7 @@ def loco(
         strategy_options,
     )
     from softbend.transfer.measurements import files_record
+    from softbend.transfer.strategies import applicable_strategies, check_applicable
 
     out = Path(out)
     inputs = tuple(measurements) if base is None else (*measurements, base)
@@ -102,13 +102,13 @@ def loco(
     _common.check_replaceable_dir(out, "--out", inputs=inputs)
     saved = load_base_saved(base)
     actuator = saved.actuator
-    paper_b = actuator == SFRBA
-    names = (
-        [n for n in DEFAULT_STRATEGIES if paper_b or n != "analytical"]
-        if strategies.strip() == "all"
-        else [n.strip() for n in strategies.split(",") if n.strip()]
-    )
+    left_out: dict[str, str] = {}
+    if strategies.strip() == "all":  # those that apply to the base, the others said
+        names, left_out = applicable_strategies(DEFAULT_STRATEGIES, saved.model, actuator)
+    else:
+        names = [n.strip() for n in strategies.split(",") if n.strip()]
     options = strategy_options(names, _common.parse_assignments(settings or ()))
+    check_applicable(names, saved.model, actuator, key="strategies")  # before any work
     data, forced = load_for_base(measurements, saved, force=force)  # before any fit
     model = saved.model
     with _common.library_progress(enabled=not as_json) as progress:
@@ -126,6 +126,7 @@ def loco(
     result.settings["measurement_files"] = files_record(measurements, data)  # type: ignore[arg-type]
     if forced:
         result.settings["forced"] = forced
+    result.settings["left_out"] = left_out
     synthetic = bool(data.synthetic.any())  # the figure flags any synthetic reading
     with (
         _common.output_errors(out, "--out"),
@@ -144,6 +145,11 @@ def loco(
                 transfer_figures.learning_curve(result, stage / "learning_curve.png")
             )
     files = {key: str(out / Path(value).name) for key, value in written.items()}
+    if left_out:  # said once the run has succeeded: an error stays the one line
+        _common.warning_line(left_out_line(left_out))
+    failed, others = result.settings.get("failed", []), result.settings.get("failed_other_fits", 0)
+    if failed or others:
+        _common.warning_line(failed_line(failed, others))
     if as_json:
         _common.print_json({**result.to_dict(), "files": files, "synthetic": synthetic})
         return
@@ -151,10 +157,45 @@ def loco(
     _common.console.print(f"tables and figures written to {out}")
 
 
+def left_out_line(left_out: dict[str, str]) -> str:
+    """The one line saying which strategies of 'all' were left out for the base, and why."""
+    reasons: dict[str, list[str]] = {}
+    for name, reason in left_out.items():
+        reasons.setdefault(reason, []).append(name)
+    parts = [f"{', '.join(names)} ({reason})" for reason, names in reasons.items()]
+    return (
+        "--strategies all runs the strategies that apply to the base; left out: "
+        + "; ".join(parts)
+        + " (recorded in loco.json, settings.left_out)"
+    )
+
+
+def failed_line(failed: list[dict[str, str]], others: int = 0) -> str:
+    """The one line listing the (strategy, held-out actuator) fits that failed.
+
+    ``others``: how many fits of the learning curve and the nested calibration failed.
+    """
+    pairs = ", ".join(f"{f['strategy']} on held-out {f['actuator_id']}" for f in failed)
+    parts = []
+    if failed:
+        parts.append(
+            f"{len(failed)} fit(s) failed and are left out of the means: {pairs}; each reason "
+            "is in per_actuator.csv (column 'error') and loco.json"
+        )
+    if others:
+        parts.append(
+            f"{others} fit(s) of the learning curve or the calibration failed (learning_curve.csv, "
+            "column 'error'; loco.json, settings.failed_other_fits)"
+        )
+    return "; ".join(parts)
+
+
 def print_loco_summary(result: LocoResult) -> None:
     """The per-strategy table beside paper B's refined MLP (paper B §4.3, Fig. 7).
 
-    The "vs baseline" column is each strategy's mean RMSE relative to the
+    A strategy that could not be fitted without some held-out actuators says
+    how many ("pressure-scale (1 failed)"): its means are over the others. The
+    "vs baseline" column is each strategy's mean RMSE relative to the
     baseline's (:data:`~softbend.transfer.loco.BASELINE_STRATEGY`, the base plus
     the mean residual against pressure): −23 % is 23 % lower. A dash when the
     baseline is not in the run.
@@ -182,6 +223,11 @@ def print_loco_summary(result: LocoResult) -> None:
             return "—"
         return f"{change:+.0f} %".replace("-", "\u2212")
 
+    def _strategy_cell(r: pd.Series) -> str:
+        """The strategy, and how many held-out actuators it could not be fitted without."""
+        failed = int(r.get("n_failed", 0))
+        return f"{r['strategy']} ({failed} failed)" if failed else str(r["strategy"])
+
     def _mape_cell(r: pd.Series) -> str | float:
         """The mean MAPE, or a dash where no held-out reading reached the floor."""
         mape = float(r["mape_pct"])
@@ -194,7 +240,7 @@ def print_loco_summary(result: LocoResult) -> None:
     for _, r in result.summary.iterrows():
         rows.append(
             [
-                r["strategy"],
+                _strategy_cell(r),
                 float(r["rmse_deg"]),
                 _baseline_cell(r),
                 _mape_cell(r),

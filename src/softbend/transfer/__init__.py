@@ -44,17 +44,22 @@ _EXPORTS = {
     "parameter_defaults": "parameters",
     "fit_pressure_scale": "pressure_map",
     "scale_mlp_pressure": "pressure_map",
+    "REFINE_DEFAULTS": "refine",
     "Refinement": "refine",
+    "default_refine_strategy": "refine",
     "refinable_strategies": "refine",
     "refine_surrogate": "refine",
     "BUILTIN_STRATEGIES": "strategies",
     "NETWORK_STRATEGIES": "strategies",
     "STRATEGIES": "strategies",
+    "applicable_strategies": "strategies",
+    "check_applicable": "strategies",
     "describe_strategies": "strategies",
     "fit_strategy": "strategies",
     "has_interval": "strategies",
     "make_strategy": "strategies",
     "strategy_parameters": "strategies",
+    "strategy_refusal": "strategies",
 }
 
 __all__ = sorted(_EXPORTS)

@@ -42,15 +42,22 @@ FINE_TUNE_THREADS = 2
 
 
 def check_mlp(base: object) -> NormalizedMLPRegressor:
-    """``base`` if it is a fitted NormalizedMLPRegressor, else :class:`InputError` keyed base."""
+    """``base`` if it is a fitted NormalizedMLPRegressor, else :class:`InputError` keyed base.
+
+    The message names the surrogate families a user saves (``mlp``, ``plr``, ...).
+    """
     from sklearn.utils.validation import check_is_fitted
 
     from softbend.surrogates.mlp import NormalizedMLPRegressor
+    from softbend.surrogates.persistence import kind_of
 
     if not isinstance(base, NormalizedMLPRegressor):
+        try:
+            family = f"a {kind_of(base)} surrogate"
+        except InputError:
+            family = "a model of no saved family" if base is not None else "none"
         raise InputError(
-            "must be a fitted NormalizedMLPRegressor (an 'mlp' surrogate): its weights are "
-            f"trained further; got {type(base).__name__}",
+            f"must be a fitted mlp surrogate: its weights are trained further; got {family}",
             key="base",
         )
     check_is_fitted(base)

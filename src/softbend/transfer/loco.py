@@ -27,19 +27,20 @@ design either.
 
 from __future__ import annotations
 
+import inspect
 import os
 import time
 from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 import pandas as pd
 
 from softbend._io import json_text, write_text_atomic
 from softbend._validation import check_int, check_range
-from softbend.errors import InputError, keyed
+from softbend.errors import InputError, SoftbendError, keyed
 from softbend.metrics import mape_floor, rmse, thresholded_mape
 from softbend.registry import UnknownNameError
 from softbend.surrogates.protocol import Surrogate
@@ -49,11 +50,17 @@ from softbend.transfer.measurements import Measurements
 from softbend.transfer.parameters import check_parameters, recorded_parameters
 from softbend.transfer.strategies import (
     BUILTIN_STRATEGIES,
+    FIT_ERRORS,
     STRATEGIES,
+    applicable_strategies,
+    check_applicable,
     has_interval,
     make_strategy,
     strategy_parameters,
 )
+
+if TYPE_CHECKING:
+    from softbend.actuators import Actuator
 
 __all__ = [
     "BASELINE_STRATEGY",
@@ -66,7 +73,8 @@ __all__ = [
     "strategy_options",
 ]
 
-#: The strategies of a default evaluation: softbend's own, in the order of the tables.
+#: The strategies of a default evaluation: softbend's own, in the order of the tables, those
+#: of them that apply to the base (:func:`~softbend.transfer.strategies.applicable_strategies`).
 DEFAULT_STRATEGIES: tuple[str, ...] = BUILTIN_STRATEGIES
 
 #: Strategies left out of the learning curve and the nested calibration (the longest training).
@@ -95,7 +103,9 @@ class LocoResult:
         ``calibrated_coverage`` and ``calibrated_width_deg``
         (share inside, and mean width in degrees, of the calibrated interval,
         calibrated without the held-out actuator; NaN when not calibrated),
-        ``calibration_half_width_deg``, ``calibration_guaranteed``, ``fit_s``.
+        ``calibration_half_width_deg``, ``calibration_guaranteed``, ``fit_s``;
+        ``status`` ("ok", or "failed": the strategy could not be fitted without
+        that actuator, its scores NaN) and ``error`` (why, else None).
     summary : DataFrame
         One row per strategy: the means over actuators (coverages weighted by
         readings), the worst actuator and its RMSE and MAPE. ``rmse_deg`` and
@@ -105,14 +115,16 @@ class LocoResult:
         baseline's − 1)`` against :data:`BASELINE_STRATEGY` (NaN when it is not
         in the run); ``calibrated_coverage`` is the share of held-out readings
         inside the calibrated interval, and ``calibrated_coverage_reason`` says
-        why it is NaN (None when it is not).
+        why it is NaN (None when it is not). The means are over the actuators
+        the strategy was fitted without; ``n_failed`` counts those it could not be.
     predictions : DataFrame
         Every held-out reading with each strategy's prediction (``lo``/``hi`` for
         interval strategies, ``cal_lo_deg``/``cal_hi_deg`` for the calibrated
         interval).
     learning_curve : DataFrame
-        ``strategy, n_actuators, held_out, rmse_deg, mape_pct``: fitted on the
-        first ``n`` of the other actuators in a seeded order.
+        ``strategy, n_actuators, held_out, rmse_deg, mape_pct, error``: fitted on
+        the first ``n`` of the other actuators in a seeded order (``error``: why
+        a fit failed, its scores NaN; None when it did not).
     loss_curves : dict of str to ndarray
         Training MSE per epoch (deg²) of the MLP strategies fitted on all
         actuators (paper B Fig. 6).
@@ -121,7 +133,11 @@ class LocoResult:
     settings : dict
         Strategies, seed, interval level, time taken; ``baseline``, the
         strategy ``rmse_vs_baseline_pct`` is relative to (None when it is not
-        in the run).
+        in the run); ``left_out``, each default strategy that cannot start
+        from the base with the reason; ``failed``, each (strategy, held-out
+        actuator) that could not be fitted with the reason, and
+        ``failed_other_fits``, how many fits of the learning curve, the
+        nested calibration and the fit on every actuator failed.
     calibrations : dict of str to dict
         Per calibrated strategy, the calibration on all the actuators (what
         ``softbend transfer refine`` would record; :meth:`Calibration.to_dict`).
@@ -215,22 +231,60 @@ def _fit_all(
     y: np.ndarray,
     row_sets: list[np.ndarray],
 ) -> tuple[list[Any], float]:
-    """Fit one fresh ``name`` strategy per row set; batched where the strategy can."""
+    """Fit one fresh ``name`` strategy per row set; batched where the strategy can.
+
+    Returns each fitted strategy, or the error (one of
+    :data:`~softbend.transfer.strategies.FIT_ERRORS`) that stopped its fit: one
+    row set that cannot be fitted leaves the others' fits. A batch whose
+    ``fit_batch`` takes ``keep_going`` records its failures itself; one that
+    does not, and fails, is fitted again one row set at a time.
+    """
     start = time.perf_counter()
-    models = [make_strategy(name, base, seed=seed, **options) for _ in row_sets]
+    models: list[Any] = [make_strategy(name, base, seed=seed, **options) for _ in row_sets]
     fit_batch = getattr(type(models[0]), "fit_batch", None)
-    if fit_batch is not None:
-        fit_batch(models, X, y, row_sets)
+    if fit_batch is not None and "keep_going" in inspect.signature(fit_batch).parameters:
+        fit_batch(models, X, y, row_sets, keep_going=True)
+        models = [getattr(m, "fit_error_", None) or m for m in models]
+    elif fit_batch is not None:
+        try:
+            fit_batch(models, X, y, row_sets)
+        except FIT_ERRORS:
+            models = [
+                _fit_one(m, X, y, rows, fit_batch) for m, rows in zip(models, row_sets, strict=True)
+            ]
     else:
-        for model, rows in zip(models, row_sets, strict=True):
-            model.fit(X[rows], y[rows])
+        models = [_fit_one(m, X, y, rows) for m, rows in zip(models, row_sets, strict=True)]
     return models, (time.perf_counter() - start) / len(row_sets)
+
+
+def _fit_one(
+    model: Any, X: np.ndarray, y: np.ndarray, rows: np.ndarray, fit_batch: Any = None
+) -> Any:
+    """``model`` fitted on ``rows`` (alone, as a batch of one with ``fit_batch``), or its error."""
+    try:
+        if fit_batch is not None:
+            fit_batch([model], X, y, [rows])
+        else:
+            model.fit(X[rows], y[rows])
+    except FIT_ERRORS as error:
+        return error
+    return model
+
+
+def _reason(error: BaseException) -> str:
+    """Why one fit failed, in the words of the run: the readings, the base, a parameter."""
+    if not isinstance(error, SoftbendError) or error.key is None:
+        return " ".join(str(error).split())
+    subject = {"X": "training readings", "y": "training readings", "base": "base"}.get(
+        error.key, error.key
+    )
+    return " ".join(error.described(subject).split())
 
 
 def leave_one_configuration_out(
     measurements: Measurements | ActuatorMeasurements,
     base: Surrogate | None,
-    strategies: Sequence[str] = DEFAULT_STRATEGIES,
+    strategies: Sequence[str] | None = None,
     *,
     level: float = 0.9,
     learning_curve: bool = True,
@@ -249,9 +303,11 @@ def leave_one_configuration_out(
     base : estimator
         The simulation-trained surrogate the strategies start from (an ``mlp``
         surrogate for ``refined``, ``refined-ensemble``).
-    strategies : sequence of str
+    strategies : sequence of str, optional
         Names among :data:`~softbend.transfer.strategies.STRATEGIES` (any
-        registered strategy).
+        registered strategy), each one that can start from ``base``. Default:
+        those of :data:`DEFAULT_STRATEGIES` that can; the others, with the
+        reason, are the settings' ``left_out``.
     level : float, default 0.9
         Probability of the prediction intervals, in (0, 1).
     learning_curve : bool, default True
@@ -279,12 +335,20 @@ def leave_one_configuration_out(
     Returns
     -------
     LocoResult
+        A fit that fails on one held-out actuator (readings it cannot fit, a
+        training that diverged) leaves the others: its row of ``per_actuator``
+        has ``status`` "failed", the reason in ``error`` and NaN scores, the
+        summary's means are over the actuators it did fit (``n_failed``
+        counts the others) and the settings' ``failed`` lists them.
 
     Raises
     ------
     InputError
-        Bad input, keyed by the parameter; among them ``calibrated`` with too
-        few actuators or only the slowest strategies (:func:`check_calibration`).
+        Bad input, keyed by the parameter; among them ``strategies`` naming one
+        that cannot start from ``base`` (before any fit), ``calibrated`` with
+        too few actuators or only the slowest strategies
+        (:func:`check_calibration`). Every fit on every held-out actuator
+        failing raises the first one's error.
     """
     if not isinstance(measurements, Measurements | ActuatorMeasurements):
         raise InputError(
@@ -296,12 +360,9 @@ def leave_one_configuration_out(
     from softbend.surrogates.persistence import describing
 
     actuator = getattr(measurements, "actuator", SFRBA)  # paper B's Measurements: SFRBA
-    if actuator != SFRBA and "analytical" in strategies:
-        raise InputError(
-            f"'analytical' models paper B's actuator only; the measurements are of "
-            f"{actuator.name}: leave it out",
-            key="strategies",
-        )
+    left_out: dict[str, str] = {}
+    if strategies is None:
+        strategies, left_out = applicable_strategies(DEFAULT_STRATEGIES, base, actuator)
     # Paper B's actuator: paper B's MAPE (only exact zeros left out); any other: the floor.
     floor = 0.0 if actuator == SFRBA else mape_floor(measurements.angle_deg)
     with describing(actuator):  # the strategies check the inputs of this actuator
@@ -317,7 +378,9 @@ def leave_one_configuration_out(
             options=options,
             progress=progress,
             floor=floor,
+            actuator=actuator,
         )
+    result.settings["left_out"] = left_out
     if actuator != SFRBA:
         result.settings["actuator"] = actuator.to_dict()
         result.settings["pressure_column"] = actuator.pressure_column
@@ -338,10 +401,12 @@ def _leave_one_out(
     options: dict[str, dict[str, Any]] | None,
     progress: Callable[[int, int, str], None] | None,
     floor: float = 0.0,
+    actuator: Actuator | None = None,
 ) -> LocoResult:
     """:func:`leave_one_configuration_out` once the measurements' kind is known.
 
-    ``floor``: the smallest ``|θ|`` in the MAPE, degrees.
+    ``floor``: the smallest ``|θ|`` in the MAPE, degrees; ``actuator``: what the
+    base is a model of (paper B's actuator by default).
     """
     names = tuple(strategies)
     if not names:
@@ -362,6 +427,7 @@ def _leave_one_out(
     _check_two_actuators(ids)
     if calibrated:
         check_calibration(ids, names)
+    check_applicable(names, base, actuator, key="strategies")  # before any fit
     X, y, groups = measurements.features, measurements.angle_deg, measurements.groups
     rng = np.random.default_rng([seed, 3])
     curve_names = [n for n in names if n not in _SLOW] if learning_curve else []
@@ -406,6 +472,10 @@ def _leave_one_out(
             for i, model in zip(batch, models, strict=True):
                 test = tasks[i][5]
                 out: dict[str, Any] = {"fit_s": fit_s}
+                if isinstance(model, BaseException):
+                    out.update(pred=np.full(test.size, np.nan), interval=None, error=model)
+                    results[i] = out
+                    continue
                 if test.size:
                     out["pred"] = np.asarray(model.predict(X[test]), dtype=np.float64)
                     out["interval"] = (
@@ -428,6 +498,13 @@ def _leave_one_out(
         elif kind == "loco" and name in nested_names:
             loco_errors.setdefault(name, {})[held_out] = np.abs(out["pred"] - y[test])
 
+    failed = [
+        (task, out["error"])
+        for task, out in zip(tasks, results, strict=True)
+        if task[0] == "loco" and "error" in out
+    ]
+    if len(failed) == len(ids) * len(names):  # nothing to report: the first fit's error
+        raise failed[0][1]
     scores, predictions, curve = [], [], []
     loss_curves: dict[str, np.ndarray] = {}
     for (kind, held_out, size, name, train, test), out in zip(tasks, results, strict=True):
@@ -438,6 +515,8 @@ def _leave_one_out(
         if kind == "nested":
             continue
         row = _score(name, held_out, y[test], out["pred"], out["interval"], floor)
+        row["status"] = "failed" if "error" in out else "ok"
+        row["error"] = _reason(out["error"]) if "error" in out else None
         if kind == "loco":
             row["fit_s"] = out["fit_s"]
             cal = _calibration(nested.get((name, held_out)), level, y[train], fallback)
@@ -458,6 +537,7 @@ def _leave_one_out(
                     "held_out": held_out,
                     "rmse_deg": row["rmse_deg"],
                     "mape_pct": row["mape_pct"],
+                    "error": row["error"],
                 }
             )
     base_curve, y_scale = getattr(base, "loss_curve_", None), getattr(base, "y_scale_", None)
@@ -470,7 +550,8 @@ def _leave_one_out(
         summary=_summarize(per_actuator, names, calibrated=calibrated),
         predictions=pd.concat(predictions, ignore_index=True),
         learning_curve=pd.DataFrame(
-            curve, columns=["strategy", "n_actuators", "held_out", "rmse_deg", "mape_pct"]
+            curve,
+            columns=["strategy", "n_actuators", "held_out", "rmse_deg", "mape_pct", "error"],
         )
         .sort_values(["strategy", "n_actuators", "held_out"], kind="stable")
         .reset_index(drop=True),
@@ -497,6 +578,15 @@ def _leave_one_out(
             "calibrated": list(nested_names),
             "baseline": BASELINE_STRATEGY if BASELINE_STRATEGY in names else None,
             "mape_floor_deg": floor,
+            "failed": [
+                {"strategy": task[3], "actuator_id": task[1], "error": _reason(error)}
+                for task, error in failed
+            ],
+            "failed_other_fits": sum(
+                "error" in out
+                for task, out in zip(tasks, results, strict=True)
+                if task[0] != "loco"
+            ),
             "fits": len(tasks),
             "wall_time_s": time.perf_counter() - start,
         },
@@ -581,6 +671,12 @@ def held_out_residuals(
     -------
     dict of str to ndarray
         Actuator id → ``|prediction − reading|`` on its readings, degrees.
+
+    Raises
+    ------
+    InputError, ConvergenceError
+        The first fit (without one actuator) that failed: the errors are those of every
+        actuator or none.
     """
     with keyed("strategy"):
         cls = STRATEGIES.get(strategy)
@@ -592,6 +688,9 @@ def held_out_residuals(
     tests = [np.flatnonzero(groups == a) for a in ids]
     trains = [np.flatnonzero(groups != a) for a in ids]
     models, _ = _fit_all(strategy, base, values, seed, X, y, trains)
+    for model in models:
+        if isinstance(model, BaseException):  # no calibration without every actuator's errors
+            raise model
     return {
         a: np.abs(np.asarray(m.predict(X[t]), dtype=np.float64) - y[t])
         for a, m, t in zip(ids, models, tests, strict=True)
@@ -627,7 +726,7 @@ def _score_calibrated(cal: Calibration | None, y: np.ndarray, pred: np.ndarray) 
 
 def _weighted(part: pd.DataFrame, column: str) -> float:
     """The mean of ``column`` weighted by readings; NaN unless every actuator has one."""
-    if not part[column].notna().all():
+    if part.empty or not part[column].notna().all():
         return np.nan
     return float((part[column] * part["n_points"]).sum() / part["n_points"].sum())
 
@@ -645,7 +744,7 @@ def _coverage_reason(name: str, calibrated: bool, coverage: float) -> str | None
         )
     return (
         "not calibrated on every held-out actuator: the leave-one-out errors of an "
-        "actuator were not finite"
+        "actuator were not finite, or a fit without it failed"
     )
 
 
@@ -654,7 +753,8 @@ def _summarize(
 ) -> pd.DataFrame:
     rows = []
     for name in names:
-        part = per_actuator[per_actuator["strategy"] == name]
+        mine = per_actuator[per_actuator["strategy"] == name]
+        part = mine[mine["status"] == "ok"]  # a failed fit has no score to average
         worst = part.loc[part["rmse_deg"].idxmax()] if part["rmse_deg"].notna().any() else None
         mean_rmse = float(part["rmse_deg"].mean())
         calibrated_coverage = _weighted(part, "calibrated_coverage")
@@ -667,11 +767,7 @@ def _summarize(
                 "mape_pct": float(part["mape_pct"].mean()),
                 "n_mape_used": int(part["n_mape_used"].sum()),
                 "max_error_deg": float(part["max_error_deg"].max()),
-                "coverage": float(
-                    (part["coverage"] * part["n_points"]).sum() / part["n_points"].sum()
-                )
-                if part["coverage"].notna().all()
-                else np.nan,
+                "coverage": _weighted(part, "coverage"),
                 "calibrated_coverage": calibrated_coverage,
                 "calibrated_coverage_reason": _coverage_reason(
                     name, calibrated, calibrated_coverage
@@ -680,7 +776,8 @@ def _summarize(
                 "worst_actuator": None if worst is None else worst["actuator_id"],
                 "worst_rmse_deg": np.nan if worst is None else float(worst["rmse_deg"]),
                 "worst_mape_pct": np.nan if worst is None else float(worst["mape_pct"]),
-                "fit_s": float(part["fit_s"].mean()),
+                "fit_s": float(mine["fit_s"].mean()),
+                "n_failed": int(len(mine) - len(part)),
             }
         )
     summary = pd.DataFrame(rows)

@@ -32,7 +32,7 @@ from softbend.surrogates.protocol import Surrogate
 if TYPE_CHECKING:
     from softbend.surrogates.mlp import NormalizedMLPRegressor
 
-__all__ = ["SCALE_BOUNDS", "fit_pressure_scale", "scale_mlp_pressure"]
+__all__ = ["SCALE_BOUNDS", "fit_pressure_scale", "pressure_column", "scale_mlp_pressure"]
 
 #: The pressure scale is searched in this range (the elastomer 4 times softer or stiffer).
 SCALE_BOUNDS: tuple[float, float] = (0.25, 4.0)
@@ -46,7 +46,8 @@ def fit_pressure_scale(base: Surrogate, X: ArrayLike, y: ArrayLike) -> float:
     base : estimator
         A fitted surrogate on the rows of :data:`softbend.design.FEATURES`.
     X : array_like of shape (n, 7)
-        Measured designs and pressures (mm, deg, MPa), finite.
+        Measured designs and pressures (mm, deg, MPa; another actuator's inputs in its
+        own units), finite.
     y : array_like of shape (n,)
         Measured angles, degrees.
 
@@ -65,10 +66,11 @@ def fit_pressure_scale(base: Surrogate, X: ArrayLike, y: ArrayLike) -> float:
     """
     rows = np.asarray(X, dtype=np.float64)
     angles = np.asarray(y, dtype=np.float64)
+    column, unit = pressure_column()
     if not np.any(rows[:, -1] > 0.0):
         raise InputError(
-            "must include a pressure above 0 MPa: the pressure scale is fitted on "
-            "pressurized readings",
+            f"must include a pressure above 0 {unit} (column '{column}'): the pressure scale "
+            "is fitted on pressurized readings",
             key="X",
         )
     low, high = SCALE_BOUNDS
@@ -96,8 +98,9 @@ def fit_pressure_scale(base: Surrogate, X: ArrayLike, y: ArrayLike) -> float:
         raise InputError(
             f"gives a pressure scale on its bound ({float(np.exp(grid[best])):.3g}, allowed "
             f"{low:g}–{high:g}): the measured actuators do not behave like the base's actuator "
-            "with a softer or stiffer elastomer. Check the units of the pressure column (MPa) "
-            "and that the base is a surrogate of the same actuator family",
+            f"with a softer or stiffer elastomer. Check that the pressure column '{column}' "
+            f"is in {unit}, the base model's unit, and that the base is a surrogate of the same "
+            "actuator family",
             key="X",
         )
     found = minimize_scalar(
@@ -107,6 +110,21 @@ def fit_pressure_scale(base: Surrogate, X: ArrayLike, y: ArrayLike) -> float:
         options={"xatol": 1e-7},
     )
     return float(np.exp(found.x))
+
+
+def pressure_column() -> tuple[str, str]:
+    """The pressure input's column and unit of the model being fitted.
+
+    Those of the actuator :func:`softbend.surrogates.persistence.describing`
+    names (the base model's own: ``p_kpa``, ``kPa``), paper B's
+    (``pressure_mpa``, ``MPa``) outside it: the words of a message about the
+    measured pressures.
+    """
+    from softbend.surrogates.features import model_features
+    from softbend.surrogates.persistence import current_units
+
+    column = model_features()[-1]
+    return column, current_units().get(column, "MPa")
 
 
 def scale_mlp_pressure(model: NormalizedMLPRegressor, scale: float) -> NormalizedMLPRegressor:

@@ -36,7 +36,13 @@ from softbend.errors import ConvergenceError, InputError, keyed
 from softbend.surrogates.protocol import Surrogate
 from softbend.transfer.conformal import Calibration, angle_floor, calibrate
 from softbend.transfer.parameters import check_parameters, recorded_parameters, takes
-from softbend.transfer.strategies import STRATEGIES, fit_strategy, learns
+from softbend.transfer.strategies import (
+    STRATEGIES,
+    applicable_strategies,
+    check_applicable,
+    fit_strategy,
+    learns,
+)
 
 if TYPE_CHECKING:
     from softbend.actuators import Actuator
@@ -44,12 +50,51 @@ if TYPE_CHECKING:
     from softbend.transfer.actuator_measurements import ActuatorMeasurements
     from softbend.transfer.measurements import Measurements
 
-__all__ = ["Refinement", "refinable_strategies", "refine_surrogate"]
+__all__ = [
+    "REFINE_DEFAULTS",
+    "Refinement",
+    "default_refine_strategy",
+    "refinable_strategies",
+    "refine_surrogate",
+]
+
+#: The strategy a refinement fits when none is named: the first of these that can start from
+#: the base (paper B's refined MLP for an ``mlp`` base; the frozen base corrected linearly,
+#: which takes any base, else).
+REFINE_DEFAULTS: tuple[str, ...] = ("refined", "scale-offset")
 
 
 def refinable_strategies() -> tuple[str, ...]:
     """The registered strategies that learn a model to save (the baselines learn nothing)."""
     return tuple(name for name in STRATEGIES if learns(name))
+
+
+def default_refine_strategy(
+    base: object, actuator: Actuator | None = None
+) -> tuple[str, dict[str, str]]:
+    """The strategy of :data:`REFINE_DEFAULTS` a refinement of ``base`` fits when none is named.
+
+    Parameters
+    ----------
+    base : estimator
+        The base surrogate.
+    actuator : Actuator, optional
+        What ``base`` is a model of (paper B's actuator by default).
+
+    Returns
+    -------
+    str
+        The first of :data:`REFINE_DEFAULTS` that can start from ``base``.
+    dict of str to str
+        The ones before it that cannot, each with the reason.
+    """
+    fits, left_out = applicable_strategies(REFINE_DEFAULTS, base, actuator)
+    if not fits:  # every default refused: name the first, refused with its reason
+        check_applicable(REFINE_DEFAULTS[:1], base, actuator, among=refinable_strategies())
+    first = fits[0]
+    return first, {
+        k: v for k, v in left_out.items() if REFINE_DEFAULTS.index(k) < REFINE_DEFAULTS.index(first)
+    }
 
 
 @dataclass(frozen=True)
@@ -63,7 +108,10 @@ class Refinement:
     metadata : dict
         The record saved with it: ``strategy``, ``parameters`` (every parameter
         as it ran, seed included), ``base``, ``measurements`` (the file, or
-        the list of files), ``measurement_files`` (path, SHA-256, readings and
+        the list of files), ``strategy_left_out`` (the default strategies
+        passed over because they cannot start from the base, each with the
+        reason; empty when the strategy was named or the first default
+        applied), ``measurement_files`` (path, SHA-256, readings and
         synthetic flag of each), ``n_measurements``, ``actuators``,
         ``synthetic_measurements`` (``true``, ``false`` or ``mixed``),
         ``training_rmse_deg`` (degrees), ``training_ranges`` (mm, deg, MPa),
@@ -140,7 +188,7 @@ def _check_finite_figures(strategy: str, figures: Mapping[str, float | None]) ->
 def refine_surrogate(
     base: str | os.PathLike[str],
     measurements: str | os.PathLike[str] | Sequence[str | os.PathLike[str]],
-    strategy: str = "refined",
+    strategy: str | None = None,
     *,
     seed: int = 0,
     settings: Mapping[str, str] | None = None,
@@ -158,9 +206,12 @@ def refine_surrogate(
     measurements : path or sequence of paths
         One or more measurements CSV files, joined
         (:func:`softbend.transfer.measurements.load_measurements_files`).
-    strategy : str, default "refined"
+    strategy : str, optional
         A registered strategy that learns from the measurements
-        (:func:`refinable_strategies`).
+        (:func:`refinable_strategies`) and can start from the base. Default:
+        the first of :data:`REFINE_DEFAULTS` that can
+        (:func:`default_refine_strategy`); the record's ``strategy_left_out``
+        names those before it that cannot, with the reason.
     seed : int, default 0
         Seed of the strategy.
     settings : mapping of str to str, optional
@@ -188,10 +239,11 @@ def refine_surrogate(
         An unknown strategy or parameter (the known ones listed), keyed
         ``strategy``, ``settings`` or ``options``.
     ValueError
-        A strategy that learns nothing (a baseline, key ``strategy``), a
-        parameter value of the wrong kind (key ``settings`` or ``options``),
-        bad measurements (pressures past the base's range, radians: unless
-        ``force``) or a fit that cannot be made.
+        A strategy that learns nothing (a baseline, key ``strategy``) or
+        cannot start from the base (key ``strategy``, before the measurements
+        are read), a parameter value of the wrong kind (key ``settings`` or
+        ``options``), bad measurements (pressures past the base's range,
+        radians: unless ``force``) or a fit that cannot be made.
     FileNotFoundError, SchemaError
         A missing or unreadable input.
     ConvergenceError
@@ -201,21 +253,30 @@ def refine_surrogate(
     from softbend.surrogates.persistence import describing, load_surrogate
     from softbend.transfer.against_base import load_for_base
 
-    with keyed("strategy"):
-        cls = STRATEGIES.get(strategy)
-    if not learns(strategy):
-        raise InputError(
-            f"{strategy!r} learns nothing from the measurements, so it has no model to save; "
-            f"known strategies that do: {', '.join(refinable_strategies())}",
-            key="strategy",
-        )
+    left_out: dict[str, str] = {}
+    if strategy is not None:
+        with keyed("strategy"):
+            STRATEGIES.check(strategy)
+        if not learns(strategy):
+            raise InputError(
+                f"{strategy!r} learns nothing from the measurements, so it has no model to "
+                f"save; known strategies that do: {', '.join(refinable_strategies())}",
+                key="strategy",
+            )
+    start = load_surrogate(base)
+    actuator = start.actuator
+    if strategy is None:
+        with keyed("strategy"):
+            strategy, left_out = default_refine_strategy(start.model, actuator)
+    check_applicable(
+        [strategy], start.model, actuator, among=refinable_strategies(), key="strategy"
+    )
+    cls = STRATEGIES.get(strategy)
     with keyed("settings"):
         from_text = check_parameters(cls, settings, from_text=True)
     with keyed("options"):
         values = {**from_text, **check_parameters(cls, options)}
     files = [measurements] if isinstance(measurements, str | os.PathLike) else list(measurements)
-    start = load_surrogate(base)
-    actuator = start.actuator
     data, forced = load_for_base(files, start, force=force)  # before any fit
     with describing(actuator):
         refinement = _refine(
@@ -231,6 +292,7 @@ def refine_surrogate(
         )
     if forced:
         refinement.metadata["forced"] = forced
+    refinement.metadata["strategy_left_out"] = left_out
     return refinement
 
 

@@ -46,7 +46,12 @@ constructor's ``base`` and ``seed``, if it takes them, are filled by the library
 its other parameters, with defaults, are the ones a user sets
 (:mod:`softbend.transfer.parameters`: ``--set NAME=VALUE``). ``fit(X, y)`` sets
 ``model_``, the surrogate that ``softbend transfer refine`` saves; a class whose
-``learns`` is False (a baseline) has nothing to save.
+``learns`` is False (a baseline) has nothing to save. A class method
+``refusal(base, actuator)`` says why the strategy cannot start from a base (the
+network strategies need an ``mlp``; ``analytical``, paper B's actuator), or None
+when it can: the default runs leave such a strategy out and say why
+(:func:`applicable_strategies`), and a run that names it is refused before any
+work (:func:`check_applicable`). A class without one takes any base.
 """
 
 from __future__ import annotations
@@ -66,7 +71,7 @@ from sklearn.utils.validation import check_is_fitted, validate_data
 
 from softbend._validation import check_int, check_range
 from softbend.design import SFRBADesign
-from softbend.errors import ConvergenceError, InputError, keyed
+from softbend.errors import ConvergenceError, InputError, SoftbendError, keyed
 from softbend.models import BendingModel
 from softbend.parameters import Range, declare_ranges, declared_ranges
 from softbend.plausibility import RANGES as PLAUSIBLE
@@ -90,15 +95,21 @@ from softbend.transfer.parameters import (
     parameter_defaults,
     takes,
 )
-from softbend.transfer.pressure_map import fit_pressure_scale, scale_mlp_pressure
+from softbend.transfer.pressure_map import (
+    fit_pressure_scale,
+    pressure_column,
+    scale_mlp_pressure,
+)
 
 if TYPE_CHECKING:
+    from softbend.actuators import Actuator
     from softbend.surrogates.mlp import NormalizedMLPRegressor
     from softbend.transfer.actuator_measurements import ActuatorMeasurements
     from softbend.transfer.measurements import Measurements
 
 __all__ = [
     "BUILTIN_STRATEGIES",
+    "FIT_ERRORS",
     "NETWORK_STRATEGIES",
     "STRATEGIES",
     "AnalyticalBaseline",
@@ -111,12 +122,16 @@ __all__ = [
     "ResidualGP",
     "ScaleOffset",
     "ScaledRefinedMLP",
+    "applicable_strategies",
+    "base_family",
+    "check_applicable",
     "describe_strategies",
     "fit_strategy",
     "has_interval",
     "learns",
     "make_strategy",
     "strategy_parameters",
+    "strategy_refusal",
 ]
 
 #: The strategies by name, in the order of the tables (filled at the end of this module).
@@ -129,6 +144,12 @@ NETWORK_STRATEGIES: tuple[str, ...] = (
     "refined-ensemble",
     "scaled-refined",
 )
+
+
+#: The errors of one strategy's fit on one set of rows that leave the other fits standing
+#: (readings it cannot fit, a fit that diverged or failed numerically); any other error (a
+#: bug, an interrupt, memory) stops the caller.
+FIT_ERRORS: tuple[type[Exception], ...] = (SoftbendError, ValueError, ArithmeticError)
 
 
 #: Adam steps of a network strategy; the largest is the ``epochs`` limit of
@@ -154,6 +175,42 @@ _LEARNING_RATE = Range(
 def _registered_name(cls: type) -> str:
     """The name ``cls`` is registered under in :data:`STRATEGIES`, else its class name."""
     return next((name for name, entry in STRATEGIES.items() if entry is cls), cls.__name__)
+
+
+def base_family(base: object) -> str:
+    """The family a base surrogate is saved as (``"plr"``, ``"mlp"``, a composite's kind).
+
+    ``"custom"`` for a model that is no saved family (built in Python), ``"no"`` for None:
+    the words a message uses for the base ("a plr surrogate").
+    """
+    from softbend.surrogates.persistence import kind_of
+
+    if base is None:
+        return "no"
+    try:
+        return kind_of(base)
+    except InputError:
+        return "custom"
+
+
+def _needs_mlp(base: object) -> str | None:
+    """Why a strategy that trains the base's network further cannot start from ``base``."""
+    from softbend.surrogates.mlp import NormalizedMLPRegressor
+
+    if isinstance(base, NormalizedMLPRegressor):
+        return None
+    return (
+        f"trains the base's network further, and the base is a {base_family(base)} "
+        "surrogate, not an mlp"
+    )
+
+
+def _fit_failed(estimator: object, error: Exception, keep_going: bool) -> None:
+    """One estimator of a batch could not be fitted: raise ``error``, or (``keep_going``)
+    record it on the estimator as ``fit_error_`` and let the others be fitted."""
+    if not keep_going:
+        raise error
+    estimator.fit_error_ = error  # type: ignore[attr-defined]
 
 
 def _check_trained(
@@ -248,10 +305,11 @@ def _check_finite_fit(strategy: str, **parameters: ArrayLike) -> None:
         if not np.isfinite(array).all():
             bad.append(f"{name}={float(array):g}" if array.ndim == 0 else f"{name} not all finite")
     if bad:
+        column, unit = pressure_column()
         raise ConvergenceError(
             f"The '{strategy}' strategy fitted non-finite parameters ({', '.join(bad)}): the "
             "measured angles or the base's predictions are too large for the fit. Check the "
-            "measurements (degrees, MPa) and the base surrogate"
+            f"measurements (angles in degrees, '{column}' in {unit}) and the base surrogate"
         )
 
 
@@ -261,9 +319,23 @@ class _Strategy(RegressorMixin, BaseEstimator):
     #: Whether fitting learns a model from the measurements (``model_``, saved by refine).
     learns: ClassVar[bool] = True
 
+    @classmethod
+    def refusal(cls, base: object, actuator: Actuator) -> str | None:
+        """Why the strategy cannot start from ``base`` for a model of ``actuator``; None if it can.
+
+        The reason is the rest of a sentence that begins with the strategy's name
+        (``"'refined' trains the base's network further, and ..."``): what chooses
+        the strategies that apply to a base (``softbend transfer loco`` by
+        default) and refuses one named for a base it cannot take, before any
+        work. Here: a strategy that starts from a base needs one that predicts.
+        """
+        if takes(cls, "base") and not callable(getattr(base, "predict", None)):
+            return "starts from a base surrogate that predicts, and none was given"
+        return None
+
     def _check_fit_data(self, X: ArrayLike, y: ArrayLike) -> tuple[np.ndarray, np.ndarray]:
         X_arr, y_arr = validate_data(self, X, y, dtype=np.float64, y_numeric=True)
-        owner = f"{type(self).__name__}.fit"
+        owner = f"the '{_registered_name(type(self))}' strategy's training readings"
         features = model_features()
         if X_arr.shape[1] != len(features):
             raise InputError(
@@ -275,7 +347,7 @@ class _Strategy(RegressorMixin, BaseEstimator):
             check_plausible(
                 X_arr[:, -1], "pressure_mpa", source=owner, column="pressure_mpa", where=_row
             )
-        check_plausible(y_arr, "angle_deg", source=owner, column="y", where=_row)
+        check_plausible(y_arr, "angle_deg", source=owner, column="angle_deg", where=_row)
         return X_arr, y_arr
 
     def _check_rows(self, X: ArrayLike) -> np.ndarray:
@@ -499,6 +571,15 @@ class AnalyticalBaseline(_Strategy):
 
     learns: ClassVar[bool] = False
 
+    @classmethod
+    def refusal(cls, base: object, actuator: Actuator) -> str | None:
+        """Paper B's actuator only: the analytical model knows no other."""
+        from softbend.actuators import SFRBA
+
+        if actuator == SFRBA:
+            return None
+        return f"models paper B's actuator only, and the base is a model of {actuator.name}"
+
     def __init__(self, model: BendingModel | None = None) -> None:
         self.model = model
 
@@ -581,6 +662,11 @@ class RefinedMLP(_Strategy):
         self.device = device
         self.seed = seed
 
+    @classmethod
+    def refusal(cls, base: object, actuator: Actuator) -> str | None:
+        """An ``mlp`` base only: its weights are trained further."""
+        return _needs_mlp(base)
+
     def fit(self, X: ArrayLike, y: ArrayLike) -> RefinedMLP:
         """Refine the base on the rows (mm, deg, MPa → degrees)."""
         X, y = self._check_fit_data(X, y)
@@ -588,41 +674,68 @@ class RefinedMLP(_Strategy):
 
     @classmethod
     def fit_batch(
-        cls, estimators: list[RefinedMLP], X: np.ndarray, y: np.ndarray, row_sets: list
+        cls,
+        estimators: list[RefinedMLP],
+        X: np.ndarray,
+        y: np.ndarray,
+        row_sets: list,
+        *,
+        keep_going: bool = False,
     ) -> list[RefinedMLP]:
         """Fit each estimator on its rows of ``X, y``, all trained at once.
 
         The same result as fitting each alone (up to rounding): see
         :mod:`softbend.transfer.finetune`. The estimators must share base,
-        epochs and learning rate.
+        epochs and learning rate. With ``keep_going``, an estimator whose rows
+        cannot be fitted (its start, or a diverged training) gets the error as
+        ``fit_error_`` and the others are fitted; else the first error is raised.
         """
         first = estimators[0]
         for estimator in estimators:
             estimator._check_parameters()
         base = check_mlp(first.base)
         _check_same(estimators, ("base", "epochs", "learning_rate", "device"))
-        models = fine_tune_many(
-            cls._starts(base, X, y, row_sets),
-            X,
-            y,
-            row_weights(row_sets, len(y)),
-            epochs=first.epochs,
-            learning_rate=first.learning_rate,
-            device=first.device,
-        )
+        starts = cls._starts(base, X, y, row_sets)
+        live: list[int] = []
+        ready: list[NormalizedMLPRegressor] = []
+        for i, start in enumerate(starts):
+            if isinstance(start, Exception):
+                _fit_failed(estimators[i], start, keep_going)
+            else:
+                live.append(i)
+                ready.append(start)
+        if not live:
+            return estimators
+        try:
+            models = fine_tune_many(
+                ready,
+                X,
+                y,
+                row_weights([row_sets[i] for i in live], len(y)),
+                epochs=first.epochs,
+                learning_rate=first.learning_rate,
+                device=first.device,
+            )
+        except ConvergenceError as error:  # the batch as a whole: every fit of it failed
+            for i in live:
+                _fit_failed(estimators[i], error, keep_going)
+            return estimators
         name = _registered_name(cls)
-        for model, rows in zip(models, row_sets, strict=True):
-            _check_trained(name, model, X[np.asarray(rows)], first.learning_rate)
-        for estimator, model in zip(estimators, models, strict=True):
-            estimator._set(model, X)
+        for i, model in zip(live, models, strict=True):
+            try:
+                _check_trained(name, model, X[np.asarray(row_sets[i])], first.learning_rate)
+            except ConvergenceError as error:
+                _fit_failed(estimators[i], error, keep_going)
+                continue
+            estimators[i]._set(model, X)
         return estimators
 
     @classmethod
     def _starts(
         cls, base: NormalizedMLPRegressor, X: np.ndarray, y: np.ndarray, row_sets: list
-    ) -> NormalizedMLPRegressor | list[NormalizedMLPRegressor]:
-        """Where training starts: the base itself, for every row set."""
-        return base
+    ) -> list[NormalizedMLPRegressor | Exception]:
+        """Where training starts for each row set (or why it cannot): the base itself."""
+        return [base] * len(row_sets)
 
     def _set(self, model: NormalizedMLPRegressor, X: np.ndarray) -> None:
         self.model_ = model
@@ -693,7 +806,13 @@ class ExperimentalMLP(_Strategy):
 
     @classmethod
     def fit_batch(
-        cls, estimators: list[ExperimentalMLP], X: np.ndarray, y: np.ndarray, row_sets: list
+        cls,
+        estimators: list[ExperimentalMLP],
+        X: np.ndarray,
+        y: np.ndarray,
+        row_sets: list,
+        *,
+        keep_going: bool = False,
     ) -> list[ExperimentalMLP]:
         """Fit each estimator on its rows, all trained at once (full batch).
 
@@ -702,7 +821,8 @@ class ExperimentalMLP(_Strategy):
         ``(seed, h1, h2, k)``, :func:`~softbend.surrogates.mlp_core.init_parameters`);
         the first is what :meth:`fit` gives. Paper B's batches of 1024 rows hold
         any set of measurements, so every epoch is one full-batch Adam step.
-        The estimators must share every parameter.
+        The estimators must share every parameter. ``keep_going`` as for
+        :meth:`RefinedMLP.fit_batch`.
         """
         from softbend.surrogates.mlp import NormalizedMLPRegressor
         from softbend.surrogates.mlp_core import init_parameters, model_rng, standardization
@@ -729,19 +849,27 @@ class ExperimentalMLP(_Strategy):
                     intercepts=intercepts,
                 )
             )
-        models = fine_tune_many(
-            starts,
-            X,
-            y,
-            row_weights(row_sets, len(y)),
-            epochs=first.epochs,
-            learning_rate=first.learning_rate,
-            device=first.device,
-        )
+        try:
+            models = fine_tune_many(
+                starts,
+                X,
+                y,
+                row_weights(row_sets, len(y)),
+                epochs=first.epochs,
+                learning_rate=first.learning_rate,
+                device=first.device,
+            )
+        except ConvergenceError as error:  # the batch as a whole: every fit of it failed
+            for estimator in estimators:
+                _fit_failed(estimator, error, keep_going)
+            return estimators
         name = _registered_name(cls)
-        for model, rows in zip(models, row_sets, strict=True):
-            _check_trained(name, model, X[np.asarray(rows)], first.learning_rate)
-        for estimator, model in zip(estimators, models, strict=True):
+        for estimator, model, rows in zip(estimators, models, row_sets, strict=True):
+            try:
+                _check_trained(name, model, X[np.asarray(rows)], first.learning_rate)
+            except ConvergenceError as error:
+                _fit_failed(estimator, error, keep_going)
+                continue
             estimator.model_ = model
             estimator.loss_curve_ = np.asarray(model.loss_curve_) * model.y_scale_**2
             estimator.n_features_in_ = X.shape[1]
@@ -858,12 +986,15 @@ class ScaledRefinedMLP(RefinedMLP):
     @classmethod
     def _starts(
         cls, base: NormalizedMLPRegressor, X: np.ndarray, y: np.ndarray, row_sets: list
-    ) -> list[NormalizedMLPRegressor]:
-        """The base mapped with the pressure scale fitted on each row set."""
-        return [
-            scale_mlp_pressure(base, fit_pressure_scale(base, X[rows], y[rows]))
-            for rows in row_sets
-        ]
+    ) -> list[NormalizedMLPRegressor | Exception]:
+        """The base mapped with the pressure scale fitted on each row set (or why not)."""
+        starts: list[NormalizedMLPRegressor | Exception] = []
+        for rows in row_sets:
+            try:
+                starts.append(scale_mlp_pressure(base, fit_pressure_scale(base, X[rows], y[rows])))
+            except InputError as error:
+                starts.append(error)
+        return starts
 
     def _set(self, model: NormalizedMLPRegressor, X: np.ndarray) -> None:
         super()._set(model, X)
@@ -1010,6 +1141,11 @@ class RefinedEnsemble(_Corrected):
         self.device = device
         self.seed = seed
 
+    @classmethod
+    def refusal(cls, base: object, actuator: Actuator) -> str | None:
+        """An ``mlp`` base only: its weights are trained further."""
+        return _needs_mlp(base)
+
     def fit(self, X: ArrayLike, y: ArrayLike) -> RefinedEnsemble:
         """Refine ``n_members`` networks on bootstrap draws of the actuators."""
         X, y = self._check_fit_data(X, y)
@@ -1030,9 +1166,19 @@ class RefinedEnsemble(_Corrected):
 
     @classmethod
     def fit_batch(
-        cls, estimators: list[RefinedEnsemble], X: np.ndarray, y: np.ndarray, row_sets: list
+        cls,
+        estimators: list[RefinedEnsemble],
+        X: np.ndarray,
+        y: np.ndarray,
+        row_sets: list,
+        *,
+        keep_going: bool = False,
     ) -> list[RefinedEnsemble]:
-        """Fit each ensemble on its rows; every member of every ensemble trained at once."""
+        """Fit each ensemble on its rows; every member of every ensemble trained at once.
+
+        ``keep_going`` as for :meth:`RefinedMLP.fit_batch`: an ensemble with a
+        member that diverged is not fitted.
+        """
         first = estimators[0]
         for estimator in estimators:
             estimator._check_parameters()
@@ -1042,27 +1188,37 @@ class RefinedEnsemble(_Corrected):
             est._draws(X, np.asarray(rows)) for est, rows in zip(estimators, row_sets, strict=True)
         ]
         flat = [d for member_rows in draws for d in member_rows]
-        models = fine_tune_many(
-            base,
-            X,
-            y,
-            row_weights(flat, len(y)),
-            epochs=first.epochs,
-            learning_rate=first.learning_rate,
-            device=first.device,
-        )
+        try:
+            models = fine_tune_many(
+                base,
+                X,
+                y,
+                row_weights(flat, len(y)),
+                epochs=first.epochs,
+                learning_rate=first.learning_rate,
+                device=first.device,
+            )
+        except ConvergenceError as error:  # the batch as a whole: every fit of it failed
+            for estimator in estimators:
+                _fit_failed(estimator, error, keep_going)
+            return estimators
         name = _registered_name(cls)
-        for model, rows in zip(models, flat, strict=True):
-            _check_trained(name, model, X[rows], first.learning_rate)
         for i, (estimator, rows) in enumerate(zip(estimators, row_sets, strict=True)):
             members = models[i * first.n_members : (i + 1) * first.n_members]
+            try:
+                for model, member_rows in zip(members, draws[i], strict=True):
+                    _check_trained(name, model, X[member_rows], first.learning_rate)
+                mean = np.mean([m.predict(X[rows]) for m in members], axis=0)
+                with np.errstate(over="ignore", invalid="ignore"):  # checked below
+                    residual_std = float(np.sqrt(np.mean((mean - y[rows]) ** 2)))
+                _check_finite_fit("refined-ensemble", residual_std=residual_std)
+            except ConvergenceError as error:
+                _fit_failed(estimator, error, keep_going)
+                continue
             estimator.members_ = members
             estimator.n_features_in_ = X.shape[1]
-            mean = np.mean([m.predict(X[rows]) for m in members], axis=0)
-            with np.errstate(over="ignore", invalid="ignore"):  # checked below
-                estimator.residual_std_ = float(np.sqrt(np.mean((mean - y[rows]) ** 2)))
-            _check_finite_fit("refined-ensemble", residual_std=estimator.residual_std_)
-            estimator.model_ = MeanEnsemble(list[Surrogate](members), estimator.residual_std_)
+            estimator.residual_std_ = residual_std
+            estimator.model_ = MeanEnsemble(list[Surrogate](members), residual_std)
         return estimators
 
 
@@ -1101,6 +1257,87 @@ def learns(name: str) -> bool:
     """Whether strategy ``name`` learns a model from the measurements (a baseline does not)."""
     with keyed("name"):
         return bool(getattr(STRATEGIES.get(name), "learns", True))
+
+
+def strategy_refusal(name: str, base: object, actuator: Actuator | None = None) -> str | None:
+    """Why strategy ``name`` cannot start from ``base`` (a model of ``actuator``); None if it can.
+
+    Asks the strategy's class (its ``refusal(base, actuator)`` class method; a
+    registered class without one takes any base). ``actuator`` defaults to
+    paper B's.
+    """
+    from softbend.actuators import SFRBA
+
+    with keyed("name"):
+        cls = STRATEGIES.get(name)
+    refusal = getattr(cls, "refusal", None)
+    return refusal(base, actuator or SFRBA) if callable(refusal) else None
+
+
+def applicable_strategies(
+    names: Sequence[str], base: object, actuator: Actuator | None = None
+) -> tuple[list[str], dict[str, str]]:
+    """The strategies of ``names`` that can start from ``base``, and why the others cannot.
+
+    Returns
+    -------
+    list of str
+        The names that apply, in the order given.
+    dict of str to str
+        Each name left out → its reason (:func:`strategy_refusal`).
+    """
+    kept, left_out = [], {}
+    for name in names:
+        reason = strategy_refusal(name, base, actuator)
+        if reason is None:
+            kept.append(name)
+        else:
+            left_out[name] = reason
+    return kept, left_out
+
+
+def check_applicable(
+    names: Sequence[str],
+    base: object,
+    actuator: Actuator | None = None,
+    *,
+    among: Sequence[str] | None = None,
+    key: str = "strategies",
+) -> None:
+    """Refuse, before any work, a strategy of ``names`` that cannot start from ``base``.
+
+    Parameters
+    ----------
+    names : sequence of str
+        The strategies asked for.
+    base : estimator or None
+        The base surrogate.
+    actuator : Actuator, optional
+        What ``base`` is a model of (paper B's actuator by default).
+    among : sequence of str, optional
+        The strategies the message offers instead, those of them that apply
+        (default: every registered strategy).
+    key : str, default "strategies"
+        The parameter the error names.
+
+    Raises
+    ------
+    InputError
+        Keyed ``key``: the first strategy that cannot, with its reason, the
+        base's family and the strategies that apply to it.
+    """
+    for name in names:
+        reason = strategy_refusal(name, base, actuator)
+        if reason is None:
+            continue
+        fits, _ = applicable_strategies(
+            STRATEGIES.names() if among is None else among, base, actuator
+        )
+        raise InputError(
+            f"{name!r} {reason}; the strategies that apply to this {base_family(base)} base: "
+            f"{', '.join(fits) or 'none'}",
+            key=key,
+        )
 
 
 def describe_strategies() -> list[dict[str, Any]]:
