@@ -8,6 +8,7 @@ import time
 
 import pytest
 
+from softbend._outdir import MANIFEST, write_manifest
 from softbend.cli import main
 
 from .conftest import one_error_line
@@ -614,12 +615,14 @@ def test_loco_failing_on_a_figure_keeps_the_previous_results(
     out = tmp_path / "loco"
     out.mkdir()
     (out / "loco.json").write_text('{"old": true}\n')
+    write_manifest(out, "transfer loco", complete=True)  # an earlier result of the command
     monkeypatch.setattr(figures, "actuator_panels", _full)
     assert _loco(lab_csv_fault, out, small_base_file) == 2
     assert one_error_line(capsys) == (
         f"softbend: error: The '--out' {out} could not be written: {FULL}."
     )
-    assert _listing(out) == ["loco.json"] and (out / "loco.json").read_text() == '{"old": true}\n'
+    assert _listing(out) == [MANIFEST, "loco.json"]
+    assert (out / "loco.json").read_text() == '{"old": true}\n'
     assert _listing(tmp_path) == ["loco"]  # no staging folder left
 
 
@@ -647,11 +650,13 @@ def test_loco_writes_its_folder_whole_with_strict_json(
     out = tmp_path / "loco"
     out.mkdir()
     (out / "learning_curve.png").write_bytes(b"an earlier run's figure")
+    write_manifest(out, "transfer loco", complete=True)  # of an earlier run
     assert _loco(lab_csv_fault, out, small_base_file) == 0
     payload = _strict_json(capsys.readouterr().out)
     # The old folder is gone as a whole: no figure of an earlier run beside the new tables.
     assert "learning_curve.png" not in _listing(out)
-    assert set(payload["files"].values()) == {str(out / name) for name in _listing(out)}
+    written = {str(out / name) for name in _listing(out) if name != MANIFEST}
+    assert set(payload["files"].values()) == written
     saved = _strict_json((out / "loco.json").read_text())
     fem_only = next(r for r in saved["summary"] if r["strategy"] == "fem-only")
     assert fem_only["coverage"] is None  # NaN written as null
@@ -672,7 +677,7 @@ def test_loco_never_replaces_a_folder_holding_other_files(
     inside.write_text(lab_csv_fault.read_text())
     (out / "notes.txt").unlink()
     assert _loco(inside, out, small_base_file) == 2
-    assert f"holds the input {inside}" in one_error_line(capsys)
+    assert f"holds the 'MEASUREMENTS' {inside}" in one_error_line(capsys)
     assert _listing(out) == ["lab.csv"]
 
 
@@ -718,7 +723,7 @@ def test_refine_on_a_full_disk_names_the_option_and_keeps_the_old_model(
     import softbend._io as io
 
     out = tmp_path / "model.json"
-    out.write_text('{"old": true}\n')
+    out.write_text('{"format": "softbend-surrogate", "old": true}\n')
 
     def full(*args, **kwargs):
         raise OSError(errno.ENOSPC, FULL)
@@ -730,7 +735,9 @@ def test_refine_on_a_full_disk_names_the_option_and_keeps_the_old_model(
     # The lab file's few actuators earn a warning about the calibration first.
     assert all(line.startswith("softbend: warning: ") for line in lines[:-1])
     assert lines[-1] == f"softbend: error: The '--out' {out} could not be written: {FULL}."
-    assert out.read_text() == '{"old": true}\n' and _listing(tmp_path) == ["model.json"]
+    assert out.read_text() == '{"format": "softbend-surrogate", "old": true}\n' and _listing(
+        tmp_path
+    ) == ["model.json"]
 
 
 @pytest.mark.parametrize("strategy", ["scale-offset", "residual-gp"])
