@@ -88,7 +88,15 @@ def test_known_noisy_warning_is_silenced_others_are_shown(capsys):
         warnings.warn("something else", UserWarning, stacklevel=1)
     err = capsys.readouterr().err
     assert "No artists" not in err
-    assert "softbend: warning: something else (UserWarning)" in err
+    assert "softbend: warning: something else\n" in err  # no Python class in the line
+
+
+def test_a_library_warning_names_its_package_not_its_class(capsys):
+    from sklearn.exceptions import ConvergenceWarning
+
+    with _common.warnings_as_lines():
+        warnings.warn("did not converge", ConvergenceWarning, stacklevel=1)
+    assert "softbend: warning: did not converge (from sklearn)" in capsys.readouterr().err
 
 
 @pytest.fixture

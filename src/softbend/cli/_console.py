@@ -73,12 +73,20 @@ def warnings_as_lines() -> Iterator[None]:
     with warnings.catch_warnings():  # the filters stay as the caller set them
 
         def show(message, category, filename, lineno, file=None, line=None) -> None:
-            warning_line(f"{message} ({category.__name__})")
+            warning_line(f"{message}{_source(category)}")
 
         warnings.showwarning = show
         for category, start in NOISY_WARNINGS:
             warnings.filterwarnings("ignore", message=re.escape(start), category=category)
         yield
+
+
+def _source(category: type[Warning]) -> str:
+    """Where a warning comes from, for a reader: nothing for softbend's own or a plain one."""
+    package = category.__module__.split(".")[0]
+    if package in ("softbend", "builtins"):
+        return ""
+    return f" (from {package})"
 
 
 def error_line(message: str) -> None:
