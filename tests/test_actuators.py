@@ -157,6 +157,29 @@ def test_description_from_a_table_reads_kinds_and_ranges():
     assert a.features == ("n", "w_mm", "layer", "p_kpa")
 
 
+def test_a_table_s_column_kind_is_numbers_or_wholly_text():
+    table = pd.DataFrame(
+        {
+            "w_mm": ["1.0", "2.5", "2.0"],  # numbers written as text (a Parquet string column)
+            "layer": ["paper", "3", "paper"],
+            "p_kpa": [0.0, 10.0, 20.0],
+            "angle_deg": [0.0, 5.0, 9.0],
+        }
+    )
+    a = Actuator.from_table(
+        table, design_columns=["w_mm"], pressure_column="p_kpa", pressure_unit="kPa"
+    )
+    assert (a.parameters[0].kind, a.parameters[0].low, a.parameters[0].high) == (
+        "continuous",
+        1.0,
+        2.5,
+    )
+    with pytest.raises(ActuatorError, match=r"^layer: mixes numbers and text \(row 1: .3.\)"):
+        Actuator.from_table(
+            table, design_columns=["layer"], pressure_column="p_kpa", pressure_unit="kPa"
+        )
+
+
 @pytest.mark.parametrize(
     ("kwargs", "match"),
     [

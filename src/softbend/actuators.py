@@ -711,12 +711,35 @@ class Actuator:
 
         A numeric column of whole numbers becomes an integer parameter, a text
         column a categorical one (its levels sorted), any other a continuous
-        one; each range is the column's span.
+        one; each range is the column's span. Text that reads as numbers in
+        every cell is numbers.
+
+        Raises
+        ------
+        ActuatorError
+            A text column with a cell that reads as a number, naming the column
+            and the cell: its kind is not the table's to guess.
         """
+        import pandas as pd
+
+        from softbend.tables import infer_cells, kind_conflict
+
         parameters = []
         for column in design_columns:
             values = table[column]
             unit = (units or {}).get(column, _unit_from_name(column))
+            if values.dtype.kind in "OUS" or str(values.dtype) == "string":
+                numbers = infer_cells(values.astype(object).where(values.notna(), None).tolist())
+                if numbers.dtype != object:  # numbers written as text are numbers
+                    values = pd.Series(numbers)
+                conflict = kind_conflict(values.tolist())
+                if conflict is not None:
+                    cell = values.iloc[conflict[0]]
+                    raise ActuatorError(
+                        f"mixes numbers and text (row {conflict[0]}: {short_repr(cell)}); a "
+                        "design column is numbers, or text for a categorical parameter",
+                        key=column,
+                    )
             if values.dtype.kind in "OUSb" or str(values.dtype) in ("category", "string"):
                 levels = tuple(sorted({str(v) for v in values.dropna()}))
                 if len(levels) < 2:

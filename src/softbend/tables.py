@@ -51,7 +51,10 @@ __all__ = [
     "Table",
     "TableFormat",
     "check_columns",
+    "infer_cells",
+    "kind_conflict",
     "read_table",
+    "reads_as_number",
 ]
 
 #: How a column's cells are read: a finite ``"number"``, an ``"integer"``
@@ -365,6 +368,56 @@ def _convert(column: Column, cells: list[str]) -> tuple[np.ndarray, int | None]:
     if column.kind == "integer":
         return np.asarray(values, dtype=np.int64), None
     return np.asarray(values, dtype=object), None
+
+
+def reads_as_number(cell: object) -> bool:
+    """Whether a filled cell is a number or text that reads as one (``"2"``, ``" 1.5e-3"``)."""
+    if isinstance(cell, bool):
+        return False
+    if isinstance(cell, int | float | np.integer | np.floating):
+        return True
+    try:
+        float(str(cell))
+    except ValueError:
+        return False
+    return True
+
+
+def _filled(cell: object) -> bool:
+    if cell is None or (isinstance(cell, str) and not cell.strip()):
+        return False
+    return not (isinstance(cell, float | np.floating) and math.isnan(cell))
+
+
+def kind_conflict(cells: Sequence[object]) -> tuple[int, int] | None:
+    """Where a column's filled cells mix numbers and text, or None where they do not.
+
+    Parameters
+    ----------
+    cells : sequence
+        The column's cells; empty ones (``""``, None, NaN) are left out.
+
+    Returns
+    -------
+    (int, int) or None
+        The position of the first cell of the rarer kind (a text cell where
+        numbers are at least as many), and how many filled cells are of the
+        other kind.
+    """
+    filled = [i for i, cell in enumerate(cells) if _filled(cell)]
+    numbers = [i for i in filled if reads_as_number(cells[i])]
+    if not numbers or len(numbers) == len(filled):
+        return None
+    texts = sorted(set(filled) - set(numbers))
+    if len(numbers) >= len(texts):
+        return texts[0], len(numbers)
+    return numbers[0], len(texts)
+
+
+def infer_cells(cells: Sequence[object]) -> np.ndarray:
+    """Cells as :func:`read_table` reads a column it infers: numbers where every filled cell
+    reads as one (empty cells NaN), else text as written (empty cells NaN)."""
+    return _infer(["" if not _filled(c) else str(c).strip() for c in cells])
 
 
 def _infer(cells: list[str]) -> np.ndarray:

@@ -75,3 +75,16 @@ def test_table_options_with_a_campaign_are_refused(small_campaign, tmp_path, cap
     )
     assert code == 2
     assert "campaign database" in one_error_line(capsys)
+
+
+def test_a_stray_text_cell_is_one_line_naming_file_line_and_column(tmp_path, capsys):
+    frame = table()
+    frame["wall_mm"] = frame["wall_mm"].astype(object)
+    frame.loc[7, "wall_mm"] = "thick"
+    path = tmp_path / "thick.csv"
+    frame.to_csv(path, index=False)
+    code = main(["train", str(path), *TABLE_OPTIONS, "--out", str(tmp_path / "m")])
+    assert code == 2
+    line = one_error_line(capsys)
+    assert f"{path}:9:3: wall_mm: must be a number" in line and "thick" in line
+    assert not (tmp_path / "m").exists()

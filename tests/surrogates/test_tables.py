@@ -8,7 +8,7 @@ import numpy as np
 import pandas as pd
 import pytest
 
-from softbend.actuators import SFRBA, ActuatorError, get_actuator
+from softbend.actuators import SFRBA, Actuator, ActuatorError, get_actuator
 from softbend.errors import DatasetError
 from softbend.surrogates.persistence import load_surrogate
 from softbend.surrogates.predict import predict_angles
@@ -56,6 +56,62 @@ def test_parquet_reads_as_the_csv_does(sims, tmp_path):
     a, b = read(sims), read(parquet)
     np.testing.assert_array_equal(a.X, b.X)
     assert a.data_hash == b.data_hash
+
+
+def with_cell(column, row, cell):
+    """The stand-in table with one cell of ``column`` replaced by ``cell``."""
+    frame = table()
+    frame[column] = frame[column].astype(object)
+    frame.loc[row, column] = cell
+    return frame
+
+
+def test_a_stray_text_cell_in_a_numeric_column_names_file_line_column_and_cell(tmp_path):
+    path = tmp_path / "thick.csv"
+    with_cell("wall_mm", 7, "thick").to_csv(path, index=False)
+    with pytest.raises(DatasetError) as info:
+        read(path)
+    error = info.value
+    # header is line 1, row 7 is line 9; wall_mm is the third column after design_id
+    assert (error.file, error.line, error.column, error.key) == (str(path), 9, 3, "wall_mm")
+    assert "must be a number" in error.detail and "'thick'" in error.detail.replace('"', "'")
+
+
+def test_a_number_in_a_text_column_is_refused_not_made_a_level(tmp_path):
+    path = tmp_path / "layers.csv"
+    with_cell("layer", 4, "3").to_csv(path, index=False)
+    with pytest.raises(DatasetError, match=r"layers\.csv:6:5: layer: mixes numbers and text"):
+        read(path)
+
+
+def test_a_text_cell_in_a_column_the_description_declares_numeric(tmp_path):
+    path = tmp_path / "described.csv"
+    with_cell("wall_mm", 2, "n/a").to_csv(path, index=False)
+    described = Actuator.from_table(
+        table(),
+        design_columns=COLUMNS.split(","),
+        pressure_column="p_kpa",
+        pressure_unit="kPa",
+        name="stand_in",
+    )
+    with pytest.raises(DatasetError, match=r"described\.csv:4:3: wall_mm: must be a number"):
+        table_training_data(path, actuator=described)
+
+
+def test_numeric_text_in_parquet_reads_as_numbers_and_a_stray_cell_names_its_row(sims, tmp_path):
+    pytest.importorskip("pyarrow")
+    frame = pd.read_csv(sims)
+    for column in ("n_chambers", "wall_mm", "height_mm"):
+        frame[column] = frame[column].astype(str)
+    parquet = tmp_path / "text.parquet"
+    frame.to_parquet(parquet)
+    a, b = read(sims), read(parquet)
+    assert [p.kind for p in b.actuator.parameters] == [p.kind for p in a.actuator.parameters]
+    np.testing.assert_array_equal(a.X, b.X)
+    frame.loc[7, "wall_mm"] = "thick"
+    frame.to_parquet(parquet)
+    with pytest.raises(DatasetError, match=r"text\.parquet: wall_mm: row 7: must be a number"):
+        read(parquet)
 
 
 @pytest.mark.parametrize(

@@ -32,12 +32,20 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
-from softbend._validation import must_be
+from softbend._validation import must_be, short_repr
 from softbend.actuators import Actuator, ActuatorError, pressure_to_mpa
 from softbend.errors import DatasetError
 from softbend.limits import check_file_size
 from softbend.surrogates.features import GROUP, TrainingData, data_hash
-from softbend.tables import Column, TableFormat, check_columns
+from softbend.tables import (
+    Column,
+    Table,
+    TableFormat,
+    check_columns,
+    infer_cells,
+    kind_conflict,
+    reads_as_number,
+)
 from softbend.tables import read_table as read_csv_table
 
 if TYPE_CHECKING:
@@ -64,17 +72,24 @@ def read_table(path: str | os.PathLike[str]) -> pd.DataFrame:
     """A CSV (``#`` comment lines allowed) or Parquet file as a DataFrame, or one clear error.
 
     A CSV goes through :func:`softbend.tables.read_table`; a Parquet file is
-    read by pandas. Both hold at most :data:`MAX_ROWS` rows.
+    read by pandas. Both hold at most :data:`MAX_ROWS` rows. A column of text
+    whose every filled cell reads as a number is read as numbers, in a Parquet
+    file as in a CSV.
     """
+    return _read(Path(path))[0]
+
+
+def _read(source: Path) -> tuple[pd.DataFrame, Table | None]:
+    """:func:`read_table`'s frame, and for a CSV the table that knows each row's line."""
     import pandas as pd
 
-    source = Path(path)
     if not source.is_file():
         raise FileNotFoundError(f"No table at {source}.")
     check_file_size(source, str(source))
     suffix = source.suffix.lower()
     if suffix == ".csv":
-        return read_csv_table(source, SIMULATION_TABLE).frame
+        table = read_csv_table(source, SIMULATION_TABLE)
+        return table.frame, table
     if suffix not in (".parquet", ".pq"):
         raise DatasetError(
             f"a training table must be a CSV or Parquet file ({', '.join(TABLE_SUFFIXES)}) "
@@ -92,7 +107,66 @@ def read_table(path: str | os.PathLike[str]) -> pd.DataFrame:
             f"has {len(frame)} rows; a training table holds at most {MAX_ROWS}", file=str(source)
         )
     frame.columns = [str(c).strip() for c in frame.columns]
-    return frame
+    for name in frame.columns:
+        series = frame[name]
+        if series.dtype.kind == "O" or str(series.dtype) == "string":
+            values = infer_cells(series.astype(object).where(series.notna(), None).tolist())
+            if values.dtype != object:  # numbers written as text: numbers, as in a CSV
+                frame[name] = values
+    return frame, None
+
+
+def _check_kinds(
+    frame: pd.DataFrame,
+    table: Table | None,
+    designs: Sequence[str],
+    actuator: Actuator | None,
+    source: Path,
+) -> None:
+    """Each design column's cells of one kind: numbers, or text for a categorical parameter.
+
+    A column is categorical when ``actuator`` declares it so or, without a
+    description, when none of its filled cells is a number. The error names
+    the file, the line (a Parquet file's row), the column and the cell.
+    """
+    for name in designs:
+        kind = actuator.parameter(name).kind if actuator is not None else None
+        series = frame[name]
+        if kind == "categorical" or (series.dtype.kind != "O" and str(series.dtype) != "string"):
+            continue
+        cells = series.tolist()
+        if kind is None:
+            conflict = kind_conflict(cells)
+            if conflict is None:
+                continue  # wholly text: the levels of a categorical parameter
+            row, others = conflict
+            if reads_as_number(cells[row]):
+                message = (
+                    f"mixes numbers and text: {others} filled cells are text, this one the "
+                    f"number {str(cells[row]).strip()}; a categorical column's levels are all "
+                    "text (or an actuator description declares the column categorical)"
+                )
+            else:
+                message = (
+                    f"must be a number, as the column's other {others} filled cells are; got "
+                    f"{short_repr(cells[row])} (a design column is categorical only when none "
+                    "of its cells is a number, or when an actuator description declares it so)"
+                )
+        else:
+            assert actuator is not None
+            row = next(
+                (i for i, c in enumerate(cells) if isinstance(c, str) and not reads_as_number(c)),
+                -1,
+            )
+            if row < 0:
+                continue
+            message = (
+                f"must be a number (the actuator {actuator.name} declares {name} {kind}); "
+                f"got {short_repr(cells[row])}"
+            )
+        if table is not None:
+            raise table.error(message, row=row, column=name)
+        raise DatasetError(f"row {row}: {message}", key=name, file=str(source))
 
 
 def _columns(text: str | Sequence[str], key: str) -> list[str]:
@@ -160,7 +234,7 @@ def table_training_data(
         is not numbers or a negative pressure (:func:`softbend.tables.check_columns`).
     """
     source = Path(path)
-    frame = read_table(source)
+    frame, table = _read(source)
     if actuator is not None:
         designs = _columns(design_columns or actuator.names, "design_columns")
         if designs != list(actuator.names):
@@ -210,6 +284,7 @@ def table_training_data(
     _check_present(frame, designs, "design_columns", str(source))
     _check_present(frame, [pressure_column], "pressure_column", str(source))
     _check_present(frame, [angle_column], "angle_column", str(source))
+    _check_kinds(frame, table, designs, actuator, source)
     check_columns(
         frame,
         TableFormat(
