@@ -238,6 +238,29 @@ def test_outside_the_training_ranges_is_not_supported(trained):
         )
 
 
+def test_a_design_past_the_sampled_span_is_an_extrapolation_not_an_error(trained):
+    path, _ = trained
+    design = "n_chambers=10,wall_mm=1.0,height_mm=12,layer=paper"  # the walls: 1.1 to 2.9 mm
+    pred = predict_angles(path, design, [20.0])
+    assert pred.outside_training_ranges == ["wall_mm 1 outside [1.1, 2.9]"]
+    assert pred.supported is not None and not pred.supported.any()
+    with pytest.raises(ValueError, match=r"wall_mm 1 outside \[1\.1, 2\.9\]"):
+        predict_angles(path, design, [20.0], strict=True)
+
+
+def test_declared_ranges_replace_the_sampled_span(sims):
+    described = read(sims, ranges=["wall_mm=0.5:3.5", "n_chambers=4:20"]).actuator
+    n, wall, height, _ = described.parameters
+    assert (wall.low, wall.high, wall.sampled) == (0.5, 3.5, False)
+    assert (n.kind, n.low, n.high, n.sampled) == ("integer", 4.0, 20.0, False)
+    assert (height.low, height.high, height.sampled) == (8.0, 16.0, True)
+    with pytest.raises(ActuatorError, match="must be in"):
+        described.parse_design("n_chambers=10,wall_mm=0.4,height_mm=12,layer=paper")
+    described.parse_design("n_chambers=10,wall_mm=2,height_mm=30,layer=paper")  # sampled only
+    with pytest.raises(ActuatorError, match=r"^ranges: declares ranges"):
+        table_training_data(sims, actuator=described, ranges=["wall_mm=1:3"])
+
+
 def test_paper_b_design_names_are_refused_for_another_actuator(trained):
     path, _ = trained
     with pytest.raises(ValueError, match="not a design parameter"):

@@ -33,7 +33,7 @@ from typing import TYPE_CHECKING
 import numpy as np
 
 from softbend._validation import must_be, short_repr
-from softbend.actuators import Actuator, ActuatorError, pressure_to_mpa
+from softbend.actuators import Actuator, ActuatorError, parse_ranges, pressure_to_mpa
 from softbend.errors import DatasetError
 from softbend.limits import check_file_size
 from softbend.surrogates.features import GROUP, TrainingData, data_hash
@@ -199,6 +199,7 @@ def table_training_data(
     angle_column: str = "angle_deg",
     actuator: Actuator | None = None,
     name: str | None = None,
+    ranges: Sequence[str] = (),
 ) -> TrainingData:
     """The training data of a simulation table, described by its columns.
 
@@ -222,6 +223,11 @@ def table_training_data(
         (:meth:`~softbend.actuators.Actuator.from_table`).
     name : str, optional
         The described actuator's name (default: the file's stem).
+    ranges : sequence of str, optional
+        Declared ranges ``NAME=LOW:HIGH`` of design parameters of a description
+        read off the table (:func:`~softbend.actuators.parse_ranges`); a
+        parameter not named keeps the table's span as its sampled range, which
+        a model flags (not refuses) a design outside of.
 
     Raises
     ------
@@ -234,8 +240,13 @@ def table_training_data(
         is not numbers or a negative pressure (:func:`softbend.tables.check_columns`).
     """
     source = Path(path)
-    frame, table = _read(source)
     if actuator is not None:
+        if ranges:
+            raise ActuatorError(
+                f"declares ranges of a description read off the table; the actuator "
+                f"{actuator.name}'s description declares its own (leave out one of the two)",
+                key="ranges",
+            )
         designs = _columns(design_columns or actuator.names, "design_columns")
         if designs != list(actuator.names):
             raise ActuatorError(
@@ -269,6 +280,7 @@ def table_training_data(
                 key="pressure_unit",
             )
         unit = pressure_unit
+    declared = parse_ranges(ranges, designs)
     pressure_to_mpa(unit)
     if angle_column.lower().endswith("_rad"):
         raise ActuatorError(
@@ -281,6 +293,7 @@ def table_training_data(
             raise ActuatorError(
                 f"{column!r} is also one of the design columns ({','.join(designs)})", key=key
             )
+    frame, table = _read(source)
     _check_present(frame, designs, "design_columns", str(source))
     _check_present(frame, [pressure_column], "pressure_column", str(source))
     _check_present(frame, [angle_column], "angle_column", str(source))
@@ -305,6 +318,7 @@ def table_training_data(
             angle_column=angle_column,
             name=name or _name_of(source),
             title=f"the actuator of {source.name}",
+            ranges=declared,
         )
     codes = np.empty((len(frame), len(designs)))
     for j, parameter in enumerate(actuator.parameters):
