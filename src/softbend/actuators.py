@@ -761,17 +761,18 @@ class Actuator:
         """
         import pandas as pd
 
-        from softbend.tables import infer_cells, kind_conflict
+        from softbend.tables import column_kind, infer_cells, kind_conflict
 
         parameters = []
         for column in design_columns:
             values = table[column]
             unit = (units or {}).get(column, _unit_from_name(column))
             if values.dtype.kind in "OUS" or str(values.dtype) == "string":
-                numbers = infer_cells(values.astype(object).where(values.notna(), None).tolist())
-                if numbers.dtype != object:  # numbers written as text are numbers
-                    values = pd.Series(numbers)
-                conflict = kind_conflict(values.tolist())
+                cells = values.astype(object).where(values.notna(), None).tolist()
+                kind_of_cells = column_kind(cells)
+                if kind_of_cells == "number":  # numbers written as text are numbers
+                    values = pd.Series(infer_cells(cells))
+                conflict = kind_conflict(cells) if kind_of_cells == "mixed" else None
                 if conflict is not None:
                     cell = values.iloc[conflict[0]]
                     raise ActuatorError(

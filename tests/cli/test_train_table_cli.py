@@ -152,3 +152,15 @@ def test_a_range_with_a_campaign_is_refused(small_campaign, tmp_path, capsys):
     assert code == 2
     line = one_error_line(capsys)
     assert "campaign database" in line and "--range" in line
+
+
+def test_a_large_table_shows_its_read_from_the_start(sims, tmp_path, capsys, monkeypatch):
+    import softbend._progress
+
+    monkeypatch.setattr(softbend._progress, "READ_REPORT_BYTES", 0)
+    options = [*TABLE_OPTIONS, "--angle-column", "theta"]  # refused once the table is read
+    assert main(["train", str(sims), *options, "--out", str(tmp_path / "m")]) == 2
+    lines = capsys.readouterr().err.strip().splitlines()
+    assert lines[0].startswith("reading sims.csv, %: 0/100")
+    assert any(line.startswith("reading sims.csv, %: 100/100") for line in lines)
+    assert lines[-1].startswith("softbend: error: --angle-column: ") and "'theta'" in lines[-1]

@@ -265,3 +265,25 @@ def test_paper_b_design_names_are_refused_for_another_actuator(trained):
     path, _ = trained
     with pytest.raises(ValueError, match="not a design parameter"):
         predict_angles(path, "l_mm=100,r_mm=6,t_mm=2,b_mm=2,phi_deg=5,lc_mm=8", [10.0])
+
+
+def test_a_large_parquet_table_reports_its_read_from_the_start(sims, tmp_path, monkeypatch):
+    pytest.importorskip("pyarrow")
+    import softbend._progress
+    from softbend._progress import listening
+
+    parquet = tmp_path / "sims.parquet"
+    pd.read_csv(sims).to_parquet(parquet)
+    monkeypatch.setattr(softbend._progress, "READ_REPORT_BYTES", 0)
+    heard = []
+    read_parquet = pd.read_parquet
+    monkeypatch.setattr(
+        pd, "read_parquet", lambda *a, **k: heard.append("read") or read_parquet(*a, **k)
+    )
+    with listening(lambda *call: heard.append(call)):
+        read(parquet)
+    assert heard == [
+        ("reading sims.parquet, %", 0, 100),
+        "read",
+        ("reading sims.parquet, %", 100, 100),
+    ]

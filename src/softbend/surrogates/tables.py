@@ -32,6 +32,7 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
+from softbend._progress import read_phase, report
 from softbend._validation import must_be, short_repr
 from softbend.actuators import Actuator, ActuatorError, parse_ranges, pressure_to_mpa
 from softbend.errors import DatasetError
@@ -42,6 +43,7 @@ from softbend.tables import (
     Table,
     TableFormat,
     check_columns,
+    column_kind,
     infer_cells,
     kind_conflict,
     reads_as_number,
@@ -74,7 +76,8 @@ def read_table(path: str | os.PathLike[str]) -> pd.DataFrame:
     A CSV goes through :func:`softbend.tables.read_table`; a Parquet file is
     read by pandas. Both hold at most :data:`MAX_ROWS` rows. A column of text
     whose every filled cell reads as a number is read as numbers, in a Parquet
-    file as in a CSV.
+    file as in a CSV. A large file reports its progress from the start of the
+    read (:func:`softbend._progress.read_phase`).
     """
     return _read(Path(path))[0]
 
@@ -96,12 +99,17 @@ def _read(source: Path) -> tuple[pd.DataFrame, Table | None]:
             f"or a campaign database; got {suffix or 'no suffix'}",
             file=str(source),
         )
+    phase = read_phase(source)
+    if phase is not None:  # one call reads the whole file: shown from its start
+        report(phase, 0, 100)
     try:
         frame = pd.read_parquet(source)
     except (OSError, ValueError) as err:  # pyarrow: not a Parquet file
         raise DatasetError(
             f"is not a readable {suffix[1:]} table ({err})", file=str(source)
         ) from None
+    if phase is not None:
+        report(phase, 100, 100)
     if len(frame) > MAX_ROWS:
         raise DatasetError(
             f"has {len(frame)} rows; a training table holds at most {MAX_ROWS}", file=str(source)
@@ -110,9 +118,9 @@ def _read(source: Path) -> tuple[pd.DataFrame, Table | None]:
     for name in frame.columns:
         series = frame[name]
         if series.dtype.kind == "O" or str(series.dtype) == "string":
-            values = infer_cells(series.astype(object).where(series.notna(), None).tolist())
-            if values.dtype != object:  # numbers written as text: numbers, as in a CSV
-                frame[name] = values
+            cells = series.astype(object).where(series.notna(), None).tolist()
+            if column_kind(cells) == "number":  # numbers written as text: numbers, as in a CSV
+                frame[name] = infer_cells(cells)
     return frame, None
 
 
