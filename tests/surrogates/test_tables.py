@@ -282,8 +282,10 @@ def test_a_large_parquet_table_reports_its_read_from_the_start(sims, tmp_path, m
     )
     with listening(lambda *call: heard.append(call)):
         read(parquet)
+    describing = [("describing sims.parquet's designs", done, 3) for done in range(4)]
     assert heard == [
         ("reading sims.parquet, %", 0, 100),
         "read",
         ("reading sims.parquet, %", 100, 100),
+        *describing,
     ]

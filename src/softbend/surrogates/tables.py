@@ -305,6 +305,9 @@ def table_training_data(
     _check_present(frame, designs, "design_columns", str(source))
     _check_present(frame, [pressure_column], "pressure_column", str(source))
     _check_present(frame, [angle_column], "angle_column", str(source))
+    describing = f"describing {source.name}'s designs" if read_phase(source) else None
+    if describing is not None:  # a large table: what follows its read takes seconds too
+        report(describing, 0, 3)
     _check_kinds(frame, table, designs, actuator, source)
     check_columns(
         frame,
@@ -328,6 +331,8 @@ def table_training_data(
             title=f"the actuator of {source.name}",
             ranges=declared,
         )
+    if describing is not None:
+        report(describing, 1, 3)
     codes = np.empty((len(frame), len(designs)))
     for j, parameter in enumerate(actuator.parameters):
         column = frame[parameter.name]
@@ -358,6 +363,8 @@ def table_training_data(
         actuator.check_designs(codes)
     except ActuatorError as err:
         raise ActuatorError(err.detail, file=str(source)) from None
+    if describing is not None:
+        report(describing, 2, 3)
     if GROUP in frame.columns:
         groups = frame[GROUP].astype(str).to_numpy()[keep]
     else:
@@ -370,6 +377,8 @@ def table_training_data(
             key=angle_column,
             file=str(source),
         )
+    if describing is not None:
+        report(describing, 3, 3)
     X = np.ascontiguousarray(np.column_stack([codes, pressures]))
     y = np.ascontiguousarray(angles)
     return TrainingData(
