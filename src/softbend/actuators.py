@@ -266,8 +266,10 @@ class DesignParameter:
             assert self.levels is not None
             return f"one of {', '.join(map(str, self.levels))}"
         unit = f" {self.unit}" if self.unit else ""
+        if self.sampled and self.kind == "integer":
+            return "a whole number"
         if self.sampled:
-            return "a whole number" if self.kind == "integer" else f"a number{unit and ' in'}{unit}"
+            return f"in{unit}" if unit else "any value"
         span = f"in [{self.low:g}, {self.high:g}]{unit}"
         return f"a whole number {span}" if self.kind == "integer" else span
 
