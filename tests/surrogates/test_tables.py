@@ -289,3 +289,14 @@ def test_a_large_parquet_table_reports_its_read_from_the_start(sims, tmp_path, m
         ("reading sims.parquet, %", 100, 100),
         *describing,
     ]
+
+
+@pytest.mark.parametrize(("column", "position"), [("p_kpa", 6), ("angle_deg", 7)])
+def test_a_stray_text_cell_in_the_pressure_or_angle_names_its_line(tmp_path, column, position):
+    path = tmp_path / "stray.csv"
+    with_cell(column, 10, "n/a").to_csv(path, index=False)
+    with pytest.raises(DatasetError) as info:
+        read(path)
+    error = info.value
+    assert (error.line, error.column, error.key) == (12, position, column)
+    assert error.detail == 'must be a number; got "n/a"'

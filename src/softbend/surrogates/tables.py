@@ -130,15 +130,23 @@ def _check_kinds(
     designs: Sequence[str],
     actuator: Actuator | None,
     source: Path,
+    numbers: Sequence[str] = (),
 ) -> None:
-    """Each design column's cells of one kind: numbers, or text for a categorical parameter.
+    """Each design column's cells of one kind: numbers, or text for a categorical parameter;
+    each column of ``numbers`` (the pressure and the angle) numbers.
 
     A column is categorical when ``actuator`` declares it so or, without a
     description, when none of its filled cells is a number. The error names
     the file, the line (a Parquet file's row), the column and the cell.
     """
-    for name in designs:
-        kind = actuator.parameter(name).kind if actuator is not None else None
+    for name in [*designs, *numbers]:
+        kind = (
+            "number"
+            if name in numbers
+            else actuator.parameter(name).kind
+            if actuator is not None
+            else None
+        )
         series = frame[name]
         if kind == "categorical" or (series.dtype.kind != "O" and str(series.dtype) != "string"):
             continue
@@ -161,17 +169,18 @@ def _check_kinds(
                     "of its cells is a number, or when an actuator description declares it so)"
                 )
         else:
-            assert actuator is not None
             row = next(
                 (i for i, c in enumerate(cells) if isinstance(c, str) and not reads_as_number(c)),
                 -1,
             )
             if row < 0:
                 continue
-            message = (
-                f"must be a number (the actuator {actuator.name} declares {name} {kind}); "
-                f"got {short_repr(cells[row])}"
+            declared = (
+                f" (the actuator {actuator.name} declares {name} {kind})"
+                if actuator is not None and name not in numbers
+                else ""
             )
+            message = f"must be a number{declared}; got {short_repr(cells[row])}"
         if table is not None:
             raise table.error(message, row=row, column=name)
         raise DatasetError(f"row {row}: {message}", key=name, file=str(source))
@@ -308,7 +317,7 @@ def table_training_data(
     describing = f"describing {source.name}'s designs" if read_phase(source) else None
     if describing is not None:  # a large table: what follows its read takes seconds too
         report(describing, 0, 3)
-    _check_kinds(frame, table, designs, actuator, source)
+    _check_kinds(frame, table, designs, actuator, source, (pressure_column, angle_column))
     check_columns(
         frame,
         TableFormat(
