@@ -14,6 +14,7 @@ from softbend.actuators import (
     ActuatorError,
     DesignParameter,
     get_actuator,
+    parse_ranges,
     pressure_to_mpa,
 )
 from softbend.design import PARAMETERS, SFRBADesign
@@ -155,6 +156,50 @@ def test_description_from_a_table_reads_kinds_and_ranges():
     assert (w.kind, w.unit, w.low, w.high) == ("continuous", "mm", 1.0, 2.5)
     assert layer.kind == "categorical" and layer.levels == ("fabric", "paper")
     assert a.features == ("n", "w_mm", "layer", "p_kpa")
+
+
+def test_ranges_are_parsed_by_name_with_one_line_naming_the_allowed_names():
+    assert parse_ranges(["w_mm=1:3", " n = 2 : 9 "], ["n", "w_mm"]) == {
+        "w_mm": (1.0, 3.0),
+        "n": (2.0, 9.0),
+    }
+    for text in ("x=1:3", "w_mm=3:1", "w_mm=1", "w_mm=a:b", "w_mm=1:inf"):
+        with pytest.raises(ActuatorError, match=r"^ranges: must be NAME=LOW:HIGH with NAME one"):
+            parse_ranges([text], ["n", "w_mm"])
+    with pytest.raises(ActuatorError, match="twice"):
+        parse_ranges(["w_mm=1:3", "w_mm=1:2"], ["w_mm"])
+
+
+def test_a_sampled_range_round_trips_and_is_no_wall():
+    p = DesignParameter("w_mm", "mm", 1.0, 2.5, sampled=True)
+    assert DesignParameter.from_dict(p.to_dict()) == p
+    assert "sampled" not in DesignParameter("w_mm", "mm", 1.0, 2.5).to_dict()
+    p.check(np.array([0.5, 3.0]))
+    with pytest.raises(ActuatorError, match="must be finite"):
+        p.check(np.array([np.nan]))
+
+
+def test_a_table_s_column_kind_is_numbers_or_wholly_text():
+    table = pd.DataFrame(
+        {
+            "w_mm": ["1.0", "2.5", "2.0"],  # numbers written as text (a Parquet string column)
+            "layer": ["paper", "3", "paper"],
+            "p_kpa": [0.0, 10.0, 20.0],
+            "angle_deg": [0.0, 5.0, 9.0],
+        }
+    )
+    a = Actuator.from_table(
+        table, design_columns=["w_mm"], pressure_column="p_kpa", pressure_unit="kPa"
+    )
+    assert (a.parameters[0].kind, a.parameters[0].low, a.parameters[0].high) == (
+        "continuous",
+        1.0,
+        2.5,
+    )
+    with pytest.raises(ActuatorError, match=r"^layer: mixes numbers and text \(row 1: .3.\)"):
+        Actuator.from_table(
+            table, design_columns=["layer"], pressure_column="p_kpa", pressure_unit="kPa"
+        )
 
 
 @pytest.mark.parametrize(

@@ -148,3 +148,30 @@ def test_a_frame_from_elsewhere_gets_the_same_column_checks():
         match=r"^t\.parquet: time_s: must be a finite number in every row; got \w+ values$",
     ):
         check_columns(good.assign(time_s=["a", "b"]), FORMAT, file="t.parquet")
+
+
+def test_a_large_file_reports_its_read_before_its_first_byte_is_read(tmp_path, monkeypatch):
+    import softbend._io
+    import softbend._progress
+    from softbend._progress import listening
+
+    path = _write(tmp_path, "# rig: r\ntime_s,pressure_kpa\n" + "0.1,1\n" * 200, "big.csv")
+    heard: list[object] = []
+    read_text = softbend._io.read_input_text
+
+    def reading(*args, **kwargs):
+        heard.append("the file is read")
+        return read_text(*args, **kwargs)
+
+    monkeypatch.setattr(softbend._io, "read_input_text", reading)
+    with listening(lambda *call: heard.append(call)):
+        read_table(path, FORMAT)  # below the size that reports: silent
+        assert heard == ["the file is read"]
+        heard.clear()
+        monkeypatch.setattr(softbend._progress, "READ_REPORT_BYTES", 0)
+        read_table(path, FORMAT)
+    phase = "reading big.csv, %"
+    assert heard[:2] == [(phase, 0, 100), "the file is read"]
+    reads = [c for c in heard if isinstance(c, tuple) and c[0] == phase]
+    assert [d for _, d, _ in reads] == sorted(d for _, d, _ in reads) and reads[-1][1] == 100
+    assert heard[-1] == ("checking big.csv's columns", 2, 2)

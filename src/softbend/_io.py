@@ -184,7 +184,10 @@ def read_header_csv(
     and a non-empty key is yielded as ``"meta"``, every other comment is
     skipped. The first other line is the column header; the rest are rows.
     The caller checks the columns, the cells and the metadata: the lines come
-    one by one, so the first problem in the file is the one reported.
+    one by one, so the first problem in the file is the one reported. A file
+    of :data:`~softbend._progress.READ_REPORT_BYTES` or more reports the
+    percent of its lines read (:func:`softbend._progress.report`), the first
+    report before the file is read.
 
     Parameters
     ----------
@@ -211,9 +214,13 @@ def read_header_csv(
     """
     import csv
 
+    from softbend._progress import every, read_phase, report
     from softbend.errors import DatasetError
     from softbend.limits import check_limit, limit
 
+    phase = read_phase(path)
+    if phase is not None:  # before a byte is read: a large file shows at once
+        report(phase, 0, 100)
     text = read_input_text(path, str(path), encoding="utf-8-sig")
     lines = text.replace("\r\n", "\n").replace("\r", "\n").split("\n")
     del text
@@ -230,7 +237,10 @@ def read_header_csv(
             )
     field_limit = csv.field_size_limit()
     in_header = True
+    stride = every(len(lines))
     for number, line in enumerate(lines, start=1):
+        if phase is not None and number % stride == 0:
+            report(phase, 100 * number // len(lines), 100)
         stripped = line.strip()
         if not stripped:
             continue
@@ -249,6 +259,8 @@ def read_header_csv(
             cells = tuple(map(str.strip, line.split(separator)))
         yield CSVLine(number, "header" if in_header else "row", cells)
         in_header = False
+    if phase is not None:
+        report(phase, 100, 100)
 
 
 def write_text_atomic(path: str | os.PathLike[str], text: str) -> Path:

@@ -19,11 +19,13 @@ Example
 
 from __future__ import annotations
 
+import os
 from collections.abc import Callable, Iterator
 from contextlib import contextmanager
 from contextvars import ContextVar
+from pathlib import Path
 
-__all__ = ["Listener", "every", "listening", "report"]
+__all__ = ["READ_REPORT_BYTES", "Listener", "every", "listening", "read_phase", "report"]
 
 #: ``listener(phase, done, total)``: ``done`` of ``total`` units of ``phase``.
 Listener = Callable[[str, int, int], None]
@@ -51,3 +53,18 @@ def report(phase: str, done: int, total: int) -> None:
 def every(total: int, steps: int = 50) -> int:
     """The stride of reports for ``total`` units: about ``steps`` reports in all."""
     return max(1, total // steps)
+
+
+#: A file at least this large (bytes) reports its read (:func:`read_phase`); a smaller one
+#: is read in well under a second, silently.
+READ_REPORT_BYTES = 1 << 20
+
+
+def read_phase(path: str | os.PathLike[str]) -> str | None:
+    """The phase a read of ``path`` reports its percent under (``"reading sims.csv, %"``),
+    or None for a file smaller than :data:`READ_REPORT_BYTES` (or one that is not there)."""
+    try:
+        size = Path(path).stat().st_size
+    except OSError:
+        return None
+    return f"reading {Path(path).name}, %" if size >= READ_REPORT_BYTES else None

@@ -65,6 +65,7 @@ __all__ = [
     "actuator_from",
     "get_actuator",
     "load_actuator",
+    "parse_ranges",
     "pressure_to_mpa",
 ]
 
@@ -131,6 +132,11 @@ class DesignParameter:
         Manufacturing resolution (the step a design search rounds to), in ``unit``.
     description : str
         What the parameter is, for tables and documentation.
+    sampled : bool, default False
+        Whether ``low`` and ``high`` are only the span a simulation table
+        sampled (:meth:`Actuator.from_table`), not a declared range: a value
+        outside them is not refused here, and a model trained on the table
+        flags it as outside its training ranges instead.
     """
 
     name: str
@@ -141,6 +147,7 @@ class DesignParameter:
     levels: tuple[Any, ...] | None = None
     resolution: float | None = None
     description: str = ""
+    sampled: bool = False
 
     def __post_init__(self) -> None:
         _check_name(self.name, "name of a design parameter")
@@ -239,7 +246,7 @@ class DesignParameter:
             )
         eps = 1e-9 * max(1.0, abs(self.low), abs(self.high))
         outside = (values < self.low - eps) | (values > self.high + eps)
-        if outside.any():
+        if outside.any() and not (self.sampled and self.kind != "categorical"):
             shown = (
                 self.decode(values[outside][0])
                 if self.kind == "categorical"
@@ -259,6 +266,10 @@ class DesignParameter:
             assert self.levels is not None
             return f"one of {', '.join(map(str, self.levels))}"
         unit = f" {self.unit}" if self.unit else ""
+        if self.sampled and self.kind == "integer":
+            return "a whole number"
+        if self.sampled:
+            return f"in{unit}" if unit else "any value"
         span = f"in [{self.low:g}, {self.high:g}]{unit}"
         return f"a whole number {span}" if self.kind == "integer" else span
 
@@ -273,6 +284,8 @@ class DesignParameter:
             out["resolution"] = self.resolution
         if self.description:
             out["description"] = self.description
+        if self.sampled:
+            out["sampled"] = True
         return out
 
     @classmethod
@@ -280,7 +293,17 @@ class DesignParameter:
         """The parameter :meth:`to_dict` wrote; one :class:`ActuatorError` for a bad record."""
         if not isinstance(data, Mapping):
             raise ActuatorError(f"A design parameter must be an object; got {data!r}.")
-        allowed = {"name", "unit", "kind", "levels", "low", "high", "resolution", "description"}
+        allowed = {
+            "name",
+            "unit",
+            "kind",
+            "levels",
+            "low",
+            "high",
+            "resolution",
+            "description",
+            "sampled",
+        }
         unknown = sorted(set(data) - allowed)
         if unknown:
             raise ActuatorError(
@@ -288,6 +311,12 @@ class DesignParameter:
                 f"{data.get('name')!r}; allowed: {', '.join(sorted(allowed))}."
             )
         levels = data.get("levels")
+        sampled = data.get("sampled", False)
+        if not isinstance(sampled, bool):
+            raise ActuatorError(
+                f"The 'sampled' of design parameter {data.get('name')!r} must be true or false; "
+                f"got {sampled!r}."
+            )
         return cls(
             name=data.get("name"),  # type: ignore[arg-type]  # checked in __post_init__
             unit=str(data.get("unit", "")),
@@ -297,6 +326,7 @@ class DesignParameter:
             levels=tuple(levels) if isinstance(levels, list | tuple) else levels,
             resolution=None if data.get("resolution") is None else _number(data["resolution"]),
             description=str(data.get("description", "")),
+            sampled=sampled,
         )
 
 
@@ -708,18 +738,60 @@ class Actuator:
         name: str = "table",
         title: str = "",
         units: Mapping[str, str] | None = None,
+        ranges: Mapping[str, tuple[float, float]] | None = None,
     ) -> Actuator:
         """A description read off a simulation table's columns.
 
         A numeric column of whole numbers becomes an integer parameter, a text
         column a categorical one (its levels sorted), any other a continuous
-        one; each range is the column's span.
+        one. Text that reads as numbers in every cell is numbers. A numeric
+        parameter's range is the one ``ranges`` declares, else the column's
+        span, marked as only sampled (:attr:`DesignParameter.sampled`): a
+        design outside it is an extrapolation, not an error.
+
+        Parameters
+        ----------
+        ranges : dict of str to (float, float), optional
+            Declared ranges ``{name: (low, high)}`` in the parameters' units
+            (:func:`parse_ranges`), each holding the column's values.
+
+        Raises
+        ------
+        ActuatorError
+            A text column with a cell that reads as a number, naming the column
+            and the cell: its kind is not the table's to guess. A declared range
+            of a categorical parameter or one that leaves out the column's
+            values (keyed ``ranges``).
         """
+        import pandas as pd
+
+        from softbend.tables import column_kind, infer_cells, kind_conflict
+
         parameters = []
         for column in design_columns:
             values = table[column]
             unit = (units or {}).get(column, _unit_from_name(column))
+            if values.dtype.kind in "OUS" or str(values.dtype) == "string":
+                cells = values.astype(object).where(values.notna(), None).tolist()
+                kind_of_cells = column_kind(cells)
+                if kind_of_cells == "number":  # numbers written as text are numbers
+                    values = pd.Series(infer_cells(cells))
+                conflict = kind_conflict(cells) if kind_of_cells == "mixed" else None
+                if conflict is not None:
+                    cell = values.iloc[conflict[0]]
+                    raise ActuatorError(
+                        f"mixes numbers and text (row {conflict[0]}: {short_repr(cell)}); a "
+                        "design column is numbers, or text for a categorical parameter",
+                        key=column,
+                    )
+            declared = (ranges or {}).get(column)
             if values.dtype.kind in "OUSb" or str(values.dtype) in ("category", "string"):
+                if declared is not None:
+                    raise ActuatorError(
+                        f"gives a range of {column}, a categorical parameter (its text "
+                        "levels); a range is for a numeric column",
+                        key="ranges",
+                    )
                 levels = tuple(sorted({str(v) for v in values.dropna()}))
                 if len(levels) < 2:
                     levels = (*levels, f"{levels[0]}_other") if levels else ("a", "b")
@@ -730,7 +802,17 @@ class Actuator:
             low, high = (float(finite.min()), float(finite.max())) if finite.size else (0.0, 0.0)
             whole = finite.size > 0 and bool(np.all(finite == np.round(finite)))
             kind: Kind = "integer" if whole and values.dtype.kind in "iu" else "continuous"
-            parameters.append(DesignParameter(column, unit, low, high, kind=kind))
+            if declared is None:
+                parameters.append(DesignParameter(column, unit, low, high, kind=kind, sampled=True))
+                continue
+            if finite.size and (low < declared[0] or high > declared[1]):
+                raise ActuatorError(
+                    f"declares {column} in [{declared[0]:g}, {declared[1]:g}]{unit and ' '}{unit}, "
+                    f"but the table's {column} spans [{low:g}, {high:g}]; a declared range "
+                    "holds every design of the table",
+                    key="ranges",
+                )
+            parameters.append(DesignParameter(column, unit, *declared, kind=kind))
         return cls(
             name=name,
             title=title or f"actuator of the table's {len(parameters)} design columns",
@@ -761,6 +843,44 @@ def _check_column_units(pressure_column: str, pressure_unit: str, angle_column: 
             "multiply by 180/π (57.2958) and name the column e.g. angle_deg",
             key="angle_column",
         )
+
+
+def parse_ranges(texts: Sequence[str], names: Sequence[str]) -> dict[str, tuple[float, float]]:
+    """Declared ranges ``{name: (low, high)}`` from ``NAME=LOW:HIGH`` texts (``wall_mm=1:3``).
+
+    Parameters
+    ----------
+    texts : sequence of str
+        The texts, such as the repeated values of ``train --range``; each
+        LOW and HIGH in the parameter's unit, finite, LOW < HIGH.
+    names : sequence of str
+        The design parameters a range may name.
+
+    Raises
+    ------
+    ActuatorError
+        Keyed ``ranges``: the form, the allowed names and the text received;
+        or a name given twice.
+    """
+    allowed = ", ".join(names)
+    out: dict[str, tuple[float, float]] = {}
+    for text in texts:
+        name, _, span = str(text).partition("=")
+        name = name.strip()
+        low_text, colon, high_text = span.partition(":")
+        try:
+            low, high = (float(low_text), float(high_text)) if colon else (math.nan, math.nan)
+        except ValueError:
+            low, high = math.nan, math.nan
+        if name not in names or not (math.isfinite(low) and math.isfinite(high) and low < high):
+            raise ActuatorError(
+                must_be(f"NAME=LOW:HIGH with NAME one of {allowed} and numbers LOW < HIGH", text),
+                key="ranges",
+            )
+        if name in out:
+            raise ActuatorError(f"gives a range of {name} twice; give it once", key="ranges")
+        out[name] = (low, high)
+    return out
 
 
 def _unit_from_name(column: str) -> str:

@@ -38,6 +38,7 @@ from typing import TYPE_CHECKING, Literal
 import numpy as np
 
 from softbend._io import read_header_csv
+from softbend._progress import read_phase, report
 from softbend._validation import must_be, short_repr
 from softbend.errors import DatasetError
 from softbend.plausibility import implausible_index, implausible_text
@@ -51,7 +52,11 @@ __all__ = [
     "Table",
     "TableFormat",
     "check_columns",
+    "column_kind",
+    "infer_cells",
+    "kind_conflict",
     "read_table",
+    "reads_as_number",
 ]
 
 #: How a column's cells are read: a finite ``"number"``, an ``"integer"``
@@ -367,6 +372,71 @@ def _convert(column: Column, cells: list[str]) -> tuple[np.ndarray, int | None]:
     return np.asarray(values, dtype=object), None
 
 
+def reads_as_number(cell: object) -> bool:
+    """Whether a filled cell is a number or text that reads as one (``"2"``, ``" 1.5e-3"``)."""
+    if isinstance(cell, bool):
+        return False
+    if isinstance(cell, int | float | np.integer | np.floating):
+        return True
+    try:
+        float(str(cell))
+    except ValueError:
+        return False
+    return True
+
+
+def _filled(cell: object) -> bool:
+    if cell is None or (isinstance(cell, str) and not cell.strip()):
+        return False
+    return not (isinstance(cell, float | np.floating) and math.isnan(cell))
+
+
+def column_kind(cells: Sequence[object]) -> Literal["empty", "number", "text", "mixed"]:
+    """Whether a column's filled cells are all numbers (or text that reads as one), all text,
+    a mix of the two, or none at all (empty cells: ``""``, None, NaN)."""
+    seen = set()
+    for cell in dict.fromkeys(cells):  # each distinct value once: a level repeats
+        if _filled(cell):
+            seen.add(reads_as_number(cell))
+            if len(seen) == 2:
+                return "mixed"
+    if not seen:
+        return "empty"
+    return "number" if True in seen else "text"
+
+
+def kind_conflict(cells: Sequence[object]) -> tuple[int, int] | None:
+    """Where a column's filled cells mix numbers and text, or None where they do not.
+
+    Parameters
+    ----------
+    cells : sequence
+        The column's cells; empty ones (``""``, None, NaN) are left out.
+
+    Returns
+    -------
+    (int, int) or None
+        The position of the first cell of the rarer kind (a text cell where
+        numbers are at least as many), and how many filled cells are of the
+        other kind.
+    """
+    if column_kind(cells) != "mixed":
+        return None
+    number = {c: reads_as_number(c) for c in dict.fromkeys(cells) if _filled(c)}
+    filled = [i for i, cell in enumerate(cells) if cell in number]
+    numbers = [i for i in filled if number[cells[i]]]
+    texts = [i for i in filled if not number[cells[i]]]
+    if len(numbers) >= len(texts):
+        return texts[0], len(numbers)
+    return numbers[0], len(texts)
+
+
+def infer_cells(cells: Sequence[object]) -> np.ndarray:
+    """Cells as :func:`read_table` reads a column it infers: numbers where every filled cell
+    reads as one (empty cells NaN), else text as written (empty cells NaN)."""
+    return _infer(["" if not _filled(c) else str(c).strip() for c in cells])
+
+
 def _infer(cells: list[str]) -> np.ndarray:
     """Cells as numbers where every filled one is a number (empty ones NaN), else as text.
 
@@ -413,6 +483,12 @@ def read_table(path: str | os.PathLike[str], fmt: TableFormat) -> Table:
     LimitError
         A file over the ``file_mib`` limit or with more data rows than the
         ``csv_rows`` limit, checked before its rows are parsed.
+
+    Notes
+    -----
+    A file of :data:`~softbend._progress.READ_REPORT_BYTES` or more reports its
+    progress to a listener (:mod:`softbend._progress`) from before its first
+    byte is read: the percent of its lines read, then its columns checked.
     """
     import pandas as pd
 
@@ -466,7 +542,10 @@ def read_table(path: str | os.PathLike[str], fmt: TableFormat) -> Table:
     data: dict[str, np.ndarray] = {}
     positions: dict[str, int] = {}
     bad: tuple[int, int, str, str] | None = None  # (row, position, column, requirement)
+    checking = f"checking {source.name}'s columns" if read_phase(source) else None
     for position, name in enumerate(names, start=1):
+        if checking is not None:
+            report(checking, position - 1, len(names))
         column = fmt.column(name)
         if column is None:
             if fmt.other_columns != "keep":
@@ -480,6 +559,8 @@ def read_table(path: str | os.PathLike[str], fmt: TableFormat) -> Table:
             continue
         data[name] = values
         positions[name] = position
+    if checking is not None:
+        report(checking, len(names), len(names))
     if bad is not None:
         at, position, name, requirement = bad
         cell = rows[at][position - 1]

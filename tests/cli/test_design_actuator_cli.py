@@ -109,7 +109,11 @@ def test_a_spec_file_names_the_model_s_parameters(model, tmp_path, capsys):
         (["--range", "wall=1:2"], ["--range: names 'wall'", "n_chambers, wall_mm, layer"]),
         (["--fix", "chambers=8"], ["--fix: names 'chambers'", "n_chambers, wall_mm, layer"]),
         (["--range", "wall_mm=2:1"], ["--range: wall_mm: ", "LOW <= HIGH"]),
-        (["--range", "wall_mm=0.1:2"], ["--range: wall_mm: 0.1 leaves", "[0.5, 3] mm"]),
+        # the table's walls are its training range, not a wall of the description
+        (
+            ["--range", "wall_mm=0.1:2"],
+            ["--allow-extrapolation: ", "'wall_mm' (0.1:2 mm)", "training range [0.5, 3]"],
+        ),
         (["--range", "n_chambers=6.5:9"], ["--range: n_chambers: 6.5 is", "not a whole number"]),
         (["--fix", "n_chambers=7.5"], ["--fix: n_chambers: 7.5 is", "not a whole number"]),
         (["--fix", "layer=wood"], ["--fix: layer: must be one of", "fabric, paper"]),

@@ -46,6 +46,17 @@ def test_grouped_splits_never_split_a_design():
     assert all(np.array_equal(a[1], b[1]) for a, b in zip(splits, again, strict=True))
 
 
+def test_grouped_splits_are_those_of_the_design_names():
+    from sklearn.model_selection import GroupKFold
+
+    rng = np.random.default_rng(3)
+    groups = rng.choice([f"d{i:03d}" for i in range(40)], size=300)
+    splitter = GroupKFold(n_splits=4, shuffle=True, random_state=2)
+    by_name = [val for _, val in splitter.split(np.zeros((300, 1)), groups=groups)]
+    ours = [val for _, val in grouped_splits(groups, 4, seed=2)]
+    assert all(np.array_equal(a, b) for a, b in zip(by_name, ours, strict=True))
+
+
 def test_too_few_designs_for_the_folds():
     with pytest.raises(ValueError, match="folds"):
         grouped_splits(np.array(["a", "a", "b"]), 5)

@@ -8,7 +8,7 @@ import numpy as np
 import pandas as pd
 import pytest
 
-from softbend.actuators import SFRBA, ActuatorError, get_actuator
+from softbend.actuators import SFRBA, Actuator, ActuatorError, get_actuator
 from softbend.errors import DatasetError
 from softbend.surrogates.persistence import load_surrogate
 from softbend.surrogates.predict import predict_angles
@@ -56,6 +56,62 @@ def test_parquet_reads_as_the_csv_does(sims, tmp_path):
     a, b = read(sims), read(parquet)
     np.testing.assert_array_equal(a.X, b.X)
     assert a.data_hash == b.data_hash
+
+
+def with_cell(column, row, cell):
+    """The stand-in table with one cell of ``column`` replaced by ``cell``."""
+    frame = table()
+    frame[column] = frame[column].astype(object)
+    frame.loc[row, column] = cell
+    return frame
+
+
+def test_a_stray_text_cell_in_a_numeric_column_names_file_line_column_and_cell(tmp_path):
+    path = tmp_path / "thick.csv"
+    with_cell("wall_mm", 7, "thick").to_csv(path, index=False)
+    with pytest.raises(DatasetError) as info:
+        read(path)
+    error = info.value
+    # header is line 1, row 7 is line 9; wall_mm is the third column after design_id
+    assert (error.file, error.line, error.column, error.key) == (str(path), 9, 3, "wall_mm")
+    assert "must be a number" in error.detail and "'thick'" in error.detail.replace('"', "'")
+
+
+def test_a_number_in_a_text_column_is_refused_not_made_a_level(tmp_path):
+    path = tmp_path / "layers.csv"
+    with_cell("layer", 4, "3").to_csv(path, index=False)
+    with pytest.raises(DatasetError, match=r"layers\.csv:6:5: layer: mixes numbers and text"):
+        read(path)
+
+
+def test_a_text_cell_in_a_column_the_description_declares_numeric(tmp_path):
+    path = tmp_path / "described.csv"
+    with_cell("wall_mm", 2, "n/a").to_csv(path, index=False)
+    described = Actuator.from_table(
+        table(),
+        design_columns=COLUMNS.split(","),
+        pressure_column="p_kpa",
+        pressure_unit="kPa",
+        name="stand_in",
+    )
+    with pytest.raises(DatasetError, match=r"described\.csv:4:3: wall_mm: must be a number"):
+        table_training_data(path, actuator=described)
+
+
+def test_numeric_text_in_parquet_reads_as_numbers_and_a_stray_cell_names_its_row(sims, tmp_path):
+    pytest.importorskip("pyarrow")
+    frame = pd.read_csv(sims)
+    for column in ("n_chambers", "wall_mm", "height_mm"):
+        frame[column] = frame[column].astype(str)
+    parquet = tmp_path / "text.parquet"
+    frame.to_parquet(parquet)
+    a, b = read(sims), read(parquet)
+    assert [p.kind for p in b.actuator.parameters] == [p.kind for p in a.actuator.parameters]
+    np.testing.assert_array_equal(a.X, b.X)
+    frame.loc[7, "wall_mm"] = "thick"
+    frame.to_parquet(parquet)
+    with pytest.raises(DatasetError, match=r"text\.parquet: wall_mm: row 7: must be a number"):
+        read(parquet)
 
 
 @pytest.mark.parametrize(
@@ -182,7 +238,65 @@ def test_outside_the_training_ranges_is_not_supported(trained):
         )
 
 
+def test_a_design_past_the_sampled_span_is_an_extrapolation_not_an_error(trained):
+    path, _ = trained
+    design = "n_chambers=10,wall_mm=1.0,height_mm=12,layer=paper"  # the walls: 1.1 to 2.9 mm
+    pred = predict_angles(path, design, [20.0])
+    assert pred.outside_training_ranges == ["wall_mm 1 outside [1.1, 2.9]"]
+    assert pred.supported is not None and not pred.supported.any()
+    with pytest.raises(ValueError, match=r"wall_mm 1 outside \[1\.1, 2\.9\]"):
+        predict_angles(path, design, [20.0], strict=True)
+
+
+def test_declared_ranges_replace_the_sampled_span(sims):
+    described = read(sims, ranges=["wall_mm=0.5:3.5", "n_chambers=4:20"]).actuator
+    n, wall, height, _ = described.parameters
+    assert (wall.low, wall.high, wall.sampled) == (0.5, 3.5, False)
+    assert (n.kind, n.low, n.high, n.sampled) == ("integer", 4.0, 20.0, False)
+    assert (height.low, height.high, height.sampled) == (8.0, 16.0, True)
+    with pytest.raises(ActuatorError, match="must be in"):
+        described.parse_design("n_chambers=10,wall_mm=0.4,height_mm=12,layer=paper")
+    described.parse_design("n_chambers=10,wall_mm=2,height_mm=30,layer=paper")  # sampled only
+    with pytest.raises(ActuatorError, match=r"^ranges: declares ranges"):
+        table_training_data(sims, actuator=described, ranges=["wall_mm=1:3"])
+
+
 def test_paper_b_design_names_are_refused_for_another_actuator(trained):
     path, _ = trained
     with pytest.raises(ValueError, match="not a design parameter"):
         predict_angles(path, "l_mm=100,r_mm=6,t_mm=2,b_mm=2,phi_deg=5,lc_mm=8", [10.0])
+
+
+def test_a_large_parquet_table_reports_its_read_from_the_start(sims, tmp_path, monkeypatch):
+    pytest.importorskip("pyarrow")
+    import softbend._progress
+    from softbend._progress import listening
+
+    parquet = tmp_path / "sims.parquet"
+    pd.read_csv(sims).to_parquet(parquet)
+    monkeypatch.setattr(softbend._progress, "READ_REPORT_BYTES", 0)
+    heard = []
+    read_parquet = pd.read_parquet
+    monkeypatch.setattr(
+        pd, "read_parquet", lambda *a, **k: heard.append("read") or read_parquet(*a, **k)
+    )
+    with listening(lambda *call: heard.append(call)):
+        read(parquet)
+    describing = [("describing sims.parquet's designs", done, 3) for done in range(4)]
+    assert heard == [
+        ("reading sims.parquet, %", 0, 100),
+        "read",
+        ("reading sims.parquet, %", 100, 100),
+        *describing,
+    ]
+
+
+@pytest.mark.parametrize(("column", "position"), [("p_kpa", 6), ("angle_deg", 7)])
+def test_a_stray_text_cell_in_the_pressure_or_angle_names_its_line(tmp_path, column, position):
+    path = tmp_path / "stray.csv"
+    with_cell(column, 10, "n/a").to_csv(path, index=False)
+    with pytest.raises(DatasetError) as info:
+        read(path)
+    error = info.value
+    assert (error.line, error.column, error.key) == (12, position, column)
+    assert error.detail == 'must be a number; got "n/a"'

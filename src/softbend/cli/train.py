@@ -45,6 +45,14 @@ def train(
         "JSON file (its columns become the defaults; ranges, kinds, resolutions and "
         "constraints are checked); without it, the description is read off the table.",
     ),
+    ranges: list[str] | None = typer.Option(
+        None,
+        "--range",
+        help="A table's design parameter's range, NAME=LOW:HIGH in its unit (repeatable): "
+        "recorded in the model's description, so that a design outside it is refused. "
+        "Without it, a parameter's range is the span the table sampled: a design outside "
+        "is a warning of predict (an error with --strict).",
+    ),
     models: str = typer.Option(
         "plr,xgb,mlp",
         help="Comma-separated surrogate families: plr, xgb, mlp (paper B's) or any registered.",
@@ -111,6 +119,9 @@ def train(
     --pressure-column (in --pressure-unit) and --angle-column (degrees) name.
     Integer columns stay integer parameters and text columns categorical ones;
     every saved model records the actuator description it was trained with.
+    Without --actuator, each numeric parameter's range is the span the table
+    sampled (predict warns outside it, --strict refuses), or the one --range
+    declares (a design outside it is refused).
 
     Every finished configuration-fold is saved in a checkpoint file beside
     --out (.NAME.train-checkpoint.jsonl for an --out named NAME); the same
@@ -142,9 +153,10 @@ def train(
         check_int(plr_patience, "plr_patience", low=1)
     if epochs is not None:
         check_limit("epochs", epochs, "--epochs")
-    source = _training_source(
-        db, design_columns, pressure_column, pressure_unit, angle_column, actuator
-    )
+    with _common.library_progress(enabled=not as_json):  # a large table's read, from its start
+        source = _training_source(
+            db, design_columns, pressure_column, pressure_unit, angle_column, actuator, ranges or []
+        )
     _common.check_output_dir(out, "--out", inputs=(db,))
     # the folder is swapped whole: nothing but an earlier result of this command may be lost
     _common.check_replaceable_dir(out, "--out", inputs=(db,))
@@ -193,20 +205,21 @@ def _training_source(
     pressure_unit: str | None,
     angle_column: str,
     actuator: str | None,
+    ranges: list[str],
 ) -> Path | TrainingData:
     """The campaign path, or a dataset's or table's training data (checked before anything runs)."""
     from softbend.family_datasets import is_dataset_name
     from softbend.surrogates.features import dataset_training_data
     from softbend.surrogates.tables import TABLE_SUFFIXES
 
-    described = actuator is not None
+    described = actuator is not None or bool(ranges)
     table_options = (design_columns, pressure_column, pressure_unit)
     if db.is_dir() or (not db.exists() and is_dataset_name(str(db))):
         if any(v is not None for v in table_options) or described or angle_column != "angle_deg":
             raise typer.BadParameter(
                 f"{db} is a dataset (its own columns and actuator); --design-columns, "
-                "--pressure-column, --pressure-unit, --angle-column and --actuator describe "
-                "a CSV or Parquet table.",
+                "--pressure-column, --pressure-unit, --angle-column, --actuator and --range "
+                "describe a CSV or Parquet table.",
                 param_hint="TABLE",
             )
         return dataset_training_data(db)
@@ -214,8 +227,8 @@ def _training_source(
         if any(v is not None for v in table_options) or described or angle_column != "angle_deg":
             raise typer.BadParameter(
                 f"{db} is a campaign database (paper B's actuator, its own columns); "
-                "--design-columns, --pressure-column, --pressure-unit, --angle-column and "
-                "--actuator describe a CSV or Parquet table.",
+                "--design-columns, --pressure-column, --pressure-unit, --angle-column, "
+                "--actuator and --range describe a CSV or Parquet table.",
                 param_hint="TABLE",
             )
         return db
@@ -229,6 +242,7 @@ def _training_source(
         pressure_unit=pressure_unit,
         angle_column=angle_column,
         actuator=actuator_from(actuator) if actuator is not None else None,
+        ranges=ranges,
     )
 
 

@@ -276,7 +276,8 @@ class SearchSpace:
         eps = 1e-9 * max(1.0, abs(p.low), abs(p.high))
         if not math.isfinite(code):
             return "is not a finite number"
-        if code < p.low - eps or code > p.high + eps:
+        outside = code < p.low - eps or code > p.high + eps
+        if outside and not (p.sampled and p.kind != "categorical"):  # sampled: training ranges
             span = f"[{p.low:g}, {p.high:g}]" + (f" {p.unit}" if p.unit else "")
             return f"leaves the range {span} the actuator {self.actuator.name} describes"
         if p.kind == "integer" and abs(code - round(code)) > 1e-9:

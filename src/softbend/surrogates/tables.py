@@ -32,12 +32,22 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
-from softbend._validation import must_be
-from softbend.actuators import Actuator, ActuatorError, pressure_to_mpa
+from softbend._progress import read_phase, report
+from softbend._validation import must_be, short_repr
+from softbend.actuators import Actuator, ActuatorError, parse_ranges, pressure_to_mpa
 from softbend.errors import DatasetError
 from softbend.limits import check_file_size
 from softbend.surrogates.features import GROUP, TrainingData, data_hash
-from softbend.tables import Column, TableFormat, check_columns
+from softbend.tables import (
+    Column,
+    Table,
+    TableFormat,
+    check_columns,
+    column_kind,
+    infer_cells,
+    kind_conflict,
+    reads_as_number,
+)
 from softbend.tables import read_table as read_csv_table
 from softbend.units import check_column_unit
 
@@ -65,35 +75,116 @@ def read_table(path: str | os.PathLike[str]) -> pd.DataFrame:
     """A CSV (``#`` comment lines allowed) or Parquet file as a DataFrame, or one clear error.
 
     A CSV goes through :func:`softbend.tables.read_table`; a Parquet file is
-    read by pandas. Both hold at most :data:`MAX_ROWS` rows.
+    read by pandas. Both hold at most :data:`MAX_ROWS` rows. A column of text
+    whose every filled cell reads as a number is read as numbers, in a Parquet
+    file as in a CSV. A large file reports its progress from the start of the
+    read (:func:`softbend._progress.read_phase`).
     """
+    return _read(Path(path))[0]
+
+
+def _read(source: Path) -> tuple[pd.DataFrame, Table | None]:
+    """:func:`read_table`'s frame, and for a CSV the table that knows each row's line."""
     import pandas as pd
 
-    source = Path(path)
     if not source.is_file():
         raise FileNotFoundError(f"No table at {source}.")
     check_file_size(source, str(source))
     suffix = source.suffix.lower()
     if suffix == ".csv":
-        return read_csv_table(source, SIMULATION_TABLE).frame
+        table = read_csv_table(source, SIMULATION_TABLE)
+        return table.frame, table
     if suffix not in (".parquet", ".pq"):
         raise DatasetError(
             f"a training table must be a CSV or Parquet file ({', '.join(TABLE_SUFFIXES)}) "
             f"or a campaign database; got {suffix or 'no suffix'}",
             file=str(source),
         )
+    phase = read_phase(source)
+    if phase is not None:  # one call reads the whole file: shown from its start
+        report(phase, 0, 100)
     try:
         frame = pd.read_parquet(source)
     except (OSError, ValueError) as err:  # pyarrow: not a Parquet file
         raise DatasetError(
             f"is not a readable {suffix[1:]} table ({err})", file=str(source)
         ) from None
+    if phase is not None:
+        report(phase, 100, 100)
     if len(frame) > MAX_ROWS:
         raise DatasetError(
             f"has {len(frame)} rows; a training table holds at most {MAX_ROWS}", file=str(source)
         )
     frame.columns = [str(c).strip() for c in frame.columns]
-    return frame
+    for name in frame.columns:
+        series = frame[name]
+        if series.dtype.kind == "O" or str(series.dtype) == "string":
+            cells = series.astype(object).where(series.notna(), None).tolist()
+            if column_kind(cells) == "number":  # numbers written as text: numbers, as in a CSV
+                frame[name] = infer_cells(cells)
+    return frame, None
+
+
+def _check_kinds(
+    frame: pd.DataFrame,
+    table: Table | None,
+    designs: Sequence[str],
+    actuator: Actuator | None,
+    source: Path,
+    numbers: Sequence[str] = (),
+) -> None:
+    """Each design column's cells of one kind: numbers, or text for a categorical parameter;
+    each column of ``numbers`` (the pressure and the angle) numbers.
+
+    A column is categorical when ``actuator`` declares it so or, without a
+    description, when none of its filled cells is a number. The error names
+    the file, the line (a Parquet file's row), the column and the cell.
+    """
+    for name in [*designs, *numbers]:
+        kind = (
+            "number"
+            if name in numbers
+            else actuator.parameter(name).kind
+            if actuator is not None
+            else None
+        )
+        series = frame[name]
+        if kind == "categorical" or (series.dtype.kind != "O" and str(series.dtype) != "string"):
+            continue
+        cells = series.tolist()
+        if kind is None:
+            conflict = kind_conflict(cells)
+            if conflict is None:
+                continue  # wholly text: the levels of a categorical parameter
+            row, others = conflict
+            if reads_as_number(cells[row]):
+                message = (
+                    f"mixes numbers and text: {others} filled cells are text, this one the "
+                    f"number {str(cells[row]).strip()}; a categorical column's levels are all "
+                    "text (or an actuator description declares the column categorical)"
+                )
+            else:
+                message = (
+                    f"must be a number, as the column's other {others} filled cells are; got "
+                    f"{short_repr(cells[row])} (a design column is categorical only when none "
+                    "of its cells is a number, or when an actuator description declares it so)"
+                )
+        else:
+            row = next(
+                (i for i, c in enumerate(cells) if isinstance(c, str) and not reads_as_number(c)),
+                -1,
+            )
+            if row < 0:
+                continue
+            declared = (
+                f" (the actuator {actuator.name} declares {name} {kind})"
+                if actuator is not None and name not in numbers
+                else ""
+            )
+            message = f"must be a number{declared}; got {short_repr(cells[row])}"
+        if table is not None:
+            raise table.error(message, row=row, column=name)
+        raise DatasetError(f"row {row}: {message}", key=name, file=str(source))
 
 
 def _columns(text: str | Sequence[str], key: str) -> list[str]:
@@ -126,6 +217,7 @@ def table_training_data(
     angle_column: str = "angle_deg",
     actuator: Actuator | None = None,
     name: str | None = None,
+    ranges: Sequence[str] = (),
 ) -> TrainingData:
     """The training data of a simulation table, described by its columns.
 
@@ -149,6 +241,11 @@ def table_training_data(
         (:meth:`~softbend.actuators.Actuator.from_table`).
     name : str, optional
         The described actuator's name (default: the file's stem).
+    ranges : sequence of str, optional
+        Declared ranges ``NAME=LOW:HIGH`` of design parameters of a description
+        read off the table (:func:`~softbend.actuators.parse_ranges`); a
+        parameter not named keeps the table's span as its sampled range, which
+        a model flags (not refuses) a design outside of.
 
     Raises
     ------
@@ -165,8 +262,13 @@ def table_training_data(
         is not numbers or a negative pressure (:func:`softbend.tables.check_columns`).
     """
     source = Path(path)
-    frame = read_table(source)
     if actuator is not None:
+        if ranges:
+            raise ActuatorError(
+                f"declares ranges of a description read off the table; the actuator "
+                f"{actuator.name}'s description declares its own (leave out one of the two)",
+                key="ranges",
+            )
         designs = _columns(design_columns or actuator.names, "design_columns")
         if designs != list(actuator.names):
             raise ActuatorError(
@@ -200,6 +302,7 @@ def table_training_data(
                 key="pressure_unit",
             )
         unit = pressure_unit
+    declared = parse_ranges(ranges, designs)
     pressure_to_mpa(unit)
     if angle_column.lower().endswith("_rad"):
         raise ActuatorError(
@@ -212,10 +315,15 @@ def table_training_data(
             raise ActuatorError(
                 f"{column!r} is also one of the design columns ({','.join(designs)})", key=key
             )
+    frame, table = _read(source)
     _check_present(frame, designs, "design_columns", str(source))
     _check_present(frame, [pressure_column], "pressure_column", str(source))
     _check_present(frame, [angle_column], "angle_column", str(source))
     check_column_unit(pressure_column, unit, "pressure_unit", key="pressure_unit")
+    describing = f"describing {source.name}'s designs" if read_phase(source) else None
+    if describing is not None:  # a large table: what follows its read takes seconds too
+        report(describing, 0, 3)
+    _check_kinds(frame, table, designs, actuator, source, (pressure_column, angle_column))
     check_columns(
         frame,
         TableFormat(
@@ -236,7 +344,10 @@ def table_training_data(
             angle_column=angle_column,
             name=name or _name_of(source),
             title=f"the actuator of {source.name}",
+            ranges=declared,
         )
+    if describing is not None:
+        report(describing, 1, 3)
     codes = np.empty((len(frame), len(designs)))
     for j, parameter in enumerate(actuator.parameters):
         column = frame[parameter.name]
@@ -267,6 +378,8 @@ def table_training_data(
         actuator.check_designs(codes)
     except ActuatorError as err:
         raise ActuatorError(err.detail, file=str(source)) from None
+    if describing is not None:
+        report(describing, 2, 3)
     if GROUP in frame.columns:
         groups = frame[GROUP].astype(str).to_numpy()[keep]
     else:
@@ -279,6 +392,8 @@ def table_training_data(
             key=angle_column,
             file=str(source),
         )
+    if describing is not None:
+        report(describing, 3, 3)
     X = np.ascontiguousarray(np.column_stack([codes, pressures]))
     y = np.ascontiguousarray(angles)
     return TrainingData(
