@@ -118,13 +118,14 @@ def identify(
             f"reading {need.csv_bytes / 2**20:.1f} MiB of CSV (about {need.rows:,} samples)",
             highlight=False,
         )
-    series = load_timeseries(
-        data,
-        _names(inputs, "inputs"),
-        _names(outputs, "outputs"),
-        experiment=experiment,
-        time=time,
-    )
+    with _common.library_progress(enabled=not as_json):  # a large file's read, from its start
+        series = load_timeseries(
+            data,
+            _names(inputs, "inputs"),
+            _names(outputs, "outputs"),
+            experiment=experiment,
+            time=time,
+        )
     held = _names(validate_on, "validate_on") if validate_on is not None else None
     split = None
     if len(series.experiments) == 1:  # one recording: segments of it, or a refusal

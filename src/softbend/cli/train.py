@@ -153,13 +153,13 @@ def train(
         check_int(plr_patience, "plr_patience", low=1)
     if epochs is not None:
         check_limit("epochs", epochs, "--epochs")
+    _common.check_output_dir(out, "--out", inputs=(db,))
+    # the folder is swapped whole: nothing but an earlier result of this command may be lost
+    _common.check_replaceable_dir(out, "--out", inputs=(db,))
     with _common.library_progress(enabled=not as_json):  # a large table's read, from its start
         source = _training_source(
             db, design_columns, pressure_column, pressure_unit, angle_column, actuator, ranges or []
         )
-    _common.check_output_dir(out, "--out", inputs=(db,))
-    # the folder is swapped whole: nothing but an earlier result of this command may be lost
-    _common.check_replaceable_dir(out, "--out", inputs=(db,))
 
     def resuming(line: str) -> None:
         _common.err_console.print(line, highlight=False, soft_wrap=True)

@@ -109,7 +109,8 @@ def loco(
         names = [n.strip() for n in strategies.split(",") if n.strip()]
     options = strategy_options(names, _common.parse_assignments(settings or ()))
     check_applicable(names, saved.model, actuator, key="strategies")  # before any work
-    data, forced = load_for_base(measurements, saved, force=force)  # before any fit
+    with _common.library_progress(enabled=not as_json):  # a large file's read, from its start
+        data, forced = load_for_base(measurements, saved, force=force)  # before any fit
     model = saved.model
     with _common.library_progress(enabled=not as_json) as progress:
         result = leave_one_configuration_out(
