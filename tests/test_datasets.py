@@ -314,7 +314,9 @@ def test_a_folder_with_other_files_is_not_replaced(campaign, tmp_path):
     folder = tmp_path / "mine"
     folder.mkdir()
     (folder / "notes.txt").write_text("keep me")
-    with pytest.raises(DatasetError, match=r"holds other files than a dataset's \(notes.txt\)"):
+    with pytest.raises(
+        ValueError, match=r"^out_dir: .*mine is replaced as a whole .*\(notes.txt\)"
+    ):
         write_dataset(campaign, folder, command="x")
     assert (folder / "notes.txt").read_text() == "keep me"
 

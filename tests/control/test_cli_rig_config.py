@@ -84,4 +84,5 @@ def test_simulate_never_leaves_half_an_output(tmp_path, capsys, monkeypatch):
     line = _one_line(capsys)
     assert "'--out'" in line and "No space left on device" in line
     assert (out / "run.png").read_bytes() == before["run.png"]
-    assert sorted(p.name for p in out.iterdir()) == ["metrics.json", "run.csv", "run.png"]
+    listed = sorted(p.name for p in out.iterdir())
+    assert listed == [".softbend-manifest.json", "metrics.json", "run.csv", "run.png"]
