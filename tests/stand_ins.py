@@ -322,3 +322,41 @@ def check_closed_form_samples(samples: pd.DataFrame, names, k_deg_per_mpa: float
     ]
     expected = k_deg_per_mpa * samples["pressure_mpa"] * samples[list(names)].sum(axis=1)
     assert np.allclose(samples["angle_deg"], expected) and len(samples) == rows
+
+
+@dataclass(frozen=True)
+class CompilingSweep:
+    """A campaign backend that runs a child process for $COMPILE_S s before each sweep.
+
+    As the FEM runs its compilers: a process a worker starts, in the worker's
+    process group, with the worker's stderr; its process id is appended to
+    ``started`` (a file). Then the analytical model sweeps the design. The time
+    is read from the environment, so that it is no setting the campaign records.
+    """
+
+    started: str
+    name: str = "compiling"
+
+    def sweep(self, design, pressures_mpa):
+        import os
+        import subprocess
+        import sys
+
+        from softbend.campaign import get_backend
+
+        code = f"import time; time.sleep({float(os.environ.get('COMPILE_S', '0'))!r})"
+        child = subprocess.Popen([sys.executable, "-c", code])
+        with open(self.started, "a", encoding="utf-8") as file:
+            file.write(f"{child.pid}\n")
+        if child.wait() != 0:
+            raise RuntimeError(f"the child process ended with {child.returncode}")
+        return get_backend("analytical").sweep(design, pressures_mpa)
+
+
+def running(pid: int) -> bool:
+    """Whether process ``pid`` exists and is not a zombie (Linux)."""
+    try:
+        status = Path(f"/proc/{pid}/status").read_text()
+    except OSError:
+        return False
+    return "\nState:\tZ" not in status

@@ -11,7 +11,9 @@ design's failure, ``"ExceptionType: message"``).
 * :func:`run_local`: a :class:`concurrent.futures.ProcessPoolExecutor` started
   through a fork server (``spawn`` where there is none); when a worker process
   dies the designs then in flight are rerun one by one, each in a process of its
-  own, and the pool is restarted at most three times;
+  own, and the pool is restarted at most three times. Workers ignore Ctrl-C
+  (SIGINT reaches the whole process group from a terminal): the coordinating
+  process alone stops, ends its workers and keeps what they recorded;
 * :func:`run_dask`: a Dask ``distributed`` client from :func:`connect`, which
   checks the scheduler address (:func:`parse_scheduler_address`) and gives up
   within its deadline when nothing Dask-like answers there.
@@ -25,7 +27,9 @@ import json
 import logging
 import math
 import multiprocessing
+import os
 import re
+import signal
 import socket
 import threading
 import time
@@ -211,6 +215,43 @@ def run_serial(
         recorder.record([_sweep_one(backend, design, pressures)], running=0)
 
 
+def _ignore_interrupts() -> None:
+    """Worker initializer: leave Ctrl-C to the coordinating process.
+
+    A terminal sends SIGINT to every process of its foreground group; a worker
+    would print a traceback of its own, and so would the processes it starts
+    (the FEM's compilers). Each worker ignores SIGINT and leads a process group
+    of its own, with the processes it starts, which the coordinating process
+    ends as one (:func:`_stop_pool`).
+    """
+    signal.signal(signal.SIGINT, signal.SIG_IGN)
+    os.setpgid(0, 0)
+
+
+def _new_pool(workers: int, context: multiprocessing.context.BaseContext) -> ProcessPoolExecutor:
+    return ProcessPoolExecutor(
+        max_workers=workers, mp_context=context, initializer=_ignore_interrupts
+    )
+
+
+def _stop_pool(pool: ProcessPoolExecutor) -> None:
+    """End ``pool`` at once: pending tasks cancelled, each worker's process group terminated.
+
+    On an interruption the designs in flight are given up (a resumed run sweeps
+    them again); waiting for them could take as long as an FEM sweep.
+    """
+    processes = list((getattr(pool, "_processes", None) or {}).values())
+    pool.shutdown(wait=False, cancel_futures=True)
+    for process in processes:
+        if process.is_alive() and process.pid is not None:
+            try:
+                os.killpg(process.pid, signal.SIGTERM)  # the worker and what it started
+            except OSError:  # not (yet) leading a group of its own
+                process.terminate()
+    for process in processes:
+        process.join(timeout=5.0)
+
+
 def _mp_context() -> multiprocessing.context.BaseContext:
     if "forkserver" in multiprocessing.get_all_start_methods():
         context = multiprocessing.get_context("forkserver")
@@ -238,7 +279,7 @@ def _run_isolated(
     while suspects:
         design = suspects.popleft()
         recorder.set_running(1)
-        pool = ProcessPoolExecutor(max_workers=1, mp_context=context)
+        pool = _new_pool(1, context)
         try:
             outcomes = pool.submit(sweep_chunk, backend, [design], pressures).result()
         except BrokenProcessPool:
@@ -253,6 +294,9 @@ def _run_isolated(
             ]
         except Exception as exc:
             outcomes = _lost_chunk([design], exc)
+        except BaseException:  # Ctrl-C: stop now, the design is left for a resumed run
+            _stop_pool(pool)
+            raise
         finally:
             pool.shutdown(wait=True, cancel_futures=True)
         recorder.record(outcomes, running=0)
@@ -280,7 +324,7 @@ def run_local(
         _run_isolated(backend, suspects, pressures, context, recorder)
         if not chunks:
             break
-        pool = ProcessPoolExecutor(max_workers=workers, mp_context=context)
+        pool = _new_pool(workers, context)
         pending: dict[Any, list[CampaignDesign]] = {}
         broken = False
         clean = False
@@ -311,6 +355,9 @@ def run_local(
                         outcomes = _lost_chunk(chunk, exc)
                     recorder.record(outcomes, running=sum(len(c) for c in pending.values()))
             clean = True
+        except BaseException:  # Ctrl-C: stop now; what was recorded stays, the rest resumes
+            _stop_pool(pool)
+            raise
         finally:
             pool.shutdown(wait=clean, cancel_futures=True)
         if broken:

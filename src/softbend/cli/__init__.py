@@ -6,14 +6,16 @@ code, so tests call ``main([...])`` directly.
 
 Exit codes: 0 success, 1 unexpected failure, 2 bad input (usage errors and any
 :class:`softbend.errors.SoftbendError` or ``ValueError``), printed as one line,
-130 interrupted (Ctrl-C): one line, naming where the finished work is kept when
-the same command resumes from it (:func:`resume_path`).
+130 interrupted (Ctrl-C): one line, naming where the finished work is kept and the
+command that resumes from it (:func:`resume_path`).
 """
 
 from __future__ import annotations
 
 import functools
 import os
+import shlex
+import signal
 import sys
 from collections.abc import Callable, Iterator, Sequence
 from pathlib import Path
@@ -123,11 +125,18 @@ def resume_path(args: Sequence[str]) -> Path | None:
 
 
 def interrupted_line(args: Sequence[str]) -> str:
-    """The one line printed when Ctrl-C stops the command ``args``."""
+    """The one line printed when Ctrl-C stops the command ``args``.
+
+    Where finished work is kept, the line names it and the command that resumes
+    from it (``args`` as typed, quoted for a shell).
+    """
     kept = resume_path(args)
     if kept is None:
         return "softbend: interrupted"
-    return f"softbend: interrupted; finished work is kept in {kept}: the same command resumes"
+    return (
+        f"softbend: interrupted; finished work is kept in {kept}; resume with: "
+        f"softbend {shlex.join(args)}"
+    )
 
 
 #: Whether Ctrl-C reached :func:`main` through a command (set by :func:`_noting_interrupts`).
@@ -217,5 +226,16 @@ def main(argv: Sequence[str] | None = None) -> int:
 
 
 def run() -> None:  # pragma: no cover - console-script shim
-    """Console-script entry point."""
-    sys.exit(main())
+    """Console-script entry point.
+
+    Once Ctrl-C has stopped the command, a second one while the process exits
+    (its worker processes ended, its staging folder removed) is ignored: the one
+    line stays the only output.
+    """
+    try:
+        code = main()
+    except KeyboardInterrupt:  # a second Ctrl-C while the first one was being reported
+        code = INTERRUPTED
+    if code == INTERRUPTED:
+        signal.signal(signal.SIGINT, signal.SIG_IGN)
+    sys.exit(code)

@@ -1,0 +1,123 @@
+"""Ctrl-C in a command that sweeps designs in worker processes, as a terminal sends it.
+
+A terminal sends SIGINT to the whole foreground process group: the command and
+its workers. Each test starts the command line in a process group of its own,
+sends SIGINT to the group once the first design is recorded, and checks one
+line, exit code 130, no worker's traceback, and that the same command resumes.
+"""
+
+from __future__ import annotations
+
+import os
+import signal
+import subprocess
+import sys
+import textwrap
+import time
+from pathlib import Path
+
+from softbend.campaign import CampaignStore
+
+from ..stand_ins import running
+
+#: The command line with a public backend ``slow`` (each sweep runs a child process for
+#: $COMPILE_S seconds, as the FEM its compilers, then the analytical model); arguments as
+#: softbend's.
+_CHILD = textwrap.dedent(
+    """
+    import os, sys
+    from softbend.campaign.backends import register_backend
+    from tests.stand_ins import CompilingSweep
+
+    register_backend("slow", lambda: CompilingSweep(os.path.abspath("started")))
+    if __name__ == "__main__":
+        from softbend.cli import run
+        sys.argv[0] = "softbend"
+        run()
+    """
+)
+
+
+def _as_at_a_terminal() -> None:
+    """In the child: SIGINT as at a terminal, even when the test runs as a background job."""
+    signal.signal(signal.SIGINT, signal.SIG_DFL)
+
+
+def _path() -> str:
+    """The import path of the child: this checkout's tests and the path softbend came from."""
+    root = Path(__file__).resolve().parents[2]
+    return os.pathsep.join([str(root), *sys.path])
+
+
+def _start(args: list[str], cwd: Path, delay_s: float) -> subprocess.Popen[str]:
+    return subprocess.Popen(
+        [sys.executable, "-c", _CHILD, *args],
+        cwd=cwd,
+        stdout=subprocess.PIPE,
+        stderr=subprocess.PIPE,
+        text=True,
+        start_new_session=True,  # a process group of its own, as a terminal's job
+        preexec_fn=_as_at_a_terminal,
+        env={**os.environ, "COMPILE_S": str(delay_s), "PYTHONPATH": _path()},
+    )
+
+
+def _interrupt_after(child: subprocess.Popen[str], started: str) -> tuple[float, str]:
+    """Send SIGINT to the child's group after a stderr line containing ``started``.
+
+    Returns the seconds the child took to end after it and its whole stderr (read
+    until every process of the group has closed it).
+    """
+    assert child.stderr is not None
+    lines = []
+    try:
+        for line in child.stderr:
+            lines.append(line)
+            if started in line:
+                break
+        os.killpg(child.pid, signal.SIGINT)
+        sent = time.monotonic()
+        child.wait(timeout=30)
+        took = time.monotonic() - sent
+        _, rest = child.communicate(timeout=30)
+    finally:
+        if child.poll() is None:
+            os.killpg(child.pid, signal.SIGKILL)
+            child.communicate()
+    return took, "".join(lines) + rest
+
+
+def _assert_none_left(folder: Path) -> None:
+    """No process a worker started is left running (each given 2 s to go)."""
+    pids = [int(line) for line in (folder / "started").read_text().split()]
+    deadline = time.monotonic() + 2.0
+    while any(running(pid) for pid in pids) and time.monotonic() < deadline:
+        time.sleep(0.1)
+    assert not any(running(pid) for pid in pids)
+
+
+def test_ctrl_c_stops_a_campaign_in_one_line_and_the_same_command_resumes(tmp_path):
+    args = ["campaign", "run", "c.duckdb", "--backend", "slow", "--space", "lhs:6"]
+    args += ["--workers", "2", "--chunk-size", "1", "--pmax", "0.1", "--pstep", "0.05"]
+    child = _start(args, tmp_path, delay_s=2.0)
+    took, err = _interrupt_after(child, "done 1 ")
+    assert child.returncode == 130, err
+    assert took < 5.0
+    assert "Traceback" not in err and "KeyboardInterrupt" not in err
+    last = err.strip().splitlines()[-1]
+    assert last == (
+        "softbend: interrupted; finished work is kept in c.duckdb; resume with: softbend "
+        + " ".join(args)
+    )
+    assert sum("interrupted" in line for line in err.splitlines()) == 1
+    _assert_none_left(tmp_path)
+    with CampaignStore(tmp_path / "c.duckdb", read_only=True) as store:
+        kept = len(store.finished_ids())
+    assert 1 <= kept < 6
+
+    resumed = _start(args, tmp_path, delay_s=0.0)
+    _, err = resumed.communicate(timeout=60)
+    assert resumed.returncode == 0, err
+    assert f"resuming c.duckdb: {kept} of 6 designs already recorded" in err
+    with CampaignStore(tmp_path / "c.duckdb", read_only=True) as store:
+        assert len(store.finished_ids()) == 6
