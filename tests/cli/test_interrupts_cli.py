@@ -8,6 +8,7 @@ line, exit code 130, no worker's traceback, and that the same command resumes.
 
 from __future__ import annotations
 
+import json
 import os
 import signal
 import subprocess
@@ -121,3 +122,37 @@ def test_ctrl_c_stops_a_campaign_in_one_line_and_the_same_command_resumes(tmp_pa
     assert f"resuming c.duckdb: {kept} of 6 designs already recorded" in err
     with CampaignStore(tmp_path / "c.duckdb", read_only=True) as store:
         assert len(store.finished_ids()) == 6
+
+
+def test_ctrl_c_stops_a_verification_in_one_line_and_the_same_command_resumes(tmp_path):
+    from tests.design_search.conftest import save_model
+
+    save_model(tmp_path / "linear.json")
+    args = ["design", "find", "--model", "linear.json", "--angle", "90", "--at", "0.08",
+            "--minimize", "l", "--fix", "r=8", "--fix", "t=3", "--fix", "b=3", "--fix", "phi=10",
+            "--fix", "lc=10", "--out", "found", "--verify", "4", "--backend", "slow",
+            "--workers", "2"]  # fmt: skip
+    child = _start(args, tmp_path, delay_s=2.0)
+    took, err = _interrupt_after(child, "(slow): 1/4")
+    assert child.returncode == 130, err
+    assert took < 5.0
+    assert "Traceback" not in err and "KeyboardInterrupt" not in err
+    (db,) = tmp_path.glob(".found.verify-*.duckdb")
+    assert err.strip().splitlines()[-1] == (
+        f"softbend: interrupted; finished work is kept in {db}; resume with: softbend "
+        + " ".join(args)
+    )
+    assert sum("interrupted" in line for line in err.splitlines()) == 1
+    assert not (tmp_path / "found").exists()
+    _assert_none_left(tmp_path)
+    with CampaignStore(db, read_only=True) as store:
+        kept = len(store.finished_ids())
+    assert 1 <= kept < 4
+
+    started = len((tmp_path / "started").read_text().split())
+    resumed = _start([*args, "--json"], tmp_path, delay_s=0.0)
+    out, err = resumed.communicate(timeout=60)
+    assert resumed.returncode == 0, err
+    assert json.loads(out)["verified"] == {"backend": "slow", "family": "sfrba", "designs": 4}
+    assert len((tmp_path / "started").read_text().split()) - started == 4 - kept
+    assert not db.exists() and (tmp_path / "found" / "search.json").is_file()

@@ -13,6 +13,7 @@ command that resumes from it (:func:`resume_path`).
 from __future__ import annotations
 
 import functools
+import glob
 import os
 import shlex
 import signal
@@ -104,8 +105,10 @@ def resume_path(args: Sequence[str]) -> Path | None:
 
     ``softbend train`` keeps every finished configuration-fold in a checkpoint
     beside ``--out``; ``softbend campaign run`` records every finished design in its
-    database; ``softbend reproduce`` keeps its campaign database beside ``--out``.
-    Each resumes when the same command is run again.
+    database; ``softbend reproduce`` keeps its campaign database beside ``--out``,
+    and ``softbend design find --verify`` the campaign of its verification
+    (the latest one, :func:`softbend.cli.design.verification_db`). Each resumes
+    when the same command is run again.
     """
     words = _positionals(args)
     path: Path | None = None
@@ -116,6 +119,11 @@ def resume_path(args: Sequence[str]) -> Path | None:
             path = path.with_name(f".{path.name}.train-checkpoint.jsonl")
     elif words[:2] == ["campaign", "run"] and len(words) > 2:
         path = Path(words[2])
+    elif words[:2] == ["design", "find"] and _option(args, "--out", "-o") is not None:
+        folder = Path(os.path.abspath(_option(args, "--out", "-o") or ""))
+        pattern = f".{glob.escape(folder.name)}.verify-*.duckdb"
+        kept = sorted(folder.parent.glob(pattern), key=lambda p: p.stat().st_mtime)
+        path = kept[-1] if kept else None
     elif words[:1] == ["reproduce"]:
         folder = Path(_option(args, "--out", "-o") or "results/reproduce")
         path = folder.with_name(f".{folder.name}.resume")
