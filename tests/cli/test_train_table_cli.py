@@ -75,3 +75,28 @@ def test_table_options_with_a_campaign_are_refused(small_campaign, tmp_path, cap
     )
     assert code == 2
     assert "campaign database" in one_error_line(capsys)
+
+
+def test_a_constraint_dividing_by_zero_is_one_line_before_any_work(sims, tmp_path, capsys):
+    description = {
+        "name": "bellows",
+        "title": "bellows",
+        "parameters": [
+            {"name": "n_chambers", "unit": "", "kind": "integer", "low": 6, "high": 14},
+            {"name": "wall_mm", "unit": "mm", "low": 1.0, "high": 3.0},
+            {"name": "height_mm", "unit": "mm", "low": 8.0, "high": 16.0},
+            {"name": "layer", "unit": "", "kind": "categorical", "levels": ["fabric", "paper"]},
+        ],
+        "pressure_column": "p_kpa",
+        "pressure_unit": "kPa",
+        "constraints": ["1 / 0 < wall_mm"],
+    }
+    path = tmp_path / "bellows.json"
+    path.write_text(json.dumps(description))
+    code = main(["train", str(sims), "--actuator", str(path), "--out", str(tmp_path / "m")])
+    assert code == 2
+    assert one_error_line(capsys).endswith(
+        "bellows.json: The constraint '1 / 0 < wall_mm' divides by zero (1 / 0); its numbers "
+        "must give finite values."
+    )
+    assert not (tmp_path / "m").exists()
