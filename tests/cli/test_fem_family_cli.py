@@ -18,6 +18,7 @@ from .conftest import one_error_line
         ("outer_wall_mm=16", "outer_wall_mm: must be < chamber_width_mm / 2"),
         ("chambers=4", "--design: chambers is not a parameter of the pneunet family"),
         ("wall_mm", "--design: must be NAME=VALUE pairs"),
+        ("n_chambers=6,n_chambers=7", "--design: gives 'n_chambers' twice (6 and 7); give it once"),
     ],
 )
 def test_a_bad_pneunet_design_is_one_line_naming_the_parameter(tmp_path, capsys, design, needle):
