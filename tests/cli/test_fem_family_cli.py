@@ -35,6 +35,16 @@ def test_an_unknown_family_and_a_tiny_mesh_are_one_line(tmp_path, capsys):
     assert "--maxh: must give at most" in one_error_line(capsys)
 
 
+def test_a_campaign_s_mesh_too_fine_for_a_design_is_refused_before_any_sweep(tmp_path, capsys):
+    db = tmp_path / "c.duckdb"
+    args = ["campaign", "run", str(db), "--family", "pneunet", "--space", "lhs:4", "--maxh", "0.05"]
+    assert main(args) == 2
+    line = one_error_line(capsys)
+    assert line.startswith("softbend: error: --maxh: must give at most 400000 elements for design ")
+    assert "got 0.05 mm (about " in line
+    assert not db.exists()
+
+
 def test_fem_run_pneunet_json_prints_pressures_and_angles_and_writes_vtk(tmp_path, capsys):
     out = tmp_path / "run"
     code = main(

@@ -246,7 +246,8 @@ def run_campaign(
     ValueError
         Bad input: unknown backend or option, empty or duplicate designs, an
         FEM mesh size that would mesh one of the designs with more elements than
-        the FEM allows (:func:`softbend.fem.options.check_mesh_size`), a
+        the FEM allows (:func:`softbend.fem.options.check_mesh_size`; another
+        family's own estimate, :meth:`~softbend.fem.families.FEMFamily.check_mesh`), a
         negative or non-increasing pressure grid, ``workers < 0``, a malformed
         scheduler address, a material given to a backend that takes none, or a
         database holding another backend or grid.
@@ -270,11 +271,9 @@ def run_campaign(
     if material is not None:
         chosen = resolve_material(material)
         backend_obj, given = with_material(backend_obj, chosen.material), chosen.given
-    fem_options = fem_options_of(backend_obj)
-    if fem_options is not None and family == DEFAULT_FAMILY:
-        # The FEM's own rule on the mesh size, for every design before any is swept:
-        # a mesh size too fine for them would otherwise fail each design in turn.
-        fem_options.check_mesh(cast(list[SFRBADesign], design_list))
+    # The FEM's own rule on the mesh size, for every design before any is swept:
+    # a mesh size too fine for them would otherwise fail each design in turn.
+    _check_meshes(backend_obj, family, design_list)
     if pressures_mpa is None:
         pressures_mpa = _default_pressures(family)
     grid = check_pressures_mpa(pressures_mpa)
@@ -332,6 +331,31 @@ def run_campaign(
         summary.wall_time_s,
     )
     return summary
+
+
+def _check_meshes(backend: Backend, family: str, designs: list[CampaignDesign]) -> None:
+    """Refuse an FEM backend's mesh size that would mesh one of ``designs`` too finely.
+
+    Paper B's designs are checked together (:meth:`FEMOptions.check_mesh
+    <softbend.fem.options.FEMOptions.check_mesh>`); another family's one by one
+    with its own estimate (:meth:`FEMFamily.check_mesh
+    <softbend.fem.families.FEMFamily.check_mesh>`, microseconds a design), before
+    NGSolve is loaded. A backend that is not the FEM is not checked.
+    """
+    options = fem_options_of(backend)
+    if options is None:
+        return
+    if family == DEFAULT_FAMILY:
+        options.check_mesh(cast(list[SFRBADesign], designs))
+        return
+    if isinstance(backend, FamilyBackend):
+        fem_family = backend.family
+    else:
+        from softbend.fem.families import get_family
+
+        fem_family = get_family(family)
+    for design in designs:
+        fem_family.check_mesh(design, options)
 
 
 def _default_pressures(family: str) -> np.ndarray:
