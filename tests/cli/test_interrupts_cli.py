@@ -19,18 +19,24 @@ from pathlib import Path
 
 from softbend.campaign import CampaignStore
 
+from ..campaign.test_runner import dask_processes  # noqa: F401  (a fixture)
 from ..stand_ins import running
 
-#: The command line with a public backend ``slow`` (each sweep runs a child process for
-#: $COMPILE_S seconds, as the FEM its compilers, then the analytical model); arguments as
-#: softbend's.
+#: The command line with the public backends ``slow`` (each sweep runs a child process for
+#: $COMPILE_S seconds, as the FEM its compilers, then the analytical model) and ``sleepy``
+#: (the analytical model after a sleep of $COMPILE_S seconds, as a Dask worker imports it);
+#: arguments as softbend's.
 _CHILD = textwrap.dedent(
     """
     import os, sys
-    from softbend.campaign.backends import register_backend
+    from softbend.campaign.backends import get_backend, register_backend
     from tests.stand_ins import CompilingSweep
 
     register_backend("slow", lambda: CompilingSweep(os.path.abspath("started")))
+    register_backend(
+        "sleepy",
+        lambda: get_backend("fault-injection", delay_s=float(os.environ["COMPILE_S"])),
+    )
     if __name__ == "__main__":
         from softbend.cli import run
         sys.argv[0] = "softbend"
@@ -156,3 +162,32 @@ def test_ctrl_c_stops_a_verification_in_one_line_and_the_same_command_resumes(tm
     assert json.loads(out)["verified"] == {"backend": "slow", "family": "sfrba", "designs": 4}
     assert len((tmp_path / "started").read_text().split()) - started == 4 - kept
     assert not db.exists() and (tmp_path / "found" / "search.json").is_file()
+
+
+def test_ctrl_c_stops_a_campaign_on_dask_in_one_line_and_the_same_command_resumes(
+    tmp_path,
+    dask_processes,  # noqa: F811  (the fixture imported above)
+):
+    _, scheduler_file = dask_processes
+    args = ["campaign", "run", "c.duckdb", "--backend", "sleepy", "--space", "lhs:4"]
+    args += ["--scheduler", str(scheduler_file), "--chunk-size", "1"]
+    args += ["--pmax", "0.1", "--pstep", "0.05"]
+    child = _start(args, tmp_path, delay_s=1.5)
+    took, err = _interrupt_after(child, "done 1 ")
+    assert child.returncode == 130, err
+    assert took < 5.0
+    assert "Traceback" not in err and "KeyboardInterrupt" not in err
+    assert err.strip().splitlines()[-1] == (
+        "softbend: interrupted; finished work is kept in c.duckdb; resume with: softbend "
+        + " ".join(args)
+    )
+    with CampaignStore(tmp_path / "c.duckdb", read_only=True) as store:
+        kept = len(store.finished_ids())
+    assert 1 <= kept < 4
+
+    resumed = _start(args, tmp_path, delay_s=1.5)
+    _, err = resumed.communicate(timeout=60)
+    assert resumed.returncode == 0, err
+    assert f"resuming c.duckdb: {kept} of 4 designs already recorded" in err
+    with CampaignStore(tmp_path / "c.duckdb", read_only=True) as store:
+        assert len(store.finished_ids()) == 4
