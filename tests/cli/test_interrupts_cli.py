@@ -23,7 +23,8 @@ from ..campaign.test_runner import dask_processes  # noqa: F401  (a fixture)
 from ..stand_ins import running
 
 #: The command line with the public backends ``slow`` (each sweep runs a child process for
-#: $COMPILE_S seconds, as the FEM its compilers, then the analytical model) and ``sleepy``
+#: $COMPILE_S seconds, as the FEM its compilers, then the analytical model), ``slow-compiled``
+#: (the child through ``system()``, as NGSolve's compilers of the compiled FEM) and ``sleepy``
 #: (the analytical model after a sleep of $COMPILE_S seconds, as a Dask worker imports it);
 #: arguments as softbend's.
 _CHILD = textwrap.dedent(
@@ -33,6 +34,9 @@ _CHILD = textwrap.dedent(
     from tests.stand_ins import CompilingSweep
 
     register_backend("slow", lambda: CompilingSweep(os.path.abspath("started")))
+    register_backend(
+        "slow-compiled", lambda: CompilingSweep(os.path.abspath("started"), compiled=True)
+    )
     register_backend(
         "sleepy",
         lambda: get_backend("fault-injection", delay_s=float(os.environ["COMPILE_S"])),
@@ -128,6 +132,22 @@ def test_ctrl_c_stops_a_campaign_in_one_line_and_the_same_command_resumes(tmp_pa
     assert f"resuming c.duckdb: {kept} of 6 designs already recorded" in err
     with CampaignStore(tmp_path / "c.duckdb", read_only=True) as store:
         assert len(store.finished_ids()) == 6
+
+
+def test_ctrl_c_stops_a_serial_campaign_of_a_backend_that_compiles(tmp_path):
+    """Its compilers run through ``system()``, which ignores SIGINT in its caller: the
+    designs run in one worker process, and Ctrl-C reaches the command."""
+    args = ["campaign", "run", "c.duckdb", "--backend", "slow-compiled", "--space", "lhs:4"]
+    args += ["--workers", "1", "--pmax", "0.1", "--pstep", "0.05"]
+    child = _start(args, tmp_path, delay_s=2.0)
+    took, err = _interrupt_after(child, "done 1 ")
+    assert child.returncode == 130, err
+    assert took < 5.0
+    assert "Traceback" not in err
+    assert err.strip().splitlines()[-1].startswith("softbend: interrupted; finished work is kept")
+    _assert_none_left(tmp_path)
+    with CampaignStore(tmp_path / "c.duckdb", read_only=True) as store:
+        assert 1 <= len(store.finished_ids()) < 4
 
 
 def test_ctrl_c_stops_a_verification_in_one_line_and_the_same_command_resumes(tmp_path):

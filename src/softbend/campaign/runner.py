@@ -88,6 +88,7 @@ from softbend.campaign.planning import (
     design_family,
     plan_run,
     resolve_backend,
+    runs_in_process,
 )
 from softbend.campaign.settings import backend_settings, fem_options_of
 from softbend.campaign.store import CampaignStore
@@ -209,7 +210,9 @@ def run_campaign(
         ``pstep_mpa``). A database keeps the grid of its first run.
     workers : int, optional
         Local worker processes; default ``os.cpu_count()``. 0 or 1 runs serially
-        in this process. Ignored with ``scheduler``.
+        in this process (in one worker process for the FEM that compiles its
+        energy, which would keep Ctrl-C from this one:
+        :func:`~softbend.campaign.planning.runs_in_process`). Ignored with ``scheduler``.
     scheduler : str, optional
         Dask scheduler address ``tcp://HOST:PORT`` (or a scheduler-file path) to
         run on an existing cluster instead of local processes.
@@ -299,6 +302,7 @@ def run_campaign(
                 address=address,
                 settings=settings,
                 accept_new_settings=accept_new_settings,
+                in_process=runs_in_process(backend_obj),
             )
             recorder = Recorder(store, backend_obj.name, len(plan.todo), progress)
             recorder.report()
