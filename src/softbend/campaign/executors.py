@@ -222,9 +222,12 @@ def _ignore_interrupts() -> None:
     would print a traceback of its own, and so would the processes it starts
     (the FEM's compilers). Each worker ignores SIGINT and leads a process group
     of its own, with the processes it starts, which the coordinating process
-    ends as one (:func:`_stop_pool`).
+    ends as one (:func:`_stop_pool`). Out of the terminal's foreground group,
+    it ignores SIGTTOU too, so that its output (and its compilers') is written
+    rather than stopping it where the terminal is set to ``stty tostop``.
     """
     signal.signal(signal.SIGINT, signal.SIG_IGN)
+    signal.signal(signal.SIGTTOU, signal.SIG_IGN)
     os.setpgid(0, 0)
 
 
