@@ -74,8 +74,10 @@ def _start(args: list[str], cwd: Path, delay_s: float) -> subprocess.Popen[str]:
     )
 
 
-def _interrupt_after(child: subprocess.Popen[str], started: str) -> tuple[float, str]:
-    """Send SIGINT to the child's group after a stderr line matching the pattern ``started``.
+def _interrupt_after(
+    child: subprocess.Popen[str], started: str, wait_s: float = 0.0
+) -> tuple[float, str]:
+    """Send SIGINT to the child's group ``wait_s`` after a stderr line matching ``started``.
 
     Returns the seconds the child took to end after it and its whole stderr (read
     until every process of the group has closed it).
@@ -87,6 +89,7 @@ def _interrupt_after(child: subprocess.Popen[str], started: str) -> tuple[float,
             lines.append(line)
             if re.search(started, line):
                 break
+        time.sleep(wait_s)
         os.killpg(child.pid, signal.SIGINT)
         sent = time.monotonic()
         child.wait(timeout=30)
@@ -133,6 +136,19 @@ def test_ctrl_c_stops_a_campaign_in_one_line_and_the_same_command_resumes(tmp_pa
     assert f"resuming c.duckdb: {kept} of 6 designs already recorded" in err
     with CampaignStore(tmp_path / "c.duckdb", read_only=True) as store:
         assert len(store.finished_ids()) == 6
+
+
+def test_ctrl_c_as_the_workers_start_is_one_line_too(tmp_path):
+    """While the fork server imports the model code and the workers start, before any
+    design: neither they nor the fork server print a traceback."""
+    args = ["campaign", "run", "c.duckdb", "--backend", "slow", "--space", "lhs:6"]
+    args += ["--workers", "2", "--chunk-size", "1", "--pmax", "0.1", "--pstep", "0.05"]
+    child = _start(args, tmp_path, delay_s=2.0)
+    took, err = _interrupt_after(child, r"done 0 ", wait_s=0.2)  # the fork server imports
+    assert child.returncode == 130, err
+    assert took < 5.0
+    assert "Traceback" not in err and "KeyboardInterrupt" not in err
+    assert err.strip().splitlines()[-1].startswith("softbend: interrupted; finished work is kept")
 
 
 def test_ctrl_c_stops_a_serial_campaign_of_a_backend_that_compiles(tmp_path):

@@ -34,9 +34,10 @@ import socket
 import threading
 import time
 from collections import deque
-from collections.abc import Callable, Iterable, Sequence
+from collections.abc import Callable, Iterable, Iterator, Sequence
 from concurrent.futures import FIRST_COMPLETED, ProcessPoolExecutor, wait
 from concurrent.futures.process import BrokenProcessPool
+from contextlib import contextmanager
 from dataclasses import dataclass
 from pathlib import Path
 from typing import TYPE_CHECKING, Any, cast
@@ -237,6 +238,28 @@ def _new_pool(workers: int, context: multiprocessing.context.BaseContext) -> Pro
     )
 
 
+@contextmanager
+def _interrupts_deferred() -> Iterator[None]:
+    """Hold a Ctrl-C back until the block ends, then raise it (KeyboardInterrupt).
+
+    Around a task's submission, which may start a worker: interrupted half-way,
+    the pool would not know the worker the fork server has already made, and
+    that worker would fail with a traceback once this process is gone. Only the
+    main thread receives signals; elsewhere the block runs as it is.
+    """
+    if threading.current_thread() is not threading.main_thread():
+        yield
+        return
+    received: list[int] = []
+    previous = signal.signal(signal.SIGINT, lambda signum, frame: received.append(signum))
+    try:
+        yield
+    finally:
+        signal.signal(signal.SIGINT, previous)
+    if received:
+        raise KeyboardInterrupt
+
+
 def _stop_pool(pool: ProcessPoolExecutor) -> None:
     """End ``pool`` at once: pending tasks cancelled, each worker's process group terminated.
 
@@ -262,8 +285,31 @@ def _mp_context() -> multiprocessing.context.BaseContext:
         context.set_forkserver_preload(
             ["__main__", "softbend.campaign.executors", "softbend.analytical"]
         )
+        _start_forkserver()
         return context
     return multiprocessing.get_context("spawn")
+
+
+def _start_forkserver() -> None:
+    """Start the fork server (if not yet running) with Ctrl-C ignored from its start.
+
+    The server ignores SIGINT only once its imports are done (a second or two);
+    a Ctrl-C meanwhile would print its traceback. Started while this process
+    ignores SIGINT, it inherits that, and so do the workers it forks. (Blocking
+    the signal instead does not reach the server: the child's signal mask is
+    reset.) A Ctrl-C in the millisecond the start takes is lost. Only the main
+    thread may change a signal's handler; elsewhere the server starts as it would.
+    """
+    from multiprocessing import forkserver
+
+    if threading.current_thread() is not threading.main_thread():
+        forkserver.ensure_running()
+        return
+    previous = signal.signal(signal.SIGINT, signal.SIG_IGN)
+    try:
+        forkserver.ensure_running()
+    finally:
+        signal.signal(signal.SIGINT, previous)
 
 
 def _run_isolated(
@@ -284,7 +330,9 @@ def _run_isolated(
         recorder.set_running(1)
         pool = _new_pool(1, context)
         try:
-            outcomes = pool.submit(sweep_chunk, backend, [design], pressures).result()
+            with _interrupts_deferred():  # the worker starts whole or not at all
+                future = pool.submit(sweep_chunk, backend, [design], pressures)
+            outcomes = future.result()
         except BrokenProcessPool:
             outcomes = [
                 Outcome(
@@ -336,7 +384,8 @@ def run_local(
                 while chunks and not broken and len(pending) < _TASKS_PER_WORKER * workers:
                     chunk = chunks.popleft()
                     try:
-                        future = pool.submit(sweep_chunk, backend, chunk, pressures)
+                        with _interrupts_deferred():  # a worker it starts starts whole
+                            future = pool.submit(sweep_chunk, backend, chunk, pressures)
                     except BrokenProcessPool:
                         chunks.appendleft(chunk)
                         broken = True
