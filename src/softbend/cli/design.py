@@ -354,7 +354,7 @@ def find(
             with _common.library_progress(enabled=not as_json):
                 for result in results:
                     if result.candidates:
-                        db = verification_db(out, result, backend, material, verify)
+                        db = verification_db(out, result, backend, elastomer, verify)
                         kept.append(db)
                         verify_candidates(
                             result,
@@ -395,19 +395,24 @@ def find(
 
 
 def verification_db(
-    out: Path, result: SearchResult, backend: str, material: str | None, verify: int
+    out: Path,
+    result: SearchResult,
+    backend: str,
+    material: ResolvedMaterial | None,
+    verify: int,
 ) -> Path:
     """The campaign database the verification of ``result`` keeps beside ``out``.
 
     ``.NAME.verify-KEY.duckdb`` for an ``out`` named NAME, where KEY is a digest
     of what decides the verification's sweeps: the search's answer (its
-    candidates, spec and ranges), the backend, the material and ``--verify``.
-    The same command after an interruption finds the same database and sweeps
-    only the designs not yet recorded in it; a command that verifies otherwise
-    starts another.
+    candidates, spec and ranges), the backend, the material (its parameters and
+    what named it, a fit file by its SHA-256) and ``--verify``. The same command
+    after an interruption finds the same database and sweeps only the designs
+    not yet recorded in it; a command that verifies otherwise starts another.
     """
     record = {key: value for key, value in result.to_dict().items() if key != "search_s"}
-    given = {"search": record, "backend": backend, "material": material, "verify": verify}
+    elastomer = None if material is None else [material.material.to_dict(), material.given]
+    given = {"search": record, "backend": backend, "material": elastomer, "verify": verify}
     digest = hashlib.sha256(_common.json_text(given).encode("utf-8")).hexdigest()[:12]
     folder = Path(os.path.abspath(out))
     return folder.with_name(f".{folder.name}.verify-{digest}.duckdb")
