@@ -322,3 +322,51 @@ def check_closed_form_samples(samples: pd.DataFrame, names, k_deg_per_mpa: float
     ]
     expected = k_deg_per_mpa * samples["pressure_mpa"] * samples[list(names)].sum(axis=1)
     assert np.allclose(samples["angle_deg"], expected) and len(samples) == rows
+
+
+@dataclass(frozen=True)
+class CompilingSweep:
+    """A campaign backend that runs a child process for $COMPILE_S s before each sweep.
+
+    As the FEM runs its compilers: a process a worker starts, in the worker's
+    process group, with the worker's stderr; the child appends its process id
+    to ``started`` (a file). With ``compiled`` the child runs through the C
+    library's ``system()``, as NGSolve runs them when the FEM compiles its
+    energy (the caller ignores SIGINT meanwhile). Then the analytical model
+    sweeps the design. The time is read from the environment, so that it is no
+    setting the campaign records.
+    """
+
+    started: str
+    compiled: bool = False
+    name: str = "compiling"
+
+    def sweep(self, design, pressures_mpa):
+        import os
+        import shlex
+        import subprocess
+        import sys
+
+        from softbend.campaign import get_backend
+
+        seconds = float(os.environ.get("COMPILE_S", "0"))
+        code = (
+            f"import os, time; open({self.started!r}, 'a').write(f'{{os.getpid()}}\\n'); "
+            f"time.sleep({seconds!r})"
+        )
+        if self.compiled:
+            status = os.system(shlex.join([sys.executable, "-c", code]))
+        else:
+            status = subprocess.run([sys.executable, "-c", code]).returncode
+        if status != 0:
+            raise RuntimeError(f"the child process ended with {status}")
+        return get_backend("analytical").sweep(design, pressures_mpa)
+
+
+def running(pid: int) -> bool:
+    """Whether process ``pid`` exists and is not a zombie (Linux)."""
+    try:
+        status = Path(f"/proc/{pid}/status").read_text()
+    except OSError:
+        return False
+    return "\nState:\tZ" not in status

@@ -2,6 +2,9 @@
 
 from __future__ import annotations
 
+import re
+import warnings
+
 import numpy as np
 import pandas as pd
 import pytest
@@ -127,6 +130,36 @@ def test_constraints_met_is_vectorised():
 def test_a_constraint_is_a_comparison_of_parameters_and_numbers_only(text):
     with pytest.raises(ActuatorError):
         Actuator("x", "x", (DesignParameter("wall_mm", "mm", 1, 3),), constraints=(text,))
+
+
+@pytest.mark.parametrize(
+    ("text", "needle"),
+    [
+        ("1 / 0 < wall_mm", "'1 / 0 < wall_mm' divides by zero (1 / 0)"),
+        ("wall_mm < 2 * (3 / (1 - 1))", "divides by zero (3 / (1 - 1))"),
+        ("wall_mm * 1e308 * 10 < 3", None),  # a parameter in it: computed per design
+        ("wall_mm < 1e308 * 10", "a number too large to compute (1e308 * 10)"),
+        ("wall_mm < -1e999", "a number too large to compute (1e999)"),
+    ],
+)
+def test_a_constraint_s_numbers_are_computed_when_it_is_read(text, needle):
+    parameters = (DesignParameter("wall_mm", "mm", 1, 3),)
+    if needle is None:
+        Actuator("x", "x", parameters, constraints=(text,))
+        return
+    with pytest.raises(ActuatorError, match=re.escape(needle)):
+        Actuator("x", "x", parameters, constraints=(text,))
+
+
+def test_a_constraint_undefined_for_a_design_is_not_met_and_warns_nothing():
+    parameters = (DesignParameter("wall_mm", "mm", 1, 3), DesignParameter("gap_mm", "mm", 1, 3))
+    actuator = Actuator("x", "x", parameters, constraints=("wall_mm / (gap_mm - 2) < 5",))
+    rows = np.array([[1.0, 1.0], [1.0, 2.0], [2.0, 3.0]])  # -1, 1/0 = inf, 2
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        np.testing.assert_array_equal(actuator.constraints_met(rows), [True, False, True])
+        with pytest.raises(ActuatorError, match="breaks the constraint wall_mm / \\(gap_mm - 2\\)"):
+            actuator.check_designs(rows)
 
 
 def test_round_trip_through_json_text():

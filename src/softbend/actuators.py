@@ -393,7 +393,51 @@ def _parse_constraint(text: str, names: Sequence[str]) -> ast.Compare:
                 f"The constraint {text!r} may use only + - * / and comparisons of the "
                 "design parameters and numbers."
             )
+    for side in (tree.left, *tree.comparators):
+        _fold(side, text)
     return tree
+
+
+def _part(text: str, node: ast.AST) -> str:
+    """The part of the constraint ``text`` that ``node`` was parsed from, as typed."""
+    return ast.get_source_segment(text, node) or ast.unparse(node)
+
+
+def _fold(node: ast.AST, text: str) -> float | None:
+    """The value of ``node`` if it holds no name (None otherwise), checked finite.
+
+    Each part of a constraint made of numbers alone is computed once, when the
+    description is read: one that divides by zero or is not a finite number is
+    refused there, naming the constraint, instead of failing (or, on arrays,
+    silently giving inf or NaN) while designs are checked.
+    """
+    if isinstance(node, ast.Constant):
+        value = float(node.value)  # type: ignore[arg-type]  # a number, as parsed
+    elif isinstance(node, ast.Name):
+        return None
+    elif isinstance(node, ast.UnaryOp):
+        inner = _fold(node.operand, text)
+        if inner is None:
+            return None
+        value = -inner if isinstance(node.op, ast.USub) else inner
+    else:
+        assert isinstance(node, ast.BinOp)
+        left, right = _fold(node.left, text), _fold(node.right, text)
+        if left is None or right is None:
+            return None
+        try:
+            value = _ARITHMETIC[type(node.op)](left, right)
+        except ZeroDivisionError:
+            raise ActuatorError(
+                f"The constraint {text!r} divides by zero ({_part(text, node)}); its numbers "
+                "must give finite values."
+            ) from None
+    if not math.isfinite(value):
+        raise ActuatorError(
+            f"The constraint {text!r} holds a number too large to compute "
+            f"({_part(text, node)}); its numbers must give finite values."
+        )
+    return value
 
 
 def _evaluate(node: ast.AST, values: Mapping[str, np.ndarray]) -> Any:
@@ -621,11 +665,12 @@ class Actuator:
         met = self.constraints_met(rows)
         if not met.all():
             i = int(np.argmin(met))
-            broken = next(
-                text
-                for text, tree in zip(self.constraints, self._trees, strict=True)
-                if not _evaluate(tree, self._columns(rows[i : i + 1]))[0]
-            )
+            with np.errstate(divide="ignore", invalid="ignore", over="ignore"):
+                broken = next(
+                    text
+                    for text, tree in zip(self.constraints, self._trees, strict=True)
+                    if not _evaluate(tree, self._columns(rows[i : i + 1]))[0]
+                )
             raise ActuatorError(
                 f"the design {self.describe(rows[i])} breaks the constraint {broken} of {self.name}"
             )
@@ -636,8 +681,11 @@ class Actuator:
         rows = np.atleast_2d(np.asarray(codes, dtype=float))
         met = np.ones(rows.shape[0], dtype=bool)
         columns = self._columns(rows)
-        for tree in self._trees:
-            met &= np.asarray(_evaluate(tree, columns), dtype=bool)
+        # A design where a side divides by zero (inf) or is undefined (NaN) is
+        # compared as computed: a NaN side meets no comparison.
+        with np.errstate(divide="ignore", invalid="ignore", over="ignore"):
+            for tree in self._trees:
+                met &= np.asarray(_evaluate(tree, columns), dtype=bool)
         return met
 
     def _columns(self, rows: np.ndarray) -> dict[str, np.ndarray]:

@@ -140,3 +140,17 @@ def test_a_pressure_is_read_in_the_model_s_unit(model, tmp_path, capsys):
     assert main(args) == 2
     line = capsys.readouterr().err.strip()
     assert "--at: " in line and "(0, 1000] kPa" in line and "got 3000" in line
+
+
+def test_a_model_whose_constraint_divides_by_zero_is_one_line(model, tmp_path, capsys):
+    from .conftest import one_error_line
+
+    text = model.read_text()
+    assert '"constraints": []' in text
+    bad = tmp_path / "bad.json"
+    bad.write_text(text.replace('"constraints": []', '"constraints": ["1 / 0 < wall_mm"]'))
+    out = tmp_path / "design"
+    assert main(["design", "find", "--model", str(bad), *TARGET, "-o", str(out)]) == 2
+    line = one_error_line(capsys)
+    assert "bad.json" in line and "'1 / 0 < wall_mm' divides by zero (1 / 0)" in line
+    assert not out.exists()

@@ -18,6 +18,7 @@ from .conftest import one_error_line
         ("outer_wall_mm=16", "outer_wall_mm: must be < chamber_width_mm / 2"),
         ("chambers=4", "--design: chambers is not a parameter of the pneunet family"),
         ("wall_mm", "--design: must be NAME=VALUE pairs"),
+        ("n_chambers=6,n_chambers=7", "--design: gives 'n_chambers' twice (6 and 7); give it once"),
     ],
 )
 def test_a_bad_pneunet_design_is_one_line_naming_the_parameter(tmp_path, capsys, design, needle):
@@ -32,6 +33,16 @@ def test_an_unknown_family_and_a_tiny_mesh_are_one_line(tmp_path, capsys):
     args = ["fem", "mesh-study", "--family", "pneunet", "--maxh", "3,0.1"]
     assert main(args) == 2
     assert "--maxh: must give at most" in one_error_line(capsys)
+
+
+def test_a_campaign_s_mesh_too_fine_for_a_design_is_refused_before_any_sweep(tmp_path, capsys):
+    db = tmp_path / "c.duckdb"
+    args = ["campaign", "run", str(db), "--family", "pneunet", "--space", "lhs:4", "--maxh", "0.05"]
+    assert main(args) == 2
+    line = one_error_line(capsys)
+    assert line.startswith("softbend: error: --maxh: must give at most 400000 elements for design ")
+    assert "got 0.05 mm (about " in line
+    assert not db.exists()
 
 
 def test_fem_run_pneunet_json_prints_pressures_and_angles_and_writes_vtk(tmp_path, capsys):

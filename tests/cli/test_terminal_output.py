@@ -125,10 +125,13 @@ def test_interrupted_train_names_its_checkpoint(tmp_path, monkeypatch):
     checkpoint.write_text("{}\n")
     line = interrupted_line(args)
     assert line == (
-        f"softbend: interrupted; finished work is kept in {checkpoint}: the same command resumes"
+        f"softbend: interrupted; finished work is kept in {checkpoint}; resume with: "
+        "softbend train table.duckdb --out models"
     )
     assert interrupted_line(["train", "table.duckdb", "-o=models"]) == "softbend: interrupted"
-    assert interrupted_line(["train", "table.duckdb", "-o", "models"]) == line
+    assert interrupted_line(["train", "table.duckdb", "-o", "models"]) == line.replace(
+        "--out", "-o"
+    )
 
 
 def test_interrupted_campaign_names_its_database(tmp_path):
@@ -136,7 +139,16 @@ def test_interrupted_campaign_names_its_database(tmp_path):
     args = ["campaign", "run", str(db), "--workers", "2"]
     assert interrupted_line(args) == "softbend: interrupted"
     db.write_bytes(b"")
-    assert str(db) in interrupted_line(args)
+    assert interrupted_line(args) == (
+        f"softbend: interrupted; finished work is kept in {db}; resume with: "
+        f"softbend campaign run {db} --workers 2"
+    )
+    spaced = tmp_path / "my runs" / "c.duckdb"
+    spaced.parent.mkdir()
+    spaced.write_bytes(b"")
+    assert interrupted_line(["campaign", "run", str(spaced)]).endswith(
+        f"resume with: softbend campaign run '{spaced}'"
+    )  # quoted as a shell takes it
     assert interrupted_line(["fem", "run", str(db)]) == "softbend: interrupted"
 
 

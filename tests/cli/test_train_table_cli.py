@@ -164,3 +164,28 @@ def test_a_large_table_shows_its_read_from_the_start(sims, tmp_path, capsys, mon
     assert lines[0].startswith("reading sims.csv, %: 0/100")
     assert any(line.startswith("reading sims.csv, %: 100/100") for line in lines)
     assert lines[-1].startswith("softbend: error: --angle-column: ") and "'theta'" in lines[-1]
+
+
+def test_a_constraint_dividing_by_zero_is_one_line_before_any_work(sims, tmp_path, capsys):
+    description = {
+        "name": "bellows",
+        "title": "bellows",
+        "parameters": [
+            {"name": "n_chambers", "unit": "", "kind": "integer", "low": 6, "high": 14},
+            {"name": "wall_mm", "unit": "mm", "low": 1.0, "high": 3.0},
+            {"name": "height_mm", "unit": "mm", "low": 8.0, "high": 16.0},
+            {"name": "layer", "unit": "", "kind": "categorical", "levels": ["fabric", "paper"]},
+        ],
+        "pressure_column": "p_kpa",
+        "pressure_unit": "kPa",
+        "constraints": ["1 / 0 < wall_mm"],
+    }
+    path = tmp_path / "bellows.json"
+    path.write_text(json.dumps(description))
+    code = main(["train", str(sims), "--actuator", str(path), "--out", str(tmp_path / "m")])
+    assert code == 2
+    assert one_error_line(capsys).endswith(
+        "bellows.json: The constraint '1 / 0 < wall_mm' divides by zero (1 / 0); its numbers "
+        "must give finite values."
+    )
+    assert not (tmp_path / "m").exists()

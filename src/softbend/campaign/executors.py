@@ -11,7 +11,9 @@ design's failure, ``"ExceptionType: message"``).
 * :func:`run_local`: a :class:`concurrent.futures.ProcessPoolExecutor` started
   through a fork server (``spawn`` where there is none); when a worker process
   dies the designs then in flight are rerun one by one, each in a process of its
-  own, and the pool is restarted at most three times;
+  own, and the pool is restarted at most three times. Workers ignore Ctrl-C
+  (SIGINT reaches the whole process group from a terminal): the coordinating
+  process alone stops, ends its workers and keeps what they recorded;
 * :func:`run_dask`: a Dask ``distributed`` client from :func:`connect`, which
   checks the scheduler address (:func:`parse_scheduler_address`) and gives up
   within its deadline when nothing Dask-like answers there.
@@ -25,14 +27,17 @@ import json
 import logging
 import math
 import multiprocessing
+import os
 import re
+import signal
 import socket
 import threading
 import time
 from collections import deque
-from collections.abc import Callable, Iterable, Sequence
+from collections.abc import Callable, Iterable, Iterator, Sequence
 from concurrent.futures import FIRST_COMPLETED, ProcessPoolExecutor, wait
 from concurrent.futures.process import BrokenProcessPool
+from contextlib import contextmanager
 from dataclasses import dataclass
 from pathlib import Path
 from typing import TYPE_CHECKING, Any, cast
@@ -211,6 +216,68 @@ def run_serial(
         recorder.record([_sweep_one(backend, design, pressures)], running=0)
 
 
+def _ignore_interrupts() -> None:
+    """Worker initializer: leave Ctrl-C to the coordinating process.
+
+    A terminal sends SIGINT to every process of its foreground group; a worker
+    would print a traceback of its own, and so would the processes it starts
+    (the FEM's compilers). Each worker ignores SIGINT and leads a process group
+    of its own, with the processes it starts, which the coordinating process
+    ends as one (:func:`_stop_pool`). Out of the terminal's foreground group,
+    it ignores SIGTTOU too, so that its output (and its compilers') is written
+    rather than stopping it where the terminal is set to ``stty tostop``.
+    """
+    signal.signal(signal.SIGINT, signal.SIG_IGN)
+    signal.signal(signal.SIGTTOU, signal.SIG_IGN)
+    os.setpgid(0, 0)
+
+
+def _new_pool(workers: int, context: multiprocessing.context.BaseContext) -> ProcessPoolExecutor:
+    return ProcessPoolExecutor(
+        max_workers=workers, mp_context=context, initializer=_ignore_interrupts
+    )
+
+
+@contextmanager
+def _interrupts_deferred() -> Iterator[None]:
+    """Hold a Ctrl-C back until the block ends, then raise it (KeyboardInterrupt).
+
+    Around a task's submission, which may start a worker: interrupted half-way,
+    the pool would not know the worker the fork server has already made, and
+    that worker would fail with a traceback once this process is gone. Only the
+    main thread receives signals; elsewhere the block runs as it is.
+    """
+    if threading.current_thread() is not threading.main_thread():
+        yield
+        return
+    received: list[int] = []
+    previous = signal.signal(signal.SIGINT, lambda signum, frame: received.append(signum))
+    try:
+        yield
+    finally:
+        signal.signal(signal.SIGINT, previous)
+    if received:
+        raise KeyboardInterrupt
+
+
+def _stop_pool(pool: ProcessPoolExecutor) -> None:
+    """End ``pool`` at once: pending tasks cancelled, each worker's process group terminated.
+
+    On an interruption the designs in flight are given up (a resumed run sweeps
+    them again); waiting for them could take as long as an FEM sweep.
+    """
+    processes = list((getattr(pool, "_processes", None) or {}).values())
+    pool.shutdown(wait=False, cancel_futures=True)
+    for process in processes:
+        if process.is_alive() and process.pid is not None:
+            try:
+                os.killpg(process.pid, signal.SIGTERM)  # the worker and what it started
+            except OSError:  # not (yet) leading a group of its own
+                process.terminate()
+    for process in processes:
+        process.join(timeout=5.0)
+
+
 def _mp_context() -> multiprocessing.context.BaseContext:
     if "forkserver" in multiprocessing.get_all_start_methods():
         context = multiprocessing.get_context("forkserver")
@@ -218,8 +285,31 @@ def _mp_context() -> multiprocessing.context.BaseContext:
         context.set_forkserver_preload(
             ["__main__", "softbend.campaign.executors", "softbend.analytical"]
         )
+        _start_forkserver()
         return context
     return multiprocessing.get_context("spawn")
+
+
+def _start_forkserver() -> None:
+    """Start the fork server (if not yet running) with Ctrl-C ignored from its start.
+
+    The server ignores SIGINT only once its imports are done (a second or two);
+    a Ctrl-C meanwhile would print its traceback. Started while this process
+    ignores SIGINT, it inherits that, and so do the workers it forks. (Blocking
+    the signal instead does not reach the server: the child's signal mask is
+    reset.) A Ctrl-C in the millisecond the start takes is lost. Only the main
+    thread may change a signal's handler; elsewhere the server starts as it would.
+    """
+    from multiprocessing import forkserver
+
+    if threading.current_thread() is not threading.main_thread():
+        forkserver.ensure_running()
+        return
+    previous = signal.signal(signal.SIGINT, signal.SIG_IGN)
+    try:
+        forkserver.ensure_running()
+    finally:
+        signal.signal(signal.SIGINT, previous)
 
 
 def _run_isolated(
@@ -238,9 +328,11 @@ def _run_isolated(
     while suspects:
         design = suspects.popleft()
         recorder.set_running(1)
-        pool = ProcessPoolExecutor(max_workers=1, mp_context=context)
+        pool = _new_pool(1, context)
         try:
-            outcomes = pool.submit(sweep_chunk, backend, [design], pressures).result()
+            with _interrupts_deferred():  # the worker starts whole or not at all
+                future = pool.submit(sweep_chunk, backend, [design], pressures)
+            outcomes = future.result()
         except BrokenProcessPool:
             outcomes = [
                 Outcome(
@@ -253,6 +345,9 @@ def _run_isolated(
             ]
         except Exception as exc:
             outcomes = _lost_chunk([design], exc)
+        except BaseException:  # Ctrl-C: stop now, the design is left for a resumed run
+            _stop_pool(pool)
+            raise
         finally:
             pool.shutdown(wait=True, cancel_futures=True)
         recorder.record(outcomes, running=0)
@@ -280,7 +375,7 @@ def run_local(
         _run_isolated(backend, suspects, pressures, context, recorder)
         if not chunks:
             break
-        pool = ProcessPoolExecutor(max_workers=workers, mp_context=context)
+        pool = _new_pool(workers, context)
         pending: dict[Any, list[CampaignDesign]] = {}
         broken = False
         clean = False
@@ -289,7 +384,8 @@ def run_local(
                 while chunks and not broken and len(pending) < _TASKS_PER_WORKER * workers:
                     chunk = chunks.popleft()
                     try:
-                        future = pool.submit(sweep_chunk, backend, chunk, pressures)
+                        with _interrupts_deferred():  # a worker it starts starts whole
+                            future = pool.submit(sweep_chunk, backend, chunk, pressures)
                     except BrokenProcessPool:
                         chunks.appendleft(chunk)
                         broken = True
@@ -311,6 +407,9 @@ def run_local(
                         outcomes = _lost_chunk(chunk, exc)
                     recorder.record(outcomes, running=sum(len(c) for c in pending.values()))
             clean = True
+        except BaseException:  # Ctrl-C: stop now; what was recorded stays, the rest resumes
+            _stop_pool(pool)
+            raise
         finally:
             pool.shutdown(wait=clean, cancel_futures=True)
         if broken:

@@ -201,6 +201,7 @@ def plan_run(
     address: str | None,
     settings: dict[str, Any] | None = None,
     accept_new_settings: bool = False,
+    in_process: bool = True,
 ) -> RunPlan:
     """Bind the campaign, find the designs left and name the executor.
 
@@ -227,6 +228,9 @@ def plan_run(
         recorded by the first run and checked by later ones.
     accept_new_settings : bool
         Run even if ``settings`` differ from the recorded ones.
+    in_process : bool
+        Whether the backend may sweep in this process (:func:`runs_in_process`);
+        if not, the designs a serial run would sweep here run in one worker process.
 
     Returns
     -------
@@ -258,10 +262,10 @@ def plan_run(
     n_skipped_done = sum(d.design_id in done_ids for d in designs)
     if address is not None:
         executor = address
-    elif workers <= 1 or len(todo) <= 1:
+    elif (workers <= 1 or len(todo) <= 1) and (in_process or not todo):
         executor = "serial"
     else:
-        workers = min(workers, len(todo))
+        workers = max(1, min(workers, len(todo)))
         executor = f"processes:{workers}"
     logger.info(
         "campaign %s: %d designs, %d already done, %d failed before and %s; %d to run on %s",
@@ -280,6 +284,24 @@ def plan_run(
         executor=executor,
         workers=workers,
     )
+
+
+def runs_in_process(backend: Backend) -> bool:
+    """Whether ``backend`` may sweep in the coordinating process (a serial run).
+
+    Not the FEM that compiles its energy (``compiled``, also inside a wrapper's
+    ``inner`` backend): NGSolve runs its compilers through the C library's
+    ``system()``, which ignores SIGINT in the calling process while they run
+    (half a minute), so Ctrl-C would neither stop the campaign nor reach a
+    KeyboardInterrupt. In a worker process the coordinating process stays
+    interruptible and ends the worker.
+    """
+    current: object = backend
+    while current is not None:
+        if getattr(current, "compiled", False) is True:
+            return False
+        current = getattr(current, "inner", None)
+    return True
 
 
 def auto_chunk_size(backend: Backend, n_designs: int, n_slots: int) -> int:

@@ -88,6 +88,7 @@ from softbend.campaign.planning import (
     design_family,
     plan_run,
     resolve_backend,
+    runs_in_process,
 )
 from softbend.campaign.settings import backend_settings, fem_options_of
 from softbend.campaign.store import CampaignStore
@@ -209,7 +210,9 @@ def run_campaign(
         ``pstep_mpa``). A database keeps the grid of its first run.
     workers : int, optional
         Local worker processes; default ``os.cpu_count()``. 0 or 1 runs serially
-        in this process. Ignored with ``scheduler``.
+        in this process (in one worker process for the FEM that compiles its
+        energy, which would keep Ctrl-C from this one:
+        :func:`~softbend.campaign.planning.runs_in_process`). Ignored with ``scheduler``.
     scheduler : str, optional
         Dask scheduler address ``tcp://HOST:PORT`` (or a scheduler-file path) to
         run on an existing cluster instead of local processes.
@@ -246,7 +249,8 @@ def run_campaign(
     ValueError
         Bad input: unknown backend or option, empty or duplicate designs, an
         FEM mesh size that would mesh one of the designs with more elements than
-        the FEM allows (:func:`softbend.fem.options.check_mesh_size`), a
+        the FEM allows (:func:`softbend.fem.options.check_mesh_size`; another
+        family's own estimate, :meth:`~softbend.fem.families.FEMFamily.check_mesh`), a
         negative or non-increasing pressure grid, ``workers < 0``, a malformed
         scheduler address, a material given to a backend that takes none, or a
         database holding another backend or grid.
@@ -270,11 +274,9 @@ def run_campaign(
     if material is not None:
         chosen = resolve_material(material)
         backend_obj, given = with_material(backend_obj, chosen.material), chosen.given
-    fem_options = fem_options_of(backend_obj)
-    if fem_options is not None and family == DEFAULT_FAMILY:
-        # The FEM's own rule on the mesh size, for every design before any is swept:
-        # a mesh size too fine for them would otherwise fail each design in turn.
-        fem_options.check_mesh(cast(list[SFRBADesign], design_list))
+    # The FEM's own rule on the mesh size, for every design before any is swept:
+    # a mesh size too fine for them would otherwise fail each design in turn.
+    _check_meshes(backend_obj, family, design_list)
     if pressures_mpa is None:
         pressures_mpa = _default_pressures(family)
     grid = check_pressures_mpa(pressures_mpa)
@@ -300,6 +302,7 @@ def run_campaign(
                 address=address,
                 settings=settings,
                 accept_new_settings=accept_new_settings,
+                in_process=runs_in_process(backend_obj),
             )
             recorder = Recorder(store, backend_obj.name, len(plan.todo), progress)
             recorder.report()
@@ -332,6 +335,31 @@ def run_campaign(
         summary.wall_time_s,
     )
     return summary
+
+
+def _check_meshes(backend: Backend, family: str, designs: list[CampaignDesign]) -> None:
+    """Refuse an FEM backend's mesh size that would mesh one of ``designs`` too finely.
+
+    Paper B's designs are checked together (:meth:`FEMOptions.check_mesh
+    <softbend.fem.options.FEMOptions.check_mesh>`); another family's one by one
+    with its own estimate (:meth:`FEMFamily.check_mesh
+    <softbend.fem.families.FEMFamily.check_mesh>`, microseconds a design), before
+    NGSolve is loaded. A backend that is not the FEM is not checked.
+    """
+    options = fem_options_of(backend)
+    if options is None:
+        return
+    if family == DEFAULT_FAMILY:
+        options.check_mesh(cast(list[SFRBADesign], designs))
+        return
+    if isinstance(backend, FamilyBackend):
+        fem_family = backend.family
+    else:
+        from softbend.fem.families import get_family
+
+        fem_family = get_family(family)
+    for design in designs:
+        fem_family.check_mesh(design, options)
 
 
 def _default_pressures(family: str) -> np.ndarray:

@@ -6,14 +6,17 @@ code, so tests call ``main([...])`` directly.
 
 Exit codes: 0 success, 1 unexpected failure, 2 bad input (usage errors and any
 :class:`softbend.errors.SoftbendError` or ``ValueError``), printed as one line,
-130 interrupted (Ctrl-C): one line, naming where the finished work is kept when
-the same command resumes from it (:func:`resume_path`).
+130 interrupted (Ctrl-C): one line, naming where the finished work is kept and the
+command that resumes from it (:func:`resume_path`).
 """
 
 from __future__ import annotations
 
 import functools
+import glob
 import os
+import shlex
+import signal
 import sys
 from collections.abc import Callable, Iterator, Sequence
 from pathlib import Path
@@ -102,8 +105,10 @@ def resume_path(args: Sequence[str]) -> Path | None:
 
     ``softbend train`` keeps every finished configuration-fold in a checkpoint
     beside ``--out``; ``softbend campaign run`` records every finished design in its
-    database; ``softbend reproduce`` keeps its campaign database beside ``--out``.
-    Each resumes when the same command is run again.
+    database; ``softbend reproduce`` keeps its campaign database beside ``--out``,
+    and ``softbend design find --verify`` the campaign of its verification
+    (the latest one, :func:`softbend.cli.design.verification_db`). Each resumes
+    when the same command is run again.
     """
     words = _positionals(args)
     path: Path | None = None
@@ -114,6 +119,11 @@ def resume_path(args: Sequence[str]) -> Path | None:
             path = path.with_name(f".{path.name}.train-checkpoint.jsonl")
     elif words[:2] == ["campaign", "run"] and len(words) > 2:
         path = Path(words[2])
+    elif words[:2] == ["design", "find"] and _option(args, "--out", "-o") is not None:
+        folder = Path(os.path.abspath(_option(args, "--out", "-o") or ""))
+        pattern = f".{glob.escape(folder.name)}.verify-*.duckdb"
+        kept = sorted(folder.parent.glob(pattern), key=lambda p: p.stat().st_mtime)
+        path = kept[-1] if kept else None
     elif words[:1] == ["reproduce"]:
         folder = Path(_option(args, "--out", "-o") or "results/reproduce")
         path = folder.with_name(f".{folder.name}.resume")
@@ -123,11 +133,18 @@ def resume_path(args: Sequence[str]) -> Path | None:
 
 
 def interrupted_line(args: Sequence[str]) -> str:
-    """The one line printed when Ctrl-C stops the command ``args``."""
+    """The one line printed when Ctrl-C stops the command ``args``.
+
+    Where finished work is kept, the line names it and the command that resumes
+    from it (``args`` as typed, quoted for a shell).
+    """
     kept = resume_path(args)
     if kept is None:
         return "softbend: interrupted"
-    return f"softbend: interrupted; finished work is kept in {kept}: the same command resumes"
+    return (
+        f"softbend: interrupted; finished work is kept in {kept}; resume with: "
+        f"softbend {shlex.join(args)}"
+    )
 
 
 #: Whether Ctrl-C reached :func:`main` through a command (set by :func:`_noting_interrupts`).
@@ -220,5 +237,16 @@ def main(argv: Sequence[str] | None = None) -> int:
 
 
 def run() -> None:  # pragma: no cover - console-script shim
-    """Console-script entry point."""
-    sys.exit(main())
+    """Console-script entry point.
+
+    Once Ctrl-C has stopped the command, a second one while the process exits
+    (its worker processes ended, its staging folder removed) is ignored: the one
+    line stays the only output.
+    """
+    try:
+        code = main()
+    except KeyboardInterrupt:  # a second Ctrl-C while the first one was being reported
+        code = INTERRUPTED
+    if code == INTERRUPTED:
+        signal.signal(signal.SIGINT, signal.SIG_IGN)
+    sys.exit(code)

@@ -73,7 +73,9 @@ def run(
         None, help="Pressure step of the sweep's grid, MPa (default 0.005; the family's)."
     ),
     workers: int | None = typer.Option(
-        None, help="Local worker processes (default: all cores; 0 or 1: serial)."
+        None,
+        help="Local worker processes (default: all cores; 0 or 1: serial, the compiled FEM in "
+        "one worker process).",
     ),
     scheduler: str | None = typer.Option(
         None, help="Dask scheduler tcp://HOST:PORT (or scheduler file) to run on a cluster."

@@ -15,12 +15,15 @@ number against its declared range (:data:`VERIFY`, :data:`WORKERS`,
 contradict each other (a target, range or objective beside ``--spec``; a
 verification option without ``--verify``), the material of the verification,
 every spec of the file and the size of every search's grid. The verification's
-temporary campaign lives in the staging folder of ``--out``, which the next run
-removes if this one is killed.
+campaign is kept beside ``--out`` (:func:`verification_db`) until the command
+ends: a run stopped by Ctrl-C or a kill keeps the designs it swept, and the same
+command resumes from them; a finished run removes it.
 """
 
 from __future__ import annotations
 
+import hashlib
+import os
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
@@ -228,7 +231,9 @@ def find(
     target, range and objective options are the file's, not given beside it).
     The results are built beside --out and swapped in when complete; a run
     killed during the verification leaves a hidden .OUT.PID-*.new folder that
-    the next run into --out removes.
+    the next run into --out removes. The verification's sweeps are kept beside
+    --out (.OUT.verify-KEY.duckdb) until the command ends: after Ctrl-C or a
+    kill the same command sweeps only the designs not yet swept.
 
     The names are the model's own: paper B's l, r, t, b, phi, lc (mm, deg;
     pressures in MPa), or the parameters of the actuator another model was
@@ -345,14 +350,18 @@ def find(
     if skipped is not None:  # another actuator: said once, and in each record
         for result in results:
             result.verify_skipped = skipped
+    kept: list[Path] = []  # the verification's campaigns, removed once the command ends
     with _common.output_errors(out, "--out"), staged_dir(out) as stage:
-        if verify and skipped is None:  # the temporary campaign in the staging folder
+        if verify and skipped is None:
             with _common.library_progress(enabled=not as_json):
                 for result in results:
                     if result.candidates:
+                        db = verification_db(out, result, backend, elastomer, verify)
+                        kept.append(db)
                         verify_candidates(
                             result,
                             verify,
+                            db_path=db,
                             backend=backend,
                             workers=workers,
                             material=elastomer,
@@ -367,6 +376,9 @@ def find(
             (stage / "search.json").write_text(
                 _common.json_text({"specs": payload}) + "\n", encoding="utf-8"
             )
+    for db in kept:
+        for path in (db, db.with_name(db.name + ".wal")):
+            path.unlink(missing_ok=True)
     for result in results:
         line = result.message()  # none meets the target (and the pressures outside, if any)
         if line is None and result.outside_pressures:
@@ -399,6 +411,30 @@ def _pressure(text: str | None, unit: str, option: str) -> float | None:
         return float(text)
     except ValueError:
         return parse_pressure(text, unit, option)
+
+
+def verification_db(
+    out: Path,
+    result: SearchResult,
+    backend: str,
+    material: ResolvedMaterial | None,
+    verify: int,
+) -> Path:
+    """The campaign database the verification of ``result`` keeps beside ``out``.
+
+    ``.NAME.verify-KEY.duckdb`` for an ``out`` named NAME, where KEY is a digest
+    of what decides the verification's sweeps: the search's answer (its
+    candidates, spec and ranges), the backend, the material (its parameters and
+    what named it, a fit file by its SHA-256) and ``--verify``. The same command
+    after an interruption finds the same database and sweeps only the designs
+    not yet recorded in it; a command that verifies otherwise starts another.
+    """
+    record = {key: value for key, value in result.to_dict().items() if key != "search_s"}
+    elastomer = None if material is None else [material.material.to_dict(), material.given]
+    given = {"search": record, "backend": backend, "material": elastomer, "verify": verify}
+    digest = hashlib.sha256(_common.json_text(given).encode("utf-8")).hexdigest()[:12]
+    folder = Path(os.path.abspath(out))
+    return folder.with_name(f".{folder.name}.verify-{digest}.duckdb")
 
 
 def _extrapolated(result: SearchResult, model: Path, named: bool) -> str | None:

@@ -342,8 +342,13 @@ class _Sweep:
         paper_b = result.spec.space.paper_b or family is None
         what = self.backend if paper_b else f"{self.backend}, {family.name}"  # type: ignore[union-attr]
 
-        def progress(done: int, failed: int, running: int, _total: int) -> None:
-            report(f"verifying {total} design{'s' * (total > 1)} ({what})", done + failed, total)
+        def progress(done: int, failed: int, running: int, to_run: int) -> None:
+            swept = total - to_run  # recorded by an interrupted run of the same command
+            report(
+                f"verifying {total} design{'s' * (total > 1)} ({what})",
+                swept + done + failed,
+                total,
+            )
 
         run_campaign(
             self.db,

@@ -154,7 +154,11 @@ class FEMFamily:
 
 
 def parse_assignments(text: str, names: tuple[str, ...]) -> dict[str, float]:
-    """``{"n_chambers": 6.0, ...}`` from ``"n_chambers=6,wall_mm=1.5"`` (errors keyed)."""
+    """``{"n_chambers": 6.0, ...}`` from ``"n_chambers=6,wall_mm=1.5"`` (errors keyed).
+
+    A pair without ``=`` or a name given twice is refused (keyed ``design``); a
+    value that is not a number is keyed by its name.
+    """
     values: dict[str, float] = {}
     for part in (p.strip() for p in text.split(",")):
         if not part:
@@ -164,6 +168,11 @@ def parse_assignments(text: str, names: tuple[str, ...]) -> dict[str, float]:
         if not sep:
             raise InputError(
                 must_be(f"NAME=VALUE pairs separated by commas (names: {', '.join(names)})", part),
+                key="design",
+            )
+        if name in values:
+            raise InputError(
+                f"gives {name!r} twice ({values[name]:g} and {value.strip()}); give it once",
                 key="design",
             )
         try:
