@@ -9,7 +9,7 @@ from pathlib import Path
 
 import pytest
 
-from softbend._outdir import write_manifest
+from softbend._outdir import MANIFEST, write_manifest
 from softbend.cli import main
 
 FIXED = ["--fix", "r=8", "--fix", "t=3", "--fix", "b=3", "--fix", "phi=10", "--fix", "lc=10"]
@@ -249,7 +249,7 @@ def test_two_good_names_each_get_their_folder(model_big, tmp_path, capsys):
         == 0
     )
     capsys.readouterr()
-    assert sorted(p.name for p in out.iterdir()) == ["search.json", "short one", "spec2"]
+    assert sorted(p.name for p in out.iterdir()) == [MANIFEST, "search.json", "short one", "spec2"]
 
 
 # -- 2. a spec file is read under the limits, every key checked ------------------------------
@@ -494,6 +494,10 @@ def test_the_verification_s_campaign_is_kept_beside_out_until_the_run_ends(
     stale = tmp_path / f".design.{_dead_pid()}-killed.new"  # a run killed with -9
     (stale / "softbend-verify-left").mkdir(parents=True)
     (stale / "softbend-verify-left" / "verify.duckdb").write_bytes(b"campaign of a dead run")
+    pid = int(stale.name.split(".")[2].split("-")[0])
+    manifest = {"format": "softbend-output-manifest", "version": 1, "command": "design find",
+                "pid": pid, "complete": False, "entries": {}}  # fmt: skip
+    (stale / MANIFEST).write_text(json.dumps(manifest))  # what a staging folder starts with
     used: list[Path] = []
     original = softbend.campaign.run_campaign
 
@@ -513,7 +517,7 @@ def test_the_verification_s_campaign_is_kept_beside_out_until_the_run_ends(
     assert db.name.startswith(".design.verify-") and db.name.endswith(".duckdb")
     assert sorted(p.name for p in tmp_path.iterdir()) == ["design"]
     assert sorted(p.name for p in out.iterdir()) == [
-        "candidates.csv", "curves.png", "front.png", "search.json"
+        MANIFEST, "candidates.csv", "curves.png", "front.png", "search.json"
     ]  # fmt: skip
     first = json.loads((out / "search.json").read_text())["candidates"][0]
     assert first["fem_meets"] is not None
