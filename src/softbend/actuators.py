@@ -49,6 +49,7 @@ from typing import TYPE_CHECKING, Any, Literal
 import numpy as np
 from numpy.typing import ArrayLike
 
+from softbend import units
 from softbend._validation import must_be, short_repr
 from softbend.errors import SoftbendError, keyed
 from softbend.registry import Registry
@@ -69,8 +70,8 @@ __all__ = [
     "pressure_to_mpa",
 ]
 
-#: Factor from each accepted pressure unit to MPa.
-PRESSURE_UNITS: dict[str, float] = {"kPa": 1e-3, "MPa": 1.0, "bar": 0.1, "psi": 6.894757293168e-3}
+#: Factor from each pressure unit an actuator is described in to MPa (:mod:`softbend.units`).
+PRESSURE_UNITS: dict[str, float] = {u: f for u, f in units.PRESSURE_UNITS.items() if u != "Pa"}
 
 Kind = Literal["continuous", "integer", "categorical"]
 KINDS: tuple[str, ...] = ("continuous", "integer", "categorical")

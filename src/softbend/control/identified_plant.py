@@ -30,7 +30,7 @@ from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
-from softbend.actuators import PRESSURE_UNITS
+from softbend import units
 from softbend.control.rig import RIG_RANGES, AngleTable
 from softbend.errors import InputError
 
@@ -50,7 +50,7 @@ __all__ = [
 
 #: MPa per unit of a pressure column, by the unit its name ends with: an actuator
 #: description's units, and pascal, which a recording may use.
-MPA_PER_UNIT: dict[str, float] = {**PRESSURE_UNITS, "Pa": 1e-6}
+MPA_PER_UNIT: dict[str, float] = units.PRESSURE_UNITS
 
 #: Grid points of the steady-state θ(p) of an identified plant.
 STEADY_POINTS = 41
