@@ -236,9 +236,16 @@ def check_replaceable(
     others = foreign_entries(target, command)
     if others:
         shown = ", ".join(others[:3]) + (f" and {len(others) - 3} more" if len(others) > 3 else "")
+        manifest = read_manifest(target)
+        if manifest is None:
+            why = f"; it has no {MANIFEST}, so nothing in it is known to be softbend's"
+        elif manifest.command != command:
+            why = f"; they are the results of '{manifest.command}'"
+        else:
+            why = ""
         raise InputError(
             f"{path} is replaced as a whole by the results of '{command}', but it holds other "
-            f"files ({shown}); choose a new or empty folder, or one of its earlier results.",
+            f"files ({shown}){why}; choose a new or empty folder, or one of its earlier results.",
             key=key,
         )
     return target
