@@ -11,6 +11,7 @@ from __future__ import annotations
 
 import math
 import re
+from collections.abc import Iterable
 
 from softbend.errors import InputError
 
@@ -20,6 +21,7 @@ __all__ = [
     "check_column_unit",
     "column_unit",
     "convert_pressure",
+    "outside",
     "parse_pressure",
 ]
 
@@ -130,3 +132,14 @@ def _pressure_unit(unit: str, option: str = "unit") -> str:
             f"{option}: unknown pressure unit {unit!r}; allowed: {', '.join(PRESSURE_UNITS)}."
         )
     return found
+
+
+def outside(values: Iterable[float], span: tuple[float, float] | None) -> list[float]:
+    """The ``values`` outside ``span`` (``(low, high)``, inclusive), in order; none without one.
+
+    For pressures asked of a model beyond those it was trained on, in the model's unit.
+    """
+    if span is None:
+        return []
+    low, high = span
+    return [float(v) for v in values if v < low or v > high]

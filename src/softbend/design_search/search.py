@@ -246,10 +246,9 @@ class SearchResult:
     @property
     def outside_pressures(self) -> list[float]:
         """The target's pressures outside :attr:`pressure_range` (its unit)."""
-        if self.pressure_range is None:
-            return []
-        low, high = self.pressure_range
-        return [float(p) for p in self.spec.target.pressures_mpa if p < low or p > high]
+        from softbend.units import outside
+
+        return outside(self.spec.target.pressures_mpa, self.pressure_range)
 
     def pressure_warning(self) -> str | None:
         """The target's pressures outside the model's trained range, and the range; else None."""

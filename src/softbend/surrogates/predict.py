@@ -87,10 +87,9 @@ class Prediction:
     @property
     def outside_pressures(self) -> list[float]:
         """The pressures asked for outside :attr:`pressure_range`, in the order asked."""
-        if self.pressure_range is None:
-            return []
-        low, high = self.pressure_range
-        return [float(p) for p in self.pressure_mpa if p < low or p > high]
+        from softbend.units import outside
+
+        return outside(self.pressure_mpa, self.pressure_range)
 
     def pressure_warning(self) -> str | None:
         """The pressures outside the trained range and the range, in words; else None."""
