@@ -21,6 +21,7 @@ from pathlib import Path
 
 import pytest
 
+from softbend._outdir import MANIFEST
 from softbend.cli import main
 
 from .conftest import one_error_line
@@ -33,8 +34,8 @@ def _snapshot(folder: Path) -> dict[str, bytes]:
 
 
 def _hidden(parent: Path) -> list[str]:
-    """Temporary files or staging folders left beside the outputs."""
-    return sorted(p.name for p in parent.rglob(".*"))
+    """Temporary files or staging folders left beside the outputs (not a folder's manifest)."""
+    return sorted(p.name for p in parent.rglob(".*") if p.name != MANIFEST)
 
 
 def test_a_run_that_never_settles_reports_null_with_the_reason(tmp_path, capsys):
@@ -99,8 +100,8 @@ def _fail_figure(*args, **kwargs):
 
 @pytest.mark.parametrize(
     ("command", "files"),
-    [("simulate", {"run.csv", "metrics.json", "run.png"}),
-     ("run", {"ticks.csv", "run.json", "run.png"})],
+    [("simulate", {"run.csv", "metrics.json", "run.png", MANIFEST}),
+     ("run", {"ticks.csv", "run.json", "run.png", MANIFEST})],
 )  # fmt: skip
 def test_a_failed_write_leaves_the_previous_results(tmp_path, capsys, monkeypatch, command, files):
     out = tmp_path / "o"
@@ -133,7 +134,7 @@ def test_a_new_run_replaces_the_old_one_whole(tmp_path, capsys):
     base = ["control", "run", "--out", str(out), "--duration", "0.3"]
     assert main(base) == 0
     assert main([*base, "--log-format", "parquet"]) == 0  # the old ticks.csv goes too
-    assert {p.name for p in out.iterdir()} == {"ticks.parquet", "run.json", "run.png"}
+    assert {p.name for p in out.iterdir()} == {"ticks.parquet", "run.json", "run.png", MANIFEST}
     assert _hidden(tmp_path) == []
 
 

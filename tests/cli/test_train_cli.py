@@ -369,7 +369,7 @@ def test_train_does_not_swap_away_a_folder_of_other_files_or_its_input(
     inside.mkdir()
     db = shutil.copy(small_campaign, inside / "c.duckdb")
     assert main(["train", str(db), "--models", "plr", "--no-onnx", "--out", str(inside)]) == 2
-    assert "holds the input" in one_error_line(capsys)
+    assert "holds the 'DB'" in one_error_line(capsys)
     assert (inside / "c.duckdb").is_file()
     # an earlier result of softbend train is replaced as before
     out = tmp_path / "out"
