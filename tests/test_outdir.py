@@ -10,8 +10,6 @@ from __future__ import annotations
 
 import json
 import os
-import subprocess
-import sys
 from pathlib import Path
 
 import pytest
@@ -32,31 +30,8 @@ from softbend._outdir import (
 )
 from softbend.errors import InputError
 
+from .folders import dead_pid, tree
 from .properties import property_settings
-
-
-def _tree(root: Path) -> dict[str, object]:
-    """Every entry under ``root``: relative path → bytes, ``"dir"`` or ``("link", target)``."""
-    found: dict[str, object] = {}
-    for path in sorted(root.rglob("*")):
-        key = path.relative_to(root).as_posix()
-        if path.is_symlink():
-            found[key] = ("link", os.readlink(path))
-        elif path.is_dir():
-            found[key] = "dir"
-        else:
-            found[key] = path.read_bytes()
-    return found
-
-
-def _dead_pid() -> int:
-    child = subprocess.run(
-        [sys.executable, "-c", "import os; print(os.getpid())"],
-        capture_output=True,
-        text=True,
-        check=True,
-    )
-    return int(child.stdout)
 
 
 def _earlier(out: Path, command: str, names: tuple[str, ...] = ("summary.json", "fig/a.png")):
@@ -94,13 +69,13 @@ def test_a_users_file_beside_an_earlier_result_is_refused_and_kept(tmp_path):
     _earlier(out, "fem run", ("sweep.json", "vtk/shape_p0.vtu"))
     (out / "thesis.txt").write_text("three years\n")
     (out / "vtk" / "mine.vtu").write_text("<VTK/>\n")
-    before = _tree(tmp_path)
+    before = tree(tmp_path)
     assert foreign_entries(out, "fem run") == ["thesis.txt", "vtk/mine.vtu"]
     with pytest.raises(InputError, match=r"holds other files \(thesis.txt, vtk/mine.vtu\)"):
         check_replaceable(out, "fem run")
     with pytest.raises(OutputFolderError, match="nothing was replaced"), staged_dir(out, "fem run"):
         pass
-    after = _tree(tmp_path)
+    after = tree(tmp_path)
     for key, value in before.items():  # every file kept as it was (a staging folder is added)
         assert after[key] == value
 
@@ -175,7 +150,7 @@ def test_the_running_command_names_the_results(tmp_path):
 
 
 def test_only_staging_folders_that_prove_they_are_softbends_are_removed(tmp_path):
-    dead = _dead_pid()
+    dead = dead_pid()
     out = tmp_path / "models"
     killed = tmp_path / f".models.{dead}-abc123.new"  # a run killed before its swap
     killed.mkdir()
@@ -205,11 +180,11 @@ def test_only_staging_folders_that_prove_they_are_softbends_are_removed(tmp_path
 def test_a_failed_block_leaves_the_folder_and_no_staging(tmp_path):
     out = tmp_path / "out"
     _earlier(out, "train")
-    before = _tree(tmp_path)
+    before = tree(tmp_path)
     with pytest.raises(RuntimeError), staged_dir(out, "train") as stage:
         (stage / "partial.json").write_text("{")
         raise RuntimeError("stopped")
-    assert _tree(tmp_path) == before
+    assert tree(tmp_path) == before
 
 
 # ----------------------------------------------------------------------------- property
@@ -257,7 +232,7 @@ def _lay_out(root: Path, layout: dict[str, object]) -> Path:
             target.mkdir(parents=True, exist_ok=True)
             link.symlink_to(outside / "precious.txt")
     if layout["staging_alike"]:
-        alike = root / f".{target.name}.{_dead_pid()}-x.new"
+        alike = root / f".{target.name}.{dead_pid()}-x.new"
         alike.mkdir()
         (alike / "mine.txt").write_text("mine\n")
     return out
@@ -268,7 +243,7 @@ def _lay_out(root: Path, layout: dict[str, object]) -> Path:
 def test_no_user_file_is_ever_removed(tmp_path_factory, layout, command):
     root = tmp_path_factory.mktemp("layout")
     out = _lay_out(root, layout)
-    before = _tree(root)
+    before = tree(root)
     own: set[str] = set()
     target = Path(os.path.realpath(out))
     manifest = read_manifest(target)
@@ -278,7 +253,7 @@ def test_no_user_file_is_ever_removed(tmp_path_factory, layout, command):
     try:
         check_replaceable(out, command)
     except InputError:
-        assert _tree(root) == before  # refused before any work: nothing touched
+        assert tree(root) == before  # refused before any work: nothing touched
         refused = True
     else:
         refused = False
@@ -287,7 +262,7 @@ def test_no_user_file_is_ever_removed(tmp_path_factory, layout, command):
             (stage / "result.json").write_text("{}\n")
     except OutputFolderError:
         assert refused
-    after = _tree(root)
+    after = tree(root)
     for key, value in before.items():
         if key in own:
             continue  # the command's own earlier results may be replaced

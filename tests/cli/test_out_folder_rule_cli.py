@@ -20,23 +20,13 @@ from hypothesis import strategies as st
 from softbend._outdir import MANIFEST, read_manifest
 from softbend.cli import main
 
+from ..folders import tree
 from ..properties import property_settings
 from .conftest import one_error_line
 
 ROOT = Path(__file__).resolve().parents[2]
 MEASUREMENTS = ROOT / "src" / "softbend" / "data" / "transfer" / "virtual_lab.csv"
 PNEUNET = ROOT / "examples" / "pneunet"
-
-
-def _tree(root: Path) -> dict[str, object]:
-    found: dict[str, object] = {}
-    for path in sorted(root.rglob("*")):
-        key = path.relative_to(root).as_posix()
-        if path.is_symlink():
-            found[key] = ("link", os.readlink(path))
-        else:
-            found[key] = "dir" if path.is_dir() else path.read_bytes()
-    return found
 
 
 @pytest.fixture
@@ -141,9 +131,9 @@ def test_a_folder_with_the_users_files_is_refused_and_kept(tmp_path_factory, inp
     def check(foreign):
         root = tmp_path_factory.mktemp("user")
         out = _lay_out(root, command, foreign)
-        before = _tree(root)
+        before = tree(root)
         code = main(_argv(command, out, inputs))
-        after = _tree(root)
+        after = tree(root)
         assert code == 2, command
         assert after == before, command
 
@@ -231,11 +221,11 @@ def test_out_as_the_current_folder_or_above_is_one_line(tmp_path, monkeypatch, c
     work.mkdir()
     (work / "notes.txt").write_text("mine\n")
     monkeypatch.chdir(work)
-    before = _tree(tmp_path)
+    before = tree(tmp_path)
     assert main(["curling", "simulate", "--out", given, "--samples", "16"]) == 2
     line = one_error_line(capsys)
     assert f"The '--out' {given} is " in line and "name a new folder" in line
-    assert _tree(tmp_path) == before
+    assert tree(tmp_path) == before
 
 
 def test_a_saved_model_never_replaces_a_users_json(tmp_path, small_base_file, capsys):

@@ -27,6 +27,7 @@ import pytest
 from softbend._outdir import MANIFEST
 from softbend.cli import main
 
+from ..folders import dead_pid
 from .conftest import one_error_line
 
 # ----------------------------------------------------------------------------- helpers
@@ -55,17 +56,6 @@ def _unfinished_manifest(folder: Path, command: str) -> None:
 
 def _full_disk(*args: object, **kwargs: object) -> None:
     raise OSError(errno.ENOSPC, "No space left on device")
-
-
-def _dead_pid() -> int:
-    """The PID of a process that has exited."""
-    child = subprocess.run(
-        [sys.executable, "-c", "import os; print(os.getpid())"],
-        capture_output=True,
-        text=True,
-        check=True,
-    )
-    return int(child.stdout)
 
 
 def _full_disk_line(out: Path, capsys: pytest.CaptureFixture[str]) -> str:
@@ -671,7 +661,7 @@ def test_reproduce_killed_resumes_the_campaign_and_removes_the_stage(
     assert main(_reproduce(out, 0)) == 0
     before = _tree(out)
     # a run killed (kill -9) after its campaign: its staging folder is left beside --out
-    stale = tmp_path / f".report.{_dead_pid()}-abcd1234.new"
+    stale = tmp_path / f".report.{dead_pid()}-abcd1234.new"
     (stale / "paper_b").mkdir(parents=True)
     (stale / "paper_b" / "campaign.duckdb").write_text("8\n")
     (stale / "paper_a").mkdir()
