@@ -419,3 +419,17 @@ def test_an_undefined_mape_is_a_dash_in_the_table(capsys):
     assert "MAPE % (|θ| ≥ 12.5°)" in out and "4.250" in out and "best by held-out RMSE: plr" in out
     plr_row = next(line for line in out.splitlines() if "degree=2" in line and "plr" in line)
     assert "—" in plr_row and "nan" not in out.lower()
+
+
+def test_predict_takes_pressures_with_units_in_the_models_unit(small_base_file, capsys):
+    """50 kPa and 7.2519 psi are 0.05 MPa, paper B's unit: the same angle as 0.05."""
+    args = ["predict", str(small_base_file), "--design", "100,6,2,2,5,8", "--json"]
+    assert main([*args, "--pressures", "0.05,50kPa,7.2519psi"]) == 0
+    payload = json.loads(capsys.readouterr().out)
+    assert payload["pressure_mpa"] == pytest.approx([0.05, 0.05, 0.05], rel=1e-5)
+    angles = payload["angle_deg"]
+    assert angles == pytest.approx([angles[0]] * 3, rel=1e-4)
+    assert main([*args, "--pressures", "0.05,5furlongs"]) == 2
+    assert "--pressures: must be comma-separated numbers, each optionally with a unit" in (
+        one_error_line(capsys)
+    )

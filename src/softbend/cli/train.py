@@ -322,7 +322,7 @@ def predict(
     pressures: str = typer.Option(
         None,
         help="Comma-separated gauge pressures in the model's pressure unit (MPa for paper "
-        "B's actuator; such as 0.05,0.1).",
+        "B's actuator; such as 0.05,0.1), or each with a unit (20psi,138kPa).",
     ),
     strict: bool = typer.Option(
         False, "--strict", help="Refuse a design or pressure outside the model's training data."

@@ -170,19 +170,30 @@ def calibrated_interval(record: object, angles: np.ndarray) -> tuple[np.ndarray,
     return np.minimum(np.maximum(angles - half, floor), angles), angles + half
 
 
-def parse_pressures(text: str) -> list[float]:
+def parse_pressures(text: str, unit: str | None = None) -> list[float]:
     """Pressures from comma-separated text such as ``"0.05,0.1"`` (in the model's unit).
+
+    With the model's ``unit``, a value may carry its own unit (``"20psi,138kPa"``,
+    :func:`softbend.units.parse_pressure`) and is converted to ``unit``.
 
     Raises
     ------
     softbend.errors.InputError
-        Text that is not comma-separated numbers, or holds none (no key: the
-        caller names the input, :func:`~softbend.errors.keyed`).
+        Text that is not comma-separated numbers (with units, given ``unit``), or
+        holds none (no key: the caller names the input, :func:`~softbend.errors.keyed`).
     """
+    from softbend.units import PRESSURE_UNITS, parse_pressure
+
+    items = [v for v in text.split(",") if v.strip()]
     try:
-        values = [float(v) for v in text.split(",") if v.strip()]
+        if unit is None:
+            values = [float(v) for v in items]
+        else:
+            values = [parse_pressure(v, unit, "pressures") for v in items]
     except ValueError:
-        raise InputError(must_be("comma-separated numbers, e.g. 0.05,0.1", text)) from None
+        units = ", ".join(PRESSURE_UNITS)
+        form = f"comma-separated numbers, each optionally with a unit ({units}), e.g. 0.05,0.1"
+        raise InputError(must_be(f"{form} or 20psi", text)) from None
     if not values:
         raise InputError(must_be("at least one number", text))
     return values
@@ -205,8 +216,8 @@ def predict_text(
         ``"A=1,B=2,..."`` by the model's parameter names, or the values in the
         model's column order (paper B's: ``"l,r,t,b,phi,lc"`` in mm and degrees).
     pressures : str
-        Comma-separated gauge pressures in the model's pressure unit
-        (:func:`parse_pressures`; MPa for paper B's actuator).
+        Comma-separated gauge pressures in the model's pressure unit, or each with
+        its own unit (:func:`parse_pressures`; MPa for paper B's actuator).
     strict : bool
         As :func:`predict_angles`.
 
@@ -217,7 +228,11 @@ def predict_text(
         not finite are keyed ``pressures``.
     """
     with keyed("pressures"):
-        values = parse_pressures(pressures)
+        try:
+            values = parse_pressures(pressures)
+        except InputError:  # values with units (20psi): in the model's unit
+            _, saved = load_predictor(path)
+            values = parse_pressures(pressures, saved.actuator.pressure_unit)
     _check_pressures(values, key="pressures")
     return predict_angles(path, design, values, strict=strict)
 
