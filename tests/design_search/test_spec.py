@@ -91,8 +91,10 @@ def test_command_line_text():
     ranges, steps = build_ranges(["phi=10"], ["t=3:4"], ["l=1"], step=0.25)
     assert ranges == {"phi": ParameterRange(10, 10), "t": ParameterRange(3, 4, 0.25)}
     assert steps["l"] == 1.0 and steps["r"] == 0.25
-    with pytest.raises(ValueError, match="given twice"):
+    with pytest.raises(ValueError, match=r"^ranges: 't' is given twice"):
         build_ranges(["t=3"], ["t=3:4"])
+    with pytest.raises(ValueError, match=r"^fixes: 't' is given twice"):  # named by its option
+        build_ranges(["t=3", "t=4"], ())
     with pytest.raises(ValueError, match="NAME=LOW:HIGH"):
         build_ranges((), ["t=3-4"])
     with pytest.raises(ValueError, match=r"^fixes: .*among l, r"):

@@ -857,28 +857,30 @@ def build_ranges(
         if value < 0:
             raise InputError(f"{name} {must_be('>= 0', value)}", key="steps")
         per_step[name] = value
-    given: list[tuple[str, ParameterRange]] = []
+    given: list[tuple[str, ParameterRange, str]] = []
     for text in fixes:
         with keyed("fixes"):
             name, value = parse_assignment(text)
             _check_design_values(name, (value,), text)
-        given.append((name, ParameterRange(value, value, 0.0)))
+        given.append((name, ParameterRange(value, value, 0.0), "fixes"))
     for text in ranges:
         with keyed("ranges"):
             name, low, high = parse_range(text)
             _check_design_values(name, (low, high), text)
-        given.append((name, ParameterRange(low, high, per_step[name])))
+        given.append((name, ParameterRange(low, high, per_step[name]), "ranges"))
     return _once(given), per_step
 
 
-def _once(given: Sequence[tuple[str, ParameterRange]]) -> dict[str, ParameterRange]:
-    """The ranges by parameter, each given once (by ``fixes`` or ``ranges``)."""
+def _once(given: Sequence[tuple[str, ParameterRange, str]]) -> dict[str, ParameterRange]:
+    """The ranges by parameter, each given once (by ``fixes`` or ``ranges``).
+
+    Each entry is ``(name, range, key)``; a name given twice is refused keyed by the
+    option of its second mention (``fixes`` or ``ranges``).
+    """
     out: dict[str, ParameterRange] = {}
-    for name, chosen in given:
+    for name, chosen, key in given:
         if name in out:
-            raise InputError(
-                f"{name!r} is given twice (fixed or ranged); give it once", key="ranges"
-            )
+            raise InputError(f"{name!r} is given twice (fixed or ranged); give it once", key=key)
         out[name] = chosen
     return out
 
@@ -925,15 +927,15 @@ def _build_other(
         if problem is not None:
             raise InputError(f"{key} ({value.strip()}) {problem}", key="steps")
         per_step[key] = number
-    given: list[tuple[str, ParameterRange]] = []
+    given: list[tuple[str, ParameterRange, str]] = []
     for text in fixes:
         with keyed("fixes"):
             key, code = parse_value(space, text)
-        given.append((key, ParameterRange(code, code, 0.0)))
+        given.append((key, ParameterRange(code, code, 0.0), "fixes"))
     for text in ranges:
         with keyed("ranges"):
             key, low, high = parse_span(space, text)
-        given.append((key, ParameterRange(low, high, per_step[key])))
+        given.append((key, ParameterRange(low, high, per_step[key]), "ranges"))
     return _once(given), {n: v for n, v in per_step.items() if space.kind(n) != "categorical"}
 
 
