@@ -186,7 +186,12 @@ def measure(
                 with _common.output_errors(figure, "--out"), _common.as_written(png, figure):
                     lab_measurements(measurements, png)
     except KeyboardInterrupt:
-        _common.error_line(f"interrupted: {out} and {figure} are as they were")
+        _common.err_console.print(
+            f"softbend: interrupted; {out} and {figure} are as they were",
+            markup=False,
+            highlight=False,
+            soft_wrap=True,
+        )
         raise typer.Exit(130) from None
     per = measurements.per_actuator()
     if as_json:
