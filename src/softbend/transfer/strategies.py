@@ -213,6 +213,36 @@ def _fit_failed(estimator: object, error: Exception, keep_going: bool) -> None:
     estimator.fit_error_ = error  # type: ignore[attr-defined]
 
 
+def _tune_batch(
+    starts: Any,
+    X: np.ndarray,
+    y: np.ndarray,
+    row_sets: list[np.ndarray],
+    first: Any,
+    estimators: Sequence[object],
+    keep_going: bool,
+) -> list[NormalizedMLPRegressor] | None:
+    """``fine_tune_many`` of ``starts`` on each of ``row_sets`` with ``first``'s settings.
+
+    None when the batch as a whole fails (every fit of it): the error is raised, or
+    (``keep_going``) recorded on each of ``estimators`` (:func:`_fit_failed`).
+    """
+    try:
+        return fine_tune_many(
+            starts,
+            X,
+            y,
+            row_weights(row_sets, len(y)),
+            epochs=first.epochs,
+            learning_rate=first.learning_rate,
+            device=first.device,
+        )
+    except ConvergenceError as error:
+        for estimator in estimators:
+            _fit_failed(estimator, error, keep_going)
+        return None
+
+
 def _check_trained(
     strategy: str, model: NormalizedMLPRegressor, X: np.ndarray, learning_rate: float
 ) -> None:
@@ -706,19 +736,11 @@ class RefinedMLP(_Strategy):
                 ready.append(start)
         if not live:
             return estimators
-        try:
-            models = fine_tune_many(
-                ready,
-                X,
-                y,
-                row_weights([row_sets[i] for i in live], len(y)),
-                epochs=first.epochs,
-                learning_rate=first.learning_rate,
-                device=first.device,
-            )
-        except ConvergenceError as error:  # the batch as a whole: every fit of it failed
-            for i in live:
-                _fit_failed(estimators[i], error, keep_going)
+        models = _tune_batch(
+            ready, X, y, [row_sets[i] for i in live], first, [estimators[i] for i in live],
+            keep_going,
+        )  # fmt: skip
+        if models is None:
             return estimators
         name = _registered_name(cls)
         for i, model in zip(live, models, strict=True):
@@ -849,19 +871,8 @@ class ExperimentalMLP(_Strategy):
                     intercepts=intercepts,
                 )
             )
-        try:
-            models = fine_tune_many(
-                starts,
-                X,
-                y,
-                row_weights(row_sets, len(y)),
-                epochs=first.epochs,
-                learning_rate=first.learning_rate,
-                device=first.device,
-            )
-        except ConvergenceError as error:  # the batch as a whole: every fit of it failed
-            for estimator in estimators:
-                _fit_failed(estimator, error, keep_going)
+        models = _tune_batch(starts, X, y, row_sets, first, estimators, keep_going)
+        if models is None:
             return estimators
         name = _registered_name(cls)
         for estimator, model, rows in zip(estimators, models, row_sets, strict=True):
@@ -1188,19 +1199,8 @@ class RefinedEnsemble(_Corrected):
             est._draws(X, np.asarray(rows)) for est, rows in zip(estimators, row_sets, strict=True)
         ]
         flat = [d for member_rows in draws for d in member_rows]
-        try:
-            models = fine_tune_many(
-                base,
-                X,
-                y,
-                row_weights(flat, len(y)),
-                epochs=first.epochs,
-                learning_rate=first.learning_rate,
-                device=first.device,
-            )
-        except ConvergenceError as error:  # the batch as a whole: every fit of it failed
-            for estimator in estimators:
-                _fit_failed(estimator, error, keep_going)
+        models = _tune_batch(base, X, y, flat, first, estimators, keep_going)
+        if models is None:
             return estimators
         name = _registered_name(cls)
         for i, (estimator, rows) in enumerate(zip(estimators, row_sets, strict=True)):
