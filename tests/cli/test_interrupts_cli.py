@@ -74,13 +74,13 @@ def _start(args: list[str], cwd: Path, delay_s: float) -> subprocess.Popen[str]:
     )
 
 
-def _interrupt_after(
-    child: subprocess.Popen[str], started: str, wait_s: float = 0.0
-) -> tuple[float, str]:
+def _interrupt_after(child: subprocess.Popen[str], started: str, wait_s: float = 0.0) -> str:
     """Send SIGINT to the child's group ``wait_s`` after a stderr line matching ``started``.
 
-    Returns the seconds the child took to end after it and its whole stderr (read
-    until every process of the group has closed it).
+    Returns the child's whole stderr (read until every process of the group has
+    closed it). A child still running 30 s later is killed and fails the test (a
+    hang guard: that it stops without finishing its designs in flight is what the
+    tests check, by the designs recorded).
     """
     assert child.stderr is not None
     lines = []
@@ -91,15 +91,13 @@ def _interrupt_after(
                 break
         time.sleep(wait_s)
         os.killpg(child.pid, signal.SIGINT)
-        sent = time.monotonic()
         child.wait(timeout=30)
-        took = time.monotonic() - sent
         _, rest = child.communicate(timeout=30)
     finally:
         if child.poll() is None:
             os.killpg(child.pid, signal.SIGKILL)
             child.communicate()
-    return took, "".join(lines) + rest
+    return "".join(lines) + rest
 
 
 def _assert_none_left(folder: Path) -> None:
@@ -115,9 +113,8 @@ def test_ctrl_c_stops_a_campaign_in_one_line_and_the_same_command_resumes(tmp_pa
     args = ["campaign", "run", "c.duckdb", "--backend", "slow", "--space", "lhs:6"]
     args += ["--workers", "2", "--chunk-size", "1", "--pmax", "0.1", "--pstep", "0.05"]
     child = _start(args, tmp_path, delay_s=2.0)
-    took, err = _interrupt_after(child, r"done [1-5] ")
+    err = _interrupt_after(child, r"done [1-5] ")
     assert child.returncode == 130, err
-    assert took < 5.0
     assert "Traceback" not in err and "KeyboardInterrupt" not in err
     last = err.strip().splitlines()[-1]
     assert last == (
@@ -144,9 +141,8 @@ def test_ctrl_c_as_the_workers_start_is_one_line_too(tmp_path):
     args = ["campaign", "run", "c.duckdb", "--backend", "slow", "--space", "lhs:6"]
     args += ["--workers", "2", "--chunk-size", "1", "--pmax", "0.1", "--pstep", "0.05"]
     child = _start(args, tmp_path, delay_s=2.0)
-    took, err = _interrupt_after(child, r"done 0 ", wait_s=0.2)  # the fork server imports
+    err = _interrupt_after(child, r"done 0 ", wait_s=0.2)  # the fork server imports
     assert child.returncode == 130, err
-    assert took < 5.0
     assert "Traceback" not in err and "KeyboardInterrupt" not in err
     assert err.strip().splitlines()[-1].startswith("softbend: interrupted; finished work is kept")
 
@@ -157,9 +153,8 @@ def test_ctrl_c_stops_a_serial_campaign_of_a_backend_that_compiles(tmp_path):
     args = ["campaign", "run", "c.duckdb", "--backend", "slow-compiled", "--space", "lhs:4"]
     args += ["--workers", "1", "--pmax", "0.1", "--pstep", "0.05"]
     child = _start(args, tmp_path, delay_s=2.0)
-    took, err = _interrupt_after(child, r"done [1-3] ")
+    err = _interrupt_after(child, r"done [1-3] ")
     assert child.returncode == 130, err
-    assert took < 5.0
     assert "Traceback" not in err
     assert err.strip().splitlines()[-1].startswith("softbend: interrupted; finished work is kept")
     _assert_none_left(tmp_path)
@@ -176,9 +171,8 @@ def test_ctrl_c_stops_a_verification_in_one_line_and_the_same_command_resumes(tm
             "--fix", "lc=10", "--out", "found", "--verify", "4", "--backend", "slow",
             "--workers", "2"]  # fmt: skip
     child = _start(args, tmp_path, delay_s=2.0)
-    took, err = _interrupt_after(child, r"\(slow\): [1-3]/4")
+    err = _interrupt_after(child, r"\(slow\): [1-3]/4")
     assert child.returncode == 130, err
-    assert took < 5.0
     assert "Traceback" not in err and "KeyboardInterrupt" not in err
     (db,) = tmp_path.glob(".found.verify-*.duckdb")
     assert err.strip().splitlines()[-1] == (
@@ -212,9 +206,8 @@ def test_ctrl_c_stops_a_campaign_on_dask_in_one_line_and_the_same_command_resume
     args += ["--scheduler", str(scheduler_file), "--chunk-size", "1"]
     args += ["--pmax", "0.1", "--pstep", "0.05"]
     child = _start(args, tmp_path, delay_s=1.5)
-    took, err = _interrupt_after(child, r"done [1-3] ")
+    err = _interrupt_after(child, r"done [1-3] ")
     assert child.returncode == 130, err
-    assert took < 5.0
     assert "Traceback" not in err and "KeyboardInterrupt" not in err
     assert err.strip().splitlines()[-1] == (
         "softbend: interrupted; finished work is kept in c.duckdb; resume with: softbend "
