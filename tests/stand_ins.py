@@ -122,6 +122,26 @@ def actuator_table(designs: int = 24, seed: int = 0) -> pd.DataFrame:
     return pd.DataFrame(rows)
 
 
+def actuator_plr_base(sims: Path, folder: Path, pressure_column: str = "p_kpa") -> Path:
+    """A quick polynomial surrogate of a table of :func:`actuator_table`, saved under ``folder``.
+
+    The pressure unit is the column's (``p_kpa`` → kPa, ``p_psi`` → psi). Returns the
+    model file, ``folder/models/plr.json``.
+    """
+    from softbend.surrogates.tables import table_training_data
+    from softbend.surrogates.workflow import train_surrogates
+    from softbend.units import column_unit
+
+    data = table_training_data(
+        sims,
+        design_columns=ACTUATOR_COLUMNS,
+        pressure_column=pressure_column,
+        pressure_unit=column_unit(pressure_column),
+    )
+    train_surrogates(data, folder, models="plr", grid_name="quick", folds=3, export_onnx=False)
+    return folder / "models" / "plr.json"
+
+
 # --- a stand-in FEM family: a closed-form sweep behind softbend.fem.families ----------------
 
 

@@ -10,10 +10,8 @@ import pytest
 
 from softbend.cli import main
 from softbend.surrogates.persistence import load_surrogate
-from softbend.surrogates.tables import table_training_data
-from softbend.surrogates.workflow import train_surrogates
 
-from ..stand_ins import ACTUATOR_COLUMNS, actuator_law, actuator_table
+from ..stand_ins import actuator_law, actuator_plr_base, actuator_table
 from .conftest import one_error_line
 
 BUILT = {  # id: (n_chambers, wall_mm, height_mm, layer)
@@ -39,12 +37,7 @@ def plr_lab(tmp_path_factory):
     folder = tmp_path_factory.mktemp("plr")
     sims = folder / "sims.csv"
     actuator_table(designs=30).to_csv(sims, index=False)
-    data = table_training_data(
-        sims, design_columns=ACTUATOR_COLUMNS, pressure_column="p_kpa", pressure_unit="kPa"
-    )
-    train_surrogates(
-        data, folder / "m", models="plr", grid_name="quick", folds=3, export_onnx=False
-    )
+    base = actuator_plr_base(sims, folder / "m")
     pressures = (0.0, 10.0, 20.0, 30.0, 40.0, 50.0)
     readings = folder / "readings.csv"
     readings.write_text(
@@ -55,7 +48,7 @@ def plr_lab(tmp_path_factory):
         "\n".join([HEADER] + [_reading("P1", p) for p in pressures] + [_reading("P3", 0.0)] * 2)
         + "\n"
     )
-    return folder / "m" / "models" / "plr.json", readings, zero
+    return base, readings, zero
 
 
 def _warnings(err: str) -> list[str]:

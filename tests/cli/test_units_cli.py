@@ -15,7 +15,7 @@ import pytest
 
 from softbend.cli import main
 
-from ..stand_ins import ACTUATOR_COLUMNS, actuator_law, actuator_table
+from ..stand_ins import ACTUATOR_COLUMNS, actuator_law, actuator_plr_base, actuator_table
 from .conftest import one_error_line
 
 HEADER = "actuator,n_chambers,wall_mm,height_mm,layer,p_kpa,angle_deg"
@@ -33,15 +33,7 @@ def sims(tmp_path_factory):
 @pytest.fixture(scope="module")
 def base(sims):
     """A polynomial fitted to ``sims`` (its trained pressure range: 0-50 kPa)."""
-    from softbend.surrogates.tables import table_training_data
-    from softbend.surrogates.workflow import train_surrogates
-
-    data = table_training_data(
-        sims, design_columns=ACTUATOR_COLUMNS, pressure_column="p_kpa", pressure_unit="kPa"
-    )
-    out = sims.parent / "m"
-    train_surrogates(data, out, models="plr", grid_name="quick", folds=3, export_onnx=False)
-    return out / "models" / "plr.json"
+    return actuator_plr_base(sims, sims.parent / "m")
 
 
 def readings(path, scale=1.0, ids=True, actuators=BUILT, stiff=1.0):
@@ -132,17 +124,11 @@ def test_force_uses_pressures_past_the_range_and_records_it(base, tmp_path, caps
 
 
 def test_kpa_numbers_in_a_psi_column_say_what_they_look_like(tmp_path, capsys):
-    from softbend.surrogates.tables import table_training_data
-    from softbend.surrogates.workflow import train_surrogates
-
     sims = tmp_path / "sims.csv"
     table = actuator_table(designs=12)
     table["p_psi"] = table.pop("p_kpa") / 6.894757  # 0-7.25 psi
     table.to_csv(sims, index=False)
-    data = table_training_data(
-        sims, design_columns=ACTUATOR_COLUMNS, pressure_column="p_psi", pressure_unit="psi"
-    )
-    train_surrogates(data, tmp_path / "m", models="plr", grid_name="quick", folds=3)
+    actuator_plr_base(sims, tmp_path / "m", pressure_column="p_psi")
     bench = readings(tmp_path / "bench.csv")  # kPa numbers in the psi column
     bench.write_text(bench.read_text().replace("p_kpa", "p_psi"))
     argv = ["transfer", "loco", str(bench), "--base", str(tmp_path / "m/models/plr.json")]

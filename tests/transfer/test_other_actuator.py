@@ -10,13 +10,11 @@ import pytest
 from softbend.cli import main
 from softbend.surrogates.persistence import load_surrogate
 from softbend.surrogates.predict import predict_angles
-from softbend.surrogates.tables import table_training_data
-from softbend.surrogates.workflow import train_surrogates
 from softbend.transfer.actuator_measurements import load_actuator_measurements
 from softbend.transfer.loco import BASELINE_STRATEGY, leave_one_configuration_out
 from softbend.transfer.refine import refine_surrogate
 
-from ..stand_ins import ACTUATOR_COLUMNS, actuator_law, actuator_table
+from ..stand_ins import actuator_law, actuator_plr_base, actuator_table
 
 BUILT = {  # id: (n_chambers, wall_mm, height_mm, layer); stiffer than simulated, more so if thin
     "P1": (8, 1.5, 10.0, "paper"),
@@ -36,12 +34,7 @@ def lab(tmp_path_factory):
     folder = tmp_path_factory.mktemp("other")
     sims = folder / "sims.csv"
     actuator_table(designs=30).to_csv(sims, index=False)
-    data = table_training_data(
-        sims, design_columns=ACTUATOR_COLUMNS, pressure_column="p_kpa", pressure_unit="kPa"
-    )
-    train_surrogates(
-        data, folder / "m", models="plr", grid_name="quick", folds=3, export_onnx=False
-    )
+    base = actuator_plr_base(sims, folder / "m")
     lines = ["# synthetic: true", "actuator,n_chambers,wall_mm,height_mm,layer,p_kpa,angle_deg"]
     for name, (n, wall, height, layer) in BUILT.items():
         for p in (0.0, 10.0, 20.0, 30.0, 40.0, 50.0):
@@ -49,7 +42,7 @@ def lab(tmp_path_factory):
             lines.append(f"{name},{n},{wall},{height},{layer},{p},{angle:.3f}")
     readings = folder / "readings.csv"
     readings.write_text("\n".join(lines) + "\n")
-    return folder / "m" / "models" / "plr.json", readings
+    return base, readings
 
 
 def test_loco_scores_every_strategy_against_the_baseline(lab):
