@@ -73,15 +73,17 @@ def file_kind(path: Path) -> str:
 
 
 def _is_softbend_model(path: Path) -> bool:
-    """Whether a JSON file is a model softbend saved (its ``format`` names softbend's)."""
+    """Whether a JSON file is a surrogate softbend saved (the format its loader accepts)."""
     import json
+
+    from softbend.surrogates.persistence import FORMAT
 
     try:
         with open(path, encoding="utf-8") as handle:
             document = json.load(handle)
     except (OSError, ValueError):
         return False
-    return isinstance(document, dict) and str(document.get("format", "")).startswith("softbend-")
+    return isinstance(document, dict) and document.get("format") == FORMAT
 
 
 def _same(a: Path, b: Path) -> bool:
@@ -170,7 +172,7 @@ def check_replaceable_dir(
 
     The one rule of :mod:`softbend._outdir` for every command that writes a folder:
     an existing ``path`` is replaced only when it is empty or holds nothing but an
-    earlier result of the same command (listed in its manifest, unchanged). Refused
+    earlier result of the same command (every entry listed in its manifest). Refused
     with one line: the current folder or one above it; a folder with other entries
     (naming them); a folder that holds one of the command's inputs. The inputs are
     ``inputs`` and every file or folder named by an option or argument of the running
