@@ -4,7 +4,14 @@ Prints the figures that a consolidation round is judged by: lines and modules in
 ``src/softbend``, library parameters that exist only to name a command-line option
 in a message (``owner``, ``field``, ``option``, ``*_field``, ``*_option``; the CLI
 package itself is not counted), parameters annotated with a bare ``Any``, and the
-modules that parse CSV text (``pandas.read_csv``, ``csv.reader``/``csv.DictReader``)::
+modules that parse CSV text (``pandas.read_csv``, ``csv.reader``/``csv.DictReader``),
+and the figures of "one road for every actuator": tests that name paper B's actuator
+outside its own modules (an ``if``/``elif``/``while``/``assert``, a conditional
+expression or a comprehension filter whose test names ``SFRBA``, ``paper_b``,
+``is_paper_b``, ``"sfrba"`` or ``DEFAULT_FAMILY``), the classes that stand for one
+design (a class whose name ends in ``Design``), ``ContextVar``s that hold actuator
+state (any but the progress listener and the CLI's command and argument records),
+and command functions of the CLI longer than 60 lines::
 
     python benchmarks/code_shape.py            # the table
     python benchmarks/code_shape.py --json     # the same figures as JSON
@@ -16,12 +23,21 @@ from __future__ import annotations
 import argparse
 import ast
 import json
+import re
 from pathlib import Path
 
 ROOT = Path(__file__).resolve().parents[1]
 SRC = ROOT / "src" / "softbend"
 MESSAGE_ONLY = {"owner", "field", "option"}
 CSV_CALLS = {"read_csv", "reader", "DictReader"}
+#: A test names paper B's actuator when its source text matches this.
+PAPER_B = re.compile(r"SFRBA|paper_b|is_paper_b|[\"']sfrba[\"']|DEFAULT_FAMILY")
+#: Paper B's own modules: its analytical model, its FEM family, its reproduction and report.
+PAPER_B_OWN = re.compile(r"(^|/)(paper_b[^/]*\.py|analytical\.py|fem/sfrba/.*)$")
+#: ContextVars that hold no actuator state: the progress listener, the running command
+#: and its arguments (for the output-folder rule).
+CONTEXT_OK = {"softbend_progress", "command", "arguments"}
+CLI_FUNCTION_LINES = 60
 
 
 def _is_message_only(name: str) -> bool:
@@ -44,6 +60,26 @@ def _is_bare_any(annotation: ast.expr | None) -> bool:
     return isinstance(annotation, ast.Attribute) and annotation.attr == "Any"
 
 
+def _tests(node: ast.AST) -> list[ast.expr]:
+    """The conditional tests ``node`` holds itself (not those of nested nodes)."""
+    if isinstance(node, ast.If | ast.While | ast.IfExp | ast.Assert):
+        return [node.test]
+    if isinstance(node, ast.comprehension):
+        return list(node.ifs)
+    if isinstance(node, ast.match_case) and node.guard is not None:
+        return [node.guard]
+    return []
+
+
+def _context_var_name(node: ast.Call) -> str | None:
+    func = node.func
+    name = func.attr if isinstance(func, ast.Attribute) else getattr(func, "id", "")
+    if name != "ContextVar" or not node.args:
+        return None
+    first = node.args[0]
+    return first.value if isinstance(first, ast.Constant) else "?"
+
+
 def measure() -> dict[str, object]:
     """Count the figures over ``src/softbend``."""
     lines = modules = 0
@@ -51,14 +87,45 @@ def measure() -> dict[str, object]:
     functions_with_message_only: set[str] = set()
     bare_any: list[str] = []
     csv_modules: list[str] = []
+    paper_b_tests: list[str] = []
+    design_classes: list[str] = []
+    actuator_context: list[str] = []
+    long_commands: list[str] = []
+    module_lines: dict[str, int] = {}
     for path in sorted(SRC.rglob("*.py")):
         text = path.read_text(encoding="utf-8")
         lines += len(text.splitlines())
         modules += 1
         rel = path.relative_to(SRC).as_posix()
+        module_lines[rel] = len(text.splitlines())
         tree = ast.parse(text)
         library = not rel.startswith("cli/")
+        own = PAPER_B_OWN.search(rel) is not None
         for node in ast.walk(tree):
+            for test in _tests(node):
+                if not own and PAPER_B.search(ast.get_source_segment(text, test) or ""):
+                    paper_b_tests.append(f"{rel}:{test.lineno}")
+            if isinstance(node, ast.ClassDef) and node.name.endswith("Design"):
+                design_classes.append(f"{rel}:{node.lineno} {node.name}")
+            if isinstance(node, ast.Call):
+                var = _context_var_name(node)
+                if var is not None and var not in CONTEXT_OK:
+                    actuator_context.append(f"{rel}:{node.lineno} {var}")
+            if (
+                rel.startswith("cli/")
+                and isinstance(node, ast.FunctionDef)
+                and node.end_lineno is not None
+                and node.end_lineno - node.lineno + 1 > CLI_FUNCTION_LINES
+                and any(
+                    isinstance(d, ast.Call)
+                    and isinstance(d.func, ast.Attribute)
+                    and d.func.attr == "command"
+                    for d in node.decorator_list
+                )
+            ):
+                long_commands.append(
+                    f"{rel}:{node.lineno} {node.name} ({node.end_lineno - node.lineno + 1} lines)"
+                )
             if isinstance(node, ast.FunctionDef | ast.AsyncFunctionDef):
                 for arg in _parameters(node):
                     where = f"{rel}:{node.lineno} {node.name}({arg.arg})"
@@ -79,8 +146,18 @@ def measure() -> dict[str, object]:
         "functions_with_message_only_parameters": len(functions_with_message_only),
         "bare_any_parameters": len(bare_any),
         "csv_parsing_modules": csv_modules,
+        "paper_b_tests_outside_its_modules": len(paper_b_tests),
+        "modules_with_paper_b_tests": len({w.split(":")[0] for w in paper_b_tests}),
+        "design_classes": len(design_classes),
+        "actuator_context_vars": len(actuator_context),
+        "cli_commands_over_60_lines": len(long_commands),
+        "modules_over_700_lines": sum(n > 700 for n in module_lines.values()),
         "_message_only": message_only,
         "_bare_any": bare_any,
+        "_paper_b_tests": paper_b_tests,
+        "_design_classes": design_classes,
+        "_actuator_context_vars": actuator_context,
+        "_cli_commands_over_60_lines": long_commands,
     }
 
 
@@ -91,7 +168,7 @@ def main() -> None:
     args = parser.parse_args()
     figures = measure()
     if args.list:
-        for key in ("_message_only", "_bare_any"):
+        for key in (k for k in figures if k.startswith("_")):
             print(f"# {key.strip('_')}")
             print("\n".join(figures[key]))  # type: ignore[arg-type]
         return
