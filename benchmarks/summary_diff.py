@@ -1,0 +1,70 @@
+"""Compare two ``summary.json`` files of ``softbend reproduce`` key by key.
+
+A refactoring that must not change paper B's figures is checked by running ``make run``
+before and after and comparing the two summaries. The run's own dates, wall times and
+commit (``seconds``, and the volatile entries of ``provenance``) differ on every run and
+are left out; every other value must be identical::
+
+    python benchmarks/summary_diff.py before/summary.json results/reproduce/summary.json
+
+Prints each differing key path with both values and exits 1 when any differs.
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import sys
+from pathlib import Path
+from typing import Any
+
+#: Top-level keys that describe the run itself rather than its figures.
+RUN_KEYS = ("seconds",)
+#: Entries of ``provenance`` that change with every run.
+VOLATILE = ("started (UTC)", "finished (UTC)", "wall time")
+
+
+def _walk(a: Any, b: Any, path: str, out: list[str]) -> None:
+    if isinstance(a, dict) and isinstance(b, dict):
+        for key in sorted(set(a) | set(b), key=str):
+            here = f"{path}.{key}" if path else str(key)
+            if key not in a or key not in b:
+                out.append(f"{here}: only in {'after' if key in b else 'before'}")
+            else:
+                _walk(a[key], b[key], here, out)
+    elif isinstance(a, list) and isinstance(b, list) and len(a) == len(b):
+        for i, (x, y) in enumerate(zip(a, b, strict=True)):
+            _walk(x, y, f"{path}[{i}]", out)
+    elif a != b:
+        out.append(f"{path}: {a!r} -> {b!r}")
+
+
+def differences(before: dict[str, Any], after: dict[str, Any]) -> list[str]:
+    """Key paths whose values differ, leaving off the run's own dates and wall time."""
+
+    def figures(summary: dict[str, Any]) -> dict[str, Any]:
+        kept = {k: v for k, v in summary.items() if k not in RUN_KEYS}
+        if isinstance(kept.get("provenance"), dict):
+            kept["provenance"] = {k: v for k, v in kept["provenance"].items() if k not in VOLATILE}
+        return kept
+
+    out: list[str] = []
+    _walk(figures(before), figures(after), "", out)
+    return out
+
+
+def main() -> None:
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("before", type=Path)
+    parser.add_argument("after", type=Path)
+    args = parser.parse_args()
+    found = differences(
+        json.loads(args.before.read_text(encoding="utf-8")),
+        json.loads(args.after.read_text(encoding="utf-8")),
+    )
+    print("\n".join(found) if found else "identical (run dates and wall time left off)")
+    sys.exit(1 if found else 0)
+
+
+if __name__ == "__main__":
+    main()
