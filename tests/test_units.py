@@ -48,3 +48,13 @@ def test_a_keyed_check_carries_the_key_and_says_the_predicate():
         "pressure_unit: is kPa, but the column 'pressure_psi' is named in psi; give psi or "
         "rename the column"
     )
+
+
+def test_one_spelling_of_a_unit_from_a_column_name():
+    from softbend.units import pressure_unit_of, seconds_per_unit, unit_from_name
+
+    names = ("p1_kpa", "p_KPA", "x_um", "t_us", "rho", "a_b", "wall_mm", "fill_pct")
+    assert [unit_from_name(n) for n in names] == ["kPa", "kPa", "µm", "µs", "", "", "mm", "%"]
+    assert unit_from_name("t_ms", ("length",)) == ""
+    assert pressure_unit_of("p_bar") == ("bar", 10.0) and pressure_unit_of("x_mm") is None
+    assert seconds_per_unit("clock_min") == 60.0 and seconds_per_unit("t") is None

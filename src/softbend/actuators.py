@@ -933,9 +933,8 @@ def parse_ranges(texts: Sequence[str], names: Sequence[str]) -> dict[str, tuple[
 
 
 def _unit_from_name(column: str) -> str:
-    """A unit guessed from a column's suffix (``wall_mm`` → mm), else ``""``."""
-    suffix = column.rsplit("_", 1)[-1] if "_" in column else ""
-    return suffix if suffix in ("mm", "cm", "m", "deg", "um", "g", "kpa") else ""
+    """A design parameter's unit from its column's name (``wall_mm`` → mm), else ``""``."""
+    return units.unit_from_name(column, ("length", "angle", "mass", "pressure"))
 
 
 def load_actuator(path: str | os.PathLike[str]) -> Actuator:

@@ -1,9 +1,13 @@
-"""Pressure and angle units: conversion factors, a column's unit from its name, values with units.
+"""Units: conversion factors, a column's unit from its name, values with units.
 
 One place for what a unit means, used by every reader of tables, measurements and command
-options: ``PRESSURE_UNITS`` (factor to MPa), :func:`column_unit` (the unit a column's name
-ends with, ``pressure_psi`` → ``psi``), :func:`check_column_unit` (a declared unit that
-disagrees with the column's name is refused, naming both) and :func:`parse_pressure`
+options, by actuator descriptions, identification and the control rig:
+``PRESSURE_UNITS`` (factor to MPa), ``SECONDS_PER_UNIT`` (factor to s),
+:func:`unit_from_name` (the unit a column's name ends with, ``p1_kpa`` → ``kPa``, in one
+spelling whatever the case), :func:`column_unit` (the pressure or angle unit of a name),
+:func:`pressure_unit_of` (a pressure column's unit and its units per MPa),
+:func:`seconds_per_unit` (a time column's), :func:`check_column_unit` (a declared unit
+that disagrees with the column's name is refused, naming both) and :func:`parse_pressure`
 (``"20psi"``, ``"138 kPa"`` or a bare number in a default unit).
 """
 
@@ -18,11 +22,16 @@ from softbend.errors import InputError
 __all__ = [
     "ANGLE_UNITS",
     "PRESSURE_UNITS",
+    "SECONDS_PER_UNIT",
+    "UNIT_KINDS",
     "check_column_unit",
     "column_unit",
     "convert_pressure",
     "outside",
     "parse_pressure",
+    "pressure_unit_of",
+    "seconds_per_unit",
+    "unit_from_name",
 ]
 
 #: Factor from each pressure unit to MPa. Pa is read (a recording may use it); the four
@@ -38,20 +47,81 @@ PRESSURE_UNITS: dict[str, float] = {
 #: Angle units, by their spelling in a column's name.
 ANGLE_UNITS: dict[str, str] = {"deg": "deg", "rad": "rad"}
 
-_SUFFIX: dict[str, str] = {u.lower(): u for u in PRESSURE_UNITS} | ANGLE_UNITS
+#: Seconds per time unit.
+SECONDS_PER_UNIT: dict[str, float] = {"s": 1.0, "ms": 1e-3, "µs": 1e-6, "min": 60.0, "h": 3600.0}
+
+#: The units a column's name may end with, by kind, each in its one spelling.
+UNIT_KINDS: dict[str, tuple[str, ...]] = {
+    "time": tuple(SECONDS_PER_UNIT),
+    "pressure": tuple(PRESSURE_UNITS),
+    "length": ("m", "cm", "mm", "µm"),
+    "angle": tuple(ANGLE_UNITS),
+    "force": ("N",),
+    "mass": ("g", "kg"),
+    "electric": ("V", "mA", "A"),
+    "volume": ("mL",),
+    "fraction": ("%",),
+}
+
+#: Name suffixes (lower case) that spell a unit otherwise than its lower case.
+_ASCII: dict[str, str] = {"µs": "us", "µm": "um", "%": "pct"}
+
+#: ``{suffix: (unit, kind)}`` for every unit of :data:`UNIT_KINDS`.
+_BY_SUFFIX: dict[str, tuple[str, str]] = {
+    _ASCII.get(unit, unit.lower()): (unit, kind)
+    for kind, names in UNIT_KINDS.items()
+    for unit in names
+}
 
 _VALUE = re.compile(r"^\s*([-+]?(?:\d+\.?\d*|\.\d+)(?:[eE][-+]?\d+)?)\s*([A-Za-z]*)\s*$")
 
 
-def column_unit(name: str) -> str:
-    """The pressure or angle unit a column's name ends with, in its canonical spelling, or ``""``.
+def unit_from_name(name: str, kinds: Iterable[str] | None = None) -> str:
+    """The unit a column's name ends with, in its one spelling, or ``""``.
 
-    Only the part after the last underscore counts, in any case: ``pressure_psi`` → ``psi``,
-    ``p_KPA`` → ``kPa``, ``angle_deg`` → ``deg``, ``pressure`` → ``""``.
+    Only the part after the last underscore counts, in any case: ``p1_kpa`` → ``kPa``,
+    ``x_mm`` → ``mm``, ``t_us`` → ``µs``, ``angle_DEG`` → ``deg``, ``rho`` → ``""``.
+
+    Parameters
+    ----------
+    name : str
+        The column's name.
+    kinds : iterable of str, optional
+        Keys of :data:`UNIT_KINDS` the unit must be of (default: any).
     """
     if "_" not in name:
         return ""
-    return _SUFFIX.get(name.rsplit("_", 1)[-1].strip().lower(), "")
+    found = _BY_SUFFIX.get(name.rsplit("_", 1)[-1].strip().lower())
+    if found is None or (kinds is not None and found[1] not in set(kinds)):
+        return ""
+    return found[0]
+
+
+def column_unit(name: str) -> str:
+    """The pressure or angle unit a column's name ends with, in its one spelling, or ``""``.
+
+    ``pressure_psi`` → ``psi``, ``p_KPA`` → ``kPa``, ``angle_deg`` → ``deg``,
+    ``pressure`` → ``""`` (:func:`unit_from_name` of those two kinds).
+    """
+    return unit_from_name(name, ("pressure", "angle"))
+
+
+def pressure_unit_of(name: str) -> tuple[str, float] | None:
+    """The pressure unit a column's name ends with and its units per MPa, else None.
+
+    ``p_kpa`` → ``("kPa", 1000.0)``; ``angle_deg`` → None.
+    """
+    unit = unit_from_name(name, ("pressure",))
+    return (unit, 1.0 / PRESSURE_UNITS[unit]) if unit else None
+
+
+def seconds_per_unit(name: str) -> float | None:
+    """Seconds per unit of a time column, from its name (``time_s`` → 1.0, ``t_ms`` → 0.001).
+
+    None when the name carries no time unit.
+    """
+    unit = unit_from_name(name, ("time",))
+    return SECONDS_PER_UNIT[unit] if unit else None
 
 
 def check_column_unit(column: str, unit: str, option: str, *, key: str | None = None) -> None:

@@ -38,7 +38,6 @@ if TYPE_CHECKING:
     from softbend.identification.dynamics import IdentifiedModel
 
 __all__ = [
-    "MPA_PER_UNIT",
     "IdentifiedPlant",
     "NARXAngle",
     "angle_output",
@@ -47,10 +46,6 @@ __all__ = [
     "pressure_unit",
     "rig_settings_from",
 ]
-
-#: MPa per unit of a pressure column, by the unit its name ends with: an actuator
-#: description's units, and pascal, which a recording may use.
-MPA_PER_UNIT: dict[str, float] = units.PRESSURE_UNITS
 
 #: Grid points of the steady-state θ(p) of an identified plant.
 STEADY_POINTS = 41
@@ -66,11 +61,9 @@ RIG_FROM_FIELDS: dict[str, str] = {
 
 
 def pressure_unit(name: str) -> tuple[str, float] | None:
-    """The unit of a pressure column by its name's end, and its units per MPa, else None."""
-    from softbend.identification.dynamics import unit_from_name
-
-    unit = unit_from_name(name.strip())
-    return (unit, 1.0 / MPA_PER_UNIT[unit]) if unit in MPA_PER_UNIT else None
+    """The unit of a pressure column by its name's end, and its units per MPa, else None
+    (:func:`softbend.units.pressure_unit_of`)."""
+    return units.pressure_unit_of(name.strip())
 
 
 def _is_angle(name: str) -> bool:
@@ -290,7 +283,7 @@ def identified_plant(path: str | Path, *, role: str = "--plant") -> IdentifiedPl
     inputs = list(identified.input_names)
     units = [pressure_unit(name) for name in inputs]
     if len(inputs) != 1 or units[0] is None:
-        suffixes = ", ".join("_" + unit.lower() for unit in MPA_PER_UNIT)
+        suffixes = ", ".join("_" + unit.lower() for unit in units.PRESSURE_UNITS)
         raise InputError(
             "must have exactly one input, a pressure whose column name gives its unit (ending "
             f"in {suffixes}) to play the actuator; {source} has the inputs {', '.join(inputs)}",

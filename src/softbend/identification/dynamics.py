@@ -41,8 +41,10 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 from numpy.typing import ArrayLike
 
+from softbend import units
 from softbend._validation import check_finite_array, must_be
 from softbend.errors import InputError, SchemaError
+from softbend.units import unit_from_name
 
 if TYPE_CHECKING:
     from softbend.identification.multi import MultiNARX
@@ -77,38 +79,16 @@ _RESPONSE = 1e-9  # smallest final change that is a response, in output standard
 _DEAD_BAND = 0.02  # fraction of the final change that ends the dead time
 _TAU_LEVEL = 1.0 - math.exp(-1.0)  # 63.2 % of the final change
 
-#: Column-name suffixes (after the last ``_``, any case) and the units they name.
-_UNITS: dict[str, str] = {
-    "s": "s", "ms": "ms", "us": "µs", "min": "min", "h": "h",
-    "pa": "Pa", "kpa": "kPa", "mpa": "MPa", "bar": "bar", "psi": "psi",
-    "m": "m", "cm": "cm", "mm": "mm", "um": "µm",
-    "deg": "deg", "rad": "rad", "n": "N", "g": "g", "kg": "kg",
-    "v": "V", "ma": "mA", "a": "A", "ml": "mL", "pct": "%",
-}  # fmt: skip
-
-#: Seconds per time unit.
-_SECONDS: dict[str, float] = {"s": 1.0, "ms": 1e-3, "µs": 1e-6, "min": 60.0, "h": 3600.0}
-
-
-def unit_from_name(name: str) -> str:
-    """The unit a column's name ends with (``p1_kpa`` → ``"kPa"``, ``x_mm`` → ``"mm"``), or ``""``.
-
-    Only the suffix after the last underscore counts, and only the units of
-    ``_UNITS`` (time, pressure, length, angle, force, mass, electric, volume).
-    """
-    if "_" not in name:
-        return ""
-    return _UNITS.get(name.rsplit("_", 1)[-1].lower(), "")
-
 
 def seconds_per_unit(time_name: str) -> float | None:
     """Seconds per unit of a time column, from its name (``time_s`` → 1.0, ``t_ms`` → 0.001).
 
-    None when the name carries no time unit, and for the sample index (``"sample"``).
+    None when the name carries no time unit, and for the sample index (``"sample"``)
+    (:func:`softbend.units.seconds_per_unit`).
     """
     if time_name == SAMPLE_TIME_NAME:
         return None
-    return _SECONDS.get(unit_from_name(time_name))
+    return units.seconds_per_unit(time_name)
 
 
 def median_sample_period(data: TimeSeriesSet) -> float:
