@@ -175,3 +175,22 @@ def test_a_large_file_reports_its_read_before_its_first_byte_is_read(tmp_path, m
     reads = [c for c in heard if isinstance(c, tuple) and c[0] == phase]
     assert [d for _, d, _ in reads] == sorted(d for _, d, _ in reads) and reads[-1][1] == 100
     assert heard[-1] == ("checking big.csv's columns", 2, 2)
+
+
+def test_an_increasing_column_is_checked_within_each_experiment(tmp_path):
+    fmt = TableFormat(
+        "time CSV", (Column("t_s", increasing=True), Column("run", kind="text")), group="run"
+    )
+    path = tmp_path / "t.csv"
+    path.write_text("t_s,run\n0,a\n0,b\n1,a\n1,b\n1,a\n", encoding="utf-8")
+    with pytest.raises(DatasetError) as caught:
+        read_table(path, fmt)
+    assert str(caught.value) == (
+        f"{path}:6:1: t_s: 1.0 does not increase after 1.0 (line 4) in experiment 'a'; "
+        "it must increase strictly"
+    )
+    path.write_text("t_s,run\n0,a\n1,a\n0,b\n2,a\n", encoding="utf-8")
+    contiguous = TableFormat(fmt.name, fmt.columns, group="run", contiguous_groups=True)
+    with pytest.raises(DatasetError, match=r":5:2: run: experiment 'a' appears again after 'b'"):
+        read_table(path, contiguous)
+    assert read_table(path, fmt).frame["t_s"].tolist() == [0, 1, 0, 2]

@@ -55,6 +55,8 @@ __all__ = [
     "column_kind",
     "infer_cells",
     "kind_conflict",
+    "not_increasing",
+    "not_increasing_text",
     "read_table",
     "reads_as_number",
 ]
@@ -95,6 +97,9 @@ class Column:
         The values of a ``"choice"`` column.
     missing : bool, default False
         Whether a cell may be empty (read as NaN, or ``""`` for text).
+    increasing : bool, default False
+        Whether its values increase strictly down the file (a time column), within
+        each run of the format's ``group`` column when it has one.
     """
 
     name: str
@@ -105,6 +110,7 @@ class Column:
     low: float | None = None
     choices: tuple[str, ...] = ()
     missing: bool = False
+    increasing: bool = False
 
     def requirement(self) -> str:
         """What a cell must be, for :func:`~softbend._validation.must_be`."""
@@ -177,6 +183,11 @@ class TableFormat:
         The most data rows; default the ``csv_rows`` limit of :mod:`softbend.limits`.
     separator : str, default ","
         The cell separator.
+    group : str, optional
+        The column that names the experiment a row is of: an ``increasing``
+        column increases within each experiment's rows.
+    contiguous_groups : bool, default False
+        Whether each experiment's rows must be contiguous (else they may interleave).
     """
 
     name: str
@@ -189,6 +200,8 @@ class TableFormat:
     min_rows: int = 1
     max_rows: int | None = None
     separator: str = ","
+    group: str | None = None
+    contiguous_groups: bool = False
     _by_name: Mapping[str, Column] = field(init=False, repr=False, compare=False)
 
     def __post_init__(self) -> None:
@@ -566,6 +579,7 @@ def read_table(path: str | os.PathLike[str], fmt: TableFormat) -> Table:
         cell = rows[at][position - 1]
         raise _error(f"must be {requirement}; got {_got(cell)}", file, lines[at], position, name)
     _check_plausible(fmt, data, positions, file, lines)
+    _check_increasing(fmt, data, positions, file, lines)
     frame = pd.DataFrame(data, columns=list(data))
     return Table(
         frame=frame,
@@ -641,6 +655,89 @@ def _check_plausible(
             line=lines[index] if lines is not None else None,
             column=position if lines is not None else None,
         )
+
+
+def not_increasing(values: np.ndarray | Sequence[float]) -> int | None:
+    """The position of the first value that does not exceed the one before it, else None."""
+    array = np.asarray(values, dtype=np.float64).ravel()
+    steps = np.flatnonzero(~(np.diff(array) > 0))
+    return int(steps[0]) + 1 if steps.size else None
+
+
+def not_increasing_text(
+    values: np.ndarray | Sequence[float],
+    k: int,
+    where: str,
+    experiment: object = None,
+) -> str:
+    """The one wording of a value ``values[k]`` that does not increase after ``values[k - 1]``.
+
+    Parameters
+    ----------
+    values : array_like
+        The column (a time column, in its unit).
+    k : int
+        The position of the value (:func:`not_increasing`).
+    where : str
+        Where the value before it is: ``"line 4"`` in a file, ``"sample 1"`` in an array.
+    experiment : optional
+        The experiment the values are of, named in the text.
+    """
+    array = np.asarray(values, dtype=np.float64).ravel()
+    of = "" if experiment is None else f" in experiment {experiment!r}"
+    return (
+        f"{float(array[k])!r} does not increase after {float(array[k - 1])!r} ({where}){of}; "
+        "it must increase strictly"
+    )
+
+
+def _check_increasing(
+    fmt: TableFormat,
+    data: Mapping[str, np.ndarray],
+    positions: Mapping[str, int],
+    file: str,
+    lines: Sequence[int],
+) -> None:
+    """The first value of an ``increasing`` column that does not increase, in file order."""
+    groups = data.get(fmt.group) if fmt.group is not None else None
+    if groups is not None and fmt.contiguous_groups:
+        _check_contiguous(fmt.group or "", groups, positions, file, lines)
+    first: tuple[int, int, str, np.ndarray, int, object] | None = None  # row, position, ...
+    for name, values in data.items():
+        column = fmt.column(name)
+        if column is None or not column.increasing:
+            continue
+        runs = [None] if groups is None else list(dict.fromkeys(groups.tolist()))
+        for run in runs:
+            rows = np.arange(len(values)) if run is None else np.flatnonzero(groups == run)
+            k = not_increasing(values[rows])
+            if k is not None and (first is None or (rows[k], positions[name]) < first[:2]):
+                first = (int(rows[k]), positions[name], name, rows, k, run)
+    if first is not None:
+        row, position, name, rows, k, run = first
+        text = not_increasing_text(data[name][rows], k, f"line {lines[rows[k - 1]]}", run)
+        raise _error(text, file, lines[row], position, name)
+
+
+def _check_contiguous(
+    name: str, groups: np.ndarray, positions: Mapping[str, int], file: str, lines: Sequence[int]
+) -> None:
+    """Each experiment's rows in one block: the first row of one that appears again, an error."""
+    ended: dict[object, int] = {}
+    values = groups.tolist()
+    for row, value in enumerate(values):
+        if row and value != values[row - 1]:
+            if value in ended:
+                raise _error(
+                    f"experiment {value!r} appears again after {values[row - 1]!r} (its rows "
+                    f"ended at line {lines[ended[value]]}); the rows of an experiment must be "
+                    "contiguous",
+                    file,
+                    lines[row],
+                    positions[name],
+                    name,
+                )
+            ended[values[row - 1]] = row - 1
 
 
 def check_columns(frame: pd.DataFrame, fmt: TableFormat, *, file: str | None = None) -> None:

@@ -250,7 +250,9 @@ def test_bad_simulation_input_is_refused():
         QUIET.simulate(time, pressures[:, :2])
     with pytest.raises(ValueError, match=r"^pressures_kpa: .*one row per time sample"):
         QUIET.simulate(time, pressures[:-1])
-    with pytest.raises(ValueError, match=r"^time_s: must increase"):
+    with pytest.raises(
+        ValueError, match=r"^time_s: .* does not increase after .*\(sample 0\); it must increase"
+    ):
         QUIET.simulate(time[::-1], pressures)
     with pytest.raises(ValueError, match=r"^seed: must be an integer"):
         QUIET.simulate(time, pressures, seed=1.5)

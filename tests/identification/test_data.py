@@ -81,7 +81,10 @@ def test_arrays_are_read_only_copies_and_frame_has_every_column():
         ({"n": 2}, "at least 3 samples"),
         ({"y_mm": np.array([0, 0, np.nan, 0, 0])}, "'y_mm'.*finite.*nan at sample 2"),
         ({"pressure_kpa": np.array([0, 1, 2, np.inf, 4])}, "'pressure_kpa'.*inf at sample 3"),
-        ({"time_s": np.array([0, 1, 1, 2, 3.0])}, "'time_s'.*increase strictly.*sample 2"),
+        (
+            {"time_s": np.array([0, 1, 1, 2, 3.0])},
+            r"time_s: 1.0 does not increase after 1.0 \(sample 1\).*'bad'.*increase strictly",
+        ),
         ({"time_s": np.zeros((5, 1))}, "'time_s'.*1-D"),
     ],
 )

@@ -368,7 +368,9 @@ def test_bad_profiles_and_datasets_are_refused():
         synthetic_dataset(actuator="soft")
     with pytest.raises(ValueError, match=r"^excitation: must be one of"):
         synthetic_dataset(excitation="uniform")
-    with pytest.raises(ValueError, match=r"^time_s: must increase"):
+    with pytest.raises(
+        ValueError, match=r"^time_s: 0.1 does not increase after 0.1 \(sample 1\); it must increase"
+    ):
         CurlingActuator().response([0.0, 0.1, 0.1], [0.0, 1.0, 2.0])
     with pytest.raises(
         ValueError, match=r"^pressure_kpa: must be a 1-D array of the length of 'time_s'"

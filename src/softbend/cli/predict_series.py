@@ -151,7 +151,7 @@ def _run(identified: Any, series: Path) -> dict[str, Any]:
     columns = [Column(name) for name in inputs]
     columns += [Column(name, required=False) for name in outputs]
     if time is not None and time not in (*inputs, *outputs):
-        columns.append(Column(time, required=False))
+        columns.append(Column(time, required=False, increasing=True))
     table = read_table(series, TableFormat("input series CSV", tuple(columns),
                                            other_columns="ignore"))  # fmt: skip
     frame = table.frame
@@ -172,16 +172,7 @@ def _run(identified: Any, series: Path) -> dict[str, Any]:
     U = np.column_stack([frame[name].to_numpy(dtype=np.float64) for name in inputs])
     times = None
     if time is not None and time in frame.columns:
-        times = frame[time].to_numpy(dtype=np.float64)
-        steps = np.flatnonzero(np.diff(times) <= 0)
-        if steps.size:
-            k = int(steps[0]) + 1
-            raise table.error(
-                f"{float(times[k])!r} does not increase after {float(times[k - 1])!r}; "
-                "time must increase strictly",
-                row=k,
-                column=time,
-            )
+        times = frame[time].to_numpy(dtype=np.float64)  # increasing: held so by the format
     measured = None
     if present:
         measured = np.column_stack([frame[name].to_numpy(dtype=np.float64) for name in outputs])

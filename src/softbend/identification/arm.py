@@ -60,6 +60,7 @@ from scipy import linalg, signal
 from softbend._validation import check_choice, check_int, check_range, must_be
 from softbend.errors import InputError
 from softbend.identification.timeseries import Series, TimeSeriesSet
+from softbend.tables import not_increasing, not_increasing_text
 
 __all__ = [
     "ARM_EXCITATIONS",
@@ -385,14 +386,9 @@ class SoftArm:
                 f"must be a finite 1-D array of length >= 2; got shape {time.shape}",
                 key="time_s",
             )
-        steps = np.diff(time)
-        if np.any(steps <= 0):
-            first = int(np.flatnonzero(steps <= 0)[0]) + 1
-            raise InputError(
-                f"must increase strictly; got {float(time[first])!r} after "
-                f"{float(time[first - 1])!r} at position {first}",
-                key="time_s",
-            )
+        first = not_increasing(time)
+        if first is not None:
+            raise InputError(not_increasing_text(time, first, f"sample {first - 1}"), key="time_s")
         command = self._check_pressures(pressures_kpa)
         if command.ndim != 2 or command.shape[0] != time.size:
             raise InputError(
@@ -422,7 +418,7 @@ class SoftArm:
         noise = rng.normal(0.0, self.noise_std_mm, size=(2, time.size))
         x, y = x + noise[0], y + noise[1]
         if self.drift_mm_per_sqrt_s > 0.0:
-            kicks = rng.normal(0.0, 1.0, size=(2, time.size - 1)) * np.sqrt(steps)
+            kicks = rng.normal(0.0, 1.0, size=(2, time.size - 1)) * np.sqrt(np.diff(time))
             drift = np.concatenate([np.zeros((2, 1)), np.cumsum(kicks, axis=1)], axis=1)
             x, y = x + self.drift_mm_per_sqrt_s * drift[0], y + self.drift_mm_per_sqrt_s * drift[1]
         return x, y

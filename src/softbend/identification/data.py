@@ -52,7 +52,15 @@ from softbend._validation import check_range, must_be
 from softbend.errors import DatasetError, LimitError, keyed
 from softbend.kinematics import bending_from_tip
 from softbend.limits import check_file_size
-from softbend.tables import Column, HeaderKey, Table, TableFormat, read_table
+from softbend.tables import (
+    Column,
+    HeaderKey,
+    Table,
+    TableFormat,
+    not_increasing,
+    not_increasing_text,
+    read_table,
+)
 
 if TYPE_CHECKING:
     import pandas as pd
@@ -175,14 +183,10 @@ class Experiment:
                     f"Got {float(values[row])!r} at sample {row} "
                     f"({int(bad.sum())} non-finite in all)."
                 )
-        steps = np.diff(columns["time_s"])
-        if np.any(steps <= 0):
-            row = int(np.flatnonzero(steps <= 0)[0]) + 1
-            time = columns["time_s"]
-            raise DatasetError(
-                f"The 'time_s' of Experiment {self.name!r} must increase strictly. "
-                f"Got {float(time[row])!r} at sample {row} after {float(time[row - 1])!r}."
-            )
+        row = not_increasing(columns["time_s"])
+        if row is not None:
+            text = not_increasing_text(columns["time_s"], row, f"sample {row - 1}", self.name)
+            raise DatasetError(text, key="time_s")
         try:
             rho, length = bending_from_tip(
                 columns["x_mm"], columns["y_mm"], rest_length_mm=self.rest_length_mm
@@ -277,7 +281,7 @@ EXPERIMENT_FORMAT = TableFormat(
     name="experiment CSV",
     columns=(
         *(
-            Column(name, unit, quantity=COLUMN_QUANTITIES[name])
+            Column(name, unit, quantity=COLUMN_QUANTITIES[name], increasing=name == "time_s")
             for name, unit in zip(REQUIRED_COLUMNS, ("s", "kPa", "mm", "mm"), strict=True)
         ),
         Column(EXPERIMENT_COLUMN, kind="text", required=False),
@@ -291,6 +295,7 @@ EXPERIMENT_FORMAT = TableFormat(
     other_columns="ignore",
     fold_keys=True,
     repeated_keys=True,
+    group=EXPERIMENT_COLUMN,
 )
 
 
@@ -344,16 +349,7 @@ def _read_csv(path: Path, rest_length_mm: float | None) -> list[Experiment]:
     experiments = []
     for name in dict.fromkeys(names.tolist()):
         rows = np.flatnonzero(names == name)
-        times = columns["time_s"][rows]
-        steps = np.flatnonzero(np.diff(times) <= 0)
-        if steps.size:
-            k = int(steps[0]) + 1
-            raise table.error(
-                f"{float(times[k])!r} does not increase after {float(times[k - 1])!r} (line "
-                f"{table.lines[rows[k - 1]]}) in experiment {name!r}; time must increase strictly",
-                row=int(rows[k]),
-                column="time_s",
-            )
+        times = columns["time_s"][rows]  # increasing: held so by EXPERIMENT_FORMAT
         if rows.size < 3:
             raise DatasetError(
                 f"experiment {name!r} has {rows.size} sample(s); at least 3 are needed",

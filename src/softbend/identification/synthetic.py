@@ -67,6 +67,7 @@ from softbend.errors import InputError, keyed
 from softbend.identification.data import Experiment
 from softbend.limits import check_limit
 from softbend.plausibility import RANGES
+from softbend.tables import not_increasing, not_increasing_text
 
 #: Profile kinds of the ``"mixed"`` excitation, in the order :func:`synthetic_dataset`
 #: cycles through them.
@@ -338,14 +339,10 @@ class CurlingActuator:
                     f"position {int(np.flatnonzero(~np.isfinite(values))[0])}",
                     key=key,
                 )
+        first = not_increasing(time)
+        if first is not None:
+            raise InputError(not_increasing_text(time, first, f"sample {first - 1}"), key="time_s")
         steps = np.diff(time)
-        if np.any(steps <= 0):
-            first = int(np.flatnonzero(steps <= 0)[0]) + 1
-            raise InputError(
-                f"must increase strictly; got {float(time[first])!r} after "
-                f"{float(time[first - 1])!r} at position {first}",
-                key="time_s",
-            )
 
         radii = self.play_radii_kpa
         weights = self.play_weights

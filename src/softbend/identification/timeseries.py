@@ -15,6 +15,8 @@ from typing import Any
 
 import numpy as np
 
+from softbend.tables import not_increasing, not_increasing_text
+
 __all__ = ["Series", "TimeSeriesSet", "from_experiments"]
 
 
@@ -57,8 +59,9 @@ class Series:
         for what, values in (("time", time), ("inputs", inputs), ("outputs", outputs)):
             if not np.all(np.isfinite(values)):
                 raise ValueError(f"The {what} of experiment {self.name!r} must be finite.")
-        if n > 1 and not np.all(np.diff(time) > 0):
-            raise ValueError(f"The time of experiment {self.name!r} must increase strictly.")
+        k = not_increasing(time)
+        if k is not None:
+            raise ValueError("time: " + not_increasing_text(time, k, f"sample {k - 1}", self.name))
         for name, value in (("time", time), ("inputs", inputs), ("outputs", outputs)):
             value.setflags(write=False)
             object.__setattr__(self, name, value)

@@ -110,31 +110,18 @@ def _format(
 ) -> TableFormat:
     """The time-series CSV of these columns, as :mod:`softbend.tables` reads it."""
     columns = [Column(experiment, kind="text")] if experiment else []
-    columns += [Column(name) for name in (*([time] if time else []), *inputs, *outputs)]
-    return TableFormat("time-series CSV", tuple(columns), other_columns="ignore")
+    columns += [Column(time, increasing=True)] if time else []
+    columns += [Column(name) for name in (*inputs, *outputs)]
+    return TableFormat("time-series CSV", tuple(columns), other_columns="ignore", group=experiment,
+                       contiguous_groups=True)  # fmt: skip
 
 
 def _runs(table: Table, column: str) -> list[tuple[str, int, int]]:
-    """Contiguous runs ``(name, start, stop)`` of the experiment column, checked."""
+    """The runs ``(name, start, stop)`` of the experiment column (contiguous: the format's)."""
     names = table.frame[column].tolist()
-    runs: list[tuple[str, int, int]] = []
-    seen: dict[str, int] = {}
-    start = 0
-    for i in range(1, len(names) + 1):
-        if i < len(names) and names[i] == names[start]:
-            continue
-        name = names[start]
-        if name in seen:
-            raise table.error(
-                f"experiment {name!r} appears again after {runs[-1][0]!r} (its rows ended at "
-                f"line {table.lines[seen[name]]}); the rows of an experiment must be contiguous",
-                row=start,
-                column=column,
-            )
-        seen[name] = i - 1
-        runs.append((name, start, i))
-        start = i
-    return runs
+    starts = [i for i in range(len(names)) if i == 0 or names[i] != names[i - 1]]
+    stops = [*starts[1:], len(names)]
+    return [(names[a], a, b) for a, b in zip(starts, stops, strict=True)]
 
 
 def _read_file(
@@ -159,18 +146,8 @@ def _read_file(
     outputs_array = np.column_stack([values[c] for c in outputs])
     series = []
     for name, start, stop in runs:
-        if time:
+        if time:  # increasing in each experiment: held so by the format
             times = table.frame[time].to_numpy(dtype=np.float64)[start:stop]
-            steps = np.flatnonzero(np.diff(times) <= 0)
-            if steps.size:
-                k = int(steps[0]) + 1
-                raise table.error(
-                    f"{float(times[k])!r} does not increase after {float(times[k - 1])!r} "
-                    f"(line {table.lines[start + k - 1]}) in experiment {name!r}; time must "
-                    "increase strictly",
-                    row=start + k,
-                    column=time,
-                )
         else:
             times = np.arange(stop - start, dtype=np.float64)
         series.append(
