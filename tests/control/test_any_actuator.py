@@ -13,7 +13,7 @@ import numpy as np
 import pandas as pd
 import pytest
 
-from softbend.actuators import Actuator, DesignParameter
+from softbend.actuators import SFRBA, Actuator, DesignParameter
 from softbend.cli import main
 from softbend.control.designs import ModelDesign, control_design
 from softbend.control.runs import simulate_control
@@ -281,8 +281,8 @@ def test_a_hardware_rig_needs_the_chamber_only_for_the_predictive_controller(mod
         ([], "must be given for the model"),
         (["--design", "100,6,2,2,5,8"], "(4 values)"),
         (["--design", "n_chambers=10,wall_mm=2,height_mm=10,layer=silk"], "fabric, paper"),
-        (["--design", DESIGN, "--plant", "fem"], "paper B's actuator only"),
-        (["--design", DESIGN, "--plant", "lab"], "paper B's actuator only"),
+        (["--design", DESIGN, "--plant", "fem"], f"is of {SFRBA.title} only"),
+        (["--design", DESIGN, "--plant", "lab"], f"is of {SFRBA.title} only"),
     ],
 )
 def test_a_design_or_plant_not_of_the_models_actuator_is_one_line(

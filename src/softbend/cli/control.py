@@ -310,9 +310,9 @@ def rig_config_cmd(
 def _served(design: str | None, plant: str) -> str:
     """What ``control serve`` says it simulates: the design, or an identified plant."""
     from softbend.control.designs import DEFAULT_DESIGN
-    from softbend.control.identified_plant import is_identified_plant
+    from softbend.control.plants import parse_plant
 
-    if design is None and is_identified_plant(plant):
+    if design is None and parse_plant(plant).kind == "identified":
         return f"of the identified model {plant}"
     return design or DEFAULT_DESIGN
 

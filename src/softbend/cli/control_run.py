@@ -181,8 +181,6 @@ def model_lines(setup: ControlSetup) -> tuple[str, list[list[Any]]]:
     the design lies in the training ranges of the controller's model (as the
     summary's ``design_supported`` and the warning do).
     """
-    from softbend.control.plants import plant_file
-
     plant, model = setup.plant, setup.model_path
     support = setup.design_support_text()
     design_row = [[DESIGN_ROW, support]] if support is not None else []
@@ -192,7 +190,7 @@ def model_lines(setup: ControlSetup) -> tuple[str, list[list[Any]]]:
             top = setup.model.angle_table.pmax_mpa
             return "", [*rows, ["controller's model", f"its steady-state θ(p), 0–{top:g} MPa"]]
         return "; model mismatch", [*rows, ["controller's model", model], *design_row]
-    if setup.model_from == "shipped" and plant_file(plant) is None:
+    if setup.model_from == "shipped" and setup.plant_choice.kind == "named":
         return "", design_row if setup.design_supported is False else []
     if setup.plant_is_model:
         return "", [["plant and controller's model", model], *design_row]

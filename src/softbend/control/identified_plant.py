@@ -281,8 +281,8 @@ def identified_plant(path: str | Path, *, role: str = "--plant") -> IdentifiedPl
     identified = load_identified(file)
     source = f"the identified model {file} ({role})"
     inputs = list(identified.input_names)
-    units = [pressure_unit(name) for name in inputs]
-    if len(inputs) != 1 or units[0] is None:
+    found = [pressure_unit(name) for name in inputs]
+    if len(inputs) != 1 or found[0] is None:
         suffixes = ", ".join("_" + unit.lower() for unit in units.PRESSURE_UNITS)
         raise InputError(
             "must have exactly one input, a pressure whose column name gives its unit (ending "
@@ -297,7 +297,7 @@ def identified_plant(path: str | Path, *, role: str = "--plant") -> IdentifiedPl
             key="plant",
         )
     index = angle_output(tuple(identified.output_names), source)
-    unit, scale = units[0]
+    unit, scale = found[0]
     rest = identified.steady_state(np.zeros(1))
     return IdentifiedPlant(
         path=file,

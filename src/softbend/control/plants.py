@@ -17,10 +17,16 @@ A model of ``softbend identify`` (a pressure input, an angle output) plays the
 plant by its dynamics instead of a θ(p) table
 (:mod:`softbend.control.identified_plant`; :func:`plant_table` does not take it).
 
+The text of ``--plant`` is parsed once (:func:`parse_plant`) into a
+:class:`~softbend.control.plant_choice.PlantChoice`, and :func:`plant_table`
+dispatches on its kind.
+
 A saved surrogate of any actuator plays the plant of its design
 (:class:`~softbend.control.designs.ModelDesign`): its θ(p) is tabulated in MPa,
-the rig's unit, from the model's own pressure unit. ``fem``, ``lab`` and a
-measurements CSV are paper B's actuator's only.
+the rig's unit, from the model's own pressure unit. A plant that is of one
+actuator only (``fem``, ``lab`` and a measurements CSV are paper B's) says so in
+:data:`PLANT_ACTUATORS`; a registered plant may also give the rig's chamber
+compliance (:data:`PLANT_COMPLIANCES`).
 """
 
 from __future__ import annotations
@@ -31,7 +37,9 @@ from typing import TYPE_CHECKING, cast
 
 import numpy as np
 
+from softbend.actuators import SFRBA, Actuator
 from softbend.control.designs import ModelDesign, actuator_of_design, control_design
+from softbend.control.plant_choice import PlantChoice
 from softbend.control.rig import AngleTable
 from softbend.design import SFRBADesign
 from softbend.errors import InputError
@@ -44,14 +52,18 @@ if TYPE_CHECKING:
     from softbend.transfer.measurements import Measurements
 
 __all__ = [
-    "PAPER_B_PLANTS",
     "PLANTS",
+    "PLANT_ACTUATORS",
+    "PLANT_COMPLIANCES",
     "check_plant",
+    "check_plant_actuator",
     "fem_angle_table",
     "fem_plant",
     "in_table1",
     "lab_angle_table",
     "lab_plant",
+    "parse_plant",
+    "plant_compliance",
     "plant_file",
     "plant_table",
     "shipped_angle_table",
@@ -62,8 +74,14 @@ __all__ = [
 #: Plant factories by name: ``factory(design, model_table) -> AngleTable``.
 PLANTS: Registry[Callable[[SFRBADesign, AngleTable], AngleTable]] = Registry("plant")
 
-#: The plants that are of paper B's actuator alone (its FEM, its virtual lab).
-PAPER_B_PLANTS: frozenset[str] = frozenset({"fem", "lab"})
+#: The actuator a plant is of alone, by the plant's name (``"measurements"``: a CSV):
+#: paper B's FEM, virtual lab and measurement files. Any other plant takes a design
+#: of the controller's model's actuator.
+PLANT_ACTUATORS: dict[str, Actuator] = {"fem": SFRBA, "lab": SFRBA, "measurements": SFRBA}
+
+#: The chamber compliance a registered plant gives the rig:
+#: ``compliance(design, supply_mpa) -> mm³/MPa or None`` (None: the design's default).
+PLANT_COMPLIANCES: dict[str, Callable[[SFRBADesign, float], float | None]] = {}
 
 
 def plant_file(name: str) -> Path | None:
@@ -72,28 +90,77 @@ def plant_file(name: str) -> Path | None:
     return path if path.suffix.lower() in (".json", ".csv") and path.is_file() else None
 
 
-def check_plant(plant: str) -> str:
-    """``plant`` if it names a plant: a name of :data:`PLANTS` or a plant file.
+def parse_plant(plant: str | PlantChoice) -> PlantChoice:
+    """What ``plant`` names: a registered plant or a plant file, of which kind.
+
+    An existing ``.csv`` file is measurements; an existing ``.json`` file is a model
+    of ``softbend identify`` when it was saved by it, else a saved surrogate; anything
+    else must be a name of :data:`PLANTS`. A :class:`PlantChoice` is returned as it is.
 
     Raises
     ------
     UnknownNameError
-        Neither (the message lists the names and says a file may be given).
+        Keyed ``plant``: neither (the message lists the names and says a file may be given).
     """
-    if plant_file(plant) is None:
-        try:
-            PLANTS.check(plant)
-        except UnknownNameError as exc:
-            raise UnknownNameError(
-                f"{exc.detail} A plant may also be the path of a saved surrogate (.json), of a "
-                "model of 'softbend identify' (.json) or of measurements (.csv).",
-                key="plant",
-            ) from None
-    return plant
+    if isinstance(plant, PlantChoice):
+        return plant
+    from softbend.control.identified_plant import is_identified_plant
+
+    text = str(plant)
+    path = plant_file(text)
+    if path is not None and path.suffix.lower() == ".csv":
+        return PlantChoice("measurements", text, path)
+    if path is not None:
+        return PlantChoice("identified" if is_identified_plant(path) else "surrogate", text, path)
+    try:
+        PLANTS.check(text)
+    except UnknownNameError as exc:
+        raise UnknownNameError(
+            f"{exc.detail} A plant may also be the path of a saved surrogate (.json), of a "
+            "model of 'softbend identify' (.json) or of measurements (.csv).",
+            key="plant",
+        ) from None
+    return PlantChoice("named", text)
+
+
+def check_plant(plant: str | PlantChoice) -> str:
+    """``plant`` if it names a plant: a name of :data:`PLANTS` or a plant file
+    (:func:`parse_plant`; UnknownNameError else)."""
+    return parse_plant(plant).text
+
+
+def _own_actuator(choice: PlantChoice) -> Actuator | None:
+    """The actuator ``choice`` is of alone (:data:`PLANT_ACTUATORS`), else None."""
+    return PLANT_ACTUATORS.get(choice.text if choice.kind == "named" else choice.kind)
+
+
+def check_plant_actuator(plant: str | PlantChoice, design: SFRBADesign | ModelDesign) -> None:
+    """Refuse a plant of one actuator alone for a design of another (InputError keyed plant)."""
+    choice = parse_plant(plant)
+    own, actuator = _own_actuator(choice), actuator_of_design(design)
+    if own is not None and own.name != actuator.name:
+        raise InputError(
+            f"{choice.text!r} is of {own.title} only; the design {design} is of the "
+            f"actuator {actuator.name}: use the plant 'surrogate' (the controller's model) or "
+            "a saved surrogate .json of that actuator",
+            key="plant",
+        )
+
+
+def plant_compliance(
+    plant: str | PlantChoice, design: SFRBADesign | ModelDesign, supply_mpa: float
+) -> float | None:
+    """The rig's chamber compliance the plant gives for ``design``, mm³/MPa, else None."""
+    choice = parse_plant(plant)
+    compliance = PLANT_COMPLIANCES.get(choice.text) if choice.kind == "named" else None
+    if compliance is None:
+        return None
+    check_plant_actuator(choice, design)
+    return compliance(cast(SFRBADesign, design), supply_mpa)
 
 
 def plant_table(
-    plant: str,
+    plant: str | PlantChoice,
     design: SFRBADesign | ModelDesign,
     model_table: AngleTable,
     *,
@@ -103,46 +170,42 @@ def plant_table(
 
     Parameters
     ----------
-    plant : str
+    plant : str or PlantChoice
         A name of :data:`PLANTS` (``model_table`` for "surrogate"), the path of a
         saved surrogate (``.json``: its θ(p) for ``design``) or of a measurements
         CSV (``.csv``: the design's loading readings, smoothed as
-        :func:`lab_angle_table` does). Anything else raises
-        :class:`~softbend.registry.UnknownNameError` listing the known names.
+        :func:`lab_angle_table` does), or that text parsed (:func:`parse_plant`).
+        Anything else raises :class:`~softbend.registry.UnknownNameError` listing
+        the known names; an identified model has no θ(p) table (InputError).
     design : SFRBADesign or ModelDesign
-        Paper B's design, or a design of another actuator (then the plant is
-        ``surrogate``, a saved surrogate of that actuator, or a registered plant
-        that takes such a design; ``fem``, ``lab`` and a CSV are refused).
+        The design, of the controller's model's actuator; a plant of another
+        actuator alone (:data:`PLANT_ACTUATORS`) is refused.
     model_table : AngleTable
         θ(p) of the controllers' own model.
     pmax_mpa : float, default 0.5
         The top of a saved surrogate's table, MPa gauge.
     """
-    path = plant_file(plant)
-    if isinstance(design, ModelDesign) and (
-        plant in PAPER_B_PLANTS or (path is not None and path.suffix.lower() == ".csv")
-    ):
-        raise InputError(
-            f"{plant!r} is of paper B's actuator only; the design "
-            f"{design} is of the actuator {design.actuator.name}: use the plant 'surrogate' "
-            "(the controller's model) or a saved surrogate .json of that actuator",
-            key="plant",
-        )
-    if path is None:
-        factory = PLANTS.get(check_plant(plant))
-        # paper B's plants were refused above for another actuator's design; a registered
-        # one receives the design the controller's model takes
-        return factory(cast(SFRBADesign, design), model_table)
-    if path.suffix.lower() == ".json":
+    choice = parse_plant(plant)
+    check_plant_actuator(choice, design)
+    if choice.kind == "named":
+        # a registered plant receives the design the controller's model takes
+        return PLANTS.get(choice.text)(cast(SFRBADesign, design), model_table)
+    if choice.kind == "surrogate":
         from softbend.surrogates.persistence import load_surrogate
 
-        saved = load_surrogate(path)
-        own = control_design(design, saved.actuator, source=f"the plant {path}")
+        saved = load_surrogate(choice.text)
+        own = control_design(design, saved.actuator, source=f"the plant {choice.path}")
         return AngleTable.from_surrogate(saved.model, own, pmax_mpa=pmax_mpa)
-    from softbend.transfer.measurements import load_measurements
+    if choice.kind == "measurements":
+        from softbend.transfer.measurements import load_measurements
 
-    assert isinstance(design, SFRBADesign)
-    return lab_angle_table(design, measurements=load_measurements(path), source=str(path))
+        readings = load_measurements(choice.text)
+        return lab_angle_table(cast(SFRBADesign, design), measurements=readings, source=choice.text)
+    raise InputError(
+        f"is the identified model {choice.text}: its dynamics play the actuator, it has no "
+        "θ(p) table of a design",
+        key="plant",
+    )
 
 
 def surrogate_plant(design: SFRBADesign, model_table: AngleTable) -> AngleTable:
@@ -158,6 +221,19 @@ def in_table1(design: SFRBADesign) -> bool:
         any(np.isclose(value, level) for level in TABLE1_LEVELS[name])
         for name, value in design.as_dict().items()
     )
+
+
+def fem_compliance(design: SFRBADesign, supply_mpa: float) -> float | None:
+    """The chamber compliance of a design's own FEM sweep up to the supply, mm³/MPa.
+
+    None for a design of Table 1 (its rig keeps the default compliance); another is
+    swept once and cached (:func:`softbend.control.fem_plant.fem_curve`).
+    """
+    if in_table1(design):
+        return None
+    from softbend.control.fem_plant import fem_curve
+
+    return fem_curve(design).compliance_mm3_per_mpa(supply_mpa)
 
 
 def fem_plant(design: SFRBADesign, model_table: AngleTable) -> AngleTable:
@@ -221,15 +297,10 @@ def support_warnings(
     own = control_design(design, actuator, source=role)
     with using_features(actuator.features):
         support = Support.from_dict(record)
-    if isinstance(own, SFRBADesign):
-        limit = float(support.max_pressure(own.as_array()[None, :])[0])
-        shown_limit, shown_supply = f"{limit:.3g} MPa", f"{up_to_mpa:g} MPa"
-    else:
-        native = float(support.max_pressure(own.as_array()[None, :])[0])
-        limit = native / own.pressure_scale
-        unit = actuator.pressure_unit
-        shown_limit = f"{native:.3g} {unit}"
-        shown_supply = f"{up_to_mpa * own.pressure_scale:g} {unit}"
+    scale, unit = 1.0 / actuator.to_mpa, actuator.pressure_unit  # from MPa to the model's unit
+    native = float(support.max_pressure(own.as_array()[None, :])[0])
+    limit = native / scale
+    shown_limit, shown_supply = f"{native:.3g} {unit}", f"{up_to_mpa * scale:g} {unit}"
     pressure_note = angle_note = None
     if up_to_mpa > limit * (1 + 1e-9):
         pressure_note = (
@@ -239,11 +310,7 @@ def support_warnings(
     reach = min(up_to_mpa, limit)
     angles = np.asarray(saved.model.predict(own.feature_rows(np.linspace(0.0, reach, 101))))
     if np.max(angles) > support.angle_limit_deg:
-        reach_text = (
-            f"{reach:.3g} MPa"
-            if isinstance(own, SFRBADesign)
-            else f"{reach * own.pressure_scale:.3g} {actuator.pressure_unit}"
-        )
+        reach_text = f"{reach * scale:.3g} {unit}"
         angle_note = (
             f"{role} predicts {np.max(angles):.4g}° for the design {own} below "
             f"{reach_text}, beyond the largest angle it was trained on "
@@ -378,3 +445,4 @@ def lab_angle_table(
 PLANTS.register("surrogate", surrogate_plant)
 PLANTS.register("fem", fem_plant)
 PLANTS.register("lab", lab_plant)
+PLANT_COMPLIANCES["fem"] = fem_compliance

@@ -9,13 +9,17 @@ as 60 kPa, paper B's models (MPa) take ``0.2`` as 0.2 MPa, as they always did.
 from __future__ import annotations
 
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 from softbend.errors import InputError, keyed
+
+if TYPE_CHECKING:
+    from softbend.control.plant_choice import PlantChoice
 
 __all__ = ["run_pressure_unit", "run_supply_mpa", "supply_mpa"]
 
 
-def run_pressure_unit(model: str | Path | None, plant: str) -> str:
+def run_pressure_unit(model: str | Path | None, plant: str | PlantChoice) -> str:
     """The pressure unit of a run's actuator, in which a bare supply pressure is read.
 
     Parameters
@@ -39,18 +43,13 @@ def run_pressure_unit(model: str | Path | None, plant: str) -> str:
         Keyed ``plant`` or ``model``: a plant that is neither a name nor a file, or a
         model file that cannot be read (as the run itself would say).
     """
-    from softbend.control.identified_plant import identified_plant, is_identified_plant
-    from softbend.control.plants import check_plant, plant_file
+    from softbend.control.plants import parse_plant
     from softbend.surrogates.persistence import load_surrogate
 
     with keyed("plant"):
-        check_plant(plant)
-        path = plant_file(plant)
-        path = path if path is not None and path.suffix.lower() == ".json" else None
-        if path is not None and is_identified_plant(path):
-            return identified_plant(path).input_unit
-        if path is not None:
-            return str(load_surrogate(path).actuator.pressure_unit)
+        unit = parse_plant(plant).pressure_unit()
+    if unit is not None:
+        return unit
     if model is not None:
         with keyed("model"):
             return str(load_surrogate(model).actuator.pressure_unit)
@@ -99,7 +98,7 @@ def supply_mpa(supply: str | float | None, unit: str) -> float | None:
 
 
 def run_supply_mpa(
-    supply: str | float | None, model: str | Path | None, plant: str
+    supply: str | float | None, model: str | Path | None, plant: str | PlantChoice
 ) -> float | None:
     """:func:`supply_mpa` of a run: a bare number in :func:`run_pressure_unit` of its
     ``model`` and ``plant`` (looked up only for a bare number), in MPa gauge."""

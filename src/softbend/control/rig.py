@@ -327,10 +327,11 @@ class RigParams:
                 "The 'result' of RigParams.from_fem_sweep must be an FEM sweep (its stats "
                 "record step_volume_rate_mm3_per_mpa); this one does not."
             )
-        if not isinstance(result.design, SFRBADesign):
+        if getattr(result.design, "cavity_volume_mm3", None) is None:
             raise ValueError(
-                "The 'result' of RigParams.from_fem_sweep must be a sweep of paper B's actuator "
-                f"(the rig's chamber is its geometry); got a design of {result.design.family!r}."
+                "The 'result' of RigParams.from_fem_sweep must be a sweep of a design whose "
+                "geometry gives its cavity volume (the rig's chamber), as paper B's does; got a "
+                f"design of {result.design.family!r}."
             )
         supply = kwargs.get("supply_gauge_mpa", cls.supply_gauge_mpa)
         compliance = cavity_compliance_mm3_per_mpa(

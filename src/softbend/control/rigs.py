@@ -51,6 +51,7 @@ __all__ = [
     "RIGS",
     "RIG_SETTINGS",
     "RigSetup",
+    "has_cavity",
     "make_rig",
     "modbus_rig",
     "pressures_in_mpa",
@@ -292,6 +293,12 @@ def pressures_in_mpa(texts: Mapping[str, str]) -> dict[str, str]:
             continue
         out[name] = repr(parse_pressure(text, "MPa", name))
     return out
+
+
+def has_cavity(design: object) -> bool:
+    """Whether ``design`` gives its own cavity volume (``cavity_volume_mm3``, mm³, from its
+    geometry, as paper B's designs do), from which the rig's chamber follows."""
+    return getattr(design, "cavity_volume_mm3", None) is not None
 
 
 def rig_params_for(

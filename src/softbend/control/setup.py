@@ -37,9 +37,15 @@ from typing import TYPE_CHECKING, Any
 
 from softbend.actuators import SFRBA, Actuator
 from softbend.control.controllers import Controller, ControllerModel
-from softbend.control.designs import DEFAULT_DESIGN, ModelDesign, control_design
+from softbend.control.designs import (
+    DEFAULT_DESIGN,
+    ModelDesign,
+    actuator_of_design,
+    control_design,
+)
 from softbend.control.factory import CONTROLLERS, DEFAULT_CONTROLLER, controller_parameters
-from softbend.control.plants import check_plant, in_table1, plant_table
+from softbend.control.plant_choice import PlantChoice
+from softbend.control.plants import check_plant_actuator, parse_plant, plant_compliance, plant_table
 from softbend.control.rig import AngleTable, RigParams
 from softbend.control.rigconfig import ControllerConfig
 from softbend.design import SFRBADesign
@@ -53,6 +59,7 @@ if TYPE_CHECKING:
 
 __all__ = [
     "DEFAULT_DESIGN",
+    "TABLE_SPAN_MPA",
     "ControlSetup",
     "beyond_support",
     "check_supply",
@@ -60,6 +67,11 @@ __all__ = [
     "prepare_control",
     "resolve_controller",
 ]
+
+
+#: The top pressure of the θ(p) tables of a run, MPa, by actuator: paper B's span
+#: 0–0.5 MPa as its figures always did; another actuator's, 0 to the supply.
+TABLE_SPAN_MPA: dict[str, float] = {SFRBA.name: 0.5}
 
 
 @dataclass(frozen=True)
@@ -73,7 +85,7 @@ class ControlSetup:
     rig_params : RigParams
         Pneumatics of the simulated rig (and the predictive controller's model).
     plant : str
-        Name of the plant (:data:`~softbend.control.plants.PLANTS`) or its file.
+        Name of the plant (:data:`~softbend.control.plants.PLANTS`) or its file, as given.
     plant_table : AngleTable
         θ(p) of the simulated actuator, degrees (pressures in MPa gauge).
     model : ControllerModel
@@ -108,6 +120,8 @@ class ControlSetup:
         The identified dynamic model that plays the actuator (``plant`` its file);
         ``plant_table`` is then its steady-state θ(p) and :meth:`plant_dynamics`
         its dynamics.
+    choice : PlantChoice, optional
+        ``plant`` as parsed (:attr:`plant_choice` parses it when not given).
     """
 
     design: SFRBADesign | ModelDesign
@@ -127,6 +141,12 @@ class ControlSetup:
     design_notes: list[str] = field(default_factory=list)
     design_outside: list[str] = field(default_factory=list)
     identified: IdentifiedPlant | None = field(default=None, repr=False)
+    choice: PlantChoice | None = field(default=None, repr=False)
+
+    @property
+    def plant_choice(self) -> PlantChoice:
+        """The plant as parsed (:func:`~softbend.control.plants.parse_plant`)."""
+        return self.choice if self.choice is not None else parse_plant(self.plant)
 
     def plant_dynamics(self) -> AngleDynamics | None:
         """A fresh dynamic model of the plant's angle for a rig, else None (θ(p) and a lag)."""
@@ -153,13 +173,14 @@ class ControlSetup:
     @property
     def mismatch(self) -> bool:
         """Whether the plant is a saved model other than the controller's model."""
-        return _plant_model(self.plant) is not None and not self.plant_is_model
+        return self.plant_choice.model_file is not None and not self.plant_is_model
 
     @property
     def plant_is_model(self) -> bool:
         """Whether the plant is the controller's model itself (``surrogate``, or its file)."""
-        path = _plant_model(self.plant)
-        return self.plant == "surrogate" or (
+        choice = self.plant_choice
+        path = choice.model_file
+        return (choice.kind, choice.text) == ("named", "surrogate") or (
             path is not None and _same_file(path, Path(self.model_path))
         )
 
@@ -178,7 +199,7 @@ class ControlSetup:
         }
         if self.identified is not None:
             out["plant_description"] = self.identified.describe()
-        if isinstance(self.design, ModelDesign):
+        if isinstance(self.design, ModelDesign):  # paper B's runs record as they always did
             out["actuator"] = self.actuator.name
             out["design_parameters"] = self.design.as_record()
             out["model_pressure_unit"] = self.actuator.pressure_unit
@@ -261,22 +282,18 @@ def resolve_controller(
     return chosen, effective_parameters(entry, {**from_toml, **from_set})
 
 
-def model_of_run(model: str | Path | None, plant: str) -> tuple[Path | None, str]:
+def model_of_run(model: str | Path | None, plant: str | PlantChoice) -> tuple[Path | None, str]:
     """The file of the controllers' model of a run, and where it came from.
 
     ``model`` when given (``"model"``); else the plant when it is a saved
-    surrogate (``"plant"``: the model that plays the actuator is its own soft
+    model (``"plant"``: the model that plays the actuator is its own soft
     sensor, as paper B ran its refined model); else None, the shipped
     FEM-trained MLP (``"shipped"``).
     """
-    from softbend.control.plants import plant_file
-
     if model is not None:
         return Path(model), "model"
-    path = plant_file(plant)
-    if path is not None and path.suffix.lower() == ".json":
-        return path, "plant"
-    return None, "shipped"
+    path = parse_plant(plant).model_file
+    return (path, "plant") if path is not None else (None, "shipped")
 
 
 def prepare_control(
@@ -286,7 +303,7 @@ def prepare_control(
     config: ControllerConfig | None = None,
     design: str | SFRBADesign | ModelDesign | None = None,
     model: str | Path | None = None,
-    plant: str = "surrogate",
+    plant: str | PlantChoice = "surrogate",
     supply_mpa: float = 0.2,
     strict: bool = False,
     rig_settings: Mapping[str, Any] | None = None,
@@ -307,12 +324,13 @@ def prepare_control(
         A saved surrogate for the controller's θ(p) and virtual sensor, of any
         actuator. Default: the plant, when the plant is a saved surrogate; else
         the shipped FEM-trained MLP.
-    plant : str
+    plant : str or PlantChoice
         The actuator's θ(p): a name of :data:`~softbend.control.plants.PLANTS`, or a
         saved surrogate ``.json`` / measurements ``.csv`` of the lab's own actuator
         (:func:`~softbend.control.plants.plant_table`), or a model of ``softbend
         identify`` (``.json``) whose dynamics play the actuator (one pressure input,
-        an angle output, a known time unit; else an InputError keyed ``plant``). A
+        an angle output, a known time unit; else an InputError keyed ``plant``),
+        parsed once (:func:`~softbend.control.plants.parse_plant`). A
         saved surrogate and ``model`` must describe the same design parameters
         (their pressure units may differ).
     supply_mpa : float, default 0.2
@@ -343,13 +361,13 @@ def prepare_control(
         actuator, a chamber volume unknown; with ``strict``, a model used beyond
         its training data.
     """
-    from softbend.control.rigs import rig_params_for
+    from softbend.control.rigs import has_cavity, rig_params_for
     from softbend.control.rigs import rig_settings as check_rig_settings
     from softbend.transfer.base import load_base_saved, shipped_base_path
 
     name, params = resolve_controller(controller, assignments, config)
     with keyed("plant"):
-        check_plant(plant)
+        choice = parse_plant(plant)
     with keyed("rig_settings"):
         settings = check_rig_settings(values=rig_settings)
     if "supply_gauge_mpa" in settings:  # held by rig_settings to the same (0, 2] MPa
@@ -357,50 +375,44 @@ def prepare_control(
     else:
         supply_mpa = check_supply(supply_mpa)
     chosen = {**settings, "supply_gauge_mpa": supply_mpa}
-    identified = _identified_plant(plant)
+    identified = choice.identified()
     if identified is not None and model is None:
         return _identified_setup(identified, name, params, design, settings, chosen, supply_mpa)
-    model_path, model_from = model_of_run(model, plant)
+    model_path, model_from = model_of_run(model, choice)
     saved = load_base_saved(model_path)
     label = str(model_path) if model_path is not None else str(shipped_base_path())
     source = "the shipped MLP" if model_path is None else f"the model {model_path}"
     actuator = saved.actuator
     with keyed("design"):
         actuator_design = control_design(design, actuator, source=source)
-    plant_path = _plant_model(plant) if identified is None else None
+    plant_path = choice.surrogate_file
     shared = (
         plant_path is not None and model_path is not None and _same_file(plant_path, model_path)
     )
     if plant_path is not None and not shared:
         _check_same_parameters(plant_path, actuator, model_path)
-    if simulated or name == "predictive" or isinstance(actuator_design, SFRBADesign):
-        rig = rig_params_for(actuator_design, chosen)
+    with keyed("plant"):
+        check_plant_actuator(choice, actuator_design)
+    if simulated or name == "predictive" or has_cavity(actuator_design):
+        # a plant's own chamber (an FEM sweep of the design, solved once) where it gives one
+        compliance = plant_compliance(choice, actuator_design, supply_mpa)
+        derived = {} if compliance is None else {"compliance_mm3_per_mpa": compliance}
+        rig = rig_params_for(actuator_design, chosen, **derived)
     else:  # hardware: its pneumatics are what they are, and no controller models them
         rig = RigParams(**chosen)
-    if (
-        plant == "fem"
-        and isinstance(actuator_design, SFRBADesign)
-        and not in_table1(actuator_design)
-    ):
-        # The design's own FEM sweep (solved once, cached) gives its chamber's compliance.
-        from softbend.control.fem_plant import fem_curve
-
-        compliance = fem_curve(actuator_design).compliance_mm3_per_mpa(supply_mpa)
-        rig = rig_params_for(actuator_design, chosen, compliance_mm3_per_mpa=compliance)
     surrogate = saved.model
     design_notes, outside = _design_check(model_path, label, actuator_design, strict)
     supported, notes = _support_check(
         saved, model_path, plant_path, shared, actuator_design, supply_mpa, strict
     )
-    # Paper B's tables span 0–0.5 MPa as always; another actuator's, 0 to the supply.
-    pmax = 0.5 if isinstance(actuator_design, SFRBADesign) else supply_mpa
+    pmax = TABLE_SPAN_MPA.get(actuator.name, supply_mpa)
     controller_model = ControllerModel.from_surrogate(
         surrogate, actuator_design, rig, pmax_mpa=pmax
     )
     if identified is None:
         with keyed("plant"):
             actuator_table = plant_table(
-                plant, actuator_design, controller_model.angle_table, pmax_mpa=pmax
+                choice, actuator_design, controller_model.angle_table, pmax_mpa=pmax
             )
     else:  # the rig steps its dynamics; its steady state is the plant's θ(p) on record
         actuator_table = identified.angle_table(supply_mpa, check=False)
@@ -408,7 +420,7 @@ def prepare_control(
     return ControlSetup(
         design=actuator_design,
         rig_params=rig,
-        plant=plant,
+        plant=choice.text,
         plant_table=actuator_table,
         model=controller_model,
         controller_name=name,
@@ -423,19 +435,8 @@ def prepare_control(
         design_notes=design_notes,
         design_outside=outside,
         identified=identified,
+        choice=choice,
     )
-
-
-def _identified_plant(plant: str) -> IdentifiedPlant | None:
-    """The plant as an identified dynamic model (checked to play the actuator), else None."""
-    from softbend.control.identified_plant import identified_plant, is_identified_plant
-    from softbend.control.plants import plant_file
-
-    path = plant_file(plant)
-    if path is None or not is_identified_plant(path):
-        return None
-    with keyed("plant"):
-        return identified_plant(path)
 
 
 def _identified_setup(
@@ -483,14 +484,6 @@ def _identified_setup(
     )
 
 
-def _plant_model(plant: str) -> Path | None:
-    """The plant as a saved model's file (a surrogate or an identified model), else None."""
-    from softbend.control.plants import plant_file
-
-    path = plant_file(plant)
-    return path if path is not None and path.suffix.lower() == ".json" else None
-
-
 def _same_file(a: Path, b: Path) -> bool:
     """Whether two paths name the same file."""
     try:
@@ -528,9 +521,8 @@ def _design_check(
     from softbend.transfer.base import shipped_base_path
 
     path = shipped_base_path() if model_path is None else model_path
-    codes: Any = design if isinstance(design, SFRBADesign) else design.as_array()
-    outside = predict_angles(path, codes, [0.0]).outside_training_ranges
-    names = set(design.actuator.names if isinstance(design, ModelDesign) else SFRBA.names)
+    outside = predict_angles(path, design.as_array(), [0.0]).outside_training_ranges
+    names = set(actuator_of_design(design).names)
     phrases = [phrase for phrase in outside if phrase.split(" ", 1)[0] in names]
     if not phrases:
         return [], []
@@ -592,12 +584,10 @@ def beyond_support(setup: ControlSetup, max_pressure_mpa: float) -> str | None:
     limit = setup.supported_mpa
     if limit is None or not max_pressure_mpa > limit * (1 + 1e-9):
         return None
-    if isinstance(setup.design, ModelDesign):
-        scale, unit = setup.design.pressure_scale, setup.actuator.pressure_unit
-        reached = f"{max_pressure_mpa * scale:.3g} {unit}"
-        trained = f"{limit * scale:.3g} {unit}"
-    else:
-        reached, trained = f"{max_pressure_mpa:.3g} MPa", f"{limit:.3g} MPa"
+    actuator = actuator_of_design(setup.design)
+    scale, unit = 1.0 / actuator.to_mpa, actuator.pressure_unit  # from MPa to the model's unit
+    reached = f"{max_pressure_mpa * scale:.3g} {unit}"
+    trained = f"{limit * scale:.3g} {unit}"
     return (
         f"The run reached {reached}, past the {trained} the models "
         f"were trained to near the design {setup.design}: the angles above it are "
