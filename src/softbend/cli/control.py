@@ -11,7 +11,7 @@ from pathlib import Path
 
 import typer
 
-from softbend.cli import _common, control_run
+from softbend.cli import _common, control_help, control_run
 from softbend.cli import control_options as opt
 
 app = typer.Typer(
@@ -24,7 +24,7 @@ app = typer.Typer(
 _FILES = ("run.csv", "metrics.json", "run.png")
 
 
-@app.command("simulate")
+@app.command("simulate", help=control_help.SIMULATE)
 def simulate_cmd(
     out: Path = typer.Option(
         ...,
@@ -52,52 +52,13 @@ def simulate_cmd(
     strict: bool = opt.STRICT,
     as_json: bool = typer.Option(False, "--json", help="Print the metrics as JSON."),
 ) -> None:
-    """Run a controller on the simulated rig and score it.
-
-    Scores the run as paper B, Figure 9 (synthetic data). metrics.json records
-    the controller and the rig, with every one of their parameters as used, and
-    the controller's model. That model (θ(p) and virtual angle sensor) is
-    --model, else the --plant when it is a saved surrogate (a refined model is
-    its own soft sensor, as in paper B), else the shipped FEM-trained MLP;
-    --model with another --plant .json is a deliberate mismatch, and the table
-    names both. A model of any actuator may be used: --design names its
-    parameters (NAME=VALUE pairs), its pressures are converted from the rig's MPa
-    (a bare --supply is in the model's pressure unit, a --rig-param pressure in
-    MPa as its name says, both take a unit such as 20psi; the scores stay in
-    MPa), and the chamber is its
-    description's (else --rig-param volume_mm3). A design outside the model's
-    training ranges is a warning naming the parameter, and the table's row
-    "design in the model's training data" and design_supported in metrics.json
-    say so; --strict refuses it. A model of 'softbend identify' (one pressure
-    input, an angle output, a time column in s or ms) may play the plant: its
-    dynamics replace θ(p) and the angle lag, and without --model its
-    steady-state θ(p) is the controller's (such a plant has no --design).
-    --rig-from such a model sets the rig's angle_time_constant_s and
-    valve_delay_s from its step reading; --rig-param values win.
-    A score the run does not define (an angle that did not settle within the
-    run, a run without a rising edge) is null in metrics.json and --json, with
-    the reason under undefined_metrics, and 'null (the reason)' in the table;
-    never NaN. Every --set and --rig-param value is held to its declared range
-    and the run to the memory it needs, before it starts. The results are
-    written beside --out and swapped in at the end: an error, Ctrl-C or kill
-    leaves the previous results (or none).
-
-    Example:
-
-    \b
-        softbend control simulate --out bb --set deadzone=0.02 --rig-param valve_delay_s=0.02
-    """
-    import signal
-
-    from softbend._outdir import staged_dir
+    """Run a controller on the simulated rig and score it (help: control_help.SIMULATE)."""
     from softbend.control.pressures import run_supply_mpa
     from softbend.control.runs import simulate_control
-    from softbend.reports import control_figures
 
     _common.check_output_dir(out, "--out", files=_FILES)
     _common.check_replaceable_dir(out, "--out")
-    previous = control_run.terminate_as_interrupt()  # `kill`: staged results removed
-    try:
+    with control_run.sigterm_as_interrupt():  # `kill`: staged results removed
         with _common.library_progress(enabled=not as_json):  # an FEM plant's sweep, if any
             result = simulate_control(
                 reference=reference, controller=controller, assignments=assignments or (),
@@ -106,36 +67,11 @@ def simulate_cmd(
                 rig_assignments=rig_assignments or (), seed=seed,
                 strict=strict, rig_from=rig_from,
             )  # fmt: skip
-        payload = dict(result.summary)
-        name, actuator = payload["controller"], control_run.actuator_of(payload)
-        with (
-            _common.output_errors(out, "--out"),
-            staged_dir(out) as stage,
-            _common.as_written(stage, out),
-        ):
-            result.run.frame().to_csv(stage / _FILES[0], index=False)
-            text = _common.json_text(payload) + "\n"
-            (stage / _FILES[1]).write_text(text, encoding="utf-8")
-            title = f"{name} on {actuator}, {reference} (simulated)"
-            control_figures.run_figure(result.run.decimated(), stage / _FILES[2], title)
-    finally:
-        if previous is not None:
-            signal.signal(signal.SIGTERM, previous)
-    payload["files"] = [str(out / name) for name in _FILES]
-    if as_json:
-        _common.print_json(payload)
-        return
-    note, named = control_run.model_lines(result.setup)
-    named += control_run.rig_from_rows(payload.get("rig_from"))
-    _common.print_table(
-        f"{name} on {actuator}, {reference}: simulated rig (SYNTHETIC){note}",
-        ["metric", "value"],
-        named + control_run.metric_rows(payload["metrics"], payload["undefined_metrics"]),
-    )
-    _common.console.print(f"run written to {out}")
+        control_run.write_simulation(result, out, _FILES, reference)
+    control_run.print_simulation(result, [out / name for name in _FILES], reference, as_json)
 
 
-app.command("run")(control_run.run_cmd)
+app.command("run", help=control_help.RUN)(control_run.run_cmd)
 
 
 @app.command("controllers")

@@ -1,4 +1,4 @@
-"""Options shared by ``softbend control simulate``, ``run`` and ``serve``."""
+"""Options of ``softbend control simulate``, ``run`` and ``serve``."""
 
 from __future__ import annotations
 
@@ -86,3 +86,38 @@ STRICT = typer.Option(
     "its training data (a pressure past what the designs nearest to it were swept to, an "
     "angle past the largest trained on); without it, each is a warning.",
 )
+RUN_OUT = typer.Option(
+    ...,
+    "--out",
+    "-o",
+    help="Folder for ticks.csv|parquet, run.json and run.png (replaced as a whole: a new "
+    "or empty folder, or an earlier result of this command).",
+)
+RIG = typer.Option(
+    "sim",
+    help="A registered rig: sim (simulated time), sim-realtime (simulated, on the wall "
+    "clock) or modbus.",
+)
+CONFIG = typer.Option(
+    None,
+    "--config",
+    help="Rig TOML: connection, register map, scaling, safety, period, [controller], "
+    "[simulation] (required for --rig modbus; its [safety] and [loop] apply to every rig).",
+)
+RUN_DURATION = typer.Option(
+    10.0,
+    "--duration",
+    help="Run time, s: in (0, 86400] and at most SOFTBEND_MAX_LOOP_TICKS ticks (default "
+    "10 000 000: 10 000 s at the default 1 ms tick), each logged in memory.",
+)
+PERIOD = typer.Option(
+    None,
+    "--period",
+    help="Loop tick (controller, valves), s (default: the config's period_s, 0.001).",
+)
+SENSOR_PERIOD = typer.Option(
+    None,
+    "--sensor-period",
+    help="Pressure reading period, s (default: the config's sensor_period_s, 0.01: 100 Hz).",
+)
+LOG_FORMAT = typer.Option("csv", help="Tick log format: csv (streamed) or parquet.")

@@ -4,6 +4,8 @@ from __future__ import annotations
 
 import signal
 import threading
+from collections.abc import Iterator
+from contextlib import contextmanager
 from pathlib import Path
 from types import FrameType
 from typing import TYPE_CHECKING, Any
@@ -14,96 +16,41 @@ from softbend.cli import _common
 from softbend.cli import control_options as opt
 
 if TYPE_CHECKING:
+    from softbend.control.runs import LoopPlan, LoopResult, Simulation
     from softbend.control.setup import ControlSetup
 
 _LOG_FORMATS = ("csv", "parquet")
 
 
 def run_cmd(
-    out: Path = typer.Option(
-        ...,
-        "--out",
-        "-o",
-        help="Folder for ticks.csv|parquet, run.json and run.png (replaced as a whole: a new "
-        "or empty folder, or an earlier result of this command).",
-    ),
-    rig: str = typer.Option(
-        "sim",
-        help="A registered rig: sim (simulated time), sim-realtime (simulated, on the wall "
-        "clock) or modbus.",
-    ),
-    config: Path = typer.Option(
-        None,
-        "--config",
-        help="Rig TOML: connection, register map, scaling, safety, period, [controller], "
-        "[simulation] (required for --rig modbus; its [safety] and [loop] apply to every rig).",
-    ),
+    out: Path = opt.RUN_OUT,
+    rig: str = opt.RIG,
+    config: Path = opt.CONFIG,
     reference: str = opt.REFERENCE,
     controller: str = opt.CONTROLLER,
     assignments: list[str] = opt.SET,
     design: str = opt.DESIGN,
     model: Path = opt.MODEL,
     plant: str = opt.PLANT,
-    duration_s: float = typer.Option(
-        10.0,
-        "--duration",
-        help="Run time, s: in (0, 86400] and at most SOFTBEND_MAX_LOOP_TICKS ticks (default "
-        "10 000 000: 10 000 s at the default 1 ms tick), each logged in memory.",
-    ),
-    period_s: float = typer.Option(
-        None,
-        "--period",
-        help="Loop tick (controller, valves), s (default: the config's period_s, 0.001).",
-    ),
-    sensor_period_s: float = typer.Option(
-        None,
-        "--sensor-period",
-        help="Pressure reading period, s (default: the config's sensor_period_s, 0.01: 100 Hz).",
-    ),
+    duration_s: float = opt.RUN_DURATION,
+    period_s: float = opt.PERIOD,
+    sensor_period_s: float = opt.SENSOR_PERIOD,
     supply_mpa: str = opt.SUPPLY,
     rig_assignments: list[str] = opt.RIG_PARAM,
     rig_from: Path = opt.RIG_FROM,
     seed: int = typer.Option(0, help="Seed of a simulated rig's sensor and camera noise."),
-    log_format: str = typer.Option("csv", help="Tick log format: csv (streamed) or parquet."),
+    log_format: str = opt.LOG_FORMAT,
     strict: bool = opt.STRICT,
     as_json: bool = typer.Option(False, "--json", help="Print the summary as JSON."),
 ) -> None:
-    """Run a controller in the fixed-period loop on a rig.
-
-    The loop keeps the rig's safety limits and a log of every tick. It calls the same
-    controller object as 'softbend control simulate' every tick (1 ms) with the latest
-    pressure reading (read every 10 ms: paper B's 100 Hz). The controller and its
-    parameters come from --controller and --set, else the config's [controller] table
-    (--set overrides its values); run.json records them. A simulated rig takes the
-    config's [simulation] table and --rig-param (which overrides it). Over-pressure, missed or stale
-    readings vent the actuator and stop the run; so do Ctrl-C and SIGTERM. Exit 0 when
-    the run completed and the rig was vented, 1 when a fault stopped it or the final
-    vent did not reach the rig (the log keeps every tick up to the fault; the one error
-    line says whether the rig was vented), 130 on Ctrl-C.
-
-    Every --set and --rig-param value is held to its declared range and the run to
-    the memory it needs, before it starts. A score the run does not define (an angle
-    that did not settle within the run, a rig without an angle sensor) is null in
-    run.json and --json, with the reason under undefined_metrics, and 'null (the
-    reason)' in the table; never NaN. The results are built beside --out and swapped
-    in once written: a kill -9 leaves the previous results whole (the ticks of the
-    killed run stay in the hidden folder .OUT.PID-*.new/ticks.csv.partial beside it
-    until the next run into --out).
-
-    Example:
-
-    \b
-        softbend control run --out loop --config rig.toml --set deadzone=0.02
-    """
-    from softbend._outdir import staged_dir
+    """Run a controller in the fixed-period loop on a rig (help: control_help.RUN)."""
     from softbend._validation import check_choice
     from softbend.control.pressures import run_supply_mpa
     from softbend.control.runs import plan_loop
-    from softbend.reports import control_figures
 
     check_choice(log_format, "log_format", _LOG_FORMATS)
-    log_name = f"ticks.{log_format}"
-    _common.check_output_dir(out, "--out", files=(log_name, "run.json", "run.png"))
+    files = [out / name for name in (f"ticks.{log_format}", "run.json", "run.png")]
+    _common.check_output_dir(out, "--out", files=tuple(f.name for f in files))
     _common.check_replaceable_dir(out, "--out")
     with _common.library_progress():  # an FEM plant's sweep, if any
         plan = plan_loop(
@@ -114,6 +61,25 @@ def run_cmd(
             rig_assignments=rig_assignments or (), seed=seed,
             strict=strict, rig_from=rig_from,
         )  # fmt: skip
+    title = f"{reference}, rig {rig}"
+    result = _run_loop(plan, out, files, title, as_json)
+    _print_loop(plan, result, files, title, as_json)
+    if result.loop.fault_kind == "interrupted":
+        _common.error_line(result.loop.stop_reason)
+        raise typer.Exit(130)
+    if not result.loop.completed or not result.loop.vented:  # a fault, or a rig left unvented
+        _common.error_line(result.loop.stop_reason)
+        raise typer.Exit(1)
+
+
+def _run_loop(
+    plan: LoopPlan, out: Path, files: list[Path], title: str, as_json: bool
+) -> LoopResult:
+    """Run the loop into a folder beside ``out`` (its tick log, run.json, run.png), swapped
+    in whole at the end; SIGTERM ends it as Ctrl-C does."""
+    from softbend._outdir import staged_dir
+    from softbend.reports import control_figures
+
     done = [0]
 
     def report(n: int, _total: int) -> None:
@@ -121,45 +87,42 @@ def run_cmd(
         done[0] = n
 
     device = plan.make_rig()
-    previous = terminate_as_interrupt()
-    try:
-        with (
-            _common.output_errors(out, "--out"),  # a full disk is one line
-            staged_dir(out) as stage,  # built beside --out, swapped in whole at the end
-            _common.as_written(stage, out),
-        ):
-            with _common.progress_bar("control loop", plan.ticks, enabled=not as_json) as advance:
-                result = plan.run(stage / log_name, progress=report, device=device)
-            payload = dict(result.summary)
-            name, actuator = payload["controller"], actuator_of(payload)
-            text = _common.json_text(payload) + "\n"
-            (stage / "run.json").write_text(text, encoding="utf-8")
-            title = (
-                f"{name} on {actuator}, {reference}, rig {rig} "
-                f"(tick {plan.period_s * 1e3:g} ms, sensor {plan.sensor_period_s * 1e3:g} ms)"
-            )
-            control_figures.run_figure(result.control_run().decimated(), stage / "run.png", title)
-    finally:
-        if previous is not None:
-            signal.signal(signal.SIGTERM, previous)
-    payload["files"] = [str(out / log_name), str(out / "run.json"), str(out / "run.png")]
+    with (
+        sigterm_as_interrupt(),
+        _common.output_errors(out, "--out"),  # a full disk is one line
+        staged_dir(out) as stage,  # built beside --out, swapped in whole at the end
+        _common.as_written(stage, out),
+    ):
+        with _common.progress_bar("control loop", plan.ticks, enabled=not as_json) as advance:
+            result = plan.run(stage / files[0].name, progress=report, device=device)
+        payload = result.summary
+        text = _common.json_text(payload) + "\n"
+        (stage / files[1].name).write_text(text, encoding="utf-8")
+        tick, sensor = plan.period_s * 1e3, plan.sensor_period_s * 1e3
+        control_figures.run_figure(
+            result.control_run().decimated(),
+            stage / files[2].name,
+            f"{payload['controller']} on {actuator_of(payload)}, {title} "
+            f"(tick {tick:g} ms, sensor {sensor:g} ms)",
+        )
+    return result
+
+
+def _print_loop(
+    plan: LoopPlan, result: LoopResult, files: list[Path], title: str, as_json: bool
+) -> None:
+    """Print a loop run's summary: as JSON, or its models, scores and jitter as a table."""
+    payload = {**result.summary, "files": [str(f) for f in files]}
     if as_json:
         _common.print_json(payload)
-    else:
-        note, named = model_lines(plan.setup)
-        named += rig_from_rows(payload.get("rig_from"))
-        rows = named + metric_rows(payload["metrics"], payload["undefined_metrics"])
-        rows += [[k, v] for k, v in payload["jitter"].items()]
-        _common.print_table(
-            f"{name} on {actuator}, {reference}, rig {rig}{note}", ["metric", "value"], rows
-        )
-        _common.console.print(f"run written to {out}")
-    if result.loop.fault_kind == "interrupted":
-        _common.error_line(result.loop.stop_reason)
-        raise typer.Exit(130)
-    if not result.loop.completed or not result.loop.vented:  # a fault, or a rig left unvented
-        _common.error_line(result.loop.stop_reason)
-        raise typer.Exit(1)
+        return
+    note, named = model_lines(plan.setup)
+    named += rig_from_rows(payload.get("rig_from"))
+    rows = named + metric_rows(payload["metrics"], payload["undefined_metrics"])
+    rows += [[k, v] for k, v in payload["jitter"].items()]
+    name = f"{payload['controller']} on {actuator_of(payload)}, {title}{note}"
+    _common.print_table(name, ["metric", "value"], rows)
+    _common.console.print(f"run written to {files[0].parent}")
 
 
 def metric_rows(metrics: dict[str, Any], undefined: dict[str, str]) -> list[list[Any]]:
@@ -216,6 +179,58 @@ def rig_from_rows(origin: dict[str, Any] | None) -> list[list[Any]]:
 DESIGN_ROW = "design in the model's training data"
 
 
+@contextmanager
+def sigterm_as_interrupt() -> Iterator[None]:
+    """Within the block, SIGTERM ends a run as Ctrl-C does (:func:`terminate_as_interrupt`);
+    the previous handler is put back after it."""
+    previous = terminate_as_interrupt()
+    try:
+        yield
+    finally:
+        if previous is not None:
+            signal.signal(signal.SIGTERM, previous)
+
+
+def write_simulation(
+    result: Simulation, out: Path, files: tuple[str, str, str], reference: str
+) -> None:
+    """Write a simulated run into ``out``: its log, its summary and its figure (``files``).
+
+    The files are written beside ``out`` and swapped in at the end: an error, Ctrl-C
+    or kill leaves the previous results (or none).
+    """
+    from softbend._outdir import staged_dir
+    from softbend.reports import control_figures
+
+    payload = result.summary
+    with (
+        _common.output_errors(out, "--out"),
+        staged_dir(out) as stage,
+        _common.as_written(stage, out),
+    ):
+        result.run.frame().to_csv(stage / files[0], index=False)
+        (stage / files[1]).write_text(_common.json_text(payload) + "\n", encoding="utf-8")
+        title = f"{payload['controller']} on {actuator_of(payload)}, {reference} (simulated)"
+        control_figures.run_figure(result.run.decimated(), stage / files[2], title)
+
+
+def print_simulation(result: Simulation, files: list[Path], reference: str, as_json: bool) -> None:
+    """Print a simulated run's summary: as JSON, or its models and scores as a table."""
+    payload = {**result.summary, "files": [str(f) for f in files]}
+    if as_json:
+        _common.print_json(payload)
+        return
+    note, named = model_lines(result.setup)
+    named += rig_from_rows(payload.get("rig_from"))
+    _common.print_table(
+        f"{payload['controller']} on {actuator_of(payload)}, {reference}: simulated rig "
+        f"(SYNTHETIC){note}",
+        ["metric", "value"],
+        named + metric_rows(payload["metrics"], payload["undefined_metrics"]),
+    )
+    _common.console.print(f"run written to {files[0].parent}")
+
+
 def terminate_as_interrupt() -> Any:
     """Make SIGTERM (``kill``, a service stop) end a loop or a server as Ctrl-C does: vented.
 
@@ -236,7 +251,10 @@ __all__ = [
     "actuator_of",
     "metric_rows",
     "model_lines",
+    "print_simulation",
     "rig_from_rows",
     "run_cmd",
+    "sigterm_as_interrupt",
     "terminate_as_interrupt",
+    "write_simulation",
 ]

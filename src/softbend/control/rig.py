@@ -46,7 +46,7 @@ import random
 from bisect import bisect_right
 from collections.abc import Callable
 from dataclasses import dataclass, fields, replace
-from typing import TYPE_CHECKING, Any, Protocol, runtime_checkable
+from typing import TYPE_CHECKING, Any, Protocol, cast, runtime_checkable
 
 import numpy as np
 from numpy.typing import ArrayLike
@@ -328,17 +328,19 @@ class RigParams:
                 "record step_volume_rate_mm3_per_mpa); this one does not."
             )
         if getattr(result.design, "cavity_volume_mm3", None) is None:
+            family = getattr(result.design, "family", type(result.design).__name__)
             raise ValueError(
                 "The 'result' of RigParams.from_fem_sweep must be a sweep of a design whose "
                 "geometry gives its cavity volume (the rig's chamber), as paper B's does; got a "
-                f"design of {result.design.family!r}."
+                f"design of {family!r}."
             )
         supply = kwargs.get("supply_gauge_mpa", cls.supply_gauge_mpa)
         compliance = cavity_compliance_mm3_per_mpa(
             stats["steps_mpa"], stats["step_volume_rate_mm3_per_mpa"], supply
         )
+        design = cast(SFRBADesign, result.design)  # a design with a cavity, checked above
         return cls.for_design(
-            result.design, tubing_mm3=tubing_mm3, compliance_mm3_per_mpa=compliance, **kwargs
+            design, tubing_mm3=tubing_mm3, compliance_mm3_per_mpa=compliance, **kwargs
         )
 
     @classmethod

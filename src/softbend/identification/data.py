@@ -183,9 +183,9 @@ class Experiment:
                     f"Got {float(values[row])!r} at sample {row} "
                     f"({int(bad.sum())} non-finite in all)."
                 )
-        row = not_increasing(columns["time_s"])
-        if row is not None:
-            text = not_increasing_text(columns["time_s"], row, f"sample {row - 1}", self.name)
+        late = not_increasing(columns["time_s"])
+        if late is not None:
+            text = not_increasing_text(columns["time_s"], late, f"sample {late - 1}", self.name)
             raise DatasetError(text, key="time_s")
         try:
             rho, length = bending_from_tip(
