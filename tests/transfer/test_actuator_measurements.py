@@ -7,7 +7,7 @@ import pytest
 
 from softbend.actuators import Actuator, ActuatorError, DesignParameter
 from softbend.errors import DatasetError
-from softbend.transfer.actuator_measurements import load_actuator_measurements
+from softbend.transfer.measurements import load_actuator_measurements
 
 ACTUATOR = Actuator(
     name="bellows",

@@ -10,8 +10,8 @@ import pytest
 from softbend.cli import main
 from softbend.surrogates.persistence import load_surrogate
 from softbend.surrogates.predict import predict_angles
-from softbend.transfer.actuator_measurements import load_actuator_measurements
 from softbend.transfer.loco import BASELINE_STRATEGY, leave_one_configuration_out
+from softbend.transfer.measurements import load_actuator_measurements
 from softbend.transfer.refine import refine_surrogate
 
 from ..stand_ins import actuator_law, actuator_plr_base, actuator_table

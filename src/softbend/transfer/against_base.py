@@ -39,8 +39,7 @@ from softbend.units import PRESSURE_UNITS
 
 if TYPE_CHECKING:
     from softbend.surrogates.persistence import SavedSurrogate
-    from softbend.transfer.actuator_measurements import ActuatorMeasurements
-    from softbend.transfer.measurements import Measurements
+    from softbend.transfer.measurements import ActuatorMeasurements, Measurements
 
 __all__ = [
     "PRESSURE_MARGIN",
@@ -100,16 +99,9 @@ def load_for_base(
         The files' own errors, pressures past the range or angles in radians (key
         ``measurements`` or the angle column), unless ``force``.
     """
-    from softbend.actuators import SFRBA
-    from softbend.transfer.actuator_measurements import load_actuator_measurements
-    from softbend.transfer.measurements import load_measurements_files
+    from softbend.transfer.measurements import read_measurements
 
-    actuator = saved.actuator
-    data: Measurements | ActuatorMeasurements = (
-        load_measurements_files(paths)
-        if actuator == SFRBA
-        else load_actuator_measurements(paths, actuator)
-    )
+    data = read_measurements(paths, saved.actuator)
     forced: dict[str, Any] = {}
     pressure = check_pressures(data, saved, force=force)
     if pressure is not None:

@@ -44,9 +44,8 @@ from softbend.errors import InputError, SoftbendError, keyed
 from softbend.metrics import mape_floor, rmse, thresholded_mape
 from softbend.registry import UnknownNameError
 from softbend.surrogates.protocol import Surrogate
-from softbend.transfer.actuator_measurements import ActuatorMeasurements
 from softbend.transfer.conformal import Calibration, angle_floor, calibrate
-from softbend.transfer.measurements import Measurements
+from softbend.transfer.measurements import ActuatorMeasurements, Measurements
 from softbend.transfer.parameters import check_parameters, recorded_parameters
 from softbend.transfer.strategies import (
     BUILTIN_STRATEGIES,

@@ -60,6 +60,41 @@ readings. Each file fills its own missing optional columns, and each reading
 keeps its file's provenance in :attr:`Measurements.provenance` (``source``,
 ``synthetic``, ``date`` and the file's other ``# key: value`` entries); the
 joined :attr:`Measurements.metadata` holds the entries every file gives alike.
+
+Any described actuator
+----------------------
+A lab refining a surrogate of its own actuator (one trained on its simulation
+table, :mod:`softbend.surrogates.tables`) measures a few built actuators and
+writes one row per reading::
+
+    # synthetic: false
+    # rig: bench 2
+    actuator,n_chambers,n_layers,wall_mm,height_mm,p_kpa,angle_deg
+    A1,10,2,2.0,12,0,0.4
+    A1,10,2,2.0,12,20,41.8
+
+Columns: ``actuator`` or ``actuator_id`` (the id of the built actuator), the
+model's design columns (its :class:`~softbend.actuators.Actuator` parameters,
+categorical ones by level), its pressure column in its unit and its angle column,
+in degrees. A file without an id column is one actuator, named by the file's stem
+(``A1.csv`` holds the readings of ``A1``), as labs keep one file per actuator.
+Nothing else: a file that lacks a design column, or names one the model does not
+have, is one error naming both. The ``# key: value`` header
+lines are optional (``synthetic: true`` marks simulated readings). Every design
+must lie in the model's description (ranges, kinds, constraints); an actuator
+has one design; pressures are finite and >= 0; angles finite (whether they are
+in radians depends on the actuator: :mod:`softbend.transfer.against_base` compares
+them with the base model's prediction).
+
+:class:`ActuatorMeasurements` offers what transfer learning reads from paper
+B's :class:`~softbend.transfer.measurements.Measurements`: ``features`` (the
+model's inputs), ``angle_deg``, ``groups``, ``actuator_ids``, ``subset``,
+``per_actuator``, ``synthetic`` and ``provenance``.
+
+:class:`Readings` is what both hold, and :func:`read_measurements` is the one reader a
+refinement calls: it reads the files
+of an actuator in that actuator's format (paper B's in the format above,
+:data:`MEASUREMENT_READERS`; any other in the plain one).
 """
 
 from __future__ import annotations
@@ -82,6 +117,7 @@ import pandas as pd
 
 from softbend._io import write_text_atomic
 from softbend._validation import must_be
+from softbend.actuators import SFRBA, Actuator, ActuatorError
 from softbend.design import FEATURE_QUANTITIES, FEATURES, PARAMETERS, SFRBADesign
 from softbend.errors import DatasetError, InputError, SoftbendError
 from softbend.plausibility import implausible_index, implausible_text
@@ -596,8 +632,54 @@ def _check_provenance(
 
 
 # ---------------------------------------------------------------- Measurements
+class Readings:
+    """What transfer learning reads of measured bending angles, in either format.
+
+    :class:`Measurements` (paper B's CSV) and :class:`ActuatorMeasurements` (any
+    described actuator's) hold a ``frame`` with ``actuator_id``, the actuator's
+    pressure column and ``angle_deg``, a ``provenance`` table with ``synthetic``,
+    and the ``actuator`` description they follow.
+    """
+
+    frame: pd.DataFrame
+    provenance: pd.DataFrame | None
+    actuator: Actuator
+
+    def __len__(self) -> int:
+        return len(self.frame)
+
+    @property
+    def angle_deg(self) -> np.ndarray:
+        """Measured bending angles, degrees, shape (n,); a new array on every call."""
+        return self.frame["angle_deg"].to_numpy(dtype=np.float64, copy=True)
+
+    @property
+    def groups(self) -> np.ndarray:
+        """Actuator id of each row, shape (n,), for ``LeaveOneGroupOut``."""
+        return self.frame["actuator_id"].to_numpy(dtype=object, copy=True)
+
+    @property
+    def synthetic(self) -> np.ndarray:
+        """Whether each reading comes from a ``# synthetic: true`` file, shape (n,), bool."""
+        assert self.provenance is not None  # set when the readings are made
+        return self.provenance["synthetic"].to_numpy(dtype=bool, copy=True)
+
+    def per_actuator(self) -> pd.DataFrame:
+        """One row per actuator, in measured order: ``points``, ``pmax`` (the actuator's
+        pressure unit: MPa for paper B's) and ``angle_max`` (deg).
+
+        Indexed by ``actuator_id``: the readings, the highest pressure set and
+        the largest angle read.
+        """
+        return self.frame.groupby("actuator_id", sort=False).agg(
+            points=("angle_deg", "size"),
+            pmax=(self.actuator.pressure_column, "max"),
+            angle_max=("angle_deg", "max"),
+        )
+
+
 @dataclass(frozen=True, eq=False, repr=False)
-class Measurements:
+class Measurements(Readings):
     """Measured bending angles of one or more actuators, one row per measurement.
 
     Parameters
@@ -652,6 +734,8 @@ class Measurements:
     source: str = ""
     provenance: pd.DataFrame | None = None
     _designs: dict[str, SFRBADesign] = field(init=False, repr=False, compare=False)
+    #: The description the readings follow: paper B's actuator's.
+    actuator: Actuator = field(default=SFRBA, init=False, repr=False, compare=False)
 
     def __post_init__(self) -> None:
         source = os.fspath(self.source) if isinstance(self.source, os.PathLike) else self.source
@@ -691,9 +775,6 @@ class Measurements:
             Where the rows come from, first in error messages.
         """
         return cls(frame, metadata=dict(metadata or {}), source=source)
-
-    def __len__(self) -> int:
-        return len(self.frame)
 
     def __eq__(self, other: object) -> bool:
         if not isinstance(other, Measurements):
@@ -741,28 +822,6 @@ class Measurements:
         """
         return self.frame[list(_FEATURE_COLUMNS)].to_numpy(dtype=np.float64, copy=True)
 
-    @property
-    def angle_deg(self) -> np.ndarray:
-        """Measured bending angles, degrees, shape (n,); a new array on every call."""
-        return self.frame["angle_deg"].to_numpy(dtype=np.float64, copy=True)
-
-    @property
-    def groups(self) -> np.ndarray:
-        """Actuator id of each row, shape (n,), for ``LeaveOneGroupOut``."""
-        return self.frame["actuator_id"].to_numpy(dtype=object, copy=True)
-
-    def per_actuator(self) -> pd.DataFrame:
-        """One row per actuator, in measured order: ``points``, ``pmax`` (MPa), ``angle_max`` (deg).
-
-        Indexed by ``actuator_id``: the readings, the highest pressure set and
-        the largest angle read.
-        """
-        return self.frame.groupby("actuator_id", sort=False).agg(
-            points=("angle_deg", "size"),
-            pmax=("pressure_mpa", "max"),
-            angle_max=("angle_deg", "max"),
-        )
-
     def subset(self, actuator_ids: Iterable[str]) -> Measurements:
         """The rows of some actuators, in their original order.
 
@@ -800,12 +859,6 @@ class Measurements:
             source=self.source,
             provenance=provenance,
         )
-
-    @property
-    def synthetic(self) -> np.ndarray:
-        """Whether each reading comes from a ``# synthetic: true`` file, shape (n,), bool."""
-        assert self.provenance is not None  # set by __post_init__
-        return self.provenance["synthetic"].to_numpy(dtype=bool, copy=True)
 
 
 # --------------------------------------------------------------------- loading
@@ -1047,3 +1100,259 @@ def save_measurements(measurements: Measurements, path: str | os.PathLike[str]) 
     target = write_text_atomic(path, format_measurements(measurements))
     logger.debug("Saved %d measurement(s) to %s.", len(measurements), target)
     return target
+
+
+# ------------------------------------------------------------ any described actuator
+#: The column naming the built actuator of each reading.
+ACTUATOR_COLUMN = "actuator"
+#: The names the id column may have: a file gives one of them, or none (one actuator, the
+#: file's stem).
+ID_COLUMNS: tuple[str, ...] = (ACTUATOR_COLUMN, "actuator_id")
+
+
+@dataclass(frozen=True, eq=False)
+class ActuatorMeasurements(Readings):
+    """Readings of built actuators of one described actuator, one row per reading.
+
+    Parameters
+    ----------
+    frame : pandas.DataFrame
+        Columns ``actuator_id`` (text), the design parameters as model-input
+        codes, the pressure column (the actuator's unit) and ``angle_deg``.
+    actuator : Actuator
+        The description the codes follow.
+    metadata : mapping of str to str
+        The ``# key: value`` lines of the file(s).
+    source : str
+        The file(s) read.
+    """
+
+    frame: pd.DataFrame
+    actuator: Actuator
+    metadata: Mapping[str, str] = field(default_factory=dict)
+    source: str = ""
+    provenance: pd.DataFrame | None = None
+
+    @property
+    def actuator_ids(self) -> tuple[str, ...]:
+        """Actuator ids in order of first appearance."""
+        return tuple(dict.fromkeys(self.frame["actuator_id"].tolist()))
+
+    def design_of(self, actuator_id: str) -> np.ndarray:
+        """The design codes of one built actuator."""
+        rows = self.frame.loc[self.frame["actuator_id"] == actuator_id, list(self.actuator.names)]
+        if rows.empty:
+            raise ValueError(
+                f"No actuator {actuator_id!r} in {self.source}; known: "
+                f"{', '.join(self.actuator_ids)}."
+            )
+        return rows.iloc[0].to_numpy(dtype=np.float64)
+
+    @property
+    def designs(self) -> tuple[np.ndarray, ...]:
+        """One design (codes) per actuator, in :attr:`actuator_ids` order."""
+        return tuple(self.design_of(a) for a in self.actuator_ids)
+
+    @property
+    def features(self) -> np.ndarray:
+        """Model inputs, shape (n, n_parameters + 1): the design codes and the pressure."""
+        return self.frame[list(self.actuator.features)].to_numpy(dtype=np.float64, copy=True)
+
+    def subset(self, actuator_ids: Iterable[str]) -> ActuatorMeasurements:
+        """The readings of some actuators, in their original order."""
+        wanted = [actuator_ids] if isinstance(actuator_ids, str) else list(actuator_ids)
+        unknown = [a for a in wanted if a not in self.actuator_ids]
+        if unknown or not wanted:
+            raise ValueError(
+                f"The actuators of a subset must be among {', '.join(self.actuator_ids)}; "
+                f"got {', '.join(map(repr, unknown)) or 'none'}."
+            )
+        mask = self.frame["actuator_id"].isin(wanted).to_numpy()
+        provenance = None
+        if self.provenance is not None:
+            provenance = self.provenance.loc[mask].reset_index(drop=True)
+        return ActuatorMeasurements(
+            self.frame.loc[mask].reset_index(drop=True),
+            self.actuator,
+            dict(self.metadata),
+            self.source,
+            provenance,
+        )
+
+
+def measurement_format(actuator: Actuator) -> TableFormat:
+    """The plain measurement CSV of ``actuator``, as :mod:`softbend.tables` reads it.
+
+    The optional id column (``actuator`` or ``actuator_id``), the design columns
+    (read as text: a categorical parameter gives its level), the pressure column
+    (>= 0, the actuator's unit) and the angle column (degrees); any ``# key: value``
+    line without spaces in its key is kept.
+    """
+    return TableFormat(
+        name=f"measurement file of the actuator {actuator.name}",
+        columns=(
+            *(Column(name, kind="text", required=False) for name in ID_COLUMNS),
+            *(Column(p.name, p.unit, kind="text") for p in actuator.parameters),
+            Column(actuator.pressure_column, actuator.pressure_unit, low=0.0),
+            Column(actuator.angle_column, "deg"),
+        ),
+        other_keys="keep",
+        other_columns="error",
+    )
+
+
+def _ids(table: Table, path: Path) -> pd.Series:
+    """Each reading's actuator: its id column (``actuator`` or ``actuator_id``), or, in a
+    file with neither, the file's stem (the file is one actuator)."""
+    given = [name for name in ID_COLUMNS if name in table.frame.columns]
+    if len(given) > 1:
+        raise ActuatorError(
+            f"names the actuators twice, by the columns {' and '.join(given)}; keep one",
+            key=given[1],
+            file=table.file,
+            line=table.header_line,
+            column=table.positions[given[1]],
+        )
+    if given:
+        return table.frame[given[0]].astype(object)
+    return pd.Series([path.stem] * len(table.frame), dtype=object)
+
+
+def _read_one(path: Path, actuator: Actuator) -> tuple[pd.DataFrame, dict[str, str], bool]:
+    """One file's readings, its ``# key: value`` lines, and whether its file names its actuator."""
+    try:
+        table = read_table(path, measurement_format(actuator))
+    except DatasetError as error:
+        if error.key is None:  # the file itself: missing, not text, no rows
+            raise
+        raise ActuatorError(
+            error.detail, key=error.key, file=error.file, line=error.line, column=error.column
+        ) from None
+    raw = table.frame
+    frame = pd.DataFrame({"actuator_id": _ids(table, path)})
+    for parameter in actuator.parameters:
+        column = table.positions[parameter.name]
+        codes = []
+        for pos, cell in enumerate(raw[parameter.name].tolist()):
+            try:
+                codes.append(parameter.encode(cell))
+            except ActuatorError as err:
+                raise ActuatorError(
+                    err.detail, file=table.file, line=int(table.lines[pos]), column=column
+                ) from None
+        values = np.asarray(codes, dtype=np.float64)
+        try:
+            parameter.check(values)
+        except ActuatorError:  # find the first row at fault
+            for pos, value in enumerate(values):
+                try:
+                    parameter.check(value[None])
+                except ActuatorError as err:
+                    raise ActuatorError(
+                        err.detail, file=table.file, line=int(table.lines[pos]), column=column
+                    ) from None
+            raise
+        frame[parameter.name] = values
+    frame[actuator.pressure_column] = raw[actuator.pressure_column]
+    frame["angle_deg"] = raw[actuator.angle_column]
+    frame["direction"] = "loading"  # a plain file records the loading branch
+    met = actuator.constraints_met(frame[list(actuator.names)].to_numpy())
+    if not met.all():
+        pos = int(np.argmin(met))
+        try:
+            actuator.check_designs(frame[list(actuator.names)].to_numpy()[pos])
+        except ActuatorError as err:
+            raise ActuatorError(err.detail, file=table.file, line=int(table.lines[pos])) from None
+    return frame, table.header, not any(name in raw.columns for name in ID_COLUMNS)
+
+
+def load_actuator_measurements(
+    paths: str | os.PathLike[str] | Sequence[str | os.PathLike[str]],
+    actuator: Actuator,
+) -> ActuatorMeasurements:
+    """Read one or more plain measurement CSV files of ``actuator`` (module docstring).
+
+    Raises
+    ------
+    softbend.actuators.ActuatorError
+        A missing or unknown column (naming it and the expected ones), a design
+        outside the description, a bad cell (naming the line and column), one
+        actuator id with two designs.
+    softbend.errors.DatasetError
+        A missing, unreadable or empty file.
+    """
+    files = [paths] if isinstance(paths, str | os.PathLike) else list(paths)
+    frames, provenance, shared = [], [], None
+    by_file: set[str] = set()  # actuators named by their file (no id column)
+    for item in files:
+        path = Path(item)
+        frame, metadata, named_by_file = _read_one(path, actuator)
+        frames.append(frame)
+        if named_by_file:
+            by_file.add(path.stem)
+        flag = metadata.get("synthetic", "false").strip().lower() == "true"
+        provenance.append(
+            pd.DataFrame(
+                {
+                    "source": [str(path)] * len(frame),
+                    "synthetic": [flag] * len(frame),
+                    "date": [metadata.get("date", "")] * len(frame),
+                }
+            )
+        )
+        shared = (
+            dict(metadata)
+            if shared is None
+            else {k: v for k, v in shared.items() if metadata.get(k) == v}
+        )
+    frame = pd.concat(frames, ignore_index=True)
+    designs = frame.groupby("actuator_id", sort=False)[list(actuator.names)].nunique()
+    twice = designs.index[(designs > 1).any(axis=1)].tolist()
+    if twice:
+        hint = (
+            f" (a file without an {' or '.join(ID_COLUMNS)} column is one actuator, named by "
+            "the file: add one of those columns to a file of several)"
+            if twice[0] in by_file
+            else ""
+        )
+        raise ActuatorError(
+            f"the actuator {twice[0]!r} has two designs in {', '.join(map(str, files))}; "
+            f"each built actuator has one (give the others their own ids){hint}",
+            key=ACTUATOR_COLUMN,
+        )
+    return ActuatorMeasurements(
+        frame,
+        actuator,
+        shared or {},
+        ", ".join(str(f) for f in files),
+        pd.concat(provenance, ignore_index=True),
+    )
+
+
+def is_actuator_measurements(data: object) -> bool:
+    """Whether ``data`` holds readings of a described actuator (not paper B's format)."""
+    return isinstance(data, ActuatorMeasurements)
+
+
+#: Readers of measurement files in a format of an actuator's own, by the actuator's name:
+#: ``(actuator, reader)``, ``reader(paths) -> measurements``. Any other actuator's files are
+#: read in the plain format of its description (:func:`load_actuator_measurements`).
+MEASUREMENT_READERS: dict[
+    str, tuple[Actuator, Callable[[Sequence[str | os.PathLike[str]]], Measurements]]
+] = {SFRBA.name: (SFRBA, load_measurements_files)}
+
+
+def read_measurements(
+    paths: str | os.PathLike[str] | Sequence[str | os.PathLike[str]], actuator: Actuator
+) -> Measurements | ActuatorMeasurements:
+    """Read one or more measurement files of ``actuator``, in its format.
+
+    Paper B's actuator reads its own CSV format (:func:`load_measurements_files`,
+    :data:`MEASUREMENT_READERS`); any other the plain CSV of its description
+    (:func:`load_actuator_measurements`).
+    """
+    files = [paths] if isinstance(paths, str | os.PathLike) else list(paths)
+    own = MEASUREMENT_READERS.get(actuator.name)
+    if own is not None and own[0] == actuator:
+        return own[1](files)
+    return load_actuator_measurements(files, actuator)

@@ -47,8 +47,7 @@ from softbend.transfer.strategies import (
 if TYPE_CHECKING:
     from softbend.actuators import Actuator
     from softbend.surrogates.persistence import SavedSurrogate
-    from softbend.transfer.actuator_measurements import ActuatorMeasurements
-    from softbend.transfer.measurements import Measurements
+    from softbend.transfer.measurements import ActuatorMeasurements, Measurements
 
 __all__ = [
     "REFINE_DEFAULTS",

@@ -104,8 +104,7 @@ from softbend.transfer.pressure_map import (
 if TYPE_CHECKING:
     from softbend.actuators import Actuator
     from softbend.surrogates.mlp import NormalizedMLPRegressor
-    from softbend.transfer.actuator_measurements import ActuatorMeasurements
-    from softbend.transfer.measurements import Measurements
+    from softbend.transfer.measurements import ActuatorMeasurements, Measurements
 
 __all__ = [
     "BUILTIN_STRATEGIES",
