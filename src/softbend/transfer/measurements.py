@@ -1,4 +1,4 @@
-"""Measured bending angles of fiber-reinforced bending actuators and their CSV format.
+"""Measured bending angles of built actuators and their CSV formats: paper B's, and any other's.
 
 Transfer learning (paper B §4.2–4.3) refines a surrogate trained on simulations
 with a few measurements of built actuators. A measurement is one bending angle of
@@ -86,15 +86,13 @@ has one design; pressures are finite and >= 0; angles finite (whether they are
 in radians depends on the actuator: :mod:`softbend.transfer.against_base` compares
 them with the base model's prediction).
 
-:class:`ActuatorMeasurements` offers what transfer learning reads from paper
-B's :class:`~softbend.transfer.measurements.Measurements`: ``features`` (the
-model's inputs), ``angle_deg``, ``groups``, ``actuator_ids``, ``subset``,
-``per_actuator``, ``synthetic`` and ``provenance``.
-
-:class:`Readings` is what both hold, and :func:`read_measurements` is the one reader a
-refinement calls: it reads the files
-of an actuator in that actuator's format (paper B's in the format above,
-:data:`MEASUREMENT_READERS`; any other in the plain one).
+:class:`ActuatorMeasurements` offers what transfer learning reads from
+:class:`Measurements` (their shared :class:`Readings`): ``features`` (the model's
+inputs), ``angle_deg``, ``groups``, ``actuator_ids``, ``subset``, ``per_actuator``,
+``synthetic``, ``provenance`` and ``actuator``. And :func:`read_measurements` is the one
+reader a refinement calls: it reads an actuator's files in that actuator's format
+(paper B's in the format above, :data:`MEASUREMENT_READERS`; any other's in the
+plain one).
 """
 
 from __future__ import annotations
