@@ -8,11 +8,15 @@ Each command parses its options, calls one function of :mod:`softbend.control`
 from __future__ import annotations
 
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 import typer
 
 from softbend.cli import _common, control_help, control_run
 from softbend.cli import control_options as opt
+
+if TYPE_CHECKING:
+    from softbend.control.plant_choice import PlantChoice
 
 app = typer.Typer(
     help="Closed-loop control of an actuator (paper B §5).\n\n"
@@ -53,6 +57,7 @@ def simulate_cmd(
     as_json: bool = typer.Option(False, "--json", help="Print the metrics as JSON."),
 ) -> None:
     """Run a controller on the simulated rig and score it (help: control_help.SIMULATE)."""
+    from softbend.control.plants import parse_plant
     from softbend.control.pressures import run_supply_mpa
     from softbend.control.runs import simulate_control
 
@@ -60,10 +65,11 @@ def simulate_cmd(
     _common.check_replaceable_dir(out, "--out")
     with control_run.sigterm_as_interrupt():  # `kill`: staged results removed
         with _common.library_progress(enabled=not as_json):  # an FEM plant's sweep, if any
+            plant_choice = parse_plant(plant)
             result = simulate_control(
                 reference=reference, controller=controller, assignments=assignments or (),
-                design=design, model=model, plant=plant, duration_s=duration_s,
-                supply_mpa=run_supply_mpa(supply_mpa, model, plant),
+                design=design, model=model, plant=plant_choice, duration_s=duration_s,
+                supply_mpa=run_supply_mpa(supply_mpa, model, plant_choice),
                 rig_assignments=rig_assignments or (), seed=seed,
                 strict=strict, rig_from=rig_from,
             )  # fmt: skip
@@ -168,37 +174,36 @@ def serve_cmd(
     \b
         softbend control serve --config rig.toml --port 5020
     """
-    import signal
     import time
 
     from softbend._validation import check_range
+    from softbend.control.plants import parse_plant
     from softbend.control.pressures import run_supply_mpa
     from softbend.control.runs import simulated_server
 
     duration = check_range(duration_s, "duration_s", low=0.0, low_inclusive=True)
     with _common.library_progress():  # an FEM plant's sweep, if any
+        plant_choice = parse_plant(plant)
         server = simulated_server(
-            config=config, host=host, port=port, design=design, model=model, plant=plant,
-            supply_mpa=run_supply_mpa(supply_mpa, model, plant),
+            config=config, host=host, port=port, design=design, model=model, plant=plant_choice,
+            supply_mpa=run_supply_mpa(supply_mpa, model, plant_choice),
             rig_assignments=rig_assignments or (), seed=seed, rig_from=rig_from,
         )  # fmt: skip
-    previous = control_run.terminate_as_interrupt()  # `kill` stops it as Ctrl-C does
-    try:
-        server.start()
-        _common.console.print(
-            f"simulated rig {_served(design, plant)} serving on "
-            f"{server.config.connection.where} "
-            f"({'Ctrl-C to stop' if duration == 0 else f'for {duration:g} s'})"
-        )
-        end = time.monotonic() + (duration if duration > 0 else float("inf"))
-        while time.monotonic() < end:
-            time.sleep(min(0.2, max(0.0, end - time.monotonic())))
-    except KeyboardInterrupt:
-        pass
-    finally:
-        server.stop()
-        if previous is not None:
-            signal.signal(signal.SIGTERM, previous)
+    with control_run.sigterm_as_interrupt():  # `kill` stops it as Ctrl-C does
+        try:
+            server.start()
+            _common.console.print(
+                f"simulated rig {_served(design, plant_choice)} serving on "
+                f"{server.config.connection.where} "
+                f"({'Ctrl-C to stop' if duration == 0 else f'for {duration:g} s'})"
+            )
+            end = time.monotonic() + (duration if duration > 0 else float("inf"))
+            while time.monotonic() < end:
+                time.sleep(min(0.2, max(0.0, end - time.monotonic())))
+        except KeyboardInterrupt:
+            pass
+        finally:
+            server.stop()
     _common.console.print(f"served {server.requests} requests; valves left vented")
 
 
@@ -243,12 +248,11 @@ def rig_config_cmd(
     _common.console.print(f"rig config written to {out}")
 
 
-def _served(design: str | None, plant: str) -> str:
+def _served(design: str | None, plant: PlantChoice) -> str:
     """What ``control serve`` says it simulates: the design, or an identified plant."""
     from softbend.control.designs import DEFAULT_DESIGN
-    from softbend.control.plants import parse_plant
 
-    if design is None and parse_plant(plant).kind == "identified":
+    if design is None and plant.kind == "identified":
         return f"of the identified model {plant}"
     return design or DEFAULT_DESIGN
 

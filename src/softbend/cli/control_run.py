@@ -45,6 +45,7 @@ def run_cmd(
 ) -> None:
     """Run a controller in the fixed-period loop on a rig (help: control_help.RUN)."""
     from softbend._validation import check_choice
+    from softbend.control.plants import parse_plant
     from softbend.control.pressures import run_supply_mpa
     from softbend.control.runs import plan_loop
 
@@ -53,11 +54,12 @@ def run_cmd(
     _common.check_output_dir(out, "--out", files=tuple(f.name for f in files))
     _common.check_replaceable_dir(out, "--out")
     with _common.library_progress():  # an FEM plant's sweep, if any
+        plant_choice = parse_plant(plant)
         plan = plan_loop(
             rig=rig, config=config, reference=reference, controller=controller,
-            assignments=assignments or (), design=design, model=model, plant=plant,
+            assignments=assignments or (), design=design, model=model, plant=plant_choice,
             duration_s=duration_s, period_s=period_s, sensor_period_s=sensor_period_s,
-            supply_mpa=run_supply_mpa(supply_mpa, model, plant),
+            supply_mpa=run_supply_mpa(supply_mpa, model, plant_choice),
             rig_assignments=rig_assignments or (), seed=seed,
             strict=strict, rig_from=rig_from,
         )  # fmt: skip

@@ -12,6 +12,7 @@ of looking at the text again.
 from __future__ import annotations
 
 from dataclasses import dataclass
+from functools import cached_property
 from pathlib import Path
 from typing import TYPE_CHECKING, Literal
 
@@ -60,9 +61,11 @@ class PlantChoice:
         return self.path if self.kind == "surrogate" else None
 
     def identified(self) -> IdentifiedPlant | None:
-        """The identified model, loaded and checked to play the actuator, else None."""
-        if self.kind != "identified":
-            return None
+        """The identified model, loaded and checked to play the actuator (once), else None."""
+        return self._identified if self.kind == "identified" else None
+
+    @cached_property
+    def _identified(self) -> IdentifiedPlant:
         from softbend.control.identified_plant import identified_plant
 
         with keyed("plant"):

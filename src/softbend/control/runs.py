@@ -46,6 +46,7 @@ from softbend.errors import InputError, keyed
 if TYPE_CHECKING:
     from softbend.control.loop import LoopRun
     from softbend.control.modbus_server import SimulatedModbusServer
+    from softbend.control.plant_choice import PlantChoice
 
 __all__ = [
     "LoopPlan",
@@ -73,7 +74,7 @@ def simulate_control(
     assignments: Sequence[str] = (),
     design: str | None = None,
     model: str | Path | None = None,
-    plant: str = "surrogate",
+    plant: str | PlantChoice = "surrogate",
     duration_s: float = 10.0,
     supply_mpa: float | None = None,
     rig_assignments: Sequence[str] = (),
@@ -282,7 +283,7 @@ def plan_loop(
     assignments: Sequence[str] = (),
     design: str | None = None,
     model: str | Path | None = None,
-    plant: str = "surrogate",
+    plant: str | PlantChoice = "surrogate",
     duration_s: float = 10.0,
     period_s: float | None = None,
     sensor_period_s: float | None = None,
@@ -366,7 +367,7 @@ def simulated_server(
     port: int | None = None,
     design: str | None = None,
     model: str | Path | None = None,
-    plant: str = "surrogate",
+    plant: str | PlantChoice = "surrogate",
     supply_mpa: float | None = None,
     rig_assignments: Sequence[str] = (),
     seed: int = 0,
