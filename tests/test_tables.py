@@ -194,3 +194,8 @@ def test_an_increasing_column_is_checked_within_each_experiment(tmp_path):
     with pytest.raises(DatasetError, match=r":5:2: run: experiment 'a' appears again after 'b'"):
         read_table(path, contiguous)
     assert read_table(path, fmt).frame["t_s"].tolist() == [0, 1, 0, 2]
+
+
+def test_a_column_s_unit_defaults_to_the_unit_its_name_ends_with():
+    assert Column("p1_KPA").unit == "kPa" and Column("t_ms").unit == "ms"
+    assert Column("rho").unit == "" and Column("p_kpa", "MPa").unit == "MPa"

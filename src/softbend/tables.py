@@ -42,6 +42,7 @@ from softbend._progress import read_phase, report
 from softbend._validation import must_be, short_repr
 from softbend.errors import DatasetError
 from softbend.plausibility import implausible_index, implausible_text
+from softbend.units import unit_from_name
 
 if TYPE_CHECKING:
     import pandas as pd
@@ -83,8 +84,9 @@ class Column:
     ----------
     name : str
         The header's name of the column (case-sensitive).
-    unit : str, default ""
-        Its unit, for messages and the documentation.
+    unit : str, optional
+        Its unit, for messages and the documentation; default the unit its name
+        ends with (:func:`softbend.units.unit_from_name`: ``time_s`` → s), else none.
     kind : {"number", "integer", "text", "choice", "any"}, default "number"
         How its cells are read (:data:`Kind`).
     required : bool, default True
@@ -111,6 +113,10 @@ class Column:
     choices: tuple[str, ...] = ()
     missing: bool = False
     increasing: bool = False
+
+    def __post_init__(self) -> None:
+        if not self.unit:
+            object.__setattr__(self, "unit", unit_from_name(self.name))
 
     def requirement(self) -> str:
         """What a cell must be, for :func:`~softbend._validation.must_be`."""

@@ -93,3 +93,46 @@ def test_serve_checks_its_plant(capsys):
     assert "--plant: Unknown plant 'camera'; known: surrogate" in capsys.readouterr().err
     code = main(["control", "serve", "--plant", "lab", "--design", "160,10,4,4,15,12"])
     assert code == 2 and "no measured loading curve" in capsys.readouterr().err
+
+
+def test_a_plant_is_parsed_once_into_its_kind(tmp_path):
+    from softbend.control.plant_choice import PlantChoice
+    from softbend.control.plants import parse_plant, plant_compliance
+    from softbend.registry import UnknownNameError
+
+    readings = tmp_path / "readings.csv"
+    readings.write_text("l\n", encoding="utf-8")
+    model = tmp_path / "model.json"
+    model.write_text("{}", encoding="utf-8")
+    assert parse_plant("fem") == PlantChoice("named", "fem")
+    assert parse_plant(str(readings)) == PlantChoice("measurements", str(readings), readings)
+    surrogate = parse_plant(str(model))
+    assert (surrogate.kind, surrogate.surrogate_file, surrogate.model_file) == (
+        "surrogate",
+        model,
+        model,
+    )
+    assert parse_plant(surrogate) is surrogate
+    assert parse_plant("lab").identified() is None and parse_plant("lab").pressure_unit() is None
+    with pytest.raises(UnknownNameError, match="saved surrogate") as caught:
+        parse_plant(str(tmp_path / "missing.json"))
+    assert caught.value.key == "plant"
+    # a design of Table 1 keeps the rig's default chamber; a plant without one gives none
+    assert plant_compliance("fem", DESIGN, 0.2) is None
+    assert plant_compliance(str(model), DESIGN, 0.2) is None
+
+
+def test_a_plant_of_paper_b_s_actuator_alone_refuses_another_actuator_s_design():
+    from softbend.actuators import SFRBA, Actuator, DesignParameter
+    from softbend.control.designs import ModelDesign
+    from softbend.control.plants import PLANT_ACTUATORS, check_plant_actuator
+    from softbend.errors import InputError
+
+    other = Actuator("other", "another actuator", (DesignParameter("w_mm", "mm", 1.0, 2.0),))
+    design = ModelDesign(other, np.array([1.5]))
+    assert {PLANT_ACTUATORS[name].name for name in ("fem", "lab", "measurements")} == {SFRBA.name}
+    check_plant_actuator("surrogate", design)
+    check_plant_actuator("fem", DESIGN)
+    with pytest.raises(InputError, match=rf"'lab' is of {SFRBA.title} only; the design") as caught:
+        check_plant_actuator("lab", design)
+    assert caught.value.key == "plant"
