@@ -8,7 +8,8 @@
 
 Named extension points (:class:`softbend.registry.Registry`): :data:`CONTROLLERS`
 (controller classes, :mod:`softbend.control.factory`), :data:`PLANTS` (θ(p)
-of the actuator, :mod:`softbend.control.plants`) and :data:`RIGS` (what the loop
+of the actuator, :mod:`softbend.control.plants`; ``--plant`` is parsed once by
+:func:`parse_plant` into a :class:`PlantChoice`) and :data:`RIGS` (what the loop
 runs on, :mod:`softbend.control.rigs`). The names below are imported on first
 use, so ``import softbend.control`` stays light.
 """
@@ -36,6 +37,8 @@ _EXPORTS: dict[str, str] = {
     "mlp_virtual_sensor": "controllers",
     "PredictivePulse": "predictive",
     "PLANTS": "plants",
+    "PlantChoice": "plant_choice",
+    "parse_plant": "plants",
     "plant_table": "plants",
     "RIGS": "rigs",
     "RigSetup": "rigs",

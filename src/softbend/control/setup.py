@@ -19,6 +19,12 @@ parameters are :class:`~softbend.control.rig.RigParams` of the design with the
 settings of :func:`~softbend.control.rigs.rig_settings` applied
 (:func:`~softbend.control.rigs.rig_params_for`).
 
+The plant is parsed once (:func:`~softbend.control.plants.parse_plant`); what is
+one actuator's alone (paper B's FEM, virtual lab and measurement files, the FEM's
+chamber compliance, the 0–0.5 MPa span of paper B's tables) is data
+(:data:`~softbend.control.plants.PLANT_ACTUATORS`,
+:data:`~softbend.control.plants.PLANT_COMPLIANCES`, :data:`TABLE_SPAN_MPA`).
+
 A model of ``softbend identify`` may play the plant
 (:mod:`~softbend.control.identified_plant`): its dynamics replace the rig's
 θ(p) and angle lag. Without ``model`` it is also the controllers' model (its
