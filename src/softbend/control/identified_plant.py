@@ -68,10 +68,10 @@ def pressure_unit(name: str) -> tuple[str, float] | None:
 
 def _is_angle(name: str) -> bool:
     """Whether an output column's name says it is an angle in degrees."""
-    lower = name.strip().lower()
-    if lower.endswith("_deg"):
-        return True
-    return lower.startswith(("angle", "theta")) and not lower.endswith("_rad")
+    unit = units.unit_from_name(name.strip(), ("angle",))
+    if unit:  # the name says its unit: degrees, or not
+        return unit == "deg"
+    return name.strip().lower().startswith(("angle", "theta"))
 
 
 def angle_output(output_names: tuple[str, ...] | list[str], source: str) -> int:
