@@ -35,7 +35,7 @@ STAGES: tuple[tuple[str, ...], ...] = (
         "units",
     ),
     ("registry", "references", "parameters"),
-    ("plausibility", "tables"),
+    ("plausibility", "column_values", "tables"),
     ("design", "metrics", "kinematics"),
     ("actuators",),
     ("materials",),
