@@ -117,3 +117,23 @@ def test_both_id_columns_at_once_are_refused_naming_both(tmp_path):
     match = r"lab\.csv:1:2: actuator_id: .*by the columns actuator and actuator_id"
     with pytest.raises(ActuatorError, match=match):
         load_actuator_measurements(path, ACTUATOR)
+
+
+def test_one_reader_reads_each_actuator_s_files_in_its_format(tmp_path):
+    from softbend.actuators import SFRBA
+    from softbend.transfer.lab import shipped_measurements
+    from softbend.transfer.measurements import (
+        ActuatorMeasurements,
+        Measurements,
+        Readings,
+        read_measurements,
+        save_measurements,
+    )
+
+    other = read_measurements(write(tmp_path, GOOD), ACTUATOR)
+    assert isinstance(other, ActuatorMeasurements) and other.actuator == ACTUATOR
+    paper_b = save_measurements(shipped_measurements(), tmp_path / "paper_b.csv")
+    read = read_measurements([paper_b], SFRBA)
+    assert isinstance(read, Measurements) and read == shipped_measurements()
+    assert isinstance(read, Readings) and read.actuator == SFRBA
+    assert read.per_actuator()["pmax"].max() == read.frame["pressure_mpa"].max()
