@@ -496,6 +496,28 @@ class Actuator:
         actuator computes it from its geometry instead).
     volume_growth_mm3_per_mpa : float, optional
         Slope of the cavity volume with pressure, mm³/MPa, for the simulated rig.
+    quantities : mapping of str to str
+        Input column → the quantity of :data:`softbend.plausibility.RANGES` its
+        values lie in (``{"pressure_mpa": "pressure_mpa"}``): a saved model's
+        training ranges, a correction's means and the readings a transfer
+        strategy fits are checked against those ranges; an input not named is
+        only checked to be finite. Not written by :meth:`to_dict` (a registered
+        description's is found again by :func:`softbend.surrogates.persistence.actuator_of`).
+    mape_floor_deg : float, optional
+        A fixed floor of the cross-validated MAPE of its surrogates, degrees (paper
+        B: 1°, as §4.1); None: :func:`softbend.metrics.mape_floor` of the table.
+    transfer_mape_floor_deg : float, optional
+        A fixed floor of the MAPE of its transfer strategies, degrees (paper B: 0,
+        only exact zeros left out, as §5); None: ``mape_floor`` of the readings.
+    analytical : bool
+        Whether :mod:`softbend.analytical`'s closed-form model describes it (a
+        transfer baseline of its readings).
+    published_cv : mapping of str to mapping
+        Published cross-validated figures of its surrogates by family (paper B's
+        Figure 5), shown beside those ``softbend train`` finds.
+    named_in_outputs : bool
+        Whether the records of train, predict and transfer name it (False for paper
+        B's, whose records are unchanged since before descriptions existed).
     """
 
     name: str
@@ -508,6 +530,12 @@ class Actuator:
     fem_family: str | None = None
     chamber_volume_mm3: float | None = None
     volume_growth_mm3_per_mpa: float | None = None
+    quantities: Mapping[str, str] = field(default_factory=dict, compare=False)
+    mape_floor_deg: float | None = field(default=None, compare=False)
+    transfer_mape_floor_deg: float | None = field(default=None, compare=False)
+    analytical: bool = field(default=False, compare=False)
+    published_cv: Mapping[str, Mapping[str, Any]] = field(default_factory=dict, compare=False)
+    named_in_outputs: bool = field(default=True, compare=False)
     _trees: tuple[ast.Compare, ...] = field(default=(), repr=False, compare=False)
 
     def __post_init__(self) -> None:
@@ -989,7 +1017,8 @@ def get_actuator(
 
 def _register_paper_b() -> Actuator:
     """Paper B's fiber-reinforced actuator (SFRBA), as its FEM and Table 1 describe it."""
-    from softbend.design import _BOUNDS
+    from softbend.design import _BOUNDS, FEATURE_QUANTITIES
+    from softbend.references import SURROGATES, values
 
     described = {
         "l_mm": ("mm", "chamber length"),
@@ -1020,6 +1049,12 @@ def _register_paper_b() -> Actuator:
         angle_column="angle_deg",
         constraints=("t_mm < r_mm",),
         fem_family="sfrba",
+        quantities=dict(FEATURE_QUANTITIES),
+        mape_floor_deg=1.0,
+        transfer_mape_floor_deg=0.0,
+        analytical=True,
+        published_cv=values(SURROGATES),
+        named_in_outputs=False,
     )
     return ACTUATORS.register(sfrba.name, sfrba)
 

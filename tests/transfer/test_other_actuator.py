@@ -145,3 +145,47 @@ def test_loco_mape_leaves_out_the_readings_below_the_floor(lab):
         assert row["n_mape_used"] == len(part) - left_out < len(part)  # the 0 kPa readings
     summary = result.summary.set_index("strategy")
     assert summary.loc["fem-only", "n_mape_used"] == result.per_actuator["n_mape_used"].sum()
+
+
+def test_loco_cli_with_an_xgb_base_of_another_actuator(lab, tmp_path, capsys):
+    """An XGBoost base of another actuator's table loads for transfer: it takes that
+    actuator's inputs, not paper B's seven (it stopped with "Feature shape mismatch")."""
+    from softbend.surrogates.tables import table_training_data
+    from softbend.surrogates.workflow import train_surrogates
+
+    from ..stand_ins import ACTUATOR_COLUMNS
+
+    plr, readings = lab
+    data = table_training_data(
+        plr.parent.parent.parent / "sims.csv",
+        design_columns=ACTUATOR_COLUMNS,
+        pressure_column="p_kpa",
+        pressure_unit="kPa",
+    )
+    train_surrogates(
+        data, tmp_path / "xgb", models="xgb", grid_name="quick", folds=2, export_onnx=False
+    )
+    base = tmp_path / "xgb" / "models" / "xgb.json"
+    saved = load_surrogate(base)
+    assert saved.model.n_features_in_ == len(saved.actuator.features) == 5
+    code = main(
+        [
+            "transfer",
+            "loco",
+            str(readings),
+            "--base",
+            str(base),
+            "--out",
+            str(tmp_path / "loco"),
+            "--strategies",
+            f"fem-only,{BASELINE_STRATEGY},scale-offset",
+            "--no-learning-curve",
+            "--json",
+        ]
+    )
+    assert code == 0, capsys.readouterr().err
+    record = json.loads(capsys.readouterr().out)
+    assert record["settings"]["pressure_unit"] == "kPa"
+    rows = {r["strategy"]: r for r in record["summary"]}
+    assert np.isfinite(rows["scale-offset"]["rmse_deg_mean"])
+    assert np.isfinite(rows["fem-only"]["rmse_deg_mean"])

@@ -287,7 +287,6 @@ def support_warnings(
         A phrase when θ(p) up to the supported pressure passes the largest
         angle trained on.
     """
-    from softbend.surrogates.features import using_features
     from softbend.surrogates.support import Support
 
     record = saved.metadata.get("support")
@@ -295,8 +294,7 @@ def support_warnings(
         return None, None, None
     actuator = getattr(saved, "actuator", actuator_of_design(design))
     own = control_design(design, actuator, source=role)
-    with using_features(actuator.features):
-        support = Support.from_dict(record)
+    support = Support.from_dict(record, parameters=actuator.names)
     scale, unit = 1.0 / actuator.to_mpa, actuator.pressure_unit  # from MPa to the model's unit
     native = float(support.max_pressure(own.as_array()[None, :])[0])
     limit = native / scale

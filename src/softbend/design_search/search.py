@@ -727,23 +727,20 @@ def find_designs(
     are not actuators: they are left out of the scores and of ``n_designs``;
     for another actuator, the designs that break a constraint of its description.
     """
-    from softbend.surrogates.persistence import describing
-
     if isinstance(top, bool) or not isinstance(top, int) or not TOP.contains(top):
         raise InputError(must_be(f"an integer in {TOP.describe()} ({TOP.why})", top), key="top")
     start = time.perf_counter()
     loaded = model if isinstance(model, LoadedModel) else LoadedModel.load(model)
     _check_actuator(spec, loaded)
-    with describing(loaded.actuator):
-        return _find(
-            loaded,
-            spec,
-            top=top,
-            allow_extrapolation=allow_extrapolation,
-            distinct=distinct,
-            progress=progress,
-            start=start,
-        )
+    return _find(
+        loaded,
+        spec,
+        top=top,
+        allow_extrapolation=allow_extrapolation,
+        distinct=distinct,
+        progress=progress,
+        start=start,
+    )
 
 
 def _check_actuator(spec: Specification, model: LoadedModel) -> None:

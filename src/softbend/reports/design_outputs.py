@@ -69,7 +69,6 @@ def write_search(result: SearchResult, predictor: Predictor, folder: str | Path)
     """
     from softbend._io import json_text
     from softbend.reports import design_figures
-    from softbend.surrogates.persistence import describing
 
     out = Path(folder)
     out.mkdir(parents=True, exist_ok=True)
@@ -87,6 +86,5 @@ def write_search(result: SearchResult, predictor: Predictor, folder: str | Path)
     (out / "search.json").write_text(json_text(result.to_dict()) + "\n", encoding="utf-8")
     shown = dataclasses.replace(result, candidates=result.candidates[:FIGURE_CANDIDATES])
     design_figures.front_figure(shown, out / "front.png")
-    with describing(result.spec.space.actuator):  # the model's own inputs
-        design_figures.curves_figure(result, predictor, out / "curves.png")
+    design_figures.curves_figure(result, predictor, out / "curves.png")
     return {name: str(out / name) for name in FILES}

@@ -11,9 +11,7 @@ from __future__ import annotations
 
 import hashlib
 import os
-from collections.abc import Iterator, Sequence
-from contextlib import contextmanager
-from contextvars import ContextVar
+from collections.abc import Sequence
 from dataclasses import dataclass
 from typing import TYPE_CHECKING
 
@@ -45,31 +43,6 @@ UNITS: dict[str, str] = {
 
 #: Target column.
 TARGET = "angle_deg"
-
-_CURRENT: ContextVar[tuple[str, ...]] = ContextVar("softbend_model_features", default=FEATURES)
-
-
-def model_features() -> tuple[str, ...]:
-    """The input columns of the model being built, saved or read: :data:`FEATURES`
-    (paper B's actuator) unless :func:`using_features` says otherwise."""
-    return _CURRENT.get()
-
-
-@contextmanager
-def using_features(names: Sequence[str]) -> Iterator[tuple[str, ...]]:
-    """Within the block, models are checked against the input columns ``names``
-    (an actuator's design parameters then its pressure column)."""
-    token = _CURRENT.set(tuple(names))
-    try:
-        yield tuple(names)
-    finally:
-        _CURRENT.reset(token)
-
-
-def is_paper_b(names: Sequence[str] | None = None) -> bool:
-    """Whether ``names`` (default: :func:`model_features`) are paper B's inputs."""
-    return tuple(model_features() if names is None else names) == FEATURES
-
 
 #: Group column: one group per design (one pressure sweep).
 GROUP = "design_id"
@@ -217,12 +190,18 @@ def family_training_data(samples: pd.DataFrame, actuator: Actuator | None) -> Tr
     return training_data(samples, actuator=actuator)
 
 
-def check_features(X: ArrayLike) -> np.ndarray:
-    """``X`` as a finite float64 array of shape (n, 7), or one :class:`InputError` (key ``X``).
+def check_features(X: ArrayLike, features: Sequence[str] = FEATURES) -> np.ndarray:
+    """``X`` as a finite float64 array of shape (n, d), or one :class:`InputError` (key ``X``).
 
-    A single sample may be given as a 1-D array of length 7.
+    Parameters
+    ----------
+    X : array_like of shape (n, d) or (d,)
+        Model inputs, one column per name of ``features`` in its units; a single
+        sample may be given as a 1-D array.
+    features : sequence of str
+        The model's input columns (an actuator's
+        :attr:`~softbend.actuators.Actuator.features`; default paper B's :data:`FEATURES`).
     """
-    features = model_features()
     array = np.asarray(X, dtype=np.float64)
     if array.ndim == 1:
         array = array[None, :]
@@ -241,32 +220,46 @@ def check_features(X: ArrayLike) -> np.ndarray:
     return array
 
 
-def training_ranges(X: ArrayLike) -> dict[str, list[float]]:
-    """``{feature: [min, max]}`` of the rows a surrogate was trained on (mm, deg, MPa).
+def training_ranges(X: ArrayLike, features: Sequence[str] = FEATURES) -> dict[str, list[float]]:
+    """``{feature: [min, max]}`` of the rows a surrogate was trained on, in the inputs' units.
 
-    Saved with a model (``metadata["training_ranges"]``) so that a prediction
-    outside them can be flagged (:func:`outside_training_ranges`).
+    Saved with a model (``metadata["training_ranges"]``, in the order of
+    ``features``) so that a prediction outside them can be flagged
+    (:func:`outside_training_ranges`).
+
+    Parameters
+    ----------
+    X : array_like of shape (n, d)
+        The training inputs, columns ``features``.
+    features : sequence of str
+        The model's input columns (default paper B's :data:`FEATURES`).
     """
-    array = check_features(X)
+    array = check_features(X, features)
     return {
         name: [float(array[:, j].min()), float(array[:, j].max())]
-        for j, name in enumerate(model_features())
+        for j, name in enumerate(features)
     }
 
 
-def outside_training_ranges(ranges: dict[str, list[float]], X: ArrayLike) -> list[str]:
+def outside_training_ranges(
+    ranges: dict[str, list[float]], X: ArrayLike, features: Sequence[str] | None = None
+) -> list[str]:
     """One phrase per feature whose values in ``X`` leave ``ranges``; empty when all inside.
 
     Parameters
     ----------
     ranges : dict
         As :func:`training_ranges` returns (features missing from it are not checked).
-    X : array_like of shape (n, 7)
-        Rows to predict.
+    X : array_like of shape (n, d)
+        Rows to predict, columns ``features``.
+    features : sequence of str, optional
+        The model's input columns; default the names of ``ranges`` in their order
+        (a saved model's ranges name each of its inputs, in input order).
     """
-    array = check_features(X)
+    names = tuple(ranges) if features is None else tuple(features)
+    array = check_features(X, names)
     out = []
-    for j, name in enumerate(model_features()):
+    for j, name in enumerate(names):
         if name not in ranges:
             continue
         low, high = (float(v) for v in ranges[name])

@@ -15,13 +15,16 @@ from __future__ import annotations
 
 import time
 from collections.abc import Callable
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 from numpy.typing import ArrayLike
 
 from softbend.metrics import mape_floor, r2, rmse, thresholded_mape
 from softbend.surrogates.protocol import Surrogate
+
+if TYPE_CHECKING:
+    from softbend.actuators import Actuator
 
 #: Paper B's MAPE, as softbend compares with its §4.1 figures: every reading but the 0 MPa
 #: ones (``|θ| >= 1°``), degrees.
@@ -30,20 +33,20 @@ PAPER_B_MAPE_FLOOR_DEG = 1.0
 MAPE_THRESHOLD_DEG = PAPER_B_MAPE_FLOOR_DEG
 
 
-def mape_floor_deg(y: ArrayLike, actuator: object = None) -> float:
+def mape_floor_deg(y: ArrayLike, actuator: Actuator | None = None) -> float:
     """The MAPE floor of a table's angles ``y`` (degrees) for ``actuator``.
 
-    Paper B's actuator (:data:`softbend.actuators.SFRBA`, or None: a campaign of
-    it) keeps paper B's definition, :data:`PAPER_B_MAPE_FLOOR_DEG`, so that its
-    figures stay comparable with paper B §4.1 (MLP 0.89 %, XGBoost 0.8 %). Any
-    other actuator gets :func:`softbend.metrics.mape_floor`: max(5°, 5 % of the
-    largest ``|y|``).
+    An actuator with a fixed floor keeps it (its
+    :attr:`~softbend.actuators.Actuator.mape_floor_deg`: paper B's,
+    :data:`PAPER_B_MAPE_FLOOR_DEG`, so that its figures stay comparable with paper
+    B §4.1, MLP 0.89 %, XGBoost 0.8 %); None is paper B's actuator (a campaign of
+    it). Any other actuator gets :func:`softbend.metrics.mape_floor`: max(5°, 5 %
+    of the largest ``|y|``).
     """
     from softbend.actuators import SFRBA
 
-    if actuator is None or actuator == SFRBA:
-        return PAPER_B_MAPE_FLOOR_DEG
-    return mape_floor(y)
+    fixed = (actuator or SFRBA).mape_floor_deg
+    return mape_floor(y) if fixed is None else float(fixed)
 
 
 def mape_text(floor_deg: float) -> str:

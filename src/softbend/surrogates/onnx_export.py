@@ -23,6 +23,7 @@ from __future__ import annotations
 import json
 import os
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 import numpy as np
 from numpy.typing import ArrayLike
@@ -32,27 +33,35 @@ from softbend._extras import require
 from softbend._io import write_bytes_atomic
 from softbend.errors import InputError
 from softbend.surrogates.families import FAMILIES
-from softbend.surrogates.features import TARGET, check_features, model_features
+from softbend.surrogates.features import FEATURES, TARGET, check_features
 from softbend.surrogates.onnx_graphs import DEFAULT_OPSET, helper, onnx
-from softbend.surrogates.persistence import COMPOSITE_KINDS, check_fitted_surrogate
+from softbend.surrogates.persistence import COMPOSITE_KINDS, check_fitted_surrogate, model_units
 from softbend.surrogates.protocol import Surrogate
+
+if TYPE_CHECKING:
+    from softbend.actuators import Actuator
 
 __all__ = ["DEFAULT_OPSET", "onnx_predict", "save_onnx", "to_onnx"]
 
 
-def to_onnx(model: Surrogate, *, opset: int | None = None) -> onnx.ModelProto:
+def to_onnx(
+    model: Surrogate, *, opset: int | None = None, actuator: Actuator | None = None
+) -> onnx.ModelProto:
     """Export a fitted surrogate as an ONNX model.
 
     Parameters
     ----------
     model : estimator
         A fitted surrogate of a family with an ONNX export (``PolynomialRegressor``,
-        ``NormalizedMLPRegressor``, ``xgboost.XGBRegressor``) on the 7 inputs
-        :data:`FEATURES` (mm, deg, MPa).
+        ``NormalizedMLPRegressor``, ``xgboost.XGBRegressor``) on the inputs of ``actuator``.
     opset : int, optional
         Opset of the ``ai.onnx`` domain. Default :data:`DEFAULT_OPSET` (17) for the
         polynomial and MLP (allowed 13 up to what the installed ``onnx`` knows);
         for XGBoost the highest that onnxmltools supports (allowed 13 up to that).
+    actuator : Actuator, optional
+        The actuator the model is of: its inputs and units are recorded in the
+        model's properties (default paper B's, :data:`softbend.actuators.SFRBA`:
+        the 7 inputs :data:`FEATURES` in mm, deg, MPa).
 
     Returns
     -------
@@ -69,7 +78,11 @@ def to_onnx(model: Surrogate, *, opset: int | None = None) -> onnx.ModelProto:
     sklearn.exceptions.NotFittedError
         If the model is not fitted.
     """
-    kind = check_fitted_surrogate(model)
+    if actuator is None:
+        from softbend.actuators import SFRBA
+
+        actuator = SFRBA
+    kind = check_fitted_surrogate(model, actuator.features)
     export = None if kind in COMPOSITE_KINDS else FAMILIES.get(kind).onnx
     if export is None:
         exporting = [name for name, family in FAMILIES.items() if family.onnx is not None]
@@ -79,16 +92,14 @@ def to_onnx(model: Surrogate, *, opset: int | None = None) -> onnx.ModelProto:
             f"got a {kind} surrogate ({type(model).__name__}), which has no ONNX export{hint}",
             key="model",
         )
-    from softbend.surrogates.persistence import current_units
-
     proto = export(model, opset)
     proto.producer_name = "softbend"
     proto.producer_version = __version__
-    inputs = ", ".join(model_features())
+    inputs = ", ".join(actuator.features)
     proto.doc_string = f"softbend {kind} surrogate: {inputs} -> {TARGET} (deg)."
     props = {
-        "features": json.dumps(list(model_features())),
-        "units": json.dumps(current_units()),
+        "features": json.dumps(list(actuator.features)),
+        "units": json.dumps(model_units(actuator)),
         "kind": kind,
         "target": TARGET,
     }
@@ -127,9 +138,10 @@ def onnx_predict(
     ----------
     model : onnx.ModelProto, bytes, str or Path
         A model from :func:`to_onnx`, its serialized bytes, or a ``.onnx`` file.
-    X : array_like, shape (n, 7) or (7,)
-        Inputs, columns :data:`FEATURES` (mm, deg, MPa), finite; cast to the
-        model's input type (double, or float32 for XGBoost).
+    X : array_like, shape (n, d) or (d,)
+        Inputs, the columns the model's ``features`` property names (:data:`FEATURES`,
+        mm, deg, MPa, when it names none), finite; cast to the model's input type
+        (double, or float32 for XGBoost).
 
     Returns
     -------
@@ -142,8 +154,9 @@ def onnx_predict(
         ``X`` of the wrong shape or not finite, or a ``model`` of another type.
     """
     onnxruntime = require("onnxruntime", "ONNX prediction (onnx_predict)")
-    X = check_features(X)
     session = onnxruntime.InferenceSession(_as_bytes(model), providers=["CPUExecutionProvider"])
+    recorded = session.get_modelmeta().custom_metadata_map.get("features")
+    X = check_features(X, FEATURES if recorded is None else tuple(json.loads(recorded)))
     (source,) = session.get_inputs()
     dtype = _NUMPY_OF_ONNX.get(source.type)
     if dtype is None:
@@ -154,16 +167,22 @@ def onnx_predict(
     return np.asarray(result, dtype=np.float64).reshape(X.shape[0])
 
 
-def save_onnx(model: Surrogate, path: str | os.PathLike[str], *, opset: int | None = None) -> Path:
+def save_onnx(
+    model: Surrogate,
+    path: str | os.PathLike[str],
+    *,
+    opset: int | None = None,
+    actuator: Actuator | None = None,
+) -> Path:
     """Export a fitted surrogate with :func:`to_onnx` and write it to ``path`` atomically.
 
     Parameters
     ----------
     model : estimator
-        A fitted polynomial, MLP or XGBoost surrogate on the 7 inputs.
+        A fitted polynomial, MLP or XGBoost surrogate on the inputs of ``actuator``.
     path : str or Path
         File to write (conventionally ``.onnx``); parent folders are created.
-    opset : int, optional
+    opset, actuator : optional
         As in :func:`to_onnx`.
 
     Returns
@@ -171,4 +190,5 @@ def save_onnx(model: Surrogate, path: str | os.PathLike[str], *, opset: int | No
     Path
         The written file.
     """
-    return write_bytes_atomic(path, to_onnx(model, opset=opset).SerializeToString())
+    proto = to_onnx(model, opset=opset, actuator=actuator)
+    return write_bytes_atomic(path, proto.SerializeToString())

@@ -66,9 +66,8 @@ import logging
 import math
 import os
 import sys
-from collections.abc import Callable, Iterator, Mapping
+from collections.abc import Callable, Iterator, Mapping, Sequence
 from contextlib import contextmanager
-from contextvars import ContextVar
 from dataclasses import dataclass, field
 from datetime import UTC, datetime
 from pathlib import Path
@@ -79,24 +78,17 @@ import numpy as np
 from softbend import __version__
 from softbend._io import json_safe, write_text_atomic
 from softbend._validation import must_be, short_repr
-from softbend.actuators import SFRBA, Actuator
+from softbend.actuators import ACTUATORS, SFRBA, Actuator
 from softbend.errors import InputError, SchemaError, SoftbendError, keyed
 from softbend.limits import check_limit, limit
 from softbend.plausibility import RANGES, implausible_index
 from softbend.surrogates.families import FAMILIES, Family, legacy_kinds
-from softbend.surrogates.features import (
-    FEATURES,
-    TARGET,
-    UNITS,
-    is_paper_b,
-    model_features,
-    using_features,
-)
+from softbend.surrogates.features import FEATURES, TARGET
 from softbend.surrogates.jsonvalues import encode as _encode
 from softbend.surrogates.jsonvalues import encode_params
 from softbend.surrogates.jsonvalues import plain_json as _plain_json
 from softbend.surrogates.protocol import Surrogate
-from softbend.surrogates.schema import COMPOSITE_SCHEMAS, QUANTITIES, Rule
+from softbend.surrogates.schema import COMPOSITE_SCHEMAS, Rule
 
 if TYPE_CHECKING:
     from softbend.surrogates.corrected import MeanEnsemble
@@ -114,6 +106,7 @@ __all__ = [
     "load_light",
     "load_state",
     "load_surrogate",
+    "model_units",
     "save_surrogate",
     "saved_kinds",
 ]
@@ -168,44 +161,28 @@ _HEADER_KEYS = (
 )
 
 
-_UNITS: ContextVar[tuple[tuple[str, str], ...]] = ContextVar(
-    "softbend_model_units", default=tuple((name, UNITS[name]) for name in (*FEATURES, TARGET))
-)
-
-
-def current_units() -> dict[str, str]:
-    """The units of the model being saved or read (paper B's unless :func:`describing`)."""
-    return dict(_UNITS.get())
-
-
 def model_units(actuator: Actuator) -> dict[str, str]:
     """The ``units`` a saved model of ``actuator`` records: each input's, and degrees."""
     units = actuator.units
     return {**{name: units[name] for name in actuator.features}, TARGET: "deg"}
 
 
-@contextmanager
-def describing(actuator: Actuator) -> Iterator[None]:
-    """Within the block, models are saved and checked as models of ``actuator``."""
-    token = _UNITS.set(tuple(model_units(actuator).items()))
-    try:
-        with using_features(actuator.features):
-            yield
-    finally:
-        _UNITS.reset(token)
-
-
-def actuator_of(metadata: dict[str, Any]) -> Actuator:
+def actuator_of(metadata: dict[str, Any], default: Actuator = SFRBA) -> Actuator:
     """The actuator description recorded in a model's ``metadata["actuator"]``.
 
-    A model without one (every model of a softbend campaign, and every model
-    saved before descriptions existed) is paper B's actuator
-    (:data:`softbend.actuators.SFRBA`).
+    A recorded description equal to a registered one (:data:`softbend.actuators.ACTUATORS`)
+    is that registered description, with what a file does not record (its
+    plausible quantities, MAPE floors). A model without one (every model of a
+    softbend campaign, every model saved before descriptions existed, and an
+    inner model of a composite) is ``default``'s: paper B's actuator
+    (:data:`softbend.actuators.SFRBA`) unless the caller says otherwise.
     """
     record = metadata.get("actuator") if isinstance(metadata, dict) else None
     if record is None:
-        return SFRBA
-    return Actuator.from_dict(record)
+        return default
+    described = Actuator.from_dict(record)
+    registered = ACTUATORS.get(described.name) if described.name in ACTUATORS else None
+    return registered if registered == described else described
 
 
 @dataclass(frozen=True)
@@ -307,13 +284,16 @@ def kind_of(model: object) -> str:
     raise InputError(f"must be one of {_allowed()}; got {type(model).__name__}", key="model")
 
 
-def check_fitted_surrogate(model: object) -> str:
-    """Return the kind of a fitted surrogate on the 7 inputs, or raise a clear error.
+def check_fitted_surrogate(model: object, features: Sequence[str] = FEATURES) -> str:
+    """Return the kind of a fitted surrogate on the inputs ``features``, or raise a clear error.
 
     Parameters
     ----------
     model : estimator
         The surrogate to check.
+    features : sequence of str
+        The inputs it must take, in order (its actuator's
+        :attr:`~softbend.actuators.Actuator.features`; default paper B's seven).
 
     Returns
     -------
@@ -323,7 +303,7 @@ def check_fitted_surrogate(model: object) -> str:
     Raises
     ------
     softbend.errors.InputError
-        Unknown model type, or a model fitted on other than the 7 :data:`FEATURES`
+        Unknown model type, or a model fitted on other inputs than ``features``
         (key ``model``).
     sklearn.exceptions.NotFittedError
         If the model is not fitted (a ``ValueError`` too).
@@ -347,7 +327,6 @@ def check_fitted_surrogate(model: object) -> str:
             f"This {name} instance is not fitted yet. Call 'fit' before saving or exporting it."
         )
     n_features = int(cast(Surrogate, model).n_features_in_)
-    features = model_features()
     if n_features != len(features):
         raise InputError(
             f"must be fitted on the {len(features)} surrogate inputs ({', '.join(features)}); "
@@ -374,46 +353,48 @@ def _params(model: Surrogate, kind: str) -> dict[str, Any]:
     return codec.params(model) if codec is not None else encode_params(model)
 
 
-def _document(model: Surrogate, kind: str, depth: int = 0) -> dict[str, Any]:
-    """The saved form of a checked model, without ``metadata``."""
+def _document(model: Surrogate, kind: str, actuator: Actuator, depth: int = 0) -> dict[str, Any]:
+    """The saved form of a checked model of ``actuator``, without ``metadata``."""
     return {
         "format": FORMAT,
         "schema_version": SCHEMA_VERSION,
         "kind": kind,
-        "features": list(model_features()),
-        "units": dict(_UNITS.get()),
+        "features": list(actuator.features),
+        "units": model_units(actuator),
         "target": TARGET,
         "softbend_version": __version__,
         "created_utc": datetime.now(UTC).isoformat(timespec="seconds"),
         "params": {} if kind in COMPOSITE_KINDS else _params(model, kind),
-        "state": _state(model, kind, depth),
+        "state": _state(model, kind, actuator, depth),
     }
 
 
-def _inner(model: Surrogate, depth: int) -> dict[str, Any]:
+def _inner(model: Surrogate, actuator: Actuator, depth: int) -> dict[str, Any]:
     """An inner surrogate of a composite as a whole document (empty metadata)."""
     if depth >= _MAX_DEPTH:
         raise InputError(
             f"must nest surrogates at most {_MAX_DEPTH} deep; got a model nesting deeper",
             key="model",
         )
-    kind = check_fitted_surrogate(model)
-    return {**_document(model, kind, depth + 1), "metadata": {}}
+    kind = check_fitted_surrogate(model, actuator.features)
+    return {**_document(model, kind, actuator, depth + 1), "metadata": {}}
 
 
-def _composite_state(model: Surrogate, kind: str, depth: int) -> dict[str, Any]:
+def _composite_state(model: Surrogate, kind: str, actuator: Actuator, depth: int) -> dict[str, Any]:
     state: dict[str, Any]
     if kind == "ensemble":
-        state = {"members": [_inner(m, depth) for m in cast("MeanEnsemble", model).members_]}
+        members = cast("MeanEnsemble", model).members_
+        state = {"members": [_inner(m, actuator, depth) for m in members]}
     else:
-        state = {"base": _inner(getattr(model, "base"), depth)}  # noqa: B009 (a composite's)
+        base = getattr(model, "base")  # noqa: B009 (a composite's)
+        state = {"base": _inner(base, actuator, depth)}
     names = [key for key in _COMPOSITE_STATE[kind] if key not in ("base", "members")]
     return state | {key: _encode(getattr(model, key), key) for key in names}
 
 
-def _state(model: Surrogate, kind: str, depth: int = 0) -> dict[str, Any]:
+def _state(model: Surrogate, kind: str, actuator: Actuator, depth: int = 0) -> dict[str, Any]:
     if kind in COMPOSITE_KINDS:
-        return _composite_state(model, kind, depth)
+        return _composite_state(model, kind, actuator, depth)
     storage = FAMILIES.get(kind).storage
     assert storage is not None  # kind_of names only families with a storage
     if storage.codec is not None:
@@ -442,7 +423,8 @@ def save_surrogate(
     Parameters
     ----------
     model : estimator
-        A fitted surrogate on the 7 inputs :data:`FEATURES` (mm, deg, MPa),
+        A fitted surrogate on the inputs of the actuator ``metadata["actuator"]``
+        records (paper B's seven :data:`FEATURES`, mm, deg, MPa, when it records none),
         predicting the bending angle in degrees: of a family with a storage
         (``PolynomialRegressor``, ``NormalizedMLPRegressor``,
         ``xgboost.XGBRegressor``, ...) or a composite; its ``kind`` is the family's
@@ -452,8 +434,9 @@ def save_surrogate(
         only once the new one is complete.
     metadata : dict, optional
         JSON-serializable provenance with string keys, e.g. ``data_hash``,
-        ``metrics``, ``cv``; NumPy numbers and arrays are written as Python ones,
-        NaN and infinities as ``null`` (the file is strict JSON).
+        ``metrics``, ``cv`` and ``actuator`` (the description the model is of,
+        :meth:`~softbend.actuators.Actuator.to_dict`); NumPy numbers and arrays are
+        written as Python ones, NaN and infinities as ``null`` (the file is strict JSON).
 
     Returns
     -------
@@ -478,12 +461,11 @@ def save_surrogate(
             f"must hold a valid 'actuator' description; got one that is not: {err}",
             key="metadata",
         ) from None
-    with describing(actuator):
-        return _save(model, Path(path), metadata)
+    return _save(model, Path(path), metadata, actuator)
 
 
-def _save(model: Surrogate, path: Path, metadata: dict[str, Any]) -> Path:
-    kind = check_fitted_surrogate(model)
+def _save(model: Surrogate, path: Path, metadata: dict[str, Any], actuator: Actuator) -> Path:
+    kind = check_fitted_surrogate(model, actuator.features)
     if not isinstance(metadata, dict) or not all(isinstance(k, str) for k in metadata):
         raise InputError(
             f"must be a dict with string keys; got {type(metadata).__name__}", key="metadata"
@@ -494,7 +476,7 @@ def _save(model: Surrogate, path: Path, metadata: dict[str, Any]) -> Path:
         raise InputError(
             f"must be JSON-serializable; got an error: {err}", key="metadata"
         ) from None
-    document = _document(model, kind)
+    document = _document(model, kind, actuator)
     # One top-level key per line: the header stays readable, big arrays stay on one line.
     # Every non-finite float is tagged by _encode, so the text is strict JSON.
     lines = [
@@ -560,9 +542,13 @@ def _read_document(path: Path) -> dict[str, Any]:
         return _checked_document(document)
 
 
-def _checked_document(document: object) -> dict[str, Any]:
+def _checked_document(document: object, within: Actuator = SFRBA) -> dict[str, Any]:
     """``document`` if its header is that of a softbend surrogate, else a :class:`SchemaError`
-    keyed by the header field at fault (the caller names the file)."""
+    keyed by the header field at fault (the caller names the file).
+
+    Its features and units are those of the actuator its metadata records, else of
+    ``within`` (paper B's for a file; the composite's for an inner surrogate).
+    """
     if not isinstance(document, dict) or document.get("format") != FORMAT:
         found = document.get("format") if isinstance(document, dict) else type(document).__name__
         shown = repr(found) if isinstance(found, str | None) else short_repr(found)
@@ -601,14 +587,11 @@ def _checked_document(document: object) -> dict[str, Any]:
     for key in ("params", "state", "metadata", "units"):
         if not isinstance(document[key], dict):
             raise SchemaError(must_be("a JSON object", document[key]), key=key)
-    if "actuator" in document["metadata"]:
-        try:
-            actuator = actuator_of(document["metadata"])
-        except ValueError as err:
-            raise SchemaError(f"is not valid: {err}", key="metadata.actuator") from None
-        features, units = list(actuator.features), model_units(actuator)
-    else:  # paper B's, or an inner model of the composite being read
-        features, units = list(model_features()), dict(_UNITS.get())
+    try:
+        actuator = actuator_of(document["metadata"], within)
+    except ValueError as err:
+        raise SchemaError(f"is not valid: {err}", key="metadata.actuator") from None
+    features, units = list(actuator.features), model_units(actuator)
     if document["features"] != features or document["target"] != TARGET:
         raise SchemaError(
             f"maps {short_repr(document['features'])} -> {short_repr(document['target'])}"
@@ -651,17 +634,18 @@ def _validated(
     return decoded
 
 
-def _check_training_ranges(metadata: dict[str, Any]) -> None:
+def _check_training_ranges(metadata: dict[str, Any], actuator: Actuator) -> None:
     """Refuse ``metadata["training_ranges"]`` unless one plausible ``[low, high]`` per input.
 
     A range that is not two finite numbers (a NaN low end) would silently stop the
-    extrapolation check of :func:`softbend.surrogates.predict.predict_angles`.
+    extrapolation check of :func:`softbend.surrogates.predict.predict_angles`. An
+    input ``actuator.quantities`` names must lie in that quantity's plausible range.
     """
     if "training_ranges" not in metadata:
         return
     ranges = metadata["training_ranges"]
     key = "metadata.training_ranges"
-    features = model_features()
+    features = actuator.features
     if not isinstance(ranges, dict):
         raise SchemaError(
             must_be(f"an object of [low, high] per input ({', '.join(features)})", ranges),
@@ -678,21 +662,8 @@ def _check_training_ranges(metadata: dict[str, Any]) -> None:
         raise SchemaError(
             f"must give [low, high] for each input {', '.join(features)}; got {found}", key=key
         )
-    if not is_paper_b():  # another actuator: its own units, no plausible range known here
-        for name, pair in ranges.items():
-            if not (
-                isinstance(pair, list)
-                and len(pair) == 2
-                and all(type(v) in (int, float) and math.isfinite(v) for v in pair)
-                and pair[0] <= pair[1]
-            ):
-                raise SchemaError(
-                    must_be("[low, high]: two finite numbers with low <= high", pair),
-                    key=f"{key}.{name}",
-                )
-        return
     for name, pair in ranges.items():
-        bounds = RANGES[QUANTITIES[name]]
+        quantity = actuator.quantities.get(name)
         values: list[float] = []
         if isinstance(pair, list) and len(pair) == 2 and all(type(v) in (int, float) for v in pair):
             try:
@@ -702,21 +673,25 @@ def _check_training_ranges(metadata: dict[str, Any]) -> None:
         if (
             not values
             or not all(math.isfinite(v) for v in values)
-            or implausible_index(values, QUANTITIES[name]) is not None
+            or (quantity is not None and implausible_index(values, quantity) is not None)
             or values[0] > values[1]
         ):
+            plausible = ""
+            if quantity is not None:
+                bounds = RANGES[quantity]
+                plausible = (
+                    f", from {bounds.low:g} to {bounds.high:g} {actuator.units[name]} "
+                    f"(a plausible {bounds.label})"
+                )
             raise SchemaError(
-                must_be(
-                    f"[low, high]: two finite numbers with low <= high, from {bounds.low:g} to "
-                    f"{bounds.high:g} {UNITS[name]} (a plausible {bounds.label})",
-                    pair,
-                ),
+                must_be(f"[low, high]: two finite numbers with low <= high{plausible}", pair),
                 key=f"{key}.{name}",
             )
 
 
-def _check_support(metadata: dict[str, Any]) -> None:
-    """Refuse ``metadata["support"]`` unless a :class:`~softbend.surrogates.support.Support` record.
+def _check_support(metadata: dict[str, Any], actuator: Actuator) -> None:
+    """Refuse ``metadata["support"]`` unless a :class:`~softbend.surrogates.support.Support`
+    record of the design parameters of ``actuator``.
 
     A broken support would silently stop the check of
     :func:`softbend.surrogates.predict.predict_angles` that a prediction lies
@@ -727,7 +702,7 @@ def _check_support(metadata: dict[str, Any]) -> None:
     from softbend.surrogates.support import Support
 
     try:
-        Support.from_dict(metadata["support"])
+        Support.from_dict(metadata["support"], parameters=actuator.names)
     except ValueError as err:  # an InputError keyed by the record's field, if one is at fault
         field_key = getattr(err, "key", None)
         detail = err.detail if isinstance(err, SoftbendError) else str(err)
@@ -738,14 +713,27 @@ def _check_support(metadata: dict[str, Any]) -> None:
         ) from None
 
 
-def _restore_inner(value: object, path: Path | str, key: str, depth: int) -> Surrogate:
+@dataclass(frozen=True)
+class _Reading:
+    """What restoring a file's surrogates needs: the actuator it is of, and the families
+    built from their arrays (:func:`load_light`; none for :func:`load_surrogate`)."""
+
+    actuator: Actuator
+    builders: Mapping[str, Callable[[SavedState], Any]] = field(default_factory=dict)
+
+
+def _restore_inner(
+    value: object, path: Path | str, key: str, reading: _Reading, depth: int
+) -> Surrogate:
     with _within(f"state.{key}"):
         if depth >= _MAX_DEPTH:
             raise SchemaError(f"surrogates nest at most {_MAX_DEPTH} deep")
-        return _restore(_checked_document(value), path, depth + 1)
+        return _restore(_checked_document(value, reading.actuator), path, reading, depth + 1)
 
 
-def _restore_composite(document: dict[str, Any], path: Path | str, depth: int) -> Surrogate:
+def _restore_composite(
+    document: dict[str, Any], path: Path | str, reading: _Reading, depth: int
+) -> Surrogate:
     """A composite's inner surrogates restored (and validated) first, then the composite."""
     kind = document["kind"]
     if document["params"]:
@@ -753,15 +741,18 @@ def _restore_composite(document: dict[str, Any], path: Path | str, depth: int) -
             must_be(f"empty: the {kind} surrogate takes no params", document["params"]),
             key="params",
         )
-    state = _validated(document["state"], COMPOSITE_SCHEMAS[kind].state, kind, "state")
-    COMPOSITE_SCHEMAS[kind].check(state)
+    schema = COMPOSITE_SCHEMAS[kind]
+    state = _validated(document["state"], schema.state, kind, "state")
+    schema.inputs(state, reading.actuator)
+    schema.check(state)
     cls = _class_of(kind)
     if kind == "ensemble":
         members = [
-            _restore_inner(m, path, f"members[{i}]", depth) for i, m in enumerate(state["members"])
+            _restore_inner(m, path, f"members[{i}]", reading, depth)
+            for i, m in enumerate(state["members"])
         ]
         return cast(Surrogate, cls(members, state["residual_std_"]))
-    base = _restore_inner(state["base"], path, "base", depth)
+    base = _restore_inner(state["base"], path, "base", reading, depth)
     if kind == "affine-corrected":
         return cast(Surrogate, cls(base, state["scale_"], state["offset_"], state["residual_std_"]))
     if kind == "pressure-scaled":
@@ -791,25 +782,28 @@ def _check_required(document: dict[str, Any], required: tuple[str, ...]) -> None
         )
 
 
-def _family_state(document: dict[str, Any]) -> dict[str, Any]:
-    """A family's state, every value validated by its schema (rules across keys included)."""
+def _family_state(document: dict[str, Any], actuator: Actuator) -> dict[str, Any]:
+    """A family's state, every value validated by its schema (rules across keys and against
+    the inputs of ``actuator`` included)."""
     kind = document["kind"]
     storage = _stored(kind).storage
     assert storage is not None  # _stored refuses a family without a storage
     _check_required(document, storage.required_state)
     schema = storage.schema
     state = _validated(document["state"], schema.state, kind, "state")
+    schema.inputs(state, actuator)
     schema.check(state)
     return state
 
 
-def _check_against(kind: str, params: dict[str, Any], state: dict[str, Any]) -> None:
-    """The declared sizes (defaults included) against the arrays, and the 7 inputs."""
+def _check_against(
+    kind: str, params: dict[str, Any], state: dict[str, Any], features: Sequence[str]
+) -> None:
+    """The declared sizes (defaults included) against the arrays, and the inputs ``features``."""
     storage = _stored(kind).storage
     assert storage is not None  # _stored refuses a family without a storage
     storage.schema.against(params, state)
     n_features = state.get("n_features_in_")
-    features = model_features()
     if isinstance(n_features, bool) or n_features != len(features):
         raise SchemaError(
             f"must be {len(features)}: the {kind} surrogate must take the inputs "
@@ -818,20 +812,24 @@ def _check_against(kind: str, params: dict[str, Any], state: dict[str, Any]) -> 
         )
 
 
-def _restore(document: dict[str, Any], path: Path | str, depth: int = 0) -> Surrogate:
-    """The model of a document, every params and state value validated by its kind's schema."""
+def _restore(
+    document: dict[str, Any], path: Path | str, reading: _Reading, depth: int = 0
+) -> Surrogate:
+    """The model of a document, every params and state value validated by its kind's schema
+    and against the inputs of the actuator being read."""
     kind = document["kind"]
     if kind in COMPOSITE_KINDS:
         _check_required(document, _COMPOSITE_STATE[kind])
-        return _restore_composite(document, path, depth)
+        return _restore_composite(document, path, reading, depth)
     storage = _stored(kind).storage
     assert storage is not None  # _stored refuses a family without a storage
-    builder = (_BUILDERS.get() or {}).get(kind)
+    actuator = reading.actuator
+    builder = reading.builders.get(kind)
     if builder is not None and _arrays_suffice(document):
-        return cast(Surrogate, builder(_saved_state(document)))
-    state = _family_state(document)
+        return cast(Surrogate, builder(_saved_state(document, actuator)))
+    state = _family_state(document, actuator)
     if builder is not None and storage.codec is not None:  # the builder may decline: None
-        light = builder(SavedState(kind, document["params"], state, document["metadata"]))
+        light = builder(SavedState(kind, document["params"], state, document["metadata"], actuator))
         if light is not None:
             return cast(Surrogate, light)
     cls = _class_of(kind)
@@ -844,6 +842,7 @@ def _restore(document: dict[str, Any], path: Path | str, depth: int = 0) -> Surr
         kind,
         model.get_params(deep=False),
         {**state, "n_features_in_": getattr(model, "n_features_in_", None)},
+        actuator.features,
     )
     return cast(Surrogate, model)
 
@@ -881,18 +880,23 @@ def load_surrogate(path: str | os.PathLike[str]) -> SavedSurrogate:
     softbend.errors.LimitError
         If the JSON nests deeper than the ``nesting`` limit of :mod:`softbend.limits`.
     """
-    path = Path(path)
+    return _load(Path(path), {})
+
+
+def _load(path: Path, builders: Mapping[str, Callable[[SavedState], Any]]) -> SavedSurrogate:
+    """:func:`load_surrogate`, with the families in ``builders`` built from their arrays."""
     document = _read_document(path)
-    with describing(actuator_of(document["metadata"])), _in_file(path):
-        _check_training_ranges(document["metadata"])
-        _check_support(document["metadata"])
-        return _saved_surrogate(document, path)
+    reading = _Reading(actuator_of(document["metadata"]), builders)
+    with _in_file(path):
+        _check_training_ranges(document["metadata"], reading.actuator)
+        _check_support(document["metadata"], reading.actuator)
+        return _saved_surrogate(document, path, reading)
 
 
-def _saved_surrogate(document: dict[str, Any], path: Path) -> SavedSurrogate:
+def _saved_surrogate(document: dict[str, Any], path: Path, reading: _Reading) -> SavedSurrogate:
     """The surrogate of a checked document, built."""
     try:
-        model = _restore(document, path)
+        model = _restore(document, path, reading)
     except RecursionError:  # only with SOFTBEND_MAX_NESTING raised far above its default
         raise SchemaError(
             "the surrogate nests too deeply to be rebuilt; lower SOFTBEND_MAX_NESTING "
@@ -922,17 +926,21 @@ class SavedState:
         validated by the family's schema exactly as :func:`load_surrogate` does.
     metadata : dict
         The caller's metadata, as :attr:`SavedSurrogate.metadata`.
+    described : Actuator, optional
+        The actuator the model is of, when the file gave it (an inner surrogate of a
+        composite takes the composite's); else the one ``metadata`` records.
     """
 
     kind: str
     params: dict[str, Any]
     state: dict[str, Any]
     metadata: dict[str, Any] = field(default_factory=dict)
+    described: Actuator | None = None
 
     @property
     def actuator(self) -> Actuator:
         """The actuator description the model was trained with (paper B's when unrecorded)."""
-        return actuator_of(self.metadata)
+        return self.described if self.described is not None else actuator_of(self.metadata)
 
 
 def load_state(path: str | os.PathLike[str], kinds: tuple[str, ...]) -> SavedState | SavedSurrogate:
@@ -964,7 +972,7 @@ def load_state(path: str | os.PathLike[str], kinds: tuple[str, ...]) -> SavedSta
     """
     path = Path(path)
     document = _read_document(path)
-    with describing(actuator_of(document["metadata"])), _in_file(path):
+    with _in_file(path):
         return _load_state(document, path, kinds)
 
 
@@ -983,31 +991,26 @@ def _arrays_suffice(document: dict[str, Any]) -> bool:
     )
 
 
-def _saved_state(document: dict[str, Any]) -> SavedState:
+def _saved_state(document: dict[str, Any], actuator: Actuator) -> SavedState:
     """A family's document validated as :func:`load_surrogate` does, its estimator not built."""
     kind = document["kind"]
     storage = _stored(kind).storage
     assert storage is not None and storage.schema.params is not None  # _arrays_suffice
-    state = _family_state(document)
+    state = _family_state(document, actuator)
     params = _validated(document["params"], storage.schema.params, kind, "params")
-    _check_against(kind, params, state)
-    return SavedState(kind=kind, params=params, state=state, metadata=document["metadata"])
+    _check_against(kind, params, state, actuator.features)
+    return SavedState(kind, params, state, document["metadata"], actuator)
 
 
 def _load_state(
     document: dict[str, Any], path: Path, kinds: tuple[str, ...]
 ) -> SavedState | SavedSurrogate:
-    _check_training_ranges(document["metadata"])
-    _check_support(document["metadata"])
+    actuator = actuator_of(document["metadata"])
+    _check_training_ranges(document["metadata"], actuator)
+    _check_support(document["metadata"], actuator)
     if document["kind"] in kinds and _arrays_suffice(document):
-        return _saved_state(document)
-    return _saved_surrogate(document, path)
-
-
-#: Family → how :func:`load_light` builds its predictor from its validated arrays.
-_BUILDERS: ContextVar[Mapping[str, Callable[[SavedState], Any]] | None] = ContextVar(
-    "softbend_light_builders", default=None
-)
+        return _saved_state(document, actuator)
+    return _saved_surrogate(document, path, _Reading(actuator))
 
 
 def load_light(
@@ -1043,8 +1046,4 @@ def load_light(
     FileNotFoundError, softbend.errors.SchemaError, softbend.errors.LimitError
         As :func:`load_surrogate`.
     """
-    token = _BUILDERS.set(dict(builders))
-    try:
-        return load_surrogate(path)
-    finally:
-        _BUILDERS.reset(token)
+    return _load(Path(path), dict(builders))

@@ -132,7 +132,7 @@ class Prediction:
         payload: dict[str, Any] = {
             "model": self.source,
             "kind": self.kind,
-            **({} if self.actuator == SFRBA else {"actuator": self.actuator.name}),
+            **({"actuator": self.actuator.name} if self.actuator.named_in_outputs else {}),
             "design": self.actuator.design_record(self.design_codes),
             self.actuator.pressure_column: self.pressure_mpa.tolist(),
             "angle_deg": self.angle_deg.tolist(),
@@ -289,7 +289,7 @@ def predict_angles(
         interval end inside its training ranges (its parameters overflow). A
         non-finite number is never returned.
     """
-    from softbend.surrogates.features import outside_training_ranges, using_features
+    from softbend.surrogates.features import outside_training_ranges
 
     # an MLP or a polynomial (alone or inside a composite) predicts from its arrays (NumPy
     # only); any other kind through its estimator
@@ -304,13 +304,13 @@ def predict_angles(
     rows[:, -1] = pressures
     ranges = saved.metadata.get("training_ranges")
     has_ranges = isinstance(ranges, dict)
-    with using_features(actuator.features):
-        outside = outside_training_ranges(ranges, rows) if isinstance(ranges, dict) else []
-        inside = (
-            np.array([not outside_training_ranges(ranges, row) for row in rows])
-            if isinstance(ranges, dict)
-            else np.ones(len(rows), dtype=bool)
-        )
+    features = actuator.features
+    outside = outside_training_ranges(ranges, rows, features) if has_ranges else []
+    inside = (
+        np.array([not outside_training_ranges(ranges, row, features) for row in rows])
+        if has_ranges
+        else np.ones(len(rows), dtype=bool)
+    )
     if strict and outside:
         raise ValueError(
             f"The 'design' and 'pressure' must lie in the training data of {path}: "
@@ -329,8 +329,7 @@ def predict_angles(
             low, high = predict_interval(rows, INTERVAL_LEVEL)
             interval = (np.asarray(low, dtype=float), np.asarray(high, dtype=float))
     _check_finite(path, saved.kind, pressures, angles, "angle", outside, unit)
-    with using_features(actuator.features):
-        beyond, supported = _support_check(saved.metadata.get("support"), rows, angles)
+    beyond, supported = _support_check(saved.metadata.get("support"), rows, angles)
     if supported is not None:  # one trust signal: inside the support and the ranges
         supported = supported & inside
     if strict and beyond:
@@ -430,13 +429,12 @@ def load_predictor(path: str | os.PathLike[str]) -> tuple[Any, Any]:
 
 def _xgboost_trees(saved: Any) -> Any:
     """A saved XGBoost model's trees in NumPy, or None where XGBoost itself must predict."""
-    from softbend.surrogates.features import model_features
     from softbend.surrogates.xgboost_core import booster_trees
 
     booster = saved.state.get("booster")
     if not isinstance(booster, str):
         return None
-    return booster_trees(booster, saved.params, len(model_features()))
+    return booster_trees(booster, saved.params, len(saved.actuator.features))
 
 
 class _PolynomialArrays:

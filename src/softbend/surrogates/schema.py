@@ -27,7 +27,7 @@ import json
 import math
 from collections.abc import Callable
 from dataclasses import dataclass
-from typing import Any, cast
+from typing import TYPE_CHECKING, Any, cast
 
 import numpy as np
 
@@ -35,7 +35,10 @@ from softbend._validation import interval_text, must_be, short_repr
 from softbend.design import FEATURE_QUANTITIES
 from softbend.errors import SchemaError
 from softbend.plausibility import RANGES, implausible_index
-from softbend.surrogates.features import FEATURES, TARGET, is_paper_b, model_features
+from softbend.surrogates.features import TARGET
+
+if TYPE_CHECKING:
+    from softbend.actuators import Actuator
 
 __all__ = [
     "COMPOSITE_SCHEMAS",
@@ -51,6 +54,7 @@ __all__ = [
     "boolean",
     "integer",
     "no_check",
+    "no_inputs_check",
     "optional",
     "real",
     "string",
@@ -352,34 +356,38 @@ def _booster(value: object) -> str:
     learner = model.get("learner") if isinstance(model, dict) else None
     if not isinstance(learner, dict):
         raise RuleError("must be XGBoost's JSON model; no 'learner' object")
+    return value
+
+
+def _check_booster_inputs(state: dict[str, Any], actuator: Actuator) -> None:
+    """The booster takes the inputs of ``actuator``, in order (its recorded names, if any)."""
+    features = actuator.features
+    learner = json.loads(state["booster"])["learner"]  # checked by _booster
     param = learner.get("learner_model_param")
     n_features = param.get("num_feature") if isinstance(param, dict) else None
-    features = model_features()
     if n_features is not None and str(n_features) != str(len(features)):
         raise RuleError(
-            f"must take the {len(features)} surrogate inputs; got {n_features} features"
+            f"must take the {len(features)} surrogate inputs; got {n_features} features",
+            key="state.booster",
         )
     names = learner.get("feature_names", [])
     if names and names != list(features):  # empty: fitted on an array, no names recorded
         raise RuleError(
             f"must be fitted on the columns {', '.join(features)} in this order (or record no "
-            f"feature names); got feature_names {short_repr(names)}"
+            f"feature names); got feature_names {short_repr(names)}",
+            key="state.booster",
         )
-    return value
 
 
-def _check_inputs(state: dict[str, Any]) -> None:
-    """Rules across keys shared by the polynomial and the MLP: the input standardization."""
-    features = model_features()
+def _check_inputs(state: dict[str, Any], actuator: Actuator) -> None:
+    """The inputs of the polynomial and the MLP are those of ``actuator``, in order."""
+    features = actuator.features
     d = len(features)
     if int(state["n_features_in_"]) != d:
         raise RuleError(
             f"must be {d} (the inputs {', '.join(features)}); got {state['n_features_in_']}",
             key="state.n_features_in_",
         )
-    for key in ("x_mean_", "x_scale_"):
-        if state[key].shape != (d,):
-            raise RuleError(f"must have shape ({d},); got {state[key].shape}", key=f"state.{key}")
     names = state.get("feature_names_in_")
     if names is not None and [str(n) for n in names] != list(features):
         raise RuleError(
@@ -388,10 +396,24 @@ def _check_inputs(state: dict[str, Any]) -> None:
         )
 
 
+def _check_standardization(state: dict[str, Any]) -> None:
+    """Rules across keys shared by the polynomial and the MLP: one mean and scale per input."""
+    d = int(state["n_features_in_"])
+    for key in ("x_mean_", "x_scale_"):
+        if state[key].shape != (d,):
+            raise RuleError(f"must have shape ({d},); got {state[key].shape}", key=f"state.{key}")
+    names = state.get("feature_names_in_")
+    if names is not None and len(names) != d:
+        raise RuleError(
+            f"must name the {d} inputs; got {', '.join(map(str, names))}",
+            key="state.feature_names_in_",
+        )
+
+
 def _check_polynomial(state: dict[str, Any]) -> None:
-    _check_inputs(state)
+    _check_standardization(state)
     powers, coef = state["powers_"], state["coef_"]
-    d = len(model_features())
+    d = int(state["n_features_in_"])
     if powers.shape[0] < 1 or powers.shape[1] != d:
         raise RuleError(
             f"must have shape (n_terms >= 1, {d}); got {powers.shape}", key="state.powers_"
@@ -414,9 +436,9 @@ def _check_polynomial(state: dict[str, Any]) -> None:
 
 
 def _check_mlp(state: dict[str, Any]) -> None:
-    _check_inputs(state)
+    _check_standardization(state)
     coefs, intercepts = state["coefs_"], state["intercepts_"]
-    d, h1, h2 = len(model_features()), coefs[0].shape[1], coefs[1].shape[1]
+    d, h1, h2 = int(state["n_features_in_"]), coefs[0].shape[1], coefs[1].shape[1]
     expected = [(d, h1), (h1, h2), (h2, 1)]
     if [c.shape for c in coefs] != expected or 0 in (h1, h2):
         raise RuleError(
@@ -434,6 +456,11 @@ def _check_mlp(state: dict[str, Any]) -> None:
 
 def no_check(state: dict[str, Any]) -> None:
     """A :attr:`Schema.check` that checks nothing across keys."""
+    return None
+
+
+def no_inputs_check(state: dict[str, Any], actuator: Actuator) -> None:
+    """A :attr:`Schema.inputs` that checks nothing against the actuator's inputs."""
     return None
 
 
@@ -477,17 +504,17 @@ def _check_affine(state: dict[str, Any]) -> None:
     _check_residual_std(state)
 
 
-def _gp_inputs() -> tuple[str, ...]:
+def _gp_inputs(actuator: Actuator) -> tuple[str, ...]:
     """The GP correction's inputs: the model's inputs and the base's angle."""
-    return (*model_features(), f"the base's {TARGET}")
+    return (*actuator.features, f"the base's {TARGET}")
 
 
-def _gp_hyperparameters() -> tuple[str, ...]:
+def _gp_hyperparameters(actuator: Actuator) -> tuple[str, ...]:
     """Names of the GP kernel's hyperparameters, in the order of ``kernel_theta_``."""
-    return ("constant", *(f"length scale of {name}" for name in _gp_inputs()), "noise")
+    return ("constant", *(f"length scale of {name}" for name in _gp_inputs(actuator)), "noise")
 
 
-def _check_gp(state: dict[str, Any]) -> None:
+def _check_gp(state: dict[str, Any], actuator: Actuator) -> None:
     """Shapes, then the plausibility of every number of a GP correction.
 
     The hyperparameters ``exp(kernel_theta_)`` are dimensionless: length scales of
@@ -500,9 +527,10 @@ def _check_gp(state: dict[str, Any]) -> None:
     ``z_scale_`` their standard deviations (or 1 for a constant column), at most the
     width of that quantity's range; the standardized ``inputs_`` lie within the
     kernel-width range in magnitude and the ``targets_`` (the base's errors,
-    degrees) are plausible angles.
+    degrees) are plausible angles. The inputs checked for plausibility are those
+    ``actuator.quantities`` names, and the base's angle.
     """
-    gp_inputs = _gp_inputs()
+    gp_inputs = _gp_inputs(actuator)
     d = len(gp_inputs)  # the inputs and the base's angle
     for key in ("z_mean_", "z_scale_"):
         if state[key].shape != (d,):
@@ -530,18 +558,17 @@ def _check_gp(state: dict[str, Any]) -> None:
             f"must hold the logarithms of the kernel's constant, "
             f"length scales and noise, each within {width.low:g} to {width.high:g} "
             f"(log {math.log(width.low):.4g} to {math.log(width.high):.4g}); got "
-            f"{_gp_hyperparameters()[bad]} {hyper[bad]:g} (log {state['kernel_theta_'][bad]:g}) "
+            f"{_gp_hyperparameters(actuator)[bad]} {hyper[bad]:g} "
+            f"(log {state['kernel_theta_'][bad]:g}) "
             f"at index {bad}",
             key="state.kernel_theta_",
         )
-    # paper B's inputs have plausible ranges; another actuator's only its angle
-    named = (*FEATURES, TARGET) if is_paper_b() else (TARGET,)
-    quantities = [QUANTITIES[name] for name in named]
-    checked = gp_inputs if is_paper_b() else gp_inputs[-1:]
-    offset = d - len(checked)
-    for k, (name, quantity) in enumerate(zip(checked, quantities, strict=True)):
-        j = offset + k
-        bounds = RANGES[quantity]
+    # the inputs with a plausible range (the actuator's quantities), and the base's angle
+    quantities = {**actuator.quantities, gp_inputs[-1]: QUANTITIES[TARGET]}
+    for j, name in enumerate(gp_inputs):
+        if name not in quantities:
+            continue
+        bounds = RANGES[quantities[name]]
         mean, scale = float(state["z_mean_"][j]), float(state["z_scale_"][j])
         unit = f" {bounds.unit}" if bounds.unit else ""
         if not bounds.low <= mean <= bounds.high:
@@ -624,12 +651,18 @@ class Schema:
     against : callable
         Rules between the parameters of the model built (its ``get_params``,
         defaults included) and the decoded state.
+    inputs : callable
+        Rules between the decoded state and the actuator the model is of
+        (:class:`~softbend.actuators.Actuator`: its inputs in order, their plausible
+        quantities); checked before ``check``. A family's ``n_features_in_`` is
+        checked against the actuator's inputs by the loader in any case.
     """
 
     params: dict[str, Rule] | None
     state: dict[str, Rule]
     check: Callable[[dict[str, Any]], None] = no_check
     against: Callable[[dict[str, Any], dict[str, Any]], None] = _no_params_check
+    inputs: Callable[[dict[str, Any], Actuator], None] = no_inputs_check
 
 
 _INPUT_STATE: dict[str, Rule] = {
@@ -658,6 +691,7 @@ POLYNOMIAL_SCHEMA = Schema(
     },
     check=_check_polynomial,
     against=_check_polynomial_degree,
+    inputs=_check_inputs,
 )
 
 #: The schema of the MLP family (``mlp``).
@@ -679,10 +713,11 @@ MLP_SCHEMA = Schema(
     },
     check=_check_mlp,
     against=_check_mlp_sizes,
+    inputs=_check_inputs,
 )
 
 #: The schema of the XGBoost family (``xgb``): its codec reads the parameters.
-XGBOOST_SCHEMA = Schema(params=None, state={"booster": _booster})
+XGBOOST_SCHEMA = Schema(params=None, state={"booster": _booster}, inputs=_check_booster_inputs)
 
 #: The schemas of the surrogates built on other surrogates, by kind.
 COMPOSITE_SCHEMAS: dict[str, Schema] = {
@@ -706,7 +741,7 @@ COMPOSITE_SCHEMAS: dict[str, Schema] = {
             "inputs_": array(_FLOAT, 2),
             "targets_": array(_FLOAT, 1),
         },
-        check=_check_gp,
+        inputs=_check_gp,
     ),
     "ensemble": Schema(
         params={},

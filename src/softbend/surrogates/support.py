@@ -206,8 +206,17 @@ class Support:
         return out
 
     @classmethod
-    def from_dict(cls, data: object) -> Support:
+    def from_dict(cls, data: object, parameters: Sequence[str] | None = None) -> Support:
         """The support a :meth:`to_dict` record describes.
+
+        Parameters
+        ----------
+        data : dict
+            The record (a saved model's ``metadata["support"]``).
+        parameters : sequence of str, optional
+            The design parameters it must be of (its model's actuator's
+            :attr:`~softbend.actuators.Actuator.names`); default those the record
+            names (paper B's when it names none).
 
         Raises
         ------
@@ -223,12 +232,17 @@ class Support:
             raise InputError(
                 f"must give designs, max_pressure_mpa and max_angle_deg; lacks {', '.join(missing)}"
             )
-        from softbend.surrogates.features import model_features
-
-        expected = list(model_features()[:-1])
-        if data.get("parameters", list(PARAMETERS)) != expected:
+        recorded = data.get("parameters", list(PARAMETERS))
+        named = isinstance(recorded, list) and all(isinstance(n, str) for n in recorded)
+        expected = list(parameters) if parameters is not None else recorded if named else []
+        if not named or recorded != expected:
             raise InputError(
-                must_be(f"the parameters {', '.join(expected)}", data.get("parameters")),
+                must_be(
+                    f"the parameters {', '.join(expected)}"
+                    if expected
+                    else "a list of the design parameters' names",
+                    data.get("parameters"),
+                ),
                 key="parameters",
             )
         unit = data.get("pressure_unit", "MPa")

@@ -137,11 +137,6 @@ def _mape_entry(cv: dict[str, float]) -> dict[str, Any]:
     return entry
 
 
-def _paper_b(name: str) -> dict[str, Any]:
-    """Paper B's figures of the family ``name`` (empty for a family it does not have)."""
-    return dict(PAPER_B_FIG5.get(name) or {})
-
-
 def _load_data(source: Source) -> TrainingData:
     if isinstance(source, TrainingData):
         return source
@@ -227,7 +222,7 @@ def train_surrogates(
     """
     from softbend.actuators import SFRBA
     from softbend.surrogates.features import training_ranges
-    from softbend.surrogates.persistence import describing, save_surrogate
+    from softbend.surrogates.persistence import save_surrogate
     from softbend.surrogates.support import support_from_rows
 
     check_choice(select_by, "select_by", tuple(SELECT_BY))
@@ -236,92 +231,91 @@ def train_surrogates(
     advice = small_data_advice(data.n_groups, grid_name, mlp="mlp" in names)
     if grid_name is None:
         grid_name = "small" if advice is not None else "quick"
-    actuator = data.actuator or SFRBA
-    with describing(actuator):  # every check and file names this actuator
-        paper_b = actuator == SFRBA
-        result = search(
-            data,
-            models=models,
-            grid_name=grid_name,
-            folds=folds,
-            seed=seed,
-            device=device,
-            n_jobs=n_jobs,
-            epochs=epochs,
-            progress=progress,
-            cv=cv,
-            halving=halving,
-            halving_rungs=halving_rungs,
-            plr_patience=plr_patience,
-            checkpoint=checkpoint,
-            tf32=tf32,
-            on_start=_telling(advise, advice),
-        )
-        out = Path(out_dir)
-        (out / "models").mkdir(parents=True, exist_ok=True)
-        files: dict[str, str] = {}
-        families: dict[str, Any] = {}
-        for name, fam in result.families.items():
-            metadata = {
-                "data_hash": data.data_hash,
-                "n_samples": data.n_samples,
-                "n_designs": data.n_groups,
-                "cv": {k: float(v) for k, v in fam.cv.items()},
-                "search": {**result.settings, "params": describe(fam.params)},
-                "training_ranges": training_ranges(data.X),
-                "support": support_from_rows(
-                    data.X, data.y, parameters=actuator.names, pressure_unit=actuator.pressure_unit
-                ).to_dict(),
-            }
-            metadata["actuator"] = actuator.to_dict()  # every model names its actuator
-            family = FAMILIES.get(name)
-            if family.storage is not None:
-                files[f"{name}_model"] = str(
-                    save_surrogate(fam.model, out / "models" / f"{name}.json", metadata=metadata)
-                )
-            entry: dict[str, Any] = {
-                "params": describe(fam.params),
-                **{k: float(v) for k, v in fam.cv.items()},
-                **_mape_entry(fam.cv),
-                **{f"inference_{k}": v for k, v in fam.timing.items()},
-                "fit_s": fam.fit_s,
-                "search_s": fam.search_s,
-                "paper_b": _paper_b(name) if paper_b else {},
-            }
-            if export_onnx and family.onnx is not None:
-                from softbend.surrogates.onnx_export import onnx_predict, save_onnx
-
-                onnx_path = save_onnx(fam.model, out / "models" / f"{name}.onnx")
-                rows = data.X[np.random.default_rng(seed).integers(0, data.n_samples, 2000)]
-                expected = fam.model.predict(rows)
-                entry["onnx_max_abs_diff_deg"] = float(
-                    np.max(np.abs(onnx_predict(onnx_path, rows) - expected))
-                )
-                files[f"{name}_onnx"] = str(onnx_path)
-            families[name] = entry
-        cv_path = out / "cv_results.csv"
-        write_text_atomic(cv_path, result.cv_results.to_csv(index=False))
-        summary_table = result.summary()
-        for key in ("params", "r2", "mape_pct", "inference_ms"):
-            summary_table[f"paper_b_{key}"] = [
-                _paper_b(m).get(key) if paper_b else None for m in summary_table["model"]
-            ]
-        write_text_atomic(out / "summary.csv", summary_table.to_csv(index=False))
-        files["cv_results"] = str(cv_path)
-        files["summary"] = str(out / "summary.csv")
-        summary = {
-            **({} if paper_b else {"actuator": actuator.to_dict()}),
-            "settings": result.settings,
-            "models": families,
-            "best": best_family(result.families, select_by),
-            "selected_by": select_by,
-            "best_by_mape": best_family(result.families, "mape"),
-            "mape_floor_deg": result.settings["mape_floor_deg"],
-            "advice": advice,
-            "resumed_config_folds": result.resumed,
-            "files": files,
+    actuator = data.actuator or SFRBA  # every check and file names this actuator
+    published = actuator.published_cv
+    result = search(
+        data,
+        models=models,
+        grid_name=grid_name,
+        folds=folds,
+        seed=seed,
+        device=device,
+        n_jobs=n_jobs,
+        epochs=epochs,
+        progress=progress,
+        cv=cv,
+        halving=halving,
+        halving_rungs=halving_rungs,
+        plr_patience=plr_patience,
+        checkpoint=checkpoint,
+        tf32=tf32,
+        on_start=_telling(advise, advice),
+    )
+    out = Path(out_dir)
+    (out / "models").mkdir(parents=True, exist_ok=True)
+    files: dict[str, str] = {}
+    families: dict[str, Any] = {}
+    for name, fam in result.families.items():
+        metadata = {
+            "data_hash": data.data_hash,
+            "n_samples": data.n_samples,
+            "n_designs": data.n_groups,
+            "cv": {k: float(v) for k, v in fam.cv.items()},
+            "search": {**result.settings, "params": describe(fam.params)},
+            "training_ranges": training_ranges(data.X, actuator.features),
+            "support": support_from_rows(
+                data.X, data.y, parameters=actuator.names, pressure_unit=actuator.pressure_unit
+            ).to_dict(),
         }
-        return result, summary
+        metadata["actuator"] = actuator.to_dict()  # every model names its actuator
+        family = FAMILIES.get(name)
+        if family.storage is not None:
+            files[f"{name}_model"] = str(
+                save_surrogate(fam.model, out / "models" / f"{name}.json", metadata=metadata)
+            )
+        entry: dict[str, Any] = {
+            "params": describe(fam.params),
+            **{k: float(v) for k, v in fam.cv.items()},
+            **_mape_entry(fam.cv),
+            **{f"inference_{k}": v for k, v in fam.timing.items()},
+            "fit_s": fam.fit_s,
+            "search_s": fam.search_s,
+            "paper_b": dict(published.get(name) or {}),
+        }
+        if export_onnx and family.onnx is not None:
+            from softbend.surrogates.onnx_export import onnx_predict, save_onnx
+
+            onnx_path = save_onnx(fam.model, out / "models" / f"{name}.onnx", actuator=actuator)
+            rows = data.X[np.random.default_rng(seed).integers(0, data.n_samples, 2000)]
+            expected = fam.model.predict(rows)
+            entry["onnx_max_abs_diff_deg"] = float(
+                np.max(np.abs(onnx_predict(onnx_path, rows) - expected))
+            )
+            files[f"{name}_onnx"] = str(onnx_path)
+        families[name] = entry
+    cv_path = out / "cv_results.csv"
+    write_text_atomic(cv_path, result.cv_results.to_csv(index=False))
+    summary_table = result.summary()
+    for key in ("params", "r2", "mape_pct", "inference_ms"):
+        summary_table[f"paper_b_{key}"] = [
+            dict(published.get(m) or {}).get(key) for m in summary_table["model"]
+        ]
+    write_text_atomic(out / "summary.csv", summary_table.to_csv(index=False))
+    files["cv_results"] = str(cv_path)
+    files["summary"] = str(out / "summary.csv")
+    summary = {
+        **({"actuator": actuator.to_dict()} if actuator.named_in_outputs else {}),
+        "settings": result.settings,
+        "models": families,
+        "best": best_family(result.families, select_by),
+        "selected_by": select_by,
+        "best_by_mape": best_family(result.families, "mape"),
+        "mape_floor_deg": result.settings["mape_floor_deg"],
+        "advice": advice,
+        "resumed_config_folds": result.resumed,
+        "files": files,
+    }
+    return result, summary
 
 
 def train_into(

@@ -18,7 +18,6 @@ import numpy as np
 
 from softbend._validation import must_be
 from softbend.errors import SchemaError
-from softbend.surrogates.features import FEATURES
 from softbend.surrogates.jsonvalues import decode, encode_params
 from softbend.surrogates.protocol import Surrogate
 from softbend.surrogates.schema import RuleError, tag_float
@@ -106,7 +105,8 @@ class XGBoostCodec:
             # here, not in the caller's first prediction.
             with warnings.catch_warnings():
                 warnings.simplefilter("ignore")
-                probe = np.asarray(model.predict(np.zeros((1, len(FEATURES)))), dtype=np.float64)
+                inputs = int(model.get_booster().num_features())  # checked against the actuator
+                probe = np.asarray(model.predict(np.zeros((1, inputs))), dtype=np.float64)
         except Exception as err:  # xgboost.core.XGBoostError, a parameter XGBoost refuses, ...
             reason = (str(err).strip().splitlines() or [type(err).__name__])[0]  # no stack trace
             raise SchemaError(f"cannot rebuild the xgb surrogate ({reason})", file=path) from None

@@ -246,15 +246,13 @@ def check_angles(
         Keyed by the angle column, naming the file, the actuator and both angles,
         unless ``force``.
     """
-    from softbend.surrogates.persistence import describing
-
     actuator = saved.actuator
     trained = trained_pressure_range(saved)
     pressure = data.frame[actuator.pressure_column].to_numpy(dtype=np.float64)
     inside = (pressure > 0) & (pressure <= (trained[1] if trained is not None else np.inf))
     groups = data.groups
     measured = np.abs(data.angle_deg)
-    with describing(actuator), np.errstate(all="ignore"):
+    with np.errstate(all="ignore"):
         predicted = np.abs(np.asarray(saved.model.predict(data.features), dtype=np.float64))
     forced = []
     for name in data.actuator_ids:

@@ -229,8 +229,10 @@ def _fit_all(
     X: np.ndarray,
     y: np.ndarray,
     row_sets: list[np.ndarray],
+    actuator: Actuator | None = None,
 ) -> tuple[list[Any], float]:
-    """Fit one fresh ``name`` strategy per row set; batched where the strategy can.
+    """Fit one fresh ``name`` strategy per row set (readings of ``actuator``, paper B's by
+    default); batched where the strategy can.
 
     Returns each fitted strategy, or the error (one of
     :data:`~softbend.transfer.strategies.FIT_ERRORS`) that stopped its fit: one
@@ -239,7 +241,9 @@ def _fit_all(
     does not, and fails, is fitted again one row set at a time.
     """
     start = time.perf_counter()
-    models: list[Any] = [make_strategy(name, base, seed=seed, **options) for _ in row_sets]
+    models: list[Any] = [
+        make_strategy(name, base, seed=seed, actuator=actuator, **options) for _ in row_sets
+    ]
     fit_batch = getattr(type(models[0]), "fit_batch", None)
     if fit_batch is not None and "keep_going" in inspect.signature(fit_batch).parameters:
         fit_batch(models, X, y, row_sets, keep_going=True)
@@ -356,31 +360,30 @@ def leave_one_configuration_out(
             key="measurements",
         )
     from softbend.actuators import SFRBA
-    from softbend.surrogates.persistence import describing
 
     actuator = getattr(measurements, "actuator", SFRBA)  # paper B's Measurements: SFRBA
     left_out: dict[str, str] = {}
     if strategies is None:
         strategies, left_out = applicable_strategies(DEFAULT_STRATEGIES, base, actuator)
-    # Paper B's actuator: paper B's MAPE (only exact zeros left out); any other: the floor.
-    floor = 0.0 if actuator == SFRBA else mape_floor(measurements.angle_deg)
-    with describing(actuator):  # the strategies check the inputs of this actuator
-        result = _leave_one_out(
-            measurements,
-            base,
-            strategies,
-            level=level,
-            learning_curve=learning_curve,
-            calibrated=calibrated,
-            fallback=fallback,
-            seed=seed,
-            options=options,
-            progress=progress,
-            floor=floor,
-            actuator=actuator,
-        )
+    # An actuator's own MAPE floor (paper B's: only exact zeros left out); else the readings'.
+    fixed = actuator.transfer_mape_floor_deg
+    floor = mape_floor(measurements.angle_deg) if fixed is None else fixed
+    result = _leave_one_out(  # the strategies check the inputs of this actuator
+        measurements,
+        base,
+        strategies,
+        level=level,
+        learning_curve=learning_curve,
+        calibrated=calibrated,
+        fallback=fallback,
+        seed=seed,
+        options=options,
+        progress=progress,
+        floor=floor,
+        actuator=actuator,
+    )
     result.settings["left_out"] = left_out
-    if actuator != SFRBA:
+    if actuator.named_in_outputs:
         result.settings["actuator"] = actuator.to_dict()
         result.settings["pressure_column"] = actuator.pressure_column
         result.settings["pressure_unit"] = actuator.pressure_unit
@@ -465,9 +468,8 @@ def _leave_one_out(
         ):
             if not batch:
                 continue
-            models, fit_s = _fit_all(
-                name, base, options.get(name, {}), seed, X, y, [tasks[i][4] for i in batch]
-            )
+            rows = [tasks[i][4] for i in batch]
+            models, fit_s = _fit_all(name, base, options.get(name, {}), seed, X, y, rows, actuator)
             for i, model in zip(batch, models, strict=True):
                 test = tasks[i][5]
                 out: dict[str, Any] = {"fit_s": fit_s}
@@ -686,7 +688,8 @@ def held_out_residuals(
     X, y, groups = measurements.features, measurements.angle_deg, measurements.groups
     tests = [np.flatnonzero(groups == a) for a in ids]
     trains = [np.flatnonzero(groups != a) for a in ids]
-    models, _ = _fit_all(strategy, base, values, seed, X, y, trains)
+    actuator = getattr(measurements, "actuator", None)  # paper B's Measurements: None
+    models, _ = _fit_all(strategy, base, values, seed, X, y, trains, actuator)
     for model in models:
         if isinstance(model, BaseException):  # no calibration without every actuator's errors
             raise model

@@ -1,9 +1,9 @@
 """The parameters of a transfer strategy: read from its constructor, checked, typed from text.
 
 A strategy is a class (see :data:`softbend.transfer.strategies.STRATEGIES`);
-its parameters are its constructor's, less the two the library fills itself:
-``base`` (the surrogate the strategy starts from) and ``seed`` (given once per
-run, ``--seed``). A user sets the others from Python
+its parameters are its constructor's, less the three the library fills itself:
+``base`` (the surrogate the strategy starts from), ``seed`` (given once per
+run, ``--seed``) and ``actuator`` (that of the readings). A user sets the others from Python
 (``make_strategy("refined", base, epochs=500)``) or as text on the command line
 (``--set epochs=500``): text is read by the kind of the parameter's default
 (``true``/``false``, an integer, a number, a string, integers separated by
@@ -43,7 +43,7 @@ __all__ = [
 ]
 
 #: Constructor parameters the library fills itself: never set by name.
-FILLED: tuple[str, ...] = ("base", "seed")
+FILLED: tuple[str, ...] = ("base", "seed", "actuator")
 
 _HINTS = {"seed": "the seed is set once per run: --seed"}
 
@@ -206,14 +206,15 @@ def check_estimator(estimator: object) -> dict[str, Any]:
 def recorded_parameters(estimator: object) -> dict[str, Any]:
     """Every parameter of a strategy object, ``seed`` included, as it will run (for a record).
 
-    The base surrogate is left out (the record names its file); a value that is
+    The base surrogate and the actuator are left out (the record names the base's
+    file and its actuator); a value that is
     not a number, a string, a boolean, ``None`` or a tuple of them is written as
     its ``repr``.
     """
     plain = (bool, int, float, str, type(None))
     out: dict[str, Any] = {}
     for key in _constructor(type(estimator)):
-        if key == "base":
+        if key in ("base", "actuator"):
             continue
         value = getattr(estimator, key, None)
         if isinstance(value, tuple | list) and all(isinstance(v, plain) for v in value):

@@ -30,26 +30,32 @@ from softbend.surrogates.corrected import scaled_pressure_rows
 from softbend.surrogates.protocol import Surrogate
 
 if TYPE_CHECKING:
+    from softbend.actuators import Actuator
     from softbend.surrogates.mlp import NormalizedMLPRegressor
 
-__all__ = ["SCALE_BOUNDS", "fit_pressure_scale", "pressure_column", "scale_mlp_pressure"]
+__all__ = ["SCALE_BOUNDS", "fit_pressure_scale", "scale_mlp_pressure"]
 
 #: The pressure scale is searched in this range (the elastomer 4 times softer or stiffer).
 SCALE_BOUNDS: tuple[float, float] = (0.25, 4.0)
 
 
-def fit_pressure_scale(base: Surrogate, X: ArrayLike, y: ArrayLike) -> float:
+def fit_pressure_scale(
+    base: Surrogate, X: ArrayLike, y: ArrayLike, actuator: Actuator | None = None
+) -> float:
     """The ``s`` that minimises ``Σ (base(design, s·p) − θ)²`` over the rows.
 
     Parameters
     ----------
     base : estimator
-        A fitted surrogate on the rows of :data:`softbend.design.FEATURES`.
-    X : array_like of shape (n, 7)
-        Measured designs and pressures (mm, deg, MPa; another actuator's inputs in its
-        own units), finite.
+        A fitted surrogate on the inputs of ``actuator``.
+    X : array_like of shape (n, d)
+        Measured designs and pressures (paper B's in mm, deg, MPa; another actuator's
+        inputs in its own units), finite.
     y : array_like of shape (n,)
         Measured angles, degrees.
+    actuator : Actuator, optional
+        The readings' actuator, whose pressure column and unit a message names
+        (default paper B's: ``pressure_mpa`` in MPa).
 
     Returns
     -------
@@ -66,7 +72,11 @@ def fit_pressure_scale(base: Surrogate, X: ArrayLike, y: ArrayLike) -> float:
     """
     rows = np.asarray(X, dtype=np.float64)
     angles = np.asarray(y, dtype=np.float64)
-    column, unit = pressure_column()
+    if actuator is None:
+        from softbend.actuators import SFRBA
+
+        actuator = SFRBA
+    column, unit = actuator.pressure_column, actuator.pressure_unit
     if not np.any(rows[:, -1] > 0.0):
         raise InputError(
             f"must include a pressure above 0 {unit} (column '{column}'): the pressure scale "
@@ -110,21 +120,6 @@ def fit_pressure_scale(base: Surrogate, X: ArrayLike, y: ArrayLike) -> float:
         options={"xatol": 1e-7},
     )
     return float(np.exp(found.x))
-
-
-def pressure_column() -> tuple[str, str]:
-    """The pressure input's column and unit of the model being fitted.
-
-    Those of the actuator :func:`softbend.surrogates.persistence.describing`
-    names (the base model's own: ``p_kpa``, ``kPa``), paper B's
-    (``pressure_mpa``, ``MPa``) outside it: the words of a message about the
-    measured pressures.
-    """
-    from softbend.surrogates.features import model_features
-    from softbend.surrogates.persistence import current_units
-
-    column = model_features()[-1]
-    return column, current_units().get(column, "MPa")
 
 
 def scale_mlp_pressure(model: NormalizedMLPRegressor, scale: float) -> NormalizedMLPRegressor:

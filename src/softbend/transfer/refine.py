@@ -249,7 +249,7 @@ def refine_surrogate(
         A refit that diverged, or whose predictions on the readings, training
         error, final loss or calibrated half-width is not finite.
     """
-    from softbend.surrogates.persistence import describing, load_surrogate
+    from softbend.surrogates.persistence import load_surrogate
     from softbend.transfer.against_base import load_for_base
 
     left_out: dict[str, str] = {}
@@ -277,18 +277,17 @@ def refine_surrogate(
         values = {**from_text, **check_parameters(cls, options)}
     files = [measurements] if isinstance(measurements, str | os.PathLike) else list(measurements)
     data, forced = load_for_base(files, start, force=force)  # before any fit
-    with describing(actuator):
-        refinement = _refine(
-            strategy,
-            start,
-            data,
-            files,
-            base,
-            actuator,
-            seed=seed,
-            values=values,
-            calibrated=calibrated,
-        )
+    refinement = _refine(
+        strategy,
+        start,
+        data,
+        files,
+        base,
+        actuator,
+        seed=seed,
+        values=values,
+        calibrated=calibrated,
+    )
     if forced:
         refinement.metadata["forced"] = forced
     refinement.metadata["strategy_left_out"] = left_out
@@ -314,7 +313,7 @@ def _refine(
 
     cls = STRATEGIES.get(strategy)
     model = fit_strategy(strategy, start.model, data, seed=seed, **values)
-    ranges = training_ranges(data.features)
+    ranges = training_ranges(data.features, actuator.features)
     support = support_from_rows(
         data.features,
         data.angle_deg,

@@ -85,7 +85,6 @@ from softbend.surrogates.corrected import (
     gp_kernel,
     scaled_pressure_rows,
 )
-from softbend.surrogates.features import is_paper_b, model_features
 from softbend.surrogates.protocol import Surrogate
 from softbend.transfer.finetune import check_mlp, fine_tune_many, row_weights
 from softbend.transfer.parameters import (
@@ -97,7 +96,6 @@ from softbend.transfer.parameters import (
 )
 from softbend.transfer.pressure_map import (
     fit_pressure_scale,
-    pressure_column,
     scale_mlp_pressure,
 )
 
@@ -322,8 +320,10 @@ def _check_readings(strategy: str, y: np.ndarray, least: int, fits: str) -> None
         )
 
 
-def _check_finite_fit(strategy: str, **parameters: ArrayLike) -> None:
+def _check_finite_fit(strategy: str, actuator: Actuator, **parameters: ArrayLike) -> None:
     """Raise :class:`ConvergenceError` naming ``strategy`` if a fitted parameter is not finite.
+
+    The message names the pressure column of ``actuator``, the readings' actuator.
 
     A fit that overflowed (absurd angles, a base that answers with huge numbers)
     must fail here, never be saved or used with an infinite spread.
@@ -334,7 +334,7 @@ def _check_finite_fit(strategy: str, **parameters: ArrayLike) -> None:
         if not np.isfinite(array).all():
             bad.append(f"{name}={float(array):g}" if array.ndim == 0 else f"{name} not all finite")
     if bad:
-        column, unit = pressure_column()
+        column, unit = actuator.pressure_column, actuator.pressure_unit
         raise ConvergenceError(
             f"The '{strategy}' strategy fitted non-finite parameters ({', '.join(bad)}): the "
             "measured angles or the base's predictions are too large for the fit. Check the "
@@ -343,7 +343,13 @@ def _check_finite_fit(strategy: str, **parameters: ArrayLike) -> None:
 
 
 class _Strategy(RegressorMixin, BaseEstimator):
-    """Validation shared by the strategies: 7 finite features, plausible angles."""
+    """Validation shared by the strategies: the inputs of the readings' actuator, finite,
+    and plausible angles.
+
+    Each strategy takes the readings' actuator (``actuator``, filled by the
+    library as ``base`` is: :func:`make_strategy`); None, or a strategy class
+    without the parameter, is paper B's.
+    """
 
     #: Whether fitting learns a model from the measurements (``model_``, saved by refine).
     learns: ClassVar[bool] = True
@@ -362,20 +368,28 @@ class _Strategy(RegressorMixin, BaseEstimator):
             return "starts from a base surrogate that predicts, and none was given"
         return None
 
+    def _described(self) -> Actuator:
+        """The readings' actuator: the one filled in, else paper B's."""
+        from softbend.actuators import SFRBA
+
+        actuator = getattr(self, "actuator", None)
+        return SFRBA if actuator is None else actuator
+
     def _check_fit_data(self, X: ArrayLike, y: ArrayLike) -> tuple[np.ndarray, np.ndarray]:
         X_arr, y_arr = validate_data(self, X, y, dtype=np.float64, y_numeric=True)
         owner = f"the '{_registered_name(type(self))}' strategy's training readings"
-        features = model_features()
+        actuator = self._described()
+        features = actuator.features
         if X_arr.shape[1] != len(features):
             raise InputError(
                 f"must have the {len(features)} columns {', '.join(features)}; got "
                 f"{X_arr.shape[1]} columns",
                 key="X",
             )
-        if is_paper_b(features):  # another actuator's pressure is in its own unit
-            check_plausible(
-                X_arr[:, -1], "pressure_mpa", source=owner, column="pressure_mpa", where=_row
-            )
+        column = actuator.pressure_column
+        quantity = actuator.quantities.get(column)  # a pressure unit with a plausible range
+        if quantity is not None:
+            check_plausible(X_arr[:, -1], quantity, source=owner, column=column, where=_row)
         check_plausible(y_arr, "angle_deg", source=owner, column="angle_deg", where=_row)
         return X_arr, y_arr
 
@@ -412,8 +426,9 @@ class BaseOnly(_Strategy):
 
     learns: ClassVar[bool] = False
 
-    def __init__(self, base: Surrogate | None = None) -> None:
+    def __init__(self, base: Surrogate | None = None, *, actuator: Actuator | None = None) -> None:
         self.base = base
+        self.actuator = actuator
 
     def fit(self, X: ArrayLike, y: ArrayLike) -> BaseOnly:
         """Check the data; nothing is learned from it."""
@@ -491,9 +506,12 @@ class BaseMeanResidual(_Strategy):
 
     learns: ClassVar[bool] = False
 
-    def __init__(self, base: Surrogate | None = None, *, n_bins: int = 8) -> None:
+    def __init__(
+        self, base: Surrogate | None = None, *, n_bins: int = 8, actuator: Actuator | None = None
+    ) -> None:
         self.base = base
         self.n_bins = n_bins
+        self.actuator = actuator
 
     def fit(self, X: ArrayLike, y: ArrayLike) -> BaseMeanResidual:
         """Fit ``r(p)`` to the residuals ``y − base(X)`` of the rows."""
@@ -524,6 +542,7 @@ class BaseMeanResidual(_Strategy):
             self.residual_std_ = float(np.sqrt(np.sum(about**2) / dof))
         _check_finite_fit(
             "base-mean-residual",
+            self._described(),
             residual_nodes=self.residual_nodes_deg_,
             residual_std=self.residual_std_,
         )
@@ -602,15 +621,16 @@ class AnalyticalBaseline(_Strategy):
 
     @classmethod
     def refusal(cls, base: object, actuator: Actuator) -> str | None:
-        """Paper B's actuator only: the analytical model knows no other."""
-        from softbend.actuators import SFRBA
-
-        if actuator == SFRBA:
+        """An actuator the analytical model describes (its ``analytical``) only."""
+        if actuator.analytical:
             return None
         return f"models paper B's actuator only, and the base is a model of {actuator.name}"
 
-    def __init__(self, model: BendingModel | None = None) -> None:
+    def __init__(
+        self, model: BendingModel | None = None, *, actuator: Actuator | None = None
+    ) -> None:
         self.model = model
+        self.actuator = actuator
 
     def fit(self, X: ArrayLike, y: ArrayLike) -> AnalyticalBaseline:
         """Check the data; nothing is learned from it."""
@@ -684,12 +704,14 @@ class RefinedMLP(_Strategy):
         learning_rate: float = 6e-4,
         device: str = "auto",
         seed: int = 0,
+        actuator: Actuator | None = None,
     ) -> None:
         self.base = base
         self.epochs = epochs
         self.learning_rate = learning_rate
         self.device = device
         self.seed = seed
+        self.actuator = actuator
 
     @classmethod
     def refusal(cls, base: object, actuator: Actuator) -> str | None:
@@ -724,7 +746,7 @@ class RefinedMLP(_Strategy):
             estimator._check_parameters()
         base = check_mlp(first.base)
         _check_same(estimators, ("base", "epochs", "learning_rate", "device"))
-        starts = cls._starts(base, X, y, row_sets)
+        starts = cls._starts(base, X, y, row_sets, first._described())
         live: list[int] = []
         ready: list[NormalizedMLPRegressor] = []
         for i, start in enumerate(starts):
@@ -753,7 +775,12 @@ class RefinedMLP(_Strategy):
 
     @classmethod
     def _starts(
-        cls, base: NormalizedMLPRegressor, X: np.ndarray, y: np.ndarray, row_sets: list
+        cls,
+        base: NormalizedMLPRegressor,
+        X: np.ndarray,
+        y: np.ndarray,
+        row_sets: list,
+        actuator: Actuator,
     ) -> list[NormalizedMLPRegressor | Exception]:
         """Where training starts for each row set (or why it cannot): the base itself."""
         return [base] * len(row_sets)
@@ -813,12 +840,14 @@ class ExperimentalMLP(_Strategy):
         learning_rate: float = 6e-4,
         device: str = "auto",
         seed: int = 0,
+        actuator: Actuator | None = None,
     ) -> None:
         self.hidden_sizes = hidden_sizes
         self.epochs = epochs
         self.learning_rate = learning_rate
         self.device = device
         self.seed = seed
+        self.actuator = actuator
 
     def fit(self, X: ArrayLike, y: ArrayLike) -> ExperimentalMLP:
         """Train from a seeded random initialization on the rows."""
@@ -898,8 +927,9 @@ class ScaleOffset(_Corrected):
     with the residual standard deviation of the fit.
     """
 
-    def __init__(self, base: Surrogate | None = None) -> None:
+    def __init__(self, base: Surrogate | None = None, *, actuator: Actuator | None = None) -> None:
         self.base = base
+        self.actuator = actuator
 
     def fit(self, X: ArrayLike, y: ArrayLike) -> ScaleOffset:
         """Fit ``a`` and ``c`` on the rows."""
@@ -924,6 +954,7 @@ class ScaleOffset(_Corrected):
             )
         _check_finite_fit(
             "scale-offset",
+            self._described(),
             scale=self.scale_,
             offset=self.offset_,
             residual_std=self.residual_std_,
@@ -949,19 +980,22 @@ class PressureScale(_Corrected):
         Residual standard deviation on the training rows, degrees.
     """
 
-    def __init__(self, base: Surrogate | None = None) -> None:
+    def __init__(self, base: Surrogate | None = None, *, actuator: Actuator | None = None) -> None:
         self.base = base
+        self.actuator = actuator
 
     def fit(self, X: ArrayLike, y: ArrayLike) -> PressureScale:
         """Fit ``s`` by least squares on the rows."""
         base = _check_base(self.base)
         X, y = self._check_fit_data(X, y)
         _check_readings("pressure-scale", y, 2, "one number and the spread around it")
-        self.scale_ = fit_pressure_scale(base, X, y)
+        self.scale_ = fit_pressure_scale(base, X, y, self._described())
         residual = np.asarray(base.predict(scaled_pressure_rows(X, self.scale_))) - y
         with np.errstate(over="ignore", invalid="ignore"):  # checked below
             self.residual_std_ = float(np.sqrt(np.sum(residual**2) / max(y.size - 1, 1)))
-        _check_finite_fit("pressure-scale", scale=self.scale_, residual_std=self.residual_std_)
+        _check_finite_fit(
+            "pressure-scale", self._described(), scale=self.scale_, residual_std=self.residual_std_
+        )
         self.model_ = PressureScaled(base, self.scale_, self.residual_std_)
         return self
 
@@ -995,13 +1029,19 @@ class ScaledRefinedMLP(RefinedMLP):
 
     @classmethod
     def _starts(
-        cls, base: NormalizedMLPRegressor, X: np.ndarray, y: np.ndarray, row_sets: list
+        cls,
+        base: NormalizedMLPRegressor,
+        X: np.ndarray,
+        y: np.ndarray,
+        row_sets: list,
+        actuator: Actuator,
     ) -> list[NormalizedMLPRegressor | Exception]:
         """The base mapped with the pressure scale fitted on each row set (or why not)."""
         starts: list[NormalizedMLPRegressor | Exception] = []
         for rows in row_sets:
             try:
-                starts.append(scale_mlp_pressure(base, fit_pressure_scale(base, X[rows], y[rows])))
+                scale = fit_pressure_scale(base, X[rows], y[rows], actuator)
+                starts.append(scale_mlp_pressure(base, scale))
             except InputError as error:
                 starts.append(error)
         return starts
@@ -1041,11 +1081,17 @@ class ResidualGP(_Corrected):
     """
 
     def __init__(
-        self, base: Surrogate | None = None, *, n_restarts: int = 3, seed: int = 0
+        self,
+        base: Surrogate | None = None,
+        *,
+        n_restarts: int = 3,
+        seed: int = 0,
+        actuator: Actuator | None = None,
     ) -> None:
         self.base = base
         self.n_restarts = n_restarts
         self.seed = seed
+        self.actuator = actuator
 
     def fit(self, X: ArrayLike, y: ArrayLike) -> ResidualGP:
         """Fit the GP to ``y − base(X)``."""
@@ -1059,7 +1105,7 @@ class ResidualGP(_Corrected):
             scale = Z.std(axis=0)
             z_scale = np.where(scale > 0, scale, 1.0)
             inputs = (Z - z_mean) / z_scale
-        _check_finite_fit("residual-gp", z_mean=z_mean, z_scale=z_scale)
+        _check_finite_fit("residual-gp", self._described(), z_mean=z_mean, z_scale=z_scale)
         # A length scale at its upper bound means "this input does not matter": a
         # normal outcome with six actuators, so the optimizer's warning is muted.
         with warnings.catch_warnings():
@@ -1077,6 +1123,7 @@ class ResidualGP(_Corrected):
             mean, std = self.gp_.predict(inputs, return_std=True)
         _check_finite_fit(
             "residual-gp",
+            self._described(),
             z_mean=z_mean,
             z_scale=z_scale,
             kernel_theta=self.model_.kernel_theta_,
@@ -1143,6 +1190,7 @@ class RefinedEnsemble(_Corrected):
         learning_rate: float = 6e-4,
         device: str = "auto",
         seed: int = 0,
+        actuator: Actuator | None = None,
     ) -> None:
         self.base = base
         self.n_members = n_members
@@ -1150,6 +1198,7 @@ class RefinedEnsemble(_Corrected):
         self.learning_rate = learning_rate
         self.device = device
         self.seed = seed
+        self.actuator = actuator
 
     @classmethod
     def refusal(cls, base: object, actuator: Actuator) -> str | None:
@@ -1210,7 +1259,9 @@ class RefinedEnsemble(_Corrected):
                 mean = np.mean([m.predict(X[rows]) for m in members], axis=0)
                 with np.errstate(over="ignore", invalid="ignore"):  # checked below
                     residual_std = float(np.sqrt(np.mean((mean - y[rows]) ** 2)))
-                _check_finite_fit("refined-ensemble", residual_std=residual_std)
+                _check_finite_fit(
+                    "refined-ensemble", estimator._described(), residual_std=residual_std
+                )
             except ConvergenceError as error:
                 _fit_failed(estimator, error, keep_going)
                 continue
@@ -1373,7 +1424,12 @@ def describe_strategies() -> list[dict[str, Any]]:
 
 
 def make_strategy(
-    name: str, base: Surrogate | None = None, *, seed: int = 0, **options: object
+    name: str,
+    base: Surrogate | None = None,
+    *,
+    seed: int = 0,
+    actuator: Actuator | None = None,
+    **options: object,
 ) -> Any:
     """A fresh, unfitted strategy by name.
 
@@ -1386,6 +1442,9 @@ def make_strategy(
         ``experimental``).
     seed : int, default 0
         Seed of the strategy's random choices, >= 0.
+    actuator : Actuator, optional
+        The actuator of the readings it will fit (their inputs, the plausible range
+        of their pressure); default paper B's.
     **options
         Parameters of the strategy (e.g. ``epochs``; see :func:`strategy_parameters`),
         each held to its declared range.
@@ -1406,7 +1465,7 @@ def make_strategy(
         options = check_parameters(cls, options)
     if takes(cls, "seed"):
         seed = check_int(seed, "seed", low=0)
-    filled = {"base": base, "seed": seed}
+    filled = {"base": base, "seed": seed, "actuator": actuator}
     return cls(**{k: v for k, v in filled.items() if takes(cls, k)}, **options)
 
 
@@ -1425,7 +1484,8 @@ def fit_strategy(
     """
     if epochs is not None:
         options["epochs"] = epochs
-    strategy: _Strategy = make_strategy(name, base, seed=seed, **options)
+    actuator = getattr(measurements, "actuator", None)  # paper B's Measurements: None
+    strategy: _Strategy = make_strategy(name, base, seed=seed, actuator=actuator, **options)
     strategy.fit(measurements.features, measurements.angle_deg)
     return strategy
 
