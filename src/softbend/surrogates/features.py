@@ -1,10 +1,13 @@
-"""Inputs and target of the surrogate models (paper B §4.1): (l, r, t, b, φ, lc, P) → θ.
+"""Inputs and target of the surrogate models: an actuator's design parameters and pressure → θ.
 
 Every surrogate in :mod:`softbend.surrogates` takes a float array of shape
-``(n_samples, 7)`` whose columns are :data:`FEATURES` in this order and units,
-and predicts the bending angle in degrees. :func:`training_data` builds that
-array from a campaign's samples table (:func:`softbend.campaign.load_samples`),
-with the design ids as CV groups so that a sweep never spans two folds.
+``(n_samples, d)`` whose columns are its actuator's
+:attr:`~softbend.actuators.Actuator.features` in this order and units (paper B's
+:data:`FEATURES`, (l, r, t, b, φ, lc, P) of §4.1, for a model that records no
+actuator), and predicts the bending angle in degrees. The functions here take
+those columns as an argument. :func:`training_data` builds that array from a
+campaign's samples table (:func:`softbend.campaign.load_samples`), with the
+design ids as CV groups so that a sweep never spans two folds.
 """
 
 from __future__ import annotations
@@ -26,7 +29,8 @@ if TYPE_CHECKING:  # a table only for training: predicting needs no pandas
 
     from softbend.actuators import Actuator
 
-#: Input columns, in the order every surrogate expects them (those of every model).
+#: Paper B's input columns, in the order its surrogates expect them (a model without an
+#: actuator record takes these).
 FEATURES: tuple[str, ...] = DESIGN_FEATURES
 
 #: Unit of each input and of the target.
@@ -54,8 +58,8 @@ class TrainingData:
 
     Attributes
     ----------
-    X : ndarray, shape (n_samples, 7)
-        Inputs, columns :data:`FEATURES`.
+    X : ndarray, shape (n_samples, d)
+        Inputs, columns the actuator's features (:data:`FEATURES` for paper B's).
     y : ndarray, shape (n_samples,)
         Bending angle, degrees.
     groups : ndarray of str, shape (n_samples,)

@@ -468,8 +468,8 @@ def _leave_one_out(
         ):
             if not batch:
                 continue
-            rows = [tasks[i][4] for i in batch]
-            models, fit_s = _fit_all(name, base, options.get(name, {}), seed, X, y, rows, actuator)
+            sets = [tasks[i][4] for i in batch]
+            models, fit_s = _fit_all(name, base, options.get(name, {}), seed, X, y, sets, actuator)
             for i, model in zip(batch, models, strict=True):
                 test = tasks[i][5]
                 out: dict[str, Any] = {"fit_s": fit_s}
