@@ -501,8 +501,7 @@ class Actuator:
         values lie in (``{"pressure_mpa": "pressure_mpa"}``): a saved model's
         training ranges, a correction's means and the readings a transfer
         strategy fits are checked against those ranges; an input not named is
-        only checked to be finite. Not written by :meth:`to_dict` (a registered
-        description's is found again by :func:`softbend.surrogates.persistence.actuator_of`).
+        only checked to be finite.
     mape_floor_deg : float, optional
         A fixed floor of the cross-validated MAPE of its surrogates, degrees (paper
         B: 1°, as §4.1); None: :func:`softbend.metrics.mape_floor` of the table.
@@ -518,6 +517,11 @@ class Actuator:
     named_in_outputs : bool
         Whether the records of train, predict and transfer name it (False for paper
         B's, whose records are unchanged since before descriptions existed).
+
+    The fields from ``quantities`` on are softbend's knowledge of a registered
+    actuator, not part of its description: :meth:`to_dict` does not write them and
+    equality ignores them; a model's recorded description that equals a registered
+    one is read back as that one (:func:`softbend.surrogates.persistence.actuator_of`).
     """
 
     name: str

@@ -66,15 +66,15 @@ def to_onnx(
     Returns
     -------
     onnx.ModelProto
-        Input ``"x"`` [N, 7] (double; float32 for XGBoost), output ``"angle_deg"``
-        [N] in degrees (double; float32 for XGBoost); checked by
-        :func:`onnx.checker.check_model`.
+        Input ``"x"`` [N, d], d the actuator's inputs (double; float32 for XGBoost),
+        output ``"angle_deg"`` [N] in degrees (double; float32 for XGBoost); checked
+        by :func:`onnx.checker.check_model`.
 
     Raises
     ------
     ValueError
         Unknown model type, a composite surrogate or a family without an ONNX
-        export, a model on other than 7 features, a bad ``opset``.
+        export, a model on other inputs than the actuator's, a bad ``opset``.
     sklearn.exceptions.NotFittedError
         If the model is not fitted.
     """

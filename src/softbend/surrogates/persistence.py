@@ -447,7 +447,7 @@ def save_surrogate(
     ------
     softbend.errors.InputError
         Unknown model type (naming the allowed kinds), a model fitted on other than
-        7 features, a parameter (key ``model``) or ``metadata`` (key ``metadata``)
+        its actuator's inputs, a parameter (key ``model``) or ``metadata`` (key ``metadata``)
         that JSON cannot hold.
     sklearn.exceptions.NotFittedError
         If the model is not fitted.
