@@ -109,7 +109,7 @@ def test_refine_refuses_a_negative_seed_and_zero_epochs(lab_csv, tmp_path, capsy
 def test_refine_a_diverged_refit_is_one_line_and_no_model(
     lab_csv, tmp_path, monkeypatch, capsys, small_base_file
 ):
-    import softbend.transfer.strategies as strategies
+    import softbend.transfer.strategies.networks as strategies
 
     train = strategies.fine_tune_many
 

@@ -219,7 +219,7 @@ def test_python_values_are_held_to_the_same_ranges(tiny_base):
 @pytest.fixture
 def no_training(monkeypatch):
     """Training that fails the test if it starts: a check must come first."""
-    import softbend.transfer.strategies as strategies
+    import softbend.transfer.strategies.networks as strategies
 
     def started(*args, **kwargs):
         raise AssertionError("training started before the parameters were checked")
@@ -266,7 +266,7 @@ def test_the_analytical_baseline_refuses_a_model_it_cannot_ask(quick_measurement
 def test_a_diverged_network_is_an_error_not_a_model(
     tiny_base, quick_measurements, monkeypatch, name, damage
 ):
-    import softbend.transfer.strategies as strategies
+    import softbend.transfer.strategies.networks as strategies
 
     train = strategies.fine_tune_many
 
