@@ -267,7 +267,7 @@ curve = [[0.05, 40.0], [0.1, 95.0]]
 @SETTINGS
 @given(data=st.data())
 def test_design_spec_toml(tmp_path, fuzz_counter, data):
-    from softbend.design_search.spec import load_specifications
+    from softbend.design_search.spec_toml import load_specifications
 
     text = data.draw(damaged_toml(SPECS))
     path = tmp_path / "specs.toml"

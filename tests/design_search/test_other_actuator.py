@@ -17,15 +17,9 @@ import pytest
 from softbend.actuators import Actuator, DesignParameter
 from softbend.design_search.search import find_designs
 from softbend.design_search.space import ActuatorDesign, space_of
-from softbend.design_search.spec import (
-    Objective,
-    ParameterRange,
-    Specification,
-    Target,
-    build_ranges,
-    load_specifications,
-    parse_objectives,
-)
+from softbend.design_search.spec import Objective, ParameterRange, Specification, Target
+from softbend.design_search.spec_text import build_ranges, parse_objectives
+from softbend.design_search.spec_toml import load_specifications
 from softbend.design_search.verify import verify_candidates
 from softbend.errors import DatasetError
 from softbend.surrogates.persistence import load_surrogate

@@ -4,16 +4,9 @@ from __future__ import annotations
 
 import pytest
 
-from softbend.design_search.spec import (
-    Objective,
-    ParameterRange,
-    Specification,
-    Target,
-    build_ranges,
-    load_specifications,
-    parse_objectives,
-    target_from_options,
-)
+from softbend.design_search.spec import Objective, ParameterRange, Specification, Target
+from softbend.design_search.spec_text import build_ranges, parse_objectives, target_from_options
+from softbend.design_search.spec_toml import load_specifications
 from softbend.errors import DatasetError
 
 TRAINED = {

@@ -33,7 +33,7 @@ _EXPORTS: dict[str, str] = {
     "SearchSpace": "space",
     "Specification": "spec",
     "Target": "spec",
-    "load_specifications": "spec",
+    "load_specifications": "spec_toml",
     "space_of": "space",
     "verify_candidates": "verify",
     "verify_family": "verify",

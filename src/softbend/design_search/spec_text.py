@@ -1,0 +1,488 @@
+"""A specification from command-line text: ``NAME=VALUE``, ``NAME=LOW:HIGH``, a target.
+
+:func:`parse_assignment` and :func:`parse_range` read paper B's parameters by
+their short names, :func:`parse_value` and :func:`parse_span` another
+actuator's; :func:`build_ranges` turns ``--fix``, ``--range`` and
+``--resolution`` into the ranges and steps of a :class:`~.spec.Specification`,
+:func:`parse_objectives` ``--minimize`` and ``--maximize``, and
+:func:`target_from_options` the target options. Every error is one
+:class:`~softbend.errors.InputError` keyed by the option or parameter at fault.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Sequence
+
+from softbend._validation import must_be
+from softbend.design_search.space import PAPER_B, SearchSpace
+from softbend.design_search.spec import (
+    CURVE_POINTS,
+    DEFAULT_STEPS,
+    NAMES,
+    OBJECTIVES,
+    STEP,
+    TOLERANCE,
+    UNITS,
+    Objective,
+    ParameterRange,
+    Specification,
+    Target,
+    check_angle,
+    check_pressure,
+    code_of,
+    design_value_problem,
+    is_number,
+)
+from softbend.errors import InputError, keyed
+
+__all__ = [
+    "build_ranges",
+    "option_pressure",
+    "parse_assignment",
+    "parse_objectives",
+    "parse_range",
+    "parse_span",
+    "parse_value",
+    "specification_from_options",
+    "target_from_options",
+]
+
+
+def parse_assignment(text: str) -> tuple[str, float]:
+    """``("phi", 10.0)`` from ``"phi=10"`` (or ``"phi_deg=10"``); one clear line for
+    anything else (keyed by the parameter where one is named). Paper B's parameters;
+    :func:`parse_value` reads another actuator's."""
+    name, sep, value = text.partition("=")
+    name = PAPER_B.canonical(name.strip()) or name.strip()
+    if not sep or name not in NAMES:
+        raise InputError(must_be(f"NAME=VALUE with NAME among {', '.join(NAMES)}", text))
+    try:
+        number = float(value)
+    except ValueError:
+        raise InputError(must_be(f"a number ({UNITS[name]})", value), key=name) from None
+    if not math.isfinite(number):
+        raise InputError(must_be("finite", value), key=name)
+    return name, number
+
+
+def parse_range(text: str) -> tuple[str, float, float]:
+    """``("t", 3.0, 4.0)`` from ``"t=3:4"``; one clear line for anything else (keyed
+    by the parameter where one is named). Paper B's parameters; :func:`parse_span` reads
+    another actuator's."""
+    name, sep, value = text.partition("=")
+    name = PAPER_B.canonical(name.strip()) or name.strip()
+    low, colon, high = value.partition(":")
+    if not sep or name not in NAMES or not colon:
+        raise InputError(must_be(f"NAME=LOW:HIGH with NAME among {', '.join(NAMES)}", text))
+    try:
+        a, b = float(low), float(high)
+    except ValueError:
+        raise InputError(must_be(f"LOW:HIGH, numbers ({UNITS[name]})", value), key=name) from None
+    if not (math.isfinite(a) and math.isfinite(b)) or a > b:
+        raise InputError(must_be("finite LOW <= HIGH", value), key=name)
+    return name, a, b
+
+
+def _named(space: SearchSpace, name: str, text: str) -> str:
+    """The parameter ``name`` of ``space``, or one line listing them."""
+    key = space.canonical(name)
+    if key is None:
+        raise InputError(
+            f"names {name!r}, which is not a design parameter of the model's actuator "
+            f"{space.actuator.name}; its parameters are {space.listing()}; got {text!r}",
+        )
+    return key
+
+
+def parse_value(space: SearchSpace, text: object) -> tuple[str, float]:
+    """``("layer", 1.0)`` from ``"layer=paper"``: a parameter of another actuator and the code
+    of its value (a level's index), checked against its description; one line (keyed
+    by the parameter where one is named) otherwise."""
+    name, sep, value = str(text).partition("=")
+    name, value = name.strip(), value.strip()
+    if not sep or not name:
+        raise InputError(must_be(f"NAME=VALUE with NAME among {space.listing()}", text))
+    key = _named(space, name, str(text))
+    return key, code_of(space, key, value)
+
+
+def parse_span(space: SearchSpace, text: str) -> tuple[str, float, float]:
+    """``("wall_mm", 1.0, 2.0)`` from ``"wall_mm=1:2"``: a range of another actuator's
+    parameter inside its description (whole ends for an integer one); a categorical one
+    is refused (fix one level, or leave it out for every level). Errors are keyed by the
+    parameter where one is named."""
+    name, sep, value = text.partition("=")
+    low, colon, high = value.partition(":")
+    if not sep or not colon or not name.strip():
+        raise InputError(must_be(f"NAME=LOW:HIGH with NAME among {space.listing()}", text))
+    key = _named(space, name.strip(), text)
+    p = space.parameter(key)
+    if p.kind == "categorical":
+        levels = list(map(str, p.levels or ()))
+        raise InputError(
+            f"cannot span the categorical parameter {key!r}: fix one level "
+            f"({key}={levels[0]}) or leave it out to search every level ({', '.join(levels)})",
+            key=key,
+        )
+    try:
+        a, b = float(low), float(high)
+    except ValueError:
+        raise InputError(must_be("LOW:HIGH, numbers", value), key=key) from None
+    if not (math.isfinite(a) and math.isfinite(b)) or a > b:
+        raise InputError(must_be("finite LOW <= HIGH", value), key=key)
+    for end in (a, b):
+        problem = space.value_problem(key, end)
+        if problem is not None:
+            raise InputError(f"{end:g} {problem}; got {value!r}", key=key)
+    return key, a, b
+
+
+def parse_objectives(
+    minimize: Sequence[str], maximize: Sequence[str], space: SearchSpace | None = None
+) -> tuple[Objective, ...]:
+    """Objectives from comma-separated names to minimise and to maximise, in order given
+    (of ``space``'s objectives; default paper B's, :data:`OBJECTIVES`)."""
+    space = PAPER_B if space is None else space
+    allowed = OBJECTIVES if space.paper_b else space.objectives
+    out = []
+    for sense, texts in (("min", minimize), ("max", maximize)):
+        for text in texts:
+            for name in (n.strip() for n in text.split(",")):
+                if name:
+                    name = space.canonical(name) or name
+                    if name not in allowed:
+                        raise InputError(
+                            must_be(f"objectives among {', '.join(allowed)}", name),
+                            key="minimize" if sense == "min" else "maximize",
+                        )
+                    unit = None if space.paper_b else allowed[name]
+                    out.append(Objective(name, sense, unit))
+    return tuple(out)
+
+
+def build_ranges(
+    fixes: Sequence[str] = (),
+    ranges: Sequence[str] = (),
+    steps: Sequence[str] = (),
+    *,
+    step: float | None = None,
+    space: SearchSpace | None = None,
+) -> tuple[dict[str, ParameterRange], dict[str, float]]:
+    """Ranges and steps from ``--fix NAME=V``, ``--range NAME=LOW:HIGH``, ``--resolution``.
+
+    ``steps`` are ``NAME=STEP`` per parameter; ``step`` is the step of every
+    parameter not named there (None: :data:`DEFAULT_STEPS`). A parameter both
+    fixed and ranged, or named twice, is refused. Returns the ranges given and
+    the step of every parameter (for those left to their training range).
+
+    With the ``space`` of another actuator than paper B's, the names are its
+    parameters: ``--fix`` takes a level by name, a whole number or a number
+    (on the resolution the description declares), ``--range`` refuses a
+    categorical parameter and takes whole ends for an integer one, and
+    ``step`` is the step of the continuous parameters only (the others stay on
+    their whole numbers and levels; by default a continuous parameter's
+    resolution, else :meth:`SearchSpace.grid_steps
+    <softbend.design_search.space.SearchSpace.grid_steps>`' round step).
+    """
+    if space is not None and not space.paper_b:
+        return _build_other(space, fixes, ranges, steps, step)
+    if step is not None and not STEP.contains(step):
+        raise InputError(
+            must_be(f"a finite number >= 0 (mm and deg; {STEP.why})", step), key="step"
+        )
+    per_step = dict(DEFAULT_STEPS) if step is None else dict.fromkeys(NAMES, float(step))
+    for text in steps:
+        with keyed("steps"):
+            name, value = parse_assignment(text)
+        if value < 0:
+            raise InputError(f"{name} {must_be('>= 0', value)}", key="steps")
+        per_step[name] = value
+    given: list[tuple[str, ParameterRange, str]] = []
+    for text in fixes:
+        with keyed("fixes"):
+            name, value = parse_assignment(text)
+            _check_design_values(name, (value,), text)
+        given.append((name, ParameterRange(value, value, 0.0), "fixes"))
+    for text in ranges:
+        with keyed("ranges"):
+            name, low, high = parse_range(text)
+            _check_design_values(name, (low, high), text)
+        given.append((name, ParameterRange(low, high, per_step[name]), "ranges"))
+    return _once(given), per_step
+
+
+def _once(given: Sequence[tuple[str, ParameterRange, str]]) -> dict[str, ParameterRange]:
+    """The ranges by parameter, each given once (by ``fixes`` or ``ranges``).
+
+    Each entry is ``(name, range, key)``; a name given twice is refused keyed by the
+    option of its second mention (``fixes`` or ``ranges``).
+    """
+    out: dict[str, ParameterRange] = {}
+    for name, chosen, key in given:
+        if name in out:
+            raise InputError(f"{name!r} is given twice (fixed or ranged); give it once", key=key)
+        out[name] = chosen
+    return out
+
+
+def _build_other(
+    space: SearchSpace,
+    fixes: Sequence[str],
+    ranges: Sequence[str],
+    steps: Sequence[str],
+    step: float | None,
+) -> tuple[dict[str, ParameterRange], dict[str, float]]:
+    """:func:`build_ranges` for another actuator than paper B's."""
+    if step is not None and not STEP.contains(step):
+        raise InputError(
+            must_be(
+                f"a finite number >= 0 (in each continuous parameter's unit; {STEP.why})", step
+            ),
+            key="step",
+        )
+    per_step = {n: space.default_step(n) for n in space.names}
+    if step is not None:
+        for name in space.names:
+            if space.kind(name) == "continuous":
+                problem = space.step_problem(name, float(step))
+                if problem is not None:
+                    raise InputError(f"{step:g} of {name!r} {problem}", key="step")
+                per_step[name] = float(step)
+    for text in steps:
+        name, sep, value = text.partition("=")
+        if not sep:
+            raise InputError(
+                must_be(f"a number or NAME=STEP with NAME among {space.listing()}", text),
+                key="steps",
+            )
+        with keyed("steps"):
+            key = _named(space, name.strip(), text)
+        try:
+            number = float(value)
+        except ValueError:
+            raise InputError(f"{key} {must_be('a number', value)}", key="steps") from None
+        if not STEP.contains(number):
+            raise InputError(f"{key} {must_be('a finite number >= 0', value)}", key="steps")
+        problem = space.step_problem(key, number)
+        if problem is not None:
+            raise InputError(f"{key} ({value.strip()}) {problem}", key="steps")
+        per_step[key] = number
+    given: list[tuple[str, ParameterRange, str]] = []
+    for text in fixes:
+        with keyed("fixes"):
+            key, code = parse_value(space, text)
+        given.append((key, ParameterRange(code, code, 0.0), "fixes"))
+    for text in ranges:
+        with keyed("ranges"):
+            key, low, high = parse_span(space, text)
+        given.append((key, ParameterRange(low, high, per_step[key]), "ranges"))
+    return _once(given), {n: v for n, v in per_step.items() if space.kind(n) != "categorical"}
+
+
+def _check_design_values(name: str, values: Sequence[float], text: str) -> None:
+    """Refuse a value (of ``text``) that a design's parameter ``name`` cannot take."""
+    for value in values:
+        problem = design_value_problem(name, value)
+        if problem is not None:
+            raise InputError(f"{problem}; got {text!r}", key=name)
+
+
+def target_from_options(
+    *,
+    angle: float | None = None,
+    at: float | None = None,
+    max_pressure: float | None = None,
+    max_angle_at: float | None = None,
+    curve: str | None = None,
+    tolerance: float = 3.0,
+    unit: str = "MPa",
+) -> Target:
+    """The :class:`Target` a command line names (``--angle`` with ``--at`` or
+    ``--max-pressure``, ``--max-angle-at``, or ``--curve P:ANGLE,...``), its
+    pressures in ``unit`` (the model's pressure unit).
+
+    Raises
+    ------
+    ValueError
+        None or several kinds of target, a missing ``--angle``, or a bad curve.
+    """
+    given = [
+        name
+        for name, value in (
+            ("at", at),
+            ("max_pressure", max_pressure),
+            ("max_angle_at", max_angle_at),
+            ("curve", curve),
+        )
+        if value is not None
+    ]
+    if len(given) != 1:
+        raise InputError(
+            "The target must be one of angle A at P, angle A max_pressure P, max_angle_at P "
+            f"or curve P:A,P:A,...; got {', '.join(given) or 'none'}",
+            key=given[1] if given else None,
+        )
+    if not (is_number(tolerance) and TOLERANCE.contains(tolerance)):
+        raise InputError(
+            must_be(f"in {TOLERANCE.describe()} ({TOLERANCE.why})", tolerance), key="tolerance"
+        )
+    for key, value in (("at", at), ("max_pressure", max_pressure), ("max_angle_at", max_angle_at)):
+        if value is not None:
+            check_pressure(value, key, unit)
+    if angle is not None:
+        check_angle(angle, "angle")
+    if curve is not None:
+        if angle is not None:
+            raise InputError(
+                "has no meaning with curve (the curve gives its angles); leave it out", key="angle"
+            )
+        with keyed("curve"):
+            points = _curve_points(curve, unit)
+        return Target("curve", tolerance_deg=tolerance, points=points, unit=unit)
+    if max_angle_at is not None:
+        if angle is not None:
+            raise InputError("has no meaning with max_angle_at; leave it out", key="angle")
+        return Target("max_angle", pressure_mpa=max_angle_at, tolerance_deg=tolerance, unit=unit)
+    if angle is None:
+        raise InputError(f"is needed with {given[0]} (degrees)", key="angle")
+    kind, pressure = ("angle_at", at) if at is not None else ("pressure_for", max_pressure)
+    assert pressure is not None  # exactly one of at and max_pressure, checked above
+    return Target(
+        kind, angle_deg=angle, pressure_mpa=float(pressure), tolerance_deg=tolerance, unit=unit
+    )
+
+
+def _curve_points(text: str, unit: str = "MPa") -> tuple[tuple[float, float], ...]:
+    """The points of ``P:ANGLE,...``: each pressure once, each number in its range."""
+    items = [x.strip() for x in text.split(",") if x.strip()]
+    if not CURVE_POINTS.contains(len(items)):
+        raise InputError(
+            f"must give {CURVE_POINTS.low:g} to {CURVE_POINTS.high:g} points PRESSURE:ANGLE "
+            f"({CURVE_POINTS.why}); got {len(items):,}",
+        )
+    points: list[tuple[float, float]] = []
+    seen: dict[float, str] = {}
+    for item in items:
+        p, colon, a = item.partition(":")
+        try:
+            pressure, angle = float(p), float(a)
+        except ValueError:
+            example = "0.05:40,0.1:95" if unit == "MPa" else "10:40,20:95"
+            raise InputError(
+                must_be(f"PRESSURE:ANGLE pairs ({unit}:deg), e.g. {example}", item)
+            ) from None
+        if not colon:
+            raise InputError(f"point {item!r} lacks ':ANGLE'")
+        check_pressure(pressure, None, unit, f"point {item!r}: ")
+        check_angle(angle, None, f"point {item!r}: ")
+        if pressure in seen:
+            raise InputError(
+                f"gives {pressure:g} {unit} twice ({seen[pressure]!r} and {item!r}); a curve "
+                "gives each pressure once (one angle at each)",
+            )
+        seen[pressure] = item
+        points.append((pressure, angle))
+    return tuple(points)
+
+
+def option_pressure(text: str | None, unit: str, flag: str) -> float | None:
+    """A pressure option in the model's ``unit``: a number, or one with a unit (``20psi``).
+
+    A bare number (``inf`` too) is returned as given, for the target's own range check;
+    ``flag`` names the option in messages (``"--at"``).
+    """
+    from softbend.units import parse_pressure
+
+    if text is None:
+        return None
+    try:
+        return float(text)
+    except ValueError:
+        return parse_pressure(text, unit, flag)
+
+
+def _every_step(resolution: Sequence[str]) -> float | None:
+    """The one bare number of ``--resolution`` (the step of every parameter), or None."""
+    numbers = [s for s in resolution if "=" not in s]
+    if len(numbers) > 1:
+        raise InputError(f"gives a number {len(numbers)} times; give it once", key="resolution")
+    try:
+        return float(numbers[0]) if numbers else None
+    except ValueError:
+        raise InputError(must_be("a number or NAME=STEP", numbers[0]), key="resolution") from None
+
+
+def specification_from_options(
+    space: SearchSpace,
+    *,
+    angle: float | None = None,
+    at: str | None = None,
+    max_pressure: str | None = None,
+    max_angle_at: str | None = None,
+    curve: str | None = None,
+    tolerance: float = 3.0,
+    margin: float = 0.0,
+    minimize: Sequence[str] = (),
+    maximize: Sequence[str] = (),
+    fixes: Sequence[str] = (),
+    ranges: Sequence[str] = (),
+    resolution: Sequence[str] = (),
+) -> Specification:
+    """The specification ``design find`` names by its options (``spec``), checked.
+
+    Parameters
+    ----------
+    space : SearchSpace
+        The parameters of the model's actuator: the names of ``fixes``,
+        ``ranges``, ``resolution`` and the objectives, and the unit of every
+        pressure.
+    angle : float, optional
+        ``--angle``, degrees.
+    at, max_pressure, max_angle_at : str, optional
+        ``--at``, ``--max-pressure``, ``--max-angle-at``: a pressure in the
+        model's unit, or with a unit of its own (``20psi``).
+    curve : str, optional
+        ``--curve P:ANGLE,...``.
+    tolerance, margin : float
+        ``--tolerance`` and ``--margin``, degrees.
+    minimize, maximize : sequence of str
+        ``--minimize`` and ``--maximize``: comma-separated objectives.
+    fixes, ranges : sequence of str
+        ``--fix NAME=VALUE`` and ``--range NAME=LOW:HIGH``.
+    resolution : sequence of str
+        ``--resolution``: one number for every parameter and ``NAME=STEP`` each.
+
+    Raises
+    ------
+    InputError
+        Keyed by the option at fault.
+    """
+    unit = space.pressure_unit
+    target = target_from_options(
+        angle=angle,
+        at=option_pressure(at, unit, "--at"),
+        max_pressure=option_pressure(max_pressure, unit, "--max-pressure"),
+        max_angle_at=option_pressure(max_angle_at, unit, "--max-angle-at"),
+        curve=curve,
+        tolerance=tolerance,
+        unit=unit,
+    )
+    if not 0 <= margin < tolerance:
+        raise InputError(
+            must_be(
+                f"in [0, {tolerance:g}) degrees (below --tolerance, the miss the "
+                "surrogate's own error may take)",
+                margin,
+            ),
+            key="margin",
+        )
+    given, steps = build_ranges(
+        fixes,
+        ranges,
+        [s for s in resolution if "=" in s],
+        step=_every_step(resolution),
+        space=space,
+    )
+    objectives = parse_objectives(minimize, maximize, space)
+    return Specification(target, given, objectives, "spec", steps, margin, space.actuator)
