@@ -24,6 +24,8 @@ from __future__ import annotations
 
 import hashlib
 import os
+from collections.abc import Sequence
+from dataclasses import dataclass
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
@@ -31,12 +33,15 @@ import typer
 
 from softbend._validation import check_choice, must_be
 from softbend.cli import _common
+from softbend.cli import design_options as opt
 from softbend.errors import InputError, SoftbendError
 from softbend.parameters import Range
 
 if TYPE_CHECKING:
     from softbend.campaign.backends import ResolvedMaterial
-    from softbend.design_search.search import SearchResult
+    from softbend.design_search.search import LoadedModel, SearchResult
+    from softbend.design_search.space import SearchSpace
+    from softbend.design_search.spec import Specification
 
 #: How many of the best candidates ``--verify`` sweeps.
 VERIFY = Range(0, 100, "designs", "each is a sweep of the FEM, minutes long")
@@ -127,206 +132,118 @@ app = typer.Typer(
 )
 
 
-@app.command("find")
+@app.command("find", help=opt.FIND_HELP)
 def find(
     ctx: typer.Context,
-    out: Path = typer.Option(..., "--out", "-o", help="Folder for the tables and figures."),
-    model: Path = typer.Option(
-        None,
-        help="Saved surrogate to search (default: the shipped FEM-trained MLP); its actuator's "
-        "parameters are the names of --fix, --range, --resolution and --minimize.",
-    ),
-    spec: Path = typer.Option(
-        None, help="A TOML file of [[spec]] tables, one folder of results per spec."
-    ),
-    angle: float = typer.Option(None, help="Target angle, deg (with --at or --max-pressure)."),
-    at: str = typer.Option(
-        None,
-        help="Pressure the target angle is read at: a number in the model's pressure unit "
-        "(MPa for paper B's actuator) or with a unit (20psi, 138kPa, 0.1MPa, 1.5bar).",
-    ),
-    max_pressure: str = typer.Option(
-        None,
-        help="Reach --angle at no more than this pressure, as --at (then --minimize pressure).",
-    ),
-    max_angle_at: str = typer.Option(
-        None, help="Bend as far as possible at this pressure, as --at."
-    ),
-    curve: str = typer.Option(
-        None,
-        help="Follow the points P:ANGLE, comma-separated (pressure in the model's unit:deg), "
-        "e.g. 0.05:40,0.1:95.",
-    ),
-    tolerance: float = typer.Option(3.0, help="How far the angle may miss, deg, in (0, 90]."),
-    margin: float = typer.Option(
-        0.0, help="Degrees of the tolerance kept back on the surrogate (its own error)."
-    ),
-    minimize: list[str] = typer.Option(
-        None,
-        help="Objectives to minimise: a design parameter (l, r, t, b, phi, lc of paper B's "
-        "actuator), pressure, volume (paper B's), sensitivity, angle, error (comma-separated "
-        "or repeated; default error).",
-    ),
-    maximize: list[str] = typer.Option(None, help="Objectives to maximise (as --minimize)."),
-    fix: list[str] = typer.Option(
-        None, help="Fix a parameter, NAME=VALUE (repeatable; a categorical one by level name)."
-    ),
-    ranges: list[str] = typer.Option(
-        None,
-        "--range",
-        help="Range of a parameter, NAME=LOW:HIGH (repeatable; whole ends for an integer one, "
-        "none for a categorical one, whose levels are all searched unless fixed).",
-    ),
-    resolution: list[str] = typer.Option(
-        None,
-        help="Mould resolution: a number for every parameter or NAME=STEP (repeatable); "
-        "0 searches continuously. Default 0.5 mm and 1° of phi; for another actuator each "
-        "continuous parameter's declared resolution (else a round step, about 1/100 of its "
-        "range), integers by 1.",
-    ),
-    top: int = typer.Option(
-        10, help="Candidates listed, 1 to 1000 (to 25 with a continuous parameter)."
-    ),
-    neighbours: bool = typer.Option(
-        False, "--neighbours", help="Also list designs one step from a better one."
-    ),
-    verify: int = typer.Option(
-        0,
-        help="Sweep the best N (at most 100) with --backend and compare (paper B's actuator, "
-        "or another with the FEM of the family its description names; one that names none "
-        "is not verified, and the output says so).",
-    ),
-    backend: str = typer.Option("fem", help="Backend of the verification: fem or analytical."),
-    workers: int = typer.Option(
-        None, help="Processes of the verification, 1 to 4096 (default: all cores)."
-    ),
-    material: str = typer.Option(None, help="Elastomer of the verification (as fem run)."),
-    replace_stopped: bool = typer.Option(
-        False,
-        "--replace-stopped",
-        help="Replace a verified candidate whose FEM sweep stops before the pressure "
-        "(chamber walls touch, no convergence) by the next listed one, until N reach it "
-        "or the --top list ends.",
-    ),
-    allow_extrapolation: bool = typer.Option(
-        False, "--allow-extrapolation", help="Search outside the training data, answers flagged."
-    ),
-    as_json: bool = typer.Option(False, "--json", help="Print the results as JSON."),
+    out: Path = opt.OUT,
+    model: Path = opt.MODEL,
+    spec: Path = opt.SPEC,
+    angle: float = opt.ANGLE,
+    at: str = opt.AT,
+    max_pressure: str = opt.MAX_PRESSURE,
+    max_angle_at: str = opt.MAX_ANGLE_AT,
+    curve: str = opt.CURVE,
+    tolerance: float = opt.TOLERANCE,
+    margin: float = opt.MARGIN,
+    minimize: list[str] = opt.MINIMIZE,
+    maximize: list[str] = opt.MAXIMIZE,
+    fix: list[str] = opt.FIX,
+    ranges: list[str] = opt.RANGE,
+    resolution: list[str] = opt.RESOLUTION,
+    top: int = opt.TOP,
+    neighbours: bool = opt.NEIGHBOURS,
+    verify: int = opt.VERIFY,
+    backend: str = opt.BACKEND,
+    workers: int = opt.WORKERS,
+    material: str = opt.MATERIAL,
+    replace_stopped: bool = opt.REPLACE_STOPPED,
+    allow_extrapolation: bool = opt.ALLOW_EXTRAPOLATION,
+    as_json: bool = opt.JSON,
 ) -> None:
-    """Find the designs that meet a target bending.
-
-    Every design of the grid of manufacturable values (--resolution) within the
-    model's training ranges (or --range, --fix) is scored on the surrogate;
-    those that meet the target within --tolerance are ranked by the
-    objectives (several: the Pareto front), each listed design more than one
-    step from a better one (--neighbours lists them all). Answers outside the model's
-    training data are passed over unless --allow-extrapolation (which lists them
-    with a "no" in the table's "trained there" column, "supported": false in the
-    JSON and a warning on stderr, as softbend predict does). With --verify N
-    the best N are swept by the FEM and set beside the surrogate.
-
-    Every input is checked before a design is scored: each number against its
-    range, the size of each grid (at most 20 million designs), the material,
-    and every [[spec]] of --spec (a name is a plain folder name of --out; the
-    target, range and objective options are the file's, not given beside it).
-    The results are built beside --out and swapped in when complete; a run
-    killed during the verification leaves a hidden .OUT.PID-*.new folder that
-    the next run into --out removes. The verification's sweeps are kept beside
-    --out (.OUT.verify-KEY.duckdb) until the command ends: after Ctrl-C or a
-    kill the same command sweeps only the designs not yet swept.
-
-    The names are the model's own: paper B's l, r, t, b, phi, lc (mm, deg;
-    pressures in MPa), or the parameters of the actuator another model was
-    trained on, searched within its training ranges and its description's
-    (integers on whole numbers, a categorical parameter on every level unless
-    --fix names one, a continuous one on its declared resolution, else on a
-    round step of about a hundredth of its range), designs breaking the
-    description's constraints left out, pressures in the model's unit.
-    --verify sweeps another actuator with the FEM of the family its description
-    names (such as pneunet; --backend fem); a sweep that stops before the
-    pressure checked (chamber walls touching, no convergence) is "stopped", with
-    the FEM's reason, not an angle; --replace-stopped then verifies the next
-    listed design instead, until N reach the pressure. An actuator that names
-    no FEM family is not verified, and the output says so (a warning, and
-    "verify_skipped" in search.json).
-
-    Example:
-
-    \b
-        softbend design find --angle 90 --at 0.08 --minimize l --fix phi=10 \\
-            --range t=3:4 --verify 5 --out design
-        softbend design find --model pneunet.json --angle 90 --at 30 \\
-            --minimize n_chambers --fix layer=paper --range wall_mm=1:2 --out design
-    """
-    from softbend._outdir import staged_dir
-    from softbend.design_search import spec as specs
-    from softbend.design_search.search import TOP, LoadedModel, find_designs, searched_ranges
-    from softbend.design_search.space import space_of
-    from softbend.design_search.verify import verify_candidates, verify_family, verify_skipped
-    from softbend.reports.design_outputs import FILES, write_search
+    """Find the designs that meet a target bending (help: :data:`.design_options.FIND_HELP`)."""
+    from softbend.design_search.search import LoadedModel
+    from softbend.design_search.spec_text import specification_from_options
     from softbend.transfer.base import shipped_base_path
 
     out = Path(out)
     model_path = shipped_base_path() if model is None else Path(model)
+    _check_outputs(out, model, spec, top)
+    elastomer = _verification(ctx, verify, backend, workers, material)
+    loaded = LoadedModel.load(model_path)  # read once; its actuator names the parameters
+    space = _space(loaded, verify)
+    if spec is not None:
+        chosen = _from_file(ctx, spec, space)
+    else:
+        chosen = [
+            specification_from_options(
+                space, angle=angle, at=at, max_pressure=max_pressure, max_angle_at=max_angle_at,
+                curve=curve, tolerance=tolerance, margin=margin, minimize=minimize or (),
+                maximize=maximize or (), fixes=fix or (), ranges=ranges or (),
+                resolution=resolution or (),
+            )
+        ]  # fmt: skip
+    _check_grids(chosen, loaded, spec, allow_extrapolation=allow_extrapolation, top=top)
+    results = _search(loaded, chosen, top, allow_extrapolation, not neighbours, as_json)
+    verification = _Verification(verify, backend, workers, elastomer, replace_stopped)
+    payload = _verify_and_write(out, results, loaded, verification, as_json)
+    _warn(results, model_path, verification.skipped)
+    if as_json:
+        _common.print_json(payload[0] if len(payload) == 1 else {"specs": payload})
+        return
+    _print_results(results, out)
+
+
+def _check_outputs(out: Path, model: Path | None, spec: Path | None, top: int) -> None:
+    """Refuse an ``--out`` that cannot take the results (nor hold the inputs), and a
+    ``--top`` outside :data:`~softbend.design_search.search.TOP`."""
+    from softbend.design_search.search import TOP
+
     inputs = tuple(p for p in (model, spec) if p is not None)
     _common.check_output_dir(out, "--out", inputs=inputs)
     _common.check_replaceable_dir(out, "--out", inputs=inputs)
     _check_count(top, "top", TOP)
-    elastomer = _verification(ctx, verify, backend, workers, material)
-    loaded = LoadedModel.load(model_path)  # read once; its actuator names the parameters
+
+
+def _space(loaded: LoadedModel, verify: int) -> SearchSpace:
+    """The search space of the model's actuator; with ``--verify`` its FEM family checked
+    first (a family that cannot sweep its designs is refused before any search)."""
+    from softbend.design_search.space import space_of
+    from softbend.design_search.verify import verify_family
+
     space = space_of(loaded.actuator)
-    if verify and space.verifiable:  # a family that cannot sweep its designs: before any search
+    if verify and space.verifiable:
         verify_family(space)
-    actuator = None if space.paper_b else space.actuator
-    if spec is not None:
-        for name, what in _SPEC_GIVES.items():
-            if _typed(ctx, name):
-                raise InputError(
-                    f"cannot be used with --spec: the spec file gives each spec's {what}",
-                    key=name,
-                )
-        chosen = specs.load_specifications(
-            spec,
-            reserved=sorted({"search.json", *FILES}),
-            actuator=actuator,
-        )
-    else:
-        unit = space.pressure_unit
-        target = specs.target_from_options(
-            angle=angle, at=_pressure(at, unit, "--at"),
-            max_pressure=_pressure(max_pressure, unit, "--max-pressure"),
-            max_angle_at=_pressure(max_angle_at, unit, "--max-angle-at"),
-            curve=curve, tolerance=tolerance, unit=unit,
-        )  # fmt: skip
-        if not 0 <= margin < tolerance:
+    return space
+
+
+def _from_file(ctx: typer.Context, spec: Path, space: SearchSpace) -> list[Specification]:
+    """The specifications of ``--spec``, refused beside an option the file gives itself."""
+    from softbend.design_search.spec_toml import load_specifications
+    from softbend.reports.design_outputs import FILES
+
+    for name, what in _SPEC_GIVES.items():
+        if _typed(ctx, name):
             raise InputError(
-                must_be(
-                    f"in [0, {tolerance:g}) degrees (below --tolerance, the miss the "
-                    "surrogate's own error may take)",
-                    margin,
-                ),
-                key="margin",
+                f"cannot be used with --spec: the spec file gives each spec's {what}", key=name
             )
-        numbers = [s for s in resolution or () if "=" not in s]
-        if len(numbers) > 1:
-            raise InputError(f"gives a number {len(numbers)} times; give it once", key="resolution")
-        try:
-            every = float(numbers[0]) if numbers else None
-        except ValueError:
-            raise InputError(
-                must_be("a number or NAME=STEP", numbers[0]), key="resolution"
-            ) from None
-        given, steps = specs.build_ranges(
-            fix or (),
-            ranges or (),
-            [s for s in resolution or () if "=" in s],
-            step=every,
-            space=space,
-        )
-        objectives = specs.parse_objectives(minimize or (), maximize or (), space)
-        chosen = [specs.Specification(target, given, objectives, "spec", steps, margin, actuator)]
+    return load_specifications(
+        spec, reserved=sorted({"search.json", *FILES}), actuator=space.actuator
+    )
+
+
+def _check_grids(
+    chosen: Sequence[Specification],
+    loaded: LoadedModel,
+    spec: Path | None,
+    *,
+    allow_extrapolation: bool,
+    top: int,
+) -> None:
+    """Count every grid before any is built; a spec of a file is named by its number."""
+    from softbend.design_search.search import searched_ranges
+
     training = loaded.metadata.get("training_ranges")
-    for number, one in enumerate(chosen, start=1):  # every grid counted before any is built
+    for number, one in enumerate(chosen, start=1):
         try:
             searched_ranges(one, training, allow_extrapolation=allow_extrapolation, top=top)
         except ValueError as exc:
@@ -334,40 +251,63 @@ def find(
                 raise
             said = exc.detail if isinstance(exc, SoftbendError) else str(exc)
             raise InputError(f"[[spec]] {number} ({one.name!r}): {said}", file=str(spec)) from None
+
+
+def _search(
+    loaded: LoadedModel,
+    chosen: Sequence[Specification],
+    top: int,
+    allow_extrapolation: bool,
+    distinct: bool,
+    as_json: bool,
+) -> list[SearchResult]:
+    """The answer to each specification, in order."""
+    from softbend.design_search.search import find_designs
+
     with _common.library_progress(enabled=not as_json):
-        results = [
+        return [
             find_designs(
-                loaded,
-                one,
-                top=top,
-                allow_extrapolation=allow_extrapolation,
-                distinct=not neighbours,
+                loaded, one, top=top, allow_extrapolation=allow_extrapolation, distinct=distinct
             )
             for one in chosen
         ]
-    payload: list[dict[str, Any]] = []
-    skipped = verify_skipped(results[0], backend) if verify else None
-    if skipped is not None:  # another actuator: said once, and in each record
+
+
+@dataclass
+class _Verification:
+    """What ``--verify`` asks for, and why it checks nothing (``skipped``), once known."""
+
+    count: int
+    backend: str
+    workers: int | None
+    material: ResolvedMaterial | None
+    replace_stopped: bool
+    skipped: str | None = None
+
+
+def _verify_and_write(
+    out: Path,
+    results: list[SearchResult],
+    loaded: LoadedModel,
+    verification: _Verification,
+    as_json: bool,
+) -> list[dict[str, Any]]:
+    """Verify the candidates (``--verify``) and write every result into ``out``, swapped in
+    when complete, the verification's campaigns removed after; the results' records."""
+    from softbend._outdir import staged_dir
+    from softbend.design_search.verify import verify_skipped
+    from softbend.reports.design_outputs import write_search
+
+    v = verification
+    v.skipped = verify_skipped(results[0], v.backend) if v.count else None
+    if v.skipped is not None:  # another actuator: said once, and in each record
         for result in results:
-            result.verify_skipped = skipped
+            result.verify_skipped = v.skipped
     kept: list[Path] = []  # the verification's campaigns, removed once the command ends
     with _common.output_errors(out, "--out"), staged_dir(out) as stage:
-        if verify and skipped is None:
+        if v.count and v.skipped is None:
             with _common.library_progress(enabled=not as_json):
-                for result in results:
-                    if result.candidates:
-                        db = verification_db(out, result, backend, elastomer, verify)
-                        kept.append(db)
-                        verify_candidates(
-                            result,
-                            verify,
-                            db_path=db,
-                            backend=backend,
-                            workers=workers,
-                            material=elastomer,
-                            scratch_dir=stage,
-                            replace_stopped=replace_stopped,
-                        )
+                kept = [_verify(out, result, v, stage) for result in results if result.candidates]
         payload = [r.to_dict() for r in results]
         for result in results:
             folder = stage / result.spec.name if len(results) > 1 else stage
@@ -379,6 +319,30 @@ def find(
     for db in kept:
         for path in (db, db.with_name(db.name + ".wal")):
             path.unlink(missing_ok=True)
+    return payload
+
+
+def _verify(out: Path, result: SearchResult, v: _Verification, stage: Path) -> Path:
+    """Sweep the best candidates of ``result``; the campaign database, kept beside ``out``."""
+    from softbend.design_search.verify import verify_candidates
+
+    db = verification_db(out, result, v.backend, v.material, v.count)
+    verify_candidates(
+        result,
+        v.count,
+        db_path=db,
+        backend=v.backend,
+        workers=v.workers,
+        material=v.material,
+        scratch_dir=stage,
+        replace_stopped=v.replace_stopped,
+    )
+    return db
+
+
+def _warn(results: Sequence[SearchResult], model_path: Path, skipped: str | None) -> None:
+    """The warnings of the search on stderr: no design meets a target, target pressures
+    outside the trained range, answers outside the training data, --verify skipped."""
     for result in results:
         line = result.message()  # none meets the target (and the pressures outside, if any)
         if line is None and result.outside_pressures:
@@ -390,27 +354,6 @@ def find(
             _common.warning_line(line)
     if skipped is not None:
         _common.warning_line(f"--verify skipped: {skipped}; the answers are the surrogate's.")
-    if as_json:
-        _common.print_json(payload[0] if len(payload) == 1 else {"specs": payload})
-        return
-    for result in results:
-        _print_result(result)
-    _common.console.print(f"{', '.join(FILES)} written to {out}")
-
-
-def _pressure(text: str | None, unit: str, option: str) -> float | None:
-    """A pressure option in the model's ``unit``: a number, or one with a unit (``20psi``).
-
-    A bare number (``inf`` too) is returned as given, for the target's own range check.
-    """
-    from softbend.units import parse_pressure
-
-    if text is None:
-        return None
-    try:
-        return float(text)
-    except ValueError:
-        return parse_pressure(text, unit, option)
 
 
 def verification_db(
@@ -452,10 +395,18 @@ def _extrapolated(result: SearchResult, model: Path, named: bool) -> str | None:
     )
 
 
+def _print_results(results: Sequence[SearchResult], out: Path) -> None:
+    """Each result's table, then the files written."""
+    from softbend.reports.design_outputs import FILES
+
+    for result in results:
+        _print_result(result)
+    _common.console.print(f"{', '.join(FILES)} written to {out}")
+
+
 def _print_result(result: SearchResult) -> None:
     spec = result.spec
-    design = "l,r,t,b,φ,lc" if spec.space.paper_b else "design"
-    columns = ["#", design, "θ (°)", "miss (°)"]
+    columns = ["#", "design", "θ (°)", "miss (°)"]
     columns += [f"{o.name}" for o in spec.objectives if o.name != "error"]
     verified = any(c.fem_meets is not None for c in result.candidates)
     if verified:
