@@ -10,10 +10,11 @@ candidate whose FEM angle misses the target by more than its tolerance is
 marked (``fem_meets`` False). For ``max_angle`` (no target angle) the check is
 that the FEM confirms the surrogate's angle within the tolerance.
 
-Paper B's actuator is swept by the backend named (its FEM, family
-``"sfrba"``, or the analytical model). Another actuator is swept by the FEM of
-the family its description names (:attr:`Actuator.fem_family
-<softbend.actuators.Actuator.fem_family>`, such as ``"pneunet"``): each
+Every actuator is swept by the FEM family its description names
+(:attr:`Actuator.fem_family <softbend.actuators.Actuator.fem_family>`: paper
+B's ``"sfrba"``, the PneuNet's ``"pneunet"``), with a backend the family
+takes (:attr:`FEMFamily.backends <softbend.fem.families.FEMFamily.backends>`:
+the FEM, or for paper B's any campaign backend, its analytical model too): each
 candidate becomes the family's design (:meth:`FEMFamily.design
 <softbend.fem.families.FEMFamily.design>`, the model's codes as the family's
 values, the pressures converted to MPa), swept from 0 to the pressure checked
@@ -90,7 +91,7 @@ def verify_family(space: SearchSpace) -> FEMFamily | None:
             key="model",
         )
     family = FEM_FAMILIES.get(name)
-    if not space.paper_b and tuple(family.names) != tuple(space.columns):
+    if tuple(family.names) != tuple(space.columns):
         raise InputError(
             f"has the parameters {', '.join(space.columns)}, not those of the FEM family "
             f"{name!r} its actuator {space.actuator.name} names ({', '.join(family.names)}); "
@@ -103,9 +104,9 @@ def verify_family(space: SearchSpace) -> FEMFamily | None:
 def verify_skipped(result: SearchResult, backend: str = "fem") -> str | None:
     """Why the candidates of ``result`` cannot be swept by ``backend`` (None: they can).
 
-    Paper B's actuator is swept by any campaign backend; another actuator by the
-    FEM (``"fem"``) of the family its description names, and not at all when it
-    names none.
+    An actuator is swept by the backends of the FEM family its description names
+    (:attr:`FEMFamily.backends <softbend.fem.families.FEMFamily.backends>`: the FEM,
+    or for paper B's any campaign backend), and not at all when it names none.
 
     Raises
     ------
@@ -117,9 +118,9 @@ def verify_skipped(result: SearchResult, backend: str = "fem") -> str | None:
     if not space.verifiable:
         return f"{who} does not model actuator {space.actuator.name}"
     family = verify_family(space)
-    if space.paper_b or backend == "fem":
-        return None
     assert family is not None  # verifiable: it names one
+    if family.backends is None or backend in family.backends:
+        return None
     return (
         f"{who} does not model actuator {space.actuator.name} (the FEM of its family "
         f"{family.name} does: --backend fem)"
@@ -271,8 +272,8 @@ def verify_candidates(
     if not pool:
         return []
     family = verify_family(result.spec.space)
-    paper_b = result.spec.space.paper_b or family is None
-    step = PRESSURE_STEP_MPA if paper_b else family.pstep_mpa  # type: ignore[union-attr]
+    assert family is not None  # not skipped: the actuator names one
+    step = family.pstep_mpa
     sweep = _Sweep(
         result,
         family,
@@ -295,11 +296,7 @@ def verify_candidates(
                 sweep.pressures = _sweep_pressures(result, batch, step)
             sweep.run(batch)
             verified += batch
-    result.verified_by = {
-        "backend": backend,
-        "family": "sfrba" if family is None else family.name,
-        "designs": len(verified),
-    }
+    result.verified_by = {"backend": backend, "family": family.name, "designs": len(verified)}
     return verified
 
 
@@ -309,7 +306,7 @@ class _Sweep:
     def __init__(
         self,
         result: SearchResult,
-        family: FEMFamily | None,
+        family: FEMFamily,
         backend: str,
         *,
         workers: int | None,
@@ -332,15 +329,14 @@ class _Sweep:
         from softbend.campaign.store import load_designs
 
         result, family = self.result, self.family
-        swept, refused = _campaign_designs(result, batch, family)
+        swept, refused = _campaign_designs(batch, family)
         for index, why in refused.items():
             _no_angle(batch[index], why)
         if not swept:
             return
         designs = list(dict.fromkeys(swept.values()))
         total = len(designs)
-        paper_b = result.spec.space.paper_b or family is None
-        what = self.backend if paper_b else f"{self.backend}, {family.name}"  # type: ignore[union-attr]
+        what = self.backend
 
         def progress(done: int, failed: int, running: int, to_run: int) -> None:
             swept = total - to_run  # recorded by an interrupted run of the same command
@@ -385,16 +381,12 @@ class _Sweep:
 
 
 def _campaign_designs(
-    result: SearchResult, chosen: Sequence[Candidate], family: FEMFamily | None
+    chosen: Sequence[Candidate], family: FEMFamily
 ) -> tuple[dict[int, Any], dict[int, str]]:
     """The design each candidate is swept as (by its index in ``chosen``), and why the
-    family refuses those it cannot build.
-
-    Paper B's candidates are swept as they are; another actuator's codes are the
-    family's values (:meth:`FEMFamily.design <softbend.fem.families.FEMFamily.design>`).
+    family refuses those it cannot build: the model's codes are the family's values
+    (:meth:`FEMFamily.design <softbend.fem.families.FEMFamily.design>`).
     """
-    if result.spec.space.paper_b or family is None:
-        return {i: c.design for i, c in enumerate(chosen)}, {}
     swept: dict[int, Any] = {}
     refused: dict[int, str] = {}
     for i, candidate in enumerate(chosen):

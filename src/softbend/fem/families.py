@@ -79,6 +79,10 @@ class FEMFamily:
         ``mesh_check(design, options)``: refuse, before NGSolve loads, a
         ``maxh_mm`` that would mesh ``design`` with too many elements (one
         :class:`~softbend.errors.InputError` keyed ``maxh_mm``); no check when absent.
+    backends : tuple of str, optional
+        The campaign backends that sweep the family's designs (a design search's
+        ``--verify``); None: every registered backend (paper B's actuator, which its
+        analytical model also sweeps). Default: the FEM only.
     """
 
     name: str
@@ -92,6 +96,7 @@ class FEMFamily:
     sweep: Callable[..., tuple[SweepResult, Any, Any]]
     default_options: Callable[..., FEMOptions] | None = None
     mesh_check: Callable[[Any, FEMOptions], None] | None = None
+    backends: tuple[str, ...] | None = ("fem",)
 
     @property
     def names(self) -> tuple[str, ...]:
@@ -230,6 +235,7 @@ def _register_paper_b() -> FEMFamily:
         make_design=_sfrba_design,
         sweep=_sfrba_sweep,
         mesh_check=_sfrba_mesh_check,
+        backends=None,
     )
     return FEM_FAMILIES.register(family.name, family)
 
