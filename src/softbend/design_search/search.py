@@ -28,8 +28,11 @@ the closest designs are returned with how far they miss.
 
 from __future__ import annotations
 
+import dataclasses
+import itertools
 import math
 import os
+import re
 import time
 from collections.abc import Callable, Mapping
 from dataclasses import dataclass, field
@@ -41,8 +44,6 @@ from softbend._validation import must_be
 from softbend.design import SFRBADesign
 from softbend.design_search.space import ActuatorDesign, SearchSpace, pressure_key, space_of
 from softbend.design_search.spec import (
-    NAMES,
-    UNITS,
     ParameterRange,
     Specification,
 )
@@ -167,13 +168,13 @@ class Candidate:
         return not self.flags
 
     def to_dict(self) -> dict[str, Any]:
-        """JSON-friendly: the design by named parameters (mm, deg; another actuator's in its
-        units, levels by name), every figure (the pressure keyed by its unit), the ``flags``
-        and ``supported`` (no flag: inside the model's training data)."""
-        if isinstance(self.design, SFRBADesign):
-            design = dict(zip(NAMES, (float(v) for v in self.design.as_array()), strict=True))
-        else:
-            design = self.design.as_dict()
+        """JSON-friendly: the design by the names of its search (paper B's short names),
+        in their units, whole numbers as integers and levels by name, every figure (the
+        pressure keyed by its unit), the ``flags`` and ``supported`` (no flag: inside the
+        model's training data)."""
+        space = space_of(getattr(self.design, "actuator", None))
+        record = space.actuator.design_record(self.design.as_array())
+        design = dict(zip(space.names, record.values(), strict=True))
         out: dict[str, Any] = {
             "design": design,
             "angle_deg": self.angle_deg,
@@ -319,9 +320,8 @@ class SearchResult:
                 "ranges": {n: _range_record(space, n, r) for n, r in self.ranges.items()},
             },
         }
-        if not space.paper_b:
-            out["actuator"] = space.actuator.name
-            out["pressure_unit"] = space.pressure_unit
+        out["actuator"] = space.actuator.name
+        out["pressure_unit"] = space.pressure_unit
         out.update(
             {
                 "model": self.model,
@@ -352,10 +352,8 @@ class SearchResult:
 
 
 def _range_record(space: SearchSpace, name: str, r: ParameterRange) -> dict[str, Any]:
-    """A searched range for the JSON: paper B's low, high, step; another actuator's with its
-    unit, whole numbers as integers and a categorical parameter's levels."""
-    if space.paper_b:
-        return {"low": r.low, "high": r.high, "step": r.step}
+    """A searched range for the JSON: low, high, step and unit, whole numbers as integers
+    and a categorical parameter's levels."""
     kind = space.kind(name)
     if kind == "categorical":
         codes = [r.low] if r.fixed else r.values()
@@ -475,7 +473,7 @@ def searched_ranges(
     )
     total = grid_size(ranges)
     space = spec.space
-    units = UNITS if space.paper_b else space.units
+    units = space.units
     if total > MAX_DESIGNS:
         shown = f"{total:,}" if total < 10**15 else f"{float(total):.3g}"
         counts = ", ".join(
@@ -496,12 +494,7 @@ def searched_ranges(
             "(range, fix)",
             key="steps",
         )
-    t, r = (ranges["t"], ranges["r"]) if space.paper_b else (None, None)
-    if t is not None and r is not None and t.low >= r.high:
-        raise ValueError(
-            f"No design of the ranges has a wall thinner than its radius (t < r): t is at "
-            f"least {t.low:g} mm and r at most {r.high:g} mm; widen the ranges of t or r."
-        )
+    _check_constraints(space, ranges)
     continuous = [n for n, one in ranges.items() if not one.fixed and one.step == 0]
     if continuous and top is not None and not TOP_CONTINUOUS.contains(top):
         raise InputError(
@@ -513,6 +506,39 @@ def searched_ranges(
             key="top",
         )
     return ranges, total
+
+
+def _check_constraints(space: SearchSpace, ranges: Mapping[str, ParameterRange]) -> None:
+    """Refuse ranges in which no design meets a constraint of the actuator's description.
+
+    Each constraint is read at the corners of the ranges of the parameters it names
+    (exact for a comparison linear, or monotone, in each of them), and shown in the
+    names of the search (paper B's ``t < r``).
+
+    Raises
+    ------
+    ValueError
+        Naming the constraint and the parameters whose ranges to widen.
+    """
+    actuator = space.actuator
+    for text in actuator.constraints:
+        named = [c for c in actuator.names if re.search(rf"\b{c}\b", text)]
+        choices = [
+            (ranges[n].low, ranges[n].high) if c in named else (ranges[n].low,)
+            for n, c in zip(space.names, space.columns, strict=True)
+        ]
+        corners = np.array(list(itertools.product(*choices)), dtype=float)
+        one = dataclasses.replace(actuator, constraints=(text,))
+        if one.constraints_met(corners).any():
+            continue
+        shown = text
+        for column, name in zip(space.columns, space.names, strict=True):
+            shown = re.sub(rf"\b{column}\b", name, shown)
+        names = [n for n, c in zip(space.names, space.columns, strict=True) if c in named]
+        raise ValueError(
+            f"No design of the ranges meets {shown} (a constraint of the actuator "
+            f"{actuator.name}); widen the ranges of {' or '.join(names)}."
+        )
 
 
 class _Scorer:
@@ -947,22 +973,15 @@ class _Listed:
         chosen = [ranges[n] for n in names]
         stepped = np.array([not r.fixed and r.step > 0 for r in chosen])
         # another level is another actuator: a categorical parameter has no neighbours
-        levels = np.array(
-            [space is not None and not space.paper_b and space.kind(n) == "categorical"
-             for n in names]
-        )  # fmt: skip
+        levels = np.array([space is not None and space.kind(n) == "categorical" for n in names])
         self.low = np.array([r.low for r in chosen])
         self.step = np.where(stepped, [r.step for r in chosen], 1.0)
         self.stepped = stepped
         self.exact = not any(not r.fixed and r.step == 0 for r in chosen)
-        steps = [r.step for r in chosen]
-        if space is not None and not space.paper_b:
-            steps = [
-                (r.high - r.low) / (CONTINUOUS_POINTS - 1)
-                if not r.fixed and r.step == 0
-                else r.step
-                for r in chosen
-            ]
+        steps = [
+            (r.high - r.low) / (CONTINUOUS_POINTS - 1) if not r.fixed and r.step == 0 else r.step
+            for r in chosen
+        ]
         self.tolerance = np.where(levels, 0.0, steps) + 1e-9
         # Indices run from -1 to count: radix count + 2, so no neighbour wraps around.
         sizes = np.array([r.count() + 2 if s else 1 for r, s in zip(chosen, stepped, strict=True)])
