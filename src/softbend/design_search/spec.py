@@ -299,10 +299,11 @@ class Target:
 class Objective:
     """One quantity to minimise (``sense="min"``) or maximise (``"max"``).
 
-    ``name`` is one of :data:`OBJECTIVES` (paper B's actuator); for another
-    actuator's search it is one of :attr:`SearchSpace.objectives
-    <softbend.design_search.space.SearchSpace.objectives>` and ``unit`` its
-    unit (:func:`parse_objectives` and :class:`Specification` set it).
+    ``name`` is one of :attr:`SearchSpace.objectives
+    <softbend.design_search.space.SearchSpace.objectives>` of the actuator
+    searched and ``unit`` its unit (:class:`Specification` sets it); left out,
+    the unit is that of :data:`OBJECTIVES` (a pressure in MPa), and ``name``
+    must be one of them.
     """
 
     name: str
@@ -316,13 +317,15 @@ class Objective:
             )
         if not isinstance(self.name, str) or not isinstance(self.unit, str | None):
             raise ValueError("The name and unit of an objective must be text.")
+        if self.unit is None:
+            object.__setattr__(self, "unit", OBJECTIVES[self.name])
         if self.sense not in ("min", "max"):
             raise ValueError(
                 f"The sense of an objective must be 'min' or 'max'. Got {self.sense!r} instead."
             )
 
     def __str__(self) -> str:
-        unit = OBJECTIVES[self.name] if self.unit is None else self.unit
+        unit = self.unit
         return f"{self.sense} {self.name} ({unit})" if unit else f"{self.sense} {self.name}"
 
 
@@ -399,15 +402,14 @@ class Specification:
             if self.target.kind == "max_angle"
             else (Objective("error", "min"),)
         )
-        if not space.paper_b:
-            allowed = space.objectives
-            for o in objectives:
-                if o.name not in allowed:
-                    raise ValueError(
-                        f"An objective of a search of {space.actuator.name} must be one of "
-                        f"{', '.join(allowed)}. Got {o.name!r} instead."
-                    )
-            objectives = tuple(Objective(o.name, o.sense, allowed[o.name]) for o in objectives)
+        allowed = space.objectives
+        for o in objectives:
+            if o.name not in allowed:
+                raise ValueError(
+                    f"An objective of a search of {space.actuator.name} must be one of "
+                    f"{', '.join(allowed)}. Got {o.name!r} instead."
+                )
+        objectives = tuple(Objective(o.name, o.sense, allowed[o.name]) for o in objectives)
         names = [o.name for o in objectives]
         if len(set(names)) != len(names):
             raise ValueError(f"Each objective may be named once. Got {', '.join(names)}.")
@@ -606,10 +608,7 @@ class Specification:
         """The specification in one line."""
         space = self.space
 
-        def value(n: str, code: float) -> str:
-            return f"{code:g}" if space.paper_b else space.shown(n, code)
-
-        fixed = [f"{n} = {value(n, r.low)}" for n, r in self.ranges.items() if r.fixed]
+        fixed = [f"{n} = {space.shown(n, r.low)}" for n, r in self.ranges.items() if r.fixed]
         ranged = [f"{n} in {r.low:g}:{r.high:g}" for n, r in self.ranges.items() if not r.fixed]
         parts = [self.target.describe(), *fixed, *ranged, ", ".join(map(str, self.objectives))]
         return "; ".join(parts)

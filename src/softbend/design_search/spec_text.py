@@ -20,7 +20,6 @@ from softbend.design_search.spec import (
     CURVE_POINTS,
     DEFAULT_STEPS,
     NAMES,
-    OBJECTIVES,
     STEP,
     TOLERANCE,
     UNITS,
@@ -142,9 +141,10 @@ def parse_objectives(
     minimize: Sequence[str], maximize: Sequence[str], space: SearchSpace | None = None
 ) -> tuple[Objective, ...]:
     """Objectives from comma-separated names to minimise and to maximise, in order given
-    (of ``space``'s objectives; default paper B's, :data:`OBJECTIVES`)."""
+    (of ``space``'s objectives, :attr:`SearchSpace.objectives
+    <softbend.design_search.space.SearchSpace.objectives>`; default paper B's)."""
     space = PAPER_B if space is None else space
-    allowed = OBJECTIVES if space.paper_b else space.objectives
+    allowed = space.objectives
     out = []
     for sense, texts in (("min", minimize), ("max", maximize)):
         for text in texts:
@@ -156,8 +156,7 @@ def parse_objectives(
                             must_be(f"objectives among {', '.join(allowed)}", name),
                             key="minimize" if sense == "min" else "maximize",
                         )
-                    unit = None if space.paper_b else allowed[name]
-                    out.append(Objective(name, sense, unit))
+                    out.append(Objective(name, sense, allowed[name]))
     return tuple(out)
 
 

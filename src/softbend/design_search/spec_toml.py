@@ -24,7 +24,6 @@ from softbend.design_search.spec import (
     CURVE_POINTS,
     DEFAULT_STEPS,
     NAMES,
-    OBJECTIVES,
     SPECS,
     STEP,
     TOLERANCE,
@@ -306,10 +305,11 @@ class _SpecTable:
         return tuple(points)
 
     def objectives(self) -> tuple[Objective, ...]:
-        """``minimize`` and ``maximize``: names of :data:`OBJECTIVES` (another actuator: of
-        its search's objectives), an array or one text."""
+        """``minimize`` and ``maximize``: names of the search's objectives
+        (:attr:`SearchSpace.objectives <softbend.design_search.space.SearchSpace.objectives>`),
+        an array or one text."""
         space = self.space
-        allowed = OBJECTIVES if space.paper_b else space.objectives
+        allowed = space.objectives
         out = []
         for key, sense in (("minimize", "min"), ("maximize", "max")):
             value = self.table.get(key, [])
@@ -323,7 +323,7 @@ class _SpecTable:
                 if name not in allowed:
                     raise self.fail(key, expected, item)
                 assert name is not None
-                out.append(Objective(name, sense, None if space.paper_b else allowed[name]))
+                out.append(Objective(name, sense, allowed[name]))
         return tuple(out)
 
     def steps(self) -> dict[str, float]:
@@ -380,8 +380,8 @@ class _SpecTable:
             out[name] = ParameterRange(fixed, fixed, 0.0)
         for name, value in self.per_parameter("range", "[low, high] pairs").items():
             key = f"range.{name}"
-            unit = UNITS[name] if space.paper_b else space.unit(name)
-            if not space.paper_b and space.kind(name) == "categorical":
+            unit = space.unit(name)
+            if space.kind(name) == "categorical":
                 levels = ", ".join(map(str, space.parameter(name).levels or ()))
                 raise DatasetError(
                     f"{self.where} '{key}': a categorical parameter takes no range; fix one "
@@ -425,9 +425,10 @@ class _SpecTable:
         if "margin" in table:
             allowed = Range(0.0, target.tolerance_deg, "deg", "below the tolerance", True, False)
             margin = self.number("margin", allowed, "degrees kept from the tolerance")
-        actuator = None if self.space.paper_b else self.space.actuator
         try:
-            return Specification(target, ranges, objectives, name, steps, margin, actuator)
+            return Specification(
+                target, ranges, objectives, name, steps, margin, self.space.actuator
+            )
         except ValueError as exc:
             keys = [k for k in ("minimize", "maximize") if k in table]
             about = f" '{' and '.join(keys)}'" if keys and "objective" in str(exc) else ""

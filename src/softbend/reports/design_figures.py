@@ -8,7 +8,7 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
-from softbend.design_search.spec import OBJECTIVES, Objective
+from softbend.design_search.spec import Objective
 
 if TYPE_CHECKING:
     from softbend.design_search.search import Predictor, SearchResult
@@ -19,7 +19,7 @@ _DPI = 120
 
 
 def _label(objective: Objective) -> str:
-    unit = OBJECTIVES[objective.name] if objective.unit is None else objective.unit
+    unit = objective.unit
     return f"{objective.name} ({unit})" if unit else objective.name
 
 
