@@ -9,6 +9,7 @@ import numpy as np
 import pytest
 
 from softbend.design_search import search
+from softbend.design_search.grid import Listed, designs_at, grid_axes
 from softbend.design_search.search import (
     MAX_DESIGNS,
     TOP,
@@ -307,10 +308,10 @@ def test_the_filed_cells_find_exactly_the_designs_one_step_away():
         "t": ParameterRange(3.0, 3.0), "b": ParameterRange(2.0, 4.0, 1.0),
         "phi": ParameterRange(5.0, 15.0, 1.0), "lc": ParameterRange(8.0, 9.0, 0.5),
     }  # fmt: skip
-    axes = search._grid(ranges)
-    designs = search._designs_at(axes, rng.integers(0, grid_size(ranges), size=800))
+    axes = grid_axes(ranges)
+    designs = designs_at(axes, rng.integers(0, grid_size(ranges), size=800))
     tolerance = np.array([ranges[n].step for n in NAMES]) + 1e-9
-    listed = search._Listed(ranges)
+    listed = Listed(ranges)
     cells = listed.cells_of(designs)
     kept: list[np.ndarray] = []
     for design, cell in zip(designs, cells, strict=True):

@@ -25,8 +25,8 @@ from softbend._lazy import export as _export
 #: Public name -> the module that defines it.
 _EXPORTS: dict[str, str] = {
     "ActuatorDesign": "space",
-    "Candidate": "search",
-    "SearchResult": "search",
+    "Candidate": "result",
+    "SearchResult": "result",
     "find_designs": "search",
     "Objective": "spec",
     "ParameterRange": "spec",

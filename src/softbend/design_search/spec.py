@@ -38,7 +38,7 @@ from dataclasses import dataclass, field
 from typing import TypeGuard
 
 from softbend._validation import must_be
-from softbend.actuators import PRESSURE_UNITS, Actuator, ActuatorError
+from softbend.actuators import PRESSURE_UNITS, Actuator
 from softbend.design import DESIGN_LIMITS, PARAMETERS
 from softbend.design_search.space import SearchSpace, aligned, space_of
 from softbend.errors import InputError
@@ -61,7 +61,6 @@ __all__ = [
     "Target",
     "check_angle",
     "check_pressure",
-    "code_of",
     "design_value_problem",
     "is_number",
     "pressure_range",
@@ -665,45 +664,3 @@ def is_number(value: object) -> TypeGuard[int | float]:
     except OverflowError:  # an integer of hundreds of digits
         return False
     return True
-
-
-def _unit_of(space: SearchSpace, name: str) -> str:
-    unit = space.unit(name)
-    return f" {unit}" if unit else ""
-
-
-def code_of(space: SearchSpace, key: str, value: object) -> float:
-    """The code of ``value`` (a level, a whole number, a number) for ``key``, checked.
-
-    Raises
-    ------
-    InputError
-        Keyed ``key`` (``layer: must be one of its levels ...``).
-    """
-    p = space.parameter(key)
-    if p.kind == "categorical":
-        try:
-            code = p.encode(value)
-        except ActuatorError:
-            levels = ", ".join(map(str, p.levels or ()))
-            raise InputError(must_be(f"one of its levels {levels}", value), key=key) from None
-        return code
-    if isinstance(value, bool):
-        value = "true" if value else "false"
-    try:
-        code = float(value)  # type: ignore[arg-type]  # anything float() reads; else refused
-    except (TypeError, ValueError, OverflowError):
-        unit = space.unit(key)
-        kind = "a whole number" if p.kind == "integer" else "a number"
-        raise InputError(must_be(kind + (f" ({unit})" if unit else ""), value), key=key) from None
-    problem = space.value_problem(key, code)
-    if problem is None and p.kind == "continuous" and p.resolution is not None:
-        ratio = code / p.resolution
-        if abs(ratio - round(ratio)) > 1e-6:
-            problem = (
-                f"is not a multiple of the resolution {p.resolution:g}{_unit_of(space, key)} "
-                f"the actuator {space.actuator.name} declares"
-            )
-    if problem is not None:
-        raise InputError(f"{value} {problem}", key=key)
-    return code

@@ -15,6 +15,7 @@ import math
 from collections.abc import Sequence
 
 from softbend._validation import must_be
+from softbend.actuators import ActuatorError
 from softbend.design_search.space import PAPER_B, SearchSpace
 from softbend.design_search.spec import (
     CURVE_POINTS,
@@ -29,7 +30,6 @@ from softbend.design_search.spec import (
     Target,
     check_angle,
     check_pressure,
-    code_of,
     design_value_problem,
     is_number,
 )
@@ -37,6 +37,7 @@ from softbend.errors import InputError, keyed
 
 __all__ = [
     "build_ranges",
+    "code_of",
     "option_pressure",
     "parse_assignment",
     "parse_objectives",
@@ -81,6 +82,48 @@ def parse_range(text: str) -> tuple[str, float, float]:
     if not (math.isfinite(a) and math.isfinite(b)) or a > b:
         raise InputError(must_be("finite LOW <= HIGH", value), key=name)
     return name, a, b
+
+
+def _unit_of(space: SearchSpace, name: str) -> str:
+    unit = space.unit(name)
+    return f" {unit}" if unit else ""
+
+
+def code_of(space: SearchSpace, key: str, value: object) -> float:
+    """The code of ``value`` (a level, a whole number, a number) for ``key``, checked.
+
+    Raises
+    ------
+    InputError
+        Keyed ``key`` (``layer: must be one of its levels ...``).
+    """
+    p = space.parameter(key)
+    if p.kind == "categorical":
+        try:
+            code = p.encode(value)
+        except ActuatorError:
+            levels = ", ".join(map(str, p.levels or ()))
+            raise InputError(must_be(f"one of its levels {levels}", value), key=key) from None
+        return code
+    if isinstance(value, bool):
+        value = "true" if value else "false"
+    try:
+        code = float(value)  # type: ignore[arg-type]  # anything float() reads; else refused
+    except (TypeError, ValueError, OverflowError):
+        unit = space.unit(key)
+        kind = "a whole number" if p.kind == "integer" else "a number"
+        raise InputError(must_be(kind + (f" ({unit})" if unit else ""), value), key=key) from None
+    problem = space.value_problem(key, code)
+    if problem is None and p.kind == "continuous" and p.resolution is not None:
+        ratio = code / p.resolution
+        if abs(ratio - round(ratio)) > 1e-6:
+            problem = (
+                f"is not a multiple of the resolution {p.resolution:g}{_unit_of(space, key)} "
+                f"the actuator {space.actuator.name} declares"
+            )
+    if problem is not None:
+        raise InputError(f"{value} {problem}", key=key)
+    return code
 
 
 def _named(space: SearchSpace, name: str, text: str) -> str:

@@ -32,10 +32,10 @@ from softbend.design_search.spec import (
     ParameterRange,
     Specification,
     Target,
-    code_of,
     is_number,
     pressure_range,
 )
+from softbend.design_search.spec_text import code_of
 from softbend.errors import DatasetError, InputError
 from softbend.parameters import Range
 
