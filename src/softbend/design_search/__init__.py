@@ -10,10 +10,14 @@ and sets the FEM's angle beside the surrogate's.
 The parameters are those of the model's actuator
 (:class:`~softbend.design_search.space.SearchSpace`): paper B's six by their
 short names, or another description's own (``Specification(...,
-actuator=saved.actuator)``). Paper B's actuator is verified by its FEM,
-another by the FEM of the family its description names (``fem_family``, such as
-the PneuNet); a sweep that stops before the pressure checked (walls touching)
+actuator=saved.actuator)``). Every actuator is verified by the FEM family its
+description names (``fem_family``: paper B's ``sfrba``, the PneuNet's
+``pneunet``); a sweep that stops before the pressure checked (walls touching)
 is reported with the FEM's stop reason, not as an angle.
+
+The specification's data classes are :mod:`.spec`'s, its reading from
+command-line text :mod:`.spec_text`'s and from a TOML file :mod:`.spec_toml`'s;
+the grid a search scores is :mod:`.grid`'s and its answer :mod:`.result`'s.
 """
 
 from __future__ import annotations
