@@ -14,10 +14,8 @@ import math
 from pathlib import Path
 from typing import Any
 
-from softbend.design import SFRBADesign
 from softbend.design_search.search import Predictor, SearchResult
 from softbend.design_search.space import pressure_key
-from softbend.design_search.spec import NAMES, UNITS
 
 __all__ = ["FIGURE_CANDIDATES", "FILES", "candidate_rows", "write_search"]
 
@@ -29,20 +27,14 @@ FIGURE_CANDIDATES = 50
 
 
 def candidate_rows(result: SearchResult) -> list[dict[str, Any]]:
-    """One flat row per candidate, best first: rank, design (mm, deg; another actuator's by
-    its parameters), the pressure, angles, miss, objectives."""
+    """One flat row per candidate, best first: rank, the design by its actuator's columns
+    (:meth:`Actuator.design_record <softbend.actuators.Actuator.design_record>`), the
+    pressure, angles, miss, objectives."""
     rows = []
+    actuator = result.spec.space.actuator
     for rank, c in enumerate(result.candidates, start=1):
         row: dict[str, Any] = {"rank": rank}
-        if isinstance(c.design, SFRBADesign):
-            row.update(
-                {
-                    f"{n}_{UNITS[n]}": float(v)
-                    for n, v in zip(NAMES, c.design.as_array(), strict=True)
-                }
-            )
-        else:
-            row.update(c.design.as_dict())
+        row.update(actuator.design_record(c.design.as_array()))
         row[pressure_key(c.pressure_unit)] = c.pressure_mpa
         row["angle_deg"] = c.angle_deg
         row["error_deg"] = c.error_deg
