@@ -57,6 +57,8 @@ from softbend.registry import Registry
 if TYPE_CHECKING:
     import pandas as pd
 
+    from softbend.parameters import Range
+
 __all__ = [
     "ACTUATORS",
     "PRESSURE_UNITS",
@@ -517,6 +519,16 @@ class Actuator:
     named_in_outputs : bool
         Whether the records of train, predict and transfer name it (False for paper
         B's, whose records are unchanged since before descriptions existed).
+    search_steps : tuple of float, optional
+        A mould's step of each parameter in a design search, in parameter order
+        (paper B's: 0.5 mm, 1° of fibre angle): a search's default grid, which then
+        keeps no value to the declared ``resolution``. Empty: each parameter's
+        resolution, else a round step of its range.
+    search_limits : tuple of Range, optional
+        The values a design may take, in parameter order, when the parameters'
+        ranges are only such limits (paper B's: (0, 50] mm of wall): a search checks
+        its values against them and takes its ranges from the model's training
+        ranges alone. Empty: the parameters' ranges, a box a search may cover.
 
     The fields from ``quantities`` on are softbend's knowledge of a registered
     actuator, not part of its description: :meth:`to_dict` does not write them and
@@ -540,6 +552,8 @@ class Actuator:
     analytical: bool = field(default=False, compare=False)
     published_cv: Mapping[str, Mapping[str, Any]] = field(default_factory=dict, compare=False)
     named_in_outputs: bool = field(default=True, compare=False)
+    search_steps: tuple[float, ...] = field(default=(), compare=False)
+    search_limits: tuple[Range, ...] = field(default=(), compare=False)
     _trees: tuple[ast.Compare, ...] = field(default=(), repr=False, compare=False)
 
     def __post_init__(self) -> None:
@@ -1022,6 +1036,7 @@ def get_actuator(
 def _register_paper_b() -> Actuator:
     """Paper B's fiber-reinforced actuator (SFRBA), as its FEM and Table 1 describe it."""
     from softbend.design import _BOUNDS, FEATURE_QUANTITIES
+    from softbend.parameters import Range
     from softbend.references import SURROGATES, values
 
     described = {
@@ -1059,6 +1074,12 @@ def _register_paper_b() -> Actuator:
         analytical=True,
         published_cv=values(SURROGATES),
         named_in_outputs=False,
+        search_steps=tuple(1.0 if unit == "deg" else 0.5 for unit, _ in described.values()),
+        search_limits=tuple(
+            Range(low, high, unit, "the values a design may take", low_inclusive)
+            for name, (unit, _) in described.items()
+            for low, high, low_inclusive in [_BOUNDS[name]]
+        ),
     )
     return ACTUATORS.register(sfrba.name, sfrba)
 

@@ -54,10 +54,7 @@ from softbend.design_search.grid import (
 )
 from softbend.design_search.result import Candidate, SearchResult
 from softbend.design_search.space import space_of
-from softbend.design_search.spec import (
-    ParameterRange,
-    Specification,
-)
+from softbend.design_search.spec import ParameterRange, Specification, search_resolution
 from softbend.errors import InputError
 from softbend.parameters import Range
 
@@ -611,7 +608,7 @@ def _polish(
         )
         if cost(result.x) <= cost(design[which]):
             out[k, which] = result.x
-    if not space.paper_b:  # a polished value ends on the resolution its description declares
-        for j, name in zip(which, continuous, strict=True):
+    for j, name in zip(which, continuous, strict=True):  # ends on the resolution searched
+        if search_resolution(space, name) is not None:
             out[:, j] = space.snap(name, out[:, j], ranges[name].low, ranges[name].high)
     return out

@@ -39,7 +39,7 @@ from typing import TypeGuard
 
 from softbend._validation import must_be
 from softbend.actuators import PRESSURE_UNITS, Actuator
-from softbend.design import DESIGN_LIMITS, PARAMETERS
+from softbend.design import PARAMETERS
 from softbend.design_search.space import SearchSpace, aligned, space_of
 from softbend.errors import InputError
 from softbend.parameters import Range
@@ -61,9 +61,12 @@ __all__ = [
     "Target",
     "check_angle",
     "check_pressure",
-    "design_value_problem",
+    "default_step",
     "is_number",
     "pressure_range",
+    "search_resolution",
+    "step_problem",
+    "value_problem",
 ]
 
 #: Short names of the design parameters, in the order of :data:`softbend.design.PARAMETERS`.
@@ -347,11 +350,9 @@ class Specification:
         A label for tables and files.
     steps : dict of str to float
         The step of each parameter left out of ``ranges`` (default
-        :data:`DEFAULT_STEPS` for paper B's actuator; for another,
-        :meth:`SearchSpace.default_step
-        <softbend.design_search.space.SearchSpace.default_step>`: a continuous
-        parameter's declared resolution, else a round step of about a hundredth
-        of its range, and 1 for an integer one; 0: continuous).
+        :func:`default_step`: a mould's step, paper B's :data:`DEFAULT_STEPS`;
+        else a continuous parameter's declared resolution, else a round step of
+        about a hundredth of its range, and 1 for an integer one; 0: continuous).
     margin_deg : float
         A design margin, degrees: on the surrogate a design must meet the target
         within ``tolerance − margin``, so that the surrogate's own error (a degree
@@ -422,9 +423,6 @@ class Specification:
         object.__setattr__(self, "objectives", objectives)
         object.__setattr__(self, "ranges", ranges)
         steps = {(space.canonical(k) or k): v for k, v in dict(self.steps).items()}
-        if space.paper_b:
-            object.__setattr__(self, "steps", {**DEFAULT_STEPS, **steps})
-            return
         for key, value in steps.items():
             if key not in space.names:
                 raise ValueError(
@@ -434,10 +432,10 @@ class Specification:
             if isinstance(value, bool) or not isinstance(value, int | float):
                 raise ValueError(f"The step of {key!r} must be a number. Got {value!r}.")
             problem = None if STEP.contains(value) else "must be finite and >= 0"
-            problem = problem or space.step_problem(key, float(value))
+            problem = problem or step_problem(space, key, float(value))
             if problem is not None:
                 raise ValueError(f"The step of {key!r} ({value:g}) {problem}.")
-        filled = {n: float(steps.get(n, space.default_step(n))) for n in space.names}
+        filled = {n: float(steps.get(n, default_step(space, n))) for n in space.names}
         object.__setattr__(self, "steps", filled)
 
     @property
@@ -453,8 +451,10 @@ class Specification:
     ) -> dict[str, ParameterRange]:
         """Every parameter's range: given, or the model's training range at the default step.
 
-        For another actuator than paper B's, a parameter left out takes its
-        training range within the range its description declares; an integer or
+        A parameter left out takes its training range, within the range its
+        description declares (not for a description whose ranges are only the
+        limits of a design, :attr:`Actuator.search_limits
+        <softbend.actuators.Actuator.search_limits>`: paper B's); an integer or
         categorical one takes whole numbers (levels' indices), a continuous one
         with a step the multiples of the step inside its range.
 
@@ -466,89 +466,21 @@ class Specification:
             parameter without a range and without training ranges to take one
             from, or a range holding no value on its step.
         """
-        if not self.space.paper_b:
-            return self._resolved_other(training_ranges, allow_extrapolation)
-        out = {}
-        for name in NAMES:
-            trained = None
-            if training_ranges is not None and COLUMNS[name] in training_ranges:
-                low, high = (float(v) for v in training_ranges[COLUMNS[name]])
-                trained = (low, high)
-            given = self.ranges.get(name)
-            if given is None:
-                if trained is None:
-                    raise InputError(
-                        f"must give the parameter {name!r} a range ({name}=LOW:HIGH, or fix "
-                        f"{name}=VALUE): the model records no training ranges",
-                        key="ranges",
-                    )
-                given = ParameterRange(trained[0], trained[1], float(self.steps[name]))
-            for end in (given.low, given.high):
-                problem = design_value_problem(name, end)
-                if problem is not None:
-                    raise ValueError(
-                        f"The range of {name!r} ({given.low:g}:{given.high:g} {UNITS[name]}) "
-                        f"{problem}."
-                    )
-            outside = trained is not None and (
-                given.low < trained[0] - 1e-9 or given.high > trained[1] + 1e-9
-            )
-            if outside and trained is not None and not allow_extrapolation:
-                raise InputError(
-                    f"must be set for the range of {name!r} ({given.low:g}:{given.high:g} "
-                    f"{UNITS[name]}), which leaves the model's training range "
-                    f"[{trained[0]:g}, {trained[1]:g}] (the answers outside are then "
-                    "flagged); or narrow the range",
-                    key="allow_extrapolation",
-                )
-            if not given.fixed and given.step > 0 and given.count() < 1:
-                raise ValueError(f"The range of {name!r} holds no value on its step.")
-            if not given.fixed and given.step > given.high - given.low + 1e-9:
-                raise ValueError(
-                    f"The resolution of {name!r} ({given.step:g} {UNITS[name]}) is wider than "
-                    f"its range {given.low:g}:{given.high:g}; fix it or refine the resolution."
-                )
-            out[name] = given
-        return out
-
-    def _resolved_other(
-        self, training: Mapping[str, Sequence[float]] | None, allow_extrapolation: bool
-    ) -> dict[str, ParameterRange]:
-        """:meth:`resolved` for another actuator than paper B's."""
         space = self.space
         out: dict[str, ParameterRange] = {}
         for name in space.names:
             p = space.parameter(name)
             unit = f" {p.unit}" if p.unit else ""
             trained = None
-            if training is not None and p.name in training:
-                trained = tuple(float(v) for v in training[p.name])
+            if training_ranges is not None and p.name in training_ranges:
+                low, high = (float(v) for v in training_ranges[p.name])
+                trained = (low, high)
             given = self.ranges.get(name)
             if given is None:
-                low, high = p.low, p.high
-                if trained is not None:
-                    low, high = max(low, trained[0]), min(high, trained[1])
-                if not (math.isfinite(low) and math.isfinite(high)):
-                    raise InputError(
-                        f"must give the parameter {name!r} a range ({name}=LOW:HIGH, or fix "
-                        f"{name}=VALUE): the model records no training range of it and the "
-                        f"actuator {space.actuator.name} declares none",
-                        key="ranges",
-                    )
-                if p.kind != "continuous":
-                    low, high = float(math.ceil(low - 1e-9)), float(math.floor(high + 1e-9))
-                if low > high:
-                    raise InputError(
-                        f"must give {name!r} a range ({name}=LOW:HIGH, or fix {name}=VALUE): "
-                        f"the model's training range of it does not meet the range "
-                        f"[{p.low:g}, {p.high:g}]{unit} the actuator {space.actuator.name} "
-                        "describes",
-                        key="ranges",
-                    )
-                given = ParameterRange(low, high, float(self.steps[name]))
+                given = self._trained_range(name, trained, unit)
             else:
                 for end in (given.low, given.high):
-                    problem = space.value_problem(name, end)
+                    problem = value_problem(space, name, end)
                     if problem is None and p.kind == "categorical" and end != round(end):
                         problem = "is not a level's index (a whole number)"
                     if problem is not None:
@@ -569,6 +501,36 @@ class Specification:
             out[name] = self._on_step(name, given, unit)
         return out
 
+    def _trained_range(
+        self, name: str, trained: tuple[float, float] | None, unit: str
+    ) -> ParameterRange:
+        """The range of a parameter left out: its training range, within the range its
+        description declares (a box to search; none where the description declares only
+        the limits of a design), at its default step."""
+        space = self.space
+        p = space.parameter(name)
+        low, high = (-math.inf, math.inf) if space.actuator.search_limits else (p.low, p.high)
+        if trained is not None:
+            low, high = max(low, trained[0]), min(high, trained[1])
+        if not (math.isfinite(low) and math.isfinite(high)):
+            raise InputError(
+                f"must give the parameter {name!r} a range ({name}=LOW:HIGH, or fix "
+                f"{name}=VALUE): the model records no training range of it and the "
+                f"actuator {space.actuator.name} declares none to search",
+                key="ranges",
+            )
+        if p.kind != "continuous":
+            low, high = float(math.ceil(low - 1e-9)), float(math.floor(high + 1e-9))
+        if low > high:
+            raise InputError(
+                f"must give {name!r} a range ({name}=LOW:HIGH, or fix {name}=VALUE): "
+                f"the model's training range of it does not meet the range "
+                f"[{p.low:g}, {p.high:g}]{unit} the actuator {space.actuator.name} "
+                "describes",
+                key="ranges",
+            )
+        return ParameterRange(low, high, float(self.steps[name]))
+
     def _on_step(self, name: str, given: ParameterRange, unit: str) -> ParameterRange:
         """``given`` on the step of its kind: whole numbers, or multiples of the step."""
         space = self.space
@@ -584,12 +546,17 @@ class Specification:
             if problem is not None:
                 raise ValueError(f"The step of {name!r} ({step:g}) {problem}.")
             return ParameterRange(given.low, given.high, step)
+        if step > given.high - given.low + 1e-9:
+            raise ValueError(
+                f"The resolution of {name!r} ({step:g}{unit}) is wider than its range "
+                f"{given.low:g}:{given.high:g}; fix it or refine the resolution."
+            )
         if step > 0:
-            problem = space.step_problem(name, step)
+            problem = step_problem(space, name, step)
             if problem is not None:
                 raise ValueError(f"The step of {name!r} ({step:g}{unit}) {problem}.")
         else:
-            resolution = space.parameter(name).resolution
+            resolution = search_resolution(space, name)
             if resolution is None:
                 return given
             step = resolution  # a continuous search still ends on the resolution: it must hold one
@@ -613,13 +580,42 @@ class Specification:
         return "; ".join(parts)
 
 
-def design_value_problem(name: str, value: float) -> str | None:
-    """Why ``value`` cannot be the parameter ``name`` of a design (its limits), or None."""
-    low, high, low_inclusive = DESIGN_LIMITS[name]
-    allowed = Range(low, high, UNITS[name], low_inclusive=low_inclusive)
-    if allowed.contains(value):
+def default_step(space: SearchSpace, name: str) -> float:
+    """The step of ``name`` when none is given: the mould's (:attr:`Actuator.search_steps
+    <softbend.actuators.Actuator.search_steps>`, paper B's 0.5 mm and 1°), else
+    :meth:`SearchSpace.default_step <softbend.design_search.space.SearchSpace.default_step>`."""
+    mould = dict(zip(space.names, space.actuator.search_steps, strict=False))
+    return float(mould[name]) if name in mould else space.default_step(name)
+
+
+def search_resolution(space: SearchSpace, name: str) -> float | None:
+    """The step a search keeps a continuous value of ``name`` to: its declared resolution,
+    none on a mould's grid (:attr:`Actuator.search_steps
+    <softbend.actuators.Actuator.search_steps>`), whose step is the resolution."""
+    return None if space.actuator.search_steps else space.parameter(name).resolution
+
+
+def step_problem(space: SearchSpace, name: str, step: float) -> str | None:
+    """Why ``step`` cannot be the step of ``name`` (:meth:`SearchSpace.step_problem
+    <softbend.design_search.space.SearchSpace.step_problem>`, a continuous one held to
+    :func:`search_resolution`), or None."""
+    if space.kind(name) == "continuous" and search_resolution(space, name) is None:
         return None
-    return f"leaves the values a design may take, {allowed.describe()}"
+    return space.step_problem(name, step)
+
+
+def value_problem(space: SearchSpace, name: str, value: float) -> str | None:
+    """Why ``value`` cannot be a value of ``name``: outside the limits of a design the
+    description declares (:attr:`Actuator.search_limits
+    <softbend.actuators.Actuator.search_limits>`), else outside its parameter's range or
+    not a whole number (:meth:`SearchSpace.value_problem
+    <softbend.design_search.space.SearchSpace.value_problem>`); None when it can."""
+    limits = dict(zip(space.names, space.actuator.search_limits, strict=False))
+    if name not in limits:
+        return space.value_problem(name, value)
+    if limits[name].contains(value):
+        return None
+    return f"leaves the values a design may take, {limits[name].describe()}"
 
 
 def pressure_range(unit: str = "MPa") -> Range:

@@ -1,8 +1,8 @@
 """A specification from command-line text: ``NAME=VALUE``, ``NAME=LOW:HIGH``, a target.
 
-:func:`parse_assignment` and :func:`parse_range` read paper B's parameters by
-their short names, :func:`parse_value` and :func:`parse_span` another
-actuator's; :func:`build_ranges` turns ``--fix``, ``--range`` and
+:func:`parse_value` and :func:`parse_span` read the parameters of any
+actuator's search (:func:`parse_assignment` and :func:`parse_range` paper B's
+alone, by their short names); :func:`build_ranges` turns ``--fix``, ``--range`` and
 ``--resolution`` into the ranges and steps of a :class:`~.spec.Specification`,
 :func:`parse_objectives` ``--minimize`` and ``--maximize``, and
 :func:`target_from_options` the target options. Every error is one
@@ -19,7 +19,6 @@ from softbend.actuators import ActuatorError
 from softbend.design_search.space import PAPER_B, SearchSpace
 from softbend.design_search.spec import (
     CURVE_POINTS,
-    DEFAULT_STEPS,
     NAMES,
     STEP,
     TOLERANCE,
@@ -30,8 +29,11 @@ from softbend.design_search.spec import (
     Target,
     check_angle,
     check_pressure,
-    design_value_problem,
+    default_step,
     is_number,
+    search_resolution,
+    step_problem,
+    value_problem,
 )
 from softbend.errors import InputError, keyed
 
@@ -113,17 +115,25 @@ def code_of(space: SearchSpace, key: str, value: object) -> float:
         unit = space.unit(key)
         kind = "a whole number" if p.kind == "integer" else "a number"
         raise InputError(must_be(kind + (f" ({unit})" if unit else ""), value), key=key) from None
-    problem = space.value_problem(key, code)
-    if problem is None and p.kind == "continuous" and p.resolution is not None:
-        ratio = code / p.resolution
+    problem = value_problem(space, key, code)
+    resolution = search_resolution(space, key)
+    if problem is None and p.kind == "continuous" and resolution is not None:
+        ratio = code / resolution
         if abs(ratio - round(ratio)) > 1e-6:
             problem = (
-                f"is not a multiple of the resolution {p.resolution:g}{_unit_of(space, key)} "
+                f"is not a multiple of the resolution {resolution:g}{_unit_of(space, key)} "
                 f"the actuator {space.actuator.name} declares"
             )
     if problem is not None:
-        raise InputError(f"{value} {problem}", key=key)
+        raise InputError(_said(space, value, problem), key=key)
     return code
+
+
+def _said(space: SearchSpace, value: object, problem: str) -> str:
+    """A value's problem as a command line says it: after the value, except against the
+    limits of a design (:attr:`Actuator.search_limits
+    <softbend.actuators.Actuator.search_limits>`), whose interval the problem names."""
+    return problem if space.actuator.search_limits else f"{value} {problem}"
 
 
 def _named(space: SearchSpace, name: str, text: str) -> str:
@@ -132,13 +142,13 @@ def _named(space: SearchSpace, name: str, text: str) -> str:
     if key is None:
         raise InputError(
             f"names {name!r}, which is not a design parameter of the model's actuator "
-            f"{space.actuator.name}; its parameters are {space.listing()}; got {text!r}",
+            f"{space.actuator.name}: give a NAME among {space.listing()}; got {text!r}",
         )
     return key
 
 
 def parse_value(space: SearchSpace, text: object) -> tuple[str, float]:
-    """``("layer", 1.0)`` from ``"layer=paper"``: a parameter of another actuator and the code
+    """``("layer", 1.0)`` from ``"layer=paper"``: a parameter of ``space`` and the code
     of its value (a level's index), checked against its description; one line (keyed
     by the parameter where one is named) otherwise."""
     name, sep, value = str(text).partition("=")
@@ -150,7 +160,7 @@ def parse_value(space: SearchSpace, text: object) -> tuple[str, float]:
 
 
 def parse_span(space: SearchSpace, text: str) -> tuple[str, float, float]:
-    """``("wall_mm", 1.0, 2.0)`` from ``"wall_mm=1:2"``: a range of another actuator's
+    """``("wall_mm", 1.0, 2.0)`` from ``"wall_mm=1:2"``: a range of ``space``'s
     parameter inside its description (whole ends for an integer one); a categorical one
     is refused (fix one level, or leave it out for every level). Errors are keyed by the
     parameter where one is named."""
@@ -174,9 +184,9 @@ def parse_span(space: SearchSpace, text: str) -> tuple[str, float, float]:
     if not (math.isfinite(a) and math.isfinite(b)) or a > b:
         raise InputError(must_be("finite LOW <= HIGH", value), key=key)
     for end in (a, b):
-        problem = space.value_problem(key, end)
+        problem = value_problem(space, key, end)
         if problem is not None:
-            raise InputError(f"{end:g} {problem}; got {value!r}", key=key)
+            raise InputError(f"{_said(space, f'{end:g}', problem)}; got {value!r}", key=key)
     return key, a, b
 
 
@@ -213,45 +223,70 @@ def build_ranges(
 ) -> tuple[dict[str, ParameterRange], dict[str, float]]:
     """Ranges and steps from ``--fix NAME=V``, ``--range NAME=LOW:HIGH``, ``--resolution``.
 
-    ``steps`` are ``NAME=STEP`` per parameter; ``step`` is the step of every
-    parameter not named there (None: :data:`DEFAULT_STEPS`). A parameter both
-    fixed and ranged, or named twice, is refused. Returns the ranges given and
-    the step of every parameter (for those left to their training range).
-
-    With the ``space`` of another actuator than paper B's, the names are its
-    parameters: ``--fix`` takes a level by name, a whole number or a number
-    (on the resolution the description declares), ``--range`` refuses a
-    categorical parameter and takes whole ends for an integer one, and
-    ``step`` is the step of the continuous parameters only (the others stay on
-    their whole numbers and levels; by default a continuous parameter's
-    resolution, else :meth:`SearchSpace.grid_steps
-    <softbend.design_search.space.SearchSpace.grid_steps>`' round step).
+    The names are the parameters of ``space`` (default paper B's, by their short
+    names): ``--fix`` takes a level by name, a whole number or a number (on the
+    resolution the description declares), ``--range`` refuses a categorical
+    parameter and takes whole ends for an integer one; ``steps`` are
+    ``NAME=STEP`` per parameter, and ``step`` is the step of every continuous
+    parameter not named there (the others stay on their whole numbers and
+    levels; by default :func:`~.spec.default_step`: a mould's step, a continuous
+    parameter's resolution, else :meth:`SearchSpace.grid_steps
+    <softbend.design_search.space.SearchSpace.grid_steps>`' round step). A
+    parameter both fixed and ranged, or named twice, is refused. Returns the
+    ranges given and the step of every parameter that is not categorical (for
+    those left to their training range).
     """
-    if space is not None and not space.paper_b:
-        return _build_other(space, fixes, ranges, steps, step)
+    space = PAPER_B if space is None else space
     if step is not None and not STEP.contains(step):
         raise InputError(
-            must_be(f"a finite number >= 0 (mm and deg; {STEP.why})", step), key="step"
+            must_be(
+                f"a finite number >= 0 (in each continuous parameter's unit; {STEP.why})", step
+            ),
+            key="step",
         )
-    per_step = dict(DEFAULT_STEPS) if step is None else dict.fromkeys(NAMES, float(step))
+    per_step = {n: default_step(space, n) for n in space.names}
+    if step is not None:
+        for name in space.names:
+            if space.kind(name) == "continuous":
+                problem = step_problem(space, name, float(step))
+                if problem is not None:
+                    raise InputError(f"{step:g} of {name!r} {problem}", key="step")
+                per_step[name] = float(step)
     for text in steps:
-        with keyed("steps"):
-            name, value = parse_assignment(text)
-        if value < 0:
-            raise InputError(f"{name} {must_be('>= 0', value)}", key="steps")
-        per_step[name] = value
+        key, number = _step_of(space, text)
+        per_step[key] = number
     given: list[tuple[str, ParameterRange, str]] = []
     for text in fixes:
         with keyed("fixes"):
-            name, value = parse_assignment(text)
-            _check_design_values(name, (value,), text)
-        given.append((name, ParameterRange(value, value, 0.0), "fixes"))
+            key, code = parse_value(space, text)
+        given.append((key, ParameterRange(code, code, 0.0), "fixes"))
     for text in ranges:
         with keyed("ranges"):
-            name, low, high = parse_range(text)
-            _check_design_values(name, (low, high), text)
-        given.append((name, ParameterRange(low, high, per_step[name]), "ranges"))
-    return _once(given), per_step
+            key, low, high = parse_span(space, text)
+        given.append((key, ParameterRange(low, high, per_step[key]), "ranges"))
+    return _once(given), {n: v for n, v in per_step.items() if space.kind(n) != "categorical"}
+
+
+def _step_of(space: SearchSpace, text: str) -> tuple[str, float]:
+    """``("l", 1.0)`` from ``--resolution l=1``, checked (keyed ``steps``)."""
+    name, sep, value = text.partition("=")
+    if not sep:
+        raise InputError(
+            must_be(f"a number or NAME=STEP with NAME among {space.listing()}", text),
+            key="steps",
+        )
+    with keyed("steps"):
+        key = _named(space, name.strip(), text)
+    try:
+        number = float(value)
+    except ValueError:
+        raise InputError(f"{key} {must_be('a number', value)}", key="steps") from None
+    if not STEP.contains(number):
+        raise InputError(f"{key} {must_be('a finite number >= 0', value)}", key="steps")
+    problem = step_problem(space, key, number)
+    if problem is not None:
+        raise InputError(f"{key} ({value.strip()}) {problem}", key="steps")
+    return key, number
 
 
 def _once(given: Sequence[tuple[str, ParameterRange, str]]) -> dict[str, ParameterRange]:
@@ -266,68 +301,6 @@ def _once(given: Sequence[tuple[str, ParameterRange, str]]) -> dict[str, Paramet
             raise InputError(f"{name!r} is given twice (fixed or ranged); give it once", key=key)
         out[name] = chosen
     return out
-
-
-def _build_other(
-    space: SearchSpace,
-    fixes: Sequence[str],
-    ranges: Sequence[str],
-    steps: Sequence[str],
-    step: float | None,
-) -> tuple[dict[str, ParameterRange], dict[str, float]]:
-    """:func:`build_ranges` for another actuator than paper B's."""
-    if step is not None and not STEP.contains(step):
-        raise InputError(
-            must_be(
-                f"a finite number >= 0 (in each continuous parameter's unit; {STEP.why})", step
-            ),
-            key="step",
-        )
-    per_step = {n: space.default_step(n) for n in space.names}
-    if step is not None:
-        for name in space.names:
-            if space.kind(name) == "continuous":
-                problem = space.step_problem(name, float(step))
-                if problem is not None:
-                    raise InputError(f"{step:g} of {name!r} {problem}", key="step")
-                per_step[name] = float(step)
-    for text in steps:
-        name, sep, value = text.partition("=")
-        if not sep:
-            raise InputError(
-                must_be(f"a number or NAME=STEP with NAME among {space.listing()}", text),
-                key="steps",
-            )
-        with keyed("steps"):
-            key = _named(space, name.strip(), text)
-        try:
-            number = float(value)
-        except ValueError:
-            raise InputError(f"{key} {must_be('a number', value)}", key="steps") from None
-        if not STEP.contains(number):
-            raise InputError(f"{key} {must_be('a finite number >= 0', value)}", key="steps")
-        problem = space.step_problem(key, number)
-        if problem is not None:
-            raise InputError(f"{key} ({value.strip()}) {problem}", key="steps")
-        per_step[key] = number
-    given: list[tuple[str, ParameterRange, str]] = []
-    for text in fixes:
-        with keyed("fixes"):
-            key, code = parse_value(space, text)
-        given.append((key, ParameterRange(code, code, 0.0), "fixes"))
-    for text in ranges:
-        with keyed("ranges"):
-            key, low, high = parse_span(space, text)
-        given.append((key, ParameterRange(low, high, per_step[key]), "ranges"))
-    return _once(given), {n: v for n, v in per_step.items() if space.kind(n) != "categorical"}
-
-
-def _check_design_values(name: str, values: Sequence[float], text: str) -> None:
-    """Refuse a value (of ``text``) that a design's parameter ``name`` cannot take."""
-    for value in values:
-        problem = design_value_problem(name, value)
-        if problem is not None:
-            raise InputError(f"{problem}; got {text!r}", key=name)
 
 
 def target_from_options(

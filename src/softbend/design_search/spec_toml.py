@@ -17,23 +17,21 @@ from typing import Any
 from softbend._names import output_name
 from softbend._tomltext import read_toml
 from softbend.actuators import Actuator
-from softbend.design import DESIGN_LIMITS
 from softbend.design_search.space import PAPER_B, SearchSpace, space_of
 from softbend.design_search.spec import (
     ANGLE,
     CURVE_POINTS,
-    DEFAULT_STEPS,
-    NAMES,
     SPECS,
     STEP,
     TOLERANCE,
-    UNITS,
     Objective,
     ParameterRange,
     Specification,
     Target,
+    default_step,
     is_number,
     pressure_range,
+    step_problem,
 )
 from softbend.design_search.spec_text import code_of
 from softbend.errors import DatasetError, InputError
@@ -66,8 +64,8 @@ def load_specifications(
     ``max_angle_at = P`` asks for the largest angle at P; ``curve = [[p, angle], ...]``
     for a curve (each pressure once).
 
-    For another actuator than paper B's (``actuator``, the model's), the
-    tables name its parameters and give its pressures in its unit::
+    For another actuator (``actuator``, the model's), the tables name its
+    parameters and give its pressures in its unit::
 
         [[spec]]
         angle = 90.0
@@ -233,16 +231,14 @@ class _SpecTable:
 
     def design_number(self, key: str, name: str, value: object) -> float:
         """``value`` as a value of the parameter ``name`` of a design (its code)."""
-        if not self.space.paper_b:
-            if self.space.kind(name) != "categorical" and not is_number(value):
-                raise self.fail(f"{key}.{name}", "a number", value)
-            try:
-                return code_of(self.space, name, value)
-            except InputError as exc:
-                raise DatasetError(f"{self.where} '{key}.{name}': {exc.detail}") from None
-        low, high, low_inclusive = DESIGN_LIMITS[name]
-        allowed = Range(low, high, UNITS[name], "the values a design may take", low_inclusive)
-        return self.number(f"{key}.{name}", allowed, "a number", value)
+        if self.space.kind(name) != "categorical" and not is_number(value):
+            raise self.fail(f"{key}.{name}", "a number", value)
+        try:
+            return code_of(self.space, name, value)
+        except InputError as exc:
+            raise DatasetError(
+                f"{self.where} '{key}.{name}': {exc.detail}; found {_found(value)}."
+            ) from None
 
     def target(self) -> Target:
         """The table's target, from exactly one of :data:`_TARGET_KEYS`."""
@@ -327,29 +323,12 @@ class _SpecTable:
         return tuple(out)
 
     def steps(self) -> dict[str, float]:
-        """``resolution``: one step for every parameter, or a table by parameter."""
-        if not self.space.paper_b:
-            return self._other_steps()
-        value = self.table.get("resolution")
-        what = "a step of the mould (mm, deg for phi)"
-        if value is None:
-            return dict(DEFAULT_STEPS)
-        if isinstance(value, dict):
-            steps = dict(DEFAULT_STEPS)
-            for name, step in self.per_parameter("resolution", "steps").items():
-                steps[name] = self.number(f"resolution.{name}", STEP, what, step)
-            return steps
-        if not is_number(value):
-            raise self.fail("resolution", f"{what}, or a table of steps by parameter", value)
-        return dict.fromkeys(NAMES, self.number("resolution", STEP, what))
-
-    def _other_steps(self) -> dict[str, float]:
-        """``resolution`` of another actuator: one step of every continuous parameter, or a
-        table by parameter; each checked against its kind and declared resolution."""
+        """``resolution``: one step of every continuous parameter, or a table by parameter;
+        each checked against its kind and declared resolution (:func:`~.spec.step_problem`)."""
         space = self.space
         value = self.table.get("resolution")
         what = "a step (each parameter's unit; 0 searches continuously)"
-        steps = {n: space.default_step(n) for n in space.names if space.kind(n) != "categorical"}
+        steps = {n: default_step(space, n) for n in space.names if space.kind(n) != "categorical"}
         if value is None:
             return steps
         if isinstance(value, dict):
@@ -363,7 +342,7 @@ class _SpecTable:
         else:
             raise self.fail("resolution", f"{what}, or a table of steps by parameter", value)
         for name, (key, step) in given.items():
-            problem = space.step_problem(name, step)
+            problem = step_problem(space, name, step)
             if problem is not None:
                 raise DatasetError(
                     f"{self.where} '{key}': the step {step:g} of {name!r} {problem}."
