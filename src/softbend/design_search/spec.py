@@ -38,8 +38,7 @@ from dataclasses import dataclass, field
 from typing import TypeGuard
 
 from softbend._validation import must_be
-from softbend.actuators import PRESSURE_UNITS, Actuator
-from softbend.design import PARAMETERS
+from softbend.actuators import PRESSURE_UNITS, SFRBA, Actuator
 from softbend.design_search.space import SearchSpace, aligned, space_of
 from softbend.errors import InputError
 from softbend.parameters import Range
@@ -72,14 +71,12 @@ __all__ = [
 #: Short names of the design parameters, in the order of :data:`softbend.design.PARAMETERS`.
 NAMES: tuple[str, ...] = ("l", "r", "t", "b", "phi", "lc")
 
-#: Short name → column of the surrogates' inputs.
-COLUMNS: dict[str, str] = dict(zip(NAMES, PARAMETERS, strict=True))
-
 #: Unit of each parameter.
 UNITS: dict[str, str] = {name: "deg" if name == "phi" else "mm" for name in NAMES}
 
-#: The default step of each parameter: a mould's resolution (0.5 mm) and 1° of fibre angle.
-DEFAULT_STEPS: dict[str, float] = {name: 1.0 if name == "phi" else 0.5 for name in NAMES}
+#: Paper B's default step of each parameter: a mould's resolution (0.5 mm) and 1° of fibre
+#: angle (:attr:`Actuator.search_steps <softbend.actuators.Actuator.search_steps>`).
+DEFAULT_STEPS: dict[str, float] = dict(zip(NAMES, SFRBA.search_steps, strict=True))
 
 #: The kinds of :class:`Target`.
 TARGETS: tuple[str, ...] = ("angle_at", "pressure_for", "max_angle", "curve")
@@ -122,8 +119,6 @@ STEP = Range(0.0, math.inf, "", "0 searches continuously", high_inclusive=False)
 
 #: The most values one parameter's grid is built with (:meth:`ParameterRange.values`).
 _MAX_VALUES = 20_000_000
-
-_OWNER = "Specification"
 
 
 @dataclass(frozen=True)

@@ -1,9 +1,9 @@
 """A specification from command-line text: ``NAME=VALUE``, ``NAME=LOW:HIGH``, a target.
 
 :func:`parse_value` and :func:`parse_span` read the parameters of any
-actuator's search (:func:`parse_assignment` and :func:`parse_range` paper B's
-alone, by their short names); :func:`build_ranges` turns ``--fix``, ``--range`` and
-``--resolution`` into the ranges and steps of a :class:`~.spec.Specification`,
+actuator's search (paper B's by their short names or columns);
+:func:`build_ranges` turns ``--fix``, ``--range`` and ``--resolution`` into
+the ranges and steps of a :class:`~.spec.Specification`,
 :func:`parse_objectives` ``--minimize`` and ``--maximize``, and
 :func:`target_from_options` the target options. Every error is one
 :class:`~softbend.errors.InputError` keyed by the option or parameter at fault.
@@ -19,10 +19,8 @@ from softbend.actuators import ActuatorError
 from softbend.design_search.space import PAPER_B, SearchSpace
 from softbend.design_search.spec import (
     CURVE_POINTS,
-    NAMES,
     STEP,
     TOLERANCE,
-    UNITS,
     Objective,
     ParameterRange,
     Specification,
@@ -41,49 +39,12 @@ __all__ = [
     "build_ranges",
     "code_of",
     "option_pressure",
-    "parse_assignment",
     "parse_objectives",
-    "parse_range",
     "parse_span",
     "parse_value",
     "specification_from_options",
     "target_from_options",
 ]
-
-
-def parse_assignment(text: str) -> tuple[str, float]:
-    """``("phi", 10.0)`` from ``"phi=10"`` (or ``"phi_deg=10"``); one clear line for
-    anything else (keyed by the parameter where one is named). Paper B's parameters;
-    :func:`parse_value` reads another actuator's."""
-    name, sep, value = text.partition("=")
-    name = PAPER_B.canonical(name.strip()) or name.strip()
-    if not sep or name not in NAMES:
-        raise InputError(must_be(f"NAME=VALUE with NAME among {', '.join(NAMES)}", text))
-    try:
-        number = float(value)
-    except ValueError:
-        raise InputError(must_be(f"a number ({UNITS[name]})", value), key=name) from None
-    if not math.isfinite(number):
-        raise InputError(must_be("finite", value), key=name)
-    return name, number
-
-
-def parse_range(text: str) -> tuple[str, float, float]:
-    """``("t", 3.0, 4.0)`` from ``"t=3:4"``; one clear line for anything else (keyed
-    by the parameter where one is named). Paper B's parameters; :func:`parse_span` reads
-    another actuator's."""
-    name, sep, value = text.partition("=")
-    name = PAPER_B.canonical(name.strip()) or name.strip()
-    low, colon, high = value.partition(":")
-    if not sep or name not in NAMES or not colon:
-        raise InputError(must_be(f"NAME=LOW:HIGH with NAME among {', '.join(NAMES)}", text))
-    try:
-        a, b = float(low), float(high)
-    except ValueError:
-        raise InputError(must_be(f"LOW:HIGH, numbers ({UNITS[name]})", value), key=name) from None
-    if not (math.isfinite(a) and math.isfinite(b)) or a > b:
-        raise InputError(must_be("finite LOW <= HIGH", value), key=name)
-    return name, a, b
 
 
 def _unit_of(space: SearchSpace, name: str) -> str:
