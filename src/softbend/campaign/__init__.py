@@ -1,4 +1,8 @@
-"""Design campaigns: sweep many actuator designs and keep the results (paper B §3.3, Table 1).
+"""Design campaigns: sweep many actuator designs and keep the results (paper B §3.3).
+
+A campaign sweeps the designs of one actuator (its description, and the FEM family or
+other backend that computes it) over pressures; paper B's Table 1 campaign over its
+fiber-reinforced actuator is one example, a PneuNet space (``--family pneunet``) another.
 
 * :mod:`~softbend.campaign.backends` — what computes one sweep (analytical model,
   FEM, a saved surrogate) behind one protocol and a registry (:data:`BACKENDS`);

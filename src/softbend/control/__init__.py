@@ -1,5 +1,9 @@
 """Closed-loop control of a bending actuator (paper B §5): rig, controllers, experiments.
 
+The controller's model and the plant are θ(p) of any actuator (a saved surrogate records
+its description: the design is given by its parameters, its pressures converted from the
+rig's MPa); paper B's actuator and its shipped FEM-trained MLP are the default.
+
 - :mod:`softbend.control.rig`: the simulated pneumatic rig (ISO 6358 valves, compliant
   chamber, lagged θ(p), sensors) and the :class:`~softbend.control.rig.Rig` protocol;
 - :mod:`softbend.control.controllers`: paper B's deadzone bang-bang and pressure-based

@@ -1,4 +1,4 @@
-"""Nonlinear 3D finite-element model of the fiber-reinforced bending actuator (paper B §3.1).
+"""Nonlinear 3D finite-element models of soft bending actuators (paper B §3.1).
 
 The pipeline: ``geometry`` (netgen.occ solid and mesh) → ``mechanics`` (energy
 densities) → ``energy`` (the energy terms, optionally compiled once per process) →
@@ -7,9 +7,10 @@ minimisation) → ``sweep`` (load stepping, :func:`simulate`) → ``model``
 (:class:`FEMModel`, the FEM as a :class:`~softbend.models.BendingModel`);
 ``verification`` holds the closed-form cases solved with the same core.
 
-The FEM simulates more than one kind of actuator: :mod:`softbend.fem.families`
-registers them (:func:`get_family`, ``--family``). Paper B's actuator above is
-``"sfrba"``; the PneuNet (``"pneunet"``, :mod:`softbend.fem.pneunet`) reuses the
+Each kind of actuator the FEM simulates is a family of :mod:`softbend.fem.families`
+(:func:`get_family`, ``--family``): its actuator description, how it makes a design,
+sweeps it and reads the angle. Paper B's fiber-reinforced actuator (``"sfrba"``) is the
+pipeline above; the PneuNet (``"pneunet"``, :mod:`softbend.fem.pneunet`) reuses the
 energy terms and the load stepping with its own geometry and readout
 (:class:`PneuNetModel`, :func:`run_pneunet_sweep`).
 

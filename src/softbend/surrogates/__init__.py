@@ -1,4 +1,9 @@
-"""Surrogate models of the bending angle: (l, r, t, b, φ, lc, P) → θ (paper B §4.1).
+"""Surrogate models of the bending angle: (design parameters, pressure) → θ (paper B §4.1).
+
+The inputs are the design parameters of the model's actuator in its description's order
+(:class:`softbend.actuators.Actuator`), then the pressure in its unit: for paper B's
+actuator (l, r, t, b, φ, lc, P) in mm, degrees and MPa, for another its own names, such as
+(n_chambers, wall_mm, height_mm, p_kpa). Every saved model records its description.
 
 Polynomial regression, XGBoost and the normalized MLP as scikit-learn
 estimators, each a family of :data:`FAMILIES` (``plr``, ``xgb``, ``mlp``; more

@@ -8,6 +8,10 @@ strategies (:mod:`~softbend.transfer.strategies`, registered by name in
 one strategy fitted and saved (:mod:`~softbend.transfer.refine`) and their
 leave-one-configuration-out evaluation (:mod:`~softbend.transfer.loco`).
 
+The measurements name the base model's actuator's own parameters and pressure unit
+(its description travels with the model); paper B's virtual lab of its fiber-reinforced
+actuator is one example, the PneuNet's built actuators (``examples/pneunet``) another.
+
 Names are imported lazily, so that ``import softbend.transfer`` imports neither
 scikit-learn nor PyTorch.
 """
