@@ -20,6 +20,7 @@ def _blocks() -> list[str]:
         ("softbend.control:CONTROLLERS", "hold"),
         ("softbend.transfer:STRATEGIES", "shifted"),
         ("softbend.surrogates.families:FAMILIES", "toy-linear"),
+        ("softbend.actuators:ACTUATORS", "bellows"),
     ],
 )
 def test_each_example_is_one_class_and_one_register_line(registry, name):
