@@ -3,11 +3,20 @@
 from __future__ import annotations
 
 from pathlib import Path
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import typer
 
 from softbend.cli import _common
+
+if TYPE_CHECKING:
+    from softbend.identification.data import Experiment
+    from softbend.identification.selection import Selection
+    from softbend.identification.study import IdentificationConfig, IdentificationResult
+    from softbend.identification.timeseries import TimeSeriesSet
+
+    #: The free-run selection per pressure sign and the data it was made on.
+    Selections = dict[str, tuple[Selection, TimeSeriesSet]]
 
 app = typer.Typer(
     help="The curling actuator of paper A.\n\n"
@@ -67,6 +76,13 @@ def simulate(
         _common.as_written(stage, out),
     ):
         paths = [out / p.name for p in save_experiments(all_experiments, stage)]
+    _print_experiments(all_experiments, paths, out, as_json)
+
+
+def _print_experiments(
+    experiments: list[Experiment], paths: list[Path], out: Path, as_json: bool
+) -> None:
+    """The written experiments: a table, or the JSON summary with ``as_json``."""
     rows = [
         [
             e.name,
@@ -75,7 +91,7 @@ def simulate(
             float(e.pressure_kpa.max()) + 0.0,
             str(p),
         ]
-        for e, p in zip(all_experiments, paths, strict=True)
+        for e, p in zip(experiments, paths, strict=True)
     ]
     if as_json:
         _common.print_json(
@@ -113,41 +129,54 @@ IDENTIFY_FILES: tuple[str, ...] = (
 )
 
 
+_DATA = typer.Argument(..., help="A CSV file or a folder of CSV files.")
+_IDENTIFY_OUT = typer.Option(
+    ...,
+    "--out",
+    "-o",
+    help="Folder for metrics, models and figures (replaced as a whole: a new or empty "
+    "folder, or an earlier result of this command).",
+)
+_C = typer.Option(100.0, "--C", help="SVR penalty C (paper A calls it gamma).")
+_EPSILON = typer.Option(0.1, help="SVR epsilon, in units of the standardized output.")
+_OUTPUT_LAGS = typer.Option(2, help="Past outputs in the regressor.")
+_INPUT_LAGS = typer.Option(2, help="Inputs in the regressor, u(t) included.")
+_KERNEL = typer.Option(
+    "moments", help="Kernel width/shape: 'moments' (paper A) or 'cv' (cross-validated)."
+)
+_MOMENTS_OF = typer.Option(
+    "differences",
+    help="What the fourth-moment shape is measured on: differences (the kernel's "
+    "arguments x - z), regressors, or components (the pooled regressors, before).",
+)
+_MAX_MEMORY_MB = typer.Option(
+    None,
+    "--max-memory-mb",
+    help="Memory the run may use, MiB; data estimated to need more are refused before "
+    "reading. Default: the memory available.",
+)
+_SELECT = typer.Option(
+    False,
+    "--select",
+    help="Also choose a model per pressure sign by held-out free-run error among linear, "
+    "polynomial and kernel NARX models of rho and L together (out/selection_<sign>/).",
+)
+_IDENTIFY_JSON = typer.Option(False, "--json", help="Print metrics as JSON.")
+
+
 @app.command("identify")
 def identify(
-    data: Path = typer.Argument(..., help="A CSV file or a folder of CSV files."),
-    out: Path = typer.Option(
-        ...,
-        "--out",
-        "-o",
-        help="Folder for metrics, models and figures (replaced as a whole: a new or empty "
-        "folder, or an earlier result of this command).",
-    ),
-    c: float = typer.Option(100.0, "--C", help="SVR penalty C (paper A calls it gamma)."),
-    epsilon: float = typer.Option(0.1, help="SVR epsilon, in units of the standardized output."),
-    output_lags: int = typer.Option(2, help="Past outputs in the regressor."),
-    input_lags: int = typer.Option(2, help="Inputs in the regressor, u(t) included."),
-    kernel: str = typer.Option(
-        "moments", help="Kernel width/shape: 'moments' (paper A) or 'cv' (cross-validated)."
-    ),
-    moments_of: str = typer.Option(
-        "differences",
-        help="What the fourth-moment shape is measured on: differences (the kernel's "
-        "arguments x - z), regressors, or components (the pooled regressors, before).",
-    ),
-    max_memory_mb: float | None = typer.Option(
-        None,
-        "--max-memory-mb",
-        help="Memory the run may use, MiB; data estimated to need more are refused before "
-        "reading. Default: the memory available.",
-    ),
-    select: bool = typer.Option(
-        False,
-        "--select",
-        help="Also choose a model per pressure sign by held-out free-run error among linear, "
-        "polynomial and kernel NARX models of rho and L together (out/selection_<sign>/).",
-    ),
-    as_json: bool = typer.Option(False, "--json", help="Print metrics as JSON."),
+    data: Path = _DATA,
+    out: Path = _IDENTIFY_OUT,
+    c: float = _C,
+    epsilon: float = _EPSILON,
+    output_lags: int = _OUTPUT_LAGS,
+    input_lags: int = _INPUT_LAGS,
+    kernel: str = _KERNEL,
+    moments_of: str = _MOMENTS_OF,
+    max_memory_mb: float | None = _MAX_MEMORY_MB,
+    select: bool = _SELECT,
+    as_json: bool = _IDENTIFY_JSON,
 ) -> None:
     """Identify NARX models of rho and L per pressure sign.
 
@@ -164,61 +193,65 @@ def identify(
     \b
         softbend curling identify experiments --out identification
     """
-    from softbend.identification.data import experiment_files, load_experiments
-    from softbend.identification.ranges import (
-        C_RANGE,
-        EPSILON_RANGE,
-        LAGS_RANGE,
-        MAX_MEMORY_MB_RANGE,
-        check_integer,
-        check_number,
-    )
+    from softbend.identification.data import experiment_files
+    from softbend.identification.ranges import check_settings
 
     # every numeric option within its declared range (softbend.identification.ranges),
     # before anything is read: lags of 10**9 would allocate GiB before the first fit
-    check_number(c, C_RANGE, "C")
-    check_number(epsilon, EPSILON_RANGE, "epsilon")
-    check_integer(output_lags, LAGS_RANGE, "output_lags")
-    check_integer(input_lags, LAGS_RANGE, "input_lags")
-    if max_memory_mb is not None:
-        check_number(max_memory_mb, MAX_MEMORY_MB_RANGE, "max_memory_mb")
+    numbers = {"epsilon": epsilon, "output_lags": output_lags, "input_lags": input_lags}
+    check_settings(C=c, max_memory_mb=max_memory_mb, **numbers)
     if not Path(data).exists():  # one line naming it, before the fitting's imports (seconds)
         experiment_files(data)
 
-    from softbend._outdir import staged_dir
-    from softbend.identification.resources import check_identify_memory
-    from softbend.identification.study import (
-        IdentificationConfig,
-        check_experiments,
-        n_fits,
-    )
+    from softbend.identification.study import IdentificationConfig, n_fits
     from softbend.identification.study import identify as run_identify
-    from softbend.reports.identify_outputs import write_identification
-    from softbend.reports.paper_a import write_identification_outputs
 
     choices: dict[str, Any] = {"kernel": kernel, "moments_of": moments_of}  # checked there
-    config = IdentificationConfig(
-        C=c, epsilon=epsilon, output_lags=output_lags, input_lags=input_lags, **choices
-    )
+    config = IdentificationConfig(C=c, **numbers, **choices)
+    out = Path(out)
     csvs = [p for p in data.iterdir() if p.suffix.lower() == ".csv"] if data.is_dir() else []
     inputs = (data, *csvs)
-    out = Path(out)
     _common.check_output_dir(out, "--out", inputs=inputs, files=("metrics.csv", "summary.csv"))
     _common.check_replaceable_dir(out, "--out", inputs=inputs)
-    experiment_files(data)  # missing data and files over the size limit: refused first
-    need = check_identify_memory(data, max_memory_mb=max_memory_mb)
-    if not as_json and need.csv_bytes >= 4 * 2**20:  # long enough to be worth a line
-        _common.err_console.print(
-            f"reading {need.csv_bytes / 2**20:.1f} MiB of CSV (about {need.rows:,} samples)",
-            highlight=False,
-        )
-    experiments = load_experiments(data)
-    check_experiments(experiments, config)  # lags the data can hold, before fits
+    experiments = _read_experiments(data, config, max_memory_mb, as_json)
     with _common.progress_bar(
         "fitting NARX models", n_fits(experiments), enabled=not as_json
     ) as bar:
         result = run_identify(experiments, config, progress=lambda label: bar(last=label))
     selections = _select(experiments, as_json) if select else {}
+    outputs = _write_identification(out, result, selections)
+    _print_identification(result, outputs, selections, out, as_json)
+
+
+def _read_experiments(
+    data: Path, config: IdentificationConfig, max_memory_mb: float | None, quiet: bool
+) -> list[Experiment]:
+    """The experiments of ``data``, refused before reading when they would not fit in memory
+    and checked against ``config`` (lags the data can hold) before any fit."""
+    from softbend.identification.data import experiment_files, load_experiments
+    from softbend.identification.resources import check_identify_memory
+    from softbend.identification.study import check_experiments
+
+    experiment_files(data)  # missing data and files over the size limit: refused first
+    need = check_identify_memory(data, max_memory_mb=max_memory_mb)
+    if not quiet and need.csv_bytes >= 4 * 2**20:  # long enough to be worth a line
+        _common.err_console.print(
+            f"reading {need.csv_bytes / 2**20:.1f} MiB of CSV (about {need.rows:,} samples)",
+            highlight=False,
+        )
+    experiments = load_experiments(data)
+    check_experiments(experiments, config)
+    return experiments
+
+
+def _write_identification(
+    out: Path, result: IdentificationResult, selections: Selections
+) -> dict[str, Path]:
+    """Write the identification (and the selections) into ``out`` as a whole; the files."""
+    from softbend._outdir import staged_dir
+    from softbend.reports.identify_outputs import write_identification
+    from softbend.reports.paper_a import write_identification_outputs
+
     with (
         _common.output_errors(out, "--out"),
         staged_dir(out) as stage,
@@ -227,7 +260,17 @@ def identify(
         written = write_identification_outputs(result, stage)
         for sign, (selection, series) in selections.items():
             write_identification(selection, series, stage / f"selection_{sign}")
-    outputs = {key: out / Path(path).relative_to(stage) for key, path in written.items()}
+    return {key: out / Path(path).relative_to(stage) for key, path in written.items()}
+
+
+def _print_identification(
+    result: IdentificationResult,
+    outputs: dict[str, Path],
+    selections: Selections,
+    out: Path,
+    as_json: bool,
+) -> None:
+    """The metrics and the selections' verdicts: tables, or JSON with ``as_json``."""
     verdicts = {sign: selection.verdict() for sign, (selection, _) in selections.items()}
     if as_json:
         _common.print_json(

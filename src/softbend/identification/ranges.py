@@ -58,6 +58,7 @@ __all__ = [
     "check_integer",
     "check_lags_fit",
     "check_number",
+    "check_settings",
 ]
 
 #: Lags of a NARX regressor, in samples (past outputs na, inputs nb).
@@ -234,3 +235,33 @@ def check_lags_fit(
                 f"must leave {leave} to predict); got {value}",
                 key=key,
             )
+
+
+def check_settings(
+    *,
+    C: object,
+    epsilon: object,
+    output_lags: object,
+    input_lags: object,
+    max_memory_mb: object = None,
+) -> None:
+    """Hold the numeric identification settings to their declared ranges.
+
+    Parameters
+    ----------
+    C, epsilon, output_lags, input_lags
+        The values given (see :class:`~softbend.identification.study.IdentificationConfig`).
+    max_memory_mb : float, optional
+        Memory the identification may use, MiB; not checked when None.
+
+    Raises
+    ------
+    InputError
+        Keyed by the first setting out of its range: the range and the value.
+    """
+    check_number(C, C_RANGE, "C")
+    check_number(epsilon, EPSILON_RANGE, "epsilon")
+    check_integer(output_lags, LAGS_RANGE, "output_lags")
+    check_integer(input_lags, LAGS_RANGE, "input_lags")
+    if max_memory_mb is not None:
+        check_number(max_memory_mb, MAX_MEMORY_MB_RANGE, "max_memory_mb")

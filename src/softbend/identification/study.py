@@ -28,14 +28,7 @@ from softbend.errors import ConvergenceError, DatasetError
 from softbend.identification.data import Experiment
 from softbend.identification.kernels import MOMENTS_OF, ShapeClippedWarning
 from softbend.identification.narx import NARXRegressor
-from softbend.identification.ranges import (
-    C_RANGE,
-    EPSILON_RANGE,
-    LAGS_RANGE,
-    check_integer,
-    check_lags_fit,
-    check_number,
-)
+from softbend.identification.ranges import check_lags_fit, check_settings
 from softbend.metrics import regression_metrics
 
 if TYPE_CHECKING:
@@ -92,31 +85,6 @@ class IdentificationConfig:
         )
         check_choice(self.kernel, "kernel", ("moments", "cv"))
         check_choice(self.moments_of, "moments_of", MOMENTS_OF)
-
-
-def check_settings(
-    *,
-    C: object,
-    epsilon: object,
-    output_lags: object,
-    input_lags: object,
-) -> None:
-    """Hold the numeric settings of :class:`IdentificationConfig` to their declared ranges.
-
-    Parameters
-    ----------
-    C, epsilon, output_lags, input_lags
-        The values given (see :class:`IdentificationConfig`).
-
-    Raises
-    ------
-    InputError
-        Keyed by the first setting out of its range: the range and the value.
-    """
-    check_number(C, C_RANGE, "C")
-    check_number(epsilon, EPSILON_RANGE, "epsilon")
-    check_integer(output_lags, LAGS_RANGE, "output_lags")
-    check_integer(input_lags, LAGS_RANGE, "input_lags")
 
 
 @dataclass
