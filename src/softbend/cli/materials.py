@@ -3,7 +3,7 @@
 from __future__ import annotations
 
 from pathlib import Path
-from typing import TYPE_CHECKING, Annotated
+from typing import TYPE_CHECKING, Annotated, Any
 
 import typer
 
@@ -11,6 +11,7 @@ from softbend.cli import _common
 
 if TYPE_CHECKING:
     from softbend.materials.fit import FitResult
+    from softbend.materials.tensile import TensileTest
 
 app = typer.Typer(
     help="Tensile tests and hyperelastic fits (paper B §3.1).\n\n"
@@ -19,9 +20,6 @@ app = typer.Typer(
     no_args_is_help=True,
 )
 
-#: Files written into ``--out`` by ``fit``.
-FIT_PNG = "fit.png"
-FIT_JSON = "fit.json"
 _SYMBOLS = {
     "c10_mpa": "C10",
     "c20_mpa": "C20",
@@ -35,45 +33,38 @@ def _describe(result: FitResult) -> str:
     return ", ".join(f"{_SYMBOLS.get(k, k)} {v:.4g}" for k, v in result.parameters.items())
 
 
+_CSV = typer.Argument(
+    help=(
+        "Tensile data file (semicolon-separated, with the columns 'Engineering Strain' "
+        "and 'Engineering Stress (MPa)') or the name of a shipped test "
+        "(see 'softbend materials list'). Default: the shipped Dragon Skin 30 test."
+    ),
+    show_default=False,
+)
+_MODELS = typer.Option(
+    "--models", help="Comma-separated models among neo-hookean, yeoh, arruda-boyce."
+)
+_OUT = typer.Option("--out", "-o", help="Folder for fit.png and fit.json (created if missing).")
+_MAX_STRETCH = typer.Option(
+    "--max-stretch",
+    help="Fit only the points with stretch ≤ this (> 1). Default: all, to failure.",
+    show_default=False,
+)
+_FORCE = typer.Option(
+    "--force",
+    help="Read a stress column that looks like kPa (stiffer than 20 MPa) as given.",
+)
+_JSON = typer.Option("--json", help="Print the results as JSON.")
+
+
 @app.command("fit")
 def fit(
-    csv: Annotated[
-        str | None,
-        typer.Argument(
-            help=(
-                "Tensile data file (semicolon-separated, with the columns 'Engineering Strain' "
-                "and 'Engineering Stress (MPa)') or the name of a shipped test "
-                "(see 'softbend materials list'). Default: the shipped Dragon Skin 30 test."
-            ),
-            show_default=False,
-        ),
-    ] = None,
-    models: Annotated[
-        str,
-        typer.Option(
-            "--models", help="Comma-separated models among neo-hookean, yeoh, arruda-boyce."
-        ),
-    ] = "neo-hookean,yeoh,arruda-boyce",
-    out: Annotated[
-        Path,
-        typer.Option("--out", "-o", help="Folder for fit.png and fit.json (created if missing)."),
-    ] = Path("results/materials"),
-    max_stretch: Annotated[
-        float | None,
-        typer.Option(
-            "--max-stretch",
-            help="Fit only the points with stretch ≤ this (> 1). Default: all, to failure.",
-            show_default=False,
-        ),
-    ] = None,
-    force: Annotated[
-        bool,
-        typer.Option(
-            "--force",
-            help="Read a stress column that looks like kPa (stiffer than 20 MPa) as given.",
-        ),
-    ] = False,
-    json_output: Annotated[bool, typer.Option("--json", help="Print the results as JSON.")] = False,
+    csv: Annotated[str | None, _CSV] = None,
+    models: Annotated[str, _MODELS] = "neo-hookean,yeoh,arruda-boyce",
+    out: Annotated[Path, _OUT] = Path("results/materials"),
+    max_stretch: Annotated[float | None, _MAX_STRETCH] = None,
+    force: Annotated[bool, _FORCE] = False,
+    json_output: Annotated[bool, _JSON] = False,
 ) -> None:
     """Fit hyperelastic models to a uniaxial tensile test.
 
@@ -87,30 +78,27 @@ def fit(
     \b
         softbend materials fit dragon-skin-30 --models yeoh --out results/materials
     """
-    from softbend._io import atomic_files
-    from softbend.materials.fit import fit_file_payload, fit_models
+    from softbend.materials.fit import fit_models
     from softbend.materials.tensile import load_tensile
-    from softbend.reports.material_figures import fit_figure
+    from softbend.reports.material_outputs import FIT_JSON, FIT_PNG, write_fit
 
     names = [m.strip() for m in models.split(",") if m.strip()]
     inputs = (Path(csv),) if csv is not None and Path(csv).exists() else ()
     _common.check_output_dir(out, "--out", inputs=inputs, files=(FIT_PNG, FIT_JSON))
     test = load_tensile(csv, force=force)
     results = fit_models(test, names, max_stretch=max_stretch)
-
-    figure = out / FIT_PNG
-    payload = fit_file_payload(test, results, max_stretch)
-    payload["files"] = {"figure": str(figure), "json": str(out / FIT_JSON)}
-    with (
-        _common.output_errors(out, "--out"),
-        atomic_files(figure, out / FIT_JSON) as (png, summary),  # both new, or both as they were
-    ):
-        fit_figure(test, results, png)
-        summary.write_text(_common.json_text(payload) + "\n", encoding="utf-8")
-
+    with _common.output_errors(out, "--out"):
+        payload = write_fit(test, results, max_stretch, out)
     if json_output:
         _common.print_json(payload)
         return
+    _print_fit(test, results, payload, out)
+
+
+def _print_fit(
+    test: TensileTest, results: dict[str, FitResult], payload: dict[str, Any], out: Path
+) -> None:
+    """The fits as a table, the data's attribution, the best model and where the files are."""
     first, last = next(iter(results.values())).stretch_range
     _common.print_table(
         f"{test.material}: {test.n_points} points, stretch {first:.4g} to {last:.4g} fitted",
