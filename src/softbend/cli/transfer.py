@@ -8,7 +8,9 @@ The virtual lab (``softbend lab``) is :mod:`~softbend.cli.transfer_lab`.
 
 from __future__ import annotations
 
+from collections.abc import Mapping
 from pathlib import Path
+from typing import Any
 
 import typer
 
@@ -73,38 +75,48 @@ def base(
     )
 
 
+_BASE = typer.Argument(..., help="Saved surrogate to start from (an mlp for 'refined').")
+_MEASUREMENTS = typer.Argument(
+    ...,
+    metavar="MEASUREMENTS",
+    help="Measurements CSV file(s); several are joined, each keeping its provenance.",
+)
+_OUT = typer.Option(..., "--out", "-o", help="File for the refined model (JSON).")
+_STRATEGY = typer.Option(
+    None,
+    help="A strategy that learns from the measurements (see 'softbend transfer "
+    "strategies'). Default: 'refined' for an mlp base, else 'scale-offset'.",
+)
+_SET = typer.Option(
+    None,
+    "--set",
+    help="A parameter of the strategy, NAME=VALUE (repeatable; recorded in the model file).",
+)
+_EPOCHS = typer.Option(
+    None,
+    min=1,
+    help="Epochs of the MLP strategies (default: the strategy's); as --set epochs=N.",
+)
+_SEED = typer.Option(0, min=0, help="Seed of the training.")
+_FORCE = typer.Option(
+    False,
+    "--force",
+    help="Use pressures past the base model's range (1.5x its top) and angles that look "
+    "like radians next to its prediction as given (with a warning; recorded in the model "
+    "file).",
+)
+
+
 @app.command("refine")
 def refine(
-    base: Path = typer.Argument(..., help="Saved surrogate to start from (an mlp for 'refined')."),
-    measurements: list[Path] = typer.Argument(
-        ...,
-        metavar="MEASUREMENTS",
-        help="Measurements CSV file(s); several are joined, each keeping its provenance.",
-    ),
-    out: Path = typer.Option(..., "--out", "-o", help="File for the refined model (JSON)."),
-    strategy: str | None = typer.Option(
-        None,
-        help="A strategy that learns from the measurements (see 'softbend transfer "
-        "strategies'). Default: 'refined' for an mlp base, else 'scale-offset'.",
-    ),
-    settings: list[str] | None = typer.Option(
-        None,
-        "--set",
-        help="A parameter of the strategy, NAME=VALUE (repeatable; recorded in the model file).",
-    ),
-    epochs: int | None = typer.Option(
-        None,
-        min=1,
-        help="Epochs of the MLP strategies (default: the strategy's); as --set epochs=N.",
-    ),
-    seed: int = typer.Option(0, min=0, help="Seed of the training."),
-    force: bool = typer.Option(
-        False,
-        "--force",
-        help="Use pressures past the base model's range (1.5x its top) and angles that look "
-        "like radians next to its prediction as given (with a warning; recorded in the model "
-        "file).",
-    ),
+    base: Path = _BASE,
+    measurements: list[Path] = _MEASUREMENTS,
+    out: Path = _OUT,
+    strategy: str | None = _STRATEGY,
+    settings: list[str] | None = _SET,
+    epochs: int | None = _EPOCHS,
+    seed: int = _SEED,
+    force: bool = _FORCE,
 ) -> None:
     """Fit a strategy on measurements and save it.
 
@@ -129,16 +141,7 @@ def refine(
         softbend transfer refine base.json lab.csv --out refined.json --set epochs=500
         softbend transfer refine base.json lab.csv bench.csv --out refined.json
     """
-    from softbend.limits import check_limit
-
-    values = _common.parse_assignments(settings or ())
-    if epochs is not None:
-        if "epochs" in values:
-            raise ValueError(
-                "The epochs are given twice, by '--epochs' and '--set'; give them once."
-            )
-        check_limit("epochs", epochs, "--epochs")
-        values["epochs"] = str(epochs)
+    values = _strategy_settings(settings, epochs)
     _check_inputs(base, measurements)
     _common.check_output_file(out, "--out", inputs=(base, *measurements), kind="model")
     from softbend.transfer.refine import refine_surrogate  # heavy: after the arguments' checks
@@ -149,7 +152,26 @@ def refine(
         )
     with _common.output_errors(out, "--out"):
         path = result.save(out)
-    meta = result.metadata
+    _print_refined(result.metadata, path)
+
+
+def _strategy_settings(settings: list[str] | None, epochs: int | None) -> dict[str, str]:
+    """The ``--set`` values, with ``--epochs`` as ``epochs`` (refused when both give it)."""
+    from softbend.limits import check_limit
+
+    values = _common.parse_assignments(settings or ())
+    if epochs is not None:
+        if "epochs" in values:
+            raise ValueError(
+                "The epochs are given twice, by '--epochs' and '--set'; give them once."
+            )
+        check_limit("epochs", epochs, "--epochs")
+        values["epochs"] = str(epochs)
+    return values
+
+
+def _print_refined(meta: Mapping[str, Any], path: Path) -> None:
+    """The strategy fitted (and any left out for it), its training error and interval."""
     strategy = str(meta["strategy"])
     for name, reason in meta.get("strategy_left_out", {}).items():
         _common.warning_line(
