@@ -198,7 +198,11 @@ def identify(
 
     # every numeric option within its declared range (softbend.identification.ranges),
     # before anything is read: lags of 10**9 would allocate GiB before the first fit
-    numbers = {"epsilon": epsilon, "output_lags": output_lags, "input_lags": input_lags}
+    numbers: dict[str, Any] = {
+        "epsilon": epsilon,
+        "output_lags": output_lags,
+        "input_lags": input_lags,
+    }
     check_settings(C=c, max_memory_mb=max_memory_mb, **numbers)
     if not Path(data).exists():  # one line naming it, before the fitting's imports (seconds)
         experiment_files(data)
