@@ -132,3 +132,11 @@ def test_design_find_keeps_to_the_resolution_and_the_constraint(model, tmp_path,
     with open(out / "candidates.csv", encoding="utf-8") as handle:
         header = next(csv.reader(handle))
     assert header[1:5] == [*NAMES, "pressure_psi"]
+
+
+def test_the_description_as_json_is_the_same_for_the_shell(bellows, tmp_path):
+    from softbend.actuators import actuator_from
+
+    path = tmp_path / "bellows.json"
+    path.write_text(json.dumps(bellows.to_dict()), encoding="utf-8")
+    assert actuator_from(str(path)) == bellows
