@@ -12,12 +12,7 @@ temporary file.
 
 from __future__ import annotations
 
-import signal
-import threading
-from collections.abc import Iterator
-from contextlib import contextmanager
 from pathlib import Path
-from types import FrameType
 from typing import TYPE_CHECKING, Any
 
 import typer
@@ -41,28 +36,6 @@ def _typed(ctx: typer.Context, parameter: str) -> bool:
     """Whether the option of ``parameter`` was given (typed or from the environment)."""
     source = ctx.get_parameter_source(parameter)
     return getattr(source, "name", None) in ("COMMANDLINE", "ENVIRONMENT")
-
-
-@contextmanager
-def _terminate_as_interrupt() -> Iterator[None]:
-    """SIGTERM (``kill``) ends the block as Ctrl-C does, so its clean-up runs.
-
-    Without it the process would die at once and leave the temporary outputs
-    beside the files. Nothing is changed off the main thread (signals cannot be
-    set there).
-    """
-    if threading.current_thread() is not threading.main_thread():
-        yield
-        return
-
-    def interrupt(signum: int, frame: FrameType | None) -> None:
-        raise KeyboardInterrupt
-
-    previous = signal.signal(signal.SIGTERM, interrupt)
-    try:
-        yield
-    finally:
-        signal.signal(signal.SIGTERM, previous)
 
 
 lab_app = typer.Typer(
@@ -206,12 +179,13 @@ def _measure_and_write(lab: VirtualLab, out: Path, figure: Path, *, quiet: bool)
     Ctrl-C or SIGTERM leaves both files as they were, says so and exits with 130.
     """
     from softbend._io import atomic_files
+    from softbend.cli.control_run import sigterm_as_interrupt
     from softbend.reports.transfer_figures import lab_measurements
     from softbend.transfer.measurements import format_measurements
 
     total = len(lab.actuators)
     try:
-        with _terminate_as_interrupt():
+        with sigterm_as_interrupt():  # `kill` leaves both files as Ctrl-C does
             with _common.progress_bar("virtual lab", total, enabled=not quiet) as advance:
                 measurements = lab.measure(progress=lambda done, n, name: advance(actuator=name))
             text = format_measurements(measurements)
