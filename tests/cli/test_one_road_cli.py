@@ -32,22 +32,7 @@ PRESSURE = "p_kpa"
 #: A simulated design of the table (d000) and its angles there, read in the tests.
 DESIGN_ID = "d000"
 
-#: What ``transfer loco``, ``transfer refine`` and ``control simulate`` stop with on an xgb
-#: model of this actuator: the saved booster is rebuilt with paper B's seven features.
-XGB_REBUILD = "cannot rebuild the xgb surrogate (Feature shape mismatch, expected: 5, got 7)"
-
-
-def _family(name: str, failing: bool = False):
-    """``name`` as a case; ``failing``: the command stops today with :data:`XGB_REBUILD`."""
-    if not failing:
-        return name
-    reason = f"softbend: error: MODEL: {XGB_REBUILD}"
-    return pytest.param(name, marks=pytest.mark.xfail(strict=True, reason=reason))
-
-
 FAMILIES = ("plr", "xgb", "mlp")
-#: The families of a command that stops today on an xgb model of another actuator.
-FAMILIES_XGB_FAILING = (_family("plr"), _family("xgb", failing=True), _family("mlp"))
 
 
 def _run(*args: str) -> int:
@@ -118,7 +103,7 @@ def test_predict(trained, family, capsys):
     assert halves[1] > halves[0]
 
 
-@pytest.mark.parametrize("family", FAMILIES_XGB_FAILING)
+@pytest.mark.parametrize("family", FAMILIES)
 def test_transfer_loco(trained, family, tmp_path, capsys):
     from softbend.transfer import STRATEGIES
 
@@ -148,7 +133,7 @@ def test_transfer_loco(trained, family, tmp_path, capsys):
     assert "l_mm" not in header and "pressure_mpa" not in header
 
 
-@pytest.mark.parametrize("family", FAMILIES_XGB_FAILING)
+@pytest.mark.parametrize("family", FAMILIES)
 def test_transfer_refine(trained, family, tmp_path, capsys):
     model = _model(trained, family, capsys)
     out = tmp_path / "refined.json"
@@ -196,7 +181,7 @@ def test_design_find(trained, family, tmp_path, capsys):
     assert header[1:6] == [*NAMES, "pressure_kpa"]
 
 
-@pytest.mark.parametrize("family", FAMILIES_XGB_FAILING)
+@pytest.mark.parametrize("family", FAMILIES)
 def test_control_simulate_with_the_model_as_plant(trained, family, tmp_path, capsys):
     model = _model(trained, family, capsys)
     out = tmp_path / "control"
