@@ -32,9 +32,9 @@ from pathlib import Path
 import numpy as np
 from _record import record, variant_name
 
+from softbend.actuators import Design
 from softbend.campaign import SweepResult, default_pressures_mpa, get_backend, run_campaign
 from softbend.cli.campaign import parse_space
-from softbend.design import SFRBADesign
 
 TARGET_OVERHEAD_MS = 20.0
 
@@ -46,7 +46,7 @@ class PrecomputedBackend:
     template: SweepResult
     name: str = "no-op"
 
-    def sweep(self, design: SFRBADesign, pressures_mpa: np.ndarray) -> SweepResult:
+    def sweep(self, design: Design, pressures_mpa: np.ndarray) -> SweepResult:
         t = self.template
         return SweepResult(
             design=design,

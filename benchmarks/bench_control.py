@@ -29,7 +29,7 @@ from softbend.control.experiments import run_metrics, simulate
 from softbend.control.factory import make_controller
 from softbend.control.plants import PLANTS, plant_table
 from softbend.control.rig import AngleTable, RigParams, SimulatedRig
-from softbend.design import SFRBADesign
+from softbend.design import sfrba_design
 from softbend.transfer.base import load_base
 
 REFERENCES = ("step:90", "square:90:4", "triangle:0.2:90:20")
@@ -61,7 +61,7 @@ def main() -> None:
     )
     parser.add_argument("--model", default=None, help="the controllers' surrogate (JSON)")
     args = parser.parse_args()
-    design = SFRBADesign(100, 6, 2, 2, 5, 8)
+    design = sfrba_design(100, 6, 2, 2, 5, 8)
     model = load_base(args.model)
     table = AngleTable.from_surrogate(model, design)
     sensor = mlp_virtual_sensor(model, design)

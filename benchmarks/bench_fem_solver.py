@@ -47,7 +47,7 @@ from _record import variant_name
 
 import softbend.fem  # noqa: F401  (loads PyTorch before NGSolve)
 from softbend.campaign.backends import default_pressures_mpa
-from softbend.design import SFRBADesign
+from softbend.design import parse_sfrba
 from softbend.fem import FEMOptions, simulate, sweep, use_compiled
 from softbend.fem.actuator import ActuatorModel
 from softbend.fem.mechanics import solid_energy
@@ -73,7 +73,7 @@ def _mean_time(action, repeats: int) -> float:
 def assembly(design: str, repeats: int) -> dict:
     import ngsolve as ngs
 
-    model = ActuatorModel(SFRBADesign.parse(design), FEMOptions())
+    model = ActuatorModel(parse_sfrba(design), FEMOptions())
     rng = np.random.default_rng(0)
     model.set_state(0.01 * rng.standard_normal(model.state().shape) * model.solver.free_mask)
     model.set_load(0.05, 1.0)
@@ -182,7 +182,7 @@ def steps(rule: str) -> dict:
         _iteration_rule()
     total_iterations = total_rejected = 0
     for design in SLOW_CORNERS:
-        result = simulate(SFRBADesign.parse(design), default_pressures_mpa(), FEMOptions())
+        result = simulate(parse_sfrba(design), default_pressures_mpa(), FEMOptions())
         iterations = int(result.stats["timings"]["iterations"])
         rejected = int(result.stats["rejected_steps"])
         total_iterations += iterations
@@ -203,9 +203,7 @@ def rtol(values: tuple[float, ...] = (1e-9, 3e-9, 1e-8)) -> dict:
     for design in RTOL_DESIGNS:
         reference = None
         for value in values:
-            result = simulate(
-                SFRBADesign.parse(design), default_pressures_mpa(), FEMOptions(rtol=value)
-            )
+            result = simulate(parse_sfrba(design), default_pressures_mpa(), FEMOptions(rtol=value))
             iterations = int(result.stats["timings"]["iterations"])
             totals[value] += iterations
             line = (

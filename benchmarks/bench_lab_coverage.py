@@ -27,7 +27,7 @@ from pathlib import Path
 
 from _record import record
 
-from softbend.design import SFRBADesign
+from softbend.design import sfrba_design
 from softbend.transfer.base import load_base
 from softbend.transfer.lab import VirtualLab, shipped_measurements, shipped_measurements_path
 from softbend.transfer.loco import leave_one_configuration_out
@@ -37,7 +37,7 @@ from softbend.transfer.measurements import (
     save_measurements,
 )
 
-EIGHTH = SFRBADesign(130, 7, 2.5, 3, 10, 9)
+EIGHTH = sfrba_design(130, 7, 2.5, 3, 10, 9)
 
 
 def eighth_actuator() -> Measurements:

@@ -35,7 +35,7 @@ from softbend.control.modbus import ModbusRig
 from softbend.control.modbus_server import free_tcp_port
 from softbend.control.rig import AngleTable, RigParams, SimulatedRig
 from softbend.control.rigconfig import RigConfig
-from softbend.design import SFRBADesign
+from softbend.design import sfrba_design
 from softbend.errors import RigError
 from softbend.transfer.base import load_base
 
@@ -47,7 +47,7 @@ def main() -> None:
     parser.add_argument("--duration", type=float, default=20.0)
     parser.add_argument("--json", action="store_true")
     args = parser.parse_args()
-    design = SFRBADesign(100, 6, 2, 2, 5, 8)
+    design = sfrba_design(100, 6, 2, 2, 5, 8)
     model = load_base()
     table = AngleTable.from_surrogate(model, design)
     sensor = mlp_virtual_sensor(model, design)

@@ -12,8 +12,8 @@ from typing import Any
 import numpy as np
 import pandas as pd
 
-from softbend.actuators import Actuator, DesignParameter
-from softbend.design import DesignSpace, FamilyDesign
+from softbend.actuators import Actuator, Design, DesignParameter
+from softbend.design import DesignSpace
 from softbend.errors import ConvergenceError, InputError
 from softbend.fem.families import FEM_FAMILIES, FEMFamily
 from softbend.models import SweepResult
@@ -165,16 +165,16 @@ class StandInDesigns:
     for its chambers; ``cap`` None accepts every design.
     """
 
-    family: str
+    actuator: Actuator
     cap: tuple[str, float] | None = None
     slack: float = 0.0
 
-    def __call__(self, values: dict[str, float]) -> FamilyDesign:
+    def __call__(self, values: dict[str, float]) -> Design:
         if self.cap is not None:
             name, limit = self.cap
             if values["n_cells"] == 5 and values[name] > limit + self.slack:
                 raise InputError(f"must be at most {limit:g} mm with 5 cells", key=name)
-        return FamilyDesign(self.family, values)
+        return Design(self.actuator, values)
 
 
 @dataclass(frozen=True)
@@ -297,17 +297,18 @@ def stand_in_family(
     **actuator
         Further fields of the actuator (``constraints``, ``pressure_unit``, ...).
     """
+    described = Actuator(
+        name=name, title=actuator_title, parameters=parameters, fem_family=name, **actuator
+    )
     return FEMFamily(
         name=name,
         title=title,
-        actuator=Actuator(
-            name=name, title=actuator_title, parameters=parameters, fem_family=name, **actuator
-        ),
+        actuator=described,
         reference=reference,
         pmax_mpa=pmax_mpa,
         pstep_mpa=pstep_mpa,
         maxh_mm=maxh_mm,
-        make_design=StandInDesigns(name, cap, cap_slack),
+        make_design=StandInDesigns(described, cap, cap_slack),
         sweep=ClosedFormSweep(
             k_deg_per_mpa,
             touch_mpa=touch_mpa,

@@ -20,7 +20,7 @@ from softbend.actuators import (
     parse_ranges,
     pressure_to_mpa,
 )
-from softbend.design import PARAMETERS, SFRBADesign
+from softbend.design import PARAMETERS, sfrba_design
 
 
 def pneunet() -> Actuator:
@@ -50,7 +50,7 @@ def test_paper_b_design_by_name_equals_by_position_and_sfrba_design():
     by_name = SFRBA.parse_design("l_mm=100,r_mm=6,t_mm=2,b_mm=2,phi_deg=5,lc_mm=8")
     by_position = SFRBA.parse_design("100,6,2,2,5,8")
     np.testing.assert_array_equal(by_name, by_position)
-    np.testing.assert_array_equal(by_name, SFRBADesign(100, 6, 2, 2, 5, 8).as_array())
+    np.testing.assert_array_equal(by_name, sfrba_design(100, 6, 2, 2, 5, 8).as_array())
 
 
 def test_paper_b_constraint_wall_thinner_than_radius():

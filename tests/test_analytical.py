@@ -14,11 +14,11 @@ from softbend.analytical import (
     section_quadrature,
     tip_position_mm,
 )
-from softbend.design import DesignSpace, SFRBADesign
+from softbend.design import DesignSpace, sfrba_design
 from softbend.errors import DatasetError
 from softbend.materials import DRAGON_SKIN_30, KEVLAR_FIBER, NeoHookean, Yeoh
 
-BASE = SFRBADesign(100, 6, 2, 2, 5, 8)
+BASE = sfrba_design(100, 6, 2, 2, 5, 8)
 PRESSURES = np.linspace(0.0, 0.17, 18)
 
 
@@ -87,25 +87,25 @@ def test_angle_trends_with_the_geometry(field, values, sign):
     rows = []
     for value in values:
         params = BASE.as_dict() | {field: value}
-        rows.append(bending_angle_deg(SFRBADesign(**params), pressures))
+        rows.append(bending_angle_deg(sfrba_design(**params), pressures))
     differences = np.diff(np.array(rows), axis=0)
     assert np.all(sign * differences > 0)
 
 
 def test_angle_scales_linearly_with_length():
     # λ depends on θ/l only, so θ/l is a function of P alone: θ ∝ l.
-    short = bending_angle_deg(SFRBADesign(100, 8, 3, 2, 5, 8), [0.05, 0.15])
-    long = bending_angle_deg(SFRBADesign(160, 8, 3, 2, 5, 8), [0.05, 0.15])
+    short = bending_angle_deg(sfrba_design(100, 8, 3, 2, 5, 8), [0.05, 0.15])
+    long = bending_angle_deg(sfrba_design(160, 8, 3, 2, 5, 8), [0.05, 0.15])
     np.testing.assert_allclose(long / short, 1.6, rtol=1e-9)
 
 
 def test_fiber_angle_and_cap_do_not_change_the_angle():
     reference = bending_angle_deg(BASE, PRESSURES)
-    for other in (SFRBADesign(100, 6, 2, 2, 15, 8), SFRBADesign(100, 6, 2, 2, 5, 12)):
+    for other in (sfrba_design(100, 6, 2, 2, 15, 8), sfrba_design(100, 6, 2, 2, 5, 12)):
         np.testing.assert_array_equal(bending_angle_deg(other, PRESSURES), reference)
 
 
-@pytest.mark.parametrize("design", [BASE, SFRBADesign(140, 10, 4, 3, 10, 12)], ids=str)
+@pytest.mark.parametrize("design", [BASE, sfrba_design(140, 10, 4, 3, 10, 12)], ids=str)
 def test_small_angle_linearization_closed_form(design):
     # σ = 2(λ² − λ⁻²)C10 and s = σ/λ give ds/dλ = 8 C10 at λ = 1, so
     # M_e ≈ 8 C10 (θ/l) ∫ y² dA and θ ≈ M_p l / (8 C10 I).
@@ -143,8 +143,8 @@ def test_pressure_moment_closed_form():
     ("design", "theta", "model"),
     [
         (BASE, 1.5, DRAGON_SKIN_30.model),
-        (SFRBADesign(160, 10, 4, 4, 15, 12), 4.0, DRAGON_SKIN_30.model),
-        (SFRBADesign(100, 6, 3, 2, 5, 8), 6.0, Yeoh(0.2, 0.05, 0.002)),
+        (sfrba_design(160, 10, 4, 4, 15, 12), 4.0, DRAGON_SKIN_30.model),
+        (sfrba_design(100, 6, 3, 2, 5, 8), 6.0, Yeoh(0.2, 0.05, 0.002)),
     ],
     ids=["base", "largest", "stiff-yeoh"],
 )

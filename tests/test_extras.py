@@ -57,7 +57,6 @@ def test_the_core_works_without_extras(tmp_path):
         from softbend.kinematics import bending_from_tip, tip_position
         from softbend.identification import NARXRegressor, synthetic_dataset
         from softbend.analytical import AnalyticalModel
-        from softbend.design import SFRBADesign
         from softbend.models import default_pressures_mpa
         from softbend.surrogates.polynomial import PolynomialRegressor
         from softbend.surrogates.persistence import load_surrogate, save_surrogate
@@ -65,7 +64,8 @@ def test_the_core_works_without_extras(tmp_path):
         experiment = synthetic_dataset(seed=0)["positive"][0]
         narx = NARXRegressor().fit(experiment.pressure_kpa, experiment.rho)
         assert np.isfinite(narx.simulate(experiment.pressure_kpa, experiment.rho)).all()
-        sweep = AnalyticalModel().sweep(SFRBADesign(100, 6, 2, 2, 5, 8), default_pressures_mpa(0.1))
+        design = sfrba_design(100, 6, 2, 2, 5, 8)
+        sweep = AnalyticalModel().sweep(design, default_pressures_mpa(0.1))
         X = np.random.default_rng(0).random((50, 7)) + 1.0
         plr = PolynomialRegressor(degree=2).fit(X, X.sum(axis=1))
         save_surrogate(plr, {str(model)!r})

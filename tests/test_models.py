@@ -7,10 +7,10 @@ import pickle
 import numpy as np
 import pytest
 
-from softbend.design import SFRBADesign
+from softbend.design import sfrba_design
 from softbend.models import SweepResult, check_pressures_mpa, default_pressures_mpa
 
-DESIGN = SFRBADesign(100, 6, 2, 2, 5, 8)
+DESIGN = sfrba_design(100, 6, 2, 2, 5, 8)
 
 
 # ----------------------------------------------------------------------------- pressure grid
@@ -84,7 +84,7 @@ def test_sweep_result_checks_lengths_truncation_and_types():
         _result(pressure_mpa=[0.0, 0.2, 0.1, 0.3])
     with pytest.raises(ValueError, match=r"^wall_time_s: "):
         _result(wall_time_s=-1.0)
-    with pytest.raises(ValueError, match=r"^design: must be an SFRBADesign"):
+    with pytest.raises(ValueError, match=r"^design: must be a Design"):
         _result(design="100,6,2,2,5,8")
     ok = _result(converged=[True, True, True, False])
     assert ok.n_converged == 3

@@ -49,7 +49,7 @@ from numpy.typing import ArrayLike
 from scipy.optimize import brentq
 
 from softbend._validation import check_finite_array, check_range
-from softbend.design import SFRBADesign
+from softbend.actuators import Design
 from softbend.errors import InputError, keyed
 from softbend.materials.models import HyperelasticModel
 from softbend.materials.presets import DRAGON_SKIN_30, Material
@@ -171,7 +171,7 @@ def _quadrature_cached(
 
 
 def section_quadrature(
-    design: SFRBADesign,
+    design: Design,
     *,
     n_radial: int = _N_RADIAL,
     n_angular: int = _N_ANGULAR,
@@ -185,7 +185,7 @@ def section_quadrature(
 
     Parameters
     ----------
-    design : SFRBADesign
+    design : Design
         Uses ``r_mm``, ``t_mm`` and ``b_mm``.
     n_radial, n_angular, n_bottom : int
         Number of nodes through the wall, along the quarter arc and through the
@@ -198,7 +198,7 @@ def section_quadrature(
     return _quadrature_cached(design.r_mm, design.t_mm, design.b_mm, *orders)
 
 
-def pressure_moment_nmm(design: SFRBADesign, pressure_mpa: ArrayLike) -> np.ndarray:
+def pressure_moment_nmm(design: Design, pressure_mpa: ArrayLike) -> np.ndarray:
     """Moment of the internal pressure about the bottom layer, ``P·[(2/3)r³ + (π/2)r²b]``.
 
     The pressure acts on the half disc of radius ``r`` (centroid ``b + 4r/(3π)``
@@ -206,7 +206,7 @@ def pressure_moment_nmm(design: SFRBADesign, pressure_mpa: ArrayLike) -> np.ndar
 
     Parameters
     ----------
-    design : SFRBADesign
+    design : Design
         Uses ``r_mm`` and ``b_mm``.
     pressure_mpa : array_like
         Gauge pressure, MPa.
@@ -222,7 +222,7 @@ def pressure_moment_nmm(design: SFRBADesign, pressure_mpa: ArrayLike) -> np.ndar
 
 
 def elastomer_moment_nmm(
-    design: SFRBADesign,
+    design: Design,
     angle_rad: ArrayLike,
     material: Material | HyperelasticModel | None = None,
 ) -> np.ndarray:
@@ -230,7 +230,7 @@ def elastomer_moment_nmm(
 
     Parameters
     ----------
-    design : SFRBADesign
+    design : Design
         Uses ``l_mm``, ``r_mm``, ``t_mm`` and ``b_mm``.
     angle_rad : array_like
         Bending angle ``θ`` of the chamber in radians, >= 0 (tension everywhere).
@@ -263,7 +263,7 @@ def _validate_pressures(pressures_mpa: ArrayLike) -> np.ndarray:
 
 
 def bending_angle_deg(
-    design: SFRBADesign,
+    design: Design,
     pressures_mpa: ArrayLike,
     material: Material | HyperelasticModel | None = None,
     *,
@@ -281,7 +281,7 @@ def bending_angle_deg(
 
     Parameters
     ----------
-    design : SFRBADesign
+    design : Design
         The actuator; ``φ`` and ``lc`` do not enter the angle.
     pressures_mpa : array_like
         Gauge pressures in MPa, finite and >= 0.
@@ -368,7 +368,7 @@ def bending_angle_deg(
     return np.degrees(angles).reshape(pressures.shape)
 
 
-def tip_position_mm(design: SFRBADesign, angle_deg: ArrayLike) -> tuple[np.ndarray, np.ndarray]:
+def tip_position_mm(design: Design, angle_deg: ArrayLike) -> tuple[np.ndarray, np.ndarray]:
     """Tip of the actuator bent at constant curvature, in the bending plane.
 
     Frame: origin at the centre of the fixed base on the strain-limiting layer; ``x``
@@ -382,7 +382,7 @@ def tip_position_mm(design: SFRBADesign, angle_deg: ArrayLike) -> tuple[np.ndarr
 
     Parameters
     ----------
-    design : SFRBADesign
+    design : Design
         Uses ``l_mm`` and ``lc_mm``.
     angle_deg : array_like
         Bending angle ``θ`` in degrees; negative bends towards ``z < 0``; NaN (an
@@ -456,7 +456,7 @@ class AnalyticalModel:
             )
             object.__setattr__(self, "max_angle_deg", limit)
 
-    def sweep(self, design: SFRBADesign, pressures_mpa: ArrayLike) -> SweepResult:
+    def sweep(self, design: Design, pressures_mpa: ArrayLike) -> SweepResult:
         """Solve the moment balance at every pressure of the grid, in MPa."""
         start = time.perf_counter()
         options = {} if self.max_angle_deg is None else {"max_angle_deg": self.max_angle_deg}

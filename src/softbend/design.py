@@ -8,28 +8,28 @@ thickness ``b`` carrying the strain-limiting layer, double-helix fibers wound at
 
 ``DesignSpace.table1()`` is paper B Table 1 (972 designs); ``DesignSpace.sample``
 draws space-filling designs (Latin hypercube or Sobol) over the same ranges.
-:class:`FamilyDesign` holds a design of another FEM actuator family (the
-PneuNet) as named values; its family checks them
-(:mod:`softbend.fem.families`).
+A design is a :class:`~softbend.actuators.Design` of :data:`~softbend.actuators.SFRBA`;
+:func:`sfrba_design` builds one and checks it (:func:`parse_sfrba` from the CLI's
+``"l,r,t,b,phi,lc"``, :func:`sfrba_from_sequence` from six values).
 """
 
 from __future__ import annotations
 
-import hashlib
 import itertools
-import math
 from collections.abc import Iterator, Mapping, Sequence
-from dataclasses import asdict, dataclass, field
+from dataclasses import dataclass
 from typing import Literal
 
 import numpy as np
 
 from softbend._validation import check_choice, check_range, must_be
+from softbend.actuators import SFRBA, Design
+from softbend.actuators.sfrba import BOUNDS, check_sfrba
 from softbend.errors import InputError, keyed
-from softbend.references import DESIGN_SPACE, MATERIALS, MEASURED_ACTUATORS
+from softbend.references import MATERIALS, MEASURED_ACTUATORS
 
 #: Order of the design parameters in tables, arrays and CLI strings.
-PARAMETERS: tuple[str, ...] = ("l_mm", "r_mm", "t_mm", "b_mm", "phi_deg", "lc_mm")
+PARAMETERS: tuple[str, ...] = SFRBA.names
 
 #: Inputs of every model of the bending angle (paper B §3.2 and §4.1), in this
 #: order: the design vector and the gauge pressure (mm, deg, MPa).
@@ -37,34 +37,23 @@ FEATURES: tuple[str, ...] = (*PARAMETERS, "pressure_mpa")
 
 #: The quantity of :data:`softbend.plausibility.RANGES` of each feature: the
 #: range a value read from a file or a model must lie in.
-FEATURE_QUANTITIES: dict[str, str] = {
-    **{name: "fiber_angle_deg" if name == "phi_deg" else "length_mm" for name in PARAMETERS},
-    "pressure_mpa": "pressure_mpa",
-}
+FEATURE_QUANTITIES: dict[str, str] = dict(SFRBA.quantities)
 
 #: Fixed quantities of paper B (mm, §2.1; :data:`softbend.references.MATERIALS`).
 FIBER_DIAMETER_MM: float = MATERIALS["kevlar"]["diameter_mm"].value
 STRAIN_LIMITING_LAYER_MM: float = MATERIALS["fiberglass"]["thickness_mm"].value
 
 
-# (low, high, low_inclusive); every upper bound is inclusive.
-_BOUNDS: dict[str, tuple[float, float, bool]] = {
-    "l_mm": (0.0, 1000.0, False),
-    "r_mm": (0.0, 100.0, False),
-    "t_mm": (0.0, 50.0, False),
-    "b_mm": (0.0, 50.0, False),
-    "phi_deg": (0.0, 60.0, True),
-    "lc_mm": (0.0, 200.0, False),
-}
 #: ``{parameter: (low, high, low_inclusive)}`` a design accepts, by short name (``l``, ``phi``).
 DESIGN_LIMITS: dict[str, tuple[float, float, bool]] = {
-    name.rsplit("_", 1)[0]: limits for name, limits in _BOUNDS.items()
+    name.rsplit("_", 1)[0]: limits for name, limits in BOUNDS.items()
 }
 
 
-@dataclass(frozen=True)
-class SFRBADesign:
-    """One fiber-reinforced bending actuator design.
+def sfrba_design(
+    l_mm: float, r_mm: float, t_mm: float, b_mm: float, phi_deg: float, lc_mm: float
+) -> Design:
+    """One design of paper B's fiber-reinforced actuator, checked.
 
     Parameters
     ----------
@@ -83,6 +72,11 @@ class SFRBADesign:
     lc_mm : float
         Length of the distal (tip) cap, mm; in (0, 200].
 
+    Returns
+    -------
+    Design
+        A design of :data:`~softbend.actuators.SFRBA`.
+
     Notes
     -----
     The wall must be thinner than the chamber radius, ``t_mm < r_mm``: the
@@ -100,114 +94,42 @@ class SFRBADesign:
         Naming the field, the allowed interval and the value received; for a wall
         not thinner than the radius, the rule and both values.
     """
+    values = (l_mm, r_mm, t_mm, b_mm, phi_deg, lc_mm)
+    return Design(SFRBA, check_sfrba(dict(zip(PARAMETERS, values, strict=True))))
 
-    l_mm: float
-    r_mm: float
-    t_mm: float
-    b_mm: float
-    phi_deg: float
-    lc_mm: float
 
-    def __post_init__(self) -> None:
-        for name in PARAMETERS:
-            low, high, low_inclusive = _BOUNDS[name]
-            value = check_range(
-                getattr(self, name),
-                name,
-                low=low,
-                high=high,
-                low_inclusive=low_inclusive,
-                high_inclusive=True,
-            )
-            object.__setattr__(self, name, value)
-        if self.t_mm >= self.r_mm:
-            raise InputError(
-                f"must be less than r_mm ({self.r_mm:g}): a wall thinner than the chamber "
-                f"radius; got {self.t_mm:g}",
-                key="t_mm",
-            )
+def sfrba_from_sequence(values: Sequence[float]) -> Design:
+    """Paper B's design of ``(l, r, t, b, phi, lc)`` in that order (:func:`sfrba_design`)."""
+    values = list(values)
+    if len(values) != len(PARAMETERS):
+        raise InputError(  # the wording other messages quote: "A design needs 6 values"
+            f"A design needs {len(PARAMETERS)} values ({', '.join(PARAMETERS)}); got {len(values)}"
+        )
+    return sfrba_design(*values)
 
-    @classmethod
-    def from_sequence(cls, values: Sequence[float]) -> SFRBADesign:
-        """Build a design from ``(l, r, t, b, phi, lc)`` in that order."""
-        values = list(values)
-        if len(values) != len(PARAMETERS):
-            raise InputError(  # the wording other messages quote: "A design needs 6 values"
-                f"A design needs {len(PARAMETERS)} values ({', '.join(PARAMETERS)}); "
-                f"got {len(values)}"
-            )
-        return cls(*values)
 
-    @classmethod
-    def parse(cls, text: str) -> SFRBADesign:
-        """Parse ``"100,6,2,2,5,10"`` (l, r, t, b, phi, lc) as used on the CLI.
+def parse_sfrba(text: str) -> Design:
+    """Parse ``"100,6,2,2,5,10"`` (l, r, t, b, phi, lc) as used on the CLI.
 
-        Errors are keyed ``design`` and name the value at fault in the message
-        (``design: t_mm: must be less than r_mm (6) ...``).
-        """
-        try:
-            values = [float(v) for v in text.split(",")]
-        except ValueError:
-            raise InputError(
-                must_be(f"six comma-separated numbers ({', '.join(PARAMETERS)})", text),
-                key="design",
-            ) from None
-        with keyed("design"):
-            return cls.from_sequence(values)
-
-    @property
-    def cavity_volume_mm3(self) -> float:
-        """Undeformed volume of the chamber, mm³: ``½·π·r²·l``.
-
-        The chamber is a half-disc of radius ``r`` (the semicircular top standing
-        on the flat bottom wall) extruded over the chamber length ``l``. The FEM
-        meshes half of it (the half model ``y ≥ 0``), the rig's air volume starts
-        from all of it.
-        """
-        return 0.5 * math.pi * self.r_mm**2 * self.l_mm
-
-    @property
-    def design_id(self) -> str:
-        """Stable 16-hex-digit identifier: a SHA-1 of the parameters rounded to 1e-6."""
-        canonical = ",".join(f"{getattr(self, n):.6f}" for n in PARAMETERS)
-        return hashlib.sha1(canonical.encode()).hexdigest()[:16]
-
-    def as_dict(self) -> dict[str, float]:
-        """Parameters as an ordered ``{name: value}`` mapping."""
-        return {k: v for k, v in asdict(self).items() if k in PARAMETERS}
-
-    def as_array(self) -> np.ndarray:
-        """Parameters as a float array in :data:`PARAMETERS` order."""
-        return np.array([getattr(self, n) for n in PARAMETERS], dtype=float)
-
-    def feature_rows(self, pressures_mpa: Sequence[float] | np.ndarray) -> np.ndarray:
-        """Model inputs for this design at each pressure: one row per pressure.
-
-        Parameters
-        ----------
-        pressures_mpa : array_like, shape (n,)
-            Gauge pressures, MPa (not checked here: models check their grids).
-
-        Returns
-        -------
-        numpy.ndarray, shape (n, 7)
-            Columns :data:`FEATURES`: l, r, t, b (mm), φ (deg), lc (mm), P (MPa).
-        """
-        pressures = np.asarray(pressures_mpa, dtype=float).reshape(-1)
-        rows = np.empty((pressures.size, len(FEATURES)))
-        rows[:, :-1] = self.as_array()
-        rows[:, -1] = pressures
-        return rows
-
-    def __str__(self) -> str:
-        return ",".join(f"{getattr(self, n):g}" for n in PARAMETERS)
+    Errors are keyed ``design`` and name the value at fault in the message
+    (``design: t_mm: must be less than r_mm (6) ...``).
+    """
+    try:
+        values = [float(v) for v in text.split(",")]
+    except ValueError:
+        raise InputError(
+            must_be(f"six comma-separated numbers ({', '.join(PARAMETERS)})", text),
+            key="design",
+        ) from None
+    with keyed("design"):
+        return sfrba_from_sequence(values)
 
 
 #: The seven actuators paper B measured (Fig. 7), nominal (l, r, t, b, φ, lc) in mm and
 #: degrees: the reference (100, 6, 2, 2, 5, 8) and one parameter changed at a time
 #: (:data:`softbend.references.MEASURED_ACTUATORS`).
-PAPER_B_FIG7_DESIGNS: tuple[SFRBADesign, ...] = tuple(
-    SFRBADesign(*values) for values in MEASURED_ACTUATORS.value
+PAPER_B_FIG7_DESIGNS: tuple[Design, ...] = tuple(
+    sfrba_design(*values) for values in MEASURED_ACTUATORS.value
 )
 
 
@@ -217,13 +139,13 @@ class DesignSpace:
 
     Parameters
     ----------
-    designs : tuple of SFRBADesign
+    designs : tuple of Design
         The designs, unique, in a stable order.
     name : str
         A label for reports.
     """
 
-    designs: tuple[SFRBADesign, ...]
+    designs: tuple[Design, ...]
     name: str = "custom"
 
     def __post_init__(self) -> None:
@@ -235,10 +157,10 @@ class DesignSpace:
     def __len__(self) -> int:
         return len(self.designs)
 
-    def __iter__(self) -> Iterator[SFRBADesign]:
+    def __iter__(self) -> Iterator[Design]:
         return iter(self.designs)
 
-    def __getitem__(self, index: int) -> SFRBADesign:
+    def __getitem__(self, index: int) -> Design:
         return self.designs[index]
 
     def shard(self, index: int, count: int) -> DesignSpace:
@@ -271,7 +193,7 @@ class DesignSpace:
                 key="levels",
             )
         combos = itertools.product(*(levels[p] for p in PARAMETERS))
-        return cls(tuple(SFRBADesign(*c) for c in combos), name=name)
+        return cls(tuple(sfrba_design(*c) for c in combos), name=name)
 
     @classmethod
     def table1(cls) -> DesignSpace:
@@ -319,7 +241,7 @@ class DesignSpace:
             sampler = qmc.Sobol(d=len(PARAMETERS), scramble=True, seed=seed)
         unit = sampler.random(n)
         values = np.round(qmc.scale(unit, low, high), 6)
-        return cls(tuple(SFRBADesign(*row) for row in values), name=f"{method}-{n}-seed{seed}")
+        return cls(tuple(sfrba_design(*row) for row in values), name=f"{method}-{n}-seed{seed}")
 
     def to_frame(self):  # -> pandas.DataFrame
         """Designs as a DataFrame with ``design_id`` and one column per parameter."""
@@ -329,54 +251,5 @@ class DesignSpace:
         return pd.DataFrame(rows, columns=["design_id", *PARAMETERS])
 
 
-#: Levels of paper B Table 1 (:data:`softbend.references.DESIGN_SPACE`).
-TABLE1_LEVELS: dict[str, tuple[float, ...]] = {
-    name: DESIGN_SPACE[name].value for name in PARAMETERS
-}
-
-
-@dataclass(frozen=True)
-class FamilyDesign:
-    """One design of a FEM family other than paper B's: named values, in the family's order.
-
-    Parameters
-    ----------
-    family : str
-        The family's registry name (``"pneunet"``).
-    values : mapping of str to float
-        Every design parameter of the family, in its units (see the family's
-        :attr:`FEMFamily.actuator`). Check values with :meth:`FEMFamily.design`,
-        which builds designs; this class only holds them.
-    """
-
-    family: str
-    values: Mapping[str, float] = field(default_factory=dict)
-
-    def __post_init__(self) -> None:
-        object.__setattr__(self, "values", {k: float(v) for k, v in dict(self.values).items()})
-
-    def __hash__(self) -> int:
-        return hash((self.family, tuple(self.values.items())))
-
-    def __getattr__(self, name: str) -> float:
-        values = self.__dict__.get("values", {})
-        if name in values:
-            return values[name]
-        raise AttributeError(name)
-
-    @property
-    def design_id(self) -> str:
-        """Stable 16-hex-digit identifier: a SHA-1 of the family and its values rounded to 1e-6."""
-        canonical = self.family + ":" + ",".join(f"{k}={v:.6f}" for k, v in self.values.items())
-        return hashlib.sha1(canonical.encode()).hexdigest()[:16]
-
-    def as_dict(self) -> dict[str, float]:
-        """Parameters as an ordered ``{name: value}`` mapping."""
-        return dict(self.values)
-
-    def as_array(self) -> np.ndarray:
-        """Parameters as a float array in the family's order."""
-        return np.array(list(self.values.values()), dtype=float)
-
-    def __str__(self) -> str:
-        return ", ".join(f"{k}={v:g}" for k, v in self.values.items())
+#: Levels of paper B Table 1 (:attr:`SFRBA.grid <softbend.actuators.Actuator.grid>`).
+TABLE1_LEVELS: dict[str, tuple[float, ...]] = dict(zip(PARAMETERS, SFRBA.grid, strict=True))

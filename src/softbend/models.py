@@ -1,6 +1,6 @@
 """The seam between bending models and everything that uses them.
 
-A *bending model* turns one :class:`~softbend.design.SFRBADesign` and an
+A *bending model* turns one :class:`~softbend.actuators.Design` and an
 increasing grid of gauge pressures into a :class:`SweepResult`: the angle and tip
 of the actuator at every pressure, and where the sweep stopped. The analytical
 model (:class:`softbend.analytical.AnalyticalModel`), the finite-element model
@@ -24,17 +24,14 @@ from __future__ import annotations
 
 from collections.abc import Mapping
 from dataclasses import dataclass, field
-from typing import TYPE_CHECKING, Any, Protocol, runtime_checkable
+from typing import Any, Protocol, runtime_checkable
 
 import numpy as np
 from numpy.typing import ArrayLike
 
 from softbend._validation import check_range, must_be
-from softbend.design import SFRBADesign
+from softbend.actuators import Design
 from softbend.errors import InputError
-
-if TYPE_CHECKING:
-    from softbend.design import FamilyDesign
 
 __all__ = [
     "DEFAULT_PMAX_MPA",
@@ -151,9 +148,9 @@ class SweepResult:
 
     Parameters
     ----------
-    design : SFRBADesign or FamilyDesign
+    design : Design
         The design swept (paper B's actuator, or a design of another FEM
-        family, :class:`softbend.design.FamilyDesign`).
+        family, :class:`~softbend.actuators.Design`).
     pressure_mpa : array_like
         Gauge pressures applied, MPa, strictly increasing.
     angle_deg : array_like
@@ -181,7 +178,7 @@ class SweepResult:
         non-converged entry is not the last one.
     """
 
-    design: SFRBADesign | FamilyDesign
+    design: Design
     pressure_mpa: np.ndarray
     angle_deg: np.ndarray
     tip_x_mm: np.ndarray
@@ -193,10 +190,9 @@ class SweepResult:
     stats: dict[str, Any] = field(default_factory=dict)
 
     def __post_init__(self) -> None:
-        from softbend.design import FamilyDesign
 
-        if not isinstance(self.design, SFRBADesign | FamilyDesign):
-            raise InputError(must_be("an SFRBADesign or a FamilyDesign", self.design), key="design")
+        if not isinstance(self.design, Design):
+            raise InputError(must_be("a Design", self.design), key="design")
         arrays = {
             "pressure_mpa": float,
             "angle_deg": float,
@@ -238,7 +234,7 @@ class SweepResult:
     @classmethod
     def from_angles(
         cls,
-        design: SFRBADesign,
+        design: Design,
         pressure_mpa: ArrayLike,
         angle_deg: ArrayLike,
         tip_x_mm: ArrayLike,
@@ -323,6 +319,6 @@ class BendingModel(Protocol):
         """Short name of the model, stored with every design of a campaign."""
         ...
 
-    def sweep(self, design: SFRBADesign, pressures_mpa: np.ndarray) -> SweepResult:
+    def sweep(self, design: Design, pressures_mpa: np.ndarray) -> SweepResult:
         """Sweep ``design`` over the increasing gauge pressures ``pressures_mpa`` (MPa)."""
         ...

@@ -5,15 +5,16 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
+from softbend.actuators import Design
 from softbend.campaign import default_pressures_mpa
-from softbend.design import DesignSpace, SFRBADesign
+from softbend.design import DesignSpace, sfrba_design
 
 #: Long, wide, thin-walled: the analytical model stops converging at 0.255 MPa.
-SOFT_DESIGN = SFRBADesign(160, 10, 2, 2, 5, 8)
+SOFT_DESIGN = sfrba_design(160, 10, 2, 2, 5, 8)
 
 
 @pytest.fixture
-def soft_design() -> SFRBADesign:
+def soft_design() -> Design:
     """A design whose analytical sweep stops converging at 0.255 MPa."""
     return SOFT_DESIGN
 

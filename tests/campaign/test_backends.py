@@ -16,10 +16,10 @@ from softbend.campaign.backends import (
     get_backend,
     register_backend,
 )
-from softbend.design import SFRBADesign
+from softbend.design import sfrba_design
 from softbend.errors import ConvergenceError
 
-DESIGN = SFRBADesign(100, 6, 2, 2, 5, 8)
+DESIGN = sfrba_design(100, 6, 2, 2, 5, 8)
 
 
 # ----------------------------------------------------------------------------- registry
@@ -92,7 +92,7 @@ def test_analytical_backend_matches_the_model_and_the_physics():
     assert result.mesh_size is None and (result.newton_iterations == 0).all()
     assert result.wall_time_s > 0
     # A thicker top wall is stiffer: less bending at every pressure.
-    thick = get_backend("analytical").sweep(SFRBADesign(100, 6, 4, 2, 5, 8), grid)
+    thick = get_backend("analytical").sweep(sfrba_design(100, 6, 4, 2, 5, 8), grid)
     assert np.all(thick.angle_deg[1:] < result.angle_deg[1:])
 
 
@@ -132,7 +132,7 @@ def test_fault_injection_fails_chosen_designs_and_delegates_the_rest():
     assert isinstance(backend, FaultInjectionBackend)
     with pytest.raises(ConvergenceError, match="injected failure for design 100,6,2,2,5,8"):
         backend.sweep(DESIGN, grid)
-    other = SFRBADesign(120, 6, 2, 2, 5, 8)
+    other = sfrba_design(120, 6, 2, 2, 5, 8)
     np.testing.assert_array_equal(
         backend.sweep(other, grid).angle_deg, AnalyticalModel().sweep(other, grid).angle_deg
     )

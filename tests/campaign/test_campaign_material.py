@@ -11,7 +11,7 @@ import pytest
 from softbend.campaign import CampaignStore, run_campaign
 from softbend.campaign.backends import backend_for_run, get_backend, with_material
 from softbend.cli import main
-from softbend.design import DesignSpace, SFRBADesign
+from softbend.design import DesignSpace, sfrba_design
 from softbend.errors import SchemaError
 from softbend.materials import DRAGON_SKIN_30, material_from_spec
 from softbend.materials.models import Yeoh
@@ -51,7 +51,7 @@ def solves(monkeypatch):
 
 def _two_designs() -> DesignSpace:
     return DesignSpace(
-        (SFRBADesign(100, 6, 2, 2, 5, 8), SFRBADesign(120, 8, 2, 2, 5, 10)), name="two"
+        (sfrba_design(100, 6, 2, 2, 5, 8), sfrba_design(120, 8, 2, 2, 5, 10)), name="two"
     )
 
 

@@ -16,14 +16,14 @@ import numpy as np
 import pandas as pd
 import pytest
 
+from softbend.actuators import Design
 from softbend.campaign import CampaignStore, load_samples, run_campaign
 from softbend.campaign.families import FamilyBackend, family_backend
 from softbend.campaign.family_spaces import parse_family_ranges, parse_family_space
 from softbend.campaign.store import campaign_actuator
 from softbend.cli import main
-from softbend.design import SFRBADesign
+from softbend.design import sfrba_design
 from softbend.errors import InputError
-from softbend.fem.families import FamilyDesign
 
 from ..cli.conftest import one_error_line
 from ..stand_ins import (
@@ -62,7 +62,7 @@ def standin():
     FAILING.clear()
 
 
-def _values(design: FamilyDesign) -> np.ndarray:
+def _values(design: Design) -> np.ndarray:
     return np.array([design.values[n] for n in NAMES])
 
 
@@ -223,7 +223,7 @@ def test_local_worker_processes_sweep_family_designs(tmp_path):
 
 def test_a_database_refuses_designs_of_another_family(tmp_path, capsys):
     paper_b = tmp_path / "paper_b.duckdb"
-    run_campaign(paper_b, [SFRBADesign(100, 6, 2, 2, 5, 8)], workers=0)
+    run_campaign(paper_b, [sfrba_design(100, 6, 2, 2, 5, 8)], workers=0)
     argv = ["campaign", "run", str(paper_b), "--family", "standin", "--space", "lhs:2"]
     assert main([*argv, "--workers", "0"]) == 2
     line = one_error_line(capsys)
@@ -240,7 +240,7 @@ def test_a_database_refuses_designs_of_another_family(tmp_path, capsys):
         merge_campaigns(tmp_path / "all.duckdb", [family_db, paper_b])
     assert not (tmp_path / "all.duckdb").exists()
     with CampaignStore(family_db) as store, pytest.raises(ValueError, match="are of the 'standin'"):
-        store.record_failure(SFRBADesign(100, 6, 2, 2, 5, 8), "x", 0.0, backend="fem")
+        store.record_failure(sfrba_design(100, 6, 2, 2, 5, 8), "x", 0.0, backend="fem")
 
 
 def test_shards_of_a_family_merge_into_a_new_database(tmp_path):

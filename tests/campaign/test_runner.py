@@ -19,7 +19,7 @@ import pytest
 
 from softbend.campaign import CampaignStore, SweepResult, get_backend, load_samples, run_campaign
 from softbend.campaign.runner import parse_scheduler_address
-from softbend.design import DesignSpace, SFRBADesign
+from softbend.design import DesignSpace, sfrba_design
 from softbend.errors import SchemaError, SoftbendError
 
 from ..stand_ins import web_server
@@ -181,9 +181,8 @@ _CHILD = textwrap.dedent(
     """
     import sys
     from softbend.campaign import default_pressures_mpa, run_campaign
-    from softbend.design import SFRBADesign
 
-    designs = [SFRBADesign.parse(text) for text in sys.argv[2].split(";")]
+    designs = [parse_sfrba(text) for text in sys.argv[2].split(";")]
 
     def progress(done, failed, running, total):
         print("recorded", done + failed, flush=True)
@@ -266,13 +265,13 @@ def test_bad_design_lists(tmp_path):
     with pytest.raises(ValueError, match=r"^designs: must not be empty"):
         run_campaign(tmp_path / "c.duckdb", [])
     with pytest.raises(ValueError, match=r"^designs: must be unique; got 1 duplicates"):
-        run_campaign(tmp_path / "c.duckdb", [SFRBADesign(100, 6, 2, 2, 5, 8)] * 2)
-    with pytest.raises(ValueError, match=r"^designs: must all be SFRBADesign; got '100,6,2,2,5,8'"):
+        run_campaign(tmp_path / "c.duckdb", [sfrba_design(100, 6, 2, 2, 5, 8)] * 2)
+    with pytest.raises(ValueError, match=r"^designs: must all be Design; got '100,6,2,2,5,8'"):
         run_campaign(tmp_path / "c.duckdb", ["100,6,2,2,5,8"])
     with pytest.raises(ValueError, match=r"^backend_options: apply to a backend name only"):
         run_campaign(
             tmp_path / "c.duckdb",
-            [SFRBADesign(100, 6, 2, 2, 5, 8)],
+            [sfrba_design(100, 6, 2, 2, 5, 8)],
             backend=get_backend("analytical"),
             backend_options={"material": None},
         )

@@ -12,15 +12,16 @@ import pandas as pd
 import pytest
 
 from softbend import __version__
+from softbend.actuators import Design
 from softbend.campaign import store as store_module
 from softbend.campaign.backends import AnalyticalBackend, SweepResult, default_pressures_mpa
 from softbend.campaign.store import SCHEMA_VERSION, CampaignStore, load_samples
-from softbend.design import PARAMETERS, SFRBADesign
+from softbend.design import PARAMETERS, sfrba_design
 from softbend.errors import SchemaError, SoftbendError
 
 GRID = default_pressures_mpa(0.5, 0.05)
-A = SFRBADesign(100, 6, 3, 2, 5, 8)  # converges up to 0.5 MPa
-B = SFRBADesign(120, 8, 3, 3, 10, 10)
+A = sfrba_design(100, 6, 3, 2, 5, 8)  # converges up to 0.5 MPa
+B = sfrba_design(120, 8, 3, 3, 10, 10)
 
 SAMPLE_COLUMNS = [
     "design_id",
@@ -38,7 +39,7 @@ SAMPLE_COLUMNS = [
 ]
 
 
-def _sweep(design: SFRBADesign, grid: np.ndarray = GRID) -> SweepResult:
+def _sweep(design: Design, grid: np.ndarray = GRID) -> SweepResult:
     return AnalyticalBackend().sweep(design, grid)
 
 

@@ -18,12 +18,12 @@ from softbend.campaign.settings import (
 )
 from softbend.campaign.store import merge_campaigns
 from softbend.cli import main
-from softbend.design import SFRBADesign
+from softbend.design import sfrba_design
 from softbend.errors import SchemaError
 from softbend.models import SweepResult, default_pressures_mpa
 
 GRID = default_pressures_mpa(0.1, 0.05)
-DESIGNS = [SFRBADesign(100, 6, 2, 2, 5, 8), SFRBADesign(120, 8, 2, 2, 5, 10)]
+DESIGNS = [sfrba_design(100, 6, 2, 2, 5, 8), sfrba_design(120, 8, 2, 2, 5, 10)]
 CLI_RUN = ["--space", "lhs:3", "--seed", "2", "--pmax", "0.1", "--pstep", "0.05", "--workers", "0"]
 
 

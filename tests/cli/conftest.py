@@ -2,6 +2,8 @@
 
 import pytest
 
+from softbend.design import sfrba_design
+
 
 def one_error_line(capsys) -> str:
     """The single ``softbend: error: …`` line a failed command wrote to stderr."""
@@ -17,7 +19,6 @@ def small_base_file(tmp_path_factory):
     import numpy as np
 
     from softbend.analytical import AnalyticalModel
-    from softbend.design import SFRBADesign
     from softbend.models import default_pressures_mpa
     from softbend.surrogates.mlp import NormalizedMLPRegressor
     from softbend.surrogates.persistence import save_surrogate
@@ -30,7 +31,7 @@ def small_base_file(tmp_path_factory):
         (100, 6, 3, 2, 5, 8),
         (140, 8, 3, 3, 10, 10),
     ]:
-        design = SFRBADesign(*values)
+        design = sfrba_design(*values)
         sweep = AnalyticalModel().sweep(design, default_pressures_mpa(0.15, 0.01))
         ok = np.asarray(sweep.converged, dtype=bool)
         rows.append(design.feature_rows(sweep.pressure_mpa[ok]))

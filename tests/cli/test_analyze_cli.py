@@ -9,6 +9,7 @@ import pandas as pd
 import pytest
 
 from softbend.cli import main
+from softbend.design import sfrba_design
 
 OUTPUTS = ("correlation.png", "loadings.png", "parity.png", "coefficients.csv", "correlation.csv")
 FEATURES = ["l_mm", "r_mm", "t_mm", "b_mm", "phi_deg", "lc_mm", "pressure_mpa"]
@@ -126,10 +127,9 @@ def _campaign_api():
 
 def test_analyze_an_analytical_campaign(tmp_path, capsys):
     campaign = _campaign_api()
-    from softbend.design import SFRBADesign
 
     designs = [
-        SFRBADesign(l_mm=l_mm, r_mm=r_mm, t_mm=t_mm, b_mm=2.0, phi_deg=5.0, lc_mm=lc_mm)
+        sfrba_design(l_mm=l_mm, r_mm=r_mm, t_mm=t_mm, b_mm=2.0, phi_deg=5.0, lc_mm=lc_mm)
         for l_mm in (100.0, 140.0)
         for r_mm in (6.0, 8.0)
         for t_mm in (2.0, 3.0)
@@ -168,14 +168,13 @@ def test_truncated_database_is_one_line_naming_the_file(tmp_path, capsys):
     store = pytest.importorskip("softbend.campaign.store")
     from softbend.campaign import default_pressures_mpa
     from softbend.campaign.backends import AnalyticalBackend
-    from softbend.design import SFRBADesign
 
     good = tmp_path / "good.duckdb"
     grid = default_pressures_mpa(0.1, 0.05)
     with store.CampaignStore(good) as opened:
         opened.bind("analytical", grid)
         for l_mm in (100.0, 120.0, 140.0):
-            design = SFRBADesign(l_mm, 8.0, 3.0, 2.0, 5.0, 10.0)
+            design = sfrba_design(l_mm, 8.0, 3.0, 2.0, 5.0, 10.0)
             opened.record_success(AnalyticalBackend().sweep(design, grid))
     data = good.read_bytes()
     db = tmp_path / "t.duckdb"

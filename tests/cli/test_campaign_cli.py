@@ -12,10 +12,11 @@ import duckdb
 import pandas as pd
 import pytest
 
+from softbend.actuators import Design
 from softbend.analytical import AnalyticalModel
 from softbend.campaign import CampaignStore, default_pressures_mpa, load_samples
 from softbend.cli import main
-from softbend.design import DesignSpace, SFRBADesign
+from softbend.design import DesignSpace, sfrba_design
 from softbend.errors import ConvergenceError
 from softbend.fem.geometry import check_mesh_size
 from softbend.fem.options import FEMOptions
@@ -530,7 +531,7 @@ def test_a_merge_with_one_bad_shard_writes_nothing(tmp_path, capsys, monkeypatch
 
         with CampaignStore(bad) as store:  # a shard of the FEM, without running one
             store.bind("fem", default_pressures_mpa(0.1, 0.05))
-            store.record_failure(SFRBADesign(100, 6, 2, 2, 5, 8), "RuntimeError: x", 1.0)
+            store.record_failure(sfrba_design(100, 6, 2, 2, 5, 8), "RuntimeError: x", 1.0)
     else:
         _run_shard(bad, "--shard", "1/2", *second)
     capsys.readouterr()
@@ -795,7 +796,7 @@ RUN_FAULT = [
 ]
 FEM_RUN = ["--backend", "fem", "--space", "corners", "--pmax", "0.01", "--workers", "0"]
 #: The largest design of the corners: the one a too-fine mesh size is refused for.
-LARGEST_CORNER = SFRBADesign(160, 10, 4, 4, 5, 12)
+LARGEST_CORNER = sfrba_design(160, 10, 4, 4, 5, 12)
 
 
 @dataclasses.dataclass(frozen=True)
@@ -819,7 +820,7 @@ def stand_in_fem(monkeypatch):
     monkeypatch.setattr(backends, "_import_fem", lambda: fem)
 
 
-def _mesh_message(design: SFRBADesign, maxh_mm: float) -> str:
+def _mesh_message(design: Design, maxh_mm: float) -> str:
     with pytest.raises(ValueError) as info:
         check_mesh_size(design, maxh_mm)
     return str(info.value)
@@ -883,7 +884,7 @@ def test_the_mesh_rule_is_the_one_the_fem_applies_when_meshing():
 
     pytest.importorskip("ngsolve")
 
-    design = SFRBADesign(100, 6, 2, 2, 5, 10)
+    design = sfrba_design(100, 6, 2, 2, 5, 10)
     with pytest.raises(ValueError) as info:
         mesh_actuator(design, maxh_mm=0.3)
     assert str(info.value) == _mesh_message(design, 0.3)
@@ -929,7 +930,7 @@ def test_a_run_whose_every_design_failed_exits_1_with_the_reason(
 
 
 def test_a_run_with_some_failed_designs_or_none_left_exits_0(tmp_path, capsys, monkeypatch):
-    failed: list[SFRBADesign] = []
+    failed: list[Design] = []
 
     def first_only(design):
         if not failed:

@@ -13,12 +13,12 @@ import numpy as np
 import pandas as pd
 import pytest
 
-from softbend.actuators import SFRBA, Actuator, DesignParameter
+from softbend.actuators import SFRBA, Actuator, Design, DesignParameter
 from softbend.cli import main
-from softbend.control.designs import ModelDesign, control_design
+from softbend.control.designs import control_design
 from softbend.control.runs import simulate_control
 from softbend.control.setup import prepare_control
-from softbend.design import SFRBADesign
+from softbend.design import parse_sfrba
 
 #: A design inside the training data, given by name.
 DESIGN = "n_chambers=10,wall_mm=2,height_mm=10,layer=paper"
@@ -304,10 +304,10 @@ def test_designs_are_read_by_the_actuator_of_the_model(models):
     from softbend.actuators import SFRBA
 
     named = control_design("l_mm=100,r_mm=6,t_mm=2,b_mm=2,phi_deg=5,lc_mm=8", SFRBA)
-    assert named == SFRBADesign.parse("100,6,2,2,5,8") == control_design(None, SFRBA)
+    assert named == parse_sfrba("100,6,2,2,5,8") == control_design(None, SFRBA)
     actuator = describe("p_kpa", "kPa")
     design = control_design("10,2,10,paper", actuator)
-    assert isinstance(design, ModelDesign)
+    assert isinstance(design, Design)
     np.testing.assert_array_equal(design.as_array(), [10.0, 2.0, 10.0, 1.0])
     # The rows a model takes: the pressure in its unit (kPa) from the rig's MPa.
     np.testing.assert_allclose(design.feature_rows([0.03])[0], [10.0, 2.0, 10.0, 1.0, 30.0])

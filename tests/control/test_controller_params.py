@@ -11,7 +11,7 @@ from softbend.control.factory import controller_parameters, make_controller
 from softbend.control.rig import RigParams, SimulatedRig
 from softbend.control.rigconfig import ControllerConfig, RigConfig, load_rig_config
 from softbend.control.study import control_study
-from softbend.design import SFRBADesign
+from softbend.design import sfrba_design
 from softbend.parameters import parse_assignments
 from softbend.registry import Registry, UnknownNameError
 
@@ -227,7 +227,7 @@ class Linear:
 
 
 def test_the_study_takes_controller_parameters():
-    design = SFRBADesign(100, 6, 2, 2, 5, 8)
+    design = sfrba_design(100, 6, 2, 2, 5, 8)
     kwargs = {"controllers": ("bang-bang",), "references": ("step:90",), "duration_s": 1.5}
     default = control_study(Linear(), design, **kwargs)
     narrow = control_study(

@@ -22,13 +22,13 @@ from softbend.control.predictive import PneumaticCurves, PredictivePulse
 from softbend.control.rig import RIG_RANGES, TUBING_RANGE, RigParams, SimulatedRig
 from softbend.control.rigconfig import simulation_settings_entry
 from softbend.control.rigs import rig_params_for, rig_settings
-from softbend.design import SFRBADesign
+from softbend.design import sfrba_design
 from softbend.parameters import Range, declared_ranges, public_parameters
 
 BUILT_IN = ("bang-bang", "bang-bang-closed", "pressure-pi", "pressure-relay", "predictive")
 #: Parameters without a unit: ratios and weights.
 DIMENSIONLESS = {"critical_ratio", "polytropic_exponent", "observer_gain"}
-DESIGN = SFRBADesign(100, 6, 2, 2, 5, 8)
+DESIGN = sfrba_design(100, 6, 2, 2, 5, 8)
 
 
 def _numeric(parameter: inspect.Parameter) -> bool:

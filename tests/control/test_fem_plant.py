@@ -9,9 +9,9 @@ import pytest
 
 from softbend.control import fem_plant as fp
 from softbend.control.plants import in_table1
-from softbend.design import SFRBADesign
+from softbend.design import sfrba_design
 
-OWN = SFRBADesign(130, 7, 2.5, 3, 10, 9)
+OWN = sfrba_design(130, 7, 2.5, 3, 10, 9)
 
 
 @pytest.fixture
@@ -24,7 +24,7 @@ def coarse(tmp_path, monkeypatch):
 
 
 def test_table1_membership():
-    assert in_table1(SFRBADesign(100, 6, 2, 2, 5, 8))
+    assert in_table1(sfrba_design(100, 6, 2, 2, 5, 8))
     assert not in_table1(OWN)
 
 

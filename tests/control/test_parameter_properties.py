@@ -26,7 +26,7 @@ from softbend.control.factory import (
 from softbend.control.rig import RigParams
 from softbend.control.rigconfig import simulation_settings_entry
 from softbend.control.rigs import rig_params_for, rig_settings
-from softbend.design import SFRBADesign
+from softbend.design import sfrba_design
 from softbend.parameters import (
     ParameterValueError,
     UnknownParameterError,
@@ -39,7 +39,7 @@ from ..properties import NASTY_VALUES, property_settings
 EXAMPLES = 40
 SETTINGS = property_settings(EXAMPLES)
 BUILT_IN = ("bang-bang", "bang-bang-closed", "pressure-pi", "pressure-relay", "predictive")
-DESIGN = SFRBADesign(100, 6, 2, 2, 5, 8)
+DESIGN = sfrba_design(100, 6, 2, 2, 5, 8)
 
 #: Text that breaks naive parsers.
 NASTY = NASTY_VALUES

@@ -9,15 +9,15 @@ import pytest
 
 from softbend.cli import main
 from softbend.control.plants import lab_angle_table, plant_table
-from softbend.design import SFRBADesign
+from softbend.design import sfrba_design
 from softbend.registry import UnknownNameError
 from softbend.transfer.lab import shipped_measurements
 from softbend.transfer.measurements import load_measurements, save_measurements
 
 SHIPPED_MLP = "src/softbend/data/transfer/table1_fem_mlp.json"
 #: A design outside Table 1 and the virtual lab (the lab's own prototype).
-OWN = SFRBADesign(130, 7, 2.5, 3, 10, 9)
-OTHER = SFRBADesign(100, 6, 2, 2, 5, 8)
+OWN = sfrba_design(130, 7, 2.5, 3, 10, 9)
+OTHER = sfrba_design(100, 6, 2, 2, 5, 8)
 
 
 @pytest.fixture(scope="module")

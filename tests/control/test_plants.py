@@ -9,10 +9,10 @@ from softbend.control.experiments import simulate
 from softbend.control.plants import fem_angle_table, lab_angle_table, plant_table
 from softbend.control.rig import AngleTable, RigParams, SimulatedRig
 from softbend.datasets import table1_fem
-from softbend.design import SFRBADesign
+from softbend.design import sfrba_design
 from softbend.transfer.lab import shipped_measurements
 
-DESIGN = SFRBADesign(100, 6, 2, 2, 5, 8)
+DESIGN = sfrba_design(100, 6, 2, 2, 5, 8)
 
 
 def test_fem_plant_passes_through_the_sweep_and_extends_it_linearly():
@@ -37,7 +37,7 @@ def _design_rows(data):
 
 def test_fem_plant_of_a_design_outside_table1_is_one_error():
     with pytest.raises(ValueError, match=r"not in the FEM dataset \(Table 1: l_mm in 100, 120"):
-        fem_angle_table(SFRBADesign(105, 6, 2, 2, 5, 8))
+        fem_angle_table(sfrba_design(105, 6, 2, 2, 5, 8))
 
 
 def test_lab_plant_follows_the_readings_within_the_camera_noise():
@@ -47,7 +47,7 @@ def test_lab_plant_follows_the_readings_within_the_camera_noise():
     residual = np.array([table(p) for p in rows["pressure_mpa"]]) - rows["angle_deg"].to_numpy()
     assert np.sqrt(np.mean(residual**2)) < 2.0  # the lab's camera noise is 1°
     with pytest.raises(ValueError, match="has no measured loading curve"):
-        lab_angle_table(SFRBADesign(160, 10, 4, 4, 15, 12))
+        lab_angle_table(sfrba_design(160, 10, 4, 4, 15, 12))
 
 
 def test_model_mismatch_sets_the_steady_state_of_a_pressure_controller():

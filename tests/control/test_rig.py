@@ -10,7 +10,7 @@ from softbend.control.rig import (
     chamber_pressure_rate_pa_s,
     iso6358_mass_flow_kg_s,
 )
-from softbend.design import SFRBADesign
+from softbend.design import sfrba_design
 
 C, B = 4e-10, 0.3
 
@@ -118,7 +118,7 @@ def test_params_validation_names_field():
 
 
 def test_for_design_volume():
-    params = RigParams.for_design(SFRBADesign(100, 6, 2, 2, 5, 8))
+    params = RigParams.for_design(sfrba_design(100, 6, 2, 2, 5, 8))
     assert params.volume_mm3 == pytest.approx(0.5 * math.pi * 36 * 100 + 2000)
 
 
@@ -151,10 +151,9 @@ def test_default_compliance_is_the_fem_cavity_of_the_default_design():
     import softbend._torch  # noqa: F401  (PyTorch before NGSolve, as softbend.fem loads them)
 
     pytest.importorskip("ngsolve")
-    from softbend.design import SFRBADesign
     from softbend.fem.model import FEMModel
 
-    design = SFRBADesign(100, 6, 2, 2, 5, 8)
+    design = sfrba_design(100, 6, 2, 2, 5, 8)
     result = FEMModel().sweep(design, np.round(np.linspace(0.0, 0.2, 21), 4))
     params = RigParams.from_fem_sweep(result)
     assert params.compliance_mm3_per_mpa == pytest.approx(
@@ -165,9 +164,8 @@ def test_default_compliance_is_the_fem_cavity_of_the_default_design():
 
 def test_from_fem_sweep_refuses_a_result_without_volumes():
     from softbend.analytical import AnalyticalModel
-    from softbend.design import SFRBADesign
 
-    result = AnalyticalModel().sweep(SFRBADesign(100, 6, 2, 2, 5, 8), [0.0, 0.05, 0.1])
+    result = AnalyticalModel().sweep(sfrba_design(100, 6, 2, 2, 5, 8), [0.0, 0.05, 0.1])
     with pytest.raises(ValueError, match="must be an FEM sweep"):
         RigParams.from_fem_sweep(result)
 

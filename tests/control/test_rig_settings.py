@@ -12,11 +12,11 @@ from softbend.control.rigs import (
     rig_params_for,
     rig_settings,
 )
-from softbend.design import SFRBADesign
+from softbend.design import sfrba_design
 from softbend.errors import DatasetError
 from softbend.parameters import ParameterValueError, UnknownParameterError
 
-DESIGN = SFRBADesign(100, 6, 2, 2, 5, 8)
+DESIGN = sfrba_design(100, 6, 2, 2, 5, 8)
 
 
 def test_text_is_read_by_the_kind_of_each_field():

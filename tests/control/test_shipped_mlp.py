@@ -5,7 +5,7 @@ import pytest
 from softbend.control.controllers import BangBang, PressurePI, mlp_virtual_sensor
 from softbend.control.experiments import run_metrics, simulate
 from softbend.control.rig import AngleTable, SimulatedRig
-from softbend.design import SFRBADesign
+from softbend.design import sfrba_design
 
 
 @pytest.fixture(scope="module")
@@ -13,7 +13,7 @@ def mlp_loop():
     from softbend.transfer.base import load_base
 
     model = load_base()
-    design = SFRBADesign(100, 6, 2, 2, 5, 8)
+    design = sfrba_design(100, 6, 2, 2, 5, 8)
     return model, design, AngleTable.from_surrogate(model, design)
 
 

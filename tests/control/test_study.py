@@ -4,7 +4,7 @@ import pytest
 
 from softbend.control.rig import AngleTable
 from softbend.control.study import control_study
-from softbend.design import SFRBADesign
+from softbend.design import sfrba_design
 
 
 class Linear:
@@ -14,7 +14,7 @@ class Linear:
         return 6.0 + 1200.0 * rows[:, -1]
 
 
-DESIGN = SFRBADesign(100, 6, 2, 2, 5, 8)
+DESIGN = sfrba_design(100, 6, 2, 2, 5, 8)
 
 
 def test_study_runs_every_pair_and_scores_it():

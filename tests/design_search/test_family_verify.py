@@ -19,7 +19,7 @@ import numpy as np
 import pandas as pd
 import pytest
 
-from softbend.actuators import Actuator
+from softbend.actuators import Actuator, Design
 from softbend.cli import main
 from softbend.design_search.search import find_designs
 from softbend.design_search.spec import Specification, Target
@@ -226,7 +226,6 @@ def test_the_pneunet_fem_verifies_its_reference_design_as_its_own_sweep(tmp_path
     # The real family end to end: the reference PneuNet at 5 kPa, checked by NGSolve.
     import softbend._torch  # noqa: F401  (before NGSolve)
     from softbend.design_search.search import Candidate, SearchResult
-    from softbend.design_search.space import ActuatorDesign
     from softbend.fem.families import get_family
     from softbend.models import default_pressures_mpa
 
@@ -238,7 +237,7 @@ def test_the_pneunet_fem_verifies_its_reference_design_as_its_own_sweep(tmp_path
         actuator=actuator,
     )
     at = 0.005 / spec.space.to_mpa  # the model's unit
-    candidate = Candidate(ActuatorDesign(actuator, codes), 10.0, at, 0.0, True, {})
+    candidate = Candidate(Design(actuator, codes), 10.0, at, 0.0, True, {})
     candidate.pressure_unit = actuator.pressure_unit
     result = SearchResult(spec, [candidate], True, {}, 1, 1, 0, np.empty((0, 1)), "", 0.0)
     (verified,) = verify_candidates(result, 1, workers=1, db_path=tmp_path / "v.duckdb")

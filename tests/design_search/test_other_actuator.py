@@ -14,9 +14,9 @@ import json
 import numpy as np
 import pytest
 
-from softbend.actuators import Actuator, DesignParameter
+from softbend.actuators import Actuator, Design, DesignParameter
 from softbend.design_search.search import find_designs
-from softbend.design_search.space import ActuatorDesign, space_of
+from softbend.design_search.space import space_of
 from softbend.design_search.spec import Objective, ParameterRange, Specification, Target
 from softbend.design_search.spec_text import build_ranges, parse_objectives
 from softbend.design_search.spec_toml import load_specifications
@@ -90,7 +90,7 @@ def test_the_smallest_chamber_count_that_bends_88_degrees_at_30_kpa(constrained)
     # the constraint decides: without it, 8 chambers would do
     assert (expected, _brute_force(88.0, 3.0, constraint=False)) == (9, 8)
     best = result.candidates[0]
-    assert isinstance(best.design, ActuatorDesign)
+    assert isinstance(best.design, Design)
     record = best.design.as_dict()
     assert record["n_chambers"] == expected and isinstance(record["n_chambers"], int)
     for c in result.candidates:

@@ -4,12 +4,12 @@ from __future__ import annotations
 
 import pytest
 
-from softbend.design import SFRBADesign
+from softbend.design import parse_sfrba
 from softbend.fem import FEMOptions
 
 #: Coarse mesh (the element size barely changes the angle: see the mesh study).
 COARSE = FEMOptions(maxh_mm=6.0)
-REFERENCE = SFRBADesign.parse("100,6,2,2,5,10")
+REFERENCE = parse_sfrba("100,6,2,2,5,10")
 
 
 @pytest.fixture(scope="session")

@@ -3,13 +3,13 @@
 import numpy as np
 import pytest
 
-from softbend.design import SFRBADesign
+from softbend.design import sfrba_design
 from softbend.fem import FEMModel, FEMOptions, energy, use_compiled
 from softbend.fem.actuator import ActuatorModel
 
 OPTIONS = FEMOptions(maxh_mm=6.0)
-DESIGN_A = SFRBADesign(100, 6, 2, 2, 5, 8)
-DESIGN_B = SFRBADesign(120, 8, 3, 2, 10, 12)  # other mesh, fiber angle and spacing
+DESIGN_A = sfrba_design(100, 6, 2, 2, 5, 8)
+DESIGN_B = sfrba_design(120, 8, 3, 2, 10, 12)  # other mesh, fiber angle and spacing
 
 
 def _state(model, seed):

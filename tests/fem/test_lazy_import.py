@@ -28,14 +28,13 @@ def test_the_pure_python_parts_import_and_work_without_ngsolve():
     done = _run(
         """
         import softbend.fem
-        from softbend.design import SFRBADesign
         from softbend.fem import (
             GRAVITY_DIRECTIONS, OUTPUT_MODES, ActuatorGeometry, FEMOptions, FEMStats, fem_stats,
         )
 
         options = FEMOptions(maxh_mm=4.0).replace(gravity="none")
         assert options.maxh_mm == 4.0 and "none" in GRAVITY_DIRECTIONS and OUTPUT_MODES
-        info = ActuatorGeometry(SFRBADesign(100, 6, 2, 2, 5, 8), options.base_cap_mm)
+        info = ActuatorGeometry(sfrba_design(100, 6, 2, 2, 5, 8), options.base_cap_mm)
         assert info.length_mm == 111.0
         assert fem_stats({"stop_reason": "x"})["stop_reason"] == "x"
         assert "stop_reason" in FEMStats.__required_keys__

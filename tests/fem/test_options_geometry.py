@@ -2,7 +2,7 @@ import math
 
 import pytest
 
-from softbend.design import SFRBADesign
+from softbend.design import sfrba_design
 from softbend.fem import FEMOptions
 from softbend.fem.geometry import actuator_geometry, mesh_actuator
 
@@ -42,18 +42,18 @@ def test_step_bounds_are_ordered():
 
 def test_impossible_geometry_is_refused_by_the_design():
     with pytest.raises(ValueError, match=r"t_mm.*\(0, 50\]"):
-        SFRBADesign(100, 6, -2, 2, 5, 10)
+        sfrba_design(100, 6, -2, 2, 5, 10)
 
 
 def test_a_mesh_too_fine_to_afford_is_refused_before_meshing():
     with pytest.raises(ValueError, match=r"^maxh_mm: must give at most"):
-        mesh_actuator(SFRBADesign(160, 10, 4, 4, 5, 12), maxh_mm=0.05)
+        mesh_actuator(sfrba_design(160, 10, 4, 4, 5, 12), maxh_mm=0.05)
 
 
 def test_faces_are_named_and_the_mesh_has_the_solid_volume():
     import ngsolve as ngs
 
-    design = SFRBADesign(100, 6, 2, 2, 5, 10)
+    design = sfrba_design(100, 6, 2, 2, 5, 10)
     shape, info = actuator_geometry(design, 3.0)
     assert {f.name for f in shape.faces} == {
         "base",
@@ -85,7 +85,7 @@ def test_one_cavity_volume_serves_the_fem_and_the_rig(values):
     from softbend.control.rig import RigParams
     from softbend.fem.geometry import ActuatorGeometry
 
-    design = SFRBADesign(*values)
+    design = sfrba_design(*values)
     l_mm, r_mm = values[0], values[1]
     # Closed form: a half-disc of radius r extruded over l.
     assert design.cavity_volume_mm3 == pytest.approx(math.pi * r_mm**2 / 2.0 * l_mm, rel=1e-15)
@@ -100,6 +100,6 @@ def test_one_cavity_volume_serves_the_fem_and_the_rig(values):
 def test_the_meshed_cavity_has_the_closed_form_volume():
     from softbend.fem.actuator import ActuatorModel
 
-    design = SFRBADesign(100, 6, 2, 2, 5, 10)
+    design = sfrba_design(100, 6, 2, 2, 5, 10)
     model = ActuatorModel(design, FEMOptions(maxh_mm=6.0))
     assert model.cavity_volume_mm3() == pytest.approx(design.cavity_volume_mm3, rel=2e-3)

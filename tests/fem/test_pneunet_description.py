@@ -7,9 +7,9 @@ import sys
 
 import pytest
 
-from softbend.actuators import ACTUATORS
+from softbend.actuators import ACTUATORS, Design
 from softbend.errors import InputError
-from softbend.fem.families import FEM_FAMILIES, FamilyDesign, get_family
+from softbend.fem.families import FEM_FAMILIES, get_family
 from softbend.fem.pneunet.description import (
     PNEUNET,
     REFERENCE,
@@ -33,7 +33,7 @@ def test_the_pneunet_is_registered_as_an_actuator_and_an_fem_family(family):
 
 def test_the_reference_is_a_checked_design_inside_its_ranges(family):
     design = family.parse(None)
-    assert isinstance(design, FamilyDesign) and design.family == "pneunet"
+    assert isinstance(design, Design) and design.actuator.fem_family == "pneunet"
     assert design.as_dict() == REFERENCE
     codes = [[design.values[n] for n in PNEUNET.names]]
     assert PNEUNET.constraints_met(codes).all()

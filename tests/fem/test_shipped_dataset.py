@@ -15,7 +15,7 @@ import pytest
 
 from softbend.campaign.backends import default_pressures_mpa
 from softbend.datasets import table1_fem, table1_fem_designs
-from softbend.design import SFRBADesign
+from softbend.design import sfrba_design
 from softbend.fem import FEMOptions, simulate
 
 ANGLE_TOL_DEG = 0.1
@@ -29,7 +29,7 @@ def shipped():
 
 
 def _check_design(design_row, samples) -> None:
-    design = SFRBADesign(
+    design = sfrba_design(
         *(float(design_row[c]) for c in ("l_mm", "r_mm", "t_mm", "b_mm", "phi_deg", "lc_mm"))
     )
     assert design_row["options_sha256"] == FEMOptions().digest(), (

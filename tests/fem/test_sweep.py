@@ -6,7 +6,7 @@ import numpy as np
 import pytest
 
 from softbend.campaign.backends import default_pressures_mpa, get_backend
-from softbend.design import SFRBADesign
+from softbend.design import parse_sfrba, sfrba_design
 from softbend.fem import FEMModel, FEMOptions, simulate
 
 from .conftest import COARSE, REFERENCE
@@ -39,12 +39,12 @@ def test_angle_rises_monotonically_and_the_result_is_complete(reference):
 
 
 def test_thicker_top_wall_bends_less(reference):
-    thick = simulate(SFRBADesign(100, 6, 3, 2, 5, 10), GRID, COARSE)
+    thick = simulate(sfrba_design(100, 6, 3, 2, 5, 10), GRID, COARSE)
     assert thick.angle_deg[-1] < reference.angle_deg[-1] - 2.0
 
 
 def test_longer_chamber_bends_more(reference):
-    longer = simulate(SFRBADesign(120, 6, 2, 2, 5, 10), GRID, COARSE)
+    longer = simulate(sfrba_design(120, 6, 2, 2, 5, 10), GRID, COARSE)
     assert longer.angle_deg[-1] > reference.angle_deg[-1] + 2.0
 
 
@@ -204,7 +204,7 @@ def test_a_flattening_pressure_volume_curve_is_told_apart_from_a_stall():
 @pytest.mark.slow
 def test_a_ballooning_end_cap_stops_as_an_inflation_instability():
     """(100, 10, 4, 4, 15, 8): its unreinforced 8 mm distal cap balloons near 0.49 MPa."""
-    result = simulate(SFRBADesign.parse("100,10,4,4,15,8"), default_pressures_mpa(), FEMOptions())
+    result = simulate(parse_sfrba("100,10,4,4,15,8"), default_pressures_mpa(), FEMOptions())
     reason = result.stats["stop_reason"]
     assert reason.startswith(("inflation instability", "stretch")), reason
     assert "distal cap" in reason

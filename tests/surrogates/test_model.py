@@ -10,7 +10,7 @@ import pytest
 from softbend.analytical import AnalyticalModel, tip_position_mm
 from softbend.campaign import load_samples, run_campaign
 from softbend.cli import main
-from softbend.design import DesignSpace, SFRBADesign
+from softbend.design import DesignSpace, sfrba_design
 from softbend.models import BendingModel, default_pressures_mpa
 from softbend.surrogates.features import training_data
 from softbend.surrogates.model import SurrogateModel
@@ -19,7 +19,7 @@ from softbend.surrogates.polynomial import PolynomialRegressor
 
 from ..cli.conftest import one_error_line
 
-DESIGN = SFRBADesign(130, 8, 3, 3, 10, 10)  # inside the space the surrogate learned
+DESIGN = sfrba_design(130, 8, 3, 3, 10, 10)  # inside the space the surrogate learned
 GRID = default_pressures_mpa(0.15, 0.01)
 
 

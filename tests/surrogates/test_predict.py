@@ -8,7 +8,7 @@ import math
 import numpy as np
 import pytest
 
-from softbend.design import SFRBADesign
+from softbend.design import sfrba_design
 from softbend.errors import SchemaError
 from softbend.surrogates.corrected import AffineCorrected, GPCorrected, gp_kernel
 from softbend.surrogates.features import training_ranges
@@ -31,7 +31,7 @@ def saved(tmp_path):
 
 def test_angles_are_the_model_prediction(saved):
     path, model = saved
-    design = SFRBADesign(130, 8, 3, 3, 10, 10)
+    design = sfrba_design(130, 8, 3, 3, 10, 10)
     result = predict_angles(path, design, [0.1, 0.05])
     np.testing.assert_array_equal(result.angle_deg, model.predict(design.feature_rows([0.1, 0.05])))
     assert result.outside_training_ranges == [] and result.has_training_ranges
@@ -39,7 +39,7 @@ def test_angles_are_the_model_prediction(saved):
 
 def test_beyond_the_training_pressures_is_flagged_and_strict_refuses(saved):
     path, _ = saved
-    design = SFRBADesign(130, 8, 3, 3, 10, 10)
+    design = sfrba_design(130, 8, 3, 3, 10, 10)
     result = predict_angles(path, design, [0.1, 0.45])
     assert len(result.outside_training_ranges) == 1
     assert result.outside_training_ranges[0].startswith("pressure_mpa 0.45 outside")
@@ -50,7 +50,7 @@ def test_beyond_the_training_pressures_is_flagged_and_strict_refuses(saved):
 @pytest.mark.parametrize("pressures", [[], [-0.1], [float("nan")], [1, float("inf")]])
 def test_bad_pressures_name_the_field(saved, pressures):
     with pytest.raises(ValueError, match="pressures_mpa: must be finite and >= 0"):
-        predict_angles(saved[0], SFRBADesign(130, 8, 3, 3, 10, 10), pressures)
+        predict_angles(saved[0], sfrba_design(130, 8, 3, 3, 10, 10), pressures)
 
 
 def _rewrite(path, change):
@@ -64,7 +64,7 @@ def test_a_nan_training_range_is_refused_on_load_not_silently_unchecked(saved):
     path, _ = saved
     _rewrite(path, lambda d: d["metadata"]["training_ranges"]["l_mm"].__setitem__(0, math.nan))
     with pytest.raises(SchemaError, match=r"metadata\.training_ranges\.l_mm: .*got \[NaN,") as info:
-        predict_angles(path, SFRBADesign(100, 8, 3, 3, 10, 10), [0.1], strict=True)
+        predict_angles(path, sfrba_design(100, 8, 3, 3, 10, 10), [0.1], strict=True)
     assert str(info.value).startswith(str(path))
 
 
@@ -77,7 +77,7 @@ def test_a_non_finite_prediction_inside_the_training_ranges_names_the_model_file
         metadata={"training_ranges": training_ranges(X)},
     )
     with pytest.raises(SchemaError, match="predicts a non-finite angle") as info:
-        predict_angles(path, SFRBADesign(130, 8, 3, 3, 10, 10), [0.2, 0.3])
+        predict_angles(path, sfrba_design(130, 8, 3, 3, 10, 10), [0.2, 0.3])
     message = str(info.value)
     assert str(path) in message and "affine-corrected" in message and "0.2 MPa" in message
 
@@ -85,7 +85,7 @@ def test_a_non_finite_prediction_inside_the_training_ranges_names_the_model_file
 def test_a_non_finite_extrapolation_is_an_error_naming_file_and_inputs(saved):
     path, _ = saved
     with pytest.raises(ValueError, match="predicts a non-finite angle") as info:
-        predict_angles(path, SFRBADesign(130, 8, 3, 3, 10, 10), [0.1, 1e308])
+        predict_angles(path, sfrba_design(130, 8, 3, 3, 10, 10), [0.1, 1e308])
     message = str(info.value)
     assert str(path) in message and "pressure_mpa 1e+308 outside" in message
 
@@ -124,7 +124,7 @@ def test_the_shipped_mlp_predicts_bit_for_bit_as_its_estimator():
     path = files("softbend") / "data" / "transfer" / "table1_fem_mlp.json"
     model = load_surrogate(path).model
     rng = np.random.default_rng(5)
-    for design in (SFRBADesign(100, 6, 2, 2, 5, 8), SFRBADesign(130, 7, 2.5, 3, 10, 9)):
+    for design in (sfrba_design(100, 6, 2, 2, 5, 8), sfrba_design(130, 7, 2.5, 3, 10, 9)):
         pressures = np.concatenate([[0.05], rng.uniform(0.0, 0.2, 20)])
         result = predict_angles(path, design, pressures)
         expected = model.predict(design.feature_rows(pressures))

@@ -7,7 +7,7 @@ import json
 import numpy as np
 import pytest
 
-from softbend.design import SFRBADesign
+from softbend.design import sfrba_design
 from softbend.errors import SchemaError
 from softbend.surrogates.features import training_ranges
 from softbend.surrogates.persistence import load_surrogate, save_surrogate
@@ -104,15 +104,15 @@ def test_predict_flags_a_pressure_past_the_design_s_sweep_and_strict_refuses(two
     model = PolynomialRegressor(degree=1).fit(X, 1000 * X[:, 6])
     metadata = {"training_ranges": training_ranges(X), "support": two_designs.to_dict()}
     path = save_surrogate(model, tmp_path / "m.json", metadata=metadata)
-    result = predict_angles(path, SFRBADesign(*A), [0.1, 0.3])
+    result = predict_angles(path, sfrba_design(*A), [0.1, 0.3])
     assert result.outside_training_ranges == []  # inside the box ...
     assert result.supported.tolist() == [True, False]  # ... but past A's sweep
     assert result.beyond_support and result.extrapolated == result.beyond_support
     payload = result.to_dict()
     assert payload["supported"] == [True, False] and payload["beyond_training_support"]
     with pytest.raises(ValueError, match=r"pressure 0\.3 MPa beyond"):
-        predict_angles(path, SFRBADesign(*A), [0.1, 0.3], strict=True)
-    assert predict_angles(path, SFRBADesign(*A), [0.1], strict=True).supported.tolist() == [True]
+        predict_angles(path, sfrba_design(*A), [0.1, 0.3], strict=True)
+    assert predict_angles(path, sfrba_design(*A), [0.1], strict=True).supported.tolist() == [True]
 
 
 def test_strict_refuses_a_model_that_records_no_support(tmp_path):
@@ -121,9 +121,9 @@ def test_strict_refuses_a_model_that_records_no_support(tmp_path):
     path = save_surrogate(
         model, tmp_path / "m.json", metadata={"training_ranges": training_ranges(X)}
     )
-    assert predict_angles(path, SFRBADesign(*A), [0.1]).supported is None
+    assert predict_angles(path, sfrba_design(*A), [0.1]).supported is None
     with pytest.raises(ValueError, match="records no training support"):
-        predict_angles(path, SFRBADesign(*A), [0.1], strict=True)
+        predict_angles(path, sfrba_design(*A), [0.1], strict=True)
 
 
 def test_the_shipped_mlp_refuses_the_long_design_past_its_sweep():
@@ -132,7 +132,7 @@ def test_the_shipped_mlp_refuses_the_long_design_past_its_sweep():
     from importlib.resources import files
 
     path = files("softbend") / "data" / "transfer" / "table1_fem_mlp.json"
-    design = SFRBADesign(150, 8, 2, 2, 5, 8)
+    design = sfrba_design(150, 8, 2, 2, 5, 8)
     result = predict_angles(path, design, [0.1, 0.3])
     assert result.outside_training_ranges == []
     assert result.supported.tolist() == [True, False]

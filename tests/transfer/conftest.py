@@ -6,7 +6,7 @@ import numpy as np
 import pytest
 
 from softbend.analytical import AnalyticalModel
-from softbend.design import SFRBADesign
+from softbend.design import sfrba_design
 from softbend.models import default_pressures_mpa
 from softbend.transfer.lab import LAB_ACTUATORS, VirtualLab
 
@@ -34,7 +34,7 @@ def small_base():
     model = AnalyticalModel()
     rows, angles = [], []
     grid = default_pressures_mpa(0.2, 0.01)
-    others = [SFRBADesign(140, 8, 3, 3, 10, 10), SFRBADesign(110, 7, 2.5, 2.5, 8, 9)]
+    others = [sfrba_design(140, 8, 3, 3, 10, 10), sfrba_design(110, 7, 2.5, 2.5, 8, 9)]
     for design in [*LAB_ACTUATORS, *others]:
         sweep = model.sweep(design, grid)
         ok = np.asarray(sweep.converged, dtype=bool)

@@ -2,7 +2,7 @@ import numpy as np
 import pandas as pd
 import pytest
 
-from softbend.design import FEATURES, SFRBADesign
+from softbend.design import FEATURES, sfrba_design
 from softbend.errors import DatasetError
 from softbend.transfer.measurements import (
     DIRECTIONS,
@@ -110,7 +110,7 @@ def test_optional_columns_get_defaults(tmp_path):
     assert m.actuator_ids == ("100,6,2,2,5,8", "120,8,3,3,10,10", "100.5,6,2,2,5,8")
     assert m.frame["cycle"].tolist() == [1, 1, 1, 1]
     assert m.frame["direction"].tolist() == ["loading"] * 4
-    assert m.design_of("100,6,2,2,5,8") == SFRBADesign(100, 6, 2, 2, 5, 8)
+    assert m.design_of("100,6,2,2,5,8") == sfrba_design(100, 6, 2, 2, 5, 8)
     assert DIRECTIONS == ("loading", "unloading")
 
 
@@ -135,8 +135,8 @@ def test_column_order_is_free_and_cells_are_stripped(tmp_path):
 def test_ids_designs_features_groups_and_subset():
     m = Measurements.from_frame(_frame())
     assert m.actuator_ids == ("A2", "B1")
-    assert m.designs == (SFRBADesign(100, 6, 2, 2, 5, 8), SFRBADesign(120, 8, 3, 3, 10, 10))
-    assert m.design_of("B1") == SFRBADesign(120, 8, 3, 3, 10, 10)
+    assert m.designs == (sfrba_design(100, 6, 2, 2, 5, 8), sfrba_design(120, 8, 3, 3, 10, 10))
+    assert m.design_of("B1") == sfrba_design(120, 8, 3, 3, 10, 10)
 
     features = m.features
     assert features.shape == (5, 7) and features.dtype == np.float64

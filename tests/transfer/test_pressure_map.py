@@ -6,7 +6,7 @@ import numpy as np
 import pytest
 
 from softbend.analytical import AnalyticalModel
-from softbend.design import SFRBADesign
+from softbend.design import sfrba_design
 from softbend.materials.models import Yeoh
 from softbend.surrogates.corrected import scaled_pressure_rows as scaled_rows
 from softbend.transfer.pressure_map import SCALE_BOUNDS, fit_pressure_scale, scale_mlp_pressure
@@ -18,7 +18,7 @@ from softbend.transfer.strategies import (
     make_strategy,
 )
 
-DESIGNS = (SFRBADesign(100, 6, 2, 2, 5, 8), SFRBADesign(120, 8, 3, 2, 10, 10))
+DESIGNS = (sfrba_design(100, 6, 2, 2, 5, 8), sfrba_design(120, 8, 3, 2, 10, 10))
 
 
 def _rows(pressures):

@@ -41,8 +41,8 @@ from typing import TYPE_CHECKING, Any, NamedTuple, cast
 import numpy as np
 
 from softbend._validation import check_range, must_be, short_repr
+from softbend.actuators import Design
 from softbend.analytical import AnalyticalModel
-from softbend.design import SFRBADesign
 from softbend.errors import ConvergenceError, InputError, SoftbendError, keyed
 from softbend.materials.presets import Material
 from softbend.models import (
@@ -157,7 +157,7 @@ class FaultInjectionBackend:
     delay_s : float
         Sleep before each sweep, s, in [0, 3600].
     fail_design_ids : frozenset of str
-        Designs (by :attr:`SFRBADesign.design_id`) whose sweep raises
+        Designs (by :attr:`Design.design_id`) whose sweep raises
         :class:`~softbend.errors.ConvergenceError` instead of running.
     crash_design_ids : frozenset of str
         Designs whose sweep ends the process running it at once (``os._exit``),
@@ -171,7 +171,7 @@ class FaultInjectionBackend:
     crash_design_ids: frozenset[str] = frozenset()
     name: str = field(default="fault-injection", init=False)
 
-    def sweep(self, design: SFRBADesign, pressures_mpa: np.ndarray) -> SweepResult:
+    def sweep(self, design: Design, pressures_mpa: np.ndarray) -> SweepResult:
         """Sleep ``delay_s``, then fail or delegate to the inner backend."""
         start = time.perf_counter()
         if self.delay_s:

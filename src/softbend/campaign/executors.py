@@ -105,7 +105,7 @@ def _error_text(exc: BaseException) -> str:
 def _sweep_one(backend: Backend, design: CampaignDesign, pressures_mpa: np.ndarray) -> Outcome:
     start = time.perf_counter()
     try:
-        # A family's backend sweeps its FamilyDesign; the protocol names paper B's design.
+        # A family's backend sweeps its Design; the protocol names paper B's design.
         result = backend.sweep(cast(Any, design), pressures_mpa)
         if not isinstance(result, SweepResult):
             raise SoftbendError(

@@ -1,10 +1,10 @@
 """Campaigns over any FEM actuator family: its backend, and what its database records.
 
 A campaign of paper B's actuator (family ``"sfrba"``) is what it always was: its
-designs are :class:`~softbend.design.SFRBADesign`, its ``designs`` table has the
+designs are :class:`~softbend.actuators.Design`, its ``designs`` table has the
 columns ``l_mm`` ... ``lc_mm`` and its database records no family. A campaign of
 another family of :data:`~softbend.fem.families.FEM_FAMILIES` sweeps
-:class:`~softbend.fem.families.FamilyDesign` objects with the family's own FEM
+:class:`~softbend.actuators.Design` objects with the family's own FEM
 sweep (:class:`FamilyBackend`), and its database records the family's name and
 actuator description (:class:`FamilySchema`): the ``designs`` table then has the
 family's parameter columns, named and in the units of its
@@ -17,7 +17,8 @@ from __future__ import annotations
 from dataclasses import dataclass, field
 from typing import TYPE_CHECKING, Any, NamedTuple, TypeAlias
 
-from softbend.design import PARAMETERS, FamilyDesign, SFRBADesign
+from softbend.actuators import Design
+from softbend.design import PARAMETERS
 
 if TYPE_CHECKING:
     import numpy as np
@@ -38,7 +39,7 @@ __all__ = [
 DEFAULT_FAMILY = "sfrba"
 
 #: A design a campaign sweeps: paper B's, or one of another FEM family.
-CampaignDesign: TypeAlias = SFRBADesign | FamilyDesign
+CampaignDesign: TypeAlias = Design
 
 
 class FamilySchema(NamedTuple):

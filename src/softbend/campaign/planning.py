@@ -21,9 +21,9 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 
 from softbend._validation import check_range, must_be
+from softbend.actuators import Design
 from softbend.campaign.backends import Backend, get_backend
-from softbend.campaign.families import DEFAULT_FAMILY, CampaignDesign
-from softbend.design import FamilyDesign, SFRBADesign
+from softbend.campaign.families import CampaignDesign
 from softbend.errors import InputError
 
 if TYPE_CHECKING:
@@ -52,7 +52,7 @@ class RunPlan:
 
     Attributes
     ----------
-    todo : list of SFRBADesign or FamilyDesign
+    todo : list of Design
         The designs to sweep, in the order asked for.
     n_skipped_done : int
         Designs already done in the database (not re-run).
@@ -76,9 +76,9 @@ class RunPlan:
 
 
 def check_designs(designs: Iterable[CampaignDesign]) -> list[CampaignDesign]:
-    """The designs as a list: non-empty, all :class:`SFRBADesign`, no two alike.
+    """The designs as a list: non-empty, all :class:`Design`, no two alike.
 
-    Designs of another FEM family (:class:`~softbend.fem.families.FamilyDesign`)
+    Designs of another FEM family (:class:`~softbend.actuators.Design`)
     are accepted too, all of one family.
 
     Raises
@@ -86,20 +86,18 @@ def check_designs(designs: Iterable[CampaignDesign]) -> list[CampaignDesign]:
     ValueError
         Not an iterable of designs, empty, of two families, or with duplicates.
     """
-    if isinstance(designs, SFRBADesign | FamilyDesign):
+    if isinstance(designs, Design):
         designs = [designs]
     try:
         items = list(designs)
     except TypeError:
-        raise InputError(must_be("an iterable of SFRBADesign", designs), key="designs") from None
+        raise InputError(must_be("an iterable of Design", designs), key="designs") from None
     if not items:
         raise InputError("must not be empty; got 0 designs", key="designs")
     family = None
     for i, design in enumerate(items):
-        if not isinstance(design, SFRBADesign | FamilyDesign):
-            raise InputError(
-                f"must all be SFRBADesign; got {design!r} at position {i}", key="designs"
-            )
+        if not isinstance(design, Design):
+            raise InputError(f"must all be Design; got {design!r} at position {i}", key="designs")
         family = design_family(design) if family is None else family
         if design_family(design) != family:
             raise InputError(
@@ -116,18 +114,18 @@ def check_designs(designs: Iterable[CampaignDesign]) -> list[CampaignDesign]:
 
 
 def design_family(design: object) -> str:
-    """The FEM family of a design: its ``family`` (FamilyDesign), ``"sfrba"`` for paper B's.
+    """The FEM family of a design: its actuator's (``"sfrba"`` for paper B's).
 
     Raises
     ------
     InputError
-        Keyed ``designs``: neither an SFRBADesign nor a FamilyDesign.
+        Keyed ``designs``: not a design of an actuator an FEM family simulates.
     """
-    if isinstance(design, FamilyDesign):
-        return design.family
-    if isinstance(design, SFRBADesign):
-        return DEFAULT_FAMILY
-    raise InputError(must_be("SFRBADesign or FamilyDesign objects", design), key="designs")
+    if isinstance(design, Design) and design.actuator.fem_family is not None:
+        return design.actuator.fem_family
+    raise InputError(
+        must_be("Design objects of an actuator an FEM family simulates", design), key="designs"
+    )
 
 
 def resolve_backend(backend: str | Backend, options: dict[str, Any] | None) -> Backend:
@@ -213,7 +211,7 @@ def plan_run(
         Backend name.
     pressures_mpa : numpy.ndarray
         Checked sweep grid, MPa.
-    designs : sequence of SFRBADesign or FamilyDesign
+    designs : sequence of Design
         The designs asked for (checked by :func:`check_designs`).
     space : str, optional
         Label of the design space, stored for reports.

@@ -48,7 +48,7 @@ import time
 from collections.abc import Iterable
 from dataclasses import asdict, dataclass, field
 from pathlib import Path
-from typing import TYPE_CHECKING, Any, cast
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 from numpy.typing import ArrayLike
@@ -92,7 +92,6 @@ from softbend.campaign.planning import (
 )
 from softbend.campaign.settings import backend_settings, fem_options_of
 from softbend.campaign.store import CampaignStore
-from softbend.design import SFRBADesign
 from softbend.errors import InputError
 
 if TYPE_CHECKING:
@@ -189,7 +188,7 @@ def run_campaign(
     ----------
     db_path : str or os.PathLike
         DuckDB file of the campaign; created if missing, resumed if present.
-    designs : iterable of SFRBADesign or FamilyDesign
+    designs : iterable of Design
         The designs (e.g. a :class:`~softbend.design.DesignSpace`, or a
         :class:`~softbend.campaign.family_spaces.FamilySpace` of another FEM
         family), non-empty, unique and of one family. A database keeps the
@@ -350,7 +349,7 @@ def _check_meshes(backend: Backend, family: str, designs: list[CampaignDesign]) 
     if options is None:
         return
     if family == DEFAULT_FAMILY:
-        options.check_mesh(cast(list[SFRBADesign], designs))
+        options.check_mesh(designs)
         return
     if isinstance(backend, FamilyBackend):
         fem_family = backend.family

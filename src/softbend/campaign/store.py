@@ -34,6 +34,7 @@ import numpy as np
 
 from softbend._io import new_file_mode
 from softbend._validation import check_choice
+from softbend.actuators import Design
 from softbend.campaign.families import DEFAULT_FAMILY, CampaignDesign, FamilySchema
 from softbend.campaign.schema import SAMPLE_COLUMNS as SAMPLE_COLUMNS
 from softbend.campaign.schema import (
@@ -59,7 +60,6 @@ from softbend.campaign.settings import (
     describe_differences,
     settings_differences,
 )
-from softbend.design import FamilyDesign, SFRBADesign
 from softbend.errors import SchemaError, SoftbendError
 from softbend.models import SweepResult, check_pressures_mpa
 
@@ -649,7 +649,7 @@ class CampaignStore:
 
         Parameters
         ----------
-        design : SFRBADesign or FamilyDesign
+        design : Design
             The design, of the campaign's family.
         error_text : str
             Why it failed, conventionally ``"ExceptionType: message"``.
@@ -658,10 +658,10 @@ class CampaignStore:
         backend : str, optional
             Backend name; default the campaign's.
         """
-        if not isinstance(design, SFRBADesign | FamilyDesign):
+        if not isinstance(design, Design):
             raise ValueError(
-                f"The 'design' of CampaignStore.record_failure must be an SFRBADesign or a "
-                f"FamilyDesign. Got {design!r} instead."
+                f"The 'design' of CampaignStore.record_failure must be a Design. "
+                f"Got {design!r} instead."
             )
         self._check_family(design)
         backend = self._backend_name(backend)

@@ -9,6 +9,7 @@ import typer
 
 from softbend._validation import must_be
 from softbend.cli import _common
+from softbend.design import parse_sfrba
 from softbend.errors import InputError, keyed
 
 if TYPE_CHECKING:
@@ -186,7 +187,6 @@ def run(
     from softbend._io import write_text_atomic
     from softbend._outdir import staged_dir
     from softbend._validation import check_int
-    from softbend.design import SFRBADesign
     from softbend.fem.families import get_family
     from softbend.fem.stats import fem_stats
     from softbend.models import default_pressures_mpa
@@ -197,7 +197,7 @@ def run(
     paper_b = chosen.name == "sfrba"
     output = "solve" if solve_every else "interpolate"
     if paper_b:
-        actuator = SFRBADesign.parse(design or SFRBA_DESIGN)
+        actuator = parse_sfrba(design or SFRBA_DESIGN)
         options = _options(
             5.0 if maxh is None else maxh,
             gravity or "bending",
@@ -326,7 +326,6 @@ def mesh_study(
     \b
         softbend fem mesh-study --maxh 6,5,4,3 --pressures 0,0.05,0.1
     """
-    from softbend.design import SFRBADesign
     from softbend.fem.families import get_family
     from softbend.fem.verification import mesh_study as study
 
@@ -342,7 +341,7 @@ def mesh_study(
     sizes = _floats(maxh or default_maxh, "maxh")
     grid = _floats(pressures or default_pressures, "pressures")
     if chosen.name == "sfrba":
-        actuator = SFRBADesign.parse(design or SFRBA_DESIGN)
+        actuator = parse_sfrba(design or SFRBA_DESIGN)
         options = _options(4.0, gravity or "bending", material or "dragon-skin-30")
     else:
         actuator = chosen.parse(design)

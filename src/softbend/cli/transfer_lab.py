@@ -21,7 +21,7 @@ from softbend.cli import _common
 from softbend.errors import InputError, SoftbendError
 
 if TYPE_CHECKING:
-    from softbend.design import SFRBADesign
+    from softbend.actuators import Design
     from softbend.transfer.lab import VirtualLab
     from softbend.transfer.measurements import Measurements
 
@@ -237,12 +237,12 @@ def _print_measurements(
     _common.console.print(f"measurements written to {out}, figure {figure}")
 
 
-def _design(text: str) -> SFRBADesign:
+def _design(text: str) -> Design:
     """One ``--design`` value as a design; a bad one is one error naming the option."""
-    from softbend.design import SFRBADesign
+    from softbend.design import parse_sfrba
 
     try:
-        return SFRBADesign.parse(text)
+        return parse_sfrba(text)
     except ValueError as exc:
         detail = exc.detail if isinstance(exc, SoftbendError) else str(exc)
         raise InputError(f"{text!r} is not a design: {detail}", key="designs") from None

@@ -59,7 +59,6 @@ _EXPORTS: dict[str, str] = {
     "run_metrics": "experiments",
     "simulate": "experiments",
     "run_loop": "loop",
-    "ModelDesign": "designs",
     "control_design": "designs",
     "ControlSetup": "setup",
     "prepare_control": "setup",

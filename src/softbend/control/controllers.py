@@ -27,14 +27,13 @@ from typing import TYPE_CHECKING, NamedTuple, Protocol, cast, runtime_checkable
 import numpy as np
 
 from softbend._validation import check_choice
+from softbend.actuators import Design
 from softbend.control._ranges import check_declared
 from softbend.control.rig import AngleTable, RigParams
 from softbend.errors import InputError
 from softbend.parameters import Range, declare_ranges, declared_ranges
 
 if TYPE_CHECKING:
-    from softbend.control.designs import ModelDesign
-    from softbend.design import SFRBADesign
     from softbend.surrogates.protocol import FastSurrogate, Surrogate
 
 __all__ = [
@@ -74,22 +73,20 @@ class Controller(Protocol):
     def reset(self) -> None: ...
 
 
-def mlp_virtual_sensor(
-    model: FastSurrogate, design: SFRBADesign | ModelDesign
-) -> Callable[[float], float]:
+def mlp_virtual_sensor(model: FastSurrogate, design: Design) -> Callable[[float], float]:
     """Paper B's virtual angle sensor: θp = MLP(design, p), one fast call per reading.
 
     ``model`` is a fitted :class:`softbend.surrogates.mlp.NormalizedMLPRegressor`
     (its ``.predictor()`` is used); returns ``f(p_mpa) -> degrees``. ``design``
-    is paper B's :class:`~softbend.design.SFRBADesign` or a
-    :class:`~softbend.control.designs.ModelDesign` of another actuator, whose
+    is paper B's :class:`~softbend.actuators.Design` or a
+    :class:`~softbend.actuators.Design` of another actuator, whose
     model takes the pressure in its own unit (the reading in MPa is converted).
     """
     predict = model.predictor()
     codes = design.as_array()
     row = np.empty(codes.size + 1)
     row[:-1] = codes
-    scale = float(getattr(design, "pressure_scale", 1.0))
+    scale = 1.0 / design.actuator.to_mpa  # MPa to the model's pressure unit
     last = codes.size
 
     if scale == 1.0:
@@ -133,14 +130,14 @@ class ControllerModel:
     def from_surrogate(
         cls,
         model: Surrogate,
-        design: SFRBADesign | ModelDesign,
+        design: Design,
         rig: RigParams | None = None,
         *,
         pmax_mpa: float = 0.5,
     ) -> ControllerModel:
         """θ(p) of ``model`` for ``design``; its ``.predictor()`` is the virtual sensor, if any.
 
-        ``design`` is paper B's, or a :class:`~softbend.control.designs.ModelDesign`
+        ``design`` is paper B's, or a :class:`~softbend.actuators.Design`
         of the model's actuator (its pressures converted from MPa); the table spans
         0 to ``pmax_mpa`` MPa gauge.
         """

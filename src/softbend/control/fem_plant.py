@@ -28,8 +28,9 @@ import numpy as np
 
 from softbend._io import json_text, write_text_atomic
 from softbend._progress import report
+from softbend.actuators import Design
 from softbend.control.rig import AngleTable, cavity_compliance_mm3_per_mpa
-from softbend.design import SFRBADesign
+from softbend.design import sfrba_design
 
 if TYPE_CHECKING:
     from softbend.fem.options import FEMOptions
@@ -53,7 +54,7 @@ class FEMCurve:
 
     Attributes
     ----------
-    design : SFRBADesign
+    design : Design
     pressure_mpa, angle_deg : ndarray
         The converged samples of the sweep (MPa, degrees).
     steps_mpa, volume_rate_mm3_per_mpa : ndarray
@@ -62,7 +63,7 @@ class FEMCurve:
         Why the sweep ended (the last pressure, 300°, an instability).
     """
 
-    design: SFRBADesign
+    design: Design
     pressure_mpa: np.ndarray
     angle_deg: np.ndarray
     steps_mpa: np.ndarray
@@ -100,7 +101,7 @@ class FEMCurve:
     def from_dict(cls, data: dict[str, Any]) -> FEMCurve:
         """Rebuild from :meth:`to_dict`; ``ValueError``/``KeyError``/``TypeError`` if damaged."""
         curve = cls(
-            design=SFRBADesign(**data["design"]),
+            design=sfrba_design(**data["design"]),
             pressure_mpa=np.asarray(data["pressure_mpa"], dtype=float),
             angle_deg=np.asarray(data["angle_deg"], dtype=float),
             steps_mpa=np.asarray(data["steps_mpa"], dtype=float),
@@ -115,13 +116,13 @@ class FEMCurve:
         return curve
 
 
-def _key(design: SFRBADesign, options: FEMOptions) -> str:
+def _key(design: Design, options: FEMOptions) -> str:
     described = json_text({"design": design.as_dict(), "options": options.to_dict()}, indent=None)
     return hashlib.sha256(described.encode()).hexdigest()[:16]
 
 
 def fem_curve(
-    design: SFRBADesign,
+    design: Design,
     options: FEMOptions | None = None,
     *,
     progress: Callable[[float, float, float], None] | None = None,
@@ -131,7 +132,7 @@ def fem_curve(
 
     Parameters
     ----------
-    design : SFRBADesign
+    design : Design
         Any design the FEM can build.
     options : FEMOptions, optional
         The FEM's settings (default :class:`~softbend.fem.FEMOptions`); part of the key.

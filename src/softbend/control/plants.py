@@ -22,7 +22,7 @@ The text of ``--plant`` is parsed once (:func:`parse_plant`) into a
 dispatches on its kind.
 
 A saved surrogate of any actuator plays the plant of its design
-(:class:`~softbend.control.designs.ModelDesign`): its θ(p) is tabulated in MPa,
+(:class:`~softbend.actuators.Design`): its θ(p) is tabulated in MPa,
 the rig's unit, from the model's own pressure unit. A plant that is of one
 actuator only (``fem``, ``lab`` and a measurements CSV are paper B's) says so in
 :data:`PLANT_ACTUATORS`; a registered plant may also give the rig's chamber
@@ -37,11 +37,10 @@ from typing import TYPE_CHECKING, cast
 
 import numpy as np
 
-from softbend.actuators import SFRBA, Actuator
-from softbend.control.designs import ModelDesign, actuator_of_design, control_design
+from softbend.actuators import SFRBA, Actuator, Design
+from softbend.control.designs import actuator_of_design, control_design
 from softbend.control.plant_choice import PlantChoice
 from softbend.control.rig import AngleTable
-from softbend.design import SFRBADesign
 from softbend.errors import InputError
 from softbend.registry import Registry, UnknownNameError
 
@@ -72,7 +71,7 @@ __all__ = [
 ]
 
 #: Plant factories by name: ``factory(design, model_table) -> AngleTable``.
-PLANTS: Registry[Callable[[SFRBADesign, AngleTable], AngleTable]] = Registry("plant")
+PLANTS: Registry[Callable[[Design, AngleTable], AngleTable]] = Registry("plant")
 
 #: The actuator a plant is of alone, by the plant's name (``"measurements"``: a CSV):
 #: paper B's FEM, virtual lab and measurement files. Any other plant takes a design
@@ -81,7 +80,7 @@ PLANT_ACTUATORS: dict[str, Actuator] = {"fem": SFRBA, "lab": SFRBA, "measurement
 
 #: The chamber compliance a registered plant gives the rig:
 #: ``compliance(design, supply_mpa) -> mm³/MPa or None`` (None: the design's default).
-PLANT_COMPLIANCES: dict[str, Callable[[SFRBADesign, float], float | None]] = {}
+PLANT_COMPLIANCES: dict[str, Callable[[Design, float], float | None]] = {}
 
 
 def plant_file(name: str) -> Path | None:
@@ -134,7 +133,7 @@ def _own_actuator(choice: PlantChoice) -> Actuator | None:
     return PLANT_ACTUATORS.get(choice.text if choice.kind == "named" else choice.kind)
 
 
-def check_plant_actuator(plant: str | PlantChoice, design: SFRBADesign | ModelDesign) -> None:
+def check_plant_actuator(plant: str | PlantChoice, design: Design) -> None:
     """Refuse a plant of one actuator alone for a design of another (InputError keyed plant)."""
     choice = parse_plant(plant)
     own, actuator = _own_actuator(choice), actuator_of_design(design)
@@ -147,21 +146,19 @@ def check_plant_actuator(plant: str | PlantChoice, design: SFRBADesign | ModelDe
         )
 
 
-def plant_compliance(
-    plant: str | PlantChoice, design: SFRBADesign | ModelDesign, supply_mpa: float
-) -> float | None:
+def plant_compliance(plant: str | PlantChoice, design: Design, supply_mpa: float) -> float | None:
     """The rig's chamber compliance the plant gives for ``design``, mm³/MPa, else None."""
     choice = parse_plant(plant)
     compliance = PLANT_COMPLIANCES.get(choice.text) if choice.kind == "named" else None
     if compliance is None:
         return None
     check_plant_actuator(choice, design)
-    return compliance(cast(SFRBADesign, design), supply_mpa)
+    return compliance(cast(Design, design), supply_mpa)
 
 
 def plant_table(
     plant: str | PlantChoice,
-    design: SFRBADesign | ModelDesign,
+    design: Design,
     model_table: AngleTable,
     *,
     pmax_mpa: float = 0.5,
@@ -177,7 +174,7 @@ def plant_table(
         :func:`lab_angle_table` does), or that text parsed (:func:`parse_plant`).
         Anything else raises :class:`~softbend.registry.UnknownNameError` listing
         the known names; an identified model has no θ(p) table (InputError).
-    design : SFRBADesign or ModelDesign
+    design : Design
         The design, of the controller's model's actuator; a plant of another
         actuator alone (:data:`PLANT_ACTUATORS`) is refused.
     model_table : AngleTable
@@ -189,7 +186,7 @@ def plant_table(
     check_plant_actuator(choice, design)
     if choice.kind == "named":
         # a registered plant receives the design the controller's model takes
-        return PLANTS.get(choice.text)(cast(SFRBADesign, design), model_table)
+        return PLANTS.get(choice.text)(cast(Design, design), model_table)
     if choice.kind == "surrogate":
         from softbend.surrogates.persistence import load_surrogate
 
@@ -200,7 +197,7 @@ def plant_table(
         from softbend.transfer.measurements import load_measurements
 
         readings = load_measurements(choice.text)
-        return lab_angle_table(cast(SFRBADesign, design), measurements=readings, source=choice.text)
+        return lab_angle_table(cast(Design, design), measurements=readings, source=choice.text)
     raise InputError(
         f"is the identified model {choice.text}: its dynamics play the actuator, it has no "
         "θ(p) table of a design",
@@ -208,12 +205,12 @@ def plant_table(
     )
 
 
-def surrogate_plant(design: SFRBADesign, model_table: AngleTable) -> AngleTable:
+def surrogate_plant(design: Design, model_table: AngleTable) -> AngleTable:
     """The controllers' own model as the plant: no model mismatch."""
     return model_table
 
 
-def in_table1(design: SFRBADesign) -> bool:
+def in_table1(design: Design) -> bool:
     """Whether ``design`` is one of the 972 of Table 1 (its FEM sweep is shipped)."""
     from softbend.design import TABLE1_LEVELS
 
@@ -223,7 +220,7 @@ def in_table1(design: SFRBADesign) -> bool:
     )
 
 
-def fem_compliance(design: SFRBADesign, supply_mpa: float) -> float | None:
+def fem_compliance(design: Design, supply_mpa: float) -> float | None:
     """The chamber compliance of a design's own FEM sweep up to the supply, mm³/MPa.
 
     None for a design of Table 1 (its rig keeps the default compliance); another is
@@ -236,7 +233,7 @@ def fem_compliance(design: SFRBADesign, supply_mpa: float) -> float | None:
     return fem_curve(design).compliance_mm3_per_mpa(supply_mpa)
 
 
-def fem_plant(design: SFRBADesign, model_table: AngleTable) -> AngleTable:
+def fem_plant(design: Design, model_table: AngleTable) -> AngleTable:
     """The design's FEM sweep: shipped for Table 1 (:func:`fem_angle_table`), else solved once.
 
     A design outside Table 1 is swept by the FEM on demand and kept in a cache
@@ -251,7 +248,7 @@ def fem_plant(design: SFRBADesign, model_table: AngleTable) -> AngleTable:
 
 def support_warnings(
     saved: SavedSurrogate,
-    design: SFRBADesign | ModelDesign,
+    design: Design,
     up_to_mpa: float,
     *,
     role: str = "the controller's model",
@@ -267,7 +264,7 @@ def support_warnings(
     ----------
     saved : SavedSurrogate
         A loaded surrogate file (``.model`` and ``.metadata``), of any actuator.
-    design : SFRBADesign or ModelDesign
+    design : Design
         The design, of the actuator of ``saved`` (a design of another actuator
         with the same parameters is taken by its values).
     up_to_mpa : float
@@ -306,7 +303,9 @@ def support_warnings(
             f"θ(p) from there to the supply ({shown_supply}) is an extrapolation"
         )
     reach = min(up_to_mpa, limit)
-    angles = np.asarray(saved.model.predict(own.feature_rows(np.linspace(0.0, reach, 101))))
+    angles = np.asarray(
+        saved.model.predict(own.feature_rows(np.linspace(0.0, reach, 101), unit="MPa"))
+    )
     if np.max(angles) > support.angle_limit_deg:
         reach_text = f"{reach * scale:.3g} {unit}"
         angle_note = (
@@ -317,14 +316,12 @@ def support_warnings(
     return limit, pressure_note, angle_note
 
 
-def lab_plant(design: SFRBADesign, model_table: AngleTable) -> AngleTable:
+def lab_plant(design: Design, model_table: AngleTable) -> AngleTable:
     """The design's virtual-lab loading readings, smoothed (:func:`lab_angle_table`)."""
     return lab_angle_table(design)
 
 
-def shipped_angle_table(
-    design: SFRBADesign, pmax_mpa: float = 0.5, points: int = 501
-) -> AngleTable:
+def shipped_angle_table(design: Design, pmax_mpa: float = 0.5, points: int = 501) -> AngleTable:
     """θ(p) of ``design`` from the shipped FEM-trained MLP (``transfer.base.load_base``)."""
     from softbend.transfer.base import load_base
 
@@ -332,7 +329,7 @@ def shipped_angle_table(
 
 
 def fem_angle_table(
-    design: SFRBADesign,
+    design: Design,
     pmax_mpa: float = 0.5,
     points: int = 501,
     data: pd.DataFrame | None = None,
@@ -348,7 +345,7 @@ def fem_angle_table(
 
     Parameters
     ----------
-    design : SFRBADesign
+    design : Design
         One of the 972 designs of Table 1.
     pmax_mpa, points : float, int
         The table's grid, as :meth:`AngleTable.from_callable`.
@@ -388,7 +385,7 @@ def _extrapolated(p: np.ndarray, a: np.ndarray) -> Callable[[np.ndarray], np.nda
 
 
 def lab_angle_table(
-    design: SFRBADesign,
+    design: Design,
     pmax_mpa: float = 0.5,
     points: int = 501,
     measurements: Measurements | None = None,
@@ -406,7 +403,7 @@ def lab_angle_table(
 
     Parameters
     ----------
-    design : SFRBADesign
+    design : Design
         One of the measured actuators (paper B Fig. 7).
     measurements : Measurements, optional
         Default: the shipped virtual-lab readings

@@ -52,13 +52,12 @@ import numpy as np
 from numpy.typing import ArrayLike
 
 from softbend._validation import check_int, check_range
+from softbend.actuators import Design
 from softbend.control._ranges import check_declared
-from softbend.design import SFRBADesign
 from softbend.parameters import Range, declare_ranges
 from softbend.plausibility import RANGES as PLAUSIBLE
 
 if TYPE_CHECKING:
-    from softbend.control.designs import ModelDesign
     from softbend.models import BendingModel, SweepResult
     from softbend.surrogates.protocol import Surrogate
 
@@ -328,7 +327,7 @@ class RigParams:
                 "record step_volume_rate_mm3_per_mpa); this one does not."
             )
         if getattr(result.design, "cavity_volume_mm3", None) is None:
-            family = getattr(result.design, "family", type(result.design).__name__)
+            family = result.design.actuator.name
             raise ValueError(
                 "The 'result' of RigParams.from_fem_sweep must be a sweep of a design whose "
                 "geometry gives its cavity volume (the rig's chamber), as paper B's does; got a "
@@ -338,15 +337,13 @@ class RigParams:
         compliance = cavity_compliance_mm3_per_mpa(
             stats["steps_mpa"], stats["step_volume_rate_mm3_per_mpa"], supply
         )
-        design = cast(SFRBADesign, result.design)  # a design with a cavity, checked above
+        design = cast(Design, result.design)  # a design with a cavity, checked above
         return cls.for_design(
             design, tubing_mm3=tubing_mm3, compliance_mm3_per_mpa=compliance, **kwargs
         )
 
     @classmethod
-    def for_design(
-        cls, design: SFRBADesign, *, tubing_mm3: float = 2000.0, **kwargs: Any
-    ) -> RigParams:
+    def for_design(cls, design: Design, *, tubing_mm3: float = 2000.0, **kwargs: Any) -> RigParams:
         """Parameters with ``volume_mm3`` = ½·π·r²·l of ``design`` plus ``tubing_mm3``."""
         tubing = check_declared(tubing_mm3, "tubing_mm3", TUBING_RANGE)
         volume = design.cavity_volume_mm3 + tubing
@@ -426,24 +423,26 @@ class AngleTable:
     def from_surrogate(
         cls,
         model: Surrogate,
-        design: SFRBADesign | ModelDesign,
+        design: Design,
         pmax_mpa: float = 0.5,
         points: int = 501,
     ) -> AngleTable:
         """Tabulate a fitted surrogate (``.predict`` on the rows ``design.feature_rows(p)``).
 
-        ``design`` is paper B's :class:`~softbend.design.SFRBADesign` (rows of
+        ``design`` is paper B's :class:`~softbend.actuators.Design` (rows of
         :data:`softbend.design.FEATURES`) or a
-        :class:`~softbend.control.designs.ModelDesign` of another actuator (rows of
+        :class:`~softbend.actuators.Design` of another actuator (rows of
         its design codes and the pressure in its model's unit); the table is in MPa.
         """
         return cls.from_callable(
-            lambda p: model.predict(design.feature_rows(p)), pmax_mpa=pmax_mpa, points=points
+            lambda p: model.predict(design.feature_rows(p, unit="MPa")),
+            pmax_mpa=pmax_mpa,
+            points=points,
         )
 
     @classmethod
     def from_bending_model(
-        cls, model: BendingModel, design: SFRBADesign, pmax_mpa: float = 0.5, points: int = 101
+        cls, model: BendingModel, design: Design, pmax_mpa: float = 0.5, points: int = 101
     ) -> AngleTable:
         """Tabulate a :class:`softbend.models.BendingModel` by one sweep (converged at every p)."""
         p = np.round(np.linspace(0.0, pmax_mpa, points), 12)

@@ -27,7 +27,7 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
-from softbend.control.designs import ModelDesign
+from softbend.actuators import SFRBA, Design
 from softbend.control.rig import AngleDynamics, AngleTable, Rig, RigParams, SimulatedRig
 from softbend.control.rigconfig import (
     DEFAULT_TUBING_MM3,
@@ -35,7 +35,6 @@ from softbend.control.rigconfig import (
     check_simulation_settings,
     simulation_settings_entry,
 )
-from softbend.design import SFRBADesign
 from softbend.errors import InputError, SoftbendError, keyed
 from softbend.parameters import declared_ranges, parse_assignments
 from softbend.registry import Registry
@@ -302,7 +301,7 @@ def has_cavity(design: object) -> bool:
 
 
 def rig_params_for(
-    design: SFRBADesign | ModelDesign,
+    design: Design,
     settings: Mapping[str, Any] | None = None,
     **defaults: float,
 ) -> RigParams:
@@ -310,7 +309,7 @@ def rig_params_for(
 
     Paper B's design: the chamber volume is the design's cavity plus
     ``tubing_mm3`` (:meth:`RigParams.for_design`) unless ``volume_mm3`` is given.
-    A design of another actuator (:class:`~softbend.control.designs.ModelDesign`):
+    A design of another actuator (:class:`~softbend.actuators.Design`):
     the chamber volume is ``volume_mm3`` when given (measured: the whole air
     volume, tubing included), else the description's ``chamber_volume_mm3`` plus
     ``tubing_mm3``; its growth with pressure is ``compliance_mm3_per_mpa`` when
@@ -326,14 +325,14 @@ def rig_params_for(
     """
     chosen = {**defaults, **(settings or {})}
     tubing = chosen.pop("tubing_mm3", DEFAULT_TUBING_MM3)
-    if isinstance(design, ModelDesign):
+    if design.actuator != SFRBA:
         return _rig_of_actuator(design, chosen, tubing)
     if "volume_mm3" in chosen:
         return RigParams(**chosen)
     return RigParams.for_design(design, tubing_mm3=tubing, **chosen)
 
 
-def _rig_of_actuator(design: ModelDesign, chosen: dict[str, Any], tubing: float) -> RigParams:
+def _rig_of_actuator(design: Design, chosen: dict[str, Any], tubing: float) -> RigParams:
     """The rig of a design of an actuator other than paper B's: its described chamber."""
     import warnings
 

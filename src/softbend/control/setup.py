@@ -41,20 +41,15 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
-from softbend.actuators import SFRBA, Actuator
+from softbend.actuators import SFRBA, Actuator, Design
 from softbend.control.controllers import Controller, ControllerModel
-from softbend.control.designs import (
-    DEFAULT_DESIGN,
-    ModelDesign,
-    actuator_of_design,
-    control_design,
-)
+from softbend.control.designs import DEFAULT_DESIGN, actuator_of_design, control_design
 from softbend.control.factory import CONTROLLERS, DEFAULT_CONTROLLER, controller_parameters
 from softbend.control.plant_choice import PlantChoice
 from softbend.control.plants import check_plant_actuator, parse_plant, plant_compliance, plant_table
 from softbend.control.rig import AngleTable, RigParams
 from softbend.control.rigconfig import ControllerConfig
-from softbend.design import SFRBADesign
+from softbend.design import parse_sfrba
 from softbend.errors import InputError, keyed
 from softbend.parameters import effective_parameters, parse_assignments
 
@@ -86,7 +81,7 @@ class ControlSetup:
 
     Attributes
     ----------
-    design : SFRBADesign or ModelDesign
+    design : Design
         Paper B's design, or a design of the actuator of the controller's model.
     rig_params : RigParams
         Pneumatics of the simulated rig (and the predictive controller's model).
@@ -130,7 +125,7 @@ class ControlSetup:
         ``plant`` as parsed (:attr:`plant_choice` parses it when not given).
     """
 
-    design: SFRBADesign | ModelDesign
+    design: Design
     rig_params: RigParams
     plant: str
     plant_table: AngleTable
@@ -205,9 +200,9 @@ class ControlSetup:
         }
         if self.identified is not None:
             out["plant_description"] = self.identified.describe()
-        if isinstance(self.design, ModelDesign):  # paper B's runs record as they always did
+        if self.design.actuator != SFRBA:  # paper B's runs record as they always did
             out["actuator"] = self.actuator.name
-            out["design_parameters"] = self.design.as_record()
+            out["design_parameters"] = self.design.record()
             out["model_pressure_unit"] = self.actuator.pressure_unit
         return out
 
@@ -307,7 +302,7 @@ def prepare_control(
     controller: str | None = None,
     assignments: Sequence[str] = (),
     config: ControllerConfig | None = None,
-    design: str | SFRBADesign | ModelDesign | None = None,
+    design: str | Design | None = None,
     model: str | Path | None = None,
     plant: str | PlantChoice = "surrogate",
     supply_mpa: float = 0.2,
@@ -321,7 +316,7 @@ def prepare_control(
     ----------
     controller, assignments, config
         The controller and its parameters (see :func:`resolve_controller`).
-    design : str, SFRBADesign or ModelDesign, optional
+    design : str, Design, optional
         The actuator's design, parsed by the actuator of the controller's model:
         paper B's ``"l,r,t,b,phi,lc"`` (mm, degrees; default
         :data:`~softbend.control.designs.DEFAULT_DESIGN`), or ``"A=1,B=2,..."``
@@ -449,7 +444,7 @@ def _identified_setup(
     identified: IdentifiedPlant,
     name: str,
     params: dict[str, Any],
-    design: str | SFRBADesign | ModelDesign | None,
+    design: str | Design | None,
     settings: dict[str, Any],
     chosen: dict[str, Any],
     supply_mpa: float,
@@ -469,13 +464,13 @@ def _identified_setup(
             "--model, a saved surrogate, for a controller's model of a design)",
             key="design",
         )
-    rig = rig_params_for(SFRBADesign.parse(DEFAULT_DESIGN), chosen)
+    rig = rig_params_for(parse_sfrba(DEFAULT_DESIGN), chosen)
     with keyed("plant"):
         table = identified.angle_table(supply_mpa)
     controller_model = ControllerModel(table, table, rig)
     built = CONTROLLERS.get(name)(controller_model, **params)  # checked by resolve_controller
     return ControlSetup(
-        design=SFRBADesign.parse(DEFAULT_DESIGN),
+        design=parse_sfrba(DEFAULT_DESIGN),
         rig_params=rig,
         plant=str(identified.path),
         plant_table=table,
@@ -515,7 +510,7 @@ def _check_same_parameters(plant_path: Path, actuator: Actuator, model_path: Pat
 def _design_check(
     model_path: Path | None,
     label: str,
-    design: SFRBADesign | ModelDesign,
+    design: Design,
     strict: bool,
 ) -> tuple[list[str], list[str]]:
     """Where ``design`` leaves the training ranges of the controller's model: a warning
@@ -547,7 +542,7 @@ def _support_check(
     model: Path | None,
     plant: Path | None,
     shared: bool,
-    design: SFRBADesign | ModelDesign,
+    design: Design,
     supply_mpa: float,
     strict: bool,
 ) -> tuple[float | None, list[str]]:

@@ -18,11 +18,11 @@ from typing import TYPE_CHECKING, Any
 
 import pandas as pd
 
+from softbend.actuators import Design
 from softbend.control.controllers import ControllerModel
 from softbend.control.experiments import ControlRun, run_metrics, simulate
 from softbend.control.factory import CONTROLLERS, controller_parameters
 from softbend.control.rig import AngleTable, RigParams, SimulatedRig
-from softbend.design import SFRBADesign
 from softbend.errors import InputError, keyed
 from softbend.references import CONTROL_RESULTS, values
 
@@ -77,7 +77,7 @@ class ControlStudy:
 
 def control_study(
     model: Surrogate,
-    design: SFRBADesign,
+    design: Design,
     *,
     plant_table: AngleTable | None = None,
     plant: str = "surrogate",
@@ -96,7 +96,7 @@ def control_study(
     model : surrogate
         The controllers' model (``.predict`` on feature rows; an MLP with
         ``.predictor()`` is also the bang-bang's virtual sensor).
-    design : SFRBADesign
+    design : Design
     plant_table : AngleTable, optional
         θ(p) of the actuator (default: ``model``'s, no mismatch).
     plant : str

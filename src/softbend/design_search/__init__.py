@@ -28,7 +28,6 @@ from softbend._lazy import export as _export
 
 #: Public name -> the module that defines it.
 _EXPORTS: dict[str, str] = {
-    "ActuatorDesign": "space",
     "Candidate": "result",
     "SearchResult": "result",
     "find_designs": "search",

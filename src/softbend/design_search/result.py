@@ -14,8 +14,8 @@ from typing import Any
 
 import numpy as np
 
-from softbend.design import SFRBADesign
-from softbend.design_search.space import ActuatorDesign, SearchSpace, pressure_key, space_of
+from softbend.actuators import Design
+from softbend.design_search.space import SearchSpace, pressure_key, space_of
 from softbend.design_search.spec import ParameterRange, Specification
 
 __all__ = ["Candidate", "SearchResult"]
@@ -27,7 +27,7 @@ class Candidate:
 
     Attributes
     ----------
-    design : SFRBADesign or ActuatorDesign
+    design : Design
         Paper B's design, or another actuator's (its codes).
     angle_deg : float
         The surrogate's angle at the target's pressure (degrees); for a curve,
@@ -62,7 +62,7 @@ class Candidate:
         sweep reached every pressure checked.
     """
 
-    design: SFRBADesign | ActuatorDesign
+    design: Design
     angle_deg: float
     pressure_mpa: float
     error_deg: float

@@ -103,7 +103,7 @@ def elastomer_volume_mm3(designs: np.ndarray) -> np.ndarray:
 
     The half-cylindrical wall ``½·π·((r+t)² − r²)·l``, the strain-limiting layer
     ``2·(r+t)·b·l`` under it, and the two end caps ``π·(r+t)²/2·lc`` (the
-    geometry of :class:`~softbend.design.SFRBADesign`, fibres neglected).
+    geometry of :class:`~softbend.actuators.Design`, fibres neglected).
     """
     d = np.atleast_2d(np.asarray(designs, dtype=np.float64))
     length, r, t, b, lc = d[:, 0], d[:, 1], d[:, 2], d[:, 3], d[:, 5]

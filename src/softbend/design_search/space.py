@@ -4,10 +4,10 @@ A design search works over the parameters of the actuator its model was trained
 on (:attr:`SavedSurrogate.actuator <softbend.surrogates.persistence.SavedSurrogate.actuator>`).
 :class:`SearchSpace` says how a specification names them and what they are:
 
-- paper B's actuator (:data:`softbend.actuators.SFRBA`) keeps the short names
-  ``l, r, t, b, phi, lc`` (mm and degrees; its column names ``l_mm`` … are
-  accepted too), the mould's default step (0.5 mm, 1°), the rule ``t < r``,
-  the objective ``volume`` (of elastomer) and the FEM check;
+- paper B's actuator (:data:`softbend.actuators.SFRBA`) is named by the short
+  names of its description (``l, r, t, b, phi, lc``, mm and degrees; its column
+  names ``l_mm`` … are accepted too), with the mould's default step (0.5 mm,
+  1°) and the objective ``volume`` (of elastomer);
 - any other actuator is named by its description's parameters
   (``n_chambers``, ``wall_mm``, ``layer``), each searched on its own kind: an
   integer on whole numbers, a categorical parameter on its levels (stored as
@@ -20,28 +20,25 @@ on (:attr:`SavedSurrogate.actuator <softbend.surrogates.persistence.SavedSurroga
   search; a description that names an FEM family (``fem_family``) is verified
   by that family's FEM.
 
-:class:`ActuatorDesign` is one design of such an actuator, by its codes.
+A design found is a :class:`~softbend.actuators.Design` of the actuator.
 """
 
 from __future__ import annotations
 
-import hashlib
 import math
 from collections.abc import Sequence
-from dataclasses import dataclass, field
+from dataclasses import dataclass
 from typing import Any
 
 import numpy as np
 
-from softbend.actuators import PRESSURE_UNITS, SFRBA, Actuator, DesignParameter
-from softbend.design import PARAMETERS, SFRBADesign
+from softbend.actuators import ACTUATORS, PRESSURE_UNITS, SFRBA, Actuator, Design, DesignParameter
 
 __all__ = [
     "DEFAULT_GRID",
     "GRID_INTERVALS",
     "PAPER_B",
     "QUANTITIES",
-    "ActuatorDesign",
     "SearchSpace",
     "aligned",
     "pressure_key",
@@ -67,47 +64,6 @@ def pressure_key(unit: str) -> str:
 
 
 @dataclass(frozen=True)
-class ActuatorDesign:
-    """One design of an actuator other than paper B's: its model-input codes.
-
-    Attributes
-    ----------
-    actuator : Actuator
-    codes : tuple of float
-        The design parameters in the order of ``actuator.names``; a categorical
-        level as its index.
-    """
-
-    actuator: Actuator = field(repr=False)
-    codes: tuple[float, ...]
-
-    def as_array(self) -> np.ndarray:
-        """The codes as a float array."""
-        return np.array(self.codes, dtype=float)
-
-    def as_dict(self) -> dict[str, Any]:
-        """``{name: value}``: whole numbers as integers, levels by name."""
-        return self.actuator.design_record(self.codes)
-
-    @property
-    def design_id(self) -> str:
-        """Stable 16-hex-digit identifier: a SHA-1 of the actuator and its codes."""
-        canonical = self.actuator.name + ":" + ",".join(f"{v:.6f}" for v in self.codes)
-        return hashlib.sha1(canonical.encode()).hexdigest()[:16]
-
-    def feature_rows(self, pressures: Sequence[float] | np.ndarray) -> np.ndarray:
-        """Model inputs for this design at each pressure (the actuator's unit), one row each."""
-        p = np.asarray(pressures, dtype=float).reshape(-1)
-        rows = np.empty((p.size, len(self.codes) + 1))
-        rows[:, :-1] = self.codes
-        rows[:, -1] = p
-        return rows
-
-    def __str__(self) -> str:
-        return self.actuator.describe(self.codes)
-
-
-@dataclass(frozen=True)
 class SearchSpace:
     """The parameters of one actuator as a design search names them.
 
@@ -115,8 +71,8 @@ class SearchSpace:
     ----------
     actuator : Actuator
     names : tuple of str
-        The names a specification gives them, in model-input order: paper B's
-        short names, or the description's own.
+        The names a specification gives them, in model-input order: the
+        description's short names (paper B's), else its own.
     """
 
     actuator: Actuator
@@ -161,8 +117,6 @@ class SearchSpace:
         """Whether the actuator names an FEM family (``--verify``): paper B's ``"sfrba"``,
         or another registered in :data:`~softbend.fem.families.FEM_FAMILIES` (checked when
         it is verified, :func:`~softbend.design_search.verify.verify_family`)."""
-        if self.paper_b:
-            return self.actuator.fem_family == "sfrba"
         return self.actuator.fem_family is not None
 
     def parameter(self, name: str) -> DesignParameter:
@@ -207,21 +161,15 @@ class SearchSpace:
         return ", ".join(self.names)
 
     def feasible(self, designs: np.ndarray) -> np.ndarray:
-        """Which rows of designs are actuators: a wall thinner than the radius (paper B's
-        ``t < r``), or every constraint of the description met."""
-        if self.paper_b:
-            return designs[:, self.names.index("t")] < designs[:, self.names.index("r")]
+        """Which rows of designs are actuators: every constraint of the description met
+        (paper B's wall thinner than the radius, ``t_mm < r_mm``)."""
         if not self.actuator.constraints:
             return np.ones(designs.shape[0], dtype=bool)
         return self.actuator.constraints_met(designs)
 
-    def design_of(self, codes: Sequence[float]) -> SFRBADesign | ActuatorDesign:
-        """One design: paper B's :class:`~softbend.design.SFRBADesign`, else an
-        :class:`ActuatorDesign`."""
-        values = [float(v) for v in codes]
-        if self.paper_b:
-            return SFRBADesign.from_sequence(values)
-        return ActuatorDesign(self.actuator, tuple(values))
+    def design_of(self, codes: Sequence[float]) -> Design:
+        """One design of the actuator, by its codes in model-input order."""
+        return Design(self.actuator, dict(zip(self.actuator.names, map(float, codes), strict=True)))
 
     def decode(self, name: str, code: float) -> Any:
         """The value of ``name`` a code stands for (a level by name, a whole number)."""
@@ -339,23 +287,25 @@ def aligned(low: float, high: float, step: float) -> tuple[float, float]:
     return _multiples(low, high, step)
 
 
-def _short(column: str) -> str:
-    return column.rsplit("_", 1)[0]
-
-
-#: Paper B's actuator, by the short names of :data:`softbend.design_search.spec.NAMES`.
-PAPER_B = SearchSpace(SFRBA, tuple(_short(c) for c in PARAMETERS))
+#: Paper B's actuator, by the short names of its description (``l, r, t, b, phi, lc``).
+PAPER_B = SearchSpace(SFRBA, SFRBA.short_names)
 
 
 def space_of(actuator: Actuator | None) -> SearchSpace:
-    """The search space of ``actuator``: :data:`PAPER_B` for None and for any record of
-    paper B's actuator (its six columns, MPa, the FEM family ``"sfrba"``), else its own."""
-    if actuator is None or actuator == SFRBA:
+    """The search space of ``actuator`` (None: paper B's, :data:`PAPER_B`).
+
+    A record of a registered actuator (its columns, pressure unit and FEM family,
+    as a model saved before its description changed records it) is searched as
+    the registered one; any actuator is named by its short names, else its own.
+    """
+    if actuator is None:
         return PAPER_B
-    if (
-        actuator.names == SFRBA.names
-        and actuator.pressure_unit == SFRBA.pressure_unit
-        and actuator.fem_family == SFRBA.fem_family
-    ):
-        return PAPER_B
-    return SearchSpace(actuator, actuator.names)
+    for _, known in ACTUATORS.items():
+        if (
+            actuator.names == known.names
+            and actuator.pressure_unit == known.pressure_unit
+            and actuator.fem_family == known.fem_family
+        ):
+            actuator = known
+            break
+    return SearchSpace(actuator, actuator.short_names or actuator.names)

@@ -31,7 +31,7 @@ from softbend._lazy import export as _export
 
 if TYPE_CHECKING:
     from softbend.fem.energy import use_compiled
-    from softbend.fem.families import FEM_FAMILIES, FamilyDesign, FEMFamily, get_family
+    from softbend.fem.families import FEM_FAMILIES, FEMFamily, get_family
     from softbend.fem.geometry import ActuatorGeometry
     from softbend.fem.model import FEMModel
     from softbend.fem.options import GRAVITY_DIRECTIONS, OUTPUT_MODES, FEMOptions
@@ -44,7 +44,6 @@ if TYPE_CHECKING:
 _EXPORTS = {
     "FEM_FAMILIES": "families",
     "FEMFamily": "families",
-    "FamilyDesign": "families",
     "PneuNetModel": "softbend.fem.pneunet.model",
     "get_family": "families",
     "run_pneunet_sweep": "softbend.fem.pneunet.sweep",
@@ -70,7 +69,6 @@ __all__ = [
     "FEMOptions",
     "FEMStats",
     "FEMTimings",
-    "FamilyDesign",
     "PneuNetModel",
     "fem_stats",
     "get_family",

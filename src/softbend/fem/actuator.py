@@ -28,7 +28,8 @@ from typing import Any
 
 import numpy as np
 
-from softbend.design import FIBER_DIAMETER_MM, SFRBADesign
+from softbend.actuators import Design
+from softbend.design import FIBER_DIAMETER_MM
 from softbend.fem._ngsolve import require_ngsolve
 from softbend.fem.energy import energy_terms
 from softbend.fem.geometry import mesh_actuator
@@ -299,11 +300,11 @@ class ActuatorModel(ModelState):
 
     Parameters
     ----------
-    design : SFRBADesign
+    design : Design
     options : FEMOptions, optional
     """
 
-    def __init__(self, design: SFRBADesign, options: FEMOptions | None = None) -> None:
+    def __init__(self, design: Design, options: FEMOptions | None = None) -> None:
         self.design = design
         self.options = options = options or FEMOptions()
         self._set_up()

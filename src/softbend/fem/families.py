@@ -7,8 +7,8 @@ pipeline uses), a reference design, the pressures a sweep covers by default, how
 a design is checked, and the sweep itself (geometry, material regions, cavity
 surfaces loaded by a follower pressure, fixture and bending-angle readout live
 behind :attr:`FEMFamily.sweep`). Paper B's fiber-reinforced actuator is the
-first family (``"sfrba"``, designs are :class:`~softbend.design.SFRBADesign`);
-other families use :class:`FamilyDesign`, named values checked by the family.
+first family (``"sfrba"``), the PneuNet the second; a family's designs are
+:class:`~softbend.actuators.Design` objects of its actuator, checked by the family.
 
 Adding a family is one module that builds a :class:`FEMFamily` and calls
 ``FEM_FAMILIES.register(name, family)``; importing this module never imports
@@ -23,7 +23,8 @@ from dataclasses import dataclass
 from typing import TYPE_CHECKING, Any
 
 from softbend._validation import must_be
-from softbend.design import FamilyDesign
+from softbend.actuators import SFRBA, Design
+from softbend.design import sfrba_design
 from softbend.errors import InputError
 from softbend.registry import Registry
 
@@ -37,7 +38,6 @@ if TYPE_CHECKING:
 __all__ = [
     "FEM_FAMILIES",
     "FEMFamily",
-    "FamilyDesign",
     "get_family",
     "parse_assignments",
 ]
@@ -64,7 +64,7 @@ class FEMFamily:
     maxh_mm : float
         Default largest element size, mm.
     make_design : callable
-        ``make_design(values: dict[str, float]) -> design``: the checked design,
+        ``make_design(values: dict[str, float]) -> Design``: the checked design,
         or one :class:`~softbend.errors.InputError` keyed by the parameter at
         fault (walls thicker than the chamber, zero chambers, a gap of zero).
     sweep : callable
@@ -92,7 +92,7 @@ class FEMFamily:
     pmax_mpa: float
     pstep_mpa: float
     maxh_mm: float
-    make_design: Callable[[dict[str, float]], Any]
+    make_design: Callable[[dict[str, float]], Design]
     sweep: Callable[..., tuple[SweepResult, Any, Any]]
     default_options: Callable[..., FEMOptions] | None = None
     mesh_check: Callable[[Any, FEMOptions], None] | None = None
@@ -103,7 +103,7 @@ class FEMFamily:
         """The design parameters' names, in order."""
         return self.actuator.names
 
-    def design(self, values: Mapping[str, float] | None = None) -> Any:
+    def design(self, values: Mapping[str, float] | None = None) -> Design:
         """The checked design of ``values``; parameters left out take the reference's values.
 
         Raises
@@ -126,7 +126,7 @@ class FEMFamily:
                 raise InputError(must_be("a finite number", v), key=n)
         return self.make_design(merged)
 
-    def parse(self, text: str | None) -> Any:
+    def parse(self, text: str | None) -> Design:
         """The design of ``"NAME=VALUE,..."`` (None or empty: the reference design)."""
         return self.design(parse_assignments(text or "", self.names))
 
@@ -196,10 +196,8 @@ def get_family(name: str) -> FEMFamily:
     return FEM_FAMILIES.get(name)
 
 
-def _sfrba_design(values: dict[str, float]) -> Any:
-    from softbend.design import SFRBADesign
-
-    return SFRBADesign(**values)
+def _sfrba_design(values: dict[str, float]) -> Design:
+    return sfrba_design(**values)
 
 
 def _sfrba_sweep(
@@ -215,8 +213,6 @@ def _sfrba_mesh_check(design: Any, options: FEMOptions) -> None:
 
 
 def _register_paper_b() -> FEMFamily:
-    from softbend.actuators import SFRBA
-
     family = FEMFamily(
         name="sfrba",
         title=SFRBA.title,

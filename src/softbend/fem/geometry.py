@@ -16,7 +16,7 @@ from collections.abc import Iterable
 from dataclasses import dataclass
 from typing import Any
 
-from softbend.design import SFRBADesign
+from softbend.actuators import Design
 from softbend.errors import InputError, SoftbendError
 from softbend.fem._ngsolve import require_ngsolve
 
@@ -42,7 +42,7 @@ class ActuatorGeometry:
 
     Attributes
     ----------
-    design : SFRBADesign
+    design : Design
     base_cap_mm : float
         Proximal end wall.
     length_mm : float
@@ -53,7 +53,7 @@ class ActuatorGeometry:
         Outer perimeter of the full section, ``π(r+t) + 2(r+t) + 2b``.
     """
 
-    design: SFRBADesign
+    design: Design
     base_cap_mm: float
 
     @property
@@ -87,13 +87,13 @@ class ActuatorGeometry:
     def half_cavity_volume_mm3(self) -> float:
         """Undeformed volume of the half cavity, mm³: ``π·r²·l/4``.
 
-        Exactly half of :attr:`softbend.design.SFRBADesign.cavity_volume_mm3` (the
+        Exactly half of :attr:`~softbend.actuators.Design.cavity_volume_mm3` (the
         mesh is the half model ``y ≥ 0``).
         """
         return self.design.cavity_volume_mm3 / 2.0
 
 
-def actuator_geometry(design: SFRBADesign, base_cap_mm: float) -> tuple[Any, ActuatorGeometry]:
+def actuator_geometry(design: Design, base_cap_mm: float) -> tuple[Any, ActuatorGeometry]:
     """Build the half actuator as an OCC solid with named faces.
 
     Returns
@@ -163,13 +163,13 @@ def name_faces(solid: Any, length_mm: float, *, tip: bool, what: str) -> None:
 
 
 def mesh_actuator(
-    design: SFRBADesign, *, maxh_mm: float, order: int = 2, base_cap_mm: float = 3.0
+    design: Design, *, maxh_mm: float, order: int = 2, base_cap_mm: float = 3.0
 ) -> tuple[Any, ActuatorGeometry]:
     """Quadratic (curved) tetrahedral mesh of the half actuator.
 
     Parameters
     ----------
-    design : SFRBADesign
+    design : Design
     maxh_mm : float
         Largest element size, mm.
     order : int
@@ -229,7 +229,7 @@ def curved_mesh(shape: Any, h_mm: float, order: int, what: str) -> Any:
     return mesh
 
 
-def estimated_elements(design: SFRBADesign, maxh_mm: float, base_cap_mm: float = 3.0) -> float:
+def estimated_elements(design: Design, maxh_mm: float, base_cap_mm: float = 3.0) -> float:
     """About how many tetrahedra the FEM's mesh of ``design`` has with ``maxh_mm``.
 
     Six times the half actuator's volume over that of a regular tetrahedron of
@@ -238,7 +238,7 @@ def estimated_elements(design: SFRBADesign, maxh_mm: float, base_cap_mm: float =
 
     Parameters
     ----------
-    design : SFRBADesign
+    design : Design
         The actuator.
     maxh_mm : float
         Largest element size, mm (> 0).
@@ -274,7 +274,7 @@ def tetrahedra_in_volume(volume_mm3: float, h_mm: float) -> float:
 
 
 def check_mesh_size(
-    designs: SFRBADesign | Iterable[SFRBADesign], maxh_mm: float, base_cap_mm: float = 3.0
+    designs: Design | Iterable[Design], maxh_mm: float, base_cap_mm: float = 3.0
 ) -> None:
     """Refuse a ``maxh_mm`` that would mesh a design with too many elements.
 
@@ -286,7 +286,7 @@ def check_mesh_size(
 
     Parameters
     ----------
-    designs : SFRBADesign or iterable of SFRBADesign
+    designs : Design or iterable of Design
         The actuators to mesh.
     maxh_mm : float
         Largest element size, mm (> 0).
@@ -299,7 +299,7 @@ def check_mesh_size(
         Keyed ``maxh_mm``: a design's estimated mesh exceeds :data:`MAX_ELEMENTS`;
         the message names the design with the most elements, as the FEM would.
     """
-    items = [designs] if isinstance(designs, SFRBADesign) else list(designs)
+    items = [designs] if isinstance(designs, Design) else list(designs)
     if not items:
         return
     estimates = [estimated_elements(d, maxh_mm, base_cap_mm) for d in items]

@@ -6,7 +6,7 @@ from dataclasses import dataclass, field
 
 from numpy.typing import ArrayLike
 
-from softbend.design import SFRBADesign
+from softbend.actuators import Design
 from softbend.errors import InputError
 from softbend.fem.energy import use_compiled
 from softbend.fem.options import FEMOptions
@@ -51,7 +51,7 @@ class FEMModel:
                 f"must be FEMOptions or None; got {type(self.options).__name__}", key="options"
             )
 
-    def sweep(self, design: SFRBADesign, pressures_mpa: ArrayLike) -> SweepResult:
+    def sweep(self, design: Design, pressures_mpa: ArrayLike) -> SweepResult:
         """Run the load-stepping sweep of ``design`` over ``pressures_mpa`` (MPa)."""
         use_compiled(self.compiled)
         return simulate(design, pressures_mpa, self.options)

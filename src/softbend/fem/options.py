@@ -7,7 +7,7 @@ from dataclasses import asdict, dataclass, field, fields
 from typing import Any, cast
 
 from softbend._validation import check_choice, check_int, check_range, must_be
-from softbend.design import SFRBADesign
+from softbend.actuators import Design
 from softbend.errors import InputError
 from softbend.fem.geometry import check_mesh_size
 from softbend.fem.mechanics import FIBER_LAWS
@@ -223,7 +223,7 @@ class FEMOptions:
         """The fibers' constitutive model (checked linear elastic on construction)."""
         return cast(LinearElastic, self.fiber.model)
 
-    def check_mesh(self, designs: SFRBADesign | Iterable[SFRBADesign]) -> None:
+    def check_mesh(self, designs: Design | Iterable[Design]) -> None:
         """Refuse these options' ``maxh_mm`` if it meshes any of ``designs`` too finely.
 
         :func:`~softbend.fem.geometry.check_mesh_size` with :attr:`maxh_mm` and

@@ -46,7 +46,7 @@ import numpy as np
 from numpy.typing import ArrayLike
 
 from softbend._validation import must_be
-from softbend.design import SFRBADesign
+from softbend.actuators import SFRBA, Design
 from softbend.errors import ConvergenceError, InputError
 from softbend.fem._ngsolve import require_ngsolve
 from softbend.fem.actuator import ActuatorModel
@@ -397,7 +397,7 @@ def _next_step(dp: float, miss_mm: float, options: FEMOptions) -> float:
 
 
 def simulate(
-    design: SFRBADesign,
+    design: Design,
     pressures_mpa: ArrayLike,
     options: FEMOptions | None = None,
     *,
@@ -407,7 +407,7 @@ def simulate(
 
     Parameters
     ----------
-    design : SFRBADesign
+    design : Design
         The actuator (l, r, t, b, φ, lc).
     pressures_mpa : array_like
         Requested gauge pressures, MPa, strictly increasing from 0 or above.
@@ -440,7 +440,7 @@ def simulate(
 
 
 def run_sweep(
-    design: SFRBADesign,
+    design: Design,
     pressures_mpa: ArrayLike,
     options: FEMOptions | None = None,
     *,
@@ -455,8 +455,8 @@ def run_sweep(
     options = options or FEMOptions()
     if not isinstance(options, FEMOptions):
         raise InputError(must_be("FEMOptions", options), key="options")
-    if not isinstance(design, SFRBADesign):
-        raise InputError(must_be("an SFRBADesign", design), key="design")
+    if not isinstance(design, Design) or design.actuator != SFRBA:
+        raise InputError(must_be("a Design of paper B's actuator", design), key="design")
     result, model, history = run_model_sweep(
         ActuatorModel, design, pressures_mpa, options, progress=progress, keep_states=keep_states
     )

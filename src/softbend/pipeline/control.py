@@ -15,6 +15,7 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
+from softbend.design import parse_sfrba
 from softbend.pipeline import Progress
 
 if TYPE_CHECKING:  # pragma: no cover
@@ -92,13 +93,12 @@ def run_control(
     """
     from softbend.control.plants import lab_angle_table
     from softbend.control.study import control_study
-    from softbend.design import SFRBADesign
     from softbend.transfer.base import load_base
 
     start = time.perf_counter()
     folder = Path(out_dir) / "control"
     folder.mkdir(parents=True, exist_ok=True)
-    design = SFRBADesign.parse(CONTROL_DESIGN)
+    design = parse_sfrba(CONTROL_DESIGN)
     base = load_base()
 
     def step(phase: str) -> Callable[[int, int], None]:

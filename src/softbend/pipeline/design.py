@@ -22,7 +22,7 @@ from softbend.design_search.spec import (
 )
 from softbend.pipeline import Progress
 
-__all__ = ["SPECIFICATIONS", "Design", "run_design"]
+__all__ = ["SPECIFICATIONS", "DesignRun", "run_design"]
 
 #: Three questions of a designer, with a 1° margin against the surrogate's own error.
 SPECIFICATIONS: tuple[Specification, ...] = (
@@ -50,7 +50,7 @@ SPECIFICATIONS: tuple[Specification, ...] = (
 
 
 @dataclass(frozen=True)
-class Design:
+class DesignRun:
     """What :func:`run_design` found: per specification its search result (the verified
     candidates carry the FEM's figures), headline figures, and the model searched (read
     once, for the figures drawn from it)."""
@@ -66,7 +66,7 @@ def run_design(
     verify: int = 1,
     backend: str = "fem",
     specifications: tuple[Specification, ...] = SPECIFICATIONS,
-) -> Design:
+) -> DesignRun:
     """Search each specification on the shipped MLP, verify the best ``verify`` designs.
 
     Parameters
@@ -108,4 +108,4 @@ def run_design(
             }
         )
     summary = {"backend": backend, "verify": verify, "specifications": rows}
-    return Design(results, summary, model)
+    return DesignRun(results, summary, model)

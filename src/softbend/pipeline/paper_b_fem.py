@@ -10,13 +10,14 @@ from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
+from softbend.actuators import Design
+from softbend.design import parse_sfrba
 from softbend.pipeline import Progress
 from softbend.references import FEM_VALIDATION
 
 if TYPE_CHECKING:  # pragma: no cover
     from numpy.typing import ArrayLike
 
-    from softbend.design import SFRBADesign
     from softbend.fem.options import FEMOptions
     from softbend.materials import FitResult, TensileTest
     from softbend.models import SweepResult
@@ -59,7 +60,7 @@ class FEMSweep:
 
 
 def sweep_with_shapes(
-    design: SFRBADesign,
+    design: Design,
     pressures_mpa: ArrayLike,
     options: FEMOptions | None,
     out_dir: str | Path,
@@ -76,7 +77,7 @@ def sweep_with_shapes(
 
     Parameters
     ----------
-    design : SFRBADesign
+    design : Design
     pressures_mpa : array_like
         Output pressures, MPa, increasing.
     options : FEMOptions or None
@@ -131,7 +132,7 @@ class Fig2:
         The shipped Dragon Skin 30 uniaxial test.
     fits : dict
         ``{model name: FitResult}`` of the hyperelastic models fitted to it.
-    design : SFRBADesign
+    design : Design
         The swept design (:data:`FIG2_DESIGN`).
     pmax_mpa : float
         Last pressure of the sweep, MPa.
@@ -178,7 +179,6 @@ def run_fig2(
     (:class:`softbend.fem.FEMOptions`) and ``pmax_mpa`` default to the model's
     defaults and paper B's 0.17 MPa; ``progress(phase, done, total)`` counts kPa.
     """
-    from softbend.design import SFRBADesign
     from softbend.materials import fit_models, load_shipped
     from softbend.models import default_pressures_mpa
 
@@ -190,7 +190,7 @@ def run_fig2(
         progress(phase, 0, total)
     test = load_shipped("dragon-skin-30")
     fits = fit_models(test)
-    design = SFRBADesign.parse(FIG2_DESIGN)
+    design = parse_sfrba(FIG2_DESIGN)
     pressures = default_pressures_mpa(pmax_mpa)
 
     def on_step(pressure: float, _angle: float, _target: float) -> None:

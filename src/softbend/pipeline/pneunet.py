@@ -71,7 +71,7 @@ class PneuNetSection:
 
     Attributes
     ----------
-    design : FamilyDesign
+    design : Design
         The reference PneuNet.
     sweep : SweepResult
         Its FEM sweep.

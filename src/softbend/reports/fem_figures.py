@@ -9,6 +9,7 @@ from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
+from softbend.actuators import Design
 from softbend.fem.stats import fem_stats
 from softbend.models import SweepResult
 from softbend.reports.analysis_figures import _figure, _save
@@ -16,7 +17,6 @@ from softbend.reports.analysis_figures import _figure, _save
 if TYPE_CHECKING:
     from numpy.typing import ArrayLike
 
-    from softbend.design import SFRBADesign
     from softbend.fem.families import FEMFamily
     from softbend.fem.options import FEMOptions
 
@@ -127,7 +127,7 @@ class FEMSweepFiles:
 
 
 def sweep_with_files(
-    design: SFRBADesign,
+    design: Design,
     pressures_mpa: ArrayLike,
     options: FEMOptions | None,
     out_dir: str | Path,
@@ -147,7 +147,7 @@ def sweep_with_files(
 
     Parameters
     ----------
-    design : SFRBADesign
+    design : Design
     pressures_mpa : array_like
         Output pressures, MPa, increasing.
     options : FEMOptions or None

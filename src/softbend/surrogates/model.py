@@ -16,9 +16,9 @@ from pathlib import Path
 
 from numpy.typing import ArrayLike
 
+from softbend.actuators import Design
 from softbend.analytical import tip_position_mm
 from softbend.campaign.backends import BACKENDS, register_backend
-from softbend.design import SFRBADesign
 from softbend.errors import InputError
 from softbend.models import SweepResult, check_pressures_mpa
 from softbend.surrogates.protocol import Surrogate
@@ -73,7 +73,7 @@ class SurrogateModel:
         saved = load_surrogate(path)
         return cls(saved.model, source=f"{saved.kind} surrogate from {Path(path)}")
 
-    def sweep(self, design: SFRBADesign, pressures_mpa: ArrayLike) -> SweepResult:
+    def sweep(self, design: Design, pressures_mpa: ArrayLike) -> SweepResult:
         """Predict the angle at every pressure of the grid (MPa); the tip from the arc.
 
         A non-finite prediction ends the sweep there (``converged=False``), as a

@@ -10,8 +10,8 @@ import numpy as np
 from numpy.typing import ArrayLike
 
 from softbend._validation import must_be
-from softbend.actuators import SFRBA, Actuator
-from softbend.design import SFRBADesign
+from softbend.actuators import SFRBA, Actuator, Design
+from softbend.design import sfrba_from_sequence
 from softbend.errors import InputError, SchemaError, keyed
 from softbend.surrogates.support import pressures_text, trained_pressure_range
 
@@ -38,7 +38,7 @@ class Prediction:
     kind : str
         The surrogate's kind: its family's name (``"plr"``, ``"xgb"``, ``"mlp"``, ...)
         or a composite kind (``"affine-corrected"``, ...).
-    design : SFRBADesign or ndarray
+    design : Design or ndarray
         Paper B's design, or another actuator's design codes (in the order of
         ``actuator.names``; a categorical level as its index).
     pressure_mpa, angle_deg : ndarray
@@ -72,7 +72,7 @@ class Prediction:
     """
 
     kind: str
-    design: SFRBADesign | np.ndarray
+    design: Design | np.ndarray
     pressure_mpa: np.ndarray
     angle_deg: np.ndarray
     outside_training_ranges: list[str] = field(default_factory=list)
@@ -106,14 +106,14 @@ class Prediction:
     @property
     def design_codes(self) -> np.ndarray:
         """The design as model inputs, in the order of ``actuator.names``."""
-        if isinstance(self.design, SFRBADesign):
+        if isinstance(self.design, Design):
             return self.design.as_array()
         return np.asarray(self.design, dtype=float)
 
     @property
     def design_text(self) -> str:
         """The design by name, in its units."""
-        if isinstance(self.design, SFRBADesign):
+        if isinstance(self.design, Design):
             return str(self.design)
         return self.actuator.describe(self.design_codes)
 
@@ -251,7 +251,7 @@ def _check_pressures(
 
 def predict_angles(
     path: str | os.PathLike[str],
-    design: SFRBADesign | str | ArrayLike,
+    design: Design | str | ArrayLike,
     pressures_mpa: ArrayLike,
     *,
     strict: bool = False,
@@ -262,7 +262,7 @@ def predict_angles(
     ----------
     path : path
         A file written by :func:`softbend.surrogates.save_surrogate`.
-    design : SFRBADesign, str or array_like
+    design : Design, str or array_like
         Paper B's design; or, for any model, ``"A=1,B=2,..."`` by its
         parameter names, the values in its column order as text, or the
         design codes as numbers (checked against the model's actuator
@@ -298,7 +298,7 @@ def predict_angles(
     unit = actuator.pressure_unit
     pressures = _check_pressures(pressures_mpa, unit)
     design = _design_of(design, actuator, path)
-    codes = design.as_array() if isinstance(design, SFRBADesign) else design
+    codes = design.as_array() if isinstance(design, Design) else design
     rows = np.empty((pressures.size, codes.size + 1))
     rows[:, :-1] = codes
     rows[:, -1] = pressures
@@ -366,14 +366,15 @@ def predict_angles(
 
 
 def _design_of(
-    design: SFRBADesign | str | ArrayLike, actuator: Actuator, path: str | os.PathLike[str]
-) -> SFRBADesign | np.ndarray:
+    design: Design | str | ArrayLike, actuator: Actuator, path: str | os.PathLike[str]
+) -> Design | np.ndarray:
     """``design`` as paper B's design (its model) or the codes of ``actuator``'s, checked."""
-    if isinstance(design, SFRBADesign):
-        if actuator != SFRBA:
+    if isinstance(design, Design):
+        if design.actuator.names != actuator.names:
             raise ValueError(
                 f"The model {path} is of the actuator {actuator.name} "
-                f"({', '.join(actuator.names)}), not paper B's; give its design by name."
+                f"({', '.join(actuator.names)}), not {design.actuator.name}'s; give its "
+                "design by name."
             )
         return design
     if isinstance(design, str):
@@ -381,7 +382,7 @@ def _design_of(
     else:
         codes = actuator.check_designs(np.asarray(design, dtype=float).ravel())[0]
     if actuator == SFRBA:
-        return SFRBADesign.from_sequence(codes.tolist())
+        return sfrba_from_sequence(codes.tolist())
     return codes
 
 

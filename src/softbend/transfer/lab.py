@@ -28,7 +28,7 @@ is synthetic and lists the gap's parameters in its header.
 from __future__ import annotations
 
 from collections.abc import Callable, Iterable, Mapping
-from dataclasses import asdict, dataclass, field, replace
+from dataclasses import asdict, dataclass, field
 from pathlib import Path
 from typing import Any
 
@@ -36,7 +36,8 @@ import numpy as np
 import pandas as pd
 
 from softbend._validation import check_choice, check_int, check_range, must_be
-from softbend.design import PAPER_B_FIG7_DESIGNS, PARAMETERS, SFRBADesign
+from softbend.actuators import SFRBA, Design
+from softbend.design import PAPER_B_FIG7_DESIGNS, PARAMETERS, sfrba_design
 from softbend.errors import ConvergenceError, InputError, keyed
 from softbend.limits import check_limit
 from softbend.materials.fit import fit_model
@@ -59,7 +60,7 @@ __all__ = [
 ]
 
 #: The seven actuators of paper B Fig. 7 (:data:`softbend.design.PAPER_B_FIG7_DESIGNS`).
-LAB_ACTUATORS: tuple[SFRBADesign, ...] = PAPER_B_FIG7_DESIGNS
+LAB_ACTUATORS: tuple[Design, ...] = PAPER_B_FIG7_DESIGNS
 
 
 def _fem_model(elastomer: Material) -> BendingModel:
@@ -81,7 +82,7 @@ LAB_MODELS.register("fem", _fem_model)
 LAB_MODELS.register("analytical", _analytical_model)
 
 
-def actuator_id(design: SFRBADesign) -> str:
+def actuator_id(design: Design) -> str:
     """The design as ``"l,r,t,b,phi,lc"`` with ``%g`` numbers, e.g. ``"100,6,2,2,5,8"``."""
     return ",".join(f"{getattr(design, name):g}" for name in PARAMETERS)
 
@@ -110,8 +111,13 @@ def _checked_settings(settings: Mapping[str, object]) -> dict[str, Any]:
     if "actuators" in settings:
         given = settings["actuators"]
         actuators = tuple(given) if isinstance(given, Iterable) else ()
-        if not actuators or not all(isinstance(a, SFRBADesign) for a in actuators):
-            raise InputError(must_be("a non-empty sequence of SFRBADesign", given), key="actuators")
+        if not actuators or not all(
+            isinstance(a, Design) and a.actuator == SFRBA for a in actuators
+        ):
+            raise InputError(
+                must_be("a non-empty sequence of designs of paper B's actuator", given),
+                key="actuators",
+            )
         ids = [actuator_id(a) for a in actuators]
         repeated = sorted({i for i in ids if ids.count(i) > 1})
         if repeated:
@@ -170,7 +176,7 @@ class VirtualLab:
 
     Parameters
     ----------
-    actuators : tuple of SFRBADesign
+    actuators : tuple of Design
         Nominal designs measured, default :data:`LAB_ACTUATORS` (paper B Fig. 7).
     plant : str
         Model of the actuators as built, a name of :data:`LAB_MODELS`: the 3D FEM
@@ -218,7 +224,7 @@ class VirtualLab:
         :class:`~softbend.errors.LimitError` for ``cycles`` over its limit.
     """
 
-    actuators: tuple[SFRBADesign, ...] = LAB_ACTUATORS
+    actuators: tuple[Design, ...] = LAB_ACTUATORS
     plant: str = "fem"
     elastomer: str = "dragon-skin-30"
     elastomer_max_stretch: float = 3.0
@@ -284,15 +290,15 @@ class VirtualLab:
             object.__setattr__(self, "_material", material)
         return self._material  # type: ignore[return-value]
 
-    def as_built(self) -> tuple[SFRBADesign, ...]:
+    def as_built(self) -> tuple[Design, ...]:
         """Each actuator as fabricated: ``t`` and ``b`` off nominal by the seeded error."""
         rng = np.random.default_rng([self.seed, 0])
         built = []
         for design in self.actuators:
             dt, db = rng.uniform(-self.fabrication_error_mm, self.fabrication_error_mm, size=2)
-            built.append(
-                replace(design, t_mm=round(design.t_mm + dt, 4), b_mm=round(design.b_mm + db, 4))
-            )
+            values = design.as_dict()
+            values.update(t_mm=round(design.t_mm + dt, 4), b_mm=round(design.b_mm + db, 4))
+            built.append(sfrba_design(**values))
         return tuple(built)
 
     def plant_model(self) -> BendingModel:
@@ -396,7 +402,7 @@ class VirtualLab:
 
     def _readings(
         self,
-        nominal: SFRBADesign,
+        nominal: Design,
         pressures: np.ndarray,
         elastic: np.ndarray,
         rng: np.random.Generator,

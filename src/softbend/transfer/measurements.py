@@ -3,7 +3,7 @@
 Transfer learning (paper B §4.2–4.3) refines a surrogate trained on simulations
 with a few measurements of built actuators. A measurement is one bending angle of
 one actuator at one gauge pressure; the actuator's design is the SFRBA tuple
-``(l, r, t, b, phi, lc)`` of :class:`softbend.design.SFRBADesign`.
+``(l, r, t, b, phi, lc)`` of :class:`~softbend.actuators.Design`.
 
 CSV format
 ----------
@@ -28,7 +28,7 @@ around cells is stripped; an empty cell is an error in every column.
 Every number must be physically plausible (:mod:`softbend.plausibility`):
 ``angle_deg`` within ±3600°, ``pressure_mpa`` at most 2 MPa, the lengths ``l``,
 ``r``, ``t``, ``b`` and ``lc`` at most 10 000 mm and ``phi`` within 0–90°; the
-design must also be one :class:`~softbend.design.SFRBADesign` accepts.
+design must also be one :class:`~softbend.actuators.Design` accepts.
 
 Lines starting with ``#`` are comments; a ``# key: value`` comment before the
 header row becomes an entry of :attr:`Measurements.metadata` (text split at the
@@ -115,8 +115,8 @@ import pandas as pd
 
 from softbend._io import write_text_atomic
 from softbend._validation import must_be
-from softbend.actuators import SFRBA, Actuator, ActuatorError
-from softbend.design import FEATURE_QUANTITIES, FEATURES, PARAMETERS, SFRBADesign
+from softbend.actuators import SFRBA, Actuator, ActuatorError, Design
+from softbend.design import FEATURE_QUANTITIES, FEATURES, PARAMETERS, sfrba_design
 from softbend.errors import DatasetError, InputError, SoftbendError
 from softbend.plausibility import implausible_index, implausible_text
 from softbend.tables import Column, HeaderKey, Table, TableFormat, read_table
@@ -441,7 +441,7 @@ def _check_column_plausible(values: np.ndarray, column: str, rows: _Rows) -> Non
         raise rows.error(text, pos, column)
 
 
-def _normalize(frame: object, rows: _Rows) -> tuple[pd.DataFrame, dict[str, SFRBADesign]]:
+def _normalize(frame: object, rows: _Rows) -> tuple[pd.DataFrame, dict[str, Design]]:
     """Check a table of measurements and return it in canonical form with its designs.
 
     Parameters
@@ -456,7 +456,7 @@ def _normalize(frame: object, rows: _Rows) -> tuple[pd.DataFrame, dict[str, SFRB
     frame : pandas.DataFrame
         All columns, in ``MEASUREMENT_COLUMNS + OPTIONAL_COLUMNS`` order, index 0..n-1.
     designs : dict
-        ``{actuator_id: SFRBADesign}`` in order of first appearance.
+        ``{actuator_id: Design}`` in order of first appearance.
     """
     if not isinstance(frame, pd.DataFrame):
         raise DatasetError(
@@ -488,10 +488,10 @@ def _normalize(frame: object, rows: _Rows) -> tuple[pd.DataFrame, dict[str, SFRB
     design_values = np.column_stack([data[c] for c in _DESIGN_COLUMNS])
     _, first_rows, codes = np.unique(design_values, axis=0, return_index=True, return_inverse=True)
     codes = codes.reshape(-1)
-    design_of_code: list[SFRBADesign] = []
+    design_of_code: list[Design] = []
     for pos in first_rows:
         try:
-            design_of_code.append(SFRBADesign(*design_values[pos].tolist()))
+            design_of_code.append(sfrba_design(*design_values[pos].tolist()))
         except ValueError as exc:
             key = exc.key if isinstance(exc, SoftbendError) else None
             if key is None:  # a check that names its parameters in the text
@@ -712,7 +712,7 @@ class Measurements(Readings):
         column, no rows, a non-numeric, non-finite or implausible number
         (:mod:`softbend.plausibility`), a negative pressure, a cycle that is
         not an integer >= 1, a direction not in :data:`DIRECTIONS`, an empty
-        actuator id, a design :class:`~softbend.design.SFRBADesign` rejects, or
+        actuator id, a design :class:`~softbend.actuators.Design` rejects, or
         one actuator id with two designs.
     ValueError
         Metadata that is not a mapping of single-line text (keys without ':'),
@@ -731,7 +731,7 @@ class Measurements(Readings):
     metadata: Mapping[str, str] = field(default_factory=dict)
     source: str = ""
     provenance: pd.DataFrame | None = None
-    _designs: dict[str, SFRBADesign] = field(init=False, repr=False, compare=False)
+    _designs: dict[str, Design] = field(init=False, repr=False, compare=False)
     #: The description the readings follow: paper B's actuator's.
     actuator: Actuator = field(default=SFRBA, init=False, repr=False, compare=False)
 
@@ -789,7 +789,7 @@ class Measurements(Readings):
         """Actuator ids in order of first appearance."""
         return tuple(self._designs)
 
-    def design_of(self, actuator_id: str) -> SFRBADesign:
+    def design_of(self, actuator_id: str) -> Design:
         """The design of one actuator.
 
         Raises
@@ -807,7 +807,7 @@ class Measurements(Readings):
             ) from None
 
     @property
-    def designs(self) -> tuple[SFRBADesign, ...]:
+    def designs(self) -> tuple[Design, ...]:
         """One design per actuator, in :attr:`actuator_ids` order."""
         return tuple(self._designs.values())
 
@@ -947,7 +947,7 @@ def load_measurements_files(
             )
         seen[key] = str(item)
     parts = [load_measurements(item) for item in items]
-    owner: dict[str, tuple[SFRBADesign, str]] = {}
+    owner: dict[str, tuple[Design, str]] = {}
     for part in parts:
         for actuator in part.actuator_ids:
             design = part.design_of(actuator)

@@ -37,8 +37,7 @@ from __future__ import annotations
 
 from typing import TYPE_CHECKING, Any
 
-from softbend.actuators import PNEUNET
-from softbend.design import FamilyDesign
+from softbend.actuators import PNEUNET, Design
 from softbend.errors import InputError
 from softbend.materials.models import NeoHookean, Yeoh
 from softbend.materials.presets import G_PER_CM3_TO_T_PER_MM3, Material
@@ -98,7 +97,7 @@ def _refuse(name: str, requirement: str, value: float) -> InputError:
     return InputError(f"must be {requirement}; got {value:g}", key=name)
 
 
-def make_pneunet_design(values: dict[str, float]) -> FamilyDesign:
+def make_pneunet_design(values: dict[str, float]) -> Design:
     """The checked PneuNet design of ``values`` (every parameter named, in mm).
 
     Only what makes the geometry impossible is refused: a design outside the
@@ -147,10 +146,10 @@ def make_pneunet_design(values: dict[str, float]) -> FamilyDesign:
             f"< chamber_height_mm = {values['chamber_height_mm']:g} mm (a roof and a cavity)",
             outer,
         )
-    return FamilyDesign("pneunet", {k: values[k] for k in PNEUNET.names})
+    return Design(PNEUNET, {k: values[k] for k in PNEUNET.names})
 
 
-def cavity_volume_mm3(design: FamilyDesign) -> float:
+def cavity_volume_mm3(design: Design) -> float:
     """Undeformed volume of all the chambers' cavities (whole actuator), mm³."""
     d = design
     inner = (
@@ -161,7 +160,7 @@ def cavity_volume_mm3(design: FamilyDesign) -> float:
     return int(d.n_chambers) * inner
 
 
-def length_mm(design: FamilyDesign, end_mm: float) -> float:
+def length_mm(design: Design, end_mm: float) -> float:
     """Length of the PneuNet from its fixed face to its tip, mm (``end_mm``: the inlet block)."""
     d = design
     n = int(d.n_chambers)

@@ -24,7 +24,7 @@ from typing import Any
 
 import numpy as np
 
-from softbend.design import FamilyDesign
+from softbend.actuators import Design
 from softbend.fem._ngsolve import require_ngsolve
 from softbend.fem.geometry import check_element_count, curved_mesh, name_faces, tetrahedra_in_volume
 from softbend.fem.pneunet.description import cavity_volume_mm3, length_mm
@@ -45,13 +45,13 @@ class PneuNetGeometry:
 
     Attributes
     ----------
-    design : FamilyDesign
+    design : Design
         The PneuNet design.
     end_mm : float
         Length of the inlet block at the fixed end.
     """
 
-    design: FamilyDesign
+    design: Design
     end_mm: float
 
     @property
@@ -124,7 +124,7 @@ class PneuNetGeometry:
         return pairs
 
 
-def pneunet_solid(design: FamilyDesign, end_mm: float) -> tuple[Any, PneuNetGeometry]:
+def pneunet_solid(design: Design, end_mm: float) -> tuple[Any, PneuNetGeometry]:
     """Build the half PneuNet as an OCC solid with named faces.
 
     Returns
@@ -159,7 +159,7 @@ def pneunet_solid(design: FamilyDesign, end_mm: float) -> tuple[Any, PneuNetGeom
 WALL_ELEMENT_RATIO = 2.5
 
 
-def element_size_mm(design: FamilyDesign, maxh_mm: float) -> float:
+def element_size_mm(design: Design, maxh_mm: float) -> float:
     """The largest element size the PneuNet is meshed with, mm: ``maxh_mm``, capped by its walls.
 
     At most :data:`WALL_ELEMENT_RATIO` times the thinnest chamber wall
@@ -171,7 +171,7 @@ def element_size_mm(design: FamilyDesign, maxh_mm: float) -> float:
     return min(maxh_mm, WALL_ELEMENT_RATIO * min(design.wall_mm, design.outer_wall_mm))
 
 
-def estimated_pneunet_elements(design: FamilyDesign, maxh_mm: float, end_mm: float) -> float:
+def estimated_pneunet_elements(design: Design, maxh_mm: float, end_mm: float) -> float:
     """About how many tetrahedra the half PneuNet's mesh has (known before meshing).
 
     As :func:`softbend.fem.geometry.estimated_elements`: six times the half
@@ -183,7 +183,7 @@ def estimated_pneunet_elements(design: FamilyDesign, maxh_mm: float, end_mm: flo
     return tetrahedra_in_volume(volume, element_size_mm(design, maxh_mm))
 
 
-def check_pneunet_mesh(design: FamilyDesign, maxh_mm: float, end_mm: float) -> None:
+def check_pneunet_mesh(design: Design, maxh_mm: float, end_mm: float) -> None:
     """Refuse a ``maxh_mm`` that would mesh ``design`` with too many elements.
 
     Raises
@@ -196,7 +196,7 @@ def check_pneunet_mesh(design: FamilyDesign, maxh_mm: float, end_mm: float) -> N
 
 
 def mesh_pneunet(
-    design: FamilyDesign, *, maxh_mm: float, order: int = 2, end_mm: float = 3.0
+    design: Design, *, maxh_mm: float, order: int = 2, end_mm: float = 3.0
 ) -> tuple[Any, PneuNetGeometry]:
     """Curved tetrahedral mesh of the half PneuNet, elements at most :func:`element_size_mm`.
 

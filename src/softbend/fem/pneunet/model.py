@@ -45,7 +45,7 @@ from typing import Any
 
 import numpy as np
 
-from softbend.design import FamilyDesign
+from softbend.actuators import Design
 from softbend.fem._ngsolve import require_ngsolve
 from softbend.fem.actuator import ModelState
 from softbend.fem.options import FEMOptions
@@ -63,7 +63,7 @@ class PneuNetModel(ModelState):
 
     Parameters
     ----------
-    design : FamilyDesign
+    design : Design
         A design of the ``"pneunet"`` family.
     options : FEMOptions
         ``base_cap_mm`` is the length of the inlet block at the fixed end;
@@ -73,7 +73,7 @@ class PneuNetModel(ModelState):
     #: What :func:`softbend.fem.sweep.run_sweep` records as the model in the stats.
     description = "3D FEM, NGSolve, half PneuNet, quadratic tetrahedra"
 
-    def __init__(self, design: FamilyDesign, options: FEMOptions) -> None:
+    def __init__(self, design: Design, options: FEMOptions) -> None:
         import ngsolve as ngs
 
         self.design = design

@@ -15,7 +15,7 @@ from collections.abc import Callable
 from numpy.typing import ArrayLike
 
 from softbend._validation import must_be
-from softbend.design import FamilyDesign
+from softbend.actuators import Design
 from softbend.errors import InputError
 from softbend.fem._ngsolve import require_ngsolve
 from softbend.fem.options import FEMOptions
@@ -29,7 +29,7 @@ __all__ = ["run_pneunet_sweep"]
 
 
 def run_pneunet_sweep(
-    design: FamilyDesign,
+    design: Design,
     pressures_mpa: ArrayLike,
     options: FEMOptions,
     *,
@@ -40,7 +40,7 @@ def run_pneunet_sweep(
 
     Parameters
     ----------
-    design : FamilyDesign
+    design : Design
         A checked design of the ``"pneunet"`` family
         (:meth:`softbend.fem.families.FEMFamily.design`).
     pressures_mpa : array_like
@@ -61,7 +61,7 @@ def run_pneunet_sweep(
     """
     if not isinstance(options, FEMOptions):
         raise InputError(must_be("FEMOptions", options), key="options")
-    if not isinstance(design, FamilyDesign) or design.family != "pneunet":
+    if not isinstance(design, Design) or design.actuator.fem_family != "pneunet":
         raise InputError(must_be("a design of the pneunet family", design), key="design")
     result, model, history = run_model_sweep(
         PneuNetModel, design, pressures_mpa, options, progress=progress, keep_states=keep_states

@@ -10,7 +10,7 @@ from numpy.typing import ArrayLike
 from scipy.stats import norm
 
 from softbend._validation import check_range
-from softbend.design import SFRBADesign
+from softbend.design import sfrba_from_sequence
 from softbend.errors import InputError
 from softbend.models import BendingModel
 from softbend.parameters import Range, declare_ranges
@@ -263,7 +263,7 @@ class AnalyticalBaseline(_Strategy):
         for k, values in enumerate(designs):
             rows = np.flatnonzero(inverse.ravel() == k)
             pressures, where = np.unique(X[rows, -1], return_inverse=True)
-            result = self.model_.sweep(SFRBADesign.from_sequence(values), pressures)
+            result = self.model_.sweep(sfrba_from_sequence(values), pressures)
             angle = np.full(pressures.size, np.nan)
             done = np.asarray(result.converged, dtype=bool)
             angle[: done.size][done] = np.asarray(result.angle_deg)[done]

@@ -1,37 +1,8 @@
-"""Actuator descriptions: the named design parameters a lab's actuator is described by.
+"""The description of an actuator: its design parameters, constraints and columns.
 
-softbend's learning pipeline (train → predict → transfer → design search →
-control) does not depend on an actuator's geometry, only on its description:
-the design parameters (name, unit, range, kind, manufacturing resolution), the
-constraints between them, and the pressure and angle columns with their units.
-Paper B's fiber-reinforced actuator is one registered description
-(``"sfrba"``); a lab's own actuator is another, registered in Python or read
-from the columns of its simulation table (:meth:`Actuator.from_table`).
-
-Every model saved by ``softbend train`` records the description it was
-trained with (:meth:`Actuator.to_dict`), so that predict, transfer, design
-search and control name the model's own parameters and check them in their
-own units::
-
-    from softbend.actuators import ACTUATORS, Actuator, DesignParameter
-
-    pneunet = Actuator(
-        name="my-pneunet",
-        title="PneuNet, 8 to 14 chambers",
-        parameters=(
-            DesignParameter("n_chambers", "", 8, 14, kind="integer"),
-            DesignParameter("wall_mm", "mm", 1.0, 3.0, resolution=0.1),
-            DesignParameter("layer", "", kind="categorical", levels=("paper", "fabric")),
-        ),
-        pressure_column="p_kpa",
-        pressure_unit="kPa",
-        constraints=("wall_mm <= 3",),
-    )
-    ACTUATORS.register(pneunet.name, pneunet)
-
-A categorical parameter's levels are stored as their index (0, 1, …) in
-every model input; :meth:`DesignParameter.encode` and
-:meth:`DesignParameter.decode` convert.
+:class:`Actuator` is what the learning pipeline knows of an actuator;
+:data:`ACTUATORS` holds the registered ones (:func:`get_actuator`,
+:func:`actuator_from`, :func:`load_actuator`).
 """
 
 from __future__ import annotations
@@ -39,9 +10,7 @@ from __future__ import annotations
 import ast
 import json
 import math
-import operator
 import os
-import re
 from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass, field
 from typing import TYPE_CHECKING, Any, Literal
@@ -51,421 +20,22 @@ from numpy.typing import ArrayLike
 
 from softbend import units
 from softbend._validation import must_be, short_repr
-from softbend.errors import SoftbendError, keyed
+from softbend.actuators.constraints import evaluate, parse_constraint
+from softbend.actuators.parameters import (
+    PRESSURE_UNITS,
+    ActuatorError,
+    DesignParameter,
+    Kind,
+    check_name,
+    pressure_to_mpa,
+)
+from softbend.errors import keyed
 from softbend.registry import Registry
 
 if TYPE_CHECKING:
     import pandas as pd
 
     from softbend.parameters import Range
-
-__all__ = [
-    "ACTUATORS",
-    "PRESSURE_UNITS",
-    "Actuator",
-    "ActuatorError",
-    "DesignParameter",
-    "actuator_from",
-    "get_actuator",
-    "load_actuator",
-    "parse_ranges",
-    "pressure_to_mpa",
-]
-
-#: Factor from each pressure unit an actuator is described in to MPa (:mod:`softbend.units`).
-PRESSURE_UNITS: dict[str, float] = {u: f for u, f in units.PRESSURE_UNITS.items() if u != "Pa"}
-
-Kind = Literal["continuous", "integer", "categorical"]
-KINDS: tuple[str, ...] = ("continuous", "integer", "categorical")
-
-_NAME = re.compile(r"^[A-Za-z_][A-Za-z0-9_]{0,63}$")
-
-
-class ActuatorError(SoftbendError, ValueError):
-    """A description, design or table that breaks an actuator's declared parameters."""
-
-
-def pressure_to_mpa(
-    unit: str,
-) -> float:
-    """The factor from ``unit`` (kPa, MPa, bar or psi; case as written) to MPa.
-
-    Raises
-    ------
-    ActuatorError
-        For any other unit (key ``pressure_unit``), naming the four allowed.
-    """
-    if unit not in PRESSURE_UNITS:
-        lowered = {u.lower(): u for u in PRESSURE_UNITS}
-        hint = f" (did you mean {lowered[unit.lower()]}?)" if str(unit).lower() in lowered else ""
-        raise ActuatorError(
-            must_be(f"one of {', '.join(PRESSURE_UNITS)}", unit) + hint, key="pressure_unit"
-        )
-    return PRESSURE_UNITS[unit]
-
-
-def _check_name(name: object, what: str) -> str:
-    if not isinstance(name, str) or not _NAME.match(name):
-        raise ActuatorError(
-            f"The {what} must be a name of letters, digits and '_' (not starting with a digit, "
-            f"at most 64 characters); got {name!r}."
-        )
-    return name
-
-
-@dataclass(frozen=True)
-class DesignParameter:
-    """One named design parameter of an actuator.
-
-    Parameters
-    ----------
-    name : str
-        Column name in tables and models (``"l_mm"``, ``"n_chambers"``).
-    unit : str
-        Unit of its values (``"mm"``, ``"deg"``; ``""`` for a count or a level).
-    low, high : float
-        The range the description covers (inclusive). For a categorical
-        parameter they are taken from its levels (0 to len(levels) - 1).
-    kind : {"continuous", "integer", "categorical"}
-        Continuous values, whole numbers, or one of ``levels``.
-    levels : tuple, optional
-        A categorical parameter's levels (strings or numbers), in the order
-        of their index codes.
-    resolution : float, optional
-        Manufacturing resolution (the step a design search rounds to), in ``unit``.
-    description : str
-        What the parameter is, for tables and documentation.
-    sampled : bool, default False
-        Whether ``low`` and ``high`` are only the span a simulation table
-        sampled (:meth:`Actuator.from_table`), not a declared range: a value
-        outside them is not refused here, and a model trained on the table
-        flags it as outside its training ranges instead.
-    """
-
-    name: str
-    unit: str = ""
-    low: float = -math.inf
-    high: float = math.inf
-    kind: Kind = "continuous"
-    levels: tuple[Any, ...] | None = None
-    resolution: float | None = None
-    description: str = ""
-    sampled: bool = False
-
-    def __post_init__(self) -> None:
-        _check_name(self.name, "name of a design parameter")
-        if self.kind not in KINDS:
-            raise ActuatorError(
-                f"The kind of design parameter {self.name!r} must be one of "
-                f"{', '.join(KINDS)}; got {self.kind!r}."
-            )
-        if self.kind == "categorical":
-            levels = self.levels or ()
-            if len(levels) < 2 or len(set(map(str, levels))) != len(levels):
-                raise ActuatorError(
-                    f"The categorical design parameter {self.name!r} needs two or more distinct "
-                    f"levels; got {self.levels!r}."
-                )
-            object.__setattr__(self, "levels", tuple(levels))
-            object.__setattr__(self, "low", 0.0)
-            object.__setattr__(self, "high", float(len(levels) - 1))
-        elif self.levels is not None:
-            raise ActuatorError(
-                f"Only a categorical design parameter has levels; {self.name!r} is {self.kind}."
-            )
-        low, high = float(self.low), float(self.high)
-        if math.isnan(low) or math.isnan(high) or low > high:
-            raise ActuatorError(
-                f"The range of design parameter {self.name!r} must have low <= high; "
-                f"got [{self.low}, {self.high}]."
-            )
-        object.__setattr__(self, "low", low)
-        object.__setattr__(self, "high", high)
-        if self.resolution is not None and not (
-            math.isfinite(self.resolution) and self.resolution > 0
-        ):
-            raise ActuatorError(
-                f"The resolution of design parameter {self.name!r} must be finite and > 0; "
-                f"got {self.resolution!r}."
-            )
-
-    @property
-    def label(self) -> str:
-        """``name (unit)`` for table headers and axis labels."""
-        return f"{self.name} ({self.unit})" if self.unit else self.name
-
-    def encode(self, value: object) -> float:
-        """The model input of ``value``: a level's index for a categorical parameter."""
-        if self.kind == "categorical":
-            assert self.levels is not None
-            for index, level in enumerate(self.levels):
-                if str(level) == str(value).strip() or (
-                    not isinstance(level, str) and _same_number(level, value)
-                ):
-                    return float(index)
-            raise ActuatorError(
-                f"{self.name} must be one of the levels {', '.join(map(str, self.levels))}; "
-                f"got {short_repr(value)}"
-            )
-        try:
-            number = float(value)  # type: ignore[arg-type]  # refused by except
-        except (TypeError, ValueError):
-            raise ActuatorError(
-                f"{self.name} must be a number ({self._what()}); got {short_repr(value)}"
-            ) from None
-        return number
-
-    def decode(self, code: float) -> Any:
-        """The value a model input ``code`` stands for (a level for a categorical parameter)."""
-        if self.kind == "categorical":
-            assert self.levels is not None
-            return self.levels[round(code)]
-        if self.kind == "integer":
-            return round(code)
-        return float(code)
-
-    def snap(self, values: np.ndarray) -> np.ndarray:
-        """``values`` moved to the nearest buildable value: a level, a whole number,
-        or a multiple of the resolution, inside the range."""
-        out = np.clip(np.asarray(values, dtype=float), self.low, self.high)
-        if self.kind in ("integer", "categorical"):
-            return np.clip(np.round(out), math.ceil(self.low), math.floor(self.high))
-        if self.resolution is not None:
-            out = np.round(out / self.resolution) * self.resolution
-            return np.clip(out, self.low, self.high)
-        return out
-
-    def check(self, codes: np.ndarray) -> None:
-        """Raise one :class:`ActuatorError` for the first code outside the range or kind.
-
-        The message names the parameter (``n_folds must be a whole number in [3, 9];
-        got 5.5``), so an error re-keyed to the input it came from keeps it.
-        """
-        values = np.asarray(codes, dtype=float)
-        bad = ~np.isfinite(values)
-        if bad.any():
-            raise ActuatorError(
-                f"{self.name} must be finite ({self._what()}); got {float(values[bad][0])!r}"
-            )
-        eps = 1e-9 * max(1.0, abs(self.low), abs(self.high))
-        outside = (values < self.low - eps) | (values > self.high + eps)
-        if outside.any() and not (self.sampled and self.kind != "categorical"):
-            shown = (
-                self.decode(values[outside][0])
-                if self.kind == "categorical"
-                else values[outside][0]
-            )
-            got = f"{shown:g}" if isinstance(shown, float) else repr(shown)
-            raise ActuatorError(f"{self.name} must be {self._what()}; got {got}")
-        if self.kind in ("integer", "categorical"):
-            fractional = np.abs(values - np.round(values)) > 1e-9
-            if fractional.any():
-                raise ActuatorError(
-                    f"{self.name} must be {self._what()}; got {values[fractional][0]:g}"
-                )
-
-    def _what(self) -> str:
-        if self.kind == "categorical":
-            assert self.levels is not None
-            return f"one of {', '.join(map(str, self.levels))}"
-        unit = f" {self.unit}" if self.unit else ""
-        if self.sampled and self.kind == "integer":
-            return "a whole number"
-        if self.sampled:
-            return f"in{unit}" if unit else "any value"
-        span = f"in [{self.low:g}, {self.high:g}]{unit}"
-        return f"a whole number {span}" if self.kind == "integer" else span
-
-    def to_dict(self) -> dict[str, Any]:
-        """JSON-friendly form (:meth:`from_dict` reads it back)."""
-        out: dict[str, Any] = {"name": self.name, "unit": self.unit, "kind": self.kind}
-        if self.kind == "categorical":
-            out["levels"] = list(self.levels or ())
-        else:
-            out["low"], out["high"] = self.low, self.high
-        if self.resolution is not None:
-            out["resolution"] = self.resolution
-        if self.description:
-            out["description"] = self.description
-        if self.sampled:
-            out["sampled"] = True
-        return out
-
-    @classmethod
-    def from_dict(cls, data: Mapping[str, Any]) -> DesignParameter:
-        """The parameter :meth:`to_dict` wrote; one :class:`ActuatorError` for a bad record."""
-        if not isinstance(data, Mapping):
-            raise ActuatorError(f"A design parameter must be an object; got {data!r}.")
-        allowed = {
-            "name",
-            "unit",
-            "kind",
-            "levels",
-            "low",
-            "high",
-            "resolution",
-            "description",
-            "sampled",
-        }
-        unknown = sorted(set(data) - allowed)
-        if unknown:
-            raise ActuatorError(
-                f"Unknown key(s) {', '.join(unknown)} in design parameter "
-                f"{data.get('name')!r}; allowed: {', '.join(sorted(allowed))}."
-            )
-        levels = data.get("levels")
-        sampled = data.get("sampled", False)
-        if not isinstance(sampled, bool):
-            raise ActuatorError(
-                f"The 'sampled' of design parameter {data.get('name')!r} must be true or false; "
-                f"got {sampled!r}."
-            )
-        return cls(
-            name=data.get("name"),  # type: ignore[arg-type]  # checked in __post_init__
-            unit=str(data.get("unit", "")),
-            low=_number(data.get("low", -math.inf)),
-            high=_number(data.get("high", math.inf)),
-            kind=data.get("kind", "continuous"),
-            levels=tuple(levels) if isinstance(levels, list | tuple) else levels,
-            resolution=None if data.get("resolution") is None else _number(data["resolution"]),
-            description=str(data.get("description", "")),
-            sampled=sampled,
-        )
-
-
-def _number(value: object) -> float:
-    if isinstance(value, bool) or not isinstance(value, int | float):
-        raise ActuatorError(f"A bound or resolution must be a number; got {value!r}.")
-    return float(value)
-
-
-def _same_number(level: object, value: object) -> bool:
-    try:
-        return float(level) == float(value)  # type: ignore[arg-type]  # refused by except
-    except (TypeError, ValueError):
-        return False
-
-
-# --- constraints -------------------------------------------------------------------------------
-
-_COMPARE: dict[type, Callable[[Any, Any], Any]] = {
-    ast.Lt: operator.lt,
-    ast.LtE: operator.le,
-    ast.Gt: operator.gt,
-    ast.GtE: operator.ge,
-}
-_ARITHMETIC: dict[type, Callable[[Any, Any], Any]] = {
-    ast.Add: operator.add,
-    ast.Sub: operator.sub,
-    ast.Mult: operator.mul,
-    ast.Div: operator.truediv,
-}
-
-
-def _parse_constraint(text: str, names: Sequence[str]) -> ast.Compare:
-    """``text`` as one comparison of arithmetic on ``names`` and numbers (nothing else)."""
-    if not isinstance(text, str) or len(text) > 200:
-        raise ActuatorError(f"A constraint must be text of at most 200 characters; got {text!r}.")
-    try:
-        tree = ast.parse(text, mode="eval").body
-    except SyntaxError:
-        raise ActuatorError(
-            f"The constraint {text!r} is not a comparison such as 't_mm < r_mm' or "
-            "'2*wall_mm + gap_mm <= 10'."
-        ) from None
-    if not isinstance(tree, ast.Compare) or not all(type(op) in _COMPARE for op in tree.ops):
-        raise ActuatorError(
-            f"The constraint {text!r} must compare with <, <=, > or >= (such as 't_mm < r_mm')."
-        )
-    for node in ast.walk(tree):
-        if isinstance(node, ast.Name) and node.id not in names:
-            raise ActuatorError(
-                f"The constraint {text!r} names {node.id!r}, which is not a design parameter "
-                f"({', '.join(names)})."
-            )
-        allowed = (ast.Compare, ast.BinOp, ast.UnaryOp, ast.USub, ast.UAdd, ast.Name, ast.Load)
-        if isinstance(node, ast.Constant):
-            if isinstance(node.value, bool) or not isinstance(node.value, int | float):
-                raise ActuatorError(f"The constraint {text!r} may hold only numbers and names.")
-        elif (
-            not isinstance(node, allowed)
-            and type(node) not in _COMPARE
-            and type(node) not in _ARITHMETIC
-        ):
-            raise ActuatorError(
-                f"The constraint {text!r} may use only + - * / and comparisons of the "
-                "design parameters and numbers."
-            )
-    for side in (tree.left, *tree.comparators):
-        _fold(side, text)
-    return tree
-
-
-def _part(text: str, node: ast.AST) -> str:
-    """The part of the constraint ``text`` that ``node`` was parsed from, as typed."""
-    return ast.get_source_segment(text, node) or ast.unparse(node)
-
-
-def _fold(node: ast.AST, text: str) -> float | None:
-    """The value of ``node`` if it holds no name (None otherwise), checked finite.
-
-    Each part of a constraint made of numbers alone is computed once, when the
-    description is read: one that divides by zero or is not a finite number is
-    refused there, naming the constraint, instead of failing (or, on arrays,
-    silently giving inf or NaN) while designs are checked.
-    """
-    if isinstance(node, ast.Constant):
-        value = float(node.value)  # type: ignore[arg-type]  # a number, as parsed
-    elif isinstance(node, ast.Name):
-        return None
-    elif isinstance(node, ast.UnaryOp):
-        inner = _fold(node.operand, text)
-        if inner is None:
-            return None
-        value = -inner if isinstance(node.op, ast.USub) else inner
-    else:
-        assert isinstance(node, ast.BinOp)
-        left, right = _fold(node.left, text), _fold(node.right, text)
-        if left is None or right is None:
-            return None
-        try:
-            value = _ARITHMETIC[type(node.op)](left, right)
-        except ZeroDivisionError:
-            raise ActuatorError(
-                f"The constraint {text!r} divides by zero ({_part(text, node)}); its numbers "
-                "must give finite values."
-            ) from None
-    if not math.isfinite(value):
-        raise ActuatorError(
-            f"The constraint {text!r} holds a number too large to compute "
-            f"({_part(text, node)}); its numbers must give finite values."
-        )
-    return value
-
-
-def _evaluate(node: ast.AST, values: Mapping[str, np.ndarray]) -> Any:
-    if isinstance(node, ast.Constant):  # a number: _parse_constraint allows no other constant
-        return float(node.value)  # type: ignore[arg-type]
-    if isinstance(node, ast.Name):
-        return values[node.id]
-    if isinstance(node, ast.UnaryOp):
-        inner = _evaluate(node.operand, values)
-        return -inner if isinstance(node.op, ast.USub) else inner
-    if isinstance(node, ast.BinOp):
-        return _ARITHMETIC[type(node.op)](
-            _evaluate(node.left, values), _evaluate(node.right, values)
-        )
-    assert isinstance(node, ast.Compare)
-    result = np.ones(np.shape(next(iter(values.values()))), dtype=bool)
-    left = _evaluate(node.left, values)
-    for op, comparator in zip(node.ops, node.comparators, strict=True):
-        right = _evaluate(comparator, values)
-        result &= np.asarray(_COMPARE[type(op)](left, right), dtype=bool)
-        left = right
-    return result
-
-
-# --- the description ---------------------------------------------------------------------------
 
 
 @dataclass(frozen=True)
@@ -530,10 +100,33 @@ class Actuator:
         its values against them and takes its ranges from the model's training
         ranges alone. Empty: the parameters' ranges, a box a search may cover.
 
+    design_ids : {"named", "values"}
+        How a design's id is computed (:attr:`~softbend.actuators.design.Design.design_id`):
+        ``"named"`` hashes ``FAMILY:name=value,...`` (``FAMILY`` the FEM family, else the
+        name), ``"values"`` the values alone (paper B's ids, older than named ones).
+    short_names : tuple of str
+        Short names of the parameters, in order (paper B's ``l, r, t, b, phi, lc``):
+        what a design search specification calls them; empty: their own names.
+    grid : tuple of tuple of float
+        A published grid of designs: the levels of each parameter, in order
+        (paper B's Table 1); empty when none.
+    check_values : callable, optional
+        ``check_values({name: value}) -> {name: value}``: the description's own
+        check of one design's values, run before its ranges, kinds and
+        constraints (:meth:`Design.checked <softbend.actuators.Design.checked>`),
+        raising :class:`~softbend.errors.InputError` keyed by the parameter at
+        fault with the description's own words (paper B's open bounds, its wall
+        thinner than the radius).
+    cavity_volume : callable, optional
+        ``cavity_volume({name: value}) -> float``: the undeformed cavity volume of
+        one design, mm³, from its geometry (paper B's ½·π·r²·l), read as
+        :attr:`Design.cavity_volume_mm3 <softbend.actuators.Design.cavity_volume_mm3>`.
+
     The fields from ``quantities`` on are softbend's knowledge of a registered
     actuator, not part of its description: :meth:`to_dict` does not write them and
     equality ignores them; a model's recorded description that equals a registered
-    one is read back as that one (:func:`softbend.surrogates.persistence.actuator_of`).
+    one is read back as that one (:meth:`registered`,
+    :func:`softbend.surrogates.persistence.actuator_of`).
     """
 
     name: str
@@ -554,16 +147,25 @@ class Actuator:
     named_in_outputs: bool = field(default=True, compare=False)
     search_steps: tuple[float, ...] = field(default=(), compare=False)
     search_limits: tuple[Range, ...] = field(default=(), compare=False)
+    design_ids: Literal["named", "values"] = field(default="named", compare=False)
+    short_names: tuple[str, ...] = field(default=(), compare=False)
+    grid: tuple[tuple[float, ...], ...] = field(default=(), compare=False)
+    check_values: Callable[[dict[str, float]], dict[str, float]] | None = field(
+        default=None, compare=False
+    )
+    cavity_volume: Callable[[Mapping[str, float]], float] | None = field(
+        default=None, compare=False
+    )
     _trees: tuple[ast.Compare, ...] = field(default=(), repr=False, compare=False)
 
     def __post_init__(self) -> None:
-        _check_name(self.name.replace("-", "_"), "name of an actuator")
+        check_name(self.name.replace("-", "_"), "name of an actuator")
         if not self.parameters:
             raise ActuatorError(f"The actuator {self.name!r} needs at least one design parameter.")
         object.__setattr__(self, "parameters", tuple(self.parameters))
         names = [p.name for p in self.parameters]
-        _check_name(self.pressure_column, "pressure column")
-        _check_name(self.angle_column, "angle column")
+        check_name(self.pressure_column, "pressure column")
+        check_name(self.angle_column, "angle column")
         columns = [*names, self.pressure_column, self.angle_column]
         repeated = sorted({n for n in columns if columns.count(n) > 1})
         if repeated:
@@ -581,7 +183,7 @@ class Actuator:
                     f"The {key} of actuator {self.name!r} must be finite and >= 0; got {value!r}."
                 )
         object.__setattr__(self, "constraints", tuple(self.constraints))
-        trees = tuple(_parse_constraint(text, names) for text in self.constraints)
+        trees = tuple(parse_constraint(text, names) for text in self.constraints)
         object.__setattr__(self, "_trees", trees)
 
     # --- names ---------------------------------------------------------------------------------
@@ -716,7 +318,7 @@ class Actuator:
                 broken = next(
                     text
                     for text, tree in zip(self.constraints, self._trees, strict=True)
-                    if not _evaluate(tree, self._columns(rows[i : i + 1]))[0]
+                    if not evaluate(tree, self._columns(rows[i : i + 1]))[0]
                 )
             raise ActuatorError(
                 f"the design {self.describe(rows[i])} breaks the constraint {broken} of {self.name}"
@@ -732,7 +334,7 @@ class Actuator:
         # compared as computed: a NaN side meets no comparison.
         with np.errstate(divide="ignore", invalid="ignore", over="ignore"):
             for tree in self._trees:
-                met &= np.asarray(_evaluate(tree, columns), dtype=bool)
+                met &= np.asarray(evaluate(tree, columns), dtype=bool)
         return met
 
     def _columns(self, rows: np.ndarray) -> dict[str, np.ndarray]:
@@ -808,7 +410,7 @@ class Actuator:
         constraints = data.get("constraints", [])
         if not isinstance(constraints, list | tuple):
             raise ActuatorError("An actuator description's 'constraints' must be a list of text.")
-        return cls(
+        described = cls(
             name=str(data.get("name", "")),
             title=str(data.get("title", "")),
             parameters=tuple(DesignParameter.from_dict(p) for p in parameters),
@@ -820,6 +422,19 @@ class Actuator:
             chamber_volume_mm3=data.get("chamber_volume_mm3"),
             volume_growth_mm3_per_mpa=data.get("volume_growth_mm3_per_mpa"),
         )
+        return described.registered()
+
+    def registered(self) -> Actuator:
+        """The registered description this one records (same name and record), else itself.
+
+        A record read back from a saved model lacks what only the registered
+        description holds (its id scheme, short names, grid); the registered
+        description that writes the same record is the one it was saved from.
+        """
+        if self.name not in ACTUATORS:
+            return self
+        known = ACTUATORS.get(self.name)
+        return known if known.to_dict() == self.to_dict() else self
 
     @classmethod
     def from_table(
@@ -1031,143 +646,3 @@ def get_actuator(
     """The registered description ``name`` (one error, keyed ``actuator``, listing the names)."""
     with keyed("actuator"):
         return ACTUATORS.get(name)
-
-
-def _register_paper_b() -> Actuator:
-    """Paper B's fiber-reinforced actuator (SFRBA), as its FEM and Table 1 describe it."""
-    from softbend.design import _BOUNDS, FEATURE_QUANTITIES
-    from softbend.parameters import Range
-    from softbend.references import SURROGATES, values
-
-    described = {
-        "l_mm": ("mm", "chamber length"),
-        "r_mm": ("mm", "inner radius of the semicircular chamber"),
-        "t_mm": ("mm", "top wall thickness"),
-        "b_mm": ("mm", "bottom wall thickness"),
-        "phi_deg": ("deg", "fiber winding angle from the circumferential direction"),
-        "lc_mm": ("mm", "distal cap length"),
-    }
-    parameters = tuple(
-        DesignParameter(
-            name,
-            unit,
-            low,
-            high,
-            resolution=0.1 if unit == "mm" else 1.0,
-            description=text,
-        )
-        for name, (unit, text) in described.items()
-        for low, high, _ in [_BOUNDS[name]]
-    )
-    sfrba = Actuator(
-        name="sfrba",
-        title="paper B's soft fiber-reinforced bending actuator",
-        parameters=parameters,
-        pressure_column="pressure_mpa",
-        pressure_unit="MPa",
-        angle_column="angle_deg",
-        constraints=("t_mm < r_mm",),
-        fem_family="sfrba",
-        quantities=dict(FEATURE_QUANTITIES),
-        mape_floor_deg=1.0,
-        transfer_mape_floor_deg=0.0,
-        analytical=True,
-        published_cv=values(SURROGATES),
-        named_in_outputs=False,
-        search_steps=tuple(1.0 if unit == "deg" else 0.5 for unit, _ in described.values()),
-        search_limits=tuple(
-            Range(low, high, unit, "the values a design may take", low_inclusive)
-            for name, (unit, _) in described.items()
-            for low, high, low_inclusive in [_BOUNDS[name]]
-        ),
-    )
-    return ACTUATORS.register(sfrba.name, sfrba)
-
-
-#: Paper B's actuator: the description of every campaign and shipped model.
-SFRBA: Actuator = _register_paper_b()
-
-
-def _register_pneunet() -> Actuator:
-    """The PneuNet's description (:mod:`softbend.fem.pneunet.description` is its FEM family)."""
-    parameters = (
-        DesignParameter(
-            "n_chambers", "", 3, 8, kind="integer", description="number of chambers in the row"
-        ),
-        DesignParameter(
-            "chamber_length_mm",
-            "mm",
-            5.0,
-            12.0,
-            resolution=0.1,
-            description="outer length of one chamber along the actuator, walls included",
-        ),
-        DesignParameter(
-            "chamber_width_mm",
-            "mm",
-            10.0,
-            20.0,
-            resolution=0.1,
-            description="outer width of a chamber across the actuator (and of the base)",
-        ),
-        DesignParameter(
-            "chamber_height_mm",
-            "mm",
-            8.0,
-            25.0,
-            resolution=0.1,
-            description="outer height of a chamber above the base",
-        ),
-        DesignParameter(
-            "wall_mm",
-            "mm",
-            0.8,
-            2.5,
-            resolution=0.1,
-            description="thickness of the expanding walls facing the neighbouring chambers",
-        ),
-        DesignParameter(
-            "outer_wall_mm",
-            "mm",
-            1.5,
-            3.0,
-            resolution=0.1,
-            description="thickness of the side walls and the roof of a chamber",
-        ),
-        DesignParameter(
-            "gap_mm",
-            "mm",
-            1.0,
-            5.0,
-            resolution=0.1,
-            description="gap between neighbouring chambers",
-        ),
-        DesignParameter(
-            "base_mm",
-            "mm",
-            1.0,
-            4.0,
-            resolution=0.1,
-            description="thickness of the base under the chambers, strain-limiting layer below",
-        ),
-    )
-
-    pneunet = Actuator(
-        name="pneunet",
-        title="PneuNet: a row of inflatable chambers on a strain-limiting layer",
-        parameters=parameters,
-        pressure_column="pressure_mpa",
-        pressure_unit="MPa",
-        angle_column="angle_deg",
-        constraints=(
-            "2 * wall_mm < chamber_length_mm",
-            "2 * outer_wall_mm < chamber_width_mm",
-            "outer_wall_mm < chamber_height_mm",
-        ),
-        fem_family="pneunet",
-    )
-    return ACTUATORS.register(pneunet.name, pneunet)
-
-
-#: The PneuNet: a row of chambers on a strain-limiting layer, the FEM's second family.
-PNEUNET: Actuator = _register_pneunet()
