@@ -57,6 +57,7 @@ def test_the_core_works_without_extras(tmp_path):
         from softbend.kinematics import bending_from_tip, tip_position
         from softbend.identification import NARXRegressor, synthetic_dataset
         from softbend.analytical import AnalyticalModel
+        from softbend.design import sfrba_design
         from softbend.models import default_pressures_mpa
         from softbend.surrogates.polynomial import PolynomialRegressor
         from softbend.surrogates.persistence import load_surrogate, save_surrogate

@@ -181,6 +181,7 @@ _CHILD = textwrap.dedent(
     """
     import sys
     from softbend.campaign import default_pressures_mpa, run_campaign
+    from softbend.design import parse_sfrba
 
     designs = [parse_sfrba(text) for text in sys.argv[2].split(";")]
 

@@ -270,7 +270,7 @@ def test_a_hardware_rig_needs_the_chamber_only_for_the_predictive_controller(mod
 
     options = {"rig": "modbus", "design": DESIGN, "model": models["MPa"], "supply_mpa": 0.06}
     plan = plan_loop(**options)
-    assert plan.setup.design.as_record()["layer"] == "paper"
+    assert plan.setup.design.record()["layer"] == "paper"
     with pytest.raises(ValueError, match="volume_mm3"):
         plan_loop(controller="predictive", **options)
 
@@ -310,4 +310,6 @@ def test_designs_are_read_by_the_actuator_of_the_model(models):
     assert isinstance(design, Design)
     np.testing.assert_array_equal(design.as_array(), [10.0, 2.0, 10.0, 1.0])
     # The rows a model takes: the pressure in its unit (kPa) from the rig's MPa.
-    np.testing.assert_allclose(design.feature_rows([0.03])[0], [10.0, 2.0, 10.0, 1.0, 30.0])
+    np.testing.assert_allclose(
+        design.feature_rows([0.03], unit="MPa")[0], [10.0, 2.0, 10.0, 1.0, 30.0]
+    )

@@ -125,7 +125,7 @@ def test_verify_sweeps_each_candidate_with_the_family_and_reports_the_stops(mode
     assert result.verified_by == {"backend": "fem", "family": "touchy", "designs": len(verified)}
     stopped = reached = 0
     for c in verified:
-        n, w = c.design.codes
+        n, w = c.design.as_array()
         assert c.pressure_mpa == 20.0  # the surrogate's unit, kPa
         if touch_mpa(w) < 0.020:
             stopped += 1
@@ -150,7 +150,7 @@ def test_a_design_the_family_refuses_is_reported_not_swept(model):
     # 150° at 20 kPa: n + w = 7.5 ± 0.15, n = 5 and w 2.4 to 2.6; the family refuses w > 2.5.
     result = find_designs(model, _spec(model, 150.0, 20.0), top=10, distinct=False)
     verified = verify_candidates(result, 10, backend="fem", workers=1)
-    widths = {round(c.design.codes[1], 6): c for c in verified}
+    widths = {round(c.design.as_array()[1], 6): c for c in verified}
     assert set(widths) == {2.4, 2.5, 2.6}
     refused = widths[2.6]
     assert math.isnan(refused.fem_angle_deg) and refused.fem_meets is False
@@ -215,8 +215,8 @@ def test_replace_stopped_verifies_the_next_candidates_until_k_reach_the_pressure
     reached = [c for c in verified if c.fem_stop is None]
     stopped = [c for c in verified if c.fem_stop is not None]
     assert len(reached) == 2 and verified[-1] is reached[-1] and stopped
-    assert all(touch_mpa(c.design.codes[1]) < 0.020 for c in stopped)
-    assert all(touch_mpa(c.design.codes[1]) >= 0.020 for c in reached)
+    assert all(touch_mpa(c.design.as_array()[1]) < 0.020 for c in stopped)
+    assert all(touch_mpa(c.design.as_array()[1]) >= 0.020 for c in reached)
     assert result.verified_by["designs"] == len(verified)
     assert all(c.fem_meets is None for c in result.candidates[len(verified) :])
 

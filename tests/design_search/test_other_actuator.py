@@ -91,10 +91,10 @@ def test_the_smallest_chamber_count_that_bends_88_degrees_at_30_kpa(constrained)
     assert (expected, _brute_force(88.0, 3.0, constraint=False)) == (9, 8)
     best = result.candidates[0]
     assert isinstance(best.design, Design)
-    record = best.design.as_dict()
+    record = best.design.record()
     assert record["n_chambers"] == expected and isinstance(record["n_chambers"], int)
     for c in result.candidates:
-        n, wall, layer = c.design.as_dict().values()
+        n, wall, layer = c.design.record().values()
         assert isinstance(n, int) and layer in ("fabric", "paper")
         assert wall == pytest.approx(round(wall * 10) / 10, abs=1e-9)  # on the resolution
         assert 1.0 - 1e-9 <= wall <= 3.0 + 1e-9  # the training range within the description
@@ -117,7 +117,7 @@ def test_every_design_of_the_grid_meets_the_constraint_or_is_left_out(constraine
     result = find_designs(path, spec, distinct=False, top=50)
     # n = 12 needs a wall of 1.8 mm at least: 1.8, 1.9, ..., 3.0 mm, 13 designs
     assert result.n_designs == 13
-    best = result.candidates[0].design.as_dict()
+    best = result.candidates[0].design.record()
     assert best == {"n_chambers": 12, "wall_mm": 1.8, "layer": "paper"}
     assert result.candidates[0].angle_deg == pytest.approx(30 * (4.8 - 0.9 + 0.2), abs=1e-3)
 
@@ -254,9 +254,9 @@ def test_a_table_described_actuator_searches_its_continuous_parameter_on_a_round
         actuator=actuator,
     )
     result = find_designs(pneunet_model, spec)
-    best = result.candidates[0].design.as_dict()
+    best = result.candidates[0].design.record()
     # paper, 30 kPa: θ = 12·n − 15·w + 6: n = 8 with w in [0.6, 1.0], n = 7 cannot reach 87°
     assert best["n_chambers"] == 8 and 0.6 - 1e-9 <= best["wall_mm"] <= 1.0 + 1e-9
     assert result.candidates[0].angle_deg == pytest.approx(90.0, abs=3.0)
-    walls = np.array([c.design.as_dict()["wall_mm"] for c in result.candidates])
+    walls = np.array([c.design.record()["wall_mm"] for c in result.candidates])
     assert np.allclose(walls / 0.025, np.round(walls / 0.025))

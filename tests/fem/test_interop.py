@@ -10,6 +10,7 @@ def test_pytorch_runs_after_an_fem_sweep_in_the_same_process():
     # softbend.fem loads PyTorch first. A crash shows as a negative return code.
     script = textwrap.dedent(
         """
+        from softbend.design import parse_sfrba
         from softbend.fem import FEMOptions, simulate
 
         simulate(parse_sfrba("100,6,2,2,5,10"), [0.0, 0.005], FEMOptions(maxh_mm=6))

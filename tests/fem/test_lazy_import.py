@@ -28,6 +28,7 @@ def test_the_pure_python_parts_import_and_work_without_ngsolve():
     done = _run(
         """
         import softbend.fem
+        from softbend.design import sfrba_design
         from softbend.fem import (
             GRAVITY_DIRECTIONS, OUTPUT_MODES, ActuatorGeometry, FEMOptions, FEMStats, fem_stats,
         )

@@ -182,6 +182,19 @@ class Actuator:
                 raise ActuatorError(
                     f"The {key} of actuator {self.name!r} must be finite and >= 0; got {value!r}."
                 )
+        if self.design_ids not in ("named", "values"):
+            raise ActuatorError(
+                f"The design_ids of actuator {self.name!r} must be 'named' or 'values'; "
+                f"got {self.design_ids!r}."
+            )
+        for key in ("short_names", "grid"):
+            given = tuple(getattr(self, key))
+            if given and len(given) != len(self.parameters):
+                raise ActuatorError(
+                    f"The {key} of actuator {self.name!r} must hold one entry per design "
+                    f"parameter ({len(self.parameters)}); got {len(given)}."
+                )
+            object.__setattr__(self, key, given)
         object.__setattr__(self, "constraints", tuple(self.constraints))
         trees = tuple(parse_constraint(text, names) for text in self.constraints)
         object.__setattr__(self, "_trees", trees)

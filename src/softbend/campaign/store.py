@@ -688,11 +688,9 @@ class CampaignStore:
             self._con.execute(self._insert_design, row)
         self._recorded.add(design.design_id)
 
-    def _check_family(self, design: Any) -> None:
+    def _check_family(self, design: Design) -> None:
         """Refuse a design of another family than the campaign's (its columns differ)."""
-        family = getattr(design, "family", DEFAULT_FAMILY)
-        if not isinstance(family, str):
-            family = DEFAULT_FAMILY
+        family = design.actuator.fem_family or design.actuator.name
         names = tuple(design.as_dict())
         if family != self.family or names != self.parameters:
             raise ValueError(

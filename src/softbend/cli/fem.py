@@ -9,7 +9,6 @@ import typer
 
 from softbend._validation import must_be
 from softbend.cli import _common
-from softbend.design import parse_sfrba
 from softbend.errors import InputError, keyed
 
 if TYPE_CHECKING:
@@ -187,6 +186,7 @@ def run(
     from softbend._io import write_text_atomic
     from softbend._outdir import staged_dir
     from softbend._validation import check_int
+    from softbend.design import parse_sfrba
     from softbend.fem.families import get_family
     from softbend.fem.stats import fem_stats
     from softbend.models import default_pressures_mpa
@@ -326,6 +326,7 @@ def mesh_study(
     \b
         softbend fem mesh-study --maxh 6,5,4,3 --pressures 0,0.05,0.1
     """
+    from softbend.design import parse_sfrba
     from softbend.fem.families import get_family
     from softbend.fem.verification import mesh_study as study
 

@@ -114,7 +114,7 @@ def curves_figure(
         rows = c.design.feature_rows(p)
         said = (
             ", ".join(
-                f"{v:g}" if isinstance(v, float) else str(v) for v in c.design.as_dict().values()
+                f"{v:g}" if isinstance(v, float) else str(v) for v in c.design.record().values()
             )
             if long
             else str(c.design)
