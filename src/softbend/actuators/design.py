@@ -165,7 +165,17 @@ class Design:
         rows[:, -1] = p
         return rows
 
-    def __str__(self) -> str:
+    def as_text(self) -> str:
+        """The design as text that reads back: ``100,6,2,2,5,8`` (the values in order, for
+        a description whose ids hash its values, paper B's) or ``n_chambers=5,
+        wall_mm=1.2, ...`` (named values, as an FEM family parses them)."""
         if self.actuator.design_ids == "values":
             return ",".join(f"{v:g}" for v in self.values.values())
+        return ", ".join(f"{k}={v:g}" for k, v in self.values.items())
+
+    def __str__(self) -> str:
+        """The design for messages: :meth:`as_text` for paper B's, else by name in its
+        units, levels by name (``n_chambers=5, wall_mm=1.2 mm, layer=paper``)."""
+        if self.actuator.design_ids == "values":
+            return self.as_text()
         return self.actuator.describe(list(self.values.values()))

@@ -247,7 +247,7 @@ def run(
         stats = fem_stats(result)
         summary = {
             **({} if paper_b else {"family": chosen.name}),
-            "design": str(actuator),
+            "design": actuator.as_text(),
             "stop_reason": stats["stop_reason"],
             "max_pressure_mpa": result.max_pressure_mpa,
             "max_angle_deg": result.max_angle_deg,
@@ -262,7 +262,9 @@ def run(
         )
         return
     title = (
-        f"FEM sweep of ({actuator})" if paper_b else f"FEM sweep of the {chosen.name} ({actuator})"
+        f"FEM sweep of ({actuator.as_text()})"
+        if paper_b
+        else f"FEM sweep of the {chosen.name} ({actuator.as_text()})"
     )
     # Paper B: a row every 0.02 MPa; another family: about ten rows over its sweep.
     every = max(1, round(0.02 / pstep)) if paper_b else max(1, len(result.pressure_mpa) // 10)
@@ -363,12 +365,12 @@ def mesh_study(
         )
         table.append({**row.__dict__, "change_pct": change})
     if json_output:
-        _common.print_json({"design": str(actuator), "pressures_mpa": grid, "rows": table})
+        _common.print_json({"design": actuator.as_text(), "pressures_mpa": grid, "rows": table})
         return
     columns = ["maxh mm", "elements", "dofs", "s"]
     columns += [f"θ at {p:g} MPa" for p in grid] + [f"Δ% at {p:g}" for p in grid]
     _common.print_table(
-        f"Mesh convergence of ({actuator})",
+        f"Mesh convergence of ({actuator.as_text()})",
         columns,
         [
             [r["maxh_mm"], r["elements"], r["ndof"], f"{r['wall_time_s']:.0f}"]

@@ -236,7 +236,7 @@ def run_pneunet(
     best = next((c for c in search.candidates if c.fem_angle_deg is not None), None)
     finest = mesh[-1].angles_deg[-1]
     summary = {
-        "reference": str(design),
+        "reference": design.as_text(),
         "stop_reason": sweep.stats["stop_reason"],
         "touch_pressure_mpa": float(p[-1]),
         "touch_angle_deg": float(a[-1]),

@@ -151,7 +151,9 @@ def pneunet_solid(design: Design, end_mm: float) -> tuple[Any, PneuNetGeometry]:
     cavity = Glue(cavities) if len(cavities) > 1 else cavities[0]
     cavity.faces.name = "cavity"
     solid = body - cavity
-    name_faces(solid, info.length_mm, tip=False, what=f"the PneuNet geometry of design {design}")
+    name_faces(
+        solid, info.length_mm, tip=False, what=f"the PneuNet geometry of design {design.as_text()}"
+    )
     return solid, info
 
 
@@ -211,5 +213,5 @@ def mesh_pneunet(
     check_pneunet_mesh(design, maxh_mm, end_mm)
     shape, info = pneunet_solid(design, end_mm)
     h = element_size_mm(design, maxh_mm)
-    what = f"the PneuNet {design} with maxh_mm={maxh_mm:g}"
+    what = f"the PneuNet {design.as_text()} with maxh_mm={maxh_mm:g}"
     return curved_mesh(shape, h, order, what), info
