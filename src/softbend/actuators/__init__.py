@@ -37,8 +37,10 @@ every model input; :meth:`DesignParameter.encode` and
 The package holds one idea a module: a design parameter (:mod:`.parameters`),
 constraints between parameters (:mod:`.constraints`), the description and its
 registry (:mod:`.description`), a design (:mod:`.design`), and the registered
-descriptions: paper B's actuator (:mod:`.sfrba`) and the PneuNet
-(:mod:`.pneunet`), each beside the FEM family that simulates it.
+descriptions, one module each: paper B's actuator (:mod:`.sfrba`, simulated by
+the FEM family ``"sfrba"``) and the PneuNet (:mod:`.pneunet`, whose FEM family
+:mod:`softbend.fem.pneunet.description` imports it). Importing the package
+registers both.
 """
 
 from __future__ import annotations
