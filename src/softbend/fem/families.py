@@ -95,7 +95,7 @@ class FEMFamily:
     make_design: Callable[[dict[str, float]], Design]
     sweep: Callable[..., tuple[SweepResult, Any, Any]]
     default_options: Callable[..., FEMOptions] | None = None
-    mesh_check: Callable[[Any, FEMOptions], None] | None = None
+    mesh_check: Callable[[Design, FEMOptions], None] | None = None
     backends: tuple[str, ...] | None = ("fem",)
 
     @property
@@ -138,14 +138,14 @@ class FEMFamily:
 
         return FEMOptions(**overrides)
 
-    def check_mesh(self, design: Any, options: FEMOptions) -> None:
+    def check_mesh(self, design: Design, options: FEMOptions) -> None:
         """Refuse ``options.maxh_mm`` if it meshes ``design`` too finely (see ``mesh_check``)."""
         if self.mesh_check is not None:
             self.mesh_check(design, options)
 
     def simulate(
         self,
-        design: Any,
+        design: Design,
         pressures_mpa: ArrayLike,
         options: FEMOptions | None = None,
         *,
@@ -201,14 +201,14 @@ def _sfrba_design(values: dict[str, float]) -> Design:
 
 
 def _sfrba_sweep(
-    design: Any, pressures_mpa: ArrayLike, options: FEMOptions | None = None, **kwargs: Any
+    design: Design, pressures_mpa: ArrayLike, options: FEMOptions | None = None, **kwargs: Any
 ) -> tuple[SweepResult, Any, Any]:
     from softbend.fem.sweep import run_sweep
 
     return run_sweep(design, pressures_mpa, options, **kwargs)
 
 
-def _sfrba_mesh_check(design: Any, options: FEMOptions) -> None:
+def _sfrba_mesh_check(design: Design, options: FEMOptions) -> None:
     options.check_mesh(design)
 
 
@@ -241,7 +241,7 @@ SFRBA_FAMILY: FEMFamily = _register_paper_b()
 
 
 def _pneunet_sweep(
-    design: Any, pressures_mpa: ArrayLike, options: FEMOptions | None = None, **kwargs: Any
+    design: Design, pressures_mpa: ArrayLike, options: FEMOptions | None = None, **kwargs: Any
 ) -> tuple[SweepResult, Any, Any]:
     from softbend.fem.pneunet.description import pneunet_options
     from softbend.fem.pneunet.sweep import run_pneunet_sweep
@@ -249,7 +249,7 @@ def _pneunet_sweep(
     return run_pneunet_sweep(design, pressures_mpa, options or pneunet_options(), **kwargs)
 
 
-def _pneunet_mesh_check(design: Any, options: FEMOptions) -> None:
+def _pneunet_mesh_check(design: Design, options: FEMOptions) -> None:
     from softbend.fem.pneunet.geometry import check_pneunet_mesh
 
     check_pneunet_mesh(design, options.maxh_mm, options.base_cap_mm)
