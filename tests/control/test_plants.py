@@ -123,13 +123,12 @@ def test_a_plant_is_parsed_once_into_its_kind(tmp_path):
 
 
 def test_a_plant_of_paper_b_s_actuator_alone_refuses_another_actuator_s_design():
-    from softbend.actuators import SFRBA, Actuator, DesignParameter
-    from softbend.control.designs import ModelDesign
+    from softbend.actuators import SFRBA, Actuator, Design, DesignParameter
     from softbend.control.plants import PLANT_ACTUATORS, check_plant_actuator
     from softbend.errors import InputError
 
     other = Actuator("other", "another actuator", (DesignParameter("w_mm", "mm", 1.0, 2.0),))
-    design = ModelDesign(other, np.array([1.5]))
+    design = Design.checked(other, np.array([1.5]))
     assert {PLANT_ACTUATORS[name].name for name in ("fem", "lab", "measurements")} == {SFRBA.name}
     check_plant_actuator("surrogate", design)
     check_plant_actuator("fem", DESIGN)

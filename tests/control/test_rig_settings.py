@@ -12,7 +12,7 @@ from softbend.control.rigs import (
     rig_params_for,
     rig_settings,
 )
-from softbend.design import cavity_volume_mm3, sfrba_design
+from softbend.design import sfrba_design
 from softbend.errors import DatasetError
 from softbend.parameters import ParameterValueError, UnknownParameterError
 
@@ -112,10 +112,10 @@ def test_a_name_given_twice_is_refused():
 
 def test_tubing_volume_is_added_to_the_cavity():
     none = rig_params_for(DESIGN, {"tubing_mm3": 0.0})
-    assert none.volume_mm3 == pytest.approx(cavity_volume_mm3(DESIGN))
+    assert none.volume_mm3 == pytest.approx(DESIGN.cavity_volume_mm3)
     more = rig_params_for(DESIGN, {"tubing_mm3": 5000.0})
     assert more.volume_mm3 - none.volume_mm3 == pytest.approx(5000.0)
-    assert rig_params_for(DESIGN).volume_mm3 == pytest.approx(cavity_volume_mm3(DESIGN) + 2000.0)
+    assert rig_params_for(DESIGN).volume_mm3 == pytest.approx(DESIGN.cavity_volume_mm3 + 2000.0)
     # an explicit chamber volume wins over the design's
     assert rig_params_for(DESIGN, {"volume_mm3": 1234.0, "tubing_mm3": 9.0}).volume_mm3 == 1234.0
 

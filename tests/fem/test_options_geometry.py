@@ -2,7 +2,7 @@ import math
 
 import pytest
 
-from softbend.design import cavity_volume_mm3, sfrba_design
+from softbend.design import sfrba_design
 from softbend.fem import FEMOptions
 from softbend.fem.geometry import actuator_geometry, mesh_actuator
 
@@ -88,13 +88,13 @@ def test_one_cavity_volume_serves_the_fem_and_the_rig(values):
     design = sfrba_design(*values)
     l_mm, r_mm = values[0], values[1]
     # Closed form: a half-disc of radius r extruded over l.
-    assert cavity_volume_mm3(design) == pytest.approx(math.pi * r_mm**2 / 2.0 * l_mm, rel=1e-15)
+    assert design.cavity_volume_mm3 == pytest.approx(math.pi * r_mm**2 / 2.0 * l_mm, rel=1e-15)
     if values[:2] == (100, 6):
-        assert cavity_volume_mm3(design) == pytest.approx(1800.0 * math.pi, rel=1e-15)
+        assert design.cavity_volume_mm3 == pytest.approx(1800.0 * math.pi, rel=1e-15)
     # The FEM meshes exactly half of it; the rig's air volume is all of it plus the tubing.
-    assert ActuatorGeometry(design, 3.0).half_cavity_volume_mm3 == cavity_volume_mm3(design) / 2
+    assert ActuatorGeometry(design, 3.0).half_cavity_volume_mm3 == design.cavity_volume_mm3 / 2
     rig = RigParams.for_design(design, tubing_mm3=2000.0)
-    assert rig.volume_mm3 == cavity_volume_mm3(design) + 2000.0
+    assert rig.volume_mm3 == design.cavity_volume_mm3 + 2000.0
 
 
 def test_the_meshed_cavity_has_the_closed_form_volume():
@@ -102,4 +102,4 @@ def test_the_meshed_cavity_has_the_closed_form_volume():
 
     design = sfrba_design(100, 6, 2, 2, 5, 10)
     model = ActuatorModel(design, FEMOptions(maxh_mm=6.0))
-    assert model.cavity_volume_mm3() == pytest.approx(cavity_volume_mm3(design), rel=2e-3)
+    assert model.cavity_volume_mm3() == pytest.approx(design.cavity_volume_mm3, rel=2e-3)

@@ -33,7 +33,7 @@ from __future__ import annotations
 
 from collections.abc import Callable
 from pathlib import Path
-from typing import TYPE_CHECKING, cast
+from typing import TYPE_CHECKING
 
 import numpy as np
 
@@ -153,7 +153,7 @@ def plant_compliance(plant: str | PlantChoice, design: Design, supply_mpa: float
     if compliance is None:
         return None
     check_plant_actuator(choice, design)
-    return compliance(cast(Design, design), supply_mpa)
+    return compliance(design, supply_mpa)
 
 
 def plant_table(
@@ -186,7 +186,7 @@ def plant_table(
     check_plant_actuator(choice, design)
     if choice.kind == "named":
         # a registered plant receives the design the controller's model takes
-        return PLANTS.get(choice.text)(cast(Design, design), model_table)
+        return PLANTS.get(choice.text)(design, model_table)
     if choice.kind == "surrogate":
         from softbend.surrogates.persistence import load_surrogate
 
@@ -197,7 +197,7 @@ def plant_table(
         from softbend.transfer.measurements import load_measurements
 
         readings = load_measurements(choice.text)
-        return lab_angle_table(cast(Design, design), measurements=readings, source=choice.text)
+        return lab_angle_table(design, measurements=readings, source=choice.text)
     raise InputError(
         f"is the identified model {choice.text}: its dynamics play the actuator, it has no "
         "θ(p) table of a design",

@@ -46,7 +46,7 @@ import random
 from bisect import bisect_right
 from collections.abc import Callable
 from dataclasses import dataclass, fields, replace
-from typing import TYPE_CHECKING, Any, Protocol, cast, runtime_checkable
+from typing import TYPE_CHECKING, Any, Protocol, runtime_checkable
 
 import numpy as np
 from numpy.typing import ArrayLike
@@ -337,7 +337,7 @@ class RigParams:
         compliance = cavity_compliance_mm3_per_mpa(
             stats["steps_mpa"], stats["step_volume_rate_mm3_per_mpa"], supply
         )
-        design = cast(Design, result.design)  # a design with a cavity, checked above
+        design = result.design  # a design with a cavity, checked above
         return cls.for_design(
             design, tubing_mm3=tubing_mm3, compliance_mm3_per_mpa=compliance, **kwargs
         )
