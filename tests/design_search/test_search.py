@@ -8,6 +8,7 @@ import time
 import numpy as np
 import pytest
 
+from softbend.actuators import SFRBA
 from softbend.design_search import search
 from softbend.design_search.grid import Listed, designs_at, grid_axes
 from softbend.design_search.search import (
@@ -181,12 +182,12 @@ def test_pareto_front_of_a_small_set():
 
 def test_elastomer_volume_grows_with_every_size():
     base = np.array([[100.0, 6.0, 2.0, 2.0, 5.0, 8.0]])
-    v0 = elastomer_volume_mm3(base)[0]
+    v0 = elastomer_volume_mm3(SFRBA, base)[0]
     for j in (0, 1, 2, 3, 5):
         bigger = base.copy()
         bigger[0, j] += 1.0
-        assert elastomer_volume_mm3(bigger)[0] > v0
-    assert elastomer_volume_mm3(np.array([[100.0, 6.0, 2.0, 2.0, 15.0, 8.0]]))[0] == v0
+        assert elastomer_volume_mm3(SFRBA, bigger)[0] > v0
+    assert elastomer_volume_mm3(SFRBA, np.array([[100.0, 6.0, 2.0, 2.0, 15.0, 8.0]]))[0] == v0
 
 
 def test_a_calibrated_model_gives_each_candidate_its_interval(tmp_path):

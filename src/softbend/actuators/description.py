@@ -121,6 +121,11 @@ class Actuator:
         ``cavity_volume({name: value}) -> float``: the undeformed cavity volume of
         one design, mm³, from its geometry (paper B's ½·π·r²·l), read as
         :attr:`Design.cavity_volume_mm3 <softbend.actuators.Design.cavity_volume_mm3>`.
+    elastomer_volume : callable, optional
+        ``elastomer_volume(rows) -> volumes``: the elastomer of each design, mm³,
+        from rows of design values in the parameters' order (paper B's wall, layer
+        and end caps); an actuator that gives it can be searched for the objective
+        ``volume``.
 
     The fields from ``quantities`` on are softbend's knowledge of a registered
     actuator, not part of its description: :meth:`to_dict` does not write them and
@@ -156,6 +161,7 @@ class Actuator:
     cavity_volume: Callable[[Mapping[str, float]], float] | None = field(
         default=None, compare=False
     )
+    elastomer_volume: Callable[[np.ndarray], np.ndarray] | None = field(default=None, compare=False)
     _trees: tuple[ast.Compare, ...] = field(default=(), repr=False, compare=False)
 
     def __post_init__(self) -> None:

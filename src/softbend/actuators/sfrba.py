@@ -15,6 +15,8 @@ from __future__ import annotations
 import math
 from collections.abc import Mapping
 
+import numpy as np
+
 from softbend._validation import check_range
 from softbend.actuators.description import ACTUATORS, Actuator
 from softbend.actuators.parameters import DesignParameter
@@ -22,7 +24,7 @@ from softbend.errors import InputError
 from softbend.parameters import Range
 from softbend.references import DESIGN_SPACE, SURROGATES, values
 
-__all__ = ["BOUNDS", "SFRBA", "cavity_volume_mm3", "check_sfrba"]
+__all__ = ["BOUNDS", "SFRBA", "cavity_volume_mm3", "check_sfrba", "elastomer_volume_mm3"]
 
 #: ``{parameter: (low, high, low_inclusive)}`` a design accepts; every upper bound inclusive.
 BOUNDS: dict[str, tuple[float, float, bool]] = {
@@ -84,6 +86,21 @@ def cavity_volume_mm3(values: Mapping[str, float]) -> float:
     return 0.5 * math.pi * values["r_mm"] ** 2 * values["l_mm"]
 
 
+def elastomer_volume_mm3(designs: np.ndarray) -> np.ndarray:
+    """Elastomer of each design (rows of 6: l, r, t, b, φ, lc), mm³.
+
+    The half-cylindrical wall ``½·π·((r+t)² − r²)·l``, the strain-limiting layer
+    ``2·(r+t)·b·l`` under it, and the two end caps ``π·(r+t)²/2·lc`` (fibres neglected).
+    """
+    d = np.atleast_2d(np.asarray(designs, dtype=np.float64))
+    length, r, t, b, lc = d[:, 0], d[:, 1], d[:, 2], d[:, 3], d[:, 5]
+    outer = r + t
+    wall = 0.5 * np.pi * (outer**2 - r**2) * length
+    layer = 2.0 * outer * b * length
+    caps = 0.5 * np.pi * outer**2 * lc
+    return wall + layer + caps
+
+
 #: Paper B's actuator: the description of every campaign and shipped model.
 SFRBA: Actuator = ACTUATORS.register(
     "sfrba",
@@ -131,5 +148,6 @@ SFRBA: Actuator = ACTUATORS.register(
         ),
         check_values=check_sfrba,
         cavity_volume=cavity_volume_mm3,
+        elastomer_volume=elastomer_volume_mm3,
     ),
 )

@@ -260,11 +260,12 @@ def print_summary(summary: dict) -> None:
     it."""
     from softbend.surrogates.metrics import mape_text
 
-    paper_b = "actuator" not in summary
+    named = summary.get("actuator")  # an actuator named in its outputs (not paper B's)
+    published = any(m.get("paper_b") for m in summary["models"].values())
     floor = summary.get("mape_floor_deg", summary.get("settings", {}).get("mape_threshold_deg"))
     rows = []
     for name, m in summary["models"].items():
-        paper = m["paper_b"]
+        paper = m.get("paper_b")
         theirs = (
             f"{paper['r2']} / {paper['mape_pct']} % / {paper['inference_ms']} ms" if paper else "—"
         )
@@ -278,14 +279,13 @@ def print_summary(summary: dict) -> None:
                 f"{m['max_abs_error_deg']:.2f}",
                 f"{m['inference_single_us']:.1f}",
                 f"{m['inference_batch_ms']:.2f}",
-                *([theirs] if paper_b else []),
+                *([theirs] if published else []),
             ]
         )
     title = "Surrogates: grouped cross-validation (held-out designs) and inference"
-    if not paper_b:
-        actuator = summary["actuator"]
-        names = ", ".join(p["name"] for p in actuator["parameters"])
-        title += f"; actuator {actuator['name']} ({names}; {actuator['pressure_unit']})"
+    if named:
+        names = ", ".join(p["name"] for p in named["parameters"])
+        title += f"; actuator {named['name']} ({names}; {named['pressure_unit']})"
     _common.print_table(
         title,
         [
@@ -297,7 +297,7 @@ def print_summary(summary: dict) -> None:
             "max |e| °",
             "1 sample µs",
             "10k batch ms",
-            *(["paper B R² / MAPE / IT"] if paper_b else []),
+            *(["paper B R² / MAPE / IT"] if published else []),
         ],
         rows,
     )

@@ -200,7 +200,7 @@ class ControlSetup:
         }
         if self.identified is not None:
             out["plant_description"] = self.identified.describe()
-        if self.design.actuator != SFRBA:  # paper B's runs record as they always did
+        if self.design.actuator.named_in_outputs:  # paper B's runs record as they always did
             out["actuator"] = self.actuator.name
             out["design_parameters"] = self.design.record()
             out["model_pressure_unit"] = self.actuator.pressure_unit

@@ -98,20 +98,23 @@ _AHEAD = 64
 _DP = 0.0025
 
 
-def elastomer_volume_mm3(designs: np.ndarray) -> np.ndarray:
-    """Elastomer of each design (rows of 6: l, r, t, b, φ, lc), mm³.
+def elastomer_volume_mm3(actuator: Actuator, designs: np.ndarray) -> np.ndarray:
+    """Elastomer of each design (rows of the actuator's parameters), mm³, from its description
+    (:attr:`~softbend.actuators.Actuator.elastomer_volume`; paper B's wall, layer and caps).
 
-    The half-cylindrical wall ``½·π·((r+t)² − r²)·l``, the strain-limiting layer
-    ``2·(r+t)·b·l`` under it, and the two end caps ``π·(r+t)²/2·lc`` (the
-    geometry of :class:`~softbend.actuators.Design`, fibres neglected).
+    Raises
+    ------
+    InputError
+        When the description gives no elastomer volume (key ``objectives``).
     """
-    d = np.atleast_2d(np.asarray(designs, dtype=np.float64))
-    length, r, t, b, lc = d[:, 0], d[:, 1], d[:, 2], d[:, 3], d[:, 5]
-    outer = r + t
-    wall = 0.5 * np.pi * (outer**2 - r**2) * length
-    layer = 2.0 * outer * b * length
-    caps = 0.5 * np.pi * outer**2 * lc
-    return wall + layer + caps
+    volume = actuator.elastomer_volume
+    if volume is None:
+        raise InputError(
+            f"The actuator {actuator.name} gives no elastomer volume of its designs: "
+            "the objective 'volume' is not available for it.",
+            key="objectives",
+        )
+    return volume(np.atleast_2d(np.asarray(designs, dtype=np.float64)))
 
 
 class _Scorer:
@@ -193,7 +196,7 @@ def _objective_matrix(
         if objective.name in names:
             value = designs[:, names.index(objective.name)]
         elif objective.name == "volume":
-            value = elastomer_volume_mm3(designs)
+            value = elastomer_volume_mm3(spec.space.actuator, designs)
         else:
             value = scores[objective.name]
         columns.append(value if objective.sense == "min" else -value)
@@ -209,7 +212,7 @@ def _objective_values(
         if objective.name in names:
             out[objective.name] = float(design[names.index(objective.name)])
         elif objective.name == "volume":
-            out["volume"] = float(elastomer_volume_mm3(design)[0])
+            out["volume"] = float(elastomer_volume_mm3(spec.space.actuator, design)[0])
         else:
             out[objective.name] = float(scores[objective.name])
     return out
@@ -329,7 +332,7 @@ def _check_actuator(spec: Specification, model: LoadedModel) -> None:
     space, actuator = spec.space, model.actuator
     if space == space_of(actuator):
         return
-    mine = "paper B's actuator" if space.paper_b else f"the actuator {space.actuator.name}"
+    mine = f"the actuator {space.actuator.name} ({space.actuator.title})"
     raise ValueError(
         f"The specification {spec.name!r} names the parameters of {mine} "
         f"({space.listing()}), but the model {model.path} is of the actuator {actuator.name} "

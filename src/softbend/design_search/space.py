@@ -88,11 +88,6 @@ class SearchSpace:
             )
 
     @property
-    def paper_b(self) -> bool:
-        """Whether this is paper B's actuator (short names, its geometry, the FEM check)."""
-        return self.actuator == SFRBA
-
-    @property
     def columns(self) -> tuple[str, ...]:
         """The model-input column of each name."""
         return self.actuator.names
@@ -147,11 +142,12 @@ class SearchSpace:
     @property
     def objectives(self) -> dict[str, str]:
         """What an objective may name, with its unit: a parameter (not a categorical one),
-        ``pressure``, ``volume`` (paper B's actuator), ``sensitivity``, ``angle``, ``error``."""
+        ``pressure``, ``volume`` (when the description gives the elastomer volume),
+        ``sensitivity``, ``angle``, ``error``."""
         unit = self.pressure_unit
         out = {n: self.unit(n) for n in self.names if self.kind(n) != "categorical"}
         out["pressure"] = unit
-        if self.paper_b:
+        if self.actuator.elastomer_volume is not None:
             out["volume"] = "mm³"
         out.update({"sensitivity": f"deg/{unit}", "angle": "deg", "error": "deg"})
         return out
