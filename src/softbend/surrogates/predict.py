@@ -11,7 +11,6 @@ from numpy.typing import ArrayLike
 
 from softbend._validation import must_be
 from softbend.actuators import SFRBA, Actuator, Design
-from softbend.design import sfrba_from_sequence
 from softbend.errors import InputError, SchemaError, keyed
 from softbend.surrogates.support import pressures_text, trained_pressure_range
 
@@ -72,7 +71,7 @@ class Prediction:
     """
 
     kind: str
-    design: Design | np.ndarray
+    design: Design
     pressure_mpa: np.ndarray
     angle_deg: np.ndarray
     outside_training_ranges: list[str] = field(default_factory=list)
@@ -106,16 +105,12 @@ class Prediction:
     @property
     def design_codes(self) -> np.ndarray:
         """The design as model inputs, in the order of ``actuator.names``."""
-        if isinstance(self.design, Design):
-            return self.design.as_array()
-        return np.asarray(self.design, dtype=float)
+        return self.design.as_array()
 
     @property
     def design_text(self) -> str:
         """The design by name, in its units."""
-        if isinstance(self.design, Design):
-            return str(self.design)
-        return self.actuator.describe(self.design_codes)
+        return str(self.design)
 
     @property
     def extrapolated(self) -> list[str]:
@@ -298,7 +293,7 @@ def predict_angles(
     unit = actuator.pressure_unit
     pressures = _check_pressures(pressures_mpa, unit)
     design = _design_of(design, actuator, path)
-    codes = design.as_array() if isinstance(design, Design) else design
+    codes = design.as_array()
     rows = np.empty((pressures.size, codes.size + 1))
     rows[:, :-1] = codes
     rows[:, -1] = pressures
@@ -367,8 +362,8 @@ def predict_angles(
 
 def _design_of(
     design: Design | str | ArrayLike, actuator: Actuator, path: str | os.PathLike[str]
-) -> Design | np.ndarray:
-    """``design`` as paper B's design (its model) or the codes of ``actuator``'s, checked."""
+) -> Design:
+    """``design`` as a design of ``actuator`` (the model's), checked."""
     if isinstance(design, Design):
         if design.actuator.names != actuator.names:
             raise ValueError(
@@ -381,9 +376,7 @@ def _design_of(
         codes = actuator.parse_design(design)
     else:
         codes = actuator.check_designs(np.asarray(design, dtype=float).ravel())[0]
-    if actuator == SFRBA:
-        return sfrba_from_sequence(codes.tolist())
-    return codes
+    return Design(actuator, dict(zip(actuator.names, codes.tolist(), strict=True)))
 
 
 def _support_check(

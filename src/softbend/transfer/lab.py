@@ -36,7 +36,7 @@ import numpy as np
 import pandas as pd
 
 from softbend._validation import check_choice, check_int, check_range, must_be
-from softbend.actuators import SFRBA, Design
+from softbend.actuators import Design
 from softbend.design import PAPER_B_FIG7_DESIGNS, PARAMETERS, sfrba_design
 from softbend.errors import ConvergenceError, InputError, keyed
 from softbend.limits import check_limit
@@ -112,10 +112,14 @@ def _checked_settings(settings: Mapping[str, object]) -> dict[str, Any]:
         given = settings["actuators"]
         actuators = tuple(given) if isinstance(given, Iterable) else ()
         if not actuators or not all(
-            isinstance(a, Design) and a.actuator == SFRBA for a in actuators
+            isinstance(a, Design) and a.actuator.analytical for a in actuators
         ):
             raise InputError(
-                must_be("a non-empty sequence of designs of paper B's actuator", given),
+                must_be(
+                    "a non-empty sequence of designs of an actuator with an analytical model "
+                    "(paper B's)",
+                    given,
+                ),
                 key="actuators",
             )
         ids = [actuator_id(a) for a in actuators]
