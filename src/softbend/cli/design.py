@@ -137,7 +137,7 @@ def find(
     ctx: typer.Context,
     out: Path = opt.OUT,
     model: Path = opt.MODEL,
-    spec: Path = opt.SPEC,
+    spec: Path = opt.SPEC_FILE,
     angle: float = opt.ANGLE,
     at: str = opt.AT,
     max_pressure: str = opt.MAX_PRESSURE,
