@@ -39,7 +39,7 @@ from softbend.errors import DatasetError
 
 __all__ = [
     "RANGES",
-    "Range",
+    "PlausibleRange",
     "check_plausible",
     "check_plausible_columns",
     "implausible_index",
@@ -48,7 +48,7 @@ __all__ = [
 
 
 @dataclass(frozen=True)
-class Range:
+class PlausibleRange:
     """The plausible range of one quantity (both ends included)."""
 
     low: float
@@ -57,18 +57,18 @@ class Range:
     label: str
 
 
-RANGES: dict[str, Range] = {
-    "angle_deg": Range(-3600.0, 3600.0, "°", "bending angle"),
-    "pressure_mpa": Range(-0.1013, 2.0, "MPa", "gauge pressure"),
-    "pressure_kpa": Range(-101.3, 2000.0, "kPa", "gauge pressure"),
-    "length_mm": Range(0.0, 10_000.0, "mm", "length"),
-    "fiber_angle_deg": Range(0.0, 90.0, "°", "fiber winding angle"),
-    "coordinate_mm": Range(-10_000.0, 10_000.0, "mm", "position"),
-    "time_s": Range(0.0, 1e7, "s", "time"),
-    "stress_mpa": Range(-1000.0, 1000.0, "MPa", "stress"),
-    "strain": Range(-1.0, 100.0, "", "strain"),
-    "modulus_mpa": Range(-1000.0, 1e6, "MPa", "material constant"),
-    "kernel_width": Range(1e-6, 1e6, "", "kernel width"),
+RANGES: dict[str, PlausibleRange] = {
+    "angle_deg": PlausibleRange(-3600.0, 3600.0, "°", "bending angle"),
+    "pressure_mpa": PlausibleRange(-0.1013, 2.0, "MPa", "gauge pressure"),
+    "pressure_kpa": PlausibleRange(-101.3, 2000.0, "kPa", "gauge pressure"),
+    "length_mm": PlausibleRange(0.0, 10_000.0, "mm", "length"),
+    "fiber_angle_deg": PlausibleRange(0.0, 90.0, "°", "fiber winding angle"),
+    "coordinate_mm": PlausibleRange(-10_000.0, 10_000.0, "mm", "position"),
+    "time_s": PlausibleRange(0.0, 1e7, "s", "time"),
+    "stress_mpa": PlausibleRange(-1000.0, 1000.0, "MPa", "stress"),
+    "strain": PlausibleRange(-1.0, 100.0, "", "strain"),
+    "modulus_mpa": PlausibleRange(-1000.0, 1e6, "MPa", "material constant"),
+    "kernel_width": PlausibleRange(1e-6, 1e6, "", "kernel width"),
 }
 
 
@@ -165,7 +165,7 @@ def check_plausible_columns(
         check_plausible(values, quantity, source=source, column=first[1], lines=lines)
 
 
-def _range(quantity: str) -> Range:
+def _range(quantity: str) -> PlausibleRange:
     if quantity not in RANGES:
         raise ValueError(
             f"Unknown quantity {quantity!r}; the quantities are {', '.join(sorted(RANGES))}."
