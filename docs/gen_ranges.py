@@ -103,8 +103,8 @@ def render() -> str:
     """The whole page, from the registries and declarations of the installed package."""
     from softbend.control.factory import CONTROLLERS
     from softbend.control.rigconfig import simulation_settings_entry
-    from softbend.transfer.parameters import FILLED
     from softbend.transfer.strategies import STRATEGIES
+    from softbend.transfer.strategies.parameters import FILLED
 
     lines = [INTRO, *_names_section()]
     lines += [

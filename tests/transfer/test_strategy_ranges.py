@@ -28,7 +28,6 @@ from softbend.parameters import (
     declare_ranges,
     declared_ranges,
 )
-from softbend.transfer.parameters import FILLED, check_parameters, item_count
 from softbend.transfer.strategies import (
     BUILTIN_STRATEGIES,
     STRATEGIES,
@@ -39,6 +38,7 @@ from softbend.transfer.strategies import (
     describe_strategies,
     make_strategy,
 )
+from softbend.transfer.strategies.parameters import FILLED, check_parameters, item_count
 
 from ..properties import NASTY_VALUES, property_settings
 

@@ -10,7 +10,9 @@ MODEL = typer.Option(
     help="Saved surrogate to search (default: the shipped FEM-trained MLP); its actuator's "
     "parameters are the names of --fix, --range, --resolution and --minimize.",
 )
-SPEC_FILE = typer.Option(None, help="A TOML file of [[spec]] tables, one folder of results per spec.")
+SPEC_FILE = typer.Option(
+    None, help="A TOML file of [[spec]] tables, one folder of results per spec."
+)
 ANGLE = typer.Option(None, help="Target angle, deg (with --at or --max-pressure).")
 AT = typer.Option(
     None,

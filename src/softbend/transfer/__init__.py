@@ -4,7 +4,7 @@ Paper B §4.2–4.3: measurements as data (:mod:`~softbend.transfer.measurements
 a virtual lab with a reality gap (:mod:`~softbend.transfer.lab`), the surrogate
 the refinement starts from (:mod:`~softbend.transfer.base`), the refinement
 strategies (:mod:`~softbend.transfer.strategies`, registered by name in
-:data:`STRATEGIES`, their parameters in :mod:`~softbend.transfer.parameters`),
+:data:`STRATEGIES`, their parameters in :mod:`~softbend.transfer.strategies.parameters`),
 one strategy fitted and saved (:mod:`~softbend.transfer.refine`) and their
 leave-one-configuration-out evaluation (:mod:`~softbend.transfer.loco`).
 
@@ -44,8 +44,8 @@ _EXPORTS = {
     "files_record": "measurements",
     "synthetic_label": "measurements",
     "save_measurements": "measurements",
-    "check_parameters": "parameters",
-    "parameter_defaults": "parameters",
+    "check_parameters": "strategies.parameters",
+    "parameter_defaults": "strategies.parameters",
     "fit_pressure_scale": "pressure_map",
     "scale_mlp_pressure": "pressure_map",
     "REFINE_DEFAULTS": "refine",

@@ -46,7 +46,6 @@ from softbend.registry import UnknownNameError
 from softbend.surrogates.protocol import Surrogate
 from softbend.transfer.conformal import Calibration, angle_floor, calibrate
 from softbend.transfer.measurements import ActuatorMeasurements, Measurements
-from softbend.transfer.parameters import check_parameters, recorded_parameters
 from softbend.transfer.strategies import (
     BUILTIN_STRATEGIES,
     FIT_ERRORS,
@@ -57,6 +56,7 @@ from softbend.transfer.strategies import (
     make_strategy,
     strategy_parameters,
 )
+from softbend.transfer.strategies.parameters import check_parameters, recorded_parameters
 
 if TYPE_CHECKING:
     from softbend.actuators import Actuator

@@ -35,7 +35,6 @@ from numpy.typing import ArrayLike
 from softbend.errors import ConvergenceError, InputError, keyed
 from softbend.surrogates.protocol import Surrogate
 from softbend.transfer.conformal import Calibration, angle_floor, calibrate
-from softbend.transfer.parameters import check_parameters, recorded_parameters, takes
 from softbend.transfer.strategies import (
     STRATEGIES,
     applicable_strategies,
@@ -43,6 +42,7 @@ from softbend.transfer.strategies import (
     fit_strategy,
     learns,
 )
+from softbend.transfer.strategies.parameters import check_parameters, recorded_parameters, takes
 
 if TYPE_CHECKING:
     from softbend.actuators import Actuator

@@ -44,7 +44,7 @@ inside softbend or outside it, and every command and report then knows it::
 A strategy class is a scikit-learn regressor on the rows above. Its
 constructor's ``base`` and ``seed``, if it takes them, are filled by the library;
 its other parameters, with defaults, are the ones a user sets
-(:mod:`softbend.transfer.parameters`: ``--set NAME=VALUE``). ``fit(X, y)`` sets
+(:mod:`softbend.transfer.strategies.parameters`: ``--set NAME=VALUE``). ``fit(X, y)`` sets
 ``model_``, the surrogate that ``softbend transfer refine`` saves; a class whose
 ``learns`` is False (a baseline) has nothing to save. A class method
 ``refusal(base, actuator)`` says why the strategy cannot start from a base (the

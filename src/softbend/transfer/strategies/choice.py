@@ -9,12 +9,6 @@ from softbend._validation import check_int
 from softbend.errors import InputError, keyed
 from softbend.parameters import declared_ranges
 from softbend.surrogates.protocol import Surrogate
-from softbend.transfer.parameters import (
-    check_parameters,
-    describe_range,
-    parameter_defaults,
-    takes,
-)
 from softbend.transfer.strategies.baselines import AnalyticalBaseline, BaseMeanResidual, BaseOnly
 from softbend.transfer.strategies.common import (
     STRATEGIES,
@@ -27,6 +21,12 @@ from softbend.transfer.strategies.networks import (
     RefinedEnsemble,
     RefinedMLP,
     ScaledRefinedMLP,
+)
+from softbend.transfer.strategies.parameters import (
+    check_parameters,
+    describe_range,
+    parameter_defaults,
+    takes,
 )
 
 if TYPE_CHECKING:

@@ -18,7 +18,7 @@ from softbend.parameters import Range
 from softbend.plausibility import check_plausible
 from softbend.registry import Registry
 from softbend.surrogates.protocol import Surrogate
-from softbend.transfer.parameters import (
+from softbend.transfer.strategies.parameters import (
     check_estimator,
     takes,
 )
