@@ -128,7 +128,7 @@ def actuator_plr_base(sims: Path, folder: Path, pressure_column: str = "p_kpa") 
     The pressure unit is the column's (``p_kpa`` → kPa, ``p_psi`` → psi). Returns the
     model file, ``folder/models/plr.json``.
     """
-    from softbend.surrogates.tables import table_training_data
+    from softbend.surrogates.simulation_table import table_training_data
     from softbend.surrogates.workflow import train_surrogates
     from softbend.units import column_unit
 

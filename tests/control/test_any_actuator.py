@@ -77,7 +77,7 @@ def describe(pressure_column: str, unit: str, **chamber: float) -> Actuator:
 @pytest.fixture(scope="module")
 def models(tmp_path_factory):
     """``{"kPa": path, "MPa": path}``: the same actuator's model in each pressure unit."""
-    from softbend.surrogates.tables import table_training_data
+    from softbend.surrogates.simulation_table import table_training_data
     from softbend.surrogates.workflow import train_surrogates
 
     root = tmp_path_factory.mktemp("pneunet")

@@ -99,7 +99,7 @@ def write_pneunet_table(path, designs):
 def train_pneunet(folder, designs, actuator=None):
     """A polynomial surrogate of :func:`write_pneunet_table` (with ``actuator``'s description,
     else the one read off the table); the path of its ``plr.json``."""
-    from softbend.surrogates.tables import table_training_data
+    from softbend.surrogates.simulation_table import table_training_data
     from softbend.surrogates.workflow import train_surrogates
 
     table = write_pneunet_table(folder / "sims.csv", designs)

@@ -74,7 +74,7 @@ def _actuator(fem_family: str | None) -> Actuator:
 
 def _train(folder, actuator: Actuator):
     """A polynomial of the closed form (kPa) over every design of the table, 0 to 50 kPa."""
-    from softbend.surrogates.tables import table_training_data
+    from softbend.surrogates.simulation_table import table_training_data
     from softbend.surrogates.workflow import train_surrogates
 
     rows = []

@@ -150,7 +150,7 @@ def test_loco_mape_leaves_out_the_readings_below_the_floor(lab):
 def test_loco_cli_with_an_xgb_base_of_another_actuator(lab, tmp_path, capsys):
     """An XGBoost base of another actuator's table loads for transfer: it takes that
     actuator's inputs, not paper B's seven (it stopped with "Feature shape mismatch")."""
-    from softbend.surrogates.tables import table_training_data
+    from softbend.surrogates.simulation_table import table_training_data
     from softbend.surrogates.workflow import train_surrogates
 
     from ..stand_ins import ACTUATOR_COLUMNS

@@ -210,7 +210,7 @@ def _training_source(
     """The campaign path, or a dataset's or table's training data (checked before anything runs)."""
     from softbend.family_datasets import is_dataset_name
     from softbend.surrogates.features import dataset_training_data
-    from softbend.surrogates.tables import TABLE_SUFFIXES
+    from softbend.surrogates.simulation_table import TABLE_SUFFIXES
 
     described = actuator is not None or bool(ranges)
     table_options = (design_columns, pressure_column, pressure_unit)
@@ -233,7 +233,7 @@ def _training_source(
             )
         return db
     from softbend.actuators import actuator_from
-    from softbend.surrogates.tables import table_training_data
+    from softbend.surrogates.simulation_table import table_training_data
 
     return table_training_data(
         db,

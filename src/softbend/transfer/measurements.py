@@ -64,7 +64,7 @@ joined :attr:`Measurements.metadata` holds the entries every file gives alike.
 Any described actuator
 ----------------------
 A lab refining a surrogate of its own actuator (one trained on its simulation
-table, :mod:`softbend.surrogates.tables`) measures a few built actuators and
+table, :mod:`softbend.surrogates.simulation_table`) measures a few built actuators and
 writes one row per reading::
 
     # synthetic: false

@@ -12,7 +12,7 @@ from softbend.actuators import SFRBA, Actuator, ActuatorError, get_actuator
 from softbend.errors import DatasetError
 from softbend.surrogates.persistence import load_surrogate
 from softbend.surrogates.predict import predict_angles
-from softbend.surrogates.tables import table_training_data
+from softbend.surrogates.simulation_table import table_training_data
 from softbend.surrogates.workflow import train_surrogates
 
 from ..stand_ins import ACTUATOR_COLUMNS as COLUMNS
