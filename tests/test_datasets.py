@@ -85,7 +85,7 @@ def test_a_missing_or_foreign_provenance_is_a_clear_error(dataset):
 
 
 def test_stop_kinds_and_regions_are_read_from_the_reasons():
-    from softbend.datasets import _stop_kind, _stop_region
+    from softbend.dataset_writing import _stop_kind, _stop_region
 
     assert _stop_kind("bending angle above 300 deg") == "angle limit"
     assert _stop_kind("reached the last pressure") == "last pressure"

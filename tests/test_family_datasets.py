@@ -18,19 +18,19 @@ import pandas as pd
 import pytest
 
 from softbend.campaign import CampaignStore, load_samples, run_campaign
-from softbend.campaign.family_spaces import parse_family_space
+from softbend.campaign.spaces import parse_family_space
 from softbend.cli import main
-from softbend.dataset_writing import write_dataset
-from softbend.datasets import DESIGN_STAT_COLUMNS, _stop_kind, table1_fem
-from softbend.errors import DatasetError, InputError
-from softbend.family_datasets import (
+from softbend.dataset_writing import _stop_kind, family_stop_region, write_dataset
+from softbend.datasets import (
+    DESIGN_STAT_COLUMNS,
     family_dataset,
     family_dataset_actuator,
     family_dataset_designs,
     family_dataset_provenance,
-    family_stop_region,
     shipped_families,
+    table1_fem,
 )
+from softbend.errors import DatasetError, InputError
 from softbend.surrogates.features import dataset_training_data
 
 from .cli.conftest import one_error_line
@@ -278,7 +278,7 @@ def test_paper_b_is_table1_under_its_family_name():
 
 
 def test_a_folder_named_after_its_family_is_shipped(dataset, tmp_path, monkeypatch):
-    import softbend.family_datasets as module
+    import softbend.datasets as module
 
     monkeypatch.setattr(module, "_data_root", lambda: tmp_path)
     assert shipped_families() == {"standin": "standin"}
@@ -321,7 +321,7 @@ def test_training_data_reads_the_pressure_in_the_actuators_unit(dataset):
 
 
 def test_train_takes_a_dataset_folder_or_a_shipped_name(dataset, tmp_path, monkeypatch, capsys):
-    import softbend.family_datasets as module
+    import softbend.datasets as module
 
     common = ["--models", "plr", "--folds", "3", "--no-onnx", "--json"]
     assert main(["train", str(dataset), "--out", str(tmp_path / "a"), *common]) == 0
@@ -346,7 +346,7 @@ def test_the_shipped_pneunet_dataset_verifies_and_spans_its_described_space():
     """data/pneunet: at least 200 swept designs, each inside the PneuNet's ranges and
     constraints, every sweep from 0 kPa, angles growing with pressure on average."""
     from softbend.actuators import PNEUNET
-    from softbend.family_datasets import family_dataset_designs, family_dataset_provenance
+    from softbend.datasets import family_dataset_designs, family_dataset_provenance
 
     provenance = family_dataset_provenance("pneunet")
     designs = family_dataset_designs("pneunet")

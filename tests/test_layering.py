@@ -42,7 +42,7 @@ STAGES: tuple[tuple[str, ...], ...] = (
     ("models",),
     ("analytical", "fem"),
     ("campaign",),
-    ("datasets", "family_datasets", "dataset_writing", "analysis"),
+    ("datasets", "dataset_writing", "analysis"),
     ("surrogates",),
     ("identification",),
     ("transfer", "control", "design_search"),

@@ -18,9 +18,16 @@ columns and dtypes of :data:`SAMPLE_COLUMN_KINDS` or :data:`DESIGN_COLUMN_KINDS`
 or with a physically implausible value is a
 :class:`~softbend.errors.DatasetError` naming the file and the field, never a
 wrong table. :func:`softbend.dataset_writing.write_dataset` makes such a folder
-from a campaign database (``softbend campaign dataset DB --out DIR``); a campaign
-of another FEM family than paper B's (``softbend campaign run --family NAME``)
-makes a dataset of that family, read by :mod:`softbend.family_datasets`.
+from a campaign database (``softbend campaign dataset DB --out DIR``).
+
+Any other FEM family's campaign (``--family NAME``) makes a dataset whose tables
+carry the family's parameter columns (:func:`family_column_kinds`) and whose
+provenance also records ``family`` and ``actuator`` (its description). Shipped
+ones lie in ``softbend/data/<family>/`` (paper B's ``"sfrba"``: ``table1_fem``);
+:func:`family_dataset`, :func:`family_dataset_designs` and
+:func:`family_dataset_provenance` read one, a design value outside the
+actuator's range being one more error, and :func:`dataset_samples` reads one by
+folder or name for ``softbend train DATASET``.
 """
 
 from __future__ import annotations
@@ -30,26 +37,37 @@ import json
 import math
 import os
 import re
-from collections.abc import Callable, Sequence
+from collections.abc import Sequence
 from importlib import resources
 from pathlib import Path
-from typing import TYPE_CHECKING, Any, cast
+from typing import TYPE_CHECKING, Any
 
-from softbend._validation import short_repr
+import numpy as np
+
+from softbend._validation import must_be, short_repr
 from softbend.design import FEATURE_QUANTITIES, PARAMETERS
-from softbend.errors import DatasetError
+from softbend.errors import DatasetError, InputError
 from softbend.limits import check_file_size
 from softbend.plausibility import RANGES, implausible_index
 
 if TYPE_CHECKING:
     import pandas as pd
 
-    from softbend.fem.stats import FEMStats
+    from softbend.actuators import Actuator
 
 __all__ = [
     "DESIGN_COLUMN_KINDS",
     "DESIGN_STAT_COLUMNS",
     "SAMPLE_COLUMN_KINDS",
+    "TABLE1_FOLDER",
+    "dataset_samples",
+    "family_column_kinds",
+    "family_dataset",
+    "family_dataset_actuator",
+    "family_dataset_designs",
+    "family_dataset_provenance",
+    "is_dataset_name",
+    "shipped_families",
     "table1_fem",
     "table1_fem_designs",
     "table1_fem_provenance",
@@ -59,7 +77,8 @@ __all__ = [
 SAMPLES_FILE = "samples.parquet"
 DESIGNS_FILE = "designs.parquet"
 PROVENANCE_FILE = "provenance.json"
-_TABLE1_FEM = "table1_fem"
+#: The folder of paper B's shipped dataset (Table 1), that of its family ``"sfrba"``.
+TABLE1_FOLDER = "table1_fem"
 
 #: The kind of dtype of each column of the designs table besides the design parameters.
 _DESIGN_STAT_KINDS: dict[str, str] = {
@@ -138,18 +157,8 @@ _COLUMN_QUANTITIES: dict[str, dict[str, str]] = {
 
 _HEX64 = re.compile(r"[0-9a-fA-F]{64}")
 
+
 #: Stop reasons of the FEM sweep, by the start of their text.
-_STOP_KINDS = (
-    ("reached the last pressure", "last pressure"),
-    ("bending angle above", "angle limit"),
-    ("stretch ", "stretch limit"),
-    ("inflation instability", "inflation instability"),
-    ("no convergence", "no convergence"),
-    ("neighbouring chamber walls touch", "walls touch"),
-)
-_REGION = re.compile(r"(proximal cap|distal cap|chamber wall)")
-
-
 def _shipped(name: str) -> Path:
     return Path(str(resources.files("softbend").joinpath("data", name)))
 
@@ -395,7 +404,7 @@ def table1_fem(folder: str | os.PathLike[str] | None = None) -> pd.DataFrame:
         :data:`SAMPLE_COLUMN_KINDS`, has one of another dtype or a physically
         implausible value (naming the file and the column).
     """
-    return _read(Path(folder) if folder is not None else _shipped(_TABLE1_FEM), SAMPLES_FILE)
+    return _read(Path(folder) if folder is not None else _shipped(TABLE1_FOLDER), SAMPLES_FILE)
 
 
 def table1_fem_designs(folder: str | os.PathLike[str] | None = None) -> pd.DataFrame:
@@ -404,65 +413,288 @@ def table1_fem_designs(folder: str | os.PathLike[str] | None = None) -> pd.DataF
     Columns: ``design_id``, the six parameters, then :data:`DESIGN_STAT_COLUMNS`
     (``stop_kind`` one of "last pressure", "angle limit", "stretch limit",
     "inflation instability", "no convergence" ("walls touch" for a PneuNet's
-    dataset, :mod:`softbend.family_datasets`); ``stop_region`` the part of the
+    dataset, :func:`family_dataset_designs`); ``stop_region`` the part of the
     actuator a stretch or instability stop names, else empty; times in s).
     Checked as :func:`table1_fem` is, the columns against :data:`DESIGN_COLUMN_KINDS`.
     """
-    return _read(Path(folder) if folder is not None else _shipped(_TABLE1_FEM), DESIGNS_FILE)
+    return _read(Path(folder) if folder is not None else _shipped(TABLE1_FOLDER), DESIGNS_FILE)
 
 
 def table1_fem_provenance(folder: str | os.PathLike[str] | None = None) -> dict[str, Any]:
     """How :func:`table1_fem` was made: command, versions, options, dates, machines, CPU time."""
-    return verify_dataset(Path(folder) if folder is not None else _shipped(_TABLE1_FEM))
+    return verify_dataset(Path(folder) if folder is not None else _shipped(TABLE1_FOLDER))
 
 
-def _stop_kind(reason: str | None) -> str:
-    text = reason or ""
-    for prefix, kind in _STOP_KINDS:
-        if text.startswith(prefix):
-            return kind
-    return "other" if text else ""
+# -- the datasets of any family ----------------------------------------------------------
+
+#: The family of paper B's actuator, whose shipped dataset is Table 1's.
+_PAPER_B = "sfrba"
 
 
-def _stop_region(reason: str, kind: str) -> str:
-    """The part of the actuator a stretch or instability stop names, else ``""``."""
-    match = _REGION.search(reason)
-    return match[1] if match and kind in ("stretch limit", "inflation instability") else ""
+def family_column_kinds(actuator: Actuator) -> tuple[dict[str, str], dict[str, str]]:
+    """The columns of a family's samples and designs tables and the kind of dtype of each.
 
+    As paper B's :data:`~softbend.datasets.SAMPLE_COLUMN_KINDS` and
+    :data:`~softbend.datasets.DESIGN_COLUMN_KINDS` with the actuator's parameter
+    names (in its units, each of kind "float") in place of ``l_mm`` … ``lc_mm``.
 
-def _design_table(
-    designs: pd.DataFrame,
-    parameters: Sequence[str] = tuple(PARAMETERS),
-    region: Callable[[str, str], str] = _stop_region,
-) -> pd.DataFrame:
-    """The campaign's designs table with its JSON stats unpacked into columns.
-
-    The stats are an FEM sweep's (:class:`~softbend.fem.stats.FEMStats`); a key
-    that another backend does not record reads as empty or zero. ``parameters``
-    are the design columns (paper B's by default) and ``region(reason, kind)``
-    the part of the actuator a stop reason names.
+    Returns
+    -------
+    (dict, dict)
+        Samples: ``design_id``, the parameters, ``pressure_mpa`` (MPa),
+        ``angle_deg`` (deg), ``tip_x_mm``, ``tip_z_mm`` (mm), ``converged``.
+        Designs: ``design_id``, the parameters, then
+        :data:`~softbend.datasets.DESIGN_STAT_COLUMNS`.
     """
-    stats = [
-        cast("FEMStats", json.loads(s) if isinstance(s, str) and s else {})
-        for s in designs["stats"]
-    ]
-    out = designs[["design_id", *parameters]].copy()
-    out["status"] = designs["status"]
-    out["error"] = designs["error"].fillna("")
-    out["n_samples"] = designs["n_samples"].astype("int32")
-    out["max_pressure_mpa"] = designs["max_pressure_mpa"]
-    out["max_angle_deg"] = designs["max_angle_deg"]
-    reasons = [s.get("stop_reason", "") for s in stats]
-    out["stop_kind"] = [_stop_kind(r) for r in reasons]
-    out["stop_region"] = [region(r, k) for r, k in zip(reasons, out["stop_kind"], strict=True)]
-    out["stop_reason"] = reasons
-    out["wall_time_s"] = designs["wall_time_s"]
-    out["newton_iterations_total"] = designs["newton_iterations_total"].astype("Int64")
-    out["load_steps"] = [len(s.get("steps_mpa", [])) for s in stats]
-    out["rejected_steps"] = [int(s.get("rejected_steps", 0)) for s in stats]
-    out["ndof"] = [int(s.get("ndof", 0)) for s in stats]
-    out["mesh_size"] = designs["mesh_size"].astype("Int64")
-    out["softbend_version"] = designs["softbend_version"]
-    out["options_sha256"] = [s.get("options_sha256", "") for s in stats]
-    out["finished_at"] = designs["finished_at"]
-    return out.reset_index(drop=True)
+    return _column_kinds(actuator.names)
+
+
+def _requirement(parameter: Any) -> str:
+    unit = f" {parameter.unit}" if parameter.unit else ""
+    span = f"in [{parameter.low:g}, {parameter.high:g}]{unit}"
+    if parameter.kind == "categorical":
+        return f"a level code {span}"
+    return f"a whole number {span}" if parameter.kind == "integer" else f"a value {span}"
+
+
+def _check_parameters(table: pd.DataFrame, where: str, actuator: Actuator) -> None:
+    """Raise :class:`DatasetError` for the first design value outside ``actuator``'s range.
+
+    The message starts with ``where`` and names the row and the column.
+    """
+    for parameter in actuator.parameters:
+        values = table[parameter.name].to_numpy(dtype="float64", na_value=math.nan)
+        eps = 1e-9 * max(1.0, abs(parameter.low), abs(parameter.high))
+        with np.errstate(invalid="ignore"):
+            bad = ~np.isfinite(values)
+            bad |= (values < parameter.low - eps) | (values > parameter.high + eps)
+            if parameter.kind != "continuous":
+                bad |= np.abs(values - np.round(values)) > 1e-9
+        hits = np.flatnonzero(bad)
+        if hits.size:
+            row = int(hits[0])
+            raise DatasetError(
+                f"{where}, row {row}, column '{parameter.name}': {values[row]:g} is outside the "
+                f"actuator {actuator.name!r}: {parameter.name} must be {_requirement(parameter)}."
+            )
+
+
+def _check_family_table(table: pd.DataFrame, path: Path, actuator: Actuator, name: str) -> None:
+    """Check a family's ``name`` table ("samples" or "designs") read from ``path``."""
+    samples, designs = family_column_kinds(actuator)
+    kinds = samples if name == "samples" else designs
+    # the design parameters are checked against the actuator's ranges, not RANGES
+    _check_table(table, path, kinds, name, quantities=_MEASURED_QUANTITIES[name])
+    _check_parameters(table, f"The dataset file {str(path)!r}", actuator)
+
+
+def _actuator_from(record: object, where: str) -> Actuator:
+    """The actuator of a recorded description, or one :class:`DatasetError` starting ``where``."""
+    from softbend.actuators import Actuator, ActuatorError
+
+    try:
+        return Actuator.from_dict(json.loads(json.dumps(record)))
+    except (ActuatorError, TypeError, ValueError) as exc:
+        raise DatasetError(
+            f"{where}: the field 'actuator' must be an actuator description "
+            f"(Actuator.to_dict): {exc}"
+        ) from None
+
+
+# -- shipped datasets -------------------------------------------------------------------
+
+
+def _data_root() -> Path:
+    """The folder of the datasets shipped in the package."""
+    return _shipped(TABLE1_FOLDER).parent
+
+
+def shipped_families() -> dict[str, str]:
+    """The families whose dataset softbend ships, each with its folder in ``softbend/data``.
+
+    Paper B's family ``"sfrba"`` is Table 1's folder (:data:`TABLE1_FOLDER`);
+    every other is a folder named after its family that holds a provenance record.
+    """
+    root = _data_root()
+    found: dict[str, str] = {}
+    if (root / TABLE1_FOLDER / PROVENANCE_FILE).is_file():
+        found[_PAPER_B] = TABLE1_FOLDER
+    if root.is_dir():
+        for entry in sorted(root.iterdir(), key=lambda p: p.name):
+            if entry.name not in (TABLE1_FOLDER, _PAPER_B) and (entry / PROVENANCE_FILE).is_file():
+                found[entry.name] = entry.name
+    return found
+
+
+def is_dataset_name(text: str) -> bool:
+    """Whether ``text`` names a dataset rather than a file: a family or ``"table1_fem"``.
+
+    True for a registered FEM family (with or without a shipped dataset: reading
+    one without is the error that names those with one), a family whose dataset
+    is shipped, and Table 1's folder name.
+    """
+    from softbend.fem.families import FEM_FAMILIES
+
+    return text == TABLE1_FOLDER or text in FEM_FAMILIES or text in shipped_families()
+
+
+def _locate(family: str, folder: str | os.PathLike[str] | None) -> tuple[str, Path]:
+    """The family and the folder of its dataset (the shipped one unless ``folder`` is given)."""
+    if not isinstance(family, str):
+        raise InputError(must_be("the name of an FEM family", family), key="family")
+    if family == TABLE1_FOLDER:
+        family = _PAPER_B
+    if folder is not None:
+        return family, Path(folder)
+    shipped = shipped_families()
+    if family not in shipped:
+        from softbend.fem.families import FEM_FAMILIES
+
+        known = ", ".join(shipped) or "none"
+        hint = (
+            f" ({family!r} is an FEM family without one: write one with 'softbend campaign "
+            "dataset' from its campaign)"
+            if family in FEM_FAMILIES
+            else ""
+        )
+        raise InputError(
+            must_be(f"a family with a shipped dataset ({known})", family) + hint, key="family"
+        )
+    return family, _data_root() / shipped[family]
+
+
+def _open(
+    family: str, folder: str | os.PathLike[str] | None
+) -> tuple[Path, dict[str, Any], Actuator | None]:
+    """The folder, the verified provenance and the recorded actuator (None for paper B's)."""
+    family, path = _locate(family, folder)
+    provenance = verify_dataset(path)
+    record = path / PROVENANCE_FILE
+    recorded = provenance.get("family", _PAPER_B)
+    if recorded != family:
+        raise DatasetError(
+            f"The dataset {str(path)!r} holds designs of the {recorded!r} family, not of the "
+            f"{family!r} family."
+        )
+    if family == _PAPER_B:
+        return path, provenance, None
+    if "actuator" not in provenance:
+        raise DatasetError(
+            f"The dataset file {str(record)!r}: the field 'actuator' is missing (a family's "
+            "dataset records its actuator description)."
+        )
+    return (
+        path,
+        provenance,
+        _actuator_from(provenance["actuator"], f"The dataset file {str(record)!r}"),
+    )
+
+
+def _load(
+    family: str, folder: str | os.PathLike[str] | None, name: str
+) -> tuple[pd.DataFrame, Actuator | None]:
+    """The checked table ``name`` of a family's dataset and its actuator (None for paper B's)."""
+    path, provenance, actuator = _open(family, folder)
+    if actuator is None:
+        return (table1_fem if name == SAMPLES_FILE else table1_fem_designs)(path), None
+    table = _read_file(path, name, provenance)
+    kind = "samples" if name == SAMPLES_FILE else "designs"
+    _check_family_table(table, path / name, actuator, kind)
+    return table, actuator
+
+
+def family_dataset(family: str, folder: str | os.PathLike[str] | None = None) -> pd.DataFrame:
+    """Every sample of a family's dataset, verified.
+
+    Parameters
+    ----------
+    family : str
+        The FEM family (``"pneunet"``; ``"sfrba"`` or ``"table1_fem"`` for paper
+        B's Table 1, :func:`softbend.datasets.table1_fem`).
+    folder : path, optional
+        A dataset folder written by ``softbend campaign dataset``; default the
+        one shipped for ``family`` (``softbend/data/<family>/``).
+
+    Returns
+    -------
+    pandas.DataFrame
+        ``design_id``, the family's parameters (in its actuator's units),
+        ``pressure_mpa`` (MPa), ``angle_deg`` (deg), ``tip_x_mm``, ``tip_z_mm``
+        (mm), ``converged``, sorted by design and pressure: the table
+        :func:`softbend.campaign.load_samples` returns for its campaign.
+
+    Raises
+    ------
+    InputError
+        ``family`` has no shipped dataset (key ``family``, naming those that have).
+    DatasetError
+        A file is missing, truncated or altered, the provenance is of another
+        shape or another family, or the table lacks a column of
+        :func:`family_column_kinds`, has one of another dtype, a physically
+        implausible value or a design value outside the recorded actuator's
+        range (naming the file, the row and the column).
+    """
+    return _load(family, folder, SAMPLES_FILE)[0]
+
+
+def family_dataset_designs(
+    family: str, folder: str | os.PathLike[str] | None = None
+) -> pd.DataFrame:
+    """One row per design of :func:`family_dataset` with its sweep's statistics.
+
+    Columns: ``design_id``, the family's parameters, then
+    :data:`~softbend.datasets.DESIGN_STAT_COLUMNS` (``stop_kind`` as Table 1's,
+    plus "walls touch" for a PneuNet whose neighbouring chamber walls touched;
+    ``stop_region`` the part a stretch or instability stop names, such as
+    ``"chamber 3"``; times in s). Checked as :func:`family_dataset` is.
+    """
+    return _load(family, folder, DESIGNS_FILE)[0]
+
+
+def family_dataset_provenance(
+    family: str, folder: str | os.PathLike[str] | None = None
+) -> dict[str, Any]:
+    """How a family's dataset was made: command, family, actuator, versions, options, CPU time."""
+    return _open(family, folder)[1]
+
+
+def family_dataset_actuator(family: str, folder: str | os.PathLike[str] | None = None) -> Actuator:
+    """The actuator description a family's dataset records (paper B's registered one for sfrba)."""
+    actuator = _open(family, folder)[2]
+    if actuator is None:
+        from softbend.actuators import get_actuator
+
+        return get_actuator(_PAPER_B)
+    return actuator
+
+
+def dataset_samples(source: str | os.PathLike[str]) -> tuple[pd.DataFrame, Actuator | None]:
+    """The samples of a dataset folder or a shipped dataset's name, and its actuator.
+
+    Parameters
+    ----------
+    source : str or path
+        A dataset folder (``softbend campaign dataset``), or the name of a
+        shipped dataset: a family of :func:`shipped_families` or ``"table1_fem"``.
+
+    Returns
+    -------
+    (pandas.DataFrame, Actuator or None)
+        :func:`family_dataset`'s table and the recorded actuator (None for paper
+        B's Table 1, whose columns are paper B's features).
+
+    Raises
+    ------
+    InputError, DatasetError
+        As :func:`family_dataset`.
+    """
+    path = Path(source)
+    if path.is_dir():
+        family = verify_dataset(path).get("family", _PAPER_B)
+        if not isinstance(family, str):
+            raise DatasetError(
+                f"The dataset file {str(path / PROVENANCE_FILE)!r}: the field 'family' must be "
+                f"the name of an FEM family; got {family!r}."
+            )
+        return _load(family, path, SAMPLES_FILE)
+    return _load(str(source), None, SAMPLES_FILE)

@@ -19,7 +19,7 @@ import pytest
 from softbend.actuators import Design
 from softbend.campaign import CampaignStore, load_samples, run_campaign
 from softbend.campaign.families import FamilyBackend, family_backend
-from softbend.campaign.family_spaces import parse_family_ranges, parse_family_space
+from softbend.campaign.spaces import parse_family_ranges, parse_family_space
 from softbend.campaign.store import campaign_actuator
 from softbend.cli import main
 from softbend.design import sfrba_design

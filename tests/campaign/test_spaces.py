@@ -5,14 +5,14 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from softbend.campaign import spaces
-from softbend.campaign.spaces import (
+from softbend.campaign import footprint, spaces
+from softbend.campaign.footprint import (
     DISK_LIMIT_BYTES,
     MEMORY_LIMIT_BYTES,
     campaign_footprint,
     check_footprint,
-    parse_space,
 )
+from softbend.campaign.spaces import parse_space
 from softbend.errors import LimitError
 
 
@@ -80,8 +80,8 @@ def test_the_footprint_grows_with_designs_and_pressures():
 @pytest.fixture
 def roomy(monkeypatch):
     """A machine with 1 TiB of memory and 1 PiB of free disk."""
-    monkeypatch.setattr(spaces, "_available_memory_bytes", lambda: 1024**4)
-    monkeypatch.setattr(spaces, "_free_disk_bytes", lambda db: 1024**5)
+    monkeypatch.setattr(footprint, "_available_memory_bytes", lambda: 1024**4)
+    monkeypatch.setattr(footprint, "_free_disk_bytes", lambda db: 1024**5)
 
 
 def test_a_large_campaign_needs_allow_large(tmp_path, roomy):
@@ -97,8 +97,8 @@ def test_a_large_campaign_needs_allow_large(tmp_path, roomy):
 
 
 def test_a_campaign_that_does_not_fit_is_refused_even_when_allowed(tmp_path, monkeypatch):
-    monkeypatch.setattr(spaces, "_available_memory_bytes", lambda: 8 * 1024**3)
-    monkeypatch.setattr(spaces, "_free_disk_bytes", lambda db: 50 * 1024**3)
+    monkeypatch.setattr(footprint, "_available_memory_bytes", lambda: 8 * 1024**3)
+    monkeypatch.setattr(footprint, "_free_disk_bytes", lambda db: 50 * 1024**3)
     big = campaign_footprint(10_000_000, 101)
     with pytest.raises(
         ValueError, match=r"^space: must give a campaign that fits this machine"
@@ -113,7 +113,7 @@ def test_a_campaign_that_does_not_fit_is_refused_even_when_allowed(tmp_path, mon
 
 
 def test_a_shard_is_k_of_n():
-    from softbend.campaign.spaces import parse_shard
+    from softbend.campaign.footprint import parse_shard
 
     assert parse_shard("0/8") == (0, 8) and parse_shard(" 2 / 3 ") == (2, 3)
     for text in ("3/3", "1of2", "0/0", "-1/2"):

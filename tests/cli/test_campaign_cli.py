@@ -427,10 +427,10 @@ def test_space_names_are_lower_case_like_every_other_choice(tmp_path, capsys, sp
 
 @pytest.fixture
 def roomy_machine(monkeypatch):
-    from softbend.campaign import spaces
+    from softbend.campaign import footprint
 
-    monkeypatch.setattr(spaces, "_available_memory_bytes", lambda: 1024**4)
-    monkeypatch.setattr(spaces, "_free_disk_bytes", lambda db: 1024**5)
+    monkeypatch.setattr(footprint, "_available_memory_bytes", lambda: 1024**4)
+    monkeypatch.setattr(footprint, "_free_disk_bytes", lambda db: 1024**5)
 
 
 def test_a_large_space_needs_allow_large_and_is_refused_before_any_design(

@@ -63,7 +63,7 @@ def test_fem_run_writes_the_sweep_figures_and_vtk(tmp_path, capsys):
 def test_maxh_has_one_rule_in_run_and_mesh_study(tmp_path, monkeypatch, capsys):
     from types import SimpleNamespace
 
-    import softbend.fem.sweep as sweep
+    import softbend.fem.sfrba.sweep as sweep
 
     message = "--maxh: must be a number in (0, 20]; got 20.5"
     for argv in (
@@ -74,12 +74,13 @@ def test_maxh_has_one_rule_in_run_and_mesh_study(tmp_path, monkeypatch, capsys):
         assert message in one_error_line(capsys)
     sizes = []
 
-    def fake_simulate(design, pressures, options):
+    def fake_run_sweep(design, pressures, options, **kwargs):
         sizes.append(options.maxh_mm)
         stats = {"ndof": 30, "stop_reason": "reached pmax"}
-        return SimpleNamespace(angle_deg=[1.0], mesh_size=10, stats=stats, wall_time_s=0.1)
+        result = SimpleNamespace(angle_deg=[1.0], mesh_size=10, stats=stats, wall_time_s=0.1)
+        return result, None, None
 
-    monkeypatch.setattr(sweep, "simulate", fake_simulate)
+    monkeypatch.setattr(sweep, "run_sweep", fake_run_sweep)
     assert main(["fem", "mesh-study", "--maxh", "20", "--pressures", "0", "--json"]) == 0
     assert sizes == [20.0]
 

@@ -17,6 +17,7 @@ import os
 import subprocess
 import sys
 import textwrap
+from collections.abc import Iterator
 from pathlib import Path
 from types import SimpleNamespace
 
@@ -98,7 +99,7 @@ def quick_figures(monkeypatch: pytest.MonkeyPatch) -> None:
 
 
 @pytest.fixture
-def fake_fem(monkeypatch: pytest.MonkeyPatch) -> dict[str, object]:
+def fake_fem(monkeypatch: pytest.MonkeyPatch) -> Iterator[dict[str, object]]:
     """The FEM solver stood in for by the analytical model; ``controls`` fail or stop it.
 
     ``controls["fail_at_shape"] = n`` raises ENOSPC while writing the n-th VTK file
@@ -107,41 +108,39 @@ def fake_fem(monkeypatch: pytest.MonkeyPatch) -> dict[str, object]:
     """
     import dataclasses
 
-    import softbend.pipeline.paper_b_fem as pipeline
+    import softbend.fem.export as export
     from softbend._io import write_text_atomic
     from softbend.analytical import AnalyticalModel
-    from softbend.fem.export import vtk_file_name, write_sweep_csv
+    from softbend.fem.families import FEM_FAMILIES
 
     controls: dict[str, object] = {"fail_at_shape": None, "stop_at_shape": None}
+    written: list[Path] = []
 
-    def sweep_with_shapes(
-        design, pressures_mpa, options, out_dir, *, shape_pressures_mpa, prefix="", vtk=False,
-        progress=None,
-    ):  # fmt: skip
+    def sweep(design, pressures_mpa, options, *, progress=None, keep_states=False):
         analytical = AnalyticalModel().sweep(design, pressures_mpa)
         stats = {"stop_reason": "reached the last pressure", "ndof": 0}
         result = dataclasses.replace(analytical, stats=stats, mesh_size=100)
-        out = Path(out_dir)
-        out.mkdir(parents=True, exist_ok=True)
-        files = {"csv": write_sweep_csv(result, out / f"{prefix}sweep.csv")}
-        outline = np.array([[0.0, 0.0], [100.0, 0.0], [100.0, 6.0], [0.0, 6.0], [0.0, 0.0]])
-        pressures = np.linspace(0.0, float(result.pressure_mpa[-1]), shape_pressures_mpa)
-        outlines, written = [], []
-        (out / "vtk").mkdir(exist_ok=True)
-        for number, p in enumerate(pressures, start=1):
-            if controls["fail_at_shape"] == number:
-                raise OSError(errno.ENOSPC, "No space left on device", str(out / "vtk"))
-            if controls["stop_at_shape"] == number:
-                raise KeyboardInterrupt
-            outlines.append((float(p), outline))
-            written.append(
-                write_text_atomic(out / "vtk" / vtk_file_name(float(p)), f"<VTKFile {p}/>\n")
-            )
-        files["vtk"] = written
-        return pipeline.FEMSweep(result, analytical, outlines, len(pressures), files)
+        steps = [SimpleNamespace(pressure_mpa=float(p), state=None) for p in result.pressure_mpa]
+        model = SimpleNamespace(set_state=lambda state: None)
+        written.clear()
+        return result, model, SimpleNamespace(steps=steps)
 
-    monkeypatch.setattr(pipeline, "sweep_with_shapes", sweep_with_shapes)
-    return controls
+    def write_vtk(model, path, *, pressure_mpa):
+        number = len(written) + 1
+        if controls["fail_at_shape"] == number:
+            raise OSError(errno.ENOSPC, "No space left on device", str(Path(path).parent))
+        if controls["stop_at_shape"] == number:
+            raise KeyboardInterrupt
+        written.append(write_text_atomic(path, f"<VTKFile {pressure_mpa}/>\n"))
+        return written[-1]
+
+    outline = np.array([[0.0, 0.0], [100.0, 0.0], [100.0, 6.0], [0.0, 6.0], [0.0, 0.0]])
+    family = FEM_FAMILIES.get("sfrba")
+    fake = dataclasses.replace(family, sweep=sweep, outline=lambda model: outline)
+    FEM_FAMILIES.register("sfrba", fake, replace=True)
+    monkeypatch.setattr(export, "write_vtk", write_vtk)
+    yield controls
+    FEM_FAMILIES.register("sfrba", family, replace=True)
 
 
 def _fem(out: Path, *extra: str) -> list[str]:

@@ -11,7 +11,7 @@ import pytest
 
 from softbend._io import json_text
 from softbend.campaign.store import CampaignStore
-from softbend.datasets import _design_table
+from softbend.dataset_writing import _design_table
 from softbend.fem import FEMStats, FEMTimings, fem_stats, simulate
 from softbend.models import default_pressures_mpa
 

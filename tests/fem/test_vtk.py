@@ -18,7 +18,7 @@ from softbend.fem.export import (
     vtu_text,
     write_vtk,
 )
-from softbend.fem.sweep import run_sweep
+from softbend.fem.sfrba.sweep import run_sweep
 
 from .conftest import REFERENCE
 

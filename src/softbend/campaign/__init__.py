@@ -11,11 +11,12 @@ fiber-reinforced actuator is one example, a PneuNet space (``--family pneunet``)
 * :mod:`~softbend.campaign.store` — the DuckDB database, one transaction per design;
 * :mod:`~softbend.campaign.settings` — the backend's settings a database records
   (mesh, FEM options, material) and checks on resume;
-* :mod:`~softbend.campaign.spaces` — design spaces and shards named by text, and
-  the memory and disk a campaign over one needs;
-* :mod:`~softbend.campaign.families` and :mod:`~softbend.campaign.family_spaces` —
-  campaigns over another FEM actuator family than paper B's (``--family``): its
-  FEM sweep as a backend, what its database records, and its design spaces;
+* :mod:`~softbend.campaign.spaces` — the design spaces of every FEM actuator
+  family named by text (paper B's Table 1 among them);
+* :mod:`~softbend.campaign.footprint` — shards, and the memory and disk a
+  campaign needs;
+* :mod:`~softbend.campaign.families` — campaigns over any FEM actuator family
+  (``--family``): its FEM sweep as a backend and what its database records;
 * :mod:`~softbend.campaign.runner` — :func:`run_campaign`: plans a run
   (:mod:`~softbend.campaign.planning`: resume, the designs left, the executor) and
   runs it (:mod:`~softbend.campaign.executors`: serial, local processes or a Dask
@@ -55,13 +56,14 @@ _EXPORTS = {
     "FamilyBackend": "families",
     "campaign_actuator": "store",
     "family_backend": "families",
-    "FamilySpace": "family_spaces",
-    "parse_family_space": "family_spaces",
+    "FamilySpace": "spaces",
+    "parse_family_space": "spaces",
     "SPACE_FORMS": "spaces",
     "SpaceSpec": "spaces",
-    "campaign_footprint": "spaces",
-    "check_footprint": "spaces",
-    "parse_shard": "spaces",
+    "campaign_space": "spaces",
+    "campaign_footprint": "footprint",
+    "check_footprint": "footprint",
+    "parse_shard": "footprint",
     "parse_space": "spaces",
     "SettingsMismatchError": "settings",
     "UncheckedSettingsWarning": "settings",

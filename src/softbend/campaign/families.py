@@ -1,15 +1,17 @@
 """Campaigns over any FEM actuator family: its backend, and what its database records.
 
-A campaign of paper B's actuator (family ``"sfrba"``) is what it always was: its
-designs are :class:`~softbend.actuators.Design`, its ``designs`` table has the
-columns ``l_mm`` ... ``lc_mm`` and its database records no family. A campaign of
-another family of :data:`~softbend.fem.families.FEM_FAMILIES` sweeps
-:class:`~softbend.actuators.Design` objects with the family's own FEM
-sweep (:class:`FamilyBackend`), and its database records the family's name and
-actuator description (:class:`FamilySchema`): the ``designs`` table then has the
-family's parameter columns, named and in the units of its
+A campaign sweeps the designs of one family of
+:data:`~softbend.fem.families.FEM_FAMILIES` (paper B's ``"sfrba"``, the
+PneuNet, ...), and its database records the family's name and actuator
+description (:class:`FamilySchema`): the ``designs`` table has the family's
+parameter columns, named and in the units of its
 :class:`~softbend.actuators.Actuator`, and ``softbend train`` reads the
-description back (:func:`softbend.campaign.store.campaign_actuator`).
+description back (:func:`softbend.campaign.store.campaign_actuator`). A family
+that is not :attr:`~softbend.fem.families.FEMFamily.recorded` (paper B's, whose
+databases predate families) records neither: a database that names no family
+holds its designs (:data:`~softbend.fem.families.FIRST_FAMILY`). Any family's designs are swept
+with its own FEM sweep by :class:`FamilyBackend`; paper B's also by the
+registered backends (``analytical``, ``fem``, ``surrogate``).
 """
 
 from __future__ import annotations
@@ -18,7 +20,6 @@ from dataclasses import dataclass, field
 from typing import TYPE_CHECKING, Any, NamedTuple, TypeAlias
 
 from softbend.actuators import Design
-from softbend.design import PARAMETERS
 
 if TYPE_CHECKING:
     import numpy as np
@@ -28,18 +29,20 @@ if TYPE_CHECKING:
     from softbend.models import SweepResult
 
 __all__ = [
-    "DEFAULT_FAMILY",
     "CampaignDesign",
     "FamilyBackend",
     "FamilySchema",
     "family_backend",
+    "is_design",
 ]
-
-#: The family of a campaign database that records none: paper B's actuator.
-DEFAULT_FAMILY = "sfrba"
 
 #: A design a campaign sweeps: paper B's, or one of another FEM family.
 CampaignDesign: TypeAlias = Design
+
+
+def is_design(value: object) -> bool:
+    """Whether ``value`` is one design (a :class:`~softbend.actuators.Design`)."""
+    return isinstance(value, Design)
 
 
 class FamilySchema(NamedTuple):
@@ -52,7 +55,9 @@ class FamilySchema(NamedTuple):
     parameters : tuple of str
         The ``designs`` table's parameter columns, in the family's order.
     actuator : dict, optional
-        The family's :meth:`~softbend.actuators.Actuator.to_dict` (None for paper B's).
+        The family's :meth:`~softbend.actuators.Actuator.to_dict`, recorded with
+        its name; None: the database records neither (a family that is not
+        :attr:`~softbend.fem.families.FEMFamily.recorded`, paper B's).
     """
 
     name: str
@@ -60,22 +65,16 @@ class FamilySchema(NamedTuple):
     actuator: dict[str, Any] | None = None
 
     @classmethod
-    def paper_b(cls) -> FamilySchema:
-        """Paper B's actuator: the columns of every campaign database before families."""
-        return cls(DEFAULT_FAMILY, tuple(PARAMETERS))
-
-    @classmethod
     def of(cls, family: FEMFamily | str | None) -> FamilySchema:
-        """The schema of a family (an object, a registered name, or None for paper B's)."""
-        if family is None:
-            return cls.paper_b()
-        if isinstance(family, str):
-            from softbend.fem.families import get_family
+        """The schema of a family: an object, a registered name, or None for
+        :data:`~softbend.fem.families.FIRST_FAMILY`."""
+        from softbend.fem.families import FIRST_FAMILY, get_family
 
-            family = get_family(family)
-        if family.name == DEFAULT_FAMILY:
-            return cls.paper_b()
-        return cls(family.name, tuple(family.names), family.actuator.to_dict())
+        if not hasattr(family, "actuator"):
+            family = get_family(str(family or FIRST_FAMILY))
+        assert not isinstance(family, str | None)
+        actuator = family.actuator.to_dict() if family.recorded else None
+        return cls(family.name, tuple(family.names), actuator)
 
 
 @dataclass(frozen=True)

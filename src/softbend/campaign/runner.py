@@ -59,7 +59,6 @@ from softbend.campaign.backends import (
     Backend,
     MaterialGiven,
     check_pressures_mpa,
-    default_pressures_mpa,
     resolve_material,
     with_material,
 )
@@ -73,7 +72,6 @@ from softbend.campaign.executors import (
     run_serial,
 )
 from softbend.campaign.families import (
-    DEFAULT_FAMILY,
     CampaignDesign,
     FamilyBackend,
     FamilySchema,
@@ -93,6 +91,7 @@ from softbend.campaign.planning import (
 from softbend.campaign.settings import backend_settings, fem_options_of
 from softbend.campaign.store import CampaignStore
 from softbend.errors import InputError
+from softbend.fem.families import get_family
 
 if TYPE_CHECKING:
     from distributed import Client
@@ -190,10 +189,9 @@ def run_campaign(
         DuckDB file of the campaign; created if missing, resumed if present.
     designs : iterable of Design
         The designs (e.g. a :class:`~softbend.design.DesignSpace`, or a
-        :class:`~softbend.campaign.family_spaces.FamilySpace` of another FEM
+        :class:`~softbend.campaign.spaces.FamilySpace` of another FEM
         family), non-empty, unique and of one family. A database keeps the
-        family of its first run (paper B's ``"sfrba"`` unless another's designs
-        created it); another is refused.
+        family of its first run; another is refused.
     backend : str or Backend
         Registered backend name (``"analytical"``, ``"fem"``, ...) or a backend
         object. A database keeps the backend of its first run; another is refused.
@@ -265,10 +263,7 @@ def run_campaign(
     start = time.perf_counter()
     design_list = check_designs(designs)
     family = design_family(design_list[0])
-    if family != DEFAULT_FAMILY:
-        backend_obj = _family_backend(family, backend, backend_options)
-    else:
-        backend_obj = resolve_backend(backend, backend_options)
+    backend_obj = _family_backend(family, backend, backend_options)
     given = None
     if material is not None:
         chosen = resolve_material(material)
@@ -277,7 +272,7 @@ def run_campaign(
     # a mesh size too fine for them would otherwise fail each design in turn.
     _check_meshes(backend_obj, family, design_list)
     if pressures_mpa is None:
-        pressures_mpa = _default_pressures(family)
+        pressures_mpa = get_family(family).campaign_pressures_mpa()
     grid = check_pressures_mpa(pressures_mpa)
     settings = backend_settings(backend_obj, grid, material_given=given)
     workers, chunk_size, timeout_s = check_run_options(workers, chunk_size, connect_timeout_s)
@@ -339,47 +334,28 @@ def run_campaign(
 def _check_meshes(backend: Backend, family: str, designs: list[CampaignDesign]) -> None:
     """Refuse an FEM backend's mesh size that would mesh one of ``designs`` too finely.
 
-    Paper B's designs are checked together (:meth:`FEMOptions.check_mesh
-    <softbend.fem.options.FEMOptions.check_mesh>`); another family's one by one
-    with its own estimate (:meth:`FEMFamily.check_mesh
-    <softbend.fem.families.FEMFamily.check_mesh>`, microseconds a design), before
+    The designs are checked with their family's own estimate (:meth:`FEMFamily.check_meshes
+    <softbend.fem.families.FEMFamily.check_meshes>`, microseconds a design), before
     NGSolve is loaded. A backend that is not the FEM is not checked.
     """
     options = fem_options_of(backend)
     if options is None:
         return
-    if family == DEFAULT_FAMILY:
-        options.check_mesh(designs)
-        return
-    if isinstance(backend, FamilyBackend):
-        fem_family = backend.family
-    else:
-        from softbend.fem.families import get_family
-
-        fem_family = get_family(family)
-    for design in designs:
-        fem_family.check_mesh(design, options)
-
-
-def _default_pressures(family: str) -> np.ndarray:
-    """The default grid: 0–0.5 MPa by 0.005 MPa, or the family's own (its pmax and pstep)."""
-    if family == DEFAULT_FAMILY:
-        return default_pressures_mpa()
-    from softbend.fem.families import get_family
-
-    fem_family = get_family(family)
-    return default_pressures_mpa(fem_family.pmax_mpa, fem_family.pstep_mpa)
+    fem_family = backend.family if isinstance(backend, FamilyBackend) else get_family(family)
+    fem_family.check_meshes(designs, options)
 
 
 def _family_backend(family: str, backend: str | Backend, options: dict[str, Any] | None) -> Backend:
-    """The backend sweeping the designs of ``family`` (not paper B's).
+    """The backend sweeping the designs of ``family``.
 
-    ``"fem"`` is the family's own FEM sweep with ``options`` ``maxh_mm`` (mm) at
-    most; a backend object is taken as given (a :class:`FamilyBackend` must be of
-    ``family``). Paper B's models (``"analytical"``, paper B's FEM) are refused.
+    A backend object is taken as given (a :class:`FamilyBackend` must be of
+    ``family``). A family swept by the registered backends
+    (:attr:`~softbend.fem.families.FEMFamily.backends` None, paper B's)
+    takes any of them by name, with ``options``; for another, ``"fem"`` is the
+    family's own FEM sweep with ``options`` ``maxh_mm`` (mm) at most and paper B's
+    models (``"analytical"``, paper B's FEM) are refused.
     """
-    from softbend.fem.families import get_family
-
+    fem_family = get_family(family)
     if isinstance(backend, FamilyBackend):
         if backend.family.name != family:
             raise InputError(
@@ -387,6 +363,8 @@ def _family_backend(family: str, backend: str | Backend, options: dict[str, Any]
                 f"{backend.family.name!r} family",
                 key="backend",
             )
+        return resolve_backend(backend, options)
+    if fem_family.backends is None:
         return resolve_backend(backend, options)
     if backend == "fem":
         options = dict(options or {})
@@ -396,7 +374,7 @@ def _family_backend(family: str, backend: str | Backend, options: dict[str, Any]
                 f"must be maxh_mm alone for the FEM of the {family!r} family; got {unknown}",
                 key="backend_options",
             )
-        return family_backend(get_family(family), maxh_mm=options.get("maxh_mm"))
+        return family_backend(fem_family, maxh_mm=options.get("maxh_mm"))
     if isinstance(backend, str) or getattr(backend, "name", None) in ("analytical", "fem"):
         shown = backend if isinstance(backend, str) else backend.name
         raise InputError(

@@ -10,13 +10,14 @@ Tables (schema version :data:`SCHEMA_VERSION`):
     mesh size, FEM options and material among them, see
     :mod:`softbend.campaign.settings`; set by the first run, checked by later
     ones, absent in databases of older softbend versions), ``runs`` (JSON list
-    of each run's record), ``space`` and ``n_designs_planned`` (of the latest run);
-    a campaign of an FEM family other than paper B's also ``family`` (its name)
-    and ``actuator`` (its :meth:`~softbend.actuators.Actuator.to_dict` as JSON),
-    set on creation (see :mod:`softbend.campaign.families`).
+    of each run's record), ``space`` and ``n_designs_planned`` (of the latest run),
+    ``family`` (the FEM family's name) and ``actuator`` (its
+    :meth:`~softbend.actuators.Actuator.to_dict` as JSON), set on creation
+    (absent for a family that is not recorded: paper B's, whose databases
+    predate families; see :mod:`softbend.campaign.families`).
 ``designs``
-    One row per attempted design: its parameters (``l_mm`` ... ``lc_mm``; those
-    of its family, in its units, for another family's campaign),
+    One row per attempted design: its parameters (those of its family, in its
+    units: ``l_mm`` ... ``lc_mm`` for paper B's),
     ``status`` ``'done'`` or ``'failed'``, ``error`` (``"ExceptionType: message"``
     for failed designs), ``wall_time_s``, ``n_samples`` (rows in ``samples``,
     including the final non-converged pressure), ``max_pressure_mpa`` and
@@ -241,7 +242,8 @@ def ensure_schema(
         The connection is read-only: a file without tables is refused rather
         than created.
     family : FamilySchema, optional
-        The family of a new database's designs (default paper B's); its
+        The family of a new database's designs (default
+        :data:`~softbend.fem.families.FIRST_FAMILY`); its
         ``designs`` table gets the family's parameter columns and its ``meta``
         table the family's name and actuator.
 
@@ -265,7 +267,7 @@ def ensure_schema(
                 f"{str(path)!r} is not a softbend campaign database "
                 f"(no 'meta' table; found {found}; {_WHAT_A_CAMPAIGN_IS})."
             )
-        _create(con, path, family or FamilySchema.paper_b())
+        _create(con, path, family or FamilySchema.of(None))
         return
     meta = dict(con.execute("SELECT key, value FROM meta").fetchall())
     version_text = meta.get("schema_version")
@@ -291,19 +293,16 @@ def ensure_schema(
 
 
 def _create(con: DuckDBPyConnection, path: Path, family: FamilySchema) -> None:
-    paper_b = family.name == FamilySchema.paper_b().name
     with transaction(con):
         for statement in _DDL:
-            if not paper_b and "designs (" in statement:
-                statement = _family_ddl(statement, family.parameters)
-            con.execute(statement)
+            con.execute(_family_ddl(statement, family.parameters))
         for key, value in (
             ("schema_version", str(SCHEMA_VERSION)),
             ("softbend_version", softbend_version()),
             ("created_at", utc_now().isoformat(timespec="seconds") + "Z"),
         ):
             con.execute("INSERT INTO meta VALUES (?, ?)", [key, value])
-        if not paper_b:
+        if family.actuator is not None:  # recorded with its description
             con.execute("INSERT INTO meta VALUES ('family', ?)", [family.name])
             actuator = json.dumps(family.actuator, sort_keys=True)
             con.execute("INSERT INTO meta VALUES ('actuator', ?)", [actuator])
@@ -311,7 +310,10 @@ def _create(con: DuckDBPyConnection, path: Path, family: FamilySchema) -> None:
 
 
 def _family_ddl(statement: str, parameters: tuple[str, ...]) -> str:
-    """The ``designs`` table's definition with ``parameters`` in place of paper B's."""
+    """A table's definition with the family's ``parameters`` as the ``designs`` table's
+    design columns (in place of those written in :data:`_DDL`); other tables as written."""
+    if "designs (" not in statement:
+        return statement
     own = "".join(f"{quoted(name)} DOUBLE NOT NULL,\n        " for name in parameters)
     start = statement.index("l_mm DOUBLE")
     end = statement.index("status VARCHAR")
@@ -346,7 +348,9 @@ def read_family(con: DuckDBPyConnection, path: Path) -> FamilySchema:
             "or status column)."
         )
     parameters = tuple(columns[columns.index("design_id") + 1 : columns.index("status")])
-    name = meta.get("family", FamilySchema.paper_b().name)
+    from softbend.fem.families import FIRST_FAMILY
+
+    name = meta.get("family", FIRST_FAMILY)
     actuator = None
     if "actuator" in meta:
         try:

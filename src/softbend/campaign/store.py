@@ -35,7 +35,7 @@ import numpy as np
 from softbend._io import new_file_mode
 from softbend._validation import check_choice
 from softbend.actuators import Design
-from softbend.campaign.families import DEFAULT_FAMILY, CampaignDesign, FamilySchema
+from softbend.campaign.families import CampaignDesign, FamilySchema
 from softbend.campaign.schema import SAMPLE_COLUMNS as SAMPLE_COLUMNS
 from softbend.campaign.schema import (
     SCHEMA_VERSION,
@@ -777,10 +777,10 @@ class CampaignStore:
             [int(max_failures)],
         ).fetchall()
         planned = self._meta_int("n_designs_planned")
-        family = {} if self.family == DEFAULT_FAMILY else {"family": self.family}
+        recorded = self._family.actuator is not None
         return {
             "path": str(self.path),
-            **family,
+            **({"family": self.family} if recorded else {}),
             "schema_version": int(meta["schema_version"]),
             "softbend_version": meta.get("softbend_version"),
             "created_at": meta.get("created_at"),
@@ -800,7 +800,7 @@ class CampaignStore:
             "sweep_time_s_mean": None if wall_mean is None else float(wall_mean),
             "max_angle_deg": None if max_angle is None else float(max_angle),
             "last_finished_at": None if last is None else last.isoformat(timespec="seconds") + "Z",
-            **({"parameters": list(self.parameters)} if family else {}),
+            **({"parameters": list(self.parameters)} if recorded else {}),
             "failures": [
                 {
                     "design_id": row[0],
@@ -1144,18 +1144,17 @@ def load_designs(db_path: str | os.PathLike[str]) -> pd.DataFrame:
         return store.load_designs()
 
 
-def campaign_actuator(db: str | os.PathLike[str]) -> Actuator | None:
-    """The actuator of the campaign database ``db``; None for paper B's (no family recorded).
+def campaign_actuator(db: str | os.PathLike[str]) -> Actuator:
+    """The actuator of the campaign database ``db``.
 
     The description recorded with the family is read back; a database that
-    names a family but no description takes the registered family's.
+    records none (written before families were recorded) takes the registered
+    family's.
     """
     from softbend.actuators import Actuator
 
     with CampaignStore(db, read_only=True) as store:
         schema = store.family_schema
-    if schema.name == DEFAULT_FAMILY:
-        return None
     if schema.actuator is not None:
         return Actuator.from_dict(json.loads(json.dumps(schema.actuator)))
     from softbend.fem.families import get_family

@@ -9,7 +9,7 @@ database, ``export`` writes its samples (or designs) to Parquet or CSV and
 from __future__ import annotations
 
 from pathlib import Path
-from typing import TYPE_CHECKING
+from typing import TYPE_CHECKING, Any
 
 import typer
 
@@ -107,6 +107,17 @@ def status(
     if json_output:
         _common.print_json(summary)
         return
+    _common.print_table(f"campaign {summary['path']}", ["quantity", "value"], _status_rows(summary))
+    if summary["failures"]:
+        _common.print_table(
+            "failed designs",
+            [_design_header(summary), "error"],
+            [[f["design"], one_line(f["error"])] for f in summary["failures"]],
+        )
+
+
+def _status_rows(summary: dict[str, Any]) -> list[list[Any]]:
+    """The rows of ``campaign status``'s table from :meth:`CampaignStore.status_summary`."""
     planned = summary["n_designs_planned"]
     settings = summary["settings"] or {}  # None in a database of an older softbend
     maxh = (settings.get("options") or {}).get("maxh_mm")
@@ -118,37 +129,27 @@ def status(
             f"{summary['pmin_mpa']:g}–{summary['pmax_mpa']:g} MPa"
         )
     )
-    _common.print_table(
-        f"campaign {summary['path']}",
-        ["quantity", "value"],
+    return [
+        *([["family", summary["family"]]] if "family" in summary else []),
+        ["backend", summary["backend"] or "-"],
+        ["material", (settings.get("material") or {}).get("name", "-")],
+        ["mesh size maxh (mm)", "-" if maxh is None else maxh],
+        ["space of the latest run", f"{summary['space'] or '-'} ({planned or 0} designs)"],
+        ["designs done", summary["done"]],
+        ["designs failed", summary["failed"]],
+        ["samples (converged)", f"{summary['samples']} ({summary['converged_samples']})"],
+        ["pressure grid", grid],
+        ["sweep time, sum (s)", summary["sweep_time_s_total"]],
         [
-            *([["family", summary["family"]]] if "family" in summary else []),
-            ["backend", summary["backend"] or "-"],
-            ["material", (settings.get("material") or {}).get("name", "-")],
-            ["mesh size maxh (mm)", "-" if maxh is None else maxh],
-            ["space of the latest run", f"{summary['space'] or '-'} ({planned or 0} designs)"],
-            ["designs done", summary["done"]],
-            ["designs failed", summary["failed"]],
-            ["samples (converged)", f"{summary['samples']} ({summary['converged_samples']})"],
-            ["pressure grid", grid],
-            ["sweep time, sum (s)", summary["sweep_time_s_total"]],
-            [
-                "largest angle (deg)",
-                summary["max_angle_deg"] if summary["max_angle_deg"] is not None else "-",
-            ],
-            ["schema / softbend", f"{summary['schema_version']} / {summary['softbend_version']}"],
-            [
-                "created / last design",
-                f"{summary['created_at']} / {summary['last_finished_at'] or '-'}",
-            ],
+            "largest angle (deg)",
+            summary["max_angle_deg"] if summary["max_angle_deg"] is not None else "-",
         ],
-    )
-    if summary["failures"]:
-        _common.print_table(
-            "failed designs",
-            [_design_header(summary), "error"],
-            [[f["design"], one_line(f["error"])] for f in summary["failures"]],
-        )
+        ["schema / softbend", f"{summary['schema_version']} / {summary['softbend_version']}"],
+        [
+            "created / last design",
+            f"{summary['created_at']} / {summary['last_finished_at'] or '-'}",
+        ],
+    ]
 
 
 def _design_header(summary: dict[str, object]) -> str:
@@ -245,6 +246,11 @@ def dataset(
     if json_output:
         _common.print_json(provenance)
         return
+    _print_provenance(out, provenance)
+
+
+def _print_provenance(out: Path, provenance: dict[str, Any]) -> None:
+    """``campaign dataset``'s table of a written dataset's provenance."""
     designs = provenance["designs"]
     _common.print_table(
         f"dataset {out}",
@@ -267,28 +273,12 @@ def dataset(
 
 
 def _planned_designs(db: Path, space: str) -> int:
-    """The number of designs of ``--space`` for the family of the campaign ``db``.
-
-    Paper B's forms are read before the database (a space over the designs limit
-    is refused first); another family's (``grid``, ``grid:K``) once it names the family.
-    """
+    """The number of designs of ``--space`` for the family of the campaign ``db``."""
     from softbend.campaign import CampaignStore
-    from softbend.campaign.families import DEFAULT_FAMILY
-    from softbend.campaign.spaces import parse_space
-    from softbend.errors import InputError
-
-    try:
-        planned, refused = parse_space(space).n_designs, None
-    except InputError as exc:
-        planned, refused = None, exc
-    with CampaignStore(db, read_only=True) as store:
-        family = store.family
-    if family == DEFAULT_FAMILY:
-        if refused is not None:
-            raise refused
-        assert planned is not None
-        return planned
-    from softbend.campaign.family_spaces import parse_family_space
+    from softbend.campaign.spaces import campaign_space, check_sampled_size
     from softbend.fem.families import get_family
 
-    return parse_family_space(space, get_family(family)).n_designs
+    check_sampled_size(space)  # refused before the database is read
+    with CampaignStore(db, read_only=True) as store:
+        family = store.family
+    return campaign_space(space, get_family(family)).n_designs

@@ -4,22 +4,137 @@ from __future__ import annotations
 
 from contextlib import ExitStack
 from pathlib import Path
-from typing import TYPE_CHECKING, Any
+from typing import TYPE_CHECKING, Annotated, Any
 
 import typer
 
 from softbend.cli import _common
 
 if TYPE_CHECKING:
-    from softbend.campaign.backends import Backend, ResolvedMaterial
+    from softbend.campaign.plan import CampaignPlan
     from softbend.campaign.runner import CampaignSummary
-    from softbend.fem.families import FEMFamily
 
 #: The design spaces of --space (softbend.campaign.spaces.SPACE_FORMS, not imported at start).
 SPACE_FORMS = "table1, corners, lhs:N or sobol:N"
 
-#: Those of another family than paper B's (softbend.campaign.family_spaces.FAMILY_SPACE_FORMS).
+#: Those of another family than paper B's (softbend.campaign.spaces.FAMILY_SPACE_FORMS).
 FAMILY_SPACE_FORMS = "lhs:N, sobol:N, grid or grid:K"
+
+DbArgument = Annotated[Path, typer.Argument(help="Campaign database (DuckDB); created or resumed.")]
+FamilyOption = Annotated[
+    str,
+    typer.Option(
+        help="FEM actuator family of the designs: sfrba (paper B's actuator) or another "
+        "registered family (pneunet), swept with its own FEM over the ranges of its "
+        "description."
+    ),
+]
+BackendOption = Annotated[
+    str | None,
+    typer.Option(
+        help="Sweep model, a campaign backend: analytical, fem or surrogate (with --model); "
+        "default analytical, and fem (the only one) for another --family than sfrba."
+    ),
+]
+ModelOption = Annotated[
+    Path | None,
+    typer.Option(
+        help="A surrogate saved by 'softbend train' (models/*.json), for --backend surrogate."
+    ),
+]
+SpaceOption = Annotated[
+    str | None,
+    typer.Option(
+        help=f"Designs: {SPACE_FORMS} (default table1); for another --family "
+        f"{FAMILY_SPACE_FORMS} over its ranges (grid: 3 levels a parameter, grid:K: K), "
+        "required."
+    ),
+]
+RangesOption = Annotated[
+    list[str] | None,
+    typer.Option(
+        "--range",
+        help="Range of one parameter of an lhs/sobol space, NAME=LOW:HIGH in mm or deg "
+        "(repeatable; the others keep paper B's Table 1 ranges, or the family's).",
+    ),
+]
+SeedOption = Annotated[int, typer.Option(help="Seed of the lhs/sobol sampler.")]
+ShardOption = Annotated[
+    str | None,
+    typer.Option(
+        help="Only shard K/N of the space (every N-th design from the K-th, K in 0..N-1); "
+        "merge the shards' databases with 'softbend campaign merge'."
+    ),
+]
+PmaxOption = Annotated[
+    float | None,
+    typer.Option(help="Largest pressure of the sweep's grid, MPa (default 0.5; the family's)."),
+]
+PstepOption = Annotated[
+    float | None,
+    typer.Option(help="Pressure step of the sweep's grid, MPa (default 0.005; the family's)."),
+]
+WorkersOption = Annotated[
+    int | None,
+    typer.Option(
+        help="Local worker processes (default: all cores; 0 or 1: serial, the compiled FEM in "
+        "one worker process)."
+    ),
+]
+SchedulerOption = Annotated[
+    str | None,
+    typer.Option(help="Dask scheduler tcp://HOST:PORT (or scheduler file) to run on a cluster."),
+]
+RetryFailedOption = Annotated[
+    bool,
+    typer.Option("--retry-failed/--no-retry-failed", help="Re-run designs recorded as failed."),
+]
+ChunkSizeOption = Annotated[
+    int | None, typer.Option(help="Designs per worker task (default: auto).")
+]
+ConnectTimeoutOption = Annotated[
+    float, typer.Option(help="Seconds allowed to reach the Dask scheduler and find a worker.")
+]
+AllowLargeOption = Annotated[
+    bool,
+    typer.Option(
+        "--allow-large",
+        help="Run a campaign estimated above 2 GiB of memory or 20 GiB of disk "
+        "(one that does not fit the machine is refused anyway).",
+    ),
+]
+CompileEnergyOption = Annotated[
+    bool,
+    typer.Option(
+        "--compile/--no-compile",
+        help="--backend fem: compile the energy to machine code once per worker "
+        "(about 30 CPU s in the background; then faster assembly, the same results; "
+        "see benchmarks/bench_fem.py).",
+    ),
+]
+MaxhOption = Annotated[
+    float | None,
+    typer.Option(
+        help="Largest element size of --backend fem, mm (default: the FEM's, 5; the family's)."
+    ),
+]
+MaterialOption = Annotated[
+    str | None,
+    typer.Option(
+        help="Elastomer of --backend fem or analytical: a preset (dragon-skin-30, the default) "
+        "or the fit.json of 'softbend materials fit', optionally with its model after # "
+        "(fit.json#yeoh; default the best fit)."
+    ),
+]
+AcceptNewSettingsOption = Annotated[
+    bool,
+    typer.Option(
+        "--accept-new-settings",
+        help="Resume DB even if its recorded settings (mesh, FEM options, material) differ "
+        "from this run's; its designs then mix both.",
+    ),
+]
+JsonOutputOption = Annotated[bool, typer.Option("--json", help="Print the summary as JSON.")]
 
 
 def one_line(text: str) -> str:
@@ -32,91 +147,48 @@ def with_surrogates() -> None:
     import softbend.surrogates.model  # noqa: F401  (registers the backend on import)
 
 
+#: ``campaign run``'s options that plan the campaign, by the name
+#: :func:`softbend.campaign.plan.plan_campaign` gives them.
+PLAN_OPTIONS = {
+    "family": "family",
+    "backend": "backend",
+    "model": "model",
+    "space": "space",
+    "ranges": "ranges",
+    "seed": "seed",
+    "shard": "shard",
+    "pmax": "pmax_mpa",
+    "pstep": "pstep_mpa",
+    "scheduler": "scheduler",
+    "allow_large": "allow_large",
+    "compile_energy": "compiled",
+    "maxh": "maxh_mm",
+    "material": "material",
+}
+
+
 def run(
-    db: Path = typer.Argument(..., help="Campaign database (DuckDB); created or resumed."),
-    family: str = typer.Option(
-        "sfrba",
-        help="FEM actuator family of the designs: sfrba (paper B's actuator) or another "
-        "registered family (pneunet), swept with its own FEM over the ranges of its "
-        "description.",
-    ),
-    backend: str | None = typer.Option(
-        None,
-        help="Sweep model, a campaign backend: analytical, fem or surrogate (with --model); "
-        "default analytical, and fem (the only one) for another --family than sfrba.",
-    ),
-    model: Path | None = typer.Option(
-        None, help="A surrogate saved by 'softbend train' (models/*.json), for --backend surrogate."
-    ),
-    space: str | None = typer.Option(
-        None,
-        help=f"Designs: {SPACE_FORMS} (default table1); for another --family "
-        f"{FAMILY_SPACE_FORMS} over its ranges (grid: 3 levels a parameter, grid:K: K), "
-        "required.",
-    ),
-    ranges: list[str] = typer.Option(
-        None,
-        "--range",
-        help="Range of one parameter of an lhs/sobol space, NAME=LOW:HIGH in mm or deg "
-        "(repeatable; the others keep paper B's Table 1 ranges, or the family's).",
-    ),
-    seed: int = typer.Option(0, help="Seed of the lhs/sobol sampler."),
-    shard: str | None = typer.Option(
-        None,
-        help="Only shard K/N of the space (every N-th design from the K-th, K in 0..N-1); "
-        "merge the shards' databases with 'softbend campaign merge'.",
-    ),
-    pmax: float | None = typer.Option(
-        None, help="Largest pressure of the sweep's grid, MPa (default 0.5; the family's)."
-    ),
-    pstep: float | None = typer.Option(
-        None, help="Pressure step of the sweep's grid, MPa (default 0.005; the family's)."
-    ),
-    workers: int | None = typer.Option(
-        None,
-        help="Local worker processes (default: all cores; 0 or 1: serial, the compiled FEM in "
-        "one worker process).",
-    ),
-    scheduler: str | None = typer.Option(
-        None, help="Dask scheduler tcp://HOST:PORT (or scheduler file) to run on a cluster."
-    ),
-    retry_failed: bool = typer.Option(
-        True, "--retry-failed/--no-retry-failed", help="Re-run designs recorded as failed."
-    ),
-    chunk_size: int | None = typer.Option(None, help="Designs per worker task (default: auto)."),
-    connect_timeout: float = typer.Option(
-        5.0, help="Seconds allowed to reach the Dask scheduler and find a worker."
-    ),
-    allow_large: bool = typer.Option(
-        False,
-        "--allow-large",
-        help="Run a campaign estimated above 2 GiB of memory or 20 GiB of disk "
-        "(one that does not fit the machine is refused anyway).",
-    ),
-    compile_energy: bool = typer.Option(
-        True,
-        "--compile/--no-compile",
-        help="--backend fem: compile the energy to machine code once per worker "
-        "(about 30 CPU s in the background; then faster assembly, the same results; "
-        "see benchmarks/bench_fem.py).",
-    ),
-    maxh: float | None = typer.Option(
-        None,
-        help="Largest element size of --backend fem, mm (default: the FEM's, 5; the family's).",
-    ),
-    material: str | None = typer.Option(
-        None,
-        help="Elastomer of --backend fem or analytical: a preset (dragon-skin-30, the default) "
-        "or the fit.json of 'softbend materials fit', optionally with its model after # "
-        "(fit.json#yeoh; default the best fit).",
-    ),
-    accept_new_settings: bool = typer.Option(
-        False,
-        "--accept-new-settings",
-        help="Resume DB even if its recorded settings (mesh, FEM options, material) differ "
-        "from this run's; its designs then mix both.",
-    ),
-    json_output: bool = typer.Option(False, "--json", help="Print the summary as JSON."),
+    db: DbArgument,
+    family: FamilyOption = "sfrba",
+    backend: BackendOption = None,
+    model: ModelOption = None,
+    space: SpaceOption = None,
+    ranges: RangesOption = None,
+    seed: SeedOption = 0,
+    shard: ShardOption = None,
+    pmax: PmaxOption = None,
+    pstep: PstepOption = None,
+    workers: WorkersOption = None,
+    scheduler: SchedulerOption = None,
+    retry_failed: RetryFailedOption = True,
+    chunk_size: ChunkSizeOption = None,
+    connect_timeout: ConnectTimeoutOption = 5.0,
+    allow_large: AllowLargeOption = False,
+    compile_energy: CompileEnergyOption = True,
+    maxh: MaxhOption = None,
+    material: MaterialOption = None,
+    accept_new_settings: AcceptNewSettingsOption = False,
+    json_output: JsonOutputOption = False,
 ) -> None:
     """Sweep a design space into a campaign database.
 
@@ -142,75 +214,25 @@ def run(
         softbend campaign run own.duckdb --space sobol:256 --range l=60:90 --range t=1:2
         softbend campaign run pneunet.duckdb --family pneunet --space sobol:256
     """
-    from softbend._validation import check_int
-    from softbend.campaign.backends import (
-        backend_for_run,
-        default_pressures_mpa,
-        resolve_material,
-    )
-    from softbend.campaign.runner import (
-        count_designs_to_run,
-        parse_scheduler_address,
-        run_campaign,
-    )
-    from softbend.campaign.spaces import (
-        campaign_footprint,
-        check_footprint,
-        parse_ranges,
-        parse_shard,
-        parse_space,
-    )
+    from softbend.campaign.plan import plan_campaign
 
+    args = dict(locals())
     _common.check_output_file(db, "DB", inputs=(model,) if model is not None else ())
-    fem_family = _fem_family(family)
-    spec: Any
-    if fem_family is None:
-        spec = parse_space("table1" if space is None else space)
-        if ranges:
-            spec = spec.with_ranges(parse_ranges(ranges))
-    else:
-        spec = _family_space(fem_family, space, ranges)
-    check_int(seed, "seed")
-    shard_of = parse_shard(shard) if shard is not None else None
-    if fem_family is None:
-        pressures = default_pressures_mpa(
-            0.5 if pmax is None else pmax, 0.005 if pstep is None else pstep
-        )
-    else:
-        pressures = default_pressures_mpa(
-            fem_family.pmax_mpa if pmax is None else pmax,
-            fem_family.pstep_mpa if pstep is None else pstep,
-        )
     with_surrogates()
-    chosen = resolve_material(material) if material is not None else None  # read once
-    if fem_family is None:
-        backend_obj = backend_for_run(
-            "analytical" if backend is None else backend,
-            model=model,
-            compiled=compile_energy,
-            material=chosen,
-            maxh_mm=maxh,
-        )
-    else:
-        backend_obj = _family_backend(fem_family, backend, model, chosen, maxh)
-    if scheduler is not None:
-        parse_scheduler_address(scheduler)
-    k, count = shard_of or (0, 1)
-    n_stored = len(range(k, spec.n_designs, count))  # designs of the shard
-    check_footprint(
-        campaign_footprint(spec.n_designs, len(pressures), n_stored=n_stored),
-        db,
-        allow_large=allow_large,
-    )
-    designs = spec.build(seed)
-    rejected = getattr(designs, "describe_rejected", lambda: "")()
-    if rejected and not json_output:
-        _common.err_console.print(
-            f"{designs.name}: {len(designs)} designs; {rejected}", highlight=False, soft_wrap=True
-        )
-    if shard_of is not None:
-        designs = designs.shard(*shard_of)
-    n_todo = count_designs_to_run(db, designs, retry_failed)
+    plan = plan_campaign(db, **{name: args[option] for option, name in PLAN_OPTIONS.items()})
+    if plan.rejected and not json_output:
+        _common.err_console.print(plan.rejected, highlight=False, soft_wrap=True)
+    summary = _sweep(plan, args)
+    _print_summary(plan, summary, db, json_output=json_output)
+    _exit_if_all_failed(summary, db)
+
+
+def _sweep(plan: CampaignPlan, args: dict[str, Any]) -> CampaignSummary:
+    """Run the planned campaign into ``args["db"]`` with a progress bar (not with --json)."""
+    from softbend.campaign.runner import count_designs_to_run, run_campaign
+
+    db, designs, quiet = args["db"], plan.designs, args["json_output"]
+    n_todo = count_designs_to_run(db, designs, args["retry_failed"])
     with ExitStack() as stack:
         # The bar opens with the first report, so errors before any work print no bar.
         advance = None
@@ -218,7 +240,7 @@ def run(
 
         def progress(done: int, failed: int, running: int, total: int) -> None:
             nonlocal advance, shown
-            if advance is None and n_todo < len(designs) and not json_output:
+            if advance is None and n_todo < len(designs) and not quiet:
                 # Said once the settings are checked: a refused resume is one error line.
                 _common.err_console.print(
                     f"resuming {db}: {len(designs) - n_todo} of {len(designs)} designs "
@@ -228,27 +250,25 @@ def run(
                 )
             if advance is None:
                 advance = stack.enter_context(
-                    _common.progress_bar(
-                        f"campaign {db.name}", total=total, enabled=not json_output
-                    )
+                    _common.progress_bar(f"campaign {db.name}", total=total, enabled=not quiet)
                 )
             advance(done + failed - shown, done=done, failed=failed, running=running)
             shown = done + failed
 
         try:
-            summary = run_campaign(
+            return run_campaign(
                 db,
                 designs,
-                backend=backend_obj,
-                pressures_mpa=pressures,
-                workers=workers,
-                scheduler=scheduler,
-                retry_failed=retry_failed,
+                backend=plan.backend,
+                pressures_mpa=plan.pressures_mpa,
+                workers=args["workers"],
+                scheduler=args["scheduler"],
+                retry_failed=args["retry_failed"],
                 progress=progress,
-                chunk_size=chunk_size,
-                connect_timeout_s=connect_timeout,
-                material=chosen,
-                accept_new_settings=accept_new_settings,
+                chunk_size=args["chunk_size"],
+                connect_timeout_s=args["connect_timeout"],
+                material=plan.material,
+                accept_new_settings=args["accept_new_settings"],
             )
         except OSError as exc:
             # A failed write of the database (a full disk) names it: one line naming DB.
@@ -257,18 +277,25 @@ def run(
                 raise
             with _common.output_errors(db, "DB"):
                 raise
+
+
+def _print_summary(
+    plan: CampaignPlan, summary: CampaignSummary, db: Path, *, json_output: bool
+) -> None:
+    """The run's summary as JSON or as tables (with the first failed designs)."""
+    designs, fem_family = plan.designs, plan.family
+    recorded = fem_family.recorded  # a family recorded with its campaigns is named in the output
     if json_output:
         extra: dict[str, Any] = {}
-        if fem_family is not None:
+        if recorded:
             extra = {"family": fem_family.name, "rejected": dict(designs.rejected)}
         _common.print_json({"space": designs.name, **extra, **summary.as_dict()})
-        _exit_if_all_failed(summary, db)
         return
     _common.print_table(
         f"campaign {summary.db_path}",
         ["quantity", "value"],
         [
-            *([] if fem_family is None else [["family", fem_family.name]]),
+            *([["family", fem_family.name]] if recorded else []),
             ["backend", summary.backend],
             ["space", f"{designs.name} ({summary.n_designs} designs)"],
             ["executor", summary.executor],
@@ -283,73 +310,12 @@ def run(
     )
     if summary.failures:
         by_id = {design.design_id: str(design) for design in designs}
-        header = "design (l,r,t,b,phi,lc)" if fem_family is None else "design"
+        header = "design" if recorded else "design (l,r,t,b,phi,lc)"
         _common.print_table(
             "failed designs",
             [header, "error"],
             [[by_id.get(i, i), one_line(e)] for i, e in summary.failures[:20]],
         )
-    _exit_if_all_failed(summary, db)
-
-
-def _fem_family(name: str) -> FEMFamily | None:
-    """The FEM family ``name`` of ``--family``; None for paper B's (the campaigns of before).
-
-    An unknown name is one error keyed ``family`` that lists the known families.
-    """
-    from softbend.errors import keyed
-    from softbend.fem.families import get_family
-
-    with keyed("family"):
-        fem_family = get_family(name)
-    return None if fem_family.name == "sfrba" else fem_family
-
-
-def _family_space(fem_family: FEMFamily, space: str | None, ranges: list[str] | None) -> Any:
-    """The checked ``--space`` (and ``--range``) of another family than paper B's."""
-    from softbend.campaign.family_spaces import parse_family_ranges, parse_family_space
-    from softbend.errors import InputError
-
-    if space is None:
-        raise InputError(
-            f"must be given for the {fem_family.name} family: one of {FAMILY_SPACE_FORMS} "
-            "over the ranges of its description",
-            key="space",
-        )
-    spec = parse_family_space(space, fem_family)
-    if ranges:
-        spec = spec.with_ranges(parse_family_ranges(ranges, fem_family))
-    return spec
-
-
-def _family_backend(
-    fem_family: FEMFamily,
-    backend: str | None,
-    model: Path | None,
-    chosen: ResolvedMaterial | None,
-    maxh: float | None,
-) -> Backend:
-    """The FEM sweep of ``fem_family`` with ``--maxh`` and ``--material`` (checked)."""
-    from softbend.campaign.families import family_backend
-    from softbend.errors import InputError
-
-    if backend not in (None, "fem"):
-        raise InputError(
-            f"must be fem for the {fem_family.name} family (its own FEM sweep); got {backend!r}",
-            key="backend",
-        )
-    if model is not None:
-        raise InputError(
-            f"applies to --backend surrogate of paper B's actuator; the {fem_family.name} "
-            f"family runs its FEM; got {str(model)!r}",
-            key="model",
-        )
-    if maxh is not None and (
-        isinstance(maxh, bool) or not (isinstance(maxh, int | float) and maxh > 0)
-    ):
-        raise InputError(f"must be a size > 0 mm; got {maxh!r}", key="maxh_mm")
-    material = None if chosen is None else chosen.material
-    return family_backend(fem_family, maxh_mm=maxh, material=material)
 
 
 def _exit_if_all_failed(summary: CampaignSummary, db: Path) -> None:

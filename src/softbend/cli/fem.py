@@ -3,7 +3,7 @@
 from __future__ import annotations
 
 from pathlib import Path
-from typing import TYPE_CHECKING, Annotated
+from typing import TYPE_CHECKING, Annotated, Any
 
 import typer
 
@@ -16,6 +16,8 @@ if TYPE_CHECKING:
 
     from softbend.fem import FEMOptions
     from softbend.fem.families import FEMFamily
+    from softbend.fem.run import FamilySweep
+    from softbend.fem.verification import MeshStudyRow
 
 app = typer.Typer(
     help="Nonlinear 3D finite-element model of the actuator.\n\n"
@@ -26,14 +28,11 @@ app = typer.Typer(
 )
 
 #: Solver statistics written by ``fem run`` beside the files of
-#: :func:`softbend.reports.fem_figures.sweep_with_files`; the marker of its folder.
+#: :func:`softbend.fem.run.sweep_with_files`; the marker of its folder.
 SWEEP_JSON = "sweep.json"
 
 #: Everything ``fem run`` writes into its ``--out`` folder (the last: the folder of VTK files).
 RUN_FILES: tuple[str, ...] = ("sweep.csv", SWEEP_JSON, "angle_pressure.png", "shapes.png", "vtk")
-
-#: Paper B's reference design, what ``--design`` sweeps for ``--family sfrba`` when not given.
-SFRBA_DESIGN = "100,6,2,2,5,10"
 
 DesignOption = Annotated[
     str | None,
@@ -78,15 +77,47 @@ MaterialOption = Annotated[
 ]
 
 
-def _options(
-    maxh: float, gravity: str, material: str = "dragon-skin-30", output: str = "interpolate"
-) -> FEMOptions:
-    from softbend.fem import FEMOptions
-    from softbend.materials.choice import material_from_spec
-
-    with keyed("material"):
-        elastomer = material_from_spec(material)
-    return FEMOptions(maxh_mm=maxh, gravity=gravity, elastomer=elastomer, output=output)
+PmaxOption = Annotated[
+    float | None,
+    typer.Option(
+        "--pmax", help="Largest pressure of the sweep's grid, MPa (default: the family's)."
+    ),
+]
+PstepOption = Annotated[
+    float | None,
+    typer.Option(
+        "--pstep", help="Pressure step of the sweep's grid (outputs), MPa (default: the family's)."
+    ),
+]
+OutOption = Annotated[
+    Path,
+    typer.Option(
+        "--out",
+        "-o",
+        help="Folder for the CSV, JSON, figures and VTK files (replaced as a whole: a new "
+        "or empty folder, or an earlier result of this command).",
+    ),
+]
+ShapesOption = Annotated[int, typer.Option("--shapes", help="Deformed shapes drawn and saved.")]
+SolveEveryOption = Annotated[
+    bool, typer.Option("--solve-every", help="Solve every output pressure (no interpolation).")
+]
+SizesOption = Annotated[
+    str | None,
+    typer.Option(
+        "--maxh",
+        help="Comma-separated element sizes, mm, coarse to fine (default sfrba 6,5,4,3; "
+        "pneunet 3,2.5,2).",
+    ),
+]
+PressuresOption = Annotated[
+    str | None,
+    typer.Option(
+        "--pressures",
+        help="Comma-separated pressures, MPa (default sfrba 0,0.05,0.1; pneunet "
+        "0,0.002,0.004,0.006: below the reference's touching walls).",
+    ),
+]
 
 
 def _family_options(
@@ -94,9 +125,10 @@ def _family_options(
     maxh: float | None,
     gravity: str | None,
     material: str | None,
-    output: str = "interpolate",
+    *,
+    solve_every: bool = False,
 ) -> FEMOptions:
-    """The options of a family other than paper B's, from its defaults and the given flags."""
+    """The options of ``family``, from its defaults and the given flags."""
     from softbend.materials.choice import material_from_spec
 
     changes: dict[str, object] = {"maxh_mm": family.maxh_mm if maxh is None else maxh}
@@ -105,7 +137,7 @@ def _family_options(
     if material is not None:
         with keyed("material"):
             changes["elastomer"] = material_from_spec(material)
-    changes["output"] = output
+    changes["output"] = "solve" if solve_every else "interpolate"
     return family.options(**changes)
 
 
@@ -122,36 +154,14 @@ def steps_reached(grid: np.ndarray, pressure_mpa: float) -> int:
 def run(
     design: DesignOption = None,
     family: FamilyOption = "sfrba",
-    pmax: Annotated[
-        float | None,
-        typer.Option(
-            "--pmax", help="Largest pressure of the sweep's grid, MPa (default: the family's)."
-        ),
-    ] = None,
-    pstep: Annotated[
-        float | None,
-        typer.Option(
-            "--pstep",
-            help="Pressure step of the sweep's grid (outputs), MPa (default: the family's).",
-        ),
-    ] = None,
-    out: Annotated[
-        Path,
-        typer.Option(
-            "--out",
-            "-o",
-            help="Folder for the CSV, JSON, figures and VTK files (replaced as a whole: a new "
-            "or empty folder, or an earlier result of this command).",
-        ),
-    ] = Path("results/fem"),
+    pmax: PmaxOption = None,
+    pstep: PstepOption = None,
+    out: OutOption = Path("results/fem"),
     maxh: MaxhOption = None,
     gravity: GravityOption = None,
     material: MaterialOption = None,
-    shapes: Annotated[int, typer.Option("--shapes", help="Deformed shapes drawn and saved.")] = 5,
-    solve_every: Annotated[
-        bool,
-        typer.Option("--solve-every", help="Solve every output pressure (no interpolation)."),
-    ] = False,
+    shapes: ShapesOption = 5,
+    solve_every: SolveEveryOption = False,
     json_output: Annotated[bool, typer.Option("--json", help="Print the sweep as JSON.")] = False,
 ) -> None:
     """Sweep one design from 0 MPa to --pmax with the FEM.
@@ -170,8 +180,8 @@ def run(
     With --family pneunet: a PneuNet, --design NAME=VALUE pairs (the reference
     PneuNet without); the sweep also stops where neighbouring chamber walls
     touch (the reason names the pressure). Its folder holds sweep.csv,
-    sweep.json, angle_pressure.png and vtk/ (no shapes.png); --json adds the
-    cavity volume of every converged step.
+    sweep.json, angle_pressure.png and vtk/ (no shapes.png, and no analytical
+    model on the curve); --json adds the cavity volume of every converged step.
 
     Example:
 
@@ -179,42 +189,43 @@ def run(
         softbend fem run --design 100,6,2,2,5,10 --pmax 0.2 --out fem
         softbend fem run --family pneunet --design n_chambers=6,wall_mm=1.5 --out pneunet
     """
-    from functools import partial
-
-    import numpy as np
-
-    from softbend._io import write_text_atomic
-    from softbend._outdir import staged_dir
     from softbend._validation import check_int
-    from softbend.design import parse_sfrba
     from softbend.fem.families import get_family
-    from softbend.fem.stats import fem_stats
     from softbend.models import default_pressures_mpa
-    from softbend.reports.fem_figures import family_sweep_with_files, sweep_with_files
 
     with keyed("family"):
         chosen = get_family(family)
-    paper_b = chosen.name == "sfrba"
-    output = "solve" if solve_every else "interpolate"
-    if paper_b:
-        actuator = parse_sfrba(design or SFRBA_DESIGN)
-        options = _options(
-            5.0 if maxh is None else maxh,
-            gravity or "bending",
-            material or "dragon-skin-30",
-            output=output,
-        )
-    else:
-        actuator = chosen.parse(design)
-        options = _family_options(chosen, maxh, gravity, material, output)
-    pmax = chosen.pmax_mpa if pmax is None else pmax
+    actuator = chosen.parse(design)
+    options = _family_options(chosen, maxh, gravity, material, solve_every=solve_every)
     pstep = chosen.pstep_mpa if pstep is None else pstep
-    pressures = default_pressures_mpa(pmax, pstep)
+    pressures = default_pressures_mpa(chosen.pmax_mpa if pmax is None else pmax, pstep)
     chosen.check_mesh(actuator, options)  # before NGSolve loads: a too fine --maxh is one line
     check_int(shapes, "shapes", low=1)
     out = Path(out)
     _common.check_output_dir(out, "--out", files=RUN_FILES[:-1])
     _common.check_replaceable_dir(out, "--out")
+    sweep = _sweep_into(out, chosen, actuator, pressures, options, shapes, quiet=json_output)
+    _print_sweep(sweep, pstep, out, json_output=json_output)
+
+
+def _sweep_into(
+    out: Path,
+    family: FEMFamily,
+    design: object,
+    pressures: np.ndarray,
+    options: FEMOptions,
+    shapes: int,
+    *,
+    quiet: bool,
+) -> FamilySweep:
+    """Sweep ``design`` into a stage swapped in as ``out``: files, figures and sweep.json."""
+    import numpy as np
+
+    from softbend._io import write_text_atomic
+    from softbend._outdir import staged_dir
+    from softbend.fem.run import sweep_summary, sweep_with_files
+    from softbend.reports.fem_figures import sweep_figures
+
     grid = np.sort(np.asarray(pressures, dtype=float))
     with (
         _common.output_errors(out, "--out"),
@@ -222,7 +233,7 @@ def run(
         _common.as_written(stage, out),
     ):
         with _common.progress_bar(
-            "FEM sweep (pressure steps)", int(grid.size), enabled=not json_output
+            "FEM sweep (pressure steps)", int(grid.size), enabled=not quiet
         ) as advance:
             state = {"done": 0}
 
@@ -233,9 +244,9 @@ def run(
                 )
                 state["done"] = max(done, state["done"])
 
-            with_files = sweep_with_files if paper_b else partial(family_sweep_with_files, chosen)
-            sweep = with_files(
-                actuator,
+            sweep = sweep_with_files(
+                family,
+                design,
                 pressures,
                 options,
                 stage,
@@ -243,31 +254,23 @@ def run(
                 vtk=True,
                 progress=on_step,
             )
-        result = sweep.result
-        stats = fem_stats(result)
-        summary = {
-            **({} if paper_b else {"family": chosen.name}),
-            "design": actuator.as_text(),
-            "stop_reason": stats["stop_reason"],
-            "max_pressure_mpa": result.max_pressure_mpa,
-            "max_angle_deg": result.max_angle_deg,
-            "wall_time_s": result.wall_time_s,
-            "elements": result.mesh_size,
-            "stats": result.stats,
-        }
-        write_text_atomic(stage / SWEEP_JSON, _common.json_text(summary))
+        sweep_figures(sweep, stage)
+        write_text_atomic(stage / SWEEP_JSON, _common.json_text(sweep_summary(sweep)))
+    return sweep
+
+
+def _print_sweep(sweep: FamilySweep, pstep: float, out: Path, *, json_output: bool) -> None:
+    """The sweep as JSON, or its table (about ten rows) and one line of solver statistics."""
+    from softbend.fem.run import sweep_summary
+    from softbend.fem.stats import fem_stats
+
+    result = sweep.result
     if json_output:
-        _common.print_json(
-            {**summary, "pressure_mpa": result.pressure_mpa, "angle_deg": result.angle_deg}
-        )
+        extra = {"pressure_mpa": result.pressure_mpa, "angle_deg": result.angle_deg}
+        _common.print_json({**sweep_summary(sweep), **extra})
         return
-    title = (
-        f"FEM sweep of ({actuator.as_text()})"
-        if paper_b
-        else f"FEM sweep of the {chosen.name} ({actuator.as_text()})"
-    )
-    # Paper B: a row every 0.02 MPa; another family: about ten rows over its sweep.
-    every = max(1, round(0.02 / pstep)) if paper_b else max(1, len(result.pressure_mpa) // 10)
+    stats = fem_stats(result)
+    every = max(1, len(result.pressure_mpa) // 10)
     rows = [
         [f"{p:.3f}", f"{a:.2f}", f"{x:.1f}", f"{z:.1f}", int(i)]
         for p, a, x, z, i in zip(
@@ -281,7 +284,7 @@ def run(
         if round(p / pstep) % every == 0
     ]
     _common.print_table(
-        title,
+        f"FEM sweep of the {sweep.family.name} ({sweep.design.as_text()})",
         ["pressure MPa", "angle °", "tip x mm", "tip z mm", "Newton its"],
         rows,
     )
@@ -298,22 +301,8 @@ def run(
 def mesh_study(
     design: DesignOption = None,
     family: FamilyOption = "sfrba",
-    maxh: Annotated[
-        str | None,
-        typer.Option(
-            "--maxh",
-            help="Comma-separated element sizes, mm, coarse to fine (default sfrba 6,5,4,3; "
-            "pneunet 3,2.5,2).",
-        ),
-    ] = None,
-    pressures: Annotated[
-        str | None,
-        typer.Option(
-            "--pressures",
-            help="Comma-separated pressures, MPa (default sfrba 0,0.05,0.1; pneunet "
-            "0,0.002,0.004,0.006: below the reference's touching walls).",
-        ),
-    ] = None,
+    maxh: SizesOption = None,
+    pressures: PressuresOption = None,
     gravity: GravityOption = None,
     material: MaterialOption = None,
     json_output: Annotated[bool, typer.Option("--json", help="Print the table as JSON.")] = False,
@@ -328,42 +317,21 @@ def mesh_study(
     \b
         softbend fem mesh-study --maxh 6,5,4,3 --pressures 0,0.05,0.1
     """
-    from softbend.design import parse_sfrba
     from softbend.fem.families import get_family
     from softbend.fem.verification import mesh_study as study
 
     with keyed("family"):
         chosen = get_family(family)
-    default_maxh, default_pressures = _MESH_STUDY_DEFAULTS.get(
-        chosen.name,
-        (
-            f"{1.5 * chosen.maxh_mm:g},{chosen.maxh_mm:g},{0.75 * chosen.maxh_mm:g}",
-            f"0,{chosen.pmax_mpa / 2:g},{chosen.pmax_mpa:g}",
-        ),
-    )
-    sizes = _floats(maxh or default_maxh, "maxh")
-    grid = _floats(pressures or default_pressures, "pressures")
-    if chosen.name == "sfrba":
-        actuator = parse_sfrba(design or SFRBA_DESIGN)
-        options = _options(4.0, gravity or "bending", material or "dragon-skin-30")
-    else:
-        actuator = chosen.parse(design)
-        options = _family_options(chosen, None, gravity, material)
+    default_maxh, default_pressures = chosen.mesh_study_defaults()
+    sizes = _floats(maxh, "maxh") if maxh else list(default_maxh)
+    grid = _floats(pressures, "pressures") if pressures else list(default_pressures)
+    actuator = chosen.parse(design)
+    options = _family_options(chosen, None, gravity, material)
     for h in sizes:  # a too fine size is one line before any sweep
         chosen.check_mesh(actuator, options.replace(maxh_mm=h))
     with _common.progress_bar("mesh sizes", len(sizes), enabled=not json_output) as advance:
         rows = study(actuator, sizes, grid, options, progress=lambda d, n: advance())
-    table = []
-    for i, row in enumerate(rows):
-        change = (
-            [
-                abs(a - b) / abs(b) * 100 if b else float("nan")
-                for a, b in zip(row.angles_deg, rows[i - 1].angles_deg, strict=True)
-            ]
-            if i
-            else [float("nan")] * len(grid)
-        )
-        table.append({**row.__dict__, "change_pct": change})
+    table = _mesh_table(rows, len(grid))
     if json_output:
         _common.print_json({"design": actuator.as_text(), "pressures_mpa": grid, "rows": table})
         return
@@ -381,12 +349,20 @@ def mesh_study(
     )
 
 
-#: ``fem mesh-study``'s default sizes and pressures by family (others: 1.5, 1 and 0.75
-#: times the family's maxh; 0, half and all of its pmax).
-_MESH_STUDY_DEFAULTS: dict[str, tuple[str, str]] = {
-    "sfrba": ("6,5,4,3", "0,0.05,0.1"),
-    "pneunet": ("3,2.5,2", "0,0.002,0.004,0.006"),
-}
+def _mesh_table(rows: list[MeshStudyRow], n_pressures: int) -> list[dict[str, Any]]:
+    """The study's rows with the change of each angle from the previous size, %."""
+    table = []
+    for i, row in enumerate(rows):
+        change = (
+            [
+                abs(a - b) / abs(b) * 100 if b else float("nan")
+                for a, b in zip(row.angles_deg, rows[i - 1].angles_deg, strict=True)
+            ]
+            if i
+            else [float("nan")] * n_pressures
+        )
+        table.append({**row.__dict__, "change_pct": change})
+    return table
 
 
 def _floats(text: str, key: str) -> list[float]:

@@ -208,7 +208,7 @@ def _training_source(
     ranges: list[str],
 ) -> Path | TrainingData:
     """The campaign path, or a dataset's or table's training data (checked before anything runs)."""
-    from softbend.family_datasets import is_dataset_name
+    from softbend.datasets import is_dataset_name
     from softbend.surrogates.features import dataset_training_data
     from softbend.surrogates.simulation_table import TABLE_SUFFIXES
 

@@ -9,10 +9,12 @@ minimisation) → ``sweep`` (load stepping, :func:`simulate`) → ``model``
 
 Each kind of actuator the FEM simulates is a family of :mod:`softbend.fem.families`
 (:func:`get_family`, ``--family``): its actuator description, how it makes a design,
-sweeps it and reads the angle. Paper B's fiber-reinforced actuator (``"sfrba"``) is the
-pipeline above; the PneuNet (``"pneunet"``, :mod:`softbend.fem.pneunet`) reuses the
-energy terms and the load stepping with its own geometry and readout
-(:class:`PneuNetModel`, :func:`run_pneunet_sweep`).
+sweeps it and reads the angle, each used the same way (:mod:`softbend.fem.run`
+sweeps one into a folder). Paper B's fiber-reinforced actuator (``"sfrba"``,
+:mod:`softbend.fem.sfrba`: its reference, its analytical model to compare with,
+:func:`simulate`) is the pipeline above; the PneuNet (``"pneunet"``,
+:mod:`softbend.fem.pneunet`) reuses the energy terms and the load stepping with
+its own geometry and readout (:class:`PneuNetModel`, :func:`run_pneunet_sweep`).
 
 Names are imported lazily, so ``import softbend.fem`` is light and the
 pure-Python parts work without NGSolve: :class:`FEMOptions`, the typed solver
@@ -37,8 +39,8 @@ if TYPE_CHECKING:
     from softbend.fem.options import GRAVITY_DIRECTIONS, OUTPUT_MODES, FEMOptions
     from softbend.fem.pneunet.model import PneuNetModel
     from softbend.fem.pneunet.sweep import run_pneunet_sweep
+    from softbend.fem.sfrba.sweep import simulate
     from softbend.fem.stats import FEMStats, FEMTimings, fem_stats
-    from softbend.fem.sweep import simulate
 
 #: Public name → submodule that defines it.
 _EXPORTS = {
@@ -55,7 +57,7 @@ _EXPORTS = {
     "GRAVITY_DIRECTIONS": "options",
     "OUTPUT_MODES": "options",
     "fem_stats": "stats",
-    "simulate": "sweep",
+    "simulate": "softbend.fem.sfrba.sweep",
     "use_compiled": "energy",
 }
 

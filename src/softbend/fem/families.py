@@ -7,8 +7,11 @@ pipeline uses), a reference design, the pressures a sweep covers by default, how
 a design is checked, and the sweep itself (geometry, material regions, cavity
 surfaces loaded by a follower pressure, fixture and bending-angle readout live
 behind :attr:`FEMFamily.sweep`). Paper B's fiber-reinforced actuator is the
-first family (``"sfrba"``), the PneuNet the second; a family's designs are
-:class:`~softbend.actuators.Design` objects of its actuator, checked by the family.
+first family (``"sfrba"``, :mod:`softbend.fem.sfrba`), the PneuNet the second
+(``"pneunet"``, :mod:`softbend.fem.pneunet`); every command and the campaign
+use both the same way, reading what differs (positional ``--design`` text, an
+analytical model to compare with, outlines of the deformed shapes, mesh-study
+defaults) from the family.
 
 Adding a family is one module that builds a :class:`FEMFamily` and calls
 ``FEM_FAMILIES.register(name, family)``; importing this module never imports
@@ -18,17 +21,17 @@ NGSolve (a family's sweep imports it when it runs).
 from __future__ import annotations
 
 import math
-from collections.abc import Callable, Mapping
+from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass
 from typing import TYPE_CHECKING, Any
 
 from softbend._validation import must_be
 from softbend.actuators import SFRBA, Design
-from softbend.design import sfrba_design
 from softbend.errors import InputError
 from softbend.registry import Registry
 
 if TYPE_CHECKING:
+    import numpy as np
     from numpy.typing import ArrayLike
 
     from softbend.actuators import Actuator
@@ -37,7 +40,10 @@ if TYPE_CHECKING:
 
 __all__ = [
     "FEM_FAMILIES",
+    "FIRST_FAMILY",
     "FEMFamily",
+    "family_name_of",
+    "family_of",
     "get_family",
     "parse_assignments",
 ]
@@ -76,13 +82,37 @@ class FEMFamily:
         defaults (strain-limiting layer, gravity, ...); plain :class:`FEMOptions`
         when absent.
     mesh_check : callable, optional
-        ``mesh_check(design, options)``: refuse, before NGSolve loads, a
-        ``maxh_mm`` that would mesh ``design`` with too many elements (one
-        :class:`~softbend.errors.InputError` keyed ``maxh_mm``); no check when absent.
+        ``mesh_check(designs, options)``: refuse, before NGSolve loads, a
+        ``maxh_mm`` that would mesh one of the sequence ``designs`` with too many
+        elements (one :class:`~softbend.errors.InputError` keyed ``maxh_mm``);
+        no check when absent.
+    parse_text : callable, optional
+        ``parse_text(text) -> design``: the family's own ``--design`` text when
+        it is not ``NAME=VALUE`` pairs (paper B's positional ``100,6,2,2,5,10``);
+        absent: :func:`parse_assignments`.
+    analytical : callable, optional
+        ``analytical(design, pressures_mpa) -> SweepResult``: a closed-form model
+        an FEM sweep is compared with (drawn beside it); absent: none.
+    outline : callable, optional
+        ``outline(model) -> ndarray (m, 2)``: the side outline, mm, of the
+        model's current state in the bending plane (``fem run`` draws the
+        deformed shapes with it); absent: no shapes are drawn.
+    campaign_pmax_mpa : float, optional
+        Largest pressure of a campaign's default grid, MPa (step ``pstep_mpa``);
+        None: ``pmax_mpa``.
+    recorded : bool, default True
+        A campaign database of its designs records the family's name and
+        description (its ``meta`` table). False for paper B's: its databases are
+        those written before families were recorded, and a database that names
+        no family holds its designs (:data:`FIRST_FAMILY`).
     backends : tuple of str, optional
         The campaign backends that sweep the family's designs (a design search's
         ``--verify``); None: every registered backend (paper B's actuator, which its
-        analytical model also sweeps). Default: the FEM only.
+        analytical model also sweeps). Default: the FEM only, its own sweep.
+    mesh_study_maxh_mm, mesh_study_pressures_mpa : tuple of float, optional
+        ``fem mesh-study``'s default element sizes (mm, coarse to fine) and
+        pressures (MPa); empty: 1.5, 1 and 0.75 times ``maxh_mm`` and 0, half
+        and all of ``pmax_mpa``.
     """
 
     name: str
@@ -95,7 +125,14 @@ class FEMFamily:
     make_design: Callable[[dict[str, float]], Design]
     sweep: Callable[..., tuple[SweepResult, Any, Any]]
     default_options: Callable[..., FEMOptions] | None = None
-    mesh_check: Callable[[Design, FEMOptions], None] | None = None
+    mesh_check: Callable[[Sequence[Design], FEMOptions], None] | None = None
+    parse_text: Callable[[str], Design] | None = None
+    analytical: Callable[[Any, ArrayLike], SweepResult] | None = None
+    outline: Callable[[Any], np.ndarray] | None = None
+    mesh_study_maxh_mm: tuple[float, ...] = ()
+    mesh_study_pressures_mpa: tuple[float, ...] = ()
+    campaign_pmax_mpa: float | None = None
+    recorded: bool = True
     backends: tuple[str, ...] | None = ("fem",)
 
     @property
@@ -127,8 +164,19 @@ class FEMFamily:
         return self.make_design(merged)
 
     def parse(self, text: str | None) -> Design:
-        """The design of ``"NAME=VALUE,..."`` (None or empty: the reference design)."""
+        """The design of ``"NAME=VALUE,..."`` or the family's own text (None or empty: the
+        reference design)."""
+        if text and self.parse_text is not None:
+            return self.parse_text(text)
         return self.design(parse_assignments(text or "", self.names))
+
+    def mesh_study_defaults(self) -> tuple[tuple[float, ...], tuple[float, ...]]:
+        """``fem mesh-study``'s default element sizes (mm) and pressures (MPa)."""
+        h, p = self.maxh_mm, self.pmax_mpa
+        return (
+            self.mesh_study_maxh_mm or (1.5 * h, h, 0.75 * h),
+            self.mesh_study_pressures_mpa or (0.0, p / 2, p),
+        )
 
     def options(self, **overrides: Any) -> FEMOptions:
         """The family's default :class:`FEMOptions`, with ``overrides``."""
@@ -140,8 +188,25 @@ class FEMFamily:
 
     def check_mesh(self, design: Design, options: FEMOptions) -> None:
         """Refuse ``options.maxh_mm`` if it meshes ``design`` too finely (see ``mesh_check``)."""
+        self.check_meshes([design], options)
+
+    def check_meshes(self, designs: Sequence[Design], options: FEMOptions) -> None:
+        """Refuse ``options.maxh_mm`` if it meshes one of ``designs`` too finely."""
         if self.mesh_check is not None:
-            self.mesh_check(design, options)
+            self.mesh_check(designs, options)
+
+    def campaign_pressures_mpa(
+        self, pmax_mpa: float | None = None, pstep_mpa: float | None = None
+    ) -> np.ndarray:
+        """A campaign's pressure grid, MPa: 0 to ``pmax_mpa`` by ``pstep_mpa``.
+
+        None takes the family's: ``campaign_pmax_mpa`` (else ``pmax_mpa``) and ``pstep_mpa``.
+        """
+        from softbend.models import default_pressures_mpa
+
+        if pmax_mpa is None:
+            pmax_mpa = self.pmax_mpa if self.campaign_pmax_mpa is None else self.campaign_pmax_mpa
+        return default_pressures_mpa(pmax_mpa, self.pstep_mpa if pstep_mpa is None else pstep_mpa)
 
     def simulate(
         self,
@@ -196,41 +261,43 @@ def get_family(name: str) -> FEMFamily:
     return FEM_FAMILIES.get(name)
 
 
-def _sfrba_design(values: dict[str, float]) -> Design:
-    return sfrba_design(**values)
+#: The family of a design that names none: paper B's, the first.
+FIRST_FAMILY = "sfrba"
 
 
-def _sfrba_sweep(
-    design: Design, pressures_mpa: ArrayLike, options: FEMOptions | None = None, **kwargs: Any
-) -> tuple[SweepResult, Any, Any]:
-    from softbend.fem.sweep import run_sweep
+def family_name_of(design: object) -> str:
+    """The registry name of ``design``'s FEM family: its actuator's ``fem_family``, else its
+    ``family``, else :data:`FIRST_FAMILY`."""
+    named = getattr(getattr(design, "actuator", None), "fem_family", None)
+    return str(named or getattr(design, "family", None) or FIRST_FAMILY)
 
-    return run_sweep(design, pressures_mpa, options, **kwargs)
 
-
-def _sfrba_mesh_check(design: Design, options: FEMOptions) -> None:
-    options.check_mesh(design)
+def family_of(design: object) -> FEMFamily:
+    """The registered FEM family of ``design`` (see :func:`family_name_of`)."""
+    return get_family(family_name_of(design))
 
 
 def _register_paper_b() -> FEMFamily:
+    from softbend.fem.sfrba import description as sfrba
+
     family = FEMFamily(
         name="sfrba",
         title=SFRBA.title,
         actuator=SFRBA,
-        reference={
-            "l_mm": 100.0,
-            "r_mm": 6.0,
-            "t_mm": 2.0,
-            "b_mm": 2.0,
-            "phi_deg": 5.0,
-            "lc_mm": 10.0,
-        },
+        reference=sfrba.REFERENCE,
         pmax_mpa=0.2,
         pstep_mpa=0.005,
         maxh_mm=5.0,
-        make_design=_sfrba_design,
-        sweep=_sfrba_sweep,
-        mesh_check=_sfrba_mesh_check,
+        make_design=sfrba.make_sfrba_design,
+        sweep=sfrba.sfrba_sweep,
+        mesh_check=sfrba.sfrba_mesh_check,
+        parse_text=sfrba.parse_sfrba_design,
+        analytical=sfrba.analytical_sweep,
+        outline=sfrba.sfrba_outline,
+        mesh_study_maxh_mm=sfrba.MESH_STUDY_MAXH_MM,
+        mesh_study_pressures_mpa=sfrba.MESH_STUDY_PRESSURES_MPA,
+        campaign_pmax_mpa=sfrba.CAMPAIGN_PMAX_MPA,
+        recorded=False,
         backends=None,
     )
     return FEM_FAMILIES.register(family.name, family)
@@ -249,10 +316,11 @@ def _pneunet_sweep(
     return run_pneunet_sweep(design, pressures_mpa, options or pneunet_options(), **kwargs)
 
 
-def _pneunet_mesh_check(design: Design, options: FEMOptions) -> None:
+def _pneunet_mesh_check(designs: Sequence[Design], options: FEMOptions) -> None:
     from softbend.fem.pneunet.geometry import check_pneunet_mesh
 
-    check_pneunet_mesh(design, options.maxh_mm, options.base_cap_mm)
+    for design in designs:
+        check_pneunet_mesh(design, options.maxh_mm, options.base_cap_mm)
 
 
 def _register_pneunet() -> FEMFamily:
@@ -271,6 +339,8 @@ def _register_pneunet() -> FEMFamily:
         sweep=_pneunet_sweep,
         default_options=pneunet.pneunet_options,
         mesh_check=_pneunet_mesh_check,
+        mesh_study_maxh_mm=pneunet.MESH_STUDY_MAXH_MM,
+        mesh_study_pressures_mpa=pneunet.MESH_STUDY_PRESSURES_MPA,
     )
     return FEM_FAMILIES.register(family.name, family)
 

@@ -10,7 +10,7 @@ from softbend.actuators import Design
 from softbend.errors import InputError
 from softbend.fem.energy import use_compiled
 from softbend.fem.options import FEMOptions
-from softbend.fem.sweep import simulate
+from softbend.fem.sfrba.sweep import simulate
 from softbend.models import SweepResult
 
 __all__ = ["FEMModel"]

@@ -1,4 +1,4 @@
-"""Load stepping: the pressure sweep of one design, ``simulate(design, pressures)``.
+"""Load stepping: the pressure sweep of one design of any FEM family (``run_model_sweep``).
 
 1. Gravity is applied first, followed in growing fractions of the weight the
    same way as the pressure below; that state is the 0 MPa output.
@@ -45,9 +45,7 @@ from typing import TYPE_CHECKING, Any, cast
 import numpy as np
 from numpy.typing import ArrayLike
 
-from softbend._validation import must_be
-from softbend.actuators import SFRBA, Design
-from softbend.errors import ConvergenceError, InputError
+from softbend.errors import ConvergenceError
 from softbend.fem._ngsolve import require_ngsolve
 from softbend.fem.actuator import ActuatorModel
 from softbend.fem.options import FEMOptions
@@ -64,7 +62,7 @@ if TYPE_CHECKING:
 
 require_ngsolve()  # NGSolve after PyTorch, or one line naming softbend[fem]
 
-__all__ = ["Step", "StepHistory", "run_model_sweep", "run_sweep", "simulate"]
+__all__ = ["ProgressCallback", "Step", "StepHistory", "run_model_sweep"]
 
 logger = logging.getLogger(__name__)
 
@@ -396,73 +394,6 @@ def _next_step(dp: float, miss_mm: float, options: FEMOptions) -> float:
     return min(options.max_step_mpa, max(options.min_step_mpa, factor * dp))
 
 
-def simulate(
-    design: Design,
-    pressures_mpa: ArrayLike,
-    options: FEMOptions | None = None,
-    *,
-    progress: ProgressCallback | None = None,
-) -> SweepResult:
-    """Sweep the FEM model of ``design`` over increasing pressures.
-
-    Parameters
-    ----------
-    design : Design
-        The actuator (l, r, t, b, φ, lc).
-    pressures_mpa : array_like
-        Requested gauge pressures, MPa, strictly increasing from 0 or above.
-    options : FEMOptions, optional
-        Modelling assumptions and solver settings (defaults documented there).
-    progress : callable, optional
-        ``progress(pressure_mpa, angle_deg, pmax_mpa)`` after each converged step.
-
-    Returns
-    -------
-    SweepResult
-        One entry per requested pressure up to where the sweep stopped. Angle by
-        the arc fit of the backbone (degrees), tip in the frame of
-        :func:`softbend.analytical.tip_position_mm` (mm), Newton iterations of
-        the step that reached each pressure, ``mesh_size`` = tetrahedra of the
-        half model. ``stats`` holds the steps, the stop reason, the degrees of
-        freedom and the time spent in assembly and factorisation: the keys of
-        :class:`~softbend.fem.stats.FEMStats` (read it with
-        :func:`~softbend.fem.stats.fem_stats`).
-
-    Raises
-    ------
-    ConvergenceError
-        If the gravity-only state does not converge.
-    ValueError
-        For a bad pressure grid or options.
-    """
-    result, _, _ = run_sweep(design, pressures_mpa, options, progress=progress)
-    return result
-
-
-def run_sweep(
-    design: Design,
-    pressures_mpa: ArrayLike,
-    options: FEMOptions | None = None,
-    *,
-    progress: ProgressCallback | None = None,
-    keep_states: bool = False,
-) -> tuple[SweepResult, ActuatorModel, StepHistory]:
-    """:func:`simulate`, also returning the model and the converged steps.
-
-    With ``keep_states=True`` every step keeps its displacement vector, so the
-    deformed shapes can be drawn or exported (``model.set_state(step.state)``).
-    """
-    options = options or FEMOptions()
-    if not isinstance(options, FEMOptions):
-        raise InputError(must_be("FEMOptions", options), key="options")
-    if not isinstance(design, Design) or design.actuator != SFRBA:
-        raise InputError(must_be("a Design of paper B's actuator", design), key="design")
-    result, model, history = run_model_sweep(
-        ActuatorModel, design, pressures_mpa, options, progress=progress, keep_states=keep_states
-    )
-    return result, cast(ActuatorModel, model), history
-
-
 def run_model_sweep(
     build: Callable[[Any, FEMOptions], SweepModel],
     design: Any,
@@ -474,7 +405,7 @@ def run_model_sweep(
 ) -> tuple[SweepResult, SweepModel, StepHistory]:
     """The sweep of the model ``build(design, options)`` (any FEM family's model).
 
-    The load stepping of :func:`run_sweep` on the model the family builds
+    The load stepping above on the model the family builds
     (one with the interface of :class:`ActuatorModel`); ``design`` and
     ``options`` are checked by the caller.
     """

@@ -23,7 +23,7 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
-from softbend.actuators import SFRBA, Design
+from softbend.actuators import Design
 from softbend.errors import ConvergenceError, InputError
 from softbend.fem._ngsolve import require_ngsolve
 from softbend.fem.mechanics import solid_energy, volume_flux
@@ -310,29 +310,20 @@ def mesh_study(
     """Bending angle at ``pressures_mpa`` for each element size in ``maxh_mm``.
 
     Each size runs the sweep of the design's FEM family
-    (:func:`softbend.fem.simulate` for paper B's actuator, the family's
-    :attr:`~softbend.fem.families.FEMFamily.sweep` for another) over ``pressures_mpa`` with
+    (:attr:`~softbend.fem.families.FEMFamily.sweep`, the family of
+    :func:`~softbend.fem.families.family_of`) over ``pressures_mpa`` with
     ``output="solve"`` (every pressure a Newton solve), so only the mesh
     differs. The relative change between consecutive rows is the convergence
     measure. ``options`` None: the family's defaults.
     """
-    from softbend.fem.families import get_family
-    from softbend.fem.options import FEMOptions
+    from softbend.fem.families import family_of
     from softbend.fem.stats import fem_stats
-    from softbend.fem.sweep import simulate
 
-    run: Callable[[FEMOptions], SweepResult]
-    if design.actuator != SFRBA:
-        family = get_family(str(design.actuator.fem_family))
-        options = options or family.options()
+    family = family_of(design)
+    options = options or family.options()
 
-        def run(opts: FEMOptions) -> SweepResult:
-            return family.sweep(design, pressures_mpa, opts)[0]
-    else:
-        options = options or FEMOptions()
-
-        def run(opts: FEMOptions) -> SweepResult:
-            return simulate(design, pressures_mpa, opts)
+    def run(opts: FEMOptions) -> SweepResult:
+        return family.sweep(design, pressures_mpa, opts)[0]
 
     sizes = [options.replace(maxh_mm=h).maxh_mm for h in maxh_mm]  # FEMOptions' rule
     if not sizes:

@@ -4,14 +4,13 @@ from __future__ import annotations
 
 import time
 from collections.abc import Callable, Sequence
-from dataclasses import dataclass, field
+from dataclasses import dataclass
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
-import numpy as np
-
 from softbend.actuators import Design
 from softbend.design import parse_sfrba
+from softbend.fem.run import FamilySweep
 from softbend.pipeline import Progress
 from softbend.references import FEM_VALIDATION
 
@@ -20,7 +19,6 @@ if TYPE_CHECKING:  # pragma: no cover
 
     from softbend.fem.options import FEMOptions
     from softbend.materials import FitResult, TensileTest
-    from softbend.models import SweepResult
 
 __all__ = ["FIG2_DESIGN", "FIG2_PMAX_MPA", "FEMSweep", "Fig2", "run_fig2", "sweep_with_shapes"]
 
@@ -30,33 +28,9 @@ FIG2_DESIGN: str = FEM_VALIDATION["design"].value
 FIG2_PMAX_MPA: float = FEM_VALIDATION["pmax_mpa"].value
 
 
-@dataclass(frozen=True)
-class FEMSweep:
-    """One FEM sweep of :func:`sweep_with_shapes` and what it was compared with.
-
-    Attributes
-    ----------
-    result, analytical : SweepResult
-        The FEM sweep and the analytical model's on the same grid.
-    outlines : list of (float, ndarray)
-        ``(pressure MPa, closed outline (m, 2) in mm)`` in the bending plane at
-        the converged steps nearest to the requested shape pressures.
-    steps : int
-        Load steps of the sweep (the gravity step not counted).
-    files : dict
-        ``{"csv": path}``, and ``"vtk"`` (list of paths) when exported.
-    """
-
-    result: SweepResult
-    analytical: SweepResult
-    outlines: list[tuple[float, np.ndarray]]
-    steps: int
-    files: dict[str, Any] = field(default_factory=dict)
-
-    @property
-    def shape_pressures_mpa(self) -> list[float]:
-        """Pressures of the outlines, MPa."""
-        return [p for p, _ in self.outlines]
+#: One FEM sweep of :func:`sweep_with_shapes`, the analytical model's on the same
+#: grid and the deformed outlines (:class:`softbend.fem.run.FamilySweep`).
+FEMSweep = FamilySweep
 
 
 def sweep_with_shapes(
@@ -69,57 +43,29 @@ def sweep_with_shapes(
     prefix: str = "",
     vtk: bool = False,
     progress: Callable[[float, float, float], None] | None = None,
-) -> FEMSweep:
-    """Sweep one design with the FEM; keep the analytical curve and the deformed outlines.
+) -> FamilySweep:
+    """Sweep one design of paper B's family with the FEM; keep the analytical curve and the
+    deformed outlines (:func:`softbend.fem.run.sweep_with_files`, ``options`` None: the
+    family's).
 
     Writes ``<prefix>sweep.csv`` (pressure, angle, tip, converged, Newton
     iterations) and with ``vtk`` the shapes as ``vtk/shape_p<MPa>MPa.vtu``.
-
-    Parameters
-    ----------
-    design : Design
-    pressures_mpa : array_like
-        Output pressures, MPa, increasing.
-    options : FEMOptions or None
-    out_dir : path
-        Folder of the files (created).
-    shape_pressures_mpa : sequence of float or int
-        Where to take the shape, MPa; an integer ``n`` takes ``n`` shapes evenly
-        spaced from 0 to the last converged step.
-    prefix : str
-        Start of every file name.
-    vtk : bool
-        Also export the shapes as VTK.
-    progress : callable, optional
-        ``progress(pressure_mpa, angle_deg, target_mpa)`` after each load step.
     """
-    from softbend.analytical import AnalyticalModel
-    from softbend.fem.export import silhouette_mm, vtk_file_name, write_sweep_csv, write_vtk
-    from softbend.fem.sweep import run_sweep
+    from softbend.fem.families import get_family
+    from softbend.fem.run import sweep_with_files
 
-    out = Path(out_dir)
-    out.mkdir(parents=True, exist_ok=True)
-    result, model, history = run_sweep(
-        design, pressures_mpa, options, progress=progress, keep_states=True
+    family = get_family("sfrba")
+    return sweep_with_files(
+        family,
+        design,
+        pressures_mpa,
+        options or family.options(),
+        out_dir,
+        shape_pressures_mpa=shape_pressures_mpa,
+        prefix=prefix,
+        vtk=vtk,
+        progress=progress,
     )
-    files: dict[str, Any] = {"csv": write_sweep_csv(result, out / f"{prefix}sweep.csv")}
-    analytical = AnalyticalModel().sweep(design, pressures_mpa)
-    shapes = (
-        np.linspace(0.0, history.pressures[-1], shape_pressures_mpa)
-        if isinstance(shape_pressures_mpa, int)
-        else shape_pressures_mpa
-    )
-    outlines, vtk_files = [], []
-    for chosen in history.nearest_steps(shapes):
-        assert chosen.state is not None  # run_sweep kept the state of every step
-        model.set_state(chosen.state)
-        outlines.append((float(chosen.pressure_mpa), silhouette_mm(model)))
-        if vtk:
-            p = float(chosen.pressure_mpa)
-            vtk_files.append(write_vtk(model, out / "vtk" / vtk_file_name(p), pressure_mpa=p))
-    if vtk:
-        files["vtk"] = vtk_files
-    return FEMSweep(result, analytical, outlines, len(history.steps) - 1, files)
 
 
 @dataclass(frozen=True)
@@ -157,6 +103,7 @@ class Fig2:
 def _angles_at(sweep: FEMSweep, pmax_mpa: float) -> list[tuple[float, float, float]]:
     """(pressure, FEM angle, analytical angle) at the round pressures the sweep converged on."""
     result, analytical = sweep.result, sweep.analytical
+    assert analytical is not None  # paper B's family has its analytical model
     picks = sorted({p for p in (0.0, 0.05, 0.10, 0.15, pmax_mpa) if p <= pmax_mpa})
     rows = []
     for p in picks:

@@ -218,7 +218,7 @@ def run_pneunet(
         Designs the FEM verifies (0: none, for a quick run); a sweep that stops
         before the target's pressure is replaced by the next design's.
     """
-    from softbend.family_datasets import family_dataset, family_dataset_designs
+    from softbend.datasets import family_dataset, family_dataset_designs
     from softbend.fem.verification import mesh_study
 
     start = time.perf_counter()

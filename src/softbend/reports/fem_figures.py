@@ -2,31 +2,20 @@
 
 from __future__ import annotations
 
-from collections.abc import Callable, Sequence
-from dataclasses import dataclass, field
+from collections.abc import Sequence
 from pathlib import Path
-from typing import TYPE_CHECKING, Any
+from typing import TYPE_CHECKING
 
 import numpy as np
 
-from softbend.actuators import Design
 from softbend.fem.stats import fem_stats
 from softbend.models import SweepResult
 from softbend.reports.analysis_figures import _figure, _save
 
 if TYPE_CHECKING:
-    from numpy.typing import ArrayLike
+    from softbend.fem.run import FamilySweep
 
-    from softbend.fem.families import FEMFamily
-    from softbend.fem.options import FEMOptions
-
-__all__ = [
-    "FEMSweepFiles",
-    "angle_pressure_curve",
-    "deformed_shapes",
-    "family_sweep_with_files",
-    "sweep_with_files",
-]
+__all__ = ["angle_pressure_curve", "deformed_shapes", "sweep_figures"]
 
 
 def angle_pressure_curve(
@@ -103,160 +92,30 @@ def deformed_shapes(
     return _save(fig, path)
 
 
-@dataclass(frozen=True)
-class FEMSweepFiles:
-    """One FEM sweep of :func:`sweep_with_files`, what it was compared with and its files.
+def sweep_figures(sweep: FamilySweep, out_dir: str | Path, *, prefix: str = "") -> dict[str, Path]:
+    """Draw one FEM sweep of :func:`softbend.fem.run.sweep_with_files` into ``out_dir``.
 
-    Attributes
-    ----------
-    result, analytical : SweepResult
-        The FEM sweep and the analytical model's on the same grid.
-    shape_pressures_mpa : list of float
-        Pressures of the converged steps whose shapes were drawn (and exported).
-    steps : int
-        Load steps of the sweep (the gravity step not counted).
-    files : dict
-        ``{"csv", "curve", "shapes"}`` paths, and ``"vtk"`` paths when exported.
+    ``<prefix>angle_pressure.png`` (with the family's analytical model when it
+    has one) and, when the family draws outlines, ``<prefix>shapes.png`` (the
+    deformed actuator at the kept steps, paper B Fig. 2b).
+
+    Returns
+    -------
+    dict
+        ``{"curve"}`` and, with outlines, ``{"shapes"}`` paths.
     """
-
-    result: SweepResult
-    analytical: SweepResult
-    shape_pressures_mpa: list[float]
-    steps: int
-    files: dict[str, Any] = field(default_factory=dict)
-
-
-def sweep_with_files(
-    design: Design,
-    pressures_mpa: ArrayLike,
-    options: FEMOptions | None,
-    out_dir: str | Path,
-    *,
-    shape_pressures_mpa: Sequence[float] | int,
-    prefix: str = "",
-    vtk: bool = False,
-    progress: Callable[[float, float, float], None] | None = None,
-) -> FEMSweepFiles:
-    """Sweep one design with the FEM and write what a person looks at.
-
-    Writes ``<prefix>sweep.csv`` (pressure, angle, tip, converged, Newton
-    iterations), ``<prefix>angle_pressure.png`` (with the analytical model) and
-    ``<prefix>shapes.png`` (the deformed actuator at the converged steps nearest
-    to ``shape_pressures_mpa``, paper B Fig. 2b), and with ``vtk`` the same
-    shapes as ``vtk/shape_p<MPa>MPa.vtu`` for ParaView.
-
-    Parameters
-    ----------
-    design : Design
-    pressures_mpa : array_like
-        Output pressures, MPa, increasing.
-    options : FEMOptions or None
-    out_dir : path
-        Folder of the files (created).
-    shape_pressures_mpa : sequence of float or int
-        Where to draw the shape, MPa; an integer ``n`` draws ``n`` shapes evenly
-        spaced from 0 to the last converged step.
-    prefix : str
-        Start of every file name.
-    vtk : bool
-        Also export the shapes as VTK.
-    progress : callable, optional
-        ``progress(pressure_mpa, angle_deg, target_mpa)`` after each load step.
-    """
-    from softbend.pipeline.paper_b_fem import sweep_with_shapes
-
     out = Path(out_dir)
-    sweep = sweep_with_shapes(
-        design,
-        pressures_mpa,
-        options,
-        out,
-        shape_pressures_mpa=shape_pressures_mpa,
-        prefix=prefix,
-        vtk=vtk,
-        progress=progress,
-    )
+    design = sweep.design
     files = {
-        "csv": sweep.files["csv"],
         "curve": angle_pressure_curve(
-            sweep.result, out / f"{prefix}angle_pressure.png", analytical=sweep.analytical
-        ),
-        "shapes": deformed_shapes(
-            sweep.outlines, out / f"{prefix}shapes.png", title=f"Design ({design}), FEM"
-        ),
+            sweep.result,
+            out / f"{prefix}angle_pressure.png",
+            analytical=sweep.analytical,
+            title=f"{sweep.family.title}\n({design})",
+        )
     }
-    if vtk:
-        files["vtk"] = sweep.files["vtk"]
-    return FEMSweepFiles(
-        sweep.result, sweep.analytical, sweep.shape_pressures_mpa, sweep.steps, files
-    )
-
-
-def family_sweep_with_files(
-    family: FEMFamily,
-    design: Any,
-    pressures_mpa: ArrayLike,
-    options: FEMOptions,
-    out_dir: str | Path,
-    *,
-    shape_pressures_mpa: int,
-    vtk: bool = True,
-    progress: Callable[[float, float, float], None] | None = None,
-) -> FEMSweepFiles:
-    """Sweep one design of an FEM family other than paper B's and write its files.
-
-    Writes ``sweep.csv`` (pressure, angle, tip, converged, Newton iterations),
-    ``angle_pressure.png`` and with ``vtk`` the whole actuator (the half model
-    mirrored) at ``shape_pressures_mpa`` converged steps evenly spaced from 0 to
-    the last reported pressure as ``vtk/shape_p<MPa>MPa.vtu``. There is no analytical model to
-    compare with: ``analytical`` is the FEM sweep itself.
-
-    Parameters
-    ----------
-    family : FEMFamily
-        The family (:func:`softbend.fem.families.get_family`).
-    design
-        A checked design of the family.
-    pressures_mpa : array_like
-        Output pressures, MPa, increasing.
-    options : FEMOptions
-    out_dir : path
-        Folder of the files (created).
-    shape_pressures_mpa : int
-        How many shapes to export.
-    vtk : bool
-        Export the shapes as VTK.
-    progress : callable, optional
-        ``progress(pressure_mpa, angle_deg, target_mpa)`` after each load step.
-    """
-    from softbend.fem.export import vtk_file_name, write_sweep_csv, write_vtk
-
-    out = Path(out_dir)
-    out.mkdir(parents=True, exist_ok=True)
-    result, model, history = family.sweep(
-        design, pressures_mpa, options, progress=progress, keep_states=True
-    )
-    files: dict[str, Any] = {"csv": write_sweep_csv(result, out / "sweep.csv")}
-    files["curve"] = angle_pressure_curve(
-        result, out / "angle_pressure.png", title=f"{family.title}\n({design})"
-    )
-    last = float(result.pressure_mpa[result.converged][-1]) if result.converged.any() else 0.0
-    # The converged steps inside the reported range (not a step past touching walls).
-    inside = [step for step in history.steps if step.pressure_mpa <= last + 1e-12]
-    at = np.array([step.pressure_mpa for step in inside])
-    picked = {int(np.abs(at - q).argmin()) for q in np.linspace(0.0, last, shape_pressures_mpa)}
-    chosen_steps = [inside[i] for i in sorted(picked)]
-    if vtk:
-        vtk_files = []
-        for chosen in chosen_steps:
-            model.set_state(chosen.state)
-            p = float(chosen.pressure_mpa)
-            vtk_files.append(write_vtk(model, out / "vtk" / vtk_file_name(p), pressure_mpa=p))
-        files["vtk"] = vtk_files
-    return FEMSweepFiles(
-        result,
-        result,
-        [float(s.pressure_mpa) for s in chosen_steps],
-        len(history.steps) - 1,
-        files,
-    )
+    if sweep.outlines:
+        files["shapes"] = deformed_shapes(
+            sweep.outlines, out / f"{prefix}shapes.png", title=f"Design ({design}), FEM"
+        )
+    return files

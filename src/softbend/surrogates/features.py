@@ -168,11 +168,11 @@ def dataset_training_data(source: str | os.PathLike[str]) -> TrainingData:
 
     ``source`` is a folder of ``softbend campaign dataset`` or the name of a
     dataset softbend ships (``"table1_fem"``, a family's name), read by
-    :func:`softbend.family_datasets.dataset_samples`. Table 1's gives paper B's
+    :func:`softbend.datasets.dataset_samples`. Table 1's gives paper B's
     :data:`FEATURES`; another family's its parameters and pressure (in its
     actuator's unit) with the recorded actuator.
     """
-    from softbend.family_datasets import dataset_samples
+    from softbend.datasets import dataset_samples
 
     return family_training_data(*dataset_samples(source))
 

@@ -47,6 +47,8 @@ if TYPE_CHECKING:
 
 __all__ = [
     "ELASTOSIL_M4601",
+    "MESH_STUDY_MAXH_MM",
+    "MESH_STUDY_PRESSURES_MPA",
     "PAPER_LAYER",
     "PNEUNET",
     "PNEUNET_MAXH_MM",
@@ -195,3 +197,9 @@ def pneunet_options(**overrides: Any) -> FEMOptions:
 
 #: Default largest element size of the PneuNet's mesh, mm.
 PNEUNET_MAXH_MM = 3.0
+
+#: ``fem mesh-study``'s default element sizes for the PneuNet, mm, coarse to fine.
+MESH_STUDY_MAXH_MM: tuple[float, ...] = (3.0, 2.5, 2.0)
+#: ``fem mesh-study``'s default pressures for the PneuNet, MPa: below the reference's
+#: touching walls.
+MESH_STUDY_PRESSURES_MPA: tuple[float, ...] = (0.0, 0.002, 0.004, 0.006)
