@@ -14,6 +14,7 @@ from softbend.errors import InputError, keyed
 if TYPE_CHECKING:
     import numpy as np
 
+    from softbend.actuators import Design
     from softbend.fem import FEMOptions
     from softbend.fem.families import FEMFamily
     from softbend.fem.run import FamilySweep
@@ -211,7 +212,7 @@ def run(
 def _sweep_into(
     out: Path,
     family: FEMFamily,
-    design: object,
+    design: Design,
     pressures: np.ndarray,
     options: FEMOptions,
     shapes: int,

@@ -23,6 +23,7 @@ import numpy as np
 if TYPE_CHECKING:
     from numpy.typing import ArrayLike
 
+    from softbend.actuators import Design
     from softbend.fem.families import FEMFamily
     from softbend.fem.options import FEMOptions
     from softbend.models import SweepResult
@@ -56,7 +57,7 @@ class FamilySweep:
     """
 
     family: FEMFamily
-    design: Any
+    design: Design
     result: SweepResult
     analytical: SweepResult | None
     shape_pressures_mpa: list[float]
@@ -89,7 +90,7 @@ def shape_steps(
 
 def sweep_with_files(
     family: FEMFamily,
-    design: Any,
+    design: Design,
     pressures_mpa: ArrayLike,
     options: FEMOptions,
     out_dir: str | Path,

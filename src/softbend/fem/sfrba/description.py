@@ -16,6 +16,7 @@ if TYPE_CHECKING:
     from numpy.typing import ArrayLike
 
     from softbend.actuators import Design
+    from softbend.fem.actuator import ActuatorModel
     from softbend.fem.options import FEMOptions
     from softbend.models import SweepResult
 
@@ -66,7 +67,7 @@ def parse_sfrba_design(text: str) -> Design:
 
 
 def sfrba_sweep(
-    design: Any, pressures_mpa: ArrayLike, options: FEMOptions | None = None, **kwargs: Any
+    design: Design, pressures_mpa: ArrayLike, options: FEMOptions | None = None, **kwargs: Any
 ) -> tuple[SweepResult, Any, Any]:
     """:func:`softbend.fem.sfrba.sweep.run_sweep` (imports NGSolve)."""
     from softbend.fem.sfrba.sweep import run_sweep
@@ -74,20 +75,20 @@ def sfrba_sweep(
     return run_sweep(design, pressures_mpa, options, **kwargs)
 
 
-def sfrba_mesh_check(designs: Sequence[Any], options: FEMOptions) -> None:
+def sfrba_mesh_check(designs: Sequence[Design], options: FEMOptions) -> None:
     """Refuse ``options.maxh_mm`` if it meshes one of ``designs`` with too many elements
     (the message names the design of the most elements)."""
     options.check_mesh(designs)
 
 
-def analytical_sweep(design: Any, pressures_mpa: ArrayLike) -> SweepResult:
+def analytical_sweep(design: Design, pressures_mpa: ArrayLike) -> SweepResult:
     """The analytical model's sweep of ``design`` (Polygerinos et al.), to compare with."""
     from softbend.analytical import AnalyticalModel
 
     return AnalyticalModel().sweep(design, pressures_mpa)
 
 
-def sfrba_outline(model: Any) -> np.ndarray:
+def sfrba_outline(model: ActuatorModel) -> np.ndarray:
     """The closed side outline (m, 2), mm, of ``model``'s state in the bending plane."""
     from softbend.fem.export import silhouette_mm
 
