@@ -7,8 +7,8 @@ package itself is not counted), parameters annotated with a bare ``Any``, and th
 modules that parse CSV text (``pandas.read_csv``, ``csv.reader``/``csv.DictReader``),
 and the figures of "one road for every actuator": tests that name paper B's actuator
 outside its own modules (an ``if``/``elif``/``while``/``assert``, a conditional
-expression or a comprehension filter whose test names ``SFRBA``, ``paper_b``,
-``is_paper_b``, ``"sfrba"`` or ``DEFAULT_FAMILY``), the classes that stand for one
+expression or a comprehension filter whose test names ``SFRBA``, ``paper_b`` in any
+case, ``is_paper_b``, ``"sfrba"`` or ``DEFAULT_FAMILY``), the classes that stand for one
 design (a class whose name ends in ``Design``), ``ContextVar``s that hold actuator
 state (any but the progress listener and the CLI's command and argument records),
 and command functions of the CLI longer than 60 lines::
@@ -31,7 +31,7 @@ SRC = ROOT / "src" / "softbend"
 MESSAGE_ONLY = {"owner", "field", "option"}
 CSV_CALLS = {"read_csv", "reader", "DictReader"}
 #: A test names paper B's actuator when its source text matches this.
-PAPER_B = re.compile(r"SFRBA|paper_b|is_paper_b|[\"']sfrba[\"']|DEFAULT_FAMILY")
+PAPER_B = re.compile(r"SFRBA|(?i:paper_b)|[\"']sfrba[\"']|DEFAULT_FAMILY")
 #: Paper B's own modules: its analytical model, its FEM family, its reproduction and report.
 PAPER_B_OWN = re.compile(r"(^|/)(paper_b[^/]*\.py|analytical\.py|fem/sfrba/.*)$")
 #: ContextVars that hold no actuator state: the progress listener, the running command
@@ -71,6 +71,15 @@ def _tests(node: ast.AST) -> list[ast.expr]:
     return []
 
 
+def _is_command(node: ast.expr) -> bool:
+    """Whether ``node`` is a typer ``app.command(...)`` call (a decorator or a registration)."""
+    return (
+        isinstance(node, ast.Call)
+        and isinstance(node.func, ast.Attribute)
+        and node.func.attr == "command"
+    )
+
+
 def _context_var_name(node: ast.Call) -> str | None:
     func = node.func
     name = func.attr if isinstance(func, ast.Attribute) else getattr(func, "id", "")
@@ -92,6 +101,8 @@ def measure() -> dict[str, object]:
     actuator_context: list[str] = []
     long_commands: list[str] = []
     module_lines: dict[str, int] = {}
+    functions: dict[str, tuple[str, ast.FunctionDef]] = {}
+    commands: set[str] = set()
     for path in sorted(SRC.rglob("*.py")):
         text = path.read_text(encoding="utf-8")
         lines += len(text.splitlines())
@@ -111,21 +122,12 @@ def measure() -> dict[str, object]:
                 var = _context_var_name(node)
                 if var is not None and var not in CONTEXT_OK:
                     actuator_context.append(f"{rel}:{node.lineno} {var}")
-            if (
-                rel.startswith("cli/")
-                and isinstance(node, ast.FunctionDef)
-                and node.end_lineno is not None
-                and node.end_lineno - node.lineno + 1 > CLI_FUNCTION_LINES
-                and any(
-                    isinstance(d, ast.Call)
-                    and isinstance(d.func, ast.Attribute)
-                    and d.func.attr == "command"
-                    for d in node.decorator_list
-                )
-            ):
-                long_commands.append(
-                    f"{rel}:{node.lineno} {node.name} ({node.end_lineno - node.lineno + 1} lines)"
-                )
+            if rel.startswith("cli/") and isinstance(node, ast.FunctionDef):
+                functions[node.name] = (rel, node)
+                if any(_is_command(d) for d in node.decorator_list):
+                    commands.add(node.name)
+            if isinstance(node, ast.Call) and _is_command(node.func):  # app.command("x")(f)
+                commands.update(a.id for a in node.args if isinstance(a, ast.Name))
             if isinstance(node, ast.FunctionDef | ast.AsyncFunctionDef):
                 for arg in _parameters(node):
                     where = f"{rel}:{node.lineno} {node.name}({arg.arg})"
@@ -139,6 +141,11 @@ def measure() -> dict[str, object]:
                 name = func.attr if isinstance(func, ast.Attribute) else getattr(func, "id", "")
                 if name in CSV_CALLS and rel not in csv_modules:
                     csv_modules.append(rel)
+    for name in sorted(commands & set(functions)):
+        rel, node = functions[name]
+        length = (node.end_lineno or node.lineno) - node.lineno + 1
+        if length > CLI_FUNCTION_LINES:
+            long_commands.append(f"{rel}:{node.lineno} {name} ({length} lines)")
     return {
         "lines": lines,
         "modules": modules,
