@@ -16,6 +16,7 @@ from softbend.errors import InputError
 
 if TYPE_CHECKING:
     from softbend.identification.segments import RecordingSplit
+    from softbend.identification.selection import Selection
     from softbend.identification.timeseries import TimeSeriesSet
 
 
@@ -27,55 +28,58 @@ def _names(text: str | None, key: str) -> list[str]:
     return names
 
 
+DATA_ARGUMENT = typer.Argument(
+    ..., help="A CSV file, or a folder of CSV files (one experiment each)."
+)
+INPUTS_OPTION = typer.Option(..., help="Comma-separated input columns (e.g. p1,p2,p3).")
+OUTPUTS_OPTION = typer.Option(..., help="Comma-separated output columns (e.g. x,y).")
+EXPERIMENT_OPTION = typer.Option(
+    None,
+    help="Column that splits a file into experiments (contiguous runs). Without it, "
+    "one recording is split into contiguous segments: the last for validation, the "
+    "others one cross-validation fold each.",
+)
+TIME_OPTION = typer.Option(None, help="Time column (default: the sample index).")
+VALIDATE_ON_OPTION = typer.Option(
+    None, help="Experiments kept out of the selection and scored at the end (comma-separated)."
+)
+FOLDS_OPTION = typer.Option(4, help="Cross-validation folds of whole experiments.")
+SEED_OPTION = typer.Option(0, help="Seed of the kernel models' random search.")
+MAX_MEMORY_MB_OPTION = typer.Option(
+    None, help="Refuse data whose identification would need more memory than this, MiB."
+)
+OUT_OPTION = typer.Option(..., "--out", "-o", help="Folder for the model, tables, figures.")
+AS_JSON_OPTION = typer.Option(False, "--json", help="Print the selection as JSON.")
+
+
 def identify(
-    data: Path = typer.Argument(
-        ..., help="A CSV file, or a folder of CSV files (one experiment each)."
-    ),
-    inputs: str = typer.Option(..., help="Comma-separated input columns (e.g. p1,p2,p3)."),
-    outputs: str = typer.Option(..., help="Comma-separated output columns (e.g. x,y)."),
-    experiment: str = typer.Option(
-        None,
-        help="Column that splits a file into experiments (contiguous runs). Without it, "
-        "one recording is split into contiguous segments: the last for validation, the "
-        "others one cross-validation fold each.",
-    ),
-    time: str = typer.Option(None, help="Time column (default: the sample index)."),
-    validate_on: str = typer.Option(
-        None, help="Experiments kept out of the selection and scored at the end (comma-separated)."
-    ),
-    folds: int = typer.Option(4, help="Cross-validation folds of whole experiments."),
-    seed: int = typer.Option(0, help="Seed of the kernel models' random search."),
-    max_memory_mb: float = typer.Option(
-        None, help="Refuse data whose identification would need more memory than this, MiB."
-    ),
-    out: Path = typer.Option(..., "--out", "-o", help="Folder for the model, tables, figures."),
-    as_json: bool = typer.Option(False, "--json", help="Print the selection as JSON."),
+    data: Path = DATA_ARGUMENT,
+    inputs: str = INPUTS_OPTION,
+    outputs: str = OUTPUTS_OPTION,
+    experiment: str = EXPERIMENT_OPTION,
+    time: str = TIME_OPTION,
+    validate_on: str = VALIDATE_ON_OPTION,
+    folds: int = FOLDS_OPTION,
+    seed: int = SEED_OPTION,
+    max_memory_mb: float = MAX_MEMORY_MB_OPTION,
+    out: Path = OUT_OPTION,
+    as_json: bool = AS_JSON_OPTION,
 ) -> None:
     """A NARX model of any time series, chosen by its free run.
 
-    Linear ARX and degree-2 polynomial NARX models (several lags), paper A's
-    GG-SVR setting, a seeded search of kernel models, and a polynomial (with a
-    learned first-order lag on each input) and a small neural NARX fitted by
-    their free-run error over the training runs are cross-validated on whole
-    held-out experiments, each run free from its first samples; the lowest
-    free-run error wins, whatever the family, and the output says when a linear
-    model is the best. Every output's regressor holds the lags of every output.
-    Writes the selection table, the model, the held-out free runs
-    (holdout_freerun.csv) and their figures into --out, and reads the chosen
-    model physically: from the operating point (the inputs' training means)
-    each input steps by one training standard deviation, and each output's
-    gain, time constant (63.2 %) and dead time (2 %) are printed and recorded
-    in model.json ("dynamics"). A 90 % band around the free run, from the
-    cross-validation residuals of the chosen model, is written beside it
-    (<output>_low, <output>_high), shaded in freerun.png and checked on
-    held-out samples; the time taken and the peak memory are printed and
-    recorded in selection.json. 'softbend predict MODEL.json --input CSV' runs
-    the model on a new input series.
-
-    Without --experiment, one recording is split into contiguous segments (the
-    last for validation, the others one fold each), said on stderr and recorded
-    in selection.json ("split"). A constant or near-constant input or output is
-    refused, naming the column.
+    Linear ARX and degree-2 polynomial NARX models, paper A's GG-SVR setting, a
+    seeded search of kernel models, and a polynomial and a small neural NARX fitted
+    by their free-run error are cross-validated on whole held-out experiments, each
+    run free from its first samples; the lowest free-run error wins, and the output
+    says when a linear model is the best. Writes the selection table, the model, the
+    held-out free runs with a 90 % band (<output>_low, <output>_high) and their
+    figures into --out. The chosen model is read physically: each output's gain,
+    time constant (63.2 %) and dead time (2 %) for a step of one standard deviation
+    of each input, printed and recorded in model.json ("dynamics"). Without
+    --experiment, one recording is split into contiguous segments (the last for
+    validation, the others one fold each), recorded in selection.json ("split").
+    A constant input or output is refused, naming the column. 'softbend predict
+    MODEL.json --input CSV' runs the model on a new input series.
 
     Example:
 
@@ -83,71 +87,66 @@ def identify(
         softbend identify arm/ --inputs p1_kpa,p2_kpa,p3_kpa --outputs x_mm,y_mm \\
             --time time_s --validate-on val01,val02 --out arm-model
     """
-    from softbend._outdir import staged_dir
-    from softbend.identification.data import experiment_files
-    from softbend.identification.ranges import (
-        FOLDS_RANGE,
-        MAX_MEMORY_MB_RANGE,
-        SEED_RANGE,
-        check_integer,
-        check_number,
-    )
-    from softbend.identification.resources import check_identify_memory
-    from softbend.identification.selection import default_candidates, select_model
-    from softbend.identification.timeseries_io import (
-        check_experiments_for_lags,
-        check_holdout,
-        check_signals,
-        load_timeseries,
-    )
-    from softbend.reports.identify_outputs import FILES, write_identification
-
-    out = Path(out)
-    # every numeric option within its declared range (softbend.identification.ranges)
-    check_integer(folds, FOLDS_RANGE, "folds")
-    check_integer(seed, SEED_RANGE, "seed")
-    if max_memory_mb is not None:
-        check_number(max_memory_mb, MAX_MEMORY_MB_RANGE, "max_memory_mb")
-    _common.check_output_dir(out, "--out", inputs=(data,))
-    _common.check_replaceable_dir(out, "--out", inputs=(data,))
     began, cpu_began = perf_counter(), process_time()
-    experiment_files(data)  # a missing path or a folder without CSV: refused first
-    need = check_identify_memory(data, max_memory_mb=max_memory_mb)
-    if not as_json and need.csv_bytes >= 4 * 2**20:  # long enough to be worth a line
-        _common.err_console.print(
-            f"reading {need.csv_bytes / 2**20:.1f} MiB of CSV (about {need.rows:,} samples)",
-            highlight=False,
-        )
-    with _common.library_progress(enabled=not as_json):  # a large file's read, from its start
-        series = load_timeseries(
-            data,
-            _names(inputs, "inputs"),
-            _names(outputs, "outputs"),
-            experiment=experiment,
-            time=time,
-        )
-    held = _names(validate_on, "validate_on") if validate_on is not None else None
-    split = None
-    if len(series.experiments) == 1:  # one recording: segments of it, or a refusal
-        split = _split_one_recording(series, experiment, held, folds)
-        series, held = split.data, list(split.validation)
-    check_holdout(series, held)
-    check_signals(series, held)  # a constant or huge output: refused before any fit
-    # every candidate's regressor must fit in every experiment (the longest lags: 3)
-    check_experiments_for_lags(series, max(c.build(10).max_lag for c in default_candidates(seed)))
-    if split is not None:  # said once the data passed its checks (an error stays one line)
-        _common.err_console.print(split.summary(), highlight=False)  # also with --json
-    with _common.library_progress(enabled=not as_json):
+    series, held, split = _checked_series(
+        data,
+        inputs,
+        outputs,
+        experiment,
+        time,
+        validate_on,
+        folds,
+        seed,
+        max_memory_mb,
+        out,
+        quiet=as_json,
+    )
+    selection = _select_and_write(series, held, split, folds, seed, out, quiet=as_json)
+    seconds, cpu = perf_counter() - began, process_time() - cpu_began
+    _print_identification(selection, series, out, seconds, cpu, as_json=as_json)
+
+
+def _select_and_write(
+    series: TimeSeriesSet,
+    held: list[str] | None,
+    split: RecordingSplit | None,
+    folds: int,
+    seed: int,
+    out: Path,
+    *,
+    quiet: bool,
+) -> Selection:
+    """Select the model (cross-validated, scored on the held-out experiments) and write
+    it with its tables and figures into ``out`` as a whole."""
+    from softbend._outdir import staged_dir
+    from softbend.identification.selection import select_model
+    from softbend.reports.identify_outputs import write_identification
+
+    with _common.library_progress(enabled=not quiet):
         selection = select_model(series, validate_on=held, folds=folds, seed=seed)
     if split is not None:
         selection = replace(selection, split=split.to_dict())
     with (
-        _common.library_progress(enabled=not as_json),
+        _common.library_progress(enabled=not quiet),
         _common.output_errors(out, "--out"),
         staged_dir(out) as stage,
     ):
         write_identification(selection, series, stage)
-    seconds, cpu = perf_counter() - began, process_time() - cpu_began
+    return selection
+
+
+def _print_identification(
+    selection: Selection,
+    series: TimeSeriesSet,
+    out: Path,
+    seconds: float,
+    cpu: float,
+    *,
+    as_json: bool,
+) -> None:
+    """The selection as JSON, or its table, verdict, band, dynamics and cost."""
+    from softbend.reports.identify_outputs import FILES
+
     if as_json:
         _common.print_json(
             {
@@ -167,6 +166,75 @@ def identify(
         _cost_line(selection, seconds, cpu, sum(e.n_samples for e in series.experiments))
     )
     _common.console.print(f"{', '.join(FILES)} written to {out}")
+
+
+def _checked_series(
+    data: Path,
+    inputs: str,
+    outputs: str,
+    experiment: str | None,
+    time: str | None,
+    validate_on: str | None,
+    folds: int,
+    seed: int,
+    max_memory_mb: float | None,
+    out: Path,
+    *,
+    quiet: bool,
+) -> tuple[TimeSeriesSet, list[str] | None, RecordingSplit | None]:
+    """The options checked, the time series read and checked before any fit: the series,
+    the experiments held out, and the split of one recording into segments (or None)."""
+    from softbend.identification.data import experiment_files
+    from softbend.identification.ranges import (
+        FOLDS_RANGE,
+        MAX_MEMORY_MB_RANGE,
+        SEED_RANGE,
+        check_integer,
+        check_number,
+    )
+    from softbend.identification.resources import check_identify_memory
+    from softbend.identification.selection import default_candidates
+    from softbend.identification.timeseries_io import (
+        check_experiments_for_lags,
+        check_holdout,
+        check_signals,
+        load_timeseries,
+    )
+
+    # every numeric option within its declared range (softbend.identification.ranges)
+    check_integer(folds, FOLDS_RANGE, "folds")
+    check_integer(seed, SEED_RANGE, "seed")
+    if max_memory_mb is not None:
+        check_number(max_memory_mb, MAX_MEMORY_MB_RANGE, "max_memory_mb")
+    _common.check_output_dir(out, "--out", inputs=(data,))
+    _common.check_replaceable_dir(out, "--out", inputs=(data,))
+    experiment_files(data)  # a missing path or a folder without CSV: refused first
+    need = check_identify_memory(data, max_memory_mb=max_memory_mb)
+    if not quiet and need.csv_bytes >= 4 * 2**20:  # long enough to be worth a line
+        _common.err_console.print(
+            f"reading {need.csv_bytes / 2**20:.1f} MiB of CSV (about {need.rows:,} samples)",
+            highlight=False,
+        )
+    with _common.library_progress(enabled=not quiet):  # a large file's read, from its start
+        series = load_timeseries(
+            data,
+            _names(inputs, "inputs"),
+            _names(outputs, "outputs"),
+            experiment=experiment,
+            time=time,
+        )
+    held = _names(validate_on, "validate_on") if validate_on is not None else None
+    split = None
+    if len(series.experiments) == 1:  # one recording: segments of it, or a refusal
+        split = _split_one_recording(series, experiment, held, folds)
+        series, held = split.data, list(split.validation)
+    check_holdout(series, held)
+    check_signals(series, held)  # a constant or huge output: refused before any fit
+    # every candidate's regressor must fit in every experiment (the longest lags: 3)
+    check_experiments_for_lags(series, max(c.build(10).max_lag for c in default_candidates(seed)))
+    if split is not None:  # said once the data passed its checks (an error stays one line)
+        _common.err_console.print(split.summary(), highlight=False)  # also with --json
+    return series, held, split
 
 
 def _split_one_recording(

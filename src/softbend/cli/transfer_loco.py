@@ -10,6 +10,7 @@ import typer
 from softbend.cli import _common
 
 if TYPE_CHECKING:
+    from softbend.surrogates.persistence import SavedSurrogate
     from softbend.transfer.loco import LocoResult
 
 #: The files 'transfer loco' writes into its '--out' folder.
@@ -26,47 +27,60 @@ LOCO_FILES: tuple[str, ...] = (
 )
 
 
+MEASUREMENTS_ARGUMENT = typer.Argument(
+    ...,
+    metavar="MEASUREMENTS",
+    help="Measurements CSV file(s) (see 'softbend lab measure'); several are joined, "
+    "each keeping its provenance.",
+)
+OUT_OPTION = typer.Option(..., "--out", "-o", help="Folder for tables and figures.")
+BASE_OPTION = typer.Option(
+    None, help="Saved surrogate to start from (default: the shipped FEM-trained MLP)."
+)
+STRATEGIES_OPTION = typer.Option(
+    "all",
+    help="Comma-separated strategies, or 'all': softbend's own "
+    "(see 'softbend transfer strategies').",
+)
+SETTINGS_OPTION = typer.Option(
+    None,
+    "--set",
+    help="A strategy parameter, STRATEGY.NAME=VALUE, or NAME=VALUE for every strategy "
+    "that takes it (repeatable; recorded in loco.json).",
+)
+LEVEL_OPTION = typer.Option(0.9, help="Probability of the prediction intervals.")
+LEARNING_CURVE_OPTION = typer.Option(
+    True, "--learning-curve/--no-learning-curve", help="Also fit on 1..n-2 actuators."
+)
+CALIBRATE_OPTION = typer.Option(
+    False,
+    "--calibrate",
+    help="Also score the calibrated 90 % interval on each held-out actuator, calibrated "
+    "without it (n-1 more fits per actuator: several times the run time; at least 3 "
+    "actuators).",
+)
+SEED_OPTION = typer.Option(0, help="Seed of the strategies and the learning curve.")
+AS_JSON_OPTION = typer.Option(False, "--json", help="Print the results as JSON.")
+FORCE_OPTION = typer.Option(
+    False,
+    "--force",
+    help="Use pressures past the base model's range (1.5x its top) and angles that look "
+    "like radians next to its prediction as given (with a warning; recorded in loco.json).",
+)
+
+
 def loco(
-    measurements: list[Path] = typer.Argument(
-        ...,
-        metavar="MEASUREMENTS",
-        help="Measurements CSV file(s) (see 'softbend lab measure'); several are joined, "
-        "each keeping its provenance.",
-    ),
-    out: Path = typer.Option(..., "--out", "-o", help="Folder for tables and figures."),
-    base: Path | None = typer.Option(
-        None, help="Saved surrogate to start from (default: the shipped FEM-trained MLP)."
-    ),
-    strategies: str = typer.Option(
-        "all",
-        help="Comma-separated strategies, or 'all': softbend's own "
-        "(see 'softbend transfer strategies').",
-    ),
-    settings: list[str] | None = typer.Option(
-        None,
-        "--set",
-        help="A strategy parameter, STRATEGY.NAME=VALUE, or NAME=VALUE for every strategy "
-        "that takes it (repeatable; recorded in loco.json).",
-    ),
-    level: float = typer.Option(0.9, help="Probability of the prediction intervals."),
-    learning_curve: bool = typer.Option(
-        True, "--learning-curve/--no-learning-curve", help="Also fit on 1..n-2 actuators."
-    ),
-    calibrate: bool = typer.Option(
-        False,
-        "--calibrate",
-        help="Also score the calibrated 90 % interval on each held-out actuator, calibrated "
-        "without it (n-1 more fits per actuator: several times the run time; at least 3 "
-        "actuators).",
-    ),
-    seed: int = typer.Option(0, help="Seed of the strategies and the learning curve."),
-    as_json: bool = typer.Option(False, "--json", help="Print the results as JSON."),
-    force: bool = typer.Option(
-        False,
-        "--force",
-        help="Use pressures past the base model's range (1.5x its top) and angles that look "
-        "like radians next to its prediction as given (with a warning; recorded in loco.json).",
-    ),
+    measurements: list[Path] = MEASUREMENTS_ARGUMENT,
+    out: Path = OUT_OPTION,
+    base: Path | None = BASE_OPTION,
+    strategies: str = STRATEGIES_OPTION,
+    settings: list[str] | None = SETTINGS_OPTION,
+    level: float = LEVEL_OPTION,
+    learning_curve: bool = LEARNING_CURVE_OPTION,
+    calibrate: bool = CALIBRATE_OPTION,
+    seed: int = SEED_OPTION,
+    as_json: bool = AS_JSON_OPTION,
+    force: bool = FORCE_OPTION,
 ) -> None:
     """Score every strategy on held-out actuators.
 
@@ -84,38 +98,22 @@ def loco(
             --strategies refined,scale-offset --set epochs=500
         softbend transfer loco lab.csv bench.csv --out loco
     """
-    from softbend._outdir import staged_dir
-    from softbend.reports import transfer_figures
     from softbend.transfer.against_base import load_for_base
     from softbend.transfer.base import load_base_saved
-    from softbend.transfer.loco import (
-        DEFAULT_STRATEGIES,
-        leave_one_configuration_out,
-        strategy_options,
-    )
+    from softbend.transfer.loco import leave_one_configuration_out
     from softbend.transfer.measurements import files_record
-    from softbend.transfer.strategies import applicable_strategies, check_applicable
 
-    out = Path(out)
     inputs = tuple(measurements) if base is None else (*measurements, base)
     _common.check_output_dir(out, "--out", inputs=inputs, files=LOCO_FILES)
     _common.check_replaceable_dir(out, "--out", inputs=inputs)
     saved = load_base_saved(base)
-    actuator = saved.actuator
-    left_out: dict[str, str] = {}
-    if strategies.strip() == "all":  # those that apply to the base, the others said
-        names, left_out = applicable_strategies(DEFAULT_STRATEGIES, saved.model, actuator)
-    else:
-        names = [n.strip() for n in strategies.split(",") if n.strip()]
-    options = strategy_options(names, _common.parse_assignments(settings or ()))
-    check_applicable(names, saved.model, actuator, key="strategies")  # before any work
+    names, left_out, options = _chosen_strategies(strategies, settings, saved)
     with _common.library_progress(enabled=not as_json):  # a large file's read, from its start
         data, forced = load_for_base(measurements, saved, force=force)  # before any fit
-    model = saved.model
     with _common.library_progress(enabled=not as_json) as progress:
         result = leave_one_configuration_out(
             data,
-            model,
+            saved.model,
             names,
             level=level,
             learning_curve=learning_curve,
@@ -124,11 +122,62 @@ def loco(
             options=options,
             progress=lambda done, total, name: progress("fitting strategies", done, total),
         )
-    result.settings["measurement_files"] = files_record(measurements, data)  # type: ignore[arg-type]
-    if forced:
-        result.settings["forced"] = forced
-    result.settings["left_out"] = left_out
+    recorded = {"measurement_files": files_record(measurements, data), "forced": forced}  # type: ignore[arg-type]
+    result.settings.update({k: v for k, v in recorded.items() if v} | {"left_out": left_out})
     synthetic = bool(data.synthetic.any())  # the figure flags any synthetic reading
+    files = _write_loco(result, out, synthetic=synthetic, learning_curve=learning_curve)
+    _print_loco(result, out, files, left_out, synthetic=synthetic, as_json=as_json)
+
+
+def _chosen_strategies(
+    strategies: str, settings: list[str] | None, saved: SavedSurrogate
+) -> tuple[list[str], dict[str, str], dict[str, dict[str, object]]]:
+    """The strategies named by ``--strategies`` (``all``: those that apply to the base, the
+    others left out with why) and their ``--set`` options, checked before any work."""
+    from softbend.transfer.loco import DEFAULT_STRATEGIES, strategy_options
+    from softbend.transfer.strategies import applicable_strategies, check_applicable
+
+    left_out: dict[str, str] = {}
+    if strategies.strip() == "all":  # those that apply to the base, the others said
+        names, left_out = applicable_strategies(DEFAULT_STRATEGIES, saved.model, saved.actuator)
+    else:
+        names = [n.strip() for n in strategies.split(",") if n.strip()]
+    options = strategy_options(names, _common.parse_assignments(settings or ()))
+    check_applicable(names, saved.model, saved.actuator, key="strategies")
+    return names, left_out, options
+
+
+def _print_loco(
+    result: LocoResult,
+    out: Path,
+    files: dict[str, str],
+    left_out: dict[str, str],
+    *,
+    synthetic: bool,
+    as_json: bool,
+) -> None:
+    """The warnings of a finished run (strategies left out, fits that failed), then the
+    results as JSON or as the summary table."""
+    if left_out:  # said once the run has succeeded: an error stays the one line
+        _common.warning_line(left_out_line(left_out))
+    failed, others = result.settings.get("failed", []), result.settings.get("failed_other_fits", 0)
+    if failed or others:
+        _common.warning_line(failed_line(failed, others))  # type: ignore[arg-type]
+    if as_json:
+        _common.print_json({**result.to_dict(), "files": files, "synthetic": synthetic})
+        return
+    print_loco_summary(result)
+    _common.console.print(f"tables and figures written to {out}")
+
+
+def _write_loco(
+    result: LocoResult, out: Path, *, synthetic: bool, learning_curve: bool
+) -> dict[str, str]:
+    """Write loco's tables and figures into ``out`` as a whole (staged, then swapped in);
+    the files written, by key."""
+    from softbend._outdir import staged_dir
+    from softbend.reports import transfer_figures
+
     with (
         _common.output_errors(out, "--out"),
         staged_dir(out) as stage,
@@ -145,17 +194,7 @@ def loco(
             written["learning_curve_figure"] = str(
                 transfer_figures.learning_curve(result, stage / "learning_curve.png")
             )
-    files = {key: str(out / Path(value).name) for key, value in written.items()}
-    if left_out:  # said once the run has succeeded: an error stays the one line
-        _common.warning_line(left_out_line(left_out))
-    failed, others = result.settings.get("failed", []), result.settings.get("failed_other_fits", 0)
-    if failed or others:
-        _common.warning_line(failed_line(failed, others))
-    if as_json:
-        _common.print_json({**result.to_dict(), "files": files, "synthetic": synthetic})
-        return
-    print_loco_summary(result)
-    _common.console.print(f"tables and figures written to {out}")
+    return {key: str(out / Path(value).name) for key, value in written.items()}
 
 
 def left_out_line(left_out: dict[str, str]) -> str:
