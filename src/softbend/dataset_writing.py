@@ -34,7 +34,7 @@ if TYPE_CHECKING:
     import pandas as pd
 
     from softbend.actuators import Actuator
-    from softbend.campaign.families import FamilySchema
+    from softbend.campaign.family_schema import FamilySchema
     from softbend.fem.stats import FEMStats
 
 __all__ = ["family_stop_region", "family_tables", "write_dataset"]

@@ -18,7 +18,7 @@ import pytest
 
 from softbend.actuators import Design
 from softbend.campaign import CampaignStore, load_samples, run_campaign
-from softbend.campaign.families import FamilyBackend, family_backend
+from softbend.campaign.family_schema import FamilyBackend, family_backend
 from softbend.campaign.spaces import parse_family_ranges, parse_family_space
 from softbend.campaign.store import campaign_actuator
 from softbend.cli import main

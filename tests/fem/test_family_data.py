@@ -7,7 +7,7 @@ from types import SimpleNamespace
 import numpy as np
 import pytest
 
-from softbend.campaign.families import FamilySchema
+from softbend.campaign.family_schema import FamilySchema
 from softbend.campaign.spaces import campaign_space, check_sampled_size, space_forms
 from softbend.errors import InputError, LimitError
 from softbend.fem.families import get_family

@@ -15,7 +15,7 @@ fiber-reinforced actuator is one example, a PneuNet space (``--family pneunet``)
   family named by text (paper B's Table 1 among them);
 * :mod:`~softbend.campaign.footprint` — shards, and the memory and disk a
   campaign needs;
-* :mod:`~softbend.campaign.families` — campaigns over any FEM actuator family
+* :mod:`~softbend.campaign.family_schema` — campaigns over any FEM actuator family
   (``--family``): its FEM sweep as a backend and what its database records;
 * :mod:`~softbend.campaign.runner` — :func:`run_campaign`: plans a run
   (:mod:`~softbend.campaign.planning`: resume, the designs left, the executor) and
@@ -53,9 +53,9 @@ _EXPORTS = {
     "count_designs_to_run": "runner",
     "parse_scheduler_address": "runner",
     "run_campaign": "runner",
-    "FamilyBackend": "families",
+    "FamilyBackend": "family_schema",
     "campaign_actuator": "store",
-    "family_backend": "families",
+    "family_backend": "family_schema",
     "FamilySpace": "spaces",
     "parse_family_space": "spaces",
     "SPACE_FORMS": "spaces",

@@ -47,7 +47,7 @@ import numpy as np
 from softbend._extras import require
 from softbend._validation import must_be
 from softbend.campaign.backends import Backend, SweepResult
-from softbend.campaign.families import CampaignDesign
+from softbend.campaign.family_schema import CampaignDesign
 from softbend.campaign.schema import first_line
 from softbend.errors import InputError, SoftbendError, keyed
 from softbend.limits import check_file_size

@@ -162,7 +162,7 @@ def campaign_backend(
     (``fem``, the default), with ``maxh_mm`` and the material.
     """
     from softbend.campaign.backends import backend_for_run
-    from softbend.campaign.families import family_backend
+    from softbend.campaign.family_schema import family_backend
 
     if fem_family.backends is None:
         return backend_for_run(

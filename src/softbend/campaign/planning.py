@@ -23,7 +23,7 @@ import numpy as np
 from softbend._validation import check_range, must_be
 from softbend.actuators import Design
 from softbend.campaign.backends import Backend, get_backend
-from softbend.campaign.families import CampaignDesign
+from softbend.campaign.family_schema import CampaignDesign
 from softbend.errors import InputError
 
 if TYPE_CHECKING:

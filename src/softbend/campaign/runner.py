@@ -71,7 +71,7 @@ from softbend.campaign.executors import (
     run_local,
     run_serial,
 )
-from softbend.campaign.families import (
+from softbend.campaign.family_schema import (
     CampaignDesign,
     FamilyBackend,
     FamilySchema,
@@ -196,7 +196,7 @@ def run_campaign(
         Registered backend name (``"analytical"``, ``"fem"``, ...) or a backend
         object. A database keeps the backend of its first run; another is refused.
         For another family's designs: ``"fem"`` (the family's own FEM sweep,
-        :class:`~softbend.campaign.families.FamilyBackend`, with
+        :class:`~softbend.campaign.family_schema.FamilyBackend`, with
         ``backend_options`` ``maxh_mm`` at most) or a backend object that sweeps them.
     backend_options : dict, optional
         Keyword options of the named backend.

@@ -14,7 +14,7 @@ Tables (schema version :data:`SCHEMA_VERSION`):
     ``family`` (the FEM family's name) and ``actuator`` (its
     :meth:`~softbend.actuators.Actuator.to_dict` as JSON), set on creation
     (absent for a family that is not recorded: paper B's, whose databases
-    predate families; see :mod:`softbend.campaign.families`).
+    predate families; see :mod:`softbend.campaign.family_schema`).
 ``designs``
     One row per attempted design: its parameters (those of its family, in its
     units: ``l_mm`` ... ``lc_mm`` for paper B's),
@@ -54,7 +54,7 @@ from datetime import UTC, datetime
 from pathlib import Path
 from typing import TYPE_CHECKING
 
-from softbend.campaign.families import FamilySchema
+from softbend.campaign.family_schema import FamilySchema
 from softbend.design import PARAMETERS
 from softbend.errors import SchemaError, SoftbendError
 

@@ -35,7 +35,7 @@ import numpy as np
 from softbend._io import new_file_mode
 from softbend._validation import check_choice
 from softbend.actuators import Design
-from softbend.campaign.families import CampaignDesign, FamilySchema
+from softbend.campaign.family_schema import CampaignDesign, FamilySchema
 from softbend.campaign.schema import SAMPLE_COLUMNS as SAMPLE_COLUMNS
 from softbend.campaign.schema import (
     SCHEMA_VERSION,
@@ -127,7 +127,7 @@ class CampaignStore:
         Open an existing database for reading only (status, export, analysis).
     family : FEMFamily, FamilySchema or str, optional
         The FEM actuator family of the campaign's designs
-        (:mod:`softbend.campaign.families`). A new database is created for it
+        (:mod:`softbend.campaign.family_schema`). A new database is created for it
         (default paper B's, ``"sfrba"``); an existing one must hold it. None
         opens an existing database of any family.
 
