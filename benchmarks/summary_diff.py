@@ -1,9 +1,11 @@
 """Compare two ``summary.json`` files of ``softbend reproduce`` key by key.
 
 A refactoring that must not change paper B's figures is checked by running ``make run``
-before and after and comparing the two summaries. The run's own dates, wall times and
-commit (``seconds``, and the volatile entries of ``provenance``) differ on every run and
-are left out; every other value must be identical::
+before and after and comparing the two summaries. What is timed differs on every run and
+is left out: the run's dates and wall time (the volatile entries of ``provenance``) and
+every value whose key names a duration or a speed (``seconds``, ``*_s``, ``*_ms``,
+``*_us``, ``*_per_s``, ``realtime_factor``, ``... (s)``); every other value must be
+identical::
 
     python benchmarks/summary_diff.py before/summary.json results/reproduce/summary.json
 
@@ -14,12 +16,15 @@ from __future__ import annotations
 
 import argparse
 import json
+import re
 import sys
 from pathlib import Path
 from typing import Any
 
 #: Top-level keys that describe the run itself rather than its figures.
 RUN_KEYS = ("seconds",)
+#: A key whose value is a duration or a speed: measured anew on every run.
+TIMED = re.compile(r"(seconds|_s|_ms|_us|_per_s|realtime_factor|\((s|ms|µs)\))$")
 #: Entries of ``provenance`` that change with every run.
 VOLATILE = ("started (UTC)", "finished (UTC)", "wall time")
 
@@ -28,6 +33,8 @@ def _walk(a: Any, b: Any, path: str, out: list[str]) -> None:
     if isinstance(a, dict) and isinstance(b, dict):
         for key in sorted(set(a) | set(b), key=str):
             here = f"{path}.{key}" if path else str(key)
+            if TIMED.search(str(key)):
+                continue
             if key not in a or key not in b:
                 out.append(f"{here}: only in {'after' if key in b else 'before'}")
             else:
@@ -62,7 +69,7 @@ def main() -> None:
         json.loads(args.before.read_text(encoding="utf-8")),
         json.loads(args.after.read_text(encoding="utf-8")),
     )
-    print("\n".join(found) if found else "identical (run dates and wall time left off)")
+    print("\n".join(found) if found else "identical (dates, durations and speeds left off)")
     sys.exit(1 if found else 0)
 
 
