@@ -1,9 +1,10 @@
 """The shape of the source tree, measured the same way every time.
 
-Prints the figures that a consolidation round is judged by: lines and modules in
-``src/softbend``, library parameters that exist only to name a command-line option
-in a message (``owner``, ``field``, ``option``, ``*_field``, ``*_option``; the CLI
-package itself is not counted), parameters annotated with a bare ``Any``, and the
+Prints the figures that a consolidation round is judged by: lines in ``src/softbend``
+(all; code, neither blank, comment nor docstring; docstrings) and its modules, library
+parameters that exist only to name a command-line option in a message (``owner``,
+``field``, ``option``, ``*_field``, ``*_option``; the CLI package itself is not counted),
+parameters annotated with a bare ``Any``, and the
 modules that parse CSV text (``pandas.read_csv``, ``csv.reader``/``csv.DictReader``),
 and the figures of "one road for every actuator": tests that name paper B's actuator
 outside its own modules (an ``if``/``elif``/``while``/``assert``, a conditional
@@ -71,6 +72,21 @@ def _tests(node: ast.AST) -> list[ast.expr]:
     return []
 
 
+def _docstring_lines(tree: ast.Module) -> set[int]:
+    """Line numbers of the module's, classes' and functions' docstrings."""
+    found: set[int] = set()
+    for node in ast.walk(tree):
+        if isinstance(node, ast.Module | ast.ClassDef | ast.FunctionDef | ast.AsyncFunctionDef):
+            first = node.body[0] if node.body else None
+            if (
+                isinstance(first, ast.Expr)
+                and isinstance(first.value, ast.Constant)
+                and isinstance(first.value.value, str)
+            ):
+                found.update(range(first.lineno, (first.end_lineno or first.lineno) + 1))
+    return found
+
+
 def _is_command(node: ast.expr) -> bool:
     """Whether ``node`` is a typer ``app.command(...)`` call (a decorator or a registration)."""
     return (
@@ -101,6 +117,7 @@ def measure() -> dict[str, object]:
     actuator_context: list[str] = []
     long_commands: list[str] = []
     module_lines: dict[str, int] = {}
+    docstring_lines = code_lines = 0
     functions: dict[str, tuple[str, ast.FunctionDef]] = {}
     commands: set[str] = set()
     for path in sorted(SRC.rglob("*.py")):
@@ -110,6 +127,13 @@ def measure() -> dict[str, object]:
         rel = path.relative_to(SRC).as_posix()
         module_lines[rel] = len(text.splitlines())
         tree = ast.parse(text)
+        documented = _docstring_lines(tree)
+        docstring_lines += len(documented)
+        code_lines += sum(
+            1
+            for number, line in enumerate(text.splitlines(), 1)
+            if number not in documented and line.strip() and not line.strip().startswith("#")
+        )
         library = not rel.startswith("cli/")
         own = PAPER_B_OWN.search(rel) is not None
         for node in ast.walk(tree):
@@ -148,6 +172,8 @@ def measure() -> dict[str, object]:
             long_commands.append(f"{rel}:{node.lineno} {name} ({length} lines)")
     return {
         "lines": lines,
+        "code_lines": code_lines,
+        "docstring_lines": docstring_lines,
         "modules": modules,
         "message_only_parameters": len(message_only),
         "functions_with_message_only_parameters": len(functions_with_message_only),
