@@ -51,6 +51,7 @@ docs: setup
 	$(BIN)/python docs/gen_ranges.py
 	@if [ -f $(OUT)/summary.json ]; then $(BIN)/python docs/gen_validation.py $(OUT)/summary.json; \
 	else echo "docs/validation.md kept: make run writes $(OUT)/summary.json"; fi
+	rm -rf docs/api/_generated  # the API pages anew: a renamed module leaves no stale page
 	$(BIN)/sphinx-build -j auto -W --keep-going -q -b html docs docs/_build/html
 	@echo "docs/_build/html/index.html"
 
