@@ -27,7 +27,7 @@ test: setup
 
 # What CI runs: every test but the slow physics cases.
 test-full: setup
-	$(BIN)/python -m pytest -q -m "not slow"
+	$(BIN)/python -m pytest -q -m "not slow" --durations=25
 
 test-all: setup
 	$(BIN)/python -m pytest -q
