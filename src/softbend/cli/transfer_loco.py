@@ -122,8 +122,8 @@ def loco(
             options=options,
             progress=lambda done, total, name: progress("fitting strategies", done, total),
         )
-    recorded = {"measurement_files": files_record(measurements, data), "forced": forced}  # type: ignore[arg-type]
-    result.settings.update({k: v for k, v in recorded.items() if v} | {"left_out": left_out})
+    result.settings["measurement_files"] = files_record(measurements, data)  # type: ignore[arg-type]
+    result.settings.update({"forced": forced} if forced else {}, left_out=left_out)
     synthetic = bool(data.synthetic.any())  # the figure flags any synthetic reading
     files = _write_loco(result, out, synthetic=synthetic, learning_curve=learning_curve)
     _print_loco(result, out, files, left_out, synthetic=synthetic, as_json=as_json)
