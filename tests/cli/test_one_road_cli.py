@@ -1,6 +1,6 @@
 """Every surrogate family of another actuator walks the road paper B's actuator walks.
 
-Each family (plr, xgb, mlp) is trained once on the PneuNet table of ``examples/pneunet``
+Each family (plr, xgb, mlp, table) is trained once on the PneuNet table of ``examples/pneunet``
 (``simulations.csv`` with its ``actuator.json``: four parameters, pressure in kPa) with the
 smallest budget that fits it, and the saved model then runs through ``predict``, ``transfer
 loco`` (every strategy that applies to it), ``transfer refine``, ``design find`` and ``control
@@ -32,7 +32,7 @@ PRESSURE = "p_kpa"
 #: A simulated design of the table (d000) and its angles there, read in the tests.
 DESIGN_ID = "d000"
 
-FAMILIES = ("plr", "xgb", "mlp")
+FAMILIES = ("plr", "xgb", "mlp", "table")
 
 
 def _run(*args: str) -> int:

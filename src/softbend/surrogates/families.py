@@ -9,7 +9,7 @@ tables, the ``models/<name>.json`` file and its ``kind``, the report. Each is a
 
 - its ``title`` (for tables and figures);
 - its ``grids``: the configurations the search tries, per grid name
-  (:data:`GRID_NAMES`);
+  (:data:`GRID_NAMES`, and optionally ``small``: :data:`OPTIONAL_GRIDS`);
 - ``make``: a factory of an unfitted estimator from a configuration and the
   search's :class:`FitSettings` (seed, threads, device, epochs);
 - ``storage``: how :func:`~softbend.surrogates.persistence.save_surrogate`
@@ -50,7 +50,13 @@ from softbend.errors import InputError, keyed
 from softbend.references import SURROGATE_TRAINING
 from softbend.registry import Registry
 from softbend.surrogates.protocol import Surrogate
-from softbend.surrogates.schema import MLP_SCHEMA, POLYNOMIAL_SCHEMA, XGBOOST_SCHEMA, Schema
+from softbend.surrogates.schema import (
+    MLP_SCHEMA,
+    POLYNOMIAL_SCHEMA,
+    TABLE_SCHEMA,
+    XGBOOST_SCHEMA,
+    Schema,
+)
 from softbend.surrogates.xgboost_codec import XGBoostCodec
 
 if TYPE_CHECKING:
@@ -64,6 +70,10 @@ __all__ = [
     "GRID_NAMES",
     "MODEL_NAMES",
     "MODEL_TITLES",
+    "OPTIONAL_GRIDS",
+    "PLR_SMALL_ALPHAS",
+    "PLR_SMALL_DEGREES",
+    "SMALL_DATA_MLP_GRID",
     "XGB_TREES",
     "Codec",
     "Family",
@@ -76,6 +86,11 @@ __all__ = [
 #: Grid names: ``quick`` (what ``softbend reproduce`` trains in its time budget) and
 #: ``paper`` (paper B's grids, §4.1).
 GRID_NAMES: tuple[str, ...] = ("quick", "paper")
+
+#: Grids a family may give or leave out: ``small``, for tables of fewer than 100 designs
+#: (:data:`softbend.surrogates.search.SMALL_DATA_DESIGNS`); a family without one searches
+#: its ``quick`` grid there.
+OPTIONAL_GRIDS: tuple[str, ...] = ("small",)
 
 #: Paper B's three families, in the order of its tables (the default of the search).
 MODEL_NAMES: tuple[str, ...] = ("plr", "xgb", "mlp")
@@ -222,7 +237,14 @@ class Family:
                 f"must be callable (params, settings) {family}; got {self.make!r}", key="make"
             )
         grids = dict(self.grids) if isinstance(self.grids, Mapping) else {}
-        for grid_name in GRID_NAMES:
+        unknown = [g for g in grids if g not in (*GRID_NAMES, *OPTIONAL_GRIDS)]
+        if unknown:
+            raise InputError(
+                f"must name only the grids {', '.join(GRID_NAMES + OPTIONAL_GRIDS)} {family}; "
+                f"got {', '.join(map(repr, unknown))}",
+                key="grids",
+            )
+        for grid_name in (*GRID_NAMES, *(g for g in OPTIONAL_GRIDS if g in grids)):
             configs = grids.get(grid_name)
             if not isinstance(configs, Sequence) or isinstance(configs, str) or not configs:
                 raise InputError(
@@ -238,9 +260,11 @@ class Family:
         object.__setattr__(self, "grids", {k: tuple(dict(c) for c in v) for k, v in grids.items()})
 
     def configs(self, grid_name: str) -> list[dict[str, Any]]:
-        """New copies of the configurations of the grid ``grid_name`` (``quick``, ``paper``)."""
-        check_choice(grid_name, "grid", GRID_NAMES)
-        return [dict(config) for config in self.grids[grid_name]]
+        """New copies of the configurations of the grid ``grid_name`` (``quick``, ``paper``,
+        ``small``: the family's own, else its ``quick`` grid)."""
+        check_choice(grid_name, "grid", (*GRID_NAMES, *OPTIONAL_GRIDS))
+        configs = self.grids.get(grid_name, self.grids["quick"])
+        return [dict(config) for config in configs]
 
 
 class _FamilyRegistry(Registry[Family]):
@@ -377,6 +401,20 @@ def _paper_range(name: str) -> range:
 
 _MLP_PICK = tuple(SURROGATE_TRAINING["mlp_hidden"].value)
 
+#: The MLP's ``small`` grid: two small networks, Adam's step 3e-3
+#: (:mod:`softbend.surrogates.search` tells why).
+SMALL_DATA_MLP_GRID: tuple[dict[str, Any], ...] = tuple(
+    {"hidden_sizes": (h, h), "learning_rate": 3e-3} for h in (16, 32)
+)
+
+#: Degrees and ridge strengths (per sample, standardized units) of the polynomial's
+#: ``small`` grid: every pair is tried, the grouped cross-validation chooses.
+#: On the first 30 designs of ``examples/pneunet/simulations.csv`` the held-out RMSE was
+#: 9.3° at degree 2 (any ridge up to 1e-3), and a ridge of 0.1 took degree 4 from 25.9° to
+#: 18.8° (docs/design-log.md).
+PLR_SMALL_DEGREES: tuple[int, ...] = (1, 2, 3, 4)
+PLR_SMALL_ALPHAS: tuple[float, ...] = (1e-8, 1e-3, 1e-2, 1e-1, 1.0)
+
 FAMILIES.register(
     "plr",
     Family(
@@ -385,6 +423,9 @@ FAMILIES.register(
         grids={
             "quick": tuple({"degree": d} for d in (2, 4, 6)),
             "paper": tuple({"degree": d} for d in _paper_range("plr_degrees")),
+            "small": tuple(
+                {"degree": d, "alpha": a} for d in PLR_SMALL_DEGREES for a in PLR_SMALL_ALPHAS
+            ),
         },
         make=_make_plr,
         storage=Storage(
@@ -437,6 +478,7 @@ FAMILIES.register(
                 for a in _paper_range("mlp_hidden_units")
                 for b in _paper_range("mlp_hidden_units")
             ),
+            "small": SMALL_DATA_MLP_GRID,
         },
         make=_make_mlp,
         storage=Storage(
@@ -446,5 +488,42 @@ FAMILIES.register(
             (*_INPUT_STATE, "coefs_", "intercepts_"),
         ),
         onnx=_mlp_onnx,
+    ),
+)
+
+
+# --- the table base ---------------------------------------------------------------------------
+
+
+def _make_table(params: dict[str, Any], settings: FitSettings) -> Any:
+    from softbend.surrogates.table import TableRegressor
+
+    return TableRegressor(**{"seed": settings.seed, **params})
+
+
+FAMILIES.register(
+    "table",
+    Family(
+        name="table",
+        title="simulation table (curves, GP between designs)",
+        grids={"quick": ({},), "paper": ({},)},
+        make=_make_table,
+        storage=Storage(
+            "softbend.surrogates.table",
+            "TableRegressor",
+            TABLE_SCHEMA,
+            (
+                "n_features_in_",
+                "designs_",
+                "curve_offsets_",
+                "curve_pressures_",
+                "curve_angles_",
+                "x_mean_",
+                "x_scale_",
+                "kernel_theta_",
+                "gp_inputs_",
+                "gp_targets_",
+            ),
+        ),
     ),
 )

@@ -70,6 +70,23 @@ class FixedGP:
         self.L = np.linalg.cholesky(K)
         self.alpha = np.linalg.solve(self.L.T, np.linalg.solve(self.L, y))
 
+    def predict_mean(self, Z: ArrayLike) -> np.ndarray:
+        """Predictive mean alone at rows ``Z``, degrees (``predict``'s first output, without
+        the cost of the variance).
+
+        Parameters
+        ----------
+        Z : array_like of shape (m, d)
+            Inputs, standardized as the training inputs.
+
+        Returns
+        -------
+        ndarray of shape (m,)
+        """
+        Z = np.asarray(Z, dtype=np.float64)
+        K_trans = self.constant * np.exp(-0.5 * _sq_distances(Z / self.length_scale, self._scaled))
+        return self.y_std * (K_trans @ self.alpha) + self.y_mean
+
     def predict(self, Z: ArrayLike) -> tuple[np.ndarray, np.ndarray]:
         """Predictive mean and standard deviation (noise included) at rows ``Z``, degrees.
 

@@ -10,7 +10,7 @@ Only a key of the schema is ever set on a model.
 
 Each surrogate family names its :class:`Schema` in its
 :class:`~softbend.surrogates.families.Storage` (:data:`POLYNOMIAL_SCHEMA`,
-:data:`MLP_SCHEMA`, :data:`XGBOOST_SCHEMA`); the composites' are
+:data:`MLP_SCHEMA`, :data:`XGBOOST_SCHEMA`, :data:`TABLE_SCHEMA`); the composites' are
 :data:`COMPOSITE_SCHEMAS`. A family added outside softbend builds its own from
 the public rules :func:`real`, :func:`integer`, :func:`string`, :func:`array`,
 :func:`boolean` and :func:`optional`.
@@ -46,6 +46,7 @@ __all__ = [
     "MLP_SCHEMA",
     "POLYNOMIAL_SCHEMA",
     "QUANTITIES",
+    "TABLE_SCHEMA",
     "XGBOOST_SCHEMA",
     "Rule",
     "RuleError",
@@ -435,6 +436,81 @@ def _check_polynomial(state: dict[str, Any]) -> None:
         ) from None
 
 
+def _check_table(state: dict[str, Any]) -> None:
+    """The table base's curves and GP fit together (:mod:`softbend.surrogates.table`)."""
+    d = int(state["n_features_in_"])
+    if d < 2:
+        raise RuleError(f"must be >= 2 (design parameters and pressure); got {d}",
+                        key="state.n_features_in_")  # fmt: skip
+    for key in ("x_mean_", "x_scale_"):
+        if state[key].shape != (d,):
+            raise RuleError(f"must have shape ({d},); got {state[key].shape}", key=f"state.{key}")
+    designs, offsets = state["designs_"], state["curve_offsets_"]
+    if designs.ndim != 2 or designs.shape[1] != d - 1 or designs.shape[0] < 1:
+        raise RuleError(
+            f"must have shape (n_designs >= 1, {d - 1}); got {designs.shape}", key="state.designs_"
+        )
+    n_points = state["curve_pressures_"].shape[0]
+    if (
+        offsets.shape != (designs.shape[0] + 1,)
+        or offsets[0] != 0
+        or offsets[-1] != n_points
+        or np.any(np.diff(offsets) < 1)
+    ):
+        raise RuleError(
+            f"must rise from 0 to {n_points} (the points) by >= 1 per design, "
+            f"{designs.shape[0] + 1} values; got {short_repr(offsets.tolist())}",
+            key="state.curve_offsets_",
+        )
+    if state["curve_angles_"].shape != (n_points,):
+        raise RuleError(
+            f"must have shape ({n_points},) (one per pressure); got {state['curve_angles_'].shape}",
+            key="state.curve_angles_",
+        )
+    pressures = state["curve_pressures_"]
+    for k in range(designs.shape[0]):
+        if np.any(np.diff(pressures[offsets[k] : offsets[k + 1]]) <= 0):
+            raise RuleError(
+                f"must rise strictly along each design's curve; design {k} does not",
+                key="state.curve_pressures_",
+            )
+    inputs, targets = state["gp_inputs_"], state["gp_targets_"]
+    if inputs.ndim != 2 or inputs.shape[1] != d or inputs.shape[0] < 1:
+        raise RuleError(f"must have shape (n >= 1, {d}); got {inputs.shape}",
+                        key="state.gp_inputs_")  # fmt: skip
+    if targets.shape != (inputs.shape[0],):
+        raise RuleError(
+            f"must have shape ({inputs.shape[0]},) (one per row of 'gp_inputs_'); got "
+            f"{targets.shape}",
+            key="state.gp_targets_",
+        )
+    if state["kernel_theta_"].shape != (d + 2,):
+        raise RuleError(
+            f"must have shape ({d + 2},) (constant, {d} length scales, noise); got "
+            f"{state['kernel_theta_'].shape}",
+            key="state.kernel_theta_",
+        )
+    width = RANGES["kernel_width"]
+    with np.errstate(over="ignore", under="ignore"):
+        hyper = np.exp(state["kernel_theta_"])
+    bad = implausible_index(hyper, "kernel_width")
+    if bad is not None:
+        raise RuleError(
+            f"must hold the logarithms of the kernel's constant, length scales and noise, "
+            f"each within {width.low:g} to {width.high:g}; got {hyper[bad]:g} at index {bad}",
+            key="state.kernel_theta_",
+        )
+    for key in ("curve_angles_", "gp_targets_"):
+        bad = implausible_index(state[key], "angle_deg")
+        if bad is not None:
+            bounds = RANGES["angle_deg"]
+            raise RuleError(
+                f"must hold plausible angles from {bounds.low:g} to {bounds.high:g} degrees; "
+                f"got {state[key][bad]:g} at index {bad}",
+                key=f"state.{key}",
+            )
+
+
 def _check_mlp(state: dict[str, Any]) -> None:
     _check_standardization(state)
     coefs, intercepts = state["coefs_"], state["intercepts_"]
@@ -713,6 +789,31 @@ MLP_SCHEMA = Schema(
     },
     check=_check_mlp,
     against=_check_mlp_sizes,
+    inputs=_check_inputs,
+)
+
+#: The schema of the table base (``table``).
+TABLE_SCHEMA = Schema(
+    params={
+        "extrapolation": string(("linear", "clamp")),
+        "max_gp_points": integer(3),
+        "n_restarts": integer(0),
+        "seed": integer(0),
+    },
+    state={
+        "n_features_in_": integer(2),
+        "feature_names_in_": array("str", 1),
+        "designs_": array(_FLOAT, 2),
+        "curve_offsets_": array(_INT, 1, low=0),
+        "curve_pressures_": array(_FLOAT, 1),
+        "curve_angles_": array(_FLOAT, 1),
+        "x_mean_": array(_FLOAT, 1),
+        "x_scale_": array(_FLOAT, 1, low=0.0, strict=True),
+        "kernel_theta_": array(_FLOAT, 1),
+        "gp_inputs_": array(_FLOAT, 2),
+        "gp_targets_": array(_FLOAT, 1),
+    },
+    check=_check_table,
     inputs=_check_inputs,
 )
 

@@ -81,6 +81,8 @@ from softbend.surrogates.families import (
     GRID_NAMES,
     MODEL_NAMES,
     MODEL_TITLES,
+    OPTIONAL_GRIDS,
+    SMALL_DATA_MLP_GRID,
     XGB_TREES,
     FitSettings,
     family_names,
@@ -107,6 +109,7 @@ __all__ = [
     "SEARCH_GRIDS",
     "SMALL_DATA_DESIGNS",
     "SMALL_DATA_MLP_GRID",
+    "SMALL_DATA_MODELS",
     "XGB_TREES",
     "FamilyResult",
     "Progress",
@@ -130,23 +133,25 @@ MLP_EPOCHS: dict[str, int] = {
 #: Adam step size of the MLP unless a configuration names its own (paper B: 6e-4).
 MLP_LEARNING_RATE = 6e-4
 
-#: Below this many designs, ``softbend train`` searches the ``small`` grid unless told a grid.
+#: Below this many designs, ``softbend train`` searches the ``small`` grid unless told a grid,
+#: and the table base among its default families (:data:`SMALL_DATA_MODELS`).
 SMALL_DATA_DESIGNS = 100
 
-#: The MLP configurations of the ``small`` grid (module docstring).
-SMALL_DATA_MLP_GRID: tuple[dict[str, Any], ...] = tuple(
-    {"hidden_sizes": (h, h), "learning_rate": 3e-3} for h in (16, 32)
-)
+#: The default families below :data:`SMALL_DATA_DESIGNS` designs: paper B's three and the
+#: table base (:mod:`softbend.surrogates.table`).
+SMALL_DATA_MODELS: tuple[str, ...] = (*MODEL_NAMES, "table")
 
-#: Every grid name: the families' own (:data:`GRID_NAMES`) and ``small``.
-SEARCH_GRIDS: tuple[str, ...] = (*GRID_NAMES, "small")
+
+#: Every grid name: the families' own (:data:`GRID_NAMES`) and ``small`` (:data:`OPTIONAL_GRIDS`).
+SEARCH_GRIDS: tuple[str, ...] = (*GRID_NAMES, *OPTIONAL_GRIDS)
 
 
 def grid(name: str, model: str) -> list[dict[str, Any]]:
     """The configurations of the family ``model`` in the grid ``name`` (module docstring).
 
-    ``small`` is the MLP's :data:`SMALL_DATA_MLP_GRID` and every other family's
-    ``quick`` grid.
+    ``small`` is a family's own small-data grid where it gives one (the MLP's
+    :data:`SMALL_DATA_MLP_GRID`, the polynomial's degrees × ridge strengths), else
+    its ``quick`` grid.
 
     Raises
     ------
@@ -156,10 +161,6 @@ def grid(name: str, model: str) -> list[dict[str, Any]]:
     check_choice(name, "grid", SEARCH_GRIDS)
     with keyed("model"):
         family = FAMILIES.get(model)
-    if name == "small":
-        if model == "mlp":
-            return [dict(config) for config in SMALL_DATA_MLP_GRID]
-        return family.configs("quick")
     return family.configs(name)
 
 

@@ -45,6 +45,7 @@ from softbend.surrogates.features import TrainingData, family_training_data, tra
 from softbend.surrogates.search import (
     MODEL_NAMES,
     SMALL_DATA_DESIGNS,
+    SMALL_DATA_MODELS,
     Progress,
     SearchResult,
     describe,
@@ -119,6 +120,14 @@ def small_data_advice(n_designs: int, grid_name: str | None, *, mlp: bool = True
     )
 
 
+def default_models(n_designs: int) -> tuple[str, ...]:
+    """The families ``softbend train`` searches unless told: paper B's three
+    (:data:`~softbend.surrogates.search.MODEL_NAMES`), and for a table of fewer than
+    :data:`~softbend.surrogates.search.SMALL_DATA_DESIGNS` designs the table base too
+    (:data:`~softbend.surrogates.search.SMALL_DATA_MODELS`)."""
+    return SMALL_DATA_MODELS if n_designs < SMALL_DATA_DESIGNS else MODEL_NAMES
+
+
 def _telling(advise: Callable[[str], None] | None, line: str | None) -> Callable[[], None] | None:
     """``advise(line)`` as a call of no arguments; None when there is nothing to tell."""
     if advise is None or line is None:
@@ -157,7 +166,7 @@ def train_surrogates(
     source: Source,
     out_dir: str | os.PathLike[str],
     *,
-    models: str | Sequence[str] = MODEL_NAMES,
+    models: str | Sequence[str] | None = None,
     grid_name: str | None = "quick",
     folds: int = 5,
     seed: int = 0,
@@ -174,6 +183,7 @@ def train_surrogates(
     plr_patience: int | None = None,
     checkpoint: SearchCheckpoint | None = None,
     tf32: bool = False,
+    interpolation: bool = True,
 ) -> tuple[SearchResult, dict[str, Any]]:
     """Search, refit, save and export the surrogates of a campaign.
 
@@ -185,7 +195,10 @@ def train_surrogates(
         Output folder (created).
     models, grid_name, folds, seed, device, n_jobs, epochs, progress
         As :func:`softbend.surrogates.search.search` (``models``: registered family
-        names, or one comma-separated text of them). ``grid_name`` None: ``small``
+        names, or one comma-separated text of them; None: :func:`default_models`,
+        paper B's three and, under
+        :data:`~softbend.surrogates.search.SMALL_DATA_DESIGNS` designs, the table
+        base). ``grid_name`` None: ``small``
         for fewer than :data:`~softbend.surrogates.search.SMALL_DATA_DESIGNS`
         designs, else ``quick``.
     export_onnx : bool
@@ -201,6 +214,11 @@ def train_surrogates(
     tf32 : bool
         TF32 matrix products for the MLP on a CUDA device (see
         :func:`softbend.surrogates.search.search`).
+    interpolation : bool, default True
+        Also score each family's chosen configuration on held-out pressure points
+        of the simulated designs (:func:`~softbend.surrogates.interpolation.interpolation_scores`:
+        one more fit per family), reported as ``interpolation`` beside the
+        grouped figures.
     select_by : {"rmse", "mape", "r2"}
         The cross-validated metric that names the best family (default RMSE).
     advise : callable, optional
@@ -215,7 +233,8 @@ def train_surrogates(
         JSON-friendly headline figures, per family and paper B's beside them
         (``paper_b``, empty for a family paper B does not have; the MAPE with
         its floor ``mape_floor_deg`` and ``n_mape_used``, null with
-        ``mape_undefined`` when no reading reaches the floor), ``best`` and
+        ``mape_undefined`` when no reading reaches the floor; with
+        ``interpolation``, the family's ``interpolation`` figures), ``best`` and
         ``selected_by``, ``best_by_mape``, ``advice`` (None for 100 designs or
         more), the files written, and ``resumed_config_folds`` (folds loaded
         from ``checkpoint``).
@@ -227,6 +246,8 @@ def train_surrogates(
 
     check_choice(select_by, "select_by", tuple(SELECT_BY))
     data = _load_data(source)
+    if models is None:
+        models = default_models(data.n_groups)
     names = [m.strip() for m in models.split(",")] if isinstance(models, str) else list(models)
     advice = small_data_advice(data.n_groups, grid_name, mlp="mlp" in names)
     if grid_name is None:
@@ -251,6 +272,25 @@ def train_surrogates(
         tf32=tf32,
         on_start=_telling(advise, advice),
     )
+    interpolated: dict[str, dict[str, float]] = {}
+    if interpolation:
+        from softbend.surrogates.families import FitSettings
+        from softbend.surrogates.interpolation import interpolation_scores
+
+        settings = FitSettings(
+            seed=seed, n_jobs=n_jobs, device=device, epochs=int(result.settings["mlp_epochs"])
+        )
+        phase = "interpolation: held-out pressures of the simulated designs"
+        if progress is not None:
+            progress(phase, 0, 1)
+        interpolated = interpolation_scores(
+            data,
+            {name: fam.params for name, fam in result.families.items()},
+            settings,
+            mape_threshold_deg=float(result.settings["mape_floor_deg"]),
+        )
+        if progress is not None:
+            progress(phase, 1, 1)
     out = Path(out_dir)
     (out / "models").mkdir(parents=True, exist_ok=True)
     files: dict[str, str] = {}
@@ -282,6 +322,8 @@ def train_surrogates(
             "search_s": fam.search_s,
             "paper_b": dict(published.get(name) or {}),
         }
+        if name in interpolated:
+            entry["interpolation"] = interpolated[name]
         if export_onnx and family.onnx is not None:
             from softbend.surrogates.onnx_export import onnx_predict, save_onnx
 
@@ -296,6 +338,11 @@ def train_surrogates(
     cv_path = out / "cv_results.csv"
     write_text_atomic(cv_path, result.cv_results.to_csv(index=False))
     summary_table = result.summary()
+    if interpolated:
+        for key in ("rmse_deg", "max_abs_error_deg", "r2"):
+            summary_table[f"interp_{key}"] = [
+                interpolated.get(m, {}).get(key) for m in summary_table["model"]
+            ]
     for key in ("params", "r2", "mape_pct", "inference_ms"):
         summary_table[f"paper_b_{key}"] = [
             dict(published.get(m) or {}).get(key) for m in summary_table["model"]
@@ -322,7 +369,7 @@ def train_into(
     source: Source,
     out_dir: str | os.PathLike[str],
     *,
-    models: str | Sequence[str] = MODEL_NAMES,
+    models: str | Sequence[str] | None = None,
     figures: Callable[[SearchResult, Path], dict[str, str]] | None = None,
     on_resume: Callable[[str], None] | None = None,
     on_discard: Callable[[str], None] | None = None,
@@ -368,7 +415,7 @@ def train_into(
     from softbend._outdir import staged_dir
     from softbend.surrogates.checkpoint import SearchCheckpoint, checkpoint_path
 
-    names = family_names(models)
+    names = None if models is None else family_names(models)
     out = Path(out_dir)
     checkpoint = SearchCheckpoint(checkpoint_path(out), on_resume=on_resume, on_discard=on_discard)
     with checkpoint:
