@@ -113,7 +113,7 @@ def test_an_unknown_family_is_one_line_listing_the_known_ones_and_exit_2(
     assert main(args) == 2
     line = one_error_line(capsys)
     assert "Unknown surrogate family 'toy-lin'" in line
-    assert "known: plr, xgb, mlp, toy-linear." in line
+    assert "known: plr, xgb, mlp, table, toy-linear." in line
     assert not out.exists()
 
 
@@ -121,4 +121,4 @@ def test_once_unregistered_the_family_is_unknown_again(small_campaign, tmp_path,
     assert "toy-linear" not in FAMILIES
     args = ["train", str(small_campaign), "--out", str(tmp_path / "o"), "--models", "toy-linear"]
     assert main(args) == 2
-    assert "known: plr, xgb, mlp." in one_error_line(capsys)
+    assert "known: plr, xgb, mlp, table." in one_error_line(capsys)

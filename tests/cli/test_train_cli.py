@@ -56,7 +56,7 @@ def test_train_writes_models_tables_figures_and_predicts(small_campaign, tmp_pat
     [
         (
             ["--models", "plr,svm"],
-            "--models: Unknown surrogate family 'svm'; known: plr, xgb, mlp.",
+            "--models: Unknown surrogate family 'svm'; known: plr, xgb, mlp, table.",
         ),
         (["--models", " , "], "--models: must be at least one surrogate family name"),
         (["--grid", "huge"], "--grid: must be one of"),

@@ -36,8 +36,30 @@ def test_paper_b_families_are_registered_under_their_command_line_names():
         "plr": "polynomial regression",
         "xgb": "XGBoost",
         "mlp": "normalized MLP",
+        "table": "simulation table (curves, GP between designs)",
     }
     assert legacy_kinds() == {"polynomial": "plr", "xgboost": "xgb"}
+
+
+def test_the_small_grids_are_a_family_s_own_or_its_quick_one():
+    small_plr = grid("small", "plr")
+    # every degree with every ridge strength; paper B's grids are left as they were
+    assert {c["degree"] for c in small_plr} == {1, 2, 3, 4}
+    assert {c["alpha"] for c in small_plr} == {1e-8, 1e-3, 1e-2, 1e-1, 1.0}
+    assert len(small_plr) == 20
+    assert grid("small", "mlp") == [
+        {"hidden_sizes": (16, 16), "learning_rate": 3e-3},
+        {"hidden_sizes": (32, 32), "learning_rate": 3e-3},
+    ]
+    assert grid("small", "xgb") == grid("quick", "xgb")  # none of its own
+    assert grid("small", "table") == [{}]
+    assert _toy(grids={"quick": ({},), "paper": ({},), "small": ({"a": 1},)}).configs("small") == [
+        {"a": 1}
+    ]
+    with pytest.raises(InputError, match="grids"):
+        _toy(grids={"quick": ({},), "paper": ({},), "huge": ({},)})
+    with pytest.raises(InputError, match="grids"):
+        _toy(grids={"quick": ({},), "paper": ({},), "small": ()})
 
 
 def test_the_grids_are_paper_b_s_and_the_quick_ones():
@@ -86,12 +108,13 @@ def test_an_unknown_family_is_one_line_listing_the_known_ones(call):
     with pytest.raises(UnknownNameError) as info:
         call()
     message = str(info.value)
-    assert "'svm'" in message and "known: plr, xgb, mlp" in message and "\n" not in message
+    assert "'svm'" in message and "known: plr, xgb, mlp, table" in message and "\n" not in message
 
 
 def test_search_refuses_an_unknown_family_before_any_fit(small_data):
     with pytest.raises(
-        UnknownNameError, match=r"models: Unknown surrogate family 'svm'; known: plr, xgb, mlp"
+        UnknownNameError,
+        match=r"models: Unknown surrogate family 'svm'; known: plr, xgb, mlp, table",
     ):
         search(small_data, models=["plr", "svm"])
     with pytest.raises(UnknownNameError, match=r"param_grid: Unknown surrogate family 'svm'"):

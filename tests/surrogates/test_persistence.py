@@ -542,7 +542,11 @@ def _composites(fitted):
 
 
 def test_every_kind_saves_strict_json_and_reloads_bit_for_bit(fitted, tmp_path):
-    models = {**fitted, **_composites(fitted)}
+    from softbend.surrogates.table import TableRegressor
+
+    X = _inputs(120, 0)
+    table = TableRegressor(n_restarts=0).fit(X, _angle(X))
+    models = {**fitted, **_composites(fitted), "table": table}
     assert set(models) == set(saved_kinds())
     X = _inputs(200, 22)
     for kind, model in models.items():

@@ -25,7 +25,7 @@ def test_grid_sizes_match_paper_b():
     ("name", "model", "match"),
     [
         ("huge", "plr", "grid: must be one of"),
-        ("quick", "svm", r"model: Unknown surrogate family 'svm'; known: plr, xgb, mlp\."),
+        ("quick", "svm", r"model: Unknown surrogate family 'svm'; known: plr, xgb, mlp, table\."),
     ],
 )
 def test_unknown_grid_or_model(name, model, match):
@@ -64,7 +64,7 @@ def test_too_few_designs_for_the_folds():
 
 def test_unknown_model_in_search(small_data):
     with pytest.raises(
-        ValueError, match=r"models: Unknown surrogate family 'gpr'; known: plr, xgb, mlp\."
+        ValueError, match=r"models: Unknown surrogate family 'gpr'; known: plr, xgb, mlp, table\."
     ):
         search(small_data, models=["plr", "gpr"])
 
@@ -367,6 +367,20 @@ def test_plr_patience_stops_raising_the_degree_once_the_cv_error_rises(small_dat
     assert (same["status"] == "ok").all()
 
 
+def test_plr_patience_judges_a_degree_by_its_best_ridge_strength(small_data):
+    """With ridge strengths in the grid, a degree is stopped whole, never halfway."""
+    configs = [{"degree": d, "alpha": a} for d in (1, 2, 3, 4, 5) for a in (1e-8, 1e-1)]
+    common = {"models": ["plr"], "param_grid": {"plr": configs}, "seed": 0, "refit": False}
+    full = search(small_data, **common).cv_results
+    per_degree = full["rmse_fold_mean"].to_numpy().reshape(5, 2).min(axis=1)
+    best = int(np.argmin(per_degree))
+    assert 0 < best < 3, "the test data must have an interior best degree"
+    table = search(small_data, plr_patience=1, **common).cv_results
+    fitted = table[table["status"] == "ok"]
+    assert list(fitted["params"]) == list(full["params"][: 2 * (best + 2)])
+    assert table[table["status"] != "ok"]["status"].str.contains("degree").all()
+
+
 @pytest.mark.parametrize("patience", [0, -1, 1.5, "2"])
 def test_plr_patience_must_be_a_positive_integer(small_data, patience):
     with pytest.raises(ValueError, match="plr_patience: must be an integer"):
@@ -383,11 +397,13 @@ def test_tf32_is_recorded_checked_and_changes_nothing_on_the_cpu(small_data):
         search(small_data, device="cpu", tf32="yes", **kwargs)
 
 
-def test_the_small_grid_changes_the_mlp_alone():
+def test_the_small_grid_changes_the_mlp_and_the_polynomial_s_ridge():
     from softbend.surrogates.search import MLP_EPOCHS, SMALL_DATA_MLP_GRID
 
-    for family in ("plr", "xgb"):
-        assert grid("small", family) == grid("quick", family)
+    assert grid("small", "xgb") == grid("quick", "xgb")
+    # the polynomial: low degrees, each with ridge strengths from none to strong
+    plr = grid("small", "plr")
+    assert {c["degree"] for c in plr} == {1, 2, 3, 4} and min(c["alpha"] for c in plr) == 1e-8
     small = [c["hidden_sizes"] for c in grid("small", "mlp")]
     assert small == [c["hidden_sizes"] for c in SMALL_DATA_MLP_GRID]
     # smaller than paper B's pick, trained longer than the quick grid

@@ -101,6 +101,12 @@ def train(
         "grouped", help="Folds: grouped (whole designs) or random (shuffled samples, paper B's)."
     ),
     no_onnx: bool = typer.Option(False, "--no-onnx", help="Skip the ONNX export."),
+    no_interpolation: bool = typer.Option(
+        False,
+        "--no-interpolation",
+        help="Skip the interpolation score (held-out pressures of the simulated designs: one "
+        "more fit per family).",
+    ),
     as_json: bool = typer.Option(False, "--json", help="Print the results as JSON."),
 ) -> None:
     """Train surrogates of a campaign by cross-validated search.
@@ -118,7 +124,8 @@ def train(
 
     Beside the grouped figures, each family's chosen configuration is scored on
     interpolation: every other interior pressure point of each simulated design
-    held out, the rest fitted (the table's "interp." columns).
+    held out, the rest fitted (the table's "interp." column; --no-interpolation
+    skips it).
 
     TABLE is a softbend campaign (of paper B's actuator or another FEM family),
     a verified dataset (a folder of 'softbend campaign dataset', or the name of
@@ -192,6 +199,7 @@ def train(
             n_jobs=workers,
             epochs=epochs,
             export_onnx=not no_onnx,
+            interpolation=not no_interpolation,
             progress=progress,
             cv=cv,
             halving=halving,

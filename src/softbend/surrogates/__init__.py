@@ -5,9 +5,10 @@ The inputs are the design parameters of the model's actuator in its description'
 actuator (l, r, t, b, φ, lc, P) in mm, degrees and MPa, for another its own names, such as
 (n_chambers, wall_mm, height_mm, p_kpa). Every saved model records its description.
 
-Polynomial regression, XGBoost and the normalized MLP as scikit-learn
-estimators, each a family of :data:`FAMILIES` (``plr``, ``xgb``, ``mlp``; more
-can be registered); a design-grouped cross-validated grid search; metrics and
+Polynomial regression, XGBoost, the normalized MLP and the table base (the
+simulated curves themselves, a Gaussian process between designs) as scikit-learn
+estimators, each a family of :data:`FAMILIES` (``plr``, ``xgb``, ``mlp``,
+``table``; more can be registered); a design-grouped cross-validated grid search; metrics and
 inference timing; persistence with metadata; ONNX export; single-sample fast
 paths for control loops; the :class:`Surrogate` protocol every fitted one
 answers. Names are imported lazily so that ``import softbend.surrogates`` does
@@ -38,6 +39,7 @@ _EXPORTS = {
     "training_data": "features",
     "PolynomialRegressor": "polynomial",
     "NormalizedMLPRegressor": "mlp",
+    "TableRegressor": "table",
     "AffineCorrected": "corrected",
     "GPCorrected": "corrected",
     "MeanEnsemble": "corrected",

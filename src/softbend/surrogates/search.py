@@ -9,8 +9,11 @@ configuration of each family (lowest mean validation RMSE) is refitted on all
 the data. The MLP configurations are trained together in one batched tensor
 program (:func:`softbend.surrogates.batched.train_mlp_grid`).
 
-Grids (``grid="paper"`` is paper B's; each family holds its own; ``small`` is
-``quick`` but for the MLP, :data:`SMALL_DATA_MLP_GRID`):
+Grids (``grid="paper"`` is paper B's; each family holds its own; ``small`` is a
+family's own small-data grid where it has one, the MLP's :data:`SMALL_DATA_MLP_GRID`
+and the polynomial's degrees 1 to 4 each with ridge strengths 1e-8 to 1
+(:data:`~softbend.surrogates.families.PLR_SMALL_ALPHAS`), else its ``quick`` one;
+the table base, :mod:`softbend.surrogates.table`, has one configuration):
 
 ========  ==================================  ====================================
 family    ``quick``                           ``paper``
@@ -406,20 +409,23 @@ def _cv_sequential(
     make: Callable[[dict[str, Any]], Any],
     tick: Callable[[], None],
     checkpoint: SearchCheckpoint | None = None,
-    stop: Callable[[list[tuple[dict[str, Any], np.ndarray | None, float, str]]], str | None]
+    stop: Callable[
+        [list[tuple[dict[str, Any], np.ndarray | None, float, str]], dict[str, Any]], str | None
+    ]
     | None = None,
 ) -> tuple[list[tuple[dict[str, Any], np.ndarray | None, float, str]], int]:
     """(params, oof predictions or None, fit seconds, status) per configuration.
 
     Also returns the number of folds loaded from ``checkpoint``; every fold
-    fitted is added to it before ``tick`` reports it. ``stop(outcomes)``, asked
-    after each configuration, returns why the remaining ones are not fitted
-    (they are listed as skipped for that reason), or None to go on.
+    fitted is added to it before ``tick`` reports it. ``stop(outcomes, params)``,
+    asked before each configuration after the first (``params``: the next one),
+    returns why the remaining ones are not fitted (they are listed as skipped for
+    that reason), or None to go on.
     """
     out: list[tuple[dict[str, Any], np.ndarray | None, float, str]] = []
     resumed = 0
     for index, params in enumerate(configs):
-        reason = stop(out) if stop is not None and out else None
+        reason = stop(out, params) if stop is not None and out else None
         if reason is not None:
             logger.info("%s: %s", model, reason)
             for rest in configs[index:]:
@@ -466,26 +472,39 @@ def _cv_sequential(
 
 def _patience_stop(
     splits: list[tuple[np.ndarray, np.ndarray]], y: np.ndarray, patience: int
-) -> Callable[[list[tuple[dict[str, Any], np.ndarray | None, float, str]]], str | None]:
-    """A ``stop`` for :func:`_cv_sequential`: the last ``patience`` fitted did not improve.
+) -> Callable[
+    [list[tuple[dict[str, Any], np.ndarray | None, float, str]], dict[str, Any]], str | None
+]:
+    """A ``stop`` for :func:`_cv_sequential`: the last ``patience`` degrees did not improve.
 
     Improvement is the mean held-out RMSE over the folds (``rmse_fold_mean`` of
-    :func:`_fold_scores`), by which the search ranks.
+    :func:`_fold_scores`), by which the search ranks; a degree's score is the best
+    of its configurations (one per degree in the ``quick`` and ``paper`` grids,
+    one per ridge strength in the ``small`` grid), and a degree is judged once all
+    its configurations are fitted (consecutive in the grid).
     """
 
-    def stop(outcomes: list[tuple[dict[str, Any], np.ndarray | None, float, str]]) -> str | None:
-        scores = [
-            _fold_scores(y, pred, splits, MAPE_THRESHOLD_DEG)["rmse_fold_mean"]
-            for _, pred, _, status in outcomes
-            if pred is not None and status == "ok"
-        ]
+    def stop(
+        outcomes: list[tuple[dict[str, Any], np.ndarray | None, float, str]],
+        upcoming: dict[str, Any],
+    ) -> str | None:
+        if outcomes and outcomes[-1][0].get("degree") == upcoming.get("degree"):
+            return None  # the degree's other configurations first
+        best: dict[Any, float] = {}
+        for params, pred, _, status in outcomes:
+            if pred is None or status != "ok":
+                continue
+            score = _fold_scores(y, pred, splits, MAPE_THRESHOLD_DEG)["rmse_fold_mean"]
+            degree = params.get("degree")
+            best[degree] = min(score, best.get(degree, math.inf))
+        scores = list(best.values())
         if len(scores) <= patience:
             return None
         best_before = min(scores[:-patience])
         if min(scores[-patience:]) < best_before:
             return None
         return (
-            f"the last {patience} configuration(s) did not improve on the best cross-validated "
+            f"the last {patience} degree(s) did not improve on the best cross-validated "
             f"RMSE {best_before:.4g} deg (patience {patience})"
         )
 
