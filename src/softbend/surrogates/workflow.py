@@ -98,11 +98,14 @@ def best_family(families: dict[str, Any], select_by: str = "rmse") -> str | None
     return pick(scored, key=scored.__getitem__)
 
 
-def small_data_advice(n_designs: int, grid_name: str | None, *, mlp: bool = True) -> str | None:
+def small_data_advice(
+    n_designs: int, grid_name: str | None, *, mlp: bool = True, table: bool = False
+) -> str | None:
     """One line for a table of fewer than :data:`SMALL_DATA_DESIGNS` designs, else None.
 
     ``grid_name`` is the grid the caller named (None: none); ``mlp`` whether the
-    MLP is among the families trained (the grid is said only then).
+    MLP is among the families trained (the grid is said only then); ``table``
+    whether the table base is (it is then said to be a candidate).
     """
     if n_designs >= SMALL_DATA_DESIGNS:
         return None
@@ -113,6 +116,11 @@ def small_data_advice(n_designs: int, grid_name: str | None, *, mlp: bool = True
         else f"--grid {grid_name} was asked for (the small-data grid is the default here)"
     )
     said = f"; {grid}" if mlp else ""
+    if table:
+        said += (
+            "; the table base (the simulated curves themselves, a Gaussian process between "
+            "designs) is a candidate"
+        )
     return (
         f"{n_designs} designs: fewer than {SMALL_DATA_DESIGNS}, so the held-out scores vary "
         f"from fold to fold and a flexible model can fit noise{said}. Compare the families "
@@ -249,7 +257,7 @@ def train_surrogates(
     if models is None:
         models = default_models(data.n_groups)
     names = [m.strip() for m in models.split(",")] if isinstance(models, str) else list(models)
-    advice = small_data_advice(data.n_groups, grid_name, mlp="mlp" in names)
+    advice = small_data_advice(data.n_groups, grid_name, mlp="mlp" in names, table="table" in names)
     if grid_name is None:
         grid_name = "small" if advice is not None else "quick"
     actuator = data.actuator or SFRBA  # every check and file names this actuator

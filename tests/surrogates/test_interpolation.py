@@ -1,0 +1,67 @@
+"""The interpolation score and the small-table defaults of training."""
+
+from __future__ import annotations
+
+import numpy as np
+import pandas as pd
+import pytest
+
+from softbend.surrogates.features import TrainingData, data_hash
+from softbend.surrogates.interpolation import interpolation_rows
+from softbend.surrogates.search import MODEL_NAMES, SMALL_DATA_DESIGNS
+from softbend.surrogates.workflow import default_models, small_data_advice, train_surrogates
+
+from .conftest import table1_inputs
+
+PRESSURES = np.linspace(0.0, 0.5, 7)  # MPa
+
+
+def _data(n_designs: int) -> TrainingData:
+    designs = table1_inputs(n_designs, 4)[:, :6]
+    X = np.array([[*d, p] for d in designs for p in PRESSURES])
+    y = 120.0 * (X[:, 0] / 130.0) / (X[:, 2] / 3.0) * (X[:, -1] / 0.5) ** 1.5
+    groups = np.repeat([f"d{k:03d}" for k in range(n_designs)], PRESSURES.size)
+    return TrainingData(X=X, y=y, groups=groups, data_hash=data_hash(X, y, groups))
+
+
+def test_every_other_interior_pressure_of_each_design_is_held_out():
+    data = _data(3)
+    order = np.random.default_rng(0).permutation(data.n_samples)  # rows in any order
+    X, groups = data.X[order], data.groups[order]
+    kept, held = interpolation_rows(X, groups)
+    assert np.array_equal(np.sort(np.concatenate([kept, held])), np.arange(X.shape[0]))
+    for name in np.unique(groups):
+        mine = groups[held] == name
+        # positions 1, 3, 5 of the 7 pressures: each between two kept ones
+        assert np.allclose(np.sort(X[held][mine, -1]), PRESSURES[1:-1:2])
+    # a curve of two points has no interior point: nothing held out
+    assert interpolation_rows(X[:2], np.array(["a", "a"]))[1].size == 0
+
+
+def test_small_tables_add_the_table_base_and_report_both_figures(tmp_path):
+    assert default_models(SMALL_DATA_DESIGNS) == MODEL_NAMES
+    assert default_models(SMALL_DATA_DESIGNS - 1) == (*MODEL_NAMES, "table")
+    assert "table base" in small_data_advice(30, None, table=True)
+    assert "table base" not in small_data_advice(30, None)
+    data = _data(12)
+    result, summary = train_surrogates(
+        data, tmp_path, models=["plr", "table"], grid_name=None, folds=3, export_onnx=False
+    )
+    assert result.settings["grid"] == "small"
+    table, plr = summary["models"]["table"], summary["models"]["plr"]
+    for entry in (table, plr):
+        figures = entry["interpolation"]
+        assert figures["n_held_out"] == 12 * 3 and np.isfinite(figures["rmse_deg"])
+    # the table base interpolates its own smooth curves far better than it generalises
+    assert table["interpolation"]["rmse_deg"] < 0.1 * table["rmse_deg"]
+    assert table["interpolation"]["rmse_deg"] < 1.0
+    written = pd.read_csv(tmp_path / "summary.csv").set_index("model")
+    assert written.loc["table", "interp_rmse_deg"] == pytest.approx(
+        table["interpolation"]["rmse_deg"]
+    )
+    # without it: no figure, no column
+    _, plain = train_surrogates(
+        data, tmp_path / "plain", models=["plr"], folds=3, export_onnx=False, interpolation=False
+    )
+    assert "interpolation" not in plain["models"]["plr"]
+    assert "interp_rmse_deg" not in pd.read_csv(tmp_path / "plain" / "summary.csv").columns
