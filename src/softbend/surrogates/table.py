@@ -4,7 +4,7 @@ A table of simulations holds, for each simulated design, its angle at a few
 pressures. :class:`TableRegressor` keeps every such curve and answers
 
 - **at a simulated design** (its design parameters equal to a row's of the
-  table; see *Matching* below) from that design's own curve: shape-preserving
+  table, by the matching rule below) from that design's own curve: shape-preserving
   piecewise-cubic interpolation (PCHIP, :class:`scipy.interpolate.PchipInterpolator`)
   through its pressure points, so it reproduces the simulated angles exactly and
   a curve that rises between two simulated pressures rises between them (no
@@ -29,8 +29,9 @@ Matching is a clear rule, not a blend: a row is at a simulated design when each
 of its design parameters equals that design's to 9 decimals in standardized
 units (``(x − mean) / scale``). The prediction therefore switches from the GP to
 the curve exactly at a simulated design; the step there is the GP's residual at
-that design, of the order of its fitted noise (reported in the docstring's
-figures of ``docs/design-log.md``). The alternative, a GP that interpolates the
+that design, of the order of its fitted noise (on the first 30 designs of
+``examples/pneunet/simulations.csv``: 0.30° RMS, 2.4° at most, fitted noise
+0.44°). The alternative, a GP that interpolates the
 curves exactly (no noise term), follows the simulations' noise and is badly
 conditioned with many points per curve; the distance rule keeps each part at
 what it does best. At a simulated design the standard deviation is the GP's
