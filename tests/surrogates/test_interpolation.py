@@ -65,3 +65,23 @@ def test_small_tables_add_the_table_base_and_report_both_figures(tmp_path):
     )
     assert "interpolation" not in plain["models"]["plr"]
     assert "interp_rmse_deg" not in pd.read_csv(tmp_path / "plain" / "summary.csv").columns
+
+
+@pytest.mark.parametrize(
+    ("n_designs", "families"), [(12, (*MODEL_NAMES, "table")), (100, MODEL_NAMES)]
+)
+def test_training_without_families_named_searches_the_defaults_of_its_size(
+    n_designs, families, tmp_path, monkeypatch
+):
+    import softbend.surrogates.workflow as workflow
+
+    class Asked(Exception):
+        pass
+
+    def search(data, *, models, **options):
+        raise Asked(models)
+
+    monkeypatch.setattr(workflow, "search", search)
+    with pytest.raises(Asked) as asked:
+        train_surrogates(_data(n_designs), tmp_path, export_onnx=False)
+    assert tuple(asked.value.args[0]) == families
