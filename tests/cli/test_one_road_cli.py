@@ -49,9 +49,11 @@ def trained(tmp_path_factory):
         if family not in models:
             out = folder / family
             # two folds, the quick grid, 30 MLP epochs: seconds, and enough to follow the data
+            # (the table base's GP: three fits of 1 000 rows, about 10 s each)
             code = _run("train", SIMULATIONS, "--actuator", ACTUATOR, "--models", family,
                         "--grid", "quick", "--folds", "2", "--epochs", "30", "--workers", "1",
-                        "--device", "cpu", "--seed", "0", "--no-onnx", "-o", out)  # fmt: skip
+                        "--device", "cpu", "--seed", "0", "--no-onnx", "--no-interpolation",
+                        "-o", out)  # fmt: skip
             assert code == 0, family
             models[family] = out / "models" / f"{family}.json"
         return models[family]
