@@ -75,13 +75,13 @@ def test_training_without_families_named_searches_the_defaults_of_its_size(
 ):
     import softbend.surrogates.workflow as workflow
 
-    class Asked(Exception):
+    class AskedError(Exception):
         pass
 
     def search(data, *, models, **options):
-        raise Asked(models)
+        raise AskedError(models)
 
     monkeypatch.setattr(workflow, "search", search)
-    with pytest.raises(Asked) as asked:
+    with pytest.raises(AskedError) as asked:
         train_surrogates(_data(n_designs), tmp_path, export_onnx=False)
     assert tuple(asked.value.args[0]) == families
