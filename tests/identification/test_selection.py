@@ -163,13 +163,13 @@ def test_figures_that_are_not_finite_fail_the_selection(monkeypatch):
     from softbend.errors import ConvergenceError
     from softbend.identification import selection as module
 
-    real = module.free_run_error
+    real = module._free_run_only
 
     def broken(model, data, ranges):
-        free, step, simulated = real(model, data, ranges)
-        return (np.nan if model.family == "poly2" else free), step, simulated
+        free, simulated = real(model, data, ranges)
+        return (np.nan if model.family == "poly2" else free), simulated
 
-    monkeypatch.setattr(module, "free_run_error", broken)
+    monkeypatch.setattr(module, "_free_run_only", broken)
     with pytest.raises(ConvergenceError, match=r"cv_freerun_nrmse of candidate poly2-1-1 is nan"):
         select_model(_linear_set(n_experiments=3, n=60), candidates=FEW[:3], folds=2)
 

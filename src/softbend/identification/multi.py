@@ -33,10 +33,11 @@ that diverges saturates there instead of overflowing, and its error shows it.
 
 from __future__ import annotations
 
+import functools
 import json
 import math
 import os
-from collections.abc import Mapping, Sequence
+from collections.abc import Callable, Mapping, Sequence
 from pathlib import Path
 from typing import Any
 
@@ -45,6 +46,7 @@ from numpy.typing import ArrayLike
 
 from softbend._validation import check_choice, check_finite_array, check_int, must_be
 from softbend.errors import InputError, SchemaError, SoftbendError
+from softbend.identification.freerun import free_run
 from softbend.identification.narx import _row_index, _segments
 from softbend.identification.persistence import svr_from_state, svr_state
 from softbend.identification.simfit import Start, refine
@@ -83,6 +85,12 @@ _SCHEMA = 1
 _RIDGE = 1e-8
 
 
+@functools.lru_cache(maxsize=64)
+def _pairs(d: int) -> tuple[np.ndarray, np.ndarray]:
+    """Row and column of every product of two of ``d`` regressors (upper triangle)."""
+    return np.triu_indices(d)
+
+
 class _Ridge:
     """Least squares with a tiny ridge on standardized regressors (closed form, exact reload)."""
 
@@ -92,7 +100,7 @@ class _Ridge:
     def _features(self, X: np.ndarray) -> np.ndarray:
         if self.degree == 1:
             return X
-        i, j = np.triu_indices(X.shape[1])
+        i, j = _pairs(X.shape[1])
         return np.hstack([X, X[:, i] * X[:, j]])
 
     def fit(self, X: np.ndarray, y: np.ndarray) -> _Ridge:
@@ -344,8 +352,7 @@ class MultiNARX:
             coef=np.column_stack([r.coef_ for r in ridges]),
             intercept=np.array([r.intercept_ for r in ridges]),
         )
-        bounds = ((self.y_low_ - self.y_mean_) / self.y_std_,
-                  (self.y_high_ - self.y_mean_) / self.y_std_)  # fmt: skip
+        bounds = self._standard_bounds()
         refined = refine(
             self.family, settings, Us, Ys, (segments.starts, segments.lengths),
             (self.output_lags, self.input_lags), bounds, start, self.input_tau_,
@@ -423,23 +430,49 @@ class MultiNARX:
         """
         U, Y0 = self._arrays(U, Y_init, "Y_init")
         self._check_fitted(U)
-        lag = self.max_lag
-        segments = _segments(groups, U.shape[0], lag)
-        Us = self._inputs_standard(U, segments)
-        Ys = (Y0 - self.y_mean_) / self.y_std_
-        low = (self.y_low_ - self.y_mean_) / self.y_std_
-        high = (self.y_high_ - self.y_mean_) / self.y_std_
-        # the maps' own evaluation, without scikit-learn's per-call validation
-        maps = [getattr(e, "_expansion", e.predict) for e in self.estimators_]
-        lengths, starts = segments.lengths, segments.starts
-        for step in range(lag, int(lengths.max(initial=0))):
-            running = lengths > step
-            t = starts[running] + step
-            Phi = self._regressors(Us, Ys, t)
-            with np.errstate(all="ignore"):
-                new = np.column_stack([f(Phi) for f in maps])
-            Ys[t] = np.clip(np.nan_to_num(new, nan=0.0), low, high)
+        segments = _segments(groups, U.shape[0], self.max_lag)
+        Ys = free_run(
+            self._step_map(),
+            self._inputs_standard(U, segments),
+            (Y0 - self.y_mean_) / self.y_std_,
+            (segments.starts, segments.lengths),
+            (self.output_lags, self.input_lags),
+            self._standard_bounds(),
+        )
         return Ys * self.y_std_ + self.y_mean_
+
+    def _standard_bounds(self) -> tuple[np.ndarray, np.ndarray]:
+        """The free run's bounds in standardized units."""
+        return ((self.y_low_ - self.y_mean_) / self.y_std_,
+                (self.y_high_ - self.y_mean_) / self.y_std_)  # fmt: skip
+
+    def _step_map(self) -> Callable[[np.ndarray], np.ndarray]:
+        """Every output's map as one call ``Phi (r, d) → (r, m)``, its constants hoisted.
+
+        A polynomial's products are formed once for all outputs; a kernel map is
+        evaluated without scikit-learn's per-call validation.
+        """
+        maps = self.estimators_
+        if all(isinstance(e, _Ridge) for e in maps):
+            coef = np.column_stack([e.coef_ for e in maps])
+            intercept = np.array([e.intercept_ for e in maps])
+            d = self.output_lags * self.n_outputs_ + self.input_lags * self.n_inputs_
+            i, j = _pairs(d) if maps[0].degree == 2 else (None, None)
+
+            def polynomial(Phi: np.ndarray) -> np.ndarray:
+                F = Phi if i is None else np.hstack([Phi, Phi[:, i] * Phi[:, j]])
+                out = F @ coef
+                out += intercept
+                return out
+
+            return polynomial
+        evaluate = [e._evaluator() if isinstance(e, GeneralizedGaussianSVR) else e.predict
+                    for e in maps]  # fmt: skip
+
+        def columns(Phi: np.ndarray) -> np.ndarray:
+            return np.column_stack([f(Phi) for f in evaluate])
+
+        return columns
 
     # -- persistence ------------------------------------------------------------------
 

@@ -16,11 +16,29 @@ paper A's setting as it was (a GG-SVR, C = 100, ε = 0.1, lags 2 and 2) —
 beside a seeded random search of kernel models (C, ε, Gaussian or estimated
 shape, lags) raced by successive halving: every kernel candidate is scored
 with its maps fitted on :data:`FIRST_RUNG_ROWS` regressor rows, and the best
-third again on ``max_rows``. The model chosen is the lowest cross-validated
-free-run error among all of them, whichever family wins; when it is a linear
-ARX, :meth:`Selection.verdict` says so plainly. With ``validate_on``, those
-experiments are never seen by the selection; every candidate, refitted on all
-the training experiments, is run free on them too. The chosen model is then
+third again on ``max_rows``.
+
+Candidates that cannot win are pruned by their one-step error. A free run
+feeds its own errors back, so its NRMSE is in practice at least the one-step
+NRMSE of the same model on the same experiments (every table of
+``benchmarks/bench_identify.py`` shows it). The one-step NRMSE is scored first on
+each fold, and a candidate is dropped, its remaining folds neither fitted nor
+run free, as soon as the sum of its one-step NRMSEs so far over the number of
+folds (a lower bound of its cross-validated one-step NRMSE, hence of its
+free-run NRMSE) reaches the lowest cross-validated free-run NRMSE of a candidate
+that may be chosen. Only candidates fitted one step ahead that are not
+baselines are pruned (:func:`prunable`; the kernel search): the baselines are
+the yardstick and always scored in full, and a model fitted by its free-run
+error may run free better than one step. In the race, the bar is set by the
+candidates that may be chosen (not by first-rung scores), and the best third
+goes on among the candidates not pruned in the first rung (none when all were);
+the table records after how many folds each candidate was pruned.
+
+The model chosen is the lowest cross-validated free-run error among all of
+them, whichever family wins; when it is a linear ARX, :meth:`Selection.verdict`
+says so plainly. With ``validate_on``, those experiments are never seen by the
+selection; every candidate, refitted on all the training experiments, is run
+free on them too. The chosen model is then
 read physically (:attr:`Selection.dynamics`): the gain, time constant and dead
 time of every output's response to a step of every input
 (:func:`~softbend.identification.dynamics.step_readings`).
@@ -63,9 +81,11 @@ from softbend.identification.dynamics import (
     step_readings,
 )
 from softbend.identification.kernels import ShapeClippedWarning
-from softbend.identification.multi import MultiNARX, nrmse
+from softbend.identification.multi import MultiNARX
 from softbend.identification.ranges import FOLDS_RANGE, SEED_RANGE, check_integer
 from softbend.identification.resources import peak_memory_mib
+from softbend.identification.scoring import _free_run_only, free_run_error, one_step_error
+from softbend.identification.simmaps import SIM_FAMILIES
 from softbend.identification.timeseries import TimeSeriesSet
 from softbend.identification.timeseries_io import check_signals
 from softbend.parameters import Range
@@ -79,6 +99,8 @@ __all__ = [
     "Selection",
     "default_candidates",
     "free_run_error",
+    "one_step_error",
+    "prunable",
     "select_model",
 ]
 
@@ -162,25 +184,10 @@ def _fold_of(names: Sequence[str], folds: int) -> dict[str, int]:
     return {name: i % folds for i, name in enumerate(names)}
 
 
-def free_run_error(
-    model: MultiNARX, data: TimeSeriesSet, ranges: np.ndarray
-) -> tuple[float, float, np.ndarray]:
-    """``(free-run NRMSE, one-step NRMSE, simulated outputs)`` of ``model`` on ``data``.
-
-    Each NRMSE is the mean over outputs of RMSE / range (``ranges``), pooled over
-    every sample after each experiment's initial conditions.
-    """
-    U, Y, groups = data.stacked()
-    simulated = model.simulate(U, Y, groups)
-    one_step = model.predict_one_step(U, Y, groups)
-    scored = np.ones(len(Y), dtype=bool)
-    start = 0
-    for e in data.experiments:
-        scored[start : start + model.max_lag] = False
-        start += e.n_samples
-    free = float(np.mean(nrmse(Y[scored], simulated[scored], ranges)))
-    step = float(np.mean(nrmse(Y[scored], one_step[scored], ranges)))
-    return free, step, simulated
+def prunable(candidate: Candidate) -> bool:
+    """Whether :func:`select_model` may prune ``candidate`` by its one-step error: a
+    candidate fitted one step ahead that is not a baseline (module docstring)."""
+    return not candidate.baseline and candidate.family not in SIM_FAMILIES
 
 
 @dataclass
@@ -194,7 +201,9 @@ class Selection:
         ``settings``, ``rows`` (regressor rows of each map), ``rung``,
         ``cv_freerun_nrmse``, ``cv_onestep_nrmse``, ``validation_freerun_nrmse``
         (NaN without validation experiments, or for a candidate dropped in
-        the first rung), ``fit_s``; sorted by the cross-validated free-run error.
+        the first rung), ``fit_s``, ``pruned_after_folds`` (0, or the folds after
+        which the candidate was pruned: its free-run NRMSEs are then NaN); sorted
+        by the cross-validated free-run error.
     best : str
         The chosen candidate.
     model : MultiNARX
@@ -433,7 +442,7 @@ def select_model(
     raced = [c for c in chosen if c.family == "gg-svr" and not c.baseline]
     survivors = max(1, math.ceil(len(raced) / 3)) if raced else 0
     cv_total = folds * (len(cheap) + len(raced) + survivors)
-    total = cv_total + (len(cheap) + survivors) * bool(held)
+    total = cv_total + (len(cheap) + survivors) * bool(held)  # pruned ones ticked unrun
     cv_phase = f"cross-validating {len(chosen)} candidates on {folds} folds (fits)"
     final_phase = (
         f"refitting {len(cheap) + survivors} candidates, free runs of the validation experiments"
@@ -453,8 +462,10 @@ def select_model(
             progress(done, total)
 
     cv_runs: dict[str, dict[str, np.ndarray]] = {}
+    bar = math.inf  # the lowest CV free-run NRMSE of a candidate that may be chosen, so far
 
-    def cross_validate(candidate: Candidate, rows: int) -> dict[str, Any]:
+    def cross_validate(candidate: Candidate, rows: int, *, eligible: bool) -> dict[str, Any]:
+        nonlocal bar
         free, step, fit_s = [], [], 0.0
         runs: dict[str, np.ndarray] = {}
         for fit_on, held_out in parts:
@@ -462,12 +473,20 @@ def select_model(
             began = time.perf_counter()
             model = candidate.build(rows).fit(U, Y, groups)
             fit_s += time.perf_counter() - began
-            f, s, simulated = free_run_error(model, held_out, ranges)
+            step.append(one_step_error(model, held_out, ranges))
+            tick()
+            if prunable(candidate) and sum(step) / folds >= bar:
+                break  # its CV one-step NRMSE, hence its free-run NRMSE, reaches the bar
+            f, simulated = _free_run_only(model, held_out, ranges)
             runs.update(_split(held_out, simulated))
             free.append(f)
-            step.append(s)
+        pruned = len(free) < folds
+        for _ in range(folds - len(step)):
             tick()
-        cv_runs[candidate.name] = runs
+        if not pruned:
+            cv_runs[candidate.name] = runs
+            if eligible:
+                bar = min(bar, float(np.mean(free)))
         return {
             "candidate": candidate.name,
             "family": candidate.family,
@@ -475,9 +494,10 @@ def select_model(
             "nb": candidate.input_lags,
             "settings": candidate.build(rows).describe(),
             "rows": model.n_train_rows_,
-            "cv_freerun_nrmse": float(np.mean(free)),
+            "cv_freerun_nrmse": math.nan if pruned else float(np.mean(free)),
             "cv_onestep_nrmse": float(np.mean(step)),
-            "fit_s": fit_s / folds,
+            "fit_s": fit_s / len(step),
+            "pruned_after_folds": len(step) if pruned else 0,
         }
 
     rows_by_name: dict[str, dict[str, Any]] = {}
@@ -485,14 +505,31 @@ def select_model(
         # A kernel shape clipped to the Gaussian is expected in a search: not a warning here.
         warnings.simplefilter("ignore", ShapeClippedWarning)
         for candidate in cheap:
-            rows_by_name[candidate.name] = {**cross_validate(candidate, max_rows), "rung": "all"}
-        first = {c.name: cross_validate(c, FIRST_RUNG_ROWS) for c in raced}
-        ranked = sorted(raced, key=lambda c: first[c.name]["cv_freerun_nrmse"])
-        for candidate in ranked[survivors:]:
-            rows_by_name[candidate.name] = {**first[candidate.name], "rung": "first"}
-        for candidate in ranked[:survivors]:
-            rows_by_name[candidate.name] = {**cross_validate(candidate, max_rows), "rung": "final"}
-        final = [c for c in chosen if rows_by_name[c.name]["rung"] != "first"]
+            rows_by_name[candidate.name] = {
+                **cross_validate(candidate, max_rows, eligible=True),
+                "rung": "all",
+            }
+        first = {c.name: cross_validate(c, FIRST_RUNG_ROWS, eligible=False) for c in raced}
+
+        # the best third of the first rung goes on, of the candidates not pruned there
+        going_on = sorted(
+            (c for c in raced if not first[c.name]["pruned_after_folds"]),
+            key=lambda c: first[c.name]["cv_freerun_nrmse"],
+        )[:survivors]
+        for _ in range(folds * (survivors - len(going_on))):
+            tick()  # the final rung's fits of the candidates that do not go on
+        for candidate in raced:
+            rows_by_name[candidate.name] = (
+                {**cross_validate(candidate, max_rows, eligible=True), "rung": "final"}
+                if candidate in going_on
+                else {**first[candidate.name], "rung": "first"}
+            )
+        final = [
+            c
+            for c in chosen
+            if rows_by_name[c.name]["rung"] != "first"
+            and not rows_by_name[c.name]["pruned_after_folds"]
+        ]
         best = min(final, key=lambda c: rows_by_name[c.name]["cv_freerun_nrmse"])
 
         if not held:
@@ -500,6 +537,8 @@ def select_model(
         U, Y, groups = train.stacked()
         validation_outputs: dict[str, np.ndarray] = {}
         fitted: dict[str, MultiNARX] = {}
+        for _ in range(bool(held) * (len(cheap) + survivors - len(final))):
+            tick()  # the refits of pruned candidates, not run
         for candidate in final:
             row = rows_by_name[candidate.name]
             row["validation_freerun_nrmse"] = math.nan
@@ -509,7 +548,7 @@ def select_model(
             fitted[candidate.name] = model
             if held:
                 validation = data.subset(held)
-                free, _, simulated = free_run_error(model, validation, ranges)
+                free, simulated = _free_run_only(model, validation, ranges)
                 row["validation_freerun_nrmse"] = free
                 tick()
                 if candidate is best:
@@ -522,7 +561,7 @@ def select_model(
         .reset_index(drop=True)
     )
     columns = ["candidate", "family", "na", "nb", "settings", "rows", "rung", "cv_freerun_nrmse"]
-    columns += ["cv_onestep_nrmse", "validation_freerun_nrmse", "fit_s"]
+    columns += ["cv_onestep_nrmse", "validation_freerun_nrmse", "fit_s", "pruned_after_folds"]
     _check_finite(table, validated=bool(held))
     if not held:
         report(final_phase, 1, 1)
@@ -621,11 +660,11 @@ def _check_finite(table: pd.DataFrame, *, validated: bool) -> None:
     The validation error is NaN by design without validation experiments and for
     a candidate dropped in the first rung; every other figure must be a number.
     """
-    figures = ["cv_freerun_nrmse", "cv_onestep_nrmse", "fit_s"]
     for _, row in table.iterrows():
-        checked = figures + (
-            ["validation_freerun_nrmse"] if validated and row["rung"] != "first" else []
-        )
+        pruned = bool(row["pruned_after_folds"])
+        checked = ["cv_onestep_nrmse", "fit_s"] + ([] if pruned else ["cv_freerun_nrmse"])
+        if validated and row["rung"] != "first" and not pruned:
+            checked.append("validation_freerun_nrmse")
         for column in checked:
             if not math.isfinite(float(row[column])):
                 raise ConvergenceError(

@@ -58,6 +58,7 @@ from softbend.identification.kernels import (
     _kernel_block,
     _kernel_from_sqdist,
     _kernel_shape_estimate,
+    _power_in_place,
     _warn_clipped,
     gg_normalization,
     gg_scale,
@@ -669,6 +670,27 @@ class GeneralizedGaussianSVR(RegressorMixin, BaseEstimator):
             out[start : start + step] = kernel @ self._coef
         out += self.intercept_
         return out
+
+    def _evaluator(self) -> Callable[[np.ndarray], np.ndarray]:
+        """:meth:`_expansion` with the fitted arrays and constants bound once (a free run's
+        step): the same arithmetic, without looking the kernel's scale up at every call."""
+        support, coef, intercept = self.support_vectors_, self._coef, self.intercept_
+        rate, exponent = self._rate, self._half_shape
+        step = _block_rows(support.shape[0])
+
+        def evaluate(X: np.ndarray) -> np.ndarray:
+            if X.shape[0] > step:
+                return self._expansion(X)
+            arg = cdist(X, support, "sqeuclidean")
+            arg *= rate
+            _power_in_place(arg, exponent)
+            np.negative(arg, out=arg)
+            np.exp(arg, out=arg)
+            out = arg @ coef
+            out += intercept
+            return out
+
+        return evaluate
 
     def predict(self, X: np.ndarray) -> np.ndarray:
         """Predict targets by the kernel expansion f(x) = Σ βᵢ K(sᵢ, x) + b.
