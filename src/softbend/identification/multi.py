@@ -104,11 +104,17 @@ class _Ridge:
         return np.hstack([X, X[:, i] * X[:, j]])
 
     def fit(self, X: np.ndarray, y: np.ndarray) -> _Ridge:
+        from threadpoolctl import threadpool_limits
+
         F = self._features(X)
         A = np.hstack([F, np.ones((F.shape[0], 1))])
-        gram = A.T @ A
+        # one BLAS thread: a Gram matrix of a hundred columns gains little from more, and
+        # on a busy machine threads waiting on each other made it 40 times slower
+        with threadpool_limits(1, user_api="blas"):
+            gram = A.T @ A
+            rhs = A.T @ y
         gram[np.diag_indices_from(gram)] += _RIDGE * max(1.0, float(np.trace(gram)) / len(gram))
-        solution = np.linalg.solve(gram, A.T @ y)
+        solution = np.linalg.solve(gram, rhs)
         self.coef_, self.intercept_ = solution[:-1], float(solution[-1])
         return self
 
@@ -280,12 +286,11 @@ class MultiNARX:
         ``rows``: at most that many regressor rows (evenly spaced); a ``gg-svr``'s ``max_rows``.
         """
         index = _row_index(segments, self.max_lag)
+        rows = self.max_rows if self.family == "gg-svr" else rows
+        if rows is not None and index.size > rows:  # only the rows kept are formed
+            index = index[np.unique(np.linspace(0, index.size - 1, rows).round().astype(int))]
         Phi = self._regressors(self._inputs_standard(U, segments), Ys, index)
         target = Ys[index]
-        rows = self.max_rows if self.family == "gg-svr" else rows
-        if rows is not None and index.size > rows:
-            keep = np.unique(np.linspace(0, index.size - 1, rows).round().astype(int))
-            Phi, target = Phi[keep], target[keep]
         self.estimators_: list[Any] = [
             self._map().fit(Phi, target[:, j]) for j in range(Ys.shape[1])
         ]
