@@ -51,9 +51,11 @@ from softbend.identification.narx import _row_index, _segments
 from softbend.identification.persistence import svr_from_state, svr_state
 from softbend.identification.simfit import Start, refine
 from softbend.identification.simmaps import (
+    MAX_SEARCHED_DELAY,
     SIM_FAMILIES,
     NeuralMap,
     check_sim_params,
+    delay_inputs,
     filter_inputs,
 )
 from softbend.identification.svr import GeneralizedGaussianSVR
@@ -150,7 +152,8 @@ class MultiNARX:
         the ``-sim`` families the settings of
         :func:`~softbend.identification.simmaps.check_sim_params` (``steps``,
         ``epochs``, ``window``, ``batch``, ``lr``, ``filter``, ``tau_init`` in
-        samples, ``hidden``, ``pretrain``, ``seed``).
+        samples, ``delay`` in samples (None: searched per input), ``hidden``,
+        ``pretrain``, ``seed``).
     max_rows : int, default 4000
         Regressor rows a ``gg-svr`` map is fitted on (evenly spaced; all when fewer).
 
@@ -165,6 +168,8 @@ class MultiNARX:
     input_tau_ : ndarray or None
         The time constant of each input's first-order filter, in samples (None:
         no filter); :meth:`input_time_constants_s` in seconds.
+    input_delay_ : ndarray of int or None
+        Each input's delay (dead time) in samples, before its filter (None: none).
     n_outputs_, n_inputs_, max_lag_ : int
     """
 
@@ -203,6 +208,9 @@ class MultiNARX:
         tau = getattr(self, "input_tau_", None)
         if tau is not None:
             text += f", input tau = {', '.join(f'{t:.3g}' for t in tau)} samples"
+        delay = getattr(self, "input_delay_", None)
+        if delay is not None:
+            text += f", input delay = {', '.join(str(int(d)) for d in delay)} samples"
         return text
 
     def input_time_constants_s(self, sample_period_s: float | None) -> list[float] | None:
@@ -220,12 +228,20 @@ class MultiNARX:
         return [float(t) * scale for t in tau]
 
     def _inputs_standard(self, U: np.ndarray, segments: Any) -> np.ndarray:
-        """Standardized inputs, through the input filters when the model has them."""
-        Us = (U - self.u_mean_) / self.u_std_
+        """Standardized inputs, delayed and through the input filters when the model has them."""
+        Us = self._delayed((U - self.u_mean_) / self.u_std_, segments)
         tau = getattr(self, "input_tau_", None)
         if tau is None:
             return Us
         return filter_inputs(Us, segments.starts, segments.lengths, tau)
+
+    def _delayed(self, Us: np.ndarray, segments: Any) -> np.ndarray:
+        """Each input delayed by its ``input_delay_`` samples, held at the experiment's first
+        sample before (started at rest, as the filter is: the two commute)."""
+        delay = getattr(self, "input_delay_", None)
+        if delay is None:
+            return Us
+        return delay_inputs(Us, segments.starts, segments.lengths, delay)
 
     def _map(self) -> _Ridge | GeneralizedGaussianSVR:
         if self.family in ("arx", "arx-sim", "nn-sim"):
@@ -263,15 +279,23 @@ class MultiNARX:
         span = np.maximum(high - low, np.finfo(np.float64).tiny)
         self.y_low_ = low - FREE_RUN_MARGIN * span
         self.y_high_ = high + FREE_RUN_MARGIN * span
-        Us, Ys = (U - self.u_mean_) / self.u_std_, (Y - self.y_mean_) / self.y_std_
+        Ys = (Y - self.y_mean_) / self.y_std_
         sim = self.family in SIM_FAMILIES
         settings = check_sim_params(self.params, self.family) if sim else None
-        self.input_tau_ = None
+        self.input_tau_ = self.input_delay_ = None
         self.n_inputs_, self.n_outputs_ = U.shape[1], Y.shape[1]
         if settings is not None and settings["filter"]:
             tau = settings["tau_init"]
             tau = self._search_tau(U, Y, Ys, segments) if tau is None else float(tau)
             self.input_tau_ = np.full(U.shape[1], tau)
+        if settings is not None and settings["delay"] != 0:
+            delay = settings["delay"]
+            self.input_delay_ = (
+                self._search_delay(U, Y, Ys, segments)
+                if delay is None
+                else np.full(U.shape[1], int(delay))
+            )
+        Us = self._delayed((U - self.u_mean_) / self.u_std_, segments)
         Phi, target = self._fit_one_step(U, Ys, segments)
         self.n_train_rows_ = int(Phi.shape[0])
         if settings is not None:
@@ -330,6 +354,33 @@ class MultiNARX:
         for x, f in ((c, fc), (d, fd)):
             if f < best_score:
                 best, best_score = math.exp(x), f
+        return best
+
+    def _search_delay(
+        self, U: np.ndarray, Y: np.ndarray, Ys: np.ndarray, segments: Any
+    ) -> np.ndarray:
+        """Each input's delay (samples, in 0 … :data:`MAX_SEARCHED_DELAY`) whose one-step fit
+        runs free best: one input at a time, in order, the others as found so far (from 0)."""
+        k = U.shape[1]
+        self.input_delay_ = np.zeros(k, dtype=np.int64)
+
+        def score(delays: np.ndarray) -> float:
+            self.input_delay_ = delays
+            self._fit_one_step(U, Ys, segments, rows=_SEARCH_ROWS)
+            return self._start_score(U, Y, segments)
+
+        best = np.zeros(k, dtype=np.int64)
+        best_score = score(best.copy())
+        for i in range(k):
+            chosen = best
+            for d in range(1, MAX_SEARCHED_DELAY + 1):
+                trial = best.copy()
+                trial[i] = d
+                value = score(trial)
+                if value < best_score:
+                    best_score, chosen = value, trial
+            best = chosen
+        self.input_delay_ = best
         return best
 
     def _start_score(self, U: np.ndarray, Y: np.ndarray, segments: Any) -> float:
@@ -490,6 +541,7 @@ class MultiNARX:
             for e in self.estimators_
         ]
         tau = getattr(self, "input_tau_", None)
+        delay = getattr(self, "input_delay_", None)
         return {
             "format": _FORMAT,
             "schema_version": _SCHEMA,
@@ -508,6 +560,7 @@ class MultiNARX:
             },
             "maps": maps,
             **({} if tau is None else {"input_tau": tau.tolist()}),
+            **({} if delay is None else {"input_delay": [int(d) for d in delay]}),
         }
 
     @classmethod
@@ -566,6 +619,19 @@ class MultiNARX:
                         key="input_tau",
                     )
                 model.input_tau_ = tau
+            model.input_delay_ = None
+            if data.get("input_delay") is not None:
+                delay = np.asarray(data["input_delay"])
+                if (
+                    delay.shape != (model.n_inputs_,)
+                    or delay.dtype.kind not in "iu"
+                    or not (delay >= 0).all()
+                ):
+                    raise SchemaError(
+                        f"must hold {model.n_inputs_} non-negative integers (samples)",
+                        key="input_delay",
+                    )
+                model.input_delay_ = delay.astype(np.int64)
         except SoftbendError as err:
             raise SchemaError(err.detail, key=err.key) from None
         except KeyError as err:

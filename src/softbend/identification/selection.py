@@ -146,8 +146,10 @@ def default_candidates(seed: int = 0, n_kernel: int = 6) -> list[Candidate]:
 
     The simulation-error models (:mod:`~softbend.identification.simfit`, each
     started from its one-step fit and seeded by ``seed``) are a degree-2
-    polynomial with an input filter and a neural NARX, both with lags 2 and 3;
-    the rest as the module docstring says.
+    polynomial with an input filter, the same with each input's delay (dead
+    time, 0–3 samples) searched, and a neural NARX, all with lags 2 and 3; the
+    rest as the module docstring says. (A tie goes to the first in this order:
+    a delay search that finds no delay does not displace the model without.)
 
     Parameters
     ----------
@@ -165,6 +167,13 @@ def default_candidates(seed: int = 0, n_kernel: int = 6) -> list[Candidate]:
     # fitted by simulation error, from the one-step fit (softbend.identification.simfit)
     out += [
         Candidate("poly2-sim-2-3-filter", "poly2-sim", 2, 3, {"filter": True, "seed": seed}),
+        Candidate(
+            "poly2-sim-2-3-filter-delay",
+            "poly2-sim",
+            2,
+            3,
+            {"filter": True, "delay": None, "seed": seed},
+        ),
         Candidate("nn-sim-2-3", "nn-sim", 2, 3, {"seed": seed}),
     ]
     rng = np.random.default_rng([seed, 32])

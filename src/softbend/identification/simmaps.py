@@ -21,11 +21,14 @@ from softbend.errors import InputError, SchemaError
 
 __all__ = [
     "DEFAULT_LR",
+    "MAX_DELAY_SAMPLES",
+    "MAX_SEARCHED_DELAY",
     "MAX_TAU_SAMPLES",
     "SIM_DEFAULTS",
     "SIM_FAMILIES",
     "NeuralMap",
     "check_sim_params",
+    "delay_inputs",
     "filter_inputs",
 ]
 
@@ -34,6 +37,12 @@ SIM_FAMILIES: tuple[str, ...] = ("arx-sim", "poly2-sim", "nn-sim")
 
 #: The largest input time constant, in samples (a training window's filter reads 12 τ back).
 MAX_TAU_SAMPLES = 50.0
+
+#: The largest input delay given, in samples.
+MAX_DELAY_SAMPLES = 50
+
+#: The largest input delay searched (``delay=None``), in samples: 0 … this, per input.
+MAX_SEARCHED_DELAY = 3
 
 #: Default settings (``hidden`` and ``pretrain`` are read by ``nn-sim`` only).
 SIM_DEFAULTS: dict[str, Any] = {
@@ -44,6 +53,7 @@ SIM_DEFAULTS: dict[str, Any] = {
     "lr": None,
     "filter": False,
     "tau_init": None,
+    "delay": 0,
     "hidden": 16,
     "pretrain": 200,
     "seed": 0,
@@ -92,6 +102,18 @@ def check_sim_params(params: Mapping[str, Any], family: str = "poly2-sim") -> di
     out["filter"] = bool(out["filter"])
     lr = DEFAULT_LR[family] if out["lr"] is None else out["lr"]
     out["lr"] = check_range(lr, "lr", low=0.0, high=1.0, high_inclusive=True)
+    delay = out["delay"]
+    if delay is not None:
+        if (
+            isinstance(delay, bool)
+            or not isinstance(delay, int | np.integer)
+            or not (0 <= delay <= MAX_DELAY_SAMPLES)
+        ):
+            raise InputError(
+                must_be(f"an integer in [0, {MAX_DELAY_SAMPLES}] (samples) or null", delay),
+                key="delay",
+            )
+        out["delay"] = int(delay)
     if out["tau_init"] is not None:
         out["tau_init"] = check_range(
             out["tau_init"], "tau_init", low=0.0, high=MAX_TAU_SAMPLES,
@@ -126,6 +148,37 @@ def filter_inputs(
         for s, n in zip(starts, lengths, strict=True):
             x = U[s : s + n, j]
             out[s : s + n, j] = signal.lfilter([1.0 - a], [1.0, -a], x, zi=[a * x[0]])[0]
+    return out
+
+
+def delay_inputs(
+    U: np.ndarray, starts: Sequence[int], lengths: Sequence[int], delay: Sequence[int]
+) -> np.ndarray:
+    """Each input delayed by its number of samples, every experiment held at its first sample
+    before (at rest, as :func:`filter_inputs` starts: the two commute).
+
+    Parameters
+    ----------
+    U : ndarray, shape (n, k)
+        Inputs, experiments concatenated.
+    starts, lengths : sequence of int
+        First row and length of each experiment.
+    delay : sequence of int, length k
+        Each input's delay, in samples (0: none).
+
+    Returns
+    -------
+    ndarray, shape (n, k)
+        ``u_d(t) = u(max(t − d, start))``.
+    """
+    out = np.array(U, dtype=np.float64, copy=True)
+    for j, d in enumerate(int(x) for x in delay):
+        if d <= 0:
+            continue
+        for s, n in zip(starts, lengths, strict=True):
+            shift = min(d, n)
+            out[s + shift : s + n, j] = U[s : s + n - shift, j]
+            out[s : s + shift, j] = U[s, j]
     return out
 
 
