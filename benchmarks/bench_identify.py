@@ -10,7 +10,8 @@
    replaced (:func:`softbend.identification.freerun._step_by_step`) against
    :func:`~softbend.identification.freerun.free_run`, for three candidates: the
    ratio of their times (a ratio holds on a loaded machine, a time does not) and
-   the largest difference of their outputs.
+   the largest difference of their outputs. Then the same selection with the
+   candidate whose input delays are searched (``identify --search-delays``).
 2. Paper A's synthetic curling actuator (seed 0; pressure in, ρ and L out), each
    pressure sign on its own, the last experiment of each held out.
 
@@ -130,6 +131,27 @@ def main() -> None:
         f"{len(pruned)} of {len(selection.table)}"
     )
     units["soft arm: candidates pruned by their one-step error"] = ""
+    start = time.perf_counter()
+    delayed = select_model(
+        arm, validate_on=list(ARM_VALIDATION), candidates=default_candidates(delays=True)
+    )
+    seconds = time.perf_counter() - start
+    label = "soft arm, with --search-delays"
+    print(f"\n{label}: {seconds:.1f} s, CPU {delayed.cpu_seconds:.1f} s")
+    print(delayed.verdict())
+    best = delayed.row(delayed.best)
+    for key, value, unit in (
+        ("wall time", round(seconds, 1), "s"),
+        ("CPU time of the selection", round(delayed.cpu_seconds, 1), "s"),
+        ("selected", delayed.best, ""),
+        ("selected: settings", best["settings"], ""),
+        (
+            "selected: validation free-run NRMSE",
+            round(float(best["validation_freerun_nrmse"]), 4),
+            "",
+        ),
+    ):
+        figures[f"{label}: {key}"], units[f"{label}: {key}"] = value, unit
     free_run_ratios(arm, figures, units)
     peak = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024
     print(f"peak memory of the process: {peak:.0f} MiB")

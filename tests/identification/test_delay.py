@@ -106,11 +106,12 @@ def test_a_bad_delay_is_refused_naming_it(delay):
     assert "integer in [0, 50]" in str(caught.value)
 
 
-def test_the_default_candidates_search_the_delays_after_the_model_without():
+def test_the_candidates_with_delays_search_them_after_the_model_without():
     from softbend.identification.selection import default_candidates
 
-    names = [c.name for c in default_candidates(3, n_kernel=0)]
+    assert all("delay" not in c.params for c in default_candidates(3, n_kernel=0))
+    names = [c.name for c in default_candidates(3, n_kernel=0, delays=True)]
     plain, delayed = names.index("poly2-sim-2-3-filter"), names.index("poly2-sim-2-3-filter-delay")
     assert plain < delayed  # a tie (no delay found) keeps the model without
-    params = default_candidates(3, n_kernel=0)[delayed].params
+    params = default_candidates(3, n_kernel=0, delays=True)[delayed].params
     assert params == {"filter": True, "delay": None, "seed": 3}

@@ -141,15 +141,18 @@ class Candidate:
         return self.family in ("arx", "poly2") or self.name == "paper-a"
 
 
-def default_candidates(seed: int = 0, n_kernel: int = 6) -> list[Candidate]:
+def default_candidates(
+    seed: int = 0, n_kernel: int = 6, *, delays: bool = False
+) -> list[Candidate]:
     """The baselines, the simulation-error models and ``n_kernel`` seeded kernel candidates.
 
     The simulation-error models (:mod:`~softbend.identification.simfit`, each
     started from its one-step fit and seeded by ``seed``) are a degree-2
-    polynomial with an input filter, the same with each input's delay (dead
-    time, 0–3 samples) searched, and a neural NARX, all with lags 2 and 3; the
-    rest as the module docstring says. (A tie goes to the first in this order:
-    a delay search that finds no delay does not displace the model without.)
+    polynomial with an input filter and a neural NARX, both with lags 2 and 3,
+    and with ``delays`` the same polynomial with each input's delay (dead time,
+    0–3 samples) searched, after the one without (a tie goes to the first: a
+    search that finds no delay does not displace it); the rest as the module
+    docstring says.
 
     Parameters
     ----------
@@ -157,6 +160,8 @@ def default_candidates(seed: int = 0, n_kernel: int = 6) -> list[Candidate]:
         Seed of the kernel candidates, in [0, 2**32 - 1].
     n_kernel : int, default 6
         Kernel candidates, in [0, 1000].
+    delays : bool, default False
+        Add the polynomial whose input delays are searched.
     """
     seed = check_integer(seed, SEED_RANGE, "seed")
     n_kernel = check_integer(n_kernel, _N_KERNEL_RANGE, "n_kernel")
@@ -167,13 +172,18 @@ def default_candidates(seed: int = 0, n_kernel: int = 6) -> list[Candidate]:
     # fitted by simulation error, from the one-step fit (softbend.identification.simfit)
     out += [
         Candidate("poly2-sim-2-3-filter", "poly2-sim", 2, 3, {"filter": True, "seed": seed}),
-        Candidate(
-            "poly2-sim-2-3-filter-delay",
-            "poly2-sim",
-            2,
-            3,
-            {"filter": True, "delay": None, "seed": seed},
-        ),
+    ]
+    if delays:
+        out.append(
+            Candidate(
+                "poly2-sim-2-3-filter-delay",
+                "poly2-sim",
+                2,
+                3,
+                {"filter": True, "delay": None, "seed": seed},
+            )
+        )
+    out += [
         Candidate("nn-sim-2-3", "nn-sim", 2, 3, {"seed": seed}),
     ]
     rng = np.random.default_rng([seed, 32])
