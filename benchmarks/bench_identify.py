@@ -144,7 +144,7 @@ def main() -> None:
         ("wall time", round(seconds, 1), "s"),
         ("CPU time of the selection", round(delayed.cpu_seconds, 1), "s"),
         ("selected", delayed.best, ""),
-        ("selected: settings", best["settings"], ""),
+        ("selected: fitted", delayed.model.describe(), ""),
         (
             "selected: validation free-run NRMSE",
             round(float(best["validation_freerun_nrmse"]), 4),
