@@ -419,3 +419,29 @@ def test_curling_identify_refuses_an_experiment_with_a_constant_output(tmp_path,
     line = one_error_line(capsys)
     assert "Experiment 'still' has a constant rho (every sample 0)" in line
     assert not out.exists()
+
+
+def test_identify_search_delays_adds_the_delay_searched_candidate(recording, tmp_path, monkeypatch):
+    """--search-delays hands the selection the default candidates and the polynomial whose
+    input delays are searched; without it, the defaults alone."""
+    from softbend.identification import selection as module
+
+    seen = []
+
+    class SeenError(Exception):
+        pass
+
+    def select(data, **kwargs):
+        seen.append([c.name for c in kwargs["candidates"]])
+        raise SeenError  # the candidates are all this test needs
+
+    monkeypatch.setattr(module, "select_model", select)
+    path, _ = recording
+    for flag in ([], ["--search-delays"]):
+        with pytest.raises(SeenError):
+            main([*["identify", str(path)], *ARGS, "--out", str(tmp_path / "o"), *flag])
+    plain, delayed = seen
+    assert "poly2-sim-2-3-filter-delay" not in plain
+    assert delayed == [*plain[: plain.index("poly2-sim-2-3-filter") + 1],
+                       "poly2-sim-2-3-filter-delay",
+                       *plain[plain.index("poly2-sim-2-3-filter") + 1 :]]  # fmt: skip
