@@ -55,7 +55,7 @@ SEARCH_DELAYS_OPTION = typer.Option(
     "--search-delays",
     help="Also try the degree-2 polynomial fitted by its free run with each input's delay "
     "(dead time, 0-3 samples) searched: for a plant whose inputs act late (a pneumatic "
-    "line); about 25 % more CPU.",
+    "line); about a third more CPU.",
 )
 
 
