@@ -104,9 +104,10 @@ def _held(draw: st.DrawFn, names: list[str]) -> list[str] | None:
 
 def _figures(selection) -> list[float]:
     table = selection.table
-    values = list(table["cv_freerun_nrmse"]) + list(table["cv_onestep_nrmse"])
+    run = table["pruned_after_folds"] == 0  # a pruned candidate is never run free: NaN
+    values = list(table.loc[run, "cv_freerun_nrmse"]) + list(table["cv_onestep_nrmse"])
     if selection.validation:
-        values += list(table.loc[table["rung"] != "first", "validation_freerun_nrmse"])
+        values += list(table.loc[run & (table["rung"] != "first"), "validation_freerun_nrmse"])
     return [float(v) for v in values] + [float(r) for r in selection.ranges]
 
 
