@@ -422,8 +422,8 @@ def test_curling_identify_refuses_an_experiment_with_a_constant_output(tmp_path,
 
 
 def test_identify_search_delays_adds_the_delay_searched_candidate(recording, tmp_path, monkeypatch):
-    """--search-delays hands the selection the default candidates and the polynomial whose
-    input delays are searched; without it, the defaults alone."""
+    """By default the selection gets the polynomial whose input delays are searched, after the
+    one without; --no-search-delays leaves it out."""
     from softbend.identification import selection as module
 
     seen = []
@@ -437,7 +437,7 @@ def test_identify_search_delays_adds_the_delay_searched_candidate(recording, tmp
 
     monkeypatch.setattr(module, "select_model", select)
     path, _ = recording
-    for flag in ([], ["--search-delays"]):
+    for flag in (["--no-search-delays"], []):
         with pytest.raises(SeenError):
             main([*["identify", str(path)], *ARGS, "--out", str(tmp_path / "o"), *flag])
     plain, delayed = seen

@@ -142,7 +142,7 @@ class Candidate:
 
 
 def default_candidates(
-    seed: int = 0, n_kernel: int = 6, *, delays: bool = False
+    seed: int = 0, n_kernel: int = 6, *, delays: bool = True
 ) -> list[Candidate]:
     """The baselines, the simulation-error models and ``n_kernel`` seeded kernel candidates.
 
@@ -160,8 +160,10 @@ def default_candidates(
         Seed of the kernel candidates, in [0, 2**32 - 1].
     n_kernel : int, default 6
         Kernel candidates, in [0, 1000].
-    delays : bool, default False
-        Add the polynomial whose input delays are searched.
+    delays : bool, default True
+        Add the polynomial whose input delays are searched (about a third more CPU;
+        on the synthetic soft arm it lowers the held-out free-run NRMSE from 0.0100
+        to 0.0077, see ``benchmarks/bench_identify.py``).
     """
     seed = check_integer(seed, SEED_RANGE, "seed")
     n_kernel = check_integer(n_kernel, _N_KERNEL_RANGE, "n_kernel")
