@@ -75,21 +75,20 @@ def identify(
 ) -> None:
     """A NARX model of any time series, chosen by its free run.
 
-    Linear ARX and degree-2 polynomial NARX models, paper A's GG-SVR setting, a
-    seeded search of kernel models, and a polynomial and a small neural NARX fitted
-    by their free-run error are cross-validated on whole held-out experiments, each
-    run free from its first samples; the lowest free-run error wins, and the output
-    says when a linear model is the best. A kernel candidate whose one-step error
-    already reaches the best free-run error so far is pruned (its remaining folds
-    skipped; the table says after how many). The candidates include the polynomial
-    whose inputs' delays (dead time) are searched (--no-search-delays leaves it out). Writes the selection table, the model, the
-    held-out free runs with a 90 % band (<output>_low, <output>_high) and their
-    figures into --out. The chosen model is read physically: each output's gain,
-    time constant (63.2 %) and dead time (2 %) for a step of one standard deviation
-    of each input, printed and recorded in model.json ("dynamics"). Without
-    --experiment, one recording is split into contiguous segments (the last for
-    validation, the others one fold each), recorded in selection.json ("split").
-    A constant input or output is refused, naming the column. 'softbend predict
+    Linear ARX and degree-2 polynomial NARX models, paper A's GG-SVR setting, a seeded
+    search of kernel models, and a polynomial and a small neural NARX fitted by their
+    free-run error are cross-validated on whole held-out experiments, each run free from its
+    first samples; the lowest free-run error wins, and the output says when a linear model
+    is the best. A kernel candidate whose one-step error already reaches the best free-run
+    error so far is pruned (its remaining folds skipped; the table says after how many). The
+    candidates include the polynomial whose inputs' delays (dead time) are searched
+    (--no-search-delays leaves it out). Writes the selection table, the model, the held-out
+    free runs with a 90 % band (<output>_low, <output>_high) and their figures into --out.
+    The chosen model is read physically: each output's gain, time constant (63.2 %) and dead
+    time (2 %) for a step of one standard deviation of each input, printed and recorded in
+    model.json ("dynamics"). Without --experiment, one recording is split into contiguous
+    segments (the last for validation, the others one fold each), recorded in selection.json
+    ("split"). A constant input or output is refused, naming the column. 'softbend predict
     MODEL.json --input CSV' runs the model on a new input series.
 
     Example:
