@@ -35,7 +35,7 @@ STAGES: tuple[tuple[str, ...], ...] = (
         "units",
     ),
     ("registry", "references", "parameters"),
-    ("plausibility", "column_values", "tables"),
+    ("plausibility", "column_values", "table_rows", "tables"),
     ("metrics", "kinematics"),
     ("actuators", "design"),
     ("materials",),

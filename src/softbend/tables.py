@@ -30,7 +30,7 @@ from __future__ import annotations
 
 import math
 import os
-from collections.abc import Callable, Mapping, Sequence
+from collections.abc import Callable, Mapping
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import TYPE_CHECKING, Literal
@@ -52,6 +52,7 @@ from softbend.column_values import (
 )
 from softbend.errors import DatasetError
 from softbend.plausibility import implausible_index, implausible_text
+from softbend.table_rows import parse_rows, row_lines
 from softbend.units import unit_from_name
 
 if TYPE_CHECKING:
@@ -444,6 +445,114 @@ def read_table(path: str | os.PathLike[str], fmt: TableFormat) -> Table:
         raise _error(f"no such file (a {fmt.name} is required)", file, None)
     if source.is_dir():
         raise _error(f"is a folder; a {fmt.name} file is required", file, None)
+    read = _read_plain(source, fmt, file) or _read_lines(source, fmt, file)
+    header, header_lines, names, header_line, data, positions, lines = read
+    _check_plausible(fmt, data, positions, file, lines)
+    _check_increasing(fmt, data, positions, file, lines)
+    frame = pd.DataFrame(data, columns=list(data), copy=False)
+    return Table(
+        frame=frame,
+        header=header,
+        file=file,
+        lines=lines,
+        header_line=header_line,
+        positions=positions,
+        header_lines=header_lines,
+        columns=tuple(names),
+    )
+
+
+#: What :func:`_read_plain` and :func:`_read_lines` give :func:`read_table`: the header's
+#: values and lines, the column names, the header's line, the columns read, their positions
+#: and each row's line.
+_Read = tuple[
+    dict[str, str],
+    dict[str, int],
+    list[str],
+    int,
+    dict[str, np.ndarray],
+    dict[str, int],
+    np.ndarray,
+]
+
+
+def _read_plain(source: Path, fmt: TableFormat, file: str) -> _Read | None:
+    """The file read by pandas' C parser where its data rows are plain, else None.
+
+    The ``# key: value`` lines and the column header are read here, the rows by
+    :mod:`softbend.table_rows`. Any problem (a header key, a column name, a row
+    that is not plain, a cell not of its column's kind, a limit) declines the
+    file to :func:`_read_lines`, which reports the first one in file order.
+    """
+    import csv
+
+    from softbend._io import read_input_text  # looked up at the call: a test may replace it
+    from softbend.limits import limit
+
+    phase = read_phase(source)
+    if phase is not None:  # before a byte is read: a large file shows at once
+        report(phase, 0, 100)
+    text = read_input_text(source, file, encoding="utf-8-sig")
+    returns = text.count("\r")
+    if returns and returns != text.count("\r\n"):
+        return None
+    header: dict[str, str] = {}
+    header_lines: dict[str, int] = {}
+    start, number, line = 0, 0, ""
+    try:
+        while start < len(text):
+            end = text.find("\n", start)
+            end = len(text) if end < 0 else end
+            number += 1
+            line, start = text[start:end].strip(), end + 1
+            if line.startswith("#"):
+                key, sep, value = line[1:].partition(":")
+                if sep and key.strip():
+                    _read_header_key(
+                        fmt, key.strip(), value.strip(), file, number, header, header_lines
+                    )
+            elif line:
+                break
+        else:
+            return None  # no column header
+        if '"' in line or "\0" in line or len(line) > csv.field_size_limit():
+            return None
+        names = [cell.strip() for cell in line.split(fmt.separator)]
+        _check_names(fmt, names, file, number)
+    except DatasetError:
+        return None
+    if phase is not None:
+        report(phase, 20, 100)
+    body = text[start:].encode("utf-8")
+    del text
+    rows = row_lines(body, fmt.separator, len(names), csv.field_size_limit())
+    bound = limit("csv_rows") if fmt.max_rows is None else fmt.max_rows
+    absent = any(h.required and h.name not in header for h in fmt.header)
+    if rows is None or not fmt.min_rows <= rows.size <= bound or absent:
+        return None
+    if phase is not None:
+        report(phase, 40, 100)
+    kept: list[tuple[int, Column]] = []
+    for position, name in enumerate(names):
+        column = fmt.column(name)
+        if column is None and fmt.other_columns == "keep":
+            column = Column(name, kind="any", missing=True)
+        if column is not None:
+            kept.append((position, column))
+    parsed = parse_rows(body, fmt.separator, len(names), kept, rows.size)
+    if parsed is None:
+        return None
+    if phase is not None:
+        report(phase, 100, 100)
+        report(f"checking {source.name}'s columns", len(names), len(names))
+    data = {names[position]: parsed[position] for position, _ in kept}
+    positions = {names[position]: position + 1 for position, _ in kept}
+    return header, header_lines, names, number, data, positions, number + 1 + rows
+
+
+def _read_lines(source: Path, fmt: TableFormat, file: str) -> _Read:
+    """The file read line by line (:func:`softbend._io.read_header_csv`): any file, and the
+    first problem in it reported."""
     header: dict[str, str] = {}
     header_lines: dict[str, int] = {}
     names: list[str] | None = None
@@ -511,19 +620,7 @@ def read_table(path: str | os.PathLike[str], fmt: TableFormat) -> Table:
         at, position, name, requirement = bad
         cell = rows[at][position - 1]
         raise _error(f"must be {requirement}; got {_got(cell)}", file, lines[at], position, name)
-    _check_plausible(fmt, data, positions, file, lines)
-    _check_increasing(fmt, data, positions, file, lines)
-    frame = pd.DataFrame(data, columns=list(data))
-    return Table(
-        frame=frame,
-        header=header,
-        file=file,
-        lines=np.asarray(lines, dtype=np.int64),
-        header_line=header_line,
-        positions=positions,
-        header_lines=header_lines,
-        columns=tuple(names),
-    )
+    return header, header_lines, names, header_line, data, positions, np.asarray(lines, np.int64)
 
 
 def _check_names(fmt: TableFormat, names: list[str], file: str, line: int) -> None:
@@ -563,7 +660,7 @@ def _check_plausible(
     data: Mapping[str, np.ndarray],
     positions: Mapping[str, int],
     file: str | None,
-    lines: Sequence[int] | None,
+    lines: np.ndarray | None,
 ) -> None:
     """The first implausible value in file order, whichever column it is in."""
     first: tuple[int, int, str, int] | None = None  # (row, position, column, index)
@@ -585,7 +682,7 @@ def _check_plausible(
             where + text,
             key=name,
             file=file,
-            line=lines[index] if lines is not None else None,
+            line=int(lines[index]) if lines is not None else None,
             column=position if lines is not None else None,
         )
 
@@ -595,7 +692,7 @@ def _check_increasing(
     data: Mapping[str, np.ndarray],
     positions: Mapping[str, int],
     file: str,
-    lines: Sequence[int],
+    lines: np.ndarray,
 ) -> None:
     """The first value of an ``increasing`` column that does not increase, in file order."""
     groups = data.get(fmt.group) if fmt.group is not None else None
@@ -614,12 +711,12 @@ def _check_increasing(
                 first = (int(rows[k]), positions[name], name, rows, k, run)
     if first is not None:
         row, position, name, rows, k, run = first
-        text = not_increasing_text(data[name][rows], k, f"line {lines[rows[k - 1]]}", run)
-        raise _error(text, file, lines[row], position, name)
+        text = not_increasing_text(data[name][rows], k, f"line {int(lines[rows[k - 1]])}", run)
+        raise _error(text, file, int(lines[row]), position, name)
 
 
 def _check_contiguous(
-    name: str, groups: np.ndarray, positions: Mapping[str, int], file: str, lines: Sequence[int]
+    name: str, groups: np.ndarray, positions: Mapping[str, int], file: str, lines: np.ndarray
 ) -> None:
     """Each experiment's rows in one block: the first row of one that appears again, an error."""
     ended: dict[object, int] = {}
@@ -629,10 +726,10 @@ def _check_contiguous(
             if value in ended:
                 raise _error(
                     f"experiment {value!r} appears again after {values[row - 1]!r} (its rows "
-                    f"ended at line {lines[ended[value]]}); the rows of an experiment must be "
+                    f"ended at line {int(lines[ended[value]])}); the rows of an experiment must be "
                     "contiguous",
                     file,
-                    lines[row],
+                    int(lines[row]),
                     positions[name],
                     name,
                 )

@@ -385,7 +385,7 @@ def table_training_data(
     else:
         _, index = np.unique(codes, axis=0, return_inverse=True)
         groups = np.array([f"d{i:05d}" for i in index.ravel()])
-    if np.unique(groups).size > 1 and np.abs(angles).max() <= _RADIAN_MAX:
+    if np.any(groups != groups[0]) and np.abs(angles).max() <= _RADIAN_MAX:  # two designs
         raise ActuatorError(
             f"no |angle| exceeds {np.abs(angles).max():.4g} over the whole table; they look "
             "like radians: multiply by 180/π (57.2958) for degrees",

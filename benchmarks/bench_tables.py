@@ -1,0 +1,250 @@
+"""Benchmark: reading and checking a large simulation table, training plr on it, predicting.
+
+Writes seeded four-parameter simulation tables (``design_id``, the four
+parameters of ``examples/pneunet/actuator.json``, ``p_kpa`` and ``angle_deg``,
+ten pressures per design, as ``examples/pneunet/simulations.csv``) of
+``--rows`` and ``--big-rows`` rows into ``--cache`` (once; a later run reuses
+them), then measures, in this process:
+
+- **read**: :func:`softbend.surrogates.simulation_table.table_training_data`
+  with the actuator description (the path ``softbend train TABLE --actuator``
+  reads and checks a table with), best of ``--repeats``, against
+  ``pandas.read_csv(engine="c")`` of the same file, best of as many, and the
+  ratio of the two (the budget: at most 1.5);
+- **first progress**: the seconds from the start of the read to the first
+  progress report (:mod:`softbend._progress`), and the longest gap between two
+  reports (or the read's start and end), on the ``--big-rows`` table;
+
+and, each in a fresh process (the ``softbend`` command):
+
+- **train plr**: ``softbend train BIG.csv --actuator ... --models plr
+  --no-onnx`` end to end, its wall seconds and the longest time stderr stayed
+  silent (the plain progress lines off a terminal);
+- **predict**: ``softbend predict MODEL --design ... --pressures ...`` on the
+  model that training saved, best and median of ``--predict-runs`` (after one
+  warm-up run).
+
+Run::
+
+    .venv/bin/python benchmarks/bench_tables.py
+    .venv/bin/python benchmarks/bench_tables.py --rows 200000 --big-rows 1000000 --repeats 3
+    .venv/bin/python benchmarks/bench_tables.py --skip-train   # the reads only
+"""
+
+from __future__ import annotations
+
+import argparse
+import os
+import statistics
+import subprocess
+import sys
+import tempfile
+import threading
+import time
+from pathlib import Path
+
+import numpy as np
+
+from _record import record
+
+ROOT = Path(__file__).resolve().parents[1]
+
+#: The actuator the tables describe.
+ACTUATOR = ROOT / "examples" / "pneunet" / "actuator.json"
+
+#: Where the tables and the trained model are kept between runs.
+CACHE = Path(tempfile.gettempdir()) / "softbend-bench-tables"
+
+#: Pressures per design.
+PRESSURES = 10
+
+
+def write_table(path: Path, rows: int, seed: int = 0) -> Path:
+    """A seeded simulation table of ``rows`` rows (``rows // 10`` designs) at ``path``, once."""
+    if path.is_file():
+        return path
+    import pandas as pd
+
+    rng = np.random.default_rng(seed)
+    n = rows // PRESSURES
+    chambers = rng.integers(6, 15, n)
+    layers = rng.integers(1, 4, n)
+    wall = np.round(rng.uniform(1.0, 3.0, n), 1)
+    height = np.round(rng.uniform(8.0, 16.0, n) * 2) / 2
+    height = np.maximum(height, 2 * wall + 0.5)  # the constraint 2 * wall_mm < height_mm
+    top = np.round(rng.uniform(40.0, 120.0, n))
+    steps = np.linspace(0.0, 1.0, PRESSURES)
+    p = (top[:, None] * steps[None, :]).ravel()
+    rep = np.repeat
+    slope = rep(chambers * np.sqrt(height / wall) / (1.0 + 0.4 * layers), PRESSURES)
+    angle = 1.5 * slope * p / (1.0 + p / 60.0) + rng.normal(0.0, 0.05, p.size) * (p > 0)
+    frame = pd.DataFrame(
+        {
+            "design_id": rep([f"d{i:06d}" for i in range(n)], PRESSURES),
+            "n_chambers": rep(chambers, PRESSURES),
+            "n_layers": rep(layers, PRESSURES),
+            "wall_mm": rep(wall, PRESSURES),
+            "height_mm": rep(height, PRESSURES),
+            "p_kpa": np.round(p, 2),
+            "angle_deg": np.round(angle, 3),
+        }
+    )
+    path.parent.mkdir(parents=True, exist_ok=True)
+    temp = path.with_suffix(".tmp")
+    frame.to_csv(temp, index=False)
+    os.replace(temp, path)
+    return path
+
+
+def time_read(path: Path, repeats: int) -> dict[str, float]:
+    """Best seconds of softbend's read-and-check and of pandas' C parser, interleaved."""
+    import pandas as pd
+
+    from softbend.actuators import actuator_from
+    from softbend.surrogates.simulation_table import table_training_data
+
+    actuator = actuator_from(str(ACTUATOR))
+    ours, theirs = [], []
+    for _ in range(repeats):
+        start = time.perf_counter()
+        pd.read_csv(path, engine="c")
+        theirs.append(time.perf_counter() - start)
+        start = time.perf_counter()
+        table_training_data(path, actuator=actuator)
+        ours.append(time.perf_counter() - start)
+    return {"softbend": min(ours), "pandas": min(theirs), "ratio": min(ours) / min(theirs)}
+
+
+def time_progress(path: Path) -> dict[str, float]:
+    """Seconds to the first progress report of a read, and the longest silence in it."""
+    from softbend._progress import listening
+    from softbend.actuators import actuator_from
+    from softbend.surrogates.simulation_table import table_training_data
+
+    actuator = actuator_from(str(ACTUATOR))
+    stamps: list[float] = []
+    start = time.perf_counter()
+    with listening(lambda phase, done, total: stamps.append(time.perf_counter())):
+        table_training_data(path, actuator=actuator)
+    end = time.perf_counter()
+    marks = [start, *stamps, end]
+    return {
+        "first": (stamps[0] - start) if stamps else float("inf"),
+        "silent": max(b - a for a, b in zip(marks, marks[1:], strict=False)),
+        "total": end - start,
+    }
+
+
+def _timed_run(argv: list[str]) -> tuple[float, float, str]:
+    """Wall seconds of a command, the longest time its stderr stayed silent, and its stderr."""
+    env = {**os.environ, "PYTHONPATH": str(ROOT / "src"), "COLUMNS": "200"}
+    start = time.perf_counter()
+    proc = subprocess.Popen(
+        argv, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True, env=env
+    )
+    stamps = [start]
+    lines: list[str] = []
+
+    def drain() -> None:
+        assert proc.stderr is not None
+        for line in proc.stderr:
+            stamps.append(time.perf_counter())
+            lines.append(line)
+
+    reader = threading.Thread(target=drain)
+    reader.start()
+    assert proc.stdout is not None
+    proc.stdout.read()
+    proc.wait()
+    reader.join()
+    end = time.perf_counter()
+    stamps.append(end)
+    if proc.returncode != 0:
+        raise RuntimeError(f"{argv[3:5]} failed ({proc.returncode}): {''.join(lines)[-2000:]}")
+    return end - start, max(b - a for a, b in zip(stamps, stamps[1:], strict=False)), "".join(lines)
+
+
+def main() -> None:
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--rows", type=int, default=200_000, help="rows of the read's table")
+    parser.add_argument("--big-rows", type=int, default=1_000_000, help="rows of the large one")
+    parser.add_argument("--repeats", type=int, default=3, help="reads timed (best counts)")
+    parser.add_argument("--predict-runs", type=int, default=5, help="predictions timed")
+    parser.add_argument("--cache", type=Path, default=CACHE, help="folder of the tables")
+    parser.add_argument("--skip-train", action="store_true", help="time the reads only")
+    parser.add_argument("--no-record", action="store_true", help="print, do not record")
+    args = parser.parse_args()
+
+    small = write_table(args.cache / f"sims_{args.rows}.csv", args.rows)
+    big = write_table(args.cache / f"sims_{args.big_rows}.csv", args.big_rows)
+    figures: dict[str, object] = {}
+    units: dict[str, str] = {}
+
+    read = time_read(small, args.repeats)
+    print(
+        f"read {args.rows} rows: softbend {read['softbend']:.2f} s, pandas C "
+        f"{read['pandas']:.2f} s, ratio {read['ratio']:.2f}"
+    )
+    figures.update(
+        {
+            f"read {args.rows} rows: softbend": round(read["softbend"], 3),
+            f"read {args.rows} rows: pandas C parser": round(read["pandas"], 3),
+            f"read {args.rows} rows: ratio": round(read["ratio"], 2),
+        }
+    )
+    units.update({f"read {args.rows} rows: softbend": "s"})
+    units.update({f"read {args.rows} rows: pandas C parser": "s"})
+
+    progress = time_progress(big)
+    print(
+        f"read {args.big_rows} rows: {progress['total']:.2f} s, first progress after "
+        f"{progress['first']:.3f} s, longest silence {progress['silent']:.2f} s"
+    )
+    figures.update(
+        {
+            f"read {args.big_rows} rows": round(progress["total"], 2),
+            f"read {args.big_rows} rows: first progress": round(progress["first"], 3),
+            f"read {args.big_rows} rows: longest silence": round(progress["silent"], 2),
+        }
+    )
+    for key in list(figures)[-3:]:
+        units[key] = "s"
+
+    if not args.skip_train:
+        out = args.cache / "plr_model"
+        cli = [sys.executable, "-c", "import sys; from softbend.cli import run; sys.argv[0] = 'softbend'; run()"]
+        train = [*cli, "train", str(big), "--actuator", str(ACTUATOR), "--models", "plr"]
+        wall, silent, log = _timed_run([*train, "--no-onnx", "--out", str(out)])
+        print(log, end="")
+        print(f"train plr on {args.big_rows} rows: {wall:.1f} s, longest silence {silent:.1f} s")
+        model = out / "models" / "best.json"
+        if not model.is_file():
+            model = next(out.rglob("*plr*.json"))
+        predict = [*cli, "predict", str(model), "--design", "10,2,2.0,12.0", "--pressures", "50"]
+        _timed_run(predict)  # warms the disk cache
+        walls = [_timed_run(predict)[0] for _ in range(args.predict_runs)]
+        print(f"predict: best {min(walls):.3f} s, median {statistics.median(walls):.3f} s")
+        figures.update(
+            {
+                f"train plr {args.big_rows} rows": round(wall, 1),
+                f"train plr {args.big_rows} rows: longest silence": round(silent, 1),
+                "predict: best": round(min(walls), 3),
+                "predict: median": round(statistics.median(walls), 3),
+            }
+        )
+        for key in list(figures)[-4:]:
+            units[key] = "s"
+
+    if not args.no_record:
+        record(
+            "tables",
+            figures,
+            units=units,
+            notes="softbend train's table read and check against pandas' C parser in the same "
+            "process (budget: ratio <= 1.5); progress and silences on a 10^6-row read; train plr "
+            "(budget 60 s, no silence over 2 s) and predict (budget 1 s) in fresh processes",
+        )
+
+
+if __name__ == "__main__":
+    main()
