@@ -34,7 +34,9 @@ Run::
 from __future__ import annotations
 
 import argparse
+import itertools
 import os
+import resource
 import statistics
 import subprocess
 import sys
@@ -44,7 +46,6 @@ import time
 from pathlib import Path
 
 import numpy as np
-
 from _record import record
 
 ROOT = Path(__file__).resolve().parents[1]
@@ -97,22 +98,35 @@ def write_table(path: Path, rows: int, seed: int = 0) -> Path:
 
 
 def time_read(path: Path, repeats: int) -> dict[str, float]:
-    """Best seconds of softbend's read-and-check and of pandas' C parser, interleaved."""
+    """Best wall and CPU seconds of softbend's read-and-check and of pandas' C parser,
+    interleaved (one untimed read of each first)."""
     import pandas as pd
 
     from softbend.actuators import actuator_from
     from softbend.surrogates.simulation_table import table_training_data
 
     actuator = actuator_from(str(ACTUATOR))
-    ours, theirs = [], []
+    pd.read_csv(path, engine="c")
+    table_training_data(path, actuator=actuator)
+    walls: dict[str, list[float]] = {"softbend": [], "pandas": []}
+    cpus: dict[str, list[float]] = {"softbend": [], "pandas": []}
     for _ in range(repeats):
-        start = time.perf_counter()
-        pd.read_csv(path, engine="c")
-        theirs.append(time.perf_counter() - start)
-        start = time.perf_counter()
-        table_training_data(path, actuator=actuator)
-        ours.append(time.perf_counter() - start)
-    return {"softbend": min(ours), "pandas": min(theirs), "ratio": min(ours) / min(theirs)}
+        for name, read in (
+            ("pandas", lambda: pd.read_csv(path, engine="c")),
+            ("softbend", lambda: table_training_data(path, actuator=actuator)),
+        ):
+            wall, cpu = time.perf_counter(), time.process_time()
+            read()
+            walls[name].append(time.perf_counter() - wall)
+            cpus[name].append(time.process_time() - cpu)
+    best = {name: min(values) for name, values in walls.items()}
+    best_cpu = {name: min(values) for name, values in cpus.items()}
+    return {
+        "softbend": best["softbend"],
+        "pandas": best["pandas"],
+        "ratio": best["softbend"] / best["pandas"],
+        "cpu ratio": best_cpu["softbend"] / best_cpu["pandas"],
+    }
 
 
 def time_progress(path: Path) -> dict[str, float]:
@@ -130,14 +144,16 @@ def time_progress(path: Path) -> dict[str, float]:
     marks = [start, *stamps, end]
     return {
         "first": (stamps[0] - start) if stamps else float("inf"),
-        "silent": max(b - a for a, b in zip(marks, marks[1:], strict=False)),
+        "silent": max(b - a for a, b in itertools.pairwise(marks)),
         "total": end - start,
     }
 
 
-def _timed_run(argv: list[str]) -> tuple[float, float, str]:
-    """Wall seconds of a command, the longest time its stderr stayed silent, and its stderr."""
+def _timed_run(argv: list[str]) -> tuple[float, float, float, str]:
+    """Wall seconds of a command, its CPU seconds (user and system), the longest time its
+    stderr stayed silent, and its stderr."""
     env = {**os.environ, "PYTHONPATH": str(ROOT / "src"), "COLUMNS": "200"}
+    before = resource.getrusage(resource.RUSAGE_CHILDREN)
     start = time.perf_counter()
     proc = subprocess.Popen(
         argv, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True, env=env
@@ -158,10 +174,13 @@ def _timed_run(argv: list[str]) -> tuple[float, float, str]:
     proc.wait()
     reader.join()
     end = time.perf_counter()
+    after = resource.getrusage(resource.RUSAGE_CHILDREN)
+    cpu = (after.ru_utime - before.ru_utime) + (after.ru_stime - before.ru_stime)
     stamps.append(end)
     if proc.returncode != 0:
         raise RuntimeError(f"{argv[3:5]} failed ({proc.returncode}): {''.join(lines)[-2000:]}")
-    return end - start, max(b - a for a, b in zip(stamps, stamps[1:], strict=False)), "".join(lines)
+    silent = max(b - a for a, b in itertools.pairwise(stamps))
+    return end - start, cpu, silent, "".join(lines)
 
 
 def main() -> None:
@@ -182,58 +201,67 @@ def main() -> None:
 
     read = time_read(small, args.repeats)
     print(
-        f"read {args.rows} rows: softbend {read['softbend']:.2f} s, pandas C "
-        f"{read['pandas']:.2f} s, ratio {read['ratio']:.2f}"
+        f"read {args.rows} rows: softbend {read['softbend']:.3f} s, pandas C "
+        f"{read['pandas']:.3f} s, ratio {read['ratio']:.2f} (CPU seconds: {read['cpu ratio']:.2f})"
     )
+    head = f"read {args.rows} rows"
     figures.update(
         {
-            f"read {args.rows} rows: softbend": round(read["softbend"], 3),
-            f"read {args.rows} rows: pandas C parser": round(read["pandas"], 3),
-            f"read {args.rows} rows: ratio": round(read["ratio"], 2),
+            f"{head}: softbend": round(read["softbend"], 3),
+            f"{head}: pandas C parser": round(read["pandas"], 3),
+            f"{head}: ratio": round(read["ratio"], 2),
+            f"{head}: ratio of CPU seconds": round(read["cpu ratio"], 2),
         }
     )
-    units.update({f"read {args.rows} rows: softbend": "s"})
-    units.update({f"read {args.rows} rows: pandas C parser": "s"})
+    units.update({f"{head}: softbend": "s", f"{head}: pandas C parser": "s"})
 
     progress = time_progress(big)
     print(
         f"read {args.big_rows} rows: {progress['total']:.2f} s, first progress after "
         f"{progress['first']:.3f} s, longest silence {progress['silent']:.2f} s"
     )
+    head = f"read {args.big_rows} rows"
     figures.update(
         {
-            f"read {args.big_rows} rows": round(progress["total"], 2),
-            f"read {args.big_rows} rows: first progress": round(progress["first"], 3),
-            f"read {args.big_rows} rows: longest silence": round(progress["silent"], 2),
+            head: round(progress["total"], 2),
+            f"{head}: first progress": round(progress["first"], 3),
+            f"{head}: longest silence": round(progress["silent"], 2),
         }
     )
-    for key in list(figures)[-3:]:
-        units[key] = "s"
+    units.update({key: "s" for key in list(figures)[-3:]})
 
     if not args.skip_train:
         out = args.cache / "plr_model"
-        cli = [sys.executable, "-c", "import sys; from softbend.cli import run; sys.argv[0] = 'softbend'; run()"]
+        cli = [sys.executable, "-c", "import sys; from softbend.cli import run; run()"]
         train = [*cli, "train", str(big), "--actuator", str(ACTUATOR), "--models", "plr"]
-        wall, silent, log = _timed_run([*train, "--no-onnx", "--out", str(out)])
+        wall, cpu, silent, log = _timed_run([*train, "--no-onnx", "--out", str(out)])
         print(log, end="")
-        print(f"train plr on {args.big_rows} rows: {wall:.1f} s, longest silence {silent:.1f} s")
-        model = out / "models" / "best.json"
-        if not model.is_file():
-            model = next(out.rglob("*plr*.json"))
+        print(
+            f"train plr on {args.big_rows} rows: {wall:.1f} s ({cpu:.1f} CPU seconds), "
+            f"longest silence {silent:.1f} s"
+        )
+        model = out / "models" / "plr.json"
         predict = [*cli, "predict", str(model), "--design", "10,2,2.0,12.0", "--pressures", "50"]
         _timed_run(predict)  # warms the disk cache
-        walls = [_timed_run(predict)[0] for _ in range(args.predict_runs)]
-        print(f"predict: best {min(walls):.3f} s, median {statistics.median(walls):.3f} s")
+        runs = [_timed_run(predict) for _ in range(args.predict_runs)]
+        walls = [run[0] for run in runs]
+        cpus = [run[1] for run in runs]
+        print(
+            f"predict: best {min(walls):.3f} s, median {statistics.median(walls):.3f} s "
+            f"(CPU seconds: best {min(cpus):.3f}, median {statistics.median(cpus):.3f})"
+        )
+        head = f"train plr {args.big_rows} rows"
         figures.update(
             {
-                f"train plr {args.big_rows} rows": round(wall, 1),
-                f"train plr {args.big_rows} rows: longest silence": round(silent, 1),
+                head: round(wall, 1),
+                f"{head}: CPU seconds": round(cpu, 1),
+                f"{head}: longest silence": round(silent, 1),
                 "predict: best": round(min(walls), 3),
                 "predict: median": round(statistics.median(walls), 3),
+                "predict: median CPU seconds": round(statistics.median(cpus), 3),
             }
         )
-        for key in list(figures)[-4:]:
-            units[key] = "s"
+        units.update({key: "s" for key in list(figures)[-6:]})
 
     if not args.no_record:
         record(

@@ -111,6 +111,8 @@ def phase_progress(*, enabled: bool = True) -> Iterator[Callable[[str, int, int]
 
     def write(phase: str, done: int, total: int) -> None:
         tenth = 10 if total <= 0 else min(10, (10 * done) // total)
+        if done == 0 and last_tenth.get(phase) == 10:  # the phase begins again (the next fit)
+            del last_tenth[phase], started[phase]
         if phase in last_tenth and tenth <= last_tenth[phase]:
             return
         started.setdefault(phase, time.monotonic())

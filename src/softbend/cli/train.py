@@ -2,8 +2,9 @@
 
 from __future__ import annotations
 
+from collections.abc import Callable
 from pathlib import Path
-from typing import TYPE_CHECKING
+from typing import TYPE_CHECKING, Any
 
 import typer
 
@@ -181,13 +182,13 @@ def train(
 
     with (
         _common.output_errors(out, "--out"),
-        _common.phase_progress(enabled=not as_json) as progress,
+        _common.library_progress(enabled=not as_json) as progress,
     ):
         _, summary = train_into(
             source,
             out,
             models=models,
-            figures=training_figures,
+            figures=lambda result, stage: _drawn(training_figures, result, stage, progress),
             on_resume=None if as_json else resuming,
             on_discard=_common.warning_line,
             grid_name=grid,
@@ -212,6 +213,19 @@ def train(
         return
     print_summary(summary)
     _common.console.print(f"models, tables and figures written to {out}")
+
+
+def _drawn(
+    draw: Callable[[Any, Path], dict[str, str]],
+    result: Any,
+    stage: Path,
+    progress: Callable[[str, int, int], None],
+) -> dict[str, str]:
+    """The figures ``draw`` writes, announced as a phase (seconds on a large table)."""
+    progress("drawing the figures", 0, 1)
+    files = draw(result, stage)
+    progress("drawing the figures", 1, 1)
+    return files
 
 
 def _training_source(

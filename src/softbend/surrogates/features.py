@@ -88,7 +88,7 @@ class TrainingData:
     @property
     def n_groups(self) -> int:
         """Number of distinct designs."""
-        return int(np.unique(self.groups).size)
+        return len(set(np.asarray(self.groups).ravel().tolist()))  # hashed: no sort of the rows
 
 
 def data_hash(X: ArrayLike, y: ArrayLike, groups: ArrayLike | None = None) -> str:

@@ -28,7 +28,9 @@ from scipy.linalg.blas import dsyrk
 from scipy.linalg.lapack import dpocon, dpotrf, dpotrs
 from sklearn.base import BaseEstimator, RegressorMixin
 from sklearn.utils.validation import check_is_fitted, validate_data
+from threadpoolctl import threadpool_limits
 
+from softbend._progress import every, report
 from softbend._validation import check_int, check_range
 from softbend.errors import ConvergenceError, InputError
 from softbend.surrogates.polynomial_core import Plan as _Plan
@@ -41,6 +43,16 @@ logger = logging.getLogger(__name__)
 __all__ = ["PolynomialRegressor", "monomial_powers", "n_terms", "system_memory_mb"]
 
 _OWNER = "PolynomialRegressor"
+
+#: Rows × terms² of a fit that reports its progress (:mod:`softbend._progress`): a fit
+#: of about a second or more on one core.
+_REPORT_WORK = 5 * 10**10
+
+# _one_thread: the sums of the normal equations are thousands of small BLAS calls (one
+# chunk of rows each). With BLAS's own threads, each call waits for every thread: on a
+# busy machine, for a core another process holds, which made a degree-2 fit of 800 000
+# rows 60 times slower than on one thread (docs/design-log.md). One thread also makes the
+# sums the same on every machine, whatever its number of cores.
 _BYTES_PER_MB = 1e6
 _BLOCK = 512
 
@@ -305,18 +317,29 @@ class PolynomialRegressor(RegressorMixin, BaseEstimator):
         G = np.zeros((terms, terms), order="F")
         rhs = np.zeros(terms)
         buffer = np.empty(terms * chunk_rows)
-        for start in range(0, n_samples, chunk_rows):
-            stop = min(start + chunk_rows, n_samples)
-            Zt = np.ascontiguousarray(((X_arr[start:stop] - x_mean) / x_scale).T)
-            rows = buffer[: terms * (stop - start)].reshape(terms, stop - start)
-            Phi_t = _design_t(plan, Zt, 0, rows)
-            target = (y_arr[start:stop] - y_mean) / y_scale
-            # Lower triangle of G += Φᵀ Φ (Phi_t.T is Fortran-ordered: no copy).
-            G = dsyrk(1.0, Phi_t.T, beta=1.0, c=G, trans=1, lower=1, overwrite_c=1)
-            rhs += Phi_t @ target
-        del buffer
-
-        coef, solver, rank = _solve(G, rhs, alpha * n_samples)
+        # A phase of its own only where the sums take seconds (about 10^10 multiply-adds).
+        phase = (
+            f"fitting a degree-{degree} polynomial ({terms} terms) to {n_samples} rows"
+            if n_samples * terms * terms >= _REPORT_WORK
+            else None
+        )
+        stride = every(n_samples // chunk_rows + 1, 20)
+        with threadpool_limits(1, user_api="blas"):  # see _one_thread
+            for k, start in enumerate(range(0, n_samples, chunk_rows)):
+                if phase is not None and k % stride == 0:
+                    report(phase, start, n_samples)
+                stop = min(start + chunk_rows, n_samples)
+                Zt = np.ascontiguousarray(((X_arr[start:stop] - x_mean) / x_scale).T)
+                rows = buffer[: terms * (stop - start)].reshape(terms, stop - start)
+                Phi_t = _design_t(plan, Zt, 0, rows)
+                target = (y_arr[start:stop] - y_mean) / y_scale
+                # Lower triangle of G += Φᵀ Φ (Phi_t.T is Fortran-ordered: no copy).
+                G = dsyrk(1.0, Phi_t.T, beta=1.0, c=G, trans=1, lower=1, overwrite_c=1)
+                rhs += Phi_t @ target
+            del buffer
+            coef, solver, rank = _solve(G, rhs, alpha * n_samples)
+        if phase is not None:
+            report(phase, n_samples, n_samples)
         if not np.all(np.isfinite(coef)):
             raise ConvergenceError(
                 f"The normal equations of {_OWNER} gave non-finite coefficients "
@@ -361,16 +384,17 @@ class PolynomialRegressor(RegressorMixin, BaseEstimator):
         check_is_fitted(self)
         X_arr = validate_data(self, X, reset=False, dtype=np.float64, ensure_all_finite=False)
         _check_finite(X_arr, "X")
-        return polynomial_predict(
-            X_arr,
-            self._current_plan(),
-            np.asarray(self.coef_, dtype=np.float64),
-            self.x_mean_,
-            self.x_scale_,
-            self.y_mean_,
-            self.y_scale_,
-            self.chunk_rows,
-        )
+        with threadpool_limits(1, user_api="blas"):  # see _one_thread
+            return polynomial_predict(
+                X_arr,
+                self._current_plan(),
+                np.asarray(self.coef_, dtype=np.float64),
+                self.x_mean_,
+                self.x_scale_,
+                self.y_mean_,
+                self.y_scale_,
+                self.chunk_rows,
+            )
 
     def predictor(self) -> Callable[[ArrayLike], float]:
         """A fast one-sample evaluator for control loops (plain NumPy, no validation).
