@@ -449,7 +449,12 @@ def read_table(path: str | os.PathLike[str], fmt: TableFormat) -> Table:
     header, header_lines, names, header_line, data, positions, lines = read
     _check_plausible(fmt, data, positions, file, lines)
     _check_increasing(fmt, data, positions, file, lines)
-    frame = pd.DataFrame(data, columns=list(data), copy=False)
+    # text stays the object array it was read as (not converted to pandas' own strings)
+    frame = pd.DataFrame(
+        {name: pd.Series(values, dtype=values.dtype, copy=False) for name, values in data.items()},
+        columns=list(data),
+        copy=False,
+    )
     return Table(
         frame=frame,
         header=header,
@@ -493,9 +498,6 @@ def _read_plain(source: Path, fmt: TableFormat, file: str) -> _Read | None:
     if phase is not None:  # before a byte is read: a large file shows at once
         report(phase, 0, 100)
     text = read_input_text(source, file, encoding="utf-8-sig")
-    returns = text.count("\r")
-    if returns and returns != text.count("\r\n"):
-        return None
     header: dict[str, str] = {}
     header_lines: dict[str, int] = {}
     start, number, line = 0, 0, ""
@@ -515,6 +517,9 @@ def _read_plain(source: Path, fmt: TableFormat, file: str) -> _Read | None:
                 break
         else:
             return None  # no column header
+        preamble = text[:start]
+        if preamble.count("\r") != preamble.count("\r\n"):
+            return None  # a lone '\r' ends a line: the line reader numbers those
         if '"' in line or "\0" in line or len(line) > csv.field_size_limit():
             return None
         names = [cell.strip() for cell in line.split(fmt.separator)]

@@ -261,6 +261,8 @@ def table_training_data(
         An unreadable file, no usable row, or a pressure or angle column that
         is not numbers or a negative pressure (:func:`softbend.tables.check_columns`).
     """
+    import pandas as pd
+
     source = Path(path)
     if actuator is not None:
         if ranges:
@@ -381,7 +383,10 @@ def table_training_data(
     if describing is not None:
         report(describing, 2, 3)
     if GROUP in frame.columns:
-        groups = frame[GROUP].astype(str).to_numpy()[keep]
+        names = frame[GROUP].to_numpy()
+        if names.dtype != object or pd.api.types.infer_dtype(names, skipna=False) != "string":
+            names = frame[GROUP].astype(str).to_numpy()
+        groups = names[keep]
     else:
         _, index = np.unique(codes, axis=0, return_inverse=True)
         groups = np.array([f"d{i:05d}" for i in index.ravel()])
