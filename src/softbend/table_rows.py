@@ -66,28 +66,33 @@ def row_lines(data: bytes, separator: str, width: int, field_limit: int) -> np.n
         are not rows); None where ``data`` is not plain (see the module) or a
         row has another number of cells than ``width``.
     """
-    if len(separator.encode()) != 1 or not data.isascii():
+    if len(separator.encode()) != 1 or separator in "\r\n" or separator.encode() in _NOT_PLAIN:
         return None
-    if any(byte in data for byte in _NOT_PLAIN):
-        return None
-    returns = data.count(b"\r")
+    returns = data.count(b"\r") if b"\r" in data else 0
     if returns and returns != data.count(b"\r\n"):
         return None  # a lone '\r' ends a line: the line reader numbers those
     buffer = np.frombuffer(data, dtype=np.uint8)
-    events = np.flatnonzero((buffer == 10) | (buffer == ord(separator)))
-    newline_at = np.flatnonzero(buffer[events] == 10)
-    ends = events[newline_at]
-    if data and not data.endswith(b"\n"):  # the last line has no newline
+    if buffer.size == 0:
+        return None
+    plain = np.ones(256, dtype=bool)
+    plain[128:] = False
+    plain[np.frombuffer(b"".join(_NOT_PLAIN), dtype=np.uint8)] = False
+    if not plain[buffer].all():
+        return None
+    ends = np.flatnonzero(buffer == 10)
+    if not data.endswith(b"\n"):  # the last line has no newline
         ends = np.append(ends, len(data))
-        newline_at = np.append(newline_at, events.size)
     starts = np.concatenate(([0], ends[:-1] + 1))
     lengths = ends - starts
     if returns:
         filled = lengths > 0
         lengths[filled] -= buffer[ends[filled] - 1] == 13
-    cells = np.diff(np.concatenate(([-1], newline_at)))  # a line's separators, plus one
     rows = np.flatnonzero(lengths > 0)
-    if rows.size == 0 or np.any(cells[rows] != width) or lengths.max() > field_limit:
+    if rows.size == 0 or lengths.max() > field_limit:
+        return None
+    # each row's separators: its segment of the file up to the next line (a blank line's, unused)
+    separators = np.add.reduceat((buffer == ord(separator)).view(np.uint8), starts, dtype=np.int64)
+    if np.any(separators[rows] != width - 1):
         return None
     return rows.astype(np.int64)
 
@@ -122,12 +127,13 @@ def parse_rows(
     """
     import pandas as pd
 
+    first = data.lstrip(b"\r\n").split(b"\n", 1)[0].rstrip(b"\r").decode().split(separator)
     dtypes: dict[int, object] = {}
     for position, column in columns:
         if column.kind in ("number", "integer"):
             dtypes[position] = np.float64
-        elif column.kind in ("text", "choice"):
-            dtypes[position] = object
+        elif column.kind in ("text", "choice") or not _number(first[position]):
+            dtypes[position] = object  # text: one cell not a number makes the column text
     try:
         frame = pd.read_csv(
             io.BytesIO(data),
@@ -153,6 +159,17 @@ def parse_rows(
             return None
         out[position] = values
     return out
+
+
+def _number(cell: str) -> bool:
+    """Whether a filled cell reads as a number, as :func:`infer_written` reads it."""
+    if not cell:
+        return True  # an empty cell says nothing of its column
+    try:
+        np.array([cell], dtype=np.float64)
+    except ValueError:
+        return False
+    return True
 
 
 def column_values(column: ColumnSpec, series: object) -> np.ndarray | None:
