@@ -141,9 +141,7 @@ class Candidate:
         return self.family in ("arx", "poly2") or self.name == "paper-a"
 
 
-def default_candidates(
-    seed: int = 0, n_kernel: int = 6, *, delays: bool = True
-) -> list[Candidate]:
+def default_candidates(seed: int = 0, n_kernel: int = 6, *, delays: bool = True) -> list[Candidate]:
     """The baselines, the simulation-error models and ``n_kernel`` seeded kernel candidates.
 
     The simulation-error models (:mod:`~softbend.identification.simfit`, each
