@@ -66,6 +66,20 @@ GravityOption = Annotated[
     ),
 ]
 
+ContactOption = Annotated[
+    str | None,
+    typer.Option(
+        "--contact",
+        help="Contact between the facing walls of neighbouring PneuNet chambers: on (the "
+        "default for --family pneunet: the sweep goes on to --pmax or 180° with the walls "
+        "pressing on each other, the contact force and pressure reported per step) or off "
+        "(the sweep stops where the walls first touch). sfrba: off only (no faces touch).",
+    ),
+]
+
+#: Where ``fem run`` with contact stops bending, degrees (the PneuNet's working range).
+CONTACT_MAX_ANGLE_DEG = 180.0
+
 
 MaterialOption = Annotated[
     str | None,
@@ -128,11 +142,24 @@ def _family_options(
     material: str | None,
     *,
     solve_every: bool = False,
+    contact: str | None = None,
 ) -> FEMOptions:
-    """The options of ``family``, from its defaults and the given flags."""
+    """The options of ``family``, from its defaults and the given flags.
+
+    ``contact`` None: "on" for the PneuNet, "off" for paper B's actuator (which
+    has no faces that touch: "on" is refused for it).
+    """
+    from softbend._validation import check_choice
+    from softbend.fem.options import CONTACT_MODES
     from softbend.materials.choice import material_from_spec
 
     changes: dict[str, object] = {"maxh_mm": family.maxh_mm if maxh is None else maxh}
+    with_contact = family.name == "pneunet"
+    if contact is not None:
+        check_choice(contact, "contact", CONTACT_MODES if with_contact else ("off",))
+    if (contact or ("on" if with_contact else "off")) == "on":
+        changes["contact"] = "on"
+        changes["max_angle_deg"] = CONTACT_MAX_ANGLE_DEG
     if gravity is not None:
         changes["gravity"] = gravity
     if material is not None:
@@ -163,6 +190,7 @@ def run(
     material: MaterialOption = None,
     shapes: ShapesOption = 5,
     solve_every: SolveEveryOption = False,
+    contact: ContactOption = None,
     json_output: Annotated[bool, typer.Option("--json", help="Print the sweep as JSON.")] = False,
 ) -> None:
     """Sweep one design from 0 MPa to --pmax with the FEM.
@@ -179,16 +207,21 @@ def run(
     runs. An existing --out may hold only what this command writes.
 
     With --family pneunet: a PneuNet, --design NAME=VALUE pairs (the reference
-    PneuNet without); the sweep also stops where neighbouring chamber walls
-    touch (the reason names the pressure). Its folder holds sweep.csv,
-    sweep.json, angle_pressure.png and vtk/ (no shapes.png, and no analytical
-    model on the curve); --json adds the cavity volume of every converged step.
+    PneuNet without). With --contact on (its default) the facing walls of
+    neighbouring chambers press on each other (frictionless penalty contact)
+    and the sweep goes on to --pmax or 180°; the table adds the contact force
+    and mean contact pressure, and --json the cavity volume, contact force and
+    contact pressure of every converged step. With --contact off the sweep
+    stops where the walls first touch (the reason names the pressure). Its
+    folder holds sweep.csv, sweep.json, angle_pressure.png and vtk/ (no
+    shapes.png, and no analytical model on the curve).
 
     Example:
 
     \b
         softbend fem run --design 100,6,2,2,5,10 --pmax 0.2 --out fem
         softbend fem run --family pneunet --design n_chambers=6,wall_mm=1.5 --out pneunet
+        softbend fem run --family pneunet --contact off --out pneunet-to-touch
     """
     from softbend._validation import check_int
     from softbend.fem.families import get_family
@@ -197,7 +230,9 @@ def run(
     with keyed("family"):
         chosen = get_family(family)
     actuator = chosen.parse(design)
-    options = _family_options(chosen, maxh, gravity, material, solve_every=solve_every)
+    options = _family_options(
+        chosen, maxh, gravity, material, solve_every=solve_every, contact=contact
+    )
     pstep = chosen.pstep_mpa if pstep is None else pstep
     pressures = default_pressures_mpa(chosen.pmax_mpa if pmax is None else pmax, pstep)
     chosen.check_mesh(actuator, options)  # before NGSolve loads: a too fine --maxh is one line
@@ -270,24 +305,33 @@ def _print_sweep(sweep: FamilySweep, pstep: float, out: Path, *, json_output: bo
         extra = {"pressure_mpa": result.pressure_mpa, "angle_deg": result.angle_deg}
         _common.print_json({**sweep_summary(sweep), **extra})
         return
+    import numpy as np
+
     stats = fem_stats(result)
     every = max(1, len(result.pressure_mpa) // 10)
+    columns = ["pressure MPa", "angle °", "tip x mm", "tip z mm", "Newton its"]
+    contact: list[np.ndarray] = []
+    if "step_contact_force_n" in stats:  # per step: read at the table's pressures
+        columns += ["contact N", "contact kPa"]
+        steps = np.asarray(stats["steps_mpa"])
+        for key in ("step_contact_force_n", "step_contact_pressure_kpa"):
+            contact.append(np.interp(result.pressure_mpa, steps, stats[key]))  # type: ignore[literal-required]
     rows = [
-        [f"{p:.3f}", f"{a:.2f}", f"{x:.1f}", f"{z:.1f}", int(i)]
-        for p, a, x, z, i in zip(
-            result.pressure_mpa,
-            result.angle_deg,
-            result.tip_x_mm,
-            result.tip_z_mm,
-            result.newton_iterations,
-            strict=True,
+        [f"{p:.3f}", f"{a:.2f}", f"{x:.1f}", f"{z:.1f}", int(i)] + [f"{c[k]:.3g}" for c in contact]
+        for k, (p, a, x, z, i) in enumerate(
+            zip(
+                result.pressure_mpa,
+                result.angle_deg,
+                result.tip_x_mm,
+                result.tip_z_mm,
+                result.newton_iterations,
+                strict=True,
+            )
         )
         if round(p / pstep) % every == 0
     ]
     _common.print_table(
-        f"FEM sweep of the {sweep.family.name} ({sweep.design.as_text()})",
-        ["pressure MPa", "angle °", "tip x mm", "tip z mm", "Newton its"],
-        rows,
+        f"FEM sweep of the {sweep.family.name} ({sweep.design.as_text()})", columns, rows
     )
     t = stats["timings"]
     _common.console.print(
@@ -327,7 +371,7 @@ def mesh_study(
     sizes = _floats(maxh, "maxh") if maxh else list(default_maxh)
     grid = _floats(pressures, "pressures") if pressures else list(default_pressures)
     actuator = chosen.parse(design)
-    options = _family_options(chosen, None, gravity, material)
+    options = _family_options(chosen, None, gravity, material, contact="off")
     for h in sizes:  # a too fine size is one line before any sweep
         chosen.check_mesh(actuator, options.replace(maxh_mm=h))
     with _common.progress_bar("mesh sizes", len(sizes), enabled=not json_output) as advance:

@@ -159,6 +159,13 @@ class EnergySolver:
         """Whether a Hessian has been factorised yet."""
         return self._inverse is not None
 
+    def forget_factorization(self) -> None:
+        """Drop the factorised Hessian: the next :meth:`factorize` starts a new one.
+
+        For a form whose sparsity changed (new contact pairs).
+        """
+        self._inverse = None
+
     def _prepare(self) -> None:
         if self.prepare is not None:
             self.prepare()

@@ -22,6 +22,8 @@ from softbend.materials.presets import (
 )
 
 __all__ = [
+    "CONTACT_FIELDS",
+    "CONTACT_MODES",
     "GRAVITY_DIRECTIONS",
     "OUTPUT_MODES",
     "FEMOptions",
@@ -32,6 +34,14 @@ GRAVITY_DIRECTIONS: tuple[str, ...] = ("bending", "against", "axial", "none")
 
 #: How outputs on the requested pressure grid are obtained.
 OUTPUT_MODES: tuple[str, ...] = ("interpolate", "solve")
+
+#: Whether faces of the model that may touch carry contact (see :class:`FEMOptions`).
+CONTACT_MODES: tuple[str, ...] = ("off", "on")
+
+#: The contact options: left out of :meth:`FEMOptions.to_dict` (and so of the
+#: digest) while ``contact`` is "off", so options without contact describe and
+#: digest as they did before contact was modelled.
+CONTACT_FIELDS: tuple[str, ...] = ("contact", "contact_penalty_mpa_per_mm", "contact_tolerance_mm")
 
 
 @dataclass(frozen=True)
@@ -133,6 +143,21 @@ class FEMOptions:
     threads : int
         Threads of NGSolve's task manager, >= 1 (1: one core per sweep, the
         campaign runs sweeps in parallel instead).
+    contact : {"off", "on"}
+        Whether the faces of the model that may touch carry frictionless
+        penalty contact (:mod:`softbend.fem.contact`): for a PneuNet, the
+        facing walls of neighbouring chambers. "off": a PneuNet's sweep stops
+        where they first touch. Paper B's actuator has no such faces.
+    contact_penalty_mpa_per_mm : float
+        Penalty stiffness of the contact: contact pressure per mm of
+        interpenetration, MPa/mm, in (0, 1e5]. Default 50: about 70 times the
+        stiffness ``E/t`` of a 1.2 mm Elastosil wall (E ≈ 0.8 MPa), so the
+        walls yield a little while the pairs barely overlap (0.001 mm at a
+        contact pressure of 50 kPa).
+    contact_tolerance_mm : float
+        Largest interpenetration of the contact faces the sweep accepts, mm,
+        in (0, 10]: a step whose faces overlap by more stops the sweep (the
+        penalty is too soft for that load). Default 0.05 mm.
     """
 
     maxh_mm: float = 5.0
@@ -159,6 +184,9 @@ class FEMOptions:
     output: str = "interpolate"
     backbone_points: int = 41
     threads: int = 1
+    contact: str = "off"
+    contact_penalty_mpa_per_mm: float = 50.0
+    contact_tolerance_mm: float = 0.05
     extra: dict[str, Any] = field(default_factory=dict, repr=False, compare=False)
 
     def __post_init__(self) -> None:
@@ -207,6 +235,9 @@ class FEMOptions:
         check_choice(self.output, "output", OUTPUT_MODES)
         check_int(self.backbone_points, "backbone_points", low=5)
         check_int(self.threads, "threads", low=1)
+        check_choice(self.contact, "contact", CONTACT_MODES)
+        number("contact_penalty_mpa_per_mm", 0.0, 1e5)
+        number("contact_tolerance_mm", 0.0, 10.0)
 
     @property
     def elastomer_model(self) -> HyperelasticModel:
@@ -263,9 +294,16 @@ class FEMOptions:
         return hashlib.sha256(text.encode()).hexdigest()
 
     def to_dict(self) -> dict[str, Any]:
-        """JSON-friendly description (materials as their own dicts)."""
+        """JSON-friendly description (materials as their own dicts).
+
+        The contact options are left out while ``contact`` is "off"
+        (:data:`CONTACT_FIELDS`).
+        """
         out = asdict(self)
         for name in ("elastomer", "layer", "fiber"):
             out[name] = getattr(self, name).to_dict()
         out.pop("extra")
+        if self.contact == "off":
+            for name in CONTACT_FIELDS:
+                out.pop(name)
         return out

@@ -56,7 +56,8 @@ class FEMStats(TypedDict):
     stop_reason : str
         Why the sweep ended ("reached the last pressure", "bending angle above …",
         "stretch … above …", "inflation instability above …", "no convergence above …",
-        and for the PneuNet "neighbouring chamber walls touch at … kPa").
+        and for the PneuNet "neighbouring chamber walls touch at … kPa" without
+        contact, "chamber walls overlap by … mm" with it).
     steps_mpa : list of float
         Pressure of every converged load step, MPa, from 0 (the gravity state).
     step_angles_deg : list of float
@@ -84,6 +85,12 @@ class FEMStats(TypedDict):
         without fibers).
     step_volume_mm3 : list of float, optional
         Volume of the whole cavity at each step, mm³ (the PneuNet's sweeps).
+    step_contact_force_n : list of float, optional
+        Contact force between the chamber walls of the whole actuator at each
+        step, N (the PneuNet's sweeps with contact; 0 before the walls touch).
+    step_contact_pressure_kpa : list of float, optional
+        Mean contact pressure of the touching walls at each step, kPa: the
+        penalty stiffness times their mean interpenetration.
     failure : str, optional
         The solver's last error, present only when the sweep stopped on one.
     """
@@ -103,6 +110,8 @@ class FEMStats(TypedDict):
     options_sha256: str
     fiber_spacing_mm: float
     step_volume_mm3: NotRequired[list[float]]
+    step_contact_force_n: NotRequired[list[float]]
+    step_contact_pressure_kpa: NotRequired[list[float]]
     failure: NotRequired[str]
 
 

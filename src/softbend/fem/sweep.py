@@ -31,6 +31,11 @@ region; otherwise it is a plain "no convergence". The reason is always in
 ``stats["stop_reason"]`` (the keys: :class:`~softbend.fem.stats.FEMStats`). A model
 that does not even hold its own weight raises
 :class:`~softbend.errors.ConvergenceError`.
+
+A model may also act around every step: ``before_step()`` before the solve
+(the PneuNet pairs its faces in contact anew) and ``reject_step()`` after a
+converged step longer than four ``min_step_mpa`` (True: the step is restored
+and halved as a failed one is; the PneuNet's walls starting to touch within it).
 """
 
 from __future__ import annotations
@@ -283,6 +288,9 @@ def run_steps(
         predicted = _predict(start, tangent, pressure, target, previous)
         model.set_state(predicted)
         model.set_load(target, 1.0)
+        before_step = getattr(model, "before_step", None)
+        if before_step is not None:
+            before_step()
         try:
             report = model.solver.solve(
                 model.force_scale_n(target), load=target, step=len(history.steps)
@@ -310,6 +318,18 @@ def run_steps(
                 history.failed_pressure_mpa = target
                 history.failure = str(exc)
                 break
+            continue
+        reject_step = getattr(model, "reject_step", None)
+        if (
+            reject_step is not None
+            and target - pressure > 4.0 * options.min_step_mpa
+            and reject_step()
+        ):
+            logger.debug("step to %.6g MPa cut: contact starts within it", target)
+            model.set_state(start)
+            model.set_load(pressure, 1.0)
+            history.rejected_steps += 1
+            dp = 0.5 * (target - pressure)
             continue
         previous = (pressure, start, tangent)
         pressure = target

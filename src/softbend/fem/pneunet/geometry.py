@@ -14,7 +14,11 @@ Each chamber is its own closed cavity at the common pressure: the inlet
 channel that links the chambers of a real PneuNet is left out (a few mm² of
 section, it carries pressure, not load). Faces are named for the physics:
 ``base`` (``x = 0``, fixed), ``symmetry`` (``y = 0``), ``bottom`` (``z = 0``,
-strain-limiting layer), ``cavity`` (pressure) and ``outer`` (the rest).
+strain-limiting layer), ``cavity`` (pressure), ``facing_back`` and
+``facing_front`` (the outer faces of the walls that face each other across a
+gap: the back face of every chamber but the last and the front face of every
+chamber but the first, which may touch: :data:`FACING_FACES`) and ``outer``
+(the rest).
 """
 
 from __future__ import annotations
@@ -30,6 +34,7 @@ from softbend.fem.geometry import check_element_count, curved_mesh, name_faces, 
 from softbend.fem.pneunet.description import cavity_volume_mm3, length_mm
 
 __all__ = [
+    "FACING_FACES",
     "PneuNetGeometry",
     "check_pneunet_mesh",
     "element_size_mm",
@@ -37,6 +42,10 @@ __all__ = [
     "mesh_pneunet",
     "pneunet_solid",
 ]
+
+
+#: Names of the faces that face each other across the gaps: (back faces, front faces).
+FACING_FACES: tuple[str, str] = ("facing_back", "facing_front")
 
 
 @dataclass(frozen=True)
@@ -154,7 +163,23 @@ def pneunet_solid(design: Design, end_mm: float) -> tuple[Any, PneuNetGeometry]:
     name_faces(
         solid, info.length_mm, tip=False, what=f"the PneuNet geometry of design {design.as_text()}"
     )
+    _name_facing(solid, info)
     return solid, info
+
+
+def _name_facing(solid: Any, info: PneuNetGeometry) -> None:
+    """Rename the ``outer`` faces across the gaps :data:`FACING_FACES` (by their centres)."""
+    tol = 1e-7 * info.length_mm
+    backs = [info.chamber_x_mm(k)[1] for k in range(info.n - 1)]
+    fronts = [info.chamber_x_mm(k)[0] for k in range(1, info.n)]
+    for face in solid.faces:
+        if face.name != "outer" or face.center.z < info.design.base_mm + tol:
+            continue
+        x = face.center.x
+        if any(abs(x - b) < tol for b in backs):
+            face.name = FACING_FACES[0]
+        elif any(abs(x - f) < tol for f in fronts):
+            face.name = FACING_FACES[1]
 
 
 #: The element size is at most this many times the thinnest chamber wall.

@@ -18,23 +18,31 @@ symmetry plane over the chambered part.
 Walls that touch
 ----------------
 As a PneuNet bends, the expanding walls of neighbouring chambers bulge into the
-gap between them and meet. This model does not model that contact: the sweep
-stops at first touch, with the pressure recorded and the reason "neighbouring
-chamber walls touch at X kPa" (:meth:`PneuNetModel.stop_after_step`). Why:
-contact turns the smooth energy minimisation into a constrained one whose
-active set changes from step to step (a penalty or Nitsche term adds a
-non-smooth Hessian, the difficulty paper B's tension-only fibers showed), the
-contacting walls need a finer mesh than the bending does, and past first touch
-the actuator's curve depends on friction and on the wall surfaces, which the
-published setups do not give. A campaign's designs are compared on the curve
-before contact; the touch pressure is itself a design output. The gap is
-measured after every converged step between pairs of points at the same
-``(y, z)`` on the two facing wall faces across each gap
-(:meth:`~softbend.fem.pneunet.geometry.PneuNetGeometry.facing_walls`): the
-deformed distance between them, signed by the deformed axial direction of the
-base between the chambers (negative once the walls overlap). The touch pressure
-is where the smallest gap reaches zero, interpolated linearly between the two
-steps around it; outputs are reported up to it.
+gap between them and meet. The gap is measured after every converged step
+between pairs of points at the same ``(y, z)`` on the two facing wall faces
+across each gap (:meth:`~softbend.fem.pneunet.geometry.PneuNetGeometry.facing_walls`):
+the deformed distance between them, signed by the deformed axial direction of
+the base between the chambers (negative once the walls overlap).
+
+With the option ``contact="on"`` the facing faces (``facing_back`` against
+``facing_front``) carry frictionless penalty contact
+(:class:`~softbend.fem.contact.PenaltyContact`, stiffness
+``contact_penalty_mpa_per_mm``), re-paired before every load step
+(:meth:`PneuNetModel.before_step`), and the sweep goes on through the touch:
+a step over which the smallest gap changes sign is cut (:meth:`PneuNetModel.reject_step`)
+so that contact starts within a short step, the contact force and the largest
+interpenetration are recorded at every converged step, and a step whose walls
+overlap by more than ``contact_tolerance_mm`` stops the sweep (the penalty is
+too soft for that load). Until the walls touch the contact energy is zero and
+the curve is the contact-free one. (The sampled gap above pairs material
+points, which slide along each other once the walls press together: it finds
+when they first touch, the contact's own pairs measure the overlap.)
+
+With ``contact="off"`` the sweep stops at first touch, with the pressure
+recorded and the reason "neighbouring chamber walls touch at X kPa"
+(:meth:`PneuNetModel.stop_after_step`): the touch pressure is where the
+smallest gap reaches zero, interpolated linearly between the two steps
+around it; outputs are reported up to it.
 """
 
 from __future__ import annotations
@@ -49,13 +57,20 @@ from softbend.actuators import Design
 from softbend.fem._ngsolve import require_ngsolve
 from softbend.fem.actuator import ModelState
 from softbend.fem.options import FEMOptions
-from softbend.fem.pneunet.geometry import mesh_pneunet
+from softbend.fem.pneunet.geometry import FACING_FACES, mesh_pneunet
 
 require_ngsolve()  # NGSolve after PyTorch, or one line naming softbend[fem]
 
 __all__ = ["PneuNetModel"]
 
 logger = logging.getLogger(__name__)
+
+#: Facing walls are paired for contact where they are closer than this fraction
+#: of the design's gap (at the predicted state of each step): the pairs couple
+#: the walls' unknowns in the Hessian, so pairing far-apart walls only slows the
+#: factorisation (the reference paired across its whole 2.5 mm gaps:
+#: about 2.6 s a step before the touch against 0.5 s unpaired).
+CONTACT_SEARCH_FRACTION = 0.25
 
 
 class PneuNetModel(ModelState):
@@ -92,6 +107,30 @@ class PneuNetModel(ModelState):
             (a, b, self._points(a), self._points(b)) for a, b in self.geometry.facing_walls()
         ]
         self._gaps: list[tuple[float, float]] = []  # (pressure MPa, smallest gap mm)
+        self.contact = None
+        if options.contact == "on" and self.geometry.n > 1:
+            from softbend.fem.contact import PenaltyContact
+
+            self.contact = PenaltyContact(
+                self.fes,
+                FACING_FACES[0],
+                FACING_FACES[1],
+                penalty_mpa_per_mm=options.contact_penalty_mpa_per_mm,
+                maxdist_mm=CONTACT_SEARCH_FRACTION * self.design.gap_mm,
+            )
+            # Newton's early give-up rules judge a solve by its first iterations;
+            # where contact pairs switch on and off those zigzag before converging
+            # (the reference past the touch: 14 iterations' residuals 0.04, 3.1,
+            # 0.78, 0.20, 196, … 6e-9 N), so only the iteration limit stays.
+            self.solver.first_contraction = math.inf
+            self.solver.stall_iteration = self.solver.progress_iteration = 10**6
+            self.before_step()
+        #: Per converged step: contact force on the walls of the whole actuator (N) and
+        #: the mean interpenetration of the touching walls
+        #: (:meth:`~softbend.fem.contact.PenaltyContact.mean_depth_mm`, mm); empty
+        #: without contact.
+        self.contact_force_n: list[float] = []
+        self.interpenetration_mm: list[float] = []
 
     def _mesh(self) -> tuple[Any, Any]:
         o = self.options
@@ -150,15 +189,52 @@ class PneuNetModel(ModelState):
             smallest = min(smallest, float(signed.min()))
         return smallest
 
+    def before_step(self) -> None:
+        """Before a load step's solve (from its predicted state): pair the facing walls anew.
+
+        Without contact, nothing. The new pairs change the Hessian's sparsity,
+        so the solver's factorisation is dropped.
+        """
+        if self.contact is None:
+            return
+        self.contact.update(self.gfu, self.form)
+        self.solver.forget_factorization()
+
+    def reject_step(self) -> bool:
+        """After a converged step with contact: whether the smallest gap changed sign over it.
+
+        The sweep then cuts the step, so that contact starts within a short
+        step. Always False without contact.
+        """
+        if self.contact is None or not self._gaps:
+            return False
+        return self._gaps[-1][1] > 0.0 >= self.wall_gap_mm()
+
     def stop_after_step(self, pressure_mpa: float) -> tuple[str, float] | None:
         """After a converged step: the reason to stop and the last valid pressure, or None.
 
-        Stops when neighbouring chamber walls touch; the touch pressure is
-        interpolated between the last two steps' gaps (MPa).
+        Without contact, stops when neighbouring chamber walls touch; the touch
+        pressure is interpolated between the last two steps' gaps (MPa). With
+        contact, records the contact force and interpenetration and stops when
+        the walls overlap by more than ``contact_tolerance_mm``.
         """
         gap = self.wall_gap_mm()
         previous = self._gaps[-1] if self._gaps else None
         self._gaps.append((pressure_mpa, gap))
+        if self.contact is not None:
+            force = self.contact.force_n(self.gfu)
+            depth = self.contact.mean_depth_mm(self.gfu, force)
+            self.contact_force_n.append(2.0 * float(np.linalg.norm(force)))  # both halves
+            self.interpenetration_mm.append(depth)
+            limit = self.options.contact_tolerance_mm
+            if depth > limit:
+                return (
+                    f"chamber walls overlap by {depth:.3g} mm at {pressure_mpa * 1000:.2f} kPa, "
+                    f"beyond contact_tolerance_mm = {limit:g} (raise "
+                    "contact_penalty_mpa_per_mm)",
+                    self._gaps[-2][0] if len(self._gaps) > 1 else pressure_mpa,
+                )
+            return None
         if gap > 0.0:
             return None
         touch = pressure_mpa

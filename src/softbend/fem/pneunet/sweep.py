@@ -3,9 +3,12 @@
 The load stepping of paper B's actuator (:func:`softbend.fem.sweep.run_model_sweep`:
 gravity, then adaptive pressure steps with a tangent predictor and Hermite dense
 output) on :class:`~softbend.fem.pneunet.model.PneuNetModel`. Besides the stop
-reasons of that sweep, a PneuNet sweep stops when neighbouring chamber walls
-touch (the reason names the pressure). The stats add the cavity volume of every
-converged step (both halves, mm³), for the volume–pressure curve.
+reasons of that sweep, a PneuNet sweep without contact stops when neighbouring
+chamber walls touch (the reason names the pressure); with contact
+(``FEMOptions.contact == "on"``) it goes on with the walls pressing on each
+other. The stats add the cavity volume of every converged step (both halves,
+mm³), for the volume–pressure curve, and with contact the contact force and
+pressure of every step.
 """
 
 from __future__ import annotations
@@ -57,7 +60,10 @@ def run_pneunet_sweep(
     -------
     (SweepResult, PneuNetModel, StepHistory)
         As :func:`softbend.fem.sweep.run_sweep`; ``stats["step_volume_mm3"]``
-        holds the cavity volume at every converged step, mm³.
+        holds the cavity volume at every converged step, mm³; with
+        ``options.contact == "on"``, ``stats["step_contact_force_n"]`` and
+        ``stats["step_contact_pressure_kpa"]`` the contact force (N) and mean
+        contact pressure (kPa) between the chamber walls at every step.
     """
     if not isinstance(options, FEMOptions):
         raise InputError(must_be("FEMOptions", options), key="options")
@@ -67,5 +73,13 @@ def run_pneunet_sweep(
         PneuNetModel, design, pressures_mpa, options, progress=progress, keep_states=keep_states
     )
     result.stats["step_volume_mm3"] = [float(s.volume_mm3) for s in history.steps]
+    if model.contact is not None:
+        # The gravity state (step 0) has no contact; a step that stopped the sweep
+        # was recorded too.
+        k = options.contact_penalty_mpa_per_mm
+        forces = [0.0, *model.contact_force_n][: len(history.steps)]
+        depths = [0.0, *model.interpenetration_mm][: len(history.steps)]
+        result.stats["step_contact_force_n"] = forces
+        result.stats["step_contact_pressure_kpa"] = [1000.0 * k * d for d in depths]
     assert isinstance(model, PneuNetModel)
     return result, model, history
