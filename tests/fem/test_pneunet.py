@@ -100,3 +100,46 @@ def test_a_single_chamber_has_no_walls_to_touch():
     model = PneuNetModel(FAMILY.parse("n_chambers=1,chamber_height_mm=12"), COARSE)
     assert model.wall_gap_mm() == math.inf
     assert model.stop_after_step(0.01) is None
+
+
+@pytest.fixture(scope="module")
+def close_walls():
+    """Walls 1 mm apart: swept without contact (to the touch, 3–4 kPa) and with it (past it)."""
+    design = FAMILY.parse(SMALL + ",gap_mm=1")
+    grid = default_pressures_mpa(0.008, 0.0005)
+    off = FAMILY.sweep(design, grid, COARSE)
+    on = FAMILY.sweep(design, grid, COARSE.replace(contact="on"))
+    return off, on
+
+
+@pytest.mark.slow
+def test_with_contact_the_curve_before_the_touch_is_the_contact_free_one(close_walls):
+    (off, _, _), (on, _, history) = close_walls
+    touch = off.pressure_mpa[-1]
+    before = off.pressure_mpa < touch - 1e-12
+    assert before.sum() >= 5
+    n = int(before.sum())
+    assert on.pressure_mpa[:n] == pytest.approx(off.pressure_mpa[:n])
+    assert np.abs(on.angle_deg[:n] - off.angle_deg[:n]).max() <= 0.1
+    # And it goes on through the touch, the walls pressing on each other.
+    assert history.pressures[-1] > touch + 0.003
+    assert on.stats["stop_reason"] != off.stats["stop_reason"]
+
+
+@pytest.mark.slow
+def test_contact_force_is_zero_before_the_touch_and_grows_after_it(close_walls):
+    (off, _, _), (on, model, history) = close_walls
+    touch = off.pressure_mpa[-1]
+    p = history.pressures
+    force = np.array(on.stats["step_contact_force_n"])
+    pressure = np.array(on.stats["step_contact_pressure_kpa"])
+    assert len(force) == len(pressure) == len(p)
+    assert np.all(force[p < 0.9 * touch] == 0.0)
+    assert force[-1] > 0.0 and pressure[-1] > 0.0
+    # Overlap within the stated tolerance; the pressure is the penalty times it.
+    k = model.options.contact_penalty_mpa_per_mm
+    assert max(model.interpenetration_mm) <= model.options.contact_tolerance_mm
+    assert pressure[-1] == pytest.approx(1000 * k * model.interpenetration_mm[-1])
+    # The bending goes on rising past the touch.
+    steps = np.array(on.stats["step_angles_deg"])
+    assert np.all(np.diff(steps) > 0.0)
