@@ -76,6 +76,9 @@ def test_fem_run_pneunet_json_prints_pressures_and_angles_and_writes_vtk(tmp_pat
     assert payload["angle_deg"][0] == pytest.approx(0.0, abs=1e-9)
     assert payload["angle_deg"][2] > payload["angle_deg"][1] > 0.0
     assert payload["stats"]["step_volume_mm3"][-1] > payload["stats"]["step_volume_mm3"][0]
+    # Contact is on by default; these walls stay apart at 4 kPa.
+    assert payload["stats"]["options"]["contact"] == "on"
+    assert payload["stats"]["step_contact_force_n"] == [0.0] * len(payload["stats"]["steps_mpa"])
     lines = (out / "sweep.csv").read_text().splitlines()
     assert len(lines) == 4
     assert (out / "angle_pressure.png").stat().st_size > 1000
@@ -83,3 +86,45 @@ def test_fem_run_pneunet_json_prints_pressures_and_angles_and_writes_vtk(tmp_pat
     assert vtks[0] == "shape_p0.000MPa.vtu" and len(vtks) == 2
     text = (out / "vtk" / vtks[-1]).read_text()
     assert 'Name="model_half"' in text and "displacement" in text
+
+
+@pytest.mark.parametrize(
+    ("family", "value", "needle"),
+    [
+        ("pneunet", "yes", "--contact: must be one of 'off', 'on'; got \"yes\""),
+        ("sfrba", "on", "--contact: must be one of 'off'; got \"on\""),
+    ],
+)
+def test_a_bad_contact_mode_is_one_line(tmp_path, capsys, family, value, needle):
+    args = ["fem", "run", "--family", family, "--contact", value, "--out", str(tmp_path / "o")]
+    assert main(args) == 2
+    assert needle in one_error_line(capsys)
+
+
+def test_contact_off_stops_where_the_walls_touch_and_reports_no_contact(tmp_path, capsys):
+    args = [
+        "fem",
+        "run",
+        "--family",
+        "pneunet",
+        "--design",
+        "n_chambers=3,chamber_height_mm=12,gap_mm=1",
+        "--pmax",
+        "0.008",
+        "--pstep",
+        "0.001",
+        "--maxh",
+        "3",
+        "--shapes",
+        "1",
+        "--contact",
+        "off",
+        "--out",
+        str(tmp_path / "off"),
+        "--json",
+    ]
+    assert main(args) == 0
+    payload = json.loads(capsys.readouterr().out)
+    assert payload["stop_reason"].startswith("neighbouring chamber walls touch at 4.")
+    assert "step_contact_force_n" not in payload["stats"]
+    assert "contact" not in payload["stats"]["options"]
