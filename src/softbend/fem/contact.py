@@ -102,10 +102,10 @@ class PenaltyContact:
             depth = (position + u - (position.Other() + u.Other())) * boundary.normal
             boundary.AddEnergy(ngs.IfPos(-depth, 0.0, 0.5 * self.penalty * depth * depth))
         self._forces_form = ngs.BilinearForm(fes, symmetric=True)
-        self._forces = None
+        self._forces: Any = None
         # A rigid translation of the master faces along x, y, z: the contact
         # forces' resultant on them is the gradient applied to these.
-        self._translations = []
+        self._translations: list[Any] = []
         for axis in range(3):
             field = ngs.GridFunction(fes)
             e = [0.0, 0.0, 0.0]

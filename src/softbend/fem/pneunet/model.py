@@ -32,9 +32,9 @@ With the option ``contact="on"`` the facing faces (``facing_back`` against
 a step within which the walls start to press on each other is cut
 (:meth:`PneuNetModel.reject_step`) so that contact starts within a short
 step, the contact force and the interpenetration are recorded at every
-converged step, and a step whose walls
-overlap by more than ``contact_tolerance_mm`` stops the sweep (the penalty is
-too soft for that load). Until the walls touch the contact energy is zero and
+converged step, and a step whose walls overlap by more than
+``contact_tolerance_mm`` stops the sweep (the penalty is too soft for that
+load). Until the walls touch the contact energy is zero and
 the curve is the contact-free one. (The sampled gap above pairs material
 points, which slide along each other once the walls press together: it finds
 when they first touch, the contact's own pairs measure the overlap.)
@@ -57,6 +57,7 @@ import numpy as np
 from softbend.actuators import Design
 from softbend.fem._ngsolve import require_ngsolve
 from softbend.fem.actuator import ModelState
+from softbend.fem.contact import PenaltyContact
 from softbend.fem.options import FEMOptions
 from softbend.fem.pneunet.geometry import FACING_FACES, mesh_pneunet
 
@@ -68,9 +69,8 @@ logger = logging.getLogger(__name__)
 
 #: Facing walls are paired for contact where they are closer than this fraction
 #: of the design's gap (at the predicted state of each step): the pairs couple
-#: the walls' unknowns in the Hessian, so pairing far-apart walls only slows the
-#: factorisation (the reference paired across its whole 2.5 mm gaps:
-#: about 2.6 s a step before the touch against 0.5 s unpaired).
+#: the walls' unknowns in the Hessian, so pairing walls that cannot touch within
+#: the step only adds fill-in to the factorisation.
 CONTACT_SEARCH_FRACTION = 0.25
 
 
@@ -108,10 +108,8 @@ class PneuNetModel(ModelState):
             (a, b, self._points(a), self._points(b)) for a, b in self.geometry.facing_walls()
         ]
         self._gaps: list[tuple[float, float]] = []  # (pressure MPa, smallest gap mm)
-        self.contact = None
+        self.contact: PenaltyContact | None = None
         if options.contact == "on" and self.geometry.n > 1:
-            from softbend.fem.contact import PenaltyContact
-
             self.contact = PenaltyContact(
                 self.fes,
                 FACING_FACES[0],

@@ -72,6 +72,7 @@ def run_pneunet_sweep(
     result, model, history = run_model_sweep(
         PneuNetModel, design, pressures_mpa, options, progress=progress, keep_states=keep_states
     )
+    assert isinstance(model, PneuNetModel)
     result.stats["step_volume_mm3"] = [float(s.volume_mm3) for s in history.steps]
     if model.contact is not None:
         # The gravity state (step 0) has no contact; a step that stopped the sweep
@@ -81,5 +82,4 @@ def run_pneunet_sweep(
         depths = [0.0, *model.interpenetration_mm][: len(history.steps)]
         result.stats["step_contact_force_n"] = forces
         result.stats["step_contact_pressure_kpa"] = [1000.0 * k * d for d in depths]
-    assert isinstance(model, PneuNetModel)
     return result, model, history
