@@ -57,7 +57,14 @@ def test_an_fem_sweep_records_exactly_the_keys_and_types_of_femstats(result):
     assert set(result.stats["timings"]) == set(FEMTimings.__required_keys__)
     assert "failure" not in result.stats  # only when the sweep stopped on an error
     assert "step_volume_mm3" not in result.stats  # the PneuNet's sweeps record it
-    assert FEMStats.__optional_keys__ == {"failure", "step_volume_mm3"}
+    # ... and, with contact, the contact force and pressure of every step.
+    assert "step_contact_force_n" not in result.stats
+    assert FEMStats.__optional_keys__ == {
+        "failure",
+        "step_volume_mm3",
+        "step_contact_force_n",
+        "step_contact_pressure_kpa",
+    }
 
 
 def test_fem_stats_is_the_same_dictionary_read_by_key(result):
