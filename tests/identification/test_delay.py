@@ -109,8 +109,8 @@ def test_a_bad_delay_is_refused_naming_it(delay):
 def test_the_candidates_with_delays_search_them_after_the_model_without():
     from softbend.identification.selection import default_candidates
 
-    assert all("delay" not in c.params for c in default_candidates(3, n_kernel=0))
-    names = [c.name for c in default_candidates(3, n_kernel=0, delays=True)]
+    assert all("delay" not in c.params for c in default_candidates(3, n_kernel=0, delays=False))
+    names = [c.name for c in default_candidates(3, n_kernel=0)]  # searched by default
     plain, delayed = names.index("poly2-sim-2-3-filter"), names.index("poly2-sim-2-3-filter-delay")
     assert plain < delayed  # a tie (no delay found) keeps the model without
     params = default_candidates(3, n_kernel=0, delays=True)[delayed].params
