@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import json
 import math
+import re
 
 import pytest
 
@@ -294,3 +295,67 @@ def test_the_report_opens_on_the_summary_table_and_says_it_is_reduced(first_run)
     summary_html = html[first : html.index("</section>", first)]
     for anchor in re.findall(r'href="#([^"]+)"', summary_html):
         assert f'id="{anchor}"' in html, anchor
+
+
+def _figures(out, volatile=re.compile(r"(seconds|_s|_ms|_us|_per_s|realtime_factor)$")):
+    """The run's summary.json less what is timed, its folder named OUT."""
+    text = (out / "summary.json").read_text().replace(str(out), "OUT")
+
+    def strip(value):
+        if isinstance(value, dict):
+            return {k: strip(v) for k, v in value.items() if not volatile.search(str(k))}
+        if isinstance(value, list):
+            return [strip(v) for v in value]
+        return value
+
+    summary = strip(json.loads(text))
+    summary.pop("provenance")
+    return summary
+
+
+def test_a_stopped_run_takes_over_its_finished_sections(
+    first_run, fem_dataset, tmp_path, monkeypatch
+):
+    from softbend.reports import reproduce, transfer_section
+
+    first_out = first_run[0]
+    settings = {
+        "seed": 0,
+        "workers": 1,
+        "design_space": small_space(),
+        "fem_options": FEMOptions(maxh_mm=6.0),
+        "fem_pmax_mpa": 0.02,
+        "fem_dataset": fem_dataset,
+        "fem_dataset_epochs": 5,
+        "transfer_options": QUICK_TRANSFER,
+        "control_options": {"duration_s": 1.5, "refine_epochs": 20},
+        "design_options": QUICK_DESIGN,
+        "pneunet_options": QUICK_PNEUNET,
+    }
+    out = tmp_path / "report"
+    computed = transfer_section.add_section
+
+    def stopped(*args, **kwargs):
+        raise KeyboardInterrupt  # Ctrl-C in the transfer section
+
+    monkeypatch.setattr(transfer_section, "add_section", stopped)
+    with pytest.raises(KeyboardInterrupt):
+        run_reproduce(out, **settings)
+    assert not (out / "summary.json").exists()
+    monkeypatch.setattr(transfer_section, "add_section", computed)
+    calls = []
+    paper_a = reproduce._paper_a
+    monkeypatch.setattr(reproduce, "_paper_a", lambda *a, **k: calls.append(1) or paper_a(*a, **k))
+    summary = run_reproduce(out, **settings)
+    assert calls == []
+    assert summary["provenance"]["sections taken over from an interrupted run"] == (
+        "paper_a, paper_b, paper_b_surrogates, paper_b_fem, paper_b_fem_data"
+    )
+    # the same figures and report as a run that was never stopped
+    assert _figures(out) == _figures(first_out)
+    html, first_html = (out / "index.html").read_text(), (first_out / "index.html").read_text()
+    assert re.findall("<h2>(.*?)</h2>", html) == re.findall("<h2>(.*?)</h2>", first_html)
+    for figure in re.findall(r'<img src="([^"]+)"', html):
+        assert (out / figure).is_file(), figure
+    assert not (out / ".sections").exists()
+    assert not out.with_name(f".{out.name}.resume").exists()

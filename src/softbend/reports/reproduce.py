@@ -26,12 +26,15 @@ section, returning its results); this module and the section modules of
 The folder is written as a whole: every section writes into a staging folder
 beside ``out_dir`` (:func:`softbend._outdir.staged_dir`), swapped in once
 ``summary.json`` is written, so ``out_dir`` holds one run, never a mix of two,
-and a run that fails or is killed leaves the previous report as it was. The one
-thing carried over is the campaign database, so that the campaign resumes: the
+and a run that fails or is killed leaves the previous report as it was. Two
+things are carried over. The campaign database, so that the campaign resumes: the
 newest of ``out_dir``'s (copied; the old report keeps its own) and that of a run
-that failed or was killed. A failed run moves its database to the hidden folder
-``.NAME.resume`` beside ``out_dir``, a killed one leaves it in its staging
-folder; the next run takes it from there and removes the folder.
+that failed or was killed. And the sections a failed, stopped (Ctrl-C) or killed
+run finished (:mod:`softbend.reports.resume`): the next run with the same
+settings and the same softbend takes them over in order and computes the rest. A
+failed or stopped run moves both to the hidden folder ``.NAME.resume`` beside
+``out_dir``, a killed one leaves them in its staging folder; the next run takes
+them from there and removes the folder once it has finished.
 """
 
 from __future__ import annotations
@@ -55,6 +58,7 @@ from softbend.design import DesignSpace
 from softbend.pipeline import Progress
 from softbend.references import FEM_DATASET
 from softbend.reports.html import Report
+from softbend.reports.resume import CHECKPOINTS, Sections, keep
 
 if TYPE_CHECKING:
     from softbend.fem.options import FEMOptions
@@ -234,6 +238,7 @@ def run_reproduce(
     out_dir = Path(out_dir)
     check_replaceable(out_dir, "reproduce", key="out_dir")
     _rescue_interrupted(out_dir)
+    kept = _resume_dir(out_dir)
     with staged_dir(out_dir, "reproduce") as stage:
         _seed_campaign(stage, out_dir)
         try:
@@ -253,10 +258,12 @@ def run_reproduce(
                 design_options=design_options,
                 pneunet_options=pneunet_options,
                 command=command,
+                kept=kept if kept.is_dir() else None,
             )
         except BaseException:
-            _keep_campaign(stage, out_dir)
+            _keep_finished(stage, out_dir)
             raise
+    shutil.rmtree(kept, ignore_errors=True)  # all taken over, or of other settings
     return summary
 
 
@@ -277,11 +284,15 @@ def _run_into(
     design_options: dict[str, Any] | None,
     pneunet_options: dict[str, Any] | None,
     command: str | None,
+    kept: Path | None = None,
 ) -> dict[str, Any]:
     """Every section of :func:`run_reproduce` written into ``stage``, paths named under ``final``.
 
     The summary (returned, and written to ``stage/summary.json``, last) names
-    every file where it will be once ``stage`` has replaced ``final``.
+    every file where it will be once ``stage`` has replaced ``final``. Sections an
+    interrupted run finished are taken over from ``kept`` (see
+    :class:`~softbend.reports.resume.Sections`): each one's settings are what its
+    figures depend on besides the code.
     """
     out_dir = stage  # every section writes into the staging folder
     started = datetime.now(UTC)
@@ -293,42 +304,78 @@ def _run_into(
         ),
     )
     summary: dict[str, Any] = {"seed": seed}
-    summary["paper_a"] = _paper_a(report, out_dir, seed, progress)
-    summary["paper_b"] = _paper_b(report, out_dir, workers, progress, design_space)
-    summary["paper_b_surrogates"] = _paper_b_surrogates(report, out_dir, seed, progress)
+    sections = Sections(
+        stage, kept, report, skip=tuple(Path(f"{_CAMPAIGN}{end}") for end in _CAMPAIGN_SUFFIXES)
+    )
+    summary["paper_a"] = sections.run(
+        "paper_a", {"seed": seed}, lambda: _paper_a(report, out_dir, seed, progress)
+    )
+    space_text = repr(design_space)
+    summary["paper_b"] = sections.run(
+        "paper_b",
+        {"space": space_text},
+        lambda: _paper_b(report, out_dir, workers, progress, design_space),
+    )
+    summary["paper_b_surrogates"] = sections.run(
+        "paper_b_surrogates",
+        {"seed": seed, "space": space_text},
+        lambda: _paper_b_surrogates(report, out_dir, seed, progress),
+    )
     from softbend.reports import paper_b_fem
 
-    summary["paper_b_fem"] = paper_b_fem.add_section(
-        report,
-        out_dir,
-        progress,
-        options=fem_options,
-        pmax_mpa=fem_pmax_mpa or paper_b_fem.FIG2_PMAX_MPA,
+    summary["paper_b_fem"] = sections.run(
+        "paper_b_fem",
+        {"options": repr(fem_options), "pmax_mpa": fem_pmax_mpa},
+        lambda: paper_b_fem.add_section(
+            report,
+            out_dir,
+            progress,
+            options=fem_options,
+            pmax_mpa=fem_pmax_mpa or paper_b_fem.FIG2_PMAX_MPA,
+        ),
     )
     from softbend.reports import paper_b_fem_data
 
-    summary["paper_b_fem_data"] = paper_b_fem_data.add_section(
-        report, out_dir, seed, progress, dataset=fem_dataset, epochs=fem_dataset_epochs
+    summary["paper_b_fem_data"] = sections.run(
+        "paper_b_fem_data",
+        {"seed": seed, "dataset": _dataset_identity(fem_dataset), "epochs": fem_dataset_epochs},
+        lambda: paper_b_fem_data.add_section(
+            report, out_dir, seed, progress, dataset=fem_dataset, epochs=fem_dataset_epochs
+        ),
     )
     from softbend.reports import transfer_section
 
-    summary["transfer"] = transfer_section.add_section(
-        report, out_dir, seed, progress, options=transfer_options
+    summary["transfer"] = sections.run(
+        "transfer",
+        {"seed": seed, "options": repr(transfer_options)},
+        lambda: transfer_section.add_section(
+            report, out_dir, seed, progress, options=transfer_options
+        ),
     )
     from softbend.reports import control_section
 
-    summary["control"] = control_section.add_section(
-        report, out_dir, seed, progress, **(control_options or {})
+    summary["control"] = sections.run(
+        "control",
+        {"seed": seed, "options": repr(control_options)},
+        lambda: control_section.add_section(
+            report, out_dir, seed, progress, **(control_options or {})
+        ),
     )
     from softbend.reports import design_section
 
-    summary["design"] = design_section.add_section(
-        report, out_dir, progress, **(design_options or {})
+    summary["design"] = sections.run(
+        "design",
+        {"options": repr(design_options)},
+        lambda: design_section.add_section(report, out_dir, progress, **(design_options or {})),
     )
     from softbend.reports import pneunet_section
 
-    summary["pneunet"] = pneunet_section.add_section(
-        report, out_dir, progress, seed=seed, **(pneunet_options or {})
+    summary["pneunet"] = sections.run(
+        "pneunet",
+        {"seed": seed, "options": repr(pneunet_options)},
+        lambda: pneunet_section.add_section(
+            report, out_dir, progress, seed=seed, **(pneunet_options or {})
+        ),
     )
     from softbend.reports.summary_section import add_summary
 
@@ -368,10 +415,15 @@ def _run_into(
         "finished (UTC)": f"{finished:%Y-%m-%d %H:%M:%S}",
         "wall time": f"{summary['seconds']:.0f} s",
     }
+    if sections.resumed:
+        report.provenance["sections taken over from an interrupted run"] = ", ".join(
+            sections.resumed
+        )
     summary["provenance"] = dict(report.provenance)
     report.write(out_dir / "index.html")
     summary = _renamed(summary, str(stage), str(final))
     summary["report"] = str(final / "index.html")
+    shutil.rmtree(out_dir / CHECKPOINTS)  # a finished report is not taken over
     write_text_atomic(out_dir / MARKER, json_text(summary) + "\n")
     return summary
 
@@ -413,12 +465,28 @@ def _move_campaign(source: Path, target: Path, *, copy: bool = False) -> None:
             (shutil.copy2 if copy else os.replace)(origin, into)
 
 
+def _dataset_identity(dataset: str | Path | None) -> Any:
+    """What a FEM dataset folder's section depends on: its path, and its files' sizes and times.
+
+    None (the shipped dataset) is covered by the key's digest of the package.
+    """
+    if dataset is None:
+        return None
+    folder = Path(dataset)
+    files = sorted(path for path in folder.rglob("*") if path.is_file()) if folder.is_dir() else []
+    return [str(folder.resolve())] + [
+        [path.relative_to(folder).as_posix(), path.stat().st_size, path.stat().st_mtime_ns]
+        for path in files
+    ]
+
+
 def _rescue_interrupted(out_dir: Path) -> None:
-    """Keep the campaign database of a killed run for this one, before its folder is removed.
+    """Keep what a killed run finished for this one, before its folder is removed.
 
     A run killed before its swap leaves its staging folder beside ``out_dir``
-    (removed by :func:`~softbend._outdir.staged_dir`); a database there newer than
-    the one kept aside (and than ``out_dir``'s) moves to :func:`_resume_dir`.
+    (removed by :func:`~softbend._outdir.staged_dir`); a campaign database there
+    newer than the one kept aside (and than ``out_dir``'s) and its finished
+    sections move to :func:`_resume_dir`.
     """
     kept = _resume_dir(out_dir)
     newest = max(_campaign_time(out_dir), _campaign_time(kept))
@@ -428,6 +496,9 @@ def _rescue_interrupted(out_dir: Path) -> None:
             _move_campaign(folder, kept)
             newest = when
             logger.info("Resuming the campaign of an interrupted run (%s).", folder.name)
+        with contextlib.suppress(OSError):
+            if taken := keep(folder, kept):
+                logger.info("Taking over %s of an interrupted run.", ", ".join(taken))
 
 
 def _seed_campaign(stage: Path, out_dir: Path) -> None:
@@ -443,16 +514,20 @@ def _seed_campaign(stage: Path, out_dir: Path) -> None:
         _move_campaign(kept, stage)
     elif out_time > -math.inf:
         _move_campaign(out_dir, stage, copy=True)
-    shutil.rmtree(kept, ignore_errors=True)
+    for suffix in _CAMPAIGN_SUFFIXES:  # an older one kept aside is not resumed
+        (kept / f"{_CAMPAIGN}{suffix}").unlink(missing_ok=True)
 
 
-def _keep_campaign(stage: Path, out_dir: Path) -> None:
-    """Keep aside the campaign database of a run that fails, for the next run to resume.
+def _keep_finished(stage: Path, out_dir: Path) -> None:
+    """Keep aside what a run that fails or is stopped finished, for the next run to resume.
 
-    Only a database that went further than ``out_dir``'s; best effort (a full
-    disk or a read-only folder: the failure itself is what is reported).
+    Its campaign database, if it went further than ``out_dir``'s, and its
+    finished sections; best effort (a full disk or a read-only folder: the
+    failure itself is what is reported).
     """
-    if _campaign_time(stage) <= _campaign_time(out_dir):
-        return
+    kept = _resume_dir(out_dir)
     with contextlib.suppress(OSError):
-        _move_campaign(stage, _resume_dir(out_dir))
+        if _campaign_time(stage) > _campaign_time(out_dir):
+            _move_campaign(stage, kept)
+        if taken := keep(stage, kept):
+            logger.info("Kept %s for the next run to take over.", ", ".join(taken))
