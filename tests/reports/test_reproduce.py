@@ -44,30 +44,85 @@ def fem_dataset(tmp_path_factory):
     return stand_in_fem_dataset(tmp_path_factory.mktemp("fem_dataset"))
 
 
+#: Sections computed by the run that is stopped, taken over by the one that completes it.
+TAKEN_OVER = ("paper_a", "paper_b", "paper_b_surrogates", "paper_b_fem", "paper_b_fem_data")
+
+
 @pytest.fixture(scope="module")
 def first_run(tmp_path_factory, fem_dataset):
+    """The quick report, as a user gets it who stops it (Ctrl-C) in its transfer section and
+    runs the same command again: the second run takes over the sections the first finished."""
+    from softbend.reports import reproduce, transfer_section
+
     out = tmp_path_factory.mktemp("reproduce")
     phases: dict[str, tuple[int, int]] = {}
 
     def progress(phase: str, done: int, total: int) -> None:
         phases[phase] = (done, total)
 
-    summary = run_reproduce(
-        out,
-        seed=0,
-        workers=1,
-        progress=progress,
-        design_space=small_space(),
-        fem_options=FEMOptions(maxh_mm=6.0),
-        fem_pmax_mpa=0.02,
-        fem_dataset=fem_dataset,
-        fem_dataset_epochs=5,
-        transfer_options=QUICK_TRANSFER,
-        control_options={"duration_s": 1.5, "refine_epochs": 20},
-        design_options=QUICK_DESIGN,
-        pneunet_options=QUICK_PNEUNET,
-    )
+    settings = {
+        "seed": 0,
+        "workers": 1,
+        "progress": progress,
+        "design_space": small_space(),
+        "fem_options": FEMOptions(maxh_mm=6.0),
+        "fem_pmax_mpa": 0.02,
+        "fem_dataset": fem_dataset,
+        "fem_dataset_epochs": 5,
+        "transfer_options": QUICK_TRANSFER,
+        "control_options": {"duration_s": 1.5, "refine_epochs": 20},
+        "design_options": QUICK_DESIGN,
+        "pneunet_options": QUICK_PNEUNET,
+    }
+
+    def stopped(*args, **kwargs):
+        raise KeyboardInterrupt
+
+    with pytest.MonkeyPatch.context() as patch:
+        patch.setattr(transfer_section, "add_section", stopped)
+        with pytest.raises(KeyboardInterrupt):
+            run_reproduce(out, **settings)
+        assert not (out / "summary.json").exists()
+        computed = []
+        paper_a = reproduce._paper_a
+        patch.undo()
+        patch.setattr(reproduce, "_paper_a", lambda *a, **k: computed.append(1) or paper_a(*a, **k))
+        summary = run_reproduce(out, **settings)
+    assert computed == []  # paper A was taken over, not computed again
     return out, summary, phases
+
+
+def _figures(out, timed=re.compile(r"(seconds|_s|_ms|_us|_per_s|realtime_factor)$")):
+    """The run's summary.json less what is timed and its provenance, its folder named OUT."""
+    text = (out / "summary.json").read_text().replace(str(out), "OUT")
+
+    def strip(value):
+        if isinstance(value, dict):
+            return {k: strip(v) for k, v in value.items() if not timed.search(str(k))}
+        if isinstance(value, list):
+            return [strip(v) for v in value]
+        return value
+
+    summary = strip(json.loads(text))
+    summary.pop("provenance")
+    return summary
+
+
+@pytest.fixture(scope="module")
+def first_figures(first_run):
+    return _figures(first_run[0])
+
+
+def test_a_stopped_run_s_sections_are_taken_over_by_the_next(first_run):
+    out, summary, _ = first_run
+    assert summary["provenance"]["sections taken over from an interrupted run"] == ", ".join(
+        TAKEN_OVER
+    )
+    html = (out / "index.html").read_text()
+    for figure in re.findall(r'<img src="([^"]+)"', html):
+        assert (out / figure).is_file(), figure
+    assert not (out / ".sections").exists()
+    assert not out.with_name(f".{out.name}.resume").exists()
 
 
 def test_report_has_both_papers_and_their_files(first_run):
@@ -168,7 +223,7 @@ def test_surrogate_section(first_run):
     ) in html
 
 
-def test_second_run_resumes_the_campaign(first_run, fem_dataset):
+def test_second_run_resumes_the_campaign(first_run, first_figures, fem_dataset):
     out, first, _ = first_run
     again = run_reproduce(
         out,
@@ -189,6 +244,12 @@ def test_second_run_resumes_the_campaign(first_run, fem_dataset):
     assert math.isclose(b["r2"], first["paper_b"]["r2"], rel_tol=1e-12)
     # Same seed, same numbers.
     assert again["paper_a"] == first["paper_a"] | {"seconds": again["paper_a"]["seconds"]}
+    # a run never stopped gives the figures of the one stopped and taken over (this one
+    # sweeps the Fig. 2 design on the default mesh to the default pressure: that section aside)
+    figures = _figures(out)
+    for section in (*TAKEN_OVER[:1], *TAKEN_OVER[2:], "transfer", "control", "design", "pneunet"):
+        if section != "paper_b_fem":
+            assert figures[section] == first_figures[section], section
 
 
 def test_fem_section_fits_dragon_skin_and_bends_with_pressure(first_run):
@@ -295,67 +356,3 @@ def test_the_report_opens_on_the_summary_table_and_says_it_is_reduced(first_run)
     summary_html = html[first : html.index("</section>", first)]
     for anchor in re.findall(r'href="#([^"]+)"', summary_html):
         assert f'id="{anchor}"' in html, anchor
-
-
-def _figures(out, volatile=re.compile(r"(seconds|_s|_ms|_us|_per_s|realtime_factor)$")):
-    """The run's summary.json less what is timed, its folder named OUT."""
-    text = (out / "summary.json").read_text().replace(str(out), "OUT")
-
-    def strip(value):
-        if isinstance(value, dict):
-            return {k: strip(v) for k, v in value.items() if not volatile.search(str(k))}
-        if isinstance(value, list):
-            return [strip(v) for v in value]
-        return value
-
-    summary = strip(json.loads(text))
-    summary.pop("provenance")
-    return summary
-
-
-def test_a_stopped_run_takes_over_its_finished_sections(
-    first_run, fem_dataset, tmp_path, monkeypatch
-):
-    from softbend.reports import reproduce, transfer_section
-
-    first_out = first_run[0]
-    settings = {
-        "seed": 0,
-        "workers": 1,
-        "design_space": small_space(),
-        "fem_options": FEMOptions(maxh_mm=6.0),
-        "fem_pmax_mpa": 0.02,
-        "fem_dataset": fem_dataset,
-        "fem_dataset_epochs": 5,
-        "transfer_options": QUICK_TRANSFER,
-        "control_options": {"duration_s": 1.5, "refine_epochs": 20},
-        "design_options": QUICK_DESIGN,
-        "pneunet_options": QUICK_PNEUNET,
-    }
-    out = tmp_path / "report"
-    computed = transfer_section.add_section
-
-    def stopped(*args, **kwargs):
-        raise KeyboardInterrupt  # Ctrl-C in the transfer section
-
-    monkeypatch.setattr(transfer_section, "add_section", stopped)
-    with pytest.raises(KeyboardInterrupt):
-        run_reproduce(out, **settings)
-    assert not (out / "summary.json").exists()
-    monkeypatch.setattr(transfer_section, "add_section", computed)
-    calls = []
-    paper_a = reproduce._paper_a
-    monkeypatch.setattr(reproduce, "_paper_a", lambda *a, **k: calls.append(1) or paper_a(*a, **k))
-    summary = run_reproduce(out, **settings)
-    assert calls == []
-    assert summary["provenance"]["sections taken over from an interrupted run"] == (
-        "paper_a, paper_b, paper_b_surrogates, paper_b_fem, paper_b_fem_data"
-    )
-    # the same figures and report as a run that was never stopped
-    assert _figures(out) == _figures(first_out)
-    html, first_html = (out / "index.html").read_text(), (first_out / "index.html").read_text()
-    assert re.findall("<h2>(.*?)</h2>", html) == re.findall("<h2>(.*?)</h2>", first_html)
-    for figure in re.findall(r'<img src="([^"]+)"', html):
-        assert (out / figure).is_file(), figure
-    assert not (out / ".sections").exists()
-    assert not out.with_name(f".{out.name}.resume").exists()

@@ -33,7 +33,9 @@ def reproduce(
     report is complete, so a run that fails or is stopped leaves the previous
     report as it was. An existing --out may hold only an earlier report. The
     campaign database resumes: from the previous report, or from a run that
-    failed or was stopped (kept in a hidden folder beside --out until the next run).
+    failed or was stopped. The sections such a run finished are taken over by
+    the next run with the same settings and the same softbend, which computes
+    only the rest (both kept in a hidden folder beside --out until then).
 
     Example:
 
