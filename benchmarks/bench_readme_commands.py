@@ -14,7 +14,7 @@
 Each is minutes long (about 6 and 15 on two cores), so each runs alone on
 request; the setup (``make setup``) is not timed. Run::
 
-    .venv/bin/python benchmarks/bench_readme_commands.py run
+    .venv/bin/python benchmarks/bench_readme_commands.py run [--out results/reproduce]
     .venv/bin/python benchmarks/bench_readme_commands.py tests
 """
 
@@ -43,10 +43,14 @@ TEST_BUDGET_S = 20.0
 _DURATION = re.compile(r"^\s*([0-9.]+)s\s+(call|setup|teardown)\s+(\S+)")
 
 
-def bench_run() -> None:
-    """Time ``softbend reproduce`` on its defaults and record the figures."""
+def bench_run(keep: Path | None = None) -> None:
+    """Time ``softbend reproduce`` on its defaults and record the figures.
+
+    The report is written into ``keep`` when given (to compare or publish its
+    figures), else into a temporary folder.
+    """
     with tempfile.TemporaryDirectory(prefix="softbend-bench-run-") as folder:
-        out = Path(folder) / "reproduce"
+        out = keep if keep is not None else Path(folder) / "reproduce"
         start = time.perf_counter()
         subprocess.run(
             [sys.executable, "-m", "softbend", "reproduce", "--out", str(out)],
@@ -123,8 +127,14 @@ def bench_tests() -> None:
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     parser.add_argument("command", choices=("run", "tests"), help="Which README command.")
+    parser.add_argument(
+        "--out", type=Path, help="run: keep the report in this folder (default: a temporary one)."
+    )
     args = parser.parse_args()
-    {"run": bench_run, "tests": bench_tests}[args.command]()
+    if args.command == "run":
+        bench_run(args.out)
+    else:
+        bench_tests()
 
 
 if __name__ == "__main__":
