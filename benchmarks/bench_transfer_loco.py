@@ -129,7 +129,12 @@ def _bases(cache: Path) -> dict[str, Path]:
     return paths
 
 
-def _loco(measurements: list[Path] | None, base: Path | None, label: str) -> dict[str, Any]:
+def _loco(
+    measurements: list[Path] | None,
+    base: Path | None,
+    label: str,
+    settings: dict[str, str] | None = None,
+) -> dict[str, Any]:
     """One ``transfer loco`` run as the command runs it; per-strategy seconds and RMSE.
 
     ``measurements`` None: paper B's run as ``softbend reproduce`` makes it (the
@@ -156,7 +161,16 @@ def _loco(measurements: list[Path] | None, base: Path | None, label: str) -> dic
         seconds[name], cpu[name] = now[0] - mark[0], now[1] - mark[1]
         mark[:] = now
 
-    result = leave_one_configuration_out(data, model, None, seed=0, progress=progress)
+    from softbend.actuators import SFRBA
+    from softbend.transfer.loco import DEFAULT_STRATEGIES, strategy_options
+    from softbend.transfer.strategies import applicable_strategies
+
+    actuator = getattr(data, "actuator", SFRBA)  # paper B's measurements: its actuator
+    names, _ = applicable_strategies(DEFAULT_STRATEGIES, model, actuator)
+    options = strategy_options(names, settings or {})
+    result = leave_one_configuration_out(
+        data, model, names, seed=0, progress=progress, options=options
+    )
     wall, cpu_all = time.perf_counter() - start, time.process_time() - cpu_start
     rmse = dict(zip(result.summary["strategy"], result.summary["rmse_deg"], strict=True))
     print(f"\n{label}: {len(data)} readings of {len(data.actuator_ids)} actuators")
@@ -242,9 +256,17 @@ def main(argv: list[str] | None = None) -> int:
     parser.add_argument("--gp-sizes", type=int, nargs="+", default=[1000, 5000])
     parser.add_argument("--cache", type=Path, default=ROOT / ".bench_transfer_loco")
     parser.add_argument("--notes", default="", help="Recorded with the figures.")
+    parser.add_argument(
+        "--set",
+        action="append",
+        default=[],
+        metavar="[STRATEGY.]NAME=VALUE",
+        help="A strategy parameter of every loco run, as transfer loco's --set.",
+    )
     parser.add_argument("--no-record", action="store_true", help="Print only.")
     args = parser.parse_args(argv)
 
+    settings = dict(item.split("=", 1) for item in args.set)
     args.cache.mkdir(parents=True, exist_ok=True)
     bases = _bases(args.cache)
     figures: dict[str, float] = {}
@@ -264,12 +286,18 @@ def main(argv: list[str] | None = None) -> int:
 
     if "pneunet" in args.cases:
         for kind, path in bases.items():
-            keep(f"pneunet {kind}", _loco([EXAMPLE / "measurements.csv"], path, f"pneunet, {kind}"))
+            keep(
+                f"pneunet {kind}",
+                _loco([EXAMPLE / "measurements.csv"], path, f"pneunet, {kind}", settings),
+            )
     if "lab14" in args.cases:
         lab = args.cache / "lab14x41.csv"
         lab_table(14, 41, seed=0).to_csv(lab, index=False, lineterminator="\n")
         for kind, path in bases.items():
-            keep(f"14x41 {kind}", _loco([lab], path, f"14 actuators x 41 pressures, {kind}"))
+            keep(
+                f"14x41 {kind}",
+                _loco([lab], path, f"14 actuators x 41 pressures, {kind}", settings),
+            )
     if "gp" in args.cases:
         for n in args.gp_sizes:
             wall, cpu = _gp_fit(n, bases["plr"])
@@ -281,7 +309,7 @@ def main(argv: list[str] | None = None) -> int:
             figures[key] = value
             units[key] = "deg" if key.endswith("RMSE") else "s"
     if "paper-b" in args.cases:
-        keep("paper B", _loco(None, None, "paper B's virtual lab, shipped MLP"))
+        keep("paper B", _loco(None, None, "paper B's virtual lab, shipped MLP", settings))
     if not args.no_record:
         record("transfer_loco", figures, units=units, notes=args.notes)
     return 0

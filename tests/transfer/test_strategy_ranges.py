@@ -105,14 +105,27 @@ def test_the_declared_ranges_are_the_documented_ones():
         ("experimental", "hidden_sizes"): (1, 1024, 2),
         ("experimental", "epochs"): (1, math.inf, None),
         ("experimental", "learning_rate"): (0, 1, None),
+        ("experimental", "patience"): (1, 1_000_000, None),
+        ("experimental", "min_delta"): (0, 1, None),
+        ("experimental", "validation_share"): (0, 1, None),
         ("refined", "epochs"): (1, math.inf, None),
         ("refined", "learning_rate"): (0, 1, None),
+        ("refined", "patience"): (1, 1_000_000, None),
+        ("refined", "min_delta"): (0, 1, None),
+        ("refined", "validation_share"): (0, 1, None),
         ("residual-gp", "n_restarts"): (0, 100, None),
+        ("residual-gp", "hyper_points"): (10, 100000, None),
         ("refined-ensemble", "n_members"): (2, 100, None),
         ("refined-ensemble", "epochs"): (1, math.inf, None),
         ("refined-ensemble", "learning_rate"): (0, 1, None),
+        ("refined-ensemble", "patience"): (1, 1_000_000, None),
+        ("refined-ensemble", "min_delta"): (0, 1, None),
+        ("refined-ensemble", "validation_share"): (0, 1, None),
         ("scaled-refined", "epochs"): (1, math.inf, None),
         ("scaled-refined", "learning_rate"): (0, 1, None),
+        ("scaled-refined", "patience"): (1, 1_000_000, None),
+        ("scaled-refined", "min_delta"): (0, 1, None),
+        ("scaled-refined", "validation_share"): (0, 1, None),
     }
     assert not declared_ranges(RefinedMLP)["learning_rate"].low_inclusive
     assert item_count(ExperimentalMLP, "hidden_sizes") == 2
@@ -124,7 +137,10 @@ def test_the_strategies_list_names_each_range():
     assert rows["experimental"]["ranges"]["hidden_sizes"].startswith(
         "2 integers separated by commas, each in [1, 1024]"
     )
-    assert rows["residual-gp"]["ranges"] == {"n_restarts": "[0, 100] restarts"}
+    assert rows["residual-gp"]["ranges"] == {
+        "n_restarts": "[0, 100] restarts",
+        "hyper_points": "[10, 100000] readings",
+    }
     assert rows["fem-only"]["ranges"] == {}
 
 

@@ -9,6 +9,16 @@ matrix product per layer, one (fused) Adam step for all. Each variant's loss is 
 weighted mean over its own rows, and Adam acts element by element, so variant
 k ends exactly where training it alone would (up to rounding).
 
+Training stops on a held-out plateau when asked (:class:`EarlyStop`): beside
+each variant trains a *shadow*, the same start on the variant's rows less a
+seeded share of them, and the shadow's loss on the rows it does not see is
+watched. When it has not fallen by ``min_delta`` (relative) for ``patience``
+epochs, the variant is stopped and keeps its weights of the shadow's best
+epoch; the epochs given are the cap. The variant itself trains on all its rows, so
+a variant that never plateaus ends exactly where training without the stop
+would, and the shadows ride in the same batched step (one training for every
+fold). Training ends when every variant has stopped.
+
 On a GPU (``device="cuda"``, or ``"auto"`` where one is seen) the same code runs
 with every tensor on the device, in float64 as on the CPU; the loss curve is
 gathered there and copied to the host once, after the last epoch, so the epoch
@@ -17,6 +27,7 @@ loop never waits for the host.
 
 from __future__ import annotations
 
+from dataclasses import dataclass
 from typing import TYPE_CHECKING, Any
 
 import numpy as np
@@ -30,7 +41,15 @@ from softbend.limits import check_limit
 if TYPE_CHECKING:
     from softbend.surrogates.mlp import NormalizedMLPRegressor
 
-__all__ = ["FINE_TUNE_THREADS", "check_mlp", "fine_tune_many", "fine_tune_mlp", "row_weights"]
+__all__ = [
+    "FINE_TUNE_THREADS",
+    "EarlyStop",
+    "check_mlp",
+    "fine_tune_many",
+    "fine_tune_mlp",
+    "held_out_rows",
+    "row_weights",
+]
 
 #: Threads of the batched training (at most; fewer if PyTorch has fewer). The
 #: stacked variants of a fold set make every step a batch of matrix products
@@ -39,6 +58,46 @@ __all__ = ["FINE_TUNE_THREADS", "check_mlp", "fine_tune_many", "fine_tune_mlp", 
 #: A fixed number, not the machine's core count, so the rounding (and the
 #: figures) are the same on every machine with two cores or more.
 FINE_TUNE_THREADS = 2
+
+
+@dataclass(frozen=True)
+class EarlyStop:
+    """When a batched refit stops before its cap: a plateau of a held-out loss.
+
+    Parameters
+    ----------
+    patience : int
+        Epochs without progress on the held-out rows before a variant stops, >= 1.
+    min_delta : float
+        Relative fall of the held-out loss that counts as progress, >= 0
+        (1e-3: 0.1 % below the best so far).
+    validation_share : float
+        Share of each variant's rows its shadow does not train on, in (0, 1):
+        a seeded draw of the rows (:func:`held_out_rows`).
+    seed : int
+        Seed of that draw.
+    """
+
+    patience: int
+    min_delta: float = 1e-3
+    validation_share: float = 0.2
+    seed: int = 0
+
+    def __post_init__(self) -> None:
+        check_int(self.patience, "patience", low=1)
+        check_range(self.min_delta, "min_delta", low=0.0, low_inclusive=True)
+        check_range(self.validation_share, "validation_share", low=0.0, high=1.0)
+        check_int(self.seed, "seed", low=0)
+
+
+def held_out_rows(n_rows: int, share: float, seed: int) -> np.ndarray:
+    """Which of ``n_rows`` rows the shadows of :class:`EarlyStop` hold out (boolean mask).
+
+    One seeded uniform draw per row (stream ``(seed, 13)``), held out below
+    ``share``: a row is held out in every variant that has it, whatever the
+    batch, so a fold's stop does not depend on the other folds trained beside it.
+    """
+    return np.random.default_rng([seed, 13]).random(n_rows) < share
 
 
 def check_mlp(base: object) -> NormalizedMLPRegressor:
@@ -78,6 +137,7 @@ def fine_tune_many(
     epochs: int = 1000,
     learning_rate: float = 6e-4,
     device: str = "auto",
+    stop: EarlyStop | None = None,
 ) -> list[NormalizedMLPRegressor]:
     """Train K copies of a fitted MLP further, full batch, each on its own weighted rows.
 
@@ -101,13 +161,22 @@ def fine_tune_many(
         Where to train, as for :class:`~softbend.surrogates.mlp.NormalizedMLPRegressor`:
         "auto" is "cuda" when torch sees a GPU, else "cpu". Recorded as each
         model's ``device_``.
+    stop : EarlyStop, optional
+        Stop each variant on a plateau of its shadow's held-out loss (module
+        docstring), ``epochs`` the cap; None trains every variant ``epochs``
+        epochs. A variant with no row held out, or none left to its shadow,
+        trains to the cap; a ``patience`` of ``epochs`` or more watches none.
 
     Returns
     -------
     list of NormalizedMLPRegressor
         K fitted models; each ``loss_curve_`` is its training MSE per epoch in
         the base's standardized units, as for any fitted MLP (times
-        ``y_scale_**2``: deg², paper B Fig. 6's unit).
+        ``y_scale_**2``: deg², paper B Fig. 6's unit). Each model's ``epochs``
+        is the steps it kept: a variant stopped early keeps its weights of its
+        shadow's best epoch, and its curve ends with their loss (``epochs + 1``
+        values: the start's, then one per step); one trained to the cap has
+        the cap and a curve of that many values, as without a stop.
     """
     from softbend._torch import require_torch
     from softbend.surrogates.mlp import NormalizedMLPRegressor
@@ -146,6 +215,16 @@ def fine_tune_many(
             f"shapes {sorted(shapes)}",
             key="base",
         )
+    # The shadows of the watched variants ride after the K variants (module docstring).
+    watched = np.zeros(0, dtype=int)
+    if stop is not None and stop.patience < epochs:  # else no variant could stop: none watched
+        held = held_out_rows(y.size, stop.validation_share, stop.seed)
+        shadow_w, check_w = w * ~held, w * held
+        watched = np.flatnonzero((shadow_w.sum(axis=1) > 0) & (check_w.sum(axis=1) > 0))
+        starts = starts + [starts[i] for i in watched]
+        check_w = check_w[watched]
+        w = np.vstack([w, shadow_w[watched]])
+    m = watched.size
     x_mean = np.array([m.x_mean_ for m in starts])[:, None, :]
     x_scale = np.array([m.x_scale_ for m in starts])[:, None, :]
     y_mean = np.array([m.y_mean_ for m in starts])[:, None]
@@ -168,23 +247,33 @@ def fine_tune_many(
         # Fused Adam: one kernel for the update of all six tensors.
         optimizer = torch.optim.Adam([*weights_, *biases], lr=learning_rate, fused=True)
         curve_t = torch.empty((k, epochs), **on)
+        watch = _Watch(torch, stop, check_w, watched, k, on) if m else None
         phase, stride = f"training {k} network{'s' * (k > 1)} (epochs)", every(epochs)
         for epoch in range(epochs):
             a = torch.tanh(z @ weights_[0] + biases[0])
             a = torch.tanh(a @ weights_[1] + biases[1])
             out = (a @ weights_[2] + biases[2])[..., 0]
             per_variant = (((out - t) ** 2) * share).sum(dim=1)
+            if watch is not None:
+                watch.see(epoch, out.detach(), t, [*weights_, *biases])
             optimizer.zero_grad()
             per_variant.sum().backward()
             optimizer.step()
-            curve_t[:, epoch] = per_variant.detach()
+            curve_t[:, epoch] = per_variant.detach()[:k]
             if (epoch + 1) % stride == 0 or epoch + 1 == epochs:
                 report(phase, epoch + 1, epochs)
+            if watch is not None and m == k and (epoch + 1) % _STOP_CHECK == 0 and watch.done():
+                report(phase, epochs, epochs)  # every variant stopped: the phase is over
+                break
         curve = curve_t.cpu().numpy()
+        kept = np.full(k, epochs)
+        params = [p.detach() for p in (*weights_, *biases)]
+        if watch is not None:
+            kept, params = watch.kept(epochs, params)
     finally:
         torch.set_num_threads(threads)
-    coefs = [p.detach().cpu().numpy() for p in weights_]
-    intercepts = [p.detach().cpu().numpy()[:, 0, :] for p in biases]
+    coefs = [p[:k].cpu().numpy() for p in params[:3]]
+    intercepts = [p[:k].cpu().numpy()[:, 0, :] for p in params[3:]]
     if not all(np.isfinite(a).all() for a in (*coefs, *intercepts)):
         raise ConvergenceError("the refit produced non-finite weights; lower the learning_rate")
     return [
@@ -195,15 +284,75 @@ def fine_tune_many(
             y_scale=starts[i].y_scale_,
             coefs=[c[i].copy() for c in coefs],
             intercepts=[b[i].copy() for b in intercepts],
-            loss_curve=curve[i].tolist(),
+            loss_curve=(curve[i] if kept[i] == epochs else curve[i, : kept[i] + 1]).tolist(),
             fitted_device=device,
-            epochs=epochs,
+            epochs=max(int(kept[i]), 1),
             batch_size=max(int(np.count_nonzero(w[i])), 1),
             learning_rate=learning_rate,
             seed=0,
         )
         for i in range(k)
     ]
+
+
+#: Epochs between two looks at whether every variant has stopped (a look waits for the device).
+_STOP_CHECK = 25
+
+
+class _Watch:
+    """The held-out losses of the shadows, and each watched variant's weights at its shadow's
+    best epoch (:class:`EarlyStop`); tensors only, so the epoch loop never waits for the host.
+    """
+
+    def __init__(
+        self, torch: Any, stop: Any, check_w: np.ndarray, watched: np.ndarray, k: int, on: Any
+    ) -> None:
+        self.torch, self.k = torch, k
+        self.patience, self.factor = int(stop.patience), 1.0 - float(stop.min_delta)
+        self.share = torch.as_tensor(check_w / check_w.sum(axis=1, keepdims=True), **on)
+        self.watched = torch.as_tensor(watched, dtype=torch.long, device=on["device"])
+        m = watched.size
+        self.best = torch.full((m,), float("inf"), **on)
+        self.best_epoch = torch.zeros(m, dtype=torch.long, device=on["device"])
+        self.stale = torch.zeros(m, dtype=torch.long, device=on["device"])
+        self.running = torch.ones(m, dtype=torch.bool, device=on["device"])
+        self.snaps: list[Any] | None = None
+
+    def see(self, epoch: int, out: Any, t: Any, params: list[Any]) -> None:
+        """Score the shadows on their held-out rows (weights after ``epoch`` steps)."""
+        torch = self.torch
+        with torch.no_grad():
+            loss = (((out[self.k :] - t[self.k :]) ** 2) * self.share).sum(dim=1)
+            better = self.running & (loss < self.best * self.factor)
+            self.best = torch.where(better, loss, self.best)
+            self.best_epoch = torch.where(better, epoch, self.best_epoch)
+            self.stale = torch.where(better, 0, self.stale + 1)
+            mine = [p[self.watched] for p in params]
+            if self.snaps is None:
+                self.snaps = [p.clone() for p in mine]
+            else:
+                self.snaps = [
+                    torch.where(better[:, None, None], p, s)
+                    for p, s in zip(mine, self.snaps, strict=True)
+                ]
+            self.running &= self.stale < self.patience
+
+    def done(self) -> bool:
+        """Whether every watched variant has stopped."""
+        return not bool(self.running.any())
+
+    def kept(self, epochs: int, params: list[Any]) -> tuple[np.ndarray, list[Any]]:
+        """Steps each variant keeps and the weights: a stopped one's at its shadow's best."""
+        kept = np.full(self.k, epochs)
+        stopped = ~self.running.cpu().numpy()
+        rows = self.watched.cpu().numpy()[stopped]
+        kept[rows] = self.best_epoch.cpu().numpy()[stopped]
+        out = []
+        for p, snap in zip(params, self.snaps or [], strict=True):
+            p = p.clone()
+            p[rows] = snap[self.torch.as_tensor(stopped, device=p.device)]
+            out.append(p)
+        return kept, out
 
 
 def fine_tune_mlp(

@@ -64,6 +64,33 @@ _LEARNING_RATE = Range(
     low_inclusive=False,
 )
 
+#: Epochs without progress on the held-out readings before a network stops training.
+_PATIENCE = Range(
+    1,
+    1_000_000,
+    "epochs",
+    "at least one epoch without progress before a stop; 'epochs' or more never stops "
+    "before the cap (a million is past any training that ends)",
+)
+#: Relative fall of the held-out loss that counts as progress.
+_MIN_DELTA = Range(
+    0,
+    1,
+    "share of the best held-out loss",
+    "0 counts any fall as progress; 1 would ask the loss to fall to zero",
+    low_inclusive=True,
+    high_inclusive=False,
+)
+#: Share of a fit's readings the held-out check of its network does not train on.
+_VALIDATION_SHARE = Range(
+    0,
+    1,
+    "share of the readings",
+    "some readings held out to watch, some left to train the watching network on",
+    low_inclusive=False,
+    high_inclusive=False,
+)
+
 
 def _registered_name(cls: type) -> str:
     """The name ``cls`` is registered under in :data:`STRATEGIES`, else its class name."""

@@ -117,6 +117,29 @@ class PressureScale(_Corrected):
         return self
 
 
+def hyper_rows(n_rows: int, most: int, seed: int) -> np.ndarray:
+    """The rows a GP's hyperparameters are chosen on: all ``n_rows`` when at most ``most``,
+    else a seeded draw of ``most`` of them without repeats, in increasing order.
+
+    Parameters
+    ----------
+    n_rows : int
+        Training readings.
+    most : int
+        The most readings the marginal likelihood is optimized on.
+    seed : int
+        Seed of the draw (stream ``(seed, 11)``).
+
+    Returns
+    -------
+    ndarray of int
+    """
+    if n_rows <= most:
+        return np.arange(n_rows)
+    rng = np.random.default_rng([seed, 11])
+    return np.sort(rng.choice(n_rows, size=most, replace=False))
+
+
 @declare_ranges(
     n_restarts=Range(
         0,
@@ -124,7 +147,15 @@ class PressureScale(_Corrected):
         "restarts",
         "each restart is one more full optimization of the GP's marginal likelihood "
         "(a Cholesky factorization per step); a billion would never end",
-    )
+    ),
+    hyper_points=Range(
+        10,
+        100000,
+        "readings",
+        "the marginal likelihood is optimized on at most this many readings (a seeded "
+        "draw; all of them when there are fewer): its cost grows as their cube, and "
+        "its memory as their square times 10 (the kernel's gradient)",
+    ),
 )
 class ResidualGP(_Corrected):
     """The base frozen, a Gaussian process on its error (scikit-learn, with a noise term).
@@ -132,7 +163,13 @@ class ResidualGP(_Corrected):
     The GP sees the standardized features and the base's angle (so an error that
     grows with the angle is a smooth function of one input); its kernel is a
     constant times an anisotropic RBF plus white noise, hyperparameters by
-    marginal likelihood (``n_restarts`` seeded restarts). Prediction intervals
+    marginal likelihood (``n_restarts`` seeded restarts) on at most
+    ``hyper_points`` readings, a seeded draw of them (all of them when there are
+    fewer); the posterior is then exact on every reading with those
+    hyperparameters fixed. The likelihood's optimization is cubic in its
+    readings and the posterior is one Cholesky factorization, so a fit on
+    5 000 readings costs about what one on ``hyper_points`` does plus that
+    factorization (docs/design-log.md gives the figures). Prediction intervals
     include the noise term, so they are intervals for a new reading.
 
     Parameters
@@ -141,8 +178,16 @@ class ResidualGP(_Corrected):
         Any fitted surrogate.
     n_restarts : int, default 3
         Restarts of the hyperparameter optimizer, in [0, 100].
+    hyper_points : int, default 200
+        Readings the hyperparameters are chosen on, at most, in [10, 100 000].
     seed : int, default 0
-        Seed of the restarts.
+        Seed of the restarts and of the draw of ``hyper_points`` readings.
+
+    Attributes
+    ----------
+    hyper_rows_ : ndarray of int
+        The training rows the hyperparameters were chosen on (every row when
+        there are at most ``hyper_points``), in increasing order.
     """
 
     def __init__(
@@ -150,11 +195,13 @@ class ResidualGP(_Corrected):
         base: Surrogate | None = None,
         *,
         n_restarts: int = 3,
+        hyper_points: int = 200,
         seed: int = 0,
         actuator: Actuator | None = None,
     ) -> None:
         self.base = base
         self.n_restarts = n_restarts
+        self.hyper_points = hyper_points
         self.seed = seed
         self.actuator = actuator
 
@@ -173,6 +220,7 @@ class ResidualGP(_Corrected):
         _check_finite_fit("residual-gp", self._described(), z_mean=z_mean, z_scale=z_scale)
         # A length scale at its upper bound means "this input does not matter": a
         # normal outcome with six actuators, so the optimizer's warning is muted.
+        rows = hyper_rows(y.size, int(self.hyper_points), int(self.seed))
         with warnings.catch_warnings():
             warnings.simplefilter("ignore", ConvergenceWarning)
             gp = GaussianProcessRegressor(
@@ -180,23 +228,31 @@ class ResidualGP(_Corrected):
                 normalize_y=True,
                 n_restarts_optimizer=int(self.n_restarts),
                 random_state=self.seed,
-            ).fit(inputs, y - theta)
+            ).fit(inputs[rows], (y - theta)[rows])
+        self.hyper_rows_ = rows
         # The chosen hyperparameters, fixed: the model saves and reloads as it predicts here.
         self.model_ = GPCorrected(base, z_mean, z_scale, gp.kernel_.theta, inputs, y - theta)
-        self.z_mean_, self.z_scale_, self.gp_ = z_mean, z_scale, self.model_.gp_
+        self.z_mean_, self.z_scale_ = z_mean, z_scale
+        # The posterior asked at the rows of the hyperparameters (all of them when few):
+        # a non-finite factor or dual coefficient shows there, at a bounded cost.
         with np.errstate(all="ignore"):  # checked below
-            mean, std = self.gp_.predict(inputs, return_std=True)
+            mean, std = self.model_.predict(X[rows], return_std=True)
         _check_finite_fit(
             "residual-gp",
             self._described(),
             z_mean=z_mean,
             z_scale=z_scale,
             kernel_theta=self.model_.kernel_theta_,
-            dual_coef=self.gp_.alpha_,
             training_prediction=mean,
             training_std=std,
         )
         return self
+
+    @property
+    def gp_(self) -> GaussianProcessRegressor:
+        """scikit-learn's GP of the fitted correction, its kernel fixed (built on first use)."""
+        gp: GaussianProcessRegressor = self.model_.gp_
+        return gp
 
     @overload
     def predict(self, X: ArrayLike, return_std: Literal[False] = ...) -> np.ndarray: ...

@@ -1,0 +1,116 @@
+"""The refits' stop on a held-out plateau (:class:`softbend.transfer.finetune.EarlyStop`)."""
+
+from __future__ import annotations
+
+import itertools
+
+import numpy as np
+import pytest
+
+from softbend.errors import InputError
+from softbend.transfer.finetune import EarlyStop, fine_tune_many, held_out_rows, row_weights
+
+pytest.importorskip("torch")
+
+
+@pytest.fixture
+def base():
+    """A 7-16-16-1 MLP with random weights."""
+    from softbend.surrogates.mlp import NormalizedMLPRegressor
+
+    rng = np.random.default_rng(0)
+    sizes = (7, 16, 16, 1)
+    return NormalizedMLPRegressor.from_arrays(
+        x_mean=rng.uniform(1.0, 10.0, 7),
+        x_scale=rng.uniform(0.5, 2.0, 7),
+        y_mean=90.0,
+        y_scale=60.0,
+        coefs=[rng.normal(0.0, 0.4, (a, b)) for a, b in itertools.pairwise(sizes)],
+        intercepts=[rng.normal(0.0, 0.1, b) for b in sizes[1:]],
+    )
+
+
+def _rows(base, n=60, seed=3):
+    rng = np.random.default_rng(seed)
+    X = base.x_mean_ + base.x_scale_ * rng.uniform(-1.0, 1.0, size=(n, base.n_features_in_))
+    noise = rng.normal(0.0, 8.0, n)  # noisy readings: the held-out loss plateaus, then rises
+    return X, base.predict(X) * 1.05 + 1.0 + noise
+
+
+def _folds(n):
+    return row_weights([np.arange(n)[np.arange(n) % 3 != k] for k in range(3)], n)
+
+
+def _same(a, b):
+    return all(np.array_equal(p, q) for p, q in zip(a.coefs_, b.coefs_, strict=True)) and all(
+        np.array_equal(p, q) for p, q in zip(a.intercepts_, b.intercepts_, strict=True)
+    )
+
+
+def test_a_patience_past_the_cap_trains_exactly_as_without_the_stop(base):
+    X, y = _rows(base)
+    w = _folds(y.size)
+    plain = fine_tune_many(base, X, y, w, epochs=60, learning_rate=1e-2, device="cpu")
+    watched = fine_tune_many(
+        base, X, y, w, epochs=60, learning_rate=1e-2, device="cpu", stop=EarlyStop(60)
+    )
+    for a, b in zip(plain, watched, strict=True):
+        assert _same(a, b)
+        assert a.loss_curve_ == b.loss_curve_
+        assert b.epochs == 60
+
+
+def test_a_stopped_variant_keeps_its_weights_of_the_shadows_best_epoch(base):
+    """Stopped after e steps, a variant is what e steps without the stop give: the
+    variant trains on all its rows; only its shadow holds rows out."""
+    X, y = _rows(base)
+    w = _folds(y.size)
+    cap = 2000
+    stopped = fine_tune_many(
+        base, X, y, w, epochs=cap, learning_rate=1e-2, device="cpu", stop=EarlyStop(30, 1e-3)
+    )
+    kept = [m.epochs for m in stopped]
+    assert all(1 <= e < cap for e in kept), kept
+    for k, model in enumerate(stopped):
+        assert len(model.loss_curve_) == model.epochs + 1
+        again = fine_tune_many(
+            base, X, y, w[k : k + 1], epochs=model.epochs, learning_rate=1e-2, device="cpu"
+        )[0]
+        np.testing.assert_allclose(again.coefs_[0], model.coefs_[0], rtol=1e-10, atol=1e-12)
+        np.testing.assert_allclose(again.predict(X), model.predict(X), rtol=1e-10, atol=1e-9)
+
+
+def test_the_stop_does_not_depend_on_the_folds_beside(base):
+    X, y = _rows(base)
+    w = _folds(y.size)
+    stop = EarlyStop(30, 1e-3, seed=4)
+    together = fine_tune_many(
+        base, X, y, w, epochs=800, learning_rate=1e-2, device="cpu", stop=stop
+    )
+    alone = fine_tune_many(
+        base, X, y, w[1:2], epochs=800, learning_rate=1e-2, device="cpu", stop=stop
+    )[0]
+    assert together[1].epochs == alone.epochs
+    np.testing.assert_allclose(together[1].predict(X), alone.predict(X), rtol=1e-10, atol=1e-9)
+
+
+def test_the_held_out_draw_is_seeded_and_of_its_share():
+    a = held_out_rows(10_000, 0.2, 0)
+    assert np.array_equal(a, held_out_rows(10_000, 0.2, 0))
+    assert not np.array_equal(a, held_out_rows(10_000, 0.2, 1))
+    assert abs(a.mean() - 0.2) < 0.02
+
+
+@pytest.mark.parametrize(
+    ("kwargs", "key"),
+    [
+        ({"patience": 0}, "patience"),
+        ({"patience": 10, "min_delta": -0.1}, "min_delta"),
+        ({"patience": 10, "validation_share": 1.0}, "validation_share"),
+        ({"patience": 10, "validation_share": 0.0}, "validation_share"),
+    ],
+)
+def test_a_bad_stop_is_one_error_naming_the_field(kwargs, key):
+    with pytest.raises(InputError) as error:
+        EarlyStop(**kwargs)
+    assert error.value.key == key
