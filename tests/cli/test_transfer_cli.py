@@ -348,6 +348,9 @@ def test_strategies_lists_every_strategy_with_its_parameters(capsys):
         "epochs": 1000,
         "learning_rate": 6e-4,
         "device": "auto",
+        "patience": 1000,
+        "min_delta": 1e-3,
+        "validation_share": 0.2,
     }
     assert by_name["experimental"]["parameters"]["hidden_sizes"] == [63, 65]
     assert not by_name["fem-only"]["learns"] and by_name["residual-gp"]["interval"]

@@ -114,3 +114,15 @@ def test_a_bad_stop_is_one_error_naming_the_field(kwargs, key):
     with pytest.raises(InputError) as error:
         EarlyStop(**kwargs)
     assert error.value.key == key
+
+
+def test_the_experimental_mlp_stops_before_its_cap(quick_measurements):
+    from softbend.transfer.strategies import ExperimentalMLP
+
+    assert ExperimentalMLP().epochs == 15000 and ExperimentalMLP().patience == 500
+    X, y = quick_measurements.features, quick_measurements.angle_deg
+    model = ExperimentalMLP(hidden_sizes=(8, 8), patience=20, min_delta=0.05, device="cpu")
+    model.fit(X, y)
+    assert 1 <= model.model_.epochs < 15000
+    assert len(model.loss_curve_) == model.model_.epochs + 1
+    assert np.all(np.isfinite(model.predict(X)))
