@@ -31,8 +31,8 @@ def _names(text: str | None, key: str) -> list[str]:
 DATA_ARGUMENT = typer.Argument(
     ..., help="A CSV file, or a folder of CSV files (one experiment each)."
 )
-INPUTS_OPTION = typer.Option(..., help="Comma-separated input columns (e.g. p1,p2,p3).")
-OUTPUTS_OPTION = typer.Option(..., help="Comma-separated output columns (e.g. x,y).")
+INPUTS_OPTION = typer.Option(..., help="Comma-separated input columns, such as p1,p2,p3.")
+OUTPUTS_OPTION = typer.Option(..., help="Comma-separated output columns, such as x,y.")
 EXPERIMENT_OPTION = typer.Option(
     None,
     help="Column that splits a file into experiments (contiguous runs). Without it, "
