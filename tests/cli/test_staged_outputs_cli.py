@@ -647,8 +647,12 @@ def test_reproduce_stopped_midway_leaves_the_previous_report(tmp_path, capsys, f
     fake_reproduce["stop_at"] = None
     capsys.readouterr()
     assert main(_reproduce(out, 1)) == 0
-    assert fake_reproduce["campaigns"] == [0, 4, 8]
-    assert json.loads((out / "summary.json").read_text())["seed"] == 1
+    # the sections finished before the stop (paper A, the campaign) are taken over, not rerun
+    assert fake_reproduce["campaigns"] == [0, 4]
+    summary = json.loads((out / "summary.json").read_text())
+    assert summary["seed"] == 1
+    taken = summary["provenance"]["sections taken over from an interrupted run"]
+    assert taken.startswith("paper_a, paper_b") and "transfer" not in taken
     assert (out / "transfer" / "result.txt").read_text() == "seed 1\n"
     assert sorted(p.name for p in tmp_path.iterdir()) == ["report"]  # nothing left beside it
 

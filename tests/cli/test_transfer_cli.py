@@ -311,6 +311,9 @@ def test_refine_parameters_by_set_are_recorded_and_match_the_epochs_option(
         "epochs": 20,
         "learning_rate": 6e-4,
         "device": "auto",
+        "patience": 1000,
+        "min_delta": 1e-3,
+        "validation_share": 0.2,
         "seed": 0,
     }
     assert b["metadata"]["parameters"] == a["metadata"]["parameters"]

@@ -169,6 +169,7 @@ def train_campaign_surrogates(
         grid_name="quick",
         seed=seed,
         progress=on_progress,
+        interpolation=False,  # paper B's figures are the grouped ones; no more fits
     )
     if progress is not None:
         progress(after, 1, 1)
