@@ -108,6 +108,14 @@ def train(
         help="Skip the interpolation score (held-out pressures of the simulated designs: one "
         "more fit per family).",
     ),
+    measurements: list[Path] | None = typer.Option(
+        None,
+        "--measurements",
+        help="Measurements CSV of built actuators (see 'softbend transfer loco'; repeatable, "
+        "joined): the best family is then the one of the lowest leave-one-actuator-out "
+        "transfer RMSE, each family's model as the base (the grouped-CV choice recorded "
+        "beside).",
+    ),
     as_json: bool = typer.Option(False, "--json", help="Print the results as JSON."),
 ) -> None:
     """Train surrogates of a campaign by cross-validated search.
@@ -127,6 +135,15 @@ def train(
     interpolation: every other interior pressure point of each simulated design
     held out, the rest fitted (the table's "interp." column; --no-interpolation
     skips it).
+
+    With --measurements, the family is selected by how well it transfers, not
+    by grouped CV alone: each family's refit model is the base of a
+    leave-one-actuator-out evaluation on the measurements (transfer loco's
+    default strategies that apply to it, but experimental and
+    refined-ensemble; no learning curve), and the family whose best strategy
+    has the lowest mean RMSE is named. Both figures per family, and which
+    criterion chose, are in the table, summary.csv and the JSON; every
+    family x strategy is in transfer_selection.csv.
 
     TABLE is a softbend campaign (of paper B's actuator or another FEM family),
     a verified dataset (a folder of 'softbend campaign dataset', or the name of
@@ -151,6 +168,8 @@ def train(
         softbend train table1.duckdb --out surrogates --models plr,xgb,mlp
         softbend train sims.csv --design-columns n_chambers,wall_mm \\
             --pressure-column p_kpa --pressure-unit kPa --out pneunet
+        softbend train sims.csv --actuator actuator.json --measurements lab.csv \\
+            --out pneunet
     """
     from softbend._validation import check_choice, check_int
     from softbend.limits import check_limit
@@ -169,13 +188,16 @@ def train(
         check_int(plr_patience, "plr_patience", low=1)
     if epochs is not None:
         check_limit("epochs", epochs, "--epochs")
-    _common.check_output_dir(out, "--out", inputs=(db,))
+    measured = tuple(measurements or ())
+    _common.check_output_dir(out, "--out", inputs=(db, *measured))
     # the folder is swapped whole: nothing but an earlier result of this command may be lost
-    _common.check_replaceable_dir(out, "--out", inputs=(db,))
+    _common.check_replaceable_dir(out, "--out", inputs=(db, *measured))
     with _common.library_progress(enabled=not as_json):  # a large table's read, from its start
         source = _training_source(
             db, design_columns, pressure_column, pressure_unit, angle_column, actuator, ranges or []
         )
+        if measured:
+            _check_measurements(measured, source)
 
     def resuming(line: str) -> None:
         _common.err_console.print(line, highlight=False, soft_wrap=True)
@@ -189,6 +211,7 @@ def train(
             out,
             models=models,
             figures=lambda result, stage: _drawn(training_figures, result, stage, progress),
+            choose=_by_transfer(measured, seed, progress) if measured else None,
             on_resume=None if as_json else resuming,
             on_discard=_common.warning_line,
             grid_name=grid,
@@ -226,6 +249,58 @@ def _drawn(
     files = draw(result, stage)
     progress("drawing the figures", 1, 1)
     return files
+
+
+def _check_measurements(measurements: tuple[Path, ...], source: object) -> None:
+    """Read the measurements for the table's actuator before any fit (a campaign's actuator
+    is known once it is read: its measurements are read after the search)."""
+    from softbend.errors import keyed
+    from softbend.surrogates.features import TrainingData
+    from softbend.transfer.measurements import read_measurements
+
+    for path in measurements:
+        if not path.is_file():
+            raise FileNotFoundError(f"--measurements: no file {path}.")
+    if isinstance(source, TrainingData) and source.actuator is not None:
+        with keyed("measurements"):
+            read_measurements(list(measurements), source.actuator)
+
+
+def _by_transfer(
+    measurements: tuple[Path, ...], seed: int, progress: Any
+) -> Callable[[Any, Path, dict[str, Any]], None]:
+    """The selection step of 'train --measurements': each family's refit model scored as a
+    transfer base (:func:`softbend.transfer.base_choice.choose_family`), the tables written."""
+
+    def choose(result: Any, stage: Path, summary: dict[str, Any]) -> None:
+        import pandas as pd
+
+        from softbend._io import write_text_atomic
+        from softbend.transfer.base_choice import choose_family
+
+        models = {
+            name: stage / "models" / f"{name}.json"
+            for name in summary["models"]
+            if (stage / "models" / f"{name}.json").is_file()
+        }
+        choice = choose_family(
+            summary,
+            models,
+            measurements,
+            seed=seed,
+            progress=lambda label, done, total: progress(f"transfer from {label}", done, total),
+        )
+        table_path = stage / "transfer_selection.csv"
+        write_text_atomic(table_path, choice.table.to_csv(index=False))
+        summary["files"]["transfer_selection"] = str(table_path)
+        table = pd.read_csv(stage / "summary.csv")
+        for column in ("transfer_rmse_deg", "transfer_strategy"):
+            table[column] = [summary["models"][m].get(column) for m in table["model"]]
+        table["selected_by_cv"] = table["model"] == summary.get("best_by_cv")
+        table["selected_by_transfer"] = table["model"] == summary["selection"]["by_transfer"]
+        write_text_atomic(stage / "summary.csv", table.to_csv(index=False))
+
+    return choose
 
 
 def _training_source(
@@ -288,6 +363,14 @@ def _mape_cell(value: float | None) -> str:
     return f"{value:.3f}"
 
 
+def _transfer_cell(m: dict) -> str:
+    """A family's mean leave-one-actuator-out RMSE and its strategy, or a dash."""
+    value = m.get("transfer_rmse_deg")
+    if value is None or value != value:
+        return "—"
+    return f"{value:.3f} ({m['transfer_strategy']})"
+
+
 def print_summary(summary: dict) -> None:
     """The per-family table, beside paper B's figures for paper B's actuator (a dash for a
     family it lacks); another actuator's table names it and leaves paper B out. The MAPE
@@ -317,6 +400,7 @@ def print_summary(summary: dict) -> None:
                 f"{m['inference_single_us']:.1f}",
                 f"{m['inference_batch_ms']:.2f}",
                 *([theirs] if published else []),
+                *([_transfer_cell(m)] if "selection" in summary else []),
             ]
         )
     title = "Surrogates: grouped cross-validation (held-out designs) and inference"
@@ -341,6 +425,7 @@ def print_summary(summary: dict) -> None:
             "1 sample µs",
             "10k batch ms",
             *(["paper B R² / MAPE / IT"] if published else []),
+            *(["transfer RMSE ° (strategy)"] if "selection" in summary else []),
         ],
         rows,
     )
@@ -351,9 +436,22 @@ def print_summary(summary: dict) -> None:
             highlight=False,
         )
     best = summary.get("best")
-    if best is not None:
-        metric = {"rmse": "RMSE", "mape": "MAPE", "r2": "R²"}.get(summary["selected_by"], "")
-        _common.console.print(f"best by held-out {metric}: {best}", highlight=False)
+    selection = summary.get("selection")
+    metric = {"rmse": "RMSE", "mape": "MAPE", "r2": "R²"}
+    if selection is not None:
+        cv_metric = metric.get(selection["cv_metric"], "")
+        if selection["by_transfer"] is None:
+            line = f"best by held-out {cv_metric}: {best} (no family could be scored in transfer)"
+        else:
+            pair = selection["best_pair"]
+            line = (
+                f"best by leave-one-actuator-out transfer RMSE: {best} ({pair['rmse_deg']:.3g}°, "
+                f"{pair['strategy']}); by held-out {cv_metric} (grouped CV): {selection['by_cv']}"
+            )
+        _common.console.print(line, highlight=False)
+    elif best is not None:
+        _common.console.print(f"best by held-out {metric.get(summary['selected_by'], '')}: {best}",
+                              highlight=False)  # fmt: skip
 
 
 def predict(

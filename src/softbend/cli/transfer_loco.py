@@ -3,7 +3,7 @@
 from __future__ import annotations
 
 from pathlib import Path
-from typing import TYPE_CHECKING
+from typing import TYPE_CHECKING, Any
 
 import typer
 
@@ -13,7 +13,8 @@ if TYPE_CHECKING:
     from softbend.surrogates.persistence import SavedSurrogate
     from softbend.transfer.loco import LocoResult
 
-#: The files 'transfer loco' writes into its '--out' folder.
+#: The files 'transfer loco' writes into its '--out' folder (with one --base; with several,
+#: each base's folder holds them and the folder itself :data:`CHOICE_FILES`).
 LOCO_FILES: tuple[str, ...] = (
     "summary.csv",
     "per_actuator.csv",
@@ -26,6 +27,10 @@ LOCO_FILES: tuple[str, ...] = (
     "learning_curve.png",
 )
 
+#: The files 'transfer loco' with several bases writes into its '--out' folder, beside a
+#: folder of :data:`LOCO_FILES` per base.
+CHOICE_FILES: tuple[str, ...] = ("summary.csv", "loco.json")
+
 
 MEASUREMENTS_ARGUMENT = typer.Argument(
     ...,
@@ -35,7 +40,10 @@ MEASUREMENTS_ARGUMENT = typer.Argument(
 )
 OUT_OPTION = typer.Option(..., "--out", "-o", help="Folder for tables and figures.")
 BASE_OPTION = typer.Option(
-    None, help="Saved surrogate to start from (default: the shipped FEM-trained MLP)."
+    None,
+    help="Saved surrogate to start from (default: the shipped FEM-trained MLP), or several "
+    "separated by commas (a.json,b.json): every base x strategy is scored and the best pair "
+    "named.",
 )
 STRATEGIES_OPTION = typer.Option(
     "all",
@@ -72,7 +80,7 @@ FORCE_OPTION = typer.Option(
 def loco(
     measurements: list[Path] = MEASUREMENTS_ARGUMENT,
     out: Path = OUT_OPTION,
-    base: Path | None = BASE_OPTION,
+    base: str | None = BASE_OPTION,
     strategies: str = STRATEGIES_OPTION,
     settings: list[str] | None = SETTINGS_OPTION,
     level: float = LEVEL_OPTION,
@@ -91,22 +99,39 @@ def loco(
     hold only what this command writes. loco.json records every parameter of every
     strategy as used, and each MEASUREMENTS file (one or more, joined) with its SHA-256.
 
+    Several bases (--base a.json,b.json) are each scored in turn, with the
+    strategies that apply to each: --out then holds one folder per base (its
+    file's stem) with that base's tables and figures, a summary.csv of every
+    base x strategy, and a loco.json recording all of it and the pair of the
+    lowest mean RMSE (a pair with failed fits competes only when every pair has
+    some; ties go to the base listed first). A base whose every fit fails is a
+    row of the table with its reason; the others go on.
+
     Example:
 
     \b
         softbend transfer loco lab.csv --out loco \\
             --strategies refined,scale-offset --set epochs=500
         softbend transfer loco lab.csv bench.csv --out loco
+        softbend transfer loco lab.csv --base plr.json,xgb.json,mlp.json --out loco
     """
     from softbend.transfer.against_base import load_for_base
     from softbend.transfer.base import load_base_saved
+    from softbend.transfer.base_choice import parse_bases
     from softbend.transfer.loco import leave_one_configuration_out
     from softbend.transfer.measurements import files_record
 
-    inputs = tuple(measurements) if base is None else (*measurements, base)
+    bases = parse_bases(base)
+    if bases is not None and len(bases) > 1:
+        _loco_bases(measurements, out, bases, strategies=strategies, settings=settings,
+                   level=level, learning_curve=learning_curve, calibrate=calibrate, seed=seed,
+                   as_json=as_json, force=force)  # fmt: skip
+        return
+    base_file = None if bases is None else bases[0]
+    inputs = tuple(measurements) if base_file is None else (*measurements, base_file)
     _common.check_output_dir(out, "--out", inputs=inputs, files=LOCO_FILES)
     _common.check_replaceable_dir(out, "--out", inputs=inputs)
-    saved = load_base_saved(base)
+    saved = load_base_saved(base_file)
     names, left_out, options = _chosen_strategies(strategies, settings, saved)
     with _common.library_progress(enabled=not as_json):  # a large file's read, from its start
         data, forced = load_for_base(measurements, saved, force=force)  # before any fit
@@ -127,6 +152,181 @@ def loco(
     synthetic = bool(data.synthetic.any())  # the figure flags any synthetic reading
     files = _write_loco(result, out, synthetic=synthetic, learning_curve=learning_curve)
     _print_loco(result, out, files, left_out, synthetic=synthetic, as_json=as_json)
+
+
+def _loco_bases(
+    measurements: list[Path],
+    out: Path,
+    bases: list[Path],
+    *,
+    strategies: str,
+    settings: list[str] | None,
+    level: float,
+    learning_curve: bool,
+    calibrate: bool,
+    seed: int,
+    as_json: bool,
+    force: bool,
+) -> None:
+    """'transfer loco' with several bases: each scored in turn, then one table of every
+    base x strategy and the pair chosen (:mod:`softbend.transfer.base_choice`)."""
+    from softbend.errors import InputError, SoftbendError, keyed
+    from softbend.transfer.against_base import load_for_base
+    from softbend.transfer.base import load_base_saved
+    from softbend.transfer.base_choice import (
+        Candidate,
+        base_labels,
+        check_same_actuator,
+        score_bases,
+    )
+    from softbend.transfer.measurements import files_record
+
+    labels = base_labels(bases)
+    inputs = (*measurements, *bases)
+    _common.check_output_dir(out, "--out", inputs=inputs, files=(*CHOICE_FILES, *labels))
+    _common.check_replaceable_dir(out, "--out", inputs=inputs)
+    saved = []
+    for path in bases:
+        with keyed("base"):
+            saved.append(load_base_saved(path))
+    check_same_actuator([(str(p), s.actuator) for p, s in zip(bases, saved, strict=True)])
+    chosen = _chosen_for_bases(strategies, settings, saved)
+    candidates, records = [], {}
+    for label, path, model, (names, left_out, options) in zip(
+        labels, bases, saved, chosen, strict=True
+    ):
+        try:
+            with _common.library_progress(enabled=not as_json):
+                data, forced = load_for_base(measurements, model, force=force)  # before any fit
+        except SoftbendError as error:  # the one line names the base it was read for
+            raise InputError(
+                f"{path} (a model of {model.actuator.name}): {' '.join(str(error).split())}",
+                key="base",
+            ) from None
+        candidates.append(Candidate(label, str(path), model.model, data, names, options))
+        records[label] = (files_record(measurements, data), forced, left_out)  # type: ignore[arg-type]
+    with _common.library_progress(enabled=not as_json) as progress:
+        choice = score_bases(
+            candidates,
+            level=level,
+            learning_curve=learning_curve,
+            calibrated=calibrate,
+            seed=seed,
+            progress=lambda label, done, total: progress(
+                f"fitting strategies on {label}", done, total
+            ),
+        )
+    for label, result in choice.results.items():
+        files, forced, left_out = records[label]
+        result.settings["measurement_files"] = files
+        result.settings.update({"forced": forced} if forced else {}, left_out=left_out)
+    synthetic = bool(candidates[0].measurements.synthetic.any())
+    written = _write_choice(choice, out, synthetic=synthetic, learning_curve=learning_curve)
+    _print_choice(choice, out, written, as_json=as_json, synthetic=synthetic)
+
+
+def _chosen_for_bases(
+    strategies: str, settings: list[str] | None, saved: list[SavedSurrogate]
+) -> list[tuple[list[str], dict[str, str], dict[str, dict[str, object]]]]:
+    """Each base's strategies, left-out strategies and options. Named strategies that do
+    not apply to a base are left out for it (with why); one that applies to none is refused."""
+    from softbend.transfer.loco import strategy_options
+    from softbend.transfer.strategies import applicable_strategies, check_applicable
+
+    if strategies.strip() == "all":
+        return [_chosen_strategies(strategies, settings, one) for one in saved]
+    named = [n.strip() for n in strategies.split(",") if n.strip()]
+    strategy_options(named, _common.parse_assignments(settings or ()))  # names, values checked
+    chosen = []
+    for one in saved:
+        names, left_out = applicable_strategies(named, one.model, one.actuator)
+        options = strategy_options(named, _common.parse_assignments(settings or ()))
+        chosen.append((names, left_out, {k: v for k, v in options.items() if k in names}))
+    everywhere = set(named).intersection(*(set(left) for _, left, _ in chosen))
+    if everywhere:  # applies to no base: the first base's refusal, one line
+        check_applicable(sorted(everywhere), saved[0].model, saved[0].actuator, key="strategies")
+    return chosen
+
+
+def _write_choice(
+    choice: Any, out: Path, *, synthetic: bool, learning_curve: bool
+) -> dict[str, str]:
+    """Write each base's results into its folder, then the table of every base x strategy
+    (summary.csv) and loco.json, as a whole (staged, then swapped in)."""
+    from softbend._io import json_text, write_text_atomic
+    from softbend._outdir import staged_dir
+
+    with (
+        _common.output_errors(out, "--out"),
+        staged_dir(out) as stage,
+        _common.as_written(stage, out),
+    ):
+        for label, result in choice.results.items():
+            write_loco_files(
+                result, stage / label, synthetic=synthetic, learning_curve=learning_curve
+            )
+        write_text_atomic(stage / "summary.csv", choice.table.to_csv(index=False))
+        record = {**choice.to_dict(), "synthetic": synthetic}
+        write_text_atomic(stage / "loco.json", json_text(record) + "\n")
+    written = {"summary": str(out / "summary.csv"), "json": str(out / "loco.json")}
+    written.update({label: str(out / label) for label in choice.results})
+    return written
+
+
+def _print_choice(
+    choice: Any, out: Path, files: dict[str, str], *, as_json: bool, synthetic: bool
+) -> None:
+    """The warnings of each base (strategies left out, fits that failed, a base that
+    failed), then the results as JSON or as the table of every base x strategy."""
+    import math
+
+    for label, result in choice.results.items():
+        left_out = result.settings.get("left_out") or {}
+        if left_out:
+            _common.warning_line(f"base {label}: " + left_out_line(left_out))
+        failed = result.settings.get("failed", [])
+        others = result.settings.get("failed_other_fits", 0)
+        if failed or others:
+            _common.warning_line(f"base {label}: " + failed_line(failed, others))
+    for label, error in choice.errors.items():
+        _common.warning_line(f"base {label}: every fit failed, left out of the choice: {error}")
+    if as_json:
+        _common.print_json({**choice.to_dict(), "files": files, "synthetic": synthetic})
+        return
+
+    def cell(value: object, form: str = ".3g") -> str:
+        if value is None or (isinstance(value, float) and not math.isfinite(value)):
+            return "—"
+        return format(value, form) if isinstance(value, float) else str(value)
+
+    rows = [
+        [
+            str(r["base"]),
+            cell(r["strategy"]),
+            cell(r["rmse_deg"], ".4g"),
+            cell(r["mape_pct"], ".4g"),
+            cell(r["max_error_deg"], ".4g"),
+            "—" if r["rank"] != r["rank"] else str(int(r["rank"])),
+            str(r["status"]) if r["error"] is None else f"{r['status']}: {r['error']}",
+        ]
+        for _, r in choice.table.iterrows()
+    ]
+    _common.print_table(
+        f"Leave one configuration out, every base x strategy ({len(choice.files)} bases)",
+        ["base", "strategy", "mean RMSE °", "mean MAPE %", "max |e| °", "rank", "status"],
+        rows,
+    )
+    best = choice.best
+    if best is None:
+        _common.warning_line("no base x strategy pair has a finite mean RMSE; none is named")
+    else:
+        ties = f" (tied with {', '.join(best['tied_with'])})" if best["tied_with"] else ""
+        _common.console.print(
+            f"best pair by mean leave-one-actuator-out RMSE: base {best['base']} "
+            f"({best['base_file']}) with {best['strategy']}, {best['rmse_deg']:.3g}°{ties}",
+            highlight=False,
+        )
+    _common.console.print(f"tables and figures written to {out}")
 
 
 def _chosen_strategies(
@@ -176,25 +376,35 @@ def _write_loco(
     """Write loco's tables and figures into ``out`` as a whole (staged, then swapped in);
     the files written, by key."""
     from softbend._outdir import staged_dir
-    from softbend.reports import transfer_figures
 
     with (
         _common.output_errors(out, "--out"),
         staged_dir(out) as stage,
         _common.as_written(stage, out),
     ):
-        written = result.write(stage)
-        written["fig6"] = str(transfer_figures.loss_curves(result, stage / "fig6_loss_curves.png"))
-        written["fig7"] = str(
-            transfer_figures.actuator_panels(
-                result, stage / "fig7_actuators.png", synthetic=synthetic
-            )
+        written = write_loco_files(
+            result, stage, synthetic=synthetic, learning_curve=learning_curve
         )
-        if learning_curve:
-            written["learning_curve_figure"] = str(
-                transfer_figures.learning_curve(result, stage / "learning_curve.png")
-            )
     return {key: str(out / Path(value).name) for key, value in written.items()}
+
+
+def write_loco_files(
+    result: LocoResult, folder: Path, *, synthetic: bool, learning_curve: bool
+) -> dict[str, str]:
+    """Write loco's tables (:meth:`LocoResult.write`) and figures into ``folder``; the files
+    written, by key."""
+    from softbend.reports import transfer_figures
+
+    written = result.write(folder)
+    written["fig6"] = str(transfer_figures.loss_curves(result, folder / "fig6_loss_curves.png"))
+    written["fig7"] = str(
+        transfer_figures.actuator_panels(result, folder / "fig7_actuators.png", synthetic=synthetic)
+    )
+    if learning_curve:
+        written["learning_curve_figure"] = str(
+            transfer_figures.learning_curve(result, folder / "learning_curve.png")
+        )
+    return written
 
 
 def left_out_line(left_out: dict[str, str]) -> str:

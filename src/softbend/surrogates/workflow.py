@@ -379,6 +379,7 @@ def train_into(
     *,
     models: str | Sequence[str] | None = None,
     figures: Callable[[SearchResult, Path], dict[str, str]] | None = None,
+    choose: Callable[[SearchResult, Path, dict[str, Any]], None] | None = None,
     on_resume: Callable[[str], None] | None = None,
     on_discard: Callable[[str], None] | None = None,
     **options: Any,
@@ -401,6 +402,12 @@ def train_into(
     figures : callable, optional
         ``figures(result, folder) -> {name: path}``: more files drawn into the
         staging folder (e.g. :func:`softbend.reports.surrogate_figures.training_figures`).
+    choose : callable, optional
+        ``choose(result, folder, summary)``: the selection step, once every family is
+        fitted and refit and saved into the staging folder, before the figures; it may
+        name another ``best`` in ``summary`` (recording its criterion), rewrite the
+        folder's tables and add files to ``summary["files"]`` (e.g.
+        :func:`softbend.transfer.base_choice.choose_family`, by transfer error).
     on_resume, on_discard : callable, optional
         Told one line when a checkpoint is resumed, or discarded as that of other
         settings (:class:`~softbend.surrogates.checkpoint.SearchCheckpoint`).
@@ -431,6 +438,8 @@ def train_into(
             result, summary = train_surrogates(
                 source, stage, models=names, checkpoint=checkpoint, **options
             )
+            if choose is not None:
+                choose(result, stage, summary)
             if figures is not None:
                 summary["files"].update(figures(result, stage))
         checkpoint.remove()  # the new folder is in place
