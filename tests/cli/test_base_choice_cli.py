@@ -78,6 +78,7 @@ def test_every_base_x_strategy_is_scored_and_the_best_pair_is_the_table_s_minimu
     ]
     assert sorted(table["rank"]) == list(range(1, 9))  # every pair a candidate, ranked
     assert payload["best"] == best
+    assert record["settings"]["measurement_files"][0]["path"] == str(MEASUREMENTS)
     # each base's record is its own run's, with the measurement files
     for label in ("plr", "xgb"):
         own = json.loads((out / label / "loco.json").read_text(encoding="utf-8"))
@@ -85,13 +86,19 @@ def test_every_base_x_strategy_is_scored_and_the_best_pair_is_the_table_s_minimu
         assert own["settings"]["measurement_files"][0]["path"] == str(MEASUREMENTS)
 
 
-def test_the_text_output_names_the_best_pair(bases, tmp_path, capsys):
+def test_the_text_output_names_the_best_pair_and_a_rerun_replaces_the_folder(
+    bases, tmp_path, capsys
+):
     out = tmp_path / "choice"
     assert _loco(out, f"{bases['xgb']},{bases['plr']}") == 0
     text = capsys.readouterr().out
     best = json.loads((out / "loco.json").read_text(encoding="utf-8"))["best"]
     assert f"best pair by mean leave-one-actuator-out RMSE: base {best['base']}" in text
     assert best["strategy"] in text
+    assert _run("transfer", "loco", MEASUREMENTS, "--base", f"{bases['xgb']},{bases['plr']}",
+                "-o", out, "--strategies", "fem-only", "--no-learning-curve") == 0  # fmt: skip
+    capsys.readouterr()
+    assert set(pd.read_csv(out / "summary.csv")["strategy"]) == {"fem-only"}
 
 
 def test_a_single_base_writes_what_it_wrote_before(bases, tmp_path, capsys):

@@ -111,6 +111,7 @@ def train(
     measurements: list[Path] | None = typer.Option(
         None,
         "--measurements",
+        metavar="<csv>",
         help="Measurements CSV of built actuators (see 'softbend transfer loco'; repeatable, "
         "joined): the best family is then the one of the lowest leave-one-actuator-out "
         "transfer RMSE, each family's model as the base (the grouped-CV choice recorded "

@@ -41,6 +41,7 @@ MEASUREMENTS_ARGUMENT = typer.Argument(
 OUT_OPTION = typer.Option(..., "--out", "-o", help="Folder for tables and figures.")
 BASE_OPTION = typer.Option(
     None,
+    metavar="<path>",
     help="Saved surrogate to start from (default: the shipped FEM-trained MLP), or several "
     "separated by commas (a.json,b.json): every base x strategy is scored and the best pair "
     "named.",
@@ -183,7 +184,7 @@ def _loco_bases(
 
     labels = base_labels(bases)
     inputs = (*measurements, *bases)
-    _common.check_output_dir(out, "--out", inputs=inputs, files=(*CHOICE_FILES, *labels))
+    _common.check_output_dir(out, "--out", inputs=inputs, files=CHOICE_FILES)
     _common.check_replaceable_dir(out, "--out", inputs=inputs)
     saved = []
     for path in bases:
@@ -221,7 +222,19 @@ def _loco_bases(
         result.settings["measurement_files"] = files
         result.settings.update({"forced": forced} if forced else {}, left_out=left_out)
     synthetic = bool(candidates[0].measurements.synthetic.any())
-    written = _write_choice(choice, out, synthetic=synthetic, learning_curve=learning_curve)
+    run_settings = {  # the run's own inputs; each base's are in its record
+        "measurement_files": records[labels[0]][0],
+        "strategies": strategies,
+        "set": list(settings or ()),
+        "level": level,
+        "learning_curve": learning_curve,
+        "calibrated": calibrate,
+        "seed": seed,
+        "force": force,
+    }
+    written = _write_choice(
+        choice, out, synthetic=synthetic, learning_curve=learning_curve, settings=run_settings
+    )
     _print_choice(choice, out, written, as_json=as_json, synthetic=synthetic)
 
 
@@ -249,7 +262,7 @@ def _chosen_for_bases(
 
 
 def _write_choice(
-    choice: Any, out: Path, *, synthetic: bool, learning_curve: bool
+    choice: Any, out: Path, *, synthetic: bool, learning_curve: bool, settings: dict[str, Any]
 ) -> dict[str, str]:
     """Write each base's results into its folder, then the table of every base x strategy
     (summary.csv) and loco.json, as a whole (staged, then swapped in)."""
@@ -266,7 +279,7 @@ def _write_choice(
                 result, stage / label, synthetic=synthetic, learning_curve=learning_curve
             )
         write_text_atomic(stage / "summary.csv", choice.table.to_csv(index=False))
-        record = {**choice.to_dict(), "synthetic": synthetic}
+        record = {**choice.to_dict(), "settings": settings, "synthetic": synthetic}
         write_text_atomic(stage / "loco.json", json_text(record) + "\n")
     written = {"summary": str(out / "summary.csv"), "json": str(out / "loco.json")}
     written.update({label: str(out / label) for label in choice.results})
