@@ -9,9 +9,9 @@ on the example's measurements (no learning curve), with every default strategy t
 to each base but the two ``softbend train --measurements`` leaves out as well
 (:data:`softbend.transfer.base_choice.CHEAP_EXCLUDED`: ``experimental`` learns from the
 measurements alone, the same for every base, with 15000 epochs; ``refined-ensemble`` is
-``refined`` five times over). It prints each base × strategy's mean leave-one-actuator-out
-RMSE, the pair named, the family grouped cross-validation selected, and the wall time of each
-step::
+``refined`` five times over; ``analytical`` models paper B's actuator only). It prints
+each base × strategy's mean leave-one-actuator-out RMSE, the pair named, the family grouped
+cross-validation selected, and the wall time of each step::
 
     PYTHONPATH=src .venv/bin/python benchmarks/bench_base_choice.py
 """
@@ -59,7 +59,7 @@ def main(argv: list[str] | None = None) -> int:
     parser.add_argument("--seed", type=int, default=0)
     parser.add_argument(
         "--strategies",
-        default=",".join(n for n in DEFAULT_STRATEGIES if n not in CHEAP_EXCLUDED),
+        default=",".join(n for n in DEFAULT_STRATEGIES if n not in (*CHEAP_EXCLUDED, "analytical")),
         help="Strategies scored (each base runs those that apply to it).",
     )
     args = parser.parse_args(argv)
@@ -90,7 +90,8 @@ def main(argv: list[str] | None = None) -> int:
     units: dict[str, str] = {}
     for _, r in table_rows.iterrows():
         value = r["rmse_deg"]
-        print(f"  {r['base']:>4} x {r['strategy']:<20} {value:.2f}   rank {r['rank']}")
+        rank = "-" if r["rank"] != r["rank"] else str(int(r["rank"]))  # NaN: no candidate
+        print(f"  {r['base']:>4} x {r['strategy']:<20} {value:.2f}   rank {rank}")
         key = f"{r['base']} x {r['strategy']}: mean LOCO RMSE"
         figures[key], units[key] = round(float(value), 3), "°"
     best = choice["best"]
