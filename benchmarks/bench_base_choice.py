@@ -3,8 +3,8 @@
 A lab with its own simulator usually has tens of designs. This script cuts the shipped
 PneuNet example (``examples/pneunet``) to its first ``--designs`` design_ids (30: the
 stand-in for a small table), trains the default families on it with ``softbend train``
-(plr, xgb, mlp; the default grid, ``small`` under 100 designs), then scores every
-family's model as a base with ``softbend transfer loco --base plr.json,xgb.json,mlp.json``
+(under 100 designs plr, xgb, mlp and table; the default grid, ``small``), then scores every
+family's model as a base with ``softbend transfer loco --base plr.json,xgb.json,...``
 on the example's measurements (no learning curve), with every default strategy that applies
 to each base but the two ``softbend train --measurements`` leaves out as well
 (:data:`softbend.transfer.base_choice.CHEAP_EXCLUDED`: ``experimental`` learns from the
@@ -55,7 +55,9 @@ def _run(*args: object) -> float:
 def main(argv: list[str] | None = None) -> int:
     parser = argparse.ArgumentParser(description=__doc__.split("\n")[0])
     parser.add_argument("--designs", type=int, default=30, help="First design_ids kept.")
-    parser.add_argument("--families", default="plr,xgb,mlp", help="Families trained.")
+    parser.add_argument(
+        "--families", default=None, help="Families trained (default: train's own default)."
+    )
     parser.add_argument("--seed", type=int, default=0)
     parser.add_argument(
         "--strategies",
@@ -68,10 +70,11 @@ def main(argv: list[str] | None = None) -> int:
         folder = Path(tmp)
         table = _cut(args.designs, folder)
         trained = folder / "train"
-        train_s = _run("train", table, "--actuator", EXAMPLE / "actuator.json",
-                       "--models", args.families, "--device", "cpu", "--no-onnx",
-                       "--seed", args.seed, "-o", trained)  # fmt: skip
-        names = [n.strip() for n in args.families.split(",")]
+        families = () if args.families is None else ("--models", args.families)
+        train_s = _run("train", table, "--actuator", EXAMPLE / "actuator.json", *families,
+                       "--device", "cpu", "--no-onnx", "--seed", args.seed,
+                       "-o", trained)  # fmt: skip
+        names = list(pd.read_csv(trained / "summary.csv")["model"])  # every family trained
         bases = ",".join(str(trained / "models" / f"{n}.json") for n in names)
         out = folder / "loco"
         loco_s = _run("transfer", "loco", EXAMPLE / "measurements.csv", "--base", bases,
@@ -118,7 +121,7 @@ def main(argv: list[str] | None = None) -> int:
         figures,
         units=units,
         notes=f"examples/pneunet cut to its first {args.designs} designs; families "
-        f"{args.families} (default grid); loco on its 6 measured actuators, strategies "
+        f"{','.join(names)} (default grid); loco on its 6 measured actuators, strategies "
         f"{args.strategies} (those that apply to each base), no learning curve",
     )
     return 0
