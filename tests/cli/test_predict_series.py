@@ -54,7 +54,7 @@ def model(tmp_path_factory):
             "--experiment", "experiment", "--folds", "2", "--out", str(out), "--json"]  # fmt: skip
     few = [c for c in selection.default_candidates(0, n_kernel=0) if c.family != "gg-svr"]
     with pytest.MonkeyPatch.context() as patch:
-        patch.setattr(selection, "default_candidates", lambda seed=0, n_kernel=6: few)
+        patch.setattr(selection, "default_candidates", lambda seed=0, n_kernel=6, delays=True: few)
         assert main(args) == 0
     return out / "model.json"
 
