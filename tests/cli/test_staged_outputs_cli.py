@@ -243,6 +243,7 @@ def fake_reproduce(monkeypatch: pytest.MonkeyPatch) -> dict[str, object]:
         design_section,
         paper_b_fem,
         paper_b_fem_data,
+        pneunet_section,
         summary_section,
         transfer_section,
     )
@@ -281,6 +282,7 @@ def fake_reproduce(monkeypatch: pytest.MonkeyPatch) -> dict[str, object]:
     monkeypatch.setattr(transfer_section, "add_section", section("transfer"))
     monkeypatch.setattr(control_section, "add_section", section("control"))
     monkeypatch.setattr(design_section, "add_section", section("design"))
+    monkeypatch.setattr(pneunet_section, "add_section", section("pneunet"))
     monkeypatch.setattr(summary_section, "add_summary", lambda report, summary, reduced: None)
     return controls
 
