@@ -25,7 +25,7 @@ from __future__ import annotations
 
 import json
 import math
-from collections.abc import Callable
+from collections.abc import Callable, Sequence
 from dataclasses import dataclass
 from typing import TYPE_CHECKING, Any, cast
 
@@ -436,6 +436,26 @@ def _check_polynomial(state: dict[str, Any]) -> None:
         ) from None
 
 
+def _check_kernel_theta(theta: np.ndarray, names: Sequence[str] = ()) -> None:
+    """Check a GP kernel's log hyperparameters (constant, length scales, noise) are plausible.
+
+    ``names`` (one per entry) name the offending hyperparameter in the error.
+    """
+    width = RANGES["kernel_width"]
+    with np.errstate(over="ignore", under="ignore"):
+        hyper = np.exp(theta)
+    bad = implausible_index(hyper, "kernel_width")
+    if bad is not None:
+        name = f"{names[bad]} " if names else ""
+        raise RuleError(
+            f"must hold the logarithms of the kernel's constant, "
+            f"length scales and noise, each within {width.low:g} to {width.high:g} "
+            f"(log {math.log(width.low):.4g} to {math.log(width.high):.4g}); got "
+            f"{name}{hyper[bad]:g} (log {theta[bad]:g}) at index {bad}",
+            key="state.kernel_theta_",
+        )
+
+
 def _check_table(state: dict[str, Any]) -> None:
     """The table base's curves and GP fit together (:mod:`softbend.surrogates.table`)."""
     d = int(state["n_features_in_"])
@@ -490,16 +510,7 @@ def _check_table(state: dict[str, Any]) -> None:
             f"{state['kernel_theta_'].shape}",
             key="state.kernel_theta_",
         )
-    width = RANGES["kernel_width"]
-    with np.errstate(over="ignore", under="ignore"):
-        hyper = np.exp(state["kernel_theta_"])
-    bad = implausible_index(hyper, "kernel_width")
-    if bad is not None:
-        raise RuleError(
-            f"must hold the logarithms of the kernel's constant, length scales and noise, "
-            f"each within {width.low:g} to {width.high:g}; got {hyper[bad]:g} at index {bad}",
-            key="state.kernel_theta_",
-        )
+    _check_kernel_theta(state["kernel_theta_"])
     for key in ("curve_angles_", "gp_targets_"):
         bad = implausible_index(state[key], "angle_deg")
         if bad is not None:
@@ -625,20 +636,7 @@ def _check_gp(state: dict[str, Any], actuator: Actuator) -> None:
             f"must have shape ({inputs.shape[0]},) (one per row of 'inputs_'); got {targets.shape}",
             key="state.targets_",
         )
-    width = RANGES["kernel_width"]
-    with np.errstate(over="ignore", under="ignore"):
-        hyper = np.exp(state["kernel_theta_"])
-    bad = implausible_index(hyper, "kernel_width")
-    if bad is not None:
-        raise RuleError(
-            f"must hold the logarithms of the kernel's constant, "
-            f"length scales and noise, each within {width.low:g} to {width.high:g} "
-            f"(log {math.log(width.low):.4g} to {math.log(width.high):.4g}); got "
-            f"{_gp_hyperparameters(actuator)[bad]} {hyper[bad]:g} "
-            f"(log {state['kernel_theta_'][bad]:g}) "
-            f"at index {bad}",
-            key="state.kernel_theta_",
-        )
+    _check_kernel_theta(state["kernel_theta_"], _gp_hyperparameters(actuator))
     # the inputs with a plausible range (the actuator's quantities), and the base's angle
     quantities = {**actuator.quantities, gp_inputs[-1]: QUANTITIES[TARGET]}
     for j, name in enumerate(gp_inputs):
@@ -661,6 +659,7 @@ def _check_gp(state: dict[str, Any], actuator: Actuator) -> None:
                 f"{bounds.high - bounds.low:g}{unit}, the width of its range)",
                 key="state.z_scale_",
             )
+    width = RANGES["kernel_width"]
     outside = np.abs(inputs) > width.high
     if outside.any():
         row, col = (int(i) for i in np.argwhere(outside)[0])
