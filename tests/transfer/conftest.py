@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+import itertools
+
 import numpy as np
 import pytest
 
@@ -44,3 +46,20 @@ def small_base():
     return NormalizedMLPRegressor(
         hidden_sizes=(16, 16), epochs=300, batch_size=64, learning_rate=3e-3, seed=0, device="cpu"
     ).fit(X, y)
+
+
+@pytest.fixture
+def random_mlp():
+    """A 7-16-16-1 MLP with random weights, seeded: a base for the refits' own tests."""
+    from softbend.surrogates.mlp import NormalizedMLPRegressor
+
+    rng = np.random.default_rng(0)
+    sizes = (7, 16, 16, 1)
+    return NormalizedMLPRegressor.from_arrays(
+        x_mean=rng.uniform(1.0, 10.0, 7),
+        x_scale=rng.uniform(0.5, 2.0, 7),
+        y_mean=90.0,
+        y_scale=60.0,
+        coefs=[rng.normal(0.0, 0.4, (a, b)) for a, b in itertools.pairwise(sizes)],
+        intercepts=[rng.normal(0.0, 0.1, b) for b in sizes[1:]],
+    )

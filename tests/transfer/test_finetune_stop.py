@@ -2,8 +2,6 @@
 
 from __future__ import annotations
 
-import itertools
-
 import numpy as np
 import pytest
 
@@ -14,20 +12,8 @@ pytest.importorskip("torch")
 
 
 @pytest.fixture
-def base():
-    """A 7-16-16-1 MLP with random weights."""
-    from softbend.surrogates.mlp import NormalizedMLPRegressor
-
-    rng = np.random.default_rng(0)
-    sizes = (7, 16, 16, 1)
-    return NormalizedMLPRegressor.from_arrays(
-        x_mean=rng.uniform(1.0, 10.0, 7),
-        x_scale=rng.uniform(0.5, 2.0, 7),
-        y_mean=90.0,
-        y_scale=60.0,
-        coefs=[rng.normal(0.0, 0.4, (a, b)) for a, b in itertools.pairwise(sizes)],
-        intercepts=[rng.normal(0.0, 0.1, b) for b in sizes[1:]],
-    )
+def base(random_mlp):
+    return random_mlp
 
 
 def _rows(base, n=60, seed=3):
