@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+import os
+import signal
 import subprocess
 import sys
 import textwrap
@@ -148,6 +150,23 @@ def test_a_design_is_written_completely_or_not_at_all(store, monkeypatch):
     assert set(store.load_samples()["design_id"]) == {B.design_id}
     store.record_success(_sweep(A))
     assert store.finished_ids() == {A.design_id, B.design_id}
+
+
+def test_a_ctrl_c_during_a_write_is_raised_after_the_design_is_committed(store, monkeypatch):
+    # A Ctrl-C inside a DuckDB query would surface as "RuntimeError: Query
+    # interrupted" and roll back a finished design; it waits for the commit.
+    real_delete = store._delete
+
+    def delete_then_ctrl_c(design_id):
+        real_delete(design_id)
+        os.kill(os.getpid(), signal.SIGINT)
+
+    monkeypatch.setattr(store, "_delete", delete_then_ctrl_c)
+    with pytest.raises(KeyboardInterrupt):
+        store.record_success(_sweep(A))
+    assert store.finished_ids() == {A.design_id}
+    assert set(store.load_samples()["design_id"]) == {A.design_id}
+    assert signal.getsignal(signal.SIGINT) is signal.default_int_handler
 
 
 def test_results_off_the_campaign_grid_are_refused(store):

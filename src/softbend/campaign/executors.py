@@ -34,10 +34,9 @@ import socket
 import threading
 import time
 from collections import deque
-from collections.abc import Callable, Iterable, Iterator, Sequence
+from collections.abc import Callable, Iterable, Sequence
 from concurrent.futures import FIRST_COMPLETED, ProcessPoolExecutor, wait
 from concurrent.futures.process import BrokenProcessPool
-from contextlib import contextmanager
 from dataclasses import dataclass
 from pathlib import Path
 from typing import TYPE_CHECKING, Any, cast
@@ -45,6 +44,7 @@ from typing import TYPE_CHECKING, Any, cast
 import numpy as np
 
 from softbend._extras import require
+from softbend._interrupts import interrupts_deferred
 from softbend._validation import must_be
 from softbend.campaign.backends import Backend, SweepResult
 from softbend.campaign.family_schema import CampaignDesign
@@ -238,28 +238,6 @@ def _new_pool(workers: int, context: multiprocessing.context.BaseContext) -> Pro
     )
 
 
-@contextmanager
-def _interrupts_deferred() -> Iterator[None]:
-    """Hold a Ctrl-C back until the block ends, then raise it (KeyboardInterrupt).
-
-    Around a task's submission, which may start a worker: interrupted half-way,
-    the pool would not know the worker the fork server has already made, and
-    that worker would fail with a traceback once this process is gone. Only the
-    main thread receives signals; elsewhere the block runs as it is.
-    """
-    if threading.current_thread() is not threading.main_thread():
-        yield
-        return
-    received: list[int] = []
-    previous = signal.signal(signal.SIGINT, lambda signum, frame: received.append(signum))
-    try:
-        yield
-    finally:
-        signal.signal(signal.SIGINT, previous)
-    if received:
-        raise KeyboardInterrupt
-
-
 def _stop_pool(pool: ProcessPoolExecutor) -> None:
     """End ``pool`` at once: pending tasks cancelled, each worker's process group terminated.
 
@@ -330,7 +308,7 @@ def _run_isolated(
         recorder.set_running(1)
         pool = _new_pool(1, context)
         try:
-            with _interrupts_deferred():  # the worker starts whole or not at all
+            with interrupts_deferred():  # the worker starts whole or not at all
                 future = pool.submit(sweep_chunk, backend, [design], pressures)
             outcomes = future.result()
         except BrokenProcessPool:
@@ -384,7 +362,7 @@ def run_local(
                 while chunks and not broken and len(pending) < _TASKS_PER_WORKER * workers:
                     chunk = chunks.popleft()
                     try:
-                        with _interrupts_deferred():  # a worker it starts starts whole
+                        with interrupts_deferred():  # a worker it starts starts whole
                             future = pool.submit(sweep_chunk, backend, chunk, pressures)
                     except BrokenProcessPool:
                         chunks.appendleft(chunk)

@@ -54,6 +54,7 @@ from datetime import UTC, datetime
 from pathlib import Path
 from typing import TYPE_CHECKING
 
+from softbend._interrupts import interrupts_deferred
 from softbend.campaign.family_schema import FamilySchema
 from softbend.design import PARAMETERS
 from softbend.errors import SchemaError, SoftbendError
@@ -209,19 +210,21 @@ def utc_now() -> datetime:
 def transaction(con: DuckDBPyConnection) -> Iterator[None]:
     """Run the body in one transaction of the DuckDB connection ``con``.
 
-    Committed when the body returns, rolled back when it raises (anything,
-    ``KeyboardInterrupt`` included).
+    Committed when the body returns, rolled back when it raises. A Ctrl-C
+    meanwhile is held back until the commit (it would otherwise interrupt the
+    query and roll back finished work), then raised as ``KeyboardInterrupt``.
     """
-    con.execute("BEGIN TRANSACTION")
-    try:
-        yield
-    except BaseException:
+    with interrupts_deferred():
+        con.execute("BEGIN TRANSACTION")
         try:
-            con.execute("ROLLBACK")
-        except Exception:  # a failed write may have ended the transaction: report the write
-            logger.debug("ROLLBACK after a failed transaction failed too", exc_info=True)
-        raise
-    con.execute("COMMIT")
+            yield
+        except BaseException:
+            try:
+                con.execute("ROLLBACK")
+            except Exception:  # a failed write may have ended the transaction: report it
+                logger.debug("ROLLBACK after a failed transaction failed too", exc_info=True)
+            raise
+        con.execute("COMMIT")
 
 
 # -- creating a database or checking an existing one -------------------------------

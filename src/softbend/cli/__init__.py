@@ -150,6 +150,9 @@ def interrupted_line(args: Sequence[str]) -> str:
 #: Whether Ctrl-C reached :func:`main` through a command (set by :func:`_noting_interrupts`).
 _CTRL_C = {"seen": False}
 
+#: What DuckDB raises (a ``RuntimeError``) when a Ctrl-C reaches it inside a query.
+_DUCKDB_INTERRUPTED = "Query interrupted"
+
 
 def _noting_interrupts(callback: Callable[..., Any]) -> Callable[..., Any]:
     """``callback`` noting a Ctrl-C it lets through (typer turns it into exit code 130).
@@ -165,6 +168,11 @@ def _noting_interrupts(callback: Callable[..., Any]) -> Callable[..., Any]:
         except KeyboardInterrupt:
             _CTRL_C["seen"] = True
             raise
+        except RuntimeError as exc:
+            if str(exc) != _DUCKDB_INTERRUPTED:
+                raise
+            _CTRL_C["seen"] = True  # a Ctrl-C inside a DuckDB query (a read: writes defer it)
+            raise KeyboardInterrupt from exc
 
     run._softbend_noting = True  # type: ignore[attr-defined]
     return run
