@@ -8,7 +8,11 @@ import numpy as np
 import pytest
 
 from softbend.metrics import rmse
-from softbend.transfer.loco import leave_one_configuration_out
+from softbend.transfer.loco import (
+    CURVE_SIZES,
+    learning_curve_sizes,
+    leave_one_configuration_out,
+)
 
 FAST = {
     "refined": {"epochs": 30},
@@ -75,6 +79,17 @@ def test_learning_curve_covers_one_to_n_minus_one_actuators(result, quick_measur
     for name, part in curve.groupby("strategy"):
         assert sorted(set(part["n_actuators"])) == list(range(1, n)), name
         assert len(part) == n * (n - 1)
+
+
+@pytest.mark.parametrize("n", range(2, 40))
+def test_learning_curve_sizes_are_every_size_up_to_the_cap_then_geometric(n):
+    sizes = learning_curve_sizes(n)
+    assert sizes == sorted(set(sizes)) and len(sizes) <= CURVE_SIZES
+    if n - 2 <= CURVE_SIZES:
+        assert sizes == list(range(1, n - 1))  # paper B's seven actuators: 1..5, unchanged
+    else:
+        assert sizes[0] == 1 and sizes[-1] == n - 2 and len(sizes) >= CURVE_SIZES - 1
+        assert np.all(np.diff(np.log(sizes)) > 0)
 
 
 def test_same_seed_same_numbers(small_base, quick_measurements, result):

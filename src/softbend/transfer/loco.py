@@ -63,11 +63,13 @@ if TYPE_CHECKING:
 
 __all__ = [
     "BASELINE_STRATEGY",
+    "CURVE_SIZES",
     "DEFAULT_STRATEGIES",
     "MIN_CALIBRATION_ACTUATORS",
     "LocoResult",
     "check_calibration",
     "held_out_residuals",
+    "learning_curve_sizes",
     "leave_one_configuration_out",
     "strategy_options",
 ]
@@ -78,6 +80,10 @@ DEFAULT_STRATEGIES: tuple[str, ...] = BUILTIN_STRATEGIES
 
 #: Strategies left out of the learning curve and the nested calibration (the longest training).
 _SLOW = ("experimental", "refined-ensemble")
+
+#: The most training-set sizes of a learning curve (:func:`learning_curve_sizes`): paper B's
+#: seven actuators give five, each size; 14 actuators give 1, 2, 3, 4, 7 and 12 of the 12.
+CURVE_SIZES = 6
 
 #: The strategy every other is judged against (``rmse_vs_baseline_pct`` of the summary): the
 #: base plus the mean residual of the training actuators as a function of pressure alone.
@@ -284,6 +290,34 @@ def _reason(error: BaseException) -> str:
     return " ".join(error.described(subject).split())
 
 
+def learning_curve_sizes(n_actuators: int, most: int = CURVE_SIZES) -> list[int]:
+    """The numbers of training actuators a learning curve fits on, with ``n_actuators`` in all.
+
+    One actuator is held out and the main evaluation fits on the n − 1 others,
+    so the curve's sizes lie in 1 … n − 2: each of them while there are at most
+    ``most``, else at most ``most`` sizes spaced geometrically from 1 to n − 2 (the
+    curve changes most at few actuators; its fits cost most at many).
+
+    Parameters
+    ----------
+    n_actuators : int
+        Actuators in the measurements, held-out one included.
+    most : int, default CURVE_SIZES
+        The most sizes, at least 2.
+
+    Returns
+    -------
+    list of int
+        Increasing sizes; none below three actuators.
+    """
+    top = int(n_actuators) - 2
+    if top < 1:
+        return []
+    if top <= most:
+        return list(range(1, top + 1))
+    return sorted({round(float(size)) for size in np.geomspace(1, top, most)})
+
+
 def leave_one_configuration_out(
     measurements: Measurements | ActuatorMeasurements,
     base: Surrogate | None,
@@ -314,9 +348,11 @@ def leave_one_configuration_out(
     level : float, default 0.9
         Probability of the prediction intervals, in (0, 1).
     learning_curve : bool, default True
-        Also fit on 1, 2, ..., n−2 of the other actuators (n−1 is the main
-        evaluation); not ``experimental`` and ``refined-ensemble``, whose
-        training would dominate the time.
+        Also fit on fewer of the other actuators (n−1 is the main evaluation):
+        each of 1, 2, ..., n−2 up to :data:`CURVE_SIZES` sizes, beyond that
+        at most that many, spaced geometrically from 1 to n−2
+        (:func:`learning_curve_sizes`); not ``experimental`` and
+        ``refined-ensemble``, whose training would dominate the time.
     calibrated : bool, default False
         Also score the calibrated interval of :mod:`softbend.transfer.conformal`
         on each held-out actuator, nested (n − 1 more fits per held-out
@@ -444,7 +480,7 @@ def _leave_one_out(
         tasks += [("loco", held_out, len(ids) - 1, n, train, test) for n in names]
         others = [a for a in ids if a != held_out]
         order = [others[i] for i in rng.permutation(len(others))]
-        for size in range(1, len(ids) - 1):
+        for size in learning_curve_sizes(len(ids)):
             rows = np.flatnonzero(np.isin(groups, order[:size]))
             tasks += [("curve", held_out, size, n, rows, test) for n in curve_names]
         # Nested calibration: each other actuator predicted without it and without held_out.
