@@ -17,7 +17,8 @@ epochs, the variant is stopped and keeps its weights of the shadow's best
 epoch; the epochs given are the cap. The variant itself trains on all its rows, so
 a variant that never plateaus ends exactly where training without the stop
 would, and the shadows ride in the same batched step (one training for every
-fold). Training ends when every variant has stopped.
+fold). A stopped variant and its shadow leave the batch (the others' steps are
+the same without them), and training ends when every variant has stopped.
 
 On a GPU (``device="cuda"``, or ``"auto"`` where one is seen) the same code runs
 with every tensor on the device, in float64 as on the CPU; the loss curve is
@@ -249,22 +250,40 @@ def fine_tune_many(
         curve_t = torch.empty((k, epochs), **on)
         watch = _Watch(torch, stop, check_w, watched, k, on) if m else None
         phase, stride = f"training {k} network{'s' * (k > 1)} (epochs)", every(epochs)
+        # The rows of the stack still trained: all (None), or those a stop has not ended.
+        active: Any = None
+        active_k: Any = None  # the variants among them
         for epoch in range(epochs):
-            a = torch.tanh(z @ weights_[0] + biases[0])
-            a = torch.tanh(a @ weights_[1] + biases[1])
-            out = (a @ weights_[2] + biases[2])[..., 0]
-            per_variant = (((out - t) ** 2) * share).sum(dim=1)
+            if active is None:
+                zz, tt, ss, ws, bs = z, t, share, weights_, biases
+            else:  # the stopped variants and their shadows ride no longer
+                zz, tt, ss = z[active], t[active], share[active]
+                ws, bs = [p[active] for p in weights_], [b[active] for b in biases]
+            a = torch.tanh(zz @ ws[0] + bs[0])
+            a = torch.tanh(a @ ws[1] + bs[1])
+            out = (a @ ws[2] + bs[2])[..., 0]
+            per_variant = (((out - tt) ** 2) * ss).sum(dim=1)
             if watch is not None:
-                watch.see(epoch, out.detach(), t, [*weights_, *biases])
+                seen = out.detach()
+                if active is not None:
+                    seen = seen.new_zeros(t.shape).index_copy_(0, active, seen)
+                watch.see(epoch, seen, t, [*weights_, *biases])
             optimizer.zero_grad()
             per_variant.sum().backward()
             optimizer.step()
-            curve_t[:, epoch] = per_variant.detach()[:k]
+            if active is None:
+                curve_t[:, epoch] = per_variant.detach()[:k]
+            else:
+                curve_t[active_k, epoch] = per_variant.detach()[: active_k.numel()]
             if (epoch + 1) % stride == 0 or epoch + 1 == epochs:
                 report(phase, epoch + 1, epochs)
-            if watch is not None and m == k and (epoch + 1) % _STOP_CHECK == 0 and watch.done():
-                report(phase, epochs, epochs)  # every variant stopped: the phase is over
-                break
+            if watch is not None and (epoch + 1) % _STOP_CHECK == 0:
+                if m == k and watch.done():
+                    report(phase, epochs, epochs)  # every variant stopped: the phase is over
+                    break
+                active = watch.active(k)
+                if active is not None:
+                    active_k = active[active < k]
         curve = curve_t.cpu().numpy()
         kept = np.full(k, epochs)
         params = [p.detach() for p in (*weights_, *biases)]
@@ -340,6 +359,18 @@ class _Watch:
     def done(self) -> bool:
         """Whether every watched variant has stopped."""
         return not bool(self.running.any())
+
+    def active(self, k: int) -> Any:
+        """The rows of the stack (``k`` variants, then the shadows) still to train, in order;
+        None while every one is. A stopped variant keeps its snapshot, so neither it nor its
+        shadow needs another step; a variant no shadow watches trains to the cap."""
+        torch = self.torch
+        keep = torch.ones(k + self.watched.numel(), dtype=torch.bool, device=self.running.device)
+        keep[self.watched[~self.running]] = False
+        keep[k:] = self.running
+        if bool(keep.all()):
+            return None
+        return torch.nonzero(keep).flatten()
 
     def kept(self, epochs: int, params: list[Any]) -> tuple[np.ndarray, list[Any]]:
         """Steps each variant keeps and the weights: a stopped one's at its shadow's best."""
