@@ -109,7 +109,8 @@ def test_a_bad_stop_is_one_error_naming_the_field(kwargs, key):
 def test_the_experimental_mlp_stops_before_its_cap(quick_measurements):
     from softbend.transfer.strategies import ExperimentalMLP
 
-    assert ExperimentalMLP().epochs == 15000 and ExperimentalMLP().patience == 500
+    default = ExperimentalMLP()
+    assert (default.epochs, default.patience, default.min_delta) == (15000, 200, 0.01)
     X, y = quick_measurements.features, quick_measurements.angle_deg
     model = ExperimentalMLP(hidden_sizes=(8, 8), patience=20, min_delta=0.05, device="cpu")
     model.fit(X, y)

@@ -61,7 +61,7 @@ LEVEL_OPTION = typer.Option(0.9, help="Probability of the prediction intervals."
 LEARNING_CURVE_OPTION = typer.Option(
     True,
     "--learning-curve/--no-learning-curve",
-    help="Also fit on fewer actuators: 1..n-2, at most 6 sizes (geometric beyond).",
+    help="Also fit on fewer actuators: 1..n-2, at most 6 sizes spaced geometrically.",
 )
 CALIBRATE_OPTION = typer.Option(
     False,
