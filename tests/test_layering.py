@@ -21,6 +21,7 @@ STAGES: tuple[tuple[str, ...], ...] = (
     (
         "__init__",
         "_extras",
+        "_interrupts",
         "_io",
         "_outdir",
         "_jsontext",
