@@ -189,3 +189,24 @@ def test_a_constraint_dividing_by_zero_is_one_line_before_any_work(sims, tmp_pat
         "must give finite values."
     )
     assert not (tmp_path / "m").exists()
+
+
+@pytest.mark.parametrize(
+    ("flag", "asked"), [([], None), (["--interpolation"], True), (["--no-interpolation"], False)]
+)
+def test_the_interpolation_flags_reach_training_and_the_default_is_the_table_size_rule(
+    sims, tmp_path, capsys, monkeypatch, flag, asked
+):
+    import softbend.surrogates.workflow as workflow
+
+    class AskedError(Exception):
+        pass
+
+    def train_into(source, out, **options):
+        raise AskedError(options["interpolation"])
+
+    monkeypatch.setattr(workflow, "train_into", train_into)
+    args = ["train", str(sims), *TABLE_OPTIONS, "--out", str(tmp_path / "m"), *flag]
+    with pytest.raises(AskedError) as told:
+        main(args)
+    assert told.value.args[0] is asked  # None: train_surrogates scores it below 100 designs

@@ -85,3 +85,40 @@ def test_training_without_families_named_searches_the_defaults_of_its_size(
     with pytest.raises(AskedError) as asked:
         train_surrogates(_data(n_designs), tmp_path, export_onnx=False)
     assert tuple(asked.value.args[0]) == families
+
+
+@pytest.mark.parametrize(
+    ("n_designs", "asked", "scored"),
+    [
+        (SMALL_DATA_DESIGNS - 1, None, True),  # the default: below the small-data bound
+        (SMALL_DATA_DESIGNS, None, False),  # from it: one more fit per family, skipped
+        (SMALL_DATA_DESIGNS, True, True),  # asked for: scored on any table
+        (SMALL_DATA_DESIGNS - 1, False, False),  # declined: skipped on any table
+    ],
+)
+def test_the_interpolation_score_is_scored_by_default_only_below_the_small_data_bound(
+    n_designs, asked, scored, tmp_path, monkeypatch
+):
+    import softbend.surrogates.interpolation as interpolation
+
+    calls: list[int] = []
+    scores = interpolation.interpolation_scores
+
+    def counted(data, *args, **kwargs):
+        calls.append(data.n_groups)
+        return scores(data, *args, **kwargs)
+
+    monkeypatch.setattr(interpolation, "interpolation_scores", counted)
+    _, summary = train_surrogates(
+        _data(n_designs),
+        tmp_path,
+        models=["plr"],
+        grid_name="small",
+        folds=3,
+        export_onnx=False,
+        interpolation=asked,
+    )
+    assert calls == ([n_designs] if scored else [])
+    assert ("interpolation" in summary["models"]["plr"]) is scored
+    if scored:
+        assert np.isfinite(summary["models"]["plr"]["interpolation"]["rmse_deg"])

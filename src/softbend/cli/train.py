@@ -102,11 +102,12 @@ def train(
         "grouped", help="Folds: grouped (whole designs) or random (shuffled samples, paper B's)."
     ),
     no_onnx: bool = typer.Option(False, "--no-onnx", help="Skip the ONNX export."),
-    no_interpolation: bool = typer.Option(
-        False,
-        "--no-interpolation",
-        help="Skip the interpolation score (held-out pressures of the simulated designs: one "
-        "more fit per family).",
+    interpolation: bool | None = typer.Option(
+        None,
+        "--interpolation/--no-interpolation",
+        help="Score interpolation too (held-out pressures of the simulated designs: one more "
+        "fit per family), or skip it (default: scored below 100 designs, skipped from 100).",
+        show_default=False,
     ),
     measurements: list[Path] | None = typer.Option(
         None,
@@ -132,10 +133,11 @@ def train(
     --grid is given, and adds the table base (the simulated curves themselves,
     a Gaussian process between designs) to the default families.
 
-    Beside the grouped figures, each family's chosen configuration is scored on
+    Below 100 designs, each family's chosen configuration is also scored on
     interpolation: every other interior pressure point of each simulated design
-    held out, the rest fitted (the table's "interp." column; --no-interpolation
-    skips it).
+    held out, the rest fitted (the table's "interp." column). From 100 designs
+    it is skipped (one more fit per family, long on a large table) unless
+    --interpolation asks for it; --no-interpolation skips it on any table.
 
     With --measurements, the family is selected by how well it transfers, not
     by grouped CV alone: each family's refit model is the base of a
@@ -224,7 +226,7 @@ def train(
             n_jobs=workers,
             epochs=epochs,
             export_onnx=not no_onnx,
-            interpolation=not no_interpolation,
+            interpolation=interpolation,
             progress=progress,
             cv=cv,
             halving=halving,

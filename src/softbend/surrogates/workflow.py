@@ -191,7 +191,7 @@ def train_surrogates(
     plr_patience: int | None = None,
     checkpoint: SearchCheckpoint | None = None,
     tf32: bool = False,
-    interpolation: bool = True,
+    interpolation: bool | None = None,
 ) -> tuple[SearchResult, dict[str, Any]]:
     """Search, refit, save and export the surrogates of a campaign.
 
@@ -222,11 +222,14 @@ def train_surrogates(
     tf32 : bool
         TF32 matrix products for the MLP on a CUDA device (see
         :func:`softbend.surrogates.search.search`).
-    interpolation : bool, default True
+    interpolation : bool, optional
         Also score each family's chosen configuration on held-out pressure points
         of the simulated designs (:func:`~softbend.surrogates.interpolation.interpolation_scores`:
         one more fit per family), reported as ``interpolation`` beside the
-        grouped figures.
+        grouped figures. None (the default): only for a table of fewer than
+        :data:`~softbend.surrogates.search.SMALL_DATA_DESIGNS` designs, where the
+        extra fit is cheap and the grouped figures alone vary most (a large
+        table pays a whole fit per family for it).
     select_by : {"rmse", "mape", "r2"}
         The cross-validated metric that names the best family (default RMSE).
     advise : callable, optional
@@ -281,6 +284,8 @@ def train_surrogates(
         on_start=_telling(advise, advice),
     )
     interpolated: dict[str, dict[str, float]] = {}
+    if interpolation is None:
+        interpolation = data.n_groups < SMALL_DATA_DESIGNS
     if interpolation:
         from softbend.surrogates.families import FitSettings
         from softbend.surrogates.interpolation import interpolation_scores
