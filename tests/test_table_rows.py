@@ -142,3 +142,44 @@ def test_row_lines_finds_the_rows_of_a_plain_section_and_declines_the_rest():
     assert row_lines("1,\u00b52\n".encode(), ",", 2, 100) is None  # not ASCII
     assert row_lines(b"1,2\n", ",", 2, 2) is None  # a line over the field limit
     assert row_lines(b"\n\n", ",", 2, 100) is None  # no row
+    assert row_lines(b"1,2,3\n4\n", ",", 2, 100) is None  # widths 3 and 1: 2 on average
+    assert row_lines(b"1\n2,3,4\n", ",", 2, 100) is None
+    assert row_lines(b"\n1,2\n\n\n3,4\n\n5,6", ",", 2, 100).tolist() == [1, 4, 6]
+    assert row_lines(b"1;2\n3;4\n", ";", 2, 100).tolist() == [0, 1]
+    assert row_lines(b"1;2\n3,4\n", ";", 2, 100) is None  # a comma is text here
+
+
+def _rows_line_by_line(data: bytes, separator: str, width: int, field_limit: int) -> list | None:
+    """What :func:`row_lines` finds, one line at a time (its definition)."""
+    text = data.decode("ascii", errors="replace")
+    if not data.isascii() or any(c in text for c in '"\0# \t\x0b\x0c\x1c\x1d\x1e\x1f'):
+        return None
+    if text.count("\r") != text.count("\r\n"):
+        return None
+    lines = text.split("\n")
+    if text.endswith("\n"):
+        lines = lines[:-1]
+    rows = []
+    for number, line in enumerate(lines):
+        line = line.removesuffix("\r")
+        if not line:
+            continue
+        if len(line) > field_limit or line.count(separator) != width - 1:
+            return None
+        rows.append(number)
+    return rows or None
+
+
+def test_row_lines_agrees_with_reading_line_by_line_on_random_sections():
+    rng = np.random.default_rng(7)
+    alphabet = [b"1", b"2", b",", b",", b"\n", b"\n", b"\r\n", b"x", b" ", b'"']
+    agreed = 0
+    for _ in range(3000):
+        pieces = rng.choice(len(alphabet), size=int(rng.integers(1, 14)))
+        data = b"".join(alphabet[k] for k in pieces)
+        width = int(rng.integers(1, 4))
+        found = row_lines(data, ",", width, 5)
+        expected = _rows_line_by_line(data, ",", width, 5)
+        assert (found.tolist() if found is not None else None) == expected, (data, width)
+        agreed += found is not None
+    assert agreed > 100  # plain sections were drawn, not only declined ones

@@ -77,3 +77,31 @@ def test_check_features_accepts_one_sample_and_names_bad_input():
     x[1, 6] = np.nan
     with pytest.raises(ValueError, match="'pressure_mpa' of row 1"):
         check_features(x)
+
+
+@pytest.mark.parametrize(
+    "groups",
+    [
+        None,
+        np.array(["d1", "d2"] * 10, dtype=object),
+        np.array(["d1", "dé"] * 10),  # NumPy's own strings
+        np.arange(20),  # numbers: their text
+        np.array([1.5, "x"] * 10, dtype=object),  # mixed: each one's text
+    ],
+)
+def test_the_data_hash_is_its_definition_whatever_the_arrays_layout(groups):
+    """SHA-256 of X's and y's float64 bytes in C order and the labels' text joined by \\x1f:
+    the hash every saved model records, so it may never change."""
+    import hashlib
+
+    rng = np.random.default_rng(3)
+    X = rng.normal(size=(3, 20)).T  # not C-contiguous
+    y = rng.normal(size=40)[::2].astype(np.float32)  # strided, another dtype
+    digest = hashlib.sha256()
+    digest.update(np.ascontiguousarray(X, dtype=np.float64).tobytes())
+    digest.update(np.ascontiguousarray(y, dtype=np.float64).tobytes())
+    if groups is not None:
+        digest.update("\x1f".join(str(g) for g in np.asarray(groups).tolist()).encode())
+    assert data_hash(X, y, groups) == digest.hexdigest()[:16]
+    # a pinned value, computed before the hash read the arrays' buffers without copies
+    assert data_hash(np.zeros((2, 2)), np.zeros(2), ["a", "b"]) == "a5103c81b199711f"

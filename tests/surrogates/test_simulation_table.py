@@ -47,6 +47,21 @@ def test_a_table_becomes_training_data_grouped_by_design(sims):
     assert a.pressure_unit == "kPa"
     # a negative angle at zero pressure (pre-curved) is kept
     assert data.y.min() == pytest.approx(-3.0)
+    # arrays of its own, writable, even where no row was dropped (no view of the read frame)
+    assert all(a.flags.writeable and a.flags.owndata for a in (data.X, data.y, data.groups))
+
+
+def test_rows_with_a_missing_value_are_dropped_and_counted(tmp_path):
+    frame = table()
+    frame.loc[[3, 10], "angle_deg"] = np.nan
+    frame.loc[17, "p_kpa"] = np.nan
+    path = tmp_path / "gaps.csv"
+    frame.to_csv(path, index=False)
+    data = read(path)
+    assert data.n_samples == len(frame) - 3 and data.n_dropped == 3
+    kept = frame.drop(index=[3, 10, 17])
+    assert np.array_equal(data.y, kept["angle_deg"].to_numpy())
+    assert np.array_equal(data.groups, kept["design_id"].to_numpy(dtype=object))
 
 
 def test_parquet_reads_as_the_csv_does(sims, tmp_path):

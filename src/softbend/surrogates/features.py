@@ -98,10 +98,16 @@ def data_hash(X: ArrayLike, y: ArrayLike, groups: ArrayLike | None = None) -> st
     group labels, so the same data in the same row order give the same hash.
     """
     digest = hashlib.sha256()
-    digest.update(np.ascontiguousarray(X, dtype=np.float64).tobytes())
-    digest.update(np.ascontiguousarray(y, dtype=np.float64).tobytes())
+    # the arrays' own buffers (no copy); the same bytes as their ``tobytes()``
+    digest.update(memoryview(np.ascontiguousarray(X, dtype=np.float64)).cast("B"))
+    digest.update(memoryview(np.ascontiguousarray(y, dtype=np.float64)).cast("B"))
     if groups is not None:
-        digest.update("\x1f".join(map(str, np.asarray(groups).tolist())).encode())
+        labels = np.asarray(groups).tolist()
+        try:
+            joined = "\x1f".join(labels)  # labels that are text already, as most are
+        except TypeError:
+            joined = "\x1f".join(map(str, labels))
+        digest.update(joined.encode())
     return digest.hexdigest()[:16]
 
 

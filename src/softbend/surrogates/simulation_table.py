@@ -375,7 +375,9 @@ def table_training_data(
             f"({len(frame)} rows in all)",
             file=str(source),
         )
-    codes, pressures, angles = codes[keep], pressures[keep], angles[keep]
+    every = bool(keep.all())  # the usual table: no row dropped, no copies
+    if not every:
+        codes, pressures, angles = codes[keep], pressures[keep], angles[keep]
     try:
         actuator.check_designs(codes)
     except ActuatorError as err:
@@ -386,11 +388,11 @@ def table_training_data(
         names = frame[GROUP].to_numpy()
         if names.dtype != object or pd.api.types.infer_dtype(names, skipna=False) != "string":
             names = frame[GROUP].astype(str).to_numpy()
-        groups = names[keep]
+        groups = names.copy() if every else names[keep]  # not a view of the frame
     else:
         _, index = np.unique(codes, axis=0, return_inverse=True)
         groups = np.array([f"d{i:05d}" for i in index.ravel()])
-    if np.any(groups != groups[0]) and np.abs(angles).max() <= _RADIAN_MAX:  # two designs
+    if np.abs(angles).max() <= _RADIAN_MAX and np.any(groups != groups[0]):  # two designs
         raise ActuatorError(
             f"no |angle| exceeds {np.abs(angles).max():.4g} over the whole table; they look "
             "like radians: multiply by 180/π (57.2958) for degrees",
@@ -400,7 +402,7 @@ def table_training_data(
     if describing is not None:
         report(describing, 3, 3)
     X = np.ascontiguousarray(np.column_stack([codes, pressures]))
-    y = np.ascontiguousarray(angles)
+    y = np.array(angles, dtype=np.float64)  # a copy: the column may be the frame's, read-only
     return TrainingData(
         X=X,
         y=y,
