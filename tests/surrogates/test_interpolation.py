@@ -122,3 +122,24 @@ def test_the_interpolation_score_is_scored_by_default_only_below_the_small_data_
     assert ("interpolation" in summary["models"]["plr"]) is scored
     if scored:
         assert np.isfinite(summary["models"]["plr"]["interpolation"]["rmse_deg"])
+
+
+def _rows_design_by_design(X, groups):
+    """The held-out rows, one design at a time (the definition)."""
+    held = []
+    for name in dict.fromkeys(groups.tolist()):
+        rows = np.flatnonzero(groups == name)
+        ordered = rows[np.argsort(X[rows, -1], kind="stable")]
+        held.extend(ordered[1:-1:2].tolist())
+    return np.array(sorted(held), dtype=np.int64)
+
+
+def test_the_held_out_rows_are_those_of_each_design_in_turn_with_ties_in_row_order():
+    rng = np.random.default_rng(11)
+    n = 400
+    groups = rng.choice(np.array(["a", "b", "c", "dd", "e"] + [f"x{k}" for k in range(40)]), n)
+    X = np.column_stack([rng.normal(size=n), rng.integers(0, 6, n).astype(float)])  # ties
+    kept, held = interpolation_rows(X, groups)
+    assert np.array_equal(held, _rows_design_by_design(X, groups))
+    assert np.array_equal(kept, np.setdiff1d(np.arange(n), held))
+    assert kept.dtype == held.dtype == np.int64

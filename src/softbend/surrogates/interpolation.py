@@ -49,15 +49,22 @@ def interpolation_rows(X: np.ndarray, groups: np.ndarray) -> tuple[np.ndarray, n
     kept, held : ndarray of int
         Sorted row indices; ``held`` is every other interior point of each curve.
     """
-    held: list[int] = []
-    names, inverse = np.unique(np.asarray(groups), return_inverse=True)
-    inverse = inverse.ravel()
-    for k in range(names.size):
-        rows = np.flatnonzero(inverse == k)
-        ordered = rows[np.argsort(X[rows, -1], kind="stable")]
-        held.extend(int(i) for i in ordered[1:-1:2])
-    held_rows = np.array(sorted(held), dtype=np.int64)
-    kept = np.setdiff1d(np.arange(X.shape[0]), held_rows)
+    import pandas as pd
+
+    n = X.shape[0]
+    # each design's rows by pressure, ties in row order (one stable sort; no pass per design:
+    # a loop over the designs read every row once per design, minutes on 10^6 rows)
+    codes, _ = pd.factorize(np.asarray(groups).ravel())
+    order = np.lexsort((X[:, -1], codes))
+    sizes = np.bincount(codes)
+    firsts = np.concatenate(([0], np.cumsum(sizes)[:-1]))
+    sorted_codes = codes[order]
+    position = np.arange(n) - firsts[sorted_codes]  # 0 at each curve's lowest pressure
+    interior_odd = (position % 2 == 1) & (position < sizes[sorted_codes] - 1)
+    held_rows = np.sort(order[interior_odd]).astype(np.int64)
+    chosen = np.ones(n, dtype=bool)
+    chosen[held_rows] = False
+    kept = np.flatnonzero(chosen).astype(np.int64)
     return kept, held_rows
 
 
