@@ -70,8 +70,9 @@ BODY = (
         "\ufeff# rig: r\n# a remark\n\n" + BODY,
         ("# rig: r\n" + BODY).replace("\n", "\r\n"),
         "# rig: r\n" + BODY.rstrip("\n"),
+        "\ufeff# rig: r \u00b5-stage\n# r\u00e9sum\u00e9: none\n\n\n" + BODY,
     ],
-    ids=["plain", "bom-and-remarks", "crlf", "no-final-newline"],
+    ids=["plain", "bom-and-remarks", "crlf", "no-final-newline", "non-ascii-header"],
 )
 def test_a_file_reads_the_same_through_pandas_and_line_by_line(tmp_path, monkeypatch, text):
     path = tmp_path / "t.csv"
@@ -146,6 +147,9 @@ def test_row_lines_finds_the_rows_of_a_plain_section_and_declines_the_rest():
     assert row_lines(b"1\n2,3,4\n", ",", 2, 100) is None
     assert row_lines(b"\n1,2\n\n\n3,4\n\n5,6", ",", 2, 100).tolist() == [1, 4, 6]
     assert row_lines(b"1;2\n3;4\n", ";", 2, 100).tolist() == [0, 1]
+    # from an offset: the bytes before it (a header, remarks) are not the section's
+    assert row_lines(b'# "\xb5"\na,b\n1,2\n\n3,4', ",", 2, 100, 10).tolist() == [0, 2]
+    assert row_lines(b"a,b\n1,2\n", ",", 2, 100, 8) is None  # nothing after the offset
     assert row_lines(b"1;2\n3,4\n", ";", 2, 100) is None  # a comma is text here
 
 
@@ -183,3 +187,17 @@ def test_row_lines_agrees_with_reading_line_by_line_on_random_sections():
         assert (found.tolist() if found is not None else None) == expected, (data, width)
         agreed += found is not None
     assert agreed > 100  # plain sections were drawn, not only declined ones
+
+
+@pytest.mark.parametrize("where", ["header", "row"])
+def test_a_file_not_utf8_is_the_line_readers_one_error(tmp_path, where):
+    head, row = b"# rig: r\n", b"0.5,2\n"
+    if where == "header":
+        head = b"# rig: r\xff\n"
+    else:
+        row = b"0.5,2\xff\n"
+    path = tmp_path / "t.csv"
+    path.write_bytes(head + b"time_s,pressure_kpa\n" + row)
+    offset = (head + b"time_s,pressure_kpa\n" + row).index(b"\xff")
+    with pytest.raises(DatasetError, match=f"not UTF-8 text .undecodable byte at offset {offset}"):
+        read_table(path, FORMAT)

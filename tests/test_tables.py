@@ -157,13 +157,13 @@ def test_a_large_file_reports_its_read_before_its_first_byte_is_read(tmp_path, m
 
     path = _write(tmp_path, "# rig: r\ntime_s,pressure_kpa\n" + "0.1,1\n" * 200, "big.csv")
     heard: list[object] = []
-    read_text = softbend._io.read_input_text
+    read_bytes = softbend._io.read_input_bytes
 
     def reading(*args, **kwargs):
         heard.append("the file is read")
-        return read_text(*args, **kwargs)
+        return read_bytes(*args, **kwargs)
 
-    monkeypatch.setattr(softbend._io, "read_input_text", reading)
+    monkeypatch.setattr(softbend._io, "read_input_bytes", reading)
     with listening(lambda *call: heard.append(call)):
         read_table(path, FORMAT)  # below the size that reports: silent
         assert heard == ["the file is read"]

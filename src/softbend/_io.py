@@ -31,6 +31,7 @@ __all__ = [
     "json_text",
     "new_file_mode",
     "read_header_csv",
+    "read_input_bytes",
     "read_input_text",
     "write_bytes_atomic",
     "write_text_atomic",
@@ -142,6 +143,23 @@ def read_input_text(
         raise (error or DatasetError)(
             f"{what} is not UTF-8 text (undecodable byte at offset {exc.start})."
         ) from None
+
+
+def read_input_bytes(path: str | os.PathLike[str], what: str) -> bytes:
+    """The bytes of an input file, after the ``file_mib`` limit (:func:`read_input_text`'s
+    check; the caller decodes what it needs).
+
+    Parameters
+    ----------
+    path : path
+        The file (its existence is the caller's to check and name).
+    what : str
+        The file as messages name it.
+    """
+    from softbend.limits import check_file_size
+
+    check_file_size(path, what)
+    return Path(path).read_bytes()
 
 
 class CSVLine(NamedTuple):

@@ -45,41 +45,49 @@ class ColumnSpec(Protocol):
     def choices(self) -> tuple[str, ...]: ...
 
 
-def row_lines(data: bytes, separator: str, width: int, field_limit: int) -> np.ndarray | None:
+def row_lines(
+    data: bytes, separator: str, width: int, field_limit: int, start: int = 0
+) -> np.ndarray | None:
     """The offsets of the data rows among the lines of a plain data section, or None.
 
     Parameters
     ----------
     data : bytes
-        The file after its column header's line.
+        The file; its data section starts at ``start``, after its column header's line.
     separator : str
         The one-character cell separator.
     width : int
         The header's number of columns.
     field_limit : int
         The longest line read without the :mod:`csv` module (characters).
+    start : int, default 0
+        The data section's first byte in ``data`` (the section is not copied out).
 
     Returns
     -------
     ndarray of int64 or None
-        For each data row, the number of lines before it in ``data`` (blank lines
+        For each data row, the number of lines before it in the section (blank lines
         are not rows); None where ``data`` is not plain (see the module) or a
         row has another number of cells than ``width``.
     """
     sep = separator.encode()
     if len(sep) != 1 or separator in "\r\n" or sep in _NOT_PLAIN:
         return None
-    # plain: ASCII without the bytes above (byte searches, no pass over an array of the bytes)
-    if not data or not data.isascii() or any(byte in data for byte in _NOT_PLAIN):
+    # plain: none of the bytes above (byte searches) and ASCII
+    if start >= len(data) or any(data.find(byte, start) >= 0 for byte in _NOT_PLAIN):
         return None
-    returns = data.count(b"\r") if b"\r" in data else 0
-    if returns and returns != data.count(b"\r\n"):
+    buffer = np.frombuffer(data, dtype=np.uint8, offset=start)
+    if buffer.max() >= 128:
+        return None
+    returns = data.count(b"\r", start) if data.find(b"\r", start) >= 0 else 0
+    if returns and returns != data.count(b"\r\n", start):
         return None  # a lone '\r' ends a line: the line reader numbers those
-    buffer = np.frombuffer(data, dtype=np.uint8)
-    newline = buffer == 10
-    ends = np.flatnonzero(newline)
+    # one scan: the separators and the line ends, in file order
+    marks = np.flatnonzero((buffer == sep[0]) | (buffer == 10))
+    ends = marks[buffer[marks] == 10]
     if not data.endswith(b"\n"):  # the last line has no newline
-        ends = np.append(ends, len(data))
+        ends = np.append(ends, buffer.size)
+        marks = np.append(marks, buffer.size)
     starts = np.concatenate(([0], ends[:-1] + 1))
     lengths = ends - starts
     if returns:
@@ -89,14 +97,10 @@ def row_lines(data: bytes, separator: str, width: int, field_limit: int) -> np.n
     rows = np.flatnonzero(~blank)
     if rows.size == 0 or lengths.max() > field_limit:
         return None
-    # Each row's cells: the separators and the row ends, in file order, fall in groups of
-    # ``width`` of which the last is the row's end (a blank line's newline left out).
-    delimiters = newline | (buffer == sep[0])
+    # Each row's cells: its separators and its end fall in a group of ``width`` marks of
+    # which the last is the row's end (a blank line's newline left out).
     if blank.any():
-        delimiters[ends[blank & (ends < len(data))]] = False
-    marks = np.flatnonzero(delimiters)
-    if ends[-1] == len(data):
-        marks = np.append(marks, len(data))
+        marks = np.setdiff1d(marks, ends[blank], assume_unique=True)
     if marks.size != rows.size * width or not np.array_equal(marks[width - 1 :: width], ends[rows]):
         return None
     return rows.astype(np.int64)
@@ -108,6 +112,7 @@ def parse_rows(
     width: int,
     columns: Sequence[tuple[int, ColumnSpec]],
     n_rows: int,
+    start: int = 0,
 ) -> dict[int, np.ndarray] | None:
     """The read columns of a plain data section (:func:`row_lines`), or None.
 
@@ -123,6 +128,8 @@ def parse_rows(
         The 0-based position of each column read and its declaration.
     n_rows : int
         The number of rows :func:`row_lines` found.
+    start : int, default 0
+        The section's first byte in ``data``.
 
     Returns
     -------
@@ -132,9 +139,11 @@ def parse_rows(
     """
     import pandas as pd
 
-    head = data.lstrip(b"\r\n")
-    end = head.find(b"\n")  # the first row's line, not a copy of the rest
-    first = head[: end if end >= 0 else len(head)].rstrip(b"\r").decode().split(separator)
+    begin = start
+    while begin < len(data) and data[begin] in b"\r\n":  # blank lines before the first row
+        begin += 1
+    end = data.find(b"\n", begin)  # the first row's line, not a copy of the rest
+    first = data[begin : end if end >= 0 else len(data)].rstrip(b"\r").decode().split(separator)
     used = [position for position, _ in columns]
     dtypes: dict[int, object] = {}
     for position, column in columns:
@@ -142,9 +151,11 @@ def parse_rows(
             dtypes[position] = np.float64
         elif column.kind in ("text", "choice") or not _number(first[position]):
             dtypes[position] = object  # text: one cell not a number makes the column text
+    stream = io.BytesIO(data)  # the bytes themselves, read from the section's start
+    stream.seek(start)
     try:
         frame = pd.read_csv(
-            io.BytesIO(data),
+            stream,
             sep=separator,
             header=None,
             names=list(range(width)),

@@ -28,6 +28,7 @@ The first problem met reading the file in order is the one reported.
 
 from __future__ import annotations
 
+import codecs
 import math
 import os
 from collections.abc import Callable, Mapping
@@ -491,22 +492,25 @@ def _read_plain(source: Path, fmt: TableFormat, file: str) -> _Read | None:
     """
     import csv
 
-    from softbend._io import read_input_text  # looked up at the call: a test may replace it
+    from softbend._io import read_input_bytes  # looked up at the call: a test may replace it
     from softbend.limits import limit
 
     phase = read_phase(source)
     if phase is not None:  # before a byte is read: a large file shows at once
         report(phase, 0, 100)
-    text = read_input_text(source, file, encoding="utf-8-sig")
+    # the bytes, not the text: the header lines are decoded here, the data section stays
+    # bytes for pandas (a file that is not UTF-8 is the line reader's to name)
+    data = read_input_bytes(source, file)
     header: dict[str, str] = {}
     header_lines: dict[str, int] = {}
-    start, number, line = 0, 0, ""
+    first = len(codecs.BOM_UTF8) if data.startswith(codecs.BOM_UTF8) else 0
+    start, number, line = first, 0, ""
     try:
-        while start < len(text):
-            end = text.find("\n", start)
-            end = len(text) if end < 0 else end
+        while start < len(data):
+            end = data.find(b"\n", start)
+            end = len(data) if end < 0 else end
             number += 1
-            line, start = text[start:end].strip(), end + 1
+            line, start = data[start:end].decode("utf-8").strip(), end + 1
             if line.startswith("#"):
                 key, sep, value = line[1:].partition(":")
                 if sep and key.strip():
@@ -517,20 +521,18 @@ def _read_plain(source: Path, fmt: TableFormat, file: str) -> _Read | None:
                 break
         else:
             return None  # no column header
-        preamble = text[:start]
-        if preamble.count("\r") != preamble.count("\r\n"):
+        preamble = data[first:start]
+        if preamble.count(b"\r") != preamble.count(b"\r\n"):
             return None  # a lone '\r' ends a line: the line reader numbers those
         if '"' in line or "\0" in line or len(line) > csv.field_size_limit():
             return None
         names = [cell.strip() for cell in line.split(fmt.separator)]
         _check_names(fmt, names, file, number)
-    except DatasetError:
+    except (DatasetError, UnicodeDecodeError):
         return None
     if phase is not None:
         report(phase, 20, 100)
-    body = text[start:].encode("utf-8")
-    del text
-    rows = row_lines(body, fmt.separator, len(names), csv.field_size_limit())
+    rows = row_lines(data, fmt.separator, len(names), csv.field_size_limit(), start)
     bound = limit("csv_rows") if fmt.max_rows is None else fmt.max_rows
     absent = any(h.required and h.name not in header for h in fmt.header)
     if rows is None or not fmt.min_rows <= rows.size <= bound or absent:
@@ -544,7 +546,7 @@ def _read_plain(source: Path, fmt: TableFormat, file: str) -> _Read | None:
             column = Column(name, kind="any", missing=True)
         if column is not None:
             kept.append((position, column))
-    parsed = parse_rows(body, fmt.separator, len(names), kept, rows.size)
+    parsed = parse_rows(data, fmt.separator, len(names), kept, rows.size, start)
     if parsed is None:
         return None
     if phase is not None:
