@@ -89,3 +89,25 @@ def test_small_tables_get_the_small_grid_and_one_line_of_advice(samples, tmp_pat
     assert "--grid quick was asked for" in small_data_advice(99, "quick")
     # without the MLP, no word of its grid
     assert "grid" not in small_data_advice(99, None, mlp=False)
+
+
+def test_saving_the_models_is_a_phase_after_the_last_refit(samples, tmp_path):
+    from softbend.surrogates.workflow import SAVING_PHASE
+
+    heard: list[tuple[str, int, int]] = []
+    _, summary = train_surrogates(
+        samples,
+        tmp_path,
+        models=["plr"],
+        folds=2,
+        export_onnx=False,
+        interpolation=False,
+        progress=lambda phase, done, total: heard.append((phase, done, total)),
+    )
+    saving = [(done, total) for phase, done, total in heard if phase == SAVING_PHASE]
+    assert saving == [(0, 1), (1, 1)]
+    first = next(i for i, call in enumerate(heard) if call[0] == SAVING_PHASE)
+    assert heard[first - 1][0].startswith("plr: refit on all designs")
+    assert all(call[0] == SAVING_PHASE for call in heard[first:])
+    saved = load_surrogate(summary["files"]["plr_model"]).metadata
+    assert saved["n_designs"] == 30 and saved["support"] and saved["training_ranges"]

@@ -143,7 +143,7 @@ def train_campaign_surrogates(
     ``models`` defaults to paper B's three families.
     """
     from softbend.surrogates.search import MODEL_NAMES
-    from softbend.surrogates.workflow import train_surrogates
+    from softbend.surrogates.workflow import SAVING_PHASE, train_surrogates
 
     folder = Path(out_dir) / "paper_b"
     families = MODEL_NAMES if models is None else tuple(models)
@@ -152,7 +152,7 @@ def train_campaign_surrogates(
     after = "paper B: surrogates, save and export (stages)"
 
     def on_progress(phase: str, done: int, total: int) -> None:
-        if progress is not None:
+        if progress is not None and phase != SAVING_PHASE:  # within ``after``
             progress(f"paper B: surrogates, {phase}", done, total)
             if (
                 families

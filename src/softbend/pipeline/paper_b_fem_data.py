@@ -91,7 +91,7 @@ def _surrogates(
     """Grouped search with saved models, then the chosen configurations under random folds."""
     from softbend.surrogates.features import training_data
     from softbend.surrogates.search import MODEL_NAMES, search
-    from softbend.surrogates.workflow import train_surrogates
+    from softbend.surrogates.workflow import SAVING_PHASE, train_surrogates
 
     families = MODEL_NAMES if models is None else tuple(models)
     # after the last family's refit on all designs: the saved models and their export
@@ -99,7 +99,7 @@ def _surrogates(
 
     def on_progress(protocol: str) -> Progress:
         def forward(phase: str, done: int, total: int) -> None:
-            if progress is not None:
+            if progress is not None and phase != SAVING_PHASE:  # within ``after``
                 progress(f"paper B FEM data: surrogates ({protocol} CV), {phase}", done, total)
                 last = (
                     protocol == "grouped"

@@ -70,6 +70,9 @@ SELECT_BY: dict[str, tuple[str, bool]] = {
     "r2": ("r2", True),
 }
 
+#: The progress phase of writing the models, after the last refit (its total: the families).
+SAVING_PHASE = "saving the models"
+
 
 def best_family(families: dict[str, Any], select_by: str = "rmse") -> str | None:
     """The family whose pooled cross-validated ``select_by`` score is best.
@@ -308,17 +311,26 @@ def train_surrogates(
     (out / "models").mkdir(parents=True, exist_ok=True)
     files: dict[str, str] = {}
     families: dict[str, Any] = {}
-    for name, fam in result.families.items():
+    saving = SAVING_PHASE
+    if progress is not None:  # the table's ranges and support: a second or more on 10^6 rows
+        progress(saving, 0, len(result.families))
+    # what every model records of the table, found once (not once per family)
+    described = {
+        "data_hash": data.data_hash,
+        "n_samples": data.n_samples,
+        "n_designs": data.n_groups,
+        "training_ranges": training_ranges(data.X, actuator.features),
+        "support": support_from_rows(
+            data.X, data.y, parameters=actuator.names, pressure_unit=actuator.pressure_unit
+        ).to_dict(),
+    }
+    for done, (name, fam) in enumerate(result.families.items(), start=1):
         metadata = {
-            "data_hash": data.data_hash,
-            "n_samples": data.n_samples,
-            "n_designs": data.n_groups,
+            **{key: described[key] for key in ("data_hash", "n_samples", "n_designs")},
             "cv": {k: float(v) for k, v in fam.cv.items()},
             "search": {**result.settings, "params": describe(fam.params)},
-            "training_ranges": training_ranges(data.X, actuator.features),
-            "support": support_from_rows(
-                data.X, data.y, parameters=actuator.names, pressure_unit=actuator.pressure_unit
-            ).to_dict(),
+            "training_ranges": described["training_ranges"],
+            "support": described["support"],
         }
         metadata["actuator"] = actuator.to_dict()  # every model names its actuator
         family = FAMILIES.get(name)
@@ -348,6 +360,8 @@ def train_surrogates(
             )
             files[f"{name}_onnx"] = str(onnx_path)
         families[name] = entry
+        if progress is not None:
+            progress(saving, done, len(result.families))
     cv_path = out / "cv_results.csv"
     write_text_atomic(cv_path, result.cv_results.to_csv(index=False))
     summary_table = result.summary()
