@@ -29,6 +29,7 @@ Run::
     .venv/bin/python benchmarks/bench_tables.py
     .venv/bin/python benchmarks/bench_tables.py --rows 200000 --big-rows 1000000 --repeats 3
     .venv/bin/python benchmarks/bench_tables.py --skip-train   # the reads only
+    .venv/bin/python benchmarks/bench_tables.py --stages 15    # each stage of the read, CPU ms
 """
 
 from __future__ import annotations
@@ -129,6 +130,63 @@ def time_read(path: Path, repeats: int) -> dict[str, float]:
     }
 
 
+def _first(module: object, *names: str) -> str:
+    """The first of ``names`` that ``module`` has."""
+    return next(name for name in names if hasattr(module, name))
+
+
+def time_stages(path: Path, repeats: int) -> dict[str, float]:
+    """Mean CPU milliseconds of each stage of softbend's read over ``repeats`` reads (after one
+    untimed read), and of ``pandas.read_csv(engine="c")`` read in turn with them."""
+    import collections
+    import functools
+
+    import pandas as pd
+
+    import softbend._io
+    import softbend.surrogates.simulation_table as simulation_table
+    import softbend.tables
+    from softbend.actuators import actuator_from
+
+    spent: dict[str, float] = collections.defaultdict(float)
+    stages = [
+        # the file's bytes (its text, decoded, before softbend read bytes: an older tree compares)
+        (softbend._io, _first(softbend._io, "read_input_bytes", "read_input_text"), "the file"),
+        (softbend.tables, "row_lines", "rows and widths (row_lines)"),
+        (softbend.tables, "parse_rows", "pandas' parse and the column checks (parse_rows)"),
+        (simulation_table, "data_hash", "the training data's hash"),
+        (simulation_table, "table_training_data", "in all"),
+    ]
+    saved = [(module, name, getattr(module, name)) for module, name, _ in stages]
+
+    def timed(function, label):
+        @functools.wraps(function)
+        def call(*args, **kwargs):
+            start = time.process_time()
+            try:
+                return function(*args, **kwargs)
+            finally:
+                spent[label] += time.process_time() - start
+
+        return call
+
+    actuator = actuator_from(str(ACTUATOR))
+    try:
+        for module, name, label in stages:
+            setattr(module, name, timed(getattr(module, name), label))
+        simulation_table.table_training_data(path, actuator=actuator)
+        spent.clear()
+        for _ in range(repeats):
+            simulation_table.table_training_data(path, actuator=actuator)
+            start = time.process_time()
+            pd.read_csv(path, engine="c")
+            spent["pandas.read_csv(engine='c')"] += time.process_time() - start
+    finally:
+        for module, name, function in saved:
+            setattr(module, name, function)
+    return {label: 1e3 * seconds / repeats for label, seconds in spent.items()}
+
+
 def time_progress(path: Path) -> dict[str, float]:
     """Seconds to the first progress report of a read, and the longest silence in it."""
     from softbend._progress import listening
@@ -192,7 +250,19 @@ def main() -> None:
     parser.add_argument("--cache", type=Path, default=CACHE, help="folder of the tables")
     parser.add_argument("--skip-train", action="store_true", help="time the reads only")
     parser.add_argument("--no-record", action="store_true", help="print, do not record")
+    parser.add_argument(
+        "--stages",
+        type=int,
+        default=0,
+        metavar="N",
+        help="only print the mean CPU ms of each stage of N reads of the --rows table",
+    )
     args = parser.parse_args()
+    if args.stages:
+        small = write_table(args.cache / f"sims_{args.rows}.csv", args.rows)
+        for label, ms in time_stages(small, args.stages).items():
+            print(f"{label}: {ms:.1f} CPU ms")
+        return
 
     small = write_table(args.cache / f"sims_{args.rows}.csv", args.rows)
     big = write_table(args.cache / f"sims_{args.big_rows}.csv", args.big_rows)
