@@ -139,3 +139,19 @@ def test_the_shipped_mlp_refuses_the_long_design_past_its_sweep():
     assert any("angle" in p for p in result.beyond_support)
     with pytest.raises(ValueError, match="beyond"):
         predict_angles(path, design, [0.3], strict=True)
+
+
+def test_the_support_of_rows_is_each_distinct_design_in_order_with_its_largest_pressure():
+
+    rng = np.random.default_rng(5)
+    for _ in range(100):
+        n, d = int(rng.integers(1, 60)), int(rng.integers(1, 5))
+        scale = rng.choice([1.0, 0.5, -1.25], d)
+        designs = rng.integers(-2, 3, (n, d)).astype(float) * scale  # repeats, ties, negatives
+        X = np.column_stack([designs, rng.uniform(0.0, 0.3, n)])
+        support = support_from_rows(X, np.ones(n), parameters=tuple(f"p{k}" for k in range(d)))
+        # the definition: np.unique's distinct rows, each design's largest pressure
+        unique, inverse = np.unique(designs, axis=0, return_inverse=True)
+        largest = np.array([X[inverse.ravel() == k, -1].max() for k in range(len(unique))])
+        assert np.array_equal(support.designs, unique)
+        assert np.array_equal(support.max_pressure_mpa, largest)

@@ -277,9 +277,21 @@ def support_from_rows(
             f"X and y must be rows of {d + 1} inputs and one angle per row; got shapes "
             f"{rows.shape} and {angles.shape}"
         )
-    unique, inverse = np.unique(rows[:, :d], axis=0, return_inverse=True)
-    pmax = np.zeros(unique.shape[0])
-    np.maximum.at(pmax, inverse.ravel(), rows[:, -1])
+    designs = rows[:, :d]
+    if rows.shape[0] and np.isfinite(designs).all():
+        # the distinct designs in np.unique's (lexicographic) order, by one sort: np.unique
+        # over rows and np.maximum.at took seconds on 10^6 rows
+        order = np.lexsort(designs.T[::-1])
+        ordered = designs[order]
+        first = np.ones(order.size, dtype=bool)
+        first[1:] = np.any(ordered[1:] != ordered[:-1], axis=1)
+        starts = np.flatnonzero(first)
+        unique = ordered[starts]
+        pmax = np.maximum(np.maximum.reduceat(rows[order, -1], starts), 0.0)
+    else:
+        unique, inverse = np.unique(designs, axis=0, return_inverse=True)
+        pmax = np.zeros(unique.shape[0])
+        np.maximum.at(pmax, inverse.ravel(), rows[:, -1])
     finite = angles[np.isfinite(angles)]
     return Support(
         unique,
