@@ -500,17 +500,17 @@ def _read_plain(source: Path, fmt: TableFormat, file: str) -> _Read | None:
         report(phase, 0, 100)
     # the bytes, not the text: the header lines are decoded here, the data section stays
     # bytes for pandas (a file that is not UTF-8 is the line reader's to name)
-    data = read_input_bytes(source, file)
+    raw = read_input_bytes(source, file)
     header: dict[str, str] = {}
     header_lines: dict[str, int] = {}
-    first = len(codecs.BOM_UTF8) if data.startswith(codecs.BOM_UTF8) else 0
+    first = len(codecs.BOM_UTF8) if raw.startswith(codecs.BOM_UTF8) else 0
     start, number, line = first, 0, ""
     try:
-        while start < len(data):
-            end = data.find(b"\n", start)
-            end = len(data) if end < 0 else end
+        while start < len(raw):
+            end = raw.find(b"\n", start)
+            end = len(raw) if end < 0 else end
             number += 1
-            line, start = data[start:end].decode("utf-8").strip(), end + 1
+            line, start = raw[start:end].decode("utf-8").strip(), end + 1
             if line.startswith("#"):
                 key, sep, value = line[1:].partition(":")
                 if sep and key.strip():
@@ -521,7 +521,7 @@ def _read_plain(source: Path, fmt: TableFormat, file: str) -> _Read | None:
                 break
         else:
             return None  # no column header
-        preamble = data[first:start]
+        preamble = raw[first:start]
         if preamble.count(b"\r") != preamble.count(b"\r\n"):
             return None  # a lone '\r' ends a line: the line reader numbers those
         if '"' in line or "\0" in line or len(line) > csv.field_size_limit():
@@ -532,7 +532,7 @@ def _read_plain(source: Path, fmt: TableFormat, file: str) -> _Read | None:
         return None
     if phase is not None:
         report(phase, 20, 100)
-    rows = row_lines(data, fmt.separator, len(names), csv.field_size_limit(), start)
+    rows = row_lines(raw, fmt.separator, len(names), csv.field_size_limit(), start)
     bound = limit("csv_rows") if fmt.max_rows is None else fmt.max_rows
     absent = any(h.required and h.name not in header for h in fmt.header)
     if rows is None or not fmt.min_rows <= rows.size <= bound or absent:
@@ -546,7 +546,7 @@ def _read_plain(source: Path, fmt: TableFormat, file: str) -> _Read | None:
             column = Column(name, kind="any", missing=True)
         if column is not None:
             kept.append((position, column))
-    parsed = parse_rows(data, fmt.separator, len(names), kept, rows.size, start)
+    parsed = parse_rows(raw, fmt.separator, len(names), kept, rows.size, start)
     if parsed is None:
         return None
     if phase is not None:

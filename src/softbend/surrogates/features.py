@@ -99,8 +99,8 @@ def data_hash(X: ArrayLike, y: ArrayLike, groups: ArrayLike | None = None) -> st
     """
     digest = hashlib.sha256()
     # the arrays' own buffers (no copy); the same bytes as their ``tobytes()``
-    digest.update(memoryview(np.ascontiguousarray(X, dtype=np.float64)).cast("B"))
-    digest.update(memoryview(np.ascontiguousarray(y, dtype=np.float64)).cast("B"))
+    digest.update(np.ascontiguousarray(X, dtype=np.float64).data.cast("B"))
+    digest.update(np.ascontiguousarray(y, dtype=np.float64).data.cast("B"))
     if groups is not None:
         labels = np.asarray(groups).tolist()
         try:
