@@ -207,9 +207,9 @@ def time_progress(path: Path) -> dict[str, float]:
     }
 
 
-def _timed_run(argv: list[str]) -> tuple[float, float, float, str]:
+def _timed_run(argv: list[str]) -> tuple[float, float, float, str, str]:
     """Wall seconds of a command, its CPU seconds (user and system), the longest time its
-    stderr stayed silent, and its stderr."""
+    stderr stayed silent and the line before that silence, and its stderr."""
     env = {**os.environ, "PYTHONPATH": str(ROOT / "src"), "COLUMNS": "200"}
     before = resource.getrusage(resource.RUSAGE_CHILDREN)
     start = time.perf_counter()
@@ -237,8 +237,12 @@ def _timed_run(argv: list[str]) -> tuple[float, float, float, str]:
     stamps.append(end)
     if proc.returncode != 0:
         raise RuntimeError(f"{argv[3:5]} failed ({proc.returncode}): {''.join(lines)[-2000:]}")
-    silent = max(b - a for a, b in itertools.pairwise(stamps))
-    return end - start, cpu, silent, "".join(lines)
+    gaps = [b - a for a, b in itertools.pairwise(stamps)]
+    silent = max(gaps)
+    # where the longest silence was: after which line (the first gap is before the first)
+    longest = gaps.index(silent)
+    quiet_after = lines[longest - 1].strip() if longest > 0 else "(the start)"
+    return end - start, cpu, silent, quiet_after, "".join(lines)
 
 
 def main() -> None:
@@ -304,11 +308,11 @@ def main() -> None:
         out = args.cache / "plr_model"
         cli = [sys.executable, "-c", "import sys; from softbend.cli import run; run()"]
         train = [*cli, "train", str(big), "--actuator", str(ACTUATOR), "--models", "plr"]
-        wall, cpu, silent, log = _timed_run([*train, "--no-onnx", "--out", str(out)])
+        wall, cpu, silent, quiet_after, log = _timed_run([*train, "--no-onnx", "--out", str(out)])
         print(log, end="")
         print(
             f"train plr on {args.big_rows} rows: {wall:.1f} s ({cpu:.1f} CPU seconds), "
-            f"longest silence {silent:.1f} s"
+            f"longest silence {silent:.1f} s, after {quiet_after!r}"
         )
         model = out / "models" / "plr.json"
         predict = [*cli, "predict", str(model), "--design", "10,2,2.0,12.0", "--pressures", "50"]
