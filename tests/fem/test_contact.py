@@ -168,3 +168,34 @@ def test_options_without_contact_digest_as_before_contact_existed():
     assert on.to_dict()["contact_penalty_mpa_per_mm"] == 50.0
     assert on.digest() != plain.digest()
     assert np.isfinite(on.contact_tolerance_mm)
+
+
+@pytest.mark.parametrize("turn_deg", [0.0, 60.0, 120.0])
+@pytest.mark.parametrize("opening_mm", [-0.01, 0.1])
+def test_penalty_energy_is_the_same_after_a_rigid_rotation(turn_deg, opening_mm):
+    """The overlap is measured along the deformed normal, so a rigid turn changes nothing.
+
+    The upper block is moved ``opening_mm`` off the lower one (negative: into
+    it) and both are turned by ``turn_deg`` about y. Along the undeformed normal
+    an opening of 0.1 mm turned past 90° would read as an overlap of
+    ``0.1 |cos θ|`` mm.
+    """
+    import math
+
+    import ngsolve as ngs
+
+    from softbend.fem.contact import PenaltyContact
+
+    _, fes, form, _ = _blocks()
+    k = OPTIONS.contact_penalty_mpa_per_mm
+    contact = PenaltyContact(fes, "upper_bottom", "lower_top", penalty_mpa_per_mm=k, maxdist_mm=0.5)
+    theta = math.radians(turn_deg)
+    c, s = math.cos(theta), math.sin(theta)
+    lift = ngs.IfPos(ngs.z - HEIGHT, opening_mm, 0.0)  # the upper block only
+    x, z = ngs.x, ngs.z + lift
+    gfu = ngs.GridFunction(fes)
+    # Set per block: the displacement jumps across the interface (two blocks, not fused).
+    gfu.Set(ngs.CF((c * x + s * z - ngs.x, 0.0, -s * x + c * z - ngs.z)))
+    contact.update(gfu, form)
+    expected = 0.5 * k * opening_mm**2 * SIDE**2 if opening_mm < 0 else 0.0
+    assert contact.energy_mj(gfu) == pytest.approx(expected, rel=0.02, abs=1e-9)

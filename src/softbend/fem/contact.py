@@ -7,12 +7,15 @@ deformed configuration (within ``maxdist_mm``), and the pairs carry the energy
 
     Π_c(u) = ∫_master ½ k ⟨d⟩₊² dA,    d = (x_master − x_minion)·n,
 
-with ``x = X + u`` the deformed positions, ``n`` the master's outward normal and
-``d`` the interpenetration (positive where the faces overlap, the signed gap is
-``−d``); ``k`` is the penalty stiffness, MPa per mm of interpenetration. The
-term is added to the bilinear form whose energy Newton minimises, so the
-contact pressure ``k·d`` and its Hessian come with the same automatic
-differentiation as the elastomer's. A pair counts as touching from ``d = 0``
+with ``x = X + u`` the deformed positions, ``n`` the master's outward unit
+normal in the deformed configuration of the last pairing (``cof(F)·N``
+normalised, held fixed until the pairs are found anew, so that between
+pairings the energy is one smooth function of ``u``; a rigid rotation of both
+faces leaves it unchanged) and ``d`` the interpenetration (positive where the
+faces overlap, the signed gap is ``−d``); ``k`` is the penalty stiffness, MPa
+per mm of interpenetration. The term is added to the bilinear form whose
+energy Newton minimises, so the contact pressure ``k·d`` and its Hessian come
+with the same automatic differentiation as the elastomer's. A pair counts as touching from ``d = 0``
 on (the branch of ``⟨d⟩₊²`` taken at zero is the active one), so two faces
 that start in contact are held together from the first solve.
 
@@ -98,8 +101,16 @@ class PenaltyContact:
         self.boundary, self._forces_boundary = (
             ngs.ContactBoundary(mesh.Boundaries(master), mesh.Boundaries(minion)) for _ in range(2)
         )
+        # The master faces' normal in the configuration of the last pairing, a
+        # field held fixed during a solve: the energy is then one smooth function
+        # of u between pairings, with exact gradient and Hessian. (The contact
+        # boundary's own ``normal`` follows the current state but is not
+        # differentiated, so its Newton converged linearly, see the design log.)
+        self._normal = ngs.GridFunction(fes)
+        self._normal.Set(ngs.specialcf.normal(3), definedon=mesh.Boundaries(master))
+        normal = self._normal / ngs.Norm(self._normal)
         for boundary in (self.boundary, self._forces_boundary):
-            depth = (position + u - (position.Other() + u.Other())) * boundary.normal
+            depth = (position + u - (position.Other() + u.Other())) * normal
             boundary.AddEnergy(ngs.IfPos(-depth, 0.0, 0.5 * self.penalty * depth * depth))
         self._forces_form = ngs.BilinearForm(fes, symmetric=True)
         self._forces: Any = None
@@ -117,8 +128,14 @@ class PenaltyContact:
     def update(self, gfu: Any, form: Any) -> None:
         """Pair the faces anew in the configuration ``gfu`` and add the pairs to ``form``.
 
-        After it, a factorisation of ``form``'s Hessian taken before is stale.
+        The master faces' normal is taken at ``gfu`` too and held until the next
+        update. After it, a factorisation of ``form``'s Hessian taken before is stale.
         """
+        import ngsolve as ngs
+
+        # Nanson: the deformed normal is cof(F)·N (F = I + ∇u), normalised.
+        deformed = ngs.Cof(ngs.Id(3) + ngs.Grad(gfu)) * ngs.specialcf.normal(3)
+        self._normal.Set(deformed / ngs.Norm(deformed), definedon=self.mesh.Boundaries(self.master))
         self.boundary.Update(gfu, form, self.intorder, self.maxdist_mm, keep_pairs=True)
         self._forces_boundary.Update(gfu, self._forces_form, self.intorder, other=self.boundary)
 

@@ -250,6 +250,7 @@ class EnergySolver:
         cuts = chords = 0
         residual = self._norm(self.residual())
         start_residual, after_first = residual, math.inf
+        logger.debug("Newton start: residual %.3g N (tolerance %.3g N)", residual, tolerance)
         energy: float | None = None
         for iteration in range(self.max_iterations + 1):
             if iteration == 1:
@@ -267,6 +268,13 @@ class EnergySolver:
             self.solve_tangent(res, du)
             alpha, residual, n_cuts, energy = self._line_search(residual, energy)
             cuts += n_cuts
+            logger.debug(
+                "Newton iteration %d: step %.3g, residual %.3g N (tolerance %.3g N)",
+                iteration + 1,
+                alpha,
+                residual,
+                tolerance,
+            )
             if alpha == 0.0:
                 break
             if energy is not None and residual > self.chord_above * tolerance:

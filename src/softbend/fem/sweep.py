@@ -33,9 +33,12 @@ that does not even hold its own weight raises
 :class:`~softbend.errors.ConvergenceError`.
 
 A model may also act around every step: ``before_step()`` before the solve
-(the PneuNet pairs its faces in contact anew) and ``reject_step()`` after a
+(the PneuNet pairs its faces in contact anew), ``reject_step()`` after a
 converged step longer than four ``min_step_mpa`` (True: the step is restored
-and halved as a failed one is; the PneuNet's walls starting to touch within it).
+and halved as a failed one is; the PneuNet's walls starting to touch within it)
+and ``linear_predictor()`` before the prediction (True: the step starts from
+the linear predictor ``u₁ + Δp·u₁'``, not the cubic; the PneuNet while its walls
+press on each other).
 """
 
 from __future__ import annotations
@@ -285,7 +288,9 @@ def run_steps(
             if ahead.size:
                 target = min(target, float(ahead[0]))
         start = model.state()
-        predicted = _predict(start, tangent, pressure, target, previous)
+        linear = getattr(model, "linear_predictor", None)
+        cubic = previous is not None and not (linear is not None and linear())
+        predicted = _predict(start, tangent, pressure, target, previous if cubic else None)
         model.set_state(predicted)
         model.set_load(target, 1.0)
         before_step = getattr(model, "before_step", None)
