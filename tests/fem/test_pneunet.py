@@ -143,3 +143,21 @@ def test_contact_force_is_zero_before_the_touch_and_grows_after_it(close_walls):
     # The bending goes on rising past the touch.
     steps = np.array(on.stats["step_angles_deg"])
     assert np.all(np.diff(steps) > 0.0)
+
+
+@pytest.mark.slow
+def test_the_reference_with_contact_bends_through_the_working_range():
+    """`fem run --family pneunet`'s sweep: to 50 kPa or 180°, rising at every output."""
+    design = FAMILY.parse("")
+    grid = default_pressures_mpa(FAMILY.pmax_mpa, FAMILY.pstep_mpa)
+    options = FAMILY.options(threads=1).replace(contact="on", max_angle_deg=180.0)
+    result = FAMILY.simulate(design, grid, options)
+    assert result.converged.all(), result.stats["stop_reason"]
+    assert result.max_pressure_mpa == pytest.approx(0.05) or result.max_angle_deg >= 179.0
+    assert np.all(np.diff(result.angle_deg) > 0.0)
+    assert result.angle_deg[-1] - result.angle_deg[0] >= 90.0
+    # The walls press on each other, within the penalty's tolerance.
+    pressure_kpa = np.array(result.stats["step_contact_pressure_kpa"])
+    assert pressure_kpa[-1] > 0.0
+    k = options.contact_penalty_mpa_per_mm
+    assert pressure_kpa.max() / (1000.0 * k) <= options.contact_tolerance_mm
