@@ -22,7 +22,7 @@ up to ``--study-pmax`` (past the touch, where the walls press on each other),
 the change of the angle between the two finest meshes at the largest pressure
 both reach (the acceptance: at most 2°)::
 
-    python benchmarks/bench_fem_pneunet.py --contact --runs 1 --study-pmax 0.012
+    python benchmarks/bench_fem_pneunet.py --contact --runs 1 --study-pmax 0.05
 """
 
 from __future__ import annotations
