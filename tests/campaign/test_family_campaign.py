@@ -142,6 +142,32 @@ def test_family_design_and_backend_pickle():
     assert result.angle_deg[1] == pytest.approx(K_DEG_PER_MPA * 0.02 * (4 + 2 + 4))
 
 
+def test_contact_is_off_by_default_and_on_where_the_family_s_walls_touch():
+    from dataclasses import replace
+
+    from softbend.fem.families import CONTACT_MAX_ANGLE_DEG, get_family
+
+    assert family_backend(STANDIN).options.contact == "off"
+    with pytest.raises(InputError) as error:
+        family_backend(STANDIN, contact="on")
+    assert error.value.key == "contact"
+    touching = replace(STANDIN, contact=True)
+    assert family_backend(touching).options.contact == "off"  # the shipped datasets' settings
+    on = family_backend(touching, contact="on").options
+    assert (on.contact, on.max_angle_deg) == ("on", CONTACT_MAX_ANGLE_DEG)
+    with pytest.raises(InputError) as error:
+        family_backend(touching, contact="sometimes")
+    assert error.value.key == "contact" and "'off', 'on'" in str(error.value)
+    assert get_family("pneunet").contact and not get_family("sfrba").contact
+
+
+def test_paper_b_s_campaign_refuses_contact_in_one_line(tmp_path, capsys):
+    db = tmp_path / "c.duckdb"
+    assert main(["campaign", "run", str(db), "--space", "lhs:2", "--contact", "on"]) == 2
+    assert "contact" in one_error_line(capsys)
+    assert not db.exists()
+
+
 # -- run, resume, export, train ------------------------------------------------------
 
 
@@ -277,6 +303,7 @@ def test_unknown_family_is_one_line_listing_the_known(tmp_path, capsys):
         (["--space", "lhs:2", "--backend", "analytical"], "must be fem for the standin family"),
         (["--space", "lhs:2", "--range", "l=60:90"], "NAME one of n_cells, width_mm, height_mm"),
         (["--space", "lhs:2", "--maxh", "0"], "must be a size > 0 mm"),
+        (["--space", "lhs:2", "--contact", "on"], "must be one of 'off'"),  # no walls touch
     ],
 )
 def test_bad_family_options_are_one_line(tmp_path, capsys, extra, expected):

@@ -102,15 +102,23 @@ class FamilyBackend:
 
 
 def family_backend(
-    family: FEMFamily, *, maxh_mm: float | None = None, material: Any = None
+    family: FEMFamily,
+    *,
+    maxh_mm: float | None = None,
+    material: Any = None,
+    contact: str | None = None,
 ) -> FamilyBackend:
-    """The backend of a family's campaign: its options with ``maxh_mm`` (mm) and ``material``.
+    """The backend of a family's campaign: its options with ``maxh_mm`` (mm), ``material``
+    and ``contact``.
 
     ``maxh_mm`` None takes the family's :attr:`~softbend.fem.families.FEMFamily.maxh_mm`;
     ``material`` (a :class:`~softbend.materials.presets.Material`) None the family's
-    elastomer.
+    elastomer; ``contact`` ("on" or "off", for a family whose walls touch) None "off",
+    the settings of the shipped datasets
+    (:meth:`~softbend.fem.families.FEMFamily.contact_options`).
     """
     overrides: dict[str, Any] = {"maxh_mm": family.maxh_mm if maxh_mm is None else maxh_mm}
+    overrides.update(family.contact_options(contact, default="off"))
     if material is not None:
         overrides["elastomer"] = material
     return FamilyBackend(family, family.options(**overrides))

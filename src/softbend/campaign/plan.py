@@ -74,6 +74,7 @@ def plan_campaign(
     compiled: bool = True,
     maxh_mm: float | None = None,
     material: str | None = None,
+    contact: str | None = None,
 ) -> CampaignPlan:
     """Check a campaign's choices and build its designs.
 
@@ -108,6 +109,8 @@ def plan_campaign(
         The FEM's largest element size, mm.
     material : str, optional
         An elastomer preset or fit file (:func:`~softbend.campaign.backends.resolve_material`).
+    contact : {"off", "on"}, optional
+        Contact between walls that touch, for a family with them (default off).
 
     Raises
     ------
@@ -128,7 +131,9 @@ def plan_campaign(
     shard_of = parse_shard(shard) if shard is not None else None
     pressures = fem_family.campaign_pressures_mpa(pmax_mpa, pstep_mpa)
     chosen = resolve_material(material) if material is not None else None  # read once
-    backend_obj = campaign_backend(fem_family, backend, model, chosen, maxh_mm, compiled)
+    backend_obj = campaign_backend(
+        fem_family, backend, model, chosen, maxh_mm, compiled, contact=contact
+    )
     if scheduler is not None:
         parse_scheduler_address(scheduler)
     k, count = shard_of or (0, 1)
@@ -153,18 +158,21 @@ def campaign_backend(
     chosen: ResolvedMaterial | None,
     maxh_mm: float | None,
     compiled: bool,
+    *,
+    contact: str | None = None,
 ) -> Backend:
     """The backend named ``backend`` for ``fem_family``'s designs (checked).
 
     A family swept by the registered backends
     (:attr:`~softbend.fem.families.FEMFamily.backends` None, paper B's)
     takes any of them (default ``analytical``); another only its own FEM sweep
-    (``fem``, the default), with ``maxh_mm`` and the material.
+    (``fem``, the default), with ``maxh_mm``, the material and ``contact``.
     """
     from softbend.campaign.backends import backend_for_run
     from softbend.campaign.family_schema import family_backend
 
     if fem_family.backends is None:
+        fem_family.contact_options(contact, default="off")  # checked: "off" only
         return backend_for_run(
             "analytical" if backend is None else backend,
             model=model,
@@ -188,4 +196,4 @@ def campaign_backend(
     ):
         raise InputError(f"must be a size > 0 mm; got {maxh_mm!r}", key="maxh_mm")
     material = None if chosen is None else chosen.material
-    return family_backend(fem_family, maxh_mm=maxh_mm, material=material)
+    return family_backend(fem_family, maxh_mm=maxh_mm, material=material, contact=contact)

@@ -126,6 +126,16 @@ MaterialOption = Annotated[
         "(fit.json#yeoh; default the best fit)."
     ),
 ]
+ContactOption = Annotated[
+    str | None,
+    typer.Option(
+        "--contact",
+        help="Contact between the facing walls of neighbouring chambers, for a family whose "
+        "walls touch (pneunet): off (the default, the shipped dataset's settings: a sweep "
+        "stops where the walls first touch) or on (they press on each other; a sweep goes "
+        "on to --pmax or 180°). sfrba: off only.",
+    ),
+]
 AcceptNewSettingsOption = Annotated[
     bool,
     typer.Option(
@@ -164,6 +174,7 @@ PLAN_OPTIONS = {
     "compile_energy": "compiled",
     "maxh": "maxh_mm",
     "material": "material",
+    "contact": "contact",
 }
 
 
@@ -187,6 +198,7 @@ def run(
     compile_energy: CompileEnergyOption = True,
     maxh: MaxhOption = None,
     material: MaterialOption = None,
+    contact: ContactOption = None,
     accept_new_settings: AcceptNewSettingsOption = False,
     json_output: JsonOutputOption = False,
 ) -> None:
@@ -213,6 +225,7 @@ def run(
         softbend campaign run table1.duckdb --backend analytical --space table1
         softbend campaign run own.duckdb --space sobol:256 --range l=60:90 --range t=1:2
         softbend campaign run pneunet.duckdb --family pneunet --space sobol:256
+        softbend campaign run contact.duckdb --family pneunet --space sobol:256 --contact on
     """
     from softbend.campaign.plan import plan_campaign
 

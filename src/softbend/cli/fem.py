@@ -77,9 +77,6 @@ ContactOption = Annotated[
     ),
 ]
 
-#: Where ``fem run`` with contact stops bending, degrees (the PneuNet's working range).
-CONTACT_MAX_ANGLE_DEG = 180.0
-
 
 MaterialOption = Annotated[
     str | None,
@@ -149,17 +146,10 @@ def _family_options(
     ``contact`` None: "on" for the PneuNet, "off" for paper B's actuator (which
     has no faces that touch: "on" is refused for it).
     """
-    from softbend._validation import check_choice
-    from softbend.fem.options import CONTACT_MODES
     from softbend.materials.choice import material_from_spec
 
     changes: dict[str, object] = {"maxh_mm": family.maxh_mm if maxh is None else maxh}
-    with_contact = family.name == "pneunet"
-    if contact is not None:
-        check_choice(contact, "contact", CONTACT_MODES if with_contact else ("off",))
-    if (contact or ("on" if with_contact else "off")) == "on":
-        changes["contact"] = "on"
-        changes["max_angle_deg"] = CONTACT_MAX_ANGLE_DEG
+    changes.update(family.contact_options(contact, default="on"))
     if gravity is not None:
         changes["gravity"] = gravity
     if material is not None:

@@ -39,6 +39,7 @@ if TYPE_CHECKING:
     from softbend.models import SweepResult
 
 __all__ = [
+    "CONTACT_MAX_ANGLE_DEG",
     "FEM_FAMILIES",
     "FIRST_FAMILY",
     "FEMFamily",
@@ -47,6 +48,11 @@ __all__ = [
     "get_family",
     "parse_assignments",
 ]
+
+
+#: Where a sweep with contact stops bending, degrees: the working range of an actuator whose
+#: walls press on each other (a PneuNet's 90-270 degrees), short of the folded states past it.
+CONTACT_MAX_ANGLE_DEG = 180.0
 
 
 @dataclass(frozen=True)
@@ -113,6 +119,10 @@ class FEMFamily:
         ``fem mesh-study``'s default element sizes (mm, coarse to fine) and
         pressures (MPa); empty: 1.5, 1 and 0.75 times ``maxh_mm`` and 0, half
         and all of ``pmax_mpa``.
+    contact : bool, default False
+        Its walls can press on each other (:class:`~softbend.fem.contact.PenaltyContact`
+        between faces its model names): ``--contact on`` applies
+        (:meth:`contact_options`); False: no faces touch, only ``off``.
     """
 
     name: str
@@ -134,6 +144,24 @@ class FEMFamily:
     campaign_pmax_mpa: float | None = None
     recorded: bool = True
     backends: tuple[str, ...] | None = ("fem",)
+    contact: bool = False
+
+    def contact_options(self, contact: str | None, *, default: str) -> dict[str, object]:
+        """The option changes of ``--contact`` ``contact`` (None: ``default``, for this family).
+
+        "on" turns the penalty contact on and ends a sweep at
+        :data:`CONTACT_MAX_ANGLE_DEG` (the working range of an actuator whose walls
+        touch); "off" changes nothing. A family without :attr:`contact` takes "off"
+        only (one :class:`~softbend.errors.InputError` keyed ``contact``).
+        """
+        from softbend._validation import check_choice
+        from softbend.fem.options import CONTACT_MODES
+
+        if contact is not None:
+            check_choice(contact, "contact", CONTACT_MODES if self.contact else ("off",))
+        if (contact or (default if self.contact else "off")) != "on":
+            return {}
+        return {"contact": "on", "max_angle_deg": CONTACT_MAX_ANGLE_DEG}
 
     @property
     def names(self) -> tuple[str, ...]:
@@ -341,6 +369,7 @@ def _register_pneunet() -> FEMFamily:
         mesh_check=_pneunet_mesh_check,
         mesh_study_maxh_mm=pneunet.MESH_STUDY_MAXH_MM,
         mesh_study_pressures_mpa=pneunet.MESH_STUDY_PRESSURES_MPA,
+        contact=True,
     )
     return FEM_FAMILIES.register(family.name, family)
 
