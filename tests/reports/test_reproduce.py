@@ -227,6 +227,7 @@ def test_surrogate_section(first_run):
     ) in html
 
 
+@pytest.mark.slow  # a second whole quick report (about 60 s); CI runs the stopped one above
 def test_second_run_resumes_the_campaign(first_run, first_figures, fem_dataset):
     out, first, _ = first_run
     again = run_reproduce(out, **_quick(fem_dataset))  # the same settings, never stopped
