@@ -22,33 +22,28 @@ def test_unknown_option_is_one_line_and_exit_2(capsys):
     assert len(err) == 1 and "--no-such-option" in err[0]
 
 
-def test_a_ctrl_c_inside_a_duckdb_query_is_the_one_interrupted_line(tmp_path, capsys, monkeypatch):
-    # DuckDB turns a Ctrl-C during a query into "RuntimeError: Query interrupted".
+def _status_raising(tmp_path, monkeypatch, message):
+    """``campaign status`` of a new database whose status query raises ``RuntimeError(message)``."""
     from softbend.campaign import CampaignStore
 
     db = tmp_path / "c.duckdb"
     with CampaignStore(db) as store:
         store.bind("analytical", np.array([0.0, 0.1]))
 
-    def interrupted(self):
-        raise RuntimeError("Query interrupted")
+    def raising(self):
+        raise RuntimeError(message)
 
-    monkeypatch.setattr(CampaignStore, "status_summary", interrupted)
-    assert main(["campaign", "status", str(db)]) == 130
+    monkeypatch.setattr(CampaignStore, "status_summary", raising)
+    return ["campaign", "status", str(db)]
+
+
+def test_a_ctrl_c_inside_a_duckdb_query_is_the_one_interrupted_line(tmp_path, capsys, monkeypatch):
+    # DuckDB turns a Ctrl-C during a query into "RuntimeError: Query interrupted".
+    assert main(_status_raising(tmp_path, monkeypatch, "Query interrupted")) == 130
     err = capsys.readouterr().err.strip().splitlines()
     assert len(err) == 1 and "Traceback" not in err[0]
 
 
 def test_other_runtime_errors_are_not_taken_for_a_ctrl_c(tmp_path, monkeypatch):
-    from softbend.campaign import CampaignStore
-
-    db = tmp_path / "c.duckdb"
-    with CampaignStore(db) as store:
-        store.bind("analytical", np.array([0.0, 0.1]))
-
-    def broken(self):
-        raise RuntimeError("something else")
-
-    monkeypatch.setattr(CampaignStore, "status_summary", broken)
     with pytest.raises(RuntimeError, match="something else"):
-        main(["campaign", "status", str(db)])
+        main(_status_raising(tmp_path, monkeypatch, "something else"))
