@@ -162,11 +162,15 @@ def test_a_ctrl_c_during_a_write_is_raised_after_the_design_is_committed(store, 
         os.kill(os.getpid(), signal.SIGINT)
 
     monkeypatch.setattr(store, "_delete", delete_then_ctrl_c)
-    with pytest.raises(KeyboardInterrupt):
-        store.record_success(_sweep(A))
+    previous = signal.signal(signal.SIGINT, signal.default_int_handler)  # as in a new process
+    try:
+        with pytest.raises(KeyboardInterrupt):
+            store.record_success(_sweep(A))
+        assert signal.getsignal(signal.SIGINT) is signal.default_int_handler
+    finally:
+        signal.signal(signal.SIGINT, previous)
     assert store.finished_ids() == {A.design_id}
     assert set(store.load_samples()["design_id"]) == {A.design_id}
-    assert signal.getsignal(signal.SIGINT) is signal.default_int_handler
 
 
 def test_results_off_the_campaign_grid_are_refused(store):
