@@ -303,7 +303,7 @@ def test_unknown_family_is_one_line_listing_the_known(tmp_path, capsys):
         (["--space", "lhs:2", "--backend", "analytical"], "must be fem for the standin family"),
         (["--space", "lhs:2", "--range", "l=60:90"], "NAME one of n_cells, width_mm, height_mm"),
         (["--space", "lhs:2", "--maxh", "0"], "must be a size > 0 mm"),
-        (["--space", "lhs:2", "--contact", "on"], "must be one of 'off'"),  # no walls touch
+        (["--space", "lhs:2", "--contact", "on"], "must be off for the standin family"),
     ],
 )
 def test_bad_family_options_are_one_line(tmp_path, capsys, extra, expected):

@@ -92,7 +92,7 @@ def test_fem_run_pneunet_json_prints_pressures_and_angles_and_writes_vtk(tmp_pat
     ("family", "value", "needle"),
     [
         ("pneunet", "yes", "--contact: must be one of 'off', 'on'; got \"yes\""),
-        ("sfrba", "on", "--contact: must be one of 'off'; got \"on\""),
+        ("sfrba", "on", "--contact: must be off for the sfrba family (none of its walls touch)"),
     ],
 )
 def test_a_bad_contact_mode_is_one_line(tmp_path, capsys, family, value, needle):

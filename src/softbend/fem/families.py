@@ -158,7 +158,13 @@ class FEMFamily:
         from softbend.fem.options import CONTACT_MODES
 
         if contact is not None:
-            check_choice(contact, "contact", CONTACT_MODES if self.contact else ("off",))
+            check_choice(contact, "contact", CONTACT_MODES)
+            if contact == "on" and not self.contact:
+                raise InputError(
+                    f"must be off for the {self.name} family (none of its walls touch); "
+                    f"got {contact!r}",
+                    key="contact",
+                )
         if (contact or (default if self.contact else "off")) != "on":
             return {}
         return {"contact": "on", "max_angle_deg": CONTACT_MAX_ANGLE_DEG}
