@@ -48,8 +48,14 @@ ship() {  # the dataset is the whole space or nothing
   local command="softbend campaign run $here/shard-K-of-$shards.duckdb ${space[*]} --shard K/$shards (K = 0..$((shards - 1))); softbend campaign merge $merged $here/shard-*-of-$shards.duckdb; softbend campaign dataset $merged --out $dataset --space $space_text"
   rm -f "$merged"
   "$softbend" campaign merge "$merged" "${files[@]}"
-  "$softbend" campaign dataset "$merged" --out "$dataset" --space "$space_text" \
+  # written beside, then put in the package's place: the dataset it replaces is git's
+  local staged=$here/dataset.new
+  rm -rf "$staged"
+  "$softbend" campaign dataset "$merged" --out "$staged" --space "$space_text" \
     --command "$command" --description "$description"
+  rm -f "$staged/.softbend-manifest.json"
+  rm -rf "$dataset"
+  mv "$staged" "$dataset"
 }
 
 shards_main() {

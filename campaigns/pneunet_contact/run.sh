@@ -19,6 +19,6 @@ space=(--family pneunet --space sobol:256 --seed 0 --contact on)
 merged=$here/pneunet_contact.duckdb
 dataset=src/softbend/data/pneunet
 space_text=sobol:256
-description="256 PneuNets (softbend's pneunet family; a scrambled Sobol sample, seed 0) swept by softbend's 3D FEM with the family's default options and frictionless penalty contact between the facing walls of neighbouring chambers, 0 to 50 kPa in 1 kPa outputs, each sweep ending at the last pressure, 180 degrees or where Newton stops converging."
+description="256 PneuNets (softbend's pneunet family: 3-8 chambers 5-12 mm long, 10-20 mm wide and 8-25 mm tall, expanding walls 0.8-2.5 mm, outer walls 1.5-3 mm, gaps 1-5 mm, base 1-4 mm; a scrambled Sobol sample, seed 0) swept by softbend's 3D FEM with the family's default options (Elastosil M4601, a 0.1 mm paper strain-limiting layer, no gravity, element size at most 3 mm and 2.5 times the thinnest wall, frictionless penalty contact between the facing walls of neighbouring chambers at 50 MPa/mm), 0 to 50 kPa in 1 kPa outputs, each sweep ending at the last pressure, at 180 degrees of bending, or where Newton stops converging."
 source campaigns/shards.sh
 shards_main "$@"
