@@ -1,7 +1,8 @@
 """FEM of the PneuNet: sweep time of the reference on one core, and its mesh convergence.
 
-Sweeps the reference PneuNet (``softbend fem run --family pneunet``: 0 to
-0.05 MPa in 1 kPa outputs, stopping where neighbouring chamber walls touch)
+Sweeps the reference PneuNet without contact (``softbend fem run --family pneunet
+--contact off``: 0 to 0.05 MPa in 1 kPa outputs, stopping where neighbouring chamber
+walls touch)
 ``--runs`` times on one thread at the family's default mesh and reports the
 median wall time. Then the mesh study for element sizes from the default to
 finer: every output pressure up to the default mesh's last solved on every mesh,
@@ -64,7 +65,7 @@ def main(argv: list[str] | None = None) -> int:
         return contact_main(args)
     family = get_family("pneunet")
     design = family.parse("")
-    options = family.options(threads=1)
+    options = family.options(threads=1, **family.contact_options("off"))
     grid = default_pressures_mpa(family.pmax_mpa, family.pstep_mpa)
     walls, result = [], None
     for run in range(args.runs):
@@ -142,8 +143,8 @@ def contact_main(args: argparse.Namespace) -> int:
     """The reference with contact: sweep time against the contact-free sweep, mesh study."""
     family = get_family("pneunet")
     design = family.parse("")
-    off = family.options(threads=1)
-    on = off.replace(contact="on", max_angle_deg=180.0)  # what `fem run` sweeps
+    off = family.options(threads=1, **family.contact_options("off"))
+    on = family.options(threads=1)  # the family's defaults: what `fem run` sweeps
     grid = default_pressures_mpa(family.pmax_mpa, family.pstep_mpa)
     start, cpu_start = time.perf_counter(), time.process_time()
     baseline = family.simulate(design, grid, off)

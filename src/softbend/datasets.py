@@ -644,7 +644,8 @@ def family_dataset_designs(
 
     Columns: ``design_id``, the family's parameters, then
     :data:`~softbend.datasets.DESIGN_STAT_COLUMNS` (``stop_kind`` as Table 1's,
-    plus "walls touch" for a PneuNet whose neighbouring chamber walls touched;
+    plus "walls touch" for a PneuNet swept without contact whose neighbouring
+    chamber walls touched;
     ``stop_region`` the part a stretch or instability stop names, such as
     ``"chamber 3"``; times in s). Checked as :func:`family_dataset` is.
     """

@@ -142,23 +142,33 @@ def test_family_design_and_backend_pickle():
     assert result.angle_deg[1] == pytest.approx(K_DEG_PER_MPA * 0.02 * (4 + 2 + 4))
 
 
-def test_contact_is_off_by_default_and_on_where_the_family_s_walls_touch():
+def test_contact_is_the_family_s_default_and_on_or_off_where_its_walls_touch():
     from dataclasses import replace
 
-    from softbend.fem.families import CONTACT_MAX_ANGLE_DEG, get_family
+    from softbend.fem.families import get_family
+    from softbend.fem.options import CONTACT_MAX_ANGLE_DEG, FEMOptions
 
     assert family_backend(STANDIN).options.contact == "off"
     with pytest.raises(InputError) as error:
         family_backend(STANDIN, contact="on")
     assert error.value.key == "contact"
     touching = replace(STANDIN, contact=True)
-    assert family_backend(touching).options.contact == "off"  # the shipped datasets' settings
+    assert family_backend(touching).options.contact == "off"  # its own defaults
     on = family_backend(touching, contact="on").options
     assert (on.contact, on.max_angle_deg) == ("on", CONTACT_MAX_ANGLE_DEG)
     with pytest.raises(InputError) as error:
         family_backend(touching, contact="sometimes")
     assert error.value.key == "contact" and "'off', 'on'" in str(error.value)
-    assert get_family("pneunet").contact and not get_family("sfrba").contact
+    pneunet = get_family("pneunet")
+    assert pneunet.contact and not get_family("sfrba").contact
+    # the PneuNet's default is its shipped dataset's: contact, to 180°
+    assert family_backend(pneunet).options == family_backend(pneunet, contact="on").options
+    assert family_backend(pneunet).options.max_angle_deg == CONTACT_MAX_ANGLE_DEG
+    # off restores the contact-free options, digest included (their largest angle too)
+    off = family_backend(pneunet, contact="off").options
+    assert (off.contact, off.max_angle_deg) == ("off", FEMOptions.max_angle_deg)
+    assert "contact" not in off.to_dict()
+    assert off.digest() == off.replace(contact="on").replace(contact="off").digest()
 
 
 def test_paper_b_s_campaign_refuses_contact_in_one_line(tmp_path, capsys):

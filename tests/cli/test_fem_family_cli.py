@@ -101,6 +101,11 @@ def test_a_bad_contact_mode_is_one_line(tmp_path, capsys, family, value, needle)
     assert needle in one_error_line(capsys)
 
 
+def test_the_mesh_study_takes_the_same_contact_flag(capsys):
+    assert main(["fem", "mesh-study", "--family", "sfrba", "--contact", "on"]) == 2
+    assert "--contact: must be off for the sfrba family" in one_error_line(capsys)
+
+
 def test_contact_off_stops_where_the_walls_touch_and_reports_no_contact(tmp_path, capsys):
     args = [
         "fem",

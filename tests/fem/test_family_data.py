@@ -27,7 +27,7 @@ def test_each_family_parses_its_design_text_and_falls_back_to_its_reference():
 def test_mesh_study_defaults_and_campaign_grids_are_the_family_s():
     sfrba, pneunet = get_family("sfrba"), get_family("pneunet")
     assert sfrba.mesh_study_defaults() == ((6.0, 5.0, 4.0, 3.0), (0.0, 0.05, 0.1))
-    assert pneunet.mesh_study_defaults() == ((3.0, 2.5, 2.0), (0.0, 0.002, 0.004, 0.006))
+    assert pneunet.mesh_study_defaults() == ((3.0, 2.5, 2.0), (0.0, 0.004, 0.008, 0.012))
     grid = sfrba.campaign_pressures_mpa()
     assert (len(grid), grid[-1]) == (101, 0.5)  # paper B's 0-0.5 MPa by 0.005 MPa
     assert pneunet.campaign_pressures_mpa()[-1] == pytest.approx(pneunet.pmax_mpa)

@@ -3,7 +3,6 @@
 from __future__ import annotations
 
 import json
-import re
 
 import numpy as np
 import pytest
@@ -26,23 +25,31 @@ def ran(tmp_path_factory):
     return out, section, phases
 
 
-def test_the_reference_bends_and_swells_to_the_touch_pressure_it_names(ran):
+def test_the_reference_bends_through_the_working_range_with_its_walls_pressing(ran):
     _, s, _ = ran
     p, a, v = s.step_pressure_mpa, s.step_angle_deg, s.step_volume_mm3
+    force, pressure = s.step_contact_force_n, s.step_contact_pressure_kpa
     assert p[0] == 0.0 and np.all(np.diff(p) > 0)
     assert np.all(np.diff(a) > 0) and np.all(np.diff(v) > 0)  # more pressure: more bend, volume
     # at 0 kPa the cavity is the drawn one (gravity barely deforms it)
     assert v[0] == pytest.approx(cavity_volume_mm3(s.design), rel=0.01)
-    reason = s.sweep.stats["stop_reason"]
-    touch_kpa = float(re.search(r"touch at ([\d.]+) kPa", reason).group(1))
-    assert p[-1] * 1e3 == pytest.approx(touch_kpa, abs=0.006)  # the curve ends at the touch
-    assert s.summary["touch_angle_deg"] == a[-1]
+    assert s.sweep.stats["stop_reason"] == "reached the last pressure"
+    assert p[-1] == pytest.approx(0.05) and a[-1] - a[0] >= 90.0  # the working range
+    # the walls touch at 6-7 kPa (the contact-free sweep's stop) and press harder after
+    assert len(force) == len(pressure) == len(p)
+    first = int(np.flatnonzero(pressure > 0)[0])
+    assert 0.006 <= p[first] <= 0.008
+    assert np.all(force[:first] == 0) and pressure[-1] > pressure[first] > 0
+    summary = s.summary
+    assert summary["contact"] == "on" and summary["last_angle_deg"] == a[-1]
+    assert summary["largest_contact_pressure_kpa"] == pytest.approx(pressure.max())
 
 
 def test_the_mesh_study_and_the_main_effects_cover_the_design_space(ran):
     _, s, _ = ran
     assert [r.maxh_mm for r in s.mesh] == [3.0]
     assert len(s.mesh[0].angles_deg) == len(pipeline.MESH_PRESSURES_MPA)
+    assert all(np.isfinite(s.mesh[0].angles_deg))  # past the touch, in contact
     names = [p.name for p in PNEUNET.parameters]
     assert list(s.effects.effects.index) == names
     assert len(s.effects.effects.columns) == 3
@@ -75,6 +82,7 @@ def test_the_section_draws_every_part_and_states_the_missing_comparison(ran, mon
     summary = pneunet_section.add_section(report, out)
     html = report.render()
     assert "the PneuNet" in html and "Published curve: not compared" in html
+    assert "mean contact pressure (kPa)" in html and "frictionless penalty contact" in html
     for name in ("reference_curves.png", "main_effects.png", "design/curves.png"):
         assert (out / "pneunet" / name).is_file(), name
         assert f"pneunet/{name}" in html

@@ -67,19 +67,26 @@ def test_the_validation_page_carries_the_run_s_provenance_and_every_row():
     ) - sum(figure.startswith("  ") for figure, *_ in headline_rows(SUMMARY))
 
 
-def test_the_pneunet_rows_give_the_mesh_change_and_the_fem_check_of_the_design():
+def test_the_pneunet_rows_give_the_reference_the_mesh_change_and_the_fem_check_of_the_design():
     summary = {
         "pneunet": {
+            "contact": "on",
+            "last_pressure_mpa": 0.05,
+            "last_angle_deg": 170.304,
             "mesh_sizes_mm": [3.0, 2.5, 2.0],
-            "mesh_pressure_mpa": 0.004,
-            "mesh_change_deg": 0.566,
-            "target": "30° ± 3° at 0.02 MPa",
-            "best": {"angle_deg": 30.0, "fem_angle_deg": None},  # a quick run: not swept
+            "mesh_pressure_mpa": 0.012,
+            "mesh_change_deg": 1.032,
+            "target": "90° ± 3° at 0.03 MPa",
+            "best": {"angle_deg": 90.0, "fem_angle_deg": None},  # a quick run: not swept
         }
     }
     rows = {figure: ours for figure, ours, _, _ in headline_rows(summary)}
-    assert rows["PneuNet reference: angle at 4 kPa, change from 3 mm to 2 mm elements"] == "0.57°"
+    assert rows["PneuNet reference (walls in contact): angle at 50 kPa"] == "170.30°"
+    assert rows["PneuNet reference: angle at 12 kPa, change from 3 mm to 2 mm elements"] == "1.03°"
     checked = rows[
-        "PneuNet design find, 30° ± 3° at 0.02 MPa: best design's angle, surrogate / FEM"
+        "PneuNet design find, 90° ± 3° at 0.03 MPa: best design's angle, surrogate / FEM"
     ]
-    assert checked == "30.00° / not computed in this run"
+    assert checked == "90.00° / not computed in this run"
+    summary["pneunet"]["contact"] = "off"  # a sweep to the first touch says so
+    rows = {figure: ours for figure, ours, _, _ in headline_rows(summary)}
+    assert "PneuNet reference (to the walls' touch): angle at 50 kPa" in rows

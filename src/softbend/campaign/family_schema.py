@@ -113,12 +113,12 @@ def family_backend(
 
     ``maxh_mm`` None takes the family's :attr:`~softbend.fem.families.FEMFamily.maxh_mm`;
     ``material`` (a :class:`~softbend.materials.presets.Material`) None the family's
-    elastomer; ``contact`` ("on" or "off", for a family whose walls touch) None "off",
-    the settings of the shipped datasets
-    (:meth:`~softbend.fem.families.FEMFamily.contact_options`).
+    elastomer; ``contact`` ("on" or "off", for a family whose walls touch) None the
+    family's default (the PneuNet's: on, its shipped dataset's settings;
+    :meth:`~softbend.fem.families.FEMFamily.contact_options`).
     """
     overrides: dict[str, Any] = {"maxh_mm": family.maxh_mm if maxh_mm is None else maxh_mm}
-    overrides.update(family.contact_options(contact, default="off"))
+    overrides.update(family.contact_options(contact))
     if material is not None:
         overrides["elastomer"] = material
     return FamilyBackend(family, family.options(**overrides))

@@ -110,7 +110,8 @@ def plan_campaign(
     material : str, optional
         An elastomer preset or fit file (:func:`~softbend.campaign.backends.resolve_material`).
     contact : {"off", "on"}, optional
-        Contact between walls that touch, for a family with them (default off).
+        Contact between walls that touch, for a family with them (default: the
+        family's, on for the PneuNet).
 
     Raises
     ------
@@ -172,7 +173,7 @@ def campaign_backend(
     from softbend.campaign.family_schema import family_backend
 
     if fem_family.backends is None:
-        fem_family.contact_options(contact, default="off")  # checked: "off" only
+        fem_family.contact_options(contact)  # checked: "off" only
         return backend_for_run(
             "analytical" if backend is None else backend,
             model=model,

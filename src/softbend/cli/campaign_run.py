@@ -131,9 +131,9 @@ ContactOption = Annotated[
     typer.Option(
         "--contact",
         help="Contact between the facing walls of neighbouring chambers, for a family whose "
-        "walls touch (pneunet): off (the default, the shipped dataset's settings: a sweep "
-        "stops where the walls first touch) or on (they press on each other; a sweep goes "
-        "on to --pmax or 180°). sfrba: off only.",
+        "walls touch (pneunet): on (the default, the shipped dataset's settings: they press "
+        "on each other, a sweep goes on to --pmax or 180°) or off (a sweep stops where the "
+        "walls first touch). sfrba: off only.",
     ),
 ]
 AcceptNewSettingsOption = Annotated[
@@ -225,7 +225,7 @@ def run(
         softbend campaign run table1.duckdb --backend analytical --space table1
         softbend campaign run own.duckdb --space sobol:256 --range l=60:90 --range t=1:2
         softbend campaign run pneunet.duckdb --family pneunet --space sobol:256
-        softbend campaign run contact.duckdb --family pneunet --space sobol:256 --contact on
+        softbend campaign run to-touch.duckdb --family pneunet --space sobol:256 --contact off
     """
     from softbend.campaign.plan import plan_campaign
 

@@ -143,13 +143,13 @@ def _family_options(
 ) -> FEMOptions:
     """The options of ``family``, from its defaults and the given flags.
 
-    ``contact`` None: "on" for the PneuNet, "off" for paper B's actuator (which
-    has no faces that touch: "on" is refused for it).
+    ``contact`` None: the family's default, "on" for the PneuNet, "off" for paper
+    B's actuator (which has no faces that touch: "on" is refused for it).
     """
     from softbend.materials.choice import material_from_spec
 
     changes: dict[str, object] = {"maxh_mm": family.maxh_mm if maxh is None else maxh}
-    changes.update(family.contact_options(contact, default="on"))
+    changes.update(family.contact_options(contact))
     if gravity is not None:
         changes["gravity"] = gravity
     if material is not None:
@@ -340,6 +340,7 @@ def mesh_study(
     pressures: PressuresOption = None,
     gravity: GravityOption = None,
     material: MaterialOption = None,
+    contact: ContactOption = None,
     json_output: Annotated[bool, typer.Option("--json", help="Print the table as JSON.")] = False,
 ) -> None:
     """Bending angle at --pressures for each element size.
@@ -361,7 +362,7 @@ def mesh_study(
     sizes = _floats(maxh, "maxh") if maxh else list(default_maxh)
     grid = _floats(pressures, "pressures") if pressures else list(default_pressures)
     actuator = chosen.parse(design)
-    options = _family_options(chosen, None, gravity, material, contact="off")
+    options = _family_options(chosen, None, gravity, material, contact=contact)
     for h in sizes:  # a too fine size is one line before any sweep
         chosen.check_mesh(actuator, options.replace(maxh_mm=h))
     with _common.progress_bar("mesh sizes", len(sizes), enabled=not json_output) as advance:

@@ -39,7 +39,6 @@ if TYPE_CHECKING:
     from softbend.models import SweepResult
 
 __all__ = [
-    "CONTACT_MAX_ANGLE_DEG",
     "FEM_FAMILIES",
     "FIRST_FAMILY",
     "FEMFamily",
@@ -48,11 +47,6 @@ __all__ = [
     "get_family",
     "parse_assignments",
 ]
-
-
-#: Where a sweep with contact stops bending, degrees: the working range of an actuator whose
-#: walls press on each other (a PneuNet's 90-270 degrees), short of the folded states past it.
-CONTACT_MAX_ANGLE_DEG = 180.0
 
 
 @dataclass(frozen=True)
@@ -121,8 +115,9 @@ class FEMFamily:
         and all of ``pmax_mpa``.
     contact : bool, default False
         Its walls can press on each other (:class:`~softbend.fem.contact.PenaltyContact`
-        between faces its model names): ``--contact on`` applies
-        (:meth:`contact_options`); False: no faces touch, only ``off``.
+        between faces its model names): ``--contact on`` and ``off`` apply
+        (:meth:`contact_options`; its ``default_options`` say which is the
+        default); False: no faces touch, only ``off``.
     """
 
     name: str
@@ -146,27 +141,31 @@ class FEMFamily:
     backends: tuple[str, ...] | None = ("fem",)
     contact: bool = False
 
-    def contact_options(self, contact: str | None, *, default: str) -> dict[str, object]:
-        """The option changes of ``--contact`` ``contact`` (None: ``default``, for this family).
+    def contact_options(self, contact: str | None) -> dict[str, object]:
+        """The option changes of ``--contact`` ``contact`` (None: the family's defaults).
 
         "on" turns the penalty contact on and ends a sweep at
-        :data:`CONTACT_MAX_ANGLE_DEG` (the working range of an actuator whose walls
-        touch); "off" changes nothing. A family without :attr:`contact` takes "off"
-        only (one :class:`~softbend.errors.InputError` keyed ``contact``).
+        :data:`~softbend.fem.options.CONTACT_MAX_ANGLE_DEG` (the working range of an
+        actuator whose walls touch), the PneuNet's defaults; "off" turns it off and
+        ends a sweep at :class:`~softbend.fem.options.FEMOptions`' own largest angle
+        (a PneuNet's sweep then stops where its walls first touch). A family without
+        :attr:`contact` takes "off" only (one :class:`~softbend.errors.InputError`
+        keyed ``contact``).
         """
         from softbend._validation import check_choice
-        from softbend.fem.options import CONTACT_MODES
+        from softbend.fem.options import CONTACT_MAX_ANGLE_DEG, CONTACT_MODES, FEMOptions
 
-        if contact is not None:
-            check_choice(contact, "contact", CONTACT_MODES)
-            if contact == "on" and not self.contact:
-                raise InputError(
-                    f"must be off for the {self.name} family (none of its walls touch); "
-                    f"got {contact!r}",
-                    key="contact",
-                )
-        if (contact or (default if self.contact else "off")) != "on":
+        if contact is None:
             return {}
+        check_choice(contact, "contact", CONTACT_MODES)
+        if contact == "on" and not self.contact:
+            raise InputError(
+                f"must be off for the {self.name} family (none of its walls touch); "
+                f"got {contact!r}",
+                key="contact",
+            )
+        if contact == "off":
+            return {"contact": "off", "max_angle_deg": FEMOptions.max_angle_deg}
         return {"contact": "on", "max_angle_deg": CONTACT_MAX_ANGLE_DEG}
 
     @property

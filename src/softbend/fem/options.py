@@ -23,6 +23,7 @@ from softbend.materials.presets import (
 
 __all__ = [
     "CONTACT_FIELDS",
+    "CONTACT_MAX_ANGLE_DEG",
     "CONTACT_MODES",
     "GRAVITY_DIRECTIONS",
     "OUTPUT_MODES",
@@ -37,6 +38,10 @@ OUTPUT_MODES: tuple[str, ...] = ("interpolate", "solve")
 
 #: Whether faces of the model that may touch carry contact (see :class:`FEMOptions`).
 CONTACT_MODES: tuple[str, ...] = ("off", "on")
+
+#: Where a sweep with contact stops bending, degrees: the working range of an actuator whose
+#: walls press on each other (a PneuNet's 90-270 degrees), short of the folded states past it.
+CONTACT_MAX_ANGLE_DEG = 180.0
 
 #: The contact options: left out of :meth:`FEMOptions.to_dict` (and so of the
 #: digest) while ``contact`` is "off", so options without contact describe and
@@ -146,8 +151,9 @@ class FEMOptions:
     contact : {"off", "on"}
         Whether the faces of the model that may touch carry frictionless
         penalty contact (:mod:`softbend.fem.contact`): for a PneuNet, the
-        facing walls of neighbouring chambers. "off": a PneuNet's sweep stops
-        where they first touch. Paper B's actuator has no such faces.
+        facing walls of neighbouring chambers. "off" (the default here; the
+        PneuNet family's defaults turn it on): a PneuNet's sweep stops where
+        they first touch. Paper B's actuator has no such faces.
     contact_penalty_mpa_per_mm : float
         Penalty stiffness of the contact: contact pressure per mm of
         interpenetration, MPa/mm, in (0, 1e5]. Default 50: about 70 times the

@@ -2,16 +2,17 @@
 
 :func:`run_pneunet` computes, for the report,
 
-1. the FEM sweep of the reference PneuNet (:data:`softbend.fem.pneunet.description.REFERENCE`):
-   its bending angle and cavity volume at every converged step, to the first touch
-   of neighbouring chamber walls;
-2. the mesh convergence of the reference at :data:`MESH_PRESSURES_MPA` (the
-   largest below its touch on every mesh of :data:`MESH_SIZES_MM`);
+1. the FEM sweep of the reference PneuNet (:data:`softbend.fem.pneunet.description.REFERENCE`)
+   with the family's default options (the facing walls of neighbouring chambers in
+   contact): its bending angle, cavity volume, contact force and mean contact
+   pressure at every converged step, to 50 kPa or 180°;
+2. the mesh convergence of the reference at :data:`MESH_PRESSURES_MPA` (past the
+   touch, the walls pressing on each other) on every mesh of :data:`MESH_SIZES_MM`;
 3. the main effects of the shipped PneuNet dataset's design space
    (:func:`softbend.analysis.main_effects`) on three responses: the angle at
    :data:`EFFECT_PRESSURE_MPA`, the largest angle before the sweep stopped and
-   the pressure it reached (the touch, the last pressure, or where Newton stopped);
-4. a design search on a surrogate trained on that dataset (30° at 20 kPa on the
+   the pressure it reached (the last pressure, 180°, or where Newton stopped);
+4. a design search on a surrogate trained on that dataset (90° at 30 kPa on the
    grid of :data:`SPECIFICATION_STEPS`),
    its best designs swept by the FEM until one reaches the specified pressure.
 """
@@ -46,12 +47,13 @@ __all__ = [
 
 #: Element sizes of the mesh study, mm (3 mm: the family's default).
 MESH_SIZES_MM: tuple[float, ...] = (3.0, 2.5, 2.0)
-#: Pressures of the mesh study, MPa: the reference touches at 6–7 kPa on these meshes.
-MESH_PRESSURES_MPA: tuple[float, ...] = (0.002, 0.004)
+#: Pressures of the mesh study, MPa: the reference's walls touch at 6–7 kPa and press on
+#: each other past it (the study to 50 kPa: ``benchmarks/bench_fem_pneunet.py --contact``).
+MESH_PRESSURES_MPA: tuple[float, ...] = (0.004, 0.008, 0.012)
 #: Pressure of the main effects' angle, MPa (227 of the 256 shipped designs reach it).
 EFFECT_PRESSURE_MPA = 0.005
-#: The search's target: 30° at 20 kPa.
-TARGET_ANGLE_DEG, TARGET_PRESSURE_MPA = 30.0, 0.02
+#: The search's target: 90° at 30 kPa.
+TARGET_ANGLE_DEG, TARGET_PRESSURE_MPA = 90.0, 0.03
 #: The search grid's step per parameter (803 520 designs over the dataset's ranges).
 SPECIFICATION_STEPS: dict[str, float] = {
     "n_chambers": 1.0,
@@ -77,11 +79,16 @@ class PneuNetSection:
         Its FEM sweep.
     step_pressure_mpa, step_angle_deg, step_volume_mm3 : ndarray
         Its converged steps' pressures (MPa), bending angles (degrees) and cavity
-        volumes (both halves, mm³), to the first touch of neighbouring walls: a
-        step past it is replaced by the values at the touch (the angle cubic
-        Hermite between the last two steps, as the sweep's outputs; the volume
-        linear).
+        volumes (both halves, mm³). Without contact they end at the first touch of
+        neighbouring walls: a step past it is replaced by the values at the touch
+        (the angle cubic Hermite between the last two steps, as the sweep's
+        outputs; the volume linear).
+    step_contact_force_n, step_contact_pressure_kpa : ndarray
+        The contact force between the walls of the whole actuator (N) and their
+        mean contact pressure (kPa) at the same steps; empty without contact.
     mesh : list of MeshStudyRow
+    mesh_pressures_mpa : tuple of float
+        The mesh study's pressures, MPa.
     designs : DataFrame
         The shipped dataset's designs (one row each, with the responses).
     effects : MainEffects
@@ -100,7 +107,10 @@ class PneuNetSection:
     step_pressure_mpa: np.ndarray
     step_angle_deg: np.ndarray
     step_volume_mm3: np.ndarray
+    step_contact_force_n: np.ndarray
+    step_contact_pressure_kpa: np.ndarray
     mesh: list[MeshStudyRow]
+    mesh_pressures_mpa: tuple[float, ...]
     designs: pd.DataFrame
     effects: MainEffects
     search: SearchResult
@@ -110,13 +120,15 @@ class PneuNetSection:
 
 
 def _reference_sweep(
-    progress: Progress | None,
-) -> tuple[Any, SweepResult, np.ndarray, np.ndarray, np.ndarray]:
+    progress: Progress | None, pmax_mpa: float | None
+) -> tuple[Any, SweepResult, list[np.ndarray]]:
+    """The reference's sweep and its steps: pressure, angle, volume, contact force, pressure."""
     from softbend.fem.families import get_family
 
     family = get_family("pneunet")
     design = family.design()
-    pressures = np.round(np.arange(0.0, family.pmax_mpa + 1e-12, family.pstep_mpa), 6)
+    pmax = family.pmax_mpa if pmax_mpa is None else pmax_mpa
+    pressures = np.round(np.arange(0.0, pmax + 1e-12, family.pstep_mpa), 6)
     phase = "PneuNet: FEM sweep of the reference, kPa"
 
     def told(pressure_mpa: float, angle_deg: float, pmax_mpa: float) -> None:
@@ -124,19 +136,23 @@ def _reference_sweep(
             progress(phase, round(pressure_mpa * 1e3), round(pmax_mpa * 1e3))
 
     result, _, history = family.sweep(design, pressures, family.options(), progress=told)
-    if progress is not None:  # done, at the touch or the last pressure
-        progress(phase, round(family.pmax_mpa * 1e3), round(family.pmax_mpa * 1e3))
+    if progress is not None:  # done, at the last pressure, 180° or the touch
+        progress(phase, round(pmax * 1e3), round(pmax * 1e3))
     p = np.array([s.pressure_mpa for s in history.steps])
     a = np.array([s.values[0] for s in history.steps])
     v = np.array(result.stats["step_volume_mm3"])
+    contact = [
+        np.array(result.stats.get(key, []), dtype=float)  # type: ignore[misc]
+        for key in ("step_contact_force_n", "step_contact_pressure_kpa")
+    ]
     limit = history.valid_up_to_mpa
-    if limit is not None and limit < p[-1]:  # past the touch: cut there
+    if limit is not None and limit < p[-1]:  # without contact, past the touch: cut there
         keep = p < limit - 1e-12
         # the angle as the sweep's own outputs (cubic Hermite), the volume linear
         a = np.append(a[keep], history.interpolate(np.array([limit]))[0, 0])
         v = np.append(v[keep], np.interp(limit, p, v))
         p = np.append(p[keep], limit)
-    return design, result, p, a, v
+    return design, result, [p, a, v, *contact]
 
 
 def _effects(designs: pd.DataFrame, samples: pd.DataFrame) -> MainEffects:
@@ -200,6 +216,8 @@ def run_pneunet(
     seed: int = 0,
     progress: Progress | None = None,
     mesh_sizes_mm: tuple[float, ...] = MESH_SIZES_MM,
+    mesh_pressures_mpa: tuple[float, ...] = MESH_PRESSURES_MPA,
+    pmax_mpa: float | None = None,
     verify: int = 1,
 ) -> PneuNetSection:
     """Compute the PneuNet section of the report (see the module's list).
@@ -214,6 +232,10 @@ def run_pneunet(
         ``progress(phase, done, total)``.
     mesh_sizes_mm : tuple of float
         Element sizes of the mesh study, mm, coarsest first (one size for a quick run).
+    mesh_pressures_mpa : tuple of float
+        Pressures of the mesh study, MPa, increasing (lower for a quick run).
+    pmax_mpa : float, optional
+        Last pressure of the reference's sweep, MPa; None: the family's (50 kPa).
     verify : int, default 1
         Designs the FEM verifies (0: none, for a quick run); a sweep that stops
         before the target's pressure is replaced by the next design's.
@@ -222,12 +244,13 @@ def run_pneunet(
     from softbend.fem.verification import mesh_study
 
     start = time.perf_counter()
-    design, sweep, p, a, v = _reference_sweep(progress)
+    design, sweep, steps = _reference_sweep(progress, pmax_mpa)
+    p, a = steps[0], steps[1]
     phase = "PneuNet: mesh study of the reference"
     mesh = mesh_study(
         design,
         mesh_sizes_mm,
-        MESH_PRESSURES_MPA,
+        mesh_pressures_mpa,
         progress=None if progress is None else lambda d, n: progress(phase, d, n),
     )
     designs = family_dataset_designs("pneunet").set_index("design_id")
@@ -238,10 +261,12 @@ def run_pneunet(
     summary = {
         "reference": design.as_text(),
         "stop_reason": sweep.stats["stop_reason"],
-        "touch_pressure_mpa": float(p[-1]),
-        "touch_angle_deg": float(a[-1]),
+        "contact": sweep.stats["options"].get("contact", "off"),
+        "last_pressure_mpa": float(p[-1]),
+        "last_angle_deg": float(a[-1]),
+        "largest_contact_pressure_kpa": float(max(steps[4], default=0.0)),
         "mesh_sizes_mm": list(mesh_sizes_mm),
-        "mesh_pressure_mpa": MESH_PRESSURES_MPA[-1],
+        "mesh_pressure_mpa": mesh_pressures_mpa[-1],
         "mesh_angles_deg": [r.angles_deg[-1] for r in mesh],
         "mesh_change_deg": float(abs(mesh[0].angles_deg[-1] - finest)),
         "surrogate": training,
@@ -252,5 +277,15 @@ def run_pneunet(
         "seconds": time.perf_counter() - start,
     }
     return PneuNetSection(
-        design, sweep, p, a, v, mesh, designs, effects, search, model, training, summary
+        design,
+        sweep,
+        *steps,
+        mesh,
+        tuple(mesh_pressures_mpa),
+        designs,
+        effects,
+        search,
+        model,
+        training,
+        summary,
     )

@@ -36,8 +36,9 @@ def reference_curves(
     *,
     stop: str,
     title: str,
+    contact_kpa: ArrayLike | None = None,
 ) -> Path:
-    """Bending angle and cavity volume of one sweep against pressure, side by side.
+    """Bending angle, cavity volume (and contact pressure) of one sweep against pressure.
 
     Parameters
     ----------
@@ -50,15 +51,41 @@ def reference_curves(
         Why the sweep stopped (the figure's footnote).
     title : str
         The figure's title (the design).
+    contact_kpa : array_like, optional
+        The walls' mean contact pressure at the same steps, kPa: a third panel,
+        and the pressure where the walls first press on each other marked on
+        every panel. None or empty: a sweep without contact, two panels.
     """
     p_kpa = np.asarray(pressure_mpa, dtype=np.float64) * 1e3
-    fig, axes = _figure(1, 2, (10.0, 3.8))
-    left, right = axes[0]
-    left.plot(p_kpa, np.asarray(angle_deg), "o-", ms=3, color="C0")
-    left.set(xlabel="pressure (kPa)", ylabel="bending angle (°)", title="θ(p)")
-    right.plot(p_kpa, np.asarray(volume_mm3) / 1e3, "o-", ms=3, color="C1")
-    right.set(xlabel="pressure (kPa)", ylabel="cavity volume (mL)", title="V(p)")
-    for ax in (left, right):
+    contact = None if contact_kpa is None else np.asarray(contact_kpa, dtype=np.float64)
+    if contact is not None and contact.size == 0:
+        contact = None
+    fig, axes = _figure(1, 2 if contact is None else 3, (10.0 if contact is None else 13.5, 3.8))
+    row = list(axes[0])
+    row[0].plot(p_kpa, np.asarray(angle_deg), "o-", ms=3, color="C0")
+    row[0].set(xlabel="pressure (kPa)", ylabel="bending angle (°)", title="θ(p)")
+    row[1].plot(p_kpa, np.asarray(volume_mm3) / 1e3, "o-", ms=3, color="C1")
+    row[1].set(xlabel="pressure (kPa)", ylabel="cavity volume (mL)", title="V(p)")
+    if contact is not None:
+        row[2].plot(p_kpa, contact, "o-", ms=3, color="C2")
+        row[2].set(
+            xlabel="pressure (kPa)",
+            ylabel="mean contact pressure (kPa)",
+            title="walls pressing on each other",
+        )
+        pressing = np.flatnonzero(contact > 0.0)
+        if pressing.size:  # the first step with the walls pressing on each other
+            touch = p_kpa[pressing[0]]
+            for ax in row:
+                ax.axvline(touch, color="0.5", ls="--", lw=0.8)
+            row[0].annotate(
+                f" walls press from {touch:.1f} kPa",
+                (touch, 0.05),
+                xycoords=("data", "axes fraction"),
+                fontsize=8,
+                color="0.3",
+            )
+    for ax in row:
         ax.grid(alpha=0.3)
         ax.set_xlim(left=0.0)
     fig.suptitle(title, fontsize=9)

@@ -22,11 +22,9 @@ PUBLISHED_NOTE = (
     "Published curve: not compared. The reference follows GIBBON's PneuNet (an FEBio model "
     "after the fast PneuNet of Mosadegh et al., Adv. Funct. Mater. 24 (2014) 2163), whose "
     "bending angle against pressure is published as a figure only; softbend ships no values "
-    "read off it, and none are invented here. The comparison is also limited by the model: "
-    "this sweep stops at the first touch of neighbouring walls (no contact), at {angle:.1f}°, "
-    "while PneuNets bend much further with their walls pressing on each other (an FEM "
-    "matched a fresh PneuNet up to 167° within about 4 %: Libby et al., arXiv 2212.03420, "
-    "2022)."
+    "read off it, and none are invented here. For scale: an FEM with wall-to-wall contact "
+    "matched a fresh PneuNet up to 167° within about 4 % (Libby et al., arXiv 2212.03420, "
+    "2022); this reference reaches {angle:.1f}° at {kpa:.0f} kPa."
 )
 
 
@@ -35,6 +33,7 @@ def _reference(section: Any, ran: Any, folder: Path, root: Path) -> Path:
     from softbend.reports.pneunet_figures import reference_curves
 
     stop = ran.sweep.stats["stop_reason"]
+    contact = ran.step_contact_pressure_kpa.size > 0
     figure = reference_curves(
         ran.step_pressure_mpa,
         ran.step_angle_deg,
@@ -42,45 +41,74 @@ def _reference(section: Any, ran: Any, folder: Path, root: Path) -> Path:
         folder / "reference_curves.png",
         stop=stop,
         title=f"Reference PneuNet ({ran.design})",
+        contact_kpa=ran.step_contact_pressure_kpa if contact else None,
     )
+    options = ran.sweep.stats["options"]
     section.text(
         f"The reference PneuNet: {ran.design} (mm), after GIBBON's PneuNet (Moerman, J. Open "
         "Source Softw. 3 (2018) 506, an FEBio model after Mosadegh et al. 2014) with a 2 mm "
         f"roof. Elastomer: {ELASTOSIL_M4601.name}, Yeoh C10 0.11, C20 0.02 MPa "
         f"({ELASTOSIL_M4601.source.split(':')[0]}); strain-limiting layer: "
         f"{PAPER_LAYER.name.lower()}, E 6.5 GPa, 0.1 mm, under the base. Quadratic tetrahedra "
-        "on the half actuator, follower pressure on every chamber. The same sweep: "
-        "`softbend fem run --family pneunet --json`.",
+        "on the half actuator, follower pressure on every chamber"
+        + (
+            "; frictionless penalty contact between the facing walls of neighbouring "
+            f"chambers (penalty {options['contact_penalty_mpa_per_mm']:g} MPa/mm, "
+            f"interpenetration at most {options['contact_tolerance_mm']:g} mm), the load "
+            "steps shortened where the walls start to touch"
+            if contact
+            else ""
+        )
+        + ". The same sweep: `softbend fem run --family pneunet --json`.",
         note=True,
     )
     stats = ran.sweep.stats
+    columns = ["pressure (kPa)", "bending angle (°)", "cavity volume (mL)"]
+    values = [ran.step_pressure_mpa * 1e3, ran.step_angle_deg, ran.step_volume_mm3 / 1e3]
+    formats = ["{:.2f}", "{:.2f}", "{:.3f}"]
+    if contact:
+        columns += ["contact force (N)", "mean contact pressure (kPa)"]
+        values += [ran.step_contact_force_n, ran.step_contact_pressure_kpa]
+        formats += ["{:.3f}", "{:.1f}"]
     section.table(
-        ["pressure (kPa)", "bending angle (°)", "cavity volume (mL)"],
+        columns,
         [
-            [f"{p * 1e3:.2f}", f"{a:.2f}", f"{v / 1e3:.3f}"]
-            for p, a, v in zip(
-                ran.step_pressure_mpa, ran.step_angle_deg, ran.step_volume_mm3, strict=True
-            )
+            [f.format(x) for f, x in zip(formats, row, strict=True)]
+            for row in zip(*values, strict=True)
         ],
         caption=(
-            f"Converged steps of the reference's sweep, the last at the touch (between "
-            f"the steps around it): {ran.sweep.mesh_size} tetrahedra, "
-            f"{stats['ndof']} unknowns, {ran.sweep.wall_time_s:.1f} s; stop: {stop}."
+            "Converged steps of the reference's sweep"
+            + (
+                " (the contact force between the walls of the whole actuator)"
+                if contact
+                else ", the last at the touch (between the steps around it)"
+            )
+            + f": {ran.sweep.mesh_size} tetrahedra, {stats['ndof']} unknowns, "
+            f"{len(stats['steps_mpa']) - 1} load steps, {sum(stats['step_iterations'])} Newton "
+            f"iterations, {ran.sweep.wall_time_s:.1f} s; stop: {stop}."
         ),
     )
     section.figure(
         figure,
-        "The reference PneuNet: bending angle and cavity volume against pressure, to the "
-        "first touch of neighbouring walls.",
+        "The reference PneuNet: bending angle, cavity volume"
+        + (" and the walls' mean contact pressure" if contact else "")
+        + " against pressure"
+        + (
+            ", the dashed line where the walls start to press"
+            if contact
+            else ", to the first touch of neighbouring walls"
+        )
+        + ".",
         root=root,
     )
-    section.text(PUBLISHED_NOTE.format(angle=ran.step_angle_deg[-1]), note=True)
+    section.text(
+        PUBLISHED_NOTE.format(angle=ran.step_angle_deg[-1], kpa=ran.step_pressure_mpa[-1] * 1e3),
+        note=True,
+    )
     return figure
 
 
 def _mesh(section: Any, ran: Any) -> None:
-    from softbend.pipeline.pneunet import MESH_PRESSURES_MPA
-
     finest = ran.mesh[-1].angles_deg
     rows = []
     for row in ran.mesh:
@@ -90,7 +118,7 @@ def _mesh(section: Any, ran: Any) -> None:
             + [f"{abs(a - f):.2f}" for a, f in zip(row.angles_deg, finest, strict=True)]
             + [f"{row.wall_time_s:.1f}"]
         )
-    kpa = [f"{p * 1e3:g} kPa" for p in MESH_PRESSURES_MPA]
+    kpa = [f"{p * 1e3:g} kPa" for p in ran.mesh_pressures_mpa]
     section.table(
         ["element size (mm)", "tetrahedra", "unknowns"]
         + [f"θ at {k} (°)" for k in kpa]
@@ -98,9 +126,10 @@ def _mesh(section: Any, ran: Any) -> None:
         + ["s"],
         rows,
         caption=(
-            "Mesh convergence of the reference at the largest pressure every mesh reaches "
-            "before its walls touch (Newton from the previous converged state at each "
-            "pressure). Finer: `softbend fem mesh-study --family pneunet --maxh 3,2,1.5,1.25`."
+            "Mesh convergence of the reference, its walls touching from 6–7 kPa and pressing on "
+            "each other past it (Newton from the previous converged state at each pressure). "
+            "To 50 kPa: `softbend fem mesh-study --family pneunet --pressures "
+            "0.012,0.025,0.05`."
         ),
     )
 
@@ -176,7 +205,8 @@ def _search(section: Any, ran: Any, folder: Path, root: Path) -> dict[str, str]:
         f"{result.n_designs} designs on a grid of steps ({steps}), {result.n_meeting} "
         f"meeting it on the surrogate; {_verified(ran.summary['verify'])}. The same "
         "search: `softbend train pneunet --models plr --out pn` then `softbend design find "
-        "--model pn/models/plr.json --angle 30 --at 0.02 --verify 1 --replace-stopped "
+        f"--model pn/models/plr.json --angle {result.spec.target.angle_deg:g} --at "
+        f"{result.spec.target.pressure_mpa:g} --verify 1 --replace-stopped "
         "--resolution NAME=STEP ...`."
     )
     rows = []
@@ -231,7 +261,8 @@ def add_section(
     seed : int
         Seed of the surrogate's folds.
     **options
-        ``mesh_sizes_mm`` and ``verify`` of :func:`softbend.pipeline.pneunet.run_pneunet`.
+        ``mesh_sizes_mm``, ``mesh_pressures_mpa``, ``pmax_mpa`` and ``verify`` of
+        :func:`softbend.pipeline.pneunet.run_pneunet`.
     """
     from softbend.pipeline.pneunet import run_pneunet
 

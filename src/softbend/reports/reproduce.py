@@ -207,7 +207,7 @@ def run_reproduce(
         each specification verified by the FEM.
     pneunet_options : dict, optional
         Options of the PneuNet section (:func:`softbend.reports.pneunet_section.add_section`,
-        e.g. ``{"mesh_sizes_mm": (3.0,), "verify": 0}`` for a quick run).
+        e.g. ``{"mesh_sizes_mm": (3.0,), "pmax_mpa": 0.012, "verify": 0}`` for a quick run).
     command : str, optional
         The command line that started the run, shown in the report's provenance.
 

@@ -200,6 +200,16 @@ def headline_rows(summary: Mapping[str, Any]) -> list[tuple[str, str, str, str]]
     pneunet = _get(summary, "pneunet") or {}
     if pneunet:
         sizes = pneunet.get("mesh_sizes_mm") or []
+        walls = "walls in contact" if pneunet.get("contact") == "on" else "to the walls' touch"
+        rows.append(
+            (
+                f"PneuNet reference ({walls}): angle at "
+                f"{_number(pneunet.get('last_pressure_mpa'), _kpa)}",
+                _number(pneunet.get("last_angle_deg"), _deg),
+                "— (beyond the papers)",
+                "pneunet",
+            )
+        )
         rows.append(
             (
                 f"PneuNet reference: angle at {_number(pneunet.get('mesh_pressure_mpa'), _kpa)}, "

@@ -176,9 +176,12 @@ def pneunet_options(**overrides: Any) -> FEMOptions:
     (:data:`PAPER_LAYER`), no gravity (the weight of the reference, about 0.05 N,
     is small against the pressure on one chamber wall, 1.5 N at 10 kPa), a 3 mm
     inlet block at the fixed end (``base_cap_mm``), pressure steps of 0.1–5 kPa
-    (first 2 kPa).
+    (first 2 kPa), and frictionless penalty contact between the facing walls of
+    neighbouring chambers, a sweep ending at
+    :data:`~softbend.fem.options.CONTACT_MAX_ANGLE_DEG` (``contact="off"``: the
+    sweep stops where the walls first touch).
     """
-    from softbend.fem.options import FEMOptions
+    from softbend.fem.options import CONTACT_MAX_ANGLE_DEG, FEMOptions
 
     values: dict[str, Any] = {
         "maxh_mm": PNEUNET_MAXH_MM,
@@ -190,6 +193,8 @@ def pneunet_options(**overrides: Any) -> FEMOptions:
         "min_step_mpa": 1e-4,
         "max_step_mpa": 0.005,
         "predictor_error_mm": 0.2,
+        "contact": "on",
+        "max_angle_deg": CONTACT_MAX_ANGLE_DEG,
     }
     values.update(overrides)
     return FEMOptions(**values)
@@ -200,6 +205,7 @@ PNEUNET_MAXH_MM = 3.0
 
 #: ``fem mesh-study``'s default element sizes for the PneuNet, mm, coarse to fine.
 MESH_STUDY_MAXH_MM: tuple[float, ...] = (3.0, 2.5, 2.0)
-#: ``fem mesh-study``'s default pressures for the PneuNet, MPa: below the reference's
-#: touching walls.
-MESH_STUDY_PRESSURES_MPA: tuple[float, ...] = (0.0, 0.002, 0.004, 0.006)
+#: ``fem mesh-study``'s default pressures for the PneuNet, MPa: the reference's walls touch
+#: at 6-7 kPa and press on each other past it (with ``--contact off`` the angles past the
+#: touch are NaN).
+MESH_STUDY_PRESSURES_MPA: tuple[float, ...] = (0.0, 0.004, 0.008, 0.012)
