@@ -363,4 +363,14 @@ def test_the_shipped_pneunet_dataset_verifies_and_spans_its_described_space():
         lambda g: g["angle_deg"].corr(g["pressure_mpa"]) > 0 if len(g) > 2 else True
     )
     assert rising.mean() > 0.95
-    assert set(designs["stop_kind"]) <= {"walls touch", "last pressure", "no convergence"}
+    # swept with contact: past the touch, to 50 kPa, 180° or where Newton stops
+    assert set(designs["stop_kind"]) <= {"angle limit", "last pressure", "no convergence"}
+    assert [options["contact"] for options in provenance["options"]] == ["on"]
+    # a campaign on the family's defaults sweeps the dataset's model (the same digest)
+    from softbend.campaign.family_schema import family_backend
+    from softbend.fem.families import get_family
+
+    defaults = family_backend(get_family("pneunet")).options.digest()
+    assert provenance["options_sha256"] == [defaults]
+    assert (designs["max_angle_deg"] <= 180.0 + 1e-9).all()
+    assert (designs["stop_kind"] == "last pressure").sum() >= 200

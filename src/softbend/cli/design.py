@@ -25,7 +25,7 @@ from __future__ import annotations
 import hashlib
 import os
 from collections.abc import Sequence
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
@@ -49,6 +49,9 @@ VERIFY = Range(0, 100, "designs", "each is a sweep of the FEM, minutes long")
 #: The processes of the verification (``--workers``).
 WORKERS = Range(1, 4096, "processes", "the bound of a campaign's local workers")
 
+#: The refinements of ``--refine-rounds``.
+REFINE_ROUNDS = Range(0, 20, "rounds", "each a refit and a search, then FEM sweeps")
+
 #: Options a spec file gives itself (by parameter), and what of each spec they set.
 _SPEC_GIVES: dict[str, str] = {
     "angle": "target",
@@ -66,7 +69,13 @@ _SPEC_GIVES: dict[str, str] = {
 }
 
 #: Options of the verification alone (by parameter).
-_VERIFY_OPTIONS: tuple[str, ...] = ("backend", "workers", "material", "replace_stopped")
+_VERIFY_OPTIONS: tuple[str, ...] = (
+    "backend",
+    "workers",
+    "material",
+    "replace_stopped",
+    "refine_rounds",
+)
 
 
 def _typed(ctx: typer.Context, parameter: str) -> bool:
@@ -157,6 +166,7 @@ def find(
     workers: int = opt.WORKERS,
     material: str = opt.MATERIAL,
     replace_stopped: bool = opt.REPLACE_STOPPED,
+    refine_rounds: int = opt.REFINE_ROUNDS,
     allow_extrapolation: bool = opt.ALLOW_EXTRAPOLATION,
     as_json: bool = opt.JSON,
 ) -> None:
@@ -168,6 +178,7 @@ def find(
     out = Path(out)
     model_path = shipped_base_path() if model is None else Path(model)
     _check_outputs(out, model, spec, top)
+    _check_count(refine_rounds, "refine_rounds", REFINE_ROUNDS)
     elastomer = _verification(ctx, verify, backend, workers, material)
     loaded = LoadedModel.load(model_path)  # read once; its actuator names the parameters
     space = _space(loaded, verify)
@@ -184,7 +195,10 @@ def find(
         ]  # fmt: skip
     _check_grids(chosen, loaded, spec, allow_extrapolation=allow_extrapolation, top=top)
     results = _search(loaded, chosen, top, allow_extrapolation, not neighbours, as_json)
-    verification = _Verification(verify, backend, workers, elastomer, replace_stopped)
+    verification = _Verification(
+        verify, backend, workers, elastomer, replace_stopped, refine_rounds,
+        dict(top=top, allow_extrapolation=allow_extrapolation, distinct=not neighbours),
+    )  # fmt: skip
     payload = _verify_and_write(out, results, loaded, verification, as_json)
     _warn(results, model_path, verification.skipped)
     if as_json:
@@ -282,6 +296,8 @@ class _Verification:
     workers: int | None
     material: ResolvedMaterial | None
     replace_stopped: bool
+    rounds: int = 0
+    search: dict[str, Any] = field(default_factory=dict)  # each round's find_designs options
     skipped: str | None = None
 
 
@@ -304,14 +320,22 @@ def _verify_and_write(
         for result in results:
             result.verify_skipped = v.skipped
     kept: list[Path] = []  # the verification's campaigns, removed once the command ends
+    models = [loaded] * len(results)  # the surrogate each answer was searched on, drawn with
     with _common.output_errors(out, "--out"), staged_dir(out) as stage:
         if v.count and v.skipped is None:
             with _common.library_progress(enabled=not as_json):
-                kept = [_verify(out, result, v, stage) for result in results if result.candidates]
+                for i, result in enumerate(results):
+                    if not result.candidates:
+                        continue
+                    folder = stage / result.spec.name if len(results) > 1 else stage
+                    results[i], models[i], db = _verify(
+                        out, result, loaded, v, stage, folder / "rounds"
+                    )
+                    kept.append(db)
         payload = [r.to_dict() for r in results]
-        for result in results:
+        for result, model in zip(results, models, strict=True):
             folder = stage / result.spec.name if len(results) > 1 else stage
-            write_search(result, loaded.predictor, folder)
+            write_search(result, model.predictor, folder)
         if len(results) > 1:  # the record of them all, and the folder's marker
             (stage / "search.json").write_text(
                 _common.json_text({"specs": payload}) + "\n", encoding="utf-8"
@@ -322,14 +346,28 @@ def _verify_and_write(
     return payload
 
 
-def _verify(out: Path, result: SearchResult, v: _Verification, stage: Path) -> Path:
-    """Sweep the best candidates of ``result``; the campaign database, kept beside ``out``."""
-    from softbend.design_search.verify import verify_candidates
+def _verify(
+    out: Path,
+    result: SearchResult,
+    loaded: LoadedModel,
+    v: _Verification,
+    stage: Path,
+    rounds_folder: Path,
+) -> tuple[SearchResult, LoadedModel, Path]:
+    """Sweep the best candidates of ``result`` (in rounds with ``--refine-rounds``): the
+    last search (its ``rounds`` recorded), the surrogate it ran on and the campaign
+    database, kept beside ``out``."""
+    from softbend.design_search.rounds import verify_in_rounds
 
     db = verification_db(out, result, v.backend, v.material, v.count)
-    verify_candidates(
+    result, model, _ = verify_in_rounds(
+        loaded,
+        result.spec,
         result,
-        v.count,
+        verify=v.count,
+        rounds=v.rounds,
+        folder=rounds_folder,
+        **v.search,
         db_path=db,
         backend=v.backend,
         workers=v.workers,
@@ -337,7 +375,7 @@ def _verify(out: Path, result: SearchResult, v: _Verification, stage: Path) -> P
         scratch_dir=stage,
         replace_stopped=v.replace_stopped,
     )
-    return db
+    return result, model, db
 
 
 def _warn(results: Sequence[SearchResult], model_path: Path, skipped: str | None) -> None:
@@ -433,6 +471,21 @@ def _print_result(result: SearchResult) -> None:
     if verified and by is not None:
         title += f"; verified by the {by['backend']} backend, FEM family {by['family']}"
     _common.print_table(title, columns, rows)
+    if result.rounds:
+        _common.console.print(
+            f"refined on the FEM sweeps {len(result.rounds) - 1} time(s); FEM angles by "
+            "round: "
+            + "; ".join(
+                f"{r['round']}: "
+                + ", ".join(
+                    "stopped" if d["fem_angle_deg"] is None else f"{d['fem_angle_deg']:.2f}°"
+                    for d in r["verified"]
+                )
+                for r in result.rounds
+            )
+            + (" (the last within the tolerance)" if any(
+                d["fem_meets"] for d in result.rounds[-1]["verified"]) else "")
+        )  # fmt: skip
     if stops:
         _common.console.print(
             "FEM sweeps stopped before the pressure checked (no angle): " + "; ".join(stops)

@@ -76,6 +76,14 @@ REPLACE_STOPPED = typer.Option(
     "(chamber walls touch, no convergence) by the next listed one, until N reach it "
     "or the --top list ends.",
 )
+REFINE_ROUNDS = typer.Option(
+    0,
+    "--refine-rounds",
+    help="While the FEM puts every verified candidate outside the tolerance, refine the "
+    "surrogate on the FEM curves swept so far (residual-gp) and search again, at most this "
+    "many times, 0 to 20 (default 0: verify once). The refined surrogates are saved in "
+    "--out/rounds/.",
+)
 ALLOW_EXTRAPOLATION = typer.Option(
     False, "--allow-extrapolation", help="Search outside the training data, answers flagged."
 )
@@ -115,7 +123,11 @@ FIND_HELP = """Find the designs that meet a target bending.
     names (such as pneunet; --backend fem); a sweep that stops before the
     pressure checked (chamber walls touching, no convergence) is "stopped", with
     the FEM's reason, not an angle; --replace-stopped then verifies the next
-    listed design instead, until N reach the pressure. An actuator that names
+    listed design instead, until N reach the pressure. --refine-rounds R closes
+    the loop: while no verified design is within the tolerance, the surrogate
+    is refined on every FEM curve swept so far (a Gaussian process on its
+    residuals, residual-gp), saved as --out/rounds/round-K.json, and searched
+    again for designs not yet swept, at most R times. An actuator that names
     no FEM family is not verified, and the output says so (a warning, and
     "verify_skipped" in search.json).
 

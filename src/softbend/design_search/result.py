@@ -144,6 +144,10 @@ class SearchResult:
     pressure_range : (float, float), optional
         The pressures the model was trained on, in the target's unit
         (:func:`softbend.surrogates.support.trained_pressure_range`); None if unrecorded.
+    rounds : list of dict, optional
+        The verification's rounds when the surrogate was refined on its FEM sweeps
+        (:meth:`softbend.design_search.rounds.Round.to_dict`, the first on the
+        given surrogate); then this result is the last round's search.
     """
 
     spec: Specification
@@ -159,6 +163,7 @@ class SearchResult:
     verify_skipped: str | None = None
     verified_by: dict[str, Any] | None = None
     pressure_range: tuple[float, float] | None = None
+    rounds: list[dict[str, Any]] | None = None
 
     @property
     def outside_pressures(self) -> list[float]:
@@ -264,6 +269,8 @@ class SearchResult:
             out["verify_skipped"] = self.verify_skipped
         elif self.verified_by is not None:
             out["verified"] = dict(self.verified_by)
+        if self.rounds is not None:
+            out["rounds"] = list(self.rounds)
         return out
 
 

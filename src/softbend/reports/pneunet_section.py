@@ -180,49 +180,68 @@ def _effects(section: Any, ran: Any, folder: Path, root: Path) -> Path:
     return figure
 
 
-def _verified(verify: int) -> str:
+def _verified(verify: int, rounds: int) -> str:
     if not verify:
         return "none swept by the FEM in this run"
     best = "the best design" if verify == 1 else f"the best {verify} designs"
     return (
-        f"{best} swept by the FEM, and the next ones while a sweep stops before the "
-        "target's pressure"
+        f"{best} swept by the FEM (the next ones while a sweep stops before the target's "
+        "pressure) and, while the FEM puts it outside the tolerance, the surrogate refined "
+        "on the FEM curves swept so far (residual-gp: a Gaussian process on its residuals "
+        f"over the design space) and searched again, at most {rounds} times"
     )
 
 
+def _fem_cell(c: Any) -> str:
+    if c.fem_angle_deg is None and c.fem_meets is None and not c.fem_stop:
+        return ""
+    if c.fem_angle_deg is None or not math.isfinite(c.fem_angle_deg):
+        return "stopped"
+    return f"{c.fem_angle_deg:.2f}"
+
+
+def _verdict(c: Any) -> str:
+    return "" if c.fem_meets is None else ("yes" if c.fem_meets else "NO")
+
+
 def _search(section: Any, ran: Any, folder: Path, root: Path) -> dict[str, str]:
-    from softbend.pipeline.pneunet import SPECIFICATION_STEPS
+    from softbend.pipeline.pneunet import REFINE_ROUNDS, SPECIFICATION_STEPS
     from softbend.reports.design_outputs import write_search
 
     result = ran.search
     files = write_search(result, ran.model.predictor, folder / "design")
     training = ran.training
+    target = result.spec.target
     steps = ", ".join(f"{k} {v:g}" for k, v in SPECIFICATION_STEPS.items())
     section.text(
         f"Design find on a surrogate of the dataset: {training['model']} "
         f"({training['params']}), five design-grouped folds, R² {training['r2']:.3f}, "
-        f"RMSE {training['rmse_deg']:.2f}°. Target: {result.spec.target.describe()}; "
-        f"{result.n_designs} designs on a grid of steps ({steps}), {result.n_meeting} "
-        f"meeting it on the surrogate; {_verified(ran.summary['verify'])}. The same "
-        "search: `softbend train pneunet --models plr --out pn` then `softbend design find "
-        f"--model pn/models/plr.json --angle {result.spec.target.angle_deg:g} --at "
-        f"{result.spec.target.pressure_mpa:g} --verify 1 --replace-stopped "
-        "--resolution NAME=STEP ...`."
+        f"RMSE {training['rmse_deg']:.2f}°. Target: {target.describe()}; "
+        f"{result.n_designs} designs on a grid of steps ({steps}); "
+        f"{_verified(ran.summary['verify'], REFINE_ROUNDS)}. The same search: `softbend "
+        f"train pneunet --models {training['model']} --out pn` then `softbend design find "
+        f"--model pn/models/{training['model']}.json --angle {target.angle_deg:g} --at "
+        f"{target.pressure_mpa:g} --verify 1 --replace-stopped --refine-rounds "
+        f"{REFINE_ROUNDS} --resolution NAME=STEP ...`."
     )
-    rows = []
-    for rank, c in enumerate(result.candidates, start=1):
-        swept = c.fem_angle_deg is not None or c.fem_meets is not None or c.fem_stop
-        fem = (
-            ""
-            if not swept
-            else (
-                "stopped"
-                if c.fem_angle_deg is None or not math.isfinite(c.fem_angle_deg)
-                else f"{c.fem_angle_deg:.2f}"
-            )
-        )
-        verdict = "" if c.fem_meets is None else ("yes" if c.fem_meets else "NO")
-        rows.append([rank, str(c.design), f"{c.angle_deg:.2f}", fem, verdict])
+    if ran.rounds:
+        section.table(
+            ["round", "surrogate", "design (mm)", "surrogate angle (°)", "FEM angle (°)",
+             "within tolerance"],
+            [
+                [r.number, Path(r.model).name, str(c.design), f"{c.angle_deg:.2f}",
+                 _fem_cell(c), _verdict(c)]
+                for r in ran.rounds
+                for c in r.verified
+            ],
+            caption="The designs the FEM swept, round by round: round 0 on the trained "
+            "surrogate, each later one on the surrogate refined on every FEM curve before it "
+            "(saved in pneunet/surrogate/rounds/).",
+        )  # fmt: skip
+    rows = [
+        [rank, str(c.design), f"{c.angle_deg:.2f}", _fem_cell(c), _verdict(c)]
+        for rank, c in enumerate(result.candidates, start=1)
+    ]
     section.table(
         ["rank", "design (mm)", "surrogate angle (°)", "FEM angle (°)", "within tolerance"],
         rows,
@@ -231,11 +250,14 @@ def _search(section: Any, ran: Any, folder: Path, root: Path) -> dict[str, str]:
             for rank, c in enumerate(result.candidates, start=1)
             if c.fem_stop
         )
-        or "The candidates, best first; the FEM swept the first.",
+        or (
+            f"The candidates of the last search ({Path(ran.model.path).name}), best first; "
+            "the FEM swept the first."
+        ),
     )
     section.figure(
         files["curves.png"],
-        "θ(p) of the best designs, surrogate (lines) and FEM (circles).",
+        "θ(p) of the best designs of the last search, surrogate (lines) and FEM (circles).",
         root=root,
     )
     return files
