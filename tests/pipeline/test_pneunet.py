@@ -64,6 +64,10 @@ def test_the_best_design_on_the_surrogate_is_within_the_tolerance_on_the_fem(ran
     assert best is not None and best["fem_meets"] is True
     assert abs(best["fem_angle_deg"] - pipeline.TARGET_ANGLE_DEG) <= 3.0
     assert s.summary["designs_searched"] == s.search.n_designs > 100_000
+    # the rounds: the last met, each earlier one refined the surrogate it searched on
+    rounds = s.summary["refinements"]
+    assert rounds["met"] and rounds["rounds"] == len(s.rounds) <= pipeline.REFINE_ROUNDS + 1
+    assert s.model.path == s.rounds[-1].model
     assert 0.5 < s.training["r2"] <= 1.0
 
 
@@ -71,7 +75,7 @@ def test_progress_finishes_and_the_summary_is_strict_json(ran):
     out, s, phases = ran
     assert phases.all_finished()
     json.loads(json.dumps(s.summary), parse_constant=lambda name: pytest.fail(name))
-    assert (out / "pneunet" / "surrogate" / "models" / "plr.json").is_file()
+    assert (out / "pneunet" / "surrogate" / "models" / f"{pipeline.SURROGATE}.json").is_file()
     assert not pictures(out / "pneunet" / "surrogate" / "models")
 
 
