@@ -36,9 +36,9 @@ def reference_curves(
     *,
     stop: str,
     title: str,
-    contact_kpa: ArrayLike | None = None,
+    contact_force_n: ArrayLike | None = None,
 ) -> Path:
-    """Bending angle, cavity volume (and contact pressure) of one sweep against pressure.
+    """Bending angle, cavity volume (and contact force) of one sweep against pressure.
 
     Parameters
     ----------
@@ -51,13 +51,13 @@ def reference_curves(
         Why the sweep stopped (the figure's footnote).
     title : str
         The figure's title (the design).
-    contact_kpa : array_like, optional
-        The walls' mean contact pressure at the same steps, kPa: a third panel,
-        and the pressure where the walls first press on each other marked on
-        every panel. None or empty: a sweep without contact, two panels.
+    contact_force_n : array_like, optional
+        The force between the walls of the whole actuator at the same steps, N: a
+        third panel, and the pressure where the walls first press on each other
+        marked on every panel. None or empty: a sweep without contact, two panels.
     """
     p_kpa = np.asarray(pressure_mpa, dtype=np.float64) * 1e3
-    contact = None if contact_kpa is None else np.asarray(contact_kpa, dtype=np.float64)
+    contact = None if contact_force_n is None else np.asarray(contact_force_n, dtype=np.float64)
     if contact is not None and contact.size == 0:
         contact = None
     fig, axes = _figure(1, 2 if contact is None else 3, (10.0 if contact is None else 13.5, 3.8))
@@ -70,7 +70,7 @@ def reference_curves(
         row[2].plot(p_kpa, contact, "o-", ms=3, color="C2")
         row[2].set(
             xlabel="pressure (kPa)",
-            ylabel="mean contact pressure (kPa)",
+            ylabel="contact force (N)",
             title="walls pressing on each other",
         )
         pressing = np.flatnonzero(contact > 0.0)

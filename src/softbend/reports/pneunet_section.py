@@ -41,7 +41,7 @@ def _reference(section: Any, ran: Any, folder: Path, root: Path) -> Path:
         folder / "reference_curves.png",
         stop=stop,
         title=f"Reference PneuNet ({ran.design})",
-        contact_kpa=ran.step_contact_pressure_kpa if contact else None,
+        contact_force_n=ran.step_contact_force_n if contact else None,
     )
     options = ran.sweep.stats["options"]
     section.text(
@@ -79,7 +79,8 @@ def _reference(section: Any, ran: Any, folder: Path, root: Path) -> Path:
         caption=(
             "Converged steps of the reference's sweep"
             + (
-                " (the contact force between the walls of the whole actuator)"
+                " (the contact force between the walls of the whole actuator; the mean "
+                "contact pressure over the area in contact, which grows as the walls press)"
                 if contact
                 else ", the last at the touch (between the steps around it)"
             )
@@ -91,7 +92,7 @@ def _reference(section: Any, ran: Any, folder: Path, root: Path) -> Path:
     section.figure(
         figure,
         "The reference PneuNet: bending angle, cavity volume"
-        + (" and the walls' mean contact pressure" if contact else "")
+        + (" and the force between the walls" if contact else "")
         + " against pressure"
         + (
             ", the dashed line where the walls start to press"
@@ -128,8 +129,8 @@ def _mesh(section: Any, ran: Any) -> None:
         caption=(
             "Mesh convergence of the reference, its walls touching from 6–7 kPa and pressing on "
             "each other past it (Newton from the previous converged state at each pressure). "
-            "To 50 kPa: `softbend fem mesh-study --family pneunet --pressures "
-            "0.012,0.025,0.05`."
+            "The same study: `softbend fem mesh-study --family pneunet`; to 50 kPa, every kPa "
+            "a solve: `python benchmarks/bench_fem_pneunet.py --contact --study-pmax 0.05`."
         ),
     )
 
