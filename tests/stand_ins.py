@@ -391,3 +391,29 @@ def running(pid: int) -> bool:
     except OSError:
         return False
     return "\nState:\tZ" not in status
+
+
+def train_closed_form(
+    folder: Path, actuator: Actuator, angle: Callable[[float, float, float], float]
+) -> Path:
+    """A polynomial surrogate of ``angle(n_cells, width_mm, p_mpa)`` (degrees), trained on
+    a 4 × 5 grid of designs (n_cells 2–5, width_mm 1–3) swept 0 to 50 kPa in 5 kPa steps,
+    the table in kPa as ``actuator`` describes it; the saved model's path."""
+    import itertools
+
+    from softbend.surrogates.simulation_table import table_training_data
+    from softbend.surrogates.workflow import train_surrogates
+
+    rows = []
+    designs = itertools.product((2, 3, 4, 5), (1.0, 1.5, 2.0, 2.5, 3.0))
+    for i, (n, w) in enumerate(designs):
+        for p_kpa in np.linspace(0.0, 50.0, 11):
+            rows.append(
+                {"design_id": f"d{i:02d}", "n_cells": n, "width_mm": w, "p_kpa": p_kpa,
+                 "angle_deg": angle(n, w, p_kpa / 1000)}
+            )  # fmt: skip
+    table = Path(folder) / "sims.csv"
+    pd.DataFrame(rows).to_csv(table, index=False)
+    data = table_training_data(table, actuator=actuator)
+    train_surrogates(data, Path(folder) / "m", models="plr", grid_name="quick", export_onnx=False)
+    return Path(folder) / "m" / "models" / "plr.json"

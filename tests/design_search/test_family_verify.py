@@ -11,12 +11,10 @@ as a surrogate trained on the swept range does not know where a sweep would stop
 from __future__ import annotations
 
 import dataclasses
-import itertools
 import json
 import math
 
 import numpy as np
-import pandas as pd
 import pytest
 
 from softbend.actuators import Actuator, Design
@@ -29,7 +27,7 @@ from softbend.fem.families import FEM_FAMILIES
 from softbend.surrogates.persistence import load_surrogate
 
 from ..cli.conftest import one_error_line
-from ..stand_ins import CELL_PARAMETERS, registered_family, stand_in_family
+from ..stand_ins import CELL_PARAMETERS, registered_family, stand_in_family, train_closed_form
 
 K_DEG_PER_MPA = 1000.0
 PARAMETERS = CELL_PARAMETERS[:2]  # n_cells, width_mm
@@ -72,27 +70,6 @@ def _actuator(fem_family: str | None) -> Actuator:
     )
 
 
-def _train(folder, actuator: Actuator):
-    """A polynomial of the closed form (kPa) over every design of the table, 0 to 50 kPa."""
-    from softbend.surrogates.simulation_table import table_training_data
-    from softbend.surrogates.workflow import train_surrogates
-
-    rows = []
-    designs = itertools.product((2, 3, 4, 5), (1.0, 1.5, 2.0, 2.5, 3.0))
-    for i, (n, w) in enumerate(designs):
-        for p_kpa in np.linspace(0.0, 50.0, 11):
-            angle = fem_angle(n, w, p_kpa / 1000)
-            rows.append(
-                {"design_id": f"d{i:02d}", "n_cells": n, "width_mm": w, "p_kpa": p_kpa,
-                 "angle_deg": angle}
-            )  # fmt: skip
-    table = folder / "sims.csv"
-    pd.DataFrame(rows).to_csv(table, index=False)
-    data = table_training_data(table, actuator=actuator)
-    train_surrogates(data, folder / "m", models="plr", grid_name="quick", export_onnx=False)
-    return folder / "m" / "models" / "plr.json"
-
-
 @pytest.fixture(autouse=True)
 def touchy():
     """The stand-in family, registered for the test and removed after it."""
@@ -102,12 +79,14 @@ def touchy():
 
 @pytest.fixture(scope="module")
 def model(tmp_path_factory):
-    return _train(tmp_path_factory.mktemp("touchy"), _actuator("touchy"))
+    return train_closed_form(tmp_path_factory.mktemp("touchy"), _actuator("touchy"), fem_angle)
 
 
 @pytest.fixture(scope="module")
 def unknown_family_model(tmp_path_factory):
-    return _train(tmp_path_factory.mktemp("nosuch"), _actuator("nosuch-family"))
+    return train_closed_form(
+        tmp_path_factory.mktemp("nosuch"), _actuator("nosuch-family"), fem_angle
+    )
 
 
 def _spec(model, angle: float, at_kpa: float) -> Specification:

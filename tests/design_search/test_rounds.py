@@ -9,11 +9,8 @@ FEM confirms.
 
 from __future__ import annotations
 
-import itertools
 import json
 
-import numpy as np
-import pandas as pd
 import pytest
 
 from softbend.actuators import Actuator
@@ -24,7 +21,7 @@ from softbend.design_search.spec import Specification, Target
 from softbend.errors import InputError
 
 from ..cli.conftest import one_error_line
-from ..stand_ins import CELL_PARAMETERS, registered_family, stand_in_family
+from ..stand_ins import CELL_PARAMETERS, registered_family, stand_in_family, train_closed_form
 
 K_DEG_PER_MPA = 1000.0
 PARAMETERS = CELL_PARAMETERS[:2]  # n_cells, width_mm
@@ -52,10 +49,6 @@ def family():
 @pytest.fixture(scope="module")
 def model(tmp_path_factory):
     """A polynomial of 80 % of the closed form (kPa), 0 to 50 kPa, on a 4 × 5 grid."""
-    from softbend.surrogates.simulation_table import table_training_data
-    from softbend.surrogates.workflow import train_surrogates
-
-    folder = tmp_path_factory.mktemp("biased")
     actuator = Actuator(
         name="biased-lab",
         title="stand-in, as a lab's table describes it",
@@ -64,19 +57,11 @@ def model(tmp_path_factory):
         pressure_unit="kPa",
         fem_family="biased",
     )
-    rows = []
-    for i, (n, w) in enumerate(itertools.product((2, 3, 4, 5), (1.0, 1.5, 2.0, 2.5, 3.0))):
-        for p_kpa in np.linspace(0.0, 50.0, 11):
-            angle = BIAS * K_DEG_PER_MPA * p_kpa / 1000 * (n + w)
-            rows.append(
-                {"design_id": f"d{i:02d}", "n_cells": n, "width_mm": w, "p_kpa": p_kpa,
-                 "angle_deg": angle}
-            )  # fmt: skip
-    table = folder / "sims.csv"
-    pd.DataFrame(rows).to_csv(table, index=False)
-    data = table_training_data(table, actuator=actuator)
-    train_surrogates(data, folder / "m", models="plr", grid_name="quick", export_onnx=False)
-    return folder / "m" / "models" / "plr.json"
+    return train_closed_form(
+        tmp_path_factory.mktemp("biased"),
+        actuator,
+        lambda n, w, p_mpa: BIAS * K_DEG_PER_MPA * p_mpa * (n + w),
+    )
 
 
 def _spec(loaded: LoadedModel) -> Specification:
