@@ -28,12 +28,13 @@ QUICK_DESIGN = {
 }
 
 #: The PneuNet section in seconds: the reference to 12 kPa (past the touch), the default
-#: mesh alone, no FEM check of the design.
+#: mesh alone, a polynomial surrogate, no FEM check of the design.
 QUICK_PNEUNET = {
     "mesh_sizes_mm": (3.0,),
     "mesh_pressures_mpa": (0.008,),
     "pmax_mpa": 0.012,
     "verify": 0,
+    "surrogate": "plr",
 }
 
 #: Transfer learning in seconds: few epochs, one ensemble pair, no GP restarts.

@@ -184,7 +184,7 @@ def _effects(designs: pd.DataFrame, samples: pd.DataFrame) -> MainEffects:
 
 
 def _search(
-    out_dir: Path, seed: int, verify: int, progress: Progress | None
+    out_dir: Path, seed: int, verify: int, surrogate: str, progress: Progress | None
 ) -> tuple[SearchResult, LoadedModel, dict[str, Any], list[Round]]:
     from softbend._progress import listening
     from softbend.actuators import PNEUNET
@@ -198,12 +198,13 @@ def _search(
     _, summary = train_into(
         dataset_training_data("pneunet"),
         folder,
-        models=SURROGATE,
+        models=surrogate,
         seed=seed,
         export_onnx=False,
+        plr_patience=1,  # a plr (a quick run's): degree 4 loses to 2, 6 (minutes) not tried
         progress=progress,
     )
-    model = LoadedModel.load(folder / "models" / f"{SURROGATE}.json")
+    model = LoadedModel.load(folder / "models" / f"{surrogate}.json")
     spec = Specification(
         Target("angle_at", angle_deg=TARGET_ANGLE_DEG, pressure_mpa=TARGET_PRESSURE_MPA),
         name="pneunet-90-at-30kPa",
@@ -228,9 +229,9 @@ def _search(
                 scratch_dir=folder,
                 replace_stopped=True,
             )
-    cv = summary["models"][SURROGATE]
+    cv = summary["models"][surrogate]
     training = {
-        "model": SURROGATE,
+        "model": surrogate,
         "params": cv["params"],
         "r2": cv["r2"],
         "rmse_deg": cv["rmse_deg"],
@@ -247,6 +248,7 @@ def run_pneunet(
     mesh_pressures_mpa: tuple[float, ...] = MESH_PRESSURES_MPA,
     pmax_mpa: float | None = None,
     verify: int = 1,
+    surrogate: str = SURROGATE,
 ) -> PneuNetSection:
     """Compute the PneuNet section of the report (see the module's list).
 
@@ -265,8 +267,10 @@ def run_pneunet(
     pmax_mpa : float, optional
         Last pressure of the reference's sweep, MPa; None: the family's (50 kPa).
     verify : int, default 1
-        Designs the FEM verifies (0: none, for a quick run); a sweep that stops
-        before the target's pressure is replaced by the next design's.
+        Designs the FEM verifies per round (0: none, for a quick run); a sweep
+        that stops before the target's pressure is replaced by the next design's.
+    surrogate : str, default "mlp"
+        The surrogate family searched (``"plr"`` trains in seconds, for a quick run).
     """
     from softbend.datasets import family_dataset, family_dataset_designs
     from softbend.design_search.rounds import rounds_summary
@@ -284,7 +288,7 @@ def run_pneunet(
     )
     designs = family_dataset_designs("pneunet").set_index("design_id")
     effects = _effects(designs, family_dataset("pneunet"))
-    search, model, training, rounds = _search(Path(out_dir), seed, verify, progress)
+    search, model, training, rounds = _search(Path(out_dir), seed, verify, surrogate, progress)
     best = next((c for c in search.candidates if c.fem_angle_deg is not None), None)
     finest = mesh[-1].angles_deg[-1]
     summary = {

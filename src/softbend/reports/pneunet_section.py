@@ -284,8 +284,8 @@ def add_section(
     seed : int
         Seed of the surrogate's folds.
     **options
-        ``mesh_sizes_mm``, ``mesh_pressures_mpa``, ``pmax_mpa`` and ``verify`` of
-        :func:`softbend.pipeline.pneunet.run_pneunet`.
+        ``mesh_sizes_mm``, ``mesh_pressures_mpa``, ``pmax_mpa``, ``verify`` and
+        ``surrogate`` of :func:`softbend.pipeline.pneunet.run_pneunet`.
     """
     from softbend.pipeline.pneunet import run_pneunet
 
