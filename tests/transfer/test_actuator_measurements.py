@@ -137,3 +137,43 @@ def test_one_reader_reads_each_actuator_s_files_in_its_format(tmp_path):
     assert isinstance(read, Measurements) and read == shipped_measurements()
     assert isinstance(read, Readings) and read.actuator == SFRBA
     assert read.per_actuator()["pmax"].max() == read.frame["pressure_mpa"].max()
+
+
+@pytest.mark.parametrize("actuator", ["bellows", "sfrba"])
+def test_written_readings_read_back_in_the_actuator_s_own_format(tmp_path, actuator):
+    import pandas as pd
+
+    from softbend.actuators import SFRBA
+    from softbend.transfer.measurements import (
+        ActuatorMeasurements,
+        Measurements,
+        read_measurements,
+        write_measurements,
+    )
+
+    described = {"bellows": ACTUATOR, "sfrba": SFRBA}[actuator]
+    designs = {
+        "bellows": [{"n_folds": 5, "wall_mm": 1.0, "skin": "latex"},
+                    {"n_folds": 7, "wall_mm": 1.5, "skin": "fabric"}],
+        "sfrba": [{"l_mm": 100.0, "r_mm": 6.0, "t_mm": 2.0, "b_mm": 2.0, "phi_deg": 5.0,
+                   "lc_mm": 8.0},
+                  {"l_mm": 120.0, "r_mm": 7.0, "t_mm": 2.5, "b_mm": 2.0, "phi_deg": 10.0,
+                   "lc_mm": 10.0}],
+    }[actuator]  # fmt: skip
+    rows = pd.DataFrame(
+        [
+            {"actuator_id": f"fem-{i}", **design, described.pressure_column: p,
+             "angle_deg": 10.0 * i + 100.0 * p}
+            for i, design in enumerate(designs, start=1)
+            for p in (0.0, 0.02, 0.05)
+        ]
+    )  # fmt: skip
+    path = write_measurements(rows, described, tmp_path / "curves.csv", {"synthetic": "true"})
+    data = read_measurements(path, described)
+    kind = Measurements if actuator == "sfrba" else ActuatorMeasurements
+    assert isinstance(data, kind)
+    assert data.actuator_ids == ("fem-1", "fem-2")
+    np.testing.assert_allclose(data.angle_deg, rows["angle_deg"])
+    assert data.synthetic.all()  # the header marks them simulated
+    codes = [[p.encode(d[p.name]) for p in described.parameters] for d in designs]
+    np.testing.assert_allclose(data.features[:, :-1], np.repeat(codes, 3, axis=0))

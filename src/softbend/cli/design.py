@@ -473,8 +473,8 @@ def _print_result(result: SearchResult) -> None:
     _common.print_table(title, columns, rows)
     if result.rounds:
         _common.console.print(
-            f"refined on the FEM sweeps {len(result.rounds) - 1} time(s); FEM angles by "
-            "round: "
+            f"refined on the verification's sweeps {len(result.rounds) - 1} time(s); their "
+            "angles by round: "
             + "; ".join(
                 f"{r['round']}: "
                 + ", ".join(
@@ -484,7 +484,8 @@ def _print_result(result: SearchResult) -> None:
                 for r in result.rounds
             )
             + (" (the last within the tolerance)" if any(
-                d["fem_meets"] for d in result.rounds[-1]["verified"]) else "")
+                d["fem_meets"] for d in result.rounds[-1]["verified"])
+               else " (none within the tolerance)")
         )  # fmt: skip
     if stops:
         _common.console.print(

@@ -89,40 +89,36 @@ class Round:
         }
 
 
-def _curves_table(verified: list[Candidate], model: LoadedModel, to_mpa: float) -> Any:
-    """The FEM curves of ``verified`` as a measurements table of the model's actuator."""
+def _write_curves(
+    verified: list[Candidate], model: LoadedModel, to_mpa: float, path: Path
+) -> Path | None:
+    """The FEM curves of ``verified`` as a measurements file of the model's actuator
+    (marked simulated); None when no sweep gave a curve."""
     import pandas as pd
+
+    from softbend.transfer.measurements import write_measurements
 
     actuator = model.actuator
     rows = []
     for i, c in enumerate(verified):
         if c.fem_curve is None:
             continue
-        pressure_mpa, angle = c.fem_curve
         values = c.design.as_dict()
-        for p, a in zip(pressure_mpa, angle, strict=True):
+        for p, a in zip(*c.fem_curve, strict=True):
             rows.append(
                 {
-                    "actuator": f"fem-{i + 1}",
+                    "actuator_id": f"fem-{i + 1}",
                     **{name: values[name] for name in actuator.names},
                     actuator.pressure_column: float(p) / to_mpa,
                     "angle_deg": float(a),
                 }
             )
-    return pd.DataFrame(rows)
-
-
-def _write_curves(table: Any, path: Path) -> Path:
-    """``table`` as a measurements CSV, marked as simulated (``# synthetic: true``)."""
-    from softbend._io import write_text_atomic
-
-    text = (
-        "# synthetic: true\n"
-        "# note: FEM sweeps of design-search candidates (softbend design find --refine-rounds)\n"
-        + table.to_csv(index=False)
+    if not rows:
+        return None
+    note = "FEM sweeps of design-search candidates (softbend design find --refine-rounds)"
+    return write_measurements(
+        pd.DataFrame(rows), actuator, path, {"synthetic": "true", "note": note}
     )
-    write_text_atomic(path, text)
-    return path
 
 
 def verify_in_rounds(
@@ -198,11 +194,10 @@ def verify_in_rounds(
             result.rounds = [r.to_dict() for r in done]
         if done[-1].met or len(done) > rounds or not verified:
             return result, current, done
-        table = _curves_table(swept, model, spec.space.to_mpa)
-        if table.empty:  # no sweep gave a curve: nothing to learn from
-            return result, current, done
         out.mkdir(parents=True, exist_ok=True)
-        curves = _write_curves(table, out / CURVES_FILE)
+        curves = _write_curves(swept, model, spec.space.to_mpa, out / CURVES_FILE)
+        if curves is None:  # no sweep gave a curve: nothing to learn from
+            return result, current, done
         refined = refine_surrogate(model.path, curves, strategy, seed=seed, calibrated=False)
         current = LoadedModel.load(refined.save(out / f"round-{len(done)}.json"))
         seen = {c.design.as_text() for c in swept}

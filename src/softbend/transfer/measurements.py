@@ -92,7 +92,7 @@ inputs), ``angle_deg``, ``groups``, ``actuator_ids``, ``subset``, ``per_actuator
 ``synthetic``, ``provenance`` and ``actuator``. And :func:`read_measurements` is the one
 reader a refinement calls: it reads an actuator's files in that actuator's format
 (paper B's in the format above, :data:`MEASUREMENT_READERS`; any other's in the
-plain one).
+plain one), and :func:`write_measurements` writes readings in the format it reads.
 """
 
 from __future__ import annotations
@@ -1338,6 +1338,62 @@ def is_actuator_measurements(data: object) -> bool:
 MEASUREMENT_READERS: dict[
     str, tuple[Actuator, Callable[[Sequence[str | os.PathLike[str]]], Measurements]]
 ] = {SFRBA.name: (SFRBA, load_measurements_files)}
+
+
+def _write_paper_b(
+    rows: pd.DataFrame, path: str | os.PathLike[str], metadata: Mapping[str, str]
+) -> Path:
+    """Paper B's readings in its own format (:func:`save_measurements`)."""
+    names = dict(zip(SFRBA.names, MEASUREMENT_COLUMNS[:6], strict=True))
+    frame = rows.rename(columns=names)
+    return save_measurements(Measurements.from_frame(frame, metadata=metadata), path)
+
+
+def _write_plain(
+    rows: pd.DataFrame, path: str | os.PathLike[str], metadata: Mapping[str, str]
+) -> Path:
+    """Readings in the plain format (:func:`measurement_format`), metadata lines first."""
+    lines = "".join(f"# {key}: {value}\n" for key, value in metadata.items())
+    return write_text_atomic(path, lines + rows.to_csv(index=False))
+
+
+#: Writers of measurement files in the format of an actuator's own, by the actuator's name:
+#: ``(actuator, writer)``, ``writer(rows, path, metadata) -> path`` (the format
+#: :data:`MEASUREMENT_READERS` reads).
+MEASUREMENT_WRITERS: dict[
+    str,
+    tuple[Actuator, Callable[[pd.DataFrame, str | os.PathLike[str], Mapping[str, str]], Path]],
+] = {SFRBA.name: (SFRBA, _write_paper_b)}
+
+
+def write_measurements(
+    rows: pd.DataFrame,
+    actuator: Actuator,
+    path: str | os.PathLike[str],
+    metadata: Mapping[str, str] | None = None,
+) -> Path:
+    """Write readings of ``actuator`` in the format :func:`read_measurements` reads for it.
+
+    Parameters
+    ----------
+    rows : pandas.DataFrame
+        ``actuator_id``, the actuator's design parameters (its names and units),
+        its pressure column (its unit) and ``angle_deg``, one row per reading.
+    actuator : Actuator
+    path : path
+        The CSV file, written atomically.
+    metadata : mapping of str to str, optional
+        ``# key: value`` lines (:data:`METADATA_KEYS`: ``synthetic``, ``note`` ...).
+
+    Returns
+    -------
+    pathlib.Path
+        The file written.
+    """
+    columns = ["actuator_id", *actuator.names, actuator.pressure_column, "angle_deg"]
+    own = MEASUREMENT_WRITERS.get(actuator.name)
+    write = own[1] if own is not None and own[0] == actuator else _write_plain
+    return write(rows[columns], path, dict(metadata or {}))
 
 
 def read_measurements(
