@@ -18,6 +18,8 @@ import textwrap
 import time
 from pathlib import Path
 
+import pytest
+
 from softbend.campaign import CampaignStore
 
 from ..campaign.test_runner import dask_processes  # noqa: F401  (a fixture)
@@ -70,7 +72,13 @@ def _start(args: list[str], cwd: Path, delay_s: float) -> subprocess.Popen[str]:
         text=True,
         start_new_session=True,  # a process group of its own, as a terminal's job
         preexec_fn=_as_at_a_terminal,
-        env={**os.environ, "COMPILE_S": str(delay_s), "PYTHONPATH": _path()},
+        # faulthandler: a child that hangs prints every thread's stack on SIGABRT
+        env={
+            **os.environ,
+            "COMPILE_S": str(delay_s),
+            "PYTHONPATH": _path(),
+            "PYTHONFAULTHANDLER": "1",
+        },
     )
 
 
@@ -78,9 +86,10 @@ def _interrupt_after(child: subprocess.Popen[str], started: str, wait_s: float =
     """Send SIGINT to the child's group ``wait_s`` after a stderr line matching ``started``.
 
     Returns the child's whole stderr (read until every process of the group has
-    closed it). A child still running 30 s later is killed and fails the test (a
-    hang guard: that it stops without finishing its designs in flight is what the
-    tests check, by the designs recorded).
+    closed it). A child still running 30 s later fails the test with every
+    thread's stack, then is killed (a hang guard: that it stops without
+    finishing its designs in flight is what the tests check, by the designs
+    recorded).
     """
     assert child.stderr is not None
     lines = []
@@ -91,7 +100,12 @@ def _interrupt_after(child: subprocess.Popen[str], started: str, wait_s: float =
                 break
         time.sleep(wait_s)
         os.killpg(child.pid, signal.SIGINT)
-        child.wait(timeout=30)
+        try:
+            child.wait(timeout=30)
+        except subprocess.TimeoutExpired:
+            os.kill(child.pid, signal.SIGABRT)  # faulthandler prints where it hangs
+            _, rest = child.communicate(timeout=30)
+            pytest.fail("still running 30 s after Ctrl-C:\n" + "".join(lines) + rest)
         _, rest = child.communicate(timeout=30)
     finally:
         if child.poll() is None:

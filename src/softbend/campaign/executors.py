@@ -82,6 +82,8 @@ _ADDRESS = re.compile(
 _TASKS_PER_WORKER = 2
 # A local pool whose worker processes keep dying is restarted at most this often.
 _MAX_POOL_RESTARTS = 3
+# Seconds between two looks for a Ctrl-C while the coordinating process waits on its workers.
+_POLL_S = 0.1
 
 
 # -- one design's sweep, in a worker -------------------------------------------------
@@ -308,8 +310,10 @@ def _run_isolated(
         recorder.set_running(1)
         pool = _new_pool(1, context)
         try:
-            with interrupts_deferred():  # the worker starts whole or not at all
+            with interrupts_deferred() as deliver:  # Ctrl-C at safe points only
                 future = pool.submit(sweep_chunk, backend, [design], pressures)
+                while not wait([future], timeout=_POLL_S).done:
+                    deliver()
             outcomes = future.result()
         except BrokenProcessPool:
             outcomes = [
@@ -358,32 +362,35 @@ def run_local(
         broken = False
         clean = False
         try:
-            while chunks or pending:
-                while chunks and not broken and len(pending) < _TASKS_PER_WORKER * workers:
-                    chunk = chunks.popleft()
-                    try:
-                        with interrupts_deferred():  # a worker it starts starts whole
+            # Ctrl-C is raised at safe points only: between waits, never inside
+            # a submission (which may start a worker) or a future's lock.
+            with interrupts_deferred() as deliver:
+                while chunks or pending:
+                    while chunks and not broken and len(pending) < _TASKS_PER_WORKER * workers:
+                        chunk = chunks.popleft()
+                        try:
                             future = pool.submit(sweep_chunk, backend, chunk, pressures)
-                    except BrokenProcessPool:
-                        chunks.appendleft(chunk)
-                        broken = True
+                        except BrokenProcessPool:
+                            chunks.appendleft(chunk)
+                            broken = True
+                            break
+                        pending[future] = chunk
+                    recorder.set_running(sum(len(c) for c in pending.values()))
+                    if not pending:
                         break
-                    pending[future] = chunk
-                recorder.set_running(sum(len(c) for c in pending.values()))
-                if not pending:
-                    break
-                finished, _ = wait(pending, return_when=FIRST_COMPLETED)
-                for future in finished:
-                    chunk = pending.pop(future)
-                    try:
-                        outcomes = future.result()
-                    except BrokenProcessPool:
-                        broken = True
-                        suspects.extend(chunk)  # not blamed yet: rerun alone
-                        continue
-                    except Exception as exc:
-                        outcomes = _lost_chunk(chunk, exc)
-                    recorder.record(outcomes, running=sum(len(c) for c in pending.values()))
+                    finished, _ = wait(pending, timeout=_POLL_S, return_when=FIRST_COMPLETED)
+                    deliver()
+                    for future in finished:
+                        chunk = pending.pop(future)
+                        try:
+                            outcomes = future.result()
+                        except BrokenProcessPool:
+                            broken = True
+                            suspects.extend(chunk)  # not blamed yet: rerun alone
+                            continue
+                        except Exception as exc:
+                            outcomes = _lost_chunk(chunk, exc)
+                        recorder.record(outcomes, running=sum(len(c) for c in pending.values()))
             clean = True
         except BaseException:  # Ctrl-C: stop now; what was recorded stays, the rest resumes
             _stop_pool(pool)
