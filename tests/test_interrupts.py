@@ -10,6 +10,23 @@ import pytest
 from softbend._interrupts import interrupts_deferred
 
 
+@pytest.fixture(autouse=True)
+def _default_handler():
+    """Python's own SIGINT handler, as in a new process: a test run started as a
+    background job inherits SIGINT ignored, and the block then runs as it is."""
+    previous = signal.signal(signal.SIGINT, signal.default_int_handler)
+    yield
+    signal.signal(signal.SIGINT, previous)
+
+
+def test_where_ctrl_c_is_ignored_the_block_runs_as_it_is():
+    signal.signal(signal.SIGINT, signal.SIG_IGN)
+    with interrupts_deferred() as deliver:
+        _ctrl_c()
+        deliver()
+    assert signal.getsignal(signal.SIGINT) is signal.SIG_IGN
+
+
 def _ctrl_c() -> None:
     """SIGINT to this thread (the main one): its handler runs before the next line."""
     signal.raise_signal(signal.SIGINT)
