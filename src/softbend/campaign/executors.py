@@ -18,6 +18,11 @@ design's failure, ``"ExceptionType: message"``).
   checks the scheduler address (:func:`parse_scheduler_address`) and gives up
   within its deadline when nothing Dask-like answers there.
 
+Both wait on their workers in short polls and raise a Ctrl-C between them
+(:func:`softbend._interrupts.interrupts_deferred`): raised wherever the signal
+lands, it could leave a lock held that the pool's or the client's own thread
+needs, and the command would hang instead of stopping.
+
 :func:`softbend.campaign.runner.run_campaign` picks one of them.
 """
 
@@ -84,6 +89,8 @@ _TASKS_PER_WORKER = 2
 _MAX_POOL_RESTARTS = 3
 # Seconds between two looks for a Ctrl-C while the coordinating process waits on its workers.
 _POLL_S = 0.1
+# Seconds between two looks at a Dask cluster's finished tasks (a look costs no round trip).
+_DASK_POLL_S = 0.02
 
 
 # -- one design's sweep, in a worker -------------------------------------------------
@@ -657,15 +664,23 @@ def run_dask(
     recorder.set_running(sum(len(c) for c in pending.values()))
     queue = as_completed(initial, loop=client.loop)
     try:
-        for future in queue:
-            chunk = pending.pop(future)
-            try:
-                outcomes = future.result()
-            except Exception as exc:  # task lost: KilledWorker, unpicklable result, ...
-                outcomes = _lost_chunk(chunk, exc)
-            if chunks:
-                queue.add(submit())
-            recorder.record(outcomes, running=sum(len(c) for c in pending.values()))
+        # As run_local: Ctrl-C is raised between polls, never inside as_completed's locks,
+        # which the client's event loop takes to hand over each finished task.
+        with interrupts_deferred() as deliver:
+            while not queue.is_empty():
+                ready = queue.next_batch(block=False)
+                deliver()
+                if not ready:
+                    time.sleep(_DASK_POLL_S)
+                for future in ready:
+                    chunk = pending.pop(future)
+                    try:
+                        outcomes = future.result()
+                    except Exception as exc:  # task lost: KilledWorker, unpicklable result, ...
+                        outcomes = _lost_chunk(chunk, exc)
+                    if chunks:
+                        queue.add(submit())
+                    recorder.record(outcomes, running=sum(len(c) for c in pending.values()))
     finally:
         if pending:
             client.cancel(list(pending))
