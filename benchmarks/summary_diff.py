@@ -60,15 +60,21 @@ def differences(before: dict[str, Any], after: dict[str, Any]) -> list[str]:
     return out
 
 
+def _summary(path: Path) -> dict:
+    """A ``summary.json``, given as the file or as the report folder that holds it."""
+    file = path / "summary.json" if path.is_dir() else path
+    if not file.is_file():
+        print(f"summary_diff: no summary.json at {path}", file=sys.stderr)
+        sys.exit(2)
+    return json.loads(file.read_text(encoding="utf-8"))
+
+
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    parser.add_argument("before", type=Path)
-    parser.add_argument("after", type=Path)
+    parser.add_argument("before", type=Path, help="summary.json, or the report folder holding it")
+    parser.add_argument("after", type=Path, help="summary.json, or the report folder holding it")
     args = parser.parse_args()
-    found = differences(
-        json.loads(args.before.read_text(encoding="utf-8")),
-        json.loads(args.after.read_text(encoding="utf-8")),
-    )
+    found = differences(_summary(args.before), _summary(args.after))
     print("\n".join(found) if found else "identical (dates, durations and speeds left off)")
     sys.exit(1 if found else 0)
 
