@@ -139,8 +139,10 @@ def test_one_reader_reads_each_actuator_s_files_in_its_format(tmp_path):
     assert read.per_actuator()["pmax"].max() == read.frame["pressure_mpa"].max()
 
 
-@pytest.mark.parametrize("actuator", ["bellows", "sfrba"])
+@pytest.mark.parametrize("actuator", ["bellows", "bellows-bend", "sfrba"])
 def test_written_readings_read_back_in_the_actuator_s_own_format(tmp_path, actuator):
+    import dataclasses
+
     import pandas as pd
 
     from softbend.actuators import SFRBA
@@ -151,10 +153,16 @@ def test_written_readings_read_back_in_the_actuator_s_own_format(tmp_path, actua
         write_measurements,
     )
 
-    described = {"bellows": ACTUATOR, "sfrba": SFRBA}[actuator]
+    # "bellows-bend": a lab's table whose angle column is its own name
+    bend = dataclasses.replace(ACTUATOR, angle_column="bend_deg")
+    described = {"bellows": ACTUATOR, "bellows-bend": bend, "sfrba": SFRBA}[actuator]
+    bellows = [
+        {"n_folds": 5, "wall_mm": 1.0, "skin": "latex"},
+        {"n_folds": 7, "wall_mm": 1.5, "skin": "fabric"},
+    ]
     designs = {
-        "bellows": [{"n_folds": 5, "wall_mm": 1.0, "skin": "latex"},
-                    {"n_folds": 7, "wall_mm": 1.5, "skin": "fabric"}],
+        "bellows": bellows,
+        "bellows-bend": bellows,
         "sfrba": [{"l_mm": 100.0, "r_mm": 6.0, "t_mm": 2.0, "b_mm": 2.0, "phi_deg": 5.0,
                    "lc_mm": 8.0},
                   {"l_mm": 120.0, "r_mm": 7.0, "t_mm": 2.5, "b_mm": 2.0, "phi_deg": 10.0,

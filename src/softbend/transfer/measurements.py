@@ -1378,7 +1378,8 @@ def write_measurements(
     ----------
     rows : pandas.DataFrame
         ``actuator_id``, the actuator's design parameters (its names and units),
-        its pressure column (its unit) and ``angle_deg``, one row per reading.
+        its pressure column (its unit) and ``angle_deg``, one row per reading
+        (written under the actuator's own angle column).
     actuator : Actuator
     path : path
         The CSV file, written atomically.
@@ -1392,8 +1393,10 @@ def write_measurements(
     """
     columns = ["actuator_id", *actuator.names, actuator.pressure_column, "angle_deg"]
     own = MEASUREMENT_WRITERS.get(actuator.name)
-    write = own[1] if own is not None and own[0] == actuator else _write_plain
-    return write(rows[columns], path, dict(metadata or {}))
+    if own is not None and own[0] == actuator:
+        return own[1](rows[columns], path, dict(metadata or {}))
+    plain = rows[columns].rename(columns={"angle_deg": actuator.angle_column})
+    return _write_plain(plain, path, dict(metadata or {}))
 
 
 def read_measurements(
