@@ -521,3 +521,23 @@ def test_the_verification_s_campaign_is_kept_beside_out_until_the_run_ends(
     ]  # fmt: skip
     first = json.loads((out / "search.json").read_text())["candidates"][0]
     assert first["fem_meets"] is not None
+
+
+def test_the_rounds_line_gives_each_round_s_fem_angles_and_whether_the_last_met():
+    from softbend.cli.design import _rounds_line
+
+    def record(number, *verified):
+        return {
+            "round": number,
+            "verified": [{"fem_angle_deg": a, "fem_meets": m} for a, m in verified],
+        }
+
+    met = [record(0, (80.123, False), (None, False)), record(1, (90.59, True))]
+    assert _rounds_line(met) == (
+        "refined on the verification's sweeps 1 time(s); their angles by round: "
+        "0: 80.12°, stopped; 1: 90.59° (the last within the tolerance)"
+    )
+    missed = [record(0, (64.61, False)), record(1, (102.67, False)), record(2, (78.69, False))]
+    line = _rounds_line(missed)
+    assert line.startswith("refined on the verification's sweeps 2 time(s)")
+    assert line.endswith("2: 78.69° (none within the tolerance)")

@@ -442,6 +442,24 @@ def _print_results(results: Sequence[SearchResult], out: Path) -> None:
     _common.console.print(f"{', '.join(FILES)} written to {out}")
 
 
+def _rounds_line(rounds: list[dict[str, Any]]) -> str:
+    """The verification's rounds in one line: the FEM angles of each, and whether one met."""
+
+    def angles(record: dict[str, Any]) -> str:
+        return ", ".join(
+            "stopped" if d["fem_angle_deg"] is None else f"{d['fem_angle_deg']:.2f}°"
+            for d in record["verified"]
+        )
+
+    met = any(d["fem_meets"] for d in rounds[-1]["verified"])
+    return (
+        f"refined on the verification's sweeps {len(rounds) - 1} time(s); their angles by "
+        "round: "
+        + "; ".join(f"{r['round']}: {angles(r)}" for r in rounds)
+        + (" (the last within the tolerance)" if met else " (none within the tolerance)")
+    )
+
+
 def _print_result(result: SearchResult) -> None:
     spec = result.spec
     columns = ["#", "design", "θ (°)", "miss (°)"]
@@ -472,21 +490,7 @@ def _print_result(result: SearchResult) -> None:
         title += f"; verified by the {by['backend']} backend, FEM family {by['family']}"
     _common.print_table(title, columns, rows)
     if result.rounds:
-        _common.console.print(
-            f"refined on the verification's sweeps {len(result.rounds) - 1} time(s); their "
-            "angles by round: "
-            + "; ".join(
-                f"{r['round']}: "
-                + ", ".join(
-                    "stopped" if d["fem_angle_deg"] is None else f"{d['fem_angle_deg']:.2f}°"
-                    for d in r["verified"]
-                )
-                for r in result.rounds
-            )
-            + (" (the last within the tolerance)" if any(
-                d["fem_meets"] for d in result.rounds[-1]["verified"])
-               else " (none within the tolerance)")
-        )  # fmt: skip
+        _common.console.print(_rounds_line(result.rounds))
     if stops:
         _common.console.print(
             "FEM sweeps stopped before the pressure checked (no angle): " + "; ".join(stops)

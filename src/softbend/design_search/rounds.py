@@ -176,7 +176,7 @@ def verify_in_rounds(
         Every round, the first on ``model``; the last one's candidates met the
         specification when any did.
     """
-    from softbend.design_search.search import LoadedModel, find_designs
+    from softbend.design_search.search import TOP, LoadedModel, find_designs
     from softbend.design_search.verify import verify_candidates
     from softbend.transfer.refine import refine_surrogate
 
@@ -204,7 +204,7 @@ def verify_in_rounds(
         result = find_designs(
             current,
             spec,
-            top=min(top + len(seen), 1000),
+            top=min(top + len(seen), int(TOP.high)),  # room for those already swept
             allow_extrapolation=allow_extrapolation,
             distinct=distinct,
         )
