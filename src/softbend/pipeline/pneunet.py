@@ -136,8 +136,9 @@ class PneuNetSection:
 
 def _reference_sweep(
     progress: Progress | None, pmax_mpa: float | None
-) -> tuple[Any, SweepResult, list[np.ndarray]]:
-    """The reference's sweep and its steps: pressure, angle, volume, contact force, pressure."""
+) -> tuple[Any, SweepResult, np.ndarray, np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+    """The reference, its sweep and its steps' pressures, angles, volumes, contact forces
+    and mean contact pressures (the last two empty without contact)."""
     from softbend.fem.families import get_family
 
     family = get_family("pneunet")
@@ -156,10 +157,8 @@ def _reference_sweep(
     p = np.array([s.pressure_mpa for s in history.steps])
     a = np.array([s.values[0] for s in history.steps])
     v = np.array(result.stats["step_volume_mm3"])
-    contact = [
-        np.array(result.stats.get(key, []), dtype=float)  # type: ignore[misc]
-        for key in ("step_contact_force_n", "step_contact_pressure_kpa")
-    ]
+    contact_n = np.array(result.stats.get("step_contact_force_n", []), dtype=float)
+    contact_kpa = np.array(result.stats.get("step_contact_pressure_kpa", []), dtype=float)
     limit = history.valid_up_to_mpa
     if limit is not None and limit < p[-1]:  # without contact, past the touch: cut there
         keep = p < limit - 1e-12
@@ -167,7 +166,7 @@ def _reference_sweep(
         a = np.append(a[keep], history.interpolate(np.array([limit]))[0, 0])
         v = np.append(v[keep], np.interp(limit, p, v))
         p = np.append(p[keep], limit)
-    return design, result, [p, a, v, *contact]
+    return design, result, p, a, v, contact_n, contact_kpa
 
 
 def _effects(designs: pd.DataFrame, samples: pd.DataFrame) -> MainEffects:
@@ -277,8 +276,7 @@ def run_pneunet(
     from softbend.fem.verification import mesh_study
 
     start = time.perf_counter()
-    design, sweep, steps = _reference_sweep(progress, pmax_mpa)
-    p, a = steps[0], steps[1]
+    design, sweep, p, a, v, contact_n, contact_kpa = _reference_sweep(progress, pmax_mpa)
     phase = "PneuNet: mesh study of the reference"
     mesh = mesh_study(
         design,
@@ -297,7 +295,7 @@ def run_pneunet(
         "contact": sweep.stats["options"].get("contact", "off"),
         "last_pressure_mpa": float(p[-1]),
         "last_angle_deg": float(a[-1]),
-        "largest_contact_pressure_kpa": float(max(steps[4], default=0.0)),
+        "largest_contact_pressure_kpa": float(contact_kpa.max(initial=0.0)),
         "mesh_sizes_mm": list(mesh_sizes_mm),
         "mesh_pressure_mpa": mesh_pressures_mpa[-1],
         "mesh_angles_deg": [r.angles_deg[-1] for r in mesh],
@@ -313,11 +311,11 @@ def run_pneunet(
     return PneuNetSection(
         design,
         sweep,
-        steps[0],
-        steps[1],
-        steps[2],
-        steps[3],
-        steps[4],
+        p,
+        a,
+        v,
+        contact_n,
+        contact_kpa,
         mesh,
         tuple(mesh_pressures_mpa),
         designs,
